@@ -1,0 +1,248 @@
+"""The synthetic validation study of the identification (DESIGN.md section 5).
+
+For every combination of K in {0, 75, 150} and D in {0, 2, 4} per joint
+(3^6 = 729) a representative subject's swing leg is perturbed by a 40 N,
+100 ms forward pulse; the "measured" perturbed stride is simulated with the
+true impedance by the same equations of motion but a much finer RK4 step
+(``truth_substeps``) than the identification uses, then sampled like motion
+capture. The identification recovers K and D from the samples, once without
+and once with uniform noise (0.01 rad or m peak-to-peak) added independently to
+the perturbed and the unperturbed generalised coordinates.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .constants import JOINTS, PARAMETERS
+from .dynamics import SegmentParameters, segment_coordinates
+from .errors import LoperInputError
+from .identification import (
+    DEFAULT_LOWER,
+    DEFAULT_UPPER,
+    identify_impedance,
+    prepare_window,
+    simulate_response,
+)
+
+__all__ = [
+    "ValidationSettings",
+    "impedance_grid",
+    "chunk_combinations",
+    "nominal_swing",
+    "perturbed_trial",
+    "run_validation_chunk",
+    "summarize_errors",
+    "CONDITIONS",
+]
+
+CONDITIONS: tuple[str, ...] = ("no_noise", "noise")
+
+
+@dataclass(frozen=True)
+class ValidationSettings:
+    """Settings of the validation study (SI units), defaults as in DESIGN.md."""
+
+    stiffness_levels_nm_per_rad: tuple[float, ...] = (0.0, 75.0, 150.0)
+    damping_levels_nms_per_rad: tuple[float, ...] = (0.0, 2.0, 4.0)
+    sample_rate_hz: float = 128.0
+    swing_duration_s: float = 0.6
+    onset_s: float = 0.05
+    pulse_force_n: float = 40.0
+    pulse_duration_s: float = 0.1
+    force_direction_deg: float = 0.0
+    window_before_s: float = 0.025
+    window_after_s: float = 0.25
+    noise_peak_to_peak: float = 0.01
+    n_starts: int = 10
+    n_substeps: int = 4
+    truth_substeps: int = 32
+    reference_cutoff_hz: float | None = None
+    initial_state_span_s: float = 0.05
+    initial_state_degree: int = 2
+    seed: int = 2024
+    lower: tuple[float, ...] = tuple(DEFAULT_LOWER)
+    upper: tuple[float, ...] = tuple(DEFAULT_UPPER)
+
+
+def impedance_grid(stiffness_levels, damping_levels) -> np.ndarray:
+    """All combinations (n_K n_D)^3 x 6 of K and D levels per joint, order of PARAMETERS.
+
+    The last parameter (D_ankle) varies fastest.
+    """
+    per_joint = [(k, d) for k in stiffness_levels for d in damping_levels]
+    combos = [sum(c, ()) for c in itertools.product(per_joint, repeat=3)]
+    return np.array(combos, dtype=float)
+
+
+def chunk_combinations(n_combinations: int, n_chunks: int, chunk: int) -> np.ndarray:
+    """Indices of combination chunk ``chunk`` (0-based) of ``n_chunks`` contiguous chunks."""
+    if not 1 <= n_chunks <= n_combinations:
+        raise LoperInputError(f"n_chunks must lie in 1 .. {n_combinations}, got {n_chunks}")
+    if not 0 <= chunk < n_chunks:
+        raise LoperInputError(f"chunk must lie in 0 .. {n_chunks - 1}, got {chunk}")
+    return np.array_split(np.arange(n_combinations), n_chunks)[chunk]
+
+
+def nominal_swing(time_s: np.ndarray, swing_duration_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Smooth swing-phase kinematics of slow treadmill walking.
+
+    Time 0 is toe-off. Returns the coordinates q (n, 4) [pelvis x (m), thigh,
+    shank, foot (rad)] and the pelvis angle (n,) in rad. Joint angles follow
+    the shape of normal slow walking: hip flexion -0.15 -> 0.45 rad, knee
+    flexion 0.70 -> peak 1.10 rad at 25 % of swing -> 0.10 rad, ankle from
+    -0.25 rad plantarflexion back to neutral.
+    """
+    s = np.asarray(time_s, dtype=float) / swing_duration_s
+
+    def smoothstep(x):
+        x = np.clip(x, 0, 1)
+        return x * x * x * (10 - 15 * x + 6 * x * x)
+
+    hip = -0.15 + 0.60 * smoothstep(s / 0.8) - 0.05 * smoothstep((s - 0.8) / 0.2)
+    knee = 0.70 + 0.40 * smoothstep(s / 0.25) - 1.00 * smoothstep((s - 0.25) / 0.75)
+    ankle = -0.25 + 0.25 * smoothstep(s / 0.5) + 0.05 * np.sin(np.pi * np.clip(s, 0, 1))
+    pelvis_angle = 0.10 + 0.02 * np.sin(2 * np.pi * (s * swing_duration_s) / (1.667 / 2))
+    pelvis_x = 0.015 * np.sin(2 * np.pi * (s * swing_duration_s) / (1.667 / 2))
+    q = segment_coordinates(np.stack([hip, knee, ankle], axis=-1), pelvis_angle, pelvis_x)
+    return q, pelvis_angle
+
+
+def perturbed_trial(params: SegmentParameters, impedance, settings: ValidationSettings):
+    """Noise-free unperturbed and perturbed samples for one true impedance.
+
+    Returns (time_s (n,), q_u (n, 4), q_p (n, 4), force_p (n, 2), pelvis (n,)).
+    The data run from 0.1 s before the window to 0.05 s after it.
+    """
+    fs = settings.sample_rate_hz
+    t_start = settings.onset_s - settings.window_before_s - 0.1
+    t_end = settings.onset_s + settings.window_after_s + 0.05
+    n = int(np.floor((t_end - t_start) * fs)) + 1
+    t = t_start + np.arange(n) / fs
+    qu, pelvis = nominal_swing(t, settings.swing_duration_s)
+    # the force rises after the onset sample and falls after onset + duration (linear between samples)
+    on = (t > settings.onset_s + 1e-12) & (t <= settings.onset_s + settings.pulse_duration_s + 1e-12)
+    ang = np.deg2rad(settings.force_direction_deg)
+    fp = np.where(on[:, None], settings.pulse_force_n * np.array([np.cos(ang), np.sin(ang)]), 0.0)
+    # truth: the same equations, integrated with a much finer RK4 step
+    window = prepare_window(
+        t, qu, qu, params, settings.onset_s,
+        force_perturbed_n=fp,
+        pelvis_angle_unperturbed_rad=pelvis,
+        pelvis_angle_perturbed_rad=pelvis,
+        window_before_s=settings.window_before_s,
+        window_after_s=t[-1] - settings.onset_s,
+        n_substeps=settings.truth_substeps,
+    )
+    from . import _kernels
+
+    E, _ = _kernels.simulate_deviation_batch(
+        np.asarray(impedance, dtype=float)[None], params.packed, window.ref_q, window.ref_qd, window.ref_qdd,
+        window.w, window.force_p, window.dpelvis, window.e0, window.ed0, window.dt_s, window.n_substeps,
+        window.n_samples,
+    )
+    qp = qu.copy()
+    qp[n - window.n_samples :] += E[0]
+    return t, qu, qp, fp, pelvis
+
+
+def run_validation_chunk(
+    params: SegmentParameters, settings: ValidationSettings, combinations
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Simulate and identify the given combination indices in both conditions.
+
+    Returns ``errors`` (one row per combination x condition x parameter:
+    condition, combination, parameter, true, estimate, error, ci95_low,
+    ci95_high) and ``fits`` (one row per combination x condition: VAF per
+    joint, cost, starts at best, success, message, seconds).
+    """
+    import time
+
+    grid = impedance_grid(settings.stiffness_levels_nm_per_rad, settings.damping_levels_nms_per_rad)
+    err_rows, fit_rows = [], []
+    for c in np.asarray(combinations, dtype=int):
+        if not 0 <= c < len(grid):
+            raise LoperInputError(f"combination {c} outside 0 .. {len(grid) - 1}")
+        truth = grid[c]
+        t, qu, qp, fp, pelvis = perturbed_trial(params, truth, settings)
+        for ci, condition in enumerate(CONDITIONS):
+            qu_m, qp_m = qu, qp
+            if condition == "noise":
+                rng = np.random.default_rng([settings.seed, int(c), ci, 0])
+                a = settings.noise_peak_to_peak / 2
+                qu_m = qu + rng.uniform(-a, a, qu.shape)
+                qp_m = qp + rng.uniform(-a, a, qp.shape)
+            t0 = time.perf_counter()
+            window = prepare_window(
+                t, qu_m, qp_m, params, settings.onset_s,
+                force_perturbed_n=fp,
+                pelvis_angle_unperturbed_rad=pelvis,
+                pelvis_angle_perturbed_rad=pelvis,
+                window_before_s=settings.window_before_s,
+                window_after_s=settings.window_after_s,
+                n_substeps=settings.n_substeps,
+                q_reference=qu,
+                reference_cutoff_hz=settings.reference_cutoff_hz,
+                initial_state_span_s=settings.initial_state_span_s,
+                initial_state_degree=settings.initial_state_degree,
+            )
+            fit = identify_impedance(
+                window,
+                n_starts=settings.n_starts,
+                seed=np.random.SeedSequence([settings.seed, int(c), ci, 1]),
+                lower=settings.lower,
+                upper=settings.upper,
+            )
+            seconds = time.perf_counter() - t0
+            for i, name in enumerate(PARAMETERS):
+                err_rows.append(
+                    {
+                        "condition": condition,
+                        "combination": int(c),
+                        "parameter": name,
+                        "true": truth[i],
+                        "estimate": fit.estimate[i],
+                        "error": fit.estimate[i] - truth[i],
+                        "ci95_low": fit.ci95_low[i],
+                        "ci95_high": fit.ci95_high[i],
+                        "success": fit.success,
+                    }
+                )
+            row = {"condition": condition, "combination": int(c)}
+            row.update({f"vaf_{j}_pct": fit.vaf_pct[k] for k, j in enumerate(JOINTS)})
+            row.update(
+                cost_rad2=fit.cost,
+                n_starts=fit.n_starts,
+                n_starts_at_best=fit.n_starts_at_best,
+                n_simulations=fit.n_simulations,
+                success=fit.success,
+                message=fit.message,
+                seconds=seconds,
+            )
+            fit_rows.append(row)
+    return pd.DataFrame(err_rows), pd.DataFrame(fit_rows)
+
+
+def summarize_errors(errors: pd.DataFrame) -> pd.DataFrame:
+    """min / max / SD of the error per condition and parameter (the study's table layout)."""
+    need = {"condition", "parameter", "error"}
+    if not need <= set(errors.columns):
+        raise LoperInputError(f"errors table lacks column(s) {sorted(need - set(errors.columns))}")
+    g = errors.groupby(["condition", "parameter"], sort=False)["error"]
+    out = pd.DataFrame(
+        {
+            "min_error": g.min(),
+            "max_error": g.max(),
+            "sd_error": g.std(ddof=1),
+            "max_abs_error": g.apply(lambda e: e.abs().max()),
+            "n": g.size(),
+        }
+    ).reset_index()
+    order = {p: i for i, p in enumerate(PARAMETERS)}
+    cond = {c: i for i, c in enumerate(CONDITIONS)}
+    out = out.sort_values(by=["condition", "parameter"], key=lambda s: s.map(cond | order)).reset_index(drop=True)
+    return out

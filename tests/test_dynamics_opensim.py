@@ -1,0 +1,292 @@
+"""Cross-check of the planar swing-leg model against a peer engine, OpenSim (Simbody).
+
+The same mechanism is built with the OpenSim Python API::
+
+    ground -SliderJoint(X)-> cart -PinJoint(Z)-> thigh -PinJoint(Z)-> shank -PinJoint(Z)-> foot
+
+OpenSim uses relative, counter-clockwise joint angles ``phi``; our model uses
+global, clockwise segment angles ``q``::
+
+    phi_x = x,  phi_1 = -q_1,  phi_2 = -(q_2 - q_1),  phi_3 = -(q_3 - q_2)
+
+so ``q = A phi`` with the constant matrix ``A`` below. Then ``q' = A phi'``,
+``q'' = A phi''``, the generalised forces map by virtual work as
+``tau_phi = A^T u`` and the mass matrices as ``M_phi = A^T M_q A``.
+
+Generalised forces enter through CoordinateActuators and the rod force
+``F = (F_x, F_y)`` through two PointActuators at the body point
+``(0, -attachment_m)`` of the thigh with the direction fixed in ground; all six
+use optimal force 1 and the actuation override, a discrete state variable that
+holds the value during a Manager integration.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+osim = pytest.importorskip("opensim")
+
+from loper_analysis.dynamics import (  # noqa: E402
+    SegmentParameters,
+    attachment_jacobian,
+    attachment_position,
+    forward_dynamics,
+    mass_matrix,
+    segment_com_positions,
+    segment_parameters_from_anthropometry,
+    simulate,
+)
+
+osim.Logger.setLevelString("error")
+osim.Logger.removeFileSink()
+
+# q = A phi (phi: OpenSim coordinates in mobility order slider, hip pin, knee pin, ankle pin)
+A = np.array(
+    [
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, -1.0, 0.0, 0.0],
+        [0.0, -1.0, -1.0, 0.0],
+        [0.0, -1.0, -1.0, -1.0],
+    ]
+)
+A_INV = np.linalg.inv(A)
+
+SEGMENT_NAMES = ("thigh", "shank", "foot")
+
+PARAMETER_SETS = {
+    "winter_1.73m_64.9kg": segment_parameters_from_anthropometry(1.73, 64.9),
+    "asymmetric": SegmentParameters(
+        cart_mass_kg=41.3,
+        mass_kg=(7.9, 3.4, 1.1),
+        inertia_kg_m2=(0.151, 0.047, 0.0062),
+        length_m=(0.43, 0.41, 0.26),
+        com_x_m=(0.021, -0.013, 0.064),
+        com_y_m=(-0.185, -0.172, -0.031),
+        attachment_m=0.29,
+        gravity_m_per_s2=9.79,
+    ),
+}
+
+
+@pytest.fixture(autouse=True)
+def _run_in_tmp(tmp_path, monkeypatch):
+    """Whatever OpenSim might write lands in pytest's tmp_path, never in the repo."""
+    monkeypatch.chdir(tmp_path)
+
+
+@pytest.fixture(params=sorted(PARAMETER_SETS))
+def params(request) -> SegmentParameters:
+    return PARAMETER_SETS[request.param]
+
+
+class OpenSimLeg:
+    """The swing-leg model built in OpenSim, with conversion to our coordinates."""
+
+    def __init__(self, p: SegmentParameters):
+        model = osim.Model()
+        model.setName("swing_leg")
+        model.setGravity(osim.Vec3(0.0, -p.gravity_m_per_s2, 0.0))
+        # the cart only translates: its inertia is irrelevant but must be valid
+        cart = osim.Body("cart", p.cart_mass_kg, osim.Vec3(0.0), osim.Inertia(1.0, 1.0, 1.0))
+        model.addBody(cart)
+        model.addJoint(
+            osim.SliderJoint("slider", model.getGround(), osim.Vec3(0.0), osim.Vec3(0.0), cart, osim.Vec3(0.0), osim.Vec3(0.0))
+        )
+        parent, parent_loc = cart, osim.Vec3(0.0)
+        for i, name in enumerate(SEGMENT_NAMES):
+            body = osim.Body(
+                name,
+                p.mass_kg[i],
+                osim.Vec3(p.com_x_m[i], p.com_y_m[i], 0.0),
+                # Ixx, Iyy do not matter for planar motion about Z
+                osim.Inertia(0.3, 0.2, p.inertia_kg_m2[i]),
+            )
+            model.addBody(body)
+            model.addJoint(
+                osim.PinJoint(f"{name}_pin", parent, parent_loc, osim.Vec3(0.0), body, osim.Vec3(0.0), osim.Vec3(0.0))
+            )
+            parent, parent_loc = body, osim.Vec3(0.0, -p.length_m[i], 0.0)
+
+        self.coord_actuators = []
+        for k in range(4):
+            coord = model.getJointSet().get(k).get_coordinates(0)
+            act = osim.CoordinateActuator(coord.getName())
+            act.setName(f"tau_{k}")
+            act.setOptimalForce(1.0)
+            act.setMinControl(-np.inf)
+            act.setMaxControl(np.inf)
+            model.addForce(act)
+            self.coord_actuators.append(act)
+        self.force_actuators = []
+        for k, direction in enumerate(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))):
+            act = osim.PointActuator("thigh")
+            act.setName(f"rod_force_{'xy'[k]}")
+            act.set_point(osim.Vec3(0.0, -p.attachment_m, 0.0))
+            act.set_point_is_global(False)
+            act.set_direction(osim.Vec3(*direction))
+            act.set_force_is_global(True)
+            act.setOptimalForce(1.0)
+            act.setMinControl(-np.inf)
+            act.setMaxControl(np.inf)
+            model.addForce(act)
+            self.force_actuators.append(act)
+
+        self.state = model.initSystem()
+        self.model = model
+        self.params = p
+        # mobility order must be slider, hip, knee, ankle for the mapping A
+        names = [model.getCoordinateSet().get(k).getName() for k in range(4)]
+        assert names == [model.getJointSet().get(k).get_coordinates(0).getName() for k in range(4)]
+        for act in (*self.coord_actuators, *self.force_actuators):
+            act.overrideActuation(self.state, True)
+
+    # ------------------------------------------------------------ state
+
+    def set_state(self, q, qd, u=np.zeros(4), force=np.zeros(2)) -> None:
+        s = self.state
+        s.setTime(0.0)
+        s.setQ(osim.Vector([float(v) for v in A_INV @ q]))
+        s.setU(osim.Vector([float(v) for v in A_INV @ qd]))
+        tau = A.T @ np.asarray(u, dtype=float)  # virtual work: tau_phi = (dq/dphi)^T u
+        for act, val in zip(self.coord_actuators, tau):
+            act.setOverrideActuation(s, float(val))
+        for act, val in zip(self.force_actuators, force):
+            act.setOverrideActuation(s, float(val))
+
+    def q(self, s=None) -> np.ndarray:
+        s = self.state if s is None else s
+        return A @ np.array([s.getQ().get(k) for k in range(4)])
+
+    def qd(self, s=None) -> np.ndarray:
+        s = self.state if s is None else s
+        return A @ np.array([s.getU().get(k) for k in range(4)])
+
+    # ------------------------------------------------------------ terms
+
+    def accelerations(self) -> np.ndarray:
+        self.model.realizeAcceleration(self.state)
+        udot = self.state.getUDot()
+        return A @ np.array([udot.get(k) for k in range(4)])
+
+    def mass_matrix(self) -> np.ndarray:
+        self.model.realizePosition(self.state)
+        M = osim.Matrix()
+        self.model.getMatterSubsystem().calcM(self.state, M)
+        M_phi = np.array([[M.get(i, j) for j in range(4)] for i in range(4)])
+        return A_INV.T @ M_phi @ A_INV  # M_q = A^-T M_phi A^-1
+
+    def station_in_ground(self, body: str, point) -> np.ndarray:
+        self.model.realizePosition(self.state)
+        b = self.model.getBodySet().get(body)
+        v = b.findStationLocationInGround(self.state, osim.Vec3(*point))
+        return np.array([v.get(0), v.get(1), v.get(2)])
+
+    def station_velocity_in_ground(self, body: str, point) -> np.ndarray:
+        self.model.realizeVelocity(self.state)
+        b = self.model.getBodySet().get(body)
+        v = b.findStationVelocityInGround(self.state, osim.Vec3(*point))
+        return np.array([v.get(0), v.get(1), v.get(2)])
+
+    # ------------------------------------------------------------ simulation
+
+    def simulate(self, time_s, q0, qd0, u, force) -> np.ndarray:
+        self.set_state(q0, qd0, u, force)
+        self.state.setTime(float(time_s[0]))
+        manager = osim.Manager(self.model)
+        manager.setIntegratorAccuracy(1e-12)
+        manager.initialize(self.state)
+        out = [self.q(self.state)]
+        for t in time_s[1:]:
+            s = manager.integrate(float(t))
+            out.append(self.q(s))
+        return np.array(out)
+
+
+def _random_states(n: int, seed: int):
+    rng = np.random.default_rng(seed)
+    for _ in range(n):
+        q = np.r_[rng.uniform(-0.5, 0.5), rng.uniform(-1.0, 1.0, 3)]
+        qd = np.r_[rng.uniform(-2.0, 2.0), rng.uniform(-5.0, 5.0, 3)]
+        u = rng.uniform(-50.0, 50.0, 4)
+        force = rng.uniform(-60.0, 60.0, 2)
+        yield q, qd, u, force
+
+
+# ---------------------------------------------------------------- tests
+
+
+def test_kinematics_and_conventions_match(params):
+    """Coordinate mapping, segment frames and attachment point agree (positions and velocities)."""
+    leg = OpenSimLeg(params)
+    for q, qd, _, _ in _random_states(10, seed=7):
+        leg.set_state(q, qd)
+        com = segment_com_positions(q, params)
+        for i, name in enumerate(SEGMENT_NAMES):
+            got = leg.station_in_ground(name, (params.com_x_m[i], params.com_y_m[i], 0.0))
+            np.testing.assert_allclose(got[:2], com[i], rtol=0, atol=1e-14)
+            assert got[2] == 0.0
+        att = leg.station_in_ground("thigh", (0.0, -params.attachment_m, 0.0))
+        np.testing.assert_allclose(att[:2], attachment_position(q, params), rtol=0, atol=1e-14)
+        v_att = leg.station_velocity_in_ground("thigh", (0.0, -params.attachment_m, 0.0))
+        np.testing.assert_allclose(v_att[:2], attachment_jacobian(q, params) @ qd, rtol=0, atol=1e-13)
+
+
+def test_forward_dynamics_and_mass_matrix_match_opensim(params):
+    leg = OpenSimLeg(params)
+    worst_acc = worst_mass = 0.0
+    for q, qd, u, force in _random_states(20, seed=2024):
+        leg.set_state(q, qd, u, force)
+        qdd_ref = leg.accelerations()
+        qdd = forward_dynamics(q, qd, u, params, force)
+        err = np.linalg.norm(qdd - qdd_ref) / np.linalg.norm(qdd_ref)
+        worst_acc = max(worst_acc, err)
+        assert err < 1e-8, f"q={q}, qd={qd}, u={u}, F={force}: ours {qdd}, OpenSim {qdd_ref}"
+
+        M_ref = leg.mass_matrix()
+        M = mass_matrix(q, params)
+        err_m = np.linalg.norm(M - M_ref) / np.linalg.norm(M_ref)
+        worst_mass = max(worst_mass, err_m)
+        assert err_m < 1e-10, f"q={q}: ours\n{M}\nOpenSim\n{M_ref}"
+    print(f"max relative acceleration error {worst_acc:.2e}, mass matrix {worst_mass:.2e}")
+
+
+def test_each_input_alone_matches_opensim(params):
+    """Unit inputs one at a time (no gravity masking): each u_i and F component has the right effect."""
+    p0 = params.replace(gravity_m_per_s2=0.0)
+    leg = OpenSimLeg(p0)
+    q = np.array([0.1, 0.3, -0.4, 0.7])
+    qd = np.zeros(4)
+    for k in range(6):
+        e = np.zeros(6)
+        e[k] = 10.0
+        u, force = e[:4], e[4:]
+        leg.set_state(q, qd, u, force)
+        qdd_ref = leg.accelerations()
+        qdd = forward_dynamics(q, qd, u, p0, force)
+        np.testing.assert_allclose(qdd, qdd_ref, rtol=0, atol=1e-10 * np.linalg.norm(qdd_ref))
+
+
+def test_simulation_matches_opensim_manager(params):
+    q0 = np.array([0.05, 0.4, 0.1, -0.2])
+    qd0 = np.array([0.3, -2.0, 1.5, 3.0])
+    u = np.array([5.0, 10.0, -4.0, 1.5])
+    force = np.array([20.0, -15.0])
+    time_s = np.linspace(0.0, 0.3, 31)
+
+    q_ref = OpenSimLeg(params).simulate(time_s, q0, qd0, u, force)
+    q_sim, _ = simulate(
+        time_s,
+        q0,
+        qd0,
+        params,
+        u_ff=np.tile(u, (len(time_s), 1)),
+        force_n=np.tile(force, (len(time_s), 1)),
+    )
+    # the motion is not trivial
+    assert np.ptp(q_sim[:, 1:], axis=0).min() > 0.05
+    diff = np.abs(q_sim - q_ref)
+    print(f"max simulation difference: cart {diff[:, 0].max():.2e} m, angles {diff[:, 1:].max():.2e} rad")
+    np.testing.assert_allclose(q_sim[-1], q_ref[-1], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(q_sim[:, 0], q_ref[:, 0], rtol=0, atol=1e-6)
+    np.testing.assert_allclose(q_sim[:, 1:], q_ref[:, 1:], rtol=0, atol=1e-6)
