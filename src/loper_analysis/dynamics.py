@@ -179,20 +179,22 @@ class SegmentParameters:
         for seg in ("cart", *SEGMENTS):
             if seg not in df.index:
                 raise LoperInputError(f"{path}: missing row for segment '{seg}'")
-        values: dict = {}
-        for c in _SEGMENT_COLUMNS:
-            col = pd.to_numeric(df.loc[list(SEGMENTS), c], errors="coerce")
-            if col.isna().any():
-                bad = col[col.isna()].index[0]
-                raise LoperInputError(f"{path}: column {c}, segment {bad}: value {df.loc[bad, c]!r} is not a number")
-            values[c] = tuple(col.to_numpy(float))
+        def number(seg: str, col: str) -> float:
+            raw = df.loc[seg, col]
+            value = pd.to_numeric(pd.Series([raw]), errors="coerce").iloc[0]
+            if pd.isna(value):
+                shown = "an empty cell" if pd.isna(raw) else f"value {raw!r}"
+                raise LoperInputError(f"{path}: column {col}, segment {seg}: {shown} is not a number")
+            return float(value)
+
+        values = {c: tuple(number(seg, c) for seg in SEGMENTS) for c in _SEGMENT_COLUMNS}
         gravity = GRAVITY_M_PER_S2
         if "gravity_m_per_s2" in df.columns and pd.notna(df.loc["cart", "gravity_m_per_s2"]):
-            gravity = float(df.loc["cart", "gravity_m_per_s2"])
+            gravity = number("cart", "gravity_m_per_s2")
         try:
             return cls(
-                cart_mass_kg=float(df.loc["cart", "mass_kg"]),
-                attachment_m=float(df.loc["thigh", "attachment_m"]),
+                cart_mass_kg=number("cart", "mass_kg"),
+                attachment_m=number("thigh", "attachment_m"),
                 gravity_m_per_s2=gravity,
                 **values,
             )

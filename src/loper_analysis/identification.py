@@ -59,6 +59,7 @@ __all__ = [
 #: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS`.
 DEFAULT_LOWER = np.zeros(6)
 DEFAULT_UPPER = np.array([200.0, 10.0, 200.0, 10.0, 200.0, 10.0])
+_MU0, _MU_DOWN, _MU_UP = 1e-2, 10.0, 10.0
 
 
 @dataclass(frozen=True)
@@ -160,11 +161,11 @@ def prepare_window(
     pelvis_angle_perturbed_rad=None,
     window_before_s: float = 0.025,
     window_after_s: float = 0.25,
-    n_substeps: int = 4,
+    n_substeps: int = 2,
     reference_cutoff_hz: float | None = None,
     q_reference=None,
-    initial_state_span_s: float = 0.05,
-    initial_state_degree: int = 2,
+    initial_state_span_s: float = 0.1,
+    initial_state_degree: int = 1,
 ) -> PreparedWindow:
     """Check the inputs of one fit and precompute reference, inputs and initial state.
 
@@ -383,8 +384,12 @@ class _Evaluator:
         return R[:, 0, :], np.transpose(J, (0, 2, 1))
 
 
-def _lm_multistart(ev: _Evaluator, starts: np.ndarray, max_iter: int, tol: float):
+def _lm_multistart(ev: _Evaluator, starts: np.ndarray, max_iter: int, tol: float, merge_tol: float):
     """Bound-constrained Levenberg-Marquardt run on all starts at once.
+
+    Residuals and forward-difference Jacobians of every active start are one
+    batch of the compiled simulation. Starts that meet (closer than
+    ``merge_tol`` of the bound range in every parameter) continue as one.
 
     Returns final parameters (N, 6), costs (N,) and per-start convergence flags.
     """
@@ -393,11 +398,29 @@ def _lm_multistart(ev: _Evaluator, starts: np.ndarray, max_iter: int, tol: float
     P = starts.copy()
     r, J = ev.residuals_and_jacobians(P)
     cost = 0.5 * np.sum(r**2, axis=1)
-    mu = np.full(N, 1e-3)
+    mu = np.full(N, _MU0)
     active = np.ones(N, bool)
     converged = np.zeros(N, bool)
+    merged_into = np.arange(N)
+    scale = ub - lb
     for _ in range(max_iter):
         ids = np.flatnonzero(active)
+        # a start that has come within merge_tol (fraction of the bounds) of a better
+        # active start follows the same path from here: stop it and let it share the result
+        if merge_tol > 0 and ids.size > 1:
+            order = ids[np.argsort(cost[ids], kind="stable")]
+            X = P[order] / scale
+            near = np.max(np.abs(X[:, None, :] - X[None, :, :]), axis=2) < merge_tol
+            if np.triu(near, 1).any():
+                kept: list[int] = []
+                for a, i in enumerate(order):
+                    partner = next((b for b in kept if near[a, b]), None)
+                    if partner is None:
+                        kept.append(a)
+                    else:
+                        merged_into[i] = order[partner]
+                        active[i] = False
+                ids = np.flatnonzero(active)
         if ids.size == 0:
             break
         trial = np.empty((ids.size, 6))
@@ -426,15 +449,20 @@ def _lm_multistart(ev: _Evaluator, starts: np.ndarray, max_iter: int, tol: float
                 P[i], r[i], J[i] = trial[k], rt[k], Jt[k]
                 small_gain = gain <= tol * cost[i] or ct[k] < 1e-30
                 cost[i] = ct[k]
-                mu[i] = max(mu[i] / 3.0, 1e-12)
+                mu[i] = max(mu[i] / _MU_DOWN, 1e-12)
                 if small_gain or small_step:
                     active[i] = False
                     converged[i] = True
             else:
-                mu[i] *= 4.0
+                mu[i] *= _MU_UP
                 if small_step or mu[i] > 1e12:
                     active[i] = False
                     converged[i] = True
+    for i in range(N):  # merged starts share the result of the start they joined
+        j = i
+        while merged_into[j] != j:
+            j = merged_into[j]
+        P[i], cost[i], converged[i] = P[j], cost[j], converged[j]
     return P, cost, converged
 
 
@@ -446,7 +474,8 @@ def identify_impedance(
     lower=DEFAULT_LOWER,
     upper=DEFAULT_UPPER,
     max_iterations: int = 60,
-    tolerance: float = 1e-10,
+    tolerance: float = 1e-6,
+    merge_tolerance: float = 1e-2,
 ) -> ImpedanceFit:
     """Fit K, D per joint to one prepared window (see the module docstring).
 
@@ -457,7 +486,11 @@ def identify_impedance(
     seed : seed of the start generator (NumPy ``default_rng``).
     lower, upper : (6,) bounds in the order of :data:`PARAMETERS`.
     max_iterations : Levenberg-Marquardt iterations per start.
-    tolerance : relative cost/step tolerance.
+    tolerance : relative cost/step tolerance of the multistart phase; the
+        SciPy polish of the best start then converges to machine precision.
+    merge_tolerance : starts closer than this fraction of the bound range in
+        every parameter continue as one (0 disables merging); a merged start
+        counts as reaching the optimum its partner reaches.
 
     Returns
     -------
@@ -471,7 +504,9 @@ def identify_impedance(
     rng = np.random.default_rng(seed)
     starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
     ev = _Evaluator(window, lb, ub)
-    P, costs, converged = _lm_multistart(ev, starts, max_iterations, tolerance)
+    if not 0 <= merge_tolerance < 1:
+        raise LoperInputError(f"merge_tolerance must lie in [0, 1), got {merge_tolerance}")
+    P, costs, converged = _lm_multistart(ev, starts, max_iterations, tolerance, merge_tolerance)
     best = int(np.argmin(costs))
 
     def fun(p):

@@ -1,0 +1,110 @@
+"""End to end: the validation workflow on a tiny config, config validation, report."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _project(tmp: Path, **changes) -> Path:
+    """Copy the workflow into tmp with a small validation study (2 levels -> 64 combinations)."""
+    for item in ("Snakefile", "workflow", "config"):
+        src = ROOT / item
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
+    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    cfg["validation"].update(stiffness_levels_nm_per_rad=[0.0, 150.0], damping_levels_nms_per_rad=[0.0, 4.0], n_chunks=2)
+    cfg["identification"]["n_starts"] = 3
+    for key, value in changes.items():
+        section, _, name = key.partition("__")
+        if name:
+            cfg[section][name] = value
+        else:
+            cfg[section] = value
+    (tmp / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    return tmp
+
+
+def _snakemake(cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", *args],
+        cwd=cwd, capture_output=True, text=True, timeout=600,
+    )
+
+
+@pytest.fixture(scope="module")
+def finished_run(tmp_path_factory) -> Path:
+    work = _project(tmp_path_factory.mktemp("run"))
+    res = _snakemake(work)
+    assert res.returncode == 0, res.stderr[-3000:]
+    return work
+
+
+def test_tiny_validation_recovers_truth(finished_run):
+    summary = pd.read_csv(finished_run / "results/validation/summary.tsv", sep="\t")
+    assert list(summary.columns[:5]) == ["condition", "parameter", "min_error", "max_error", "sd_error"]
+    assert len(summary) == 12
+    clean = summary[summary.condition == "no_noise"].set_index("parameter")
+    k = [p for p in clean.index if p.startswith("K")]
+    d = [p for p in clean.index if p.startswith("D")]
+    assert (clean.loc[k, "max_abs_error"] <= 0.05).all(), clean
+    assert (clean.loc[d, "max_abs_error"] <= 0.005).all(), clean
+    errors = pd.read_csv(finished_run / "results/validation/errors.tsv", sep="\t")
+    assert len(errors) == 64 * 2 * 6
+    assert sorted(errors.combination.unique()) == list(range(64))
+    np.testing.assert_allclose(errors.error, errors.estimate - errors.true, atol=1e-12)
+    fits = pd.read_csv(finished_run / "results/validation/fits.tsv", sep="\t")
+    assert len(fits) == 128 and fits.success.all()
+
+
+def test_rerun_does_nothing_and_report_builds(finished_run):
+    res = _snakemake(finished_run, "-n")
+    assert res.returncode == 0
+    assert "Nothing to be done" in res.stdout + res.stderr
+    res = _snakemake(finished_run, "--report", "report.html")
+    assert res.returncode == 0, res.stderr[-3000:]
+    html = (finished_run / "report.html").read_bytes()
+    assert len(html) > 10_000 and b"errors.png" in html
+
+
+def test_same_config_gives_same_bytes(finished_run, tmp_path):
+    work = _project(tmp_path)
+    res = _snakemake(work, "results/validation/summary.tsv")
+    assert res.returncode == 0, res.stderr[-3000:]
+    for name in ("errors.tsv", "fits.tsv", "summary.tsv"):
+        assert (work / "results/validation" / name).read_bytes() == (
+            finished_run / "results/validation" / name
+        ).read_bytes(), name
+
+
+@pytest.mark.parametrize(
+    ("changes", "expected"),
+    [
+        ({"identification__n_stars": 3}, "n_stars"),
+        ({"identification__n_starts": "ten"}, "ten"),
+        ({"validation__n_chunks": 0}, "n_chunks"),
+        ({"subjects": "config/nowhere.tsv"}, "config/nowhere.tsv"),
+    ],
+)
+def test_bad_config_is_refused_with_its_key(tmp_path, changes, expected):
+    work = _project(tmp_path, **changes)
+    res = _snakemake(work, "-n")
+    assert res.returncode != 0
+    assert expected in res.stdout + res.stderr
+
+
+def test_bad_subject_sheet_is_refused(tmp_path):
+    work = _project(tmp_path)
+    (work / "config/subjects.tsv").write_text("subject\tsource\nS_01\tsynthetic\n")
+    res = _snakemake(work, "-n")
+    assert res.returncode != 0
+    out = res.stdout + res.stderr
+    assert "subjects.tsv" in out and "S_01" in out
