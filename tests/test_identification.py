@@ -235,3 +235,21 @@ def test_same_seed_same_result_bitwise(trial_mid):
     assert np.all(a.starts >= 0.0) and np.all(a.starts <= np.asarray(SETTINGS.upper))
     # different starts, same optimum (noise-free data)
     np.testing.assert_allclose(c.estimate, a.estimate, rtol=0, atol=1e-3)
+
+
+def test_response_jacobian_matches_central_differences():
+    from loper_analysis.identification import response_jacobian
+
+    params = segment_parameters_from_anthropometry(1.73, 64.9)
+    s = ValidationSettings()
+    truth = np.array([75.0, 2.0, 75.0, 2.0, 75.0, 2.0])
+    t, qu, qp, fp, pel = perturbed_trial(params, truth, s)
+    w = prepare_window(t, qu, qp, params, s.onset_s, force_perturbed_n=fp,
+                       pelvis_angle_unperturbed_rad=pel, pelvis_angle_perturbed_rad=pel)
+    J = response_jacobian(w, truth)
+    h = np.array([1e-3, 1e-5] * 3)
+    for k in range(6):
+        dp = np.zeros(6)
+        dp[k] = h[k]
+        central = (simulate_response(w, truth + dp) - simulate_response(w, truth - dp)).ravel() / (2 * h[k])
+        np.testing.assert_allclose(J[:, k], central, rtol=1e-4, atol=1e-6 * np.abs(central).max())

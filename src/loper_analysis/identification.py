@@ -54,6 +54,7 @@ __all__ = [
     "prediction_error",
     "identify_impedance",
     "variance_accounted_for",
+    "response_jacobian",
 ]
 
 #: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS`.
@@ -332,6 +333,22 @@ def simulate_response(window: PreparedWindow, impedance) -> np.ndarray:
 def prediction_error(window: PreparedWindow, impedance) -> np.ndarray:
     """PE = measured - model (n_out, 3) or (B, n_out, 3), rad."""
     return window.measured - simulate_response(window, impedance)
+
+
+def response_jacobian(window: PreparedWindow, impedance, lower=DEFAULT_LOWER, upper=DEFAULT_UPPER) -> np.ndarray:
+    """Sensitivity of the model response to the parameters, (n_out * 3, 6).
+
+    Row order: samples, then hip/knee/ankle; units rad per (N m/rad) or per
+    (N m s/rad). Forward differences as used by the fit (backward at an upper
+    bound). With white noise of SD s on the prediction error,
+    ``s * sqrt(diag((J^T J)^-1))`` is the Cramér-Rao bound of the parameter SD.
+    """
+    lb, ub = _check_bounds(lower, upper)
+    p = np.asarray(impedance, dtype=float)
+    if p.shape != (6,) or not np.all(np.isfinite(p)):
+        raise LoperInputError(f"impedance must be 6 finite values, got {p}")
+    _, J = _Evaluator(window, lb, ub).residuals_and_jacobians(p[None])
+    return -J[0]
 
 
 def variance_accounted_for(measured: np.ndarray, model: np.ndarray) -> np.ndarray:

@@ -5,16 +5,22 @@ import pandas as pd
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
-validate(config, "../schemas/config.schema.yaml")
+from loper_analysis.errors import LoperInputError
+from loper_analysis.schema import check_config, check_table
 
-_subjects_path = Path(config["subjects"])
-if not _subjects_path.is_file():
-    raise WorkflowError(f"config key 'subjects': file '{_subjects_path}' not found")
-subjects = pd.read_csv(_subjects_path, sep="\t", dtype={"subject": str}, comment="#")
+_SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
 try:
+    # one short message naming the key, then Snakemake's own validation
+    check_config(config, _SCHEMAS / "config.schema.yaml", "config/config.yaml")
+    validate(config, "../schemas/config.schema.yaml")
+    _subjects_path = Path(config["subjects"])
+    if not _subjects_path.is_file():
+        raise LoperInputError(f"config key 'subjects': file '{_subjects_path}' not found")
+    subjects = pd.read_csv(_subjects_path, sep="\t", dtype={"subject": str}, comment="#")
+    check_table(subjects, _SCHEMAS / "subjects.schema.yaml", str(_subjects_path))
     validate(subjects, "../schemas/subjects.schema.yaml")
-except WorkflowError as exc:
-    raise WorkflowError(f"{_subjects_path}: {exc}") from exc
+except LoperInputError as exc:
+    raise WorkflowError(str(exc)) from None
 if subjects["subject"].duplicated().any():
     dup = subjects.loc[subjects["subject"].duplicated(), "subject"].iloc[0]
     raise WorkflowError(f"{_subjects_path}: subject '{dup}' appears twice")

@@ -1,0 +1,66 @@
+"""Config and subject-sheet checks against the workflow's schemas."""
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.schema import check_config, check_table
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG_SCHEMA = ROOT / "workflow/schemas/config.schema.yaml"
+SUBJECT_SCHEMA = ROOT / "workflow/schemas/subjects.schema.yaml"
+
+
+def _config() -> dict:
+    return yaml.safe_load((ROOT / "config/config.yaml").read_text())
+
+
+def test_shipped_config_and_sheet_are_valid():
+    check_config(_config(), CONFIG_SCHEMA)
+    sheet = pd.read_csv(ROOT / "config/subjects.tsv", sep="\t", dtype={"subject": str})
+    check_table(sheet, SUBJECT_SCHEMA, "subjects.tsv")
+    assert len(sheet) >= 1
+
+
+@pytest.mark.parametrize(
+    ("section", "key", "value", "words"),
+    [
+        ("identification", "n_starts", 0, ["identification.n_starts", "0"]),
+        ("identification", "n_starts", "ten", ["identification.n_starts", "'ten'"]),
+        ("validation", "noise_peak_to_peak", -0.01, ["validation.noise_peak_to_peak", "-0.01"]),
+        ("validation", "colour", "red", ["validation", "colour"]),
+    ],
+)
+def test_bad_config_names_key_and_value(section, key, value, words):
+    cfg = _config()
+    cfg[section][key] = value
+    with pytest.raises(LoperInputError) as info:
+        check_config(cfg, CONFIG_SCHEMA, "config.yaml")
+    for w in words:
+        assert w in str(info.value), str(info.value)
+
+
+def test_missing_required_key():
+    cfg = _config()
+    del cfg["seed"]
+    with pytest.raises(LoperInputError, match="'seed' is a required property"):
+        check_config(cfg, CONFIG_SCHEMA)
+
+
+@pytest.mark.parametrize(
+    ("row", "words"),
+    [
+        ({"subject": "S 1", "source": "synthetic"}, ["row 2", "subject", "S 1"]),
+        ({"subject": "S2", "source": "simulated"}, ["row 2", "source", "simulated"]),
+        ({"subject": "S3", "source": "synthetic", "height_m": 3.0}, ["row 2", "height_m", "3.0"]),
+    ],
+)
+def test_bad_subject_row_names_row_column_value(row, words):
+    sheet = pd.DataFrame([{"subject": "S0", "source": "synthetic"}, row])
+    with pytest.raises(LoperInputError) as info:
+        check_table(sheet, SUBJECT_SCHEMA, "subjects.tsv")
+    for w in words:
+        assert w in str(info.value), str(info.value)
