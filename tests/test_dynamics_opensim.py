@@ -34,7 +34,6 @@ from loper_analysis.dynamics import (  # noqa: E402
     forward_dynamics,
     mass_matrix,
     segment_com_positions,
-    segment_parameters_from_anthropometry,
     simulate,
 )
 
@@ -54,19 +53,9 @@ A_INV = np.linalg.inv(A)
 
 SEGMENT_NAMES = ("thigh", "shank", "foot")
 
-PARAMETER_SETS = {
-    "winter_1.73m_64.9kg": segment_parameters_from_anthropometry(1.73, 64.9),
-    "asymmetric": SegmentParameters(
-        cart_mass_kg=41.3,
-        mass_kg=(7.9, 3.4, 1.1),
-        inertia_kg_m2=(0.151, 0.047, 0.0062),
-        length_m=(0.43, 0.41, 0.26),
-        com_x_m=(0.021, -0.013, 0.064),
-        com_y_m=(-0.185, -0.172, -0.031),
-        attachment_m=0.29,
-        gravity_m_per_s2=9.79,
-    ),
-}
+from parameter_sets import ASYMMETRIC, WINTER
+
+PARAMETER_SETS = {"winter_1.73m_64.9kg": WINTER, "asymmetric": ASYMMETRIC}
 
 
 @pytest.fixture(autouse=True)

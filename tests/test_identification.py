@@ -20,36 +20,15 @@ from loper_analysis.identification import (
     simulate_response,
     variance_accounted_for,
 )
-from loper_analysis.validation import ValidationSettings, perturbed_trial
+from loper_analysis.validation import ValidationSettings, perturbed_trial, validation_window
 
 PARAMS = segment_parameters_from_anthropometry(1.73, 64.9)
 SETTINGS = ValidationSettings()
 
 
 def window_for(trial, settings=SETTINGS, *, qu_measured=None, qp_measured=None, **overrides):
-    """prepare_window as in run_validation_chunk (q_reference = noise-free unperturbed coordinates)."""
-    t, qu, qp, fp, pelvis = trial
-    kwargs = dict(
-        force_perturbed_n=fp,
-        pelvis_angle_unperturbed_rad=pelvis,
-        pelvis_angle_perturbed_rad=pelvis,
-        window_before_s=settings.window_before_s,
-        window_after_s=settings.window_after_s,
-        n_substeps=settings.n_substeps,
-        q_reference=qu,
-        reference_cutoff_hz=settings.reference_cutoff_hz,
-        initial_state_span_s=settings.initial_state_span_s,
-        initial_state_degree=settings.initial_state_degree,
-    )
-    kwargs.update(overrides)
-    return prepare_window(
-        t,
-        qu if qu_measured is None else qu_measured,
-        qp if qp_measured is None else qp_measured,
-        PARAMS,
-        settings.onset_s,
-        **kwargs,
-    )
+    """The window run_validation_chunk builds (q_reference = noise-free unperturbed coordinates)."""
+    return validation_window(PARAMS, settings, trial, qu_measured, qp_measured, **overrides)
 
 
 def fit(window, n_starts=5, seed=0, settings=SETTINGS):

@@ -26,7 +26,6 @@ from .identification import (
     DEFAULT_UPPER,
     identify_impedance,
     prepare_window,
-    simulate_response,
 )
 
 __all__ = [
@@ -35,6 +34,7 @@ __all__ = [
     "chunk_combinations",
     "nominal_swing",
     "perturbed_trial",
+    "validation_window",
     "run_validation_chunk",
     "summarize_errors",
     "CONDITIONS",
@@ -166,6 +166,40 @@ def perturbed_trial(params: SegmentParameters, impedance, settings: ValidationSe
     return t, qu, qp, fp, pelvis
 
 
+def validation_window(
+    params: SegmentParameters, settings: ValidationSettings, trial, qu_measured=None, qp_measured=None, **overrides
+):
+    """The identification window of one validation trial (from :func:`perturbed_trial`).
+
+    ``qu_measured`` / ``qp_measured`` replace the noise-free coordinates in the
+    prediction error and the initial state (noise condition); the reference for
+    ``u_ff`` stays the noise-free unperturbed stride. ``overrides`` go to
+    :func:`prepare_window`.
+    """
+    t, qu, qp, fp, pelvis = trial
+    kwargs = dict(
+        force_perturbed_n=fp,
+        pelvis_angle_unperturbed_rad=pelvis,
+        pelvis_angle_perturbed_rad=pelvis,
+        window_before_s=settings.window_before_s,
+        window_after_s=settings.window_after_s,
+        n_substeps=settings.n_substeps,
+        q_reference=qu,
+        reference_cutoff_hz=settings.reference_cutoff_hz,
+        initial_state_span_s=settings.initial_state_span_s,
+        initial_state_degree=settings.initial_state_degree,
+    )
+    kwargs.update(overrides)
+    return prepare_window(
+        t,
+        qu if qu_measured is None else qu_measured,
+        qp if qp_measured is None else qp_measured,
+        params,
+        settings.onset_s,
+        **kwargs,
+    )
+
+
 def run_validation_chunk(
     params: SegmentParameters, settings: ValidationSettings, combinations
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -190,19 +224,7 @@ def run_validation_chunk(
                 a = settings.noise_peak_to_peak / 2
                 qu_m = qu + rng.uniform(-a, a, qu.shape)
                 qp_m = qp + rng.uniform(-a, a, qp.shape)
-            window = prepare_window(
-                t, qu_m, qp_m, params, settings.onset_s,
-                force_perturbed_n=fp,
-                pelvis_angle_unperturbed_rad=pelvis,
-                pelvis_angle_perturbed_rad=pelvis,
-                window_before_s=settings.window_before_s,
-                window_after_s=settings.window_after_s,
-                n_substeps=settings.n_substeps,
-                q_reference=qu,
-                reference_cutoff_hz=settings.reference_cutoff_hz,
-                initial_state_span_s=settings.initial_state_span_s,
-                initial_state_degree=settings.initial_state_degree,
-            )
+            window = validation_window(params, settings, (t, qu, qp, fp, pelvis), qu_m, qp_m)
             fit = identify_impedance(
                 window,
                 n_starts=settings.n_starts,
