@@ -232,3 +232,13 @@ def test_response_jacobian_matches_central_differences():
         dp[k] = h[k]
         central = (simulate_response(w, truth + dp) - simulate_response(w, truth - dp)).ravel() / (2 * h[k])
         np.testing.assert_allclose(J[:, k], central, rtol=1e-4, atol=1e-6 * np.abs(central).max())
+
+
+def test_unconverged_fit_says_so(trial_mid):
+    window = window_for(trial_mid)
+    result = identify_impedance(window, n_starts=2, seed=0, max_iterations=1)
+    assert not result.success
+    assert "not converged" in result.message
+    # the estimate is still the best point seen, inside the bounds, with its cost
+    assert np.all(result.estimate >= 0) and np.all(result.estimate <= [200, 10, 200, 10, 200, 10])
+    np.testing.assert_allclose(result.cost, np.sum(prediction_error(window, result.estimate) ** 2), rtol=1e-12)
