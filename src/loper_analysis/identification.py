@@ -24,14 +24,16 @@ Method (DESIGN.md section 5):
    reflective), whose status is the fit's status.
 
 Beyond the study: 95 % confidence intervals from the Jacobian at the optimum
-(``cov = s^2 (J^T J)^-1``, ``s^2 = SSR / (m - 6)``, Student t quantile) and
-the parameter correlation matrix. A wide CI or a correlation near +-1 flags a
+(``cov = s^2 (J^T J)^-1 + A J^T G S0 G^T J A``, ``A = (J^T J)^-1``,
+``s^2 = SSR / (m - 6)``, ``G`` the sensitivity to the initial state and ``S0``
+its covariance from the pre-onset fit; Student t quantile) and the parameter
+correlation matrix. A wide CI or a correlation near +-1 flags a
 parameter the data cannot identify (typically the ankle).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -70,7 +72,9 @@ class PreparedWindow:
     Stage arrays are sampled every ``dt_s / 2`` from the window start
     (``2 * n_steps + 1`` rows). ``measured`` (n_out, 3) is the measured
     perturbed-minus-unperturbed joint angle difference (rad) at the window's
-    samples ``time_s`` (n_out,).
+    samples ``time_s`` (n_out,). ``initial_state_cov`` (8, 8) is the covariance
+    of ``[e0, ed0]`` from the scatter of the pre-onset differences about their
+    polynomial (zero for noise-free data).
     """
 
     params: SegmentParameters
@@ -86,6 +90,7 @@ class PreparedWindow:
     ed0: np.ndarray
     dt_s: float
     n_substeps: int
+    initial_state_cov: np.ndarray = field(default_factory=lambda: np.zeros((8, 8)))
 
     @property
     def n_samples(self) -> int:
@@ -275,6 +280,16 @@ def prepare_window(
     coef, *_ = np.linalg.lstsq(V, (qp - qu)[sel], rcond=None)
     e0 = coef[0]
     ed0 = coef[1] if initial_state_degree >= 1 else np.zeros(4)
+    n_sel, n_coef = V.shape
+    state_cov = np.zeros((8, 8))
+    if n_sel > n_coef:
+        resid = (qp - qu)[sel] - V @ coef
+        var = np.sum(resid**2, axis=0) / (n_sel - n_coef)  # per coordinate
+        C = np.linalg.pinv(V.T @ V)
+        k = min(n_coef, 2)
+        for a in range(4):
+            idx = [a, 4 + a][:k]
+            state_cov[np.ix_(idx, idx)] = var[a] * C[:k, :k]
     measured = joint_angles(qp[i0 : i1 + 1], pp[i0 : i1 + 1]) - joint_angles(qu[i0 : i1 + 1], pu[i0 : i1 + 1])
     return PreparedWindow(
         params=params,
@@ -290,6 +305,7 @@ def prepare_window(
         ed0=np.ascontiguousarray(ed0),
         dt_s=h,
         n_substeps=n_substeps,
+        initial_state_cov=state_cov,
     )
 
 
@@ -399,6 +415,19 @@ class _Evaluator:
         R = self.residuals(batch.reshape(-1, 6)).reshape(B, 7, -1)
         J = (R[:, 1:, :] - R[:, :1, :]) / step[:, :, None]
         return R[:, 0, :], np.transpose(J, (0, 2, 1))
+
+
+def _initial_state_jacobian(window: PreparedWindow, impedance: np.ndarray) -> np.ndarray:
+    """Sensitivity (m, 8) of the model response (rad) to the initial state [e0, ed0]."""
+    base = simulate_response(window, impedance).ravel()
+    G = np.empty((base.size, 8))
+    for k in range(8):
+        h = 1e-6
+        e0, ed0 = window.e0.copy(), window.ed0.copy()
+        (e0 if k < 4 else ed0)[k % 4] += h
+        shifted = replace(window, e0=e0, ed0=ed0)
+        G[:, k] = (simulate_response(shifted, impedance).ravel() - base) / h
+    return G
 
 
 def _lm_multistart(ev: _Evaluator, starts: np.ndarray, max_iter: int, tol: float, merge_tol: float):
@@ -550,13 +579,17 @@ def identify_impedance(
     # how many starts reached the best optimum (same cost within tolerance)
     at_best = np.sum(0.5 * costs <= 0.5 * cost * (1 + 1e-3) + 1e-14) if cost > 0 else np.sum(costs <= 1e-14)
     n_at_best = int(max(at_best, 1))
-    # confidence intervals and correlations from the Jacobian
+    # confidence intervals and correlations from the Jacobian: white residual
+    # noise plus the uncertainty of the initial state, propagated (sandwich)
     m = r.size
     dof = max(m - 6, 1)
     s2 = cost / dof
     JTJ = J.T @ J
+    A = np.linalg.pinv(JTJ, rcond=1e-13)
+    G = _initial_state_jacobian(window, estimate)
+    JG = J.T @ G
     with np.errstate(divide="ignore", invalid="ignore"):
-        cov = s2 * np.linalg.pinv(JTJ, rcond=1e-13)
+        cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
         sd = np.sqrt(np.clip(np.diag(cov), 0, None))
         corr = cov / np.outer(sd, sd)
     rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
