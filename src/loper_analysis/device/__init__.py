@@ -1,0 +1,1 @@
+"""The LOPER device: controller simulation (:mod:`.controller`) and device-test analysis (:mod:`.analysis`)."""

@@ -1,0 +1,1 @@
+"""Readers and writers of the lab's file formats (robot logs; C3D/TRC later)."""
