@@ -1,0 +1,660 @@
+"""The robot (LOPER) log: one file format, its reader and its writer.
+
+A robot log is the 1000 Hz record of the treadmill robot, one file per
+subject and trial at ``data/raw/{subject}/{trial}.loper.tsv``
+(:func:`robot_log_path`). The format, ``loper-log 1``, is UTF-8 text with
+tab-separated values::
+
+    # format: loper-log 1
+    # sample_rate_hz: 1000
+    # trial: steps40                 <- optional free keys, '# key: value'
+    # clock: robot
+    time_s<TAB>force_desired_n<TAB>force_measured_n<TAB>motor_angle_rad<TAB>...
+    0<TAB>0<TAB>0.0312<TAB>0.00104<TAB>...
+    0.001<TAB>...
+
+* Header comment lines come first, each ``# key: value``. ``format`` (exactly
+  ``loper-log 1``) and ``sample_rate_hz`` are required; any other key is free
+  metadata, read back as a string.
+* Then one row of column names, which carry their units (:data:`UNITS`):
+  exactly :data:`COLUMNS`, in that order; missing, unknown, duplicated or
+  reordered columns are refused.
+* Then one data row per sample: ``time_s`` strictly increasing with steps of
+  ``1 / sample_rate_hz`` (each within 1 %); ``force_desired_n`` and
+  ``force_measured_n`` finite; ``motor_angle_rad``, ``motor_velocity_rad_s``
+  and ``sync_v`` may be ``nan`` (missing) but not infinite; ``perturbation``
+  0 or 1; ``safety_state`` one of the codes of :data:`SAFETY_STATES`. At
+  least 2 samples.
+
+The writer prints ``time_s`` with ``%.15g``, the other real-valued channels
+with ``%.9g`` and the two integer columns as integers, so the same data give
+the same bytes. Every check of the reader is applied to the frame before
+anything is written (one shared validation), so nothing invalid is written,
+and writing is atomic (a temporary file in the target directory, then
+:func:`os.replace`).
+
+Every problem raises :class:`~loper_analysis.errors.LoperInputError` whose
+message names the file, and where applicable the column and the sample
+(0-based row index of the data, with its time and, for text files, its line
+number).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import numbers
+import os
+import re
+import secrets
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import LoperInputError
+
+__all__ = [
+    "FORMAT_NAME",
+    "COLUMNS",
+    "UNITS",
+    "SAFETY_STATES",
+    "TIME_STEP_TOLERANCE",
+    "robot_log_path",
+    "read_robot_log",
+    "read_robot_log_mat",
+    "write_robot_log",
+]
+
+#: Value of the required ``# format:`` header line.
+FORMAT_NAME = "loper-log 1"
+
+#: The columns of a robot log, in file order.
+COLUMNS: tuple[str, ...] = (
+    "time_s",
+    "force_desired_n",
+    "force_measured_n",
+    "motor_angle_rad",
+    "motor_velocity_rad_s",
+    "sync_v",
+    "perturbation",
+    "safety_state",
+)
+
+#: Unit of each column ("1": dimensionless flag or code).
+UNITS: dict[str, str] = {
+    "time_s": "s",  # robot clock
+    "force_desired_n": "N",  # desired interaction force
+    "force_measured_n": "N",  # load cell
+    "motor_angle_rad": "rad",
+    "motor_velocity_rad_s": "rad/s",
+    "sync_v": "V",  # sync signal sent to the motion-capture analog input
+    "perturbation": "1",  # 0/1 flag
+    "safety_state": "1",  # integer code, see SAFETY_STATES
+}
+
+#: Safety-state codes of the ``safety_state`` column.
+SAFETY_STATES: dict[int, str] = {
+    0: "ok",
+    1: "limited",  # position/velocity/acceleration (PVA) limiter active
+    2: "motor_off_position",
+    3: "motor_off_velocity",
+    4: "motor_off_torque",
+    5: "servo_off_position",
+}
+
+#: Largest allowed relative deviation of a time step from ``1 / sample_rate_hz``.
+TIME_STEP_TOLERANCE = 0.01
+
+_INT_COLUMNS = ("perturbation", "safety_state")
+_FLOAT_COLUMNS = tuple(c for c in COLUMNS if c not in _INT_COLUMNS)
+_FORCE_COLUMNS = ("force_desired_n", "force_measured_n")
+_MAY_BE_NAN = ("motor_angle_rad", "motor_velocity_rad_s", "sync_v")
+#: Optional channels of a .mat export (may be mapped to None -> zeros).
+_MAT_OPTIONAL = ("sync_v", "perturbation", "safety_state")
+_RESERVED_KEYS = ("format", "sample_rate_hz")
+_KEY_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
+_TIME_FORMAT = "%.15g"
+_VALUE_FORMAT = "%.9g"
+
+
+# ---------------------------------------------------------------------------
+# paths
+
+
+def robot_log_path(raw_dir: str | os.PathLike, subject: str, trial: str) -> Path:
+    """Path of a trial's robot log: ``raw_dir/subject/trial.loper.tsv``.
+
+    Parameters
+    ----------
+    raw_dir : str or path-like
+        Directory of the raw data (``data/raw``).
+    subject, trial : str
+        Subject and trial identifiers; each a single non-empty path component.
+
+    Returns
+    -------
+    pathlib.Path
+    """
+    for name, value in (("subject", subject), ("trial", trial)):
+        if not isinstance(value, str) or value in ("", ".", "..") or "/" in value or os.sep in value:
+            raise LoperInputError(f"{name} must be a non-empty file name without path separators, got {value!r}")
+    return Path(raw_dir) / subject / f"{trial}.loper.tsv"
+
+
+# ---------------------------------------------------------------------------
+# shared validation
+
+
+def _where(source: str, column: str | None, sample: int, time: float | None, line: int | None = None) -> str:
+    """Message prefix naming file, column and sample."""
+    parts = [f"sample {sample}"]
+    detail = []
+    if time is not None:
+        detail.append(f"t = {time:.9g} s")
+    if line is not None:
+        detail.append(f"line {line}")
+    if detail:
+        parts[0] += f" ({', '.join(detail)})"
+    if column is not None:
+        parts.insert(0, f"column '{column}'")
+    return f"{source}: {', '.join(parts)}"
+
+
+def _percent(value: float) -> str:
+    """Signed, 3 significant digits, no exponent (e.g. +20, -50, +99900)."""
+    return np.format_float_positional(value, precision=3, fractional=False, trim="-", sign=True)
+
+
+def _check_sample_rate(value, what: str) -> float:
+    try:
+        rate = float(value)
+    except (TypeError, ValueError):
+        raise LoperInputError(f"{what} must be a positive number, got {value!r}") from None
+    if not math.isfinite(rate) or rate <= 0:
+        raise LoperInputError(f"{what} must be a positive number, got {value!r}")
+    return rate
+
+
+def _as_float(series: pd.Series, column: str, source: str, time: np.ndarray | None) -> np.ndarray:
+    """The column as float64; refuses non-numeric cells, naming the first."""
+    if pd.api.types.is_numeric_dtype(series.dtype) and not pd.api.types.is_complex_dtype(series.dtype):
+        return series.to_numpy(dtype=np.float64, na_value=np.nan)
+    values = series.to_numpy(dtype=object)
+    out = np.empty(len(values), dtype=np.float64)
+    for i, v in enumerate(values):
+        if isinstance(v, numbers.Real) and not isinstance(v, (str, bytes)):
+            out[i] = float(v)
+        else:
+            t = None if time is None else float(time[i])
+            raise LoperInputError(f"{_where(source, column, i, t)}: non-numeric value {v!r}")
+    return out
+
+
+def _validate(
+    frame: pd.DataFrame, sample_rate_hz: float, source: str, first_line: int | None = None
+) -> pd.DataFrame:
+    """Check a robot-log frame; return it normalised.
+
+    The one validation of the format, shared by the TSV reader, the .mat
+    reader and the writer.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        Exactly the columns :data:`COLUMNS` (any order), one row per sample.
+    sample_rate_hz : float
+        Sample rate (Hz) the time steps must match.
+    source : str
+        What to name in messages (the file).
+    first_line : int, optional
+        Line of the text file holding sample 0 (1-based), to name the line
+        of a bad sample in messages.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Shape (n, 8): columns in :data:`COLUMNS` order, float64 except
+        ``perturbation`` and ``safety_state`` (int64), index ``0..n-1``.
+    """
+    if not isinstance(frame, pd.DataFrame):
+        raise LoperInputError(f"{source}: a robot log must be a pandas DataFrame, got {type(frame).__name__}")
+    names = [str(c) for c in frame.columns]
+    duplicated = sorted({c for c in names if names.count(c) > 1})
+    if duplicated:
+        raise LoperInputError(f"{source}: duplicated column(s) {', '.join(duplicated)}")
+    missing = [c for c in COLUMNS if c not in names]
+    if missing:
+        raise LoperInputError(
+            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}"
+        )
+    unknown = [c for c in names if c not in COLUMNS]
+    if unknown:
+        raise LoperInputError(
+            f"{source}: unknown column(s) {', '.join(unknown)}; a robot log has exactly the columns "
+            f"{', '.join(COLUMNS)}"
+        )
+    rate = _check_sample_rate(sample_rate_hz, f"{source}: sample_rate_hz")
+    n = len(frame)
+    if n < 2:
+        raise LoperInputError(f"{source}: {n} sample(s); a robot log needs at least 2")
+
+    frame = frame.set_axis(names, axis=1)
+    time = _as_float(frame["time_s"], "time_s", source, None)
+    data = {"time_s": time}
+    for col in COLUMNS[1:]:
+        data[col] = _as_float(frame[col], col, source, time)
+
+    def fail(column: str, i: int, problem: str):
+        line = None if first_line is None else first_line + int(i)
+        raise LoperInputError(f"{_where(source, column, int(i), float(time[i]), line)}: {problem}")
+
+    bad = np.flatnonzero(~np.isfinite(time))
+    if bad.size:
+        fail("time_s", bad[0], f"non-finite time {time[bad[0]]}")
+    step = np.diff(time)
+    bad = np.flatnonzero(step <= 0)
+    if bad.size:
+        i = bad[0] + 1
+        fail("time_s", i, f"time not strictly increasing (sample {i - 1} is at t = {time[i - 1]:.9g} s)")
+    deviation = step * rate - 1.0
+    bad = np.flatnonzero(np.abs(deviation) > TIME_STEP_TOLERANCE)
+    if bad.size:
+        i = bad[0] + 1
+        fail(
+            "time_s",
+            i,
+            f"time step {1e3 * step[i - 1]:.6g} ms since sample {i - 1} deviates {_percent(100 * deviation[i - 1])} % "
+            f"from 1/sample_rate_hz = {1e3 / rate:.6g} ms (tolerance {100 * TIME_STEP_TOLERANCE:g} %)",
+        )
+    for col in _FORCE_COLUMNS:
+        bad = np.flatnonzero(~np.isfinite(data[col]))
+        if bad.size:
+            fail(col, bad[0], f"non-finite force {data[col][bad[0]]}")
+    for col in _MAY_BE_NAN:
+        bad = np.flatnonzero(np.isinf(data[col]))
+        if bad.size:
+            fail(col, bad[0], f"infinite value {data[col][bad[0]]} (missing samples are nan)")
+    pert = data["perturbation"]
+    bad = np.flatnonzero((pert != 0) & (pert != 1))
+    if bad.size:
+        fail("perturbation", bad[0], f"value {pert[bad[0]]:g} is not 0 or 1")
+    safety = data["safety_state"]
+    known = np.array(sorted(SAFETY_STATES), dtype=np.float64)
+    bad = np.flatnonzero(~np.isin(safety, known))
+    if bad.size:
+        codes = ", ".join(f"{k} {v}" for k, v in SAFETY_STATES.items())
+        fail("safety_state", bad[0], f"unknown safety state {safety[bad[0]]:g} (codes: {codes})")
+
+    out = pd.DataFrame({c: data[c] for c in _FLOAT_COLUMNS}, index=pd.RangeIndex(n))
+    for col in _INT_COLUMNS:
+        out[col] = data[col].astype(np.int64)
+    return out[list(COLUMNS)]
+
+
+# ---------------------------------------------------------------------------
+# TSV
+
+
+def _format_rate(rate: float) -> str:
+    return _TIME_FORMAT % rate
+
+
+def write_robot_log(
+    path: str | os.PathLike,
+    frame: pd.DataFrame,
+    sample_rate_hz: float = 1000.0,
+    metadata: dict | None = None,
+) -> None:
+    """Write a robot log (format ``loper-log 1``) atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Target file (``*.loper.tsv``); its directory must exist. An existing
+        file is replaced.
+    frame : pandas.DataFrame
+        Shape (n, 8), n >= 2: exactly the columns :data:`COLUMNS` (any order;
+        written in :data:`COLUMNS` order), units as in :data:`UNITS`. It must
+        pass every check of :func:`read_robot_log`; the index is ignored.
+    sample_rate_hz : float, default 1000.0
+        Sample rate (Hz), written as the ``sample_rate_hz`` header line; the
+        steps of ``time_s`` must match it within 1 %.
+    metadata : dict, optional
+        Free header keys, written in the given order as ``# key: value``.
+        Keys match ``[A-Za-z_][A-Za-z0-9_.-]*``; values are written with
+        ``str`` and must be single-line without leading or trailing
+        whitespace. ``format`` and ``sample_rate_hz`` may be present (e.g. the
+        metadata returned by :func:`read_robot_log`) only if they agree with
+        the log.
+
+    Raises
+    ------
+    LoperInputError
+        On invalid data or metadata; then nothing is written (an existing
+        file is left as it was).
+    """
+    path = Path(path)
+    source = f"refusing to write {path}"
+    rate = _check_sample_rate(sample_rate_hz, f"{source}: sample_rate_hz")
+    clean = _validate(frame, rate, source)
+    header = [f"# format: {FORMAT_NAME}", f"# sample_rate_hz: {_format_rate(rate)}"]
+    if metadata is not None and not isinstance(metadata, Mapping):
+        raise LoperInputError(f"{source}: metadata must be a dict of key -> value, got {type(metadata).__name__}")
+    for key, value in (metadata or {}).items():
+        if not isinstance(key, str) or not _KEY_PATTERN.match(key):
+            raise LoperInputError(
+                f"{source}: metadata key {key!r} must match [A-Za-z_][A-Za-z0-9_.-]*"
+            )
+        text = str(value)
+        if key == "format":
+            if text != FORMAT_NAME:
+                raise LoperInputError(f"{source}: metadata format {text!r} is not {FORMAT_NAME!r}")
+            continue
+        if key == "sample_rate_hz":
+            try:
+                agrees = math.isclose(float(value), rate, rel_tol=1e-12)
+            except (TypeError, ValueError):
+                agrees = False
+            if not agrees:
+                raise LoperInputError(
+                    f"{source}: metadata sample_rate_hz {value!r} disagrees with sample_rate_hz {rate:g}"
+                )
+            continue
+        if "\n" in text or "\r" in text or text != text.strip():
+            raise LoperInputError(
+                f"{source}: metadata value of {key!r} must be one line without leading or trailing "
+                f"whitespace, got {text!r}"
+            )
+        header.append(f"# {key}: {text}")
+    header.append("\t".join(COLUMNS))
+
+    cells = []
+    for col in COLUMNS:
+        values = clean[col].tolist()
+        if col in _INT_COLUMNS:
+            cells.append([str(v) for v in values])
+        else:
+            fmt = _TIME_FORMAT if col == "time_s" else _VALUE_FORMAT
+            cells.append([fmt % v for v in values])
+    text = "\n".join(header) + "\n" + "\n".join("\t".join(row) for row in zip(*cells)) + "\n"
+    _write_atomic(path, text.encode("utf-8"))
+
+
+def _write_atomic(path: Path, data: bytes) -> None:
+    """Write to a temporary file beside ``path``, then rename it over ``path``."""
+    directory = path.parent
+    for _ in range(100):
+        tmp = directory / f".{path.name}.{secrets.token_hex(6)}.tmp"
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # mode honours the umask
+        except FileExistsError:
+            continue
+        break
+    else:  # pragma: no cover - 100 collisions of 48 random bits
+        raise OSError(f"cannot create a temporary file in {directory}")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        tmp.unlink(missing_ok=True)
+        raise
+
+
+def _parse_floats(cells: list[str], column: str, source: str, first_line: int, time: np.ndarray | None):
+    try:
+        return np.array(cells, dtype=np.float64)
+    except ValueError:
+        pass
+    out = np.empty(len(cells), dtype=np.float64)
+    for i, cell in enumerate(cells):
+        try:
+            out[i] = float(cell)
+        except ValueError:
+            t = None if time is None else float(time[i])
+            raise LoperInputError(
+                f"{_where(source, column, i, t, first_line + i)}: non-numeric value {cell!r}"
+            ) from None
+    return out  # pragma: no cover - numpy and float() disagree
+
+
+def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None) -> tuple[pd.DataFrame, dict]:
+    """Read and check a robot log (format ``loper-log 1``).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``*.loper.tsv`` file.
+    sample_rate_hz : float, optional
+        Expected sample rate (Hz); if given, the file's ``sample_rate_hz``
+        header must equal it.
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        Shape (n, 8), n >= 2: columns :data:`COLUMNS` (units :data:`UNITS`),
+        float64 except ``perturbation`` and ``safety_state`` (int64); index
+        ``0..n-1`` is the sample number.
+    metadata : dict
+        The header in file order: ``format`` (str), ``sample_rate_hz``
+        (float, Hz) and every free key (str values).
+
+    Raises
+    ------
+    LoperInputError
+        If the file cannot be read or violates the format; the message names
+        the file and, where applicable, the column and the sample (0-based
+        data row, its time and its line in the file).
+    """
+    path = Path(path)
+    source = str(path)
+    expected = None if sample_rate_hz is None else _check_sample_rate(sample_rate_hz, "sample_rate_hz")
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as exc:
+        raise LoperInputError(f"{source}: not a loper log: not UTF-8 text ({exc})") from exc
+    except OSError as exc:
+        raise LoperInputError(f"{source}: cannot read robot log ({exc})") from exc
+    lines = text.splitlines()
+    while lines and not lines[-1].strip():
+        lines.pop()
+
+    meta: dict = {}
+    k = 0
+    while k < len(lines) and lines[k].startswith("#"):
+        key, sep, value = lines[k][1:].partition(":")
+        key, value = key.strip(), value.strip()
+        if not sep or not _KEY_PATTERN.match(key):
+            if "format" not in meta:
+                break  # reported below as not a loper log
+            raise LoperInputError(f"{source}: line {k + 1}: header line must be '# key: value', found {lines[k]!r}")
+        if key in meta:
+            raise LoperInputError(f"{source}: line {k + 1}: header key {key!r} repeated")
+        meta[key] = value
+        k += 1
+    if "format" not in meta:
+        raise LoperInputError(f"{source}: not a loper log: no '# format: {FORMAT_NAME}' header line")
+    if meta["format"] != FORMAT_NAME:
+        raise LoperInputError(f"{source}: unsupported format {meta['format']!r}; this reader reads {FORMAT_NAME!r}")
+    if "sample_rate_hz" not in meta:
+        raise LoperInputError(f"{source}: no '# sample_rate_hz: ...' header line")
+    rate = _check_sample_rate(meta["sample_rate_hz"], f"{source}: header sample_rate_hz")
+    meta["sample_rate_hz"] = rate
+    if expected is not None and not math.isclose(rate, expected, rel_tol=1e-12):
+        raise LoperInputError(
+            f"{source}: sample_rate_hz in the file is {rate:g} Hz but {expected:g} Hz was declared"
+        )
+
+    if k >= len(lines):
+        raise LoperInputError(f"{source}: no column header row after the '#' header lines")
+    names = [c.strip() for c in lines[k].split("\t")]
+    header_line = k + 1
+    duplicated = sorted({c for c in names if names.count(c) > 1})
+    if duplicated:
+        raise LoperInputError(f"{source}: line {header_line}: duplicated column(s) {', '.join(duplicated)}")
+    missing = [c for c in COLUMNS if c not in names]
+    if missing:
+        raise LoperInputError(
+            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}"
+        )
+    unknown = [c or "''" for c in names if c not in COLUMNS]
+    if unknown:
+        raise LoperInputError(
+            f"{source}: unknown column(s) {', '.join(unknown)}; a robot log has exactly the columns "
+            f"{', '.join(COLUMNS)}"
+        )
+    if tuple(names) != COLUMNS:
+        raise LoperInputError(
+            f"{source}: line {header_line}: columns in the order {', '.join(names)}; a robot log has them in "
+            f"the order {', '.join(COLUMNS)}"
+        )
+
+    rows = lines[k + 1:]
+    first_line = header_line + 1
+    data = _parse_rows(rows, source, first_line)
+    frame = _validate(pd.DataFrame(data), rate, source, first_line)
+    return frame, meta
+
+
+def _parse_rows(rows: list[str], source: str, first_line: int) -> dict[str, np.ndarray]:
+    """Data rows -> one float64 array per column; names the first malformed row or cell."""
+    width = len(COLUMNS)
+    if rows:  # fast path (C parser); any doubt -> the checking path below
+        try:
+            table = np.loadtxt(io.StringIO("\n".join(rows)), delimiter="\t", dtype=np.float64, ndmin=2,
+                               comments=None)
+        except ValueError:
+            table = None
+        if table is not None and table.shape == (len(rows), width):
+            return {col: np.ascontiguousarray(table[:, j]) for j, col in enumerate(COLUMNS)}
+    split = [row.split("\t") for row in rows]
+    for i, fields in enumerate(split):
+        if len(fields) != width:
+            raise LoperInputError(
+                f"{_where(source, None, i, None, first_line + i)}: {len(fields)} field(s), expected {width} "
+                f"(one per column)"
+            )
+    columns = list(zip(*split)) if split else [()] * width
+    time = _parse_floats(list(columns[0]), "time_s", source, first_line, None)
+    data = {"time_s": time}
+    for j, col in enumerate(COLUMNS[1:], start=1):
+        data[col] = _parse_floats(list(columns[j]), col, source, first_line, time)
+    return data
+
+
+# ---------------------------------------------------------------------------
+# MATLAB export
+
+
+def read_robot_log_mat(
+    path: str | os.PathLike,
+    column_map: Mapping[str, str | None],
+    sample_rate_hz: float,
+    time_scale: float = 1.0,
+) -> tuple[pd.DataFrame, dict]:
+    """Read a robot log exported from MATLAB (.mat, version 4 to 7.2).
+
+    Parameters
+    ----------
+    path : str or path-like
+        The .mat file (read with :func:`scipy.io.loadmat`).
+    column_map : mapping of str to str or None
+        Our column (:data:`COLUMNS`) -> name of the variable in the .mat.
+        Every column must be mapped, except that ``time_s`` may be absent or
+        None (then ``time_s = arange(n) / sample_rate_hz``) and ``sync_v``,
+        ``perturbation`` and ``safety_state`` may map to None (then zeros).
+        Variables are numeric vectors of equal length n, stored as (n,),
+        (n, 1) or (1, n).
+    sample_rate_hz : float
+        Sample rate of the export (Hz).
+    time_scale : float, default 1.0
+        Factor from the time variable's unit to seconds (0.001 for ms).
+
+    Returns
+    -------
+    frame : pandas.DataFrame
+        Shape (n, 8), as from :func:`read_robot_log`.
+    metadata : dict
+        ``format``, ``sample_rate_hz`` (float, Hz) and ``source`` (the path).
+
+    Raises
+    ------
+    LoperInputError
+        On a bad map, an unreadable file, a missing or non-vector variable,
+        unequal lengths, or any check of :func:`read_robot_log`.
+    """
+    from scipy.io import loadmat
+
+    path = Path(path)
+    source = str(path)
+    rate = _check_sample_rate(sample_rate_hz, "sample_rate_hz")
+    try:
+        scale = float(time_scale)
+    except (TypeError, ValueError):
+        scale = math.nan
+    if not math.isfinite(scale) or scale <= 0:
+        raise LoperInputError(f"time_scale must be a positive number, got {time_scale!r}")
+    if not isinstance(column_map, Mapping):
+        raise LoperInputError(f"column_map must be a mapping column -> .mat variable, got {type(column_map).__name__}")
+    unknown = [str(c) for c in column_map if c not in COLUMNS]
+    if unknown:
+        raise LoperInputError(f"column_map: unknown column(s) {', '.join(unknown)}; columns are {', '.join(COLUMNS)}")
+    unmapped = [c for c in COLUMNS if c != "time_s" and c not in column_map]
+    if unmapped:
+        raise LoperInputError(f"column_map: column(s) {', '.join(unmapped)} not mapped to a .mat variable")
+    for col, var in column_map.items():
+        if var is None:
+            if col != "time_s" and col not in _MAT_OPTIONAL:
+                raise LoperInputError(
+                    f"column_map: column '{col}' must map to a .mat variable (only time_s, "
+                    f"{', '.join(_MAT_OPTIONAL)} may be None)"
+                )
+        elif not isinstance(var, str) or not var:
+            raise LoperInputError(f"column_map: variable of column '{col}' must be a name or None, got {var!r}")
+
+    try:
+        contents = loadmat(path)
+    except NotImplementedError as exc:  # MATLAB v7.3 (HDF5)
+        raise LoperInputError(f"{source}: cannot read .mat file ({exc}); save it with -v7 or older") from exc
+    except (OSError, ValueError, TypeError) as exc:
+        raise LoperInputError(f"{source}: cannot read .mat file ({exc})") from exc
+    available = sorted(k for k in contents if not k.startswith("__"))
+
+    vectors: dict[str, np.ndarray] = {}
+    for col in COLUMNS:
+        var = column_map.get(col)
+        if var is None:
+            continue
+        if var not in contents:
+            raise LoperInputError(
+                f"{source}: variable '{var}' (for column '{col}') not found; variables in the file: "
+                f"{', '.join(available) or 'none'}"
+            )
+        arr = np.asarray(contents[var])
+        if arr.ndim > 2 or (arr.ndim == 2 and min(arr.shape) > 1):
+            raise LoperInputError(
+                f"{source}: variable '{var}' (for column '{col}') has shape {arr.shape}; expected a vector "
+                f"(n,), (n, 1) or (1, n)"
+            )
+        if arr.dtype.kind not in "biuf":
+            raise LoperInputError(
+                f"{source}: variable '{var}' (for column '{col}') is not real numeric (dtype {arr.dtype})"
+            )
+        vectors[col] = arr.reshape(-1).astype(np.float64)
+    lengths = {column_map[c]: len(v) for c, v in vectors.items()}
+    if len(set(lengths.values())) > 1:
+        listed = ", ".join(f"{var} {n}" for var, n in lengths.items())
+        raise LoperInputError(f"{source}: variables have unequal lengths: {listed}")
+    n = next(iter(lengths.values()))
+    if "time_s" in vectors:
+        vectors["time_s"] = vectors["time_s"] * scale
+    else:
+        vectors["time_s"] = np.arange(n) / rate
+    for col in _MAT_OPTIONAL:
+        vectors.setdefault(col, np.zeros(n))
+    frame = _validate(pd.DataFrame({c: vectors[c] for c in COLUMNS}), rate, source)
+    return frame, {"format": FORMAT_NAME, "sample_rate_hz": rate, "source": source}
