@@ -25,6 +25,14 @@ if subjects["subject"].duplicated().any():
     dup = subjects.loc[subjects["subject"].duplicated(), "subject"].iloc[0]
     raise WorkflowError(f"{_subjects_path}: subject '{dup}' appears twice")
 
+SUBJECT_SOURCE = dict(zip(subjects["subject"], subjects["source"]))
+if config["device"]["subject"] not in SUBJECT_SOURCE:
+    raise WorkflowError(
+        f"config key 'device.subject': subject '{config['device']['subject']}' is not in {_subjects_path}"
+    )
+_synthetic = [s for s, src in SUBJECT_SOURCE.items() if src == "synthetic"]
+SYNTHETIC_PATTERN = "|".join(_synthetic) if _synthetic else "(?!)"
+
 VALIDATION_CHUNKS = [f"{i:03d}" for i in range(config["validation"]["n_chunks"])]
 
 
@@ -71,4 +79,7 @@ def all_targets() -> list[str]:
         "results/validation/errors.tsv",
         "results/validation/fits.tsv",
         "results/validation/errors.png",
+        "results/device/summary.tsv",
+        "results/device/bode.png",
+        "results/device/steps.png",
     ]

@@ -88,11 +88,13 @@ class DeviceParameters:
     """Constants of the LOPER and its controller (SI units; config key ``device``).
 
     Controller constants (I_v, B_v, K_a, c) and safety limits are the study's.
-    The black-box parts (prefilter, servo, rods/brace) were tuned so that the
-    simulated device reproduces the study's device figures on a free-hanging
-    leg (``FreeLeg()``): steady state 36.8 N for 40 N (study 36), overshoot
-    29.6 % (29-32), rise time 9.7 ms (9.7-10.3), bandwidth 38.8 Hz (39), and
-    in minimal-impedance walking RMS 1.9 N / max 4.5 N (2.0-2.1 / 4.5-4.6).
+    The black-box parts (prefilter, servo, rods/brace) were tuned (Nelder-Mead
+    on the simulated device-test trials of :mod:`.trials`, analysed like
+    recorded ones) so that the simulated device reproduces the study's device
+    figures on a free-hanging leg (``FreeLeg()``): bandwidth 38.7 Hz (study
+    39), rise time 9.9 ms (9.7-10.3), overshoot 30.5 % (29-32), steady state
+    35.2 N for 40 N (36); in minimal-impedance walking (prescribed brace
+    motion, hip +-0.3 rad) RMS 1.9 N and max 4.6 N (2.0-2.1 and 4.5-4.6).
     """
 
     sample_rate_hz: float = 1000.0
@@ -101,13 +103,13 @@ class DeviceParameters:
     lead_time_s: float = 0.017
     setpoint_weight: float = 0.5
     lever_arm_m: float = 0.7
-    prefilter_cutoff_hz: float = 39.4
-    prefilter_damping: float = 0.65
-    servo_bandwidth_hz: float = 29.4
-    servo_damping: float = 0.72
+    prefilter_cutoff_hz: float = 34.1
+    prefilter_damping: float = 0.644
+    servo_bandwidth_hz: float = 29.97
+    servo_damping: float = 0.716
     servo_delay_s: float = 0.002
     rod_stiffness_n_per_m: float = 3390.0
-    rod_damping_ns_per_m: float = 25.1
+    rod_damping_ns_per_m: float = 26.05
     motor_inertia_kg_m2: float = 0.05
     motor_friction_nms_per_rad: float = 0.5
     loadcell_noise_sd_n: float = 0.2

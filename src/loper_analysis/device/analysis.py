@@ -1,0 +1,263 @@
+"""Device-performance analysis of the LOPER force controller (DESIGN.md section 3).
+
+* Frequency response ``H = S_{Fm,Fd} / S_{Fd,Fd}`` (Welch averaging, Hann
+  window), coherence and the -3 dB bandwidth relative to the low-frequency gain.
+* Step responses: rising edges of the desired force, averaging over
+  repetitions, 10-90 % rise time, overshoot relative to the steady state.
+
+Signals are 1-D arrays of force in N sampled at ``sample_rate_hz``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy.signal import csd, coherence, welch
+
+from ..errors import LoperInputError
+
+__all__ = [
+    "frequency_response",
+    "bandwidth_hz",
+    "step_onsets",
+    "average_step",
+    "step_metrics",
+    "step_averages",
+    "step_table",
+]
+
+
+def _signal(name: str, x, min_len: int = 2) -> np.ndarray:
+    a = np.asarray(x, dtype=float)
+    if a.ndim != 1:
+        raise LoperInputError(f"{name} must be 1-D, got shape {a.shape}")
+    if a.size < min_len:
+        raise LoperInputError(f"{name} needs >= {min_len} samples, got {a.size}")
+    bad = np.flatnonzero(~np.isfinite(a))
+    if bad.size:
+        raise LoperInputError(f"{name} is not finite at sample {bad[0]}: {a[bad[0]]}")
+    return a
+
+
+def _rate(sample_rate_hz: float) -> float:
+    if not np.isfinite(sample_rate_hz) or sample_rate_hz <= 0:
+        raise LoperInputError(f"sample_rate_hz must be positive, got {sample_rate_hz}")
+    return float(sample_rate_hz)
+
+
+def frequency_response(
+    desired_n, measured_n, sample_rate_hz: float, window_samples: int = 5000, overlap_samples: int = 50
+) -> pd.DataFrame:
+    """FRF from desired to measured force: columns frequency_hz, gain (N/N), phase_deg, coherence."""
+    fs = _rate(sample_rate_hz)
+    if int(window_samples) != window_samples or window_samples < 8:
+        raise LoperInputError(f"window_samples must be an integer >= 8, got {window_samples}")
+    if int(overlap_samples) != overlap_samples or not 0 <= overlap_samples < window_samples:
+        raise LoperInputError(f"overlap_samples must lie in 0 .. window_samples - 1, got {overlap_samples}")
+    fd = _signal("desired_n", desired_n, int(window_samples))
+    fm = _signal("measured_n", measured_n, int(window_samples))
+    if fd.size != fm.size:
+        raise LoperInputError(f"desired_n ({fd.size}) and measured_n ({fm.size}) differ in length")
+    kw = dict(fs=fs, window="hann", nperseg=int(window_samples), noverlap=int(overlap_samples), detrend="constant")
+    f, s_dm = csd(fd, fm, **kw)  # scipy: conj(FFT(fd)) * FFT(fm)  ->  S_{Fm,Fd} in our notation
+    _, s_dd = welch(fd, **kw)
+    _, coh = coherence(fd, fm, **kw)
+    if np.any(s_dd[1:] <= 0):
+        raise LoperInputError("desired_n has no power at some frequencies: is it a broadband signal?")
+    h = s_dm[1:] / s_dd[1:]
+    return pd.DataFrame({
+        "frequency_hz": f[1:],
+        "gain": np.abs(h),
+        "phase_deg": np.degrees(np.unwrap(np.angle(h))),
+        "coherence": coh[1:],
+    })
+
+
+def bandwidth_hz(
+    frequency_hz,
+    gain,
+    reference_band_hz: tuple[float, float] = (0.5, 2.0),
+    drop_db: float = 3.0,
+    min_coherence: float | None = None,
+    coherence=None,
+) -> float:
+    """Lowest frequency above the reference band where the gain is ``drop_db`` below the reference.
+
+    The reference is the mean gain in ``reference_band_hz``; the crossing is
+    interpolated linearly in log-frequency (gain in dB).
+    """
+    f = _signal("frequency_hz", frequency_hz)
+    g = _signal("gain", gain)
+    if f.size != g.size:
+        raise LoperInputError(f"frequency_hz ({f.size}) and gain ({g.size}) differ in length")
+    lo, hi = reference_band_hz
+    keep = np.ones(f.size, bool)
+    if min_coherence is not None:
+        c = _signal("coherence", coherence)
+        keep = c >= min_coherence
+    band = keep & (f >= lo) & (f <= hi)
+    if not band.any():
+        raise LoperInputError(f"no frequencies in the reference band {lo} .. {hi} Hz")
+    ref_db = 20 * np.log10(np.mean(g[band]))
+    sel = keep & (f > hi) & (g > 0)
+    fs_, db = f[sel], 20 * np.log10(g[sel])
+    below = np.flatnonzero(db <= ref_db - drop_db)
+    if below.size == 0:
+        raise LoperInputError(
+            f"the gain never drops {drop_db} dB below {ref_db:.2f} dB up to {f.max():.1f} Hz"
+        )
+    i = below[0]
+    if i == 0:
+        return float(fs_[0])
+    x0, x1 = np.log(fs_[i - 1]), np.log(fs_[i])
+    y0, y1 = db[i - 1], db[i]
+    target = ref_db - drop_db
+    return float(np.exp(x0 + (target - y0) * (x1 - x0) / (y1 - y0)))
+
+
+def step_onsets(desired_n, sample_rate_hz: float, min_step_n: float = 5.0, min_interval_s: float = 0.2) -> np.ndarray:
+    """Sample indices of rising edges (>= ``min_step_n`` within one sample) of the desired force."""
+    fs = _rate(sample_rate_hz)
+    fd = _signal("desired_n", desired_n)
+    rise = np.flatnonzero(np.diff(fd) >= min_step_n) + 1
+    onsets: list[int] = []
+    for i in rise:
+        if not onsets or i - onsets[-1] >= min_interval_s * fs:
+            onsets.append(int(i))
+    if not onsets:
+        raise LoperInputError(f"no step found: the desired force never rises by {min_step_n} N within one sample")
+    return np.array(onsets)
+
+
+def average_step(
+    desired_n, measured_n, sample_rate_hz: float, onsets, before_s: float = 0.05, after_s: float = 0.3
+) -> pd.DataFrame:
+    """Mean (and SD) over repetitions of the responses around ``onsets`` (baseline removed)."""
+    fs = _rate(sample_rate_hz)
+    fd = _signal("desired_n", desired_n)
+    fm = _signal("measured_n", measured_n)
+    if fd.size != fm.size:
+        raise LoperInputError(f"desired_n ({fd.size}) and measured_n ({fm.size}) differ in length")
+    nb, na = int(round(before_s * fs)), int(round(after_s * fs))
+    if nb < 1 or na < 2:
+        raise LoperInputError(f"before_s and after_s must hold samples, got {before_s}, {after_s}")
+    on = np.asarray(onsets, dtype=int)
+    if on.size == 0:
+        raise LoperInputError("no onsets to average")
+    d, m = [], []
+    for i in on:
+        if i - nb < 0 or i + na > fd.size:
+            raise LoperInputError(
+                f"step at sample {i}: window -{before_s} .. +{after_s} s leaves the signal (0 .. {fd.size - 1})"
+            )
+        seg_d, seg_m = fd[i - nb : i + na], fm[i - nb : i + na]
+        d.append(seg_d - seg_d[:nb].mean())
+        m.append(seg_m - seg_m[:nb].mean())
+    d, m = np.array(d), np.array(m)
+    return pd.DataFrame({
+        "time_s": (np.arange(-nb, na)) / fs,
+        "desired_n": d.mean(axis=0),
+        "measured_n": m.mean(axis=0),
+        "measured_sd_n": m.std(axis=0, ddof=1) if len(m) > 1 else np.zeros(nb + na),
+    })
+
+
+def _first_crossing(t: np.ndarray, y: np.ndarray, level: float) -> float:
+    above = np.flatnonzero(y >= level)
+    if above.size == 0:
+        raise LoperInputError(f"the response never reaches {level:.3g} N")
+    i = above[0]
+    if i == 0:
+        return float(t[0])
+    return float(t[i - 1] + (level - y[i - 1]) * (t[i] - t[i - 1]) / (y[i] - y[i - 1]))
+
+
+def step_metrics(time_s, response_n, target_n: float, steady_window_s: tuple[float, float] = (0.15, 0.3)) -> dict:
+    """Rise time (10-90 % of steady state, ms), overshoot (%), steady state, peak of one step response."""
+    t = _signal("time_s", time_s)
+    y = _signal("response_n", response_n)
+    if t.size != y.size:
+        raise LoperInputError(f"time_s ({t.size}) and response_n ({y.size}) differ in length")
+    w = (t >= steady_window_s[0]) & (t <= steady_window_s[1])
+    if not w.any():
+        raise LoperInputError(f"steady_window_s {steady_window_s} holds no samples of time_s ({t[0]} .. {t[-1]} s)")
+    ss = float(np.mean(y[w]))
+    if ss <= 0:
+        raise LoperInputError(f"steady state {ss:.3g} N is not positive: not a rising step")
+    after = t >= 0
+    ta, ya = t[after], y[after]
+    t10 = _first_crossing(ta, ya, 0.1 * ss)
+    t90 = _first_crossing(ta, ya, 0.9 * ss)
+    k = int(np.argmax(ya))
+    return {
+        "rise_time_ms": 1e3 * (t90 - t10),
+        "overshoot_pct": 100.0 * (ya[k] - ss) / ss,
+        "steady_state_n": ss,
+        "target_n": float(target_n),
+        "peak_n": float(ya[k]),
+        "peak_time_ms": 1e3 * float(ta[k]),
+    }
+
+
+def step_averages(
+    desired_n,
+    measured_n,
+    sample_rate_hz: float,
+    amplitudes_n: tuple[float, ...] = (20.0, 40.0, 60.0),
+    before_s: float = 0.05,
+    after_s: float = 0.3,
+    min_step_n: float = 5.0,
+) -> pd.DataFrame:
+    """Averaged step responses per amplitude (columns of :func:`average_step` plus
+    ``amplitude_n`` and ``n_repetitions``); every step is matched to the nearest
+    amplitude and refused when more than 20 % away from all."""
+    fd = _signal("desired_n", desired_n)
+    onsets = step_onsets(fd, sample_rate_hz, min_step_n=min_step_n)
+    heights = fd[onsets] - fd[np.maximum(onsets - 1, 0)]
+    amps = np.asarray(amplitudes_n, dtype=float)
+    nearest = np.argmin(np.abs(heights[:, None] - amps[None, :]), axis=1)
+    far = np.abs(heights - amps[nearest]) > 0.2 * amps[nearest]
+    if far.any():
+        i = int(np.flatnonzero(far)[0])
+        raise LoperInputError(
+            f"step at sample {onsets[i]} has height {heights[i]:.3g} N, more than 20 % from every amplitude {amps.tolist()}"
+        )
+    frames = []
+    for j, a in enumerate(amps):
+        sel = onsets[nearest == j]
+        if sel.size == 0:
+            raise LoperInputError(f"no step of {a} N found")
+        avg = average_step(fd, measured_n, sample_rate_hz, sel, before_s, after_s)
+        frames.append(avg.assign(amplitude_n=a, n_repetitions=int(sel.size)))
+    return pd.concat(frames, ignore_index=True)
+
+
+def step_table(
+    desired_n,
+    measured_n,
+    sample_rate_hz: float,
+    amplitudes_n: tuple[float, ...] = (20.0, 40.0, 60.0),
+    before_s: float = 0.05,
+    after_s: float = 0.3,
+    steady_window_s: tuple[float, float] = (0.15, 0.3),
+    min_step_n: float = 5.0,
+    averages: pd.DataFrame | None = None,
+) -> pd.DataFrame:
+    """One row per amplitude: amplitude_n, n_repetitions, rise_time_ms, overshoot_pct, steady_state_n, peak_n.
+
+    ``averages`` from :func:`step_averages` may be passed to avoid recomputing them.
+    """
+    if averages is None:
+        averages = step_averages(desired_n, measured_n, sample_rate_hz, amplitudes_n, before_s, after_s, min_step_n)
+    rows = []
+    for a, avg in averages.groupby("amplitude_n", sort=True):
+        m = step_metrics(avg["time_s"].to_numpy(), avg["measured_n"].to_numpy(), a, steady_window_s)
+        rows.append({
+            "amplitude_n": a,
+            "n_repetitions": int(avg["n_repetitions"].iloc[0]),
+            "rise_time_ms": m["rise_time_ms"],
+            "overshoot_pct": m["overshoot_pct"],
+            "steady_state_n": m["steady_state_n"],
+            "peak_n": m["peak_n"],
+        })
+    return pd.DataFrame(rows)

@@ -1,0 +1,126 @@
+# LOPER device tests: simulated logs for a synthetic device subject, FRF and step analysis from disk.
+
+DEVICE = config["device"]
+DEVICE_SUBJECT = DEVICE["subject"]
+DEVICE_RATE_HZ = DEVICE["parameters"]["sample_rate_hz"]
+
+
+def device_log(trial):
+    """Robot log of a device trial: generated (synthetic), converted from .mat, or as recorded."""
+    raw = Path("data/raw") / DEVICE_SUBJECT
+    if SUBJECT_SOURCE[DEVICE_SUBJECT] == "recorded" and (raw / f"{trial}.mat").exists():
+        return f"results/device/{DEVICE_SUBJECT}/{trial}.loper.tsv"
+    return str(raw / f"{trial}.loper.tsv")
+
+
+rule device_trial:
+    output:
+        "data/raw/{subject}/{trial}.loper.tsv",
+    wildcard_constraints:
+        subject=SYNTHETIC_PATTERN,
+        trial="device-frf|device-steps",
+    params:
+        device=DEVICE["parameters"],
+        leg=DEVICE["leg"],
+        tests=DEVICE["tests"],
+        seed=config["seed"],
+    log:
+        "results/logs/device_trial/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/device_trial/{subject}/{trial}.tsv"
+    script:
+        "../scripts/device_trial.py"
+
+
+rule device_log_from_mat:
+    input:
+        "data/raw/{subject}/{trial}.mat",
+    output:
+        "results/device/{subject}/{trial}.loper.tsv",
+    params:
+        column_map=DEVICE["mat_column_map"],
+        sample_rate_hz=DEVICE_RATE_HZ,
+    log:
+        "results/logs/device_log_from_mat/{subject}/{trial}.log",
+    script:
+        "../scripts/device_log_from_mat.py"
+
+
+rule device_frf:
+    input:
+        device_log("device-frf"),
+    output:
+        "results/device/frf.tsv",
+    params:
+        sample_rate_hz=DEVICE_RATE_HZ,
+        window_samples=DEVICE["analysis"]["welch_window_samples"],
+        overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
+    log:
+        "results/logs/device_frf/frf.log",
+    benchmark:
+        "results/benchmarks/device_frf/frf.tsv"
+    script:
+        "../scripts/device_frf.py"
+
+
+rule device_steps:
+    input:
+        device_log("device-steps"),
+    output:
+        metrics="results/device/step_metrics.tsv",
+        average="results/device/step_average.tsv",
+    params:
+        sample_rate_hz=DEVICE_RATE_HZ,
+        amplitudes_n=DEVICE["tests"]["step_amplitudes_n"],
+        before_s=DEVICE["analysis"]["step_before_s"],
+        after_s=DEVICE["analysis"]["step_after_s"],
+        steady_window_s=DEVICE["analysis"]["steady_window_s"],
+    log:
+        "results/logs/device_steps/steps.log",
+    benchmark:
+        "results/benchmarks/device_steps/steps.tsv"
+    script:
+        "../scripts/device_steps.py"
+
+
+rule device_summary:
+    input:
+        frf="results/device/frf.tsv",
+        metrics="results/device/step_metrics.tsv",
+    output:
+        report(
+            "results/device/summary.tsv",
+            caption="../report/device_summary.rst",
+            category="Device",
+            labels={"table": "device figures vs study"},
+        ),
+    params:
+        reference_band_hz=DEVICE["analysis"]["bandwidth_reference_band_hz"],
+    log:
+        "results/logs/device_summary/summary.log",
+    script:
+        "../scripts/device_summary.py"
+
+
+rule device_figures:
+    input:
+        frf="results/device/frf.tsv",
+        summary="results/device/summary.tsv",
+        average="results/device/step_average.tsv",
+    output:
+        bode=report(
+            "results/device/bode.png",
+            caption="../report/device_bode.rst",
+            category="Device",
+            labels={"figure": "Bode plot"},
+        ),
+        steps=report(
+            "results/device/steps.png",
+            caption="../report/device_steps.rst",
+            category="Device",
+            labels={"figure": "step responses"},
+        ),
+    log:
+        "results/logs/device_figures/figures.log",
+    script:
+        "../scripts/device_figures.py"
