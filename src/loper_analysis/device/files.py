@@ -11,7 +11,7 @@ import pandas as pd
 from ..errors import LoperInputError
 from ..io.robot_log import read_robot_log, write_robot_log
 from .analysis import bandwidth_hz, frequency_response, step_averages, step_table
-from .controller import DeviceParameters, FreeLeg
+from .controller import DeviceParameters, FreeLeg, safety_events
 from .trials import DeviceTestSettings, simulate_device_trial
 
 __all__ = [
@@ -37,10 +37,11 @@ _FLOAT = "%.10g"
 
 def write_device_trial(
     out_path, trial: str, device: DeviceParameters, leg: FreeLeg, settings: DeviceTestSettings, seed
-) -> None:
-    """Simulate one device-test trial and write it as a robot log."""
+) -> pd.DataFrame:
+    """Simulate one device-test trial, write it as a robot log; returns the safety events (time, state, name)."""
     frame = simulate_device_trial(trial, device, leg, settings, seed)
     write_robot_log(out_path, frame, device.sample_rate_hz, {"trial": trial, "source": "synthetic"})
+    return safety_events(frame)
 
 
 def write_frf_table(log_path, out_tsv, sample_rate_hz: float, window_samples: int, overlap_samples: int) -> pd.DataFrame:
@@ -93,11 +94,11 @@ def write_device_summary(frf_tsv, metrics_tsv, out_tsv, reference_band_hz) -> pd
     for _, r in steps.iterrows():
         a = int(round(r["amplitude_n"]))
         rows += [
-            {"metric": f"rise_time_ms_{a}n", "value": r["rise_time_ms"], "study_value": np.nan, "unit": "ms",
+            {"metric": f"rise_time_ms_at_{a}n", "value": r["rise_time_ms"], "study_value": np.nan, "unit": "ms",
              "difference_pct": np.nan},
-            {"metric": f"overshoot_pct_{a}n", "value": r["overshoot_pct"], "study_value": np.nan, "unit": "%",
+            {"metric": f"overshoot_pct_at_{a}n", "value": r["overshoot_pct"], "study_value": np.nan, "unit": "%",
              "difference_pct": np.nan},
-            {"metric": f"steady_state_{a}n_n", "value": r["steady_state_n"], "study_value": np.nan, "unit": "N",
+            {"metric": f"steady_state_n_at_{a}n", "value": r["steady_state_n"], "study_value": np.nan, "unit": "N",
              "difference_pct": np.nan},
         ]
     out = pd.DataFrame(rows)

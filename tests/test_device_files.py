@@ -1,0 +1,79 @@
+"""Device rules' file steps: logs read from disk, bad logs refused with nothing written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from loper_analysis.device.controller import DeviceParameters, FreeLeg
+from loper_analysis.device.files import (
+    write_device_summary,
+    write_device_trial,
+    write_frf_table,
+    write_step_tables,
+)
+from loper_analysis.device.trials import DeviceTestSettings
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.robot_log import read_robot_log, write_robot_log
+
+SHORT = DeviceTestSettings(broadband_duration_s=30.0, step_repetitions=3)
+
+
+@pytest.fixture(scope="module")
+def logs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("raw")
+    for trial in ("device-frf", "device-steps"):
+        write_device_trial(d / f"{trial}.loper.tsv", trial, DeviceParameters(), FreeLeg(), SHORT, 3)
+    return d
+
+
+def test_logs_on_disk_give_the_device_figures(logs, tmp_path):
+    frf = write_frf_table(logs / "device-frf.loper.tsv", tmp_path / "frf.tsv", 1000.0, 5000, 50)
+    assert list(frf.columns) == ["frequency_hz", "gain", "phase_deg", "coherence"]
+    np.testing.assert_allclose(frf.frequency_hz.iloc[0], 0.2)  # 1000 Hz / 5000 samples
+    metrics = write_step_tables(logs / "device-steps.loper.tsv", tmp_path / "m.tsv", tmp_path / "a.tsv", 1000.0,
+                                (20.0, 40.0, 60.0), 0.05, 0.45, (0.15, 0.3))
+    assert list(metrics.columns[:4]) == ["amplitude_n", "n_repetitions", "rise_time_ms", "overshoot_pct"]
+    assert (metrics.n_repetitions == 3).all()
+    summary = write_device_summary(tmp_path / "frf.tsv", tmp_path / "m.tsv", tmp_path / "s.tsv", (0.5, 2.0))
+    s = summary.set_index("metric")
+    assert {"bandwidth_hz", "rise_time_ms", "overshoot_pct"} <= set(s.index)
+    assert list(summary.columns[:4]) == ["metric", "value", "study_value", "unit"]
+    for metric in ("bandwidth_hz", "rise_time_ms", "overshoot_pct", "steady_state_40n_n"):
+        assert abs(s.loc[metric, "difference_pct"]) <= 15.0, (metric, s.loc[metric, "value"])
+    # the table on disk equals the returned one
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "s.tsv", sep="\t"), summary, check_exact=False, rtol=1e-9)
+
+
+def test_a_step_trial_without_steps_is_refused_and_nothing_written(logs, tmp_path):
+    frame, meta = read_robot_log(logs / "device-steps.loper.tsv")
+    frame["force_desired_n"] = 0.0
+    frame["perturbation"] = 0
+    bad = tmp_path / "no-steps.loper.tsv"
+    write_robot_log(bad, frame, 1000.0)
+    with pytest.raises(LoperInputError, match=r"no-steps\.loper\.tsv: no step found"):
+        write_step_tables(bad, tmp_path / "m.tsv", tmp_path / "a.tsv", 1000.0, (20.0, 40.0, 60.0), 0.05, 0.45,
+                          (0.15, 0.3))
+    assert not (tmp_path / "m.tsv").exists() and not (tmp_path / "a.tsv").exists()
+
+
+def test_a_log_with_nan_force_is_refused_naming_file_column_sample(logs, tmp_path):
+    text = (logs / "device-frf.loper.tsv").read_text().splitlines()
+    header_end = next(i for i, line in enumerate(text) if line.startswith("time_s"))
+    cells = text[header_end + 101].split("\t")
+    cells[2] = "nan"
+    text[header_end + 101] = "\t".join(cells)
+    bad = tmp_path / "nan.loper.tsv"
+    bad.write_text("\n".join(text) + "\n")
+    with pytest.raises(LoperInputError) as info:
+        write_frf_table(bad, tmp_path / "frf.tsv", 1000.0, 5000, 50)
+    msg = str(info.value)
+    assert "nan.loper.tsv" in msg and "force_measured_n" in msg and "sample 100" in msg, msg
+    assert not (tmp_path / "frf.tsv").exists()
+
+
+def test_declared_rate_must_match(logs, tmp_path):
+    with pytest.raises(LoperInputError, match="sample_rate_hz"):
+        write_frf_table(logs / "device-frf.loper.tsv", tmp_path / "frf.tsv", 500.0, 5000, 50)
+    assert not (tmp_path / "frf.tsv").exists()
