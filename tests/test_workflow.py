@@ -108,3 +108,17 @@ def test_bad_subject_sheet_is_refused(tmp_path):
     assert res.returncode != 0
     out = res.stdout + res.stderr
     assert "subjects.tsv" in out and "S_01" in out
+
+
+def test_device_outputs_from_the_default_run(finished_run):
+    summary = pd.read_csv(finished_run / "results/device/summary.tsv", sep="\t").set_index("metric")
+    assert list(summary.columns[:3]) == ["value", "study_value", "unit"]
+    for metric in ("bandwidth_hz", "rise_time_ms", "overshoot_pct", "steady_state_40n_n"):
+        assert abs(summary.loc[metric, "value"] / summary.loc[metric, "study_value"] - 1) <= 0.15, metric
+    frf = pd.read_csv(finished_run / "results/device/frf.tsv", sep="\t")
+    assert list(frf.columns) == ["frequency_hz", "gain", "phase_deg", "coherence"]
+    steps = pd.read_csv(finished_run / "results/device/step_metrics.tsv", sep="\t")
+    assert list(steps.amplitude_n) == [20.0, 40.0, 60.0] and (steps.n_repetitions == 10).all()
+    # the logs the analysis read are on disk, in the robot-log format
+    head = (finished_run / "data/raw/S01/device-steps.loper.tsv").read_text().splitlines()[:2]
+    assert head == ["# format: loper-log 1", "# sample_rate_hz: 1000"]
