@@ -192,6 +192,24 @@ def _as_float(series: pd.Series, column: str, source: str, time: np.ndarray | No
     return out
 
 
+def _check_column_names(names: list[str], source: str, where: str) -> None:
+    """Refuse duplicated, missing or unknown columns (``where`` prefixes the duplicate message)."""
+    duplicated = sorted({c for c in names if names.count(c) > 1})
+    if duplicated:
+        raise LoperInputError(f"{source}: {where}duplicated column(s) {', '.join(duplicated)}")
+    missing = [c for c in COLUMNS if c not in names]
+    if missing:
+        raise LoperInputError(
+            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}"
+        )
+    unknown = [c or "''" for c in names if c not in COLUMNS]
+    if unknown:
+        raise LoperInputError(
+            f"{source}: unknown column(s) {', '.join(unknown)}; a robot log has exactly the columns "
+            f"{', '.join(COLUMNS)}"
+        )
+
+
 def _validate(
     frame: pd.DataFrame, sample_rate_hz: float, source: str, first_line: int | None = None
 ) -> pd.DataFrame:
@@ -221,20 +239,7 @@ def _validate(
     if not isinstance(frame, pd.DataFrame):
         raise LoperInputError(f"{source}: a robot log must be a pandas DataFrame, got {type(frame).__name__}")
     names = [str(c) for c in frame.columns]
-    duplicated = sorted({c for c in names if names.count(c) > 1})
-    if duplicated:
-        raise LoperInputError(f"{source}: duplicated column(s) {', '.join(duplicated)}")
-    missing = [c for c in COLUMNS if c not in names]
-    if missing:
-        raise LoperInputError(
-            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}"
-        )
-    unknown = [c for c in names if c not in COLUMNS]
-    if unknown:
-        raise LoperInputError(
-            f"{source}: unknown column(s) {', '.join(unknown)}; a robot log has exactly the columns "
-            f"{', '.join(COLUMNS)}"
-        )
+    _check_column_names(names, source, "")
     rate = _check_sample_rate(sample_rate_hz, f"{source}: sample_rate_hz")
     n = len(frame)
     if n < 2:
@@ -493,20 +498,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
         raise LoperInputError(f"{source}: no column header row after the '#' header lines")
     names = [c.strip() for c in lines[k].split("\t")]
     header_line = k + 1
-    duplicated = sorted({c for c in names if names.count(c) > 1})
-    if duplicated:
-        raise LoperInputError(f"{source}: line {header_line}: duplicated column(s) {', '.join(duplicated)}")
-    missing = [c for c in COLUMNS if c not in names]
-    if missing:
-        raise LoperInputError(
-            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}"
-        )
-    unknown = [c or "''" for c in names if c not in COLUMNS]
-    if unknown:
-        raise LoperInputError(
-            f"{source}: unknown column(s) {', '.join(unknown)}; a robot log has exactly the columns "
-            f"{', '.join(COLUMNS)}"
-        )
+    _check_column_names(names, source, f"line {header_line}: ")
     if tuple(names) != COLUMNS:
         raise LoperInputError(
             f"{source}: line {header_line}: columns in the order {', '.join(names)}; a robot log has them in "
