@@ -1,0 +1,140 @@
+"""Inverse kinematics against known joint angles and against OpenSim's InverseKinematicsTool."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.kinematics import inverse_kinematics, marker_positions, read_ik_tasks
+from loper_analysis.model import MARKERS, build_lower_body_model, quiet_opensim
+
+FS = 128.0
+
+
+@pytest.fixture(scope="module")
+def model_path(tmp_path_factory):
+    path = tmp_path_factory.mktemp("ik") / "model.osim"
+    build_lower_body_model(1.73, 64.9, path)
+    return path
+
+
+def _truth(n=256):
+    t = np.arange(n) / FS
+    w = 2 * np.pi * 0.6
+    return t, {
+        "pelvis_tx": 0.02 * np.sin(2 * w * t), "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
+        "pelvis_tilt": 0.05 * np.sin(w * t),
+        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t), "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
+        "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2),
+        "hip_flexion_r": 0.1 - 0.3 * np.sin(w * t), "knee_flexion_r": 0.6 - 0.5 * np.sin(w * t + 1),
+        "ankle_dorsiflexion_r": -0.1 * np.sin(w * t + 2),
+    }
+
+
+@pytest.fixture(scope="module")
+def synthetic(model_path):
+    t, truth = _truth()
+    return t, truth, marker_positions(model_path, truth)
+
+
+def test_ik_recovers_known_angles(model_path, synthetic):
+    t, truth, X = synthetic
+    res = inverse_kinematics(model_path, t, X, list(MARKERS))
+    for i, name in enumerate(res.coordinate_names):
+        err = np.abs(res.coordinates[:, i] - truth[name]).max()
+        assert err < np.deg2rad(0.1) / 10, (name, err)  # well inside the 0.1 deg requirement
+    assert np.nanmax(res.marker_rms_m) < 1e-5
+
+
+def test_missing_marker_frames_are_dropped_not_fatal(model_path, synthetic):
+    t, truth, X = synthetic
+    X = X.copy()
+    X[50:60, list(MARKERS).index("LKNE")] = np.nan
+    res = inverse_kinematics(model_path, t, X, list(MARKERS))
+    k = res.coordinate_names.index("knee_flexion_l")
+    np.testing.assert_allclose(res.coordinates[:, k], truth["knee_flexion_l"], atol=1e-4)
+
+
+def test_coordinate_task_locks_the_ankle(model_path, synthetic):
+    t, truth, X = synthetic
+    weights = {m: (0.0 if m in ("RHEE", "RMT1", "RMT5") else 1.0) for m in MARKERS}
+    res = inverse_kinematics(model_path, t, X, list(MARKERS), weights, {"ankle_dorsiflexion_r": (1e3, 0.25)})
+    k = res.coordinate_names.index("ankle_dorsiflexion_r")
+    np.testing.assert_allclose(res.coordinates[:, k], 0.25, atol=1e-3)
+
+
+def test_matches_opensims_inverse_kinematics_tool(model_path, synthetic, tmp_path):
+    osim = quiet_opensim()
+    t, truth, X = synthetic
+    rng = np.random.default_rng(0)
+    Xn = X + rng.normal(0, 0.002, X.shape)  # noisy markers: the two must agree on the least-squares answer
+    # TRC in mm through OpenSim's own adapter
+    from loper_analysis.kinematics import markers_table
+
+    table = markers_table(t, Xn * 1000.0, list(MARKERS))
+    table.removeTableMetaDataKey("Units")
+    table.addTableMetaDataString("Units", "mm")
+    table.addTableMetaDataString("DataRate", str(FS))
+    table.addTableMetaDataString("CameraRate", str(FS))
+    trc = tmp_path / "trial.trc"
+    osim.TRCFileAdapter().write(table, str(trc))
+    # a task set with marker weights and one coordinate task
+    tasks = osim.IKTaskSet()
+    weights = {m: (2.0 if m.endswith("ASI") else 1.0) for m in MARKERS}
+    for m, w in weights.items():
+        mt = osim.IKMarkerTask()
+        mt.setName(m)
+        mt.setWeight(w)
+        tasks.cloneAndAppend(mt)
+    ct = osim.IKCoordinateTask()
+    ct.setName("ankle_dorsiflexion_r")
+    ct.setWeight(10.0)
+    ct.setValueType(osim.IKCoordinateTask.ManualValue)
+    ct.setValue(0.05)
+    tasks.cloneAndAppend(ct)
+    tasks_xml = tmp_path / "tasks.xml"
+    tasks.printToXML(str(tasks_xml))
+    tool = osim.InverseKinematicsTool()
+    tool_model = osim.Model(str(model_path))  # keep a reference: the tool does not own it
+    tool.setModel(tool_model)
+    tool.setMarkerDataFileName(str(trc))
+    tool.set_IKTaskSet(osim.IKTaskSet(str(tasks_xml)))
+    tool.setStartTime(t[0])
+    tool.setEndTime(t[-1])
+    tool.set_accuracy(1e-8)
+    mot = tmp_path / "tool.mot"
+    tool.setOutputMotionFileName(str(mot))
+    tool.set_results_directory(str(tmp_path))
+    assert tool.run()
+    ref = osim.TimeSeriesTable(str(mot))
+    in_degrees = ref.getTableMetaDataAsString("inDegrees") == "yes"
+    ours_w, ours_c = read_ik_tasks(tasks_xml)
+    assert ours_w == weights and ours_c == {"ankle_dorsiflexion_r": (10.0, 0.05)}
+    res = inverse_kinematics(model_path, t, Xn, list(MARKERS), ours_w, ours_c, accuracy=1e-8)
+    labels = list(ref.getColumnLabels())
+    for i, name in enumerate(res.coordinate_names):
+        col = ref.getDependentColumn(name).to_numpy()
+        if in_degrees and not name.endswith(("_tx", "_ty")):
+            col = np.deg2rad(col)
+        assert name in labels
+        np.testing.assert_allclose(res.coordinates[:, i], col, atol=1e-6, err_msg=name)
+
+
+def test_tsv_tasks_and_bad_input(model_path, synthetic, tmp_path):
+    tsv = tmp_path / "tasks.tsv"
+    tsv.write_text("name\tkind\tweight\tvalue\nLASI\tmarker\t2\t\nknee_flexion_r\tcoordinate\t5\t0.3\n"
+                   "ankle_dorsiflexion_r\tcoordinate\t1\t\n")
+    w, c = read_ik_tasks(tsv)
+    assert w == {"LASI": 2.0} and c == {"knee_flexion_r": (5.0, 0.3), "ankle_dorsiflexion_r": (1.0, None)}
+    bad = tmp_path / "bad.tsv"
+    bad.write_text("name\tkind\tweight\nLASI\tmarkr\t1\n")
+    with pytest.raises(LoperInputError, match="row 1, column kind: 'markr'"):
+        read_ik_tasks(bad)
+    t, truth, X = synthetic
+    with pytest.raises(LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in model"):
+        inverse_kinematics(model_path, t, X, list(MARKERS), {"XYZ": 1.0})
+    with pytest.raises(LoperInputError, match=r"\['RASI'\] of the IK tasks are not in the marker data"):
+        inverse_kinematics(model_path, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
+    with pytest.raises(LoperInputError, match="coordinate task on 'knee_angle_r'"):
+        inverse_kinematics(model_path, t, X, list(MARKERS), None, {"knee_angle_r": (1.0, None)})
