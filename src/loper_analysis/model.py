@@ -31,6 +31,7 @@ direction and whose midpoint the rod attachment.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -46,6 +47,7 @@ __all__ = [
     "build_lower_body_model",
     "segment_parameters_from_model",
     "quiet_opensim",
+    "scale_model",
 ]
 
 SIDES = ("r", "l")
@@ -255,3 +257,88 @@ def _foot_length(model, side: str) -> float:
     except Exception:
         return 0.2
     return float((t.get(0) - h.get(0)) / 0.95)
+
+
+#: Marker pairs whose distances scale each body (ScaleTool "measurements").
+SCALE_MEASUREMENTS: dict[str, list[tuple[str, str]]] = {
+    **{f"thigh_{s}": [(f"{s.upper()}GTR", f"{s.upper()}KNE")] for s in SIDES},
+    **{f"shank_{s}": [(f"{s.upper()}KNE", f"{s.upper()}ANK")] for s in SIDES},
+    **{f"foot_{s}": [(f"{s.upper()}HEE", f"{s.upper()}MT1")] for s in SIDES},
+    "pelvis": [("RASI", "LASI"), ("RASI", "RPSI"), ("LASI", "LPSI")],
+}
+
+
+def scale_model(generic_osim, static_trc, mass_kg: float, out_osim, time_range_s: tuple[float, float] | None = None):
+    """Personalise the generic model with OpenSim's ScaleTool from a static trial (TRC).
+
+    Each body is scaled uniformly by the ratio of the marker-pair distances in
+    the static trial to those of the model (:data:`SCALE_MEASUREMENTS`); the
+    mass distribution is preserved at ``mass_kg``. The static markers must be
+    complete (ScaleTool crashes on NaN, PITFALLS.md): the first missing marker
+    is named. Writes ``out_osim``; returns it as a Path.
+    """
+    osim = quiet_opensim()
+    generic_osim, static_trc, out_osim = Path(generic_osim), Path(static_trc), Path(out_osim)
+    for path in (generic_osim, static_trc):
+        if not path.is_file():
+            raise LoperInputError(f"file not found: {path}")
+    if not 0 < mass_kg <= 300:
+        raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
+    table = osim.TimeSeriesTableVec3(str(static_trc))
+    labels = list(table.getColumnLabels())
+    times = np.array(table.getIndependentColumn())
+    t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
+    needed = sorted({m for pairs in SCALE_MEASUREMENTS.values() for pair in pairs for m in pair})
+    missing = [m for m in needed if m not in labels]
+    if missing:
+        raise LoperInputError(f"{static_trc}: static trial lacks marker(s) {missing} needed for scaling")
+    flat_table = table.flatten(osim.StdVectorString(["_x", "_y", "_z"]))  # keep the temporaries alive
+    matrix = flat_table.getMatrix()
+    flat = np.array(matrix.to_numpy(), copy=True)
+    sel = (times >= t0 - 1e-9) & (times <= t1 + 1e-9)
+    for j, lab in enumerate(labels):
+        if lab in needed:
+            bad = np.flatnonzero(~np.all(np.isfinite(flat[:, 3 * j : 3 * j + 3]), axis=1) & sel)
+            if bad.size:
+                raise LoperInputError(
+                    f"{static_trc}: marker {lab} is missing at frame {bad[0]} (t = {times[bad[0]]:.3f} s) of the "
+                    "static trial; fill the gap or choose another time range"
+                )
+    tool = osim.ScaleTool()
+    tool.setSubjectMass(float(mass_kg))
+    tool.getGenericModelMaker().setModelFileName(str(generic_osim))
+    scaler = tool.getModelScaler()
+    scaler.setApply(True)
+    order = osim.ArrayStr()
+    order.append("measurements")
+    scaler.setScalingOrder(order)
+    scaler.setMarkerFileName(str(static_trc))
+    tr = osim.ArrayDouble()
+    tr.append(float(t0))
+    tr.append(float(t1))
+    scaler.setTimeRange(tr)
+    scaler.setPreserveMassDist(True)
+    measurements = scaler.getMeasurementSet()
+    for body, pairs in SCALE_MEASUREMENTS.items():
+        m = osim.Measurement()
+        m.setName(body)
+        m.setApply(True)
+        for a, b in pairs:
+            m.getMarkerPairSet().cloneAndAppend(osim.MarkerPair(a, b))
+        scale = osim.BodyScale()
+        scale.setName(body)
+        axes = osim.ArrayStr()
+        for axis in "XYZ":
+            axes.append(axis)
+        scale.setAxisNames(axes)
+        m.getBodyScaleSet().cloneAndAppend(scale)
+        measurements.cloneAndAppend(m)
+    tmp = out_osim.with_name(f".{out_osim.name}.partial.osim")
+    tmp.unlink(missing_ok=True)
+    scaler.setOutputModelFileName(str(tmp))
+    tool.getMarkerPlacer().setApply(False)
+    tool.run()  # returns False when the marker placer is off, even after a good scaling: check the file
+    if not tmp.is_file():
+        raise LoperInputError(f"OpenSim ScaleTool failed for {static_trc} with {generic_osim}")
+    os.replace(tmp, out_osim)
+    return out_osim
