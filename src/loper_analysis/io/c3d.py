@@ -1,0 +1,602 @@
+"""C3D motion-capture files: reading and writing with ``ezc3d``.
+
+Inside the library markers are in metres, shape (n_frames, n_markers, 3),
+NaN where a marker is missing; analog channels are (n_samples, n_channels)
+in each channel's own unit (``ANALOG:UNITS``), sampled at an integer multiple
+of the point rate.
+
+Reading (:func:`read_c3d`)
+    * The point unit comes from ``POINT:UNITS`` (``mm``, ``cm`` or ``m``, case
+      insensitive); a file with markers but no or an unknown unit is refused.
+    * A point is missing (NaN) if ezc3d returns NaN for it (ezc3d 1.7 does so
+      for every point whose stored residual is negative), if its residual is
+      negative, or if all three coordinates are exactly 0 (the convention of
+      writers that ignore residuals). Residuals are not trusted beyond their
+      sign (ezc3d #386); a real marker exactly at the lab origin is therefore
+      read as missing.
+    * ``LABELS``, ``LABELS2``, ... are joined (ezc3d splits more than 255
+      labels over several parameters).
+    * Analog values are ezc3d's, i.e. after its SCALE/OFFSET handling.
+      ``ANALOG:RATE`` must be an integer multiple of ``POINT:RATE``.
+    * ezc3d accepts some damaged files silently (a file cut inside its
+      parameter section comes back with garbage frames, one cut inside its
+      data with fewer frames and a header lowered to match), so the file
+      size and the frame count are checked here against the raw header;
+      ezc3d's own exceptions are wrapped.
+
+Writing (:func:`write_c3d`)
+    Float C3D through ezc3d with ``POINT:RATE/LABELS/UNITS`` and
+    ``ANALOG:RATE/LABELS/UNITS`` set explicitly and ``ANALOG:SCALE`` 1,
+    ``OFFSET`` 0, ``GEN_SCALE`` 1, so a round trip is exact to float32. A
+    missing (NaN) point is stored as (0, 0, 0) with residual -1. Writing is
+    atomic (a temporary directory beside the target, then :func:`os.replace`)
+    and deterministic: the same inputs give the same bytes. ezc3d's writer
+    runs in a child Python process, because in-process it breaks OpenSim's
+    vector arguments or is broken by them (:func:`write_c3d`, Notes).
+
+Every problem raises :class:`~loper_analysis.errors.LoperInputError` whose
+message names the file and the field (``GROUP:PARAMETER``) or argument.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import LoperInputError
+
+__all__ = [
+    "LENGTH_UNITS_PER_M",
+    "C3DRecording",
+    "read_c3d",
+    "write_c3d",
+]
+
+#: Length units accepted in files, as the number of units per metre.
+LENGTH_UNITS_PER_M: dict[str, float] = {"mm": 1000.0, "cm": 100.0, "m": 1.0}
+
+#: Longest label ezc3d can write and read back (longer ones give an unreadable file).
+_MAX_LABEL_CHARS = 255
+#: Relative tolerance of the integer analog/point rate ratio.
+_RATIO_TOLERANCE = 1e-6
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
+
+
+@dataclass
+class C3DRecording:
+    """Markers and analog channels of one C3D file, in SI units.
+
+    Attributes
+    ----------
+    source : str
+        Path of the file read (used in error messages).
+    marker_labels : list of str
+        One label per marker, in file order.
+    markers_m : numpy.ndarray
+        Shape (n_frames, n_markers, 3), metres, lab frame; NaN where missing.
+    point_rate_hz : float
+        Frame rate of the markers (Hz).
+    first_frame : int
+        0-based frame number of the first frame (C3D header word 4 minus 1).
+    analog_labels, analog_units : list of str
+        One label and one unit per analog channel ("" when the file has no unit).
+    analogs : numpy.ndarray
+        Shape (n_samples, n_channels) with n_samples = n_frames * ratio, in
+        each channel's unit; (n_frames, 0) when the file has no analogs.
+    analog_rate_hz : float
+        Analog sample rate (Hz), ``ratio * point_rate_hz`` with an integer
+        ratio >= 1; equals ``point_rate_hz`` when there are no analogs.
+    """
+
+    source: str
+    marker_labels: list[str]
+    markers_m: np.ndarray
+    point_rate_hz: float
+    first_frame: int = 0
+    analog_labels: list[str] = field(default_factory=list)
+    analog_units: list[str] = field(default_factory=list)
+    analogs: np.ndarray | None = None
+    analog_rate_hz: float | None = None
+
+    def __post_init__(self) -> None:
+        self.markers_m = np.asarray(self.markers_m, dtype=float)
+        X = self.markers_m
+        if X.ndim != 3 or X.shape[2] != 3 or X.shape[1] != len(self.marker_labels):
+            raise LoperInputError(
+                f"{self.source}: markers_m must have shape (n_frames, n_markers={len(self.marker_labels)}, 3), "
+                f"got {X.shape}"
+            )
+        if self.analog_rate_hz is None:
+            self.analog_rate_hz = float(self.point_rate_hz)
+        ratio = _rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
+        if self.analogs is None:
+            self.analogs = np.zeros((X.shape[0] * ratio, 0))
+        self.analogs = np.asarray(self.analogs, dtype=float)
+        n_ch = len(self.analog_labels)
+        if self.analogs.shape != (X.shape[0] * ratio, n_ch) or len(self.analog_units) != n_ch:
+            raise LoperInputError(
+                f"{self.source}: analogs must have shape (n_frames * {ratio} = {X.shape[0] * ratio}, "
+                f"n_channels = {n_ch}) with one unit per channel, got {self.analogs.shape} and "
+                f"{len(self.analog_units)} unit(s)"
+            )
+
+    @property
+    def samples_per_frame(self) -> int:
+        """Analog samples per marker frame (the integer rate ratio)."""
+        return _rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
+
+    @property
+    def time_s(self) -> np.ndarray:
+        """Frame times (n_frames,) in s: ``(first_frame + arange(n_frames)) / point_rate_hz``."""
+        return (self.first_frame + np.arange(self.markers_m.shape[0])) / float(self.point_rate_hz)
+
+    @property
+    def analog_time_s(self) -> np.ndarray:
+        """Analog sample times (n_samples,) in s; sample ``f * samples_per_frame`` is at frame ``f``'s time."""
+        ratio = self.samples_per_frame
+        return (self.first_frame * ratio + np.arange(self.analogs.shape[0])) / float(self.analog_rate_hz)
+
+    def analog(self, label: str) -> np.ndarray:
+        """One analog channel (n_samples,), in its unit.
+
+        Raises
+        ------
+        LoperInputError
+            If no channel, or more than one, has this label; the message names
+            the file, the label and the channels present.
+        """
+        hits = [i for i, lab in enumerate(self.analog_labels) if lab == label]
+        if len(hits) != 1:
+            problem = "no analog channel" if not hits else f"{len(hits)} analog channels"
+            raise LoperInputError(
+                f"{self.source}: {problem} '{label}'; channels present: {', '.join(self.analog_labels) or 'none'}"
+            )
+        return self.analogs[:, hits[0]].copy()
+
+
+# ---------------------------------------------------------------- helpers
+
+
+def _rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int:
+    """The integer ratio analog/point rate; refuses a non-integer one."""
+    ratio = float(analog_rate_hz) / float(point_rate_hz)
+    n = round(ratio)
+    if n < 1 or abs(ratio - n) > _RATIO_TOLERANCE * ratio:
+        raise LoperInputError(
+            f"{source}: mismatched analog/point rates: ANALOG:RATE = {analog_rate_hz:g} Hz is not an integer "
+            f"multiple of POINT:RATE = {point_rate_hz:g} Hz (ratio {ratio:.6g})"
+        )
+    return int(n)
+
+
+@contextlib.contextmanager
+def _staged_output(path: Path, what: str) -> Iterator[Path]:
+    """Yield a temporary path with ``path``'s name in a fresh directory beside it; on success move it over ``path``.
+
+    Nothing remains beside ``path`` when the body or the move fails. ``what``
+    names the kind of file in error messages.
+    """
+    directory = path.parent
+    if not directory.is_dir():
+        raise LoperInputError(f"{path}: cannot write {what}: directory {directory} does not exist")
+    stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory))
+    try:
+        tmp = stage / path.name
+        yield tmp
+        try:
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise LoperInputError(f"{path}: cannot write {what} ({exc})") from exc
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def _param(params, group: str, name: str):
+    """The ``value`` of GROUP:NAME, or None when absent."""
+    try:
+        return params[group][name]["value"]
+    except KeyError:
+        return None
+
+
+def _param_strings(params, group: str, name: str) -> list[str]:
+    """GROUP:NAME joined with NAME2, NAME3, ... (ezc3d splits more than 255 entries), stripped."""
+    out: list[str] = []
+    for key in [name] + [f"{name}{k}" for k in range(2, 100)]:
+        value = _param(params, group, key)
+        if value is None:
+            if key != name:
+                break
+            continue
+        out.extend(str(v).strip() for v in value)
+    return out
+
+
+def _param_float(params, group: str, name: str, source: str) -> float:
+    """First value of GROUP:NAME as a float; refuses absence and non-positive values."""
+    value = _param(params, group, name)
+    try:
+        rate = float(np.asarray(value, dtype=float).ravel()[0])
+    except (TypeError, ValueError, IndexError):
+        raise LoperInputError(f"{source}: {group}:{name} not declared") from None
+    if not math.isfinite(rate) or rate <= 0:
+        raise LoperInputError(f"{source}: {group}:{name} must be a positive number, got {rate:g}")
+    return rate
+
+
+def _labels_for(params, group: str, n: int, source: str) -> list[str]:
+    labels = _param_strings(params, group, "LABELS")
+    if len(labels) < n:
+        raise LoperInputError(f"{source}: {group}:LABELS holds {len(labels)} label(s) for {n} {group.lower()}s")
+    return labels[:n]
+
+
+def _point_units_per_m(params, source: str) -> float:
+    units = _param_strings(params, "POINT", "UNITS")
+    if not units or not units[0]:
+        raise LoperInputError(
+            f"{source}: POINT:UNITS not declared; cannot tell whether markers are in mm, cm or m"
+        )
+    unit = units[0].lower()
+    if unit not in LENGTH_UNITS_PER_M:
+        raise LoperInputError(
+            f"{source}: unknown POINT:UNITS '{units[0]}'; expected one of {', '.join(LENGTH_UNITS_PER_M)}"
+        )
+    return LENGTH_UNITS_PER_M[unit]
+
+
+def _header_frames(path: Path) -> int | None:
+    """Frame count from the raw C3D header (words 4 and 5, 1-based first and last frame).
+
+    ezc3d lowers its own header copy to the frames it could read, so a
+    truncated file cannot be recognised from ezc3d's header. None when the
+    header cannot tell (last frame saturated at 65535 in long files).
+    """
+    with path.open("rb") as fh:
+        head = fh.read(512)
+        fh.seek(max(head[0] - 1, 0) * 512 + 3)
+        processor = fh.read(1)
+    byte_order = ">" if processor == bytes([86]) else "<"  # 84 Intel, 85 DEC: little-endian integers; 86 MIPS
+    first, last = struct.unpack(byte_order + "HH", head[6:10])
+    if last >= 0xFFFF or last < first:
+        return None
+    return last - first + 1
+
+
+def _check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> None:
+    """Refuse a file shorter than its header says (ezc3d reads truncated files silently)."""
+    source = str(path)
+    declared = _header_frames(path)
+    if declared is not None and n_frames < declared:
+        raise LoperInputError(
+            f"{source}: truncated file: the header declares {declared} frames but only {n_frames} could be read"
+        )
+    params = c3d["parameters"]
+    start = _param(params, "POINT", "DATA_START")
+    scale = _param(params, "POINT", "SCALE")
+    if start is None or len(start) == 0:
+        raise LoperInputError(f"{source}: POINT:DATA_START not declared")
+    word_bytes = 4 if scale is None or len(scale) == 0 or float(scale[0]) < 0 else 2
+    needed = (int(start[0]) - 1) * 512 + n_frames * words_per_frame * word_bytes
+    size = path.stat().st_size
+    if size < needed:
+        raise LoperInputError(
+            f"{source}: truncated file: {n_frames} frames of {words_per_frame} words need {needed} bytes, "
+            f"the file has {size}"
+        )
+
+
+def _open_c3d(path: Path):
+    """ezc3d's reader with its exceptions turned into LoperInputError."""
+    import ezc3d
+
+    source = str(path)
+    if not path.exists():
+        raise LoperInputError(f"{source}: C3D file not found")
+    if not path.is_file():  # ezc3d does not return on a directory
+        raise LoperInputError(f"{source}: not a regular file")
+    try:
+        return ezc3d.c3d(source)
+    except Exception as exc:  # ezc3d raises OSError, RuntimeError, ValueError, ... for damaged files
+        raise LoperInputError(
+            f"{source}: not a readable C3D file (truncated, damaged or another format): "
+            f"{type(exc).__name__}: {exc}"
+        ) from exc
+
+
+def _markers_from(c3d, units_per_m: float) -> np.ndarray:
+    """(n_frames, n_markers, 3) in m, NaN where ezc3d gives NaN, the residual is negative or the point is (0,0,0)."""
+    points = np.asarray(c3d["data"]["points"], dtype=float)[:3]  # (3, n_markers, n_frames)
+    X = np.transpose(points, (2, 1, 0)) / units_per_m
+    missing = ~np.all(np.isfinite(X), axis=2) | np.all(X == 0.0, axis=2)
+    residuals = np.asarray(c3d["data"]["meta_points"]["residuals"], dtype=float)
+    if residuals.shape == (1, X.shape[1], X.shape[0]):
+        missing |= residuals[0].T < 0
+    X[missing] = np.nan
+    return X
+
+
+def _analogs_from(c3d, point_rate_hz: float, source: str) -> tuple[float, int, list[str], list[str], np.ndarray]:
+    """Analog rate (Hz), samples per frame, labels, units and samples (n_samples, n_channels) of a read file.
+
+    Without channels: the point rate, 1, [], [] and an empty (n_samples, 0) array.
+    """
+    analogs = np.asarray(c3d["data"]["analogs"], dtype=float)  # (1, n_channels, n_samples)
+    if analogs.ndim != 3 or analogs.shape[1] == 0:
+        n_samples = analogs.shape[2] if analogs.ndim == 3 else 0
+        return point_rate_hz, 1, [], [], np.zeros((n_samples, 0))
+    n_channels = analogs.shape[1]
+    params = c3d["parameters"]
+    rate = _param_float(params, "ANALOG", "RATE", source)
+    ratio = _rate_ratio(point_rate_hz, rate, source)
+    labels = _labels_for(params, "ANALOG", n_channels, source)
+    units = (_param_strings(params, "ANALOG", "UNITS") + [""] * n_channels)[:n_channels]
+    return rate, ratio, labels, units, analogs[0].T.copy()
+
+
+# ---------------------------------------------------------------- reader
+
+
+def read_c3d(path: str | os.PathLike) -> C3DRecording:
+    """Read markers (converted to m) and analog channels of a C3D file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.c3d`` file.
+
+    Returns
+    -------
+    C3DRecording
+        ``markers_m`` (n_frames, n_markers, 3) in m with NaN for missing
+        points; ``analogs`` (n_frames * ratio, n_channels) in the channels'
+        units; rates in Hz; ``first_frame`` 0-based.
+
+    Raises
+    ------
+    LoperInputError
+        Missing file; not a C3D file, damaged or truncated (ezc3d's exception
+        is quoted); ``POINT:UNITS`` not declared or unknown (markers
+        present); ``POINT:RATE`` missing; too few labels; ``ANALOG:RATE`` not
+        an integer multiple of ``POINT:RATE`` ("mismatched analog/point
+        rates"). The message names the file.
+    """
+    path = Path(path)
+    source = str(path)
+    c3d = _open_c3d(path)
+    params = c3d["parameters"]
+    point_rate = _param_float(params, "POINT", "RATE", source)
+    n_markers = int(np.shape(c3d["data"]["points"])[1])
+    labels = _labels_for(params, "POINT", n_markers, source)
+    units_per_m = _point_units_per_m(params, source) if n_markers else 1.0
+    analog_rate, ratio, analog_labels, analog_units, samples = _analogs_from(c3d, point_rate, source)
+    n_channels = samples.shape[1]
+    n_frames = int(np.shape(c3d["data"]["points"])[2]) if n_markers else samples.shape[0] // ratio
+    if n_channels and samples.shape[0] != n_frames * ratio:
+        raise LoperInputError(
+            f"{source}: {samples.shape[0]} analog samples for {n_frames} frames at {ratio} samples per frame"
+        )
+    _check_complete(c3d, path, n_frames, 4 * n_markers + n_channels * ratio)
+    markers = _markers_from(c3d, units_per_m) if n_markers else np.zeros((n_frames, 0, 3))
+    return C3DRecording(
+        source=source,
+        marker_labels=labels,
+        markers_m=markers,
+        point_rate_hz=point_rate,
+        first_frame=int(c3d["header"]["points"]["first_frame"]),
+        analog_labels=analog_labels,
+        analog_units=analog_units,
+        analogs=samples if n_channels else None,
+        analog_rate_hz=analog_rate,
+    )
+
+
+# ---------------------------------------------------------------- writer
+
+
+def _check_labels(labels: Sequence[str], what: str, n: int, source: str) -> list[str]:
+    """Labels as a list: n of them, unique, non-empty str of at most 255 characters without edge blanks."""
+    labels = list(labels)
+    if len(labels) != n:
+        raise LoperInputError(f"{source}: {what} must name {n} item(s), got {len(labels)}")
+    for lab in labels:
+        if not isinstance(lab, str) or not lab or lab != lab.strip() or len(lab) > _MAX_LABEL_CHARS:
+            raise LoperInputError(
+                f"{source}: {what} must be non-empty strings of at most {_MAX_LABEL_CHARS} characters without "
+                f"leading/trailing blanks, got {lab!r}"
+            )
+    duplicated = sorted({lab for lab in labels if labels.count(lab) > 1})
+    if duplicated:
+        raise LoperInputError(f"{source}: {what} duplicated: {', '.join(duplicated)}")
+    return labels
+
+
+def _check_rate(value, what: str, source: str) -> float:
+    try:
+        rate = float(value)
+    except (TypeError, ValueError):
+        raise LoperInputError(f"{source}: {what} must be a positive number, got {value!r}") from None
+    if not math.isfinite(rate) or rate <= 0:
+        raise LoperInputError(f"{source}: {what} must be a positive number, got {value!r}")
+    return rate
+
+
+def _points_for_file(markers_m, units_per_m: float, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """ezc3d points (4, n_markers, n_frames) and residuals (1, n_markers, n_frames); NaN -> 0 with residual -1."""
+    X = np.asarray(markers_m, dtype=float)
+    if X.ndim != 3 or X.shape[2] != 3 or X.shape[0] < 1 or X.shape[1] < 1:
+        raise LoperInputError(f"{source}: markers_m must have shape (n_frames >= 1, n_markers >= 1, 3), got {X.shape}")
+    scaled = X * units_per_m
+    too_big = np.abs(np.nan_to_num(scaled, nan=0.0)) > _FLOAT32_MAX  # inf included; NaN means missing
+    if np.any(too_big):
+        f, m, _ = np.argwhere(too_big)[0]
+        raise LoperInputError(f"{source}: markers_m[{f}, {m}] = {X[f, m]} is not finite in float32")
+    missing = ~np.all(np.isfinite(scaled), axis=2)  # (n_frames, n_markers)
+    scaled[missing] = 0.0
+    points = np.ones((4, X.shape[1], X.shape[0]))
+    points[:3] = np.transpose(scaled, (2, 1, 0))
+    residuals = np.where(missing.T, -1.0, 0.0)[np.newaxis]
+    return points, residuals
+
+
+def _analogs_for_file(analogs, n_channels: int, n_samples: int, source: str) -> np.ndarray:
+    """ezc3d analogs (1, n_channels, n_samples) from (n_samples, n_channels); refuses wrong shapes and non-finite values."""
+    A = np.zeros((n_samples, 0)) if analogs is None else np.asarray(analogs, dtype=float)
+    if A.ndim != 2 or A.shape != (n_samples, n_channels):
+        raise LoperInputError(
+            f"{source}: analogs must have shape (n_frames * samples per frame = {n_samples}, "
+            f"n_channels = {n_channels}), got {A.shape}"
+        )
+    bad = np.isnan(A) | (np.abs(np.nan_to_num(A)) > _FLOAT32_MAX)  # inf included
+    if np.any(bad):
+        k, ch = np.argwhere(bad)[0]
+        raise LoperInputError(f"{source}: analogs[{k}, {ch}] = {A[k, ch]} is not finite in float32")
+    return A.T[np.newaxis]
+
+
+_CHILD_CODE = "import sys; from loper_analysis.io.c3d import _write_payload; _write_payload(sys.argv[1], sys.argv[2])"
+
+
+def _write_payload(payload_path: str, out_path: str) -> None:
+    """Child-process side of :func:`write_c3d`: build the ezc3d object from the payload (.npz) and write it."""
+    import ezc3d
+
+    with np.load(payload_path, allow_pickle=False) as d:
+        c3d = ezc3d.c3d()
+        P = c3d["parameters"]["POINT"]
+        P["RATE"]["value"] = [float(d["point_rate_hz"])]
+        P["LABELS"]["value"] = [str(v) for v in d["marker_labels"]]
+        P["UNITS"]["value"] = [str(d["point_unit"])]
+        residuals = d["residuals"]
+        c3d["data"]["meta_points"] = {
+            "residuals": residuals,
+            "camera_masks": np.zeros((7, *residuals.shape[1:]), dtype=bool),
+        }
+        c3d["data"]["points"] = d["points"]
+        n_ch = len(d["analog_labels"])
+        if n_ch:
+            A = c3d["parameters"]["ANALOG"]
+            A["RATE"]["value"] = [float(d["analog_rate_hz"])]
+            A["LABELS"]["value"] = [str(v) for v in d["analog_labels"]]
+            A["UNITS"]["value"] = [str(v) for v in d["analog_units"]]
+            A["SCALE"]["value"] = [1.0] * n_ch
+            A["OFFSET"]["value"] = [0] * n_ch
+            A["GEN_SCALE"]["value"] = [1.0]
+            c3d["data"]["analogs"] = d["analogs"]
+    c3d.write(out_path)
+
+
+def _write_in_child(payload: dict[str, np.ndarray], out: Path, source: str) -> None:
+    """Write ``out`` with ezc3d in a fresh Python process (see :func:`write_c3d`, Notes)."""
+    payload_path = out.with_name(out.name + ".payload.npz")
+    np.savez(payload_path, **payload)
+    proc = subprocess.run(
+        [sys.executable, "-c", _CHILD_CODE, str(payload_path), str(out)], capture_output=True, text=True
+    )
+    if proc.returncode != 0 or not out.is_file():
+        lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
+        raise LoperInputError(f"{source}: ezc3d could not write the file: {lines[-1] if lines else 'no message'}")
+
+
+def write_c3d(
+    path: str | os.PathLike,
+    marker_labels: Sequence[str],
+    markers_m,
+    point_rate_hz: float,
+    analog_labels: Sequence[str] = (),
+    analogs=None,
+    analog_units: Sequence[str] = (),
+    analog_rate_hz: float | None = None,
+    point_unit: str = "mm",
+) -> Path:
+    """Write markers (given in m) and analog channels to a float C3D file, atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Target ``.c3d`` file; its directory must exist.
+    marker_labels : sequence of str
+        One unique label per marker (at most 255 characters, no edge blanks).
+    markers_m : array_like
+        Shape (n_frames, n_markers, 3), metres; a point with any NaN
+        coordinate is written as missing ((0, 0, 0), residual -1). A point
+        exactly at (0, 0, 0) m is read back as missing (:func:`read_c3d`).
+    point_rate_hz : float
+        Frame rate (Hz).
+    analog_labels, analog_units : sequence of str
+        One label and one unit (e.g. ``"N"``, ``"V"``) per analog channel.
+    analogs : array_like, optional
+        Shape (n_frames * ratio, n_channels), finite, in the channels' units.
+    analog_rate_hz : float, optional
+        Analog rate (Hz), an integer multiple ``ratio`` of ``point_rate_hz``;
+        default ``point_rate_hz``.
+    point_unit : {"mm", "cm", "m"}
+        Unit stored in ``POINT:UNITS``; coordinates are float32 in that unit.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    LoperInputError
+        Bad shapes, labels, units, rates (including a non-integer
+        analog/point rate ratio), non-finite analogs, values beyond float32,
+        a missing directory, or a failed write; nothing is left behind.
+
+    Notes
+    -----
+    ezc3d's writer runs in a child Python process: in one process, ezc3d's
+    and OpenSim's SWIG wrappers share the converters of ``std::vector``
+    (process-wide ``STB_GNU_UNIQUE`` statics), and whichever library uses
+    them first breaks the other's vector arguments (an in-process ezc3d write
+    makes ``opensim.StdVectorDouble`` arguments raise TypeError; earlier
+    OpenSim use makes ezc3d's write raise TypeError). Reading is unaffected.
+    """
+    path = Path(path)
+    source = str(path)
+    unit = str(point_unit).lower()
+    if unit not in LENGTH_UNITS_PER_M:
+        raise LoperInputError(f"{source}: point_unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {point_unit!r}")
+    point_rate = _check_rate(point_rate_hz, "point_rate_hz", source)
+    points, residuals = _points_for_file(markers_m, LENGTH_UNITS_PER_M[unit], source)
+    labels = _check_labels(marker_labels, "marker_labels", points.shape[1], source)
+    a_labels = list(analog_labels)
+    n_ch = len(a_labels)
+    if n_ch == 0 and analogs is not None and np.size(analogs) > 0:
+        raise LoperInputError(f"{source}: analogs given without analog_labels")
+    analog_rate = point_rate if analog_rate_hz is None else _check_rate(analog_rate_hz, "analog_rate_hz", source)
+    ratio = _rate_ratio(point_rate, analog_rate, source)
+    if n_ch:
+        a_labels = _check_labels(a_labels, "analog_labels", n_ch, source)
+        a_units = [str(u) for u in analog_units]
+        if len(a_units) != n_ch:
+            raise LoperInputError(f"{source}: analog_units must give one unit per channel ({n_ch}), got {len(a_units)}")
+        samples = _analogs_for_file(analogs, n_ch, points.shape[2] * ratio, source)
+
+    payload = {
+        "point_rate_hz": np.float64(point_rate),
+        "point_unit": np.str_(unit),
+        "marker_labels": np.array(labels, dtype=str),
+        "points": points,
+        "residuals": residuals,
+        "analog_rate_hz": np.float64(analog_rate),
+        "analog_labels": np.array(a_labels if n_ch else [], dtype=str),
+        "analog_units": np.array(a_units if n_ch else [], dtype=str),
+        "analogs": samples if n_ch else np.zeros((1, 0, 0)),
+    }
+    with _staged_output(path, "C3D file") as tmp:
+        _write_in_child(payload, tmp, source)
+    return path

@@ -1,0 +1,349 @@
+"""OpenSim's text formats (TRC markers, MOT/STO coordinates) through OpenSim's own adapters.
+
+TRC (:func:`write_trc`, :func:`read_markers`)
+    Written with ``opensim.TRCFileAdapter``, which needs the table metadata
+    ``DataRate`` and ``Units`` (it refuses to write without them) and fills in
+    ``CameraRate`` (set here equal to ``DataRate``), ``NumFrames``,
+    ``NumMarkers``, ``OrigDataRate``, ``OrigDataStartFrame`` and
+    ``OrigNumFrames`` itself. Missing markers are written as ``nan`` and read
+    back as NaN. OpenSim prints the path it was given in the first line
+    (``PathFileType 4 (X/Y/Z) <path>``); the writer puts the bare file name
+    there so the bytes do not depend on the directory. Reading takes the
+    unit from the ``Units`` metadata (mm, cm or m) and refuses a file
+    without it, since OpenSim itself would silently assume metres.
+    ``TimeSeriesTable.packVec3`` of OpenSim 4.6 fails on a single marker
+    ("Cannot guess the suffix"); the writer packs a padding marker and
+    removes it again.
+
+MOT/STO (:func:`write_mot`, :func:`read_mot`)
+    Written with ``opensim.STOFileAdapter`` (header name line
+    ``Coordinates``, ``inDegrees=yes|no``, ``DataType``, ``version=3``,
+    ``OpenSimVersion``, ``endheader``; values to 16 significant digits).
+    Columns whose name ends in ``_tx``, ``_ty`` or ``_tz`` are translations
+    in m and never converted; every other column is an angle, rad inside,
+    printed in degrees when ``inDegrees=yes``. The reader honours the
+    header and refuses a file without ``inDegrees``.
+
+Vectors are handed to OpenSim as plain Python lists, never as
+``opensim.StdVector*`` objects: those stop working in a process where ezc3d's
+SWIG wrapper used its ``std::vector`` converters first (see
+:func:`loper_analysis.io.c3d.write_c3d`, Notes). Writers are atomic (a
+temporary directory beside the target, then :func:`os.replace`). Every problem raises
+:class:`~loper_analysis.errors.LoperInputError` naming the file.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import LoperInputError
+from ..model import quiet_opensim
+from .c3d import LENGTH_UNITS_PER_M, _staged_output, read_c3d
+
+__all__ = [
+    "TRANSLATION_SUFFIXES",
+    "write_trc",
+    "read_markers",
+    "write_mot",
+    "read_mot",
+]
+
+#: Coordinate-name endings of translations (m), which are never converted to degrees.
+TRANSLATION_SUFFIXES: tuple[str, ...] = ("_tx", "_ty", "_tz")
+
+#: Relative tolerance on equal time steps of a TRC (it declares one DataRate).
+_STEP_TOLERANCE = 1e-6
+_WHITESPACE = re.compile(r"\s")
+
+
+def _is_translation(name: str) -> bool:
+    return name.endswith(TRANSLATION_SUFFIXES)
+
+
+def _check_names(names: Sequence, what: str, source: str) -> list[str]:
+    """Non-empty, unique str without whitespace (the files are tab separated)."""
+    names = list(names)
+    for name in names:
+        if not isinstance(name, str) or not name or _WHITESPACE.search(name):
+            raise LoperInputError(f"{source}: {what} must be non-empty strings without whitespace, got {name!r}")
+    duplicated = sorted({n for n in names if names.count(n) > 1})
+    if duplicated:
+        raise LoperInputError(f"{source}: {what} duplicated: {', '.join(duplicated)}")
+    return names
+
+
+def _check_time(time_s, source: str, min_rows: int) -> np.ndarray:
+    t = np.asarray(time_s, dtype=float)
+    if t.ndim != 1 or t.size < min_rows:
+        raise LoperInputError(f"{source}: time_s must be 1-D with at least {min_rows} value(s), got shape {t.shape}")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        bad = int(np.flatnonzero(~np.isfinite(t) | np.r_[False, np.diff(t) <= 0])[0])
+        raise LoperInputError(f"{source}: time_s must be finite and strictly increasing; fails at row {bad} ({t[bad]!r} s)")
+    return t
+
+
+def _data_rate(t: np.ndarray, source: str) -> float:
+    """The one rate of equally spaced times (Hz); refuses unequal steps."""
+    step = (t[-1] - t[0]) / (t.size - 1)
+    worst = int(np.argmax(np.abs(np.diff(t) - step)))
+    if abs(t[worst + 1] - t[worst] - step) > _STEP_TOLERANCE * step:
+        raise LoperInputError(
+            f"{source}: a TRC needs equally spaced times; step {t[worst + 1] - t[worst]:.9g} s at row {worst} "
+            f"differs from the mean step {step:.9g} s"
+        )
+    return 1.0 / step
+
+
+def _open_table(osim, path: Path, kind: str, what: str):
+    """``osim.<kind>(path)`` with a missing file and OpenSim's exceptions turned into LoperInputError."""
+    if not path.is_file():
+        raise LoperInputError(f"{path}: {what} not found")
+    try:
+        return getattr(osim, kind)(str(path))
+    except Exception as exc:  # OpenSim raises RuntimeError (and others) for unreadable files
+        raise LoperInputError(f"{path}: OpenSim cannot read this {what}: {exc}") from exc
+
+
+# ---------------------------------------------------------------- TRC
+
+
+def _vec3_table(osim, t: np.ndarray, X: np.ndarray, labels: list[str]):
+    """``TimeSeriesTableVec3`` from (n,) and (n, m, 3); pads one marker around OpenSim's packVec3 bug."""
+    pad = "PAD"
+    while pad in labels:
+        pad += "_"
+    flat = np.hstack([X.reshape(t.size, -1), np.zeros((t.size, 3))])
+    cols = [f"{lab}_{a}" for lab in [*labels, pad] for a in "xyz"]
+    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(flat), cols)
+    v3 = table.packVec3(["_x", "_y", "_z"])
+    v3.removeColumn(pad)
+    return v3
+
+
+def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str], unit: str = "mm") -> Path:
+    """Write marker trajectories to a TRC file with OpenSim's ``TRCFileAdapter``, atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Target ``.trc`` file; its directory must exist.
+    time_s : array_like
+        Shape (n_frames,), n_frames >= 2, s, strictly increasing and equally
+        spaced (relative tolerance 1e-6); ``DataRate`` = 1 / mean step.
+    markers_m : array_like
+        Shape (n_frames, n_markers, 3), metres; NaN (missing) is written as ``nan``.
+    labels : sequence of str
+        One unique marker name per marker, without whitespace.
+    unit : {"mm", "cm", "m"}
+        Unit of the file (``Units`` metadata); values are converted from m.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    LoperInputError
+        Bad shapes, labels, unit or times, infinite values, a missing
+        directory or a failed write.
+    """
+    path = Path(path)
+    source = str(path)
+    if unit not in LENGTH_UNITS_PER_M:
+        raise LoperInputError(f"{source}: unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {unit!r}")
+    t = _check_time(time_s, source, min_rows=2)
+    X = np.asarray(markers_m, dtype=float)
+    labels = list(labels)
+    if X.ndim != 3 or X.shape != (t.size, len(labels), 3) or not labels:
+        raise LoperInputError(
+            f"{source}: markers_m must have shape (n_frames = {t.size}, n_labels = {len(labels)} >= 1, 3), got {X.shape}"
+        )
+    labels = _check_names(labels, "labels", source)
+    if np.any(np.isinf(X)):
+        raise LoperInputError(f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})")
+    rate = _data_rate(t, source)
+    osim = quiet_opensim()
+    table = _vec3_table(osim, t, X * LENGTH_UNITS_PER_M[unit], labels)
+    table.addTableMetaDataString("DataRate", f"{rate:.12g}")
+    table.addTableMetaDataString("CameraRate", f"{rate:.12g}")
+    table.addTableMetaDataString("Units", unit)
+    with _staged_output(path, "TRC file") as tmp:
+        try:
+            osim.TRCFileAdapter().write(table, str(tmp))
+        except Exception as exc:
+            raise LoperInputError(f"{source}: OpenSim could not write the TRC file: {exc}") from exc
+        _name_in_first_line(tmp, path.name)
+    return path
+
+
+def _name_in_first_line(tmp: Path, name: str) -> None:
+    """Replace the path OpenSim printed in ``PathFileType 4 (X/Y/Z) <path>`` by the bare file name."""
+    data = tmp.read_bytes()
+    first, sep, rest = data.partition(b"\n")
+    fields = first.split(b"\t")
+    if fields and fields[0] == b"PathFileType" and len(fields) >= 4:
+        fields[3] = name.encode("utf-8")
+        tmp.write_bytes(b"\t".join(fields) + sep + rest)
+
+
+def _read_trc(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    osim = quiet_opensim()
+    table = _open_table(osim, path, "TimeSeriesTableVec3", "TRC file")
+    if not table.hasTableMetaDataKey("Units"):
+        raise LoperInputError(f"{path}: the TRC header does not declare Units; cannot tell mm from m")
+    unit = table.getTableMetaDataAsString("Units").strip()
+    if unit.lower() not in LENGTH_UNITS_PER_M:
+        raise LoperInputError(f"{path}: unknown TRC Units '{unit}'; expected one of {', '.join(LENGTH_UNITS_PER_M)}")
+    labels = list(table.getColumnLabels())
+    t = np.array(table.getIndependentColumn(), dtype=float)
+    if not labels:
+        return t, np.zeros((t.size, 0, 3)), labels
+    flat_table = table.flatten(["_x", "_y", "_z"])  # keep temporaries alive
+    matrix = flat_table.getMatrix()
+    flat = np.array(matrix.to_numpy(), dtype=float, copy=True)
+    return t, flat.reshape(t.size, len(labels), 3) / LENGTH_UNITS_PER_M[unit.lower()], labels
+
+
+def read_markers(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Marker trajectories in metres from a ``.trc`` (OpenSim) or ``.c3d`` (ezc3d) file.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.trc`` or ``.c3d`` file (suffix case-insensitive).
+
+    Returns
+    -------
+    time_s : numpy.ndarray
+        Shape (n_frames,), s (the TRC's Time column; for a C3D
+        ``(first_frame + k) / point_rate``).
+    markers_m : numpy.ndarray
+        Shape (n_frames, n_markers, 3), m, NaN where missing.
+    labels : list of str
+        Marker names, in file order.
+
+    Raises
+    ------
+    LoperInputError
+        Unknown suffix, missing or unreadable file, units not declared or
+        unknown (see also :func:`~loper_analysis.io.c3d.read_c3d`).
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".trc":
+        return _read_trc(path)
+    if suffix == ".c3d":
+        rec = read_c3d(path)
+        return rec.time_s, rec.markers_m, list(rec.marker_labels)
+    raise LoperInputError(f"{path}: unknown marker file type '{path.suffix}'; expected .trc or .c3d")
+
+
+# ---------------------------------------------------------------- MOT / STO
+
+
+def _check_mot_suffix(path: Path) -> None:
+    if path.suffix.lower() not in (".mot", ".sto"):
+        raise LoperInputError(f"{path}: expected a .mot or .sto file, got suffix '{path.suffix}'")
+
+
+def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = True) -> Path:
+    """Write coordinate trajectories to an OpenSim ``.mot``/``.sto`` file with ``STOFileAdapter``, atomically.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Target ``.mot`` or ``.sto`` file; its directory must exist.
+    frame : pandas.DataFrame
+        Column ``time_s`` (s, finite, strictly increasing, >= 1 row) plus at
+        least one coordinate column: rad, or m for names ending in ``_tx``,
+        ``_ty``, ``_tz``. Names without whitespace; NaN is written as ``nan``.
+    in_degrees : bool
+        Print angles in degrees and declare ``inDegrees=yes`` (OpenSim's
+        usual .mot); otherwise rad and ``inDegrees=no``.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    LoperInputError
+        Wrong suffix, no ``time_s`` or no coordinate column, bad names,
+        non-numeric or infinite values, bad times, a failed write.
+    """
+    path = Path(path)
+    source = str(path)
+    _check_mot_suffix(path)
+    if not isinstance(frame, pd.DataFrame) or "time_s" not in frame.columns:
+        raise LoperInputError(f"{source}: frame must be a DataFrame with a 'time_s' column")
+    names = _check_names([c for c in frame.columns if c != "time_s"], "coordinate columns", source)
+    if not names or "time" in names:
+        raise LoperInputError(f"{source}: frame needs coordinate column(s) besides time_s (and none named 'time')")
+    t = _check_time(frame["time_s"].to_numpy(dtype=float), source, min_rows=1)
+    values = np.empty((t.size, len(names)))
+    for j, name in enumerate(names):
+        if not pd.api.types.is_numeric_dtype(frame[name].dtype) or pd.api.types.is_bool_dtype(frame[name].dtype):
+            raise LoperInputError(f"{source}: column '{name}' is not numeric ({frame[name].dtype})")
+        col = frame[name].to_numpy(dtype=float)
+        if np.any(np.isinf(col)):
+            raise LoperInputError(f"{source}: column '{name}' is infinite at row {int(np.flatnonzero(np.isinf(col))[0])}")
+        values[:, j] = col if (_is_translation(name) or not in_degrees) else np.degrees(col)
+    osim = quiet_opensim()
+    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(values), names)
+    table.addTableMetaDataString("header", "Coordinates")
+    table.addTableMetaDataString("inDegrees", "yes" if in_degrees else "no")
+    with _staged_output(path, "motion file") as tmp:
+        try:
+            osim.STOFileAdapter().write(table, str(tmp))
+        except Exception as exc:
+            raise LoperInputError(f"{source}: OpenSim could not write the motion file: {exc}") from exc
+    return path
+
+
+def read_mot(path: str | os.PathLike) -> pd.DataFrame:
+    """Read an OpenSim ``.mot``/``.sto`` coordinate file (any OpenSim version) with angles in rad.
+
+    Parameters
+    ----------
+    path : str or path-like
+        ``.mot`` or ``.sto`` file with an ``inDegrees=yes|no`` header line.
+
+    Returns
+    -------
+    pandas.DataFrame
+        ``time_s`` (s) plus one float64 column per file column, in file
+        order: rad (converted from degrees when ``inDegrees=yes``), or m for
+        names ending in ``_tx``, ``_ty``, ``_tz``.
+
+    Raises
+    ------
+    LoperInputError
+        Wrong suffix, missing or unreadable file, ``inDegrees`` absent or
+        not yes/no.
+    """
+    path = Path(path)
+    _check_mot_suffix(path)
+    osim = quiet_opensim()
+    table = _open_table(osim, path, "TimeSeriesTable", "motion file")
+    if not table.hasTableMetaDataKey("inDegrees"):
+        raise LoperInputError(f"{path}: the header does not declare inDegrees; cannot tell degrees from radians")
+    flag = table.getTableMetaDataAsString("inDegrees").strip().lower()
+    if flag not in ("yes", "no"):
+        raise LoperInputError(f"{path}: header inDegrees must be yes or no, got '{flag}'")
+    names = list(table.getColumnLabels())
+    t = np.array(table.getIndependentColumn(), dtype=float)
+    matrix = table.getMatrix()
+    values = np.array(matrix.to_numpy(), dtype=float, copy=True).reshape(t.size, len(names))
+    out = {"time_s": t}
+    for j, name in enumerate(names):
+        col = values[:, j]
+        out[name] = np.radians(col) if flag == "yes" and not _is_translation(name) else col
+    return pd.DataFrame(out)
