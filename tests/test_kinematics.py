@@ -138,3 +138,43 @@ def test_tsv_tasks_and_bad_input(model_path, synthetic, tmp_path):
         inverse_kinematics(model_path, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
     with pytest.raises(LoperInputError, match="coordinate task on 'knee_angle_r'"):
         inverse_kinematics(model_path, t, X, list(MARKERS), None, {"knee_angle_r": (1.0, None)})
+
+
+def test_chunks_join_seamlessly(model_path, synthetic):
+    from loper_analysis.kinematics import chunk_frames, join_chunks
+
+    t, truth, X = synthetic
+    whole = inverse_kinematics(model_path, t, X, list(MARKERS)).frame()
+    parts = []
+    for c in range(3):
+        sel = chunk_frames(len(t), 3, c)
+        parts.append(inverse_kinematics(model_path, t[sel], X[sel], list(MARKERS)).frame())
+    assert [len(p) for p in parts] == [85, 86, 85]
+    joined = join_chunks(parts)
+    np.testing.assert_array_equal(joined.time_s, whole.time_s)
+    np.testing.assert_allclose(joined.drop(columns="time_s"), whole.drop(columns="time_s"), atol=1e-7)
+    with pytest.raises(LoperInputError, match="chunk 1: starts at t = 0.0000"):
+        join_chunks([parts[0], parts[0]])
+    with pytest.raises(LoperInputError, match="gap"):
+        join_chunks([parts[0], parts[2]])
+    with pytest.raises(LoperInputError, match="chunk must lie in 0 .. 2"):
+        chunk_frames(10, 3, 3)
+
+
+def test_joint_angle_table_maps_names_and_signs():
+    import pandas as pd
+
+    from loper_analysis.kinematics import DEFAULT_COORDINATE_MAP, joint_angle_table
+
+    coords = pd.DataFrame({"time_s": [0.0, 0.01], "pelvis_tilt": [0.1, 0.2], "pelvis_tx": [0.5, 0.6],
+                           **{c: [0.3, 0.4] for c, _ in list(DEFAULT_COORDINATE_MAP.values())[2:]}})
+    angles = joint_angle_table(coords)
+    np.testing.assert_allclose(angles.pelvis_angle_rad, [-0.1, -0.2])
+    np.testing.assert_allclose(angles.knee_left_rad, [0.3, 0.4])
+    gait2392 = {"pelvis_angle": {"coordinate": "pelvis_tilt", "sign": -1},
+                "knee_left": {"coordinate": "knee_angle_l", "sign": -1}}
+    angles = joint_angle_table(coords.rename(columns={"knee_flexion_l": "knee_angle_l"}), gait2392)
+    assert list(angles.columns) == ["time_s", "pelvis_angle_rad", "knee_left_rad"]
+    np.testing.assert_allclose(angles.knee_left_rad, [-0.3, -0.4])
+    with pytest.raises(LoperInputError, match="coordinate 'knee_angle_l'"):
+        joint_angle_table(coords, gait2392, source="trial.mot")

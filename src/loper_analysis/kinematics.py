@@ -31,6 +31,11 @@ __all__ = [
     "markers_table",
     "inverse_kinematics",
     "read_ik_tasks",
+    "chunk_frames",
+    "join_chunks",
+    "DEFAULT_COORDINATE_MAP",
+    "ANGLE_COLUMNS",
+    "joint_angle_table",
 ]
 
 
@@ -238,3 +243,88 @@ def read_ik_tasks(path) -> tuple[dict[str, float], dict[str, tuple[float, float 
         else:
             raise LoperInputError(f"{path}: row {row_no}, column kind: {r.kind!r} is not 'marker' or 'coordinate'")
     return markers, coords
+
+
+def chunk_frames(n_frames: int, n_chunks: int, chunk: int) -> slice:
+    """Frames of time chunk ``chunk`` (0-based) of ``n_chunks`` near-equal chunks of a trial of ``n_frames``.
+
+    The chunks tile the trial without overlap. IK solves every frame on its
+    own (the previous frame is only the starting guess), so chunks solved
+    separately join seamlessly (:func:`join_chunks`; checked against one run
+    in ``tests/test_kinematics.py``).
+    """
+    if n_chunks < 1 or not 0 <= chunk < n_chunks:
+        raise LoperInputError(f"chunk must lie in 0 .. {n_chunks - 1} (n_chunks = {n_chunks}), got {chunk}")
+    if n_frames < n_chunks:
+        raise LoperInputError(f"a trial of {n_frames} frames cannot be split into {n_chunks} chunks")
+    edges = np.linspace(0, n_frames, n_chunks + 1).round().astype(int)
+    return slice(int(edges[chunk]), int(edges[chunk + 1]))
+
+
+def join_chunks(frames: list[pd.DataFrame], sources: list[str] | None = None) -> pd.DataFrame:
+    """Concatenate IK chunks (``time_s`` + coordinates) in order; refuse gaps, overlaps or differing columns."""
+    if not frames:
+        raise LoperInputError("no IK chunk to join")
+    sources = sources or [f"chunk {i}" for i in range(len(frames))]
+    cols = list(frames[0].columns)
+    for f, src in zip(frames[1:], sources[1:]):
+        if list(f.columns) != cols:
+            raise LoperInputError(f"{src}: columns {list(f.columns)} differ from {sources[0]}'s {cols}")
+    for a, b, src in zip(frames[:-1], frames[1:], sources[1:]):
+        if len(a) < 2 or len(b) < 1:
+            raise LoperInputError(f"{src}: an IK chunk needs at least 2 frames")
+        step = float(np.median(np.diff(a["time_s"].to_numpy())))
+        gap = float(b["time_s"].iloc[0] - a["time_s"].iloc[-1])
+        if not 0.5 * step < gap < 1.5 * step:
+            raise LoperInputError(
+                f"{src}: starts at t = {b['time_s'].iloc[0]:.6f} s, {gap:.6f} s after the previous chunk's last frame "
+                f"(expected one frame, {step:.6f} s): chunks overlap or leave a gap"
+            )
+    return pd.concat(frames, ignore_index=True)
+
+
+#: Our angle columns (swing-leg convention, DESIGN.md section 4) -> (model coordinate, sign) for the generic model.
+#: ``pelvis_angle`` is the swing-leg model's theta_pelvis (= -pelvis_tilt of the OpenSim model).
+DEFAULT_COORDINATE_MAP: dict[str, tuple[str, float]] = {
+    "pelvis_x": ("pelvis_tx", 1.0),
+    "pelvis_angle": ("pelvis_tilt", -1.0),
+    "hip_left": ("hip_flexion_l", 1.0),
+    "knee_left": ("knee_flexion_l", 1.0),
+    "ankle_left": ("ankle_dorsiflexion_l", 1.0),
+    "hip_right": ("hip_flexion_r", 1.0),
+    "knee_right": ("knee_flexion_r", 1.0),
+    "ankle_right": ("ankle_dorsiflexion_r", 1.0),
+}
+#: Column of each mapped quantity in the angle tables (SI unit in the name).
+ANGLE_COLUMNS: dict[str, str] = {k: (f"{k}_m" if k == "pelvis_x" else f"{k}_rad") for k in DEFAULT_COORDINATE_MAP}
+
+
+def joint_angle_table(coordinates: pd.DataFrame, coordinate_map: dict | None = None, source: str = "") -> pd.DataFrame:
+    """Tidy table of our joint angles from model coordinates (rad, m).
+
+    ``coordinates`` has ``time_s`` plus model coordinate columns (rad or m);
+    ``coordinate_map`` maps each of :data:`ANGLE_COLUMNS`' keys to
+    ``(coordinate, sign)`` or ``{"coordinate": name, "sign": ±1}`` (a user
+    model such as gait2392: ``knee_left: [knee_angle_l, -1]``). Returns
+    ``time_s`` plus one column per mapped quantity, flexion / dorsiflexion
+    positive, pelvis angle as theta_pelvis of the swing-leg model.
+    """
+    cmap = DEFAULT_COORDINATE_MAP if coordinate_map is None else coordinate_map
+    unknown = sorted(set(cmap) - set(ANGLE_COLUMNS))
+    if unknown:
+        raise LoperInputError(f"coordinate map: unknown key(s) {unknown}; known: {sorted(ANGLE_COLUMNS)}")
+    out = {"time_s": coordinates["time_s"].to_numpy(float)}
+    for key, column in ANGLE_COLUMNS.items():
+        if key not in cmap:
+            continue
+        entry = cmap[key]
+        name, sign = (entry["coordinate"], entry["sign"]) if isinstance(entry, dict) else entry
+        if float(sign) not in (1.0, -1.0):
+            raise LoperInputError(f"coordinate map, key {key}: sign must be 1 or -1, got {sign}")
+        if name not in coordinates.columns:
+            raise LoperInputError(
+                f"{source or 'coordinates'}: coordinate '{name}' (coordinate map, key {key}) is not among "
+                f"{[c for c in coordinates.columns if c != 'time_s']}"
+            )
+        out[column] = float(sign) * coordinates[name].to_numpy(float)
+    return pd.DataFrame(out)
