@@ -4,12 +4,15 @@ Subcommands
 -----------
 segments     write the swing-leg segment table of a subject from height and mass
 validate     run (part of) the validation study and write its tables
+ik           OpenSim inverse kinematics of a marker file (.c3d or .trc) to a .mot
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+
+import numpy as np
 
 from .errors import LoperInputError
 
@@ -27,6 +30,43 @@ def _validate(args: argparse.Namespace) -> None:
 
     settings = ValidationSettings(n_starts=args.n_starts, seed=args.seed)
     validation_chunk_tables(args.segments, settings, args.chunk, args.n_chunks, args.errors, args.fits)
+
+
+def _ik(args: argparse.Namespace) -> None:
+    from pathlib import Path
+
+    from .kinematics import inverse_kinematics, read_ik_tasks
+    from .io.tables import read_markers, write_mot
+    from .markers import rotate_markers
+
+    markers_path = Path(args.markers)
+    time_s, markers_m, labels = read_markers(markers_path)
+    rotation = args.rotate_deg
+    if rotation is None:
+        rotation = (-90.0, 0.0, 0.0) if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
+    markers_m = rotate_markers(markers_m, rotation)
+    start = time_s[0] if args.start is None else args.start
+    end = time_s[-1] if args.end is None else args.end
+    sel = (time_s >= start - 1e-9) & (time_s <= end + 1e-9)
+    if not sel.any():
+        raise LoperInputError(
+            f"{markers_path}: no frame between --start {start} and --end {end} s "
+            f"(the file spans {time_s[0]:.4f} .. {time_s[-1]:.4f} s)"
+        )
+    weights, coordinate_tasks = (None, None) if args.tasks is None else read_ik_tasks(args.tasks)
+    if weights is not None and not weights:
+        weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
+    try:
+        result = inverse_kinematics(
+            args.model, time_s[sel], markers_m[sel], labels, weights, coordinate_tasks, accuracy=args.accuracy
+        )
+    except LoperInputError as exc:
+        raise LoperInputError(f"{markers_path} with {args.model}: {exc}") from None
+    write_mot(args.out, result.frame(), in_degrees=True)
+    print(
+        f"{args.out}: {sel.sum()} frames, marker error RMS {1e3 * np.nanmean(result.marker_rms_m):.2f} mm "
+        f"(max {1e3 * np.nanmax(result.marker_max_m):.2f} mm)"
+    )
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -47,6 +87,19 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--errors", required=True, help="output TSV, one row per combination x condition x parameter")
     p.add_argument("--fits", required=True, help="output TSV, one row per combination x condition")
     p.set_defaults(func=_validate)
+    p = sub.add_parser("ik", help="OpenSim inverse kinematics of a .c3d or .trc marker file to a .mot (degrees)")
+    p.add_argument("--model", required=True, help="OpenSim model (.osim)")
+    p.add_argument("--markers", required=True, help="marker file: .c3d (units from POINT:UNITS) or .trc (Units header)")
+    p.add_argument("--out", required=True, help="output .mot (angles in degrees, OpenSim's convention)")
+    p.add_argument("--tasks", help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: every "
+                   "model marker found in the file, weight 1")
+    p.add_argument("--start", type=float, help="first time (s) to solve")
+    p.add_argument("--end", type=float, help="last time (s) to solve")
+    p.add_argument("--rotate-deg", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                   help="rotate the markers about the fixed X, Y, Z axes (degrees) into the model frame; default "
+                   "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc")
+    p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
+    p.set_defaults(func=_ik)
     args = parser.parse_args(argv)
     try:
         args.func(args)
