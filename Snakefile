@@ -13,6 +13,8 @@ report: "workflow/report/workflow.rst"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/validation.smk"
 include: "workflow/rules/device.smk"
+include: "workflow/rules/processing.smk"
+include: "workflow/rules/synthetic.smk"
 
 
 rule all:

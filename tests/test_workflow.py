@@ -23,6 +23,12 @@ def _project(tmp: Path, **changes) -> Path:
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     cfg["validation"].update(stiffness_levels_nm_per_rad=[0.0, 150.0], damping_levels_nms_per_rad=[0.0, 4.0], n_chunks=2)
     cfg["identification"]["n_starts"] = 3
+    # one synthetic subject, short trials, one perturbation trial
+    (tmp / "config/subjects.tsv").write_text(
+        "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
+    )
+    cfg["synthetic"]["walking_duration_s"] = 25.0
+    cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     for key, value in changes.items():
         section, _, name = key.partition("__")
         if name:
@@ -72,17 +78,40 @@ def test_rerun_does_nothing_and_report_builds(finished_run):
     res = _snakemake(finished_run, "--report", "report.html")
     assert res.returncode == 0, res.stderr[-3000:]
     html = (finished_run / "report.html").read_bytes()
-    assert len(html) > 10_000 and b"errors.png" in html
+    assert len(html) > 10_000 and b"errors.png" in html and b"transparency.png" in html
 
 
 def test_same_config_gives_same_bytes(finished_run, tmp_path):
     work = _project(tmp_path)
-    res = _snakemake(work, "results/validation/summary.tsv")
+    raw = ["data/raw/S01/static.c3d", "data/raw/S01/walk-device.c3d", "data/raw/S01/walk-device.loper.tsv"]
+    res = _snakemake(work, "results/validation/summary.tsv", *raw)
     assert res.returncode == 0, res.stderr[-3000:]
     for name in ("errors.tsv", "fits.tsv", "summary.tsv"):
         assert (work / "results/validation" / name).read_bytes() == (
             finished_run / "results/validation" / name
         ).read_bytes(), name
+    for name in raw:
+        assert (work / name).read_bytes() == (finished_run / name).read_bytes(), name
+
+
+def test_processing_outputs_from_the_default_run(finished_run):
+    results = finished_run / "results"
+    for trial in ("walk-nodevice", "walk-device", "pert050-1"):
+        strides = pd.read_csv(results / f"strides/S01/{trial}.strides.tsv", sep="\t")
+        # 25 s at 36 strides/min: 13-14 complete left strides, at most 20 % removed as outliers
+        assert 12 <= len(strides) <= 15 and strides.removed.sum() <= 0.2 * len(strides), trial
+        np.testing.assert_allclose(strides.duration_s.mean(), 60 / 36, rtol=0.05)
+    angles = pd.read_csv(results / "ik/S01/walk-device.angles.tsv", sep="\t")
+    assert len(angles) == 25 * 128 and np.ptp(angles.knee_left_rad) > np.deg2rad(45)
+    rmsd = pd.read_csv(results / "transparency/rmsd.tsv", sep="\t")
+    assert len(rmsd) == 12 and set(rmsd.subject) == {"S01", "all"}
+    # the synthetic subject walks the same with and without the device
+    assert rmsd.transparent.all() and (rmsd.rmsd_rad < rmsd.isv_ave_rad).all()
+    force = pd.read_csv(results / "transparency/force.tsv", sep="\t").set_index(["subject", "phase"])
+    for phase in ("stance", "swing"):
+        row = force.loc[("S01", phase)]
+        assert abs(row.rms_force_mean_n / row.study_rms_force_mean_n - 1) <= 0.3, (phase, row.rms_force_mean_n)
+    assert (results / "transparency/transparency.png").stat().st_size > 20_000
 
 
 @pytest.mark.parametrize(

@@ -26,6 +26,11 @@ if subjects["subject"].duplicated().any():
     raise WorkflowError(f"{_subjects_path}: subject '{dup}' appears twice")
 
 SUBJECT_SOURCE = dict(zip(subjects["subject"], subjects["source"]))
+#: subject -> {column: value} of the subject sheet, empty cells left out
+SUBJECT_ROWS = {
+    r["subject"]: {k: v for k, v in r.items() if not (isinstance(v, float) and pd.isna(v))}
+    for r in subjects.to_dict("records")
+}
 if config["device"]["subject"] not in SUBJECT_SOURCE:
     raise WorkflowError(
         f"config key 'device.subject': subject '{config['device']['subject']}' is not in {_subjects_path}"
@@ -39,6 +44,7 @@ VALIDATION_CHUNKS = [f"{i:03d}" for i in range(config["validation"]["n_chunks"])
 wildcard_constraints:
     subject=r"[A-Za-z0-9-]+",
     chunk=r"[0-9]{3}",
+    trial=r"[A-Za-z0-9-]+",
 
 
 def validation_settings() -> dict:
@@ -72,9 +78,54 @@ def validation_settings() -> dict:
     )
 
 
+def perturbation_trials() -> list[str]:
+    """Trial IDs of the impedance experiment: pert{onset:03d}-{k}."""
+    t = config["trials"]
+    return [f"pert{onset:03d}-{k}" for onset in t["perturbation_onsets_ms"] for k in range(1, t["perturbation_repeats"] + 1)]
+
+
+def walking_trials() -> list[str]:
+    """Every walking trial of the design: the transparency pair, then the perturbation trials."""
+    return [config["trials"]["no_device"], config["trials"]["device"], *perturbation_trials()]
+
+
+def subject_trials(subject: str) -> list[str]:
+    """Walking trials of a subject: all for a synthetic one, those with a raw C3D on disk for a recorded one."""
+    if SUBJECT_SOURCE[subject] == "synthetic":
+        return walking_trials()
+    raw = Path("data/raw") / subject
+    return [t for t in walking_trials() if (raw / f"{t}.c3d").is_file()]
+
+
+def processed_subjects() -> list[str]:
+    """Synthetic subjects and recorded subjects with a static trial on disk: their walking trials are processed."""
+    static = config["trials"]["static"]
+    return [s for s, src in SUBJECT_SOURCE.items()
+            if src == "synthetic" or (Path("data/raw") / s / f"{static}.c3d").is_file()]
+
+
+def transparency_subjects() -> list[str]:
+    """Processed subjects with both walking trials of the transparency experiment."""
+    pair = {config["trials"]["no_device"], config["trials"]["device"]}
+    return [s for s in processed_subjects() if pair <= set(subject_trials(s))]
+
+
+def processing_targets() -> list[str]:
+    """Stride tables of every processed trial, the segment tables and the transparency analysis."""
+    out = []
+    for s in processed_subjects():
+        out.append(f"results/model/{s}/segments.tsv")
+        out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
+    if transparency_subjects():
+        out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",
+                "results/transparency/transparency.png"]
+    return out
+
+
 def all_targets() -> list[str]:
     """Everything `snakemake` builds by default."""
     return [
+        *processing_targets(),
         "results/validation/summary.tsv",
         "results/validation/errors.tsv",
         "results/validation/fits.tsv",

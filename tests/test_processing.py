@@ -1,0 +1,120 @@
+"""The processing chain on a synthetic trial with known kinematics, events and clocks.
+
+Raw files are written by the synthetic lab (C3D with noisy markers and gaps in
+the lab frame, GRF and sync analogs; robot log on a drifting clock); every
+step reads them back from disk.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from loper_analysis import processing
+from loper_analysis.device.controller import DeviceParameters
+from loper_analysis.errors import LoperInputError
+from loper_analysis.kinematics import joint_angle_table
+from loper_analysis.model import build_lower_body_model
+from loper_analysis.synthetic.gait import leg_length_from_height
+from loper_analysis.synthetic.trials import (
+    LabSettings,
+    synthetic_static_file,
+    walking_with_margins,
+    write_walking_trial,
+)
+
+HEIGHT, MASS = 1.75, 70.0
+LAB = LabSettings()
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    d = tmp_path_factory.mktemp("lab")
+    synthetic_static_file(d / "static.c3d", "S99", HEIGHT, MASS, 2.0, LAB, 7)
+    full, events = walking_with_margins(20.0, LAB, np.random.default_rng(3), 0.03, 0.05, leg_length_from_height(HEIGHT))
+    model = build_lower_body_model(HEIGHT, MASS)
+    write_walking_trial(d / "walk.c3d", model, full, events, MASS, LAB, 11, d / "walk.loper.tsv",
+                        DeviceParameters(), 0.35, duration_s=20.0)
+    coords = full[(full.time_s >= 0) & (full.time_s < 20.0 - 1e-9)].reset_index(drop=True)
+    events = events[(events.time_s >= 0) & (events.time_s <= 20.0)]
+    # the chain
+    processing.process_markers(d / "static.c3d", d / "static.trc", duration_s=1.0)
+    gaps = processing.process_markers(d / "walk.c3d", d / "walk.trc", d / "walk.gaps.tsv")
+    processing.model_generic(d / "generic.osim", HEIGHT, MASS)
+    processing.model_scaled(d / "generic.osim", d / "static.trc", d / "scaled.osim", MASS)
+    for c in range(2):
+        processing.ik_chunk(d / "scaled.osim", d / "walk.trc", d / f"walk.{c}.mot", c, 2)
+    angles = processing.ik_join([d / "walk.0.mot", d / "walk.1.mot"], d / "walk.mot", d / "walk.angles.tsv")
+    found = processing.detect_events(d / "walk.c3d", d / "walk.events.tsv", {"left": "Fz_left", "right": "Fz_right"})
+    force = processing.loadcell_forces(d / "walk.c3d", d / "walk.loper.tsv", d / "walk.force.tsv")
+    strides = processing.cut_strides(d / "walk.angles.tsv", d / "walk.events.tsv", d / "walk.strides.tsv",
+                                     d / "walk.cycles.tsv", d / "walk.force.tsv")
+    return dict(dir=d, coords=coords, events=events, gaps=gaps, angles=angles, found=found, force=force,
+                strides=strides)
+
+
+def test_gaps_written_by_the_lab_are_filled(lab):
+    assert len(lab["gaps"]) == LAB.n_gaps
+    assert (lab["gaps"]["n_frames"] <= LAB.max_gap_frames).all()
+
+
+def test_ik_recovers_the_simulated_angles(lab):
+    truth = joint_angle_table(lab["coords"])
+    angles = lab["angles"]
+    np.testing.assert_allclose(angles["time_s"], truth["time_s"], atol=1e-9)
+    for col in ("hip_left_rad", "knee_left_rad", "ankle_left_rad", "hip_right_rad", "knee_right_rad"):
+        err = np.abs(angles[col] - truth[col])[64:-64]  # half a second off the filter's ends
+        # 0.5 mm marker noise, 40 Hz low-pass, scaled model: well under a degree
+        assert err.max() < np.deg2rad(1.0), (col, np.rad2deg(err.max()))
+
+
+def test_events_within_one_analog_sample(lab):
+    true, found = lab["events"], lab["found"]
+    for (side, event), group in true.groupby(["side", "event"]):
+        f = found[(found.side == side) & (found.event == event)]["time_s"].to_numpy()
+        t = group["time_s"].to_numpy()
+        t = t[(t > f.min() - 0.1) & (t < f.max() + 0.1)]
+        assert len(f) == len(t), (side, event, len(f), len(t))
+        assert np.abs(f - t).max() <= 1.0 / LAB.analog_rate_hz, (side, event, np.abs(f - t).max())
+
+
+def test_loadcell_force_on_the_mocap_clock(lab):
+    force = lab["force"]
+    cm = force.attrs["clock_map"]
+    # the mapped time is right within half a robot sample over the whole trial
+    t = np.array([0.0, 20.0])
+    true = -LAB.clock_offset_s + (1 + 1e-6 * LAB.clock_drift_ppm) * (t + LAB.clock_offset_s)
+    assert np.abs(cm.to_mocap(t + LAB.clock_offset_s) - true).max() < 0.5e-3
+    assert force["force_measured_n"].notna().all()
+    rms = float(np.sqrt(np.mean(force["force_measured_n"] ** 2)))
+    assert 1.5 < rms < 3.0, rms  # minimal-impedance walking: about 2 N in the study
+    assert force["force_measured_n"].abs().max() < 10.0  # no start transient, no safety stop
+
+
+def test_strides_and_outliers(lab):
+    strides = lab["strides"]
+    hs = lab["events"].query("side == 'left' and event == 'heel_strike'")["time_s"].to_numpy()
+    assert len(strides) >= len(hs) - 3
+    np.testing.assert_allclose(strides["duration_s"].mean(), 60 / 36, rtol=0.05)
+    assert strides["removed"].sum() <= 0.2 * len(strides)
+    assert {"rms_force_stance_n", "max_abs_force_swing_n"} <= set(strides.columns)
+    cycles = pd.read_csv(lab["dir"] / "walk.cycles.tsv", sep="\t")
+    assert len(cycles) == 3 * 101 * len(strides)
+
+
+def test_model_marker_missing_from_the_trial_is_named(lab, tmp_path):
+    from loper_analysis.io.tables import read_markers, write_trc
+
+    t, X, labels = read_markers(lab["dir"] / "walk.trc")
+    i = labels.index("LKNE")
+    write_trc(tmp_path / "cut.trc", t, np.delete(X, i, axis=1), labels[:i] + labels[i + 1:])
+    with pytest.raises(LoperInputError, match=r"cut.trc: marker\(s\) \['LKNE'\]"):
+        processing.ik_chunk(lab["dir"] / "scaled.osim", tmp_path / "cut.trc", tmp_path / "x.mot", 0, 1)
+    assert not (tmp_path / "x.mot").exists()
+
+
+def test_missing_belt_channel_is_named(lab, tmp_path):
+    with pytest.raises(LoperInputError, match="Fz_belt3"):
+        processing.detect_events(lab["dir"] / "walk.c3d", tmp_path / "e.tsv", {"left": "Fz_belt3", "right": "Fz_right"})
+    assert not (tmp_path / "e.tsv").exists()

@@ -1,0 +1,220 @@
+# Processing: raw C3D + robot log -> markers (TRC) -> scaled OpenSim model -> IK (chunked) -> events -> forces.
+
+TRIALS = config["trials"]
+FILTER = config["filter"]
+OPENSIM = config["opensim"]
+EVENTS = config["events"]
+IK_CHUNKS = [f"{i:03d}" for i in range(OPENSIM["ik_chunks"])]
+
+
+def subject_model(wildcards):
+    """The subject's OpenSim model: user-supplied (subjects.tsv column model_osim) or scaled from the static trial."""
+    user = SUBJECT_ROWS[wildcards.subject].get("model_osim")
+    return user if user else f"results/model/{wildcards.subject}/scaled.osim"
+
+
+rule markers:
+    input:
+        "data/raw/{subject}/{trial}.c3d",
+    output:
+        trc="results/markers/{subject}/{trial}.trc",
+        gaps="results/markers/{subject}/{trial}.gaps.tsv",
+    params:
+        rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
+        max_gap_frames=config["markers"]["max_gap_frames"],
+        cutoff_hz=FILTER["cutoff_hz"],
+        order=FILTER["order"],
+        duration_s=lambda wc: config["markers"]["static_duration_s"] if wc.trial == TRIALS["static"] else None,
+    log:
+        "results/logs/markers/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/markers/{subject}/{trial}.tsv"
+    script:
+        "../scripts/markers.py"
+
+
+rule model_generic:
+    output:
+        "results/model/{subject}/generic.osim",
+    params:
+        height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
+        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
+    log:
+        "results/logs/model_generic/{subject}.log",
+    script:
+        "../scripts/model_generic.py"
+
+
+rule model_scaled:
+    input:
+        generic="results/model/{subject}/generic.osim",
+        static=f"results/markers/{{subject}}/{TRIALS['static']}.trc",
+    output:
+        "results/model/{subject}/scaled.osim",
+    params:
+        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
+    log:
+        "results/logs/model_scaled/{subject}.log",
+    benchmark:
+        "results/benchmarks/model_scaled/{subject}.tsv"
+    script:
+        "../scripts/model_scaled.py"
+
+
+rule model_segments:
+    input:
+        subject_model,
+    output:
+        "results/model/{subject}/segments.tsv",
+    params:
+        side=TRIALS["perturbed_side"],
+        height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
+        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
+        user_model=lambda wc: bool(SUBJECT_ROWS[wc.subject].get("model_osim")),
+    log:
+        "results/logs/model_segments/{subject}.log",
+    script:
+        "../scripts/model_segments.py"
+
+
+rule ik_chunk:
+    input:
+        model=subject_model,
+        trc="results/markers/{subject}/{trial}.trc",
+    output:
+        temp("results/ik/{subject}/{trial}.chunk{chunk}.mot"),
+    params:
+        n_chunks=OPENSIM["ik_chunks"],
+        tasks_file=OPENSIM["ik_tasks"],
+        default_weight=OPENSIM["default_marker_weight"],
+        marker_weights=OPENSIM["marker_weights"],
+        coordinate_tasks=OPENSIM["coordinate_tasks"],
+        accuracy=OPENSIM["accuracy"],
+    log:
+        "results/logs/ik_chunk/{subject}/{trial}.{chunk}.log",
+    benchmark:
+        "results/benchmarks/ik_chunk/{subject}/{trial}.{chunk}.tsv"
+    script:
+        "../scripts/ik_chunk.py"
+
+
+rule ik_join:
+    input:
+        expand("results/ik/{{subject}}/{{trial}}.chunk{chunk}.mot", chunk=IK_CHUNKS),
+    output:
+        mot="results/ik/{subject}/{trial}.mot",
+        angles="results/ik/{subject}/{trial}.angles.tsv",
+    params:
+        coordinate_map=OPENSIM["coordinate_map"],
+    log:
+        "results/logs/ik_join/{subject}/{trial}.log",
+    script:
+        "../scripts/ik_join.py"
+
+
+rule events:
+    input:
+        "data/raw/{subject}/{trial}.c3d",
+    output:
+        "results/events/{subject}/{trial}.events.tsv",
+    params:
+        grf_channels=EVENTS["grf_channels"],
+        threshold_on_n=EVENTS["threshold_on_n"],
+        threshold_off_n=EVENTS["threshold_off_n"],
+        min_stance_s=EVENTS["min_stance_s"],
+        min_swing_s=EVENTS["min_swing_s"],
+        cutoff_hz=EVENTS["grf_cutoff_hz"],
+        order=FILTER["order"],
+    log:
+        "results/logs/events/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/events/{subject}/{trial}.tsv"
+    script:
+        "../scripts/events.py"
+
+
+rule loadcell:
+    input:
+        c3d="data/raw/{subject}/{trial}.c3d",
+        log="data/raw/{subject}/{trial}.loper.tsv",
+    output:
+        "results/loadcell/{subject}/{trial}.force.tsv",
+    params:
+        sync_channel=EVENTS["sync_channel"],
+        cutoff_hz=FILTER["cutoff_hz"],
+        order=FILTER["order"],
+    log:
+        "results/logs/loadcell/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/loadcell/{subject}/{trial}.tsv"
+    script:
+        "../scripts/loadcell.py"
+
+
+def stride_force(wildcards):
+    """The interaction force of a trial walked with the device (none without it)."""
+    if wildcards.trial == TRIALS["no_device"]:
+        return []
+    return f"results/loadcell/{wildcards.subject}/{wildcards.trial}.force.tsv"
+
+
+rule strides:
+    input:
+        angles="results/ik/{subject}/{trial}.angles.tsv",
+        events="results/events/{subject}/{trial}.events.tsv",
+        force=stride_force,
+    output:
+        strides="results/strides/{subject}/{trial}.strides.tsv",
+        cycles="results/strides/{subject}/{trial}.cycles.tsv",
+    params:
+        side=TRIALS["perturbed_side"],
+        n_points=config["strides"]["n_points"],
+        whisker=config["strides"]["iqr_whisker"],
+        max_fraction=config["strides"]["max_outlier_fraction"],
+        min_valid=config["strides"]["min_valid_strides"],
+    log:
+        "results/logs/strides/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/strides/{subject}/{trial}.tsv"
+    script:
+        "../scripts/strides.py"
+
+
+def transparency_inputs(wildcards):
+    return {
+        f"{cond}_{kind}_{s}": f"results/strides/{s}/{TRIALS[cond]}.{kind}.tsv"
+        for s in transparency_subjects()
+        for cond in ("no_device", "device")
+        for kind in ("strides", "cycles")
+    }
+
+
+rule transparency:
+    input:
+        unpack(transparency_inputs),
+    output:
+        rmsd=report(
+            "results/transparency/rmsd.tsv",
+            caption="../report/transparency_rmsd.rst",
+            category="Transparency",
+            labels={"table": "RMSD vs ISV_ave"},
+        ),
+        force=report(
+            "results/transparency/force.tsv",
+            caption="../report/transparency_force.rst",
+            category="Transparency",
+            labels={"table": "interaction force"},
+        ),
+        figure=report(
+            "results/transparency/transparency.png",
+            caption="../report/transparency_figure.rst",
+            category="Transparency",
+            labels={"figure": "gait cycle with and without LOPER"},
+        ),
+    params:
+        subjects=transparency_subjects(),
+        side=TRIALS["perturbed_side"],
+    log:
+        "results/logs/transparency/transparency.log",
+    script:
+        "../scripts/transparency.py"
