@@ -118,3 +118,34 @@ def test_missing_belt_channel_is_named(lab, tmp_path):
     with pytest.raises(LoperInputError, match="Fz_belt3"):
         processing.detect_events(lab["dir"] / "walk.c3d", tmp_path / "e.tsv", {"left": "Fz_belt3", "right": "Fz_right"})
     assert not (tmp_path / "e.tsv").exists()
+
+
+def test_stride_summary_flags_too_few_strides(lab, tmp_path):
+    walk = lab["dir"] / "walk.strides.tsv"
+    table = pd.read_csv(walk, sep="\t")
+    few = table.copy()
+    few.loc[3:, "removed"] = True
+    few.loc[3:, "reason"] = "knee: 30.0 % of samples outside 1.5·IQR"
+    few.to_csv(tmp_path / "few.strides.tsv", sep="\t", index=False)
+    out = processing.stride_summary({("S99", "walk"): walk, ("S99", "few"): tmp_path / "few.strides.tsv"},
+                                    tmp_path / "summary.tsv", min_valid=5)
+    ok, flagged = out.iloc[0], out.iloc[1]
+    assert ok.status == "ok" and ok.n_strides == len(table) and ok.n_kept == (~table.removed).sum()
+    assert flagged.status == "too_few_strides" and flagged.n_kept == 3
+    assert flagged.n_removed == flagged.n_removed_knee == len(table) - 3 and flagged.n_removed_hip == 0
+    assert pd.read_csv(tmp_path / "summary.tsv", sep="\t").status.tolist() == ["ok", "too_few_strides"]
+
+
+def test_fewer_than_five_valid_strides_warn(lab, tmp_path):
+    from loper_analysis.gait import TooFewStridesWarning
+
+    d = lab["dir"]
+    events = pd.read_csv(d / "walk.events.tsv", sep="\t")
+    # keep 5 left heel strikes: 4 strides, each kept (too few for the analysis, enough for the outlier rule)
+    hs = events[(events.side == "left") & (events.event == "heel_strike")].time_s.to_numpy()
+    short = events[events.time_s <= hs[4] + 1e-9]
+    short.to_csv(tmp_path / "short.events.tsv", sep="\t", index=False)
+    with pytest.warns(TooFewStridesWarning, match="4"):
+        table = processing.cut_strides(d / "walk.angles.tsv", tmp_path / "short.events.tsv",
+                                       tmp_path / "s.strides.tsv", tmp_path / "s.cycles.tsv")
+    assert len(table) == 4 and table.attrs["too_few_strides"]

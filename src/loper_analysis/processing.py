@@ -39,6 +39,7 @@ __all__ = [
     "loadcell_forces",
     "cut_strides",
     "read_cycles",
+    "stride_summary",
     "transparency_tables",
 ]
 
@@ -356,6 +357,30 @@ def cut_strides(angles_tsv, events_tsv, strides_out, cycles_out, force_tsv=None,
         cycles.append(pd.DataFrame(block))
     write_tsv(pd.concat(cycles, ignore_index=True), cycles_out)
     write_tsv(out, strides_out)
+    return out
+
+
+def stride_summary(strides_tsvs: Mapping[tuple[str, str], str], out_tsv, min_valid: int = 5) -> pd.DataFrame:
+    """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.
+
+    ``status`` is ``ok`` or ``too_few_strides`` (fewer than ``min_valid``
+    kept: the trial is flagged, not dropped silently).
+    """
+    rows = []
+    for (subject, trial), path in strides_tsvs.items():
+        table = pd.read_csv(path, sep="\t", keep_default_na=False, na_values=[""])
+        removed = table[table["removed"]]
+        signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
+        why = {s: int(removed["reason"].fillna("").str.contains(f"{s}:").sum()) for s in signals}
+        n_kept = int((~table["removed"]).sum())
+        rows.append({
+            "subject": subject, "trial": trial, "n_strides": len(table), "n_removed": len(removed), "n_kept": n_kept,
+            **{f"n_removed_{s}": n for s, n in why.items()},
+            "mean_stride_s": table["duration_s"].mean(),
+            "status": "ok" if n_kept >= min_valid else "too_few_strides",
+        })
+    out = pd.DataFrame(rows)
+    write_tsv(out, out_tsv)
     return out
 
 

@@ -116,6 +116,8 @@ def processing_targets() -> list[str]:
     for s in processed_subjects():
         out.append(f"results/model/{s}/segments.tsv")
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
+    if out:
+        out.append("results/strides/summary.tsv")
     if transparency_subjects():
         out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",
                 "results/transparency/transparency.png"]

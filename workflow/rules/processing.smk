@@ -218,3 +218,22 @@ rule transparency:
         "results/logs/transparency/transparency.log",
     script:
         "../scripts/transparency.py"
+
+
+rule strides_summary:
+    input:
+        [f"results/strides/{s}/{t}.strides.tsv" for s in processed_subjects() for t in subject_trials(s)],
+    output:
+        report(
+            "results/strides/summary.tsv",
+            caption="../report/strides_summary.rst",
+            category="Processing",
+            labels={"table": "strides per trial"},
+        ),
+    params:
+        subject_trial=[(s, t) for s in processed_subjects() for t in subject_trials(s)],
+        min_valid=config["strides"]["min_valid_strides"],
+    log:
+        "results/logs/strides_summary/summary.log",
+    script:
+        "../scripts/strides_summary.py"
