@@ -41,10 +41,12 @@ def main(duration_s: float = 240.0) -> None:
             for k in range(1, cfg["trials"]["perturbation_repeats"] + 1)
         ]
         raw = [f"data/raw/S01/{cfg['trials']['static']}.c3d"] + [f"data/raw/S01/{t}.c3d" for t in trials]
-        run = lambda *targets: subprocess.run(  # noqa: E731
-            [sys.executable, "-m", "snakemake", "--cores", "2", "-q", *targets], cwd=work, check=True,
-            capture_output=True, text=True,
-        )
+        def run(*targets: str) -> None:
+            res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *targets, "--quiet", "all"], cwd=work,
+                                 capture_output=True, text=True)
+            if res.returncode:
+                sys.exit(res.stderr[-3000:])
+
         t0 = time.perf_counter()
         run(*raw)
         t1 = time.perf_counter()

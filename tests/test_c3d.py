@@ -359,6 +359,29 @@ def test_trc_round_trip_through_opensim(tmp_path, rng, unit, scale):
     assert first == pytest.approx(X[0, 0, 0] * scale, rel=1e-15)
 
 
+@pytest.mark.parametrize("unit", ["mm", "m"])
+def test_fast_trc_reader_equals_opensims_parser(tmp_path, rng, unit):
+    from loper_analysis.io.tables import _read_trc_text
+    from loper_analysis.model import quiet_opensim
+
+    t = np.arange(N_FRAMES) / POINT_HZ
+    X = lab_markers(rng)  # with NaN gaps
+    path = write_trc(tmp_path / "walk.trc", t, X, LABELS, unit=unit)
+    fast_t, fast_X, fast_labels = _read_trc_text(path)
+    osim = quiet_opensim()
+    table = osim.TimeSeriesTableVec3(str(path))
+    flat_table = table.flatten(["_x", "_y", "_z"])
+    matrix = flat_table.getMatrix()
+    ref = np.array(matrix.to_numpy()).reshape(fast_X.shape) / {"mm": 1000.0, "m": 1.0}[unit]
+    assert fast_labels == list(table.getColumnLabels())
+    np.testing.assert_array_equal(fast_t, np.array(table.getIndependentColumn()))
+    np.testing.assert_array_equal(fast_X, ref)  # bit for bit, NaN where OpenSim has NaN
+    # a layout it does not know goes to OpenSim's parser
+    other = tmp_path / "other.trc"
+    other.write_text(path.read_text().replace("PathFileType", "PathFileTypo", 1))
+    assert _read_trc_text(other) is None
+
+
 def test_trc_with_one_marker_round_trips(tmp_path, rng):
     # OpenSim 4.6's packVec3 refuses a single marker; the writer works around it.
     t = np.arange(5) / 100.0

@@ -16,6 +16,7 @@ OpenSim IK task-set XML or a TSV (``name``, ``kind`` = marker|coordinate,
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -171,22 +172,36 @@ def inverse_kinematics(
     solver.setAccuracy(float(accuracy))
     state.setTime(float(t[0]))
     solver.assemble(state)
-    Q = np.empty((t.size, len(names)))
+    perm = _q_order(model, state, cs)
+    Q = np.empty((t.size, state.getNQ()))
     n_m = solver.getNumMarkersInUse()
     rms = np.empty(t.size)
     mx = np.empty(t.size)
     errs = osim.SimTKArrayDouble()
-    for k in range(t.size):
-        state.setTime(float(t[k]))
-        solver.track(state)
-        for i in range(len(names)):
-            Q[k, i] = cs.get(i).getValue(state)
-        solver.computeCurrentMarkerErrors(errs)
-        e = np.array([errs.getElt(j) for j in range(n_m)])
-        e = e[np.isfinite(e)]
-        rms[k] = np.sqrt(np.mean(e**2)) if e.size else np.nan
-        mx[k] = e.max() if e.size else np.nan
-    return IKResult(time_s=t, coordinates=Q, coordinate_names=names, marker_rms_m=rms, marker_max_m=mx)
+    get_elt, track, set_time, get_q = errs.getElt, solver.track, state.setTime, state.getQ
+    compute_errors = solver.computeCurrentMarkerErrors
+    for k in range(t.size):  # the hot loop: one SWIG call per quantity, no NumPy on small arrays
+        set_time(float(t[k]))
+        track(state)
+        Q[k] = get_q().to_numpy()
+        compute_errors(errs)
+        e = [v for v in (get_elt(j) for j in range(n_m)) if v == v]
+        rms[k] = math.sqrt(math.fsum(v * v for v in e) / len(e)) if e else math.nan
+        mx[k] = max(e) if e else math.nan
+    return IKResult(time_s=t, coordinates=Q[:, perm], coordinate_names=names, marker_rms_m=rms, marker_max_m=mx)
+
+
+def _q_order(model, state, cs) -> np.ndarray:
+    """Index into the state's Q of each coordinate of the coordinate set (found by setting distinct values)."""
+    probe = model.initSystem() if state is None else state.__class__(state)
+    values = 0.001 * (np.arange(cs.getSize()) + 1)
+    for i in range(cs.getSize()):
+        cs.get(i).setValue(probe, float(values[i]), False)
+    q = probe.getQ().to_numpy()
+    perm = np.array([int(np.argmin(np.abs(q - v))) for v in values])
+    if len(set(perm.tolist())) != cs.getSize() or not np.allclose(q[perm], values):
+        raise LoperInputError(f"model {model.getName()}: coordinates do not map one to one onto the state's Q")
+    return perm
 
 
 def read_ik_tasks(path) -> tuple[dict[str, float], dict[str, tuple[float, float | None]]]:
