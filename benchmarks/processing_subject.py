@@ -1,6 +1,7 @@
 """Processing one subject's 8 walking trials end to end (read -> IK -> strides) with `snakemake -j2`.
 
-Usage: python benchmarks/processing_subject.py [walking_duration_s]   (default 240 s, the study's trials)
+Usage: python benchmarks/processing_subject.py [walking_duration_s [ik_chunks]]
+       (defaults: 240 s, the study's trials; the config's opensim.ik_chunks)
 
 Copies the workflow into a temporary directory with one synthetic subject,
 generates its raw files first (not timed: C3D + robot logs, as a lab records
@@ -24,7 +25,7 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def main(duration_s: float = 240.0) -> None:
+def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for item in ("Snakefile", "workflow", "config"):
@@ -32,6 +33,8 @@ def main(duration_s: float = 240.0) -> None:
             (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
         cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
         cfg["synthetic"]["walking_duration_s"] = duration_s
+        if ik_chunks is not None:
+            cfg["opensim"]["ik_chunks"] = ik_chunks
         (work / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
         (work / "config/subjects.tsv").write_text(
             "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
@@ -70,4 +73,4 @@ def main(duration_s: float = 240.0) -> None:
 
 
 if __name__ == "__main__":
-    main(float(sys.argv[1]) if len(sys.argv) > 1 else 240.0)
+    main(float(sys.argv[1]) if len(sys.argv) > 1 else 240.0, int(sys.argv[2]) if len(sys.argv) > 2 else None)

@@ -33,11 +33,14 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .dynamics import SegmentParameters
 from .errors import LoperInputError
+
+if TYPE_CHECKING:  # the dynamics (numba kernels) load only when a segment table is made
+    from .dynamics import SegmentParameters
 
 __all__ = [
     "SIDES",
@@ -201,6 +204,8 @@ def segment_parameters_from_model(model_or_path, side: str = "l", brace_markers=
     leg; the rod attachment is the projection of the brace markers' midpoint on
     the thigh axis.
     """
+    from .dynamics import SegmentParameters
+
     osim = quiet_opensim()
     model = model_or_path
     if isinstance(model_or_path, (str, Path)):
