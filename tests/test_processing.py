@@ -15,12 +15,11 @@ from loper_analysis import processing
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.kinematics import joint_angle_table
-from loper_analysis.model import build_lower_body_model
-from loper_analysis.synthetic.gait import leg_length_from_height
+from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.synthetic.trials import (
     LabSettings,
+    simulate_walking_trial,
     synthetic_static_file,
-    walking_with_margins,
     write_walking_trial,
 )
 
@@ -32,12 +31,11 @@ LAB = LabSettings()
 def lab(tmp_path_factory):
     d = tmp_path_factory.mktemp("lab")
     synthetic_static_file(d / "static.c3d", "S99", HEIGHT, MASS, 2.0, LAB, 7)
-    full, events = walking_with_margins(20.0, LAB, np.random.default_rng(3), 0.03, 0.05, leg_length_from_height(HEIGHT))
     model = build_lower_body_model(HEIGHT, MASS)
-    write_walking_trial(d / "walk.c3d", model, full, events, MASS, LAB, 11, d / "walk.loper.tsv",
-                        DeviceParameters(), 0.35, duration_s=20.0)
-    coords = full[(full.time_s >= 0) & (full.time_s < 20.0 - 1e-9)].reset_index(drop=True)
-    events = events[(events.time_s >= 0) & (events.time_s <= 20.0)]
+    walk = simulate_walking_trial(20.0, LAB, 3, HEIGHT, segment_parameters_from_model(model), 0.03, 0.05,
+                                  DeviceParameters())
+    write_walking_trial(d / "walk.c3d", d / "walk.loper.tsv", model, walk, MASS, LAB, 11)
+    coords, events = walk.mocap_coordinates(LAB.marker_rate_hz), walk.mocap_events()
     # the chain
     processing.process_markers(d / "static.c3d", d / "static.trc", duration_s=1.0)
     gaps = processing.process_markers(d / "walk.c3d", d / "walk.trc", d / "walk.gaps.tsv")
@@ -131,6 +129,7 @@ def test_stride_summary_flags_too_few_strides(lab, tmp_path):
                                     tmp_path / "summary.tsv", min_valid=5)
     ok, flagged = out.iloc[0], out.iloc[1]
     assert ok.status == "ok" and ok.n_strides == len(table) and ok.n_kept == (~table.removed).sum()
+    assert ok.n_perturbed == 0
     assert flagged.status == "too_few_strides" and flagged.n_kept == 3
     assert flagged.n_removed == flagged.n_removed_knee == len(table) - 3 and flagged.n_removed_hip == 0
     assert pd.read_csv(tmp_path / "summary.tsv", sep="\t").status.tolist() == ["ok", "too_few_strides"]

@@ -286,8 +286,11 @@ def cut_strides(angles_tsv, events_tsv, strides_out, cycles_out, force_tsv=None,
     (:func:`loper_analysis.gait.iqr_outliers`). Writes
 
     * ``strides_out``: one row per stride, absolute times (s) for perturbation
-      windows, ``fraction_outlying_*``, ``removed``, ``reason`` and, with a
-      force file, RMS and max |F| per phase (N);
+      windows, ``perturbed`` and its ``onset_s`` (from the robot log's
+      perturbation flag), ``fraction_outlying_*``, ``removed``, ``reason`` and,
+      with a force file, RMS and max |F| per phase (N). The outlier rule runs
+      on the unperturbed strides; perturbed strides are kept for the response
+      analysis (``reason`` = ``perturbed``), which judges them in their window;
     * ``cycles_out``: one row per stride x phase (stride, stance, swing) x
       normalised sample: ``stride``, ``phase``, ``point``, ``percent``, the
       joint angles (rad) and ``force_n`` (with a force file).
@@ -327,18 +330,36 @@ def cut_strides(angles_tsv, events_tsv, strides_out, cycles_out, force_tsv=None,
             log.info("%s: %d stride(s) outside the robot log's span dropped", force_tsv, len(ok) - sum(ok))
             table = table[ok].reset_index(drop=True)
             table["stride"] = np.arange(len(table))
+    table["perturbed"] = False
+    table["onset_s"] = np.nan
+    if force is not None and "perturbation" in f.columns:
+        from .loadcell import perturbation_onsets
+
+        onsets = perturbation_onsets(t, f["perturbation"].to_numpy(float))
+        for i, (a, b) in enumerate(zip(table.heel_strike_s, table.end_s)):
+            inside = onsets[(onsets >= a) & (onsets < b)]
+            if inside.size:
+                table.loc[i, ["perturbed", "onset_s"]] = (True, inside[0])
     by_stride = normalise(t, values, table, "stride", n_points, source=str(angles_tsv))
-    verdict = iqr_outliers(by_stride, whisker, max_fraction, names=[c.split("_")[0] for c in cols],
-                           source=str(angles_tsv))
-    out = table.merge(verdict, on="stride")
+    names = [c.split("_")[0] for c in cols]
+    plain = ~table["perturbed"].to_numpy()  # perturbed strides are the responses, judged in their window later
+    if plain.sum() < 4:
+        raise LoperInputError(f"{angles_tsv}: {int(plain.sum())} unperturbed stride(s); need at least 4 for the outlier rule")
+    verdict = iqr_outliers(by_stride[plain], whisker, max_fraction, names=names, source=str(angles_tsv))
+    verdict["stride"] = table.loc[plain, "stride"].to_numpy()
+    out = table.merge(verdict, on="stride", how="left")
+    out["removed"] = out["removed"].fillna(False).astype(bool)
+    out.loc[out["perturbed"], "reason"] = "perturbed"
+    out["reason"] = out["reason"].fillna("")
     if force is not None:
         metrics = force_phase_metrics(t, force, table, source=str(force_tsv))
         wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
         wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
         out = out.merge(wide.reset_index(), on="stride")
-    n_kept = int((~out["removed"]).sum())
-    log.info("%s: %d strides, %d removed as outliers, %d kept", angles_tsv, len(out), len(out) - n_kept, n_kept)
-    for r in out[out["removed"]].itertuples():
+    n_kept = int((~out["removed"] & ~out["perturbed"]).sum())
+    log.info("%s: %d strides, %d perturbed, %d removed as outliers, %d unperturbed kept", angles_tsv, len(out),
+             int(out["perturbed"].sum()), int(out["removed"].sum()), n_kept)
+    for r in out[out["removed"]].itertuples():  # noqa: B007 - one log line per removed stride
         log.info("stride %d removed: %s", r.stride, r.reason)
     out.attrs["too_few_strides"] = not check_enough_strides(n_kept, str(angles_tsv), min_valid)
     cycles = []
@@ -372,9 +393,11 @@ def stride_summary(strides_tsvs: Mapping[tuple[str, str], str], out_tsv, min_val
         removed = table[table["removed"]]
         signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
         why = {s: int(removed["reason"].fillna("").str.contains(f"{s}:").sum()) for s in signals}
-        n_kept = int((~table["removed"]).sum())
+        perturbed = table["perturbed"].astype(bool) if "perturbed" in table.columns else pd.Series(False, index=table.index)
+        n_kept = int((~table["removed"] & ~perturbed).sum())
         rows.append({
-            "subject": subject, "trial": trial, "n_strides": len(table), "n_removed": len(removed), "n_kept": n_kept,
+            "subject": subject, "trial": trial, "n_strides": len(table), "n_perturbed": int(perturbed.sum()),
+            "n_removed": len(removed), "n_kept": n_kept,
             **{f"n_removed_{s}": n for s, n in why.items()},
             "mean_stride_s": table["duration_s"].mean(),
             "status": "ok" if n_kept >= min_valid else "too_few_strides",
@@ -385,10 +408,12 @@ def stride_summary(strides_tsvs: Mapping[tuple[str, str], str], out_tsv, min_val
 
 
 def read_cycles(cycles_tsv, strides_tsv, phase: str, columns: Sequence[str], keep_removed: bool = False) -> np.ndarray:
-    """Normalised cycles of one phase as (n_strides, n_points, len(columns)), outlier strides left out."""
+    """Normalised cycles of one phase as (n_strides, n_points, len(columns)); perturbed strides and (unless
+    ``keep_removed``) outliers left out."""
     cycles = pd.read_csv(cycles_tsv, sep="\t")
     table = pd.read_csv(strides_tsv, sep="\t")
-    keep = table["stride"] if keep_removed else table.loc[~table["removed"], "stride"]
+    plain = ~table["perturbed"].astype(bool) if "perturbed" in table.columns else True
+    keep = table.loc[plain, "stride"] if keep_removed else table.loc[~table["removed"] & plain, "stride"]
     sel = cycles[(cycles["phase"] == phase) & cycles["stride"].isin(keep)]
     n_points = int(sel["point"].max()) + 1 if len(sel) else 0
     missing = [c for c in columns if c not in sel.columns]

@@ -7,6 +7,7 @@ from snakemake.utils import validate
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.schema import check_config, check_table
+from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
 try:
@@ -26,11 +27,36 @@ if subjects["subject"].duplicated().any():
     raise WorkflowError(f"{_subjects_path}: subject '{dup}' appears twice")
 
 SUBJECT_SOURCE = dict(zip(subjects["subject"], subjects["source"]))
-#: subject -> {column: value} of the subject sheet, empty cells left out
+#: subject -> {column: value} of the subject sheet, empty cells left out; a synthetic subject's missing
+#: anthropometrics drawn from the study's subjects (loper_analysis.synthetic.subjects)
 SUBJECT_ROWS = {
     r["subject"]: {k: v for k, v in r.items() if not (isinstance(v, float) and pd.isna(v))}
     for r in subjects.to_dict("records")
 }
+try:
+    for _s, _row in SUBJECT_ROWS.items():
+        if _row["source"] == "synthetic":
+            _row.update(subject_anthropometry(_row, config["seed"]))
+            # the truth must lie inside the identification bounds: checked before any work starts
+            true_impedance(_s, config["seed"], config["synthetic"]["stiffness_nm_per_rad"],
+                           config["synthetic"]["damping_nms_per_rad"], config["synthetic"]["between_subject_cv"],
+                           config["identification"]["stiffness_bounds_nm_per_rad"],
+                           config["identification"]["damping_bounds_nms_per_rad"])
+        elif not (Path("data/raw") / _s / f"{config['trials']['static']}.c3d").is_file():
+            raise LoperInputError(
+                f"{_subjects_path}: recorded subject '{_s}' has no static trial "
+                f"data/raw/{_s}/{config['trials']['static']}.c3d (raw files are named data/raw/{{subject}}/{{trial}}.c3d)"
+            )
+        elif not {"height_m", "mass_kg"} <= set(_row):
+            raise LoperInputError(f"{_subjects_path}: recorded subject '{_s}' needs height_m and mass_kg")
+    _onsets = {int(o) for o in config["synthetic"]["stiffness_nm_per_rad"]}
+    if not set(config["trials"]["perturbation_onsets_ms"]) <= _onsets:
+        raise LoperInputError(
+            f"config key 'synthetic.stiffness_nm_per_rad': no truth for onset(s) "
+            f"{sorted(set(config['trials']['perturbation_onsets_ms']) - _onsets)} ms of trials.perturbation_onsets_ms"
+        )
+except LoperInputError as exc:
+    raise WorkflowError(str(exc)) from None
 if config["device"]["subject"] not in SUBJECT_SOURCE:
     raise WorkflowError(
         f"config key 'device.subject': subject '{config['device']['subject']}' is not in {_subjects_path}"
@@ -84,6 +110,11 @@ def perturbation_trials() -> list[str]:
     return [f"pert{onset:03d}-{k}" for onset in t["perturbation_onsets_ms"] for k in range(1, t["perturbation_repeats"] + 1)]
 
 
+def trial_onset_ms(trial: str) -> int | None:
+    """Perturbation onset (ms) of a trial pert{onset:03d}-{k}; None for other trials."""
+    return int(trial[4:7]) if trial in perturbation_trials() else None
+
+
 def walking_trials() -> list[str]:
     """Every walking trial of the design: the transparency pair, then the perturbation trials."""
     return [config["trials"]["no_device"], config["trials"]["device"], *perturbation_trials()]
@@ -115,6 +146,8 @@ def processing_targets() -> list[str]:
     out = []
     for s in processed_subjects():
         out.append(f"results/model/{s}/segments.tsv")
+        if SUBJECT_SOURCE[s] == "synthetic":
+            out.append(f"data/raw/{s}/truth.yaml")
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
     if out:
         out.append("results/strides/summary.tsv")

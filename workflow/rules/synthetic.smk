@@ -33,7 +33,34 @@ rule synthetic_static:
         "../scripts/synthetic_static.py"
 
 
+rule synthetic_truth:
+    output:
+        "data/raw/{subject}/truth.yaml",
+    wildcard_constraints:
+        subject=SYNTHETIC_PATTERN,
+    params:
+        row=lambda wc: SUBJECT_ROWS[wc.subject],
+        stiffness=SYNTH["stiffness_nm_per_rad"],
+        damping=SYNTH["damping_nms_per_rad"],
+        cv=SYNTH["between_subject_cv"],
+        stiffness_bounds=config["identification"]["stiffness_bounds_nm_per_rad"],
+        damping_bounds=config["identification"]["damping_bounds_nms_per_rad"],
+        seed=config["seed"],
+    log:
+        "results/logs/synthetic_truth/{subject}.log",
+    script:
+        "../scripts/synthetic_truth.py"
+
+
+def walking_truth(wildcards):
+    """A perturbation trial needs the subject's true impedance."""
+    trial = wildcards.get("trial", TRIALS["no_device"])
+    return f"data/raw/{wildcards.subject}/truth.yaml" if trial_onset_ms(trial) is not None else []
+
+
 rule synthetic_walking:
+    input:
+        truth=walking_truth,
     output:
         c3d="data/raw/{subject}/{trial}.c3d",
         log="data/raw/{subject}/{trial}.loper.tsv",
@@ -43,6 +70,7 @@ rule synthetic_walking:
     params:
         row=lambda wc: SUBJECT_ROWS[wc.subject],
         trial=lambda wc: wc.get("trial", TRIALS["no_device"]),
+        onset_ms=lambda wc: trial_onset_ms(wc.get("trial", TRIALS["no_device"])),
         settings=SYNTH,
         lab=lab_settings(),
         device=config["device"]["parameters"],

@@ -35,7 +35,10 @@ from ..errors import LoperInputError
 
 __all__ = [
     "LabSettings",
+    "PerturbationSettings",
+    "WalkingTrial",
     "lab_markers",
+    "simulate_walking_trial",
     "write_walking_trial",
     "write_static_trial",
     "walking_with_margins",
@@ -112,85 +115,90 @@ def _brace_position_m(coordinates: pd.DataFrame, attachment_m: float, side: str 
     return coordinates["pelvis_tx"].to_numpy(float) + attachment_m * np.sin(angle)
 
 
-def write_walking_trial(
-    c3d_path,
-    model_osim,
-    coordinates: pd.DataFrame,
-    events: pd.DataFrame,
-    body_mass_kg: float,
-    lab: LabSettings,
-    seed,
-    log_path=None,
-    device=None,
-    attachment_m: float = 0.35,
-    desired_force_n=None,
-    duration_s: float | None = None,
-) -> None:
-    """Write one walking trial: the C3D and, with ``log_path``, the robot log of the device.
+@dataclass(frozen=True)
+class PerturbationSettings:
+    """LOPER force pulses of an impedance trial and the impedance the subject answers with."""
 
-    ``coordinates`` (``time_s`` at ``marker_rate_hz``, model coordinates) and
-    ``events`` come from :func:`loper_analysis.synthetic.gait.walking_kinematics`,
-    shifted so that the motion capture runs from 0 to ``duration_s`` (default:
-    to the end of ``coordinates``). With a robot log they must also cover the
-    robot's span (``clock_offset_s`` before 0 to ``robot_margin_s`` after the
-    end), which drives the device. ``device`` is a
-    :class:`~loper_analysis.device.controller.DeviceParameters`;
-    ``desired_force_n`` (robot samples) the desired interaction force, zero
-    (minimal impedance) by default.
+    onset_s: float  # after toe-off of the perturbed (left) leg
+    impedance: tuple[float, ...]  # K_hip, D_hip, K_knee, D_knee, K_ankle, D_ankle (N·m/rad, N·m·s/rad)
+    force_n: float = 40.0
+    duration_s: float = 0.1
+    every_strides: tuple[int, int] = (3, 5)
+
+
+@dataclass
+class WalkingTrial:
+    """A simulated walking trial on the motion-capture clock (t = 0 at the first frame).
+
+    ``fine`` holds the model coordinates at the analog rate over the robot
+    log's span (perturbed where pulses hit); ``events`` the true gait events;
+    ``schedule`` the perturbations (``toe_off_s``, ``onset_s``,
+    ``heel_strike_s``); ``robot`` the robot-log frame (None without the device).
     """
-    from ..io.c3d import write_c3d
-    from ..io.robot_log import write_robot_log
+
+    duration_s: float
+    fine: pd.DataFrame
+    events: pd.DataFrame
+    schedule: pd.DataFrame
+    robot: pd.DataFrame | None
+    sync_starts_s: np.ndarray
+
+    def mocap_coordinates(self, marker_rate_hz: float) -> pd.DataFrame:
+        """The coordinates at the motion-capture frames 0 .. duration (marker rate)."""
+        t = self.fine["time_s"].to_numpy()
+        step = int(round(1.0 / (marker_rate_hz * (t[1] - t[0]))))
+        first = int(np.argmin(np.abs(t)))
+        n = int(round(self.duration_s * marker_rate_hz))
+        out = self.fine.iloc[first:first + n * step:step].reset_index(drop=True)
+        return out.assign(time_s=np.arange(n) / marker_rate_hz)
+
+    def mocap_events(self) -> pd.DataFrame:
+        e = self.events
+        return e[(e["time_s"] >= 0) & (e["time_s"] <= self.duration_s)].reset_index(drop=True)
+
+
+def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: float, params,
+                           timing_cv: float = 0.03, amplitude_cv: float = 0.05, device=None,
+                           perturbation: PerturbationSettings | None = None, gait=None) -> WalkingTrial:
+    """Simulate kinematics, device and perturbation responses of one walking trial.
+
+    ``params`` is the subject's :class:`~loper_analysis.dynamics.SegmentParameters`
+    (its ``attachment_m`` places the brace); ``device`` a
+    :class:`~loper_analysis.device.controller.DeviceParameters` or None (no
+    device). The device runs on the robot clock (``clock_offset_s``,
+    ``clock_drift_ppm``), driven by the brace motion of the unperturbed
+    thigh and the desired pulses; the leg answers the difference of the
+    measured force with and without the pulses (:mod:`.response`).
+    """
+    from ..device.controller import simulate_device
     from ..loadcell import pulse_train_at, sync_pulse_starts
-    from .gait import treadmill_grf
+    from .gait import leg_length_from_height
+    from .response import perturbation_schedule, pulse_train, swing_response
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
-    marker_seed, grf_seed, sync_seed, device_seed = ss.spawn(4)
-    t_all = coordinates["time_s"].to_numpy(float)
-    duration = float(t_all[-1] + 1.0 / lab.marker_rate_hz if duration_s is None else duration_s)
-    n_frames = int(round(duration * lab.marker_rate_hz))
-    first = int(np.searchsorted(t_all, -1e-9))
-    mocap = coordinates.iloc[first:first + n_frames].reset_index(drop=True)
-    if len(mocap) != n_frames or abs(mocap["time_s"].iloc[0]) > 1e-9:
-        raise LoperInputError(f"coordinates must hold the frames 0 .. {duration} s at {lab.marker_rate_hz} Hz")
-    X, labels = lab_markers(model_osim, mocap, lab, np.random.default_rng(marker_seed))
-    inside = events[(events["time_s"] >= 0) & (events["time_s"] <= duration)]
-    grf = treadmill_grf(inside, duration, lab.analog_rate_hz, body_mass_kg, np.random.default_rng(grf_seed),
-                        noise_sd_n=lab.grf_noise_sd_n)
-    ta = grf["time_s"].to_numpy(float)
+    gait_seed, sync_seed, device_seed, schedule_seed = ss.spawn(4)
+    fine, events = walking_with_margins(duration_s, lab, np.random.default_rng(gait_seed), timing_cv, amplitude_cv,
+                                        leg_length_from_height(height_m), gait, sample_rate_hz=lab.analog_rate_hz)
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
-
-    def to_robot(tm):  # t_mocap = -offset + scale * t_robot
-        return (np.asarray(tm) + lab.clock_offset_s) / scale
-
-    robot_duration = float(to_robot(duration + lab.robot_margin_s))
+    robot_duration = (duration_s + lab.robot_margin_s + lab.clock_offset_s) / scale
     starts = sync_pulse_starts(robot_duration, sync_seed)
-    names, columns, units = [], [], []
-    for side, suffix in zip(("left", "right"), lab.grf_prefix):
-        for quantity, unit in (("fx", "N"), ("fz", "N"), ("mx", "N.m"), ("my", "N.m"), ("mz", "N.m")):
-            key = f"{quantity}_{side}_{'nm' if unit == 'N.m' else 'n'}"
-            names.append(f"{quantity.capitalize()}{suffix}")
-            columns.append(grf[key].to_numpy(float))
-            units.append(unit)
-    names.append(lab.sync_channel)
-    columns.append(pulse_train_at(to_robot(ta), starts))
-    units.append("V")
-    write_c3d(c3d_path, labels, X, lab.marker_rate_hz, names, np.column_stack(columns), units, lab.analog_rate_hz)
-    if log_path is None:
-        return
-    from ..device.controller import simulate_device
-
-    n_robot = int(np.floor(robot_duration * lab.robot_rate_hz))
-    t_robot = np.arange(n_robot) / lab.robot_rate_hz
+    schedule = pd.DataFrame(columns=["toe_off_s", "onset_s", "heel_strike_s"])
+    if perturbation is not None:
+        schedule = perturbation_schedule(events, perturbation.onset_s, np.random.default_rng(schedule_seed), 0.5,
+                                         duration_s - 0.5, "left", perturbation.every_strides)
+    if device is None:
+        return WalkingTrial(duration_s, fine, events, schedule, None, starts)
+    t_fine = fine["time_s"].to_numpy()
+    t_robot = np.arange(int(np.floor(robot_duration * lab.robot_rate_hz))) / lab.robot_rate_hz
     t_mocap = -lab.clock_offset_s + scale * t_robot
-    if t_mocap[0] < t_all[0] - 1e-9 or t_mocap[-1] > t_all[-1] + 1e-9:
-        raise LoperInputError(
-            f"coordinates span {t_all[0]:.3f} .. {t_all[-1]:.3f} s; the robot log needs {t_mocap[0]:.3f} .. "
-            f"{t_mocap[-1]:.3f} s (mocap clock)"
-        )
-    brace = np.interp(t_mocap, t_all, _brace_position_m(coordinates, attachment_m))
-    fd = np.zeros(n_robot) if desired_force_n is None else np.asarray(desired_force_n, float)
-    sim = simulate_device(fd, device, None, brace_position_m=brace - brace.mean(), seed=device_seed)
-    frame = pd.DataFrame({
+    if t_mocap[0] < t_fine[0] - 1e-9 or t_mocap[-1] > t_fine[-1] + 1e-9:
+        raise LoperInputError("simulate_walking_trial: the kinematics do not cover the robot log")
+    brace = np.interp(t_mocap, t_fine, _brace_position_m(fine, params.attachment_m))
+    brace -= brace.mean()
+    onsets_robot = (schedule["onset_s"].to_numpy(float) + lab.clock_offset_s) / scale
+    fd = pulse_train(t_robot, onsets_robot, perturbation.force_n, perturbation.duration_s) if perturbation else 0 * t_robot
+    sim = simulate_device(fd, device, None, brace_position_m=brace, seed=device_seed)
+    robot = pd.DataFrame({
         "time_s": t_robot,
         "force_desired_n": sim["force_desired_n"].to_numpy(),
         "force_measured_n": sim["force_measured_n"].to_numpy(),
@@ -200,20 +208,70 @@ def write_walking_trial(
         "perturbation": (np.abs(fd) > 0).astype(np.int64),
         "safety_state": sim["safety_state"].to_numpy().astype(np.int64),
     })
-    write_robot_log(log_path, frame, lab.robot_rate_hz, {"clock": "robot"})
+    if perturbation is not None and len(schedule):
+        free = simulate_device(0 * t_robot, device, None, brace_position_m=brace, seed=device_seed)
+        to_robot_fine = (t_fine + lab.clock_offset_s) / scale
+        fp = np.interp(to_robot_fine, t_robot, robot["force_measured_n"].to_numpy())
+        fu = np.interp(to_robot_fine, t_robot, free["force_measured_n"].to_numpy())
+        angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
+        pelvis_angle = -fine["pelvis_tilt"].to_numpy()
+        delta = np.zeros_like(angles)
+        for row in schedule.itertuples():
+            sl = slice(int(np.searchsorted(t_fine, row.onset_s - 0.3)), int(np.searchsorted(t_fine, row.heel_strike_s + 0.35)))
+            delta[sl] += swing_response(t_fine[sl], angles[sl], pelvis_angle[sl], fine["pelvis_tx"].to_numpy()[sl],
+                                        params, perturbation.impedance, fp[sl], fu[sl], row.onset_s,
+                                        row.heel_strike_s)
+        fine = fine.copy()
+        for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
+            fine[c] = angles[:, i] + delta[:, i]
+    return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
+
+
+def write_walking_trial(c3d_path, log_path, model_osim, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings,
+                        seed) -> None:
+    """Write the C3D (markers with noise and gaps, GRF, sync) and, with a device, the robot log of a trial."""
+    from ..io.c3d import write_c3d
+    from ..io.robot_log import write_robot_log
+    from ..loadcell import pulse_train_at
+    from .gait import treadmill_grf
+
+    ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
+    marker_seed, grf_seed = ss.spawn(2)
+    coords = trial.mocap_coordinates(lab.marker_rate_hz)
+    X, labels = lab_markers(model_osim, coords, lab, np.random.default_rng(marker_seed))
+    grf = treadmill_grf(trial.mocap_events(), trial.duration_s, lab.analog_rate_hz, body_mass_kg,
+                        np.random.default_rng(grf_seed), noise_sd_n=lab.grf_noise_sd_n)
+    scale = 1.0 + 1e-6 * lab.clock_drift_ppm
+    names, columns, units = [], [], []
+    for side, suffix in zip(("left", "right"), lab.grf_prefix):
+        for quantity, unit in (("fx", "N"), ("fz", "N"), ("mx", "N.m"), ("my", "N.m"), ("mz", "N.m")):
+            key = f"{quantity}_{side}_{'nm' if unit == 'N.m' else 'n'}"
+            names.append(f"{quantity.capitalize()}{suffix}")
+            columns.append(grf[key].to_numpy(float))
+            units.append(unit)
+    names.append(lab.sync_channel)
+    columns.append(pulse_train_at((grf["time_s"].to_numpy(float) + lab.clock_offset_s) / scale, trial.sync_starts_s))
+    units.append("V")
+    write_c3d(c3d_path, labels, X, lab.marker_rate_hz, names, np.column_stack(columns), units, lab.analog_rate_hz)
+    if log_path is not None:
+        if trial.robot is None:
+            raise LoperInputError(f"{log_path}: the trial was simulated without the device")
+        write_robot_log(log_path, trial.robot, lab.robot_rate_hz, {"clock": "robot"})
 
 
 def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Generator, timing_cv: float,
-                         amplitude_cv: float, leg_length_m: float, gait=None) -> tuple[pd.DataFrame, pd.DataFrame]:
+                         amplitude_cv: float, leg_length_m: float, gait=None,
+                         sample_rate_hz: float | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Kinematics and events that cover the robot log's span: from ``clock_offset_s`` (+1 s) before the
-    motion capture to ``robot_margin_s`` (+1 s) after it; time 0 is the first motion-capture frame."""
+    motion capture to ``robot_margin_s`` (+1 s) after it; time 0 is the first motion-capture frame.
+    ``sample_rate_hz`` defaults to the marker rate and must be a multiple of it."""
     from .gait import NominalGait, walking_kinematics
 
+    rate = lab.marker_rate_hz if sample_rate_hz is None else sample_rate_hz
     lead = np.ceil((lab.clock_offset_s + 1.0) * lab.marker_rate_hz) / lab.marker_rate_hz
     total = lead + duration_s + lab.robot_margin_s + 1.0
-    coords, events = walking_kinematics(total, lab.marker_rate_hz, gait or NominalGait(), rng, timing_cv,
-                                        amplitude_cv, leg_length_m)
-    coords = coords.assign(time_s=np.round((coords["time_s"] - lead) * lab.marker_rate_hz) / lab.marker_rate_hz)
+    coords, events = walking_kinematics(total, rate, gait or NominalGait(), rng, timing_cv, amplitude_cv, leg_length_m)
+    coords = coords.assign(time_s=np.round((coords["time_s"] - lead) * rate) / rate)
     return coords, events.assign(time_s=events["time_s"] - lead)
 
 
@@ -236,17 +294,14 @@ def synthetic_static_file(c3d_path, subject: str, height_m: float, mass_kg: floa
 
 def synthetic_walking_files(c3d_path, log_path, subject: str, trial: str, height_m: float, mass_kg: float,
                             duration_s: float, timing_cv: float, amplitude_cv: float, lab: LabSettings,
-                            device, attachment_fraction: float, seed: int) -> pd.DataFrame:
-    """One walking trial of a synthetic subject (C3D and, with ``log_path``, the robot log); returns the true events."""
+                            device, seed: int, perturbation: PerturbationSettings | None = None) -> WalkingTrial:
+    """One walking trial of a synthetic subject: its C3D and, with ``log_path``, the robot log."""
     from ..model import build_lower_body_model, segment_parameters_from_model
-    from .gait import leg_length_from_height
 
     model = build_lower_body_model(height_m, mass_kg)
-    ss = np.random.SeedSequence(_seed(seed, subject, trial))
-    gait_seed, file_seed = ss.spawn(2)
-    coords, events = walking_with_margins(duration_s, lab, np.random.default_rng(gait_seed), timing_cv, amplitude_cv,
-                                          leg_length_from_height(height_m))
-    thigh_m = segment_parameters_from_model(model).length_m[0]
-    write_walking_trial(c3d_path, model, coords, events, mass_kg, lab, file_seed, log_path, device,
-                        attachment_fraction * thigh_m, duration_s=duration_s)
-    return events[(events["time_s"] >= 0) & (events["time_s"] <= duration_s)].reset_index(drop=True)
+    params = segment_parameters_from_model(model)
+    sim_seed, file_seed = np.random.SeedSequence(_seed(seed, subject, trial)).spawn(2)
+    walk = simulate_walking_trial(duration_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv,
+                                  device if log_path is not None else None, perturbation)
+    write_walking_trial(c3d_path, log_path, model, walk, mass_kg, lab, file_seed)
+    return walk
