@@ -130,6 +130,41 @@ def test_bad_config_is_refused_with_its_key(tmp_path, changes, expected):
     assert expected in res.stdout + res.stderr
 
 
+@pytest.mark.parametrize(
+    ("sheet", "changes", "expected"),
+    [
+        ("subject\tsource\theight_m\nS01\tsynthetic\t2.7\n", {}, "height_m"),
+        ("subject\tsource\tmass_kg\nS01\tsynthetic\t-4\n", {}, "mass_kg"),
+        (None, {"synthetic__stiffness_nm_per_rad": {"50": [230.0, 3.0, 8.0], "175": [38.0, 0.5, 8.0],
+                                                    "300": [62.0, 2.5, 8.0]}}, "outside the identification bounds"),
+        ("subject\tsource\theight_m\tmass_kg\nS01\tsynthetic\t1.8\t70\nR01\trecorded\t1.7\t60\n", {},
+         "data/raw/R01/static.c3d"),
+    ],
+)
+def test_bad_subjects_are_refused_before_any_work(tmp_path, sheet, changes, expected):
+    work = _project(tmp_path, **changes)
+    if sheet is not None:
+        (work / "config/subjects.tsv").write_text(sheet)
+    res = _snakemake(work, "-n")
+    assert res.returncode != 0
+    assert expected in res.stdout + res.stderr
+    assert not (work / "data").exists() and not (work / "results").exists()
+
+
+def test_recorded_subjects_raw_files_are_never_written(tmp_path):
+    work = _project(tmp_path)
+    (work / "config/subjects.tsv").write_text(
+        "subject\tsource\theight_m\tmass_kg\nS01\tsynthetic\t1.8\t70\nR01\trecorded\t1.7\t60\n"
+    )
+    raw = work / "data/raw/R01"
+    raw.mkdir(parents=True)
+    (raw / "static.c3d").write_bytes(b"placeholder")
+    res = _snakemake(work, "-n", "data/raw/R01/walk-device.c3d")
+    assert res.returncode != 0 and "MissingRuleException" in res.stdout + res.stderr
+    res = _snakemake(work, "-n", "data/raw/R01/truth.yaml")
+    assert res.returncode != 0
+
+
 def test_bad_subject_sheet_is_refused(tmp_path):
     work = _project(tmp_path)
     (work / "config/subjects.tsv").write_text("subject\tsource\nS_01\tsynthetic\n")
