@@ -15,6 +15,7 @@ include: "workflow/rules/validation.smk"
 include: "workflow/rules/device.smk"
 include: "workflow/rules/processing.smk"
 include: "workflow/rules/synthetic.smk"
+include: "workflow/rules/impedance.smk"
 
 
 rule all:

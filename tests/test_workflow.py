@@ -114,6 +114,24 @@ def test_processing_outputs_from_the_default_run(finished_run):
     assert (results / "transparency/transparency.png").stat().st_size > 20_000
 
 
+def test_impedance_table_from_the_default_run(finished_run):
+    """One subject, one 25 s trial at the 50 ms onset: too few perturbations to fit, reported as failed."""
+    from loper_analysis.impedance import IMPEDANCE_COLUMNS
+
+    table = pd.read_csv(finished_run / "results/tables/impedance.tsv", sep="\t")
+    assert list(table.columns) == list(IMPEDANCE_COLUMNS)
+    assert list(table.joint) == ["hip", "knee", "ankle"] and (table.onset_ms == 50).all()
+    counts = pd.read_csv(finished_run / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
+    # a pulse every 3-5 of ~14 strides: 3 perturbed, all matched and kept (too few for the IQR rule to judge)
+    assert counts.loc["total", ["n_perturbed", "n_kept"]].tolist() == [3, 3]
+    assert counts.loc["total", "status"] == "too_few_strides"
+    assert (table.status == "failed").all() and table.reason.str.contains("3 valid perturbed stride").all()
+    assert table.K.isna().all()
+    truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())
+    np.testing.assert_allclose(table.K_true, [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"]
+                                              for j in ("hip", "knee", "ankle")])
+
+
 @pytest.mark.parametrize(
     ("changes", "expected"),
     [

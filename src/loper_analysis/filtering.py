@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import butter, sosfiltfilt
 
 from .errors import LoperInputError
 
@@ -11,6 +10,8 @@ __all__ = ["lowpass", "lowpass_gain"]
 
 
 def _design(sample_rate_hz: float, cutoff_hz: float, order: int):
+    from scipy.signal import butter  # imported here: scipy.signal costs ~1 s, and most rules never filter
+
     if not np.isfinite(sample_rate_hz) or sample_rate_hz <= 0:
         raise LoperInputError(f"sample_rate_hz must be positive, got {sample_rate_hz}")
     nyq = 0.5 * sample_rate_hz
@@ -50,6 +51,8 @@ def lowpass(signal, sample_rate_hz: float, cutoff_hz: float = 40.0, order: int =
     padlen = 3 * (2 * len(sos) + 1)
     if x.shape[axis] <= padlen:
         raise LoperInputError(f"signal has {x.shape[axis]} samples; the filter needs more than {padlen}")
+    from scipy.signal import sosfiltfilt
+
     return sosfiltfilt(sos, x, axis=axis)
 
 

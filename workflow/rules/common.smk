@@ -70,6 +70,7 @@ VALIDATION_CHUNKS = [f"{i:03d}" for i in range(config["validation"]["n_chunks"])
 wildcard_constraints:
     subject=r"[A-Za-z0-9-]+",
     chunk=r"[0-9]{3}",
+    onset=r"[0-9]{3}",
     trial=r"[A-Za-z0-9-]+",
 
 
@@ -151,6 +152,8 @@ def processing_targets() -> list[str]:
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
     if out:
         out.append("results/strides/summary.tsv")
+    if any(trial_onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
+        out.append("results/tables/impedance.tsv")
     if transparency_subjects():
         out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",
                 "results/transparency/transparency.png"]

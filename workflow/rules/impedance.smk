@@ -1,0 +1,74 @@
+# Perturbation analysis: responses (matched strides) and impedance fits per subject and onset, aggregate tables.
+
+IDENT = config["identification"]
+
+
+def onset_trials(subject: str, onset: str) -> list[str]:
+    """The subject's trials of one onset that are on disk (or generated)."""
+    return [t for t in subject_trials(subject) if trial_onset_ms(t) == int(onset)]
+
+
+def fit_inputs(wildcards):
+    s = wildcards.subject
+    out = {"segments": f"results/model/{s}/segments.tsv"}
+    if SUBJECT_SOURCE[s] == "synthetic":
+        out["truth"] = f"data/raw/{s}/truth.yaml"
+    for t in onset_trials(s, wildcards.onset):
+        out[f"angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
+        out[f"strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
+        out[f"force_{t}"] = f"results/loadcell/{s}/{t}.force.tsv"
+        out[f"markers_{t}"] = f"results/markers/{s}/{t}.trc"
+    return out
+
+
+rule impedance_fit:
+    input:
+        unpack(fit_inputs),
+    output:
+        response="results/responses/{subject}/{onset}.response.tsv",
+        counts="results/responses/{subject}/{onset}.counts.tsv",
+        fit="results/impedance/{subject}/{onset}.tsv",
+        curves="results/impedance/{subject}/{onset}.curves.tsv",
+    wildcard_constraints:
+        onset=r"[0-9]{3}",
+    params:
+        trials=lambda wc: onset_trials(wc.subject, wc.onset),
+        settings=dict(
+            window_before_s=IDENT["window_before_s"],
+            window_after_s=IDENT["window_after_s"],
+            initial_state_span_s=IDENT["initial_state_span_s"],
+            initial_state_degree=IDENT["initial_state_degree"],
+            n_starts=IDENT["n_starts"],
+            n_substeps=IDENT["n_substeps"],
+            tolerance=IDENT["tolerance"],
+            merge_tolerance=IDENT["merge_tolerance"],
+            stiffness_bounds=IDENT["stiffness_bounds_nm_per_rad"],
+            damping_bounds=IDENT["damping_bounds_nms_per_rad"],
+            whisker=config["strides"]["iqr_whisker"],
+            max_fraction=config["strides"]["max_outlier_fraction"],
+            min_strides=config["strides"]["min_valid_strides"],
+            max_ci_fraction=IDENT["max_ci_fraction"],
+            seed=config["seed"],
+        ),
+    log:
+        "results/logs/impedance_fit/{subject}/{onset}.log",
+    benchmark:
+        "results/benchmarks/impedance_fit/{subject}/{onset}.tsv"
+    script:
+        "../scripts/impedance_fit.py"
+
+
+rule impedance_table:
+    input:
+        [f"results/impedance/{s}/{o:03d}.tsv" for s in processed_subjects() for o in TRIALS["perturbation_onsets_ms"]],
+    output:
+        report(
+            "results/tables/impedance.tsv",
+            caption="../report/impedance_table.rst",
+            category="Impedance",
+            labels={"table": "impedance per subject, onset and joint"},
+        ),
+    log:
+        "results/logs/impedance_table/impedance.log",
+    script:
+        "../scripts/impedance_table.py"

@@ -1,0 +1,16 @@
+from _logging import setup
+
+from loper_analysis.impedance import fit_subject_onset
+
+log = setup(snakemake.log[0])
+inp, out, p = snakemake.input, snakemake.output, snakemake.params
+trials = [
+    {"name": t, "angles": inp[f"angles_{t}"], "strides": inp[f"strides_{t}"], "force": inp[f"force_{t}"],
+     "markers": inp[f"markers_{t}"]}
+    for t in p.trials
+]
+rows = fit_subject_onset(
+    trials, inp.segments, int(snakemake.wildcards.onset), snakemake.wildcards.subject, out.response, out.counts,
+    out.fit, out.curves, inp.get("truth"), **p.settings,
+)
+log.info("impedance:\n%s", rows.to_string(index=False))
