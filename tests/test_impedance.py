@@ -55,3 +55,18 @@ def test_brace_normal_is_perpendicular_and_forward():
     np.testing.assert_allclose(n, np.stack([np.cos(q), -np.sin(q)], axis=-1), atol=1e-12)
     with pytest.raises(LoperInputError, match=r"trial.trc: brace marker\(s\) \['LBRA_D'\]"):
         brace_force_direction(X[:, :1], ["LBRA_P"], source="trial.trc")
+
+
+def test_onset_without_trials_is_reported_missing(tmp_path):
+    from loper_analysis.impedance import fit_subject_onset
+    from loper_analysis.synthetic.subjects import write_truth
+
+    write_truth(tmp_path / "truth.yaml", {"subject": "S01", "sex": "male", "age_yr": 26, "height_m": 1.8, "mass_kg": 72},
+                {175: {j: {"K": 40.0, "D": 2.0} for j in ("hip", "knee", "ankle")}})
+    out = [tmp_path / n for n in ("r.tsv", "c.tsv", "f.tsv", "k.tsv")]
+    rows = fit_subject_onset([], tmp_path / "segments.tsv", 175, "S01", *out, truth_yaml=tmp_path / "truth.yaml")
+    assert (rows.status == "missing").all() and rows.K.isna().all() and (rows.K_true == 40.0).all()
+    assert all(p.is_file() for p in out)
+    import pandas as pd
+
+    assert pd.read_csv(out[2], sep="\t").status.tolist() == ["missing"] * 3
