@@ -70,3 +70,25 @@ def test_onset_without_trials_is_reported_missing(tmp_path):
     import pandas as pd
 
     assert pd.read_csv(out[2], sep="\t").status.tolist() == ["missing"] * 3
+
+
+def test_summary_and_literature_rows():
+    import pandas as pd
+
+    from loper_analysis.impedance import impedance_summary, literature_table
+
+    rows = []
+    for subject, k, d in (("S01", 50.0, 3.0), ("S02", 60.0, 5.0)):
+        rows.append(status_rows(subject, 50, "ok", "").assign(K=k, D=d, vaf_pct=99.0, K_true=55.0, D_true=3.0))
+    rows.append(status_rows("S03", 50, "missing", "no trial"))
+    table = pd.concat(rows, ignore_index=True)
+    table["K_error"], table["D_error"] = table.K - table.K_true, table.D - table.D_true
+    summary = impedance_summary(table)
+    hip = summary[summary.joint == "hip"].iloc[0]
+    assert hip.n_subjects == 2 and hip.K_mean == 55.0 and hip.K_sd == pytest.approx(np.sqrt(50.0))
+    assert hip.K_within_tolerance == 1.0  # |5| <= 0.1 * 55
+    assert hip.D_within_tolerance == 0.5  # 0 ok, 2 > 0.15 * 3
+    lit = literature_table(summary)
+    ours = lit[lit.source.str.startswith("this pipeline") & (lit.joint == "hip")].iloc[0]
+    assert (ours.K_low, ours.K_high, ours.D_low, ours.D_high) == (55.0, 55.0, 4.0, 4.0)
+    assert len(lit) == 9

@@ -127,6 +127,10 @@ def test_impedance_table_from_the_default_run(finished_run):
     assert counts.loc["total", "status"] == "too_few_strides"
     assert (table.status == "failed").all() and table.reason.str.contains("3 valid perturbed stride").all()
     assert table.K.isna().all()
+    summary = pd.read_csv(finished_run / "results/tables/impedance_summary.tsv", sep="\t")
+    assert len(summary) == 0 and list(summary.columns[:2]) == ["joint", "onset_ms"]  # nothing fitted
+    literature = pd.read_csv(finished_run / "results/tables/literature.tsv", sep="\t")
+    assert len(literature) == 7 and literature.K_low.iloc[0] == 50.0
     truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())
     np.testing.assert_allclose(table.K_true, [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"]
                                               for j in ("hip", "knee", "ankle")])

@@ -32,6 +32,9 @@ __all__ = [
     "impedance_rows",
     "status_rows",
     "fit_subject_onset",
+    "LITERATURE",
+    "impedance_summary",
+    "literature_table",
 ]
 
 #: Columns of ``results/impedance/{subject}/{onset}.tsv`` and ``results/tables/impedance.tsv``.
@@ -219,3 +222,61 @@ def fit_subject_onset(
                               **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)}})
     write_tsv(fit_frame, curves_out)
     return rows
+
+
+#: Joint impedance in the literature (relaxed conditions), DESIGN.md section 5: (source, joint, K range, D range).
+LITERATURE = (
+    ("force perturbation, static", "hip", (50.0, 60.0), (7.0, 9.0)),
+    ("force perturbation, static", "knee", (15.0, 20.0), (1.0, 2.0)),
+    ("position perturbation, static", "hip", (75.0, 318.0), (2.0, 21.0)),
+    ("position perturbation, static", "knee", (36.0, 75.0), (1.8, 2.2)),
+    ("position perturbation, imposed motion", "knee", (25.0, 30.0), (None, None)),
+    ("the study: swing phase, across-subject mean over onsets", "hip", (34.0, 66.0), (1.9, 4.6)),
+    ("the study: swing phase, across-subject mean over onsets", "knee", (0.0, 3.5), (0.02, 0.14)),
+)
+
+
+def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=(0.15, 0.05)) -> pd.DataFrame:
+    """Across-subject summary per joint and onset: mean, SD, min, max of K and D over subjects (fitted rows only).
+
+    Columns ``joint, onset_ms, n_subjects, K_mean, K_sd, K_min, K_max, D_mean, ..., vaf_pct_mean``; where
+    the truth is known also ``K_error_mean``, ``K_max_abs_error``, ``K_within_tolerance`` (fraction of
+    subjects within ``max(rel * |truth|, abs)``) and the same for D.
+    """
+    fitted = table[table["status"].isin(["ok", "not_identifiable"])]
+    rows = []
+    for (joint, onset), g in fitted.groupby(["joint", "onset_ms"], sort=False):
+        row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique()}
+        for p in ("K", "D"):
+            row.update({f"{p}_mean": g[p].mean(), f"{p}_sd": g[p].std(ddof=1), f"{p}_min": g[p].min(),
+                        f"{p}_max": g[p].max()})
+        row["vaf_pct_mean"] = g["vaf_pct"].mean()
+        known = g[g["K_true"].notna()]
+        if len(known):
+            for p, (rel, ab) in (("K", k_tolerance), ("D", d_tolerance)):
+                err = known[f"{p}_error"]
+                tol = np.maximum(rel * known[f"{p}_true"].abs(), ab)
+                row.update({f"{p}_error_mean": err.mean(), f"{p}_max_abs_error": err.abs().max(),
+                            f"{p}_within_tolerance": float((err.abs() <= tol).mean())})
+        rows.append(row)
+    order = {j: i for i, j in enumerate(JOINTS)}
+    out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects"])
+    if len(out):
+        out = out.sort_values(["joint", "onset_ms"], key=lambda c: c.map(order) if c.name == "joint" else c,
+                              kind="stable", ignore_index=True)
+    return out
+
+
+def literature_table(summary: pd.DataFrame) -> pd.DataFrame:
+    """DESIGN.md section 5's literature values with our row added: range over onsets of the across-subject mean."""
+    rows = [{"source": s, "joint": j, "K_low": k[0], "K_high": k[1], "D_low": d[0], "D_high": d[1]}
+            for s, j, k, d in LITERATURE]
+    for joint in ("hip", "knee"):
+        if "joint" not in summary.columns:  # nothing fitted
+            break
+        g = summary[summary["joint"] == joint]
+        if len(g):
+            rows.append({"source": "this pipeline: swing phase, across-subject mean over onsets", "joint": joint,
+                         "K_low": g["K_mean"].min(), "K_high": g["K_mean"].max(),
+                         "D_low": g["D_mean"].min(), "D_high": g["D_mean"].max()})
+    return pd.DataFrame(rows)

@@ -153,7 +153,7 @@ def processing_targets() -> list[str]:
     if out:
         out.append("results/strides/summary.tsv")
     if any(trial_onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
-        out.append("results/tables/impedance.tsv")
+        out += ["results/tables/impedance.tsv", "results/tables/impedance_summary.tsv", "results/tables/literature.tsv"]
     if transparency_subjects():
         out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",
                 "results/transparency/transparency.png"]

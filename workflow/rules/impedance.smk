@@ -72,3 +72,25 @@ rule impedance_table:
         "results/logs/impedance_table/impedance.log",
     script:
         "../scripts/impedance_table.py"
+
+
+rule impedance_summary:
+    input:
+        "results/tables/impedance.tsv",
+    output:
+        summary=report(
+            "results/tables/impedance_summary.tsv",
+            caption="../report/impedance_summary.rst",
+            category="Impedance",
+            labels={"table": "across-subject summary per onset"},
+        ),
+        literature=report(
+            "results/tables/literature.tsv",
+            caption="../report/literature.rst",
+            category="Impedance",
+            labels={"table": "literature comparison"},
+        ),
+    log:
+        "results/logs/impedance_summary/summary.log",
+    script:
+        "../scripts/impedance_summary.py"
