@@ -79,6 +79,7 @@ def test_rerun_does_nothing_and_report_builds(finished_run):
     assert res.returncode == 0, res.stderr[-3000:]
     html = (finished_run / "report.html").read_bytes()
     assert len(html) > 10_000 and b"errors.png" in html and b"transparency.png" in html
+    assert b"responses.png" in html and b"impedance.png" in html
 
 
 def test_same_config_gives_same_bytes(finished_run, tmp_path):
@@ -131,6 +132,8 @@ def test_impedance_table_from_the_default_run(finished_run):
     assert len(summary) == 0 and list(summary.columns[:2]) == ["joint", "onset_ms"]  # nothing fitted
     literature = pd.read_csv(finished_run / "results/tables/literature.tsv", sep="\t")
     assert len(literature) == 7 and literature.K_low.iloc[0] == 50.0
+    for fig in ("figures/impedance.png", "figures/S01/responses.png", "figures/S01/fit.png"):
+        assert (finished_run / "results" / fig).read_bytes()[:4] == b"\x89PNG", fig
     truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())
     np.testing.assert_allclose(table.K_true, [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"]
                                               for j in ("hip", "knee", "ankle")])

@@ -94,3 +94,46 @@ rule impedance_summary:
         "results/logs/impedance_summary/summary.log",
     script:
         "../scripts/impedance_summary.py"
+
+
+rule impedance_figures:
+    input:
+        responses=lambda wc: {int(o): f"results/responses/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]}.values(),
+        curves=lambda wc: {int(o): f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]}.values(),
+    output:
+        responses=report(
+            "results/figures/{subject}/responses.png",
+            caption="../report/responses_figure.rst",
+            category="Impedance",
+            subcategory="{subject}",
+            labels={"subject": "{subject}", "figure": "responses"},
+        ),
+        fit=report(
+            "results/figures/{subject}/fit.png",
+            caption="../report/fit_figure.rst",
+            category="Impedance",
+            subcategory="{subject}",
+            labels={"subject": "{subject}", "figure": "fit vs data"},
+        ),
+    params:
+        onsets=TRIALS["perturbation_onsets_ms"],
+    log:
+        "results/logs/impedance_figures/{subject}.log",
+    script:
+        "../scripts/impedance_figures.py"
+
+
+rule impedance_figure:
+    input:
+        "results/tables/impedance.tsv",
+    output:
+        report(
+            "results/figures/impedance.png",
+            caption="../report/impedance_figure.rst",
+            category="Impedance",
+            labels={"figure": "K and D per onset"},
+        ),
+    log:
+        "results/logs/impedance_figure/impedance.log",
+    script:
+        "../scripts/impedance_figure.py"
