@@ -132,6 +132,9 @@ def test_impedance_table_from_the_default_run(finished_run):
     assert len(summary) == 0 and list(summary.columns[:2]) == ["joint", "onset_ms"]  # nothing fitted
     literature = pd.read_csv(finished_run / "results/tables/literature.tsv", sep="\t")
     assert len(literature) == 7 and literature.K_low.iloc[0] == 50.0
+    md = (finished_run / "results/tables/tables.md").read_text()
+    assert "## Impedance per subject, onset and joint" in md and "| S01 | 50 | hip |" in md
+    assert "## Transparency: RMSD vs ISV_ave" in md and "## Validation study" in md
     for fig in ("figures/impedance.png", "figures/S01/responses.png", "figures/S01/fit.png"):
         assert (finished_run / "results" / fig).read_bytes()[:4] == b"\x89PNG", fig
     truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())

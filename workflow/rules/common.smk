@@ -154,7 +154,7 @@ def processing_targets() -> list[str]:
         out.append("results/strides/summary.tsv")
     if any(trial_onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
         out += ["results/tables/impedance.tsv", "results/tables/impedance_summary.tsv", "results/tables/literature.tsv",
-                "results/figures/impedance.png"]
+                "results/figures/impedance.png", "results/tables/tables.md"]
         out += [f"results/figures/{s}/{f}.png" for s in processed_subjects() for f in ("responses", "fit")]
     if transparency_subjects():
         out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",

@@ -137,3 +137,32 @@ rule impedance_figure:
         "results/logs/impedance_figure/impedance.log",
     script:
         "../scripts/impedance_figure.py"
+
+
+def markdown_sections() -> dict:
+    """Every result table of the run, for the Markdown rendering."""
+    sections = {
+        "Impedance per subject, onset and joint": "results/tables/impedance.tsv",
+        "Across-subject summary": "results/tables/impedance_summary.tsv",
+        "Literature": "results/tables/literature.tsv",
+        "Strides per trial": "results/strides/summary.tsv",
+        "Validation study": "results/validation/summary.tsv",
+        "Device": "results/device/summary.tsv",
+    }
+    if transparency_subjects():
+        sections["Transparency: RMSD vs ISV_ave"] = "results/transparency/rmsd.tsv"
+        sections["Transparency: interaction force"] = "results/transparency/force.tsv"
+    return sections
+
+
+rule tables_markdown:
+    input:
+        list(markdown_sections().values()),
+    output:
+        "results/tables/tables.md",
+    params:
+        headings=list(markdown_sections()),
+    log:
+        "results/logs/tables_markdown/tables.log",
+    script:
+        "../scripts/tables_markdown.py"
