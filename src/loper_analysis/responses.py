@@ -45,7 +45,8 @@ from scipy.interpolate import CubicSpline
 from .constants import JOINTS
 from .dynamics import segment_coordinates
 from .errors import LoperInputError
-from .gait import check_enough_strides, iqr_outliers, window, window_times_s
+from .gait import _finite_number, check_enough_strides, iqr_outliers, window, window_times_s
+from .gait import _where as _gait_where
 
 __all__ = [
     "MATCH_COLUMNS",
@@ -77,19 +78,9 @@ _TIME_TOL_S = 1e-9  # tolerance of time comparisons on exact quantities (grids, 
 # --------------------------------------------------------------------------- checks
 
 
-def _where(source: str) -> str:
-    return f"{source}: " if source else ""
-
-
-def _number(name: str, value, source: str, minimum: float | None = None) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise LoperInputError(f"{_where(source)}{name} must be a number, got {value!r}") from None
-    if not math.isfinite(v) or (minimum is not None and v < minimum):
-        bound = f" >= {minimum:g}" if minimum is not None else ""
-        raise LoperInputError(f"{_where(source)}{name} must be a finite number{bound}, got {value!r}")
-    return v
+# input checks shared with :mod:`.gait`
+_where = _gait_where
+_number = _finite_number
 
 
 def _time(time_s, source: str) -> np.ndarray:
