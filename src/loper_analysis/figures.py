@@ -207,13 +207,7 @@ def plot_responses(
                 if c == 0:
                     ax_a.set_ylabel(f"{joint} (deg)")
                     ax_d.set_ylabel(f"Δ{joint} (deg)")
-            if c == 0:
-                axes[0, c].legend(fontsize=7, loc="best")
-        for c in range(n_cols):
-            axes[-1, c].set_xlabel("time after onset (ms)")
-        if title:
-            fig.suptitle(title)
-        _save_png_atomic(fig, out_png)
+        _finish(fig, axes, "time after onset (ms)", title, out_png)
     finally:
         plt.close(fig)
     return peaks
@@ -277,13 +271,7 @@ def plot_fit(
                 ax.axhline(0.0, color="0.7", lw=0.6)
                 if c == 0:
                     ax.set_ylabel(f"{joint} (deg)")
-            if c == 0:
-                axes[0, c].legend(fontsize=7, loc="best")
-        for c in range(n_cols):
-            axes[-1, c].set_xlabel("time (ms)")
-        if title:
-            fig.suptitle(title)
-        _save_png_atomic(fig, out_png)
+        _finish(fig, axes, "time (ms)", title, out_png)
     finally:
         plt.close(fig)
 
@@ -402,3 +390,14 @@ def plot_impedance(impedance_tsv: str | Path, out_png: str | Path) -> pd.DataFra
     finally:
         plt.close(fig)
     return mean
+
+
+def _finish(fig, axes, xlabel: str, title: str | None, out_png) -> None:
+    """Legend in the first panel (if it has labelled curves), x labels on the bottom row, title, atomic PNG."""
+    if axes[0, 0].get_legend_handles_labels()[1]:
+        axes[0, 0].legend(fontsize=7, loc="best")
+    for ax in axes[-1]:
+        ax.set_xlabel(xlabel)
+    if title:
+        fig.suptitle(title)
+    _save_png_atomic(fig, out_png)
