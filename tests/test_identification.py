@@ -7,6 +7,8 @@ The "measured" data come from :func:`loper_analysis.validation.perturbed_trial`
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -15,6 +17,8 @@ from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
     identify_impedance,
+    nuisance_projection,
+    null_pair_errors,
     prediction_error,
     prepare_window,
     simulate_response,
@@ -248,3 +252,86 @@ def test_unconverged_fit_says_so(trial_mid):
     # the estimate is still the best point seen, inside the bounds, with its cost
     assert np.all(result.estimate >= 0) and np.all(result.estimate <= [200, 10, 200, 10, 200, 10])
     np.testing.assert_allclose(result.cost, np.sum(prediction_error(window, result.estimate) ** 2), rtol=1e-12)
+
+
+# ---------------------------------------------------------------- stride-to-stride deviation
+
+
+def _deviation_shape(window):
+    """A smooth deviation (n_out, 3) that starts at the onset: what a matched stride leaves behind."""
+    tau = np.clip(window.time_s - window.onset_s, 0.0, None)
+    return np.stack([0.3 * tau**2, -0.5 * tau**2 + 0.2 * tau**3, 0.1 * tau**2], axis=-1)
+
+
+def test_nuisance_projection_is_the_orthogonal_complement_of_the_dominant_shapes():
+    rng = np.random.default_rng(3)
+    v = np.linalg.qr(rng.normal(size=(30, 2)))[0]  # two orthonormal shapes
+    errors = rng.normal(size=(50, 2)) * [3.0, 1.0] @ v.T + 1e-9 * rng.normal(size=(50, 30))
+    W = nuisance_projection(errors, 2)
+    np.testing.assert_allclose(W @ v, 0.0, atol=1e-8)
+    np.testing.assert_allclose(W, W.T, atol=1e-12)
+    np.testing.assert_allclose(W @ W, W, atol=1e-12)
+    assert np.trace(W) == pytest.approx(28.0, abs=1e-9)
+    np.testing.assert_allclose(nuisance_projection(errors, 0), np.eye(30), atol=0)
+    with pytest.raises(LoperInputError, match="n_components"):
+        nuisance_projection(errors, 30)
+
+
+def test_projecting_out_the_deviation_recovers_the_truth_the_white_fit_misses(trial_mid):
+    """Noise-free response plus a smooth deviation whose shape the null pairs show.
+
+    White least squares lets the deviation pull D; with the shape projected out
+    the fit returns the truth, and the sandwich CI from the null pairs cover it.
+    Measured: white D_hip 0.26 (truth 2.0), K_knee 85.6 (75); projected 1.999 and 75.001.
+    """
+    truth = np.array([75.0, 2.0, 75.0, 2.0, 75.0, 2.0])
+    window = window_for(trial_mid, n_substeps=SETTINGS.truth_substeps)
+    shape = _deviation_shape(window)
+    biased = replace(window, measured=window.measured + 0.3 * shape)
+    white = fit(biased)
+    assert abs(white.estimate[1] - truth[1]) > 1.0  # the deviation biases D_hip
+    rng = np.random.default_rng(5)
+    errors = rng.normal(0.0, 0.3, (40, 1)) * shape.reshape(1, -1) + rng.normal(0.0, 1e-5, (40, shape.size))
+    projected = replace(biased, residual_weight=nuisance_projection(errors, 1),
+                        noise_cov=np.cov(errors, rowvar=False) / 10)
+    result = fit(projected)
+    hip_knee = [0, 1, 2, 3]
+    np.testing.assert_allclose(result.estimate[hip_knee], truth[hip_knee], rtol=2e-3)
+    assert np.all(result.ci95_low[hip_knee] <= truth[hip_knee]) and np.all(truth[hip_knee] <= result.ci95_high[hip_knee])
+    # the VAF and cost describe the unweighted prediction error
+    np.testing.assert_allclose(result.model, biased.measured - prediction_error(biased, result.estimate), atol=0)
+
+
+def _null_pairs(window, t, qu, pu, dq):
+    """Null pairs on the window's data grid: perturbed = unperturbed + dq (M, n, 4); pelvis unchanged."""
+    M = dq.shape[0]
+    return {"time_s": t - window.onset_s, "q_unperturbed": np.broadcast_to(qu, dq.shape).copy(),
+            "q_perturbed": qu + dq, "pelvis_angle_unperturbed_rad": np.broadcast_to(pu, (M, len(t))).copy(),
+            "pelvis_angle_perturbed_rad": np.broadcast_to(pu, (M, len(t))).copy()}
+
+
+def test_null_pair_errors_subtract_the_free_response_of_the_initial_state(trial_mid):
+    """Three pairs with known errors: identical strides (0); a difference that starts after the
+    pre-onset span (its joint-angle difference, as no initial state is seen); a small thigh
+    offset before the window (its measured difference minus the change of the model's
+    response that offset makes, simulated in full by the peer function simulate_response)."""
+    t, qu, _, _, pelvis = trial_mid
+    window = window_for(trial_mid)
+    theta = np.array([75.0, 2.0, 75.0, 2.0, 75.0, 2.0])
+    dq = np.zeros((3,) + qu.shape)
+    after = np.clip(t - window.onset_s, 0.0, None)
+    dq[1, :, 2] = 0.2 * after**2  # shank only, from the onset on: invisible to the pre-onset line
+    dq[2, :, 1] = 1e-4  # constant thigh offset
+    errors = null_pair_errors(window, theta, _null_pairs(window, t, qu, pelvis, dq))
+    assert errors.shape == (3, window.measured.size)
+    np.testing.assert_allclose(errors[0], 0.0, atol=1e-15)
+    idx = np.searchsorted(t, window.time_s - 1e-9)
+    expected = np.stack([np.zeros(idx.size), dq[1, idx, 2], dq[1, idx, 2]], axis=-1)  # hip, knee, ankle
+    np.testing.assert_allclose(errors[1], expected.ravel(), atol=1e-9)
+    still = replace(window, e0=np.zeros(4), ed0=np.zeros(4))
+    free = (simulate_response(replace(still, e0=np.array([0.0, 1e-4, 0.0, 0.0])), theta)
+            - simulate_response(still, theta))
+    measured = np.tile([-1e-4, -1e-4, 0.0], (idx.size, 1))
+    # G is linear about theta: 2.6e-9 rad from the full simulation for a 1e-4 rad offset
+    np.testing.assert_allclose(errors[2], (measured - free).ravel(), rtol=0, atol=1e-8)
+    assert np.abs(free).max() > 1e-5  # the subtraction mattered

@@ -16,7 +16,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import JOINTS
-from loper_analysis.dynamics import segment_coordinates, segment_parameters_from_anthropometry
+from loper_analysis.dynamics import joint_angles, segment_coordinates, segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait import TooFewStridesWarning, window_times_s
 from loper_analysis.identification import prepare_window
@@ -24,6 +24,7 @@ from loper_analysis.responses import (
     COUNT_COLUMNS,
     MATCH_COLUMNS,
     match_unperturbed,
+    null_pair_windows,
     paired_windows,
     subject_onset_response,
     too_short,
@@ -391,3 +392,58 @@ def test_subject_inputs_are_checked(rng):
         subject_onset_response([bad], 100)
     with pytest.raises(LoperInputError, match="S01: trial name 'walk-1' appears twice"):
         subject_onset_response([trial.inputs(), trial.inputs()], 100, source="S01")
+
+
+# --------------------------------------------------------------------------- null pairs
+
+
+def null_trial(rng):
+    """Unperturbed strides in twin pairs (equal offsets); perturbed strides 4 and 8 copy stride 10's
+    offsets, so a stride 10 that could match them would tie with them (and ties go to the first)."""
+    n = 16
+    i = np.arange(n)
+    stance, swing = 88 + (7 * i) % 5, 58 + (3 * i) % 5
+    offsets = rng.uniform(-0.05, 0.05, (n, 3))
+    twins = {0: 1, 2: 3, 5: 6, 7: 9, 10: 11, 12: 13, 14: 15}
+    for a, b in twins.items():
+        offsets[b] = offsets[a]
+    offsets[4] = offsets[8] = offsets[10]
+    trial = make_trial("walk-n", stance, swing, offsets, {4: BUMP_AMP, 8: BUMP_AMP})
+    return trial, {**twins, **{b: a for a, b in twins.items()}}
+
+
+def test_null_pairs_match_each_unperturbed_stride_to_its_twin_never_itself_or_a_perturbed_one(rng):
+    trial, twin = null_trial(rng)
+    t = trial.angles["time_s"].to_numpy()
+    m = match_unperturbed(t, trial.angles[JOINT_COLS].to_numpy(), trial.strides, onset_after_toe_off_s=DELAY / RATE,
+                          span_s=(-0.125, 0.25), missing="drop", null_pairs=True)
+    assert len(m) >= 12  # every stride but those whose window leaves the data
+    assert not set(m["stride"]) & {4, 8} and not set(m["matched_stride"]) & {4, 8}
+    for s, u in zip(m["stride"], m["matched_stride"]):
+        assert u == twin[s], (s, u)
+    np.testing.assert_allclose(m["rmsd_rad"], 0.0, atol=1e-12)
+    # the nominal onset: DELAY frames after each stride's own toe-off
+    toe = trial.strides.set_index("stride")["toe_off_s"]
+    np.testing.assert_allclose(m["onset_s"], toe[m["stride"]].to_numpy() + DELAY / RATE, atol=1e-12)
+    with pytest.raises(LoperInputError, match="null_pairs needs onset_after_toe_off_s"):
+        match_unperturbed(t, trial.angles[JOINT_COLS].to_numpy(), trial.strides, null_pairs=True)
+
+
+def test_null_pair_windows_of_twins_are_identical_and_pool_trials(rng):
+    """Twin pairs differ by nothing: zero differences in every coordinate; two trials pool their pairs."""
+    a, _ = null_trial(rng)
+    b, _ = null_trial(rng)
+    b.name = "walk-m"
+    out = null_pair_windows([a.inputs(), b.inputs()], DELAY / RATE * 1e3, RATE, source="S01")
+    single = null_pair_windows([a.inputs()], DELAY / RATE * 1e3, RATE)
+    assert out["n_pairs"] == 2 * single["n_pairs"] >= 24 and out["n_outliers"] == 0
+    np.testing.assert_allclose(out["time_s"], window_times_s(0.125, 0.25, RATE))
+    assert out["q_perturbed"].shape == (out["n_pairs"], out["time_s"].size, 4)
+    # joint angles and cart agree; the pelvis angle carries 1 mrad per stride number (make_trial)
+    angles = [joint_angles(out[f"q_{w}"].reshape(-1, 4), out[f"pelvis_angle_{w}_rad"].reshape(-1))
+              for w in ("perturbed", "unperturbed")]
+    np.testing.assert_allclose(angles[0] - angles[1], 0.0, atol=1e-12)
+    np.testing.assert_allclose(out["q_perturbed"][..., 0] - out["q_unperturbed"][..., 0], 0.0, atol=1e-12)
+    dp = out["pelvis_angle_perturbed_rad"] - out["pelvis_angle_unperturbed_rad"]
+    np.testing.assert_allclose(dp - dp[:, :1], 0.0, atol=1e-12)  # constant per pair:
+    assert set(np.round(np.abs(dp[:, 0]) / 0.001).astype(int)) == {1, 2}  # twins are neighbours or (7, 9)

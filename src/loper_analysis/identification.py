@@ -29,6 +29,18 @@ Beyond the study: 95 % confidence intervals from the Jacobian at the optimum
 its covariance from the pre-onset fit; Student t quantile) and the parameter
 correlation matrix. A wide CI or a correlation near +-1 flags a
 parameter the data cannot identify (typically the ankle).
+
+Also beyond the study: the stride-to-stride deviation. The prediction error
+of a mean response is not white: the matched unperturbed stride differs from
+the perturbed stride's own unperturbed course by a smooth deviation that the
+25 ms pre-onset match cannot remove, and with a dozen strides its average
+still biases D. Unperturbed strides paired by the same rule (*null pairs*)
+show that error without a response (:func:`null_pair_errors`). Its few
+dominant shapes (principal components) are projected out of the prediction
+error (:func:`nuisance_projection`, ``PreparedWindow.residual_weight``) - the
+same as fitting their amplitudes as nuisance parameters - and the CI come
+from the null pairs' covariance by the sandwich ``cov = M C M^T``,
+``M = (W J)^+ W``, ``C = PreparedWindow.noise_cov``.
 """
 
 from __future__ import annotations
@@ -57,6 +69,8 @@ __all__ = [
     "identify_impedance",
     "variance_accounted_for",
     "response_jacobian",
+    "null_pair_errors",
+    "nuisance_projection",
 ]
 
 #: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS`.
@@ -74,7 +88,12 @@ class PreparedWindow:
     perturbed-minus-unperturbed joint angle difference (rad) at the window's
     samples ``time_s`` (n_out,). ``initial_state_cov`` (8, 8) is the covariance
     of ``[e0, ed0]`` from the scatter of the pre-onset differences about their
-    polynomial (zero for noise-free data).
+    polynomial (zero for noise-free data). Optional, m = 3 n_out values
+    (samples, then hip/knee/ankle): ``residual_weight`` (m, m) multiplies the
+    prediction error before it is squared (:func:`nuisance_projection`);
+    ``noise_cov`` (m, m) is the covariance of the prediction error at the true
+    impedance (rad^2, e.g. from :func:`null_pair_errors` divided by the number
+    of averaged pairs), from which the CI are taken when given.
     """
 
     params: SegmentParameters
@@ -91,6 +110,11 @@ class PreparedWindow:
     dt_s: float
     n_substeps: int
     initial_state_cov: np.ndarray = field(default_factory=lambda: np.zeros((8, 8)))
+    onset_s: float = 0.0
+    initial_state_span_s: float = 0.1
+    initial_state_degree: int = 1
+    noise_cov: np.ndarray | None = None
+    residual_weight: np.ndarray | None = None
 
     @property
     def n_samples(self) -> int:
@@ -275,8 +299,7 @@ def prepare_window(
             f"(initial_state_span_s = {initial_state_span_s}) with >= {initial_state_degree + 1} samples; "
             f"data start at {t[0]:.4f} s"
         )
-    tau = t[sel] - t[i0]
-    V = np.vander(tau, int(initial_state_degree) + 1, increasing=True)
+    V = _initial_state_basis(t[sel] - t[i0], initial_state_degree)
     coef, *_ = np.linalg.lstsq(V, (qp - qu)[sel], rcond=None)
     e0 = coef[0]
     ed0 = coef[1] if initial_state_degree >= 1 else np.zeros(4)
@@ -306,7 +329,79 @@ def prepare_window(
         dt_s=h,
         n_substeps=n_substeps,
         initial_state_cov=state_cov,
+        onset_s=float(onset_s),
+        initial_state_span_s=float(initial_state_span_s),
+        initial_state_degree=int(initial_state_degree),
     )
+
+
+def _initial_state_basis(tau: np.ndarray, degree: int) -> np.ndarray:
+    """Polynomial basis (n, degree + 1) in the time ``tau`` (s) from window start."""
+    return np.vander(tau, int(degree) + 1, increasing=True)
+
+
+def null_pair_errors(window: PreparedWindow, impedance, null_pairs: dict) -> np.ndarray:
+    """Prediction errors (M, m) of pairs without perturbation, at ``impedance``.
+
+    A null pair (:func:`loper_analysis.responses.null_pair_windows`) is an
+    unperturbed stride matched to another one: its difference is what a
+    perturbed-minus-matched difference holds besides the response. Its
+    prediction error is ``eps - G s0``: its measured joint-angle difference
+    over the window (rad; samples, then hip/knee/ankle, like the fit's
+    residuals) minus the model's free response from its own initial state
+    ``s0`` (the pre-onset polynomial, as :func:`prepare_window` takes it; ``G``
+    the sensitivity to the initial state, linear about ``impedance``).
+
+    ``null_pairs``: ``time_s`` (n,) relative to the onset on the grid of the
+    window's data; ``q_perturbed``, ``q_unperturbed`` (M, n, 4);
+    ``pelvis_angle_perturbed_rad``, ``pelvis_angle_unperturbed_rad`` (M, n).
+    """
+    t = np.asarray(null_pairs["time_s"], dtype=float) + window.onset_s
+    qp, qu = (np.asarray(null_pairs[k], dtype=float) for k in ("q_perturbed", "q_unperturbed"))
+    pp, pu = (np.asarray(null_pairs[k], dtype=float) for k in ("pelvis_angle_perturbed_rad",
+                                                               "pelvis_angle_unperturbed_rad"))
+    n_pairs = qp.shape[0]
+    if qp.ndim != 3 or qp.shape != qu.shape or qp.shape[1:] != (t.size, 4) or pp.shape != qp.shape[:2] \
+            or pu.shape != pp.shape:
+        raise LoperInputError(f"null pairs: q arrays must be (M, {t.size}, 4) and pelvis angles (M, {t.size}); got "
+                              f"{qp.shape}, {qu.shape}, {pp.shape}, {pu.shape}")
+    m = 3 * window.n_samples
+    if n_pairs < 1:
+        raise LoperInputError("null pairs: none given")
+    tol = 1e-6 * window.dt_s * window.n_substeps
+    idx = np.searchsorted(t, window.time_s - tol)
+    if np.any(idx >= t.size) or np.any(np.abs(t[np.minimum(idx, t.size - 1)] - window.time_s) > tol):
+        raise LoperInputError(f"null pairs: their grid ({t[0]:.4f} .. {t[-1]:.4f} s) does not hold the window's "
+                              f"samples ({window.time_s[0]:.4f} .. {window.time_s[-1]:.4f} s)")
+    sel = (t >= window.onset_s - window.initial_state_span_s - tol) & (t <= window.onset_s + tol)
+    V = _initial_state_basis(t[sel] - window.time_s[0], window.initial_state_degree)
+    dq = qp - qu
+    coef, *_ = np.linalg.lstsq(V, np.moveaxis(dq[:, sel], 1, 0).reshape(sel.sum(), -1), rcond=None)
+    coef = coef.reshape(V.shape[1], n_pairs, 4)
+    s0 = np.concatenate([coef[0], coef[1] if window.initial_state_degree >= 1 else np.zeros((n_pairs, 4))], axis=1)
+    eps = np.stack([joint_angles(qp[i, idx], pp[i, idx]) - joint_angles(qu[i, idx], pu[i, idx])
+                    for i in range(n_pairs)]).reshape(n_pairs, m)
+    return eps - s0 @ _initial_state_jacobian(window, np.asarray(impedance, dtype=float)).T
+
+
+def nuisance_projection(errors, n_components: int) -> np.ndarray:
+    """Projection (m, m) that removes the ``n_components`` dominant shapes of ``errors``.
+
+    ``errors`` (M, m): e.g. :func:`null_pair_errors`. The shapes are the
+    leading right singular vectors ``V`` of the centred errors; the
+    projection is ``I - V V^T``. Used as ``PreparedWindow.residual_weight``
+    it fits K and D to what these shapes cannot explain, as if their
+    amplitudes were free nuisance parameters.
+    """
+    E = np.asarray(errors, dtype=float)
+    if E.ndim != 2 or not np.all(np.isfinite(E)):
+        raise LoperInputError(f"errors must be a finite (M, m) array, got shape {E.shape}")
+    r = int(n_components)
+    if r != n_components or not 0 <= r < min(E.shape):
+        raise LoperInputError(f"n_components must be an integer in 0 .. {min(E.shape) - 1} "
+                              f"(M = {E.shape[0]} null pairs, m = {E.shape[1]}), got {n_components}")
+    _, _, vt = np.linalg.svd(E - E.mean(axis=0), full_matrices=False)
+    return np.eye(E.shape[1]) - vt[:r].T @ vt[:r]
 
 
 # ---------------------------------------------------------------- model response
@@ -399,10 +494,18 @@ class _Evaluator:
         self.lb, self.ub = lb, ub
         self.typical = 0.01 * (ub - lb)
         self.n_sim = 0
+        m = 3 * window.n_samples
+        for name in ("residual_weight", "noise_cov"):
+            value = getattr(window, name)
+            if value is not None and (np.shape(value) != (m, m) or not np.all(np.isfinite(value))):
+                raise LoperInputError(f"{name} must be a finite ({m}, {m}) matrix, got shape {np.shape(value)}")
+        self.weight = None if window.residual_weight is None else np.asarray(window.residual_weight, dtype=float)
 
     def residuals(self, P: np.ndarray) -> np.ndarray:
+        """Prediction errors (B, m), times ``residual_weight`` when the window has one."""
         self.n_sim += len(P)
-        return (self.window.measured - simulate_response(self.window, P)).reshape(len(P), -1)
+        r = (self.window.measured - simulate_response(self.window, P)).reshape(len(P), -1)
+        return r if self.weight is None else r @ self.weight.T
 
     def residuals_and_jacobians(self, P: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """r (B, m) and J (B, m, 6) of the residuals at the rows of P."""
@@ -522,6 +625,7 @@ def identify_impedance(
     max_iterations: int = 60,
     tolerance: float = 1e-6,
     merge_tolerance: float = 1e-2,
+    extra_starts=None,
 ) -> ImpedanceFit:
     """Fit K, D per joint to one prepared window (see the module docstring).
 
@@ -537,6 +641,8 @@ def identify_impedance(
     merge_tolerance : starts closer than this fraction of the bound range in
         every parameter continue as one (0 disables merging); a merged start
         counts as reaching the optimum its partner reaches.
+    extra_starts : (k, 6) starts tried before the random ones (e.g. a
+        previous estimate), clipped to the bounds.
 
     Returns
     -------
@@ -549,6 +655,11 @@ def identify_impedance(
         raise LoperInputError(f"n_starts must be an integer >= 1, got {n_starts}")
     rng = np.random.default_rng(seed)
     starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
+    if extra_starts is not None:
+        extra = np.atleast_2d(np.asarray(extra_starts, dtype=float))
+        if extra.shape[1:] != (6,) or not np.all(np.isfinite(extra)):
+            raise LoperInputError(f"extra_starts must be finite with 6 values per row, got shape {extra.shape}")
+        starts = np.vstack([np.clip(extra, lb, ub), starts])
     ev = _Evaluator(window, lb, ub)
     if not 0 <= merge_tolerance < 1:
         raise LoperInputError(f"merge_tolerance must lie in [0, 1), got {merge_tolerance}")
@@ -571,32 +682,41 @@ def identify_impedance(
         estimate = P[best]
     r, J = ev.residuals_and_jacobians(estimate[None])
     r, J = r[0], J[0]
-    cost = float(np.sum(r**2))
+    pe = prediction_error(window, estimate)
+    cost = float(np.sum(pe**2))
     success = bool(polish.status > 0 and converged[best])
     message = polish.message if success else (
         f"not converged: multistart LM converged={bool(converged[best])}, polish status {polish.status} ({polish.message})"
     )
     # how many starts reached the best optimum (same cost within tolerance)
-    at_best = np.sum(0.5 * costs <= 0.5 * cost * (1 + 1e-3) + 1e-14) if cost > 0 else np.sum(costs <= 1e-14)
+    fit_cost = float(np.sum(r**2))  # the cost minimised (weighted by residual_weight)
+    at_best = (np.sum(0.5 * costs <= 0.5 * fit_cost * (1 + 1e-3) + 1e-14) if fit_cost > 0
+               else np.sum(costs <= 1e-14))
     n_at_best = int(max(at_best, 1))
-    # confidence intervals and correlations from the Jacobian: white residual
-    # noise plus the uncertainty of the initial state, propagated (sandwich)
+    # confidence intervals and correlations from the Jacobian. Without
+    # noise_cov: white residual noise plus the uncertainty of the initial
+    # state, propagated (sandwich). With noise_cov: the sandwich of the
+    # linearised estimator M = (W J)^+ W; noise_cov holds the initial
+    # state's share already.
     m = r.size
     dof = max(m - 6, 1)
-    s2 = cost / dof
+    s2 = float(np.sum(r**2)) / dof
     JTJ = J.T @ J
     A = np.linalg.pinv(JTJ, rcond=1e-13)
-    G = _initial_state_jacobian(window, estimate)
-    JG = J.T @ G
     with np.errstate(divide="ignore", invalid="ignore"):
-        cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
+        if window.noise_cov is None:
+            JG = J.T @ _initial_state_jacobian(window, estimate)
+            cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
+        else:
+            M = A @ J.T if ev.weight is None else A @ J.T @ ev.weight
+            cov = M @ np.asarray(window.noise_cov, dtype=float) @ M.T
         sd = np.sqrt(np.clip(np.diag(cov), 0, None))
         corr = cov / np.outer(sd, sd)
     rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
     if rank < 6:
         sd = np.where(np.diag(JTJ) > 0, sd, np.inf)
     half = student_t.ppf(0.975, dof) * sd
-    model = window.measured - r.reshape(-1, 3)
+    model = window.measured - pe
     vaf = variance_accounted_for(window.measured, model)
     return ImpedanceFit(
         estimate=estimate,

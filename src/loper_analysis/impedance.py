@@ -40,7 +40,8 @@ __all__ = [
 #: Columns of ``results/impedance/{subject}/{onset}.tsv`` and ``results/tables/impedance.tsv``.
 IMPEDANCE_COLUMNS: tuple[str, ...] = (
     "subject", "onset_ms", "joint", "K", "D", "K_ci95_low", "K_ci95_high", "D_ci95_low", "D_ci95_high",
-    "vaf_pct", "n_strides", "K_true", "D_true", "K_error", "D_error", "cost_rad2", "status", "reason",
+    "vaf_pct", "n_strides", "K_true", "D_true", "K_error", "D_error", "cost_rad2", "noise_model", "n_null_pairs",
+    "status", "reason",
 )
 
 
@@ -70,11 +71,14 @@ def brace_force_direction(markers_m: np.ndarray, labels: Sequence[str], brace=("
 
 
 def impedance_rows(fit, subject: str, onset_ms: int, n_strides: int, truth: Mapping | None = None,
-                   lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 0.5) -> pd.DataFrame:
+                   lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 0.5,
+                   noise_model: str = "white", n_null_pairs: int = 0, note: str = "") -> pd.DataFrame:
     """One row per joint from an :class:`~loper_analysis.identification.ImpedanceFit` (columns :data:`IMPEDANCE_COLUMNS`).
 
     ``truth``: ``{joint: {"K": .., "D": ..}}`` of a synthetic subject (errors
-    = estimate - truth), None for a recorded one.
+    = estimate - truth), None for a recorded one. ``noise_model`` (``white`` |
+    ``null_pairs``) and ``n_null_pairs`` say how the fit weighted its errors;
+    ``note`` is appended to every row's reason.
     """
     rows = []
     span = np.array(upper, float) - np.array(lower, float)
@@ -86,6 +90,7 @@ def impedance_rows(fit, subject: str, onset_ms: int, n_strides: int, truth: Mapp
             "K_ci95_low": fit.ci95_low[k], "K_ci95_high": fit.ci95_high[k],
             "D_ci95_low": fit.ci95_low[d], "D_ci95_high": fit.ci95_high[d],
             "vaf_pct": fit.vaf_pct[j], "n_strides": int(n_strides), "cost_rad2": fit.cost,
+            "noise_model": noise_model, "n_null_pairs": int(n_null_pairs),
         }
         if truth is not None:
             row.update(K_true=truth[joint]["K"], D_true=truth[joint]["D"],
@@ -99,6 +104,8 @@ def impedance_rows(fit, subject: str, onset_ms: int, n_strides: int, truth: Mapp
                               f"{max_ci_fraction:g} of the bounds")
         else:
             row.update(status="ok", reason="")
+        if note:
+            row["reason"] = "; ".join(r for r in (row["reason"], note) if r)
         rows.append(row)
     return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
 
@@ -127,6 +134,10 @@ def fit_subject_onset(
     curves_out,
     truth_yaml=None,
     *,
+    null_trials: Sequence[Mapping] = (),
+    noise_model: str = "null_pairs",
+    null_pair_components: int = 6,
+    min_null_pairs: int = 30,
     rate_hz: float = 128.0,
     window_before_s: float = 0.025,
     window_after_s: float = 0.25,
@@ -152,16 +163,34 @@ def fit_subject_onset(
     the mean response (:func:`loper_analysis.responses.subject_onset_response`),
     the stride counts, the fit rows (:data:`IMPEDANCE_COLUMNS`) and the
     measured and model responses of the fit (``curves_out``, rad).
+
+    ``noise_model``: ``white`` fits the plain least squares of the study;
+    ``null_pairs`` fits it first, then takes the null pairs
+    (:func:`loper_analysis.responses.null_pair_windows` over ``null_trials``:
+    ``name``, ``angles``, ``strides``, e.g. all the subject's walking trials
+    with the device; the onset's own trials when empty), their prediction
+    errors at that estimate
+    (:func:`loper_analysis.identification.null_pair_errors`), projects their
+    ``null_pair_components`` dominant shapes out of the prediction error
+    (:func:`loper_analysis.identification.nuisance_projection`) and fits again
+    from the first estimate and the random starts, with CI from the null
+    pairs' covariance divided by the number of averaged pairs. With fewer
+    than ``min_null_pairs`` null pairs the first fit stands and the reason
+    says so.
     """
     import warnings
 
     from .dynamics import SegmentParameters
     from .gait import TooFewStridesWarning
-    from .identification import identify_impedance, prepare_window
+    from dataclasses import replace
+
+    from .identification import identify_impedance, null_pair_errors, nuisance_projection, prepare_window
     from .io.tables import read_markers
     from .processing import write_tsv
-    from .responses import subject_onset_response
+    from .responses import null_pair_windows, subject_onset_response
 
+    if noise_model not in ("null_pairs", "white"):
+        raise LoperInputError(f"identification.noise_model must be 'null_pairs' or 'white', got {noise_model!r}")
     truth = None
     if truth_yaml:
         from .synthetic.subjects import read_truth
@@ -215,8 +244,28 @@ def fit_subject_onset(
     upper = np.array([stiffness_bounds[1], damping_bounds[1]] * 3, float)
     fit = identify_impedance(window, n_starts=n_starts, seed=seed, lower=lower, upper=upper, tolerance=tolerance,
                              merge_tolerance=merge_tolerance)
+    used, n_null, note = "white", 0, ""
+    if noise_model == "null_pairs":
+        loaded = {i["name"]: i for i in inputs}
+        pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
+        null = null_pair_windows(
+            pool, onset_ms, rate_hz, window_before_s, window_after_s, initial_state_span_s,
+            whisker, max_fraction, source=subject,
+        )
+        n_null = null["n_pairs"]
+        if n_null >= max(int(min_null_pairs), int(null_pair_components) + 2):
+            errors = null_pair_errors(window, fit.estimate, null)
+            weight = nuisance_projection(errors, null_pair_components)
+            cov = np.cov(errors, rowvar=False) / n_kept
+            fit = identify_impedance(replace(window, noise_cov=cov, residual_weight=weight), n_starts=n_starts,
+                                     seed=seed, lower=lower, upper=upper, tolerance=tolerance,
+                                     merge_tolerance=merge_tolerance, extra_starts=fit.estimate)
+            used = "null_pairs"
+        else:
+            note = (f"white-noise fit: {n_null} null pair(s), fewer than min_null_pairs = {min_null_pairs}; "
+                    "the CI ignore the stride-to-stride deviation")
     rows = impedance_rows(fit, subject, onset_ms, n_kept, truth, (stiffness_bounds[0], damping_bounds[0]),
-                          (stiffness_bounds[1], damping_bounds[1]), max_ci_fraction)
+                          (stiffness_bounds[1], damping_bounds[1]), max_ci_fraction, used, n_null, note)
     write_tsv(rows, fit_out)
     fit_frame = pd.DataFrame({"time_s": fit.time_s, **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
                               **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)}})

@@ -15,6 +15,8 @@ identification (:func:`loper_analysis.identification.prepare_window`) fits.
 * :func:`subject_onset_response` - all of it for one subject and onset, over
   the subject's trials: the mean response table, the stride counts and the
   averaged series for the identification.
+* :func:`null_pair_windows` - unperturbed strides paired the same way: the
+  stride-to-stride noise the identification weights its errors by.
 
 Conventions
 -----------
@@ -57,6 +59,7 @@ __all__ = [
     "paired_windows",
     "window_outliers",
     "subject_onset_response",
+    "null_pair_windows",
 ]
 
 log = logging.getLogger(__name__)
@@ -283,6 +286,7 @@ def match_unperturbed(
     window_after_s: float | None = None,
     candidate_within_swing: bool = False,
     missing: str = "raise",
+    null_pairs: bool = False,
 ) -> pd.DataFrame:
     """For each perturbed stride, the unperturbed stride most similar just before the onset.
 
@@ -328,6 +332,12 @@ def match_unperturbed(
     missing : {"raise", "drop"}
         A perturbed stride without match raises, or is left out and listed in
         ``attrs["unmatched"]``.
+    null_pairs : bool
+        Match the *unperturbed* strides instead, each as if perturbed
+        ``onset_after_toe_off_s`` after its toe-off, among the other
+        candidates (never itself); perturbed strides take no part. Their
+        differences are the stride-to-stride noise of a response
+        (:func:`null_pair_windows`). Needs ``onset_after_toe_off_s``.
 
     Returns
     -------
@@ -358,13 +368,21 @@ def match_unperturbed(
         raise LoperInputError(f"{_where(source)}missing must be 'raise' or 'drop', got {missing!r}")
     perturbed, onset = _perturbed_onsets(table, source)
     removed = _bool_column(table, "removed", source)
+    if null_pairs:
+        if onset_after_toe_off_s is None:
+            raise LoperInputError(f"{_where(source)}null_pairs needs onset_after_toe_off_s")
+        delay = _number("onset_after_toe_off_s", onset_after_toe_off_s, source, minimum=0.0)
+        table = table.assign(onset_s=np.where(perturbed, np.nan, table["toe_off_s"].to_numpy(float) + delay),
+                             perturbed=~perturbed & ~removed, removed=removed | perturbed)
+        perturbed, onset = _perturbed_onsets(table, source)
+        removed = _bool_column(table, "removed", source)
     short = (too_short(table, onset_after_toe_off_s, window_after_s, source) if window_after_s is not None
              else np.zeros(len(table), dtype=bool))
     stride_no = table["stride"].to_numpy()
     toe_off = table["toe_off_s"].to_numpy(float)
     end = table["end_s"].to_numpy(float)
     p = np.flatnonzero(perturbed & ~short)
-    c = np.flatnonzero(~perturbed & ~removed)
+    c = np.flatnonzero((null_pairs | ~perturbed) & ~removed)
     sampler = _Sampler(t, v2)
     tol = sampler.tol
     unmatched: dict[int, str] = {}
@@ -391,6 +409,8 @@ def match_unperturbed(
     ok = own[:, None] & (sampler.run(anchors + lo_span, anchors + hi_span) >= 0)
     if candidate_within_swing:
         ok &= anchors + hi_span <= end[c][None, :] + tol
+    if null_pairs:
+        ok &= p[:, None] != c[None, :]
     targets = anchors[:, :, None] + rel[:, None, :]  # (np, nc, m)
     sq = np.zeros(targets.shape)
     if ok.any():
@@ -879,3 +899,84 @@ def subject_onset_response(
     series.update({"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial,
                    "n_pairs": n_pairs})
     return response, counts, series
+
+
+# --------------------------------------------------------------------------- null pairs
+
+
+def null_pair_windows(
+    trials: Sequence[Mapping],
+    onset_ms: float,
+    rate_hz: float = 128.0,
+    before_s: float = 0.025,
+    after_s: float = 0.25,
+    initial_span_s: float = 0.1,
+    whisker: float = 1.5,
+    max_fraction: float = 0.2,
+    *,
+    side: str = "left",
+    source: str = "",
+) -> dict:
+    """Unperturbed strides paired like perturbed ones: samples of a response's stride-to-stride noise.
+
+    Every unperturbed stride of every trial is treated as if perturbed at
+    ``onset_ms`` after its toe-off, matched by the study's rule among the
+    other unperturbed strides of its trial (:func:`match_unperturbed` with
+    ``null_pairs``), windowed like :func:`subject_onset_response` does and
+    judged by the same IQR rule (:func:`window_outliers`). What its
+    difference shows is what a perturbed-minus-matched difference holds
+    besides the response: the residual of the matching. Trials need
+    ``name``, ``angles`` and ``strides`` (DataFrame or TSV path, as for
+    :func:`subject_onset_response`); they may include trials of other onsets
+    and unperturbed walking.
+
+    Returns
+    -------
+    dict
+        ``time_s`` (n_grid,) relative to the onset (s); per kept pair
+        ``q_perturbed``, ``q_unperturbed`` (n_pairs, n_grid, 4): [pelvis_x (m),
+        thigh, shank, foot (rad)]; ``pelvis_angle_perturbed_rad``,
+        ``pelvis_angle_unperturbed_rad`` (n_pairs, n_grid); ``n_pairs`` and
+        ``n_outliers``.
+    """
+    onset_s = _number("onset_ms", onset_ms, source, minimum=0.0) / 1e3
+    before = _number("before_s", before_s, source, minimum=0.0)
+    after = _number("after_s", after_s, source, minimum=0.0)
+    initial = _number("initial_span_s", initial_span_s, source, minimum=0.0)
+    if side not in ("left", "right"):
+        raise LoperInputError(f"{_where(source)}side must be 'left' or 'right', got {side!r}")
+    if isinstance(trials, Mapping) or not len(trials):
+        raise LoperInputError(f"{_where(source)}trials must be a non-empty sequence of trial mappings")
+    start = -(initial + before)
+    grid = window_times_s(-start, after, _number("rate_hz", rate_hz, source))
+    joints = [f"{j}_{side}_rad" for j in JOINTS]
+    parts = []
+    for k, trial in enumerate(trials):
+        name = str(trial.get("name", f"trial {k}")) if isinstance(trial, Mapping) else f"trial {k}"
+        if not isinstance(trial, Mapping) or any(key not in trial for key in ("angles", "strides")):
+            raise LoperInputError(f"{_where(source)}{name}: a trial needs angles and strides")
+        angles, where_a = _read_table(trial["angles"], "angles", name)
+        strides, where_s = _read_table(trial["strides"], "strides", name)
+        absent = [c for c in ("time_s", "pelvis_x_m", "pelvis_angle_rad", *joints) if c not in angles.columns]
+        if absent:
+            raise LoperInputError(f"{where_a}: column(s) {absent} missing")
+        t = _time(angles["time_s"].to_numpy(float), where_a)
+        columns = {"joints": angles[joints].to_numpy(float), "pelvis_angle": angles["pelvis_angle_rad"].to_numpy(float),
+                   "pelvis_x": angles["pelvis_x_m"].to_numpy(float)}
+        matches = match_unperturbed(t, columns["joints"], strides, before, source=where_s, span_s=(start, after),
+                                    onset_after_toe_off_s=onset_s, window_after_s=after, missing="drop",
+                                    null_pairs=True)
+        parts.append(paired_windows(t, columns, matches, start, after, rate_hz, source=where_s))
+    win = {key: tuple(np.concatenate([w[key][i] for w in parts]) for i in range(2)) for key in parts[0]}
+    jp, ju = win["joints"]
+    label = f"{source} null pairs, onset {onset_ms:g} ms" if source else f"null pairs, onset {onset_ms:g} ms"
+    keep = ~window_outliers(jp - ju, grid, before, after, whisker, max_fraction, JOINTS, label)["removed"].to_numpy()
+    out: dict = {"time_s": grid}
+    for what, i in (("perturbed", 0), ("unperturbed", 1)):
+        j, pel, x = (win[key][i][keep] for key in ("joints", "pelvis_angle", "pelvis_x"))
+        out[f"q_{what}"] = segment_coordinates(j.reshape(-1, 3), pel.reshape(-1), x.reshape(-1)).reshape(
+            j.shape[:2] + (4,))
+        out[f"pelvis_angle_{what}_rad"] = pel
+    out["n_pairs"], out["n_outliers"] = int(keep.sum()), int((~keep).sum())
+    log.info("%s: %d null pairs kept, %d outliers", label, out["n_pairs"], out["n_outliers"])
+    return out

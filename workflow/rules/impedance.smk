@@ -8,6 +8,12 @@ def onset_trials(subject: str, onset: str) -> list[str]:
     return [t for t in subject_trials(subject) if trial_onset_ms(t) == int(onset)]
 
 
+def null_pair_trials(subject: str) -> list[str]:
+    """The subject's trials with the device (minimal impedance and perturbation): their unperturbed strides
+    are the null pairs of every onset's fit."""
+    return [t for t in subject_trials(subject) if t != config["trials"]["no_device"]]
+
+
 def fit_inputs(wildcards):
     s = wildcards.subject
     out = {"segments": f"results/model/{s}/segments.tsv"}
@@ -18,6 +24,10 @@ def fit_inputs(wildcards):
         out[f"strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
         out[f"force_{t}"] = f"results/loadcell/{s}/{t}.force.tsv"
         out[f"markers_{t}"] = f"results/markers/{s}/{t}.trc"
+    if IDENT["noise_model"] == "null_pairs":
+        for t in null_pair_trials(s):
+            out[f"null_angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
+            out[f"null_strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
     return out
 
 
@@ -33,6 +43,7 @@ rule impedance_fit:
         onset=r"[0-9]{3}",
     params:
         trials=lambda wc: onset_trials(wc.subject, wc.onset),
+        null_trials=lambda wc: null_pair_trials(wc.subject) if IDENT["noise_model"] == "null_pairs" else [],
         settings=dict(
             window_before_s=IDENT["window_before_s"],
             window_after_s=IDENT["window_after_s"],
@@ -48,6 +59,9 @@ rule impedance_fit:
             max_fraction=config["strides"]["max_outlier_fraction"],
             min_strides=config["strides"]["min_valid_strides"],
             max_ci_fraction=IDENT["max_ci_fraction"],
+            noise_model=IDENT["noise_model"],
+            null_pair_components=IDENT["null_pair_components"],
+            min_null_pairs=IDENT["min_null_pairs"],
             seed=config["seed"],
         ),
     log:
