@@ -25,7 +25,8 @@ def fit_inputs(wildcards):
         out[f"force_{t}"] = f"results/loadcell/{s}/{t}.force.tsv"
         out[f"markers_{t}"] = f"results/markers/{s}/{t}.trc"
     if IDENT["noise_model"] == "null_pairs":
-        for t in null_pair_trials(s):
+        own = onset_trials(s, wildcards.onset)
+        for t in [t for t in null_pair_trials(s) if t not in own]:  # the onset's own trials are inputs already
             out[f"null_angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
             out[f"null_strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
     return out

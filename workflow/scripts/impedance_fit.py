@@ -9,8 +9,8 @@ trials = [
      "markers": inp[f"markers_{t}"]}
     for t in p.trials
 ]
-null_trials = [{"name": t, "angles": inp[f"null_angles_{t}"], "strides": inp[f"null_strides_{t}"]}
-               for t in p.null_trials]
+null_trials = [{"name": t, "angles": inp.get(f"null_angles_{t}", inp.get(f"angles_{t}")),
+                "strides": inp.get(f"null_strides_{t}", inp.get(f"strides_{t}"))} for t in p.null_trials]
 rows = fit_subject_onset(
     trials, inp.segments, int(snakemake.wildcards.onset), snakemake.wildcards.subject, out.response, out.counts,
     out.fit, out.curves, inp.get("truth"), null_trials=null_trials, **p.settings,
