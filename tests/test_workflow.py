@@ -214,3 +214,44 @@ def test_device_outputs_from_the_default_run(finished_run):
     # the logs the analysis read are on disk, in the robot-log format
     head = (finished_run / "data/raw/S01/device-steps.loper.tsv").read_text().splitlines()[:2]
     assert head == ["# format: loper-log 1", "# sample_rate_hz: 1000"]
+
+
+def test_recorded_subject_without_a_trial_reports_that_onset_missing(finished_run, tmp_path):
+    """A recorded subject whose only perturbation trial is absent: the run completes, its rows say missing."""
+    work = _project(tmp_path, device__subject="R01")
+    (work / "config/subjects.tsv").write_text("subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.8\t72\n")
+    raw = work / "data/raw/R01"
+    raw.mkdir(parents=True)
+    for name in ("static.c3d", "walk-nodevice.c3d", "walk-device.c3d", "walk-device.loper.tsv"):
+        shutil.copy(finished_run / "data/raw/S01" / name, raw / name)
+    res = _snakemake(work, "results/tables/impedance.tsv")
+    assert res.returncode == 0, res.stderr[-3000:]
+    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+    assert list(table.joint) == ["hip", "knee", "ankle"] and (table.subject == "R01").all()
+    assert (table.status == "missing").all() and (table.reason == "no trial of this onset").all()
+    assert table[["K", "D", "K_true", "D_true"]].isna().all().all()
+    assert not (work / "results/ik").exists()  # nothing was processed for an onset without trials
+
+
+def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
+    """Last in this file: it changes a raw file's time (and restores it)."""
+    import os
+    import re
+
+    raw = finished_run / "data/raw/S01/pert050-1.c3d"
+    before = raw.stat()
+    os.utime(raw, (before.st_atime, before.st_mtime + 3600))
+    try:
+        res = _snakemake(finished_run, "-n")
+    finally:
+        os.utime(raw, (before.st_atime, before.st_mtime))
+    assert res.returncode == 0, res.stderr[-3000:]
+    blocks = re.split(r"^(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
+    jobs = [(name, (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0])
+            for name, body in zip(blocks[::2], blocks[1::2])]
+    rules = {name for name, _ in jobs}
+    assert rules == {"markers", "ik_chunk", "ik_join", "events", "loadcell", "strides", "strides_summary",
+                     "impedance_fit", "impedance_table", "impedance_summary", "impedance_figures", "impedance_figure",
+                     "tables_markdown", "all"}, rules
+    trials = {w.split("trial=")[1].split(",")[0] for _, w in jobs if "trial=" in w}
+    assert trials == {"pert050-1"}

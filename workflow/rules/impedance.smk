@@ -19,13 +19,13 @@ def fit_inputs(wildcards):
     out = {"segments": f"results/model/{s}/segments.tsv"}
     if SUBJECT_SOURCE[s] == "synthetic":
         out["truth"] = f"data/raw/{s}/truth.yaml"
-    for t in onset_trials(s, wildcards.onset):
+    own = onset_trials(s, wildcards.onset)
+    for t in own:
         out[f"angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
         out[f"strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
         out[f"force_{t}"] = f"results/loadcell/{s}/{t}.force.tsv"
         out[f"markers_{t}"] = f"results/markers/{s}/{t}.trc"
-    if IDENT["noise_model"] == "null_pairs":
-        own = onset_trials(s, wildcards.onset)
+    if IDENT["noise_model"] == "null_pairs" and own:  # a missing onset is reported without any input
         for t in [t for t in null_pair_trials(s) if t not in own]:  # the onset's own trials are inputs already
             out[f"null_angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
             out[f"null_strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
