@@ -38,6 +38,19 @@ def synthetic(model_path):
     return t, truth, marker_positions(model_path, truth)
 
 
+def test_marker_positions_hold_length_one_trajectories_and_select_markers(model_path, synthetic):
+    t, truth, X = synthetic
+    held = {**truth, "pelvis_ty": truth["pelvis_ty"][:1]}
+    expected = marker_positions(model_path, {**truth, "pelvis_ty": np.full(t.size, truth["pelvis_ty"][0])})
+    np.testing.assert_array_equal(marker_positions(model_path, held), expected)
+    picked = ["LHEE", "RASI"]
+    np.testing.assert_array_equal(
+        marker_positions(model_path, truth, picked), X[:, [list(MARKERS).index(m) for m in picked]]
+    )
+    with pytest.raises(LoperInputError, match="length 1 or 256"):
+        marker_positions(model_path, {**truth, "pelvis_ty": truth["pelvis_ty"][:10]})
+
+
 def test_ik_recovers_known_angles(model_path, synthetic):
     t, truth, X = synthetic
     res = inverse_kinematics(model_path, t, X, list(MARKERS))

@@ -69,7 +69,15 @@ def _load(model):
 def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_names=None) -> np.ndarray:
     """Ground positions (n, n_markers, 3) in m of markers for coordinate trajectories (rad or m).
 
-    Coordinates not given stay at their defaults.
+    ``coordinate_values`` maps coordinate names to trajectories of one common
+    length n, or of length 1 (held for every frame); coordinates not given
+    stay at their defaults. ``marker_names`` selects and orders the markers
+    (default: every model marker, in model order).
+
+    Raises
+    ------
+    LoperInputError
+        An unknown coordinate or marker, or trajectories of unequal lengths.
     """
     osim, model = _load(model)
     state = model.initSystem()
@@ -80,21 +88,24 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
         raise LoperInputError(f"model {model.getName()}: unknown coordinate(s) {unknown}; has {names}")
     values = {c: np.atleast_1d(np.asarray(v, float)) for c, v in coordinate_values.items()}
     n = max((len(v) for v in values.values()), default=1)
+    uneven = {c: len(v) for c, v in values.items() if len(v) not in (1, n)}
+    if uneven:
+        raise LoperInputError(f"coordinate trajectories must have length 1 or {n}, got {uneven}")
     ms = model.getMarkerSet()
     all_markers = [ms.get(i).getName() for i in range(ms.getSize())]
     wanted = list(all_markers if marker_names is None else marker_names)
     missing = [mk for mk in wanted if mk not in all_markers]
     if missing:
         raise LoperInputError(f"model {model.getName()}: marker(s) {missing} not in the model")
-    idx = [all_markers.index(mk) for mk in wanted]
+    # Look the coordinates and markers up once: per-frame lookups through SWIG cost more than the kinematics.
+    coordinates = [(cs.get(c), np.broadcast_to(v, (n,))) for c, v in values.items()]
+    markers = [ms.get(all_markers.index(mk)) for mk in wanted]
     out = np.empty((n, len(wanted), 3))
     for k in range(n):
-        for c, v in values.items():
-            cs.get(c).setValue(state, float(v[k if len(v) > 1 else 0]), False)
+        for coordinate, v in coordinates:
+            coordinate.setValue(state, float(v[k]), False)
         model.realizePosition(state)
-        for j, i in enumerate(idx):
-            p = ms.get(i).getLocationInGround(state)
-            out[k, j] = (p.get(0), p.get(1), p.get(2))
+        out[k] = [marker.getLocationInGround(state).to_numpy() for marker in markers]
     return out
 
 
