@@ -188,8 +188,9 @@ def ik_weights(model_osim, labels: Sequence[str], tasks_file=None, default_weigh
 
 
 def ik_chunk(model_osim, trc_path, out_mot, chunk: int, n_chunks: int, tasks_file=None,
-             default_weight: float = 1.0, marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6) -> None:
-    """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees)."""
+             default_weight: float = 1.0, marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6
+             ) -> pd.DataFrame:
+    """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the coordinates."""
     from .io.tables import read_markers, write_mot
     from .kinematics import chunk_frames, inverse_kinematics
 
@@ -200,7 +201,22 @@ def ik_chunk(model_osim, trc_path, out_mot, chunk: int, n_chunks: int, tasks_fil
     res = inverse_kinematics(model_osim, time_s[sel], X[sel], labels, weights, coords, accuracy=accuracy)
     log.info("%s chunk %d/%d: %d frames, marker RMS error mean %.2f mm, max %.2f mm", trc_path, chunk, n_chunks,
              len(res.time_s), 1e3 * np.nanmean(res.marker_rms_m), 1e3 * np.nanmax(res.marker_max_m))
-    write_mot(out_mot, res.frame(), in_degrees=True)
+    frame = res.frame()
+    write_mot(out_mot, frame, in_degrees=True)
+    return frame
+
+
+def ik_trial(model_osim, trc_path, out_mot, angles_tsv, coordinate_map=None, tasks_file=None,
+             default_weight: float = 1.0, marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6
+             ) -> pd.DataFrame:
+    """IK of a whole TRC in one go: the .mot (degrees) and the tidy angle table that :func:`ik_join` gives."""
+    from .kinematics import joint_angle_table
+
+    coords = ik_chunk(model_osim, trc_path, out_mot, 0, 1, tasks_file, default_weight, marker_weights,
+                      coordinate_tasks, accuracy)
+    angles = joint_angle_table(coords, coordinate_map, source=str(out_mot))
+    write_tsv(angles, angles_tsv)
+    return angles
 
 
 def ik_join(chunk_mots: Sequence, out_mot, angles_tsv, coordinate_map=None) -> pd.DataFrame:

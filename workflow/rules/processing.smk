@@ -77,39 +77,65 @@ rule model_segments:
         "../scripts/model_segments.py"
 
 
-rule ik_chunk:
-    input:
-        model=subject_model,
-        trc="results/markers/{subject}/{trial}.trc",
-    output:
-        temp("results/ik/{subject}/{trial}.chunk{chunk}.mot"),
-    params:
-        n_chunks=OPENSIM["ik_chunks"],
-        tasks_file=OPENSIM["ik_tasks"],
-        default_weight=OPENSIM["default_marker_weight"],
-        marker_weights=OPENSIM["marker_weights"],
-        coordinate_tasks=OPENSIM["coordinate_tasks"],
-        accuracy=OPENSIM["accuracy"],
-    log:
-        "results/logs/ik_chunk/{subject}/{trial}.{chunk}.log",
-    benchmark:
-        "results/benchmarks/ik_chunk/{subject}/{trial}.{chunk}.tsv"
-    script:
-        "../scripts/ik_chunk.py"
+IK_SETTINGS = dict(
+    tasks_file=OPENSIM["ik_tasks"],
+    default_weight=OPENSIM["default_marker_weight"],
+    marker_weights=OPENSIM["marker_weights"],
+    coordinate_tasks=OPENSIM["coordinate_tasks"],
+    accuracy=OPENSIM["accuracy"],
+)
 
+if OPENSIM["ik_chunks"] == 1:
 
-rule ik_join:
-    input:
-        expand("results/ik/{{subject}}/{{trial}}.chunk{chunk}.mot", chunk=IK_CHUNKS),
-    output:
-        mot="results/ik/{subject}/{trial}.mot",
-        angles="results/ik/{subject}/{trial}.angles.tsv",
-    params:
-        coordinate_map=OPENSIM["coordinate_map"],
-    log:
-        "results/logs/ik_join/{subject}/{trial}.log",
-    script:
-        "../scripts/ik_join.py"
+    rule ik:
+        """The whole trial in one job (the default): IK, .mot and angle table."""
+        input:
+            model=subject_model,
+            trc="results/markers/{subject}/{trial}.trc",
+        output:
+            mot="results/ik/{subject}/{trial}.mot",
+            angles="results/ik/{subject}/{trial}.angles.tsv",
+        params:
+            coordinate_map=OPENSIM["coordinate_map"],
+            settings=IK_SETTINGS,
+        log:
+            "results/logs/ik/{subject}/{trial}.log",
+        benchmark:
+            "results/benchmarks/ik/{subject}/{trial}.tsv"
+        script:
+            "../scripts/ik.py"
+
+else:
+
+    rule ik_chunk:
+        """One of opensim.ik_chunks time chunks of a trial (long trials, many cores)."""
+        input:
+            model=subject_model,
+            trc="results/markers/{subject}/{trial}.trc",
+        output:
+            temp("results/ik/{subject}/{trial}.chunk{chunk}.mot"),
+        params:
+            n_chunks=OPENSIM["ik_chunks"],
+            settings=IK_SETTINGS,
+        log:
+            "results/logs/ik_chunk/{subject}/{trial}.{chunk}.log",
+        benchmark:
+            "results/benchmarks/ik_chunk/{subject}/{trial}.{chunk}.tsv"
+        script:
+            "../scripts/ik_chunk.py"
+
+    rule ik_join:
+        input:
+            expand("results/ik/{{subject}}/{{trial}}.chunk{chunk}.mot", chunk=IK_CHUNKS),
+        output:
+            mot="results/ik/{subject}/{trial}.mot",
+            angles="results/ik/{subject}/{trial}.angles.tsv",
+        params:
+            coordinate_map=OPENSIM["coordinate_map"],
+        log:
+            "results/logs/ik_join/{subject}/{trial}.log",
+        script:
+            "../scripts/ik_join.py"
 
 
 rule events:

@@ -17,22 +17,6 @@ def lab_settings() -> dict:
     )
 
 
-rule synthetic_static:
-    output:
-        f"data/raw/{{subject}}/{TRIALS['static']}.c3d",
-    wildcard_constraints:
-        subject=SYNTHETIC_PATTERN,
-    params:
-        row=lambda wc: SUBJECT_ROWS[wc.subject],
-        duration_s=SYNTH["static_duration_s"],
-        lab=lab_settings(),
-        seed=config["seed"],
-    log:
-        "results/logs/synthetic_static/{subject}.log",
-    script:
-        "../scripts/synthetic_static.py"
-
-
 rule synthetic_truth:
     output:
         "data/raw/{subject}/truth.yaml",
@@ -52,43 +36,30 @@ rule synthetic_truth:
         "../scripts/synthetic_truth.py"
 
 
-def walking_truth(wildcards):
-    """A perturbation trial needs the subject's true impedance."""
-    trial = wildcards.get("trial", TRIALS["no_device"])
-    return f"data/raw/{wildcards.subject}/truth.yaml" if trial_onset_ms(trial) is not None else []
-
-
-rule synthetic_walking:
+rule synthetic_lab:
+    """One session of the simulated gait lab per synthetic subject: the static trial and every walking trial
+    (C3D, and the robot log of trials with the device). One job per subject: a trial's own work is a second,
+    the start of a job (Python, SciPy, OpenSim, numba) almost three."""
     input:
-        truth=walking_truth,
+        truth="data/raw/{subject}/truth.yaml",
     output:
-        c3d="data/raw/{subject}/{trial}.c3d",
-        log="data/raw/{subject}/{trial}.loper.tsv",
+        static=f"data/raw/{{subject}}/{TRIALS['static']}.c3d",
+        c3d=[f"data/raw/{{subject}}/{t}.c3d" for t in walking_trials()],
+        logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in walking_trials() if t != TRIALS["no_device"]],
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
-        trial="|".join(t for t in walking_trials() if t != TRIALS["no_device"]),
     params:
         row=lambda wc: SUBJECT_ROWS[wc.subject],
-        trial=lambda wc: wc.get("trial", TRIALS["no_device"]),
-        onset_ms=lambda wc: trial_onset_ms(wc.get("trial", TRIALS["no_device"])),
+        trials=walking_trials(),
+        no_device=TRIALS["no_device"],
+        onsets_ms=[trial_onset_ms(t) for t in walking_trials()],
         settings=SYNTH,
         lab=lab_settings(),
         device=config["device"]["parameters"],
         seed=config["seed"],
     log:
-        "results/logs/synthetic_walking/{subject}/{trial}.log",
+        "results/logs/synthetic_lab/{subject}.log",
     benchmark:
-        "results/benchmarks/synthetic_walking/{subject}/{trial}.tsv"
+        "results/benchmarks/synthetic_lab/{subject}.tsv"
     script:
-        "../scripts/synthetic_walking.py"
-
-
-use rule synthetic_walking as synthetic_walking_no_device with:
-    output:
-        c3d=f"data/raw/{{subject}}/{TRIALS['no_device']}.c3d",
-    wildcard_constraints:
-        subject=SYNTHETIC_PATTERN,
-    log:
-        f"results/logs/synthetic_walking/{{subject}}/{TRIALS['no_device']}.log",
-    benchmark:
-        f"results/benchmarks/synthetic_walking/{{subject}}/{TRIALS['no_device']}.tsv"
+        "../scripts/synthetic_lab.py"
