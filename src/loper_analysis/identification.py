@@ -50,7 +50,6 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.optimize import least_squares
-from scipy.signal import butter, filtfilt
 from scipy.stats import t as student_t
 
 from . import _kernels
@@ -276,6 +275,8 @@ def prepare_window(
         nyq = 0.5 / dt
         if not 0 < reference_cutoff_hz < nyq:
             raise LoperInputError(f"reference_cutoff_hz must lie in 0 .. {nyq} Hz, got {reference_cutoff_hz}")
+        from scipy.signal import butter, filtfilt  # only here: scipy.signal costs ~1 s to import
+
         b, a = butter(2, reference_cutoff_hz / nyq)
         q_ref = filtfilt(b, a, q_ref, axis=0)
     spline = CubicSpline(t, q_ref, axis=0)
