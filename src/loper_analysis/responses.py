@@ -654,6 +654,21 @@ def _mean_sd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return mean, sd
 
 
+def _window_settings(trials, onset_ms, rate_hz, before_s, after_s, initial_span_s, side, source):
+    """Checked settings of a subject's windows: onset (s), before, after, initial span, window start (s), grid."""
+    onset_s = _number("onset_ms", onset_ms, source, minimum=0.0) / 1e3
+    before = _number("before_s", before_s, source, minimum=0.0)
+    after = _number("after_s", after_s, source, minimum=0.0)
+    initial = _number("initial_span_s", initial_span_s, source, minimum=0.0)
+    if side not in ("left", "right"):
+        raise LoperInputError(f"{_where(source)}side must be 'left' or 'right', got {side!r}")
+    if isinstance(trials, Mapping) or not len(trials):
+        raise LoperInputError(f"{_where(source)}trials must be a non-empty sequence of trial mappings")
+    start = -(initial + before)
+    grid = window_times_s(-start, after, _number("rate_hz", rate_hz, source))
+    return onset_s, before, after, initial, start, grid
+
+
 def _trial_inputs(trial: Mapping, k: int, side: str):
     """Checked frame data of one trial: name, time, columns to window, stride table."""
     if not isinstance(trial, Mapping):
@@ -794,17 +809,9 @@ def subject_onset_response(
         Bad inputs or settings (naming the trial/file, column and value),
         duplicate trial names.
     """
-    onset_s = _number("onset_ms", onset_ms, source, minimum=0.0) / 1e3
-    before = _number("before_s", before_s, source, minimum=0.0)
-    after = _number("after_s", after_s, source, minimum=0.0)
-    initial = _number("initial_span_s", initial_span_s, source, minimum=0.0)
+    onset_s, before, after, initial, start, grid = _window_settings(
+        trials, onset_ms, rate_hz, before_s, after_s, initial_span_s, side, source)
     min_n = int(_number("min_strides", min_strides, source, minimum=0.0))
-    if side not in ("left", "right"):
-        raise LoperInputError(f"{_where(source)}side must be 'left' or 'right', got {side!r}")
-    if isinstance(trials, Mapping) or not len(trials):
-        raise LoperInputError(f"{_where(source)}trials must be a non-empty sequence of trial mappings")
-    start = -(initial + before)
-    grid = window_times_s(-start, after, _number("rate_hz", rate_hz, source))
 
     per_trial, pairs, windows = [], [], []
     for k, trial in enumerate(trials):
@@ -939,16 +946,8 @@ def null_pair_windows(
         ``pelvis_angle_unperturbed_rad`` (n_pairs, n_grid); ``n_pairs`` and
         ``n_outliers``.
     """
-    onset_s = _number("onset_ms", onset_ms, source, minimum=0.0) / 1e3
-    before = _number("before_s", before_s, source, minimum=0.0)
-    after = _number("after_s", after_s, source, minimum=0.0)
-    initial = _number("initial_span_s", initial_span_s, source, minimum=0.0)
-    if side not in ("left", "right"):
-        raise LoperInputError(f"{_where(source)}side must be 'left' or 'right', got {side!r}")
-    if isinstance(trials, Mapping) or not len(trials):
-        raise LoperInputError(f"{_where(source)}trials must be a non-empty sequence of trial mappings")
-    start = -(initial + before)
-    grid = window_times_s(-start, after, _number("rate_hz", rate_hz, source))
+    onset_s, before, after, initial, start, grid = _window_settings(
+        trials, onset_ms, rate_hz, before_s, after_s, initial_span_s, side, source)
     joints = [f"{j}_{side}_rad" for j in JOINTS]
     parts = []
     for k, trial in enumerate(trials):
