@@ -69,6 +69,22 @@ def test_missing_marker_frames_are_dropped_not_fatal(model_path, synthetic):
     np.testing.assert_allclose(res.coordinates[:, k], truth["knee_flexion_l"], atol=1e-4)
 
 
+def test_marker_errors_equal_the_distances_of_the_solved_pose(model_path, synthetic):
+    """Per-frame RMS and max marker error against forward kinematics of the IK solution; a missing
+    marker is left out of its frames (OpenSim reports 0 for it)."""
+    t, truth, X = synthetic
+    noisy = X + np.random.default_rng(7).normal(0.0, 2e-3, X.shape)
+    knee = list(MARKERS).index("LKNE")
+    noisy[50:60, knee] = np.nan
+    res = inverse_kinematics(model_path, t, noisy, list(MARKERS))
+    solved = marker_positions(model_path, {c: res.coordinates[:, i] for i, c in enumerate(res.coordinate_names)})
+    dist = np.linalg.norm(solved - noisy, axis=2)  # NaN where the marker is missing
+    np.testing.assert_allclose(res.marker_rms_m, np.sqrt(np.nanmean(dist**2, axis=1)), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(res.marker_max_m, np.nanmax(dist, axis=1), rtol=1e-9, atol=1e-12)
+    # 2 mm per axis on 36 markers, 9 coordinates absorb part of it: E[rms^2] = 4e-6 * (3 * 36 - 9) / 36
+    assert np.sqrt(np.mean(res.marker_rms_m**2)) == pytest.approx(2e-3 * np.sqrt(99 / 36), rel=0.05)
+
+
 def test_coordinate_task_locks_the_ankle(model_path, synthetic):
     t, truth, X = synthetic
     weights = {m: (0.0 if m in ("RHEE", "RMT1", "RMT5") else 1.0) for m in MARKERS}

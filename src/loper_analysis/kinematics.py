@@ -16,7 +16,6 @@ OpenSim IK task-set XML or a TSV (``name``, ``kind`` = marker|coordinate,
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -186,19 +185,24 @@ def inverse_kinematics(
     perm = _q_order(model, state, cs)
     Q = np.empty((t.size, state.getNQ()))
     n_m = solver.getNumMarkersInUse()
-    rms = np.empty(t.size)
-    mx = np.empty(t.size)
+    E = np.empty((t.size, n_m))  # marker distance errors (m)
     errs = osim.SimTKArrayDouble()
     get_elt, track, set_time, get_q = errs.getElt, solver.track, state.setTime, state.getQ
-    compute_errors = solver.computeCurrentMarkerErrors
-    for k in range(t.size):  # the hot loop: one SWIG call per quantity, no NumPy on small arrays
+    compute_errors, markers_in_use = solver.computeCurrentMarkerErrors, range(n_m)
+    for k in range(t.size):  # the hot loop: one SWIG call per quantity
         set_time(float(t[k]))
         track(state)
         Q[k] = get_q().to_numpy()
         compute_errors(errs)
-        e = [v for v in (get_elt(j) for j in range(n_m)) if v == v]
-        rms[k] = math.sqrt(math.fsum(v * v for v in e) / len(e)) if e else math.nan
-        mx[k] = max(e) if e else math.nan
+        E[k] = [get_elt(j) for j in markers_in_use]
+    # OpenSim reports 0 (not NaN) for a marker missing in a frame: leave those out of RMS and max
+    in_use = [kept_labels.index(solver.getMarkerNameForIndex(j)) for j in range(n_m)]
+    present = ~np.isnan(E) & ~np.isnan(X[:, in_use, :]).any(axis=2)
+    n_present = present.sum(axis=1)
+    E0 = np.where(present, E, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rms = np.where(n_present > 0, np.sqrt((E0 * E0).sum(axis=1) / n_present), np.nan)
+    mx = np.where(n_present > 0, np.where(present, E, -np.inf).max(axis=1, initial=-np.inf), np.nan)
     return IKResult(time_s=t, coordinates=Q[:, perm], coordinate_names=names, marker_rms_m=rms, marker_max_m=mx)
 
 
