@@ -34,13 +34,17 @@ def main(n: int = 30720) -> None:
             "ankle_dorsiflexion_r": -0.1 * np.sin(w * t + 2),
         }
         X = marker_positions(path, truth)
+
+        def angle_errors(res):  # (n_frames, n_angles) rad, translations left out
+            return np.column_stack([res.coordinates[:, i] - truth[c] for i, c in enumerate(res.coordinate_names)
+                                    if not c.endswith(("_tx", "_ty"))])
+
         # the pipeline's default (config opensim.accuracy) is 1e-6; looser ones show what speed would cost
         for accuracy in (1e-4, 1e-5, 1e-6, 1e-8):
             t0 = time.perf_counter()
             res = inverse_kinematics(path, t, X, list(MARKERS), accuracy=accuracy)
             dt = time.perf_counter() - t0
-            err = np.column_stack([res.coordinates[:, i] - truth[c] for i, c in enumerate(res.coordinate_names)
-                                   if not c.endswith(("_tx", "_ty"))])
+            err = angle_errors(res)
             print(f"IK of {n} frames ({n / 128 / 60:.1f} min at 128 Hz), {len(MARKERS)} markers, accuracy "
                   f"{accuracy:g}: {dt:.1f} s ({dt / n * 1e3:.2f} ms/frame; target 30 s for 30,720 frames); "
                   f"angle error max {np.rad2deg(np.abs(err).max()):.2e} deg, "
@@ -48,8 +52,7 @@ def main(n: int = 30720) -> None:
         # for scale: what the synthetic lab's marker noise (config synthetic.marker_noise_sd_m) does at 1e-8
         noisy = X + np.random.default_rng(0).normal(0.0, 0.5e-3, X.shape)
         res = inverse_kinematics(path, t, noisy, list(MARKERS), accuracy=1e-8)
-        err = np.column_stack([res.coordinates[:, i] - truth[c] for i, c in enumerate(res.coordinate_names)
-                               if not c.endswith(("_tx", "_ty"))])
+        err = angle_errors(res)
         print(f"0.5 mm marker noise, accuracy 1e-8: angle error max {np.rad2deg(np.abs(err).max()):.2e} deg, "
               f"rms {np.rad2deg(np.sqrt(np.mean(err ** 2))):.2e} deg")
 

@@ -16,6 +16,7 @@ OpenSim IK task-set XML or a TSV (``name``, ``kind`` = marker|coordinate,
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -196,13 +197,11 @@ def inverse_kinematics(
         compute_errors(errs)
         E[k] = [get_elt(j) for j in markers_in_use]
     # OpenSim reports 0 (not NaN) for a marker missing in a frame: leave those out of RMS and max
-    in_use = [kept_labels.index(solver.getMarkerNameForIndex(j)) for j in range(n_m)]
-    present = ~np.isnan(E) & ~np.isnan(X[:, in_use, :]).any(axis=2)
-    n_present = present.sum(axis=1)
-    E0 = np.where(present, E, 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        rms = np.where(n_present > 0, np.sqrt((E0 * E0).sum(axis=1) / n_present), np.nan)
-    mx = np.where(n_present > 0, np.where(present, E, -np.inf).max(axis=1, initial=-np.inf), np.nan)
+    in_use = [kept_labels.index(solver.getMarkerNameForIndex(j)) for j in markers_in_use]
+    E[np.isnan(X[:, in_use, :]).any(axis=2)] = np.nan
+    with warnings.catch_warnings():  # a frame without any marker gives NaN, silently
+        warnings.simplefilter("ignore", RuntimeWarning)
+        rms, mx = np.sqrt(np.nanmean(E * E, axis=1)), np.nanmax(E, axis=1)
     return IKResult(time_s=t, coordinates=Q[:, perm], coordinate_names=names, marker_rms_m=rms, marker_max_m=mx)
 
 
