@@ -14,33 +14,32 @@ from pathlib import Path
 
 import yaml
 
-from loper_analysis.device.controller import DeviceParameters, FreeLeg
-from loper_analysis.device.files import write_device_summary, write_device_trial, write_frf_table, write_step_tables
-from loper_analysis.device.trials import DeviceTestSettings
+from loper_analysis.device.controller import DeviceParameters
+from loper_analysis.steps import device
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())["device"]
-    dev = DeviceParameters(**cfg["parameters"])
-    tests = DeviceTestSettings(**dict(cfg["tests"], step_amplitudes_n=tuple(cfg["tests"]["step_amplitudes_n"])))
+    rate = DeviceParameters(**cfg["parameters"]).sample_rate_hz
     a = cfg["analysis"]
-    # compile once outside the timing (numba caches it for later runs anyway)
-    write_device_trial(Path(tempfile.mkdtemp()) / "warm.loper.tsv", "device-steps", dev, FreeLeg(**cfg["leg"]),
-                       DeviceTestSettings(step_repetitions=1), 0)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
+        # compile once outside the timing (numba caches it for later runs anyway)
+        device.device_trial(tmp / "warm.loper.tsv", "warm", "device-steps", cfg["parameters"], cfg["leg"],
+                            {**cfg["tests"], "step_repetitions": 1}, 0)
         t0 = time.perf_counter()
         for trial in ("device-frf", "device-steps"):
-            write_device_trial(tmp / f"{trial}.loper.tsv", trial, dev, FreeLeg(**cfg["leg"]), tests, [1, 2])
+            device.device_trial(tmp / f"{trial}.loper.tsv", "S01", trial, cfg["parameters"], cfg["leg"], cfg["tests"],
+                                2024)
         t1 = time.perf_counter()
-        write_frf_table(tmp / "device-frf.loper.tsv", tmp / "frf.tsv", dev.sample_rate_hz,
-                        a["welch_window_samples"], a["welch_overlap_samples"])
-        write_step_tables(tmp / "device-steps.loper.tsv", tmp / "steps.tsv", tmp / "avg.tsv", dev.sample_rate_hz,
-                          tests.step_amplitudes_n, a["step_before_s"], a["step_after_s"], a["steady_window_s"])
-        summary = write_device_summary(tmp / "frf.tsv", tmp / "steps.tsv", tmp / "summary.tsv",
-                                       a["bandwidth_reference_band_hz"])
+        device.frf(tmp / "device-frf.loper.tsv", tmp / "frf.tsv", rate, a["welch_window_samples"],
+                   a["welch_overlap_samples"])
+        device.steps(tmp / "device-steps.loper.tsv", tmp / "steps.tsv", tmp / "avg.tsv", rate,
+                     cfg["tests"]["step_amplitudes_n"], a["step_before_s"], a["step_after_s"], a["steady_window_s"])
+        summary = device.summary(tmp / "frf.tsv", tmp / "steps.tsv", tmp / "summary.tsv",
+                                 a["bandwidth_reference_band_hz"])
         t2 = time.perf_counter()
     print(f"simulate + write 2 device trials: {t1 - t0:.2f} s; read + analyse: {t2 - t1:.2f} s; "
           f"total {t2 - t0:.2f} s (target 10 s)")

@@ -15,7 +15,8 @@ import numpy as np
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.identification import prepare_window, response_jacobian
-from loper_analysis.validation import STUDY_NOISE_ERRORS, ValidationSettings, perturbed_trial
+from loper_analysis.reference import STUDY_VALIDATION_NOISE
+from loper_analysis.validation import ValidationSettings, perturbed_trial
 
 
 def main() -> None:
@@ -31,7 +32,7 @@ def main() -> None:
         J = response_jacobian(w, truth + 1e-9)
         crlb = sd_noise * np.sqrt(np.diag(np.linalg.inv(J.T @ J)))
         print(f"CRLB SD at {truth.astype(int).tolist()}".ljust(34) + "".join(f"{v:9.3g}" for v in crlb))
-    print("study SD (noise)".ljust(34) + "".join(f"{v:9.3g}" for v in STUDY_NOISE_ERRORS.study_sd_error))
+    print("study SD (noise)".ljust(34) + "".join(f"{STUDY_VALIDATION_NOISE[p][2]:9.3g}" for p in PARAMETERS))
 
 
 if __name__ == "__main__":

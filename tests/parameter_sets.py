@@ -1,6 +1,9 @@
 """Shared test data: segment parameter sets."""
 
-from loper_analysis.dynamics import SegmentParameters, segment_parameters_from_anthropometry
+from loper_analysis.dynamics import (
+    SegmentParameters,
+    segment_parameters_from_anthropometry,
+)
 
 WINTER = segment_parameters_from_anthropometry(1.73, 64.9)
 # COM off the segment axes and a non-standard gravity exercise every term

@@ -8,6 +8,7 @@ Known answers used here:
   forces from the Christoffel symbols of ``M`` (all by central differences);
 * a physical pendulum (thigh alone, cart pinned by a huge mass);
 * virtual work of the joint torques;
+* the segment table: frame and TSV round trips, and its input checks;
 * the compiled RK4 of :mod:`loper_analysis.identification` against SciPy's
   DOP853 in :func:`loper_analysis.dynamics.simulate`.
 """
@@ -35,9 +36,9 @@ from loper_analysis.dynamics import (
 )
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import prepare_window, simulate_response
+from loper_analysis.steps.model import read_segments, write_segments
 from loper_analysis.validation import ValidationSettings, nominal_swing, perturbed_trial
-
-from parameter_sets import ASYMMETRIC, WINTER
+from tests.parameter_sets import ASYMMETRIC, WINTER
 
 PARAMETER_SETS = {"winter": WINTER, "asymmetric": ASYMMETRIC}
 
@@ -201,7 +202,7 @@ def test_joint_angles_segment_coordinates_round_trip():
     np.testing.assert_allclose(q[:, 0], x, rtol=0, atol=0)
     np.testing.assert_allclose(joint_angles(q, pelvis), theta, rtol=0, atol=1e-15)
     np.testing.assert_allclose(segment_coordinates(joint_angles(q, pelvis), pelvis, x), q, rtol=0, atol=1e-15)
-    # sign conventions (DESIGN.md section 4): pure hip flexion swings the thigh forward (q_thigh < 0)
+    # sign conventions (docs/conventions.md): pure hip flexion swings the thigh forward (q_thigh < 0)
     q1 = segment_coordinates([0.3, 0.0, 0.0], 0.0, 0.0)
     np.testing.assert_allclose(q1, [0.0, -0.3, -0.3, -0.3], rtol=0, atol=0)
 
@@ -226,16 +227,21 @@ def _fields(p: SegmentParameters) -> np.ndarray:
     return np.asarray(p.packed, dtype=float)
 
 
+def test_segment_parameters_frame_round_trip(params):
+    back = SegmentParameters.from_frame(params.to_frame())
+    np.testing.assert_array_equal(_fields(back), _fields(params))
+
+
 def test_segment_parameters_tsv_round_trip(tmp_path, params):
     path = tmp_path / "segments.tsv"
-    params.to_tsv(path)
-    back = SegmentParameters.from_tsv(path)
-    # %.10g in to_tsv: measured 6.3e-11 relative for the Winter set, 0 for the asymmetric set
+    write_segments(params, path)
+    back = read_segments(path)
+    # %.10g in write_segments: measured 6.3e-11 relative for the Winter set, 0 for the asymmetric set
     np.testing.assert_allclose(_fields(back), _fields(params), rtol=1e-10, atol=0)
 
 
 def test_segment_parameters_tsv_round_trip_many_digits(tmp_path):
-    """Values with 16 significant digits survive to the 10 digits that to_tsv writes (<= 5e-10)."""
+    """Values with 16 significant digits survive to the 10 digits that write_segments writes (<= 5e-10)."""
     rng = np.random.default_rng(9)
     p = SegmentParameters(
         cart_mass_kg=rng.uniform(40, 60),
@@ -247,8 +253,8 @@ def test_segment_parameters_tsv_round_trip_many_digits(tmp_path):
         attachment_m=0.27123456789012345,
         gravity_m_per_s2=9.80665,
     )
-    p.to_tsv(tmp_path / "s.tsv")
-    back = SegmentParameters.from_tsv(tmp_path / "s.tsv")
+    write_segments(p, tmp_path / "s.tsv")
+    back = read_segments(tmp_path / "s.tsv")
     np.testing.assert_allclose(_fields(back), _fields(p), rtol=5e-10, atol=0)
 
 
@@ -274,41 +280,51 @@ def test_segment_parameters_reject_bad_values(changes, words):
         assert w in str(info.value), (w, str(info.value))
 
 
-def _edited_table(tmp_path, row: str, column: str, value: str):
-    good = tmp_path / "good.tsv"
-    PARAMETER_SETS["asymmetric"].to_tsv(good)
-    df = pd.read_csv(good, sep="\t", dtype=str, keep_default_na=False).set_index("segment")
+def _edited_frame(row: str, column: str, value: str) -> pd.DataFrame:
+    df = PARAMETER_SETS["asymmetric"].to_frame().astype(object).set_index("segment")
     df.loc[row, column] = value
-    bad = tmp_path / f"bad_{row}_{column}.tsv"
-    df.reset_index().to_csv(bad, sep="\t", index=False)
-    return bad
+    return df.reset_index()
 
 
-def test_from_tsv_missing_column(tmp_path):
+def test_read_segments_names_the_file_and_the_missing_column(tmp_path):
     good = tmp_path / "good.tsv"
-    PARAMETER_SETS["asymmetric"].to_tsv(good)
+    write_segments(PARAMETER_SETS["asymmetric"], good)
     bad = tmp_path / "no_com_x.tsv"
     pd.read_csv(good, sep="\t").drop(columns="com_x_m").to_csv(bad, sep="\t", index=False)
     with pytest.raises(LoperInputError) as info:
-        SegmentParameters.from_tsv(bad)
+        read_segments(bad)
     assert str(bad) in str(info.value) and "com_x_m" in str(info.value)
 
 
-@pytest.mark.parametrize("row, column", [("shank", "mass_kg"), ("foot", "inertia_kg_m2"), ("thigh", "com_y_m")])
-def test_from_tsv_non_numeric_segment_cell(tmp_path, row, column):
-    bad = _edited_table(tmp_path, row, column, "abc")
+def test_from_frame_missing_column():
+    frame = PARAMETER_SETS["asymmetric"].to_frame().drop(columns="com_x_m")
     with pytest.raises(LoperInputError) as info:
-        SegmentParameters.from_tsv(bad)
+        SegmentParameters.from_frame(frame, source="segments.tsv")
+    assert "segments.tsv" in str(info.value) and "com_x_m" in str(info.value)
+
+
+@pytest.mark.parametrize("row, column", [("shank", "mass_kg"), ("foot", "inertia_kg_m2"), ("thigh", "com_y_m")])
+def test_from_frame_non_numeric_segment_cell(row, column):
+    with pytest.raises(LoperInputError) as info:
+        SegmentParameters.from_frame(_edited_frame(row, column, "abc"), source="segments.tsv")
     msg = str(info.value)
-    assert str(bad) in msg and column in msg and "abc" in msg, msg
+    assert "segments.tsv" in msg and column in msg and "abc" in msg, msg
 
 
 @pytest.mark.parametrize("row, column", [("cart", "mass_kg"), ("thigh", "attachment_m"), ("cart", "gravity_m_per_s2")])
-def test_from_tsv_non_numeric_scalar_cell(tmp_path, row, column):
-    bad = _edited_table(tmp_path, row, column, "abc")
+def test_from_frame_non_numeric_scalar_cell(row, column):
     with pytest.raises(LoperInputError) as info:
-        SegmentParameters.from_tsv(bad)
-    assert str(bad) in str(info.value) and column in str(info.value)
+        SegmentParameters.from_frame(_edited_frame(row, column, "abc"), source="segments.tsv")
+    assert "segments.tsv" in str(info.value) and column in str(info.value)
+
+
+def test_read_segments_names_the_file_of_a_non_numeric_cell(tmp_path):
+    bad = tmp_path / "bad.tsv"
+    _edited_frame("shank", "mass_kg", "abc").to_csv(bad, sep="\t", index=False)
+    with pytest.raises(LoperInputError) as info:
+        read_segments(bad)
+    msg = str(info.value)
+    assert str(bad) in msg and "mass_kg" in msg and "abc" in msg, msg
 
 
 # ---------------------------------------------------------------- compiled RK4 vs DOP853
@@ -344,25 +360,25 @@ def test_compiled_rk4_matches_dop853_for_a_perturbed_swing_with_feedback():
         initial_state_span_s=0.05,
         initial_state_degree=1,
     )
-    np.testing.assert_array_equal(window.e0, 0.0)  # q_perturbed = q_unperturbed before the onset
+    np.testing.assert_array_equal(window.initial_deviation, 0.0)  # q_perturbed = q_unperturbed before the onset
     rk4 = simulate_response(window, impedance)
 
-    ts = window.time_s[0] + 0.5 * window.dt_s * np.arange(len(window.ref_q))
+    ts = window.time_s[0] + 0.5 * window.step_s * np.arange(len(window.reference_q))
     np.testing.assert_allclose(ts[:: 2 * n_sub], window.time_s, rtol=0, atol=1e-12)
-    u_ff = inverse_dynamics(window.ref_q, window.ref_qd, window.ref_qdd, p)
+    u_ff = inverse_dynamics(window.reference_q, window.reference_qd, window.reference_qdd, p)
     force = np.column_stack([np.interp(ts, t, fp[:, j]) for j in range(2)])
     # the pelvis angle cancels in theta - theta_ref, so both may use pelvis 0
     common = dict(
         u_ff=u_ff,
         impedance=impedance,
-        reference_joint_angles_rad=joint_angles(window.ref_q, 0.0),
-        reference_joint_velocities_rad_s=joint_angles(window.ref_qd, 0.0),
+        reference_joint_angles_rad=joint_angles(window.reference_q, 0.0),
+        reference_joint_velocities_rad_s=joint_angles(window.reference_qd, 0.0),
     )
-    q_p, _ = simulate(ts, window.ref_q[0], window.ref_qd[0], p, force_n=force, **common)
-    q_u, _ = simulate(ts, window.ref_q[0], window.ref_qd[0], p, **common)
+    q_p, _ = simulate(ts, window.reference_q[0], window.reference_qd[0], p, force_n=force, **common)
+    q_u, _ = simulate(ts, window.reference_q[0], window.reference_qd[0], p, **common)
     th_p = joint_angles(q_p[:: 2 * n_sub], 0.0)
     assert np.abs(rk4).max() > 0.05  # a real perturbation
-    np.testing.assert_allclose(rk4, th_p - joint_angles(window.ref_q[:: 2 * n_sub], 0.0), rtol=0, atol=1e-5)
+    np.testing.assert_allclose(rk4, th_p - joint_angles(window.reference_q[:: 2 * n_sub], 0.0), rtol=0, atol=1e-5)
     np.testing.assert_allclose(rk4, th_p - joint_angles(q_u[:: 2 * n_sub], 0.0), rtol=0, atol=1e-6)
 
 

@@ -53,7 +53,7 @@ A_INV = np.linalg.inv(A)
 
 SEGMENT_NAMES = ("thigh", "shank", "foot")
 
-from parameter_sets import ASYMMETRIC, WINTER
+from tests.parameter_sets import ASYMMETRIC, WINTER
 
 PARAMETER_SETS = {"winter_1.73m_64.9kg": WINTER, "asymmetric": ASYMMETRIC}
 

@@ -1,19 +1,34 @@
-"""Impedance table rows, statuses and the brace force direction."""
+"""Impedance table rows (loper_analysis.impedance): estimates, truth, statuses, the brace force direction,
+an onset without trials, and the across-subject summary with the literature rows."""
 
 from __future__ import annotations
 
 from dataclasses import replace
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import identify_impedance
-from loper_analysis.impedance import IMPEDANCE_COLUMNS, brace_force_direction, impedance_rows, status_rows
-from loper_analysis.validation import ValidationSettings, perturbed_trial, validation_window
+from loper_analysis.impedance import (
+    IMPEDANCE_COLUMNS,
+    brace_force_direction,
+    fit_onset,
+    impedance_rows,
+    impedance_summary,
+    literature_table,
+    status_rows,
+)
+from loper_analysis.validation import (
+    ValidationSettings,
+    perturbed_trial,
+    validation_window,
+)
 
 TRUTH = (60.0, 3.0, 5.0, 0.2, 20.0, 0.5)
+TRUTH_BY_JOINT = {"hip": {"K": 60.0, "D": 3.0}, "knee": {"K": 5.0, "D": 0.2}, "ankle": {"K": 20.0, "D": 0.5}}
 
 
 @pytest.fixture(scope="module")
@@ -25,25 +40,33 @@ def fit():
 
 
 def test_rows_carry_estimates_truth_and_errors(fit):
-    truth = {"hip": {"K": 60.0, "D": 3.0}, "knee": {"K": 5.0, "D": 0.2}, "ankle": {"K": 20.0, "D": 0.5}}
-    rows = impedance_rows(fit, "S01", 50, 12, truth)
+    rows = impedance_rows(fit, "S01", 50, 12, TRUTH_BY_JOINT)
     assert list(rows.columns) == list(IMPEDANCE_COLUMNS) and list(rows.joint) == ["hip", "knee", "ankle"]
-    np.testing.assert_allclose(rows.K, TRUTH[0::2], atol=0.05)
-    np.testing.assert_allclose(rows.D, TRUTH[1::2], atol=0.005)
-    np.testing.assert_allclose(rows.K_error, rows.K - rows.K_true)
+    np.testing.assert_allclose(rows.K_nm_per_rad, TRUTH[0::2], atol=0.05)
+    np.testing.assert_allclose(rows.D_nms_per_rad, TRUTH[1::2], atol=0.005)
+    np.testing.assert_allclose(rows.K_error_nm_per_rad, rows.K_nm_per_rad - rows.K_true_nm_per_rad)
+    np.testing.assert_allclose(rows.D_error_nms_per_rad, rows.D_nms_per_rad - rows.D_true_nms_per_rad)
     assert (rows.status == "ok").all() and (rows.n_strides == 12).all()
-    assert (rows.K_ci95_low <= rows.K).all() and (rows.K <= rows.K_ci95_high).all()
+    assert (rows.K_ci95_low_nm_per_rad <= rows.K_nm_per_rad).all()
+    assert (rows.K_nm_per_rad <= rows.K_ci95_high_nm_per_rad).all()
+
+
+def test_rows_carry_the_fit_summary(fit):
+    """The unweighted sum of squared errors and the start counts of the fit, the same on every joint's row."""
+    rows = impedance_rows(fit, "S01", 50, 12, TRUTH_BY_JOINT)
+    assert (rows.sum_sq_error_rad2 == fit.sum_sq_error_rad2).all()
+    assert (rows.n_starts == fit.n_starts).all() and (rows.n_starts_at_best == fit.n_starts_at_best).all()
 
 
 def test_statuses(fit):
     wide = replace(fit, ci95_low=fit.ci95_low - np.array([0, 0, 0, 0, 150.0, 0]))
     rows = impedance_rows(wide, "S01", 175, 9)
     assert list(rows.status) == ["ok", "ok", "not_identifiable"] and "CI width K" in rows.reason.iloc[2]
-    assert rows.K_true.isna().all()  # a recorded subject
+    assert rows.K_true_nm_per_rad.isna().all()  # a recorded subject
     failed = impedance_rows(replace(fit, success=False, message="max iterations"), "S01", 175, 9)
     assert (failed.status == "failed").all() and failed.reason.str.contains("max iterations").all()
     missing = status_rows("S02", 300, "missing", "no trial of this onset")
-    assert len(missing) == 3 and missing.K.isna().all() and (missing.status == "missing").all()
+    assert len(missing) == 3 and missing.K_nm_per_rad.isna().all() and (missing.status == "missing").all()
 
 
 def test_brace_normal_is_perpendicular_and_forward():
@@ -57,38 +80,33 @@ def test_brace_normal_is_perpendicular_and_forward():
         brace_force_direction(X[:, :1], ["LBRA_P"], source="trial.trc")
 
 
-def test_onset_without_trials_is_reported_missing(tmp_path):
-    from loper_analysis.impedance import fit_subject_onset
-    from loper_analysis.synthetic.subjects import write_truth
-
-    write_truth(tmp_path / "truth.yaml", {"subject": "S01", "sex": "male", "age_yr": 26, "height_m": 1.8, "mass_kg": 72},
-                {175: {j: {"K": 40.0, "D": 2.0} for j in ("hip", "knee", "ankle")}})
-    out = [tmp_path / n for n in ("r.tsv", "c.tsv", "f.tsv", "k.tsv")]
-    rows = fit_subject_onset([], tmp_path / "segments.tsv", 175, "S01", *out, truth_yaml=tmp_path / "truth.yaml")
-    assert (rows.status == "missing").all() and rows.K.isna().all() and (rows.K_true == 40.0).all()
-    assert all(p.is_file() for p in out)
-    import pandas as pd
-
-    assert pd.read_csv(out[2], sep="\t").status.tolist() == ["missing"] * 3
+def test_onset_without_trials_is_reported_missing():
+    truth = {j: {"K": 40.0, "D": 2.0} for j in ("hip", "knee", "ankle")}
+    result = fit_onset([], None, 175, "S01", truth=truth)
+    rows = result.rows
+    assert (rows.status == "missing").all() and rows.K_nm_per_rad.isna().all()
+    assert (rows.K_true_nm_per_rad == 40.0).all() and (rows.D_true_nms_per_rad == 2.0).all()
+    assert result.counts.status.tolist() == ["missing"] and result.response.empty
+    assert list(result.curves.columns) == ["time_s"] and result.curves.empty
 
 
 def test_summary_and_literature_rows():
-    import pandas as pd
-
-    from loper_analysis.impedance import impedance_summary, literature_table
-
     rows = []
     for subject, k, d in (("S01", 50.0, 3.0), ("S02", 60.0, 5.0)):
-        rows.append(status_rows(subject, 50, "ok", "").assign(K=k, D=d, vaf_pct=99.0, K_true=55.0, D_true=3.0))
+        rows.append(status_rows(subject, 50, "ok", "").assign(K_nm_per_rad=k, D_nms_per_rad=d, vaf_pct=99.0,
+                                                               K_true_nm_per_rad=55.0, D_true_nms_per_rad=3.0))
     rows.append(status_rows("S03", 50, "missing", "no trial"))
     table = pd.concat(rows, ignore_index=True)
-    table["K_error"], table["D_error"] = table.K - table.K_true, table.D - table.D_true
+    table["K_error_nm_per_rad"] = table.K_nm_per_rad - table.K_true_nm_per_rad
+    table["D_error_nms_per_rad"] = table.D_nms_per_rad - table.D_true_nms_per_rad
     summary = impedance_summary(table)
     hip = summary[summary.joint == "hip"].iloc[0]
-    assert hip.n_subjects == 2 and hip.K_mean == 55.0 and hip.K_sd == pytest.approx(np.sqrt(50.0))
-    assert hip.K_within_tolerance == 1.0  # |5| <= 0.1 * 55
-    assert hip.D_within_tolerance == 0.5  # 0 ok, 2 > 0.15 * 3
+    assert hip.n_subjects == 2 and hip.K_mean_nm_per_rad == 55.0
+    assert hip.K_sd_nm_per_rad == pytest.approx(np.sqrt(50.0))
+    assert hip.K_fraction_within_tolerance == 1.0  # |5| <= 0.1 * 55
+    assert hip.D_fraction_within_tolerance == 0.5  # 0 ok, 2 > 0.15 * 3
     lit = literature_table(summary)
     ours = lit[lit.source.str.startswith("this pipeline") & (lit.joint == "hip")].iloc[0]
-    assert (ours.K_low, ours.K_high, ours.D_low, ours.D_high) == (55.0, 55.0, 4.0, 4.0)
+    assert (ours.K_low_nm_per_rad, ours.K_high_nm_per_rad, ours.D_low_nms_per_rad, ours.D_high_nms_per_rad) == (
+        55.0, 55.0, 4.0, 4.0)
     assert len(lit) == 9

@@ -1,22 +1,39 @@
-"""Inverse kinematics against known joint angles and against OpenSim's InverseKinematicsTool."""
+"""Inverse kinematics (loper_analysis.kinematics) against known joint angles and OpenSim's InverseKinematicsTool.
+
+Also the IK task files (loper_analysis.io.ik_tasks), the time chunks of a trial and the joint-angle table.
+"""
 
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.kinematics import inverse_kinematics, marker_positions, read_ik_tasks
-from loper_analysis.model import MARKERS, build_lower_body_model, quiet_opensim
+from loper_analysis.io.ik_tasks import read_ik_tasks
+from loper_analysis.io.osim import quiet_opensim, read_model, write_model
+from loper_analysis.kinematics import (
+    DEFAULT_COORDINATE_MAP,
+    chunk_frames,
+    inverse_kinematics,
+    join_chunks,
+    joint_angle_table,
+    marker_positions,
+    markers_table,
+)
+from loper_analysis.model import MARKERS, build_lower_body_model
 
 FS = 128.0
 
 
 @pytest.fixture(scope="module")
 def model_path(tmp_path_factory):
-    path = tmp_path_factory.mktemp("ik") / "model.osim"
-    build_lower_body_model(1.73, 64.9, path)
-    return path
+    return write_model(build_lower_body_model(1.73, 64.9), tmp_path_factory.mktemp("ik") / "model.osim")
+
+
+@pytest.fixture(scope="module")
+def model(model_path):
+    return read_model(model_path)
 
 
 def _truth(n=256):
@@ -33,51 +50,51 @@ def _truth(n=256):
 
 
 @pytest.fixture(scope="module")
-def synthetic(model_path):
+def synthetic(model):
     t, truth = _truth()
-    return t, truth, marker_positions(model_path, truth)
+    return t, truth, marker_positions(model, truth)
 
 
-def test_marker_positions_hold_length_one_trajectories_and_select_markers(model_path, synthetic):
+def test_marker_positions_hold_length_one_trajectories_and_select_markers(model, synthetic):
     t, truth, X = synthetic
     held = {**truth, "pelvis_ty": truth["pelvis_ty"][:1]}
-    expected = marker_positions(model_path, {**truth, "pelvis_ty": np.full(t.size, truth["pelvis_ty"][0])})
-    np.testing.assert_array_equal(marker_positions(model_path, held), expected)
+    expected = marker_positions(model, {**truth, "pelvis_ty": np.full(t.size, truth["pelvis_ty"][0])})
+    np.testing.assert_array_equal(marker_positions(model, held), expected)
     picked = ["LHEE", "RASI"]
     np.testing.assert_array_equal(
-        marker_positions(model_path, truth, picked), X[:, [list(MARKERS).index(m) for m in picked]]
+        marker_positions(model, truth, picked), X[:, [list(MARKERS).index(m) for m in picked]]
     )
     with pytest.raises(LoperInputError, match="length 1 or 256"):
-        marker_positions(model_path, {**truth, "pelvis_ty": truth["pelvis_ty"][:10]})
+        marker_positions(model, {**truth, "pelvis_ty": truth["pelvis_ty"][:10]})
 
 
-def test_ik_recovers_known_angles(model_path, synthetic):
+def test_ik_recovers_known_angles(model, synthetic):
     t, truth, X = synthetic
-    res = inverse_kinematics(model_path, t, X, list(MARKERS))
+    res = inverse_kinematics(model, t, X, list(MARKERS))
     for i, name in enumerate(res.coordinate_names):
         err = np.abs(res.coordinates[:, i] - truth[name]).max()
         assert err < np.deg2rad(0.1) / 10, (name, err)  # well inside the 0.1 deg requirement
     assert np.nanmax(res.marker_rms_m) < 1e-5
 
 
-def test_missing_marker_frames_are_dropped_not_fatal(model_path, synthetic):
+def test_missing_marker_frames_are_dropped_not_fatal(model, synthetic):
     t, truth, X = synthetic
     X = X.copy()
     X[50:60, list(MARKERS).index("LKNE")] = np.nan
-    res = inverse_kinematics(model_path, t, X, list(MARKERS))
+    res = inverse_kinematics(model, t, X, list(MARKERS))
     k = res.coordinate_names.index("knee_flexion_l")
     np.testing.assert_allclose(res.coordinates[:, k], truth["knee_flexion_l"], atol=1e-4)
 
 
-def test_marker_errors_equal_the_distances_of_the_solved_pose(model_path, synthetic):
+def test_marker_errors_equal_the_distances_of_the_solved_pose(model, synthetic):
     """Per-frame RMS and max marker error against forward kinematics of the IK solution; a missing
     marker is left out of its frames (OpenSim reports 0 for it)."""
-    t, truth, X = synthetic
+    t, _, X = synthetic
     noisy = X + np.random.default_rng(7).normal(0.0, 2e-3, X.shape)
     knee = list(MARKERS).index("LKNE")
     noisy[50:60, knee] = np.nan
-    res = inverse_kinematics(model_path, t, noisy, list(MARKERS))
-    solved = marker_positions(model_path, {c: res.coordinates[:, i] for i, c in enumerate(res.coordinate_names)})
+    res = inverse_kinematics(model, t, noisy, list(MARKERS))
+    solved = marker_positions(model, {c: res.coordinates[:, i] for i, c in enumerate(res.coordinate_names)})
     dist = np.linalg.norm(solved - noisy, axis=2)  # NaN where the marker is missing
     np.testing.assert_allclose(res.marker_rms_m, np.sqrt(np.nanmean(dist**2, axis=1)), rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(res.marker_max_m, np.nanmax(dist, axis=1), rtol=1e-9, atol=1e-12)
@@ -85,22 +102,20 @@ def test_marker_errors_equal_the_distances_of_the_solved_pose(model_path, synthe
     assert np.sqrt(np.mean(res.marker_rms_m**2)) == pytest.approx(2e-3 * np.sqrt(99 / 36), rel=0.05)
 
 
-def test_coordinate_task_locks_the_ankle(model_path, synthetic):
-    t, truth, X = synthetic
+def test_coordinate_task_locks_the_ankle(model, synthetic):
+    t, _, X = synthetic
     weights = {m: (0.0 if m in ("RHEE", "RMT1", "RMT5") else 1.0) for m in MARKERS}
-    res = inverse_kinematics(model_path, t, X, list(MARKERS), weights, {"ankle_dorsiflexion_r": (1e3, 0.25)})
+    res = inverse_kinematics(model, t, X, list(MARKERS), weights, {"ankle_dorsiflexion_r": (1e3, 0.25)})
     k = res.coordinate_names.index("ankle_dorsiflexion_r")
     np.testing.assert_allclose(res.coordinates[:, k], 0.25, atol=1e-3)
 
 
-def test_matches_opensims_inverse_kinematics_tool(model_path, synthetic, tmp_path):
+def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, tmp_path):
     osim = quiet_opensim()
-    t, truth, X = synthetic
+    t, _, X = synthetic
     rng = np.random.default_rng(0)
     Xn = X + rng.normal(0, 0.002, X.shape)  # noisy markers: the two must agree on the least-squares answer
     # TRC in mm through OpenSim's own adapter
-    from loper_analysis.kinematics import markers_table
-
     table = markers_table(t, Xn * 1000.0, list(MARKERS))
     table.removeTableMetaDataKey("Units")
     table.addTableMetaDataString("Units", "mm")
@@ -140,7 +155,7 @@ def test_matches_opensims_inverse_kinematics_tool(model_path, synthetic, tmp_pat
     in_degrees = ref.getTableMetaDataAsString("inDegrees") == "yes"
     ours_w, ours_c = read_ik_tasks(tasks_xml)
     assert ours_w == weights and ours_c == {"ankle_dorsiflexion_r": (10.0, 0.05)}
-    res = inverse_kinematics(model_path, t, Xn, list(MARKERS), ours_w, ours_c, accuracy=1e-8)
+    res = inverse_kinematics(model, t, Xn, list(MARKERS), ours_w, ours_c, accuracy=1e-8)
     labels = list(ref.getColumnLabels())
     for i, name in enumerate(res.coordinate_names):
         col = ref.getDependentColumn(name).to_numpy()
@@ -150,7 +165,7 @@ def test_matches_opensims_inverse_kinematics_tool(model_path, synthetic, tmp_pat
         np.testing.assert_allclose(res.coordinates[:, i], col, atol=1e-6, err_msg=name)
 
 
-def test_tsv_tasks_and_bad_input(model_path, synthetic, tmp_path):
+def test_tsv_tasks_and_bad_input(model, synthetic, tmp_path):
     tsv = tmp_path / "tasks.tsv"
     tsv.write_text("name\tkind\tweight\tvalue\nLASI\tmarker\t2\t\nknee_flexion_r\tcoordinate\t5\t0.3\n"
                    "ankle_dorsiflexion_r\tcoordinate\t1\t\n")
@@ -160,24 +175,22 @@ def test_tsv_tasks_and_bad_input(model_path, synthetic, tmp_path):
     bad.write_text("name\tkind\tweight\nLASI\tmarkr\t1\n")
     with pytest.raises(LoperInputError, match="row 1, column kind: 'markr'"):
         read_ik_tasks(bad)
-    t, truth, X = synthetic
+    t, _, X = synthetic
     with pytest.raises(LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in model"):
-        inverse_kinematics(model_path, t, X, list(MARKERS), {"XYZ": 1.0})
+        inverse_kinematics(model, t, X, list(MARKERS), {"XYZ": 1.0})
     with pytest.raises(LoperInputError, match=r"\['RASI'\] of the IK tasks are not in the marker data"):
-        inverse_kinematics(model_path, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
+        inverse_kinematics(model, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
     with pytest.raises(LoperInputError, match="coordinate task on 'knee_angle_r'"):
-        inverse_kinematics(model_path, t, X, list(MARKERS), None, {"knee_angle_r": (1.0, None)})
+        inverse_kinematics(model, t, X, list(MARKERS), None, {"knee_angle_r": (1.0, None)})
 
 
-def test_chunks_join_seamlessly(model_path, synthetic):
-    from loper_analysis.kinematics import chunk_frames, join_chunks
-
-    t, truth, X = synthetic
-    whole = inverse_kinematics(model_path, t, X, list(MARKERS)).frame()
+def test_chunks_join_seamlessly(model, synthetic):
+    t, _, X = synthetic
+    whole = inverse_kinematics(model, t, X, list(MARKERS)).frame()
     parts = []
     for c in range(3):
         sel = chunk_frames(len(t), 3, c)
-        parts.append(inverse_kinematics(model_path, t[sel], X[sel], list(MARKERS)).frame())
+        parts.append(inverse_kinematics(model, t[sel], X[sel], list(MARKERS)).frame())
     assert [len(p) for p in parts] == [85, 86, 85]
     joined = join_chunks(parts)
     np.testing.assert_array_equal(joined.time_s, whole.time_s)
@@ -191,10 +204,6 @@ def test_chunks_join_seamlessly(model_path, synthetic):
 
 
 def test_joint_angle_table_maps_names_and_signs():
-    import pandas as pd
-
-    from loper_analysis.kinematics import DEFAULT_COORDINATE_MAP, joint_angle_table
-
     coords = pd.DataFrame({"time_s": [0.0, 0.01], "pelvis_tilt": [0.1, 0.2], "pelvis_tx": [0.5, 0.6],
                            **{c: [0.3, 0.4] for c, _ in list(DEFAULT_COORDINATE_MAP.values())[2:]}})
     angles = joint_angle_table(coords)

@@ -1,4 +1,4 @@
-"""Sync pulses, clock map and the robot log on mocap frames, against known clocks."""
+"""loper_analysis.loadcell: the robot log's forces and perturbation flag on the mocap frames, against known clocks."""
 
 import numpy as np
 import pandas as pd
@@ -6,179 +6,14 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.loadcell import (
-    ClockMap,
     OUTPUT_COLUMNS,
-    clock_map,
     perturbation_onsets,
-    pulse_train_at,
     robot_log_on_mocap_frames,
-    rising_edges,
-    sync_pulse_starts,
-    sync_pulse_train,
 )
+from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
+from tests.sync_records import ANALOG_HZ, ROBOT_HZ, mocap_view
 
-ROBOT_HZ = 1000.0
-ANALOG_HZ = 1024.0
 FRAME_HZ = 128.0
-
-
-def mocap_view(starts, offset_s, ppm, robot_t0_s, robot_duration_s, mocap_duration_s, pulse_s=0.01):
-    """The robot's sync train as the mocap analog input records it (zero while the robot is not running).
-
-    Robot clock: the log's sample 0 is at ``robot_t0_s``; pulses start at
-    ``robot_t0_s + starts``. Mocap clock: analog sample 0 at t = 0;
-    ``t_mocap = offset_s + (1 + ppm * 1e-6) * t_robot``.
-    """
-    scale = 1 + ppm * 1e-6
-    t_analog = np.arange(int(round(mocap_duration_s * ANALOG_HZ))) / ANALOG_HZ
-    rel = (t_analog - offset_s) / scale - robot_t0_s  # time since the robot log's sample 0
-    running = (rel >= 0) & (rel < robot_duration_s)
-    return np.where(running, pulse_train_at(rel, starts, pulse_s), 0.0)
-
-
-# ---------------------------------------------------------------------------
-# pulse train and edges
-
-
-def test_pulse_train_is_seeded_and_random():
-    a = sync_pulse_train(60.0, ROBOT_HZ, seed=4)
-    b = sync_pulse_train(60.0, ROBOT_HZ, seed=4)
-    c = sync_pulse_train(60.0, ROBOT_HZ, seed=5)
-    assert a.shape == (60000,)
-    np.testing.assert_array_equal(a, b)
-    assert not np.array_equal(a, c)
-    assert set(np.unique(a)) == {0.0, 5.0}
-    starts = sync_pulse_starts(60.0, seed=4)
-    intervals = np.diff(starts)
-    assert starts[0] >= 0.5 and starts[-1] < 60.0
-    assert intervals.min() >= 0.5 and intervals.max() < 1.5 and intervals.std() > 0.2
-    # each pulse is 10 ms = 10 samples high
-    edges = rising_edges(a, ROBOT_HZ)
-    assert edges.size == starts.size
-    np.testing.assert_allclose(edges, starts, atol=0.5 / ROBOT_HZ + 1e-12)
-    # a longer train starts with the same pulses
-    np.testing.assert_array_equal(sync_pulse_starts(120.0, seed=4)[: starts.size], starts)
-
-
-def test_pulse_train_bad_settings():
-    with pytest.raises(LoperInputError, match="periodic"):
-        sync_pulse_starts(10.0, 1, min_interval_s=1.0, max_interval_s=1.0)
-    with pytest.raises(LoperInputError, match="pulse_s"):
-        sync_pulse_train(10.0, ROBOT_HZ, 1, pulse_s=0.6)
-    with pytest.raises(LoperInputError, match="duration_s"):
-        sync_pulse_train(-1.0, ROBOT_HZ, 1)
-
-
-def test_rising_edges_interpolate_ramps_exactly():
-    fs = 100.0
-    t = np.arange(1000) / fs
-    true = np.array([1.2345, 4.0071, 7.5])
-    x = np.zeros_like(t)
-    for e in true:  # 0 -> 2 V ramp over 50 ms centred on e, then high for 0.5 s
-        x = np.maximum(x, np.clip((t - e) / 0.05 + 0.5, 0, 1) * 2.0 * (t < e + 0.5))
-    np.testing.assert_allclose(rising_edges(x, fs), true, atol=1e-12)
-    # explicit threshold: 0.5 V is crossed a quarter of the ramp earlier than 1 V
-    np.testing.assert_allclose(rising_edges(x, fs, threshold_v=0.5), true - 0.0125, atol=1e-12)
-
-
-def test_rising_edges_reject_noise_chatter_and_gaps():
-    rng = np.random.default_rng(0)
-    fs = 1000.0
-    starts = np.array([1.0004, 2.5007, 3.1, 4.9])
-    x = pulse_train_at(np.arange(6000) / fs, starts, 0.05) + rng.normal(0, 0.15, 6000)
-    edges = rising_edges(x, fs)
-    assert edges.size == 4
-    np.testing.assert_allclose(edges, starts, atol=2e-3)
-    # a rise with chatter around the threshold is one edge
-    y = np.zeros(200)
-    y[100:] = 5.0
-    y[[95, 97]] = 2.6  # brief excursions above 2.5 V without reaching the high band
-    y[150:] = 0.0
-    y[170:] = 5.0
-    e = rising_edges(y, fs)
-    np.testing.assert_allclose(e, [99.5e-3, 169.5e-3])
-    # an edge inside a NaN gap is not reported
-    z = pulse_train_at(np.arange(6000) / fs, starts, 0.05)
-    z[2495:2510] = np.nan
-    np.testing.assert_allclose(rising_edges(z, fs), starts[[0, 2, 3]], atol=0.5e-3)
-
-
-def test_rising_edges_refusals():
-    with pytest.raises(LoperInputError, match="chan A: the sync signal has no finite sample"):
-        rising_edges(np.full(100, np.nan), 1000.0, source="chan A")
-    with pytest.raises(LoperInputError, match="chan A: the sync signal is flat"):
-        rising_edges(np.full(100, 5.0), 1000.0, source="chan A")
-    one = np.zeros(100)
-    one[50:60] = 5.0
-    with pytest.raises(LoperInputError, match="1 rising edge"):
-        rising_edges(one, 1000.0)
-    with pytest.raises(LoperInputError, match="outside"):
-        rising_edges(one, 1000.0, threshold_v=7.0)
-
-
-# ---------------------------------------------------------------------------
-# clock map
-
-
-@pytest.mark.parametrize(
-    "offset_s, ppm, mocap_duration_s, seed",
-    [
-        (3.217, 150.0, 200.0, 11),  # robot starts 3.217 s after the mocap; mocap ends mid-train
-        (-1.5, -80.0, 250.0, 12),  # robot starts 1.5 s before the mocap (mocap starts mid-train); robot ends first
-        (-20.0, 150.0, 150.0, 13),  # mocap starts and ends mid-train
-    ],
-)
-def test_clock_map_recovers_offset_and_drift(offset_s, ppm, mocap_duration_s, seed):
-    robot_duration_s = 240.0
-    starts = sync_pulse_starts(robot_duration_s, seed)
-    robot = sync_pulse_train(robot_duration_s, ROBOT_HZ, seed)
-    mocap = mocap_view(starts, offset_s, ppm, 0.0, robot_duration_s, mocap_duration_s)
-    r, m = rising_edges(robot, ROBOT_HZ), rising_edges(mocap, ANALOG_HZ)
-    assert m.size < r.size or m[0] > offset_s + 1  # the records do not hold the same edges
-    cm = clock_map(r, m, source="trial-x")
-    assert isinstance(cm, ClockMap)
-    assert abs(cm.offset_s - offset_s) < 0.2e-3
-    assert abs(cm.scale - (1 + ppm * 1e-6)) < 5e-6
-    assert abs(cm.drift_ppm - ppm) < 5.0
-    assert cm.rms_residual_s < 0.6e-3  # +-0.5 sample quantisation in each record
-    assert cm.n_edges >= 100
-    np.testing.assert_allclose(cm.to_robot(cm.to_mocap([1.0, 50.0])), [1.0, 50.0], rtol=1e-12)
-
-
-def test_clock_map_refuses_a_periodic_train_as_ambiguous():
-    starts = np.arange(1.0, 240.0, 1.0)
-    robot = pulse_train_at(np.arange(240000) / ROBOT_HZ, starts)
-    mocap = mocap_view(starts, -20.0, 100.0, 0.0, 240.0, 120.0)
-    with pytest.raises(LoperInputError, match=r"trial-p: ambiguous sync match.*periodic"):
-        clock_map(rising_edges(robot, ROBOT_HZ), rising_edges(mocap, ANALOG_HZ), source="trial-p")
-
-
-def test_clock_map_refuses_too_few_edges():
-    r = np.array([1.0, 2.2, 2.9, 4.3, 5.1, 6.6, 7.2, 8.9])
-    with pytest.raises(LoperInputError, match="trial-f: mocap_edges_s has 3 edge"):
-        clock_map(r, r[:3] + 5.0, source="trial-f")
-    # four or more edges in each record, but only three in common
-    m = np.concatenate([r[5:], [9.8, 10.6, 12.0]]) + 5.0
-    with pytest.raises(LoperInputError, match="trial-f: no 4 consecutive sync edges"):
-        clock_map(r, m, source="trial-f")
-    # exactly four in common is enough
-    m4 = np.concatenate([r[4:], [9.8, 10.6, 12.0]]) + 5.0
-    cm = clock_map(r, m4, source="trial-f")
-    assert cm.n_edges == 4
-    assert abs(cm.offset_s - 5.0) < 1e-9 and abs(cm.scale - 1) < 1e-12
-
-
-def test_clock_map_refuses_a_clock_jump():
-    r = sync_pulse_starts(60.0, 3)
-    m = 2.0 + r
-    m[m.size // 2 :] += 0.02  # 20 ms jump half-way
-    with pytest.raises(LoperInputError, match="trial-j: sync edges do not lie on one line"):
-        clock_map(r, m, source="trial-j")
-
-
-# ---------------------------------------------------------------------------
-# robot log on mocap frames
-
 FORCE_COMPONENTS = ((8.0, 0.7, 0.3), (5.0, 2.3, 1.1), (3.0, 6.1, 2.0))  # (N, Hz, rad), all < 10 Hz
 
 
@@ -201,7 +36,8 @@ def make_trial(offset_s, ppm, robot_t0_s, seed, robot_duration_s=60.0, mocap_dur
         "force_measured_n": force(t),
         "motor_angle_rad": 0.0,
         "motor_velocity_rad_s": 0.0,
-        "sync_v": sync_pulse_train(robot_duration_s, ROBOT_HZ, seed),
+        "sync_v": pulse_train_at(np.arange(int(round(robot_duration_s * ROBOT_HZ))) / ROBOT_HZ,
+                                 sync_pulse_starts(robot_duration_s, seed)),
         "perturbation": flag,
         "safety_state": 0,
     })

@@ -1,62 +1,20 @@
-"""Transparency metrics against analytic answers."""
+"""loper_analysis.transparency: statistics of normalised strides and the transparency table, against analytic answers."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.reference import STUDY_TRANSPARENCY_RAD
 from loper_analysis.transparency import (
-    STUDY_TRANSPARENCY_RAD,
     TRANSPARENCY_COLUMNS,
-    force_phase_metrics,
     isv_ave,
     mean_sd,
     mean_toe_off_pct,
-    plot_transparency,
     rmsd,
     transparency_table,
     within_subject_sd,
 )
-
-FS = 1000.0
-
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(7)
-
-
-def _stride_table():
-    # strides of 1 s: stance 0.6 s (3 periods of 5 Hz), swing 0.4 s (2 periods)
-    hs = np.array([0.5, 1.5, 2.5])
-    return pd.DataFrame({
-        "stride": [0, 1, 2], "heel_strike_s": hs, "toe_off_s": hs + 0.6, "end_s": hs + 1.0,
-        "stance_s": 0.6, "duration_s": 1.0,
-    })
-
-
-def test_force_metrics_of_a_constant_force():
-    t = np.arange(0, 4, 1 / FS)
-    m = force_phase_metrics(t, np.full(t.size, -3.5), _stride_table())
-    assert list(m.columns) == ["stride", "phase", "rms_force_n", "max_abs_force_n"]
-    np.testing.assert_array_equal(m["stride"], [0, 0, 1, 1, 2, 2])
-    np.testing.assert_array_equal(m["phase"], ["stance", "swing"] * 3)
-    np.testing.assert_allclose(m["rms_force_n"], 3.5, rtol=1e-12)
-    np.testing.assert_allclose(m["max_abs_force_n"], 3.5, rtol=0)
-
-
-def test_force_metrics_of_a_sine_have_the_analytic_rms():
-    t = np.arange(0, 4, 1 / FS)
-    amplitude = 6.0
-    # phase starts at 0.5 s, a whole number of 5 Hz periods from 0: integer periods in each phase
-    m = force_phase_metrics(t, amplitude * np.sin(2 * np.pi * 5.0 * t), _stride_table())
-    np.testing.assert_allclose(m["rms_force_n"], amplitude / np.sqrt(2), rtol=1e-12)
-    np.testing.assert_allclose(m["max_abs_force_n"], amplitude, rtol=1e-12)  # 200 samples/period: the peak is a sample
-    # a force only in swing: stance is zero
-    f = np.where(((t - 0.5) % 1.0) >= 0.6 - 1e-9, 2.0, 0.0)
-    m = force_phase_metrics(t, f, _stride_table())
-    np.testing.assert_allclose(m.loc[m.phase == "stance", "rms_force_n"], 0.0, atol=0)
-    np.testing.assert_allclose(m.loc[m.phase == "swing", "rms_force_n"], 2.0, rtol=1e-12)
 
 
 def test_mean_sd_and_within_subject_sd():
@@ -84,6 +42,12 @@ def test_rmsd_of_known_curves():
 def test_isv_ave_of_known_sds():
     assert isv_ave([0.02, 0.03, 0.04, 0.05, 0.06]) == pytest.approx(2 / 5 * 0.20, rel=1e-12)
     np.testing.assert_allclose(isv_ave([[0.02, 0.1], [0.04, 0.3]]), [0.06, 0.4], rtol=1e-12)
+
+
+def test_mean_toe_off_pct_of_known_strides():
+    # strides of 1 s with a 0.6 s stance: toe-off at 60 %
+    strides = pd.DataFrame({"stride": [0, 1, 2], "stance_s": 0.6, "duration_s": 1.0})
+    assert mean_toe_off_pct(strides) == pytest.approx(60.0, rel=1e-12)
 
 
 def _subject(offsets, sd_no_device, sd_device, n_points=51):
@@ -141,32 +105,7 @@ def test_transparency_table_known_answers():
     assert set(STUDY_TRANSPARENCY_RAD) == {(p, j) for p in ("stance", "swing") for j in ("hip", "knee", "ankle")}
 
 
-def test_plot_writes_a_png(tmp_path, rng):
-    u = np.linspace(0, 1, 101)
-    base = np.column_stack([0.4 * np.sin(2 * np.pi * u), 0.6 * np.sin(np.pi * u) ** 2, 0.1 * np.cos(2 * np.pi * u)])
-    angles = {
-        "no_device": base + rng.normal(0, 0.02, (12, 101, 3)),
-        "device": base + 0.01 + rng.normal(0, 0.02, (10, 101, 3)),
-    }
-    force = 5 * np.sin(2 * np.pi * u) + rng.normal(0, 1, (10, 101))
-    out = tmp_path / "transparency.png"
-    plot_transparency(out, angles, force, toe_off_pct={"no_device": 61.0, "device": 62.5}, title="S01")
-    data = out.read_bytes()
-    assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 10_000
-    assert [p.name for p in tmp_path.iterdir()] == ["transparency.png"]  # no temporary left behind
-    assert mean_toe_off_pct(_stride_table()) == pytest.approx(60.0, rel=1e-12)
-
-
-def test_bad_inputs_name_the_source():
-    t = np.arange(0, 4, 1 / FS)
-    f = np.zeros(t.size)
-    f[1234] = np.inf
-    with pytest.raises(LoperInputError, match="S01/T02: force_n is not finite at sample 1234"):
-        force_phase_metrics(t, f, _stride_table(), source="S01/T02")
-    with pytest.raises(LoperInputError, match=r"S01/T02: stride 2 swing \(3.1 .. 3.5 s\) is empty or outside"):
-        force_phase_metrics(t[:3200], np.zeros(3200), _stride_table(), source="S01/T02")
-    with pytest.raises(LoperInputError, match="S01/T02: stride_table lacks column"):
-        force_phase_metrics(t, np.zeros(t.size), _stride_table().drop(columns="toe_off_s"), source="S01/T02")
+def test_bad_inputs_are_named():
     good = np.zeros((3, 11, 3))
     with pytest.raises(LoperInputError, match="subject S07: condition 'device' missing"):
         transparency_table({"S07": {"no_device": {"stance": good, "swing": good}}})

@@ -127,18 +127,18 @@ def test_impedance_table_from_the_default_run(finished_run):
     assert counts.loc["total", ["n_perturbed", "n_kept"]].tolist() == [3, 3]
     assert counts.loc["total", "status"] == "too_few_strides"
     assert (table.status == "failed").all() and table.reason.str.contains("3 valid perturbed stride").all()
-    assert table.K.isna().all()
+    assert table.K_nm_per_rad.isna().all()
     summary = pd.read_csv(finished_run / "results/tables/impedance_summary.tsv", sep="\t")
     assert len(summary) == 0 and list(summary.columns[:2]) == ["joint", "onset_ms"]  # nothing fitted
     literature = pd.read_csv(finished_run / "results/tables/literature.tsv", sep="\t")
-    assert len(literature) == 7 and literature.K_low.iloc[0] == 50.0
+    assert len(literature) == 7 and literature.K_low_nm_per_rad.iloc[0] == 50.0
     md = (finished_run / "results/tables/tables.md").read_text()
     assert "## Impedance per subject, onset and joint" in md and "| S01 | 50 | hip |" in md
     assert "## Transparency: RMSD vs ISV_ave" in md and "## Validation study" in md
     for fig in ("figures/impedance.png", "figures/S01/responses.png", "figures/S01/fit.png"):
         assert (finished_run / "results" / fig).read_bytes()[:4] == b"\x89PNG", fig
     truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())
-    np.testing.assert_allclose(table.K_true, [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"]
+    np.testing.assert_allclose(table.K_true_nm_per_rad, [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"]
                                               for j in ("hip", "knee", "ankle")])
 
 
@@ -229,7 +229,7 @@ def test_recorded_subject_without_a_trial_reports_that_onset_missing(finished_ru
     table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
     assert list(table.joint) == ["hip", "knee", "ankle"] and (table.subject == "R01").all()
     assert (table.status == "missing").all() and (table.reason == "no trial of this onset").all()
-    assert table[["K", "D", "K_true", "D_true"]].isna().all().all()
+    assert table[["K_nm_per_rad", "D_nms_per_rad", "K_true_nm_per_rad", "D_true_nms_per_rad"]].isna().all().all()
     assert not (work / "results/ik").exists()  # nothing was processed for an onset without trials
 
 

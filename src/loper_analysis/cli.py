@@ -20,51 +20,25 @@ __all__ = ["main"]
 
 
 def _segments(args: argparse.Namespace) -> None:
-    from .dynamics import segment_parameters_from_anthropometry
+    from .steps.model import anthropometric_segments
 
-    segment_parameters_from_anthropometry(args.height_m, args.mass_kg, args.attachment_fraction).to_tsv(args.out)
+    anthropometric_segments(args.out, args.height_m, args.mass_kg, args.attachment_fraction)
 
 
 def _validate(args: argparse.Namespace) -> None:
-    from .validation import ValidationSettings, validation_chunk_tables
+    from .steps.validation import validation_chunk
 
-    settings = ValidationSettings(n_starts=args.n_starts, seed=args.seed)
-    validation_chunk_tables(args.segments, settings, args.chunk, args.n_chunks, args.errors, args.fits)
+    validation_chunk(args.segments, {"n_starts": args.n_starts, "seed": args.seed}, args.chunk, args.n_chunks,
+                     args.errors, args.fits)
 
 
 def _ik(args: argparse.Namespace) -> None:
-    from pathlib import Path
+    from .steps.ik import ik_file
 
-    from .kinematics import inverse_kinematics, read_ik_tasks
-    from .io.tables import read_markers, write_mot
-    from .markers import rotate_markers
-
-    markers_path = Path(args.markers)
-    time_s, markers_m, labels = read_markers(markers_path)
-    rotation = args.rotate_deg
-    if rotation is None:
-        rotation = (-90.0, 0.0, 0.0) if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
-    markers_m = rotate_markers(markers_m, rotation)
-    start = time_s[0] if args.start is None else args.start
-    end = time_s[-1] if args.end is None else args.end
-    sel = (time_s >= start - 1e-9) & (time_s <= end + 1e-9)
-    if not sel.any():
-        raise LoperInputError(
-            f"{markers_path}: no frame between --start {start} and --end {end} s "
-            f"(the file spans {time_s[0]:.4f} .. {time_s[-1]:.4f} s)"
-        )
-    weights, coordinate_tasks = (None, None) if args.tasks is None else read_ik_tasks(args.tasks)
-    if weights is not None and not weights:
-        weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
-    try:
-        result = inverse_kinematics(
-            args.model, time_s[sel], markers_m[sel], labels, weights, coordinate_tasks, accuracy=args.accuracy
-        )
-    except LoperInputError as exc:
-        raise LoperInputError(f"{markers_path} with {args.model}: {exc}") from None
-    write_mot(args.out, result.frame(), in_degrees=True)
+    result = ik_file(args.model, args.markers, args.out, args.tasks, args.start, args.end, args.rotate_deg,
+                     args.accuracy)
     print(
-        f"{args.out}: {sel.sum()} frames, marker error RMS {1e3 * np.nanmean(result.marker_rms_m):.2f} mm "
+        f"{args.out}: {len(result.time_s)} frames, marker error RMS {1e3 * np.nanmean(result.marker_rms_m):.2f} mm "
         f"(max {1e3 * np.nanmax(result.marker_max_m):.2f} mm)"
     )
 
@@ -78,7 +52,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--attachment-fraction", type=float, default=0.8, help="brace position along the thigh")
     p.add_argument("--out", required=True, help="output TSV")
     p.set_defaults(func=_segments)
-    p = sub.add_parser("validate", help="one chunk of the validation study (defaults of DESIGN.md)")
+    p = sub.add_parser("validate", help="one chunk of the validation study (the study's design)")
     p.add_argument("--segments", required=True, help="segment table TSV")
     p.add_argument("--chunk", type=int, default=0)
     p.add_argument("--n-chunks", type=int, default=1)

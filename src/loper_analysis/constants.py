@@ -1,16 +1,50 @@
-"""Names shared by the library, the rules and the tables."""
+"""Names shared by the library, the rules and the tables: sides, joints, coordinates, parameters, columns.
+
+Sign convention (the one statement of it in the code; ``docs/conventions.md``
+explains it with figures in words):
+
+* Units are SI inside (m, rad, N, s); units appear in names (``time_s``,
+  ``hip_left_rad``, ``K_nm_per_rad``).
+* Swing-leg coordinates ``q = [x, q_thigh, q_shank, q_foot]``: cart
+  (pelvis) position in m, forward positive, and global segment angles in
+  rad, zero when the segment hangs (thigh, shank) or is in its neutral pose
+  (foot), positive when the distal end moves backward.
+* Joint angles are flexion positive::
+
+      theta_hip   = theta_pelvis - q_thigh      (hip flexion)
+      theta_knee  = q_shank - q_thigh           (knee flexion)
+      theta_ankle = q_shank - q_foot            (ankle dorsiflexion)
+
+  and the generalised forces of joint torques follow by virtual work::
+
+      u_x = 0,  u_thigh = -T_hip - T_knee,  u_shank = T_knee + T_ankle,  u_foot = -T_ankle
+
+* Forces are positive forward (walking direction) and up; the model frame
+  has X forward, Y up, Z to the right (OpenSim's).
+"""
 
 from __future__ import annotations
 
 __all__ = [
+    "SIDES",
+    "SIDE_SUFFIX",
     "JOINTS",
     "COORDINATES",
     "SEGMENTS",
     "PARAMETERS",
     "PARAMETER_UNITS",
+    "UNIT_SUFFIX",
+    "EVENTS",
+    "PHASES",
     "GRAVITY_M_PER_S2",
+    "angle_column",
+    "parameter_column",
 ]
 
+#: Sides of the body, as written in tables and config (one treadmill belt each).
+SIDES: tuple[str, ...] = ("left", "right")
+#: Suffix of each side in OpenSim body, joint and coordinate names (``thigh_l``, ``hip_flexion_r``).
+SIDE_SUFFIX: dict[str, str] = {"left": "l", "right": "r"}
 #: Joints of the swing leg, in model order.
 JOINTS: tuple[str, ...] = ("hip", "knee", "ankle")
 #: Generalised coordinates of the swing-leg model (cart x in m, segment angles in rad).
@@ -23,4 +57,24 @@ PARAMETERS: tuple[str, ...] = ("K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", 
 PARAMETER_UNITS: dict[str, str] = {
     p: ("N·m/rad" if p.startswith("K") else "N·m·s/rad") for p in PARAMETERS
 }
+#: Unit suffix of stiffness (K) and damping (D) in column names.
+UNIT_SUFFIX: dict[str, str] = {"K": "nm_per_rad", "D": "nms_per_rad"}
+#: Gait events, in the order they appear in event tables.
+EVENTS: tuple[str, ...] = ("heel_strike", "toe_off")
+#: Normalisation phases: the whole stride (HS -> next HS), stance (HS -> TO), swing (TO -> next HS).
+PHASES: tuple[str, ...] = ("stride", "stance", "swing")
 GRAVITY_M_PER_S2: float = 9.81
+
+
+def angle_column(joint: str, side: str) -> str:
+    """Column of a joint angle in the angle and cycle tables, e.g. ``hip_left_rad``."""
+    return f"{joint}_{side}_rad"
+
+
+def parameter_column(kind: str, what: str = "") -> str:
+    """Column of a stiffness or damping quantity with its unit, e.g. ``K_nm_per_rad``, ``D_ci95_low_nms_per_rad``.
+
+    ``kind`` is ``"K"`` or ``"D"``; ``what`` an optional qualifier (``ci95_low``, ``true``, ``error``, ``mean`` ...).
+    """
+    middle = f"_{what}" if what else ""
+    return f"{kind}{middle}_{UNIT_SUFFIX[kind]}"

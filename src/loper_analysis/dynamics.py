@@ -1,33 +1,18 @@
 """Planar swing-leg model: a cart (pelvis translation) carrying thigh, shank and foot.
 
-Equations of motion (DESIGN.md section 5)::
+Equations of motion (``docs/swing_leg_model.md``)::
 
     M(q) q'' = -C(q, q') + G(q) + u + Ja(q)^T F
 
-* ``q = [x, q_thigh, q_shank, q_foot]``: cart position (m, forward positive)
-  and global segment angles (rad). A segment angle is 0 when the segment hangs
-  (thigh, shank) or is in its neutral pose (foot), and positive when the
-  distal end moves backward, i.e. clockwise seen with the walking direction
-  to the right.
-* Joint angles (flexion positive, DESIGN.md section 4)::
-
-      theta_hip   = theta_pelvis - q_thigh      (hip flexion)
-      theta_knee  = q_shank - q_thigh           (knee flexion)
-      theta_ankle = q_shank - q_foot            (ankle dorsiflexion)
-
-  DESIGN.md section 5 writes the knee as ``q_thigh - q_shank``; with segment
-  angles of one sense that is knee *extension*, so we use the flexion-positive
-  form stated in section 4. The generalised forces of the joint torques follow
-  from virtual work and change with it::
-
-      u_x = 0,  u_thigh = -T_hip - T_knee,  u_shank = T_knee + T_ankle,  u_foot = -T_ankle
-
+* ``q = [x, q_thigh, q_shank, q_foot]``, joint angles and the generalised
+  forces of joint torques as stated in :mod:`loper_analysis.constants`
+  (flexion and dorsiflexion positive).
 * ``Ja`` is the Jacobian (2 x 4) of the rod attachment point on the thigh, at
   ``attachment_m`` from the hip along the thigh axis; ``F = (F_x, F_y)`` in N,
   world frame (x forward, y up).
 
 Segment parameters come from :class:`SegmentParameters` (SI units). The heavy
-lifting is compiled in :mod:`loper_analysis._kernels`; this module offers the
+lifting is compiled in :mod:`loper_analysis.kernels`; this module offers the
 checked, vectorised NumPy API and a reference forward simulation on SciPy's
 ``solve_ivp``.
 """
@@ -35,13 +20,14 @@ checked, vectorised NumPy API and a reference forward simulation on SciPy's
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy.integrate import solve_ivp
 
-from . import _kernels
+from . import kernels
+from .anthropometry import ANKLE_HEIGHT_FRACTION, HEEL_BEHIND_ANKLE_FRACTION, WINTER_SEGMENTS
+from .checks import finite_rows
 from .constants import GRAVITY_M_PER_S2, SEGMENTS
 from .errors import LoperInputError
 
@@ -115,24 +101,24 @@ class SegmentParameters:
             )
         if self.gravity_m_per_s2 < 0:
             raise LoperInputError(f"gravity_m_per_s2 must be >= 0, got {self.gravity_m_per_s2}")
-        packed = np.empty(_kernels.N_PACKED)
-        packed[0] = self.cart_mass_kg
+        packed = np.empty(kernels.N_PACKED)
+        packed[kernels.CART_MASS] = self.cart_mass_kg
         for i in range(3):
-            packed[1 + 5 * i : 6 + 5 * i] = [
+            packed[kernels.segment_slot(i) : kernels.segment_slot(i) + 5] = [
                 self.mass_kg[i],
                 self.inertia_kg_m2[i],
                 self.length_m[i],
                 self.com_x_m[i],
                 self.com_y_m[i],
             ]
-        packed[16] = self.attachment_m
-        packed[17] = self.gravity_m_per_s2
+        packed[kernels.ATTACHMENT] = self.attachment_m
+        packed[kernels.GRAVITY] = self.gravity_m_per_s2
         packed.setflags(write=False)
         object.__setattr__(self, "_packed", packed)
 
     @property
     def packed(self) -> np.ndarray:
-        """Parameter vector (18,) in the layout of :mod:`loper_analysis._kernels`."""
+        """Parameter vector (18,) in the layout of :mod:`loper_analysis.kernels`."""
         return self._packed
 
     @property
@@ -159,32 +145,24 @@ class SegmentParameters:
             rows.append(row)
         return pd.DataFrame(rows)
 
-    def to_tsv(self, path: str | Path) -> None:
-        """Write the table of :meth:`to_frame` as TSV (empty cells where not applicable)."""
-        self.to_frame().to_csv(path, sep="\t", index=False, float_format="%.10g", na_rep="")
-
     @classmethod
-    def from_tsv(cls, path: str | Path) -> "SegmentParameters":
-        """Read a table written by :meth:`to_tsv` (rows cart, thigh, shank, foot)."""
-        path = Path(path)
-        try:
-            df = pd.read_csv(path, sep="\t")
-        except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-            raise LoperInputError(f"{path}: cannot read segment table ({exc})") from exc
+    def from_frame(cls, df: pd.DataFrame, source: str = "segment table") -> "SegmentParameters":
+        """Parameters from the table of :meth:`to_frame` (rows cart, thigh, shank, foot); ``source`` names it in errors."""
         need = {"segment", *_SEGMENT_COLUMNS, "attachment_m"}
         missing = need - set(df.columns)
         if missing:
-            raise LoperInputError(f"{path}: missing column(s) {sorted(missing)}")
+            raise LoperInputError(f"{source}: missing column(s) {sorted(missing)}")
         df = df.set_index("segment")
         for seg in ("cart", *SEGMENTS):
             if seg not in df.index:
-                raise LoperInputError(f"{path}: missing row for segment '{seg}'")
+                raise LoperInputError(f"{source}: missing row for segment '{seg}'")
+
         def number(seg: str, col: str) -> float:
             raw = df.loc[seg, col]
             value = pd.to_numeric(pd.Series([raw]), errors="coerce").iloc[0]
             if pd.isna(value):
                 shown = "an empty cell" if pd.isna(raw) else f"value {raw!r}"
-                raise LoperInputError(f"{path}: column {col}, segment {seg}: {shown} is not a number")
+                raise LoperInputError(f"{source}: column {col}, segment {seg}: {shown} is not a number")
             return float(value)
 
         values = {c: tuple(number(seg, c) for seg in SEGMENTS) for c in _SEGMENT_COLUMNS}
@@ -199,21 +177,18 @@ class SegmentParameters:
                 **values,
             )
         except LoperInputError as exc:
-            raise LoperInputError(f"{path}: {exc}") from exc
+            raise LoperInputError(f"{source}: {exc}") from exc
 
 
 def segment_parameters_from_anthropometry(
     height_m: float, body_mass_kg: float, attachment_fraction: float = 0.8
 ) -> SegmentParameters:
-    """Segment parameters from height and body mass with Winter's table.
+    """Segment parameters from height and body mass with Winter's table (:mod:`loper_analysis.anthropometry`).
 
-    Segment mass fractions, lengths (fraction of height), COM location and
-    radius of gyration about the COM (fractions of segment length) after
-    D. A. Winter, *Biomechanics and Motor Control of Human Movement*, 4th ed.,
-    Wiley 2009, Table 4.1 (thigh 0.100 M, 0.245 H, COM 0.433, k 0.323; leg
-    0.0465 M, 0.246 H, 0.433, 0.302; foot 0.0145 M, foot length 0.152 H, COM
-    0.50 of heel-toe, k 0.475; ankle height 0.039 H). The foot COM lies half a
-    foot length from the heel, the heel 0.2 foot lengths behind the ankle.
+    Masses, lengths, COM positions and radii of gyration are the table's
+    fractions of body mass and height; the foot COM lies half a foot length
+    from the heel, the heel :data:`~loper_analysis.anthropometry.HEEL_BEHIND_ANKLE_FRACTION`
+    foot lengths behind the ankle, half the ankle height below the ankle.
     The cart carries the rest of the body. The brace sits at
     ``attachment_fraction`` of the thigh length from the hip.
     """
@@ -222,13 +197,14 @@ def segment_parameters_from_anthropometry(
     if not body_mass_kg > 0:
         raise LoperInputError(f"body_mass_kg must be positive, got {body_mass_kg}")
     H, Mb = float(height_m), float(body_mass_kg)
-    m = (0.100 * Mb, 0.0465 * Mb, 0.0145 * Mb)
-    L = (0.245 * H, 0.246 * H, 0.152 * H)
-    k = (0.323 * L[0], 0.302 * L[1], 0.475 * L[2])
+    thigh, shank, foot = (WINTER_SEGMENTS[s] for s in SEGMENTS)
+    m = (thigh.mass * Mb, shank.mass * Mb, foot.mass * Mb)
+    L = (thigh.length * H, shank.length * H, foot.length * H)
+    k = (thigh.gyration * L[0], shank.gyration * L[1], foot.gyration * L[2])
     inertia = tuple(mi * ki**2 for mi, ki in zip(m, k))
-    ankle_height = 0.039 * H
-    com_x = (0.0, 0.0, 0.5 * L[2] - 0.2 * L[2])
-    com_y = (-0.433 * L[0], -0.433 * L[1], -0.5 * ankle_height)
+    ankle_height = ANKLE_HEIGHT_FRACTION * H
+    com_x = (0.0, 0.0, foot.com * L[2] - HEEL_BEHIND_ANKLE_FRACTION * L[2])
+    com_y = (-thigh.com * L[0], -shank.com * L[1], -0.5 * ankle_height)
     return SegmentParameters(
         cart_mass_kg=Mb - sum(m),
         mass_kg=m,
@@ -243,19 +219,6 @@ def segment_parameters_from_anthropometry(
 # ---------------------------------------------------------------- checks
 
 
-def _states(name: str, arr, width: int) -> tuple[np.ndarray, bool]:
-    """(n, width) float array and whether the input was a single row."""
-    a = np.asarray(arr, dtype=float)
-    single = a.ndim == 1
-    a2 = np.atleast_2d(a)
-    if a2.ndim != 2 or a2.shape[1] != width:
-        raise LoperInputError(f"{name} must have shape ({width},) or (n, {width}), got {a.shape}")
-    if not np.all(np.isfinite(a2)):
-        i = np.argwhere(~np.isfinite(a2))[0]
-        raise LoperInputError(f"{name} is not finite at row {i[0]}, column {i[1]}: {a2[tuple(i)]}")
-    return np.ascontiguousarray(a2), single
-
-
 def _same_rows(*arrays: tuple[str, np.ndarray]) -> None:
     n = arrays[0][1].shape[0]
     for name, a in arrays[1:]:
@@ -266,7 +229,7 @@ def _same_rows(*arrays: tuple[str, np.ndarray]) -> None:
 def _force(force_n, n: int) -> np.ndarray:
     if force_n is None:
         return np.zeros((n, 2))
-    f, _ = _states("force_n", force_n, 2)
+    f, _ = finite_rows("force_n", force_n, 2)
     if f.shape[0] == 1 and n > 1:
         f = np.repeat(f, n, axis=0)
     _same_rows(("q", np.empty((n, 0))), ("force_n", f))
@@ -282,33 +245,33 @@ def _out(a: np.ndarray, single: bool) -> np.ndarray:
 
 def mass_matrix(q, params: SegmentParameters) -> np.ndarray:
     """Mass matrix M(q): (4, 4) for one state or (n, 4, 4); kg and kg m^2 (mixed units)."""
-    q2, single = _states("q", q, 4)
-    M, _, _ = _kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    q2, single = finite_rows("q", q, 4)
+    M, _, _ = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
     return _out(M, single)
 
 
 def coriolis_forces(q, qd, params: SegmentParameters) -> np.ndarray:
     """C(q, q') (n, 4): velocity-product forces, entering as -C (N, N m)."""
-    q2, single = _states("q", q, 4)
-    qd2, _ = _states("qd", qd, 4)
+    q2, single = finite_rows("q", q, 4)
+    qd2, _ = finite_rows("qd", qd, 4)
     _same_rows(("q", q2), ("qd", qd2))
-    sv = params.packed.copy()
-    sv[17] = 0.0
-    _, h, _ = _kernels.terms_batch(q2, qd2, sv)
+    no_gravity = params.packed.copy()
+    no_gravity[kernels.GRAVITY] = 0.0
+    _, h, _ = kernels.terms_batch(q2, qd2, no_gravity)
     return _out(-h, single)
 
 
 def gravity_forces(q, params: SegmentParameters) -> np.ndarray:
     """G(q) (n, 4): generalised gravity forces, entering as +G (N, N m)."""
-    q2, single = _states("q", q, 4)
-    _, h, _ = _kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    q2, single = finite_rows("q", q, 4)
+    _, h, _ = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
     return _out(h, single)
 
 
 def attachment_jacobian(q, params: SegmentParameters) -> np.ndarray:
     """Jacobian of the rod attachment point, (2, 4) or (n, 2, 4) (m/m, m/rad)."""
-    q2, single = _states("q", q, 4)
-    _, _, Ja = _kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    q2, single = finite_rows("q", q, 4)
+    _, _, Ja = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
     return _out(Ja, single)
 
 
@@ -320,7 +283,7 @@ def _rot(q: np.ndarray, v: tuple[float, float]) -> np.ndarray:
 
 def segment_com_positions(q, params: SegmentParameters) -> np.ndarray:
     """World positions of the thigh, shank and foot COM, (n, 3, 2) in m (hip at (x, 0))."""
-    q2, single = _states("q", q, 4)
+    q2, single = finite_rows("q", q, 4)
     base = np.stack([q2[:, 0], np.zeros(len(q2))], axis=-1)
     out = np.empty((len(q2), 3, 2))
     for i in range(3):
@@ -331,7 +294,7 @@ def segment_com_positions(q, params: SegmentParameters) -> np.ndarray:
 
 def attachment_position(q, params: SegmentParameters) -> np.ndarray:
     """World position (n, 2) of the rod attachment point on the thigh (m)."""
-    q2, single = _states("q", q, 4)
+    q2, single = finite_rows("q", q, 4)
     pos = np.stack([q2[:, 0], np.zeros(len(q2))], axis=-1) + _rot(q2[:, 1], (0.0, -params.attachment_m))
     return _out(pos, single)
 
@@ -339,36 +302,36 @@ def attachment_position(q, params: SegmentParameters) -> np.ndarray:
 # ---------------------------------------------------------------- dynamics
 
 
+def _checked_terms(q, qd, name: str, values, params: SegmentParameters, force_n):
+    """Checked (n, 4) ``values`` and force (n, 2), the terms M, h, Ja at (q, q'), and whether q was one state."""
+    q2, single = finite_rows("q", q, 4)
+    qd2, _ = finite_rows("qd", qd, 4)
+    v2, _ = finite_rows(name, values, 4)
+    _same_rows(("q", q2), ("qd", qd2), (name, v2))
+    M, h, Ja = kernels.terms_batch(q2, qd2, params.packed)
+    return v2, _force(force_n, len(q2)), M, h, Ja, single
+
+
 def inverse_dynamics(q, qd, qdd, params: SegmentParameters, force_n=None) -> np.ndarray:
     """Generalised forces u (n, 4) that produce q'' at (q, q') under the external force.
 
     ``u = M q'' + C - G - Ja^T F``; units N (cart) and N m (segments).
     """
-    q2, single = _states("q", q, 4)
-    qd2, _ = _states("qd", qd, 4)
-    qdd2, _ = _states("qdd", qdd, 4)
-    _same_rows(("q", q2), ("qd", qd2), ("qdd", qdd2))
-    F = _force(force_n, len(q2))
-    M, h, Ja = _kernels.terms_batch(q2, qd2, params.packed)
+    qdd2, F, M, h, Ja, single = _checked_terms(q, qd, "qdd", qdd, params, force_n)
     u = np.einsum("nij,nj->ni", M, qdd2) - h - np.einsum("nji,nj->ni", Ja, F)
     return _out(u, single)
 
 
 def forward_dynamics(q, qd, u, params: SegmentParameters, force_n=None) -> np.ndarray:
     """Accelerations q'' (n, 4) from M q'' = -C + G + u + Ja^T F."""
-    q2, single = _states("q", q, 4)
-    qd2, _ = _states("qd", qd, 4)
-    u2, _ = _states("u", u, 4)
-    _same_rows(("q", q2), ("qd", qd2), ("u", u2))
-    F = _force(force_n, len(q2))
-    M, h, Ja = _kernels.terms_batch(q2, qd2, params.packed)
+    u2, F, M, h, Ja, single = _checked_terms(q, qd, "u", u, params, force_n)
     rhs = h + u2 + np.einsum("nji,nj->ni", Ja, F)
     return _out(np.linalg.solve(M, rhs[..., None])[..., 0], single)
 
 
 def joint_angles(q, pelvis_angle_rad) -> np.ndarray:
     """Hip flexion, knee flexion, ankle dorsiflexion (n, 3) in rad from segment angles."""
-    q2, single = _states("q", q, 4)
+    q2, single = finite_rows("q", q, 4)
     pel = np.broadcast_to(np.asarray(pelvis_angle_rad, dtype=float), (len(q2),))
     th = np.stack([pel - q2[:, 1], q2[:, 2] - q2[:, 1], q2[:, 2] - q2[:, 3]], axis=-1)
     return _out(th, single)
@@ -376,7 +339,7 @@ def joint_angles(q, pelvis_angle_rad) -> np.ndarray:
 
 def segment_coordinates(joint_angles_rad, pelvis_angle_rad, pelvis_x_m) -> np.ndarray:
     """Inverse of :func:`joint_angles`: q (n, 4) from joint angles, pelvis angle and cart x."""
-    th, single = _states("joint_angles_rad", joint_angles_rad, 3)
+    th, single = finite_rows("joint_angles_rad", joint_angles_rad, 3)
     n = len(th)
     pel = np.broadcast_to(np.asarray(pelvis_angle_rad, dtype=float), (n,))
     x = np.broadcast_to(np.asarray(pelvis_x_m, dtype=float), (n,))
@@ -388,7 +351,7 @@ def segment_coordinates(joint_angles_rad, pelvis_angle_rad, pelvis_x_m) -> np.nd
 
 def generalized_joint_forces(torques_nm) -> np.ndarray:
     """Generalised forces (n, 4) of hip, knee, ankle joint torques (n, 3) in N m."""
-    T, single = _states("torques_nm", torques_nm, 3)
+    T, single = finite_rows("torques_nm", torques_nm, 3)
     u = np.stack([np.zeros(len(T)), -T[:, 0] - T[:, 1], T[:, 1] + T[:, 2], -T[:, 2]], axis=-1)
     return _out(u, single)
 
@@ -427,9 +390,9 @@ def simulate(
     if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise LoperInputError("time_s must be a finite, strictly increasing 1-D array of >= 2 samples")
     n = len(t)
-    x0, _ = _states("q0", q0, 4)
-    v0, _ = _states("qd0", qd0, 4)
-    uff = np.zeros((n, 4)) if u_ff is None else _states("u_ff", u_ff, 4)[0]
+    x0, _ = finite_rows("q0", q0, 4)
+    v0, _ = finite_rows("qd0", qd0, 4)
+    uff = np.zeros((n, 4)) if u_ff is None else finite_rows("u_ff", u_ff, 4)[0]
     F = _force(force_n, n)
     _same_rows(("time_s", t[:, None]), ("u_ff", uff), ("force_n", F))
 
@@ -437,7 +400,7 @@ def simulate(
         if value is None:
             return np.zeros((n, width))
         a = np.asarray(value, dtype=float)
-        a2, _ = _states(name, a.reshape(n, width) if a.ndim == 1 and width == 1 else a, width)
+        a2, _ = finite_rows(name, a.reshape(n, width) if a.ndim == 1 and width == 1 else a, width)
         _same_rows(("time_s", t[:, None]), (name, a2))
         return a2
 
@@ -449,17 +412,16 @@ def simulate(
         p = np.asarray(impedance, dtype=float)
         if p.shape != (6,) or not np.all(np.isfinite(p)):
             raise LoperInputError(f"impedance must be 6 finite values (K, D per joint), got {p}")
-    sv = params.packed
+    packed = params.packed
     M = np.empty((4, 4))
     h = np.empty(4)
     Ja = np.empty((2, 4))
-    scratch = np.empty((4, 4))
     inputs = np.hstack([uff, F, pel, peld, th_ref, thd_ref])
 
     def rhs(time, y):
         q, qd = y[:4], y[4:]
         z = _interp_columns(time, t, inputs)
-        _kernels.terms(q, qd, sv, M, h, Ja, scratch)
+        kernels.terms(q, qd, packed, M, h, Ja)
         r = h + z[:4] + Ja.T @ z[4:6]
         if impedance is not None:
             pel_t, peld_t = z[6], z[7]

@@ -1,4 +1,4 @@
-"""Zero-phase low-pass filtering of markers and forces (DESIGN.md section 4)."""
+"""Zero-phase low-pass filtering of markers and forces (``docs/processing.md``, the filter)."""
 
 from __future__ import annotations
 

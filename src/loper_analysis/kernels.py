@@ -5,16 +5,16 @@ Everything here works on a packed parameter vector (see
 it once (``cache=True``) and the Python layer in :mod:`loper_analysis.dynamics`
 and :mod:`loper_analysis.identification` stays readable.
 
-Packed segment vector ``sv`` (length 18)::
+Packed segment vector ``packed`` (length :data:`N_PACKED`)::
 
-    sv[0]            cart mass (kg)
-    sv[1 + 5 i + 0]  mass of segment i (kg), i = 0 thigh, 1 shank, 2 foot
-    sv[1 + 5 i + 1]  inertia about the COM (kg m^2)
-    sv[1 + 5 i + 2]  length (m): proximal joint -> distal joint along -y
-    sv[1 + 5 i + 3]  COM x in the segment frame (m)
-    sv[1 + 5 i + 4]  COM y in the segment frame (m)
-    sv[16]           rod attachment distance from the hip along the thigh (m)
-    sv[17]           gravity (m/s^2)
+    packed[CART_MASS]                  cart mass (kg)
+    packed[segment_slot(i) + 0]        mass of segment i (kg), i = 0 thigh, 1 shank, 2 foot
+    packed[segment_slot(i) + 1]        inertia about the COM (kg m^2)
+    packed[segment_slot(i) + 2]        length (m): proximal joint -> distal joint along -y
+    packed[segment_slot(i) + 3]        COM x in the segment frame (m)
+    packed[segment_slot(i) + 4]        COM y in the segment frame (m)
+    packed[ATTACHMENT]                 rod attachment distance from the hip along the thigh (m)
+    packed[GRAVITY]                    gravity (m/s^2)
 
 Segment frame: origin at the proximal joint, x forward and y up when the
 segment angle is zero (segment hanging). The global angle q_i is positive when
@@ -27,24 +27,47 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+__all__ = [
+    "N_COORD",
+    "N_PACKED",
+    "CART_MASS",
+    "ATTACHMENT",
+    "GRAVITY",
+    "segment_slot",
+    "terms",
+    "solve4",
+    "terms_batch",
+    "feedback_torques",
+    "simulate_deviation_batch",
+]
+
 N_COORD = 4
+#: Length of the packed parameter vector and the index of its scalar entries.
 N_PACKED = 18
+CART_MASS = 0
+ATTACHMENT = 16
+GRAVITY = 17
+
+
+def segment_slot(i: int) -> int:
+    """Index of segment ``i``'s first entry (its mass) in the packed vector; 5 entries per segment."""
+    return 1 + 5 * i
 
 
 @njit(cache=True, inline="always")
-def terms(q, qd, sv, M, h, Ja, scratch):
+def terms(q, qd, packed, M, h, Ja):
     """Fill M (4x4), h = G - C (4,) and the attachment Jacobian Ja (2x4) in place.
 
     Closed form for the cart + three segments, unrolled so that the hot loop
     stays in registers. For segment i the COM Jacobian column of an earlier
     segment j is a_j = dR(q_j) (0, -L_j) = (-L_j c_j, L_j s_j), its own column
     b_i = dR(q_i) (rx_i, ry_i); the velocity-product acceleration is
-    -sum R(-q_j) v_j q_j'^2. ``scratch`` is unused (kept for a stable signature).
+    -sum R(-q_j) v_j q_j'^2.
     """
-    g = sv[17]
-    m1, I1, L1, x1, y1 = sv[1], sv[2], sv[3], sv[4], sv[5]
-    m2, I2, L2, x2, y2 = sv[6], sv[7], sv[8], sv[9], sv[10]
-    m3, I3, x3, y3 = sv[11], sv[12], sv[14], sv[15]
+    g = packed[GRAVITY]
+    m1, I1, L1, x1, y1 = packed[1], packed[2], packed[3], packed[4], packed[5]
+    m2, I2, L2, x2, y2 = packed[6], packed[7], packed[8], packed[9], packed[10]
+    m3, I3, x3, y3 = packed[11], packed[12], packed[14], packed[15]
     c1 = np.cos(q[1])
     s1 = np.sin(q[1])
     c2 = np.cos(q[2])
@@ -79,7 +102,7 @@ def terms(q, qd, sv, M, h, Ja, scratch):
     f3x = m3 * acc3x
     f3y = m3 * (-g + acc3y)
     m23 = m2 + m3
-    M[0, 0] = sv[0] + m1 + m23
+    M[0, 0] = packed[CART_MASS] + m1 + m23
     M[0, 1] = m1 * b1x + m23 * a1x
     M[0, 2] = m2 * b2x + m3 * a2x
     M[0, 3] = m3 * b3x
@@ -100,7 +123,7 @@ def terms(q, qd, sv, M, h, Ja, scratch):
     h[1] = b1x * f1x + b1y * f1y + a1x * (f2x + f3x) + a1y * (f2y + f3y)
     h[2] = b2x * f2x + b2y * f2y + a2x * f3x + a2y * f3y
     h[3] = b3x * f3x + b3y * f3y
-    d = sv[16]
+    d = packed[ATTACHMENT]
     Ja[0, 0] = 1.0
     Ja[1, 0] = 0.0
     Ja[0, 1] = -d * c1
@@ -137,15 +160,14 @@ def solve4(M, r, out):
 
 
 @njit(cache=True)
-def terms_batch(q, qd, sv):
+def terms_batch(q, qd, packed):
     """M (n,4,4), h (n,4), Ja (n,2,4) for n states."""
     n = q.shape[0]
     M = np.empty((n, 4, 4))
     h = np.empty((n, 4))
     Ja = np.empty((n, 2, 4))
-    scratch = np.empty((4, 4))
     for k in range(n):
-        terms(q[k], qd[k], sv, M[k], h[k], Ja[k], scratch)
+        terms(q[k], qd[k], packed, M[k], h[k], Ja[k])
     return M, h, Ja
 
 
@@ -169,14 +191,14 @@ def feedback_torques(e, ed, dpel, dpeld, p, T):
 
 
 @njit(cache=True, inline="always")
-def _deviation_rhs(k, e, ed, p, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, qdd, scratch):
-    """Acceleration of the deviation e = q - q_ref at stage index k (fills qdd)."""
-    q = scratch[4]
-    qd = scratch[5]
+def _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, qdd, state):
+    """Acceleration of the deviation e = q - q_ref at stage index k (fills qdd; ``state`` (2, 4) is work space)."""
+    q = state[0]
+    qd = state[1]
     for a in range(4):
         q[a] = ref_q[k, a] + e[a]
         qd[a] = ref_qd[k, a] + ed[a]
-    terms(q, qd, sv, M, h, Ja, scratch)
+    terms(q, qd, packed, M, h, Ja)
     feedback_torques(e, ed, dpel[k, 0], dpel[k, 1], p, T)
     rhs[0] = h[0] + w[k, 0] + Ja[0, 0] * fp[k, 0] + Ja[1, 0] * fp[k, 1]
     rhs[1] = h[1] + w[k, 1] - T[0] - T[1] + Ja[0, 1] * fp[k, 0] + Ja[1, 1] * fp[k, 1]
@@ -188,7 +210,7 @@ def _deviation_rhs(k, e, ed, p, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, J
 
 
 @njit(cache=True)
-def simulate_deviation_batch(P, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0, ed0, dt, n_sub, n_out):
+def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0, ed0, dt, n_sub, n_out):
     """RK4 of the deviation dynamics for a batch of parameter sets.
 
     The model trajectory is q = q_ref + e with
@@ -219,7 +241,7 @@ def simulate_deviation_batch(P, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0, ed0
     k4 = np.empty(4)
     v2 = np.empty(4)
     v3 = np.empty(4)
-    scratch = np.empty((6, 4))
+    state = np.empty((2, 4))
     for b in range(B):
         p = P[b]
         for a in range(4):
@@ -231,23 +253,23 @@ def simulate_deviation_batch(P, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0, ed0
         for o in range(1, n_out):
             for _ in range(n_sub):
                 k = 2 * st
-                _deviation_rhs(k, e, ed, p, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k1, scratch)
+                _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k1, state)
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * ed[a]
                     edt[a] = ed[a] + 0.5 * dt * k1[a]
-                _deviation_rhs(k + 1, et, edt, p, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k2, scratch)
+                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k2, state)
                 for a in range(4):
                     v2[a] = edt[a]
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * v2[a]
                     edt[a] = ed[a] + 0.5 * dt * k2[a]
-                _deviation_rhs(k + 1, et, edt, p, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k3, scratch)
+                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k3, state)
                 for a in range(4):
                     v3[a] = edt[a]
                 for a in range(4):
                     et[a] = e[a] + dt * v3[a]
                     edt[a] = ed[a] + dt * k3[a]
-                _deviation_rhs(k + 2, et, edt, p, sv, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k4, scratch)
+                _deviation_rhs(k + 2, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k4, state)
                 for a in range(4):
                     e[a] += dt / 6.0 * (ed[a] + 2.0 * v2[a] + 2.0 * v3[a] + edt[a])
                     ed[a] += dt / 6.0 * (k1[a] + 2.0 * k2[a] + 2.0 * k3[a] + k4[a])

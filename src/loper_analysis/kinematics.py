@@ -2,36 +2,36 @@
 
 One ``InverseKinematicsSolver`` is reused for all frames (far faster than
 ``InverseKinematicsTool`` per call); markers enter as a ``TimeSeriesTableVec3``
-in metres with its ``Units`` metadata set (PITFALLS.md). Missing (NaN) markers
-are dropped by OpenSim in that frame. Coordinate tasks (e.g. locking a
-coordinate at its default) are honoured.
+in metres with its ``Units`` metadata set (OpenSim assumes metres when the
+metadata is missing). Missing (NaN) markers are dropped by OpenSim in that
+frame. Coordinate tasks (e.g. locking a coordinate at its default) are
+honoured. Models are ``opensim.Model`` objects (:func:`loper_analysis.io.osim.read_model`).
 
 Task specification: ``marker_weights`` {marker: weight} and
 ``coordinate_tasks`` {coordinate: (weight, value or None)} where ``None``
 means the coordinate's default value. Without marker weights every model
-marker present in the data gets weight 1. :func:`read_ik_tasks` reads an
-OpenSim IK task-set XML or a TSV (``name``, ``kind`` = marker|coordinate,
-``weight``, optional ``value``).
+marker present in the data gets weight 1. :func:`loper_analysis.io.ik_tasks.read_ik_tasks`
+reads them from an OpenSim IK task-set XML or a TSV.
 """
 
 from __future__ import annotations
 
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from .errors import LoperInputError
-from .model import quiet_opensim
+from .io.osim import quiet_opensim
 
 __all__ = [
     "IKResult",
     "marker_positions",
     "markers_table",
     "inverse_kinematics",
-    "read_ik_tasks",
+    "ik_task_weights",
     "chunk_frames",
     "join_chunks",
     "DEFAULT_COORDINATE_MAP",
@@ -57,17 +57,8 @@ class IKResult:
         ]
 
 
-def _load(model):
-    osim = quiet_opensim()
-    if isinstance(model, (str, Path)):
-        if not Path(model).is_file():
-            raise LoperInputError(f"model file not found: {model}")
-        model = osim.Model(str(model))
-    return osim, model
-
-
 def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_names=None) -> np.ndarray:
-    """Ground positions (n, n_markers, 3) in m of markers for coordinate trajectories (rad or m).
+    """Ground positions (n, n_markers, 3) in m of an ``opensim.Model``'s markers for coordinate trajectories (rad or m).
 
     ``coordinate_values`` maps coordinate names to trajectories of one common
     length n, or of length 1 (held for every frame); coordinates not given
@@ -79,7 +70,6 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
     LoperInputError
         An unknown coordinate or marker, or trajectories of unequal lengths.
     """
-    osim, model = _load(model)
     state = model.initSystem()
     cs = model.getCoordinateSet()
     names = [cs.get(i).getName() for i in range(cs.getSize())]
@@ -135,7 +125,7 @@ def inverse_kinematics(
     coordinate_tasks: dict[str, tuple[float, float | None]] | None = None,
     accuracy: float = 1e-8,
 ) -> IKResult:
-    """OpenSim IK of marker trajectories (m) with one reused solver.
+    """OpenSim IK of marker trajectories (m) with one reused solver on an ``opensim.Model``.
 
     Raises
     ------
@@ -143,7 +133,7 @@ def inverse_kinematics(
         A weighted marker missing from the model or from the data, a
         coordinate task on an unknown coordinate, no model marker in the data.
     """
-    osim, model = _load(model)
+    osim = quiet_opensim()
     labels = list(labels)
     t = np.asarray(time_s, float)
     if t.ndim != 1 or t.size < 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
@@ -205,6 +195,39 @@ def inverse_kinematics(
     return IKResult(time_s=t, coordinates=Q[:, perm], coordinate_names=names, marker_rms_m=rms, marker_max_m=mx)
 
 
+def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: float = 1.0,
+                    marker_weights: Mapping[str, float] | None = None,
+                    coordinate_tasks: Mapping[str, Mapping] | None = None, source: str = ""):
+    """Marker weights and coordinate tasks of one trial.
+
+    ``tasks`` is ``(marker_weights, coordinate_tasks)`` as read from an IK task
+    file (:func:`loper_analysis.io.ik_tasks.read_ik_tasks`); without it every
+    marker of ``model`` gets ``marker_weights.get(marker, default_weight)`` and
+    ``coordinate_tasks`` (``{coordinate: {"weight": w, "value": rad or None}}``)
+    are taken as given. A weighted model marker absent from the trial's
+    ``labels`` is an error naming it and ``source``.
+
+    Returns
+    -------
+    (dict, dict)
+        ``{marker: weight}`` and ``{coordinate: (weight, value or None)}``.
+    """
+    if tasks is not None:
+        weights, coords = tasks
+    else:
+        ms = model.getMarkerSet()
+        names = [ms.get(i).getName() for i in range(ms.getSize())]
+        extra = sorted(set(marker_weights or {}) - set(names))
+        if extra:
+            raise LoperInputError(f"opensim.marker_weights: marker(s) {extra} are not in model {model.getName()}")
+        weights = {m: float((marker_weights or {}).get(m, default_weight)) for m in names}
+        coords = {c: (float(v["weight"]), v.get("value")) for c, v in (coordinate_tasks or {}).items()}
+    missing = [m for m, w in weights.items() if w > 0 and m not in labels]
+    if missing:
+        raise LoperInputError(f"{source}: marker(s) {missing} of the model's marker set are missing from the file")
+    return weights, coords
+
+
 def _q_order(model, state, cs) -> np.ndarray:
     """Index into the state's Q of each coordinate of the coordinate set (found by setting distinct values)."""
     probe = model.initSystem() if state is None else state.__class__(state)
@@ -216,62 +239,6 @@ def _q_order(model, state, cs) -> np.ndarray:
     if len(set(perm.tolist())) != cs.getSize() or not np.allclose(q[perm], values):
         raise LoperInputError(f"model {model.getName()}: coordinates do not map one to one onto the state's Q")
     return perm
-
-
-def read_ik_tasks(path) -> tuple[dict[str, float], dict[str, tuple[float, float | None]]]:
-    """Marker weights and coordinate tasks from an OpenSim IK task-set XML or a TSV.
-
-    TSV columns: ``name``, ``kind`` (marker | coordinate), ``weight`` and
-    optional ``value`` (coordinate tasks; empty = the default value). Tasks with
-    ``apply`` false in the XML are skipped; XML coordinate tasks with value type
-    ``manual_value`` use their value, ``default_value`` the model default.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise LoperInputError(f"IK task file not found: {path}")
-    markers: dict[str, float] = {}
-    coords: dict[str, tuple[float, float | None]] = {}
-    if path.suffix.lower() == ".xml":
-        osim = quiet_opensim()
-        try:
-            ts = osim.IKTaskSet(str(path))
-        except Exception as exc:
-            raise LoperInputError(f"{path}: not an OpenSim IK task set ({exc})") from exc
-        if ts.getSize() == 0:
-            raise LoperInputError(f"{path}: the IK task set holds no task")
-        for i in range(ts.getSize()):
-            task = ts.get(i)
-            if not task.getApply():
-                continue
-            if task.getConcreteClassName() == "IKMarkerTask":
-                markers[task.getName()] = task.getWeight()
-            else:
-                ct = osim.IKCoordinateTask.safeDownCast(task)
-                vt = ct.getValueType()
-                if vt == osim.IKCoordinateTask.FromFile:
-                    raise LoperInputError(f"{path}: coordinate task {task.getName()} takes its value from a file; not supported")
-                value = ct.getValue() if vt == osim.IKCoordinateTask.ManualValue else None
-                coords[task.getName()] = (task.getWeight(), value)
-        return markers, coords
-    try:
-        df = pd.read_csv(path, sep="\t")
-    except (OSError, pd.errors.ParserError, pd.errors.EmptyDataError) as exc:
-        raise LoperInputError(f"{path}: cannot read IK task table ({exc})") from exc
-    need = {"name", "kind", "weight"}
-    if not need <= set(df.columns):
-        raise LoperInputError(f"{path}: missing column(s) {sorted(need - set(df.columns))}")
-    for row_no, r in enumerate(df.itertuples(index=False), start=1):
-        w = pd.to_numeric(pd.Series([r.weight]), errors="coerce").iloc[0]
-        if pd.isna(w) or w < 0:
-            raise LoperInputError(f"{path}: row {row_no}, column weight: {r.weight!r} is not a weight >= 0")
-        if r.kind == "marker":
-            markers[str(r.name)] = float(w)
-        elif r.kind == "coordinate":
-            value = getattr(r, "value", np.nan) if "value" in df.columns else np.nan
-            coords[str(r.name)] = (float(w), None if pd.isna(value) else float(value))
-        else:
-            raise LoperInputError(f"{path}: row {row_no}, column kind: {r.kind!r} is not 'marker' or 'coordinate'")
-    return markers, coords
 
 
 def chunk_frames(n_frames: int, n_chunks: int, chunk: int) -> slice:
@@ -312,7 +279,7 @@ def join_chunks(frames: list[pd.DataFrame], sources: list[str] | None = None) ->
     return pd.concat(frames, ignore_index=True)
 
 
-#: Our angle columns (swing-leg convention, DESIGN.md section 4) -> (model coordinate, sign) for the generic model.
+#: Our angle columns (the convention of :mod:`loper_analysis.constants`) -> (model coordinate, sign) for the generic model.
 #: ``pelvis_angle`` is the swing-leg model's theta_pelvis (= -pelvis_tilt of the OpenSim model).
 DEFAULT_COORDINATE_MAP: dict[str, tuple[str, float]] = {
     "pelvis_x": ("pelvis_tx", 1.0),

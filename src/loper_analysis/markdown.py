@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from pathlib import Path
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 
-__all__ = ["markdown_table", "write_markdown"]
+__all__ = ["markdown_table", "markdown_document"]
 
 
 def _cell(value) -> str:
@@ -25,15 +24,14 @@ def markdown_table(frame: pd.DataFrame) -> str:
     return "\n".join([header, rule, *rows]) + "\n"
 
 
-def write_markdown(sections: Mapping[str, str | Path], out_md, title: str = "loper-analysis: result tables") -> None:
-    """One Markdown file with a section per table: ``{heading: tsv_path}``; an empty TSV says so."""
+def markdown_document(sections: Sequence[tuple[str, str, pd.DataFrame]],
+                      title: str = "loper-analysis: result tables") -> str:
+    """One Markdown document with a section per table: ``(heading, where the table lives, table)``.
+
+    A table without columns is shown as ``(empty)``.
+    """
     parts = [f"# {title}\n"]
-    for heading, path in sections.items():
-        text = Path(path).read_text()
-        frame = pd.read_csv(path, sep="\t") if text.strip() else pd.DataFrame()
+    for heading, where, frame in sections:
         body = markdown_table(frame) if len(frame.columns) else "(empty)\n"
-        parts.append(f"## {heading}\n\n`{path}`\n\n{body}")
-    out = Path(out_md)
-    tmp = out.with_name(f".{out.name}.partial")
-    tmp.write_text("\n".join(parts))
-    tmp.replace(out)
+        parts.append(f"## {heading}\n\n`{where}`\n\n{body}")
+    return "\n".join(parts)

@@ -1,11 +1,11 @@
 """The generic sagittal-plane lower-body OpenSim model and the segment table it yields.
 
-Built with the OpenSim API (no CustomJoint, which crashed from Python in
-older versions; PITFALLS.md):
+Built with the OpenSim API (no CustomJoint, which crashed when built from
+Python in older OpenSim versions):
 
 * ``pelvis`` on a ``PlanarJoint`` (``pelvis_tilt`` about Z, ``pelvis_tx``,
   ``pelvis_ty``); it carries head, arms and trunk (HAT) as one mass.
-* per side ``s`` in {r, l}: ``thigh_s``, ``shank_s``, ``foot_s`` on
+* per side (suffix ``s`` in {r, l}): ``thigh_s``, ``shank_s``, ``foot_s`` on
   ``PinJoint``s about Z with coordinates ``hip_flexion_s``, ``knee_flexion_s``,
   ``ankle_dorsiflexion_s``, all positive in flexion / dorsiflexion (the knee
   joint frames are turned half a turn about Y so that knee flexion is
@@ -16,10 +16,9 @@ older versions; PITFALLS.md):
   angles are the coordinates themselves (checked against OpenSim's body
   positions in ``tests/test_model.py``).
 
-Segment masses, lengths, COM and radii of gyration follow D. A. Winter,
-*Biomechanics and Motor Control of Human Movement*, 4th ed., Wiley 2009,
-Table 4.1 (the same numbers as
-:func:`loper_analysis.dynamics.segment_parameters_from_anthropometry`).
+Segment masses, lengths, COM and radii of gyration follow Winter's table
+(:mod:`loper_analysis.anthropometry`), as do
+:func:`loper_analysis.dynamics.segment_parameters_from_anthropometry`.
 
 The marker set is close to a 32-marker Qualisys lower-body set: pelvis
 (RASI, LASI, RPSI, LPSI) and per leg greater trochanter, a 4-marker thigh
@@ -31,29 +30,41 @@ direction and whose midpoint the rod attachment.
 
 from __future__ import annotations
 
-import os
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .anthropometry import (
+    ANKLE_HEIGHT_FRACTION,
+    HAT_COM_FRACTION,
+    HAT_GYRATION_FRACTION,
+    HEEL_BEHIND_ANKLE_FRACTION,
+    HIP_HALF_WIDTH_FRACTION,
+    HIP_TO_SHOULDER_FRACTION,
+    PELVIS_DEPTH_FRACTION,
+    WINTER_SEGMENTS,
+)
+from .checks import where
+from .constants import SEGMENTS, SIDE_SUFFIX
 from .errors import LoperInputError
+from .io.osim import quiet_opensim
 
 if TYPE_CHECKING:  # the dynamics (numba kernels) load only when a segment table is made
     from .dynamics import SegmentParameters
 
 __all__ = [
-    "SIDES",
     "MARKERS",
     "BRACE_MARKERS",
     "COORDINATES",
+    "SCALE_MEASUREMENTS",
+    "model_dimensions",
     "build_lower_body_model",
     "segment_parameters_from_model",
-    "quiet_opensim",
-    "scale_model",
+    "static_marker_problem",
 ]
 
-SIDES = ("r", "l")
+#: OpenSim side suffixes in the order the model builds the legs (right leg first).
+_LEGS = (SIDE_SUFFIX["right"], SIDE_SUFFIX["left"])
 BRACE_MARKERS = ("LBRA_P", "LBRA_D")
 COORDINATES = (
     "pelvis_tilt", "pelvis_tx", "pelvis_ty",
@@ -62,32 +73,30 @@ COORDINATES = (
 )
 
 
-def quiet_opensim():
-    """Import opensim with logging at 'error' and no opensim.log file; returns the module."""
-    import opensim
+def model_dimensions(height_m: float, mass_kg: float) -> dict:
+    """Masses (kg) and lengths (m) of the generic model for a subject (Winter's table).
 
-    opensim.Logger.setLevelString("error")
-    opensim.Logger.removeFileSink()
-    return opensim
-
-
-def _anthropometry(height_m: float, mass_kg: float) -> dict:
+    ``segments``: per segment ``mass``, ``length`` and the fractions ``com``
+    and ``k`` (radius of gyration) of its length; ``pelvis_mass`` (pelvis
+    with head, arms and trunk), ``hat_com_height``, ``hat_k``,
+    ``hip_half_width``, ``pelvis_depth``, ``ankle_height``.
+    """
     H, M = height_m, mass_kg
     seg = {
-        "thigh": dict(mass=0.100 * M, length=0.245 * H, com=0.433, k=0.323),
-        "shank": dict(mass=0.0465 * M, length=0.246 * H, com=0.433, k=0.302),
-        "foot": dict(mass=0.0145 * M, length=0.152 * H, com=0.5, k=0.475),
+        s: dict(mass=WINTER_SEGMENTS[s].mass * M, length=WINTER_SEGMENTS[s].length * H,
+                com=WINTER_SEGMENTS[s].com, k=WINTER_SEGMENTS[s].gyration)
+        for s in SEGMENTS
     }
     leg = sum(s["mass"] for s in seg.values())
     pelvis_hat = M - 2 * leg
     return {
         "segments": seg,
         "pelvis_mass": pelvis_hat,
-        "hat_com_height": 0.626 * 0.288 * H,  # Winter: HAT COM 0.626 of the hip-shoulder length (0.288 H)
-        "hat_k": 0.496 * 0.288 * H,
-        "hip_half_width": 0.05 * H,
-        "pelvis_depth": 0.075 * H,
-        "ankle_height": 0.039 * H,
+        "hat_com_height": HAT_COM_FRACTION * HIP_TO_SHOULDER_FRACTION * H,
+        "hat_k": HAT_GYRATION_FRACTION * HIP_TO_SHOULDER_FRACTION * H,
+        "hip_half_width": HIP_HALF_WIDTH_FRACTION * H,
+        "pelvis_depth": PELVIS_DEPTH_FRACTION * H,
+        "ankle_height": ANKLE_HEIGHT_FRACTION * H,
     }
 
 
@@ -102,7 +111,7 @@ def _marker_table(a: dict) -> list[tuple[str, str, tuple[float, float, float]]]:
         ("RPSI", "pelvis", (-0.4 * d, 0.11, 0.35 * w)),
         ("LPSI", "pelvis", (-0.4 * d, 0.11, -0.35 * w)),
     ]
-    for side in SIDES:
+    for side in _LEGS:
         S = side.upper()
         z = 1.0 if side == "r" else -1.0  # lateral direction of this leg
         out += [
@@ -118,7 +127,7 @@ def _marker_table(a: dict) -> list[tuple[str, str, tuple[float, float, float]]]:
             (f"{S}TIB_AI", f"shank_{side}", (0.035, -0.6 * Ls, z * 0.045)),
             (f"{S}ANK", f"shank_{side}", (0.0, -Ls, z * 0.035)),
             (f"{S}ANM", f"shank_{side}", (0.0, -Ls, -z * 0.035)),
-            (f"{S}HEE", f"foot_{side}", (-0.2 * Lf, -0.6 * ah, 0.0)),
+            (f"{S}HEE", f"foot_{side}", (-HEEL_BEHIND_ANKLE_FRACTION * Lf, -0.6 * ah, 0.0)),
             (f"{S}MT1", f"foot_{side}", (0.75 * Lf, -ah, -z * 0.035)),
             (f"{S}MT5", f"foot_{side}", (0.65 * Lf, -ah, z * 0.035)),
         ]
@@ -130,20 +139,17 @@ def _marker_table(a: dict) -> list[tuple[str, str, tuple[float, float, float]]]:
 
 
 #: Marker names of the default model, in model order.
-MARKERS: tuple[str, ...] = tuple(name for name, _, _ in _marker_table(_anthropometry(1.75, 70.0)))
+MARKERS: tuple[str, ...] = tuple(name for name, _, _ in _marker_table(model_dimensions(1.75, 70.0)))
 
 
-def build_lower_body_model(height_m: float, mass_kg: float, out_path: str | Path | None = None, name: str = "loper_lower_body"):
-    """Build the generic model for a subject of this height and mass; optionally print it to ``out_path`` (.osim).
-
-    Returns the ``opensim.Model`` (system initialised).
-    """
+def build_lower_body_model(height_m: float, mass_kg: float, name: str = "loper_lower_body"):
+    """The generic model for a subject of this height and mass, an ``opensim.Model`` (system initialised)."""
     if not 1.0 <= height_m <= 2.5:
         raise LoperInputError(f"height_m must lie in 1 .. 2.5 m, got {height_m}")
     if not 0 < mass_kg <= 300:
         raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
     osim = quiet_opensim()
-    a = _anthropometry(float(height_m), float(mass_kg))
+    a = model_dimensions(float(height_m), float(mass_kg))
     model = osim.Model()
     model.setName(name)
     model.setGravity(osim.Vec3(0, -9.81, 0))
@@ -162,7 +168,7 @@ def build_lower_body_model(height_m: float, mass_kg: float, out_path: str | Path
     leg_height = a["segments"]["thigh"]["length"] + a["segments"]["shank"]["length"] + a["ankle_height"]
     pj.upd_coordinates(2).setDefaultValue(leg_height)
 
-    for side in SIDES:
+    for side in _LEGS:
         z = 1.0 if side == "r" else -1.0
         parent = pelvis
         parent_offset = osim.Vec3(0, 0, z * a["hip_half_width"])
@@ -174,7 +180,7 @@ def build_lower_body_model(height_m: float, mass_kg: float, out_path: str | Path
             p = a["segments"][seg]
             m, L = p["mass"], p["length"]
             if seg == "foot":
-                com = osim.Vec3((p["com"] - 0.2) * L, -0.5 * a["ankle_height"], 0)
+                com = osim.Vec3((p["com"] - HEEL_BEHIND_ANKLE_FRACTION) * L, -0.5 * a["ankle_height"], 0)
             else:
                 com = osim.Vec3(0, -p["com"] * L, 0)
             k = p["k"] * L
@@ -190,13 +196,11 @@ def build_lower_body_model(height_m: float, mass_kg: float, out_path: str | Path
         model.addMarker(osim.Marker(mname, model.getBodySet().get(body), osim.Vec3(*loc)))
     model.finalizeConnections()
     model.initSystem()
-    if out_path is not None:
-        model.printToXML(str(out_path))
     return model
 
 
-def segment_parameters_from_model(model_or_path, side: str = "l", brace_markers=BRACE_MARKERS) -> SegmentParameters:
-    """Swing-leg segment table from an OpenSim model built by :func:`build_lower_body_model` (or scaled from it).
+def segment_parameters_from_model(model, side: str = "l", brace_markers=BRACE_MARKERS) -> SegmentParameters:
+    """Swing-leg segment table from an ``opensim.Model`` built by :func:`build_lower_body_model` (or scaled from it).
 
     Masses, COM (x, y in the body frame) and the inertia about Z come from the
     bodies ``thigh_{side}``, ``shank_{side}``, ``foot_{side}``; lengths from the
@@ -206,12 +210,6 @@ def segment_parameters_from_model(model_or_path, side: str = "l", brace_markers=
     """
     from .dynamics import SegmentParameters
 
-    osim = quiet_opensim()
-    model = model_or_path
-    if isinstance(model_or_path, (str, Path)):
-        if not Path(model_or_path).is_file():
-            raise LoperInputError(f"model file not found: {model_or_path}")
-        model = osim.Model(str(model_or_path))
     model.initSystem()
     bodies = model.getBodySet()
     names = [bodies.get(i).getName() for i in range(bodies.getSize())]
@@ -266,84 +264,41 @@ def _foot_length(model, side: str) -> float:
 
 #: Marker pairs whose distances scale each body (ScaleTool "measurements").
 SCALE_MEASUREMENTS: dict[str, list[tuple[str, str]]] = {
-    **{f"thigh_{s}": [(f"{s.upper()}GTR", f"{s.upper()}KNE")] for s in SIDES},
-    **{f"shank_{s}": [(f"{s.upper()}KNE", f"{s.upper()}ANK")] for s in SIDES},
-    **{f"foot_{s}": [(f"{s.upper()}HEE", f"{s.upper()}MT1")] for s in SIDES},
+    **{f"thigh_{s}": [(f"{s.upper()}GTR", f"{s.upper()}KNE")] for s in _LEGS},
+    **{f"shank_{s}": [(f"{s.upper()}KNE", f"{s.upper()}ANK")] for s in _LEGS},
+    **{f"foot_{s}": [(f"{s.upper()}HEE", f"{s.upper()}MT1")] for s in _LEGS},
     "pelvis": [("RASI", "LASI"), ("RASI", "RPSI"), ("LASI", "LPSI")],
 }
 
 
-def scale_model(generic_osim, static_trc, mass_kg: float, out_osim, time_range_s: tuple[float, float] | None = None):
-    """Personalise the generic model with OpenSim's ScaleTool from a static trial (TRC).
+def static_marker_problem(time_s, markers_m, labels, time_range_s: tuple[float, float] | None = None,
+                          source: str = "") -> None:
+    """Refuse a static trial that OpenSim's ScaleTool cannot use: a measurement marker absent, or missing (NaN).
 
-    Each body is scaled uniformly by the ratio of the marker-pair distances in
-    the static trial to those of the model (:data:`SCALE_MEASUREMENTS`); the
-    mass distribution is preserved at ``mass_kg``. The static markers must be
-    complete (ScaleTool crashes on NaN, PITFALLS.md): the first missing marker
-    is named. Writes ``out_osim``; returns it as a Path.
+    ``time_s`` (n,), ``markers_m`` (n, n_markers, 3) in m, ``labels`` their
+    names; only frames inside ``time_range_s`` (s, default all) count.
+    ScaleTool crashes on NaN markers, so the first missing marker is named
+    with its frame.
+
+    Raises
+    ------
+    LoperInputError
+        A marker of :data:`SCALE_MEASUREMENTS` absent from ``labels`` or NaN in a frame.
     """
-    osim = quiet_opensim()
-    generic_osim, static_trc, out_osim = Path(generic_osim), Path(static_trc), Path(out_osim)
-    for path in (generic_osim, static_trc):
-        if not path.is_file():
-            raise LoperInputError(f"file not found: {path}")
-    if not 0 < mass_kg <= 300:
-        raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
-    table = osim.TimeSeriesTableVec3(str(static_trc))
-    labels = list(table.getColumnLabels())
-    times = np.array(table.getIndependentColumn())
+    labels = list(labels)
+    times = np.asarray(time_s, dtype=float)
+    X = np.asarray(markers_m, dtype=float)
     t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
     needed = sorted({m for pairs in SCALE_MEASUREMENTS.values() for pair in pairs for m in pair})
     missing = [m for m in needed if m not in labels]
     if missing:
-        raise LoperInputError(f"{static_trc}: static trial lacks marker(s) {missing} needed for scaling")
-    flat_table = table.flatten(osim.StdVectorString(["_x", "_y", "_z"]))  # keep the temporaries alive
-    matrix = flat_table.getMatrix()
-    flat = np.array(matrix.to_numpy(), copy=True)
+        raise LoperInputError(f"{where(source)}static trial lacks marker(s) {missing} needed for scaling")
     sel = (times >= t0 - 1e-9) & (times <= t1 + 1e-9)
     for j, lab in enumerate(labels):
         if lab in needed:
-            bad = np.flatnonzero(~np.all(np.isfinite(flat[:, 3 * j : 3 * j + 3]), axis=1) & sel)
+            bad = np.flatnonzero(~np.all(np.isfinite(X[:, j]), axis=1) & sel)
             if bad.size:
                 raise LoperInputError(
-                    f"{static_trc}: marker {lab} is missing at frame {bad[0]} (t = {times[bad[0]]:.3f} s) of the "
+                    f"{where(source)}marker {lab} is missing at frame {bad[0]} (t = {times[bad[0]]:.3f} s) of the "
                     "static trial; fill the gap or choose another time range"
                 )
-    tool = osim.ScaleTool()
-    tool.setSubjectMass(float(mass_kg))
-    tool.getGenericModelMaker().setModelFileName(str(generic_osim))
-    scaler = tool.getModelScaler()
-    scaler.setApply(True)
-    order = osim.ArrayStr()
-    order.append("measurements")
-    scaler.setScalingOrder(order)
-    scaler.setMarkerFileName(str(static_trc))
-    tr = osim.ArrayDouble()
-    tr.append(float(t0))
-    tr.append(float(t1))
-    scaler.setTimeRange(tr)
-    scaler.setPreserveMassDist(True)
-    measurements = scaler.getMeasurementSet()
-    for body, pairs in SCALE_MEASUREMENTS.items():
-        m = osim.Measurement()
-        m.setName(body)
-        m.setApply(True)
-        for a, b in pairs:
-            m.getMarkerPairSet().cloneAndAppend(osim.MarkerPair(a, b))
-        scale = osim.BodyScale()
-        scale.setName(body)
-        axes = osim.ArrayStr()
-        for axis in "XYZ":
-            axes.append(axis)
-        scale.setAxisNames(axes)
-        m.getBodyScaleSet().cloneAndAppend(scale)
-        measurements.cloneAndAppend(m)
-    tmp = out_osim.with_name(f".{out_osim.name}.partial.osim")
-    tmp.unlink(missing_ok=True)
-    scaler.setOutputModelFileName(str(tmp))
-    tool.getMarkerPlacer().setApply(False)
-    tool.run()  # returns False when the marker placer is off, even after a good scaling: check the file
-    if not tmp.is_file():
-        raise LoperInputError(f"OpenSim ScaleTool failed for {static_trc} with {generic_osim}")
-    os.replace(tmp, out_osim)
-    return out_osim

@@ -1,49 +1,47 @@
-"""Transparency of LOPER in minimal-impedance mode (DESIGN.md section 4 "Transparency").
+"""Transparency of LOPER in minimal-impedance mode (``docs/processing.md``, transparency).
 
 Walking with the device is compared with walking without it:
 
-* :func:`force_phase_metrics` - RMS and peak interaction force per stride and
-  phase (stance, swing);
 * :func:`mean_sd`, :func:`rmsd`, :func:`within_subject_sd`, :func:`isv_ave` -
   the statistics of time-normalised joint angles;
 * :func:`transparency_table` - RMSD between the mean trajectories with and
   without the device per subject, phase and joint, against the averaged
   inter-stride variability ISV_ave = (2 / n_subjects) · Σ σ_subject; the
   device counts as transparent where RMSD < ISV_ave;
-* :func:`plot_transparency` - the study's figure (force and joint angles over
-  the gait cycle, mean ± SD, with and without the device).
+* :func:`transparency_results` - all of it for the pipeline's stride and
+  cycle tables, with the study's values beside ours.
 
+The study's figure is :func:`loper_analysis.figures.transparency.transparency_figure`.
 Angles are in rad, forces in N, time in s. Normalised arrays have shape
-(n_strides, n_points[, n_joints]) as produced by :func:`loper_analysis.gait.cut`.
+(n_strides, n_points[, n_joints]) as produced by :func:`loper_analysis.resampling.cut`.
 """
 
 from __future__ import annotations
 
-import io
-import os
-import secrets
-from pathlib import Path
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from .constants import JOINTS
+from .constants import JOINTS, angle_column
 from .errors import LoperInputError
+from .reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
+from .strides import phase_cycles
 
 __all__ = [
     "CONDITIONS",
     "TRANSPARENCY_PHASES",
+    "strides_array",
     "TRANSPARENCY_COLUMNS",
-    "STUDY_TRANSPARENCY_RAD",
-    "force_phase_metrics",
     "mean_sd",
     "rmsd",
     "within_subject_sd",
     "isv_ave",
     "mean_toe_off_pct",
     "transparency_table",
-    "plot_transparency",
+    "TransparencyResults",
+    "transparency_results",
 ]
 
 #: Walking conditions of the transparency experiment.
@@ -55,24 +53,9 @@ TRANSPARENCY_COLUMNS: tuple[str, ...] = (
     "subject", "phase", "joint", "n_strides_no_device", "n_strides_device",
     "rmsd_rad", "sd_rad", "isv_ave_rad", "transparent",
 )
-#: The study's values (DESIGN.md section 4): (phase, joint) -> (RMSD, ISV_ave), in rad.
-STUDY_TRANSPARENCY_RAD: dict[tuple[str, str], tuple[float, float]] = {
-    ("stance", "hip"): (0.024, 0.040),
-    ("stance", "knee"): (0.032, 0.062),
-    ("stance", "ankle"): (0.017, 0.040),
-    ("swing", "hip"): (0.035, 0.059),
-    ("swing", "knee"): (0.071, 0.129),
-    ("swing", "ankle"): (0.035, 0.064),
-}
 
-_PHASE_BOUNDS = {"stance": ("heel_strike_s", "toe_off_s"), "swing": ("toe_off_s", "end_s")}
-
-
-def _where(source: str) -> str:
-    return f"{source}: " if source else ""
-
-
-def _strides_array(name: str, normalised, min_strides: int = 2) -> np.ndarray:
+def strides_array(name: str, normalised, min_strides: int = 2) -> np.ndarray:
+    """Normalised strides (n_strides >= ``min_strides``, n_points[, k]), finite; ``name`` is quoted in errors."""
     x = np.asarray(normalised, dtype=float)
     if x.ndim not in (2, 3):
         raise LoperInputError(f"{name} must have shape (n_strides, n_points[, k]), got {x.shape}")
@@ -84,96 +67,6 @@ def _strides_array(name: str, normalised, min_strides: int = 2) -> np.ndarray:
     return x
 
 
-# --------------------------------------------------------------------------- interaction force
-
-
-def force_phase_metrics(time_s, force_n, stride_table: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """RMS and largest absolute interaction force per stride and phase.
-
-    The phases are half-open sample sets: stance = samples with
-    ``heel_strike_s <= t < toe_off_s``, swing = ``toe_off_s <= t < end_s``,
-    so every sample belongs to at most one phase. RMS is the root of the mean
-    square over those samples (equal weights: uniform sampling assumed).
-    ``time_s`` and the stride table must share one clock (synchronised
-    robot log and treadmill).
-
-    Parameters
-    ----------
-    time_s : array_like, shape (n_samples,)
-        Times of the force samples in s, finite and strictly increasing.
-    force_n : array_like, shape (n_samples,)
-        Interaction force in N, finite.
-    stride_table : pandas.DataFrame
-        Columns ``stride``, ``heel_strike_s``, ``toe_off_s``, ``end_s``
-        (:func:`loper_analysis.gait.strides`); every phase must lie inside
-        ``time_s[0] .. time_s[-1]`` and hold at least one sample.
-    source : str
-        Name of the trial, quoted in error messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per stride and phase (stride order, stance before swing):
-        ``stride``, ``phase`` (``stance`` | ``swing``), ``rms_force_n``,
-        ``max_abs_force_n`` (N).
-
-    Raises
-    ------
-    LoperInputError
-        Bad shapes, non-finite or non-increasing input, missing columns, a
-        phase outside the data or without samples.
-    """
-    t = np.asarray(time_s, dtype=float)
-    f = np.asarray(force_n, dtype=float)
-    if t.ndim != 1 or f.shape != t.shape or t.size < 2:
-        raise LoperInputError(
-            f"{_where(source)}time_s {t.shape} and force_n {f.shape} must be 1-D of equal length >= 2"
-        )
-    for name, a in (("time_s", t), ("force_n", f)):
-        bad = np.flatnonzero(~np.isfinite(a))
-        if bad.size:
-            raise LoperInputError(f"{_where(source)}{name} is not finite at sample {bad[0]}: {a[bad[0]]}")
-    if np.any(np.diff(t) <= 0):
-        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
-        raise LoperInputError(f"{_where(source)}time_s must increase strictly; sample {i} does not")
-    needed = {"stride", "heel_strike_s", "toe_off_s", "end_s"}
-    if not needed <= set(stride_table.columns):
-        raise LoperInputError(
-            f"{_where(source)}stride_table lacks column(s) {sorted(needed - set(stride_table.columns))}"
-        )
-    square = np.concatenate([[0.0], np.cumsum(f * f)])
-    absf = np.abs(f)
-    rms, peak = [], []
-    for phase in TRANSPARENCY_PHASES:
-        a = stride_table[_PHASE_BOUNDS[phase][0]].to_numpy(float)
-        b = stride_table[_PHASE_BOUNDS[phase][1]].to_numpy(float)
-        out = np.flatnonzero(~((a >= t[0]) & (b <= t[-1]) & (a < b)))
-        if out.size:
-            r = out[0]
-            raise LoperInputError(
-                f"{_where(source)}stride {stride_table['stride'].iloc[r]} {phase} "
-                f"({float(a[r])!r} .. {float(b[r])!r} s) "
-                f"is empty or outside the force data ({float(t[0])!r} .. {float(t[-1])!r} s)"
-            )
-        lo = np.searchsorted(t, a, side="left")
-        hi = np.searchsorted(t, b, side="left")
-        empty = np.flatnonzero(hi <= lo)
-        if empty.size:
-            r = empty[0]
-            raise LoperInputError(
-                f"{_where(source)}stride {stride_table['stride'].iloc[r]} {phase} holds no force sample"
-            )
-        rms.append(np.sqrt((square[hi] - square[lo]) / (hi - lo)))
-        peak.append(np.array([absf[i:j].max() for i, j in zip(lo, hi)]))  # a loop per stride, not per sample
-    n_phases = len(TRANSPARENCY_PHASES)
-    return pd.DataFrame({
-        "stride": np.repeat(stride_table["stride"].to_numpy(), n_phases),
-        "phase": np.tile(TRANSPARENCY_PHASES, len(stride_table)),
-        "rms_force_n": np.column_stack(rms).ravel(),
-        "max_abs_force_n": np.column_stack(peak).ravel(),
-    })
-
-
 # --------------------------------------------------------------------------- statistics
 
 
@@ -183,7 +76,7 @@ def mean_sd(normalised) -> tuple[np.ndarray, np.ndarray]:
     ``normalised`` has shape (n_strides, n_points[, k]) with >= 2 finite
     strides; returns two arrays of shape (n_points[, k]) in the input's unit.
     """
-    x = _strides_array("normalised", normalised)
+    x = strides_array("normalised", normalised)
     return x.mean(axis=0), x.std(axis=0, ddof=1)
 
 
@@ -265,7 +158,7 @@ def _subject_arrays(per_subject: Mapping, phases: Sequence[str], k: int):
             arrays = {}
             for condition in CONDITIONS:
                 name = f"subject {subject}, {condition}, {phase}"
-                x = _strides_array(name, conditions[condition][phase])
+                x = strides_array(name, conditions[condition][phase])
                 if x.ndim != 3 or x.shape[2] != k:
                     raise LoperInputError(f"{name}: shape must be (n_strides, n_points, {k}), got {x.shape}")
                 arrays[condition] = x
@@ -297,7 +190,7 @@ def transparency_table(
     per_subject : mapping
         ``{subject: {"device" | "no_device": {"stance" | "swing": array}}}``;
         each array has shape (n_strides >= 2, n_points, n_joints) in rad,
-        phase-normalised (:func:`loper_analysis.gait.normalise`); the two
+        phase-normalised (:func:`loper_analysis.resampling.normalise`); the two
         conditions of a subject and phase share ``n_points``.
     joints : sequence of str
         Names of the last axis, in order.
@@ -373,128 +266,74 @@ def transparency_table(
     return out
 
 
-# --------------------------------------------------------------------------- figure
+# --------------------------------------------------------------------------- the pipeline's tables
 
 
-def _pyplot():
-    import matplotlib
+@dataclass
+class TransparencyResults:
+    """Transparency of a group of subjects (:func:`transparency_results`).
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
-def _save_png_atomic(fig, out_png: Path) -> None:
-    """Render to memory, write a temporary file beside ``out_png`` (mode honours the umask), rename it over."""
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=110, metadata={"Software": None})
-    tmp = out_png.with_name(f".{out_png.name}.{secrets.token_hex(6)}.tmp")
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(buffer.getvalue())
-        os.replace(tmp, out_png)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
-def plot_transparency(
-    out_png,
-    angles_rad: Mapping[str, np.ndarray],
-    force_n=None,
-    toe_off_pct: float | Mapping[str, float] | None = None,
-    joints: Sequence[str] = JOINTS,
-    title: str | None = None,
-) -> None:
-    """The transparency figure: interaction force and joint angles over the gait cycle.
-
-    Panels top to bottom: interaction force (device only), then one panel per
-    joint; each curve is the mean across strides with ±1 SD shaded, against
-    0-100 % of the stride. Angles are drawn in degrees (converted here).
-    Dashed vertical lines mark the mean toe-off of each condition. Written
-    atomically as PNG.
-
-    Parameters
-    ----------
-    out_png : path
-        Output file; its directory must exist.
-    angles_rad : mapping
-        ``{"no_device" | "device": array (n_strides >= 2, n_points, n_joints)}``,
-        stride-normalised joint angles in rad (either condition may be absent,
-        not both).
-    force_n : array_like, shape (n_strides >= 2, n_points), optional
-        Stride-normalised interaction force in N (device condition).
-    toe_off_pct : float or mapping, optional
-        Mean toe-off in % of the stride (:func:`mean_toe_off_pct`), one value
-        or one per condition.
-    joints : sequence of str
-        Names of the joint axis.
-    title : str, optional
-        Figure title.
+    ``rmsd``: :func:`transparency_table` with the study's ``study_rmsd_rad``
+    and ``study_isv_ave_rad``; ``force``: per subject and phase the mean and
+    SD over kept strides of the RMS and max |F| (N), summary rows ``all``
+    (mean and SD over subjects) and the study's values; for the figure the
+    kept stride-normalised angles pooled over subjects per condition
+    (``angles_rad``), the interaction force with the device (``force_n``)
+    and the mean toe-off per condition (``toe_off_pct``).
     """
-    conditions = [c for c in CONDITIONS if c in angles_rad]
-    if not conditions or set(angles_rad) - set(CONDITIONS):
-        raise LoperInputError(f"angles_rad must map some of {CONDITIONS} to arrays, got {sorted(angles_rad)}")
-    joints = [str(j) for j in joints]
-    data = {}
-    for c in conditions:
-        x = _strides_array(f"angles_rad[{c!r}]", angles_rad[c])
-        if x.ndim != 3 or x.shape[2] != len(joints):
-            raise LoperInputError(
-                f"angles_rad[{c!r}] must have shape (n_strides, n_points, {len(joints)}), got {x.shape}"
-            )
-        data[c] = x
-    force = None if force_n is None else _strides_array("force_n", force_n)
-    if force is not None and force.ndim != 2:
-        raise LoperInputError(f"force_n must have shape (n_strides, n_points), got {force.shape}")
-    if isinstance(toe_off_pct, Mapping):
-        toe_off = {c: float(v) for c, v in toe_off_pct.items() if c in conditions}
-    elif toe_off_pct is not None:
-        toe_off = {c: float(toe_off_pct) for c in conditions}
-    else:
-        toe_off = {}
-    out_png = Path(out_png)
-    if not out_png.parent.is_dir():
-        raise LoperInputError(f"out_png: directory {out_png.parent} does not exist")
 
-    plt = _pyplot()
-    colors = {"no_device": "0.35", "device": "tab:blue"}
-    labels = {"no_device": "without device", "device": "with device"}
-    n_panels = len(joints) + (force is not None)
-    fig, axes = plt.subplots(n_panels, 1, figsize=(5.5, 2.0 * n_panels + 0.6), sharex=True,
-                             constrained_layout=True, squeeze=False)
-    axes = axes[:, 0]
+    rmsd: pd.DataFrame
+    force: pd.DataFrame
+    angles_rad: dict[str, np.ndarray]
+    force_n: np.ndarray | None
+    toe_off_pct: dict[str, float]
 
-    def band(ax, x, color, label):
-        m, s = x.mean(axis=0), x.std(axis=0, ddof=1)
-        pct = np.linspace(0.0, 100.0, m.size)
-        ax.plot(pct, m, color=color, lw=1.5, label=label)
-        ax.fill_between(pct, m - s, m + s, color=color, alpha=0.25, lw=0)
 
-    panel = 0
-    if force is not None:
-        band(axes[0], force, colors["device"], f"{labels['device']} (n = {force.shape[0]})")
-        axes[0].axhline(0, color="0.6", lw=0.8)
-        axes[0].set_ylabel("interaction force (N)")
-        panel = 1
-    for j, joint in enumerate(joints):
-        ax = axes[panel + j]
-        for c in conditions:
-            band(ax, np.degrees(data[c][:, :, j]), colors[c], f"{labels[c]} (n = {data[c].shape[0]})")
-        ax.set_ylabel(f"{joint} angle (deg)")
-    for ax in axes:
-        for c, pct in toe_off.items():
-            ax.axvline(pct, color=colors[c], ls="--", lw=1)
-    axes[panel].legend(frameon=False, fontsize=8)
-    if force is not None:
-        axes[0].legend(frameon=False, fontsize=8)
-    axes[-1].set_xlim(0, 100)
-    axes[-1].set_xlabel("gait cycle (%)  -  dashed: mean toe-off")
-    if title:
-        fig.suptitle(title)
-    try:
-        _save_png_atomic(fig, out_png)
-    finally:
-        plt.close(fig)
+def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, pd.DataFrame]]],
+                         side: str = "left") -> TransparencyResults:
+    """Transparency of the device from each subject's stride and cycle tables with and without it.
+
+    ``trials``: ``{subject: {"no_device": (strides, cycles), "device": (strides, cycles)}}``,
+    the tables of :func:`loper_analysis.strides.stride_tables` (kept,
+    unperturbed strides count).
+    """
+    cols = [angle_column(j, side) for j in JOINTS]
+    per_subject, force_rows, pooled, pooled_force, toe_off = {}, [], {"no_device": [], "device": []}, [], {}
+    for subject, conds in trials.items():
+        per_subject[subject] = {}
+        for cond, (strides, cycles) in conds.items():
+            per_subject[subject][cond] = {ph: phase_cycles(cycles, strides, ph, cols) for ph in TRANSPARENCY_PHASES}
+            pooled[cond].append(phase_cycles(cycles, strides, "stride", cols))
+            kept = strides[~strides["removed"]]
+            toe_off.setdefault(cond, []).append(mean_toe_off_pct(kept))
+            if cond == "device":
+                pooled_force.append(phase_cycles(cycles, strides, "stride", ["force_n"])[:, :, 0])
+                for ph in TRANSPARENCY_PHASES:
+                    force_rows.append({
+                        "subject": subject, "phase": ph, "n_strides": len(kept),
+                        "rms_force_mean_n": kept[f"rms_force_{ph}_n"].mean(),
+                        "rms_force_sd_n": kept[f"rms_force_{ph}_n"].std(ddof=1),
+                        "max_abs_force_mean_n": kept[f"max_abs_force_{ph}_n"].mean(),
+                        "max_abs_force_sd_n": kept[f"max_abs_force_{ph}_n"].std(ddof=1),
+                    })
+    rmsd = transparency_table(per_subject, JOINTS)
+    study = pd.DataFrame([{"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}
+                          for (ph, j), (r, isv) in STUDY_TRANSPARENCY_RAD.items()])
+    rmsd = rmsd.merge(study, on=["phase", "joint"], how="left")
+    force = pd.DataFrame(force_rows)
+    if len(force):
+        summary = force.groupby("phase", sort=False).agg(
+            n_strides=("n_strides", "sum"), rms_force_mean_n=("rms_force_mean_n", "mean"),
+            rms_force_sd_n=("rms_force_mean_n", "std"), max_abs_force_mean_n=("max_abs_force_mean_n", "mean"),
+            max_abs_force_sd_n=("max_abs_force_mean_n", "std")).reset_index().assign(subject="all")
+        force = pd.concat([force, summary[force.columns]], ignore_index=True)
+        for i, name in enumerate(("study_rms_force_mean_n", "study_rms_force_sd_n", "study_max_abs_force_mean_n",
+                                  "study_max_abs_force_sd_n")):
+            force[name] = [STUDY_INTERACTION_FORCE_N[ph][i] for ph in force["phase"]]
+    return TransparencyResults(
+        rmsd=rmsd,
+        force=force,
+        angles_rad={c: np.concatenate(v) for c, v in pooled.items() if v},
+        force_n=np.concatenate(pooled_force) if pooled_force else None,
+        toe_off_pct={c: float(np.mean(v)) for c, v in toe_off.items()},
+    )

@@ -1,4 +1,4 @@
-"""The synthetic validation study of the identification (DESIGN.md section 5).
+"""The synthetic validation study of the identification (``docs/validation.md``).
 
 For every combination of K in {0, 75, 150} and D in {0, 2, 4} per joint
 (3^6 = 729) a representative subject's swing leg is perturbed by a 40 N,
@@ -26,7 +26,9 @@ from .identification import (
     DEFAULT_UPPER,
     identify_impedance,
     prepare_window,
+    simulate_deviation,
 )
+from .reference import STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
 
 __all__ = [
     "ValidationSettings",
@@ -38,11 +40,7 @@ __all__ = [
     "run_validation_chunk",
     "summarize_errors",
     "CONDITIONS",
-    "STUDY_NOISE_ERRORS",
-    "write_tsv",
-    "validation_chunk_tables",
     "gather_validation_tables",
-    "plot_validation_errors",
     "with_study_values",
 ]
 
@@ -51,7 +49,7 @@ CONDITIONS: tuple[str, ...] = ("no_noise", "noise")
 
 @dataclass(frozen=True)
 class ValidationSettings:
-    """Settings of the validation study (SI units), defaults as in DESIGN.md."""
+    """Settings of the validation study (SI units); the defaults are the study's design."""
 
     stiffness_levels_nm_per_rad: tuple[float, ...] = (0.0, 75.0, 150.0)
     damping_levels_nms_per_rad: tuple[float, ...] = (0.0, 2.0, 4.0)
@@ -154,15 +152,9 @@ def perturbed_trial(params: SegmentParameters, impedance, settings: ValidationSe
         window_after_s=t[-1] - settings.onset_s,
         n_substeps=settings.truth_substeps,
     )
-    from . import _kernels
-
-    E, _ = _kernels.simulate_deviation_batch(
-        np.asarray(impedance, dtype=float)[None], params.packed, window.ref_q, window.ref_qd, window.ref_qdd,
-        window.w, window.force_p, window.dpelvis, window.e0, window.ed0, window.dt_s, window.n_substeps,
-        window.n_samples,
-    )
+    deviation = simulate_deviation(window, np.asarray(impedance, dtype=float)[None])
     qp = qu.copy()
-    qp[n - window.n_samples :] += E[0]
+    qp[n - window.n_samples :] += deviation[0]
     return t, qu, qp, fp, pelvis
 
 
@@ -208,7 +200,7 @@ def run_validation_chunk(
     Returns ``errors`` (one row per combination x condition x parameter:
     condition, combination, parameter, true, estimate, error, ci95_low,
     ci95_high) and ``fits`` (one row per combination x condition: VAF per
-    joint, cost, starts at best, simulations, success, message).
+    joint, cost (rad^2), starts, starts at the best cost, simulations, success, message).
     """
     grid = impedance_grid(settings.stiffness_levels_nm_per_rad, settings.damping_levels_nms_per_rad)
     err_rows, fit_rows = [], []
@@ -283,98 +275,41 @@ def summarize_errors(errors: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
-# ---------------------------------------------------------------- file-level steps (called by rules)
+def gather_validation_tables(error_chunks, fit_chunks) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """Concatenate the chunks' error and fit tables (sorted by condition, combination) and summarise them.
 
-_FLOAT_FORMAT = "%.15g"
-
-
-def write_tsv(frame: pd.DataFrame, path) -> None:
-    """Write a tidy TSV with a fixed float format (same data -> same bytes)."""
-    frame.to_csv(path, sep="\t", index=False, float_format=_FLOAT_FORMAT, na_rep="")
-
-
-def validation_chunk_tables(
-    segments_tsv, settings: ValidationSettings, chunk: int, n_chunks: int, errors_out, fits_out
-) -> None:
-    """Run one chunk of the validation study and write its two tables."""
-    params = SegmentParameters.from_tsv(segments_tsv)
-    grid_size = len(settings.stiffness_levels_nm_per_rad) ** 3 * len(settings.damping_levels_nms_per_rad) ** 3
-    combos = chunk_combinations(grid_size, n_chunks, chunk)
-    errors, fits = run_validation_chunk(params, settings, combos)
-    write_tsv(errors, errors_out)
-    write_tsv(fits, fits_out)
-
-
-def gather_validation_tables(error_tsvs, fit_tsvs, errors_out, fits_out, summary_out) -> pd.DataFrame:
-    """Concatenate chunk tables (sorted by condition, combination) and write the summary."""
+    Returns ``errors``, ``fits`` and the summary (:func:`summarize_errors` with the study's values).
+    """
     cond = {c: i for i, c in enumerate(CONDITIONS)}
     par = {p: i for i, p in enumerate(PARAMETERS)}
 
-    def load(paths, keys):
-        frames = [pd.read_csv(p, sep="\t") for p in paths]
-        df = pd.concat(frames, ignore_index=True)
+    def gather(frames, keys):
+        df = pd.concat(list(frames), ignore_index=True)
         return df.sort_values(keys, key=lambda s: s.map(cond) if s.name == "condition" else (
             s.map(par) if s.name == "parameter" else s)).reset_index(drop=True)
 
-    errors = load(error_tsvs, ["condition", "combination", "parameter"])
-    fits = load(fit_tsvs, ["condition", "combination"])
-    summary = with_study_values(summarize_errors(errors))
-    write_tsv(errors, errors_out)
-    write_tsv(fits, fits_out)
-    write_tsv(summary, summary_out)
-    return summary
-
-
-#: The study's validation table (DESIGN.md section 5): min, max, SD of the error with noise.
-STUDY_NOISE_ERRORS = pd.DataFrame(
-    {
-        "parameter": list(PARAMETERS),
-        "study_min_error": [-6.2, -0.57, -2.5, -0.11, -120.0, -4.0],
-        "study_max_error": [6.5, 0.50, 3.5, 0.19, 120.0, 10.0],
-        "study_sd_error": [15.0, 0.12, 0.53, 0.030, 24.0, 1.5],
-    }
-)
+    errors = gather(error_chunks, ["condition", "combination", "parameter"])
+    fits = gather(fit_chunks, ["condition", "combination"])
+    return errors, fits, with_study_values(summarize_errors(errors))
 
 
 def with_study_values(summary: pd.DataFrame) -> pd.DataFrame:
     """Add the study's min / max / SD of the error beside ours (no SD without noise in the study)."""
-    study = STUDY_NOISE_ERRORS.assign(condition="noise")
+    study = pd.DataFrame(
+        {
+            "parameter": list(PARAMETERS),
+            "study_min_error": [STUDY_VALIDATION_NOISE[p][0] for p in PARAMETERS],
+            "study_max_error": [STUDY_VALIDATION_NOISE[p][1] for p in PARAMETERS],
+            "study_sd_error": [STUDY_VALIDATION_NOISE[p][2] for p in PARAMETERS],
+        }
+    ).assign(condition="noise")
     no_noise = pd.DataFrame(
         {
             "parameter": list(PARAMETERS),
-            "study_min_error": [-0.87, -0.092] * 3,
-            "study_max_error": [0.59, 0.047] * 3,
+            "study_min_error": [STUDY_VALIDATION_NO_NOISE[p[0]][0] for p in PARAMETERS],
+            "study_max_error": [STUDY_VALIDATION_NO_NOISE[p[0]][1] for p in PARAMETERS],
             "study_sd_error": [np.nan] * 6,
             "condition": "no_noise",
         }
     )
     return summary.merge(pd.concat([no_noise, study]), on=["condition", "parameter"], how="left")
-
-
-def plot_validation_errors(errors_tsv, out_png) -> None:
-    """Box plots of the estimation error per parameter, without and with noise."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    errors = pd.read_csv(errors_tsv, sep="\t")
-    fig, axes = plt.subplots(2, 6, figsize=(13, 5.5), constrained_layout=True)
-    for r, condition in enumerate(CONDITIONS):
-        sub = errors[errors.condition == condition]
-        for c, name in enumerate(PARAMETERS):
-            ax = axes[r, c]
-            e = sub.loc[sub.parameter == name, "error"].to_numpy()
-            if e.size:
-                ax.boxplot(e, widths=0.6, showfliers=True, flierprops={"markersize": 2})
-            ax.axhline(0, color="0.6", lw=0.8)
-            ax.set_xticks([])
-            if r == 0:
-                ax.set_title(name.replace("_", " "))
-            if c == 0:
-                ax.set_ylabel(f"{condition.replace('_', ' ')}\nerror")
-            unit = "N·m/rad" if name.startswith("K") else "N·m·s/rad"
-            ax.set_xlabel(unit, fontsize=8)
-    fig.suptitle(f"Validation study: estimate − true over {errors.combination.nunique()} K/D combinations")
-    fig.savefig(out_png, dpi=110, metadata={"Software": None})
-    plt.close(fig)

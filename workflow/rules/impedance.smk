@@ -15,21 +15,28 @@ def null_pair_trials(subject: str) -> list[str]:
 
 
 def fit_inputs(wildcards):
+    """Files of the fit: the onset's trials (angles, strides, force, markers in the order of onset_trials), the
+    null-pair trials (angles, strides in the order of null_pair_trials), the segment table and a synthetic truth."""
     s = wildcards.subject
     out = {"segments": f"results/model/{s}/segments.tsv"}
     if SUBJECT_SOURCE[s] == "synthetic":
         out["truth"] = f"data/raw/{s}/truth.yaml"
     own = onset_trials(s, wildcards.onset)
-    for t in own:
-        out[f"angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
-        out[f"strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
-        out[f"force_{t}"] = f"results/loadcell/{s}/{t}.force.tsv"
-        out[f"markers_{t}"] = f"results/markers/{s}/{t}.trc"
-    if IDENT["noise_model"] == "null_pairs" and own:  # a missing onset is reported without any input
-        for t in [t for t in null_pair_trials(s) if t not in own]:  # the onset's own trials are inputs already
-            out[f"null_angles_{t}"] = f"results/ik/{s}/{t}.angles.tsv"
-            out[f"null_strides_{t}"] = f"results/strides/{s}/{t}.strides.tsv"
+    out["angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in own]
+    out["strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in own]
+    out["force"] = [f"results/loadcell/{s}/{t}.force.tsv" for t in own]
+    out["markers"] = [f"results/markers/{s}/{t}.trc" for t in own]
+    null = fit_null_trials(s, wildcards.onset)
+    out["null_angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in null]
+    out["null_strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in null]
     return out
+
+
+def fit_null_trials(subject: str, onset: str) -> list[str]:
+    """Null-pair trials of a fit: none for a white-noise fit or a missing onset (reported without any input)."""
+    if IDENT["noise_model"] != "null_pairs" or not onset_trials(subject, onset):
+        return []
+    return null_pair_trials(subject)
 
 
 rule impedance_fit:
@@ -44,25 +51,27 @@ rule impedance_fit:
         onset=r"[0-9]{3}",
     params:
         trials=lambda wc: onset_trials(wc.subject, wc.onset),
-        null_trials=lambda wc: null_pair_trials(wc.subject) if IDENT["noise_model"] == "null_pairs" else [],
-        settings=dict(
+        null_trials=lambda wc: fit_null_trials(wc.subject, wc.onset),
+        response=dict(
             window_before_s=IDENT["window_before_s"],
             window_after_s=IDENT["window_after_s"],
             initial_state_span_s=IDENT["initial_state_span_s"],
+            whisker=config["strides"]["iqr_whisker"],
+            max_fraction=config["strides"]["max_outlier_fraction"],
+            min_strides=config["strides"]["min_valid_strides"],
+        ),
+        identification=dict(
+            noise_model=IDENT["noise_model"],
+            null_pair_components=IDENT["null_pair_components"],
+            min_null_pairs=IDENT["min_null_pairs"],
             initial_state_degree=IDENT["initial_state_degree"],
             n_starts=IDENT["n_starts"],
             n_substeps=IDENT["n_substeps"],
             tolerance=IDENT["tolerance"],
             merge_tolerance=IDENT["merge_tolerance"],
-            stiffness_bounds=IDENT["stiffness_bounds_nm_per_rad"],
-            damping_bounds=IDENT["damping_bounds_nms_per_rad"],
-            whisker=config["strides"]["iqr_whisker"],
-            max_fraction=config["strides"]["max_outlier_fraction"],
-            min_strides=config["strides"]["min_valid_strides"],
+            stiffness_bounds_nm_per_rad=IDENT["stiffness_bounds_nm_per_rad"],
+            damping_bounds_nms_per_rad=IDENT["damping_bounds_nms_per_rad"],
             max_ci_fraction=IDENT["max_ci_fraction"],
-            noise_model=IDENT["noise_model"],
-            null_pair_components=IDENT["null_pair_components"],
-            min_null_pairs=IDENT["min_null_pairs"],
             seed=config["seed"],
         ),
     log:
@@ -113,8 +122,8 @@ rule impedance_summary:
 
 rule impedance_figures:
     input:
-        responses=lambda wc: {int(o): f"results/responses/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]}.values(),
-        curves=lambda wc: {int(o): f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]}.values(),
+        responses=lambda wc: [f"results/responses/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]],
+        curves=lambda wc: [f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]],
     output:
         responses=report(
             "results/figures/{subject}/responses.png",

@@ -1,18 +1,5 @@
-import zlib
+from loper_analysis.steps import device, rule_log
 
-from _logging import setup
-
-from loper_analysis.device.controller import DeviceParameters, FreeLeg
-from loper_analysis.device.files import write_device_trial
-from loper_analysis.device.trials import DeviceTestSettings
-
-log = setup(snakemake.log[0])
-p = snakemake.params
-tests = dict(p.tests, step_amplitudes_n=tuple(p.tests["step_amplitudes_n"]))
-seed = [p.seed, zlib.crc32(snakemake.wildcards.subject.encode()), zlib.crc32(snakemake.wildcards.trial.encode())]
-events = write_device_trial(
-    snakemake.output[0], snakemake.wildcards.trial, DeviceParameters(**p.device), FreeLeg(**p.leg),
-    DeviceTestSettings(**tests), seed,
-)
-log.info("wrote %s (seed %s)", snakemake.output[0], seed)
-log.info("safety state changes (time_s, state, name):\n%s", events.to_string(index=False))
+p, wc = snakemake.params, snakemake.wildcards
+with rule_log(snakemake.log[0]):
+    device.device_trial(snakemake.output[0], wc.subject, wc.trial, p.device, p.leg, p.tests, p.seed)

@@ -1,8 +1,5 @@
-from _logging import setup
+from loper_analysis.steps import ik, rule_log
 
-from loper_analysis.processing import ik_trial
-
-log = setup(snakemake.log[0])
 p, out = snakemake.params, snakemake.output
-angles = ik_trial(snakemake.input.model, snakemake.input.trc, out.mot, out.angles, p.coordinate_map, **p.settings)
-log.info("%d frames, %s", len(angles), list(angles.columns))
+with rule_log(snakemake.log[0]):
+    ik.ik_trial(snakemake.input.model, snakemake.input.trc, out.mot, out.angles, p.coordinate_map, **p.settings)

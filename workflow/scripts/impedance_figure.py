@@ -1,7 +1,4 @@
-from _logging import setup
+from loper_analysis.steps import impedance, rule_log
 
-from loper_analysis.figures import plot_impedance
-
-log = setup(snakemake.log[0])
-mean = plot_impedance(snakemake.input[0], snakemake.output[0])
-log.info("across-subject mean:\n%s", mean.to_string())
+with rule_log(snakemake.log[0]):
+    impedance.impedance_figure(snakemake.input[0], snakemake.output[0])

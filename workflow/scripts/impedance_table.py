@@ -1,9 +1,4 @@
-import pandas as pd
-from _logging import setup
+from loper_analysis.steps import impedance, rule_log
 
-from loper_analysis.processing import write_tsv
-
-log = setup(snakemake.log[0])
-table = pd.concat([pd.read_csv(f, sep="\t") for f in snakemake.input], ignore_index=True)
-write_tsv(table, snakemake.output[0])
-log.info("%d rows, status counts:\n%s", len(table), table.status.value_counts().to_string())
+with rule_log(snakemake.log[0]):
+    impedance.impedance_table(snakemake.input, snakemake.output[0])

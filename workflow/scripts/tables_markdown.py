@@ -1,7 +1,4 @@
-from _logging import setup
+from loper_analysis.steps import report, rule_log
 
-from loper_analysis.tables import write_markdown
-
-log = setup(snakemake.log[0])
-write_markdown(dict(zip(snakemake.params.headings, snakemake.input)), snakemake.output[0])
-log.info("rendered %d tables", len(snakemake.input))
+with rule_log(snakemake.log[0]):
+    report.markdown_tables(dict(zip(snakemake.params.headings, snakemake.input)), snakemake.output[0])

@@ -1,7 +1,4 @@
-from _logging import setup
+from loper_analysis.steps import rule_log, validation
 
-from loper_analysis.validation import plot_validation_errors
-
-log = setup(snakemake.log[0])
-plot_validation_errors(snakemake.input.errors, snakemake.output[0])
-log.info("wrote %s", snakemake.output[0])
+with rule_log(snakemake.log[0]):
+    validation.validation_figure(snakemake.input.errors, snakemake.output[0])

@@ -1,1 +1,1 @@
-"""The LOPER device: controller simulation (:mod:`.controller`) and device-test analysis (:mod:`.analysis`)."""
+"""The LOPER device: controller simulation (:mod:`.controller`), device-test trials (:mod:`.trials`) and their analysis (:mod:`.analysis`)."""

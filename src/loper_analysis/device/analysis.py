@@ -1,4 +1,4 @@
-"""Device-performance analysis of the LOPER force controller (DESIGN.md section 3).
+"""Device-performance analysis of the LOPER force controller (``docs/device.md``).
 
 * Frequency response ``H = S_{Fm,Fd} / S_{Fd,Fd}`` (Welch averaging, Hann
   window), coherence and the -3 dB bandwidth relative to the low-frequency gain.
@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy.signal import csd, coherence, welch
+from scipy.signal import coherence, csd, welch
 
+from ..checks import finite_vector, positive
 from ..errors import LoperInputError
+from ..reference import STUDY_DEVICE
 
 __all__ = [
     "frequency_response",
@@ -24,38 +26,21 @@ __all__ = [
     "step_metrics",
     "step_averages",
     "step_table",
+    "device_summary",
 ]
-
-
-def _signal(name: str, x, min_len: int = 2) -> np.ndarray:
-    a = np.asarray(x, dtype=float)
-    if a.ndim != 1:
-        raise LoperInputError(f"{name} must be 1-D, got shape {a.shape}")
-    if a.size < min_len:
-        raise LoperInputError(f"{name} needs >= {min_len} samples, got {a.size}")
-    bad = np.flatnonzero(~np.isfinite(a))
-    if bad.size:
-        raise LoperInputError(f"{name} is not finite at sample {bad[0]}: {a[bad[0]]}")
-    return a
-
-
-def _rate(sample_rate_hz: float) -> float:
-    if not np.isfinite(sample_rate_hz) or sample_rate_hz <= 0:
-        raise LoperInputError(f"sample_rate_hz must be positive, got {sample_rate_hz}")
-    return float(sample_rate_hz)
 
 
 def frequency_response(
     desired_n, measured_n, sample_rate_hz: float, window_samples: int = 5000, overlap_samples: int = 50
 ) -> pd.DataFrame:
     """FRF from desired to measured force: columns frequency_hz, gain (N/N), phase_deg, coherence."""
-    fs = _rate(sample_rate_hz)
+    fs = positive("sample_rate_hz", sample_rate_hz)
     if int(window_samples) != window_samples or window_samples < 8:
         raise LoperInputError(f"window_samples must be an integer >= 8, got {window_samples}")
     if int(overlap_samples) != overlap_samples or not 0 <= overlap_samples < window_samples:
         raise LoperInputError(f"overlap_samples must lie in 0 .. window_samples - 1, got {overlap_samples}")
-    fd = _signal("desired_n", desired_n, int(window_samples))
-    fm = _signal("measured_n", measured_n, int(window_samples))
+    fd = finite_vector("desired_n", desired_n, min_count=int(window_samples))
+    fm = finite_vector("measured_n", measured_n, min_count=int(window_samples))
     if fd.size != fm.size:
         raise LoperInputError(f"desired_n ({fd.size}) and measured_n ({fm.size}) differ in length")
     kw = dict(fs=fs, window="hann", nperseg=int(window_samples), noverlap=int(overlap_samples), detrend="constant")
@@ -86,14 +71,14 @@ def bandwidth_hz(
     The reference is the mean gain in ``reference_band_hz``; the crossing is
     interpolated linearly in log-frequency (gain in dB).
     """
-    f = _signal("frequency_hz", frequency_hz)
-    g = _signal("gain", gain)
+    f = finite_vector("frequency_hz", frequency_hz)
+    g = finite_vector("gain", gain)
     if f.size != g.size:
         raise LoperInputError(f"frequency_hz ({f.size}) and gain ({g.size}) differ in length")
     lo, hi = reference_band_hz
     keep = np.ones(f.size, bool)
     if min_coherence is not None:
-        c = _signal("coherence", coherence)
+        c = finite_vector("coherence", coherence)
         keep = c >= min_coherence
     band = keep & (f >= lo) & (f <= hi)
     if not band.any():
@@ -117,8 +102,8 @@ def bandwidth_hz(
 
 def step_onsets(desired_n, sample_rate_hz: float, min_step_n: float = 5.0, min_interval_s: float = 0.2) -> np.ndarray:
     """Sample indices of rising edges (>= ``min_step_n`` within one sample) of the desired force."""
-    fs = _rate(sample_rate_hz)
-    fd = _signal("desired_n", desired_n)
+    fs = positive("sample_rate_hz", sample_rate_hz)
+    fd = finite_vector("desired_n", desired_n)
     rise = np.flatnonzero(np.diff(fd) >= min_step_n) + 1
     onsets: list[int] = []
     for i in rise:
@@ -133,9 +118,9 @@ def average_step(
     desired_n, measured_n, sample_rate_hz: float, onsets, before_s: float = 0.05, after_s: float = 0.3
 ) -> pd.DataFrame:
     """Mean (and SD) over repetitions of the responses around ``onsets`` (baseline removed)."""
-    fs = _rate(sample_rate_hz)
-    fd = _signal("desired_n", desired_n)
-    fm = _signal("measured_n", measured_n)
+    fs = positive("sample_rate_hz", sample_rate_hz)
+    fd = finite_vector("desired_n", desired_n)
+    fm = finite_vector("measured_n", measured_n)
     if fd.size != fm.size:
         raise LoperInputError(f"desired_n ({fd.size}) and measured_n ({fm.size}) differ in length")
     nb, na = int(round(before_s * fs)), int(round(after_s * fs))
@@ -174,8 +159,8 @@ def _first_crossing(t: np.ndarray, y: np.ndarray, level: float) -> float:
 
 def step_metrics(time_s, response_n, target_n: float, steady_window_s: tuple[float, float] = (0.15, 0.3)) -> dict:
     """Rise time (10-90 % of steady state, ms), overshoot (%), steady state, peak of one step response."""
-    t = _signal("time_s", time_s)
-    y = _signal("response_n", response_n)
+    t = finite_vector("time_s", time_s)
+    y = finite_vector("response_n", response_n)
     if t.size != y.size:
         raise LoperInputError(f"time_s ({t.size}) and response_n ({y.size}) differ in length")
     w = (t >= steady_window_s[0]) & (t <= steady_window_s[1])
@@ -211,7 +196,7 @@ def step_averages(
     """Averaged step responses per amplitude (columns of :func:`average_step` plus
     ``amplitude_n`` and ``n_repetitions``); every step is matched to the nearest
     amplitude and refused when more than 20 % away from all."""
-    fd = _signal("desired_n", desired_n)
+    fd = finite_vector("desired_n", desired_n)
     onsets = step_onsets(fd, sample_rate_hz, min_step_n=min_step_n)
     heights = fd[onsets] - fd[np.maximum(onsets - 1, 0)]
     amps = np.asarray(amplitudes_n, dtype=float)
@@ -232,23 +217,11 @@ def step_averages(
     return pd.concat(frames, ignore_index=True)
 
 
-def step_table(
-    desired_n,
-    measured_n,
-    sample_rate_hz: float,
-    amplitudes_n: tuple[float, ...] = (20.0, 40.0, 60.0),
-    before_s: float = 0.05,
-    after_s: float = 0.3,
-    steady_window_s: tuple[float, float] = (0.15, 0.3),
-    min_step_n: float = 5.0,
-    averages: pd.DataFrame | None = None,
-) -> pd.DataFrame:
-    """One row per amplitude: amplitude_n, n_repetitions, rise_time_ms, overshoot_pct, steady_state_n, peak_n.
+def step_table(averages: pd.DataFrame, steady_window_s: tuple[float, float] = (0.15, 0.3)) -> pd.DataFrame:
+    """Step metrics (:func:`step_metrics`) of the averaged responses of :func:`step_averages`, one row per amplitude.
 
-    ``averages`` from :func:`step_averages` may be passed to avoid recomputing them.
+    Columns amplitude_n, n_repetitions, rise_time_ms, overshoot_pct, steady_state_n, peak_n.
     """
-    if averages is None:
-        averages = step_averages(desired_n, measured_n, sample_rate_hz, amplitudes_n, before_s, after_s, min_step_n)
     rows = []
     for a, avg in averages.groupby("amplitude_n", sort=True):
         m = step_metrics(avg["time_s"].to_numpy(), avg["measured_n"].to_numpy(), a, steady_window_s)
@@ -260,4 +233,39 @@ def step_table(
             "steady_state_n": m["steady_state_n"],
             "peak_n": m["peak_n"],
         })
+    return pd.DataFrame(rows)
+
+
+def device_summary(frf: pd.DataFrame, steps: pd.DataFrame, reference_band_hz=(0.5, 2.0)) -> pd.DataFrame:
+    """Simulated (or recorded) device figures beside the study's.
+
+    ``frf`` from :func:`frequency_response`, ``steps`` from :func:`step_table`.
+    Columns ``metric, value, study_value, unit, difference_pct``: the -3 dB
+    bandwidth, the mean rise time and overshoot over the amplitudes, the
+    steady state of the 40 N steps, then per amplitude its rise time,
+    overshoot and steady state.
+    """
+    bw = bandwidth_hz(frf["frequency_hz"].to_numpy(), frf["gain"].to_numpy(), reference_band_hz=tuple(reference_band_hz))
+    values = {
+        "bandwidth_hz": bw,
+        "rise_time_ms": float(steps["rise_time_ms"].mean()),
+        "overshoot_pct": float(steps["overshoot_pct"].mean()),
+    }
+    at40 = steps.loc[np.isclose(steps["amplitude_n"], 40.0), "steady_state_n"]
+    values["steady_state_40n_n"] = float(at40.iloc[0]) if len(at40) else np.nan
+    rows = []
+    for metric, (study, unit) in STUDY_DEVICE.items():
+        v = values[metric]
+        rows.append({"metric": metric, "value": v, "study_value": study, "unit": unit,
+                     "difference_pct": 100.0 * (v - study) / study})
+    for _, r in steps.iterrows():
+        a = int(round(r["amplitude_n"]))
+        rows += [
+            {"metric": f"rise_time_ms_at_{a}n", "value": r["rise_time_ms"], "study_value": np.nan, "unit": "ms",
+             "difference_pct": np.nan},
+            {"metric": f"overshoot_pct_at_{a}n", "value": r["overshoot_pct"], "study_value": np.nan, "unit": "%",
+             "difference_pct": np.nan},
+            {"metric": f"steady_state_n_at_{a}n", "value": r["steady_state_n"], "study_value": np.nan, "unit": "N",
+             "difference_pct": np.nan},
+        ]
     return pd.DataFrame(rows)

@@ -1,6 +1,6 @@
 """Time-domain simulation of the admittance-controlled LOPER interacting with a leg.
 
-Block arrangement (DESIGN.md section 3 leaves it open; this is our choice)::
+Block arrangement (the study does not fix it; this is our choice, ``docs/device.md``)::
 
     F_d --H_F--> F_r ----------------------------.
                                                   v

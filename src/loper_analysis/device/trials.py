@@ -1,6 +1,6 @@
 """Device-test trials of a synthetic subject: desired-force profiles and simulated robot logs.
 
-Two trials per subject (DESIGN.md section 2), both with the free-hanging leg:
+Two trials per subject (the study's device tests), both with the free-hanging leg:
 
 * ``device-frf``: broadband desired force (low-pass filtered Gaussian noise)
   for the frequency response;

@@ -1,4 +1,4 @@
-"""C3D motion-capture files: reading and writing with ``ezc3d``.
+"""C3D motion-capture files: reading with ``ezc3d``.
 
 Inside the library markers are in metres, shape (n_frames, n_markers, 3),
 NaN where a marker is missing; analog channels are (n_samples, n_channels)
@@ -24,15 +24,7 @@ Reading (:func:`read_c3d`)
       size and the frame count are checked here against the raw header;
       ezc3d's own exceptions are wrapped.
 
-Writing (:func:`write_c3d`)
-    Float C3D through ezc3d with ``POINT:RATE/LABELS/UNITS`` and
-    ``ANALOG:RATE/LABELS/UNITS`` set explicitly and ``ANALOG:SCALE`` 1,
-    ``OFFSET`` 0, ``GEN_SCALE`` 1, so a round trip is exact to float32. A
-    missing (NaN) point is stored as (0, 0, 0) with residual -1. Writing is
-    atomic (a temporary directory beside the target, then :func:`os.replace`)
-    and deterministic: the same inputs give the same bytes. ezc3d's writer
-    runs in a child Python process, because in-process it breaks OpenSim's
-    vector arguments or is broken by them (:func:`write_c3d`, Notes).
+Writing is :func:`loper_analysis.io.c3d_writer.write_c3d`.
 
 Every problem raises :class:`~loper_analysis.errors.LoperInputError` whose
 message names the file and the field (``GROUP:PARAMETER``) or argument.
@@ -40,15 +32,9 @@ message names the file and the field (``GROUP:PARAMETER``) or argument.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import shutil
 import struct
-import subprocess
-import sys
-import tempfile
-from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -59,18 +45,15 @@ from ..errors import LoperInputError
 __all__ = [
     "LENGTH_UNITS_PER_M",
     "C3DRecording",
+    "rate_ratio",
     "read_c3d",
-    "write_c3d",
 ]
 
 #: Length units accepted in files, as the number of units per metre.
 LENGTH_UNITS_PER_M: dict[str, float] = {"mm": 1000.0, "cm": 100.0, "m": 1.0}
 
-#: Longest label ezc3d can write and read back (longer ones give an unreadable file).
-_MAX_LABEL_CHARS = 255
 #: Relative tolerance of the integer analog/point rate ratio.
 _RATIO_TOLERANCE = 1e-6
-_FLOAT32_MAX = float(np.finfo(np.float32).max)
 
 
 @dataclass
@@ -119,7 +102,7 @@ class C3DRecording:
             )
         if self.analog_rate_hz is None:
             self.analog_rate_hz = float(self.point_rate_hz)
-        ratio = _rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
+        ratio = rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
         if self.analogs is None:
             self.analogs = np.zeros((X.shape[0] * ratio, 0))
         self.analogs = np.asarray(self.analogs, dtype=float)
@@ -134,7 +117,7 @@ class C3DRecording:
     @property
     def samples_per_frame(self) -> int:
         """Analog samples per marker frame (the integer rate ratio)."""
-        return _rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
+        return rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
 
     @property
     def time_s(self) -> np.ndarray:
@@ -168,7 +151,7 @@ class C3DRecording:
 # ---------------------------------------------------------------- helpers
 
 
-def _rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int:
+def rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int:
     """The integer ratio analog/point rate; refuses a non-integer one."""
     ratio = float(analog_rate_hz) / float(point_rate_hz)
     n = round(ratio)
@@ -178,28 +161,6 @@ def _rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int
             f"multiple of POINT:RATE = {point_rate_hz:g} Hz (ratio {ratio:.6g})"
         )
     return int(n)
-
-
-@contextlib.contextmanager
-def _staged_output(path: Path, what: str) -> Iterator[Path]:
-    """Yield a temporary path with ``path``'s name in a fresh directory beside it; on success move it over ``path``.
-
-    Nothing remains beside ``path`` when the body or the move fails. ``what``
-    names the kind of file in error messages.
-    """
-    directory = path.parent
-    if not directory.is_dir():
-        raise LoperInputError(f"{path}: cannot write {what}: directory {directory} does not exist")
-    stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory))
-    try:
-        tmp = stage / path.name
-        yield tmp
-        try:
-            os.replace(tmp, path)
-        except OSError as exc:
-            raise LoperInputError(f"{path}: cannot write {what} ({exc})") from exc
-    finally:
-        shutil.rmtree(stage, ignore_errors=True)
 
 
 def _param(params, group: str, name: str):
@@ -339,7 +300,7 @@ def _analogs_from(c3d, point_rate_hz: float, source: str) -> tuple[float, int, l
     n_channels = analogs.shape[1]
     params = c3d["parameters"]
     rate = _param_float(params, "ANALOG", "RATE", source)
-    ratio = _rate_ratio(point_rate_hz, rate, source)
+    ratio = rate_ratio(point_rate_hz, rate, source)
     labels = _labels_for(params, "ANALOG", n_channels, source)
     units = (_param_strings(params, "ANALOG", "UNITS") + [""] * n_channels)[:n_channels]
     return rate, ratio, labels, units, analogs[0].T.copy()
@@ -402,201 +363,3 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
     )
 
 
-# ---------------------------------------------------------------- writer
-
-
-def _check_labels(labels: Sequence[str], what: str, n: int, source: str) -> list[str]:
-    """Labels as a list: n of them, unique, non-empty str of at most 255 characters without edge blanks."""
-    labels = list(labels)
-    if len(labels) != n:
-        raise LoperInputError(f"{source}: {what} must name {n} item(s), got {len(labels)}")
-    for lab in labels:
-        if not isinstance(lab, str) or not lab or lab != lab.strip() or len(lab) > _MAX_LABEL_CHARS:
-            raise LoperInputError(
-                f"{source}: {what} must be non-empty strings of at most {_MAX_LABEL_CHARS} characters without "
-                f"leading/trailing blanks, got {lab!r}"
-            )
-    duplicated = sorted({lab for lab in labels if labels.count(lab) > 1})
-    if duplicated:
-        raise LoperInputError(f"{source}: {what} duplicated: {', '.join(duplicated)}")
-    return labels
-
-
-def _check_rate(value, what: str, source: str) -> float:
-    try:
-        rate = float(value)
-    except (TypeError, ValueError):
-        raise LoperInputError(f"{source}: {what} must be a positive number, got {value!r}") from None
-    if not math.isfinite(rate) or rate <= 0:
-        raise LoperInputError(f"{source}: {what} must be a positive number, got {value!r}")
-    return rate
-
-
-def _points_for_file(markers_m, units_per_m: float, source: str) -> tuple[np.ndarray, np.ndarray]:
-    """ezc3d points (4, n_markers, n_frames) and residuals (1, n_markers, n_frames); NaN -> 0 with residual -1."""
-    X = np.asarray(markers_m, dtype=float)
-    if X.ndim != 3 or X.shape[2] != 3 or X.shape[0] < 1 or X.shape[1] < 1:
-        raise LoperInputError(f"{source}: markers_m must have shape (n_frames >= 1, n_markers >= 1, 3), got {X.shape}")
-    scaled = X * units_per_m
-    too_big = np.abs(np.nan_to_num(scaled, nan=0.0)) > _FLOAT32_MAX  # inf included; NaN means missing
-    if np.any(too_big):
-        f, m, _ = np.argwhere(too_big)[0]
-        raise LoperInputError(f"{source}: markers_m[{f}, {m}] = {X[f, m]} is not finite in float32")
-    missing = ~np.all(np.isfinite(scaled), axis=2)  # (n_frames, n_markers)
-    scaled[missing] = 0.0
-    points = np.ones((4, X.shape[1], X.shape[0]))
-    points[:3] = np.transpose(scaled, (2, 1, 0))
-    residuals = np.where(missing.T, -1.0, 0.0)[np.newaxis]
-    return points, residuals
-
-
-def _analogs_for_file(analogs, n_channels: int, n_samples: int, source: str) -> np.ndarray:
-    """ezc3d analogs (1, n_channels, n_samples) from (n_samples, n_channels); refuses wrong shapes and non-finite values."""
-    A = np.zeros((n_samples, 0)) if analogs is None else np.asarray(analogs, dtype=float)
-    if A.ndim != 2 or A.shape != (n_samples, n_channels):
-        raise LoperInputError(
-            f"{source}: analogs must have shape (n_frames * samples per frame = {n_samples}, "
-            f"n_channels = {n_channels}), got {A.shape}"
-        )
-    bad = np.isnan(A) | (np.abs(np.nan_to_num(A)) > _FLOAT32_MAX)  # inf included
-    if np.any(bad):
-        k, ch = np.argwhere(bad)[0]
-        raise LoperInputError(f"{source}: analogs[{k}, {ch}] = {A[k, ch]} is not finite in float32")
-    return A.T[np.newaxis]
-
-
-_CHILD_CODE = "import sys; from loper_analysis.io.c3d import _write_payload; _write_payload(sys.argv[1], sys.argv[2])"
-
-
-def _write_payload(payload_path: str, out_path: str) -> None:
-    """Child-process side of :func:`write_c3d`: build the ezc3d object from the payload (.npz) and write it."""
-    import ezc3d
-
-    with np.load(payload_path, allow_pickle=False) as d:
-        c3d = ezc3d.c3d()
-        P = c3d["parameters"]["POINT"]
-        P["RATE"]["value"] = [float(d["point_rate_hz"])]
-        P["LABELS"]["value"] = [str(v) for v in d["marker_labels"]]
-        P["UNITS"]["value"] = [str(d["point_unit"])]
-        residuals = d["residuals"]
-        c3d["data"]["meta_points"] = {
-            "residuals": residuals,
-            "camera_masks": np.zeros((7, *residuals.shape[1:]), dtype=bool),
-        }
-        c3d["data"]["points"] = d["points"]
-        n_ch = len(d["analog_labels"])
-        if n_ch:
-            A = c3d["parameters"]["ANALOG"]
-            A["RATE"]["value"] = [float(d["analog_rate_hz"])]
-            A["LABELS"]["value"] = [str(v) for v in d["analog_labels"]]
-            A["UNITS"]["value"] = [str(v) for v in d["analog_units"]]
-            A["SCALE"]["value"] = [1.0] * n_ch
-            A["OFFSET"]["value"] = [0] * n_ch
-            A["GEN_SCALE"]["value"] = [1.0]
-            c3d["data"]["analogs"] = d["analogs"]
-    c3d.write(out_path)
-
-
-def _write_in_child(payload: dict[str, np.ndarray], out: Path, source: str) -> None:
-    """Write ``out`` with ezc3d in a fresh Python process (see :func:`write_c3d`, Notes)."""
-    payload_path = out.with_name(out.name + ".payload.npz")
-    np.savez(payload_path, **payload)
-    proc = subprocess.run(
-        [sys.executable, "-c", _CHILD_CODE, str(payload_path), str(out)], capture_output=True, text=True
-    )
-    if proc.returncode != 0 or not out.is_file():
-        lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
-        raise LoperInputError(f"{source}: ezc3d could not write the file: {lines[-1] if lines else 'no message'}")
-
-
-def write_c3d(
-    path: str | os.PathLike,
-    marker_labels: Sequence[str],
-    markers_m,
-    point_rate_hz: float,
-    analog_labels: Sequence[str] = (),
-    analogs=None,
-    analog_units: Sequence[str] = (),
-    analog_rate_hz: float | None = None,
-    point_unit: str = "mm",
-) -> Path:
-    """Write markers (given in m) and analog channels to a float C3D file, atomically.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Target ``.c3d`` file; its directory must exist.
-    marker_labels : sequence of str
-        One unique label per marker (at most 255 characters, no edge blanks).
-    markers_m : array_like
-        Shape (n_frames, n_markers, 3), metres; a point with any NaN
-        coordinate is written as missing ((0, 0, 0), residual -1). A point
-        exactly at (0, 0, 0) m is read back as missing (:func:`read_c3d`).
-    point_rate_hz : float
-        Frame rate (Hz).
-    analog_labels, analog_units : sequence of str
-        One label and one unit (e.g. ``"N"``, ``"V"``) per analog channel.
-    analogs : array_like, optional
-        Shape (n_frames * ratio, n_channels), finite, in the channels' units.
-    analog_rate_hz : float, optional
-        Analog rate (Hz), an integer multiple ``ratio`` of ``point_rate_hz``;
-        default ``point_rate_hz``.
-    point_unit : {"mm", "cm", "m"}
-        Unit stored in ``POINT:UNITS``; coordinates are float32 in that unit.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
-
-    Raises
-    ------
-    LoperInputError
-        Bad shapes, labels, units, rates (including a non-integer
-        analog/point rate ratio), non-finite analogs, values beyond float32,
-        a missing directory, or a failed write; nothing is left behind.
-
-    Notes
-    -----
-    ezc3d's writer runs in a child Python process: in one process, ezc3d's
-    and OpenSim's SWIG wrappers share the converters of ``std::vector``
-    (process-wide ``STB_GNU_UNIQUE`` statics), and whichever library uses
-    them first breaks the other's vector arguments (an in-process ezc3d write
-    makes ``opensim.StdVectorDouble`` arguments raise TypeError; earlier
-    OpenSim use makes ezc3d's write raise TypeError). Reading is unaffected.
-    """
-    path = Path(path)
-    source = str(path)
-    unit = str(point_unit).lower()
-    if unit not in LENGTH_UNITS_PER_M:
-        raise LoperInputError(f"{source}: point_unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {point_unit!r}")
-    point_rate = _check_rate(point_rate_hz, "point_rate_hz", source)
-    points, residuals = _points_for_file(markers_m, LENGTH_UNITS_PER_M[unit], source)
-    labels = _check_labels(marker_labels, "marker_labels", points.shape[1], source)
-    a_labels = list(analog_labels)
-    n_ch = len(a_labels)
-    if n_ch == 0 and analogs is not None and np.size(analogs) > 0:
-        raise LoperInputError(f"{source}: analogs given without analog_labels")
-    analog_rate = point_rate if analog_rate_hz is None else _check_rate(analog_rate_hz, "analog_rate_hz", source)
-    ratio = _rate_ratio(point_rate, analog_rate, source)
-    if n_ch:
-        a_labels = _check_labels(a_labels, "analog_labels", n_ch, source)
-        a_units = [str(u) for u in analog_units]
-        if len(a_units) != n_ch:
-            raise LoperInputError(f"{source}: analog_units must give one unit per channel ({n_ch}), got {len(a_units)}")
-        samples = _analogs_for_file(analogs, n_ch, points.shape[2] * ratio, source)
-
-    payload = {
-        "point_rate_hz": np.float64(point_rate),
-        "point_unit": np.str_(unit),
-        "marker_labels": np.array(labels, dtype=str),
-        "points": points,
-        "residuals": residuals,
-        "analog_rate_hz": np.float64(analog_rate),
-        "analog_labels": np.array(a_labels if n_ch else [], dtype=str),
-        "analog_units": np.array(a_units if n_ch else [], dtype=str),
-        "analogs": samples if n_ch else np.zeros((1, 0, 0)),
-    }
-    with _staged_output(path, "C3D file") as tmp:
-        _write_in_child(payload, tmp, source)
-    return path

@@ -27,24 +27,25 @@ MOT/STO (:func:`write_mot`, :func:`read_mot`)
 Vectors are handed to OpenSim as plain Python lists, never as
 ``opensim.StdVector*`` objects: those stop working in a process where ezc3d's
 SWIG wrapper used its ``std::vector`` converters first (see
-:func:`loper_analysis.io.c3d.write_c3d`, Notes). Writers are atomic (a
-temporary directory beside the target, then :func:`os.replace`). Every problem raises
+:func:`loper_analysis.io.c3d_writer.write_c3d`, Notes). Writers go through
+the atomic writer (:func:`loper_analysis.io.atomic.staged`). Every problem raises
 :class:`~loper_analysis.errors.LoperInputError` naming the file.
 """
 
 from __future__ import annotations
 
 import os
-import re
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ..checks import time_vector, uniform_step_s, unique_names
 from ..errors import LoperInputError
-from ..model import quiet_opensim
-from .c3d import LENGTH_UNITS_PER_M, _staged_output, read_c3d
+from .atomic import staged
+from .c3d import LENGTH_UNITS_PER_M, read_c3d
+from .osim import quiet_opensim
 
 __all__ = [
     "TRANSLATION_SUFFIXES",
@@ -57,47 +58,8 @@ __all__ = [
 #: Coordinate-name endings of translations (m), which are never converted to degrees.
 TRANSLATION_SUFFIXES: tuple[str, ...] = ("_tx", "_ty", "_tz")
 
-#: Relative tolerance on equal time steps of a TRC (it declares one DataRate).
-_STEP_TOLERANCE = 1e-6
-_WHITESPACE = re.compile(r"\s")
-
-
 def _is_translation(name: str) -> bool:
     return name.endswith(TRANSLATION_SUFFIXES)
-
-
-def _check_names(names: Sequence, what: str, source: str) -> list[str]:
-    """Non-empty, unique str without whitespace (the files are tab separated)."""
-    names = list(names)
-    for name in names:
-        if not isinstance(name, str) or not name or _WHITESPACE.search(name):
-            raise LoperInputError(f"{source}: {what} must be non-empty strings without whitespace, got {name!r}")
-    duplicated = sorted({n for n in names if names.count(n) > 1})
-    if duplicated:
-        raise LoperInputError(f"{source}: {what} duplicated: {', '.join(duplicated)}")
-    return names
-
-
-def _check_time(time_s, source: str, min_rows: int) -> np.ndarray:
-    t = np.asarray(time_s, dtype=float)
-    if t.ndim != 1 or t.size < min_rows:
-        raise LoperInputError(f"{source}: time_s must be 1-D with at least {min_rows} value(s), got shape {t.shape}")
-    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        bad = int(np.flatnonzero(~np.isfinite(t) | np.r_[False, np.diff(t) <= 0])[0])
-        raise LoperInputError(f"{source}: time_s must be finite and strictly increasing; fails at row {bad} ({t[bad]!r} s)")
-    return t
-
-
-def _data_rate(t: np.ndarray, source: str) -> float:
-    """The one rate of equally spaced times (Hz); refuses unequal steps."""
-    step = (t[-1] - t[0]) / (t.size - 1)
-    worst = int(np.argmax(np.abs(np.diff(t) - step)))
-    if abs(t[worst + 1] - t[worst] - step) > _STEP_TOLERANCE * step:
-        raise LoperInputError(
-            f"{source}: a TRC needs equally spaced times; step {t[worst + 1] - t[worst]:.9g} s at row {worst} "
-            f"differs from the mean step {step:.9g} s"
-        )
-    return 1.0 / step
 
 
 def _open_table(osim, path: Path, kind: str, what: str):
@@ -127,12 +89,12 @@ def _vec3_table(osim, t: np.ndarray, X: np.ndarray, labels: list[str]):
 
 
 def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str], unit: str = "mm") -> Path:
-    """Write marker trajectories to a TRC file with OpenSim's ``TRCFileAdapter``, atomically.
+    """Write marker trajectories to a TRC file with OpenSim's ``TRCFileAdapter``, atomically; returns ``path``.
 
     Parameters
     ----------
     path : str or path-like
-        Target ``.trc`` file; its directory must exist.
+        Target ``.trc`` file (a missing directory is created).
     time_s : array_like
         Shape (n_frames,), n_frames >= 2, s, strictly increasing and equally
         spaced (relative tolerance 1e-6); ``DataRate`` = 1 / mean step.
@@ -142,11 +104,6 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
         One unique marker name per marker, without whitespace.
     unit : {"mm", "cm", "m"}
         Unit of the file (``Units`` metadata); values are converted from m.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
 
     Raises
     ------
@@ -158,23 +115,23 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
     source = str(path)
     if unit not in LENGTH_UNITS_PER_M:
         raise LoperInputError(f"{source}: unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {unit!r}")
-    t = _check_time(time_s, source, min_rows=2)
+    t = time_vector(time_s, source, min_count=2, item="row")
     X = np.asarray(markers_m, dtype=float)
     labels = list(labels)
     if X.ndim != 3 or X.shape != (t.size, len(labels), 3) or not labels:
         raise LoperInputError(
             f"{source}: markers_m must have shape (n_frames = {t.size}, n_labels = {len(labels)} >= 1, 3), got {X.shape}"
         )
-    labels = _check_names(labels, "labels", source)
+    labels = unique_names(labels, "labels", source, allow_whitespace=False)
     if np.any(np.isinf(X)):
         raise LoperInputError(f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})")
-    rate = _data_rate(t, source)
+    rate = 1.0 / uniform_step_s(t, source)
     osim = quiet_opensim()
     table = _vec3_table(osim, t, X * LENGTH_UNITS_PER_M[unit], labels)
     table.addTableMetaDataString("DataRate", f"{rate:.12g}")
     table.addTableMetaDataString("CameraRate", f"{rate:.12g}")
     table.addTableMetaDataString("Units", unit)
-    with _staged_output(path, "TRC file") as tmp:
+    with staged(path, "TRC file") as tmp:
         try:
             osim.TRCFileAdapter().write(table, str(tmp))
         except Exception as exc:
@@ -197,7 +154,7 @@ def _read_trc_text(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]] | Non
     """Fast reader for the TRC layout OpenSim's ``TRCFileAdapter`` writes; None if the file deviates from it.
 
     OpenSim's own parser needs 3.6 s for a 4-minute trial (30,720 frames, 36
-    markers), this one 0.3 s; ``tests/test_c3d.py`` checks that both return
+    markers), this one 0.3 s; ``tests/io/test_opensim_tables.py`` checks that both return
     the same arrays. Anything unexpected (header keys, counts, a units field
     we do not know) returns None and the caller falls back to OpenSim.
     """
@@ -291,12 +248,12 @@ def _check_mot_suffix(path: Path) -> None:
 
 
 def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = True) -> Path:
-    """Write coordinate trajectories to an OpenSim ``.mot``/``.sto`` file with ``STOFileAdapter``, atomically.
+    """Write coordinates to an OpenSim ``.mot``/``.sto`` file with ``STOFileAdapter``, atomically; returns ``path``.
 
     Parameters
     ----------
     path : str or path-like
-        Target ``.mot`` or ``.sto`` file; its directory must exist.
+        Target ``.mot`` or ``.sto`` file (a missing directory is created).
     frame : pandas.DataFrame
         Column ``time_s`` (s, finite, strictly increasing, >= 1 row) plus at
         least one coordinate column: rad, or m for names ending in ``_tx``,
@@ -304,11 +261,6 @@ def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = T
     in_degrees : bool
         Print angles in degrees and declare ``inDegrees=yes`` (OpenSim's
         usual .mot); otherwise rad and ``inDegrees=no``.
-
-    Returns
-    -------
-    pathlib.Path
-        ``path``.
 
     Raises
     ------
@@ -321,10 +273,10 @@ def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = T
     _check_mot_suffix(path)
     if not isinstance(frame, pd.DataFrame) or "time_s" not in frame.columns:
         raise LoperInputError(f"{source}: frame must be a DataFrame with a 'time_s' column")
-    names = _check_names([c for c in frame.columns if c != "time_s"], "coordinate columns", source)
+    names = unique_names([c for c in frame.columns if c != "time_s"], "coordinate columns", source, allow_whitespace=False)
     if not names or "time" in names:
         raise LoperInputError(f"{source}: frame needs coordinate column(s) besides time_s (and none named 'time')")
-    t = _check_time(frame["time_s"].to_numpy(dtype=float), source, min_rows=1)
+    t = time_vector(frame["time_s"].to_numpy(dtype=float), source, min_count=1, item="row")
     values = np.empty((t.size, len(names)))
     for j, name in enumerate(names):
         if not pd.api.types.is_numeric_dtype(frame[name].dtype) or pd.api.types.is_bool_dtype(frame[name].dtype):
@@ -337,7 +289,7 @@ def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = T
     table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(values), names)
     table.addTableMetaDataString("header", "Coordinates")
     table.addTableMetaDataString("inDegrees", "yes" if in_degrees else "no")
-    with _staged_output(path, "motion file") as tmp:
+    with staged(path, "motion file") as tmp:
         try:
             osim.STOFileAdapter().write(table, str(tmp))
         except Exception as exc:

@@ -2,7 +2,7 @@
 
 A robot log is the 1000 Hz record of the treadmill robot, one file per
 subject and trial at ``data/raw/{subject}/{trial}.loper.tsv``
-(:func:`robot_log_path`). The format, ``loper-log 1``, is UTF-8 text with
+. The format, ``loper-log 1``, is UTF-8 text with
 tab-separated values::
 
     # format: loper-log 1
@@ -29,7 +29,7 @@ tab-separated values::
 The writer prints ``time_s`` with ``%.15g``, the other real-valued channels
 with ``%.9g`` and the two integer columns as integers, so the same data give
 the same bytes. Every check of the reader is applied to the frame before
-anything is written (one shared validation), so nothing invalid is written,
+anything is written (one shared validation, :func:`validated_log`), so nothing invalid is written,
 and writing is atomic (a temporary file in the target directory, then
 :func:`os.replace`).
 
@@ -46,14 +46,15 @@ import math
 import numbers
 import os
 import re
-import secrets
 from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from ..checks import positive
 from ..errors import LoperInputError
+from .atomic import write_bytes
 
 __all__ = [
     "FORMAT_NAME",
@@ -61,9 +62,8 @@ __all__ = [
     "UNITS",
     "SAFETY_STATES",
     "TIME_STEP_TOLERANCE",
-    "robot_log_path",
+    "validated_log",
     "read_robot_log",
-    "read_robot_log_mat",
     "write_robot_log",
 ]
 
@@ -111,36 +111,10 @@ _INT_COLUMNS = ("perturbation", "safety_state")
 _FLOAT_COLUMNS = tuple(c for c in COLUMNS if c not in _INT_COLUMNS)
 _FORCE_COLUMNS = ("force_desired_n", "force_measured_n")
 _MAY_BE_NAN = ("motor_angle_rad", "motor_velocity_rad_s", "sync_v")
-#: Optional channels of a .mat export (may be mapped to None -> zeros).
-_MAT_OPTIONAL = ("sync_v", "perturbation", "safety_state")
 _RESERVED_KEYS = ("format", "sample_rate_hz")
 _KEY_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
 _TIME_FORMAT = "%.15g"
 _VALUE_FORMAT = "%.9g"
-
-
-# ---------------------------------------------------------------------------
-# paths
-
-
-def robot_log_path(raw_dir: str | os.PathLike, subject: str, trial: str) -> Path:
-    """Path of a trial's robot log: ``raw_dir/subject/trial.loper.tsv``.
-
-    Parameters
-    ----------
-    raw_dir : str or path-like
-        Directory of the raw data (``data/raw``).
-    subject, trial : str
-        Subject and trial identifiers; each a single non-empty path component.
-
-    Returns
-    -------
-    pathlib.Path
-    """
-    for name, value in (("subject", subject), ("trial", trial)):
-        if not isinstance(value, str) or value in ("", ".", "..") or "/" in value or os.sep in value:
-            raise LoperInputError(f"{name} must be a non-empty file name without path separators, got {value!r}")
-    return Path(raw_dir) / subject / f"{trial}.loper.tsv"
 
 
 # ---------------------------------------------------------------------------
@@ -165,16 +139,6 @@ def _where(source: str, column: str | None, sample: int, time: float | None, lin
 def _percent(value: float) -> str:
     """Signed, 3 significant digits, no exponent (e.g. +20, -50, +99900)."""
     return np.format_float_positional(value, precision=3, fractional=False, trim="-", sign=True)
-
-
-def _check_sample_rate(value, what: str) -> float:
-    try:
-        rate = float(value)
-    except (TypeError, ValueError):
-        raise LoperInputError(f"{what} must be a positive number, got {value!r}") from None
-    if not math.isfinite(rate) or rate <= 0:
-        raise LoperInputError(f"{what} must be a positive number, got {value!r}")
-    return rate
 
 
 def _as_float(series: pd.Series, column: str, source: str, time: np.ndarray | None) -> np.ndarray:
@@ -210,7 +174,7 @@ def _check_column_names(names: list[str], source: str, where: str) -> None:
         )
 
 
-def _validate(
+def validated_log(
     frame: pd.DataFrame, sample_rate_hz: float, source: str, first_line: int | None = None
 ) -> pd.DataFrame:
     """Check a robot-log frame; return it normalised.
@@ -240,7 +204,7 @@ def _validate(
         raise LoperInputError(f"{source}: a robot log must be a pandas DataFrame, got {type(frame).__name__}")
     names = [str(c) for c in frame.columns]
     _check_column_names(names, source, "")
-    rate = _check_sample_rate(sample_rate_hz, f"{source}: sample_rate_hz")
+    rate = positive("sample_rate_hz", sample_rate_hz, source)
     n = len(frame)
     if n < 2:
         raise LoperInputError(f"{source}: {n} sample(s); a robot log needs at least 2")
@@ -317,7 +281,7 @@ def write_robot_log(
     Parameters
     ----------
     path : str or path-like
-        Target file (``*.loper.tsv``); its directory must exist. An existing
+        Target file (``*.loper.tsv``; a missing directory is created). An existing
         file is replaced.
     frame : pandas.DataFrame
         Shape (n, 8), n >= 2: exactly the columns :data:`COLUMNS` (any order;
@@ -342,8 +306,8 @@ def write_robot_log(
     """
     path = Path(path)
     source = f"refusing to write {path}"
-    rate = _check_sample_rate(sample_rate_hz, f"{source}: sample_rate_hz")
-    clean = _validate(frame, rate, source)
+    rate = positive("sample_rate_hz", sample_rate_hz, source)
+    clean = validated_log(frame, rate, source)
     header = [f"# format: {FORMAT_NAME}", f"# sample_rate_hz: {_format_rate(rate)}"]
     if metadata is not None and not isinstance(metadata, Mapping):
         raise LoperInputError(f"{source}: metadata must be a dict of key -> value, got {type(metadata).__name__}")
@@ -384,30 +348,7 @@ def write_robot_log(
             fmt = _TIME_FORMAT if col == "time_s" else _VALUE_FORMAT
             cells.append([fmt % v for v in values])
     text = "\n".join(header) + "\n" + "\n".join("\t".join(row) for row in zip(*cells)) + "\n"
-    _write_atomic(path, text.encode("utf-8"))
-
-
-def _write_atomic(path: Path, data: bytes) -> None:
-    """Write to a temporary file beside ``path``, then rename it over ``path``."""
-    directory = path.parent
-    for _ in range(100):
-        tmp = directory / f".{path.name}.{secrets.token_hex(6)}.tmp"
-        try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)  # mode honours the umask
-        except FileExistsError:
-            continue
-        break
-    else:  # pragma: no cover - 100 collisions of 48 random bits
-        raise OSError(f"cannot create a temporary file in {directory}")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    write_bytes(path, text.encode("utf-8"), "robot log")
 
 
 def _parse_floats(cells: list[str], column: str, source: str, first_line: int, time: np.ndarray | None):
@@ -457,7 +398,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
     """
     path = Path(path)
     source = str(path)
-    expected = None if sample_rate_hz is None else _check_sample_rate(sample_rate_hz, "sample_rate_hz")
+    expected = None if sample_rate_hz is None else positive("sample_rate_hz", sample_rate_hz)
     try:
         text = path.read_text(encoding="utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -487,7 +428,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
         raise LoperInputError(f"{source}: unsupported format {meta['format']!r}; this reader reads {FORMAT_NAME!r}")
     if "sample_rate_hz" not in meta:
         raise LoperInputError(f"{source}: no '# sample_rate_hz: ...' header line")
-    rate = _check_sample_rate(meta["sample_rate_hz"], f"{source}: header sample_rate_hz")
+    rate = positive("header sample_rate_hz", meta["sample_rate_hz"], source)
     meta["sample_rate_hz"] = rate
     if expected is not None and not math.isclose(rate, expected, rel_tol=1e-12):
         raise LoperInputError(
@@ -508,7 +449,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
     rows = lines[k + 1:]
     first_line = header_line + 1
     data = _parse_rows(rows, source, first_line)
-    frame = _validate(pd.DataFrame(data), rate, source, first_line)
+    frame = validated_log(pd.DataFrame(data), rate, source, first_line)
     return frame, meta
 
 
@@ -536,117 +477,3 @@ def _parse_rows(rows: list[str], source: str, first_line: int) -> dict[str, np.n
     for j, col in enumerate(COLUMNS[1:], start=1):
         data[col] = _parse_floats(list(columns[j]), col, source, first_line, time)
     return data
-
-
-# ---------------------------------------------------------------------------
-# MATLAB export
-
-
-def read_robot_log_mat(
-    path: str | os.PathLike,
-    column_map: Mapping[str, str | None],
-    sample_rate_hz: float,
-    time_scale: float = 1.0,
-) -> tuple[pd.DataFrame, dict]:
-    """Read a robot log exported from MATLAB (.mat, version 4 to 7.2).
-
-    Parameters
-    ----------
-    path : str or path-like
-        The .mat file (read with :func:`scipy.io.loadmat`).
-    column_map : mapping of str to str or None
-        Our column (:data:`COLUMNS`) -> name of the variable in the .mat.
-        Every column must be mapped, except that ``time_s`` may be absent or
-        None (then ``time_s = arange(n) / sample_rate_hz``) and ``sync_v``,
-        ``perturbation`` and ``safety_state`` may map to None (then zeros).
-        Variables are numeric vectors of equal length n, stored as (n,),
-        (n, 1) or (1, n).
-    sample_rate_hz : float
-        Sample rate of the export (Hz).
-    time_scale : float, default 1.0
-        Factor from the time variable's unit to seconds (0.001 for ms).
-
-    Returns
-    -------
-    frame : pandas.DataFrame
-        Shape (n, 8), as from :func:`read_robot_log`.
-    metadata : dict
-        ``format``, ``sample_rate_hz`` (float, Hz) and ``source`` (the path).
-
-    Raises
-    ------
-    LoperInputError
-        On a bad map, an unreadable file, a missing or non-vector variable,
-        unequal lengths, or any check of :func:`read_robot_log`.
-    """
-    from scipy.io import loadmat
-
-    path = Path(path)
-    source = str(path)
-    rate = _check_sample_rate(sample_rate_hz, "sample_rate_hz")
-    try:
-        scale = float(time_scale)
-    except (TypeError, ValueError):
-        scale = math.nan
-    if not math.isfinite(scale) or scale <= 0:
-        raise LoperInputError(f"time_scale must be a positive number, got {time_scale!r}")
-    if not isinstance(column_map, Mapping):
-        raise LoperInputError(f"column_map must be a mapping column -> .mat variable, got {type(column_map).__name__}")
-    unknown = [str(c) for c in column_map if c not in COLUMNS]
-    if unknown:
-        raise LoperInputError(f"column_map: unknown column(s) {', '.join(unknown)}; columns are {', '.join(COLUMNS)}")
-    unmapped = [c for c in COLUMNS if c != "time_s" and c not in column_map]
-    if unmapped:
-        raise LoperInputError(f"column_map: column(s) {', '.join(unmapped)} not mapped to a .mat variable")
-    for col, var in column_map.items():
-        if var is None:
-            if col != "time_s" and col not in _MAT_OPTIONAL:
-                raise LoperInputError(
-                    f"column_map: column '{col}' must map to a .mat variable (only time_s, "
-                    f"{', '.join(_MAT_OPTIONAL)} may be None)"
-                )
-        elif not isinstance(var, str) or not var:
-            raise LoperInputError(f"column_map: variable of column '{col}' must be a name or None, got {var!r}")
-
-    try:
-        contents = loadmat(path)
-    except NotImplementedError as exc:  # MATLAB v7.3 (HDF5)
-        raise LoperInputError(f"{source}: cannot read .mat file ({exc}); save it with -v7 or older") from exc
-    except (OSError, ValueError, TypeError) as exc:
-        raise LoperInputError(f"{source}: cannot read .mat file ({exc})") from exc
-    available = sorted(k for k in contents if not k.startswith("__"))
-
-    vectors: dict[str, np.ndarray] = {}
-    for col in COLUMNS:
-        var = column_map.get(col)
-        if var is None:
-            continue
-        if var not in contents:
-            raise LoperInputError(
-                f"{source}: variable '{var}' (for column '{col}') not found; variables in the file: "
-                f"{', '.join(available) or 'none'}"
-            )
-        arr = np.asarray(contents[var])
-        if arr.ndim > 2 or (arr.ndim == 2 and min(arr.shape) > 1):
-            raise LoperInputError(
-                f"{source}: variable '{var}' (for column '{col}') has shape {arr.shape}; expected a vector "
-                f"(n,), (n, 1) or (1, n)"
-            )
-        if arr.dtype.kind not in "biuf":
-            raise LoperInputError(
-                f"{source}: variable '{var}' (for column '{col}') is not real numeric (dtype {arr.dtype})"
-            )
-        vectors[col] = arr.reshape(-1).astype(np.float64)
-    lengths = {column_map[c]: len(v) for c, v in vectors.items()}
-    if len(set(lengths.values())) > 1:
-        listed = ", ".join(f"{var} {n}" for var, n in lengths.items())
-        raise LoperInputError(f"{source}: variables have unequal lengths: {listed}")
-    n = next(iter(lengths.values()))
-    if "time_s" in vectors:
-        vectors["time_s"] = vectors["time_s"] * scale
-    else:
-        vectors["time_s"] = np.arange(n) / rate
-    for col in _MAT_OPTIONAL:
-        vectors.setdefault(col, np.zeros(n))
-    frame = _validate(pd.DataFrame({c: vectors[c] for c in COLUMNS}), rate, source)
-    return frame, {"format": FORMAT_NAME, "sample_rate_hz": rate, "source": source}

@@ -1,6 +1,11 @@
-"""Synthetic gait lab: walking kinematics, gait events and treadmill forces of virtual subjects.
+"""The synthetic gait lab: virtual subjects with known impedance and the raw recordings a lab would make of them.
 
-:mod:`.gait` holds the nominal gait (joint-angle curves as Fourier series),
-the stride-to-stride variable trial simulation and the split-belt treadmill
-ground reaction forces. Importing the package has no side effects.
+* :mod:`.subjects` - anthropometrics and the true impedance per onset;
+* :mod:`.gait_curves`, :mod:`.walking` - nominal slow walking and stride-variable trials;
+* :mod:`.treadmill` - split-belt ground reaction forces;
+* :mod:`.response` - the swing leg's answer to a LOPER pulse with the true impedance;
+* :mod:`.sync` - the robot's sync pulse trains;
+* :mod:`.trials` - whole trials: C3D contents and robot logs.
+
+Importing the package has no side effects.
 """

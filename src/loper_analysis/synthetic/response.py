@@ -1,6 +1,6 @@
 """The swing leg's response to a LOPER force pulse, with a known impedance (the synthetic truth).
 
-The perturbed swing follows the swing-leg model of DESIGN.md section 5 (the
+The perturbed swing follows the swing-leg model (``docs/swing_leg_model.md``; the
 same equations the identification fits, :mod:`loper_analysis.dynamics`):
 the unperturbed stride is the reference, its inverse dynamics with the
 minimal-impedance force ``F_u`` is the feedforward, and the perturbed leg

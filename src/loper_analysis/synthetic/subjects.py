@@ -2,31 +2,31 @@
 
 A row of ``config/subjects.tsv`` with ``source = synthetic`` may leave
 ``sex``, ``age_yr``, ``height_m`` and ``mass_kg`` empty: they are drawn from
-the study's impedance-experiment subjects (DESIGN.md section 2: 6 of 9 male,
-26.1 ± 1.2 years, 1.73 ± 0.14 m, 64.9 ± 12.1 kg; normal distributions
+the study's impedance-experiment subjects
+(:data:`loper_analysis.reference.STUDY_SUBJECTS`; normal distributions
 clipped to ± 2 SD), seeded by the master seed and the subject ID, so adding a
 subject never changes the others. The true stiffness and damping per joint
 and onset are the config's group values times a per-subject factor
 (log-normal with the configured between-subject CV, one factor per joint,
-parameter and onset), written to ``data/raw/{subject}/truth.yaml``.
+parameter and onset); :func:`truth_document` is what
+``data/raw/{subject}/truth.yaml`` holds.
 """
 
 from __future__ import annotations
 
 import zlib
 from collections.abc import Mapping, Sequence
-from pathlib import Path
 
 import numpy as np
-import yaml
 
 from ..constants import JOINTS
 from ..errors import LoperInputError
+from ..reference import STUDY_SUBJECTS
 
-__all__ = ["STUDY_ANTHROPOMETRY", "subject_anthropometry", "true_impedance", "write_truth", "read_truth"]
+__all__ = ["TRUTH_HEADER", "subject_anthropometry", "true_impedance", "truth_document", "truth_from_document"]
 
-#: Mean and SD of the study's 9 subjects (impedance experiment); 6 of 9 male.
-STUDY_ANTHROPOMETRY = {"age_yr": (26.1, 1.2), "height_m": (1.73, 0.14), "mass_kg": (64.9, 12.1), "male_fraction": 6 / 9}
+#: First line of a truth file.
+TRUTH_HEADER = "true impedance of a synthetic subject (loper-analysis)"
 
 
 def _rng(seed: int, subject: str, what: str) -> np.random.Generator:
@@ -43,7 +43,7 @@ def subject_anthropometry(row: Mapping, seed: int) -> dict:
     subject = str(row["subject"])
     rng = _rng(seed, subject, "anthropometry")
     draws = {k: rng.standard_normal() for k in ("age_yr", "height_m", "mass_kg")}
-    male = rng.uniform() < STUDY_ANTHROPOMETRY["male_fraction"]
+    male = rng.uniform() < STUDY_SUBJECTS["male_fraction"]
     out = {"subject": subject}
 
     def given(key):
@@ -54,7 +54,7 @@ def subject_anthropometry(row: Mapping, seed: int) -> dict:
     for key in ("age_yr", "height_m", "mass_kg"):
         value = given(key)
         if value is None:
-            mean, sd = STUDY_ANTHROPOMETRY[key]
+            mean, sd = STUDY_SUBJECTS[key]
             value = round(float(mean + sd * np.clip(draws[key], -2.0, 2.0)), 2)
         out[key] = float(value)
     if not 1.0 <= out["height_m"] <= 2.5:
@@ -100,9 +100,9 @@ def true_impedance(subject: str, seed: int, stiffness_nm_per_rad: Mapping, dampi
     return out
 
 
-def write_truth(path, anthropometry: Mapping, impedance: Mapping) -> None:
-    """``truth.yaml``: anthropometrics and K, D per onset and joint (units in the keys)."""
-    doc = {
+def truth_document(anthropometry: Mapping, impedance: Mapping) -> dict:
+    """The contents of ``truth.yaml``: anthropometrics and K, D per onset and joint (units in the keys)."""
+    return {
         "subject": anthropometry["subject"],
         "sex": anthropometry["sex"],
         "age_yr": anthropometry["age_yr"],
@@ -115,18 +115,11 @@ def write_truth(path, anthropometry: Mapping, impedance: Mapping) -> None:
             for onset, joints in impedance.items()
         },
     }
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.partial")
-    tmp.write_text("# true impedance of a synthetic subject (loper-analysis)\n" + yaml.safe_dump(doc, sort_keys=False))
-    tmp.replace(path)
 
 
-def read_truth(path) -> dict:
-    """``{onset_ms: {joint: {"K": ..., "D": ...}}}`` from a ``truth.yaml``."""
-    path = Path(path)
+def truth_from_document(doc, source: str = "truth file") -> dict:
+    """``{onset_ms: {joint: {"K": ..., "D": ...}}}`` from the contents of a ``truth.yaml``."""
     try:
-        doc = yaml.safe_load(path.read_text())
         return {
             int(key.split("_")[1]): {
                 joint: {"K": float(v["stiffness_nm_per_rad"]), "D": float(v["damping_nms_per_rad"])}
@@ -134,5 +127,5 @@ def read_truth(path) -> dict:
             }
             for key, joints in doc["impedance"].items()
         }
-    except (OSError, yaml.YAMLError, KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
-        raise LoperInputError(f"{path}: not a readable truth file ({exc})") from exc
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
+        raise LoperInputError(f"{source}: not a readable truth file ({exc})") from exc

@@ -1,6 +1,6 @@
-"""Raw files of a synthetic gait lab: C3D (markers 128 Hz, analogs 1024 Hz) and the robot log (1000 Hz).
+"""Recordings of a synthetic gait lab: C3D contents (markers 128 Hz, analogs 1024 Hz) and the robot log (1000 Hz).
 
-A walking trial is written exactly as a lab records it:
+A walking trial is recorded exactly as a lab records it:
 
 * markers: the OpenSim model's markers at the simulated coordinates
   (:func:`loper_analysis.kinematics.marker_positions`), turned from the model
@@ -8,7 +8,7 @@ A walking trial is written exactly as a lab records it:
   Qualisys Z-up), Gaussian measurement noise, a few short gaps (NaN), stored
   in mm;
 * analogs: per belt the vertical and fore-aft force and the moments
-  (:func:`loper_analysis.synthetic.gait.treadmill_grf`), and the robot's sync
+  (:func:`loper_analysis.synthetic.treadmill.treadmill_grf`), and the robot's sync
   output as the motion-capture system samples it;
 * the robot log (trials with the device) on the robot's own clock, which
   starts ``clock_offset_s`` before the motion capture and runs
@@ -18,32 +18,36 @@ A walking trial is written exactly as a lab records it:
   simulated thigh (:func:`loper_analysis.device.controller.simulate_device`).
 
 Time zero is the first motion-capture frame. Everything random derives from
-the seed; the same seed gives the same bytes.
+the seed; the same seed gives the same recordings. The recordings are
+:class:`loper_analysis.io.c3d.C3DRecording` objects and robot-log frames;
+writing them is the file layer's job.
 """
 
 from __future__ import annotations
 
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
+from ..constants import SIDES
 from ..errors import LoperInputError
+from ..io.c3d import C3DRecording
 
 __all__ = [
     "LabSettings",
     "PerturbationSettings",
     "WalkingTrial",
     "lab_markers",
+    "static_recording",
     "simulate_walking_trial",
-    "write_walking_trial",
-    "write_static_trial",
+    "walking_recording",
     "walking_with_margins",
-    "synthetic_static_file",
-    "synthetic_walking_files",
+    "subject_static_recording",
+    "subject_walking_trial",
 ]
 
 
@@ -71,16 +75,13 @@ def _model_to_lab(points_m: np.ndarray, rotation_deg: Sequence[float]) -> np.nda
     return rot.apply(points_m.reshape(-1, 3)).reshape(points_m.shape)
 
 
-def lab_markers(model_osim, coordinates: pd.DataFrame, lab: LabSettings, rng: np.random.Generator | None = None):
+def lab_markers(model, coordinates: pd.DataFrame, lab: LabSettings, rng: np.random.Generator | None = None):
     """Marker trajectories (n_frames, n_markers, 3) in the lab frame (m) and their labels, with noise and gaps.
 
-    ``model_osim`` is a path or an ``opensim.Model``; without ``rng`` the markers are exact.
+    ``model`` is an ``opensim.Model``; without ``rng`` the markers are exact.
     """
     from ..kinematics import marker_positions
-    from ..model import quiet_opensim
 
-    osim = quiet_opensim()
-    model = osim.Model(str(model_osim)) if isinstance(model_osim, (str, Path)) else model_osim
     ms = model.getMarkerSet()
     labels = [ms.get(i).getName() for i in range(ms.getSize())]
     values = {c: coordinates[c].to_numpy(float) for c in coordinates.columns if c != "time_s"}
@@ -95,18 +96,16 @@ def lab_markers(model_osim, coordinates: pd.DataFrame, lab: LabSettings, rng: np
     return X, labels
 
 
-def write_static_trial(c3d_path, model_osim, coordinates: pd.DataFrame, duration_s: float, lab: LabSettings,
-                       seed) -> None:
+def static_recording(model, coordinates: pd.DataFrame, duration_s: float, lab: LabSettings, seed,
+                     source: str = "static trial") -> C3DRecording:
     """A static trial: the first row of ``coordinates`` held for ``duration_s``, markers only (no gaps)."""
-    from ..io.c3d import write_c3d
-
     n = int(round(duration_s * lab.marker_rate_hz))
     if n < 2:
         raise LoperInputError(f"static trial of {duration_s} s has fewer than 2 frames")
     still = pd.DataFrame({c: np.repeat(coordinates[c].iloc[0], n) for c in coordinates.columns})
     rng = np.random.default_rng(seed)
-    X, labels = lab_markers(model_osim, still, lab.__class__(**{**lab.__dict__, "n_gaps": 0}), rng)
-    write_c3d(c3d_path, labels, X, lab.marker_rate_hz)
+    X, labels = lab_markers(model, still, lab.__class__(**{**lab.__dict__, "n_gaps": 0}), rng)
+    return C3DRecording(source=source, marker_labels=labels, markers_m=X, point_rate_hz=lab.marker_rate_hz)
 
 
 def _brace_position_m(coordinates: pd.DataFrame, attachment_m: float, side: str = "l") -> np.ndarray:
@@ -171,9 +170,9 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
     measured force with and without the pulses (:mod:`.response`).
     """
     from ..device.controller import simulate_device
-    from ..loadcell import pulse_train_at, sync_pulse_starts
-    from .gait import leg_length_from_height
     from .response import perturbation_schedule, pulse_train, swing_response
+    from .sync import pulse_train_at, sync_pulse_starts
+    from .walking import leg_length_from_height
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     gait_seed, sync_seed, device_seed, schedule_seed = ss.spawn(4)
@@ -227,23 +226,21 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
     return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
 
 
-def write_walking_trial(c3d_path, log_path, model_osim, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings,
-                        seed) -> None:
-    """Write the C3D (markers with noise and gaps, GRF, sync) and, with a device, the robot log of a trial."""
-    from ..io.c3d import write_c3d
-    from ..io.robot_log import write_robot_log
-    from ..loadcell import pulse_train_at
-    from .gait import treadmill_grf
+def walking_recording(model, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings, seed,
+                      source: str = "walking trial") -> C3DRecording:
+    """The C3D contents of a walking trial: markers with noise and gaps, GRF per belt and the sync channel."""
+    from .sync import pulse_train_at
+    from .treadmill import treadmill_grf
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     marker_seed, grf_seed = ss.spawn(2)
     coords = trial.mocap_coordinates(lab.marker_rate_hz)
-    X, labels = lab_markers(model_osim, coords, lab, np.random.default_rng(marker_seed))
+    X, labels = lab_markers(model, coords, lab, np.random.default_rng(marker_seed))
     grf = treadmill_grf(trial.mocap_events(), trial.duration_s, lab.analog_rate_hz, body_mass_kg,
                         np.random.default_rng(grf_seed), noise_sd_n=lab.grf_noise_sd_n)
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     names, columns, units = [], [], []
-    for side, suffix in zip(("left", "right"), lab.grf_prefix):
+    for side, suffix in zip(SIDES, lab.grf_prefix):
         for quantity, unit in (("fx", "N"), ("fz", "N"), ("mx", "N.m"), ("my", "N.m"), ("mz", "N.m")):
             key = f"{quantity}_{side}_{'nm' if unit == 'N.m' else 'n'}"
             names.append(f"{quantity.capitalize()}{suffix}")
@@ -252,11 +249,9 @@ def write_walking_trial(c3d_path, log_path, model_osim, trial: WalkingTrial, bod
     names.append(lab.sync_channel)
     columns.append(pulse_train_at((grf["time_s"].to_numpy(float) + lab.clock_offset_s) / scale, trial.sync_starts_s))
     units.append("V")
-    write_c3d(c3d_path, labels, X, lab.marker_rate_hz, names, np.column_stack(columns), units, lab.analog_rate_hz)
-    if log_path is not None:
-        if trial.robot is None:
-            raise LoperInputError(f"{log_path}: the trial was simulated without the device")
-        write_robot_log(log_path, trial.robot, lab.robot_rate_hz, {"clock": "robot"})
+    return C3DRecording(source=source, marker_labels=labels, markers_m=X, point_rate_hz=lab.marker_rate_hz,
+                        analog_labels=names, analog_units=units, analogs=np.column_stack(columns),
+                        analog_rate_hz=lab.analog_rate_hz)
 
 
 def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Generator, timing_cv: float,
@@ -265,7 +260,8 @@ def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Gen
     """Kinematics and events that cover the robot log's span: from ``clock_offset_s`` (+1 s) before the
     motion capture to ``robot_margin_s`` (+1 s) after it; time 0 is the first motion-capture frame.
     ``sample_rate_hz`` defaults to the marker rate and must be a multiple of it."""
-    from .gait import NominalGait, walking_kinematics
+    from .gait_curves import NominalGait
+    from .walking import walking_kinematics
 
     rate = lab.marker_rate_hz if sample_rate_hz is None else sample_rate_hz
     lead = np.ceil((lab.clock_offset_s + 1.0) * lab.marker_rate_hz) / lab.marker_rate_hz
@@ -276,32 +272,32 @@ def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Gen
 
 
 def _seed(seed, *names: str) -> list[int]:
-    import zlib
-
     return [int(seed), *(zlib.crc32(n.encode()) for n in names)]
 
 
-def synthetic_static_file(c3d_path, subject: str, height_m: float, mass_kg: float, duration_s: float,
-                          lab: LabSettings, seed: int) -> None:
-    """The static trial of a synthetic subject: standing, joints at 0, feet on the floor."""
+def subject_static_recording(subject: str, height_m: float, mass_kg: float, duration_s: float, lab: LabSettings,
+                             seed: int) -> C3DRecording:
+    """The static trial of a synthetic subject: standing, joints at 0, feet on the floor (seeded by subject)."""
     from ..model import COORDINATES, build_lower_body_model
-    from .gait import leg_length_from_height
+    from .walking import leg_length_from_height
 
     model = build_lower_body_model(height_m, mass_kg)
     still = pd.DataFrame({c: [0.0] for c in COORDINATES}).assign(pelvis_ty=leg_length_from_height(height_m))
-    write_static_trial(c3d_path, model, still, duration_s, lab, _seed(seed, subject, "static"))
+    return static_recording(model, still, duration_s, lab, _seed(seed, subject, "static"), f"{subject} static")
 
 
-def synthetic_walking_files(c3d_path, log_path, subject: str, trial: str, height_m: float, mass_kg: float,
-                            duration_s: float, timing_cv: float, amplitude_cv: float, lab: LabSettings,
-                            device, seed: int, perturbation: PerturbationSettings | None = None) -> WalkingTrial:
-    """One walking trial of a synthetic subject: its C3D and, with ``log_path``, the robot log."""
+def subject_walking_trial(subject: str, trial: str, height_m: float, mass_kg: float, duration_s: float,
+                          timing_cv: float, amplitude_cv: float, lab: LabSettings, device, seed: int,
+                          perturbation: PerturbationSettings | None = None) -> tuple[WalkingTrial, C3DRecording]:
+    """One walking trial of a synthetic subject (seeded by subject and trial): the simulation and its C3D contents.
+
+    ``device`` None simulates walking without the device (no robot log).
+    """
     from ..model import build_lower_body_model, segment_parameters_from_model
 
     model = build_lower_body_model(height_m, mass_kg)
     params = segment_parameters_from_model(model)
     sim_seed, file_seed = np.random.SeedSequence(_seed(seed, subject, trial)).spawn(2)
-    walk = simulate_walking_trial(duration_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv,
-                                  device if log_path is not None else None, perturbation)
-    write_walking_trial(c3d_path, log_path, model, walk, mass_kg, lab, file_seed)
-    return walk
+    walk = simulate_walking_trial(duration_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv, device,
+                                  perturbation)
+    return walk, walking_recording(model, walk, mass_kg, lab, file_seed, f"{subject} {trial}")

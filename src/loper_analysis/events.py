@@ -1,0 +1,237 @@
+"""Gait events and strides from the treadmill's vertical ground reaction force.
+
+* :func:`gait_events` - heel strikes and toe-offs from one belt's vertical
+  force, with hysteresis and minimum phase durations;
+* :func:`strides` - the stride table of one side (heel strike -> heel strike,
+  with its toe-off).
+
+Time is in s, force in N. Side, event and phase names are those of
+:mod:`loper_analysis.constants`.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from .checks import number, time_vector, where
+from .checks import side as check_side
+from .errors import LoperInputError
+
+__all__ = ["EVENT_COLUMNS", "STRIDE_COLUMNS", "gait_events", "strides"]
+
+logger = logging.getLogger(__name__)
+
+#: Columns of the event table.
+EVENT_COLUMNS: tuple[str, ...] = ("side", "event", "time_s", "sample")
+#: Columns of the stride table.
+STRIDE_COLUMNS: tuple[str, ...] = (
+    "stride", "side", "heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s",
+)
+_HS, _TO = 1, 0  # state codes: 1 = loaded (stance), 0 = unloaded (swing)
+
+
+def _hysteresis_events(force: np.ndarray, on: float, off: float) -> tuple[np.ndarray, np.ndarray]:
+    """Samples and kinds (1 = heel strike, 0 = toe-off) of the state changes of the hysteresis."""
+    n = force.size
+    state = np.full(n, -1, dtype=np.int8)
+    state[force <= off] = _TO
+    state[force >= on] = _HS  # on > off: the two sets are disjoint
+    last = np.where(state >= 0, np.arange(n), -1)
+    np.maximum.accumulate(last, out=last)
+    held = np.where(last >= 0, state[np.maximum(last, 0)], -1)  # state carried through the dead band
+    change = np.flatnonzero((held[1:] != held[:-1]) & (held[:-1] >= 0)) + 1
+    return change, held[change].astype(np.int8)
+
+
+def _drop_short_periods(
+    samples: np.ndarray, kinds: np.ndarray, time: np.ndarray, min_stance_s: float, min_swing_s: float
+) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+    """Remove, shortest first, each stance or swing period shorter than its minimum (both bounding events)."""
+    dropped: list[dict] = []
+    while samples.size >= 2:
+        t = time[samples]
+        duration = np.diff(t)
+        minimum = np.where(kinds[:-1] == _HS, min_stance_s, min_swing_s)
+        short = np.flatnonzero(duration < minimum)
+        if not short.size:
+            break
+        i = short[np.argmin(duration[short])]
+        dropped.append({
+            "phase": "stance" if kinds[i] == _HS else "swing",
+            "start_s": float(t[i]),
+            "end_s": float(t[i + 1]),
+            "duration_s": float(duration[i]),
+            "start_sample": int(samples[i]),
+            "end_sample": int(samples[i + 1]),
+        })
+        samples = np.delete(samples, [i, i + 1])
+        kinds = np.delete(kinds, [i, i + 1])
+    return samples, kinds, dropped
+
+
+def gait_events(
+    time_s,
+    vertical_force_n,
+    side: str,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    source: str = "",
+) -> pd.DataFrame:
+    """Heel strikes and toe-offs from one belt's vertical ground-reaction force.
+
+    A two-threshold (hysteresis) detector. A sample with force
+    ``>= threshold_on_n`` sets the state "loaded", a sample with force
+    ``<= threshold_off_n`` sets "unloaded"; samples in between keep the state.
+
+    * **Heel strike** = the first sample with force ``>= threshold_on_n``
+      after the force was last ``<= threshold_off_n``.
+    * **Toe-off** = the first sample with force ``<= threshold_off_n`` after
+      the force was last ``>= threshold_on_n``.
+
+    The event time is ``time_s`` at that sample (no interpolation between
+    samples). A trial starting inside the dead band has an unknown state until
+    the first threshold is reached; that first reach is not an event.
+
+    Periods shorter than the minimum durations are noise blips: a stance
+    (heel strike -> toe-off) shorter than ``min_stance_s`` or a swing (toe-off
+    -> heel strike) shorter than ``min_swing_s`` is removed with both bounding
+    events, shortest first, until none remains (the surrounding periods
+    merge). The periods before the first and after the last event are
+    incomplete and never judged. Removed periods are logged (INFO) and listed
+    in ``attrs["dropped"]``.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n_samples,)
+        Sample times in s, finite and strictly increasing.
+    vertical_force_n : array_like, shape (n_samples,)
+        Vertical ground-reaction force of the belt under ``side``, in N; must be finite.
+    side : {"left", "right"}
+    threshold_on_n, threshold_off_n : float
+        Loading and unloading thresholds in N; ``threshold_on_n > threshold_off_n``.
+    min_stance_s, min_swing_s : float
+        Shortest accepted stance and swing period in s (>= 0).
+    source : str
+        Name of the trial or file, quoted in error and log messages.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per event, in time order: ``side``, ``event``
+        (``heel_strike`` | ``toe_off``), ``time_s`` (s), ``sample`` (int,
+        index into ``time_s``). Heel strikes and toe-offs alternate.
+        ``attrs``: ``source``, ``side``, the thresholds and minimum
+        durations, and ``dropped`` - a list of dicts (``phase``, ``start_s``,
+        ``end_s``, ``duration_s``, ``start_sample``, ``end_sample``).
+
+    Raises
+    ------
+    LoperInputError
+        Non-finite or non-increasing time, non-finite force (the first sample
+        is named), mismatched lengths, ``threshold_on_n <= threshold_off_n``,
+        negative minimum durations, an unknown side, or no event at all.
+    """
+    side = check_side(side, source)
+    t = time_vector(time_s, source)
+    f = np.asarray(vertical_force_n, dtype=float)
+    if f.ndim != 1 or f.size != t.size:
+        raise LoperInputError(
+            f"{where(source)}vertical_force_n has shape {f.shape}; time_s has {t.size} samples"
+        )
+    bad = np.flatnonzero(~np.isfinite(f))
+    if bad.size:
+        raise LoperInputError(f"{where(source)}vertical_force_n is not finite at sample {bad[0]}: {f[bad[0]]}")
+    on = number("threshold_on_n", threshold_on_n, source)
+    off = number("threshold_off_n", threshold_off_n, source)
+    if on <= off:
+        raise LoperInputError(
+            f"{where(source)}threshold_on_n ({on} N) must exceed threshold_off_n ({off} N) for hysteresis"
+        )
+    min_stance = number("min_stance_s", min_stance_s, source, minimum=0.0)
+    min_swing = number("min_swing_s", min_swing_s, source, minimum=0.0)
+
+    samples, kinds = _hysteresis_events(f, on, off)
+    samples, kinds, dropped = _drop_short_periods(samples, kinds, t, min_stance, min_swing)
+    for d in dropped:
+        logger.info(
+            "%s%s side: dropped a %.3f s %s period (%.3f-%.3f s), shorter than the minimum",
+            where(source), side, d["duration_s"], d["phase"], d["start_s"], d["end_s"],
+        )
+    if not samples.size:
+        raise LoperInputError(
+            f"{where(source)}no gait event in vertical_force_n ({side} side): the force never crosses "
+            f"{off} N and {on} N in turn (range {f.min():.1f} .. {f.max():.1f} N)"
+        )
+    events = pd.DataFrame({
+        "side": side,
+        "event": np.where(kinds == _HS, "heel_strike", "toe_off"),
+        "time_s": t[samples],
+        "sample": samples.astype(np.int64),
+    })
+    events.attrs.update({
+        "source": source, "side": side, "threshold_on_n": on, "threshold_off_n": off,
+        "min_stance_s": min_stance, "min_swing_s": min_swing, "dropped": dropped,
+    })
+    return events
+
+
+def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
+    """Stride table of one side from an event table.
+
+    A stride runs from a heel strike to the next heel strike of the same side
+    and must contain exactly one toe-off (strictly between the two); strides
+    without one (or with several) are dropped, as are the incomplete strides
+    before the first and after the last heel strike.
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        Columns ``side``, ``event``, ``time_s`` as returned by :func:`gait_events`
+        (tables of both sides may be concatenated).
+    side : {"left", "right"}
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per complete stride, in time order: ``stride`` (0, 1, ... over
+        the kept strides), ``side``, ``heel_strike_s`` (start), ``toe_off_s``,
+        ``end_s`` (next heel strike), ``duration_s`` = end - start,
+        ``stance_s`` = toe-off - start, ``swing_s`` = end - toe-off; all in s.
+        Empty (with these columns) when the side has fewer than two heel strikes.
+
+    Raises
+    ------
+    LoperInputError
+        Missing columns, an unknown side or non-finite event times.
+    """
+    source = str(events.attrs.get("source", "")) if isinstance(events, pd.DataFrame) else ""
+    if not isinstance(events, pd.DataFrame) or not {"side", "event", "time_s"} <= set(events.columns):
+        raise LoperInputError(f"{where(source)}events must be a table with columns side, event, time_s")
+    side = check_side(side, source)
+    mine = events[events["side"] == side]
+    t = mine["time_s"].to_numpy(dtype=float)
+    if not np.isfinite(t).all():
+        raise LoperInputError(f"{where(source)}events: time_s is not finite for the {side} side")
+    hs = np.sort(t[mine["event"].to_numpy() == "heel_strike"])
+    to = np.sort(t[mine["event"].to_numpy() == "toe_off"])
+    start, end = hs[:-1], hs[1:]
+    first = np.searchsorted(to, start, side="right")  # first toe-off after the start
+    count = np.searchsorted(to, end, side="left") - first  # toe-offs strictly inside
+    keep = count == 1
+    start, end = start[keep], end[keep]
+    toe_off = to[first[keep]] if to.size else np.empty(0)
+    return pd.DataFrame({
+        "stride": np.arange(start.size, dtype=np.int64),
+        "side": side,
+        "heel_strike_s": start,
+        "toe_off_s": toe_off,
+        "end_s": end,
+        "duration_s": end - start,
+        "stance_s": toe_off - start,
+        "swing_s": end - toe_off,
+    }, columns=list(STRIDE_COLUMNS))

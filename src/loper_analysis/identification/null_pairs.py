@@ -1,0 +1,131 @@
+"""The stride-to-stride deviation in the identification: null-pair errors, their projection, and the refit.
+
+A mean response's prediction error is not white: the matched unperturbed
+stride differs from the perturbed stride's own unperturbed course by a
+smooth deviation that the 25 ms pre-onset match cannot remove, and with a
+dozen strides its average still biases D. Unperturbed strides paired by the
+same rule (*null pairs*, :func:`loper_analysis.responses.null_pair_windows`)
+show that error without a response (:func:`null_pair_errors`). Its few
+dominant shapes are projected out of the prediction error
+(:func:`nuisance_projection`, ``PreparedWindow.residual_weight``) - the same
+as fitting their amplitudes as nuisance parameters - and the CIs come from
+the null pairs' covariance by the sandwich ``cov = M C M^T``,
+``M = (W J)^+ W``, ``C = PreparedWindow.noise_cov``
+(:func:`refit_with_null_pairs`; method: ``docs/null_pairs.md``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..dynamics import joint_angles
+from ..errors import LoperInputError
+from .fit import ImpedanceFit, identify_impedance, initial_state_jacobian
+from .window import PreparedWindow, initial_state_basis
+
+__all__ = ["NullPairFit", "null_pair_errors", "nuisance_projection", "refit_with_null_pairs"]
+
+
+@dataclass
+class NullPairFit:
+    """The fit a row reports: ``noise_model`` ``null_pairs`` (the refit) or ``white`` (the first fit stands).
+
+    ``n_null_pairs`` null pairs were available; ``note`` says why the white fit stands, if it does.
+    """
+
+    fit: ImpedanceFit
+    noise_model: str
+    n_null_pairs: int
+    note: str = ""
+
+
+def null_pair_errors(window: PreparedWindow, impedance, null_pairs: dict) -> np.ndarray:
+    """Prediction errors (M, m) of pairs without perturbation, at ``impedance``.
+
+    A null pair (:func:`loper_analysis.responses.null_pair_windows`) is an
+    unperturbed stride matched to another one: its difference is what a
+    perturbed-minus-matched difference holds besides the response. Its
+    prediction error is ``eps - G s0``: its measured joint-angle difference
+    over the window (rad; samples, then hip/knee/ankle, like the fit's
+    residuals) minus the model's free response from its own initial state
+    ``s0`` (the pre-onset polynomial, as :func:`prepare_window` takes it; ``G``
+    the sensitivity to the initial state, linear about ``impedance``).
+
+    ``null_pairs``: ``time_s`` (n,) relative to the onset on the grid of the
+    window's data; ``q_perturbed``, ``q_unperturbed`` (M, n, 4);
+    ``pelvis_angle_perturbed_rad``, ``pelvis_angle_unperturbed_rad`` (M, n).
+    """
+    t = np.asarray(null_pairs["time_s"], dtype=float) + window.onset_s
+    qp, qu = (np.asarray(null_pairs[k], dtype=float) for k in ("q_perturbed", "q_unperturbed"))
+    pp, pu = (np.asarray(null_pairs[k], dtype=float) for k in ("pelvis_angle_perturbed_rad",
+                                                               "pelvis_angle_unperturbed_rad"))
+    n_pairs = qp.shape[0]
+    if qp.ndim != 3 or qp.shape != qu.shape or qp.shape[1:] != (t.size, 4) or pp.shape != qp.shape[:2] \
+            or pu.shape != pp.shape:
+        raise LoperInputError(f"null pairs: q arrays must be (M, {t.size}, 4) and pelvis angles (M, {t.size}); got "
+                              f"{qp.shape}, {qu.shape}, {pp.shape}, {pu.shape}")
+    m = 3 * window.n_samples
+    if n_pairs < 1:
+        raise LoperInputError("null pairs: none given")
+    tol = 1e-6 * window.step_s * window.n_substeps
+    idx = np.searchsorted(t, window.time_s - tol)
+    if np.any(idx >= t.size) or np.any(np.abs(t[np.minimum(idx, t.size - 1)] - window.time_s) > tol):
+        raise LoperInputError(f"null pairs: their grid ({t[0]:.4f} .. {t[-1]:.4f} s) does not hold the window's "
+                              f"samples ({window.time_s[0]:.4f} .. {window.time_s[-1]:.4f} s)")
+    sel = (t >= window.onset_s - window.initial_state_span_s - tol) & (t <= window.onset_s + tol)
+    V = initial_state_basis(t[sel] - window.time_s[0], window.initial_state_degree)
+    dq = qp - qu
+    coef, *_ = np.linalg.lstsq(V, np.moveaxis(dq[:, sel], 1, 0).reshape(sel.sum(), -1), rcond=None)
+    coef = coef.reshape(V.shape[1], n_pairs, 4)
+    s0 = np.concatenate([coef[0], coef[1] if window.initial_state_degree >= 1 else np.zeros((n_pairs, 4))], axis=1)
+    eps = np.stack([joint_angles(qp[i, idx], pp[i, idx]) - joint_angles(qu[i, idx], pu[i, idx])
+                    for i in range(n_pairs)]).reshape(n_pairs, m)
+    return eps - s0 @ initial_state_jacobian(window, impedance).T
+
+def nuisance_projection(errors, n_components: int) -> np.ndarray:
+    """Projection (m, m) that removes the ``n_components`` dominant shapes of ``errors``.
+
+    ``errors`` (M, m): e.g. :func:`null_pair_errors`. The shapes are the
+    leading right singular vectors ``V`` of the centred errors; the
+    projection is ``I - V V^T``. Used as ``PreparedWindow.residual_weight``
+    it fits K and D to what these shapes cannot explain, as if their
+    amplitudes were free nuisance parameters.
+    """
+    E = np.asarray(errors, dtype=float)
+    if E.ndim != 2 or not np.all(np.isfinite(E)):
+        raise LoperInputError(f"errors must be a finite (M, m) array, got shape {E.shape}")
+    r = int(n_components)
+    if r != n_components or not 0 <= r < min(E.shape):
+        raise LoperInputError(f"n_components must be an integer in 0 .. {min(E.shape) - 1} "
+                              f"(M = {E.shape[0]} null pairs, m = {E.shape[1]}), got {n_components}")
+    _, _, vt = np.linalg.svd(E - E.mean(axis=0), full_matrices=False)
+    return np.eye(E.shape[1]) - vt[:r].T @ vt[:r]
+
+
+def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pairs: dict, n_averaged: int,
+                          n_components: int = 6, min_null_pairs: int = 30, **fit_options) -> NullPairFit:
+    """Fit again with the null pairs' dominant shapes projected out and CIs from their covariance.
+
+    ``first`` is the white-noise fit of ``window``; ``null_pairs`` as for
+    :func:`null_pair_errors` (with ``n_pairs``); ``n_averaged`` the number of
+    perturbed strides averaged in ``window`` (the null pairs' covariance is
+    divided by it). The refit starts from the first estimate and the random
+    starts of ``fit_options`` (keyword arguments of :func:`identify_impedance`).
+    With fewer than ``max(min_null_pairs, n_components + 2)`` null pairs the
+    first fit stands and ``note`` says so.
+    """
+    n_null = int(null_pairs["n_pairs"])
+    if n_null < max(int(min_null_pairs), int(n_components) + 2):
+        note = (f"white-noise fit: {n_null} null pair(s), fewer than min_null_pairs = {min_null_pairs}; "
+                "the CI ignore the stride-to-stride deviation")
+        return NullPairFit(first, "white", n_null, note)
+    if int(n_averaged) < 1:
+        raise LoperInputError(f"n_averaged must be >= 1 (strides in the mean response), got {n_averaged}")
+    errors = null_pair_errors(window, first.estimate, null_pairs)
+    weight = nuisance_projection(errors, n_components)
+    cov = np.cov(errors, rowvar=False) / n_averaged
+    fit = identify_impedance(replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate,
+                             **fit_options)
+    return NullPairFit(fit, "null_pairs", n_null)

@@ -1,0 +1,125 @@
+"""The one atomic writer: every output of the pipeline is staged beside its target and moved over it whole.
+
+:func:`staged` yields a temporary path with the target's own file name, in
+a fresh hidden directory beside the target (so writers that look at the
+suffix or print the name, like OpenSim's adapters, see the real one). When
+the body returns, the file is moved over the target with :func:`os.replace`
+(atomic on one file system); when the body raises, or the move fails, the
+staging directory is removed and the target is left as it was. A reader
+therefore sees either the old file or the complete new one, never a part.
+
+The other functions are the writers of the common kinds of output (bytes,
+text, tidy TSV, figures, YAML), all through :func:`staged`. Writers of file
+formats with their own libraries (C3D, TRC/.mot, .osim) call :func:`staged`
+themselves.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import pandas as pd
+import yaml
+
+from ..errors import LoperInputError
+
+__all__ = [
+    "PathLike",
+    "TSV_FLOAT_FORMAT",
+    "FIGURE_DPI",
+    "staged",
+    "write_bytes",
+    "write_text",
+    "write_tsv",
+    "write_figure",
+    "write_yaml",
+]
+
+#: A file path as the writers and steps take it.
+PathLike = str | os.PathLike
+#: Default float format of tidy TSV tables (9 significant digits: below any measurement's precision).
+TSV_FLOAT_FORMAT = "%.9g"
+#: Resolution of PNG figures.
+FIGURE_DPI = 110
+
+
+@contextlib.contextmanager
+def staged(path: str | os.PathLike, what: str = "file") -> Iterator[Path]:
+    """Yield a temporary path for ``path``; on success move it over ``path``, on failure leave nothing.
+
+    The parent directory is created when missing. ``what`` names the kind of
+    file in error messages.
+
+    Raises
+    ------
+    LoperInputError
+        The directory cannot be created or written, or the finished file
+        cannot be moved into place (the message names the path and the cause).
+    """
+    path = Path(path)
+    directory = path.parent
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".partial", dir=directory))
+    except OSError as exc:
+        raise LoperInputError(f"{path}: cannot write {what} ({exc})") from exc
+    try:
+        tmp = stage / path.name
+        yield tmp
+        if not tmp.is_file():
+            raise LoperInputError(f"{path}: cannot write {what}: the writer produced no file")
+        try:
+            os.replace(tmp, path)
+        except OSError as exc:
+            raise LoperInputError(f"{path}: cannot write {what} ({exc})") from exc
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+def write_bytes(path: str | os.PathLike, data: bytes, what: str = "file") -> Path:
+    """Write ``data`` to ``path`` atomically; returns the path."""
+    with staged(path, what) as tmp:
+        tmp.write_bytes(data)
+    return Path(path)
+
+
+def write_text(path: str | os.PathLike, text: str, what: str = "file") -> Path:
+    """Write UTF-8 ``text`` to ``path`` atomically; returns the path."""
+    return write_bytes(path, text.encode("utf-8"), what)
+
+
+def write_tsv(frame: pd.DataFrame, path: str | os.PathLike, float_format: str = TSV_FLOAT_FORMAT) -> Path:
+    """Write a tidy table as TSV atomically: no index, ``\\n`` line ends, NaN empty, floats by ``float_format``.
+
+    The same frame gives the same bytes.
+    """
+    with staged(path, "table") as tmp:
+        frame.to_csv(tmp, sep="\t", index=False, float_format=float_format, na_rep="", lineterminator="\n")
+    return Path(path)
+
+
+def write_figure(figure, path: str | os.PathLike, dpi: int = FIGURE_DPI, close: bool = True) -> Path:
+    """Render a matplotlib figure to PNG atomically (no software tag: the same figure gives the same bytes).
+
+    The figure is closed afterwards (also when rendering fails) unless ``close`` is False.
+    """
+    try:
+        with staged(path, "figure") as tmp:
+            figure.savefig(tmp, format="png", dpi=dpi, metadata={"Software": None})
+    finally:
+        if close:
+            import matplotlib.pyplot as plt
+
+            plt.close(figure)
+    return Path(path)
+
+
+def write_yaml(path: str | os.PathLike, document, header: str = "") -> Path:
+    """Write a YAML document (keys in the given order) atomically, after an optional ``# header`` line."""
+    text = (f"# {header}\n" if header else "") + yaml.safe_dump(document, sort_keys=False)
+    return write_text(path, text, "YAML file")

@@ -1,0 +1,242 @@
+"""The mean perturbation response of one subject at one onset, over the subject's trials.
+
+The averaged pair is what the identification
+(:func:`loper_analysis.identification.prepare_window`) fits.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from ..checks import bool_column, number, where
+from ..constants import JOINTS
+from ..dynamics import segment_coordinates
+from ..errors import LoperInputError
+from ..outliers import check_enough_strides
+from .inputs import trial_angles, trial_name, trial_table
+from .matching import match_unperturbed, stride_table, too_short
+from .sampling import TIME_TOLERANCE_S
+from .windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
+
+__all__ = ["COUNT_COLUMNS", "mean_and_sd", "subject_onset_response"]
+
+log = logging.getLogger(__name__)
+
+#: Columns of the counts table returned by :func:`subject_onset_response`.
+COUNT_COLUMNS: tuple[str, ...] = (
+    "trial", "n_perturbed", "n_too_short", "n_no_match", "n_outliers", "n_kept", "status", "reason",
+)
+
+
+def mean_and_sd(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and SD (ddof 1) over axis 0; NaN where too few rows (no warnings)."""
+    shape = a.shape[1:]
+    mean = a.mean(axis=0) if a.shape[0] else np.full(shape, np.nan)
+    sd = a.std(axis=0, ddof=1) if a.shape[0] >= 2 else np.full(shape, np.nan)
+    return mean, sd
+
+
+def _trial_inputs(trial: Mapping, k: int, side: str, source: str):
+    """Checked frame data of one trial: name, stride-table label, time, columns to window, stride table."""
+    name = trial_name(trial, k, ("angles", "strides", "force", "force_direction"), source)
+    t, columns, where_a = trial_angles(trial, name, side)
+    strides, where_s = trial_table(trial, "strides", name)
+    force, where_f = trial_table(trial, "force", name, ("time_s", "force_measured_n"))
+    tf = force["time_s"].to_numpy(float)
+    if tf.shape != t.shape or not np.allclose(tf, t, rtol=0.0, atol=1e-6):
+        raise LoperInputError(f"{where_f}: time_s ({tf.size} frames) differs from the angles' frames in {where_a} "
+                              f"({t.size} frames)")
+    direction = np.asarray(trial["force_direction"], dtype=float)
+    if direction.shape != (t.size, 2):
+        raise LoperInputError(f"{name}: force_direction must have shape ({t.size}, 2), got {direction.shape}")
+    with np.errstate(invalid="ignore"):
+        off = np.flatnonzero(np.abs(np.hypot(direction[:, 0], direction[:, 1]) - 1.0) > 1e-6)
+    if off.size:
+        i = int(off[0])
+        raise LoperInputError(f"{name}: force_direction at frame {i} (t = {t[i]:.4f} s) is not a unit vector: "
+                              f"{direction[i].tolist()}")
+    magnitude = force["force_measured_n"].to_numpy(float)
+    columns["force"] = magnitude
+    columns["force_vector"] = magnitude[:, None] * direction  # NaN frames stay NaN
+    return name, where_s, t, columns, strides
+
+
+def subject_onset_response(
+    trials: Sequence[Mapping],
+    onset_ms: float,
+    settings: ResponseSettings = ResponseSettings(),
+    *,
+    side: str = "left",
+    method: str = "cubic",
+    candidate_within_swing: bool = False,
+    source: str = "",
+) -> tuple[pd.DataFrame, pd.DataFrame, dict]:
+    """Mean perturbation response of one subject at one onset, over the subject's trials.
+
+    With ``settings`` (:class:`~loper_analysis.responses.windows.ResponseSettings`)
+    ``before``, ``after`` and ``initial``: per trial, perturbed strides that
+    are :func:`too_short` for ``onset_ms`` and ``after`` are dropped; the
+    others are matched within the trial (:func:`match_unperturbed` on hip,
+    knee and ankle of ``side`` over ``before``; candidates must cover the
+    whole window); windows from ``-(initial + before)`` to ``after`` around
+    the onset are taken (:func:`paired_windows`). The pairs of all trials are
+    pooled, judged by :func:`window_outliers` on ``-before .. after``, and
+    the kept pairs averaged. Status ``too_few_strides`` (and a
+    :class:`loper_analysis.errors.TooFewStridesWarning` for the total) when
+    fewer than ``settings.min_strides`` pairs are kept.
+
+    Parameters
+    ----------
+    trials : sequence of mapping
+        One per trial of this onset: ``name``, ``angles``, ``strides``,
+        ``force`` and ``force_direction`` (:mod:`loper_analysis.responses.inputs`).
+    onset_ms : float
+        Nominal onset after toe-off, ms (e.g. 300).
+    settings : ResponseSettings
+        Windows, grid rate, IQR rule and fewest kept pairs.
+    side : {"left", "right"}
+        Swing leg of the joint-angle columns.
+    method : {"cubic", "linear"}
+        Interpolation of :func:`paired_windows`.
+    candidate_within_swing : bool
+        See :func:`match_unperturbed`.
+    source : str
+        Name of the subject, quoted in messages.
+
+    Returns
+    -------
+    response : pandas.DataFrame
+        One row per grid sample: ``time_s`` (relative to onset, s);
+        ``{hip,knee,ankle}_rad_mean`` / ``_sd`` - perturbed minus matched
+        unperturbed angle (rad, SD ddof 1); ``force_n_mean`` / ``force_n_sd``
+        - perturbed minus unperturbed measured force (N);
+        ``{joint}_perturbed_rad_mean``, ``{joint}_unperturbed_rad_mean``
+        (rad); ``force_perturbed_n_mean``, ``force_unperturbed_n_mean`` (N);
+        ``n_pairs`` (kept pairs); ``analysis_window`` (bool, inside
+        ``-before_s .. after_s``). NaN where no (mean) or one (SD) pair is kept.
+    counts : pandas.DataFrame
+        Columns :data:`COUNT_COLUMNS`, one row per trial and a row ``total``:
+        perturbed strides, too short, without match, outliers, kept pairs,
+        ``status`` (``ok`` | ``too_few_strides``: ``n_kept < min_strides``) and
+        ``reason``. ``attrs["pairs"]``: one row per pair (``trial``,
+        ``stride``, ``matched_stride``, ``onset_s``, ``matched_anchor_s``,
+        ``rmsd_rad``, ``removed``, ``reason``); ``attrs["outliers_judged"]``.
+    series : dict
+        Means over kept pairs on the grid, named like the arguments of
+        :func:`loper_analysis.identification.prepare_window`: ``time_s``
+        (n_grid,), ``onset_s`` (0.0), ``q_unperturbed`` / ``q_perturbed``
+        (n_grid, 4): [pelvis_x (m), thigh, shank, foot (rad)] from
+        :func:`loper_analysis.dynamics.segment_coordinates`,
+        ``pelvis_angle_unperturbed_rad`` / ``pelvis_angle_perturbed_rad``
+        (n_grid,), ``force_unperturbed_n`` / ``force_perturbed_n`` (n_grid, 2):
+        ``force_measured_n * force_direction`` (N, world x/y); plus
+        ``window_before_s``, ``window_after_s``, ``initial_state_span_s`` and
+        ``n_pairs``. Arrays are NaN when no pair is kept.
+
+    Raises
+    ------
+    LoperInputError
+        Bad inputs or settings (naming the trial/file, column and value),
+        duplicate trial names.
+    """
+    onset_s, before, after, initial, start, grid = analysis_grid(trials, onset_ms, settings, side, source)
+    min_n = int(number("min_strides", settings.min_strides, source, minimum=0.0))
+    rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
+
+    per_trial, pairs, windows = [], [], []
+    for k, trial in enumerate(trials):
+        name, where_s, t, columns, strides = _trial_inputs(trial, k, side, source)
+        if any(rec["trial"] == name for rec in per_trial):
+            raise LoperInputError(f"{where(source)}trial name {name!r} appears twice; names must be unique")
+        table = stride_table(strides, where_s)
+        n_perturbed = int(bool_column(table, "perturbed", where_s, what="strides").sum())
+        n_short = int(too_short(table, onset_s, after, source=where_s).sum())
+        matches = match_unperturbed(
+            t, columns["joints"], table, before, source=where_s, span_s=(start, after),
+            onset_after_toe_off_s=onset_s, window_after_s=after, candidate_within_swing=candidate_within_swing,
+            missing="drop",
+        )
+        for s, why in matches.attrs["unmatched"].items():
+            log.info("%s: perturbed stride %s has no match: %s", where_s, s, why)
+        windows.append(paired_windows(t, columns, matches, start, after, rate_hz, method=method, source=where_s))
+        pairs.append(matches.assign(trial=name))
+        per_trial.append({"trial": name, "n_perturbed": n_perturbed, "n_too_short": n_short,
+                          "n_no_match": len(matches.attrs["unmatched"])})
+
+    win = {key: tuple(np.concatenate([w[key][i] for w in windows]) for i in range(2)) for key in windows[0]}
+    joints_p, joints_u = win["joints"]
+    label = f"{source} onset {onset_ms:g} ms" if source else f"onset {onset_ms:g} ms"
+    verdict = window_outliers(joints_p - joints_u, grid, before, after, whisker, max_fraction, JOINTS, label)
+    pair_columns = ["trial", "stride", "matched_stride", "onset_s", "matched_anchor_s", "rmsd_rad"]
+    filled = [m[pair_columns] for m in pairs if len(m)]
+    pair_table = (pd.concat(filled, ignore_index=True) if filled else pairs[0][pair_columns]).reset_index(drop=True)
+    pair_table.attrs = {}
+    pair_table = pair_table.assign(removed=verdict["removed"].to_numpy(), reason=verdict["reason"].to_numpy())
+    keep = ~pair_table["removed"].to_numpy(bool)
+    n_pairs = int(keep.sum())
+
+    # counts
+    judged = bool(verdict.attrs["judged"])
+    rows = []
+    for rec in per_trial:
+        mine = pair_table["trial"].to_numpy() == rec["trial"]
+        rows.append({**rec, "n_outliers": int((mine & ~keep).sum()), "n_kept": int((mine & keep).sum())})
+    total = {key: sum(r[key] for r in rows) for key in ("n_perturbed", "n_too_short", "n_no_match", "n_outliers",
+                                                         "n_kept")}
+    rows.append({"trial": "total", **total})
+    for r in rows:
+        parts = []
+        if r["n_kept"] < min_n:
+            parts.append(f"{r['n_kept']} pair(s) kept, fewer than min_strides = {min_n}"
+                         + ("" if r["trial"] == "total" else " (the average pools the trials: see total)"))
+        if r["n_too_short"]:
+            parts.append(f"{r['n_too_short']} too short (swing < onset delay + {after * 1e3:g} ms)")
+        if r["n_no_match"]:
+            parts.append(f"{r['n_no_match']} without unperturbed match")
+        if r["n_outliers"]:
+            parts.append(f"{r['n_outliers']} outlier(s) in the window -{before * 1e3:g} .. {after * 1e3:g} ms")
+        if not judged:
+            parts.append(verdict["reason"].iloc[0] if len(verdict) else "outliers not judged: no pair")
+        r["status"] = "ok" if r["n_kept"] >= min_n else "too_few_strides"
+        r["reason"] = "; ".join(parts)
+    counts = pd.DataFrame(rows, columns=list(COUNT_COLUMNS))
+    check_enough_strides(n_pairs, label or "perturbation response", min_n)
+    counts.attrs = {"pairs": pair_table, "outliers_judged": judged, "onset_ms": float(onset_ms), "source": source}
+    log.info("%s: %d perturbed, %d too short, %d without match, %d outliers, %d kept", label, total["n_perturbed"],
+             total["n_too_short"], total["n_no_match"], total["n_outliers"], total["n_kept"])
+
+    # averages over the kept pairs
+    kept = {key: (p[keep], u[keep]) for key, (p, u) in win.items()}
+    jp, ju = kept["joints"]
+    d_mean, d_sd = mean_and_sd(jp - ju)
+    fp, fu = kept["force"]
+    f_mean, f_sd = mean_and_sd(fp - fu)
+    jp_mean, ju_mean = mean_and_sd(jp)[0], mean_and_sd(ju)[0]
+    response = pd.DataFrame({"time_s": grid})
+    for j, joint in enumerate(JOINTS):
+        response[f"{joint}_rad_mean"] = d_mean[:, j]
+        response[f"{joint}_rad_sd"] = d_sd[:, j]
+    response["force_n_mean"], response["force_n_sd"] = f_mean, f_sd
+    for j, joint in enumerate(JOINTS):
+        response[f"{joint}_perturbed_rad_mean"] = jp_mean[:, j]
+        response[f"{joint}_unperturbed_rad_mean"] = ju_mean[:, j]
+    response["force_perturbed_n_mean"], response["force_unperturbed_n_mean"] = mean_and_sd(fp)[0], mean_and_sd(fu)[0]
+    response["n_pairs"] = n_pairs
+    response["analysis_window"] = (grid >= -before - TIME_TOLERANCE_S) & (grid <= after + TIME_TOLERANCE_S)
+    response.attrs = {"onset_ms": float(onset_ms), "n_pairs": n_pairs, "source": source, "before_s": before,
+                      "after_s": after, "initial_span_s": initial}
+
+    series: dict = {"time_s": grid.copy(), "onset_s": 0.0}
+    for what, i in (("perturbed", 0), ("unperturbed", 1)):
+        j, pel, x = kept["joints"][i], kept["pelvis_angle"][i], kept["pelvis_x"][i]
+        q = segment_coordinates(j.reshape(-1, 3), pel.reshape(-1), x.reshape(-1)).reshape(j.shape[:2] + (4,))
+        series[f"q_{what}"] = mean_and_sd(q)[0]
+        series[f"pelvis_angle_{what}_rad"] = mean_and_sd(pel)[0]
+        series[f"force_{what}_n"] = mean_and_sd(kept["force_vector"][i])[0]
+    series.update({"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial,
+                   "n_pairs": n_pairs})
+    return response, counts, series

@@ -1,0 +1,282 @@
+"""Matching each perturbed stride with the unperturbed stride of its trial that is most similar before the onset.
+
+* :func:`too_short` - perturbed strides whose swing cannot hold the window;
+* :func:`match_unperturbed` - the matched unperturbed stride and its anchor
+  (also for null pairs: unperturbed strides matched as if perturbed).
+
+Alignment: a candidate unperturbed stride ``u`` is aligned to a perturbed
+stride ``p`` at the same time after its own toe-off,
+``anchor_u = toe_off_u + (onset_p - toe_off_p)``; relative time 0 is the
+onset in ``p`` and the anchor in ``u``. Times in s on the motion-capture
+clock; angles in rad.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from ..checks import bool_column, number, require_columns, signal, time_vector, where
+from ..errors import LoperInputError
+from .sampling import TIME_TOLERANCE_S, SplineSampler, window_span
+
+__all__ = ["MATCH_COLUMNS", "STRIDE_TABLE_COLUMNS", "stride_table", "too_short", "match_unperturbed"]
+
+#: Columns of the table returned by :func:`match_unperturbed`.
+MATCH_COLUMNS: tuple[str, ...] = (
+    "stride", "onset_s", "toe_off_s", "matched_stride", "matched_anchor_s", "rmsd_rad", "n_candidates",
+)
+#: Stride-table columns a response needs (:func:`loper_analysis.strides.stride_tables`).
+STRIDE_TABLE_COLUMNS: tuple[str, ...] = ("stride", "toe_off_s", "swing_s", "perturbed", "onset_s")
+
+
+def stride_table(strides, source: str = "", columns: Sequence[str] = STRIDE_TABLE_COLUMNS) -> pd.DataFrame:
+    """The stride table of a trial, checked to hold ``columns``, with a fresh index."""
+    return require_columns(strides, columns, source, what="strides").reset_index(drop=True)
+
+
+def _perturbed_onsets(table: pd.DataFrame, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """Perturbed mask and onsets; a perturbed stride needs a finite onset."""
+    perturbed = bool_column(table, "perturbed", source, what="strides")
+    onset = table["onset_s"].to_numpy(float)
+    bad = np.flatnonzero(perturbed & ~np.isfinite(onset))
+    if bad.size:
+        i = int(bad[0])
+        raise LoperInputError(
+            f"{where(source)}strides: perturbed stride {table['stride'].iloc[i]} has onset_s = {float(onset[i])!r}"
+        )
+    toe_off = table["toe_off_s"].to_numpy(float)
+    bad = np.flatnonzero(~np.isfinite(toe_off))
+    if bad.size:
+        i = int(bad[0])
+        raise LoperInputError(
+            f"{where(source)}strides: stride {table['stride'].iloc[i]} has toe_off_s = {float(toe_off[i])!r}"
+        )
+    return perturbed, onset
+
+
+def too_short(strides: pd.DataFrame, onset_after_toe_off_s: float | None = None, window_after_s: float = 0.25,
+              source: str = "") -> np.ndarray:
+    """Perturbed strides whose swing is too short to hold the window after the onset.
+
+    A perturbed stride is too short if ``swing_s < delay + window_after_s``,
+    where ``delay`` is its own onset delay ``onset_s - toe_off_s`` (the
+    window must end before the next heel strike) or, when
+    ``onset_after_toe_off_s`` is given, the larger of the two (the study's
+    rule: the 300 ms onset needs a swing of at least 550 ms). A swing of
+    exactly the needed length is kept (1e-9 s tolerance). Unperturbed strides
+    are never too short.
+
+    Parameters
+    ----------
+    strides : pandas.DataFrame
+        Stride table (:func:`loper_analysis.strides.stride_tables`): columns
+        ``stride``, ``toe_off_s``, ``swing_s``, ``perturbed`` (bool) and
+        ``onset_s`` (s, absolute; finite for perturbed strides).
+    onset_after_toe_off_s : float, optional
+        Nominal onset of the condition after toe-off, s (e.g. 0.3).
+    window_after_s : float
+        Length of the analysis window after the onset, s (>= 0).
+    source : str
+        Name of the trial, quoted in error messages.
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (n_strides,)
+        True for perturbed strides that are too short, in table order.
+
+    Raises
+    ------
+    LoperInputError
+        Missing columns, non-boolean flags, a perturbed stride without a
+        finite onset, negative or non-finite settings.
+    """
+    table = stride_table(strides, source, ("stride", "toe_off_s", "swing_s", "perturbed", "onset_s"))
+    after = number("window_after_s", window_after_s, source, minimum=0.0)
+    perturbed, onset = _perturbed_onsets(table, source)
+    delay = onset - table["toe_off_s"].to_numpy(float)
+    if onset_after_toe_off_s is not None:
+        delay = np.fmax(delay, number("onset_after_toe_off_s", onset_after_toe_off_s, source, minimum=0.0))
+    swing = table["swing_s"].to_numpy(float)
+    with np.errstate(invalid="ignore"):
+        short = swing < delay + after - TIME_TOLERANCE_S
+    return perturbed & short
+
+
+# --------------------------------------------------------------------------- matching
+
+
+def match_unperturbed(
+    time_s,
+    signals,
+    strides: pd.DataFrame,
+    before_s: float = 0.025,
+    source: str = "",
+    *,
+    span_s: tuple[float, float] | None = None,
+    onset_after_toe_off_s: float | None = None,
+    window_after_s: float | None = None,
+    candidate_within_swing: bool = False,
+    missing: str = "raise",
+    null_pairs: bool = False,
+) -> pd.DataFrame:
+    """For each perturbed stride, the unperturbed stride most similar just before the onset.
+
+    Candidates are the strides of the same table (one trial) that are
+    neither perturbed nor ``removed``. Candidate ``u`` is aligned to the
+    perturbed stride ``p`` at ``anchor_u = toe_off_u + (onset_p - toe_off_p)``.
+    The matching frames are the frames of ``p`` with
+    ``onset_p - before_s <= time_s <= onset_p``; at their times relative to
+    the onset the candidate is sampled by cubic spline, and the RMSD over
+    these frames and all signals is taken. The candidate with the smallest
+    RMSD wins (ties: the first in table order).
+
+    A candidate is skipped when its aligned span ``anchor_u + span_s`` leaves
+    the (finite) data, or - with ``candidate_within_swing`` - ends after its
+    own heel strike (``end_s``). A perturbed stride whose own span leaves the
+    data, or without any candidate, has no match.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n_frames,)
+        Frame times in s, strictly increasing.
+    signals : array_like, shape (n_frames,) or (n_frames, k)
+        Signals compared, usually hip, knee and ankle angles of the leg, rad.
+        NaN policy: the matching frames of ``p`` must be finite; a candidate
+        whose span touches non-finite frames is skipped.
+    strides : pandas.DataFrame
+        Stride table of the trial: ``stride``, ``toe_off_s``, ``end_s``,
+        ``swing_s``, ``perturbed`` (bool), ``onset_s`` (s), ``removed`` (bool).
+    before_s : float
+        Matching span before the onset, s (>= 0).
+    source : str
+        Name of the trial, quoted in error messages and ``attrs``.
+    span_s : (float, float), optional
+        Span (start, end) relative to onset/anchor, s, that perturbed and
+        candidate data must cover, e.g. ``(-0.125, 0.25)`` for the windows of
+        :func:`paired_windows`; it is widened to hold ``-before_s .. 0``.
+        Default ``(-before_s, 0)``.
+    onset_after_toe_off_s, window_after_s : float, optional
+        With ``window_after_s``, perturbed strides that are :func:`too_short`
+        are left out (listed in ``attrs["too_short"]``).
+    candidate_within_swing : bool
+        Require the candidate's span to end before its own heel strike.
+    missing : {"raise", "drop"}
+        A perturbed stride without match raises, or is left out and listed in
+        ``attrs["unmatched"]``.
+    null_pairs : bool
+        Match the *unperturbed* strides instead, each as if perturbed
+        ``onset_after_toe_off_s`` after its toe-off, among the other
+        candidates (never itself); perturbed strides take no part. Their
+        differences are the stride-to-stride noise of a response
+        (:func:`null_pair_windows`). Needs ``onset_after_toe_off_s``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per matched perturbed stride, in table order, columns
+        :data:`MATCH_COLUMNS`: ``stride``, ``onset_s`` and ``toe_off_s`` of
+        the perturbed stride (s), ``matched_stride``, ``matched_anchor_s``
+        (s), ``rmsd_rad`` (RMSD in the signals' unit, rad for angles) and
+        ``n_candidates`` (candidates that covered the span). ``attrs``:
+        ``source``, ``before_s``, ``span_s``, ``too_short`` (list of stride
+        numbers) and ``unmatched`` (dict stride number -> reason).
+
+    Raises
+    ------
+    LoperInputError
+        Bad time, shapes, settings or stride table; with ``missing="raise"`` a
+        perturbed stride without match (naming the stride and ``source``).
+    """
+    t = time_vector(time_s, source, min_count=4, item="frame")
+    v = signal("signals", signals, t.size, source)
+    v2 = v.reshape(t.size, -1)
+    cols = ["stride", "toe_off_s", "end_s", "swing_s", "perturbed", "onset_s", "removed"]
+    table = stride_table(strides, source, cols)
+    before = number("before_s", before_s, source, minimum=0.0)
+    lo_span, hi_span = (-before, 0.0) if span_s is None else window_span(*span_s, source)
+    lo_span, hi_span = min(lo_span, -before), max(hi_span, 0.0)
+    if missing not in ("raise", "drop"):
+        raise LoperInputError(f"{where(source)}missing must be 'raise' or 'drop', got {missing!r}")
+    perturbed, onset = _perturbed_onsets(table, source)
+    removed = bool_column(table, "removed", source, what="strides")
+    if null_pairs:
+        if onset_after_toe_off_s is None:
+            raise LoperInputError(f"{where(source)}null_pairs needs onset_after_toe_off_s")
+        delay = number("onset_after_toe_off_s", onset_after_toe_off_s, source, minimum=0.0)
+        table = table.assign(onset_s=np.where(perturbed, np.nan, table["toe_off_s"].to_numpy(float) + delay),
+                             perturbed=~perturbed & ~removed, removed=removed | perturbed)
+        perturbed, onset = _perturbed_onsets(table, source)
+        removed = bool_column(table, "removed", source, what="strides")
+    short = (too_short(table, onset_after_toe_off_s, window_after_s, source) if window_after_s is not None
+             else np.zeros(len(table), dtype=bool))
+    stride_no = table["stride"].to_numpy()
+    toe_off = table["toe_off_s"].to_numpy(float)
+    end = table["end_s"].to_numpy(float)
+    p = np.flatnonzero(perturbed & ~short)
+    c = np.flatnonzero((null_pairs | ~perturbed) & ~removed)
+    sampler = SplineSampler(t, v2)
+    tol = sampler.tol
+    unmatched: dict[int, str] = {}
+
+    # matching frames of each perturbed stride, padded to the longest
+    onset_p, toe_p = onset[p], toe_off[p]
+    first = np.searchsorted(t, onset_p - before - tol, side="left")
+    count = np.searchsorted(t, onset_p + tol, side="right") - first
+    m = max(int(count.max()) if p.size else 0, 1)
+    valid = np.arange(m) < count[:, None]  # (np, m)
+    idx = np.minimum(first[:, None] + np.arange(m), t.size - 1)
+    rel = np.where(valid, t[idx] - onset_p[:, None], 0.0)
+    vp = v2[idx]  # (np, m, k)
+    own = sampler.run(onset_p + lo_span, onset_p + hi_span) >= 0
+    own &= (count > 0) & np.where(valid[..., None], np.isfinite(vp), True).all(axis=(1, 2))
+    for i in np.flatnonzero(~own):
+        unmatched[int(stride_no[p[i]])] = (
+            f"its window {onset_p[i] + lo_span:.4f} .. {onset_p[i] + hi_span:.4f} s leaves the finite data "
+            f"({sampler.finite_spans()})"
+        )
+
+    # candidates aligned at the same time after their own toe-off
+    anchors = toe_off[c][None, :] + (onset_p - toe_p)[:, None]  # (np, nc)
+    ok = own[:, None] & (sampler.run(anchors + lo_span, anchors + hi_span) >= 0)
+    if candidate_within_swing:
+        ok &= anchors + hi_span <= end[c][None, :] + tol
+    if null_pairs:
+        ok &= p[:, None] != c[None, :]
+    targets = anchors[:, :, None] + rel[:, None, :]  # (np, nc, m)
+    sq = np.zeros(targets.shape)
+    if ok.any():
+        runs = sampler.run(anchors[ok] + lo_span, anchors[ok] + hi_span)
+        vc = sampler(targets[ok], runs)  # (n_ok, m, k)
+        diff = vc - np.broadcast_to(vp[:, None], ok.shape + vp.shape[1:])[ok]
+        sq[ok] = np.sum(diff**2, axis=-1)
+    n_values = np.maximum(count, 1)[:, None] * v2.shape[1]
+    rmsd = np.where(ok, np.sqrt(np.sum(np.where(valid[:, None, :], sq, 0.0), axis=-1) / n_values), np.inf)
+    best = np.argmin(rmsd, axis=1) if c.size else np.zeros(p.size, dtype=int)
+    n_cand = ok.sum(axis=1)
+    for i in np.flatnonzero(own & (n_cand == 0)):
+        unmatched[int(stride_no[p[i]])] = (
+            f"no unperturbed candidate among {c.size} (not perturbed, not removed) covers the aligned window"
+            + (" inside its swing" if candidate_within_swing else "")
+        )
+    hit = own & (n_cand > 0)
+    if unmatched and missing == "raise":
+        s, why = next(iter(unmatched.items()))
+        raise LoperInputError(f"{where(source)}perturbed stride {s} has no unperturbed match: {why}")
+    rows = np.flatnonzero(hit)
+    out = pd.DataFrame({
+        "stride": stride_no[p[rows]],
+        "onset_s": onset_p[rows],
+        "toe_off_s": toe_p[rows],
+        "matched_stride": stride_no[c][best[rows]] if c.size else np.empty(0, dtype=stride_no.dtype),
+        "matched_anchor_s": anchors[rows, best[rows]] if c.size else np.empty(0),
+        "rmsd_rad": rmsd[rows, best[rows]] if c.size else np.empty(0),
+        "n_candidates": n_cand[rows].astype(np.int64),
+    }, columns=list(MATCH_COLUMNS))
+    out.attrs.update({
+        "source": source, "before_s": before, "span_s": (lo_span, hi_span),
+        "too_short": [int(s) for s in stride_no[short]], "unmatched": unmatched,
+    })
+    return out

@@ -1,0 +1,23 @@
+"""The file layer: one function per workflow rule (and command-line subcommand).
+
+Every function here reads its input files, calls the library (which works on
+arrays and frames only) and writes exactly its declared outputs through the
+atomic writer (:mod:`loper_analysis.io.atomic`); nothing below this layer
+touches a path. Workflow scripts call one of these functions inside
+:func:`rule_log`, which routes the messages, warnings and, on failure, the
+full error of the job to its log file.
+
+* :mod:`.processing` - markers, gait events, load cell, strides, stride summary;
+* :mod:`.model` - generic model, scaling, segment tables;
+* :mod:`.ik` - inverse kinematics (one job per trial, or in time chunks);
+* :mod:`.transparency` - the transparency tables and figure;
+* :mod:`.impedance` - responses and fits per subject and onset, aggregates, figures;
+* :mod:`.validation` - the validation study;
+* :mod:`.device` - device tests: simulated logs, FRF, steps, summary, figures;
+* :mod:`.synthetic` - raw files of synthetic subjects;
+* :mod:`.report` - the Markdown rendering of the result tables.
+"""
+
+from .logs import rule_log
+
+__all__ = ["rule_log"]

@@ -1,0 +1,119 @@
+"""File steps of inverse kinematics: OpenSim IK of a trial's TRC to a .mot and the joint-angle table."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..errors import LoperInputError
+from ..io.atomic import PathLike, write_tsv
+
+__all__ = ["ik_chunk", "ik_trial", "ik_join", "ik_file"]
+
+log = logging.getLogger(__name__)
+
+
+def _solve(model_osim: PathLike, time_s: np.ndarray, markers_m: np.ndarray, labels: Sequence[str], tasks_file=None,
+           default_weight: float = 1.0, marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6,
+           source: str = ""):
+    """IK of marker arrays with the tasks of a file or of the config; returns the :class:`IKResult`."""
+    from ..io.ik_tasks import read_ik_tasks
+    from ..io.osim import read_model
+    from ..kinematics import ik_task_weights, inverse_kinematics
+
+    model = read_model(model_osim)
+    tasks = read_ik_tasks(tasks_file) if tasks_file else None
+    weights, coords = ik_task_weights(model, labels, tasks, default_weight, marker_weights, coordinate_tasks, source)
+    return inverse_kinematics(model, time_s, markers_m, labels, weights, coords, accuracy=accuracy)
+
+
+def ik_chunk(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, chunk: int, n_chunks: int, tasks_file=None,
+             default_weight: float = 1.0, marker_weights: Mapping[str, float] | None = None,
+             coordinate_tasks: Mapping[str, Mapping] | None = None, accuracy: float = 1e-6) -> pd.DataFrame:
+    """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the coordinates."""
+    from ..io.opensim_tables import read_markers, write_mot
+    from ..kinematics import chunk_frames
+
+    time_s, X, labels = read_markers(trc_path)
+    sel = chunk_frames(len(time_s), n_chunks, chunk)
+    res = _solve(model_osim, time_s[sel], X[sel], labels, tasks_file, default_weight, marker_weights,
+                 coordinate_tasks, accuracy, source=str(trc_path))
+    log.info("%s chunk %d/%d: %d frames, marker RMS error mean %.2f mm, max %.2f mm", trc_path, chunk, n_chunks,
+             len(res.time_s), 1e3 * np.nanmean(res.marker_rms_m), 1e3 * np.nanmax(res.marker_max_m))
+    frame = res.frame()
+    write_mot(out_mot, frame, in_degrees=True)
+    return frame
+
+
+def ik_trial(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, angles_tsv: PathLike,
+             coordinate_map: Mapping | None = None, tasks_file=None, default_weight: float = 1.0,
+             marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6) -> pd.DataFrame:
+    """IK of a whole TRC in one go: the .mot (degrees) and the tidy angle table that :func:`ik_join` gives."""
+    from ..kinematics import joint_angle_table
+
+    coords = ik_chunk(model_osim, trc_path, out_mot, 0, 1, tasks_file, default_weight, marker_weights,
+                      coordinate_tasks, accuracy)
+    angles = joint_angle_table(coords, coordinate_map, source=str(out_mot))
+    write_tsv(angles, angles_tsv)
+    log.info("%d frames, %s", len(angles), list(angles.columns))
+    return angles
+
+
+def ik_join(chunk_mots: Sequence[PathLike], out_mot: PathLike, angles_tsv: PathLike,
+            coordinate_map: Mapping | None = None) -> pd.DataFrame:
+    """Join IK chunks into one .mot and the tidy angle table (rad, m; :data:`kinematics.ANGLE_COLUMNS`)."""
+    from ..io.opensim_tables import read_mot, write_mot
+    from ..kinematics import join_chunks, joint_angle_table
+
+    frames = [read_mot(p) for p in chunk_mots]
+    coords = join_chunks(frames, [str(p) for p in chunk_mots])
+    angles = joint_angle_table(coords, coordinate_map, source=str(chunk_mots[0]))
+    write_mot(out_mot, coords, in_degrees=True)
+    write_tsv(angles, angles_tsv)
+    log.info("%d frames, %s", len(angles), list(angles.columns))
+    return angles
+
+
+def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tasks_file=None,
+            start_s: float | None = None, end_s: float | None = None,
+            rotate_deg: Sequence[float] | None = None, accuracy: float = 1e-6):
+    """IK of a .c3d or .trc marker file to a .mot (degrees), for the command line.
+
+    ``rotate_deg`` turns the markers into the model frame (default -90 0 0
+    for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). Without a
+    task file every model marker found in the file gets weight 1. Returns the
+    :class:`~loper_analysis.kinematics.IKResult`.
+    """
+    from ..io.ik_tasks import read_ik_tasks
+    from ..io.opensim_tables import read_markers, write_mot
+    from ..io.osim import read_model
+    from ..kinematics import inverse_kinematics
+    from ..markers import rotate_markers
+
+    markers_path = Path(markers_path)
+    time_s, markers_m, labels = read_markers(markers_path)
+    if rotate_deg is None:
+        rotate_deg = (-90.0, 0.0, 0.0) if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
+    markers_m = rotate_markers(markers_m, rotate_deg)
+    start = time_s[0] if start_s is None else start_s
+    end = time_s[-1] if end_s is None else end_s
+    sel = (time_s >= start - 1e-9) & (time_s <= end + 1e-9)
+    if not sel.any():
+        raise LoperInputError(
+            f"{markers_path}: no frame between --start {start} and --end {end} s "
+            f"(the file spans {time_s[0]:.4f} .. {time_s[-1]:.4f} s)"
+        )
+    weights, coordinate_tasks = (None, None) if tasks_file is None else read_ik_tasks(tasks_file)
+    if weights is not None and not weights:
+        weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
+    try:
+        result = inverse_kinematics(read_model(model_osim), time_s[sel], markers_m[sel], labels, weights,
+                                    coordinate_tasks, accuracy=accuracy)
+    except LoperInputError as exc:
+        raise LoperInputError(f"{markers_path} with {model_osim}: {exc}") from None
+    write_mot(out_mot, result.frame(), in_degrees=True)
+    return result

@@ -1,0 +1,304 @@
+"""Strides of one leg from the joint angles, the gait events and the interaction force; outliers; cycles.
+
+* :func:`stride_tables` - the stride table (absolute times, perturbed flag,
+  outlier verdicts, interaction force per phase) and the time-normalised
+  cycles (stride, stance, swing) of one trial;
+* :func:`stride_summary` - one row per trial: strides found, removed, kept, status;
+* :func:`phase_cycles` - the normalised cycles of one phase as an array.
+
+Times in s on the motion-capture clock, angles in rad, force in N.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from .checks import require_columns, where
+from .constants import JOINTS, PHASES, angle_column
+from .errors import LoperInputError
+from .events import strides as strides_from_events
+from .loadcell import perturbation_onsets
+from .outliers import check_enough_strides, iqr_outliers
+from .resampling import PHASE_BOUNDS, normalise
+
+__all__ = [
+    "MIN_STRIDES_FOR_OUTLIERS",
+    "FORCE_PHASES",
+    "StrideTables",
+    "force_phase_metrics",
+    "stride_tables",
+    "stride_summary",
+    "phase_cycles",
+]
+
+log = logging.getLogger(__name__)
+
+#: Fewest (unperturbed) strides the IQR rule needs.
+MIN_STRIDES_FOR_OUTLIERS = 4
+#: Phases of the interaction-force metrics (half-open sample sets).
+FORCE_PHASES: tuple[str, ...] = ("stance", "swing")
+
+
+@dataclass
+class StrideTables:
+    """The stride table and the normalised cycles of one trial (:func:`stride_tables`).
+
+    ``too_few_strides``: fewer unperturbed strides kept than required.
+    """
+
+    strides: pd.DataFrame
+    cycles: pd.DataFrame
+    too_few_strides: bool
+
+
+def force_phase_metrics(time_s, force_n, stride_table: pd.DataFrame, source: str = "") -> pd.DataFrame:
+    """RMS and largest absolute interaction force per stride and phase.
+
+    The phases are half-open sample sets: stance = samples with
+    ``heel_strike_s <= t < toe_off_s``, swing = ``toe_off_s <= t < end_s``,
+    so every sample belongs to at most one phase. RMS is the root of the mean
+    square over those samples (equal weights: uniform sampling assumed).
+    ``time_s`` and the stride table must share one clock (synchronised
+    robot log and treadmill).
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n_samples,)
+        Times of the force samples in s, finite and strictly increasing.
+    force_n : array_like, shape (n_samples,)
+        Interaction force in N, finite.
+    stride_table : pandas.DataFrame
+        Columns ``stride``, ``heel_strike_s``, ``toe_off_s``, ``end_s``
+        (:func:`loper_analysis.events.strides`); every phase must lie inside
+        ``time_s[0] .. time_s[-1]`` and hold at least one sample.
+    source : str
+        Name of the trial, quoted in error messages.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per stride and phase (stride order, stance before swing):
+        ``stride``, ``phase`` (``stance`` | ``swing``), ``rms_force_n``,
+        ``max_abs_force_n`` (N).
+
+    Raises
+    ------
+    LoperInputError
+        Bad shapes, non-finite or non-increasing input, missing columns, a
+        phase outside the data or without samples.
+    """
+    t = np.asarray(time_s, dtype=float)
+    f = np.asarray(force_n, dtype=float)
+    if t.ndim != 1 or f.shape != t.shape or t.size < 2:
+        raise LoperInputError(
+            f"{where(source)}time_s {t.shape} and force_n {f.shape} must be 1-D of equal length >= 2"
+        )
+    for name, a in (("time_s", t), ("force_n", f)):
+        bad = np.flatnonzero(~np.isfinite(a))
+        if bad.size:
+            raise LoperInputError(f"{where(source)}{name} is not finite at sample {bad[0]}: {a[bad[0]]}")
+    if np.any(np.diff(t) <= 0):
+        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        raise LoperInputError(f"{where(source)}time_s must increase strictly; sample {i} does not")
+    needed = {"stride", "heel_strike_s", "toe_off_s", "end_s"}
+    if not needed <= set(stride_table.columns):
+        raise LoperInputError(
+            f"{where(source)}stride_table lacks column(s) {sorted(needed - set(stride_table.columns))}"
+        )
+    square = np.concatenate([[0.0], np.cumsum(f * f)])
+    absf = np.abs(f)
+    rms, peak = [], []
+    for phase in FORCE_PHASES:
+        a = stride_table[PHASE_BOUNDS[phase][0]].to_numpy(float)
+        b = stride_table[PHASE_BOUNDS[phase][1]].to_numpy(float)
+        out = np.flatnonzero(~((a >= t[0]) & (b <= t[-1]) & (a < b)))
+        if out.size:
+            r = out[0]
+            raise LoperInputError(
+                f"{where(source)}stride {stride_table['stride'].iloc[r]} {phase} "
+                f"({float(a[r])!r} .. {float(b[r])!r} s) "
+                f"is empty or outside the force data ({float(t[0])!r} .. {float(t[-1])!r} s)"
+            )
+        lo = np.searchsorted(t, a, side="left")
+        hi = np.searchsorted(t, b, side="left")
+        empty = np.flatnonzero(hi <= lo)
+        if empty.size:
+            r = empty[0]
+            raise LoperInputError(
+                f"{where(source)}stride {stride_table['stride'].iloc[r]} {phase} holds no force sample"
+            )
+        rms.append(np.sqrt((square[hi] - square[lo]) / (hi - lo)))
+        peak.append(np.array([absf[i:j].max() for i, j in zip(lo, hi)]))  # a loop per stride, not per sample
+    n_phases = len(FORCE_PHASES)
+    return pd.DataFrame({
+        "stride": np.repeat(stride_table["stride"].to_numpy(), n_phases),
+        "phase": np.tile(FORCE_PHASES, len(stride_table)),
+        "rms_force_n": np.column_stack(rms).ravel(),
+        "max_abs_force_n": np.column_stack(peak).ravel(),
+    })
+
+
+def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFrame | None = None,
+                  side: str = "left", n_points: int = 101, whisker: float = 1.5, max_fraction: float = 0.2,
+                  min_valid: int = 5, sources: Mapping[str, str] | None = None) -> StrideTables:
+    """Strides of one leg, their outlier verdicts and the time-normalised cycles.
+
+    Strides run heel strike to heel strike of ``side`` (``events``:
+    :func:`loper_analysis.events.gait_events`), kept only where the joint
+    angles cover them (and, with a force table, the robot log). Outliers:
+    :func:`loper_analysis.outliers.iqr_outliers` on the stride-normalised
+    hip, knee and ankle angles of the unperturbed strides.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        ``time_s`` and ``{hip,knee,ankle}_<side>_rad`` per motion-capture frame.
+    events : pandas.DataFrame
+        ``side``, ``event``, ``time_s`` of both legs.
+    force : pandas.DataFrame, optional
+        The interaction force on the same frames (``time_s``,
+        ``force_measured_n``, optional ``perturbation`` 0/1 flag; NaN outside
+        the robot log), for trials walked with the device.
+    side : {"left", "right"}
+    n_points : int
+        Samples per normalised stride, stance or swing.
+    whisker, max_fraction : float
+        Settings of the IQR rule.
+    min_valid : int
+        Fewest kept unperturbed strides without a warning.
+    sources : mapping, optional
+        Names (files) of ``angles``, ``events`` and ``force``, quoted in messages.
+
+    Returns
+    -------
+    StrideTables
+        ``strides``: one row per stride, absolute times (s), ``perturbed`` and
+        its ``onset_s``, ``fraction_outlying_*``, ``removed``, ``reason``
+        (``perturbed`` for perturbed strides, which the response analysis
+        judges in their window) and, with a force table, RMS and max |F| per
+        phase (N); ``cycles``: one row per stride x phase x normalised sample
+        (``stride``, ``phase``, ``point``, ``percent``, the joint angles in rad
+        and ``force_n``). Fewer than ``min_valid`` kept strides: a
+        :class:`~loper_analysis.errors.TooFewStridesWarning` and
+        ``too_few_strides`` True.
+
+    Raises
+    ------
+    LoperInputError
+        Missing columns, force frames that differ from the angles', fewer
+        than :data:`MIN_STRIDES_FOR_OUTLIERS` (unperturbed) strides.
+    """
+    names = {"angles": "angles", "events": "events", "force": "force", **(sources or {})}
+    cols = [angle_column(j, side) for j in JOINTS]
+    require_columns(angles, ["time_s", *cols], names["angles"])
+    table = strides_from_events(events, side)
+    t = angles["time_s"].to_numpy(float)
+    inside = (table["heel_strike_s"] >= t[0]) & (table["end_s"] <= t[-1])
+    table = table[inside].reset_index(drop=True)
+    table["stride"] = np.arange(len(table))
+    if len(table) < MIN_STRIDES_FOR_OUTLIERS:
+        raise LoperInputError(
+            f"{names['events']}: {len(table)} complete {side} stride(s) inside the kinematics of {names['angles']}; "
+            f"need at least {MIN_STRIDES_FOR_OUTLIERS} for the outlier rule"
+        )
+    values = angles[cols].to_numpy(float)
+    force_n = None
+    if force is not None:
+        if len(force) != len(angles) or not np.allclose(force["time_s"].to_numpy(float), t, atol=1e-6):
+            raise LoperInputError(f"{names['force']}: frames differ from the kinematics in {names['angles']}")
+        force_n = force["force_measured_n"].to_numpy(float)
+        covered = np.isfinite(force_n)
+        ok = [bool(covered[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
+        if not all(ok):
+            log.info("%s: %d stride(s) outside the robot log's span dropped", names["force"], len(ok) - sum(ok))
+            table = table[ok].reset_index(drop=True)
+            table["stride"] = np.arange(len(table))
+    table["perturbed"] = False
+    table["onset_s"] = np.nan
+    if force_n is not None and "perturbation" in force.columns:
+        onsets = perturbation_onsets(t, force["perturbation"].to_numpy(float))
+        for i, (a, b) in enumerate(zip(table.heel_strike_s, table.end_s)):
+            within = onsets[(onsets >= a) & (onsets < b)]
+            if within.size:
+                table.loc[i, ["perturbed", "onset_s"]] = (True, within[0])
+    by_stride = normalise(t, values, table, "stride", n_points, source=names["angles"])
+    joint_names = [c.split("_")[0] for c in cols]
+    plain = ~table["perturbed"].to_numpy()  # perturbed strides are the responses, judged in their window later
+    if plain.sum() < MIN_STRIDES_FOR_OUTLIERS:
+        raise LoperInputError(f"{names['angles']}: {int(plain.sum())} unperturbed stride(s); need at least "
+                              f"{MIN_STRIDES_FOR_OUTLIERS} for the outlier rule")
+    verdict = iqr_outliers(by_stride[plain], whisker, max_fraction, names=joint_names, source=names["angles"])
+    verdict["stride"] = table.loc[plain, "stride"].to_numpy()
+    out = table.merge(verdict, on="stride", how="left")
+    out["removed"] = out["removed"].fillna(False).astype(bool)
+    out.loc[out["perturbed"], "reason"] = "perturbed"
+    out["reason"] = out["reason"].fillna("")
+    if force_n is not None:
+        metrics = force_phase_metrics(t, force_n, table, source=names["force"])
+        wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
+        wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
+        out = out.merge(wide.reset_index(), on="stride")
+    n_kept = int((~out["removed"] & ~out["perturbed"]).sum())
+    log.info("%s: %d strides, %d perturbed, %d removed as outliers, %d unperturbed kept", names["angles"], len(out),
+             int(out["perturbed"].sum()), int(out["removed"].sum()), n_kept)
+    for r in out[out["removed"]].itertuples():
+        log.info("stride %d removed: %s", r.stride, r.reason)
+    too_few = not check_enough_strides(n_kept, names["angles"], min_valid)
+    cycles = []
+    for phase in PHASES:
+        arr = normalise(t, values, table, phase, n_points, source=names["angles"])
+        block = {
+            "stride": np.repeat(table["stride"].to_numpy(), n_points),
+            "phase": phase,
+            "point": np.tile(np.arange(n_points), len(table)),
+            "percent": np.tile(np.linspace(0.0, 100.0, n_points), len(table)),
+        }
+        for i, c in enumerate(cols):
+            block[c] = arr[:, :, i].ravel()
+        if force_n is not None:
+            block["force_n"] = normalise(t, force_n, table, phase, n_points, source=names["force"]).ravel()
+        cycles.append(pd.DataFrame(block))
+    return StrideTables(out, pd.concat(cycles, ignore_index=True), too_few)
+
+
+def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: int = 5) -> pd.DataFrame:
+    """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.
+
+    ``tables``: ``{(subject, trial): stride table}`` of :func:`stride_tables`.
+    ``status`` is ``ok`` or ``too_few_strides`` (fewer than ``min_valid``
+    kept: the trial is flagged, not dropped silently).
+    """
+    rows = []
+    for (subject, trial), table in tables.items():
+        removed = table[table["removed"]]
+        signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
+        why = {s: int(removed["reason"].fillna("").str.contains(f"{s}:").sum()) for s in signals}
+        perturbed = table["perturbed"].astype(bool) if "perturbed" in table.columns else pd.Series(False, index=table.index)
+        n_kept = int((~table["removed"] & ~perturbed).sum())
+        rows.append({
+            "subject": subject, "trial": trial, "n_strides": len(table), "n_perturbed": int(perturbed.sum()),
+            "n_removed": len(removed), "n_kept": n_kept,
+            **{f"n_removed_{s}": n for s, n in why.items()},
+            "mean_stride_s": table["duration_s"].mean(),
+            "status": "ok" if n_kept >= min_valid else "too_few_strides",
+        })
+    return pd.DataFrame(rows)
+
+
+def phase_cycles(cycles: pd.DataFrame, strides: pd.DataFrame, phase: str, columns: Sequence[str],
+                 keep_removed: bool = False, source: str = "cycles") -> np.ndarray:
+    """Normalised cycles of one phase as (n_strides, n_points, len(columns)).
+
+    Perturbed strides and (unless ``keep_removed``) outliers are left out.
+    """
+    plain = ~strides["perturbed"].astype(bool) if "perturbed" in strides.columns else True
+    keep = strides.loc[plain, "stride"] if keep_removed else strides.loc[~strides["removed"] & plain, "stride"]
+    sel = cycles[(cycles["phase"] == phase) & cycles["stride"].isin(keep)]
+    n_points = int(sel["point"].max()) + 1 if len(sel) else 0
+    require_columns(sel, list(columns), source)
+    return sel[list(columns)].to_numpy(float).reshape(-1, n_points, len(columns))

@@ -1,0 +1,67 @@
+"""Shared inputs of the identification tests: validation trials with a known impedance and their windows.
+
+The "measured" data come from :func:`loper_analysis.validation.perturbed_trial`
+(fine-step RK4 of the same model with a known impedance), prepared the way
+:func:`loper_analysis.validation.run_validation_chunk` does it.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from loper_analysis.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.identification import identify_impedance
+from loper_analysis.validation import (
+    ValidationSettings,
+    perturbed_trial,
+    validation_window,
+)
+
+PARAMS = segment_parameters_from_anthropometry(1.73, 64.9)
+SETTINGS = ValidationSettings()
+#: The impedance of the mid trial (order of PARAMETERS).
+MID_TRUTH = np.array([75.0, 2.0, 75.0, 2.0, 75.0, 2.0])
+
+
+@lru_cache(maxsize=None)
+def _mid_trial():
+    arrays = perturbed_trial(PARAMS, MID_TRUTH, SETTINGS)
+    for a in arrays:
+        a.setflags(write=False)
+    return arrays
+
+
+def mid_trial():
+    """(time_s, q_u, q_p, force_p, pelvis) of the mid impedance (computed once, read-only)."""
+    return _mid_trial()
+
+
+def window_for(trial, settings=SETTINGS, *, qu_measured=None, qp_measured=None, **overrides):
+    """The window run_validation_chunk builds (q_reference = noise-free unperturbed coordinates)."""
+    return validation_window(PARAMS, settings, trial, qu_measured, qp_measured, **overrides)
+
+
+def fit(window, n_starts=5, seed=0, settings=SETTINGS):
+    """identify_impedance with the validation study's bounds and tolerance."""
+    return identify_impedance(
+        window,
+        n_starts=n_starts,
+        seed=seed,
+        lower=settings.lower,
+        upper=settings.upper,
+        tolerance=settings.tolerance,
+    )
+
+
+def expect_error(func, *words):
+    """``func()`` raises LoperInputError whose message holds every one of ``words``."""
+    import pytest
+
+    from loper_analysis.errors import LoperInputError
+
+    with pytest.raises(LoperInputError) as info:
+        func()
+    for w in words:
+        assert w in str(info.value), (w, str(info.value))

@@ -1,0 +1,209 @@
+"""The atomic writer: every kind of output is complete or absent, never half-written.
+
+Each writer is made to fail halfway through a real write (a figure that
+cannot render, a table cell that cannot be formatted, a library writer that
+raises after writing part of its file); afterwards the target must hold its
+old bytes (or not exist) and no staging file or directory may remain.
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.figures import pyplot
+from loper_analysis.io.atomic import (
+    staged,
+    write_bytes,
+    write_figure,
+    write_text,
+    write_tsv,
+    write_yaml,
+)
+from loper_analysis.io.c3d_writer import write_c3d
+from loper_analysis.io.opensim_tables import write_mot, write_trc
+from loper_analysis.io.osim import write_model
+from loper_analysis.io.robot_log import write_robot_log
+from loper_analysis.steps.logs import rule_log
+
+
+def _entries(directory):
+    return sorted(p.name for p in directory.iterdir())
+
+
+class _Unprintable:
+    """A table cell whose text cannot be made: formatting it raises, as a broken object would."""
+
+    def __str__(self):
+        raise RuntimeError("cell cannot be formatted")
+
+    __repr__ = __format__ = __str__
+
+
+def test_staged_moves_the_finished_file_and_leaves_nothing_else(tmp_path):
+    target = tmp_path / "out" / "table.tsv"  # the directory is created
+    with staged(target) as tmp:
+        assert tmp.name == "table.tsv" and tmp.parent != target.parent
+        tmp.write_text("a\n1\n")
+    assert target.read_text() == "a\n1\n"
+    assert _entries(target.parent) == ["table.tsv"]
+
+
+def test_staged_keeps_the_old_file_when_the_writer_fails_halfway(tmp_path):
+    target = tmp_path / "data.bin"
+    target.write_bytes(b"old")
+    with pytest.raises(OSError, match="disk interrupted"):
+        with staged(target) as tmp:
+            with tmp.open("wb") as fh:
+                fh.write(b"first half")
+                raise OSError("disk interrupted")
+    assert target.read_bytes() == b"old"
+    assert _entries(tmp_path) == ["data.bin"]
+
+
+def test_staged_refuses_a_writer_that_wrote_nothing(tmp_path):
+    with pytest.raises(LoperInputError, match="produced no file"):
+        with staged(tmp_path / "x.tsv"):
+            pass
+    assert _entries(tmp_path) == []
+
+
+def test_staged_names_the_path_when_the_directory_cannot_be_made(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a directory")
+    with pytest.raises(LoperInputError, match=f"{blocker}/sub/x.tsv: cannot write"):
+        write_text(blocker / "sub" / "x.tsv", "x")
+
+
+def test_tsv_writer_leaves_no_partial_table_when_a_cell_fails(tmp_path):
+    target = tmp_path / "strides.tsv"
+    write_tsv(pd.DataFrame({"a": [1.0, 2.0]}), target)
+    old = target.read_bytes()
+    rows = 10_000  # the failing cell comes after thousands of rows were formatted
+    frame = pd.DataFrame({"a": np.arange(rows, dtype=float), "b": ["x"] * (rows - 1) + [_Unprintable()]})
+    with pytest.raises(RuntimeError, match="cannot be formatted"):
+        write_tsv(frame, target)
+    assert target.read_bytes() == old
+    assert _entries(tmp_path) == ["strides.tsv"]
+
+
+def test_tsv_writer_gives_the_same_bytes_for_the_same_frame(tmp_path):
+    frame = pd.DataFrame({"time_s": [0.0, 1 / 3], "flag": [True, False], "x": [np.nan, 2.5e-7]})
+    write_tsv(frame, tmp_path / "a.tsv")
+    write_tsv(frame, tmp_path / "b.tsv")
+    assert (tmp_path / "a.tsv").read_bytes() == (tmp_path / "b.tsv").read_bytes()
+    assert (tmp_path / "a.tsv").read_text() == "time_s\tflag\tx\n0\tTrue\t\n0.333333333\tFalse\t2.5e-07\n"
+
+
+def test_figure_writer_leaves_no_partial_png_when_rendering_fails(tmp_path):
+    target = tmp_path / "fit.png"
+    figure = pyplot().figure()
+    figure.gca().set_title(r"$\frac{1}{$")  # invalid mathtext: fails only when the figure is drawn
+    with pytest.raises(ValueError):
+        write_figure(figure, target)
+    assert _entries(tmp_path) == []
+    assert not pyplot().fignum_exists(figure.number)  # closed although it failed
+
+
+def test_figure_writer_gives_the_same_bytes_for_the_same_figure(tmp_path):
+    for name in ("a.png", "b.png"):
+        figure = pyplot().figure(figsize=(2, 2))
+        figure.gca().plot([0, 1], [1, 0])
+        write_figure(figure, tmp_path / name)
+    assert (tmp_path / "a.png").read_bytes() == (tmp_path / "b.png").read_bytes()
+    assert (tmp_path / "a.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_yaml_writer_writes_nothing_for_a_document_it_cannot_represent(tmp_path):
+    target = tmp_path / "truth.yaml"
+    target.write_text("old: 1\n")
+    with pytest.raises(Exception, match="cannot represent"):
+        write_yaml(target, {"subject": "S01", "bad": object()})
+    assert target.read_text() == "old: 1\n"
+    assert _entries(tmp_path) == ["truth.yaml"]
+
+
+def test_text_and_bytes_writers_replace_the_whole_file(tmp_path):
+    target = tmp_path / "notes.md"
+    write_text(target, "a much longer first version\n")
+    write_bytes(target, b"short\n")
+    assert target.read_bytes() == b"short\n"
+
+
+def test_trc_writer_refuses_before_writing_and_leaves_no_file(tmp_path):
+    target = tmp_path / "walk.trc"
+    with pytest.raises(LoperInputError, match="walk.trc: .*infinite"):
+        write_trc(target, [0.0, 0.01], np.array([[[0.0, 0.0, np.inf]], [[0.0, 0.0, 0.0]]]), ["LASI"])
+    assert _entries(tmp_path) == []
+
+
+def test_mot_writer_keeps_the_old_file_when_a_column_is_not_numeric(tmp_path):
+    target = tmp_path / "walk.mot"
+    write_mot(target, pd.DataFrame({"time_s": [0.0, 0.01], "hip_flexion_l": [0.1, 0.2]}))
+    old = target.read_bytes()
+    with pytest.raises(LoperInputError, match="walk.mot: column 'hip_flexion_l' is not numeric"):
+        write_mot(target, pd.DataFrame({"time_s": [0.0, 0.01], "hip_flexion_l": ["a", "b"]}))
+    assert target.read_bytes() == old
+    assert _entries(tmp_path) == ["walk.mot"]
+
+
+def test_c3d_writer_refuses_a_label_ezc3d_cannot_read_back_and_leaves_no_file(tmp_path):
+    target = tmp_path / "static.c3d"
+    # ezc3d writes a label of 256 characters into a file it cannot read back, so the writer refuses it up front
+    with pytest.raises(LoperInputError, match="static.c3d: marker_labels"):
+        write_c3d(target, ["x" * 256], np.zeros((2, 1, 3)), 128.0)
+    assert _entries(tmp_path) == []
+
+
+class _HalfWrittenModel:
+    """An object that prints half a model file and then fails, as OpenSim does when the disk fills."""
+
+    def printToXML(self, path):  # noqa: N802 - OpenSim's method name
+        with open(path, "w") as fh:
+            fh.write("<OpenSimDocument>")
+        raise RuntimeError("disk full")
+
+
+def test_model_writer_leaves_no_partial_osim(tmp_path):
+    target = tmp_path / "scaled.osim"
+    with pytest.raises(RuntimeError, match="disk full"):
+        write_model(_HalfWrittenModel(), target)
+    assert _entries(tmp_path) == []
+
+
+def test_robot_log_writer_refuses_bad_data_before_writing(tmp_path):
+    target = tmp_path / "trial.loper.tsv"
+    frame = pd.DataFrame({"time_s": [0.0, 0.001], "force_desired_n": [0.0, np.nan], "force_measured_n": [0.0, 0.0],
+                          "motor_angle_rad": 0.0, "motor_velocity_rad_s": 0.0, "sync_v": 0.0, "perturbation": 0,
+                          "safety_state": 0})
+    with pytest.raises(LoperInputError, match="force_desired_n"):
+        write_robot_log(target, frame, 1000.0)
+    assert _entries(tmp_path) == []
+
+
+def test_rule_log_writes_the_messages_and_the_full_error_when_the_job_fails(tmp_path):
+    log_path = tmp_path / "logs" / "job.log"
+    with pytest.raises(LoperInputError, match="pert050-1.c3d: POINT:UNITS"):
+        with rule_log(log_path) as log:
+            log.info("reading the trial")
+            logging.getLogger("loper_analysis.steps.processing").warning("a gap of 12 frames")
+            raise LoperInputError("pert050-1.c3d: POINT:UNITS not declared")
+    text = log_path.read_text()
+    assert "INFO loper_analysis.rule: reading the trial" in text
+    assert "WARNING loper_analysis.steps.processing: a gap of 12 frames" in text
+    assert "ERROR loper_analysis.rule: LoperInputError: pert050-1.c3d: POINT:UNITS not declared" in text
+    assert "Traceback (most recent call last)" in text
+    assert _entries(log_path.parent) == ["job.log"]
+
+
+def test_rule_log_captures_warnings(tmp_path):
+    import warnings
+
+    log_path = tmp_path / "job.log"
+    with rule_log(log_path):
+        warnings.warn("only 3 valid strides", UserWarning)
+    assert "only 3 valid strides" in log_path.read_text()
