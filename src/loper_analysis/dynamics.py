@@ -26,7 +26,11 @@ import pandas as pd
 from scipy.integrate import solve_ivp
 
 from . import kernels
-from .anthropometry import ANKLE_HEIGHT_FRACTION, HEEL_BEHIND_ANKLE_FRACTION, WINTER_SEGMENTS
+from .anthropometry import (
+    ANKLE_HEIGHT_FRACTION,
+    HEEL_BEHIND_ANKLE_FRACTION,
+    WINTER_SEGMENTS,
+)
 from .checks import finite_rows
 from .constants import GRAVITY_M_PER_S2, SEGMENTS
 from .errors import LoperInputError

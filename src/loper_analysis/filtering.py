@@ -10,7 +10,9 @@ __all__ = ["lowpass", "lowpass_gain"]
 
 
 def _design(sample_rate_hz: float, cutoff_hz: float, order: int):
-    from scipy.signal import butter  # imported here: scipy.signal costs ~1 s, and most rules never filter
+    from scipy.signal import (
+        butter,  # imported here: scipy.signal costs ~1 s, and most rules never filter
+    )
 
     if not np.isfinite(sample_rate_hz) or sample_rate_hz <= 0:
         raise LoperInputError(f"sample_rate_hz must be positive, got {sample_rate_hz}")

@@ -27,7 +27,12 @@ import pandas as pd
 from .constants import JOINTS, parameter_column
 from .dynamics import SegmentParameters
 from .errors import LoperInputError, TooFewStridesWarning
-from .identification import ImpedanceFit, identify_impedance, prepare_window, refit_with_null_pairs
+from .identification import (
+    ImpedanceFit,
+    identify_impedance,
+    prepare_window,
+    refit_with_null_pairs,
+)
 from .reference import LITERATURE
 from .responses import ResponseSettings, null_pair_windows, subject_onset_response
 

@@ -144,7 +144,7 @@ def test_stride_summary_flags_too_few_strides(lab, tmp_path):
     few.loc[3:, "removed"] = True
     few.loc[3:, "reason"] = "knee: 30.0 % of samples outside 1.5·IQR"
     few.to_csv(tmp_path / "few.strides.tsv", sep="\t", index=False)
-    out = processing.strides_summary({("S99", "walk"): walk, ("S99", "few"): tmp_path / "few.strides.tsv"},
+    out = processing.strides_summary([("S99", "walk"), ("S99", "few")], [walk, tmp_path / "few.strides.tsv"],
                                      tmp_path / "summary.tsv", min_valid=5)
     ok, flagged = out.iloc[0], out.iloc[1]
     assert ok.status == "ok" and ok.n_strides == len(table) and ok.n_kept == (~table.removed).sum()
@@ -170,9 +170,9 @@ def test_fewer_than_five_valid_strides_warn(lab, tmp_path):
 def test_transparency_of_a_trial_against_itself(lab, tmp_path):
     """The same trial as both conditions: RMSD 0 everywhere, so transparent; tables and figure written."""
     d = lab["dir"]
-    pair = (d / "walk.strides.tsv", d / "walk.cycles.tsv")
-    trials = {"S98": {"no_device": pair, "device": pair}, "S99": {"no_device": pair, "device": pair}}
-    out = transparency.transparency(trials, tmp_path / "rmsd.tsv", tmp_path / "force.tsv", tmp_path / "t.png")
+    strides, cycles = [d / "walk.strides.tsv"] * 2, [d / "walk.cycles.tsv"] * 2
+    out = transparency.transparency(["S98", "S99"], strides, cycles, strides, cycles, tmp_path / "rmsd.tsv",
+                                    tmp_path / "force.tsv", tmp_path / "t.png")
     rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
     assert len(rmsd) == 3 * 2 * 3  # (2 subjects + all) x 2 phases x 3 joints
     np.testing.assert_allclose(rmsd["rmsd_rad"], 0.0, atol=1e-12)

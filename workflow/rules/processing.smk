@@ -207,9 +207,9 @@ rule strides:
 
 
 def transparency_inputs(wildcards):
+    """Stride and cycle tables of the transparency pair, one list per condition and kind, in subject order."""
     return {
-        f"{cond}_{kind}_{s}": f"results/strides/{s}/{TRIALS[cond]}.{kind}.tsv"
-        for s in transparency_subjects()
+        f"{cond}_{kind}": [f"results/strides/{s}/{TRIALS[cond]}.{kind}.tsv" for s in transparency_subjects()]
         for cond in ("no_device", "device")
         for kind in ("strides", "cycles")
     }

@@ -196,7 +196,9 @@ def _plant_matrices(dev: DeviceParameters, leg: FreeLeg | None):
         off[1, 1] = -(r * br * r + bm) / Jm
         Boff[1, 1] = r * kr / Jm
         Boff[1, 2] = r * br / Jm
-    from scipy.linalg import expm  # imported here, as bilinear below: importing the module stays cheap
+    from scipy.linalg import (
+        expm,  # imported here, as bilinear below: importing the module stays cheap
+    )
 
     out = []
     for A, B in ((on, Bon), (off, Boff)):
@@ -211,7 +213,9 @@ def _plant_matrices(dev: DeviceParameters, leg: FreeLeg | None):
 
 def _filter_coefficients(dev: DeviceParameters):
     """Discrete (Tustin) coefficients of H_F and of the two admittance paths."""
-    from scipy.signal import bilinear  # imported here: scipy.signal costs ~1 s per process
+    from scipy.signal import (
+        bilinear,  # imported here: scipy.signal costs ~1 s per process
+    )
 
     fs = dev.sample_rate_hz
     wf = 2 * np.pi * dev.prefilter_cutoff_hz

@@ -32,8 +32,19 @@ from .fit import (
     starts_at_best,
     variance_accounted_for,
 )
-from .null_pairs import NullPairFit, nuisance_projection, null_pair_errors, refit_with_null_pairs
-from .window import PreparedWindow, prediction_error, prepare_window, simulate_deviation, simulate_response
+from .null_pairs import (
+    NullPairFit,
+    nuisance_projection,
+    null_pair_errors,
+    refit_with_null_pairs,
+)
+from .window import (
+    PreparedWindow,
+    prediction_error,
+    prepare_window,
+    simulate_deviation,
+    simulate_response,
+)
 
 __all__ = [
     "AT_BEST_RELATIVE",

@@ -194,7 +194,10 @@ def prepare_window(
         nyq = 0.5 / dt
         if not 0 < reference_cutoff_hz < nyq:
             raise LoperInputError(f"reference_cutoff_hz must lie in 0 .. {nyq} Hz, got {reference_cutoff_hz}")
-        from scipy.signal import butter, filtfilt  # only here: scipy.signal costs ~1 s to import
+        from scipy.signal import (  # only here: scipy.signal costs ~1 s to import
+            butter,
+            filtfilt,
+        )
 
         b, a = butter(2, reference_cutoff_hz / nyq)
         q_ref = filtfilt(b, a, q_ref, axis=0)

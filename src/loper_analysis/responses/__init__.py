@@ -40,7 +40,13 @@ Conventions
 from .average import COUNT_COLUMNS, subject_onset_response
 from .matching import MATCH_COLUMNS, match_unperturbed, too_short
 from .null_pairs import null_pair_windows
-from .windows import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings, analysis_grid, paired_windows, window_outliers
+from .windows import (
+    MIN_PAIRS_FOR_OUTLIERS,
+    ResponseSettings,
+    analysis_grid,
+    paired_windows,
+    window_outliers,
+)
 
 __all__ = [
     "MATCH_COLUMNS",

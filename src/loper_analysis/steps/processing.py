@@ -125,12 +125,16 @@ def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, c
     return tables
 
 
-def strides_summary(strides_tsvs: Mapping[tuple[str, str], PathLike], out_tsv: PathLike, min_valid: int = 5) -> pd.DataFrame:
-    """One row per subject x trial of the stride tables (:func:`loper_analysis.strides.stride_summary`)."""
+def strides_summary(subject_trials: Sequence[tuple[str, str]], strides_tsvs: Sequence[PathLike], out_tsv: PathLike,
+                    min_valid: int = 5) -> pd.DataFrame:
+    """One row per subject x trial of the stride tables (:func:`loper_analysis.strides.stride_summary`).
+
+    ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of ``subject_trials``, in order.
+    """
     from ..strides import stride_summary
 
-    tables = {key: read_tsv(path, "stride table", keep_default_na=False, na_values=[""])
-              for key, path in strides_tsvs.items()}
+    tables = {tuple(key): read_tsv(path, "stride table", keep_default_na=False, na_values=[""])
+              for key, path in zip(subject_trials, strides_tsvs, strict=True)}
     table = stride_summary(tables, min_valid)
     write_tsv(table, out_tsv)
     for row in table[table.status != "ok"].itertuples():

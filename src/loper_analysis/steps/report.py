@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Sequence
 
 from ..io.atomic import PathLike, write_text
 from ..io.readers import read_tsv
@@ -13,11 +13,12 @@ __all__ = ["markdown_tables"]
 log = logging.getLogger(__name__)
 
 
-def markdown_tables(sections: Mapping[str, PathLike], out_md: PathLike) -> str:
-    """Render every table of ``{heading: tsv_path}`` into one Markdown file; an empty TSV says so."""
+def markdown_tables(headings: Sequence[str], tsvs: Sequence[PathLike], out_md: PathLike) -> str:
+    """Render every table (one TSV per heading, in order) into one Markdown file; an empty TSV says so."""
     from ..markdown import markdown_document
 
-    text = markdown_document([(heading, str(path), read_tsv(path, "table")) for heading, path in sections.items()])
+    sections = [(heading, str(path), read_tsv(path, "table")) for heading, path in zip(headings, tsvs, strict=True)]
+    text = markdown_document(sections)
     write_text(out_md, text, "Markdown file")
     log.info("rendered %d tables", len(sections))
     return text

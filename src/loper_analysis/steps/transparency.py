@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Sequence
 
 from ..io.atomic import PathLike, write_figure, write_tsv
 from ..io.readers import read_tsv
@@ -13,26 +13,30 @@ __all__ = ["transparency"]
 log = logging.getLogger(__name__)
 
 
-def transparency(trials: Mapping[str, Mapping[str, tuple[PathLike, PathLike]]], rmsd_out: PathLike,
-                 force_out: PathLike, figure_out: PathLike, side: str = "left"):
+def transparency(subjects: Sequence[str], no_device_strides: Sequence[PathLike],
+                 no_device_cycles: Sequence[PathLike], device_strides: Sequence[PathLike],
+                 device_cycles: Sequence[PathLike], rmsd_out: PathLike, force_out: PathLike, figure_out: PathLike,
+                 side: str = "left"):
     """Transparency of the device from the stride and cycle tables of each subject's two walking trials.
 
-    ``trials``: ``{subject: {"no_device": (strides_tsv, cycles_tsv), "device": (strides_tsv, cycles_tsv)}}``.
+    The four lists hold one file per subject, in the order of ``subjects``:
+    the stride and cycle tables of walking without and with the device.
     Writes the tables of :func:`loper_analysis.transparency.transparency_results`
     and the figure (kept strides of all subjects pooled); returns the results.
     """
     from ..figures.transparency import transparency_figure
     from ..transparency import transparency_results
 
+    files = zip(subjects, no_device_strides, no_device_cycles, device_strides, device_cycles, strict=True)
     frames = {
-        subject: {cond: (read_tsv(strides, "stride table"), read_tsv(cycles, "cycle table"))
-                  for cond, (strides, cycles) in conds.items()}
-        for subject, conds in trials.items()
+        subject: {"no_device": (read_tsv(ns, "stride table"), read_tsv(nc, "cycle table")),
+                  "device": (read_tsv(ds, "stride table"), read_tsv(dc, "cycle table"))}
+        for subject, ns, nc, ds, dc in files
     }
     results = transparency_results(frames, side)
     write_tsv(results.rmsd, rmsd_out)
     write_tsv(results.force, force_out)
     write_figure(transparency_figure(results.angles_rad, results.force_n, results.toe_off_pct,
-                                     title=f"Transparency: {len(trials)} subject(s), kept strides pooled"), figure_out)
+                                     title=f"Transparency: {len(frames)} subject(s), kept strides pooled"), figure_out)
     log.info("transparency:\n%s", results.rmsd.to_string())
     return results

@@ -24,7 +24,12 @@ def validation_chunk(segments_tsv: PathLike, settings: Mapping, chunk: int, n_ch
 
     ``settings``: keyword arguments of :class:`~loper_analysis.validation.ValidationSettings`.
     """
-    from ..validation import ValidationSettings, chunk_combinations, impedance_grid, run_validation_chunk
+    from ..validation import (
+        ValidationSettings,
+        chunk_combinations,
+        impedance_grid,
+        run_validation_chunk,
+    )
     from .model import read_segments
 
     study = ValidationSettings(**settings)
