@@ -293,15 +293,8 @@ def _impedance_long(table: pd.DataFrame, source: str) -> tuple[pd.DataFrame, np.
     return pd.concat(long, ignore_index=True), onsets
 
 
-def impedance_means(table: pd.DataFrame, source: str = "impedance table") -> pd.DataFrame:
-    """Across-subject mean of K and D per onset, as drawn by :func:`impedance_figure`.
-
-    Index ``onset_ms`` (all onsets of the table, sorted), columns the
-    parameters of :data:`~loper_analysis.constants.PARAMETERS` (``K_hip``,
-    ``D_hip``, ...) in their units; NaN where no subject has a value. Only
-    rows with ``status`` in :data:`IMPEDANCE_STATUSES_SHOWN` and a finite value count.
-    """
-    long, onsets = _impedance_long(table, source)
+def _means(long: pd.DataFrame, onsets: np.ndarray) -> pd.DataFrame:
+    """Across-subject mean per onset and parameter from the long form of :func:`_impedance_long`."""
     values = long.pivot(index="onset_ms", columns=["parameter", "subject"], values="value")
     mean = pd.DataFrame(
         {p: (values[p].mean(axis=1, skipna=True) if p in values.columns.get_level_values(0)
@@ -310,6 +303,17 @@ def impedance_means(table: pd.DataFrame, source: str = "impedance table") -> pd.
     mean.index.name = "onset_ms"
     mean.columns.name = None
     return mean
+
+
+def impedance_means(table: pd.DataFrame, source: str = "impedance table") -> pd.DataFrame:
+    """Across-subject mean of K and D per onset, as drawn by :func:`impedance_figure`.
+
+    Index ``onset_ms`` (all onsets of the table, sorted), columns the
+    parameters of :data:`~loper_analysis.constants.PARAMETERS` (``K_hip``,
+    ``D_hip``, ...) in their units; NaN where no subject has a value. Only
+    rows with ``status`` in :data:`IMPEDANCE_STATUSES_SHOWN` and a finite value count.
+    """
+    return _means(*_impedance_long(table, source))
 
 
 def impedance_figure(table: pd.DataFrame, source: str = "impedance table") -> Figure:
@@ -338,7 +342,7 @@ def impedance_figure(table: pd.DataFrame, source: str = "impedance table") -> Fi
     Returns the figure.
     """
     long, onsets = _impedance_long(table, source)
-    mean = impedance_means(table, source)
+    mean = _means(long, onsets)
     joints = [j for j in JOINTS if j != "ankle" or mean[[f"K_{j}", f"D_{j}"]].notna().any().any()]
     plt = pyplot()
     fig, axes = plt.subplots(2, len(joints), figsize=(3.3 * len(joints) + 0.6, 5.8),
