@@ -208,7 +208,6 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         leaves such a marker where it is); a scaled model without the
         configured bodies; ScaleTool failing. Nothing is written then.
     """
-    from ..checks import number
     from ..io.opensim_tables import read_markers
     from ..io.osim import read_marker_set, read_model, read_scale_setup, quiet_opensim
     from ..model import static_marker_problem
@@ -220,10 +219,14 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
             raise LoperInputError(f"file not found: {path}")
     if static_trc.suffix.lower() != ".trc":
         raise LoperInputError(f"{static_trc}: ScaleTool reads a static trial as .trc, got '{static_trc.suffix}'")
-    mass_kg = number("mass_kg", mass_kg, str(setup_xml), 1e-9, 300.0)
+    if not 0 < mass_kg <= 300:
+        raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
     tool = read_scale_setup(setup_xml)
     maker = tool.getGenericModelMaker()
     marker_set = _setup_file(maker.getMarkerSetFileName(), setup_xml)
+    if marker_set is not None and not marker_set.is_file():
+        raise LoperInputError(f"{setup_xml}: GenericModelMaker/marker_set_file {maker.getMarkerSetFileName()} "
+                              f"not found (looked for {marker_set})")
     model_markers = set(_names(read_model(generic_osim).getMarkerSet()))
     if marker_set is not None:
         model_markers |= set(_names(read_marker_set(marker_set)))
