@@ -20,7 +20,12 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
 from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.segments_from_model import segments_from_model
-from loper_analysis.steps.model import read_segments, segments, segments_from_model_file, write_segments
+from loper_analysis.steps.model import (
+    read_segments,
+    segments,
+    segments_from_model_file,
+    write_segments,
+)
 
 DATA = Path(__file__).parent / "data" / "gait2392"
 GAIT2392 = DATA / "gait2392_simbody.osim"
@@ -89,7 +94,7 @@ def _function(element, q: float) -> float:
     if kind == "SimmSpline":
         return _fmm_spline(_vec(element, "x"), _vec(element, "y"), q)
     if kind == "MultiplierFunction":
-        return float(element.find("scale").text) * _function(list(element.find("function"))[0], q)
+        return float(element.find("scale").text) * _function(next(iter(element.find("function"))), q)
     raise AssertionError(f"function {kind} not handled here")
 
 
@@ -101,7 +106,7 @@ class HandModel:
         self.bodies = {}
         for b in root.iter("Body"):
             I6 = _vec(b, "inertia")
-            self.bodies[b.get("name")] = dict(mass=float(b.find("mass").text), com=_vec(b, "mass_center"), izz=I6[2])
+            self.bodies[b.get("name")] = {"mass": float(b.find("mass").text), "com": _vec(b, "mass_center"), "izz": I6[2]}
         defaults = {c.get("name"): float(c.find("default_value").text) for c in root.iter("Coordinate")}
         self.joints = {}  # child body -> (parent body, child-frame origin in the parent body, its offset in the child)
         for j in root.find("JointSet").find("objects"):
@@ -119,7 +124,7 @@ class HandModel:
                     assert value == 0.0
                 else:
                     shift += value * _vec(axis, "axis")
-            body = lambda f: f.find("socket_parent").text.strip().split("/")[-1]  # noqa: E731
+            body = lambda f: f.find("socket_parent").text.strip().split("/")[-1]
             self.joints[body(child)] = (body(parent), _vec(parent, "translation") + shift, _vec(child, "translation"))
 
     def centre(self, body: str) -> np.ndarray:
@@ -160,15 +165,15 @@ def hand_segment_table(path: Path, side: str = "l", attachment_fraction: float =
     c_t = A_t @ (h.bodies[femur]["com"] - hip)[:2]
     c_s = A_s @ (h.bodies[tibia]["com"] - knee)[:2]
     leg = h.bodies[femur]["mass"] + h.bodies[tibia]["mass"] + m.sum()
-    return dict(
-        cart_mass_kg=sum(b["mass"] for b in h.bodies.values()) - leg,
-        mass_kg=(h.bodies[femur]["mass"], h.bodies[tibia]["mass"], m.sum()),
-        inertia_kg_m2=(h.bodies[femur]["izz"], h.bodies[tibia]["izz"], I_f),
-        length_m=(L_t, L_s, np.hypot(*mtp)),
-        com_x_m=(c_t[0], c_s[0], c_f[0]),
-        com_y_m=(c_t[1], c_s[1], c_f[1]),
-        attachment_m=attachment_fraction * L_t,
-    )
+    return {
+        "cart_mass_kg": sum(b["mass"] for b in h.bodies.values()) - leg,
+        "mass_kg": (h.bodies[femur]["mass"], h.bodies[tibia]["mass"], m.sum()),
+        "inertia_kg_m2": (h.bodies[femur]["izz"], h.bodies[tibia]["izz"], I_f),
+        "length_m": (L_t, L_s, np.hypot(*mtp)),
+        "com_x_m": (c_t[0], c_s[0], c_f[0]),
+        "com_y_m": (c_t[1], c_s[1], c_f[1]),
+        "attachment_m": attachment_fraction * L_t,
+    }
 
 
 # ---------------------------------------------------------------- tests

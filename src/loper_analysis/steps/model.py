@@ -209,7 +209,7 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         configured bodies; ScaleTool failing. Nothing is written then.
     """
     from ..io.opensim_tables import read_markers
-    from ..io.osim import read_marker_set, read_model, read_scale_setup, quiet_opensim
+    from ..io.osim import quiet_opensim, read_marker_set, read_model, read_scale_setup
     from ..model import static_marker_problem
     from ..segments_from_model import check_segment_bodies
 
