@@ -272,24 +272,27 @@ SCALE_MEASUREMENTS: dict[str, list[tuple[str, str]]] = {
 
 
 def static_marker_problem(time_s, markers_m, labels, time_range_s: tuple[float, float] | None = None,
-                          source: str = "") -> None:
+                          source: str = "", needed=None) -> None:
     """Refuse a static trial that OpenSim's ScaleTool cannot use: a measurement marker absent, or missing (NaN).
 
     ``time_s`` (n,), ``markers_m`` (n, n_markers, 3) in m, ``labels`` their
     names; only frames inside ``time_range_s`` (s, default all) count.
-    ScaleTool crashes on NaN markers, so the first missing marker is named
-    with its frame.
+    ``needed`` names the measurement markers (default: those of
+    :data:`SCALE_MEASUREMENTS`). ScaleTool crashes, or scales with a wrong
+    factor, on NaN markers, so the first missing marker is named with its frame.
 
     Raises
     ------
     LoperInputError
-        A marker of :data:`SCALE_MEASUREMENTS` absent from ``labels`` or NaN in a frame.
+        A marker of ``needed`` absent from ``labels`` or NaN in a frame.
     """
     labels = list(labels)
     times = np.asarray(time_s, dtype=float)
     X = np.asarray(markers_m, dtype=float)
     t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
-    needed = sorted({m for pairs in SCALE_MEASUREMENTS.values() for pair in pairs for m in pair})
+    if needed is None:
+        needed = {m for pairs in SCALE_MEASUREMENTS.values() for pair in pairs for m in pair}
+    needed = sorted(set(needed))
     missing = [m for m in needed if m not in labels]
     if missing:
         raise LoperInputError(f"{where(source)}static trial lacks marker(s) {missing} needed for scaling")

@@ -1,14 +1,15 @@
-"""OpenSim models on disk (.osim) and the quiet import of OpenSim itself."""
+"""OpenSim files on disk (models .osim, ScaleTool setups, marker sets) and the quiet import of OpenSim itself."""
 
 from __future__ import annotations
 
 import os
+import xml.etree.ElementTree as ET
 from pathlib import Path
 
 from ..errors import LoperInputError
 from .atomic import staged
 
-__all__ = ["quiet_opensim", "read_model", "write_model"]
+__all__ = ["quiet_opensim", "read_model", "write_model", "read_scale_setup", "read_marker_set"]
 
 
 def quiet_opensim():
@@ -43,3 +44,50 @@ def write_model(model, path: str | os.PathLike) -> Path:
     with staged(path, "OpenSim model") as tmp:
         model.printToXML(str(tmp))
     return Path(path)
+
+
+def read_scale_setup(path: str | os.PathLike):
+    """An ``opensim.ScaleTool`` from a ScaleTool setup XML file.
+
+    The file must be an OpenSim document holding a ``<ScaleTool>`` element
+    (checked before OpenSim reads it, since OpenSim reads any XML file
+    without complaint and yields an empty tool).
+
+    Raises
+    ------
+    LoperInputError
+        The file is missing, is not XML, is not a ScaleTool setup, or OpenSim
+        cannot read it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LoperInputError(f"scale setup file not found: {path}")
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError) as exc:
+        raise LoperInputError(f"{path}: not an XML file ({exc})") from None
+    if root.tag != "ScaleTool" and root.find("ScaleTool") is None:
+        raise LoperInputError(f"{path}: not an OpenSim ScaleTool setup (its <{root.tag}> element holds no <ScaleTool>)")
+    osim = quiet_opensim()
+    try:
+        return osim.ScaleTool(str(path))
+    except Exception as exc:  # OpenSim raises its own exception types
+        raise LoperInputError(f"{path}: OpenSim cannot read this ScaleTool setup ({exc})") from exc
+
+
+def read_marker_set(path: str | os.PathLike):
+    """An ``opensim.MarkerSet`` from a marker-set XML file.
+
+    Raises
+    ------
+    LoperInputError
+        The file is missing or OpenSim cannot read it.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LoperInputError(f"marker set file not found: {path}")
+    osim = quiet_opensim()
+    try:
+        return osim.MarkerSet(str(path))
+    except Exception as exc:  # OpenSim raises its own exception types
+        raise LoperInputError(f"{path}: OpenSim cannot read this marker set ({exc})") from exc

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping, Sequence
+from pathlib import Path
 
 from ..dynamics import SegmentParameters, segment_parameters_from_anthropometry
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, staged, write_tsv
 from ..io.readers import read_tsv
 
-__all__ = ["SEGMENT_FLOAT_FORMAT", "read_segments", "write_segments", "generic_model", "scaled_model", "segments",
-           "anthropometric_segments"]
+__all__ = ["SEGMENT_FLOAT_FORMAT", "read_segments", "write_segments", "generic_model", "scaled_model",
+           "scale_with_setup", "segments", "segments_from_model_file", "anthropometric_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -102,24 +104,55 @@ def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLik
 
 
 def segments(model_osim: PathLike, out_tsv: PathLike, side: str = "left", height_m: float | None = None,
-             mass_kg: float | None = None, user_model: bool = False) -> SegmentParameters:
-    """Segment table of the swing leg (TSV) for the dynamics model.
+             mass_kg: float | None = None, user_model: bool = False,
+             segment_bodies: Mapping[str, Sequence[str]] | None = None,
+             attachment_fraction: float = 0.8) -> SegmentParameters:
+    """Segment table of the swing leg (TSV) for the dynamics model, from the model itself.
 
-    From the scaled model; for a user-supplied model (whose bodies need not be
-    ours) from Winter's table with the subject's height and mass.
+    Our generated (and scaled) model and any user model alike go through
+    :func:`segments_from_model_file`. ``height_m``, ``mass_kg`` and
+    ``user_model`` no longer change the table (the table of a user model
+    used to come from Winter's proportions); they are accepted so that
+    existing callers keep working.
     """
+    return segments_from_model_file(model_osim, out_tsv, side, segment_bodies, attachment_fraction)
+
+
+def segments_from_model_file(model_osim: PathLike, out_tsv: PathLike, side: str = "left",
+                             segment_bodies: Mapping[str, Sequence[str]] | None = None,
+                             attachment_fraction: float = 0.8) -> SegmentParameters:
+    """Segment table (TSV) of one leg of an OpenSim model file (:func:`loper_analysis.segments_from_model.segments_from_model`).
+
+    Parameters
+    ----------
+    model_osim : path
+        A (scaled) ``.osim`` model: gait2392, Rajagopal2016, our generated
+        model or any model whose bodies ``segment_bodies`` names.
+    out_tsv : path
+        The table (:func:`write_segments`), written atomically.
+    side : {"left", "right"}
+        The swing leg.
+    segment_bodies : mapping, optional
+        Segment -> body names with ``{s}`` for the side suffix (setting
+        ``opensim.segment_bodies``); ``None``: the model's own kind.
+    attachment_fraction : float
+        Rod attachment as a fraction of the thigh length, for a model without brace markers.
+
+    Raises
+    ------
+    LoperInputError
+        Missing or unreadable model, unknown side, a configured body missing.
+    """
+    from ..checks import side as check_side
     from ..constants import SIDE_SUFFIX
     from ..io.osim import read_model
-    from ..model import segment_parameters_from_model
+    from ..segments_from_model import segments_from_model
 
-    if user_model:
-        if height_m is None or mass_kg is None:
-            raise LoperInputError(f"{model_osim}: a user model needs the subject's height_m and mass_kg for its segment table")
-        params = segment_parameters_from_anthropometry(height_m, mass_kg)
-    else:
-        params = segment_parameters_from_model(read_model(model_osim), side=SIDE_SUFFIX[side])
+    check_side(side, str(model_osim))
+    params = segments_from_model(read_model(model_osim), SIDE_SUFFIX[side], segment_bodies, attachment_fraction,
+                                 source=str(model_osim))
     write_segments(params, out_tsv)
-    log.info("segment table of %s", model_osim)
+    log.info("segment table of %s (%s leg)", model_osim, side)
     return params
 
 
@@ -130,3 +163,147 @@ def anthropometric_segments(out_tsv: PathLike, height_m: float, mass_kg: float,
     write_segments(params, out_tsv)
     log.info("segment table for %s m, %s kg: %s", height_m, mass_kg, params)
     return params
+
+
+def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: PathLike, mass_kg: float,
+                     out_osim: PathLike, time_range_s: tuple[float, float] | None = None,
+                     segment_bodies: Mapping[str, Sequence[str]] | None = None) -> None:
+    """Scale a generic OpenSim model with a lab's own ScaleTool setup and a static trial (TRC).
+
+    The setup (``opensim.ScaleTool(setup_xml)``) keeps its measurements,
+    scale set, scaling order, mass-distribution flag, marker-placer tasks
+    and its marker set file (resolved, like OpenSim does, relative to the
+    setup's folder); replaced are the generic model file, the marker file
+    of the model scaler and the marker placer (``static_trc``), the subject
+    mass, the time range and the output files: only the final model is
+    written, atomically, to ``out_osim`` (the marker placer's model when it
+    applies, else the model scaler's).
+
+    Parameters
+    ----------
+    generic_osim : path
+        The generic ``.osim`` model.
+    setup_xml : path
+        An OpenSim ScaleTool setup.
+    static_trc : path
+        The static trial (``.trc``, any length unit OpenSim knows).
+    mass_kg : float
+        Subject mass, kg (0 .. 300).
+    out_osim : path
+        The scaled model.
+    time_range_s : (float, float), optional
+        Frames of the static trial used, s (default: the whole trial).
+    segment_bodies : mapping, optional
+        The bodies the segment table will need (``opensim.segment_bodies``);
+        the scaled model must have them on both sides.
+
+    Raises
+    ------
+    LoperInputError
+        A missing file; a file that is not a ScaleTool setup; measurement
+        markers that the model (with the setup's marker set) or the static
+        trial lacks (all listed); a measurement marker missing (NaN) in a
+        frame of the time range (ScaleTool would crash or scale with a wrong
+        factor; markers used only by the marker placer may have gaps, OpenSim
+        leaves such a marker where it is); a scaled model without the
+        configured bodies; ScaleTool failing. Nothing is written then.
+    """
+    from ..io.opensim_tables import read_markers
+    from ..io.osim import quiet_opensim, read_marker_set, read_model, read_scale_setup
+    from ..model import static_marker_problem
+    from ..segments_from_model import check_segment_bodies
+
+    generic_osim, setup_xml, static_trc = Path(generic_osim), Path(setup_xml), Path(static_trc)
+    for path in (generic_osim, static_trc):
+        if not path.is_file():
+            raise LoperInputError(f"file not found: {path}")
+    if static_trc.suffix.lower() != ".trc":
+        raise LoperInputError(f"{static_trc}: ScaleTool reads a static trial as .trc, got '{static_trc.suffix}'")
+    if not 0 < mass_kg <= 300:
+        raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
+    tool = read_scale_setup(setup_xml)
+    maker = tool.getGenericModelMaker()
+    marker_set = _setup_file(maker.getMarkerSetFileName(), setup_xml)
+    if marker_set is not None and not marker_set.is_file():
+        raise LoperInputError(f"{setup_xml}: GenericModelMaker/marker_set_file {maker.getMarkerSetFileName()} "
+                              f"not found (looked for {marker_set})")
+    model_markers = set(_names(read_model(generic_osim).getMarkerSet()))
+    if marker_set is not None:
+        model_markers |= set(_names(read_marker_set(marker_set)))
+    needed = _measurement_markers(tool)
+    lacking = sorted(needed - model_markers)
+    if lacking:
+        extra = f" with marker set {marker_set}" if marker_set is not None else ""
+        raise LoperInputError(f"{setup_xml}: measurement marker(s) {lacking} are not on the model {generic_osim}{extra}")
+    times, X, labels = read_markers(static_trc)
+    lacking = sorted(needed - set(labels))
+    if lacking:
+        raise LoperInputError(f"{setup_xml}: measurement marker(s) {lacking} are not in the static trial {static_trc}")
+    t0, t1 = (float(times[0]), float(times[-1])) if time_range_s is None else map(float, time_range_s)
+    if not (t0 <= t1 and t0 <= times[-1] + 1e-9 and t1 >= times[0] - 1e-9):
+        raise LoperInputError(f"{static_trc}: time_range_s {time_range_s} lies outside the trial "
+                              f"({times[0]:.3f} .. {times[-1]:.3f} s) or is reversed")
+    static_marker_problem(times, X, labels, (t0, t1), source=str(static_trc), needed=needed)
+
+    osim = quiet_opensim()
+    tool.setPathToSubject("")  # OpenSim prefixes the setup's folder to every file name; ours are absolute
+    tool.setSubjectMass(mass_kg)
+    maker.setModelFileName(str(generic_osim.resolve()))
+    maker.setMarkerSetFileName(str(marker_set) if marker_set is not None else "Unassigned")
+    scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
+    time_range = osim.ArrayDouble()
+    time_range.append(t0)
+    time_range.append(t1)
+    trc = str(static_trc.resolve())
+    coordinates = _setup_file(placer.getCoordinateFileName(), setup_xml)
+    placer.setCoordinateFileName(str(coordinates) if coordinates is not None else "Unassigned")
+    for part in (scaler, placer):
+        part.setMarkerFileName(trc)
+        part.setTimeRange(time_range)
+    scaler.setOutputScaleFileName("Unassigned")
+    placer.setOutputMotionFileName("Unassigned")
+    placer.setOutputMarkerFileName("Unassigned")
+    with staged(out_osim, "OpenSim model") as tmp:
+        final, other = (placer, scaler) if placer.getApply() else (scaler, placer)
+        final.setOutputModelFileName(str(tmp))
+        other.setOutputModelFileName("Unassigned")
+        try:
+            tool.run()
+        except Exception as exc:  # OpenSim raises its own exception types
+            raise LoperInputError(f"{setup_xml}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} "
+                                  f"({exc})") from exc
+        if not tmp.is_file():
+            raise LoperInputError(f"{setup_xml}: OpenSim's ScaleTool wrote no model for {static_trc} with "
+                                  f"{generic_osim} (are the model scaler and the marker placer both off?)")
+        check_segment_bodies(read_model(tmp), segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
+    log.info("scaled %s with %s to %s", generic_osim, setup_xml, static_trc)
+
+
+def _names(object_set) -> list[str]:
+    return [object_set.get(i).getName() for i in range(object_set.getSize())]
+
+
+def _setup_file(name: str, setup_xml: Path) -> Path | None:
+    """A file named in a setup, relative to the setup's folder (as OpenSim reads it); None when unset."""
+    name = (name or "").strip()
+    if name in ("", "Unassigned"):
+        return None
+    path = Path(name)
+    return (path if path.is_absolute() else setup_xml.parent / path).resolve()
+
+
+def _measurement_markers(tool) -> set[str]:
+    """Markers of the applied measurements of a ScaleTool (empty when its model scaler does not measure)."""
+    scaler = tool.getModelScaler()
+    order = scaler.getScalingOrder()
+    if not scaler.getApply() or "measurements" not in [order.get(i) for i in range(order.getSize())]:
+        return set()
+    out: set[str] = set()
+    measurements = scaler.getMeasurementSet()
+    for i in range(measurements.getSize()):
+        m = measurements.get(i)
+        if m.getApply():
+            for j in range(m.getNumMarkerPairs()):
+                pair = m.getMarkerPair(j)
+                out |= {pair.getMarkerName(0), pair.getMarkerName(1)}
+    return out

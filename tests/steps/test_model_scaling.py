@@ -1,0 +1,177 @@
+"""Scaling with a lab's own ScaleTool setup (steps.model.scale_with_setup) on gait2392.
+
+The static trial is made here: gait2392 with its scale markers is scaled
+with known factors (OpenSim's Model.scale) and its markers' ground
+positions in the default pose are written as a TRC. The lab setup
+(``examples/gait2392/scale_setup.xml``) must recover the factors, and our
+step must give the same model as OpenSim's own ``ScaleTool(setup).run()``.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.opensim_tables import read_markers, write_trc
+from loper_analysis.io.osim import quiet_opensim, read_marker_set, read_model
+from loper_analysis.kinematics import marker_positions
+from loper_analysis.segments_from_model import segments_from_model
+from loper_analysis.steps.model import scale_with_setup
+
+ROOT = Path(__file__).resolve().parents[2]
+DATA = ROOT / "tests" / "data" / "gait2392"
+GENERIC = DATA / "gait2392_simbody.osim"
+MARKER_SET = DATA / "gait2392_Scale_MarkerSet.xml"
+SETUP = ROOT / "examples" / "gait2392" / "scale_setup.xml"
+FACTORS = {"pelvis": 1.05, "torso": 1.02, "femur": 1.10, "tibia": 0.95, "talus": 1.08, "calcn": 1.08, "toes": 1.08}
+MASS_KG = 80.0
+GENERIC_MASS_KG = 75.1646
+
+
+def _bodies(name: str) -> list[str]:
+    return [name] if name in ("pelvis", "torso") else [f"{name}_r", f"{name}_l"]
+
+
+@pytest.fixture(scope="module")
+def lab(tmp_path_factory):
+    """A lab folder: the setup, its marker set beside it, and a static trial of a subject of known proportions."""
+    d = tmp_path_factory.mktemp("lab")
+    shutil.copy(SETUP, d / "scale_setup.xml")
+    shutil.copy(MARKER_SET, d / MARKER_SET.name)
+    osim = quiet_opensim()
+    model = read_model(GENERIC)
+    model.updateMarkerSet(read_marker_set(MARKER_SET))
+    state = model.initSystem()
+    scales = osim.ScaleSet()
+    for body, f in FACTORS.items():
+        for name in _bodies(body):
+            s = osim.Scale()
+            s.setSegmentName(name)
+            s.setScaleFactors(osim.Vec3(f, f, f))
+            s.setApply(True)
+            scales.cloneAndAppend(s)
+    model.scale(state, scales, True, MASS_KG)
+    markers = model.getMarkerSet()
+    labels = [markers.get(i).getName() for i in range(markers.getSize())]
+    X = np.repeat(marker_positions(model, {}, labels), 10, axis=0)
+    write_trc(d / "static.trc", np.arange(10) / 100.0, X, labels)
+    return d
+
+
+@pytest.fixture(scope="module")
+def scaled(lab):
+    out = lab / "out" / "scaled.osim"
+    scale_with_setup(GENERIC, lab / "scale_setup.xml", lab / "static.trc", MASS_KG, out)
+    return out
+
+
+def test_lab_setup_recovers_the_known_factors(scaled):
+    model, generic = read_model(scaled), read_model(GENERIC)
+    p, g = segments_from_model(model, "l"), segments_from_model(generic, "l")
+    ratios = np.array(p.length_m) / np.array(g.length_m)
+    np.testing.assert_allclose(ratios, (1.10, 0.95, 1.08), rtol=1e-9)
+    for body in ("pelvis", "femur_r", "tibia_l", "calcn_r", "toes_l", "torso"):
+        np.testing.assert_allclose(model.getBodySet().get(body).getMass(),
+                                   generic.getBodySet().get(body).getMass() * MASS_KG / GENERIC_MASS_KG, rtol=1e-12)
+    hip = model.getJointSet().get("hip_r").getParentFrame().findTransformInBaseFrame().p().to_numpy()
+    np.testing.assert_allclose(hip, 1.05 * np.array([-0.0707, -0.0661, 0.0835]), rtol=1e-9)
+
+
+def _peer_setup(lab: Path, d: Path) -> Path:
+    """The lab setup filled in by hand (files beside it) for OpenSim's own ScaleTool."""
+    for f in (GENERIC, lab / MARKER_SET.name, lab / "static.trc"):
+        shutil.copy(f, d / f.name)
+    text = (lab / "scale_setup.xml").read_text()
+    text = text.replace("<mass>75</mass>", f"<mass>{MASS_KG}</mass>")
+    text = text.replace("<model_file>gait2392_simbody.osim</model_file>", f"<model_file>{GENERIC.name}</model_file>")
+    text = re.sub(r"<time_range>[^<]*</time_range>", "<time_range> 0 0.09</time_range>", text)
+    text = text.replace("<output_model_file>scaled.osim</output_model_file>", "<output_model_file>peer.osim</output_model_file>")
+    (d / "setup.xml").write_text(text)
+    return d / "setup.xml"
+
+
+def test_step_equals_opensims_own_scale_tool(lab, scaled, tmp_path):
+    osim = quiet_opensim()
+    assert osim.ScaleTool(str(_peer_setup(lab, tmp_path))).run()
+    ours, peer = read_model(scaled), read_model(tmp_path / "peer.osim")
+    s1, s2 = ours.initSystem(), peer.initSystem()
+    bodies = peer.getBodySet()
+    assert ours.getBodySet().getSize() == bodies.getSize() == 12
+    for i in range(bodies.getSize()):
+        b2 = bodies.get(i)
+        b1 = ours.getBodySet().get(b2.getName())
+        np.testing.assert_allclose(b1.getMass(), b2.getMass(), rtol=1e-9)
+        np.testing.assert_allclose(b1.getMassCenter().to_numpy(), b2.getMassCenter().to_numpy(), rtol=1e-9, atol=1e-12)
+        for part in ("getMoments", "getProducts"):
+            np.testing.assert_allclose(getattr(b1.getInertia(), part)().to_numpy(),
+                                       getattr(b2.getInertia(), part)().to_numpy(), rtol=1e-9, atol=1e-12)
+    joints = peer.getJointSet()
+    for i in range(joints.getSize()):
+        j2 = joints.get(i)
+        j1 = ours.getJointSet().get(j2.getName())
+        for frame in ("getParentFrame", "getChildFrame"):
+            np.testing.assert_allclose(getattr(j1, frame)().findTransformInBaseFrame().p().to_numpy(),
+                                       getattr(j2, frame)().findTransformInBaseFrame().p().to_numpy(), atol=1e-9)
+            np.testing.assert_allclose(getattr(j1, frame)().getPositionInGround(s1).to_numpy(),
+                                       getattr(j2, frame)().getPositionInGround(s2).to_numpy(), atol=1e-9)
+    m1, m2 = ours.getMarkerSet(), peer.getMarkerSet()
+    assert m1.getSize() == m2.getSize() == 39
+    for i in range(m2.getSize()):
+        np.testing.assert_allclose(m1.get(m2.get(i).getName()).get_location().to_numpy(),
+                                   m2.get(i).get_location().to_numpy(), atol=1e-9)
+    np.testing.assert_allclose(segments_from_model(ours, "l").packed, segments_from_model(peer, "l").packed, rtol=1e-9)
+
+
+def test_not_a_scale_setup_is_refused(lab, tmp_path):
+    with pytest.raises(LoperInputError, match=r"gait2392_Scale_MarkerSet\.xml: not an OpenSim ScaleTool setup "
+                                              r"\(its <OpenSimDocument> element holds no <ScaleTool>\)"):
+        scale_with_setup(GENERIC, MARKER_SET, lab / "static.trc", MASS_KG, tmp_path / "never.osim")
+    assert not (tmp_path / "never.osim").exists()
+
+
+def test_markers_the_static_trial_lacks_are_listed(lab, tmp_path):
+    t, X, labels = read_markers(lab / "static.trc")
+    keep = [i for i, name in enumerate(labels) if name not in ("R.Knee.Lat", "L.Heel")]
+    write_trc(tmp_path / "short.trc", t, X[:, keep], [labels[i] for i in keep])
+    with pytest.raises(LoperInputError, match=r"scale_setup\.xml: measurement marker\(s\) \['L\.Heel', 'R\.Knee\.Lat'\] "
+                                              r"are not in the static trial .*short\.trc"):
+        scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "short.trc", MASS_KG, tmp_path / "never.osim")
+    assert not (tmp_path / "never.osim").exists()
+
+
+def test_markers_the_model_lacks_are_listed(lab, tmp_path):
+    shutil.copy(lab / MARKER_SET.name, tmp_path / MARKER_SET.name)
+    text = (lab / "scale_setup.xml").read_text().replace("L.Thigh.Upper L.Knee.Lat", "L.Thigh.Upper L.Epicondyle")
+    (tmp_path / "setup.xml").write_text(text)
+    with pytest.raises(LoperInputError, match=r"setup\.xml: measurement marker\(s\) \['L\.Epicondyle'\] are not on the "
+                                              r"model .*gait2392_simbody\.osim with marker set .*gait2392_Scale_MarkerSet"):
+        scale_with_setup(GENERIC, tmp_path / "setup.xml", lab / "static.trc", MASS_KG, tmp_path / "never.osim")
+    assert not (tmp_path / "never.osim").exists()
+
+
+def test_gap_in_a_measurement_marker_is_refused_naming_marker_and_frame(lab, tmp_path):
+    t, X, labels = read_markers(lab / "static.trc")
+    X[6, labels.index("R.Ankle.Lat")] = np.nan
+    write_trc(tmp_path / "gappy.trc", t, X, labels)
+    with pytest.raises(LoperInputError, match=r"gappy\.trc: marker R\.Ankle\.Lat is missing at frame 6 \(t = 0\.060 s\)"):
+        scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "never.osim")
+    # outside the chosen time range the gap does not matter
+    scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "early.osim",
+                     time_range_s=(0.0, 0.05))
+    p = segments_from_model(read_model(tmp_path / "early.osim"), "r")
+    np.testing.assert_allclose(p.length_m[1] / 0.43, 0.95, rtol=1e-9)
+
+
+def test_scaled_model_without_the_configured_bodies_is_refused(lab, tmp_path):
+    bodies = {"thigh": ["thigh_{s}"], "shank": ["shank_{s}"], "foot": ["foot_{s}"]}
+    with pytest.raises(LoperInputError, match=r"never\.osim \(scaled from .*gait2392_simbody\.osim\): "
+                                              r"opensim\.segment_bodies: thigh body 'thigh_l' is not in the model"):
+        scale_with_setup(GENERIC, lab / "scale_setup.xml", lab / "static.trc", MASS_KG, tmp_path / "never.osim",
+                         segment_bodies=bodies)
+    assert not (tmp_path / "never.osim").exists()
+    assert not list(tmp_path.iterdir())
