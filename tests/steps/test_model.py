@@ -14,7 +14,7 @@ from loper_analysis.model import (
     build_lower_body_model,
     segment_parameters_from_model,
 )
-from loper_analysis.steps.model import read_segments, scaled_model, segments
+from loper_analysis.steps.model import read_segments, scaled_model, segments_from_model_file
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +67,7 @@ def test_static_trial_with_a_gap_is_refused_and_nothing_written(model_file, tall
 
 def test_segment_table_file_of_the_generic_model_equals_winter(model_file, tmp_path):
     out = tmp_path / "segments.tsv"
-    returned = segments(model_file, out, side="left")
+    returned = segments_from_model_file(model_file, out, side="left")
     ref = segment_parameters_from_anthropometry(1.73, 64.9)
     np.testing.assert_allclose(returned.packed, ref.packed, rtol=1e-12, atol=1e-14)
     np.testing.assert_allclose(read_segments(out).packed, ref.packed, rtol=1e-9)  # 10 significant digits
@@ -75,5 +75,5 @@ def test_segment_table_file_of_the_generic_model_equals_winter(model_file, tmp_p
 
 def test_missing_model_file_is_named(tmp_path):
     with pytest.raises(LoperInputError, match=r"model file not found: /nonexistent/model\.osim"):
-        segments("/nonexistent/model.osim", tmp_path / "segments.tsv")
+        segments_from_model_file("/nonexistent/model.osim", tmp_path / "segments.tsv")
     assert not (tmp_path / "segments.tsv").exists()

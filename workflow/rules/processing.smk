@@ -33,7 +33,13 @@ rule markers:
         "../scripts/markers.py"
 
 
+def generic_model(wildcards):
+    """The model scaled per subject: opensim.generic_model, or the generated model for the subject."""
+    return OPENSIM["generic_model"] or f"results/model/{wildcards.subject}/generic.osim"
+
+
 rule model_generic:
+    """The generated sagittal model (used when opensim.generic_model is null)."""
     output:
         "results/model/{subject}/generic.osim",
     params:
@@ -46,13 +52,17 @@ rule model_generic:
 
 
 rule model_scaled:
+    """The generic model scaled to the static trial (OpenSim's ScaleTool, with opensim.scale_setup when given)."""
     input:
-        generic="results/model/{subject}/generic.osim",
+        generic=generic_model,
         static=f"results/markers/{{subject}}/{TRIALS['static']}.trc",
+        setup=[OPENSIM["scale_setup"]] if OPENSIM["scale_setup"] else [],
     output:
         "results/model/{subject}/scaled.osim",
     params:
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
+        scale_setup=OPENSIM["scale_setup"],
+        segment_bodies=OPENSIM["segment_bodies"],
     log:
         "results/logs/model_scaled/{subject}.log",
     benchmark:
@@ -62,15 +72,15 @@ rule model_scaled:
 
 
 rule model_segments:
+    """The swing leg's segment table, exported from the subject's model (opensim.segment_bodies)."""
     input:
         subject_model,
     output:
         "results/model/{subject}/segments.tsv",
     params:
         side=TRIALS["perturbed_side"],
-        height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
-        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
-        user_model=lambda wc: bool(SUBJECT_ROWS[wc.subject].get("model_osim")),
+        segment_bodies=OPENSIM["segment_bodies"],
+        attachment_fraction=OPENSIM["brace_attachment_fraction"],
     log:
         "results/logs/model_segments/{subject}.log",
     script:

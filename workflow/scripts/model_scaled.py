@@ -1,4 +1,6 @@
 from loper_analysis.steps import model, rule_log
 
+p = snakemake.params
 with rule_log(snakemake.log[0]):
-    model.scaled_model(snakemake.input.generic, snakemake.input.static, snakemake.output[0], snakemake.params.mass_kg)
+    model.scale(snakemake.input.generic, snakemake.input.static, snakemake.output[0], p.mass_kg, p.scale_setup,
+                p.segment_bodies)

@@ -12,7 +12,7 @@ from ..io.atomic import PathLike, staged, write_tsv
 from ..io.readers import read_tsv
 
 __all__ = ["SEGMENT_FLOAT_FORMAT", "read_segments", "write_segments", "generic_model", "scaled_model",
-           "scale_with_setup", "segments", "segments_from_model_file", "anthropometric_segments"]
+           "scale_with_setup", "scale", "segments_from_model_file", "anthropometric_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -103,19 +103,14 @@ def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLik
     log.info("scaled %s to %s", generic_osim, static_trc)
 
 
-def segments(model_osim: PathLike, out_tsv: PathLike, side: str = "left", height_m: float | None = None,
-             mass_kg: float | None = None, user_model: bool = False,
-             segment_bodies: Mapping[str, Sequence[str]] | None = None,
-             attachment_fraction: float = 0.8) -> SegmentParameters:
-    """Segment table of the swing leg (TSV) for the dynamics model, from the model itself.
-
-    Our generated (and scaled) model and any user model alike go through
-    :func:`segments_from_model_file`. ``height_m``, ``mass_kg`` and
-    ``user_model`` no longer change the table (the table of a user model
-    used to come from Winter's proportions); they are accepted so that
-    existing callers keep working.
-    """
-    return segments_from_model_file(model_osim, out_tsv, side, segment_bodies, attachment_fraction)
+def scale(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float,
+          setup_xml: PathLike | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None) -> None:
+    """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when ``setup_xml``
+    is given, else with the generated model's marker-pair measurements (:func:`scaled_model`)."""
+    if setup_xml is None:
+        scaled_model(generic_osim, static_trc, out_osim, mass_kg)
+    else:
+        scale_with_setup(generic_osim, setup_xml, static_trc, mass_kg, out_osim, segment_bodies=segment_bodies)
 
 
 def segments_from_model_file(model_osim: PathLike, out_tsv: PathLike, side: str = "left",
