@@ -53,12 +53,12 @@ __all__ = [
     "EXTERNAL_LOADS_SUFFIXES",
     "PlateLoads",
     "VerticalLoads",
-    "external_loads_columns",
-    "surface_normal",
-    "resting_level",
     "centre_of_pressure",
-    "plate_loads",
+    "external_loads_columns",
     "external_loads_table",
+    "plate_loads",
+    "resting_level",
+    "surface_normal",
     "vertical_loads",
 ]
 
@@ -275,13 +275,13 @@ def _nearest_loaded(loaded: np.ndarray) -> np.ndarray | None:
     return np.where(use_prev, prv, nxt)
 
 
-def plate_loads(number_: int, time_s, force_n, moment_nm, corners_m, threshold_n: float = 20.0,
+def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, threshold_n: float = 20.0,
                 band_n: float = 10.0, max_rest_n: float = 100.0, source: str = "") -> PlateLoads:
     """Resting level removed, COP and free moment of one plate, with the unloaded policy of the module notes.
 
     Parameters
     ----------
-    number_ : int
+    plate_number : int
         Plate number (1-based).
     time_s : array_like
         Shape (n,), s.
@@ -320,7 +320,7 @@ def plate_loads(number_: int, time_s, force_n, moment_nm, corners_m, threshold_n
     else:
         cop = cop[nearest]
     free = np.where(loaded, free, 0.0)
-    return PlateLoads(number=int(number_), time_s=t.copy(), force_n=F, moment_nm=M, cop_m=cop, free_moment_nm=free,
+    return PlateLoads(number=int(plate_number), time_s=t.copy(), force_n=F, moment_nm=M, cop_m=cop, free_moment_nm=free,
                       loaded=loaded, rest_force_n=rest_f, rest_moment_nm=rest_m, normal=normal, corners_m=corners.copy(),
                       centre_m=centre)
 

@@ -8,7 +8,10 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.force_platforms import count_force_platforms, read_force_platforms
+from loper_analysis.io.force_platforms import (
+    count_force_platforms,
+    read_force_platforms,
+)
 from tests.io.force_plate_files import (
     R_PLATE_TO_LAB,
     channels_for_load,
