@@ -8,6 +8,7 @@ touches a path. Workflow scripts call one of these functions inside
 full error of the job to its log file.
 
 * :mod:`.processing` - markers, gait events, load cell, strides, stride summary;
+* :mod:`.grf` - force platforms to an OpenSim external-loads ``.mot``;
 * :mod:`.model` - generic model, scaling, segment tables;
 * :mod:`.ik` - inverse kinematics (one job per trial, or in time chunks);
 * :mod:`.transparency` - the transparency tables and figure;

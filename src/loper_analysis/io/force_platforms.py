@@ -1,0 +1,275 @@
+"""Force platforms of a C3D file, read with ezc3d's platform extraction, in SI units and the lab frame.
+
+What ezc3d returns (``ezc3d.c3d(path, extract_forceplat_data=True)``,
+``["data"]["platform"]``; checked against OpenSim's reading of
+``walking5.c3d`` in ``tests/io/test_force_platforms.py``):
+
+* Channels are taken from ``FORCE_PLATFORM:CHANNEL`` (1-based analog channel
+  numbers), never from their labels; TYPE 4 applies ``CAL_MATRIX``
+  (``CAL_MATRIX[row, column, plate]``, ``[F; M] = CAL @ channels``), TYPE 3
+  (Kistler, 8 channels) sums the sensor forces and builds the moments from
+  ``ORIGIN``; TYPE 2 takes the six channels as they are. ``ANALOG:SCALE``,
+  ``OFFSET`` and ``GEN_SCALE`` are applied by ezc3d's analog reader.
+* The plate frame comes from the corners: x = corner 1 - corner 2, y =
+  corner 1 - corner 4, z = x cross y (for the usual plate, z points down).
+  Force and moment are rotated into the lab frame.
+* The moment is about the centre of the top surface, the mean of the four
+  corners: ezc3d moves the channel moment from the sensor origin with
+  ``ORIGIN`` (whose sign it normalises so that the surface lies at negative
+  plate z, i.e. above the sensor).
+* Units: force in ``FORCE_PLATFORM:UNITS`` (N when absent), corners and
+  positions in ``POINT:UNITS``, moments in force unit x position unit
+  (N·mm for a file in mm). Converted here to N, m and N·m.
+* Sign: the force is the one the plate exerts on the body (ground reaction):
+  its vertical (lab +Z) component is positive while someone stands on the
+  plate (walking5: +480 N in stance, channel ``Fz1`` = -480 N in the
+  plate's downward z). No sign is changed here.
+* Times: sample k of the analogs is at ``first_frame / point_rate + k /
+  analog_rate``, with ezc3d's 0-based ``first_frame``.
+
+Supported TYPEs are 2, 3 and 4; others (1, 5, 6, 7, 11, 12, 21, ...) are
+refused. Every problem raises :class:`~loper_analysis.errors.LoperInputError`
+naming the file, the field and the value.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import LoperInputError
+from .c3d import LENGTH_UNITS_PER_M
+
+__all__ = [
+    "SUPPORTED_TYPES",
+    "ForcePlatform",
+    "count_force_platforms",
+    "read_force_platforms",
+]
+
+#: FORCE_PLATFORM:TYPE values read; the number of analog channels each uses.
+SUPPORTED_TYPES: dict[int, int] = {2: 6, 3: 8, 4: 6}
+
+#: Moment units recognised in ``ANALOG:UNITS`` (spelling normalised), as N·m per unit.
+_MOMENT_UNITS: dict[str, float] = {"nmm": 1e-3, "ncm": 1e-2, "nm": 1.0}
+
+
+@dataclass(frozen=True)
+class ForcePlatform:
+    """One force platform: the ground reaction on the body and the plate's geometry, lab frame, SI units.
+
+    Attributes
+    ----------
+    number : int
+        Plate number, 1-based (order of ``FORCE_PLATFORM`` entries).
+    type : int
+        ``FORCE_PLATFORM:TYPE`` (2, 3 or 4).
+    channels : tuple of int
+        The 1-based analog channels of ``FORCE_PLATFORM:CHANNEL`` used (6 or 8).
+    analog_rate_hz : float
+        Sample rate of the force and moment (Hz).
+    time_s : numpy.ndarray
+        Shape (n_samples,), s: ``first_frame / point_rate + k / analog_rate``.
+    force_n : numpy.ndarray
+        Shape (n_samples, 3), N, lab frame: force the plate exerts on the body
+        (vertical component positive while loaded), resting level included.
+    moment_nm : numpy.ndarray
+        Shape (n_samples, 3), N·m, lab frame: moment of that force about
+        :attr:`centre_m`, resting level included.
+    corners_m : numpy.ndarray
+        Shape (4, 3), m, lab frame, in ``FORCE_PLATFORM:CORNERS`` order.
+    centre_m : numpy.ndarray
+        Shape (3,), m, lab frame: centre of the top surface (mean of the corners),
+        the point the moment is about.
+    source : str
+        The file read (for messages).
+    """
+
+    number: int
+    type: int
+    channels: tuple[int, ...]
+    analog_rate_hz: float
+    time_s: np.ndarray
+    force_n: np.ndarray
+    moment_nm: np.ndarray
+    corners_m: np.ndarray
+    centre_m: np.ndarray
+    source: str = ""
+
+
+def _value(params, name: str):
+    """``FORCE_PLATFORM:name`` value as an array, or None when absent."""
+    try:
+        return np.asarray(params["FORCE_PLATFORM"][name]["value"])
+    except KeyError:
+        return None
+
+
+def _used(params) -> int:
+    used = _value(params, "USED")
+    if used is None or used.size == 0:
+        return 0
+    return int(np.ravel(used)[0])
+
+
+def _open(path: Path, extract: bool):
+    import ezc3d
+
+    source = str(path)
+    if not path.is_file():
+        raise LoperInputError(f"{source}: C3D file not found" if not path.exists() else f"{source}: not a regular file")
+    try:
+        return ezc3d.c3d(source, extract_forceplat_data=extract)
+    except Exception as exc:  # ezc3d raises RuntimeError, ValueError, ... for damaged files and bad parameters
+        return exc
+
+
+def count_force_platforms(path: str | os.PathLike) -> int:
+    """``FORCE_PLATFORM:USED`` of a C3D file; 0 when the group or the parameter is absent.
+
+    Raises
+    ------
+    LoperInputError
+        Missing or unreadable file.
+    """
+    path = Path(path)
+    c3d = _open(path, extract=False)
+    if isinstance(c3d, Exception):
+        raise LoperInputError(f"{path}: not a readable C3D file: {type(c3d).__name__}: {c3d}") from c3d
+    return _used(c3d["parameters"])
+
+
+def _check_parameters(params, n_analogs: int, source: str) -> tuple[int, list[int], list[tuple[int, ...]]]:
+    """USED, TYPEs and CHANNEL entries of every plate; refuses what ezc3d cannot (or should not) read."""
+    used = _used(params)
+    if used <= 0:
+        value = "absent" if _value(params, "USED") is None else f"= {used}"
+        raise LoperInputError(f"{source}: FORCE_PLATFORM:USED {value}: the file holds no force platforms")
+    types = _value(params, "TYPE")
+    channel = _value(params, "CHANNEL")
+    for name, value in (("TYPE", types), ("CHANNEL", channel), ("CORNERS", _value(params, "CORNERS")),
+                        ("ORIGIN", _value(params, "ORIGIN"))):
+        if value is None or value.size == 0:
+            raise LoperInputError(f"{source}: FORCE_PLATFORM:{name} not declared for {used} force platform(s)")
+    types = np.ravel(types).astype(int)
+    if types.size < used:
+        raise LoperInputError(f"{source}: FORCE_PLATFORM:TYPE holds {types.size} value(s) for USED = {used} platforms")
+    channel = channel.reshape(channel.shape[0], -1) if channel.ndim >= 2 else channel.reshape(-1, 1)
+    plate_channels = []
+    for k in range(used):
+        kind = int(types[k])
+        if kind not in SUPPORTED_TYPES:
+            raise LoperInputError(
+                f"{source}: FORCE_PLATFORM:TYPE of platform {k + 1} is {kind}; supported types are "
+                f"{', '.join(map(str, SUPPORTED_TYPES))}"
+            )
+        n = SUPPORTED_TYPES[kind]
+        if channel.shape[0] < n or channel.shape[1] <= k:
+            raise LoperInputError(
+                f"{source}: FORCE_PLATFORM:CHANNEL has shape {channel.shape}; platform {k + 1} (TYPE {kind}) needs {n} "
+                "channel numbers"
+            )
+        chans = tuple(int(c) for c in channel[:n, k])
+        bad = [c for c in chans if not 1 <= c <= n_analogs]
+        if bad:
+            raise LoperInputError(
+                f"{source}: FORCE_PLATFORM:CHANNEL of platform {k + 1} = {list(chans)} points at analog channel(s) "
+                f"{bad}, but the file has {n_analogs} analog channel(s)"
+            )
+        plate_channels.append(chans)
+    return used, [int(t) for t in types[:used]], plate_channels
+
+
+def _moment_unit_check(params, plate: int, chans: tuple[int, ...], kind: int, expected_nm: float, source: str) -> None:
+    """Refuse moment channels whose declared unit differs from the one ezc3d assumes (force x position unit)."""
+    if kind == 3:
+        return
+    try:
+        units = [str(u).strip() for u in params["ANALOG"]["UNITS"]["value"]]
+    except KeyError:
+        return
+    for c in chans[3:6]:
+        if c - 1 >= len(units):
+            continue
+        key = re.sub(r"[\s.·*_-]", "", units[c - 1]).lower()
+        if key in _MOMENT_UNITS and not np.isclose(_MOMENT_UNITS[key], expected_nm):
+            raise LoperInputError(
+                f"{source}: ANALOG:UNITS of channel {c} (a moment of platform {plate}) is '{units[c - 1]}', but "
+                f"POINT:UNITS makes ezc3d expect N·m x {expected_nm:g}; the moments cannot be placed consistently"
+            )
+
+
+def read_force_platforms(path: str | os.PathLike) -> list[ForcePlatform]:
+    """Every force platform of a C3D file, in file order.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.c3d`` file.
+
+    Returns
+    -------
+    list of ForcePlatform
+        One per plate (``FORCE_PLATFORM:USED`` of them), numbered from 1;
+        forces in N, moments in N·m about the surface centre, corners in m,
+        all in the lab frame (see the module notes for the conventions).
+
+    Raises
+    ------
+    LoperInputError
+        Missing or unreadable file; ``FORCE_PLATFORM:USED`` absent or 0 (the
+        file holds no platforms: use :func:`count_force_platforms` to test
+        first); TYPE not 2, 3 or 4; ``FORCE_PLATFORM:CHANNEL`` pointing at
+        analog channels that do not exist; ``POINT:UNITS`` or
+        ``FORCE_PLATFORM:UNITS`` unknown; moment channels whose unit
+        disagrees with ``POINT:UNITS``; ezc3d's own refusal (quoted).
+    """
+    path = Path(path)
+    source = str(path)
+    c3d = _open(path, extract=True)
+    failure = c3d if isinstance(c3d, Exception) else None
+    if failure is not None:
+        c3d = _open(path, extract=False)  # diagnose the parameters ezc3d's extraction refused
+        if isinstance(c3d, Exception):
+            raise LoperInputError(f"{source}: not a readable C3D file: {type(c3d).__name__}: {c3d}") from c3d
+    params = c3d["parameters"]
+    n_analogs = int(np.shape(c3d["data"]["analogs"])[1])
+    used, types, plate_channels = _check_parameters(params, n_analogs, source)
+    if failure is not None:
+        raise LoperInputError(
+            f"{source}: ezc3d cannot extract the force platforms: {type(failure).__name__}: {failure}"
+        ) from failure
+    platforms = c3d["data"]["platform"]
+    if len(platforms) != used:
+        raise LoperInputError(f"{source}: ezc3d extracted {len(platforms)} platform(s) for FORCE_PLATFORM:USED = {used}")
+    header = c3d["header"]
+    point_rate = float(header["points"]["frame_rate"])
+    analog_rate = float(header["analogs"]["frame_rate"])
+    if not (point_rate > 0 and analog_rate > 0):
+        raise LoperInputError(f"{source}: POINT:RATE = {point_rate:g} and ANALOG:RATE = {analog_rate:g} must be positive")
+    t0 = int(header["points"]["first_frame"]) / point_rate
+    out = []
+    for k, (pf, kind, chans) in enumerate(zip(platforms, types, plate_channels)):
+        unit_pos = str(pf["unit_position"]).strip()
+        unit_force = str(pf["unit_force"]).strip()
+        if unit_pos.lower() not in LENGTH_UNITS_PER_M:
+            raise LoperInputError(f"{source}: POINT:UNITS = '{unit_pos}' is not one of {', '.join(LENGTH_UNITS_PER_M)}")
+        if unit_force != "N":
+            raise LoperInputError(f"{source}: FORCE_PLATFORM:UNITS = '{unit_force}'; only N is supported")
+        per_m = LENGTH_UNITS_PER_M[unit_pos.lower()]
+        _moment_unit_check(params, k + 1, chans, kind, 1.0 / per_m, source)
+        force = np.asarray(pf["force"], dtype=float).T.copy()
+        moment = np.asarray(pf["moment"], dtype=float).T / per_m
+        corners = np.asarray(pf["corners"], dtype=float).T / per_m
+        if not (np.all(np.isfinite(force)) and np.all(np.isfinite(moment)) and np.all(np.isfinite(corners))):
+            raise LoperInputError(f"{source}: platform {k + 1} holds non-finite forces, moments or corners")
+        out.append(ForcePlatform(
+            number=k + 1, type=kind, channels=chans, analog_rate_hz=analog_rate,
+            time_s=t0 + np.arange(force.shape[0]) / analog_rate, force_n=force, moment_nm=moment,
+            corners_m=corners, centre_m=corners.mean(axis=0), source=source,
+        ))
+    return out

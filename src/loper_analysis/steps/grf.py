@@ -1,0 +1,73 @@
+"""File step: ground reaction forces of a C3D's force platforms -> OpenSim external-loads ``.mot``.
+
+C3D (ezc3d's platform extraction, :mod:`loper_analysis.io.force_platforms`)
+-> resting level removed, COP, free moment, lab -> model rotation
+(:mod:`loper_analysis.ground_reaction`) -> ``.mot`` at the analog rate
+(:func:`loper_analysis.io.opensim_tables.write_external_loads_mot`), columns
+``{n}_ground_force_v{x,y,z}`` (N), ``{n}_ground_force_p{x,y,z}`` (m),
+``{n}_ground_torque_{x,y,z}`` (N·m) for plate n = 1, 2, ...
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from ..io.atomic import PathLike
+
+__all__ = ["grf", "plate_vertical_loads"]
+
+log = logging.getLogger(__name__)
+
+
+def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest_n: float):
+    from ..ground_reaction import plate_loads
+    from ..io.force_platforms import read_force_platforms
+
+    plates = read_force_platforms(c3d_path)
+    return [plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, threshold_n, band_n, max_rest_n,
+                        source=f"{c3d_path} (force platform {p.number})") for p in plates]
+
+
+def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+        threshold_n: float = 20.0, band_n: float = 10.0, max_rest_n: float = 100.0,
+        xml_out: PathLike | None = None, bodies: Mapping[int, str] | None = None) -> pd.DataFrame:
+    """C3D force platforms -> ground reaction on the body in the model frame -> external-loads ``.mot``.
+
+    ``threshold_n`` is the vertical force above the resting level from which
+    a plate counts as loaded (below it force and torque are written as 0 and
+    the COP is held, see :mod:`loper_analysis.ground_reaction`); ``band_n``
+    and ``max_rest_n`` set the resting-level rule. With ``xml_out`` and
+    ``bodies`` (plate number -> body name) an OpenSim ExternalLoads ``.xml``
+    pointing at ``out_mot`` (path relative to the ``.xml``) is written too. Returns the table written
+    (``time_s`` plus nine columns per plate).
+    """
+    from ..ground_reaction import external_loads_table
+    from ..io.opensim_tables import write_external_loads_mot, write_external_loads_xml
+
+    loads = _plate_loads(c3d_path, threshold_n, band_n, max_rest_n)
+    table = external_loads_table(loads, rotation_deg)
+    write_external_loads_mot(out_mot, table)
+    if xml_out is not None and bodies:
+        datafile = os.path.relpath(Path(out_mot).resolve(), Path(xml_out).resolve().parent)
+        write_external_loads_xml(xml_out, bodies, datafile)
+    for p in loads:
+        log.info("%s: plate %d: resting level %.1f N vertical, loaded %.1f %% of %d samples", c3d_path, p.number,
+                 p.rest_force_n[2], 100.0 * p.loaded.mean(), p.loaded.size)
+    return table
+
+
+def plate_vertical_loads(c3d_path: PathLike, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), band_n: float = 10.0,
+                         max_rest_n: float = 100.0):
+    """Each plate's lab-vertical force above its resting level at the analog rate, corners in the model frame.
+
+    Reads only (writes nothing); returns a
+    :class:`loper_analysis.ground_reaction.VerticalLoads`.
+    """
+    from ..ground_reaction import vertical_loads
+
+    return vertical_loads(_plate_loads(c3d_path, 20.0, band_n, max_rest_n), rotation_deg)
