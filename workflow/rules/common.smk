@@ -150,6 +150,8 @@ def processing_targets() -> list[str]:
         if SUBJECT_SOURCE[s] == "synthetic":
             out.append(f"data/raw/{s}/truth.yaml")
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
+        if SUBJECT_SOURCE[s] == "recorded":  # lab files: their force platforms as OpenSim external loads
+            out += [f"results/grf/{s}/{t}.grf.mot" for t in subject_trials(s)]
     if out:
         out.append("results/strides/summary.tsv")
     if any(trial_onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):

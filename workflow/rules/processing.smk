@@ -148,6 +148,25 @@ else:
             "../scripts/ik_join.py"
 
 
+rule grf:
+    """Ground reaction forces of the C3D's force platforms as an OpenSim external-loads .mot (model frame)."""
+    input:
+        "data/raw/{subject}/{trial}.c3d",
+    output:
+        "results/grf/{subject}/{trial}.grf.mot",
+    params:
+        rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
+        threshold_n=config["grf"]["loaded_threshold_n"],
+        band_n=config["grf"]["resting_band_n"],
+        max_rest_n=config["grf"]["max_resting_n"],
+    log:
+        "results/logs/grf/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/grf/{subject}/{trial}.tsv"
+    script:
+        "../scripts/grf.py"
+
+
 rule events:
     input:
         "data/raw/{subject}/{trial}.c3d",

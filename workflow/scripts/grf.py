@@ -1,0 +1,5 @@
+from loper_analysis.steps import grf, rule_log
+
+p = snakemake.params
+with rule_log(snakemake.log[0]):
+    grf.grf(snakemake.input[0], snakemake.output[0], p.rotation_deg, p.threshold_n, p.band_n, p.max_rest_n)
