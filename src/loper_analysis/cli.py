@@ -1,16 +1,26 @@
-"""The ``loper-analysis`` command: library steps for use outside the workflow.
+"""The ``loper-analysis`` command: each stage of the pipeline on one file, with the functions the rules call.
 
 Subcommands
 -----------
-segments     write the swing-leg segment table of a subject from height and mass
-validate     run (part of) the validation study and write its tables
+markers      C3D markers -> label map, gap fill, lab -> model frame, low-pass -> TRC (mm)
+grf          C3D force platforms -> OpenSim external-loads .mot (model frame)
+events       heel strikes and toe-offs from the force platforms (or named GRF channels) -> events TSV
+scale        scale a generic OpenSim model with a lab's ScaleTool setup and a static trial
+segments     swing-leg segment table from a scaled model, or from height and mass (Winter's table)
 ik           OpenSim inverse kinematics of a marker file (.c3d or .trc) to a .mot
+validate     run (part of) the validation study and write its tables
+
+Every command exits with 0 on success and with 2 and one line on standard
+error naming the file and the cause when an input cannot serve
+(``--traceback`` shows Python's traceback instead, for bug reports).
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+import tempfile
+from pathlib import Path
 
 import numpy as np
 
@@ -18,11 +28,92 @@ from .errors import LoperInputError
 
 __all__ = ["main"]
 
+#: Lab -> model rotation (degrees about X, Y, Z) used for a C3D when --rotate-deg is not given: Qualisys Z-up -> OpenSim Y-up.
+C3D_ROTATION_DEG = (-90.0, 0.0, 0.0)
+
+
+def _rotation(args: argparse.Namespace, path: str) -> tuple[float, float, float]:
+    """--rotate-deg, else -90 0 0 for a C3D (Z-up lab) and 0 0 0 for anything else."""
+    if args.rotate_deg is not None:
+        return tuple(args.rotate_deg)
+    return C3D_ROTATION_DEG if str(path).lower().endswith(".c3d") else (0.0, 0.0, 0.0)
+
+
+def _label_map(path: str | None) -> dict[str, str] | None:
+    from .io.readers import read_label_map
+
+    return None if path is None else read_label_map(path)
+
+
+def _markers(args: argparse.Namespace) -> None:
+    from .steps.processing import markers
+
+    gaps = markers(args.c3d, args.out, args.gaps, _rotation(args, args.c3d), args.max_gap_frames,
+                   args.cutoff_hz or None, args.order, label_map=_label_map(args.label_map))
+    print(f"{args.out}: {gaps.attrs.get('n_frames', '?')} frames; {len(gaps)} gap(s) filled")
+
+
+def _grf(args: argparse.Namespace) -> None:
+    from .steps.grf import grf
+
+    table = grf(args.c3d, args.out, _rotation(args, args.c3d), args.threshold_n)
+    n_plates = (table.shape[1] - 1) // 9
+    print(f"{args.out}: {len(table)} samples, {n_plates} force platform(s)")
+
+
+def _plates(text: str | None) -> dict[str, int] | None:
+    """``left=1,right=2`` -> {"left": 1, "right": 2}."""
+    if text is None:
+        return None
+    out = {}
+    for item in text.split(","):
+        side, _, number = item.partition("=")
+        try:
+            out[side.strip()] = int(number)
+        except ValueError:
+            raise LoperInputError(f"--plates: expected SIDE=N[,SIDE=N] such as left=1,right=2, got {text!r}") from None
+    return out
+
+
+def _events(args: argparse.Namespace) -> None:
+    from .steps.processing import events
+
+    table = events(args.c3d, args.out, grf_channels=None, threshold_on_n=args.threshold_on_n,
+                   threshold_off_n=args.threshold_off_n, foot_markers=dict(zip(("left", "right"), args.feet)),
+                   plate_sides=_plates(args.plates), rotation_deg=_rotation(args, args.c3d),
+                   label_map=_label_map(args.label_map))
+    flagged = table.attrs.get("n_contacts_flagged", 0)
+    print(f"{args.out}: {len(table)} events; {flagged} contact(s) flagged and left out")
+
+
+def _scale(args: argparse.Namespace) -> None:
+    from .steps.model import scale_with_setup
+    from .steps.processing import markers
+
+    static = Path(args.static)
+    with tempfile.TemporaryDirectory() as tmp:
+        if static.suffix.lower() == ".c3d":
+            trc = Path(tmp) / (static.stem + ".trc")
+            markers(static, trc, None, _rotation(args, args.static), args.max_gap_frames, args.cutoff_hz or None,
+                    label_map=_label_map(args.label_map))
+            static = trc
+        time_range = None if args.start is None else (args.start, args.end)
+        scale_with_setup(args.model, args.setup, static, args.mass_kg, args.out, time_range_s=time_range)
+    print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({args.mass_kg:g} kg)")
+
 
 def _segments(args: argparse.Namespace) -> None:
-    from .steps.model import anthropometric_segments
+    from .steps.model import anthropometric_segments, segments_from_model_file
 
-    anthropometric_segments(args.out, args.height_m, args.mass_kg, args.attachment_fraction)
+    if args.model is not None:
+        if args.height_m is not None or args.mass_kg is not None:
+            raise LoperInputError("segments: give either --model or --height-m and --mass-kg, not both")
+        segments_from_model_file(args.model, args.out, args.side, attachment_fraction=args.attachment_fraction)
+    elif args.height_m is None or args.mass_kg is None:
+        raise LoperInputError("segments: give --model SCALED.osim, or --height-m and --mass-kg")
+    else:
+        anthropometric_segments(args.out, args.height_m, args.mass_kg, args.attachment_fraction)
+    print(f"{args.out}: segment table")
 
 
 def _validate(args: argparse.Namespace) -> None:
@@ -43,15 +134,89 @@ def _ik(args: argparse.Namespace) -> None:
     )
 
 
-def main(argv: list[str] | None = None) -> int:
+def _rotate_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--rotate-deg", type=float, nargs=3, metavar=("X", "Y", "Z"),
+                   help="rotate lab coordinates about the fixed X, Y, Z axes (degrees) into the model frame; default "
+                   "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc")
+
+
+def _label_map_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--label-map", metavar="MAP", help="TSV (columns label, marker) or YAML mapping: lab label -> "
+                   "model marker; subject prefixes (Name:) are stripped first")
+
+
+def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="loper-analysis", description=__doc__.splitlines()[0])
+    parser.add_argument("--traceback", action="store_true", help="show the Python traceback of a failure")
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("segments", help="segment table (TSV) from height and mass (Winter's table)")
-    p.add_argument("--height-m", type=float, required=True)
-    p.add_argument("--mass-kg", type=float, required=True)
-    p.add_argument("--attachment-fraction", type=float, default=0.8, help="brace position along the thigh")
+
+    p = sub.add_parser("markers", help="C3D markers -> TRC (mm) in the model frame")
+    p.add_argument("c3d", help="marker file (.c3d)")
+    p.add_argument("--out", required=True, help="output .trc")
+    p.add_argument("--gaps", help="output TSV: per marker, frames filled and left missing")
+    _label_map_option(p)
+    _rotate_option(p)
+    p.add_argument("--cutoff-hz", type=float, default=40.0, help="zero-phase Butterworth low-pass (Hz); 0: no filter")
+    p.add_argument("--order", type=int, default=4, help="designed filter order (run forward and backward)")
+    p.add_argument("--max-gap-frames", type=int, default=10, help="fill gaps up to this many frames; 0: no filling")
+    p.set_defaults(func=_markers)
+
+    p = sub.add_parser("grf", help="C3D force platforms -> OpenSim external-loads .mot")
+    p.add_argument("c3d", help="C3D file with a FORCE_PLATFORM group")
+    p.add_argument("--out", required=True, help="output .mot (columns {n}_ground_force_v*, _p*, {n}_ground_torque_*)")
+    _rotate_option(p)
+    p.add_argument("--threshold-n", type=float, default=20.0, help="loaded above this vertical force over rest (N)")
+    p.set_defaults(func=_grf)
+
+    p = sub.add_parser("events", help="heel strikes and toe-offs from the force platforms -> TSV")
+    p.add_argument("c3d", help="C3D file with force platforms and the feet's heel markers")
+    p.add_argument("--out", required=True, help="output TSV (side, event, time_s, sample)")
+    p.add_argument("--feet", nargs=2, metavar=("LEFT_HEEL", "RIGHT_HEEL"), default=("LHEE", "RHEE"),
+                   help="heel marker of each foot (model names, after --label-map)")
+    p.add_argument("--plates", metavar="left=N,right=M", help="belt of each side: a contact on the other foot's "
+                   "plate is flagged")
+    _label_map_option(p)
+    _rotate_option(p)
+    p.add_argument("--threshold-on-n", type=float, default=50.0, help="heel strike: force over rest rises through (N)")
+    p.add_argument("--threshold-off-n", type=float, default=20.0, help="toe-off: force over rest falls through (N)")
+    p.set_defaults(func=_events)
+
+    p = sub.add_parser("scale", help="scale a generic model with a lab's ScaleTool setup and a static trial")
+    p.add_argument("--model", required=True, help="generic OpenSim model (.osim)")
+    p.add_argument("--setup", required=True, help="OpenSim ScaleTool setup (.xml)")
+    p.add_argument("--static", required=True, help="static trial (.c3d or .trc)")
+    p.add_argument("--mass-kg", type=float, required=True, help="subject's body mass (kg)")
+    p.add_argument("--out", required=True, help="output scaled model (.osim)")
+    p.add_argument("--start", type=float, help="first time of the static trial to use (s)")
+    p.add_argument("--end", type=float, help="last time of the static trial to use (s)")
+    _label_map_option(p)
+    _rotate_option(p)
+    p.add_argument("--cutoff-hz", type=float, default=0.0, help="low-pass of a .c3d static trial (Hz); 0: none")
+    p.add_argument("--max-gap-frames", type=int, default=10, help="fill gaps of a .c3d static trial up to this")
+    p.set_defaults(func=_scale)
+
+    p = sub.add_parser("segments", help="segment table (TSV) from a scaled model, or from height and mass")
+    p.add_argument("--model", help="scaled OpenSim model (.osim): gait2392, Rajagopal2016 or the generated model")
+    p.add_argument("--side", default="left", choices=("left", "right"), help="the swing leg (with --model)")
+    p.add_argument("--height-m", type=float, help="without --model: Winter's table from height ...")
+    p.add_argument("--mass-kg", type=float, help="... and body mass")
+    p.add_argument("--attachment-fraction", type=float, default=0.8,
+                   help="brace position along the thigh (fraction of its length; a model's brace markers win)")
     p.add_argument("--out", required=True, help="output TSV")
     p.set_defaults(func=_segments)
+
+    p = sub.add_parser("ik", help="OpenSim inverse kinematics of a .c3d or .trc marker file to a .mot (degrees)")
+    p.add_argument("--model", required=True, help="OpenSim model (.osim)")
+    p.add_argument("--markers", required=True, help="marker file: .c3d (units from POINT:UNITS) or .trc (Units header)")
+    p.add_argument("--out", required=True, help="output .mot (angles in degrees, OpenSim's convention)")
+    p.add_argument("--tasks", help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: every "
+                   "model marker found in the file, weight 1")
+    p.add_argument("--start", type=float, help="first time (s) to solve")
+    p.add_argument("--end", type=float, help="last time (s) to solve")
+    _rotate_option(p)
+    p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
+    p.set_defaults(func=_ik)
+
     p = sub.add_parser("validate", help="one chunk of the validation study (the study's design)")
     p.add_argument("--segments", required=True, help="segment table TSV")
     p.add_argument("--chunk", type=int, default=0)
@@ -61,24 +226,23 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--errors", required=True, help="output TSV, one row per combination x condition x parameter")
     p.add_argument("--fits", required=True, help="output TSV, one row per combination x condition")
     p.set_defaults(func=_validate)
-    p = sub.add_parser("ik", help="OpenSim inverse kinematics of a .c3d or .trc marker file to a .mot (degrees)")
-    p.add_argument("--model", required=True, help="OpenSim model (.osim)")
-    p.add_argument("--markers", required=True, help="marker file: .c3d (units from POINT:UNITS) or .trc (Units header)")
-    p.add_argument("--out", required=True, help="output .mot (angles in degrees, OpenSim's convention)")
-    p.add_argument("--tasks", help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: every "
-                   "model marker found in the file, weight 1")
-    p.add_argument("--start", type=float, help="first time (s) to solve")
-    p.add_argument("--end", type=float, help="last time (s) to solve")
-    p.add_argument("--rotate-deg", type=float, nargs=3, metavar=("X", "Y", "Z"),
-                   help="rotate the markers about the fixed X, Y, Z axes (degrees) into the model frame; default "
-                   "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc")
-    p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
-    p.set_defaults(func=_ik)
-    args = parser.parse_args(argv)
+    return parser
+
+
+def _one_line(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return text if isinstance(exc, LoperInputError) else f"{type(exc).__name__}: {text}"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run one subcommand; 0 on success, 2 with one line on standard error when an input cannot serve."""
+    args = _parser().parse_args(argv)
     try:
         args.func(args)
-    except LoperInputError as exc:
-        print(f"loper-analysis {args.command}: {exc}", file=sys.stderr)
+    except Exception as exc:  # noqa: BLE001 - the command's contract: one line, exit code 2, no traceback
+        if args.traceback:
+            raise
+        print(f"loper-analysis {args.command}: {_one_line(exc)}", file=sys.stderr)
         return 2
     return 0
 
