@@ -13,10 +13,10 @@ from loper_analysis.contacts import (
     contact_events,
     foot_contacts,
     plate_contacts,
-    plate_offsets,
 )
 from loper_analysis.errors import LoperInputError
 from loper_analysis.events import EVENT_COLUMNS, flagged_contacts, gait_events, strides
+from loper_analysis.plate_geometry import plate_offsets
 
 FS = 2000.0  # analog rate, Hz
 MARKER_HZ = 200.0
@@ -26,7 +26,7 @@ STANCE_S = 0.7
 PERIOD_S = 1.1
 REST_N = -40.0  # unloaded plates read this (not zeroed)
 ON_N, OFF_N = 50.0, 20.0
-SETTINGS = dict(threshold_on_n=ON_N, threshold_off_n=OFF_N, min_stance_s=0.08, min_swing_s=0.08)
+SETTINGS = {"threshold_on_n": ON_N, "threshold_off_n": OFF_N, "min_stance_s": 0.08, "min_swing_s": 0.08}
 # plate 1 under the left belt, plate 2 under the right one (walking along +y, surface z = 0)
 CORNERS = {
     1: np.array([[-0.50, 0.0, 0.0], [-0.01, 0.0, 0.0], [-0.01, 1.6, 0.0], [-0.50, 1.6, 0.0]]),
@@ -114,7 +114,7 @@ def trial():
 
 @pytest.fixture(scope="module")
 def judged(trial):
-    t, raw, tm, heels, steps = trial
+    t, raw, tm, heels, _ = trial
     return foot_contacts(_plates(t, raw), tm, heels, **SETTINGS, source="S01/walk")
 
 
@@ -329,7 +329,7 @@ def test_walking5_contacts_feet_and_events(walking5):
     # plate 1 (x 0.665 .. 1.173 m): the plate loaded only at 1.965 s, under the forefoot, with the heel
     # 0.135 m off its edge -> off_plate, left, no event. The right heel (RCAL) landed on plate 2 (x 0 .. 0.610 m)
     # at x = 0.52 m -> ok, right.
-    frame = int(round(1.88 * 250))
+    frame = round(1.88 * 250)
     assert heels["left"][frame, 2] < 0.055 and heels["left"][frame, 0] > 1.30
     p1, p2 = found.iloc[0], found.iloc[1]
     assert (p1["side"], p1["flag"]) == ("left", "off_plate")

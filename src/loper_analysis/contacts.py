@@ -2,8 +2,6 @@
 
 * :func:`plate_contacts` - loaded periods of one plate from its vertical force
   above the resting level (the hysteresis of :func:`loper_analysis.events.load_transitions`);
-* :func:`plate_offsets` - where points lie relative to a plate: horizontal
-  distance outside its corners and height above its surface;
 * :func:`foot_contacts` - the contacts of every plate, each given a foot from
   the heel markers shortly after the contact starts, and a flag
   (:data:`loper_analysis.constants.CONTACT_FLAGS`);
@@ -28,13 +26,13 @@ from .checks import side as check_side
 from .constants import CONTACT_FLAGS, FLAGGED_EVENTS, SIDES
 from .errors import LoperInputError
 from .events import EVENT_COLUMNS, load_transitions
+from .plate_geometry import plate_axes, plate_offsets
 
 __all__ = [
     "PLATE_CONTACT_COLUMNS",
     "CONTACT_COLUMNS",
     "PlateForce",
     "plate_contacts",
-    "plate_offsets",
     "foot_contacts",
     "contact_events",
 ]
@@ -145,74 +143,6 @@ def _loaded_at_end(f: np.ndarray, on: float, off: float) -> bool:
     """Whether a force without transitions is held loaded (it reached ``on`` and never fell to ``off`` after)."""
     reached = np.flatnonzero(f >= on)
     return bool(reached.size) and not np.any(f[reached[0]:] <= off)
-
-
-def _plate_axes(corners_m, vertical_axis: int | None, source: str) -> tuple[np.ndarray, np.ndarray]:
-    """Centre (3,) and rows u, v (in the plate's plane) and n (its normal) of one plate."""
-    c = np.asarray(corners_m, dtype=float)
-    if c.shape != (4, 3) or not np.isfinite(c).all():
-        raise LoperInputError(f"{where(source)}corners_m must be a finite (4, 3) array, got shape {c.shape}")
-    if vertical_axis is None:
-        n = np.cross(c[2] - c[0], c[3] - c[1])  # the diagonals' cross product: twice the area along the normal
-        size = float(np.linalg.norm(n))
-        if size < 1e-12:
-            raise LoperInputError(f"{where(source)}corners_m enclose no area: {c.tolist()}")
-        n = n / size
-        n = n if n[np.argmax(np.abs(n))] > 0 else -n
-    else:
-        axis = integer("vertical_axis", vertical_axis, source, minimum=0)
-        if axis > 2:
-            raise LoperInputError(f"{where(source)}vertical_axis must be 0, 1 or 2, got {vertical_axis!r}")
-        n = np.eye(3)[axis]
-    u = (c[1] - c[0]) - np.dot(c[1] - c[0], n) * n
-    if np.linalg.norm(u) < 1e-12:
-        raise LoperInputError(f"{where(source)}corners_m: the first edge is vertical or empty: {c.tolist()}")
-    u = u / np.linalg.norm(u)
-    return c.mean(axis=0), np.vstack([u, np.cross(n, u), n])
-
-
-def plate_offsets(points_m, corners_m, vertical_axis: int | None = None, source: str = "") -> tuple[np.ndarray, np.ndarray]:
-    """Horizontal distance outside a plate and height above it of points (heel markers).
-
-    The horizontal plane is the plate's plane: the normal is inferred from
-    the corners (the diagonals' cross product) or, with ``vertical_axis``,
-    is that coordinate axis. Points and corners are projected onto that
-    plane; the corners must outline a convex quadrilateral (any winding).
-
-    Parameters
-    ----------
-    points_m : array_like, shape (k, 3) or (3,)
-        Positions in m; NaN rows give NaN.
-    corners_m : array_like, shape (4, 3)
-        The plate's corners in m, in order around the plate.
-    vertical_axis : {0, 1, 2} or None
-        The vertical coordinate axis; None: the plate's normal.
-    source : str
-        Name quoted in messages.
-
-    Returns
-    -------
-    outside_m : numpy.ndarray, shape (k,)
-        0 for a point over the plate, else its horizontal distance to the
-        plate's outline (m).
-    height_m : numpy.ndarray, shape (k,)
-        Distance of the point from the plate's plane (m, unsigned).
-    """
-    centre, axes = _plate_axes(corners_m, vertical_axis, source)
-    p = np.atleast_2d(np.asarray(points_m, dtype=float))
-    if p.ndim != 2 or p.shape[1] != 3:
-        raise LoperInputError(f"{where(source)}points_m must have shape (k, 3), got {np.shape(points_m)}")
-    q = (p - centre) @ axes.T  # plate coordinates: u, v, n
-    c = (np.asarray(corners_m, dtype=float) - centre) @ axes[:2].T
-    edge = np.roll(c, -1, axis=0) - c  # (4, 2)
-    rel = q[:, None, :2] - c[None]  # (k, 4, 2)
-    cross = edge[None, :, 0] * rel[..., 1] - edge[None, :, 1] * rel[..., 0]
-    inside = np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
-    s = np.clip(np.sum(rel * edge, axis=2) / np.sum(edge * edge, axis=1), 0.0, 1.0)
-    gap = np.linalg.norm(rel - s[..., None] * edge[None], axis=2).min(axis=1)
-    outside = np.where(inside, 0.0, gap)
-    finite = np.isfinite(p).all(axis=1)
-    return np.where(finite, outside, np.nan), np.where(finite, np.abs(q[:, 2]), np.nan)
 
 
 def _at(time_s: np.ndarray, xyz: np.ndarray, when: np.ndarray) -> np.ndarray:
@@ -330,7 +260,7 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
     names = [f"{where(source)}plate {n}" for n in numbers]
     corners = [np.asarray(p.corners_m, dtype=float) for p in plates]
     for name, c in zip(names, corners):
-        _plate_axes(c, vertical_axis, name)
+        plate_axes(c, vertical_axis, name)
 
     def on(outside: np.ndarray, up: np.ndarray) -> np.ndarray:
         return (outside <= margin) & (up <= height)  # NaN: False
