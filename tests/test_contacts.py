@@ -149,6 +149,24 @@ def test_plate_contacts_mark_contacts_cut_by_the_recording(trial):
     assert plate_contacts(t, np.zeros(t.size)).empty
     whole = plate_contacts(t, np.full(t.size, 300.0))
     assert whole[["start_sample", "end_sample"]].values.tolist() == [[0, t.size - 1]] and whole["incomplete"].all()
+    # a 50 ms unloading is shorter than min_swing_s (0.2 s): still one contact over the whole recording
+    blip = np.full(t.size, 300.0)
+    blip[1000:1100] = 0.0
+    assert plate_contacts(t, blip)[["start_sample", "end_sample"]].values.tolist() == [[0, t.size - 1]]
+
+
+def test_bad_input_is_named(trial):
+    t, raw, tm, heels, _ = trial
+    plates = _plates(t, raw)
+    with pytest.raises(LoperInputError, match=r"walk: heels_m\['right'\] must have shape \(2200, 3\)"):
+        foot_contacts(plates, tm, {"left": heels["left"], "right": heels["right"][:-1]}, source="walk")
+    with pytest.raises(LoperInputError, match=r"plate numbers must be distinct, got \[1, 1\]"):
+        foot_contacts([plates[0], plates[0]], tm, heels)
+    with pytest.raises(LoperInputError, match="walk: plate 2: corners_m must be a finite"):
+        foot_contacts([plates[0], PlateForce(2, t, raw[2], np.zeros((3, 3)))], tm, heels, source="walk")
+    with pytest.raises(LoperInputError, match="unknown flag"):
+        contact_events(pd.DataFrame({"side": ["left"], "flag": ["fine"], "start_s": [0.0], "end_s": [1.0],
+                                     "start_sample": [0], "end_sample": [9]}))
 
 
 def test_plate_offsets_inside_outside_and_height():

@@ -116,10 +116,9 @@ def plate_contacts(time_s, vertical_force_n, threshold_on_n: float = 50.0, thres
                                                  min_stance_s, min_swing_s, source)
     starts, ends = list(samples[loading]), list(samples[~loading])
     open_start = bool(samples.size) and not loading[0]
-    if not samples.size:  # no transition: loaded throughout or never loaded
-        f = np.asarray(vertical_force_n, dtype=float)
-        open_start = bool(f.size) and float(f.max()) >= float(threshold_on_n) and \
-            _loaded_at_end(f, float(threshold_on_n), float(threshold_off_n))
+    if not samples.size:  # no transition left: loaded throughout or never loaded
+        open_start = _loaded_at_end(np.asarray(vertical_force_n, dtype=float), float(threshold_on_n),
+                                    float(threshold_off_n))
     if open_start:
         starts.insert(0, 0)
     open_end = len(starts) > len(ends)
@@ -140,9 +139,9 @@ def plate_contacts(time_s, vertical_force_n, threshold_on_n: float = 50.0, thres
 
 
 def _loaded_at_end(f: np.ndarray, on: float, off: float) -> bool:
-    """Whether a force without transitions is held loaded (it reached ``on`` and never fell to ``off`` after)."""
-    reached = np.flatnonzero(f >= on)
-    return bool(reached.size) and not np.any(f[reached[0]:] <= off)
+    """Whether the hysteresis ends loaded: the force last reached ``on`` after it last fell to ``off``."""
+    high, low = np.flatnonzero(f >= on), np.flatnonzero(f <= off)
+    return bool(high.size) and (not low.size or high[-1] > low[-1])
 
 
 def _at(time_s: np.ndarray, xyz: np.ndarray, when: np.ndarray) -> np.ndarray:
