@@ -35,6 +35,8 @@ __all__ = [
     "PARAMETER_UNITS",
     "UNIT_SUFFIX",
     "EVENTS",
+    "FLAGGED_EVENTS",
+    "CONTACT_FLAGS",
     "PHASES",
     "GRAVITY_M_PER_S2",
     "angle_column",
@@ -61,6 +63,10 @@ PARAMETER_UNITS: dict[str, str] = {
 UNIT_SUFFIX: dict[str, str] = {"K": "nm_per_rad", "D": "nms_per_rad"}
 #: Gait events, in the order they appear in event tables.
 EVENTS: tuple[str, ...] = ("heel_strike", "toe_off")
+#: Rows of an event table that bound a flagged foot contact (no gait event; strides must not span it).
+FLAGGED_EVENTS: tuple[str, ...] = ("flagged_start", "flagged_end")
+#: Verdicts on a force-plate contact (``docs/events.md``): ``ok`` gives events, every other one does not.
+CONTACT_FLAGS: tuple[str, ...] = ("ok", "incomplete", "heel_missing", "two_feet", "no_foot", "off_plate", "wrong_belt")
 #: Normalisation phases: the whole stride (HS -> next HS), stance (HS -> TO), swing (TO -> next HS).
 PHASES: tuple[str, ...] = ("stride", "stance", "swing")
 GRAVITY_M_PER_S2: float = 9.81

@@ -2,8 +2,11 @@
 
 * :func:`gait_events` - heel strikes and toe-offs from one belt's vertical
   force, with hysteresis and minimum phase durations;
+* :func:`load_transitions` - the hysteresis itself (loading and unloading
+  samples of any vertical force), shared with :mod:`loper_analysis.contacts`;
 * :func:`strides` - the stride table of one side (heel strike -> heel strike,
-  with its toe-off).
+  with its toe-off), leaving out strides that span a flagged contact;
+* :func:`flagged_contacts` - how many flagged contacts an event table holds.
 
 Time is in s, force in N. Side, event and phase names are those of
 :mod:`loper_analysis.constants`.
@@ -18,9 +21,10 @@ import pandas as pd
 
 from .checks import number, time_vector, where
 from .checks import side as check_side
+from .constants import FLAGGED_EVENTS
 from .errors import LoperInputError
 
-__all__ = ["EVENT_COLUMNS", "STRIDE_COLUMNS", "gait_events", "strides"]
+__all__ = ["EVENT_COLUMNS", "STRIDE_COLUMNS", "load_transitions", "gait_events", "strides", "flagged_contacts"]
 
 logger = logging.getLogger(__name__)
 
@@ -70,6 +74,80 @@ def _drop_short_periods(
         samples = np.delete(samples, [i, i + 1])
         kinds = np.delete(kinds, [i, i + 1])
     return samples, kinds, dropped
+
+
+def load_transitions(
+    time_s,
+    vertical_force_n,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    source: str = "",
+) -> tuple[np.ndarray, np.ndarray, list[dict]]:
+    """Loading and unloading samples of one vertical force: the hysteresis of :func:`gait_events`.
+
+    A sample with force ``>= threshold_on_n`` sets the state "loaded", a
+    sample with force ``<= threshold_off_n`` sets "unloaded"; samples in
+    between keep the state. A transition is the first sample of a new state;
+    the state a trial starts in (or reaches first from the dead band) is not a
+    transition. Loaded (unloaded) periods shorter than ``min_stance_s``
+    (``min_swing_s``) are removed with both bounding transitions, shortest
+    first, until none remains; the periods before the first and after the
+    last transition are never judged.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n_samples,)
+        Sample times in s, finite and strictly increasing.
+    vertical_force_n : array_like, shape (n_samples,)
+        Vertical force in N (above the unloaded level); must be finite.
+    threshold_on_n, threshold_off_n : float
+        Loading and unloading thresholds in N; ``threshold_on_n > threshold_off_n``.
+    min_stance_s, min_swing_s : float
+        Shortest accepted loaded and unloaded period in s (>= 0).
+    source : str
+        Name of the trial or signal, quoted in error messages.
+
+    Returns
+    -------
+    samples : numpy.ndarray of int64, shape (n_transitions,)
+        Indices into ``time_s`` of the transitions, increasing; loading and
+        unloading alternate.
+    loading : numpy.ndarray of bool, shape (n_transitions,)
+        True where the transition is a loading (force reached
+        ``threshold_on_n``), False for an unloading.
+    dropped : list of dict
+        The removed periods: ``phase`` (``stance`` | ``swing``), ``start_s``,
+        ``end_s``, ``duration_s``, ``start_sample``, ``end_sample``.
+
+    Raises
+    ------
+    LoperInputError
+        Non-finite or non-increasing time, non-finite force (the first sample
+        is named), mismatched lengths, ``threshold_on_n <= threshold_off_n``
+        or negative minimum durations.
+    """
+    t = time_vector(time_s, source)
+    f = np.asarray(vertical_force_n, dtype=float)
+    if f.ndim != 1 or f.size != t.size:
+        raise LoperInputError(
+            f"{where(source)}vertical_force_n has shape {f.shape}; time_s has {t.size} samples"
+        )
+    bad = np.flatnonzero(~np.isfinite(f))
+    if bad.size:
+        raise LoperInputError(f"{where(source)}vertical_force_n is not finite at sample {bad[0]}: {f[bad[0]]}")
+    on = number("threshold_on_n", threshold_on_n, source)
+    off = number("threshold_off_n", threshold_off_n, source)
+    if on <= off:
+        raise LoperInputError(
+            f"{where(source)}threshold_on_n ({on} N) must exceed threshold_off_n ({off} N) for hysteresis"
+        )
+    min_stance = number("min_stance_s", min_stance_s, source, minimum=0.0)
+    min_swing = number("min_swing_s", min_swing_s, source, minimum=0.0)
+    samples, kinds = _hysteresis_events(f, on, off)
+    samples, kinds, dropped = _drop_short_periods(samples, kinds, t, min_stance, min_swing)
+    return samples.astype(np.int64), kinds == _HS, dropped
 
 
 def gait_events(
@@ -138,25 +216,10 @@ def gait_events(
     """
     side = check_side(side, source)
     t = time_vector(time_s, source)
+    samples, loading, dropped = load_transitions(t, vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s,
+                                                 min_swing_s, source)
     f = np.asarray(vertical_force_n, dtype=float)
-    if f.ndim != 1 or f.size != t.size:
-        raise LoperInputError(
-            f"{where(source)}vertical_force_n has shape {f.shape}; time_s has {t.size} samples"
-        )
-    bad = np.flatnonzero(~np.isfinite(f))
-    if bad.size:
-        raise LoperInputError(f"{where(source)}vertical_force_n is not finite at sample {bad[0]}: {f[bad[0]]}")
-    on = number("threshold_on_n", threshold_on_n, source)
-    off = number("threshold_off_n", threshold_off_n, source)
-    if on <= off:
-        raise LoperInputError(
-            f"{where(source)}threshold_on_n ({on} N) must exceed threshold_off_n ({off} N) for hysteresis"
-        )
-    min_stance = number("min_stance_s", min_stance_s, source, minimum=0.0)
-    min_swing = number("min_swing_s", min_swing_s, source, minimum=0.0)
-
-    samples, kinds = _hysteresis_events(f, on, off)
-    samples, kinds, dropped = _drop_short_periods(samples, kinds, t, min_stance, min_swing)
+    on, off = float(threshold_on_n), float(threshold_off_n)  # checked by load_transitions
     for d in dropped:
         logger.info(
             "%s%s side: dropped a %.3f s %s period (%.3f-%.3f s), shorter than the minimum",
@@ -169,13 +232,13 @@ def gait_events(
         )
     events = pd.DataFrame({
         "side": side,
-        "event": np.where(kinds == _HS, "heel_strike", "toe_off"),
+        "event": np.where(loading, "heel_strike", "toe_off"),
         "time_s": t[samples],
         "sample": samples.astype(np.int64),
     })
     events.attrs.update({
         "source": source, "side": side, "threshold_on_n": on, "threshold_off_n": off,
-        "min_stance_s": min_stance, "min_swing_s": min_swing, "dropped": dropped,
+        "min_stance_s": float(min_stance_s), "min_swing_s": float(min_swing_s), "dropped": dropped,
     })
     return events
 
@@ -188,11 +251,22 @@ def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
     without one (or with several) are dropped, as are the incomplete strides
     before the first and after the last heel strike.
 
+    Event tables of force-plate contacts (:func:`loper_analysis.contacts.contact_events`)
+    also hold ``flagged_start`` / ``flagged_end`` rows: the span of a contact
+    that gave no event. A stride whose swing (toe-off -> next heel strike)
+    overlaps such a span of its side (``flagged_start < end`` and
+    ``flagged_end > toe_off``) is dropped: a contact of that foot may hide in
+    it, so the "stride" may be two. A flagged span during the stride's stance
+    cannot hide a contact of the same foot (it stands on the contact that gave
+    the heel strike) and leaves the stride in. Tables without these rows give
+    the same strides as before.
+
     Parameters
     ----------
     events : pandas.DataFrame
         Columns ``side``, ``event``, ``time_s`` as returned by :func:`gait_events`
-        (tables of both sides may be concatenated).
+        (tables of both sides may be concatenated) or
+        :func:`loper_analysis.contacts.contact_events`.
     side : {"left", "right"}
 
     Returns
@@ -207,7 +281,8 @@ def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
     Raises
     ------
     LoperInputError
-        Missing columns, an unknown side or non-finite event times.
+        Missing columns, an unknown side, non-finite event times, or
+        ``flagged_start`` / ``flagged_end`` rows that do not pair up.
     """
     source = str(events.attrs.get("source", "")) if isinstance(events, pd.DataFrame) else ""
     if not isinstance(events, pd.DataFrame) or not {"side", "event", "time_s"} <= set(events.columns):
@@ -223,6 +298,16 @@ def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
     first = np.searchsorted(to, start, side="right")  # first toe-off after the start
     count = np.searchsorted(to, end, side="left") - first  # toe-offs strictly inside
     keep = count == 1
+    flag_start, flag_end = _flagged_spans(mine, t, side, source)
+    if flag_start.size and keep.any():
+        swing_start = to[np.minimum(first, to.size - 1)]  # the stride's toe-off where keep (keep needs one)
+        # a flagged span overlaps the swing [toe-off, end] when it begins before the end and ends after the toe-off
+        overlaps = (flag_start[None, :] < end[:, None]) & (flag_end[None, :] > swing_start[:, None])
+        spanning = keep & overlaps.any(axis=1)
+        if spanning.any():
+            logger.info("%s%s side: %d stride(s) whose swing overlaps a flagged contact are left out",
+                        where(source), side, int(spanning.sum()))
+        keep &= ~spanning
     start, end = start[keep], end[keep]
     toe_off = to[first[keep]] if to.size else np.empty(0)
     return pd.DataFrame({
@@ -235,3 +320,43 @@ def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
         "stance_s": toe_off - start,
         "swing_s": end - toe_off,
     }, columns=list(STRIDE_COLUMNS))
+
+
+def _flagged_spans(mine: pd.DataFrame, t: np.ndarray, side: str, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end times (s) of the flagged contacts in one side's event rows, paired in time order."""
+    kind = mine["event"].to_numpy()
+    a = np.sort(t[kind == FLAGGED_EVENTS[0]])
+    b = np.sort(t[kind == FLAGGED_EVENTS[1]])
+    if a.size != b.size or np.any(b < a):
+        raise LoperInputError(
+            f"{where(source)}events: {a.size} {FLAGGED_EVENTS[0]} and {b.size} {FLAGGED_EVENTS[1]} row(s) "
+            f"of the {side} side do not pair up (each flagged contact needs a start and a later end)"
+        )
+    return a, b
+
+
+def flagged_contacts(events: pd.DataFrame, side: str | None = None) -> int:
+    """Number of flagged contacts in an event table (its ``flagged_start`` rows).
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        Columns ``side``, ``event``, ``time_s``
+        (:func:`loper_analysis.contacts.contact_events`); tables from
+        :func:`gait_events` hold none.
+    side : {"left", "right"} or None
+        Count the contacts flagged for that side's strides (a contact whose
+        foot is unknown or both feet counts for both sides); None: every
+        flagged contact once (rows of one contact share their start time).
+
+    Returns
+    -------
+    int
+    """
+    source = str(events.attrs.get("source", "")) if isinstance(events, pd.DataFrame) else ""
+    if not isinstance(events, pd.DataFrame) or not {"side", "event", "time_s"} <= set(events.columns):
+        raise LoperInputError(f"{where(source)}events must be a table with columns side, event, time_s")
+    starts = events[events["event"] == FLAGGED_EVENTS[0]]
+    if side is None:
+        return int(starts["time_s"].nunique())
+    return int((starts["side"] == check_side(side, source)).sum())
