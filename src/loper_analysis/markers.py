@@ -265,6 +265,8 @@ def require_markers_per_frame(markers_m, labels: Sequence[str], min_markers: int
     if len(runs) > _MAX_LISTED:
         spans.append(f"and {len(runs) - _MAX_LISTED} more run(s)")
     absent = [labels[used[k]] for k in np.flatnonzero((~present[short]).any(axis=0))]
+    if len(absent) > 2 * _MAX_LISTED:
+        absent = absent[:2 * _MAX_LISTED] + [f"and {len(absent) - 2 * _MAX_LISTED} more"]
     raise LoperInputError(
         f"{where}: {int(short.sum())} frame(s) hold fewer than {min_markers} of the {len(used)} weighted markers, "
         f"too few to solve IK: frames {', '.join(spans)}; markers missing there: {', '.join(absent) or 'none'}"
