@@ -4,7 +4,12 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.filtering import lowpass, lowpass_finite_runs, lowpass_gain, min_run_samples
+from loper_analysis.filtering import (
+    lowpass,
+    lowpass_finite_runs,
+    lowpass_gain,
+    min_run_samples,
+)
 
 FS = 128.0
 

@@ -17,10 +17,10 @@ from .errors import LoperInputError
 
 __all__ = [
     "LABEL_MAP_FIELD",
-    "strip_subject_prefix",
-    "model_marker_names",
     "missing_model_markers",
+    "model_marker_names",
     "require_model_markers",
+    "strip_subject_prefix",
 ]
 
 #: Configuration field of the label map (named in messages).

@@ -38,7 +38,6 @@ message names the file and the field (``GROUP:PARAMETER``) or argument.
 
 from __future__ import annotations
 
-import math
 import os
 import struct
 from dataclasses import dataclass, field
@@ -48,7 +47,13 @@ import numpy as np
 import pandas as pd
 
 from ..errors import LoperInputError
-from .c3d_parameters import EVENT_COLUMNS, param_float, param_strings, param_value, read_events
+from .c3d_parameters import (
+    EVENT_COLUMNS,
+    param_float,
+    param_strings,
+    param_value,
+    read_events,
+)
 
 __all__ = [
     "LENGTH_UNITS_PER_M",

@@ -28,9 +28,9 @@ from ..errors import LoperInputError
 __all__ = [
     "EVENT_COLUMNS",
     "decode_text",
-    "param_value",
-    "param_strings",
     "param_float",
+    "param_strings",
+    "param_value",
     "read_events",
 ]
 

@@ -11,7 +11,7 @@ import yaml
 
 from ..errors import LoperInputError
 
-__all__ = ["read_tsv", "read_yaml", "read_label_map"]
+__all__ = ["read_label_map", "read_tsv", "read_yaml"]
 
 
 def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str] = (), **read_csv) -> pd.DataFrame:
