@@ -252,3 +252,17 @@ def test_only_weighted_markers_count():
                                   source=SOURCE)
     with pytest.raises(LoperInputError, match="min_markers must be an integer >= 1, got 0"):
         require_markers_per_frame(X, labels, 0, source=SOURCE)
+
+
+def test_summary_counts_frames_the_filter_left_unfiltered(trial):
+    from loper_analysis.filtering import lowpass_finite_runs
+
+    gappy = trial.copy()
+    gappy[50:60, 1] = np.nan
+    gappy[65:200, 1] = np.nan  # leaves frames 60..64 (5 frames) between two long gaps: too short to filter
+    filtered, unfiltered = lowpass_finite_runs(gappy, FS, 10.0, 4)
+    np.testing.assert_array_equal(filtered[60:65, 1], trial[60:65, 1])
+    summary = gap_summary(gappy, filtered, ["CUB", "SIN"], unfiltered)
+    assert summary[["n_missing_frames", "longest_gap_frames", "n_unfiltered_frames"]].values.tolist() == [
+        [0, 0, 0], [145, 135, 5]
+    ]

@@ -43,10 +43,11 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     the first ``duration_s`` seconds of the trial (static trials).
 
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
-    row per gap, :data:`loper_analysis.markers.GAP_REPORT_COLUMNS`), with the
+    row per gap, :data:`loper_analysis.markers.GAP_REPORT_COLUMNS`). The
     per-marker summary of filled and still missing frames
-    (:func:`loper_analysis.markers.gap_summary`) in ``.attrs["per_marker"]``
-    (written to ``summary_out`` when given).
+    (:func:`loper_analysis.markers.gap_summary`) is written to ``summary_out``
+    when given and kept as a list of row dicts in ``.attrs["per_marker"]``
+    (plain values: pandas compares the attrs of frames it concatenates).
     """
     from ..filtering import lowpass_finite_runs
     from ..io.c3d import read_c3d
@@ -84,7 +85,7 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     if len(left):
         log.warning("%s: %d marker(s) still missing in some frames (written as NaN):\n%s", c3d_path, len(left),
                     left.to_string(index=False))
-    gaps.attrs["per_marker"] = summary
+    gaps.attrs["per_marker"] = summary.to_dict("records")
     return gaps
 
 
