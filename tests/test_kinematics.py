@@ -216,3 +216,38 @@ def test_joint_angle_table_maps_names_and_signs():
     np.testing.assert_allclose(angles.knee_left_rad, [-0.3, -0.4])
     with pytest.raises(LoperInputError, match="coordinate 'knee_angle_l'"):
         joint_angle_table(coords, gait2392, source="trial.mot")
+
+
+def test_nan_marker_is_left_out_of_its_frames_known_angles(model, synthetic):
+    """OpenSim 4.6's MarkersReference drops a NaN marker in its frames: exact markers of known angles with
+    LKNE and RHEE missing in some frames give the known angles (measured within 1.1e-8 rad, markers within
+    7.6e-10 m, at accuracy 1e-10; 8.5e-7 rad at the default 1e-8)."""
+    t, truth, X = synthetic
+    X = X.copy()
+    X[40:120, list(MARKERS).index("LKNE")] = np.nan
+    X[::3, list(MARKERS).index("RHEE")] = np.nan
+    res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=1e-10)
+    for i, name in enumerate(res.coordinate_names):
+        err = np.abs(res.coordinates[:, i] - truth[name]).max()
+        assert err < 1e-6, (name, err)
+    assert np.nanmax(res.marker_max_m) < 1e-6
+
+
+def test_frames_with_too_few_markers_stop_ik_before_solving(model, synthetic):
+    t, _, X = synthetic
+    X = X.copy()
+    keep = ["LASI", "RASI", "LKNE", "LHEE"]
+    X[:, [i for i, m in enumerate(MARKERS) if m not in keep]] = np.nan
+    X[100:103, [list(MARKERS).index("LASI"), list(MARKERS).index("LKNE")]] = np.nan
+    with pytest.raises(LoperInputError) as err:
+        inverse_kinematics(model, t, X, list(MARKERS), min_markers=3, source="walk.trc")
+    message = str(err.value)
+    assert message.startswith(f"walk.trc: 3 frame(s) hold fewer than 3 of the {len(MARKERS)} weighted markers")
+    assert "frames 100..102 (t = 0.7812..0.7969 s); markers missing there: LASI, RPSI, LPSI," in message
+    assert message.endswith(", LTHI_AS, and 14 more")  # 34 markers missing in those frames: 20 named
+    with pytest.raises(LoperInputError) as err:
+        inverse_kinematics(model, t, X, list(MARKERS), {m: 1.0 for m in keep}, min_markers=3, source="walk.trc")
+    assert str(err.value) == (
+        "walk.trc: 3 frame(s) hold fewer than 3 of the 4 weighted markers, too few to solve IK: "
+        "frames 100..102 (t = 0.7812..0.7969 s); markers missing there: LASI, LKNE"
+    )

@@ -4,7 +4,14 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.markers import GAP_REPORT_COLUMNS, fill_gaps, rotate_markers
+from loper_analysis.markers import (
+    GAP_REPORT_COLUMNS,
+    GAP_SUMMARY_COLUMNS,
+    fill_gaps,
+    gap_summary,
+    require_markers_per_frame,
+    rotate_markers,
+)
 
 FS = 128.0
 N = 256
@@ -178,3 +185,84 @@ def test_rotation_keeps_shape_distances_and_nan(rng):
 def test_rotation_checks_its_arguments(markers, angles, match):
     with pytest.raises(LoperInputError, match=match):
         rotate_markers(markers, angles)
+
+
+# ---------------------------------------------------------------- gaps left missing (real recordings)
+
+
+def test_keep_fills_short_interior_gaps_and_leaves_the_rest_missing(trial):
+    gappy = trial.copy()
+    gappy[:4, 0] = np.nan  # start of the trial
+    gappy[40:45, 0] = np.nan  # 5 frames: filled
+    gappy[100:130, 0] = np.nan  # 30 frames: too long
+    gappy[N - 2:, 1] = np.nan  # end of the trial
+    filled, report = fill_gaps(gappy, 5, ["CUB", "SIN"], SOURCE, unfillable="keep")
+    np.testing.assert_allclose(filled[40:45, 0], trial[40:45, 0], rtol=0, atol=1e-12)  # a cubic comes back
+    assert np.isnan(filled[:4, 0]).all() and np.isnan(filled[100:130, 0]).all() and np.isnan(filled[N - 2:, 1]).all()
+    assert np.isnan(filled).any(axis=2).sum() == 4 + 30 + 2
+    assert report.to_dict("records") == [{"marker": "CUB", "first_frame": 40, "last_frame": 44, "n_frames": 5}]
+    summary = gap_summary(gappy, filled, ["CUB", "SIN"])
+    assert list(summary.columns) == list(GAP_SUMMARY_COLUMNS)
+    assert summary.to_dict("records") == [
+        {"marker": "CUB", "n_frames": N, "n_filled_frames": 5, "n_missing_frames": 34, "longest_gap_frames": 30,
+         "n_unfiltered_frames": 0},
+        {"marker": "SIN", "n_frames": N, "n_filled_frames": 0, "n_missing_frames": 2, "longest_gap_frames": 2,
+         "n_unfiltered_frames": 0},
+    ]
+
+
+def test_keep_with_no_filling_and_a_marker_missing_everywhere(trial):
+    gappy = trial.copy()
+    gappy[:, 1] = np.nan
+    gappy[10:12, 0] = np.nan
+    filled, report = fill_gaps(gappy, 0, ["CUB", "SIN"], SOURCE, unfillable="keep")
+    np.testing.assert_array_equal(filled, gappy)
+    assert len(report) == 0
+    with pytest.raises(LoperInputError, match="unfillable must be 'error' or 'keep'"):
+        fill_gaps(gappy, 0, ["CUB", "SIN"], SOURCE, unfillable="drop")
+
+
+# ---------------------------------------------------------------- markers per frame for IK
+
+
+def test_too_few_markers_names_frames_times_markers_and_file():
+    X = np.ones((50, 4, 3)) * np.arange(4)[None, :, None]
+    labels = ["LASI", "RASI", "LKNE", "LHEE"]
+    X[10:13, [0, 1]] = np.nan  # two of four left
+    X[30, 2] = np.nan  # three of four: enough
+    X[40, [1, 3]] = np.nan
+    require_markers_per_frame(X, labels, 2, source=SOURCE)  # two everywhere: no error
+    t = 1.0 + np.arange(50) / 100.0
+    with pytest.raises(LoperInputError) as err:
+        require_markers_per_frame(X, labels, 3, time_s=t, source=SOURCE)
+    assert str(err.value) == (
+        f"{SOURCE}: 4 frame(s) hold fewer than 3 of the 4 weighted markers, too few to solve IK: "
+        "frames 10..12 (t = 1.1000..1.1200 s), 40 (t = 1.4000 s); markers missing there: LASI, RASI, LHEE"
+    )
+
+
+def test_only_weighted_markers_count():
+    X = np.zeros((5, 4, 3))
+    X[2, :2] = np.nan
+    labels = ["LASI", "RASI", "LKNE", "LHEE"]
+    require_markers_per_frame(X, labels, 2, source=SOURCE)  # frame 2 holds LKNE and LHEE
+    # ... but LHEE has weight 0: only LKNE counts there
+    with pytest.raises(LoperInputError, match="1 frame.* fewer than 2 of the 3 weighted markers.*frames 2;.*: LASI, RASI$"):
+        require_markers_per_frame(X, labels, 2, weights={"LASI": 1, "LKNE": 1, "LHEE": 0, "RASI": 2},
+                                  source=SOURCE)
+    with pytest.raises(LoperInputError, match="min_markers must be an integer >= 1, got 0"):
+        require_markers_per_frame(X, labels, 0, source=SOURCE)
+
+
+def test_summary_counts_frames_the_filter_left_unfiltered(trial):
+    from loper_analysis.filtering import lowpass_finite_runs
+
+    gappy = trial.copy()
+    gappy[50:60, 1] = np.nan
+    gappy[65:200, 1] = np.nan  # leaves frames 60..64 (5 frames) between two long gaps: too short to filter
+    filtered, unfiltered = lowpass_finite_runs(gappy, FS, 10.0, 4)
+    np.testing.assert_array_equal(filtered[60:65, 1], trial[60:65, 1])
+    summary = gap_summary(gappy, filtered, ["CUB", "SIN"], unfiltered)
+    assert summary[["n_missing_frames", "longest_gap_frames", "n_unfiltered_frames"]].values.tolist() == [
+        [0, 0, 0], [145, 135, 5]
+    ]

@@ -4,7 +4,8 @@ One ``InverseKinematicsSolver`` is reused for all frames (far faster than
 ``InverseKinematicsTool`` per call); markers enter as a ``TimeSeriesTableVec3``
 in metres with its ``Units`` metadata set (OpenSim assumes metres when the
 metadata is missing). Missing (NaN) markers are dropped by OpenSim in that
-frame. Coordinate tasks (e.g. locking a coordinate at its default) are
+frame; a frame with fewer than ``min_markers`` weighted markers is refused
+before solving. Coordinate tasks (e.g. locking a coordinate at its default) are
 honoured. Models are ``opensim.Model`` objects (:func:`loper_analysis.io.osim.read_model`).
 
 Task specification: ``marker_weights`` {marker: weight} and
@@ -25,6 +26,7 @@ import pandas as pd
 
 from .errors import LoperInputError
 from .io.osim import quiet_opensim
+from .markers import require_markers_per_frame
 
 __all__ = [
     "IKResult",
@@ -124,14 +126,23 @@ def inverse_kinematics(
     marker_weights: dict[str, float] | None = None,
     coordinate_tasks: dict[str, tuple[float, float | None]] | None = None,
     accuracy: float = 1e-8,
+    min_markers: int = 3,
+    source: str = "",
 ) -> IKResult:
     """OpenSim IK of marker trajectories (m) with one reused solver on an ``opensim.Model``.
+
+    A marker that is NaN in a frame is left out of that frame's solve (OpenSim's
+    ``MarkersReference`` drops it). Before solving, every frame must hold at
+    least ``min_markers`` weighted markers
+    (:func:`loper_analysis.markers.require_markers_per_frame`); ``source``
+    names the file in messages.
 
     Raises
     ------
     LoperInputError
         A weighted marker missing from the model or from the data, a
-        coordinate task on an unknown coordinate, no model marker in the data.
+        coordinate task on an unknown coordinate, no model marker in the data,
+        a frame with fewer than ``min_markers`` weighted markers present.
     """
     osim = quiet_opensim()
     labels = list(labels)
@@ -153,6 +164,7 @@ def inverse_kinematics(
     keep = [i for i, lab in enumerate(labels) if lab in marker_weights and marker_weights[lab] > 0]
     X = np.asarray(markers_m, float)[:, keep, :]
     kept_labels = [labels[i] for i in keep]
+    require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
     table = markers_table(t, X, kept_labels)
     weights = osim.SetMarkerWeights()
     for mk in kept_labels:

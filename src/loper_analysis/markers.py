@@ -1,4 +1,4 @@
-"""Marker processing: gap filling and the lab-to-model rotation.
+"""Marker processing: gap filling, gap summaries, the markers-per-frame rule of IK and the lab-to-model rotation.
 
 Markers are arrays (n_frames, n_markers, 3) in metres, NaN where missing
 (as returned by :func:`loper_analysis.io.c3d.read_c3d`). A marker counts as
@@ -8,7 +8,7 @@ messages and reports are 0-based indices into the array.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from numbers import Integral
 
 import numpy as np
@@ -20,12 +20,20 @@ from .errors import LoperInputError
 
 __all__ = [
     "GAP_REPORT_COLUMNS",
+    "GAP_SUMMARY_COLUMNS",
     "fill_gaps",
+    "gap_summary",
+    "require_markers_per_frame",
     "rotate_markers",
 ]
 
 #: Columns of the gap report of :func:`fill_gaps`.
 GAP_REPORT_COLUMNS: tuple[str, ...] = ("marker", "first_frame", "last_frame", "n_frames")
+
+#: Columns of the per-marker summary of :func:`gap_summary`.
+GAP_SUMMARY_COLUMNS: tuple[str, ...] = (
+    "marker", "n_frames", "n_filled_frames", "n_missing_frames", "longest_gap_frames", "n_unfiltered_frames"
+)
 
 #: Problems listed in one error message before the rest are only counted.
 _MAX_LISTED = 10
@@ -69,11 +77,11 @@ def _gap_problems(label: str, runs: list[tuple[int, int]], n_frames: int, max_ga
 
 
 def fill_gaps(
-    markers_m, max_gap_frames: int, labels: Sequence[str], source: str = ""
+    markers_m, max_gap_frames: int, labels: Sequence[str], source: str = "", unfillable: str = "error"
 ) -> tuple[np.ndarray, pd.DataFrame]:
     """Fill short interior gaps of each marker with a cubic spline through its valid frames.
 
-    For each marker with gaps, one ``scipy.interpolate.CubicSpline``
+    For each marker with gaps to fill, one ``scipy.interpolate.CubicSpline``
     (not-a-knot ends) of the frame index is fitted through all frames where
     the marker is present (x, y and z together) and evaluated in the missing
     frames; a trajectory that is a cubic polynomial of time is therefore
@@ -85,16 +93,22 @@ def fill_gaps(
         Shape (n_frames, n_markers, 3), metres, NaN where missing; a frame
         with any NaN coordinate counts as missing. Not modified.
     max_gap_frames : int
-        Longest run of missing frames that may be filled (>= 0).
+        Longest run of missing frames that may be filled (>= 0; 0 fills nothing).
     labels : sequence of str
         One name per marker (for messages and the report).
     source : str
         File the markers came from (for messages).
+    unfillable : {"error", "keep"}
+        What to do with a gap that cannot be filled (touching the start or
+        end of the trial, longer than ``max_gap_frames``, or a marker missing
+        in every frame): ``"error"`` refuses the trial, ``"keep"`` leaves
+        those frames NaN (real recordings; :func:`gap_summary` counts them).
 
     Returns
     -------
     filled : numpy.ndarray
-        Shape (n_frames, n_markers, 3), metres, without NaN.
+        Shape (n_frames, n_markers, 3), metres; without NaN when
+        ``unfillable="error"``, NaN in the unfilled gaps otherwise.
     report : pandas.DataFrame
         One row per filled gap, columns :data:`GAP_REPORT_COLUMNS`:
         ``marker`` (str), ``first_frame``, ``last_frame`` (0-based,
@@ -103,11 +117,12 @@ def fill_gaps(
     Raises
     ------
     LoperInputError
-        Bad shapes or ``max_gap_frames``, infinite values, a marker missing
-        in every frame, a gap touching the start or end of the trial, or an
-        interior gap longer than ``max_gap_frames``. The message names the
-        source file and lists every such marker with its first and last
-        missing frame and the gap length.
+        Bad shapes, ``max_gap_frames`` or ``unfillable``, infinite values;
+        with ``unfillable="error"`` also a marker missing in every frame, a
+        gap touching the start or end of the trial, or an interior gap
+        longer than ``max_gap_frames``. The message names the source file
+        and lists every such marker with its first and last missing frame
+        and the gap length.
     """
     where = source or "markers"
     X = _check_markers(markers_m, where)
@@ -116,6 +131,8 @@ def fill_gaps(
         raise LoperInputError(f"{where}: labels must name {X.shape[1]} markers, got {len(labels)}")
     if isinstance(max_gap_frames, bool) or not isinstance(max_gap_frames, Integral) or max_gap_frames < 0:
         raise LoperInputError(f"{where}: max_gap_frames must be an integer >= 0, got {max_gap_frames!r}")
+    if unfillable not in ("error", "keep"):
+        raise LoperInputError(f"{where}: unfillable must be 'error' or 'keep', got {unfillable!r}")
     n_frames = X.shape[0]
     missing = ~np.all(np.isfinite(X), axis=2)  # (n_frames, n_markers)
     problems: list[str] = []
@@ -128,14 +145,17 @@ def fill_gaps(
             continue
         runs = _missing_runs(missing[:, j])
         bad = _gap_problems(label, runs, n_frames, int(max_gap_frames))
-        if bad:
+        if bad and unfillable == "error":
             problems.extend(bad)
             continue
+        runs = [(a, b) for a, b in runs if a > 0 and b < n_frames - 1 and b - a + 1 <= max_gap_frames]
+        if not runs:
+            continue
         valid = np.flatnonzero(~missing[:, j])
-        gaps = np.flatnonzero(missing[:, j])
+        gaps = np.concatenate([np.arange(a, b + 1) for a, b in runs])
         X[gaps, j] = CubicSpline(valid, X[valid, j])(gaps)
         rows += [(label, first, last, last - first + 1) for first, last in runs]
-    if problems:
+    if problems and unfillable == "error":
         more = len(problems) - _MAX_LISTED
         listed = "; ".join(problems[:_MAX_LISTED]) + (f"; and {more} more" if more > 0 else "")
         raise LoperInputError(f"{where}: cannot fill marker gaps: {listed}")
@@ -143,6 +163,114 @@ def fill_gaps(
         {"marker": object, "first_frame": np.int64, "last_frame": np.int64, "n_frames": np.int64}
     )
     return X, report
+
+
+def gap_summary(raw_m, processed_m, labels: Sequence[str], unfiltered=None) -> pd.DataFrame:
+    """Per marker: frames filled, frames still missing and the longest remaining gap.
+
+    Parameters
+    ----------
+    raw_m, processed_m : array_like
+        Shape (n_frames, n_markers, 3), metres: the markers as read (NaN
+        where missing) and after gap filling (and filtering); a frame with
+        any NaN coordinate counts as missing.
+    labels : sequence of str
+        One name per marker.
+    unfiltered : array_like of bool, optional
+        Shape (n_frames, n_markers) or (n_frames, n_markers, 3): samples left
+        unfiltered by :func:`loper_analysis.filtering.lowpass_finite_runs`.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per marker, in order, columns :data:`GAP_SUMMARY_COLUMNS`:
+        ``marker``, ``n_frames``, ``n_filled_frames`` (missing in ``raw_m``,
+        present in ``processed_m``), ``n_missing_frames`` (missing in
+        ``processed_m``), ``longest_gap_frames`` (longest run still missing;
+        0 if none) and ``n_unfiltered_frames`` (int).
+    """
+    raw = ~np.all(np.isfinite(np.asarray(raw_m, float)), axis=2)
+    out = ~np.all(np.isfinite(np.asarray(processed_m, float)), axis=2)
+    labels = [str(lab) for lab in labels]
+    if raw.shape != out.shape or raw.shape[1] != len(labels):
+        raise LoperInputError(
+            f"raw_m {raw.shape}, processed_m {out.shape} and {len(labels)} labels must describe the same markers"
+        )
+    if unfiltered is None:
+        raw_kept = np.zeros_like(out)
+    else:
+        raw_kept = np.asarray(unfiltered, bool)
+        raw_kept = raw_kept.any(axis=2) if raw_kept.ndim == 3 else raw_kept
+    rows = []
+    for j, label in enumerate(labels):
+        runs = _missing_runs(out[:, j])
+        rows.append((label, out.shape[0], int((raw[:, j] & ~out[:, j]).sum()), int(out[:, j].sum()),
+                     max((b - a + 1 for a, b in runs), default=0), int(raw_kept[:, j].sum())))
+    return pd.DataFrame(rows, columns=list(GAP_SUMMARY_COLUMNS)).astype(
+        {c: (object if c == "marker" else np.int64) for c in GAP_SUMMARY_COLUMNS})
+
+
+def require_markers_per_frame(markers_m, labels: Sequence[str], min_markers: int = 3,
+                              weights: Mapping[str, float] | None = None, time_s=None, source: str = "") -> None:
+    """Refuse a trial with a frame in which fewer than ``min_markers`` weighted markers are present.
+
+    The rule: IK needs, in every frame, at least ``min_markers`` markers of
+    positive weight (every marker of ``labels`` when ``weights`` is None)
+    with finite coordinates. Three is the least that fixes one rigid body
+    (if not collinear); it does not guarantee that every coordinate of a
+    multi-segment model is determined, it only stops a solve that cannot
+    give an answer at all.
+
+    Parameters
+    ----------
+    markers_m : array_like
+        Shape (n_frames, n_markers, 3), metres, NaN where missing.
+    labels : sequence of str
+        One name per marker.
+    min_markers : int
+        Least number of weighted markers a frame must hold (>= 1).
+    weights : mapping of str to float, optional
+        IK weight per marker; markers absent from it or of weight <= 0 do not count.
+    time_s : array_like, optional
+        Shape (n_frames,), s; frame times for the message.
+    source : str
+        File the markers came from (for the message).
+
+    Raises
+    ------
+    LoperInputError
+        Naming the file, the rule, the frames (0-based runs, with their
+        times when given) and the weighted markers missing in them.
+    """
+    where = source or "markers"
+    X = np.asarray(markers_m, dtype=float)
+    labels = [str(lab) for lab in labels]
+    if X.ndim != 3 or X.shape[2] != 3 or X.shape[1] != len(labels):
+        raise LoperInputError(f"{where}: markers_m must have shape (n_frames, {len(labels)}, 3), got {X.shape}")
+    if isinstance(min_markers, bool) or not isinstance(min_markers, Integral) or min_markers < 1:
+        raise LoperInputError(f"{where}: min_markers must be an integer >= 1, got {min_markers!r}")
+    used = [j for j, lab in enumerate(labels) if weights is None or float(weights.get(lab, 0.0)) > 0]
+    present = np.all(np.isfinite(X[:, used]), axis=2)  # (n_frames, n_used)
+    short = present.sum(axis=1) < min_markers
+    if not short.any():
+        return
+    runs = _missing_runs(short)
+    t = None if time_s is None else np.asarray(time_s, float)
+    spans = []
+    for a, b in runs[:_MAX_LISTED]:
+        span = f"{a}..{b}" if b > a else f"{a}"
+        if t is not None:
+            span += f" (t = {t[a]:.4f}..{t[b]:.4f} s)" if b > a else f" (t = {t[a]:.4f} s)"
+        spans.append(span)
+    if len(runs) > _MAX_LISTED:
+        spans.append(f"and {len(runs) - _MAX_LISTED} more run(s)")
+    absent = [labels[used[k]] for k in np.flatnonzero((~present[short]).any(axis=0))]
+    if len(absent) > 2 * _MAX_LISTED:
+        absent = absent[:2 * _MAX_LISTED] + [f"and {len(absent) - 2 * _MAX_LISTED} more"]
+    raise LoperInputError(
+        f"{where}: {int(short.sum())} frame(s) hold fewer than {min_markers} of the {len(used)} weighted markers, "
+        f"too few to solve IK: frames {', '.join(spans)}; markers missing there: {', '.join(absent) or 'none'}"
+    )
 
 
 def rotate_markers(markers_m, rotation_deg: Sequence[float]) -> np.ndarray:

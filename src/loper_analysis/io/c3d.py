@@ -16,6 +16,12 @@ Reading (:func:`read_c3d`)
       read as missing.
     * ``LABELS``, ``LABELS2``, ... are joined (ezc3d splits more than 255
       labels over several parameters).
+    * Labels and units are decoded as UTF-8, or as Latin-1 when they are not
+      valid UTF-8 (:func:`~loper_analysis.io.c3d_parameters.decode_text`).
+    * Events come from ``EVENT:CONTEXTS/LABELS/TIMES``
+      (:func:`~loper_analysis.io.c3d_parameters.read_events`), times on the
+      frames' clock: frame ``k`` of the array is at
+      ``(first_frame + k) / POINT:RATE``.
     * Analog values are ezc3d's, i.e. after its SCALE/OFFSET handling.
       ``ANALOG:RATE`` must be an integer multiple of ``POINT:RATE``.
     * ezc3d accepts some damaged files silently (a file cut inside its
@@ -32,15 +38,22 @@ message names the file and the field (``GROUP:PARAMETER``) or argument.
 
 from __future__ import annotations
 
-import math
 import os
 import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from ..errors import LoperInputError
+from .c3d_parameters import (
+    EVENT_COLUMNS,
+    param_float,
+    param_strings,
+    param_value,
+    read_events,
+)
 
 __all__ = [
     "LENGTH_UNITS_PER_M",
@@ -80,6 +93,9 @@ class C3DRecording:
     analog_rate_hz : float
         Analog sample rate (Hz), ``ratio * point_rate_hz`` with an integer
         ratio >= 1; equals ``point_rate_hz`` when there are no analogs.
+    events : pandas.DataFrame
+        The file's events, columns ``context``, ``label`` (str) and
+        ``time_s`` (s, on the clock of :attr:`time_s`); empty by default.
     """
 
     source: str
@@ -91,6 +107,7 @@ class C3DRecording:
     analog_units: list[str] = field(default_factory=list)
     analogs: np.ndarray | None = None
     analog_rate_hz: float | None = None
+    events: pd.DataFrame = field(default_factory=lambda: _no_events())
 
     def __post_init__(self) -> None:
         self.markers_m = np.asarray(self.markers_m, dtype=float)
@@ -100,6 +117,8 @@ class C3DRecording:
                 f"{self.source}: markers_m must have shape (n_frames, n_markers={len(self.marker_labels)}, 3), "
                 f"got {X.shape}"
             )
+        if not isinstance(self.events, pd.DataFrame) or list(self.events.columns) != list(EVENT_COLUMNS):
+            raise LoperInputError(f"{self.source}: events must be a DataFrame with columns {list(EVENT_COLUMNS)}")
         if self.analog_rate_hz is None:
             self.analog_rate_hz = float(self.point_rate_hz)
         ratio = rate_ratio(self.point_rate_hz, self.analog_rate_hz, self.source)
@@ -151,6 +170,12 @@ class C3DRecording:
 # ---------------------------------------------------------------- helpers
 
 
+def _no_events() -> pd.DataFrame:
+    """An empty event table (columns :data:`~loper_analysis.io.c3d_parameters.EVENT_COLUMNS`)."""
+    return pd.DataFrame({"context": pd.Series(dtype=object), "label": pd.Series(dtype=object),
+                         "time_s": pd.Series(dtype=float)})
+
+
 def rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int:
     """The integer ratio analog/point rate; refuses a non-integer one."""
     ratio = float(analog_rate_hz) / float(point_rate_hz)
@@ -163,48 +188,15 @@ def rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int:
     return int(n)
 
 
-def _param(params, group: str, name: str):
-    """The ``value`` of GROUP:NAME, or None when absent."""
-    try:
-        return params[group][name]["value"]
-    except KeyError:
-        return None
-
-
-def _param_strings(params, group: str, name: str) -> list[str]:
-    """GROUP:NAME joined with NAME2, NAME3, ... (ezc3d splits more than 255 entries), stripped."""
-    out: list[str] = []
-    for key in [name] + [f"{name}{k}" for k in range(2, 100)]:
-        value = _param(params, group, key)
-        if value is None:
-            if key != name:
-                break
-            continue
-        out.extend(str(v).strip() for v in value)
-    return out
-
-
-def _param_float(params, group: str, name: str, source: str) -> float:
-    """First value of GROUP:NAME as a float; refuses absence and non-positive values."""
-    value = _param(params, group, name)
-    try:
-        rate = float(np.asarray(value, dtype=float).ravel()[0])
-    except (TypeError, ValueError, IndexError):
-        raise LoperInputError(f"{source}: {group}:{name} not declared") from None
-    if not math.isfinite(rate) or rate <= 0:
-        raise LoperInputError(f"{source}: {group}:{name} must be a positive number, got {rate:g}")
-    return rate
-
-
 def _labels_for(params, group: str, n: int, source: str) -> list[str]:
-    labels = _param_strings(params, group, "LABELS")
+    labels = param_strings(params, group, "LABELS")
     if len(labels) < n:
         raise LoperInputError(f"{source}: {group}:LABELS holds {len(labels)} label(s) for {n} {group.lower()}s")
     return labels[:n]
 
 
 def _point_units_per_m(params, source: str) -> float:
-    units = _param_strings(params, "POINT", "UNITS")
+    units = param_strings(params, "POINT", "UNITS")
     if not units or not units[0]:
         raise LoperInputError(
             f"{source}: POINT:UNITS not declared; cannot tell whether markers are in mm, cm or m"
@@ -244,8 +236,8 @@ def _check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> Non
             f"{source}: truncated file: the header declares {declared} frames but only {n_frames} could be read"
         )
     params = c3d["parameters"]
-    start = _param(params, "POINT", "DATA_START")
-    scale = _param(params, "POINT", "SCALE")
+    start = param_value(params, "POINT", "DATA_START")
+    scale = param_value(params, "POINT", "SCALE")
     if start is None or len(start) == 0:
         raise LoperInputError(f"{source}: POINT:DATA_START not declared")
     word_bytes = 4 if scale is None or len(scale) == 0 or float(scale[0]) < 0 else 2
@@ -299,10 +291,10 @@ def _analogs_from(c3d, point_rate_hz: float, source: str) -> tuple[float, int, l
         return point_rate_hz, 1, [], [], np.zeros((n_samples, 0))
     n_channels = analogs.shape[1]
     params = c3d["parameters"]
-    rate = _param_float(params, "ANALOG", "RATE", source)
+    rate = param_float(params, "ANALOG", "RATE", source)
     ratio = rate_ratio(point_rate_hz, rate, source)
     labels = _labels_for(params, "ANALOG", n_channels, source)
-    units = (_param_strings(params, "ANALOG", "UNITS") + [""] * n_channels)[:n_channels]
+    units = (param_strings(params, "ANALOG", "UNITS") + [""] * n_channels)[:n_channels]
     return rate, ratio, labels, units, analogs[0].T.copy()
 
 
@@ -322,7 +314,8 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
     C3DRecording
         ``markers_m`` (n_frames, n_markers, 3) in m with NaN for missing
         points; ``analogs`` (n_frames * ratio, n_channels) in the channels'
-        units; rates in Hz; ``first_frame`` 0-based.
+        units; rates in Hz; ``first_frame`` 0-based; ``events`` (context,
+        label, time_s).
 
     Raises
     ------
@@ -331,13 +324,13 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         is quoted); ``POINT:UNITS`` not declared or unknown (markers
         present); ``POINT:RATE`` missing; too few labels; ``ANALOG:RATE`` not
         an integer multiple of ``POINT:RATE`` ("mismatched analog/point
-        rates"). The message names the file.
+        rates"); malformed ``EVENT:TIMES``. The message names the file.
     """
     path = Path(path)
     source = str(path)
     c3d = _open_c3d(path)
     params = c3d["parameters"]
-    point_rate = _param_float(params, "POINT", "RATE", source)
+    point_rate = param_float(params, "POINT", "RATE", source)
     n_markers = int(np.shape(c3d["data"]["points"])[1])
     labels = _labels_for(params, "POINT", n_markers, source)
     units_per_m = _point_units_per_m(params, source) if n_markers else 1.0
@@ -360,6 +353,7 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         analog_units=analog_units,
         analogs=samples if n_channels else None,
         analog_rate_hz=analog_rate,
+        events=read_events(params, source),
     )
 
 

@@ -11,7 +11,7 @@ import yaml
 
 from ..errors import LoperInputError
 
-__all__ = ["read_tsv", "read_yaml"]
+__all__ = ["read_label_map", "read_tsv", "read_yaml"]
 
 
 def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str] = (), **read_csv) -> pd.DataFrame:
@@ -55,3 +55,40 @@ def read_yaml(path: str | os.PathLike, what: str = "YAML file"):
         return yaml.safe_load(path.read_text())
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         raise LoperInputError(f"{path}: not a readable {what} ({exc})") from exc
+
+
+def read_label_map(path: str | os.PathLike) -> dict[str, str]:
+    """A marker label map {lab label: model marker} from a TSV or YAML file.
+
+    ``.yaml``/``.yml``: one mapping ``label: marker``. Anything else is read
+    as a TSV with the columns ``label`` and ``marker`` (further columns are
+    ignored). Labels and markers are stripped of edge blanks.
+
+    Raises
+    ------
+    LoperInputError
+        A missing or unreadable file, a YAML document that is not a mapping
+        of names to names, a TSV without the two columns, an empty cell, or
+        a label given twice (naming the file and the value).
+    """
+    path = Path(path)
+    if path.suffix.lower() in (".yaml", ".yml"):
+        if not path.is_file():
+            raise LoperInputError(f"{path}: label map not found")
+        doc = read_yaml(path, "label map")
+        if not isinstance(doc, dict):
+            raise LoperInputError(f"{path}: a label map must be a YAML mapping 'label: marker', got {type(doc).__name__}")
+        pairs = list(doc.items())
+    else:
+        table = read_tsv(path, "label map", ("label", "marker"), dtype=str, keep_default_na=False)
+        if table.empty:
+            return {}
+        pairs = list(zip(table["label"], table["marker"]))
+    out: dict[str, str] = {}
+    for row, (label, marker) in enumerate(pairs, start=1):
+        if not isinstance(label, str) or not isinstance(marker, str) or not label.strip() or not marker.strip():
+            raise LoperInputError(f"{path}: label map entry {row}: {label!r} -> {marker!r} is not a pair of names")
+        if label.strip() in out:
+            raise LoperInputError(f"{path}: label map names label '{label.strip()}' twice")
+        out[label.strip()] = marker.strip()
+    return out

@@ -19,7 +19,7 @@ log = logging.getLogger(__name__)
 
 def _solve(model_osim: PathLike, time_s: np.ndarray, markers_m: np.ndarray, labels: Sequence[str], tasks_file=None,
            default_weight: float = 1.0, marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6,
-           source: str = ""):
+           source: str = "", min_markers: int = 3):
     """IK of marker arrays with the tasks of a file or of the config; returns the :class:`IKResult`."""
     from ..io.ik_tasks import read_ik_tasks
     from ..io.osim import read_model
@@ -28,20 +28,27 @@ def _solve(model_osim: PathLike, time_s: np.ndarray, markers_m: np.ndarray, labe
     model = read_model(model_osim)
     tasks = read_ik_tasks(tasks_file) if tasks_file else None
     weights, coords = ik_task_weights(model, labels, tasks, default_weight, marker_weights, coordinate_tasks, source)
-    return inverse_kinematics(model, time_s, markers_m, labels, weights, coords, accuracy=accuracy)
+    return inverse_kinematics(model, time_s, markers_m, labels, weights, coords, accuracy=accuracy,
+                              min_markers=min_markers, source=source)
 
 
 def ik_chunk(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, chunk: int, n_chunks: int, tasks_file=None,
              default_weight: float = 1.0, marker_weights: Mapping[str, float] | None = None,
-             coordinate_tasks: Mapping[str, Mapping] | None = None, accuracy: float = 1e-6) -> pd.DataFrame:
-    """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the coordinates."""
+             coordinate_tasks: Mapping[str, Mapping] | None = None, accuracy: float = 1e-6,
+             min_markers: int = 3) -> pd.DataFrame:
+    """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the coordinates.
+
+    Markers missing (NaN) in a frame are left out of its solve; a frame with
+    fewer than ``min_markers`` weighted markers stops the run with an error
+    naming the frames and the TRC (:func:`loper_analysis.markers.require_markers_per_frame`).
+    """
     from ..io.opensim_tables import read_markers, write_mot
     from ..kinematics import chunk_frames
 
     time_s, X, labels = read_markers(trc_path)
     sel = chunk_frames(len(time_s), n_chunks, chunk)
     res = _solve(model_osim, time_s[sel], X[sel], labels, tasks_file, default_weight, marker_weights,
-                 coordinate_tasks, accuracy, source=str(trc_path))
+                 coordinate_tasks, accuracy, source=str(trc_path), min_markers=min_markers)
     log.info("%s chunk %d/%d: %d frames, marker RMS error mean %.2f mm, max %.2f mm", trc_path, chunk, n_chunks,
              len(res.time_s), 1e3 * np.nanmean(res.marker_rms_m), 1e3 * np.nanmax(res.marker_max_m))
     frame = res.frame()
@@ -51,12 +58,13 @@ def ik_chunk(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, chunk:
 
 def ik_trial(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, angles_tsv: PathLike,
              coordinate_map: Mapping | None = None, tasks_file=None, default_weight: float = 1.0,
-             marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6) -> pd.DataFrame:
+             marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6,
+             min_markers: int = 3) -> pd.DataFrame:
     """IK of a whole TRC in one go: the .mot (degrees) and the tidy angle table that :func:`ik_join` gives."""
     from ..kinematics import joint_angle_table
 
     coords = ik_chunk(model_osim, trc_path, out_mot, 0, 1, tasks_file, default_weight, marker_weights,
-                      coordinate_tasks, accuracy)
+                      coordinate_tasks, accuracy, min_markers)
     angles = joint_angle_table(coords, coordinate_map, source=str(out_mot))
     write_tsv(angles, angles_tsv)
     log.info("%d frames, %s", len(angles), list(angles.columns))
@@ -80,7 +88,7 @@ def ik_join(chunk_mots: Sequence[PathLike], out_mot: PathLike, angles_tsv: PathL
 
 def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tasks_file=None,
             start_s: float | None = None, end_s: float | None = None,
-            rotate_deg: Sequence[float] | None = None, accuracy: float = 1e-6):
+            rotate_deg: Sequence[float] | None = None, accuracy: float = 1e-6, min_markers: int = 3):
     """IK of a .c3d or .trc marker file to a .mot (degrees), for the command line.
 
     ``rotate_deg`` turns the markers into the model frame (default -90 0 0
@@ -112,7 +120,7 @@ def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tas
         weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
     try:
         result = inverse_kinematics(read_model(model_osim), time_s[sel], markers_m[sel], labels, weights,
-                                    coordinate_tasks, accuracy=accuracy)
+                                    coordinate_tasks, accuracy=accuracy, min_markers=min_markers)
     except LoperInputError as exc:
         raise LoperInputError(f"{markers_path} with {model_osim}: {exc}") from None
     write_mot(out_mot, result.frame(), in_degrees=True)

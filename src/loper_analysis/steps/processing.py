@@ -1,7 +1,7 @@
 """File steps of the processing chain: raw C3D and robot log to markers, events, forces and strides.
 
-Chain: raw C3D -> :func:`markers` (gap fill, lab -> model frame, zero-phase
-low-pass, TRC) -> (model and IK: :mod:`.model`, :mod:`.ik`) ->
+Chain: raw C3D -> :func:`markers` (model marker names, gap fill, lab -> model
+frame, zero-phase low-pass, TRC) -> (model and IK: :mod:`.model`, :mod:`.ik`) ->
 :func:`events` (GRF) -> :func:`loadcell` (robot log on the mocap clock) ->
 :func:`strides` (strides, IQR outliers, cycles) -> :func:`strides_summary`.
 """
@@ -24,35 +24,68 @@ log = logging.getLogger(__name__)
 
 
 def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = None,
-            rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), max_gap_frames: int = 10, cutoff_hz: float = 40.0,
-            order: int = 4, duration_s: float | None = None) -> pd.DataFrame:
-    """C3D markers -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
+            rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), max_gap_frames: int = 10,
+            cutoff_hz: float | None = 40.0, order: int = 4, duration_s: float | None = None,
+            label_map: Mapping[str, str] | None = None, required_markers: Sequence[str] | None = None,
+            summary_out: PathLike | None = None) -> pd.DataFrame:
+    """C3D markers -> model names -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
 
-    ``duration_s`` keeps only the first part of the trial (static trials).
-    Returns the table of filled gaps (written to ``gaps_out`` when given).
+    Labels lose their subject prefix (``Subject:LASI`` -> ``LASI``) and are
+    renamed by ``label_map`` {lab label: model marker}
+    (:func:`loper_analysis.marker_names.model_marker_names`); every marker of
+    ``required_markers`` must then be among them. Interior gaps of up to
+    ``max_gap_frames`` frames are filled (0: none); longer gaps and gaps at
+    the trial's ends stay NaN and are written to the TRC as missing. The
+    low-pass (``cutoff_hz`` Hz, Butterworth of ``order`` run forward and
+    backward; None or 0: no filter) runs over each run of present frames on
+    its own (:func:`loper_analysis.filtering.lowpass_finite_runs`). Times
+    are the file's own, ``(first_frame + k) / rate``; ``duration_s`` keeps
+    the first ``duration_s`` seconds of the trial (static trials).
+
+    Returns the table of filled gaps (written to ``gaps_out`` when given; one
+    row per gap, :data:`loper_analysis.markers.GAP_REPORT_COLUMNS`). The
+    per-marker summary of filled and still missing frames
+    (:func:`loper_analysis.markers.gap_summary`) is written to ``summary_out``
+    when given and kept as a list of row dicts in ``.attrs["per_marker"]``
+    (plain values: pandas compares the attrs of frames it concatenates).
     """
-    from ..filtering import lowpass
+    from ..filtering import lowpass_finite_runs
     from ..io.c3d import read_c3d
     from ..io.opensim_tables import write_trc
-    from ..markers import fill_gaps, rotate_markers
+    from ..marker_names import model_marker_names, require_model_markers
+    from ..markers import fill_gaps, gap_summary, rotate_markers
 
+    source = str(c3d_path)
     rec = read_c3d(c3d_path)
-    time_s, X = rec.time_s, rec.markers_m
+    names = model_marker_names(rec.marker_labels, label_map, source)
+    if required_markers is not None:
+        require_model_markers(names, required_markers, source, rec.marker_labels)
+    time_s, raw = rec.time_s, rec.markers_m
     if duration_s is not None:
         keep = time_s < time_s[0] + duration_s - 1e-9
-        time_s, X = time_s[keep], X[keep]
-    filled, gaps = fill_gaps(X, max_gap_frames, rec.marker_labels, source=str(c3d_path))
+        time_s, raw = time_s[keep], raw[keep]
+    filled, gaps = fill_gaps(raw, max_gap_frames, names, source=source, unfillable="keep")
     X = rotate_markers(filled, rotation_deg)
-    try:
-        X = lowpass(X, rec.point_rate_hz, cutoff_hz, order, axis=0)
-    except LoperInputError as exc:
-        raise LoperInputError(f"{c3d_path}: markers: {exc}") from None
+    unfiltered = None
+    if cutoff_hz:
+        try:
+            X, unfiltered = lowpass_finite_runs(X, rec.point_rate_hz, cutoff_hz, order, axis=0)
+        except LoperInputError as exc:
+            raise LoperInputError(f"{c3d_path}: markers: {exc}") from None
+    summary = gap_summary(raw, X, names, unfiltered)
     log.info("%s: %d frames at %g Hz, %d markers, %d gap(s) filled", c3d_path, len(time_s), rec.point_rate_hz,
-             len(rec.marker_labels), len(gaps))
-    write_trc(trc_out, time_s, X, rec.marker_labels)
+             len(names), len(gaps))
+    write_trc(trc_out, time_s, X, names)
     if gaps_out is not None:
         write_tsv(gaps, gaps_out)
+    if summary_out is not None:
+        write_tsv(summary, summary_out)
     log.info("filled gaps:\n%s", gaps.to_string(index=False))
+    left = summary[summary.n_missing_frames > 0]
+    if len(left):
+        log.warning("%s: %d marker(s) still missing in some frames (written as NaN):\n%s", c3d_path, len(left),
+                    left.to_string(index=False))
+    gaps.attrs["per_marker"] = summary.to_dict("records")
     return gaps
 
 

@@ -1,0 +1,154 @@
+"""The markers step (loper_analysis.steps.processing.markers) on files written by others.
+
+walking5.c3d (Vicon, from opensim-core) has 5 to 59 % of the frames of each
+marker missing, most of them in long gaps and at the ends of the trial;
+std_walking5_markers.trc is OpenSim's own reading of it (every 10th frame
+and the last, values printed to 5 significant digits).
+"""
+
+from __future__ import annotations
+
+import struct
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d import read_c3d
+from loper_analysis.io.c3d_writer import write_c3d
+from loper_analysis.io.opensim_tables import read_markers
+from loper_analysis.io.osim import quiet_opensim
+from loper_analysis.markers import GAP_REPORT_COLUMNS, GAP_SUMMARY_COLUMNS
+from loper_analysis.steps.processing import markers
+
+DATA = Path(__file__).parents[1] / "data" / "opensim-core"
+WALKING5 = DATA / "walking5.c3d"
+
+
+def _opensim_trc(path):
+    """Times (n,), markers (n, m, 3) in the file's unit and labels, read by OpenSim's TRCFileAdapter."""
+    osim = quiet_opensim()
+    table = osim.TimeSeriesTableVec3(str(path))
+    labels = list(table.getColumnLabels())
+    t = np.array(table.getIndependentColumn(), dtype=float)
+    flat_table = table.flatten(["_x", "_y", "_z"])  # keep every temporary alive while reading
+    matrix = flat_table.getMatrix()
+    values = np.array(matrix.to_numpy(), dtype=float, copy=True).reshape(t.size, len(labels), 3)
+    assert table.getTableMetaDataAsString("Units") == "mm"
+    return t, values, labels
+
+
+def test_walking5_as_read_equals_opensims_reading(tmp_path):
+    """No rotation, no filter, no filling: our TRC holds the numbers OpenSim read from the same file."""
+    gaps = markers(WALKING5, tmp_path / "w5.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, max_gap_frames=0)
+    assert len(gaps) == 0
+    t, X_m, labels = read_markers(tmp_path / "w5.trc")
+    t_ref, ref_mm, labels_ref = _opensim_trc(DATA / "std_walking5_markers.trc")
+    assert labels == labels_ref and len(labels) == 40
+    # times: the file's own clock (frame k at k / 250 s); the reference holds every 10th frame and the last
+    assert len(t) == 1103
+    np.testing.assert_allclose(t, np.arange(1103) / 250.0, rtol=0, atol=1e-12)
+    frames = np.round(t_ref * 250.0).astype(int)
+    assert frames[:3].tolist() == [0, 10, 20] and frames[-2:].tolist() == [1100, 1102]
+    np.testing.assert_allclose(t[frames], t_ref, rtol=0, atol=1e-9)
+    ours_mm = 1000.0 * X_m[frames]
+    np.testing.assert_array_equal(np.isnan(ours_mm), np.isnan(ref_mm))  # missing in the same places
+    both = np.isfinite(ref_mm)
+    assert both.sum() == 7209
+    diff = np.abs(ours_mm - ref_mm)[both]
+    # the reference prints 5 significant digits: half a unit of the last digit (0.05 mm above 1 m) plus 1e-5 mm
+    # (OpenSim's value differs from ours by up to 3e-6 mm, so a few values sit just past a rounding edge)
+    half_unit = 0.5 * 10.0 ** (np.floor(np.log10(np.abs(ref_mm[both]))) - 4)
+    assert np.all(diff <= half_unit + 1e-5), np.max(diff - half_unit)
+    below_1m = np.abs(ref_mm[both]) < 1000.0
+    assert below_1m.sum() == 5458
+    assert diff[below_1m].max() < 0.01  # measured 0.0050 mm; 0.050 mm where the reference prints one decimal
+
+
+def _runs(missing):
+    edges = np.diff(np.r_[0, missing.astype(int), 0])
+    return list(zip(np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1))
+
+
+def test_walking5_through_the_default_chain_keeps_long_gaps_missing(tmp_path):
+    """Filling, rotation and a 6 Hz low-pass on the real file: every gap of walking5 touches an end of the
+    trial (the subject walks into and out of the volume), so nothing is filled and every gap stays NaN in the
+    TRC; the reports count them."""
+    raw = read_c3d(WALKING5).markers_m
+    gaps = markers(WALKING5, tmp_path / "w5.trc", tmp_path / "w5.gaps.tsv", cutoff_hz=6.0, max_gap_frames=10,
+                   summary_out=tmp_path / "w5.markers.tsv")
+    _, X, labels = read_markers(tmp_path / "w5.trc")
+    missing_raw = np.isnan(raw).any(axis=2)
+    expected_rows, expected_filled = [], np.zeros_like(missing_raw)
+    for j, label in enumerate(labels):
+        for a, b in _runs(missing_raw[:, j]):
+            if a > 0 and b < len(raw) - 1 and b - a + 1 <= 10:
+                expected_rows.append({"marker": label, "first_frame": a, "last_frame": b, "n_frames": b - a + 1})
+                expected_filled[a:b + 1, j] = True
+    assert len(expected_rows) == 0
+    assert gaps.to_dict("records") == expected_rows
+    written = pd.read_csv(tmp_path / "w5.gaps.tsv", sep="\t")
+    assert list(written.columns) == list(GAP_REPORT_COLUMNS) and len(written) == 0
+    still = np.isnan(X).any(axis=2)
+    np.testing.assert_array_equal(still, missing_raw & ~expected_filled)
+    summary = pd.read_csv(tmp_path / "w5.markers.tsv", sep="\t")
+    assert list(summary.columns) == list(GAP_SUMMARY_COLUMNS)
+    np.testing.assert_array_equal(summary["n_filled_frames"], expected_filled.sum(axis=0))
+    np.testing.assert_array_equal(summary["n_missing_frames"], still.sum(axis=0))
+    assert summary["n_missing_frames"].tolist()[:3] == [57, 218, 269]
+    assert summary["longest_gap_frames"].max() == 463
+    assert (summary["n_unfiltered_frames"] == 0).all()
+    assert summary.to_dict("records") == gaps.attrs["per_marker"]
+    # the rotation by -90 deg about X took Vicon's Z up to Y up: the pelvis markers sit about 1 m high
+    assert 0.8 < np.nanmedian(X[:, labels.index("RASI"), 1]) < 1.2
+
+
+@pytest.fixture
+def prefixed(tmp_path):
+    X = np.random.default_rng(11).uniform(-1, 1, size=(60, 3, 3))
+    X[20:23, 1] = np.nan  # filled
+    X[:4, 0] = np.nan  # at the start: stays missing
+    X[30:42, 2] = np.nan  # 12 frames, longer than 10: stays missing
+    path = tmp_path / "prefixed.c3d"
+    write_c3d(path, ["Anna:LASIS", "Anna:RASIS", "Anna:LHEE"], X, 100.0)
+    return path
+
+
+def test_prefixes_and_label_map_name_the_trc_columns_and_gaps(prefixed, tmp_path):
+    gaps = markers(prefixed, tmp_path / "p.trc", rotation_deg=(0, 0, 0), cutoff_hz=0,
+                   label_map={"LASIS": "LASI", "Anna:RASIS": "RASI"}, required_markers=["LASI", "RASI", "LHEE"])
+    _, X, labels = read_markers(tmp_path / "p.trc")
+    assert labels == ["LASI", "RASI", "LHEE"]
+    assert gaps.to_dict("records") == [{"marker": "RASI", "first_frame": 20, "last_frame": 22, "n_frames": 3}]
+    raw = read_c3d(prefixed).markers_m
+    np.testing.assert_array_equal(np.isnan(X).any(axis=2).sum(axis=0), [4, 0, 12])
+    np.testing.assert_allclose(X[[10, 59]], raw[[10, 59]], rtol=0, atol=1e-12)
+    per_marker = pd.DataFrame(gaps.attrs["per_marker"])
+    assert per_marker[["n_filled_frames", "n_missing_frames", "longest_gap_frames"]].values.tolist() == [
+        [0, 4, 4], [3, 0, 0], [0, 12, 12]
+    ]
+
+
+def test_missing_model_markers_stop_the_step_before_writing(prefixed, tmp_path):
+    with pytest.raises(LoperInputError) as err:
+        markers(prefixed, tmp_path / "p.trc", label_map={"LASIS": "LASI"}, required_markers=["LASI", "RASI", "RHEE"])
+    assert str(err.value).startswith(f"{prefixed}: model marker(s) RASI, RHEE not provided by any label")
+    with pytest.raises(LoperInputError, match=r"markers.label_map: label\(s\) L_ASIS not in the file"):
+        markers(prefixed, tmp_path / "p.trc", label_map={"L_ASIS": "LASI"})
+    assert not (tmp_path / "p.trc").exists()
+
+
+def test_time_base_of_a_file_not_starting_at_frame_one(prefixed, tmp_path):
+    """First frame 101 at 100 Hz: the TRC's times start at 1.00 s, and a 0.1 s static cut keeps 1.00..1.09 s."""
+    data = bytearray(prefixed.read_bytes())
+    data[6:10] = struct.pack("<HH", 101, 160)
+    late = tmp_path / "late.c3d"
+    late.write_bytes(bytes(data))
+    markers(late, tmp_path / "late.trc", rotation_deg=(0, 0, 0), cutoff_hz=None)
+    t, _, _ = read_markers(tmp_path / "late.trc")
+    np.testing.assert_allclose(t, 1.0 + np.arange(60) / 100.0, rtol=0, atol=1e-12)
+    markers(late, tmp_path / "cut.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, duration_s=0.1)
+    t, _, _ = read_markers(tmp_path / "cut.trc")
+    np.testing.assert_allclose(t, 1.0 + np.arange(10) / 100.0, rtol=0, atol=1e-12)
