@@ -266,14 +266,20 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
     return StrideTables(out, pd.concat(cycles, ignore_index=True), too_few)
 
 
-def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: int = 5) -> pd.DataFrame:
+def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: int = 5,
+                   contacts: Mapping[tuple[str, str], pd.DataFrame] | None = None) -> pd.DataFrame:
     """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.
 
     ``tables``: ``{(subject, trial): stride table}`` of :func:`stride_tables`.
     ``status`` is ``ok`` or ``too_few_strides`` (fewer than ``min_valid``
-    kept: the trial is flagged, not dropped silently).
+    kept: the trial is flagged, not dropped silently). ``contacts``: the
+    force-plate contact tables (:func:`loper_analysis.contacts.foot_contacts`,
+    column ``flag``) of the same trials; when any trial has one, the column
+    ``n_contacts_flagged`` counts the contacts left out of the events
+    (trials whose events came from named GRF channels have an empty table).
     """
     rows = []
+    with_contacts = contacts is not None and any(len(c) for c in contacts.values())
     for (subject, trial), table in tables.items():
         removed = table[table["removed"]]
         signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
@@ -287,6 +293,9 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
             "mean_stride_s": table["duration_s"].mean(),
             "status": "ok" if n_kept >= min_valid else "too_few_strides",
         })
+        if with_contacts:
+            flags = contacts[(subject, trial)]["flag"] if len(contacts[(subject, trial)]) else pd.Series([], dtype=str)
+            rows[-1]["n_contacts_flagged"] = int((flags != "ok").sum())
     return pd.DataFrame(rows)
 
 

@@ -13,18 +13,25 @@ def subject_model(wildcards):
     return user if user else f"results/model/{wildcards.subject}/scaled.osim"
 
 
+LABEL_MAP = config["markers"]["label_map"]
+
+
 rule markers:
+    """Markers of a C3D in the model's names and frame, gaps filled or left missing, low-passed: a TRC (mm)."""
     input:
-        "data/raw/{subject}/{trial}.c3d",
+        c3d="data/raw/{subject}/{trial}.c3d",
+        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
     output:
         trc="results/markers/{subject}/{trial}.trc",
         gaps="results/markers/{subject}/{trial}.gaps.tsv",
+        summary="results/markers/{subject}/{trial}.markers.tsv",
     params:
         rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
         max_gap_frames=config["markers"]["max_gap_frames"],
         cutoff_hz=FILTER["cutoff_hz"],
         order=FILTER["order"],
         duration_s=lambda wc: config["markers"]["static_duration_s"] if wc.trial == TRIALS["static"] else None,
+        label_map=LABEL_MAP or None,
     log:
         "results/logs/markers/{subject}/{trial}.log",
     benchmark:
@@ -168,10 +175,13 @@ rule grf:
 
 
 rule events:
+    """Heel strikes and toe-offs: force platforms with the heel markers, or the named GRF channels of each belt."""
     input:
-        "data/raw/{subject}/{trial}.c3d",
+        c3d="data/raw/{subject}/{trial}.c3d",
+        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
     output:
-        "results/events/{subject}/{trial}.events.tsv",
+        events="results/events/{subject}/{trial}.events.tsv",
+        contacts="results/events/{subject}/{trial}.contacts.tsv",
     params:
         grf_channels=EVENTS["grf_channels"],
         threshold_on_n=EVENTS["threshold_on_n"],
@@ -180,6 +190,12 @@ rule events:
         min_swing_s=EVENTS["min_swing_s"],
         cutoff_hz=EVENTS["grf_cutoff_hz"],
         order=FILTER["order"],
+        foot_markers=EVENTS["foot_markers"],
+        plate_sides=EVENTS["plate_sides"],
+        label_map=LABEL_MAP or None,
+        rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
+        band_n=config["grf"]["resting_band_n"],
+        max_rest_n=config["grf"]["max_resting_n"],
     log:
         "results/logs/events/{subject}/{trial}.log",
     benchmark:
@@ -188,10 +204,19 @@ rule events:
         "../scripts/events.py"
 
 
+def robot_log(wildcards):
+    """A trial's robot log: data/raw/{subject}/{trial}.loper.tsv, or converted from the MATLAB export {trial}.mat."""
+    raw = Path("data/raw") / wildcards.subject
+    if SUBJECT_SOURCE[wildcards.subject] == "recorded" and not (raw / f"{wildcards.trial}.loper.tsv").exists() \
+            and (raw / f"{wildcards.trial}.mat").exists():
+        return f"results/device/{wildcards.subject}/{wildcards.trial}.loper.tsv"
+    return str(raw / f"{wildcards.trial}.loper.tsv")
+
+
 rule loadcell:
     input:
         c3d="data/raw/{subject}/{trial}.c3d",
-        log="data/raw/{subject}/{trial}.loper.tsv",
+        log=robot_log,
     output:
         "results/loadcell/{subject}/{trial}.force.tsv",
     params:
@@ -277,7 +302,8 @@ rule transparency:
 
 rule strides_summary:
     input:
-        [f"results/strides/{s}/{t}.strides.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        strides=[f"results/strides/{s}/{t}.strides.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        contacts=[f"results/events/{s}/{t}.contacts.tsv" for s in processed_subjects() for t in subject_trials(s)],
     output:
         report(
             "results/strides/summary.tsv",

@@ -23,10 +23,19 @@ __all__ = ["markers", "events", "loadcell", "strides", "strides_summary"]
 log = logging.getLogger(__name__)
 
 
+def _label_map(label_map: Mapping[str, str] | PathLike | None) -> Mapping[str, str] | None:
+    """A label map given inline, or read from its file (TSV with columns label, marker, or YAML)."""
+    if label_map is None or isinstance(label_map, Mapping):
+        return label_map
+    from ..io.readers import read_label_map
+
+    return read_label_map(label_map)
+
+
 def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = None,
             rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), max_gap_frames: int = 10,
             cutoff_hz: float | None = 40.0, order: int = 4, duration_s: float | None = None,
-            label_map: Mapping[str, str] | None = None, required_markers: Sequence[str] | None = None,
+            label_map: Mapping[str, str] | PathLike | None = None, required_markers: Sequence[str] | None = None,
             summary_out: PathLike | None = None) -> pd.DataFrame:
     """C3D markers -> model names -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
 
@@ -57,7 +66,7 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
 
     source = str(c3d_path)
     rec = read_c3d(c3d_path)
-    names = model_marker_names(rec.marker_labels, label_map, source)
+    names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
     if required_markers is not None:
         require_model_markers(names, required_markers, source, rec.marker_labels)
     time_s, raw = rec.time_s, rec.markers_m
@@ -89,16 +98,57 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     return gaps
 
 
-def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str], threshold_on_n: float = 50.0,
-           threshold_off_n: float = 20.0, min_stance_s: float = 0.2, min_swing_s: float = 0.2,
-           cutoff_hz: float | None = None, order: int = 4) -> pd.DataFrame:
-    """Heel strikes and toe-offs of both legs from the belts' vertical GRF, on the mocap clock.
+def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str] | None = None,
+           threshold_on_n: float = 50.0, threshold_off_n: float = 20.0, min_stance_s: float = 0.2,
+           min_swing_s: float = 0.2, cutoff_hz: float | None = None, order: int = 4,
+           foot_markers: Mapping[str, str] | None = None, plate_sides: Mapping[str, int] | None = None,
+           label_map: Mapping[str, str] | PathLike | None = None, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+           band_n: float = 10.0, max_rest_n: float = 100.0, contacts_out: PathLike | None = None) -> pd.DataFrame:
+    """Heel strikes and toe-offs of both legs, on the mocap clock (the file's own time base).
 
-    ``cutoff_hz`` low-passes the GRF first (zero-phase Butterworth); None
-    thresholds the raw force (the hysteresis rejects noise, and a filter would
-    smear the unloading at toe-off: 40 Hz moves a 20 N toe-off threshold by
-    about 4.5 ms).
+    A file with force platforms (``FORCE_PLATFORM:USED`` > 0): each plate's
+    contacts from its vertical force above the resting level, each assigned to
+    a foot by the heel markers ``foot_markers`` {side: model marker, after
+    ``label_map``} over the plate (:func:`loper_analysis.contacts.foot_contacts`;
+    ``plate_sides`` {side: plate number} is a check); flagged contacts give no
+    heel strike or toe-off but a ``flagged_start``/``flagged_end`` pair that
+    keeps strides from spanning them. The contact table goes to
+    ``contacts_out`` when given. ``attrs["n_contacts_flagged"]`` counts them.
+
+    A file without platforms: the vertical force of each belt from the
+    analog channel ``grf_channels[side]`` (N), as recorded; ``cutoff_hz``
+    low-passes it first (zero-phase Butterworth; None thresholds the raw
+    force: a 40 Hz filter moves a 20 N toe-off threshold by about 4.5 ms).
     """
+    from ..io.force_platforms import count_force_platforms
+
+    if count_force_platforms(c3d_path):
+        table, contacts = _plate_events(c3d_path, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n,
+                                        threshold_off_n, min_stance_s, min_swing_s, band_n, max_rest_n)
+        if contacts_out is not None:
+            write_tsv(contacts, contacts_out)
+        log.info("contacts:\n%s", contacts.to_string(index=False))
+    else:
+        if not grf_channels:
+            raise LoperInputError(
+                f"{c3d_path}: no force platforms (FORCE_PLATFORM:USED is 0 or absent) and no GRF channel configured "
+                "(events.grf_channels); cannot detect gait events"
+            )
+        table = _channel_events(c3d_path, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
+                                cutoff_hz, order)
+        if contacts_out is not None:
+            write_tsv(pd.DataFrame(columns=["plate", "contact", "side", "flag"]), contacts_out)
+    write_tsv(table, out_tsv)
+    from ..events import flagged_contacts
+
+    table.attrs["n_contacts_flagged"] = flagged_contacts(table)
+    log.info("events per side and kind:\n%s", table.groupby(["side", "event"]).size().to_string())
+    return table
+
+
+def _channel_events(c3d_path, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz,
+                    order) -> pd.DataFrame:
+    """Events from one named vertical-GRF analog channel per belt."""
     from ..events import gait_events
     from ..filtering import lowpass
     from ..io.c3d import read_c3d
@@ -111,10 +161,31 @@ def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str
             fz = lowpass(fz, rec.analog_rate_hz, cutoff_hz, order)
         tables.append(gait_events(rec.analog_time_s, fz, side, threshold_on_n, threshold_off_n, min_stance_s,
                                   min_swing_s, source=f"{c3d_path} ({grf_channels[side]})"))
-    table = pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
-    write_tsv(table, out_tsv)
-    log.info("events per side and kind:\n%s", table.groupby(["side", "event"]).size().to_string())
-    return table
+    return pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
+
+
+def _plate_events(c3d_path, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n, threshold_off_n,
+                  min_stance_s, min_swing_s, band_n, max_rest_n) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Events and the contact table from the force platforms and the heel markers."""
+    from ..contacts import PlateForce, contact_events, foot_contacts
+    from ..io.c3d import read_c3d
+    from ..marker_names import model_marker_names, require_model_markers
+    from ..markers import rotate_markers
+    from .grf import plate_vertical_loads
+
+    source = str(c3d_path)
+    if not foot_markers:
+        raise LoperInputError(f"{source}: force platforms need the heel marker of each foot (events.foot_markers)")
+    rec = read_c3d(c3d_path)
+    names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
+    require_model_markers(names, [foot_markers[s] for s in SIDES], source, rec.marker_labels)
+    loads = plate_vertical_loads(c3d_path, rotation_deg, band_n, max_rest_n)
+    plates = [PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i])
+              for i, n in enumerate(loads.numbers)]
+    heels = {s: rotate_markers(rec.markers_m[:, names.index(foot_markers[s]), :], rotation_deg) for s in SIDES}
+    contacts = foot_contacts(plates, rec.time_s, heels, plate_sides, threshold_on_n, threshold_off_n, min_stance_s,
+                             min_swing_s, source=source)
+    return contact_events(contacts), contacts
 
 
 def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_channel: str = "sync", cutoff_hz: float = 40.0,
@@ -159,16 +230,24 @@ def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, c
 
 
 def strides_summary(subject_trials: Sequence[tuple[str, str]], strides_tsvs: Sequence[PathLike], out_tsv: PathLike,
-                    min_valid: int = 5) -> pd.DataFrame:
+                    min_valid: int = 5, contacts_tsvs: Sequence[PathLike] | None = None) -> pd.DataFrame:
     """One row per subject x trial of the stride tables (:func:`loper_analysis.strides.stride_summary`).
 
-    ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of ``subject_trials``, in order.
+    ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
+    ``subject_trials``, in order; ``contacts_tsvs`` (optional, same order) the
+    force-plate contact tables written by :func:`events`, whose flagged
+    contacts are counted.
     """
     from ..strides import stride_summary
 
-    tables = {tuple(key): read_tsv(path, "stride table", keep_default_na=False, na_values=[""])
-              for key, path in zip(subject_trials, strides_tsvs, strict=True)}
-    table = stride_summary(tables, min_valid)
+    keys = [tuple(key) for key in subject_trials]
+    tables = {key: read_tsv(path, "stride table", keep_default_na=False, na_values=[""])
+              for key, path in zip(keys, strides_tsvs, strict=True)}
+    contacts = None
+    if contacts_tsvs is not None:
+        contacts = {key: read_tsv(path, "contact table", ("flag",), keep_default_na=False)
+                    for key, path in zip(keys, contacts_tsvs, strict=True)}
+    table = stride_summary(tables, min_valid, contacts)
     write_tsv(table, out_tsv)
     for row in table[table.status != "ok"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
