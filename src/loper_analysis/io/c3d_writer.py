@@ -33,7 +33,7 @@ from ..errors import LoperInputError
 from .atomic import staged
 from .c3d import LENGTH_UNITS_PER_M, C3DRecording, rate_ratio
 
-__all__ = ["MAX_LABEL_CHARS", "MAX_ANALOG_OFFSET", "ForcePlatform", "write_c3d", "write_recording"]
+__all__ = ["MAX_ANALOG_OFFSET", "MAX_LABEL_CHARS", "ForcePlatform", "write_c3d", "write_recording"]
 
 #: Longest label ezc3d can write and read back (longer ones give an unreadable file).
 MAX_LABEL_CHARS = 255

@@ -17,7 +17,7 @@ from ..errors import LoperInputError
 from .atomic import write_bytes
 from .robot_log import COLUMNS, FORMAT_NAME, validated_log
 
-__all__ = ["MAT_OPTIONAL", "MAT_HEADER_TEXT", "read_robot_log_mat", "write_robot_log_mat"]
+__all__ = ["MAT_HEADER_TEXT", "MAT_OPTIONAL", "read_robot_log_mat", "write_robot_log_mat"]
 
 #: Descriptive text of the .mat header (116 bytes, blank-padded); fixed, so the same log gives the same bytes.
 MAT_HEADER_TEXT = "MATLAB 5.0 MAT-file, robot log written by loper-analysis"

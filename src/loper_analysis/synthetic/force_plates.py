@@ -26,7 +26,7 @@ from ..errors import LoperInputError
 from ..io.c3d import LENGTH_UNITS_PER_M
 from ..io.c3d_writer import ForcePlatform
 
-__all__ = ["plate_frame", "wrench_channels", "plate_channels", "plate_load"]
+__all__ = ["plate_channels", "plate_frame", "plate_load", "wrench_channels"]
 
 
 def plate_frame(plate: ForcePlatform) -> tuple[np.ndarray, np.ndarray]:
