@@ -132,3 +132,42 @@ def test_mat_bad_map_and_bad_variables(tmp_path):
     junk = tmp_path / "junk.mat"
     junk.write_bytes(b"not a mat file at all" * 10)
     assert mat_refusal(junk).startswith(f"{junk}: cannot read .mat file (")
+
+
+# ---------------------------------------------------------------------------
+# the .mat writer
+
+
+MAT_NAMES = {"time_s": "t_ms", "force_desired_n": "F_des", "force_measured_n": "F_meas", "motor_angle_rad": "theta_m",
+             "motor_velocity_rad_s": "omega_m", "sync_v": "sync", "perturbation": "pert", "safety_state": "safety"}
+
+
+def test_mat_writer_round_trip_and_fixed_bytes(tmp_path):
+    from loper_analysis.io.robot_log_mat import MAT_HEADER_TEXT, write_robot_log_mat
+
+    frame = make_frame()
+    mat = write_robot_log_mat(tmp_path / "rec.loper.mat", frame, FS, MAT_NAMES, time_scale=0.001)
+    back, meta = read_robot_log_mat(mat, MAT_NAMES, FS, time_scale=0.001)
+    assert meta["sample_rate_hz"] == FS
+    pd.testing.assert_frame_equal(back.drop(columns="time_s"), frame.drop(columns="time_s"), check_exact=True,
+                                  check_dtype=False)
+    np.testing.assert_allclose(back["time_s"], frame["time_s"], rtol=1e-15, atol=0)  # ms -> s
+    assert mat.read_bytes()[:len(MAT_HEADER_TEXT)] == MAT_HEADER_TEXT.encode()
+    again = write_robot_log_mat(tmp_path / "again.loper.mat", frame, FS, MAT_NAMES, time_scale=0.001)
+    assert again.read_bytes() == mat.read_bytes()
+    plain = write_robot_log_mat(tmp_path / "plain.mat", frame, FS)  # the column names as variable names
+    got, _ = read_robot_log_mat(plain, {c: c for c in COLUMNS}, FS)
+    pd.testing.assert_frame_equal(got, frame, check_exact=True, check_dtype=False)
+
+
+@pytest.mark.parametrize("names, match", [
+    ({**MAT_NAMES, "sync_v": "2sync"}, "is not a MATLAB name"),
+    ({k: v for k, v in MAT_NAMES.items() if k != "sync_v"}, "missing: sync_v"),
+    ({**MAT_NAMES, "sync_v": "pert"}, "all different"),
+])
+def test_mat_writer_refuses_bad_names_and_leaves_nothing(tmp_path, names, match):
+    from loper_analysis.io.robot_log_mat import write_robot_log_mat
+
+    with pytest.raises(LoperInputError, match=match):
+        write_robot_log_mat(tmp_path / "rec.mat", make_frame(), FS, names)
+    assert list(tmp_path.iterdir()) == []

@@ -11,7 +11,7 @@ from ..io.c3d_writer import write_recording
 from ..io.readers import read_yaml
 from ..io.robot_log import write_robot_log
 
-__all__ = ["truth", "lab_session"]
+__all__ = ["lab_export_session", "lab_session", "truth"]
 
 log = logging.getLogger(__name__)
 
@@ -77,3 +77,93 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
             write_robot_log(robot_log, walk.robot, lab_settings.robot_rate_hz, {"clock": "robot"})
         log.info("%s: true events:\n%s", trial, walk.mocap_events().to_string(index=False))
         log.info("%s: perturbations:\n%s", trial, walk.schedule.to_string(index=False))
+
+
+def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, marker_set_xml: PathLike,
+                       label_map_tsv: PathLike, trials: Sequence[str], onsets_ms: Sequence[int | None],
+                       no_device: str, height_m: float, mass_kg: float, duration_s: float, seed: int,
+                       impedance: Sequence[float] = (55.0, 3.5, 3.0, 0.1, 8.0, 0.3), static_name: str = "static",
+                       static_duration_s: float = 2.0, lab: Mapping | None = None, device: Mapping | None = None,
+                       export: Mapping | None = None, timing_cv: float = 0.03, amplitude_cv: float = 0.05,
+                       pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1,
+                       perturb_every_strides: Sequence[int] = (3, 5)) -> dict:
+    """One subject's session as the lab exports it (QTM C3D + MATLAB robot logs), into ``out_dir``.
+
+    Writes ``{static_name}.c3d`` and per trial ``{trial}.c3d``, plus
+    ``{trial}.loper.mat`` for every trial but ``no_device``
+    (:func:`loper_analysis.synthetic.lab_export.qtm_walking_export`, variables
+    :data:`~loper_analysis.synthetic.lab_export.ROBOT_LOG_MAT_VARIABLES`, time
+    in s). The markers are those of ``label_map_tsv`` (columns ``label``,
+    ``marker``) on the model ``model_osim`` with the marker set
+    ``marker_set_xml``; the kinematics are simulated for a subject of
+    ``height_m`` and ``mass_kg``. ``onsets_ms`` gives each trial's
+    perturbation onset (ms after left toe-off; None: no pulses), answered with
+    ``impedance`` (K_hip, D_hip, K_knee, D_knee, K_ankle, D_ankle in N·m/rad
+    and N·m·s/rad). ``lab``, ``device`` and ``export`` are keyword arguments
+    of :class:`~loper_analysis.synthetic.trials.LabSettings`,
+    :class:`~loper_analysis.device.controller.DeviceParameters` and
+    :class:`~loper_analysis.synthetic.lab_export.QTMExportSettings`. Seeded by
+    ``seed``, subject and trial: the same arguments give the same files.
+
+    Returns
+    -------
+    dict
+        ``{static_name: LabExport, trial: (WalkingTrial, LabExport), ...}``:
+        the truth behind the files (coordinates, forces, events, perturbations).
+    """
+    import zlib
+    from pathlib import Path
+
+    import numpy as np
+
+    from ..device.controller import DeviceParameters
+    from ..io.osim import quiet_opensim, read_model
+    from ..io.readers import read_tsv
+    from ..io.robot_log_mat import write_robot_log_mat
+    from ..model import build_lower_body_model, segment_parameters_from_model
+    from ..synthetic.lab_export import (
+        ROBOT_LOG_MAT_VARIABLES,
+        QTMExportSettings,
+        qtm_static_export,
+        qtm_walking_export,
+    )
+    from ..synthetic.trials import (
+        LabSettings,
+        PerturbationSettings,
+        simulate_walking_trial,
+    )
+
+    def seeded(*names: str) -> np.random.SeedSequence:
+        return np.random.SeedSequence([int(seed), *(zlib.crc32(n.encode()) for n in (subject, *names))])
+
+    out = Path(out_dir)
+    lab_settings = LabSettings(**(lab or {}))
+    settings = QTMExportSettings(**(export or {}))
+    model = read_model(model_osim)
+    model.updateMarkerSet(quiet_opensim().MarkerSet(str(marker_set_xml)))
+    table = read_tsv(label_map_tsv, "label map", ("label", "marker"), dtype=str)
+    label_map = dict(zip(table["marker"], table["label"]))
+    params = segment_parameters_from_model(build_lower_body_model(height_m, mass_kg))
+    results: dict = {}
+    static = qtm_static_export(model, label_map, mass_kg, static_duration_s, lab_settings, seeded("qtm", static_name),
+                               settings, source=f"{subject} {static_name}")
+    write_recording(out / f"{static_name}.c3d", static.recording, **static.writer_extras())
+    results[static_name] = static
+    for trial, onset_ms in zip(trials, onsets_ms, strict=True):
+        perturbation = None
+        if onset_ms is not None:
+            perturbation = PerturbationSettings(onset_ms / 1000.0, tuple(impedance), pulse_force_n, pulse_duration_s,
+                                                tuple(perturb_every_strides))
+        device_parameters = None if trial == no_device else DeviceParameters(**(device or {}))
+        sim_seed, file_seed = seeded("qtm", trial).spawn(2)
+        walk = simulate_walking_trial(duration_s, lab_settings, sim_seed, height_m, params, timing_cv, amplitude_cv,
+                                      device_parameters, perturbation)
+        exported = qtm_walking_export(model, walk, label_map, mass_kg, lab_settings, file_seed, settings,
+                                      f"{subject} {trial}")
+        write_recording(out / f"{trial}.c3d", exported.recording, **exported.writer_extras())
+        if walk.robot is not None:
+            write_robot_log_mat(out / f"{trial}.loper.mat", walk.robot, lab_settings.robot_rate_hz,
+                                ROBOT_LOG_MAT_VARIABLES)
+        log.info("%s %s: lab export in %s (first frame %d)", subject, trial, out, settings.first_frame)
+        results[trial] = (walk, exported)
+    return results
