@@ -22,12 +22,11 @@ from loper_analysis.model import build_lower_body_model, segment_parameters_from
 from loper_analysis.segments_from_model import segments_from_model
 from loper_analysis.steps.model import (
     read_segments,
-    segments,
     segments_from_model_file,
     write_segments,
 )
 
-DATA = Path(__file__).parent / "data" / "gait2392"
+DATA = Path(__file__).parents[1] / "examples" / "gait2392"
 GAIT2392 = DATA / "gait2392_simbody.osim"
 #: Known scale factors (uniform per body) of the scaled gait2392.
 FACTORS = {"pelvis": 1.05, "torso": 1.02, "femur": 1.10, "tibia": 0.95, "talus": 1.08, "calcn": 1.08, "toes": 1.08}
@@ -227,8 +226,6 @@ def test_generated_model_table_is_unchanged(tmp_path):
     path = write_model(model, tmp_path / "generated.osim")
     segments_from_model_file(path, b, "left")
     assert a.read_bytes() == b.read_bytes()
-    segments(path, tmp_path / "old_call.tsv", "left", 1.73, 64.9, True)
-    assert (tmp_path / "old_call.tsv").read_bytes() == a.read_bytes()
 
 
 def test_segment_table_file_of_a_user_model(scaled_gait2392, tmp_path):

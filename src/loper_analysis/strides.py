@@ -275,15 +275,18 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
     kept: the trial is flagged, not dropped silently). ``contacts``: the
     force-plate contact tables (:func:`loper_analysis.contacts.foot_contacts`,
     column ``flag``) of the same trials; when any trial has one, the column
-    ``n_contacts_flagged`` counts the contacts left out of the events
-    (trials whose events came from named GRF channels have an empty table).
+    ``n_contacts_flagged`` counts the contacts left out of the events for a
+    reason (two feet, no foot, off the plate, wrong belt, heel marker missing;
+    not the contacts cut by the start or end of the recording). Trials whose
+    events came from named GRF channels have an empty table.
     """
     rows = []
     with_contacts = contacts is not None and any(len(c) for c in contacts.values())
     for (subject, trial), table in tables.items():
         removed = table[table["removed"]]
         signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
-        why = {s: int(removed["reason"].fillna("").str.contains(f"{s}:").sum()) for s in signals}
+        reasons = removed["reason"].fillna("").astype(str)  # a column without any reason reads as float
+        why = {s: int(reasons.str.contains(f"{s}:").sum()) for s in signals}
         perturbed = table["perturbed"].astype(bool) if "perturbed" in table.columns else pd.Series(False, index=table.index)
         n_kept = int((~table["removed"] & ~perturbed).sum())
         rows.append({
@@ -295,7 +298,7 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
         })
         if with_contacts:
             flags = contacts[(subject, trial)]["flag"] if len(contacts[(subject, trial)]) else pd.Series([], dtype=str)
-            rows[-1]["n_contacts_flagged"] = int((flags != "ok").sum())
+            rows[-1]["n_contacts_flagged"] = int((~flags.isin(["ok", "incomplete"])).sum())
     return pd.DataFrame(rows)
 
 

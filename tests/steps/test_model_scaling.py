@@ -24,7 +24,7 @@ from loper_analysis.segments_from_model import segments_from_model
 from loper_analysis.steps.model import scale_with_setup
 
 ROOT = Path(__file__).resolve().parents[2]
-DATA = ROOT / "tests" / "data" / "gait2392"
+DATA = ROOT / "examples" / "gait2392"
 GENERIC = DATA / "gait2392_simbody.osim"
 MARKER_SET = DATA / "gait2392_Scale_MarkerSet.xml"
 SETUP = ROOT / "examples" / "gait2392" / "scale_setup.xml"

@@ -26,7 +26,7 @@ from loper_analysis.synthetic.lab_export import (
 )
 from loper_analysis.synthetic.trials import LabSettings
 
-GAIT2392 = Path(__file__).resolve().parents[1] / "data" / "gait2392"
+GAIT2392 = Path(__file__).resolve().parents[2] / "examples" / "gait2392"
 FIRST_FRAME = 1000
 LAB = LabSettings()
 
@@ -57,13 +57,13 @@ def session(tmp_path_factory):
 
 def test_session_files_and_labels(session):
     out, truth = session
-    assert sorted(p.name for p in out.iterdir()) == ["pert050-1.c3d", "pert050-1.loper.mat", "static.c3d",
-                                                     "walk-device.c3d", "walk-device.loper.mat"]
+    assert sorted(p.name for p in out.iterdir()) == ["pert050-1.c3d", "pert050-1.mat", "static.c3d",
+                                                     "walk-device.c3d", "walk-device.mat"]
     rec = read_c3d(out / "walk-device.c3d")
     labels = pd.read_csv(GAIT2392 / "qtm_label_map.tsv", sep="\t")
-    assert rec.marker_labels == [f"Subject:{lab}" for lab in labels["label"]]
+    assert rec.marker_labels == [f"Subject:{lab}" for lab in labels["label"]] + ["Subject:LBRA_P", "Subject:LBRA_D"]
     assert rec.first_frame == FIRST_FRAME and rec.time_s[0] == FIRST_FRAME / 128.0 == 7.8125
-    assert rec.markers_m.shape == (8 * 128, 39, 3)
+    assert rec.markers_m.shape == (8 * 128, 41, 3)
     for k in (1, 2):
         assert [f"FP{k}_{q}" for q in ("FX", "FY", "FZ", "MX", "MY", "MZ")] == \
             rec.analog_labels[12 * k - 6:12 * k]
@@ -124,7 +124,7 @@ def test_events_are_on_the_file_clock(session):
 def test_robot_log_maps_onto_mocap_frames_that_start_at_7_8_s(session):
     out, truth = session
     rec = read_c3d(out / "pert050-1.c3d")
-    log, _ = read_robot_log_mat(out / "pert050-1.loper.mat", ROBOT_LOG_MAT_VARIABLES, 1000.0)
+    log, _ = read_robot_log_mat(out / "pert050-1.mat", ROBOT_LOG_MAT_VARIABLES, 1000.0)
     walk, _ = truth["pert050-1"]
     pd.testing.assert_frame_equal(log, walk.robot, check_exact=True, check_dtype=False)
     frames = robot_log_on_mocap_frames(log, 1000.0, rec.analog(LAB.sync_channel), rec.analog_rate_hz, rec.time_s)
@@ -146,7 +146,7 @@ def test_ik_of_the_exported_markers_recovers_the_simulated_angles(session):
     rec = read_c3d(out / "walk-device.c3d")
     table = pd.read_csv(GAIT2392 / "qtm_label_map.tsv", sep="\t")
     to_marker = dict(zip(table["label"], table["marker"]))
-    labels = [to_marker[lab.removeprefix("Subject:")] for lab in rec.marker_labels]
+    labels = [to_marker.get(lab.removeprefix("Subject:"), lab.removeprefix("Subject:")) for lab in rec.marker_labels]
     frames = slice(128, 128 + 3 * 128, 4)  # 3 s at 32 Hz
     X = rotate_markers(rec.markers_m[frames], LAB.lab_to_model_rotation_deg)
     ik = inverse_kinematics(gait2392_model(), rec.time_s[frames], X, labels).frame()

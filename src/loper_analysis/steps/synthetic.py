@@ -86,17 +86,24 @@ def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, ma
                        static_duration_s: float = 2.0, lab: Mapping | None = None, device: Mapping | None = None,
                        export: Mapping | None = None, timing_cv: float = 0.03, amplitude_cv: float = 0.05,
                        pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1,
-                       perturb_every_strides: Sequence[int] = (3, 5)) -> dict:
+                       perturb_every_strides: Sequence[int] = (3, 5), brace_fraction: float = 0.8) -> dict:
     """One subject's session as the lab exports it (QTM C3D + MATLAB robot logs), into ``out_dir``.
 
     Writes ``{static_name}.c3d`` and per trial ``{trial}.c3d``, plus
-    ``{trial}.loper.mat`` for every trial but ``no_device``
+    ``{trial}.mat`` for every trial but ``no_device``
     (:func:`loper_analysis.synthetic.lab_export.qtm_walking_export`, variables
     :data:`~loper_analysis.synthetic.lab_export.ROBOT_LOG_MAT_VARIABLES`, time
     in s). The markers are those of ``label_map_tsv`` (columns ``label``,
     ``marker``) on the model ``model_osim`` with the marker set
-    ``marker_set_xml``; the kinematics are simulated for a subject of
-    ``height_m`` and ``mass_kg``. ``onsets_ms`` gives each trial's
+    ``marker_set_xml``, plus the two brace markers ``LBRA_P`` and ``LBRA_D``
+    on the left thigh (:func:`loper_analysis.synthetic.lab_export.add_brace_markers`,
+    centred at ``brace_fraction`` of the thigh length; their labels are their
+    names unless the map lists them); the kinematics are simulated for a
+    subject of ``height_m`` and ``mass_kg``, and the perturbation responses
+    with the swing-leg segment table of ``model_osim`` itself
+    (:func:`loper_analysis.segments_from_model.segments_from_model`, left leg,
+    rod attachment at ``brace_fraction``), so that a fit with the table of the
+    same model scaled by factors of 1 meets the exact truth. ``onsets_ms`` gives each trial's
     perturbation onset (ms after left toe-off; None: no pulses), answered with
     ``impedance`` (K_hip, D_hip, K_knee, D_knee, K_ankle, D_ankle in N·m/rad
     and N·m·s/rad). ``lab``, ``device`` and ``export`` are keyword arguments
@@ -120,10 +127,11 @@ def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, ma
     from ..io.osim import quiet_opensim, read_model
     from ..io.readers import read_tsv
     from ..io.robot_log_mat import write_robot_log_mat
-    from ..model import build_lower_body_model, segment_parameters_from_model
+    from ..segments_from_model import segments_from_model
     from ..synthetic.lab_export import (
         ROBOT_LOG_MAT_VARIABLES,
         QTMExportSettings,
+        add_brace_markers,
         qtm_static_export,
         qtm_walking_export,
     )
@@ -143,7 +151,9 @@ def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, ma
     model.updateMarkerSet(quiet_opensim().MarkerSet(str(marker_set_xml)))
     table = read_tsv(label_map_tsv, "label map", ("label", "marker"), dtype=str)
     label_map = dict(zip(table["marker"], table["label"]))
-    params = segment_parameters_from_model(build_lower_body_model(height_m, mass_kg))
+    params = segments_from_model(model, "l", attachment_fraction=brace_fraction, source=str(model_osim))
+    add_brace_markers(model, params.attachment_m)
+    label_map = {**label_map, **{m: m for m in ("LBRA_P", "LBRA_D") if m not in label_map}}
     results: dict = {}
     static = qtm_static_export(model, label_map, mass_kg, static_duration_s, lab_settings, seeded("qtm", static_name),
                                settings, source=f"{subject} {static_name}")
@@ -162,7 +172,7 @@ def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, ma
                                       f"{subject} {trial}")
         write_recording(out / f"{trial}.c3d", exported.recording, **exported.writer_extras())
         if walk.robot is not None:
-            write_robot_log_mat(out / f"{trial}.loper.mat", walk.robot, lab_settings.robot_rate_hz,
+            write_robot_log_mat(out / f"{trial}.mat", walk.robot, lab_settings.robot_rate_hz,
                                 ROBOT_LOG_MAT_VARIABLES)
         log.info("%s %s: lab export in %s (first frame %d)", subject, trial, out, settings.first_frame)
         results[trial] = (walk, exported)

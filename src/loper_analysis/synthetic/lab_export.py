@@ -49,6 +49,7 @@ __all__ = [
     "ROBOT_LOG_MAT_VARIABLES",
     "TREADMILL_CAL_MATRIX",
     "LabExport",
+    "add_brace_markers",
     "QTMExportSettings",
     "floor_offset_m",
     "gait2392_coordinates",
@@ -72,10 +73,11 @@ TREADMILL_CAL_MATRIX: tuple[tuple[float, ...], ...] = tuple(map(tuple, (
                                     [0, 1, 0, 0, -1, 1], [2, 0, -1, 1, 0, 0], [0, 0, 1, -1, 1, 0]]))
 ).tolist()))
 
-#: Variable names of the robot log in the lab's MATLAB export (our column -> variable).
+#: Variable names of the robot log in the lab's MATLAB export (our column -> variable; those of the default
+#: ``device.mat_column_map``).
 ROBOT_LOG_MAT_VARIABLES: dict[str, str] = {
-    "time_s": "t", "force_desired_n": "F_des", "force_measured_n": "F_meas", "motor_angle_rad": "theta_m",
-    "motor_velocity_rad_s": "omega_m", "sync_v": "sync_out", "perturbation": "pert_active", "safety_state": "safety",
+    "time_s": "t", "force_desired_n": "Fd", "force_measured_n": "Fm", "motor_angle_rad": "theta",
+    "motor_velocity_rad_s": "omega", "sync_v": "sync", "perturbation": "pert", "safety_state": "safety",
 }
 
 _CONTEXT = {"left": "Left", "right": "Right"}
@@ -142,6 +144,35 @@ class LabExport:
         """Keyword arguments of :func:`loper_analysis.io.c3d_writer.write_recording` beside the recording."""
         return {"force_platforms": self.force_platforms, "analog_scales": self.analog_scales,
                 "analog_offsets": self.analog_offsets, "events": self.events}
+
+
+def add_brace_markers(model, attachment_m: float, thigh_body: str = "femur_l", knee_body: str = "tibia_l",
+                      spacing_m: float = 0.08, anterior_m: float = 0.07, lateral_m: float = -0.06) -> None:
+    """Put the LOPER brace markers ``LBRA_P`` and ``LBRA_D`` on the left thigh of an ``opensim.Model`` (in place).
+
+    Both lie ``anterior_m`` in front of the hip-knee line (m), ``spacing_m``
+    apart along it and centred ``attachment_m`` (m) from the hip, and
+    ``lateral_m`` along the body's z axis (negative: lateral on the left leg),
+    as on the generated model (:data:`loper_analysis.model.BRACE_MARKERS`):
+    their line is parallel to the thigh and the projection of their midpoint
+    on it is the rod attachment. The knee is the origin of ``knee_body`` in
+    the default pose.
+    """
+    from ..io.osim import quiet_opensim
+
+    osim = quiet_opensim()
+    state = model.initSystem()
+    bodies = model.getBodySet()
+    thigh = bodies.get(thigh_body)
+    knee = bodies.get(knee_body).findStationLocationInAnotherFrame(state, osim.Vec3(0.0), thigh)
+    axis = np.array([knee.get(0), knee.get(1)])
+    u = axis / np.linalg.norm(axis)
+    n = np.array([-u[1], u[0]])  # the forward normal of the thigh axis (u points down)
+    for name, along in (("LBRA_P", attachment_m - spacing_m / 2), ("LBRA_D", attachment_m + spacing_m / 2)):
+        xy = along * u + anterior_m * n
+        model.addMarker(osim.Marker(name, thigh, osim.Vec3(float(xy[0]), float(xy[1]), float(lateral_m))))
+    model.finalizeConnections()
+    model.initSystem()
 
 
 def gait2392_coordinates(coordinates: pd.DataFrame, pelvis_ty_offset_m: float = 0.0) -> pd.DataFrame:
