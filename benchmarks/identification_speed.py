@@ -13,7 +13,11 @@ import numpy as np
 
 from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.identification import identify_impedance, prepare_window
-from loper_analysis.validation import ValidationSettings, impedance_grid, perturbed_trial
+from loper_analysis.validation import (
+    ValidationSettings,
+    impedance_grid,
+    perturbed_trial,
+)
 
 
 def main(n_cases: int = 40) -> None:

@@ -138,7 +138,7 @@ def test_segments_command_from_a_model(lab, tmp_path, capsys):
     table = read_segments(out)
     np.testing.assert_allclose(table.mass_kg, (9.3014, 3.7075, 1.5666), rtol=1e-9)  # femur; tibia; talus+calcn+toes
     assert subprocess.run(["loper-analysis", "segments", "--model", str(GAIT2392 / "gait2392_simbody.osim"),
-                           "--side", "right", "--out", str(tmp_path / "r.tsv")], capture_output=True).returncode == 0
+                           "--side", "right", "--out", str(tmp_path / "r.tsv")], capture_output=True, check=False).returncode == 0
     np.testing.assert_allclose(read_segments(tmp_path / "r.tsv").mass_kg, table.mass_kg, rtol=1e-12)
 
 

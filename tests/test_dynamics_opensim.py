@@ -27,7 +27,7 @@ import pytest
 
 osim = pytest.importorskip("opensim")
 
-from loper_analysis.dynamics import (  # noqa: E402
+from loper_analysis.dynamics import (
     SegmentParameters,
     attachment_jacobian,
     attachment_position,

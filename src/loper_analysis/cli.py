@@ -239,7 +239,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         args.func(args)
-    except Exception as exc:  # noqa: BLE001 - the command's contract: one line, exit code 2, no traceback
+    except Exception as exc:
         if args.traceback:
             raise
         print(f"loper-analysis {args.command}: {_one_line(exc)}", file=sys.stderr)

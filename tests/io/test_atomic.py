@@ -162,7 +162,7 @@ def test_c3d_writer_refuses_a_label_ezc3d_cannot_read_back_and_leaves_no_file(tm
 class _HalfWrittenModel:
     """An object that prints half a model file and then fails, as OpenSim does when the disk fills."""
 
-    def printToXML(self, path):  # noqa: N802 - OpenSim's method name
+    def printToXML(self, path):
         with open(path, "w") as fh:
             fh.write("<OpenSimDocument>")
         raise RuntimeError("disk full")

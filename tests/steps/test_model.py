@@ -14,7 +14,11 @@ from loper_analysis.model import (
     build_lower_body_model,
     segment_parameters_from_model,
 )
-from loper_analysis.steps.model import read_segments, scaled_model, segments_from_model_file
+from loper_analysis.steps.model import (
+    read_segments,
+    scaled_model,
+    segments_from_model_file,
+)
 
 
 @pytest.fixture(scope="module")

@@ -223,7 +223,7 @@ def _filter_coefficients(dev: DeviceParameters):
     Iv, Bv, Ka = dev.virtual_inertia_kg_m2, dev.virtual_damping_nms_per_rad, dev.lead_time_s
     b1, a1 = bilinear([1.0], [Iv, Bv], fs)  # e -> v_d
     b2, a2 = bilinear([Ka, 0.0], [Iv, Bv], fs)  # w -> v_d (lead)
-    pad = lambda v: np.pad(np.asarray(v, float), (0, 3 - len(v)))  # noqa: E731
+    pad = lambda v: np.pad(np.asarray(v, float), (0, 3 - len(v)))
     return np.stack([pad(bF), pad(aF), pad(b1), pad(a1), pad(b2), pad(a2)])
 
 
