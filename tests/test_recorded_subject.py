@@ -1,6 +1,7 @@
 """End to end on a recorded subject in the style of a real lab: QTM-like C3D files with treadmill force
 platforms, the lab's own marker names, gaps, a late first frame, MATLAB robot logs, and the study's gait2392
-scaled with a lab's ScaleTool setup, through the workflow to the impedance table.
+scaled with a lab's ScaleTool setup (the settings of ``examples/gait2392/config.yaml``), through the
+workflow to the impedance table.
 
 The raw files come from :func:`loper_analysis.steps.synthetic.lab_export_session` (a simulated subject
 whose markers are gait2392's, whose perturbation responses follow a known impedance with gait2392's
@@ -38,27 +39,17 @@ TRUE_IMPEDANCE = {"hip": (55.0, 3.5), "knee": (3.0, 0.1), "ankle": (8.0, 0.3)}  
 TARGETS = ("results/tables/impedance.tsv", "results/strides/summary.tsv", "results/grf/R01/pert050-1.grf.mot")
 
 
-def _gait2392_config() -> dict:
-    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    cfg["device"]["subject"] = "R01"
-    cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
-    cfg["opensim"].update(generic_model=str(GENERIC), scale_setup=str(EXAMPLE / "scale_setup.xml"))
-    cfg["opensim"]["coordinate_map"] = {
-        "pelvis_x": {"coordinate": "pelvis_tx", "sign": 1}, "pelvis_angle": {"coordinate": "pelvis_tilt", "sign": -1},
-        **{f"{joint}_{side}": {"coordinate": f"{coordinate}_{side[0]}", "sign": sign} for side in ("left", "right")
-           for joint, coordinate, sign in (("hip", "hip_flexion", 1), ("knee", "knee_angle", -1),
-                                           ("ankle", "ankle_angle", 1))},
-    }
-    cfg["markers"]["label_map"] = str(EXAMPLE / "qtm_label_map.tsv")
-    cfg["events"].update(foot_markers={"left": "L.Heel", "right": "R.Heel"}, plate_sides={"left": 1, "right": 2})
-    return cfg
+def _test_config() -> dict:
+    """What this test sets on top of the default config and the gait2392 example: one subject, one onset."""
+    return {"subjects": "config/subjects.tsv", "device": {"subject": "R01"},
+            "trials": {"perturbation_onsets_ms": [50], "perturbation_repeats": 1}}
 
 
 @pytest.fixture(scope="module")
 def lab_run(tmp_path_factory):
     """The workflow on one recorded subject: its session (walking with the device, one perturbation trial)."""
     work = tmp_path_factory.mktemp("lab")
-    for item in ("Snakefile", "workflow", "config"):
+    for item in ("Snakefile", "workflow", "config", "examples"):
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
     truth = lab_export_session(work / "data/raw/R01", "R01", GENERIC, EXAMPLE / "gait2392_Scale_MarkerSet.xml",
@@ -67,8 +58,9 @@ def lab_run(tmp_path_factory):
                                impedance=[v for j in ("hip", "knee", "ankle") for v in TRUE_IMPEDANCE[j]],
                                perturb_every_strides=(2, 3))
     (work / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.80\t{MASS_KG}\n")
-    (work / "config/config.yaml").write_text(yaml.safe_dump(_gait2392_config(), sort_keys=False))
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *TARGETS], cwd=work,
+    (work / "config/test.yaml").write_text(yaml.safe_dump(_test_config(), sort_keys=False))
+    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *TARGETS, "--configfile",
+                          "examples/gait2392/config.yaml", "config/test.yaml"], cwd=work,
                          capture_output=True, text=True, timeout=900, check=False)
     assert res.returncode == 0, res.stderr[-3000:]
     return work, truth
