@@ -369,3 +369,10 @@ def test_walking5_contacts_feet_and_events(walking5):
     assert gait["sample"].tolist() == [4767, 5954]
     # with a shorter reach no heel explains plate 1 any more
     assert foot_contacts(plates, tm, heels, reach_m=0.10)["flag"].tolist() == ["no_foot", "ok"]
+
+
+def test_count_flagged_leaves_out_contacts_cut_by_the_recording():
+    from loper_analysis.contacts import count_flagged
+
+    assert count_flagged(["ok", "incomplete", "two_feet", "no_foot", "ok", "wrong_belt"]) == 3
+    assert count_flagged(pd.Series([], dtype=object)) == 0

@@ -35,6 +35,7 @@ __all__ = [
     "plate_contacts",
     "foot_contacts",
     "contact_events",
+    "count_flagged",
 ]
 
 logger = logging.getLogger(__name__)
@@ -353,6 +354,17 @@ def _belt_sides(plate_sides: Mapping[str, int] | None, numbers: list[int], sourc
             raise LoperInputError(f"{where(source)}plate_sides gives plate {n} to both sides")
         belt[n] = s
     return belt
+
+
+def count_flagged(flags) -> int:
+    """Number of contacts left out for a reason: flags other than ``ok`` and ``incomplete``.
+
+    ``flags`` is the ``flag`` column of a contact table (:data:`CONTACT_COLUMNS`);
+    contacts cut by the start or end of the recording are not counted (a
+    trial's first and last periods never give events).
+    """
+    flags = pd.Series(flags, dtype=object)
+    return int((~flags.isin(["ok", "incomplete"])).sum())
 
 
 def contact_events(contacts: pd.DataFrame) -> pd.DataFrame:

@@ -297,8 +297,9 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
             "status": "ok" if n_kept >= min_valid else "too_few_strides",
         })
         if with_contacts:
-            flags = contacts[(subject, trial)]["flag"] if len(contacts[(subject, trial)]) else pd.Series([], dtype=str)
-            rows[-1]["n_contacts_flagged"] = int((~flags.isin(["ok", "incomplete"])).sum())
+            from .contacts import count_flagged
+
+            rows[-1]["n_contacts_flagged"] = count_flagged(contacts[(subject, trial)]["flag"])
     return pd.DataFrame(rows)
 
 

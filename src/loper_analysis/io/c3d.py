@@ -96,6 +96,9 @@ class C3DRecording:
     events : pandas.DataFrame
         The file's events, columns ``context``, ``label`` (str) and
         ``time_s`` (s, on the clock of :attr:`time_s`); empty by default.
+    n_force_platforms : int
+        ``FORCE_PLATFORM:USED`` (0 without platforms); the platforms
+        themselves are read by :mod:`loper_analysis.io.force_platforms`.
     """
 
     source: str
@@ -108,6 +111,7 @@ class C3DRecording:
     analogs: np.ndarray | None = None
     analog_rate_hz: float | None = None
     events: pd.DataFrame = field(default_factory=lambda: _no_events())
+    n_force_platforms: int = 0
 
     def __post_init__(self) -> None:
         self.markers_m = np.asarray(self.markers_m, dtype=float)
@@ -298,6 +302,15 @@ def _analogs_from(c3d, point_rate_hz: float, source: str) -> tuple[float, int, l
     return rate, ratio, labels, units, analogs[0].T.copy()
 
 
+def _force_platforms_used(params) -> int:
+    """``FORCE_PLATFORM:USED`` (0 when the group or the parameter is absent)."""
+    used = param_value(params, "FORCE_PLATFORM", "USED")
+    try:
+        return max(int(np.asarray(used, dtype=float).ravel()[0]), 0)
+    except (TypeError, ValueError, IndexError):
+        return 0
+
+
 # ---------------------------------------------------------------- reader
 
 
@@ -354,6 +367,7 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         analogs=samples if n_channels else None,
         analog_rate_hz=analog_rate,
         events=read_events(params, source),
+        n_force_platforms=_force_platforms_used(params),
     )
 
 

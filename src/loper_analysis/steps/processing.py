@@ -113,17 +113,20 @@ def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str
     ``plate_sides`` {side: plate number} is a check); flagged contacts give no
     heel strike or toe-off but a ``flagged_start``/``flagged_end`` pair that
     keeps strides from spanning them. The contact table goes to
-    ``contacts_out`` when given. ``attrs["n_contacts_flagged"]`` counts them.
+    ``contacts_out`` when given. ``attrs["n_contacts_flagged"]`` counts them
+    (:func:`loper_analysis.contacts.count_flagged`).
 
     A file without platforms: the vertical force of each belt from the
     analog channel ``grf_channels[side]`` (N), as recorded; ``cutoff_hz``
     low-passes it first (zero-phase Butterworth; None thresholds the raw
     force: a 40 Hz filter moves a 20 N toe-off threshold by about 4.5 ms).
     """
-    from ..io.force_platforms import count_force_platforms
+    from ..contacts import count_flagged
+    from ..io.c3d import read_c3d
 
-    if count_force_platforms(c3d_path):
-        table, contacts = _plate_events(c3d_path, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n,
+    rec = read_c3d(c3d_path)
+    if rec.n_force_platforms:
+        table, contacts = _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n,
                                         threshold_off_n, min_stance_s, min_swing_s, band_n, max_rest_n)
         if contacts_out is not None:
             write_tsv(contacts, contacts_out)
@@ -134,26 +137,23 @@ def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str
                 f"{c3d_path}: no force platforms (FORCE_PLATFORM:USED is 0 or absent) and no GRF channel configured "
                 "(events.grf_channels); cannot detect gait events"
             )
-        table = _channel_events(c3d_path, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
+        table = _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
                                 cutoff_hz, order)
         if contacts_out is not None:
             write_tsv(pd.DataFrame(columns=["plate", "contact", "side", "flag"]), contacts_out)
     write_tsv(table, out_tsv)
-    from ..events import flagged_contacts
-
-    table.attrs["n_contacts_flagged"] = flagged_contacts(table)
+    table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"]) if rec.n_force_platforms else 0
     log.info("events per side and kind:\n%s", table.groupby(["side", "event"]).size().to_string())
     return table
 
 
-def _channel_events(c3d_path, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz,
+def _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz,
                     order) -> pd.DataFrame:
-    """Events from one named vertical-GRF analog channel per belt."""
+    """Events from one named vertical-GRF analog channel per belt of a read C3D."""
     from ..events import gait_events
     from ..filtering import lowpass
-    from ..io.c3d import read_c3d
 
-    rec = read_c3d(c3d_path)
+    c3d_path = rec.source
     tables = []
     for side in SIDES:
         fz = rec.analog(grf_channels[side])
@@ -164,19 +164,17 @@ def _channel_events(c3d_path, grf_channels, threshold_on_n, threshold_off_n, min
     return pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
 
 
-def _plate_events(c3d_path, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n, threshold_off_n,
+def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n, threshold_off_n,
                   min_stance_s, min_swing_s, band_n, max_rest_n) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Events and the contact table from the force platforms and the heel markers."""
+    """Events and the contact table from the force platforms and the heel markers of a read C3D."""
     from ..contacts import PlateForce, contact_events, foot_contacts
-    from ..io.c3d import read_c3d
     from ..marker_names import model_marker_names, require_model_markers
     from ..markers import rotate_markers
     from .grf import plate_vertical_loads
 
-    source = str(c3d_path)
+    source = c3d_path = rec.source
     if not foot_markers:
         raise LoperInputError(f"{source}: force platforms need the heel marker of each foot (events.foot_markers)")
-    rec = read_c3d(c3d_path)
     names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
     require_model_markers(names, [foot_markers[s] for s in SIDES], source, rec.marker_labels)
     loads = plate_vertical_loads(c3d_path, rotation_deg, band_n, max_rest_n)
