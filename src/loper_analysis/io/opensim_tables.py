@@ -24,13 +24,7 @@ MOT/STO (:func:`write_mot`, :func:`read_mot`)
     printed in degrees when ``inDegrees=yes``. The reader honours the
     header and refuses a file without ``inDegrees``.
 
-External loads (:func:`write_external_loads_mot`, :func:`write_external_loads_xml`)
-    The ground-reaction table (force in N, point in m, torque in N·m, all
-    in ground) is written with ``STOFileAdapter`` (``inDegrees=no``), which
-    OpenSim's ``Storage``, ``ExternalLoads`` and ``ExternalForce`` read;
-    the ExternalLoads ``.xml`` names one ``ExternalForce`` per plate with
-    the identifiers ``{n}_ground_force_v``, ``{n}_ground_force_p`` and
-    ``{n}_ground_torque_``, force and point expressed in ground.
+External loads: :mod:`loper_analysis.io.external_loads`.
 
 Vectors are handed to OpenSim as plain Python lists, never as
 ``opensim.StdVector*`` objects: those stop working in a process where ezc3d's
@@ -43,7 +37,7 @@ the atomic writer (:func:`loper_analysis.io.atomic.staged`). Every problem raise
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -57,12 +51,10 @@ from .osim import quiet_opensim
 
 __all__ = [
     "TRANSLATION_SUFFIXES",
-    "write_trc",
     "read_markers",
-    "write_mot",
     "read_mot",
-    "write_external_loads_mot",
-    "write_external_loads_xml",
+    "write_mot",
+    "write_trc",
 ]
 
 #: Coordinate-name endings of translations (m), which are never converted to degrees.
@@ -346,109 +338,3 @@ def read_mot(path: str | os.PathLike) -> pd.DataFrame:
         col = values[:, j]
         out[name] = np.radians(col) if flag == "yes" and not _is_translation(name) else col
     return pd.DataFrame(out)
-
-
-# ---------------------------------------------------------------- external loads
-
-
-def write_external_loads_mot(path: str | os.PathLike, frame: pd.DataFrame) -> Path:
-    """Write a ground-reaction table to an OpenSim external-loads ``.mot``, atomically; returns ``path``.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Target ``.mot`` or ``.sto`` file (a missing directory is created).
-    frame : pandas.DataFrame
-        Column ``time_s`` (s, finite, strictly increasing, >= 1 row) and the
-        load columns, written as they are (no unit conversion): force in N,
-        point in m, torque in N·m, e.g. ``1_ground_force_vx`` ...
-        ``1_ground_torque_z`` (:func:`loper_analysis.ground_reaction.external_loads_table`).
-        The file's time column is named ``time``; NaN is written as ``nan``.
-
-    Raises
-    ------
-    LoperInputError
-        Wrong suffix, no ``time_s`` or no load column, bad names,
-        non-numeric or infinite values, bad times, a failed write.
-    """
-    path = Path(path)
-    source = str(path)
-    _check_mot_suffix(path)
-    if not isinstance(frame, pd.DataFrame) or "time_s" not in frame.columns:
-        raise LoperInputError(f"{source}: frame must be a DataFrame with a 'time_s' column")
-    names = unique_names([c for c in frame.columns if c != "time_s"], "load columns", source, allow_whitespace=False)
-    if not names or "time" in names:
-        raise LoperInputError(f"{source}: frame needs load column(s) besides time_s (and none named 'time')")
-    t = time_vector(frame["time_s"].to_numpy(dtype=float), source, min_count=1, item="row")
-    for name in names:
-        if not pd.api.types.is_numeric_dtype(frame[name].dtype) or pd.api.types.is_bool_dtype(frame[name].dtype):
-            raise LoperInputError(f"{source}: column '{name}' is not numeric ({frame[name].dtype})")
-    values = frame[names].to_numpy(dtype=float)
-    if np.any(np.isinf(values)):
-        row, col = np.argwhere(np.isinf(values))[0]
-        raise LoperInputError(f"{source}: column '{names[col]}' is infinite at row {int(row)}")
-    osim = quiet_opensim()
-    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(values), names)
-    table.addTableMetaDataString("header", "ExternalLoads")
-    table.addTableMetaDataString("inDegrees", "no")
-    with staged(path, "external-loads file") as tmp:
-        try:
-            osim.STOFileAdapter().write(table, str(tmp))
-        except Exception as exc:
-            raise LoperInputError(f"{source}: OpenSim could not write the external-loads file: {exc}") from exc
-    return path
-
-
-def write_external_loads_xml(path: str | os.PathLike, bodies: Mapping[int, str], datafile: str,
-                             name: str = "ground_reactions") -> Path:
-    """Write an OpenSim ``ExternalLoads`` file applying plate n's loads to a body, atomically; returns ``path``.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Target ``.xml`` file.
-    bodies : mapping of int to str
-        Plate number (1-based) -> name of the model body the load acts on
-        (e.g. ``{1: "calcn_r", 2: "calcn_l"}``); plates left out are not applied.
-    datafile : str
-        The external-loads ``.mot``, as OpenSim should find it (relative
-        paths are relative to the ``.xml``'s directory).
-    name : str
-        Name of the ExternalLoads object.
-
-    Raises
-    ------
-    LoperInputError
-        No plates, a plate number < 1, an empty or blank body name, a failed write.
-    """
-    path = Path(path)
-    source = str(path)
-    if not bodies:
-        raise LoperInputError(f"{source}: bodies must map at least one plate number to a body")
-    osim = quiet_opensim()
-    loads = osim.ExternalLoads()
-    loads.setName(name)
-    loads.setDataFileName(str(datafile))
-    for number, body in sorted(bodies.items()):
-        if isinstance(number, bool) or not isinstance(number, (int, np.integer)) or number < 1:
-            raise LoperInputError(f"{source}: plate numbers must be integers >= 1, got {number!r}")
-        if not isinstance(body, str) or not body.strip() or body != body.strip():
-            raise LoperInputError(f"{source}: plate {number}: body name must be a non-empty name, got {body!r}")
-        force = osim.ExternalForce()
-        force.setName(f"plate{int(number)}")
-        force.set_applied_to_body(body)
-        force.set_force_expressed_in_body("ground")
-        force.set_point_expressed_in_body("ground")
-        force.set_force_identifier(f"{int(number)}_ground_force_v")
-        force.set_point_identifier(f"{int(number)}_ground_force_p")
-        force.set_torque_identifier(f"{int(number)}_ground_torque_")
-        force.set_data_source_name(str(datafile))
-        loads.cloneAndAppend(force)
-    with staged(path, "external-loads setup") as tmp:
-        try:
-            ok = loads.printToXML(str(tmp))
-        except Exception as exc:
-            raise LoperInputError(f"{source}: OpenSim could not write the external-loads setup: {exc}") from exc
-        if ok is False:
-            raise LoperInputError(f"{source}: OpenSim could not write the external-loads setup")
-    return path

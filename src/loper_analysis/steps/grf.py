@@ -3,7 +3,7 @@
 C3D (ezc3d's platform extraction, :mod:`loper_analysis.io.force_platforms`)
 -> resting level removed, COP, free moment, lab -> model rotation
 (:mod:`loper_analysis.ground_reaction`) -> ``.mot`` at the analog rate
-(:func:`loper_analysis.io.opensim_tables.write_external_loads_mot`), columns
+(:func:`loper_analysis.io.external_loads.write_external_loads_mot`), columns
 ``{n}_ground_force_v{x,y,z}`` (N), ``{n}_ground_force_p{x,y,z}`` (m),
 ``{n}_ground_torque_{x,y,z}`` (N·m) for plate n = 1, 2, ...
 """
@@ -47,7 +47,7 @@ def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (
     (``time_s`` plus nine columns per plate).
     """
     from ..ground_reaction import external_loads_table
-    from ..io.opensim_tables import write_external_loads_mot, write_external_loads_xml
+    from ..io.external_loads import write_external_loads_mot, write_external_loads_xml
 
     loads = _plate_loads(c3d_path, threshold_n, band_n, max_rest_n)
     table = external_loads_table(loads, rotation_deg)
