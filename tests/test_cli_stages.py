@@ -18,10 +18,11 @@ import pytest
 from loper_analysis.cli import main
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
-from loper_analysis.io.osim import read_marker_set, read_model
+from loper_analysis.io.osim import read_model
 from loper_analysis.kinematics import marker_positions
 from loper_analysis.segments_from_model import segments_from_model
 from loper_analysis.steps.model import read_segments, scale_with_setup
+from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[1]
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"
@@ -93,21 +94,9 @@ def test_events_command_on_walking5(tmp_path, capsys):
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
     """gait2392 scaled with known factors to 80 kg; its markers in the default pose as a static TRC and C3D (Z up)."""
-    import opensim as osim
-
     d = tmp_path_factory.mktemp("scale")
-    model = read_model(GAIT2392 / "gait2392_simbody.osim")
-    model.updateMarkerSet(read_marker_set(GAIT2392 / "gait2392_Scale_MarkerSet.xml"))
-    state = model.initSystem()
-    scales = osim.ScaleSet()
-    for body in ("pelvis", "torso", *(f"{b}_{s}" for b in ("femur", "tibia", "talus", "calcn", "toes") for s in "rl")):
-        s = osim.Scale()
-        s.setSegmentName(body)
-        factor = {"femur": 1.10, "tibia": 0.95}.get(body[:5], 1.05)
-        s.setScaleFactors(osim.Vec3(factor, factor, factor))
-        s.setApply(True)
-        scales.cloneAndAppend(s)
-    model.scale(state, scales, True, 80.0)
+    factors = {"pelvis": 1.05, "torso": 1.05, "femur": 1.10, "tibia": 0.95, "talus": 1.05, "calcn": 1.05, "toes": 1.05}
+    model = scaled_gait2392(factors, 80.0, markers=True)
     markers = model.getMarkerSet()
     labels = [markers.get(i).getName() for i in range(markers.getSize())]
     X = np.repeat(marker_positions(model, {}, labels), 20, axis=0)

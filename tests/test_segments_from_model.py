@@ -25,6 +25,7 @@ from loper_analysis.steps.model import (
     segments_from_model_file,
     write_segments,
 )
+from tests.gait2392_models import scaled_gait2392
 
 DATA = Path(__file__).parents[1] / "examples" / "gait2392"
 GAIT2392 = DATA / "gait2392_simbody.osim"
@@ -34,20 +35,9 @@ MASS_KG = 80.0
 
 
 @pytest.fixture(scope="module")
-def scaled_gait2392(tmp_path_factory):
+def scaled_model_file(tmp_path_factory):
     """gait2392 scaled with OpenSim's Model.scale by :data:`FACTORS` to 80 kg, printed to a file."""
-    osim = quiet_opensim()
-    model = read_model(GAIT2392)
-    state = model.initSystem()
-    scales = osim.ScaleSet()
-    for body, f in FACTORS.items():
-        for name in ([body] if body in ("pelvis", "torso") else [f"{body}_r", f"{body}_l"]):
-            s = osim.Scale()
-            s.setSegmentName(name)
-            s.setScaleFactors(osim.Vec3(f, f, f))
-            s.setApply(True)
-            scales.cloneAndAppend(s)
-    model.scale(state, scales, True, MASS_KG)
+    model = scaled_gait2392(FACTORS, MASS_KG)
     return write_model(model, tmp_path_factory.mktemp("scaled") / "gait2392_scaled.osim")
 
 
@@ -179,9 +169,9 @@ def hand_segment_table(path: Path, side: str = "l", attachment_fraction: float =
 
 
 @pytest.mark.parametrize("side", ["l", "r"])
-def test_scaled_gait2392_table_equals_the_hand_computation_from_the_xml(scaled_gait2392, side):
-    p = segments_from_model(read_model(scaled_gait2392), side)
-    ref = hand_segment_table(scaled_gait2392, side)
+def test_scaled_gait2392_table_equals_the_hand_computation_from_the_xml(scaled_model_file, side):
+    p = segments_from_model(read_model(scaled_model_file), side)
+    ref = hand_segment_table(scaled_model_file, side)
     for name, value in ref.items():
         np.testing.assert_allclose(getattr(p, name), value, rtol=1e-6, atol=1e-12, err_msg=name)
     # the scaling shows: thigh length and mass of the 80 kg subject against the generic model's
@@ -228,10 +218,10 @@ def test_generated_model_table_is_unchanged(tmp_path):
     assert a.read_bytes() == b.read_bytes()
 
 
-def test_segment_table_file_of_a_user_model(scaled_gait2392, tmp_path):
+def test_segment_table_file_of_a_user_model(scaled_model_file, tmp_path):
     out = tmp_path / "segments.tsv"
-    returned = segments_from_model_file(scaled_gait2392, out, "right", attachment_fraction=0.7)
-    ref = hand_segment_table(scaled_gait2392, "r", 0.7)
+    returned = segments_from_model_file(scaled_model_file, out, "right", attachment_fraction=0.7)
+    ref = hand_segment_table(scaled_model_file, "r", 0.7)
     np.testing.assert_allclose(read_segments(out).packed, returned.packed, rtol=1e-9)
     np.testing.assert_allclose(returned.attachment_m, ref["attachment_m"], rtol=1e-9)
 

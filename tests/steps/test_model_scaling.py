@@ -18,10 +18,11 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.opensim_tables import read_markers, write_trc
-from loper_analysis.io.osim import quiet_opensim, read_marker_set, read_model
+from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.kinematics import marker_positions
 from loper_analysis.segments_from_model import segments_from_model
 from loper_analysis.steps.model import scale_with_setup
+from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "examples" / "gait2392"
@@ -33,29 +34,13 @@ MASS_KG = 80.0
 GENERIC_MASS_KG = 75.1646
 
 
-def _bodies(name: str) -> list[str]:
-    return [name] if name in ("pelvis", "torso") else [f"{name}_r", f"{name}_l"]
-
-
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
     """A lab folder: the setup, its marker set beside it, and a static trial of a subject of known proportions."""
     d = tmp_path_factory.mktemp("lab")
     shutil.copy(SETUP, d / "scale_setup.xml")
     shutil.copy(MARKER_SET, d / MARKER_SET.name)
-    osim = quiet_opensim()
-    model = read_model(GENERIC)
-    model.updateMarkerSet(read_marker_set(MARKER_SET))
-    state = model.initSystem()
-    scales = osim.ScaleSet()
-    for body, f in FACTORS.items():
-        for name in _bodies(body):
-            s = osim.Scale()
-            s.setSegmentName(name)
-            s.setScaleFactors(osim.Vec3(f, f, f))
-            s.setApply(True)
-            scales.cloneAndAppend(s)
-    model.scale(state, scales, True, MASS_KG)
+    model = scaled_gait2392(FACTORS, MASS_KG, markers=True)
     markers = model.getMarkerSet()
     labels = [markers.get(i).getName() for i in range(markers.getSize())]
     X = np.repeat(marker_positions(model, {}, labels), 10, axis=0)

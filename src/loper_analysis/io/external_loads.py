@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..checks import time_vector, unique_names
 from ..errors import LoperInputError
 from .atomic import staged
+from .opensim_tables import storage_columns, write_storage
 from .osim import quiet_opensim
 
 __all__ = ["write_external_loads_mot", "write_external_loads_xml"]
@@ -49,32 +49,8 @@ def write_external_loads_mot(path: str | os.PathLike, frame: pd.DataFrame) -> Pa
         non-numeric or infinite values, bad times, a failed write.
     """
     path = Path(path)
-    source = str(path)
-    if path.suffix.lower() not in (".mot", ".sto"):
-        raise LoperInputError(f"{source}: an external-loads file must end in .mot or .sto")
-    if not isinstance(frame, pd.DataFrame) or "time_s" not in frame.columns:
-        raise LoperInputError(f"{source}: frame must be a DataFrame with a 'time_s' column")
-    names = unique_names([c for c in frame.columns if c != "time_s"], "load columns", source, allow_whitespace=False)
-    if not names or "time" in names:
-        raise LoperInputError(f"{source}: frame needs load column(s) besides time_s (and none named 'time')")
-    t = time_vector(frame["time_s"].to_numpy(dtype=float), source, min_count=1, item="row")
-    for name in names:
-        if not pd.api.types.is_numeric_dtype(frame[name].dtype) or pd.api.types.is_bool_dtype(frame[name].dtype):
-            raise LoperInputError(f"{source}: column '{name}' is not numeric ({frame[name].dtype})")
-    values = frame[names].to_numpy(dtype=float)
-    if np.any(np.isinf(values)):
-        row, col = np.argwhere(np.isinf(values))[0]
-        raise LoperInputError(f"{source}: column '{names[col]}' is infinite at row {int(row)}")
-    osim = quiet_opensim()
-    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(values), names)
-    table.addTableMetaDataString("header", "ExternalLoads")
-    table.addTableMetaDataString("inDegrees", "no")
-    with staged(path, "external-loads file") as tmp:
-        try:
-            osim.STOFileAdapter().write(table, str(tmp))
-        except Exception as exc:
-            raise LoperInputError(f"{source}: OpenSim could not write the external-loads file: {exc}") from exc
-    return path
+    t, names, values = storage_columns(path, frame, "load columns")
+    return write_storage(path, t, values, names, "ExternalLoads", False, "external-loads file")
 
 
 def write_external_loads_xml(path: str | os.PathLike, bodies: Mapping[int, str], datafile: str,

@@ -271,13 +271,32 @@ def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = T
         non-numeric or infinite values, bad times, a failed write.
     """
     path = Path(path)
+    t, names, values = storage_columns(path, frame, "coordinate columns")
+    for j, name in enumerate(names):
+        if in_degrees and not _is_translation(name):
+            values[:, j] = np.degrees(values[:, j])
+    return write_storage(path, t, values, names, "Coordinates", in_degrees, "motion file")
+
+
+def storage_columns(path: Path, frame: pd.DataFrame, what: str) -> tuple[np.ndarray, list[str], np.ndarray]:
+    """Checked times (n,), column names and values (n, m) of a table for a ``.mot``/``.sto`` file.
+
+    ``frame`` has ``time_s`` (s, finite, strictly increasing, >= 1 row) and at
+    least one numeric, finite-or-NaN column (``what`` names them in messages).
+
+    Raises
+    ------
+    LoperInputError
+        Wrong suffix, no ``time_s`` or no other column, bad names, non-numeric
+        or infinite values, bad times; the message names ``path``.
+    """
     source = str(path)
     _check_mot_suffix(path)
     if not isinstance(frame, pd.DataFrame) or "time_s" not in frame.columns:
         raise LoperInputError(f"{source}: frame must be a DataFrame with a 'time_s' column")
-    names = unique_names([c for c in frame.columns if c != "time_s"], "coordinate columns", source, allow_whitespace=False)
+    names = unique_names([c for c in frame.columns if c != "time_s"], what, source, allow_whitespace=False)
     if not names or "time" in names:
-        raise LoperInputError(f"{source}: frame needs coordinate column(s) besides time_s (and none named 'time')")
+        raise LoperInputError(f"{source}: frame needs {what.split()[0]} column(s) besides time_s (and none named 'time')")
     t = time_vector(frame["time_s"].to_numpy(dtype=float), source, min_count=1, item="row")
     values = np.empty((t.size, len(names)))
     for j, name in enumerate(names):
@@ -286,16 +305,27 @@ def write_mot(path: str | os.PathLike, frame: pd.DataFrame, in_degrees: bool = T
         col = frame[name].to_numpy(dtype=float)
         if np.any(np.isinf(col)):
             raise LoperInputError(f"{source}: column '{name}' is infinite at row {int(np.flatnonzero(np.isinf(col))[0])}")
-        values[:, j] = col if (_is_translation(name) or not in_degrees) else np.degrees(col)
+        values[:, j] = col
+    return t, names, values
+
+
+def write_storage(path: Path, time_s: np.ndarray, values: np.ndarray, names: list[str], header: str,
+                  in_degrees: bool, what: str) -> Path:
+    """Write checked columns (:func:`storage_columns`) with OpenSim's ``STOFileAdapter``, atomically.
+
+    ``header`` is the file's name line (``Coordinates``, ``ExternalLoads``);
+    ``inDegrees`` is declared as ``in_degrees`` (the values are written as
+    given); ``what`` names the file in messages.
+    """
     osim = quiet_opensim()
-    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(values), names)
-    table.addTableMetaDataString("header", "Coordinates")
+    table = osim.TimeSeriesTable(time_s.tolist(), osim.Matrix.createFromMat(values), names)
+    table.addTableMetaDataString("header", header)
     table.addTableMetaDataString("inDegrees", "yes" if in_degrees else "no")
-    with staged(path, "motion file") as tmp:
+    with staged(path, what) as tmp:
         try:
             osim.STOFileAdapter().write(table, str(tmp))
         except Exception as exc:
-            raise LoperInputError(f"{source}: OpenSim could not write the motion file: {exc}") from exc
+            raise LoperInputError(f"{path}: OpenSim could not write the {what}: {exc}") from exc
     return path
 
 
