@@ -101,25 +101,6 @@ def test_plate_load_inverts_plate_channels():
         np.testing.assert_allclose(load["free_moment_nm"], free, atol=1e-9)
 
 
-def test_plates_read_back_by_opensim(tmp_path):
-    osim = pytest.importorskip("opensim")
-    if not hasattr(osim, "C3DFileAdapter"):
-        pytest.skip("this OpenSim build has no C3D support (C3DFileAdapter)")
-    path = tmp_path / "plates.c3d"
-    force, cops, _ = plate_file(path, first_frame=250)
-    adapter = osim.C3DFileAdapter()
-    adapter.setLocationForForceExpression(1)  # centre of pressure
-    tables = adapter.read(str(path))
-    forces = adapter.getForcesTable(tables)
-    time = np.array(forces.getIndependentColumn())
-    np.testing.assert_allclose(time[:3], 2.5 + np.arange(3) / (RATE * RATIO), atol=1e-9)
-    for k, cop in enumerate(cops, start=1):
-        f = np.array([forces.getDependentColumn(f"f{k}")[i].to_numpy() for i in range(forces.getNumRows())])
-        p = np.array([forces.getDependentColumn(f"p{k}")[i].to_numpy() for i in range(forces.getNumRows())])
-        np.testing.assert_allclose(f, force, atol=1e-3)
-        np.testing.assert_allclose(p, 1000.0 * cop, atol=0.01)  # mm, as in the file
-
-
 def test_first_frame_sets_header_and_times(tmp_path):
     path = tmp_path / "late.c3d"
     plate_file(path, first_frame=1000)

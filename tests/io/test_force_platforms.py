@@ -59,21 +59,6 @@ def test_walking5_equals_opensims_reading(walking5):
     assert walking5[0].force_n[4100, 2] == pytest.approx(480.3877, abs=1e-3)
 
 
-def test_walking5_equals_opensim_c3d_adapter(walking5):
-    osim = pytest.importorskip("opensim")
-    if not hasattr(osim, "C3DFileAdapter"):
-        pytest.skip("this OpenSim build has no C3DFileAdapter")
-    adapter = osim.C3DFileAdapter()
-    adapter.setLocationForForceExpression(0)  # OriginOfForcePlate
-    tables = adapter.read(str(WALKING5))
-    forces = adapter.getForcesTable(tables).flatten()
-    labels = list(forces.getColumnLabels())
-    values = np.array(forces.getMatrix().to_numpy(), dtype=float).reshape(forces.getNumRows(), len(labels))
-    for p in walking5:
-        cols = [labels.index(f"f{p.number}_{a}") for a in (1, 2, 3)]
-        assert np.max(np.abs(values[:, cols] - p.force_n)) < 0.05
-
-
 LOAD_N = np.array([30.0, -20.0, 700.0])
 POINT_MM = np.array([380.0, 150.0, 0.0])
 FREE_NMM = 1500.0
