@@ -68,6 +68,7 @@ def test_markers_command_on_walking5_equals_opensims_reading(tmp_path, capsys):
     code = main(["markers", str(WALKING5), "--out", str(out), "--rotate-deg", "0", "0", "0", "--cutoff-hz", "0",
                  "--max-gap-frames", "0"])
     assert code == 0, capsys.readouterr()
+    assert "40 markers, 1103 frames; 0 gap(s) filled, 40 marker(s) still missing" in capsys.readouterr().out
     t, X, labels = read_markers(out)
     t_ref, X_ref, labels_ref = read_markers(ROOT / "tests" / "data" / "opensim-core" / "std_walking5_markers.trc")
     assert labels == labels_ref

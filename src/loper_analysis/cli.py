@@ -50,7 +50,11 @@ def _markers(args: argparse.Namespace) -> None:
 
     gaps = markers(args.c3d, args.out, args.gaps, _rotation(args, args.c3d), args.max_gap_frames,
                    args.cutoff_hz or None, args.order, label_map=_label_map(args.label_map))
-    print(f"{args.out}: {gaps.attrs.get('n_frames', '?')} frames; {len(gaps)} gap(s) filled")
+    per_marker = gaps.attrs.get("per_marker", [])
+    n_frames = per_marker[0]["n_frames"] if per_marker else 0
+    missing = sum(row["n_missing_frames"] > 0 for row in per_marker)
+    print(f"{args.out}: {len(per_marker)} markers, {n_frames} frames; {len(gaps)} gap(s) filled, "
+          f"{missing} marker(s) still missing somewhere")
 
 
 def _grf(args: argparse.Namespace) -> None:
