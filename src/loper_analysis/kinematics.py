@@ -19,12 +19,13 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from .errors import LoperInputError
+from .ik_determinacy import model_tree, require_markers_beyond_root, undetermined_coordinates
 from .io.osim import quiet_opensim
 from .markers import require_markers_per_frame
 
@@ -44,13 +45,20 @@ __all__ = [
 
 @dataclass
 class IKResult:
-    """IK output: ``coordinates`` (n_frames, n_coordinates) in rad or m, in model order."""
+    """IK output: ``coordinates`` (n_frames, n_coordinates) in rad or m, in model order.
+
+    ``marker_rms_m`` and ``marker_max_m`` (n_frames,) are the RMS and largest
+    marker distance error per frame (m). ``undetermined`` maps each coordinate
+    that no marker, task or model constraint determined in some frames to the
+    number of those frames, written as NaN (:mod:`loper_analysis.ik_determinacy`).
+    """
 
     time_s: np.ndarray
     coordinates: np.ndarray
     coordinate_names: list[str]
     marker_rms_m: np.ndarray
     marker_max_m: np.ndarray
+    undetermined: dict[str, int] = field(default_factory=dict)
 
     def frame(self) -> pd.DataFrame:
         """Tidy-wide table: time_s plus one column per coordinate (rad or m)."""
@@ -128,21 +136,33 @@ def inverse_kinematics(
     accuracy: float = 1e-8,
     min_markers: int = 3,
     source: str = "",
+    undetermined: str = "nan",
 ) -> IKResult:
     """OpenSim IK of marker trajectories (m) with one reused solver on an ``opensim.Model``.
 
     A marker that is NaN in a frame is left out of that frame's solve (OpenSim's
     ``MarkersReference`` drops it). Before solving, every frame must hold at
     least ``min_markers`` weighted markers
-    (:func:`loper_analysis.markers.require_markers_per_frame`); ``source``
-    names the file in messages.
+    (:func:`loper_analysis.markers.require_markers_per_frame`) and the
+    weighted markers must not all sit on the body jointed to the ground
+    (:func:`loper_analysis.ik_determinacy.require_markers_beyond_root`);
+    ``source`` names the file in messages.
+
+    A coordinate that no present weighted marker, coordinate task or model
+    constraint determines in a frame
+    (:func:`loper_analysis.ik_determinacy.undetermined_coordinates`, e.g. the
+    knee when no shank or foot marker is present) is NaN in that frame with
+    ``undetermined="nan"`` (counted in :attr:`IKResult.undetermined`);
+    ``undetermined="error"`` refuses the trial instead.
 
     Raises
     ------
     LoperInputError
         A weighted marker missing from the model or from the data, a
         coordinate task on an unknown coordinate, no model marker in the data,
-        a frame with fewer than ``min_markers`` weighted markers present.
+        a frame with fewer than ``min_markers`` weighted markers present,
+        weighted markers on the pelvis only, undetermined coordinates with
+        ``undetermined="error"``.
     """
     osim = quiet_opensim()
     labels = list(labels)
@@ -165,6 +185,17 @@ def inverse_kinematics(
     X = np.asarray(markers_m, float)[:, keep, :]
     kept_labels = [labels[i] for i in keep]
     require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
+    if undetermined not in ("nan", "error"):
+        raise LoperInputError(f"undetermined must be 'nan' or 'error', got {undetermined!r}")
+    tree = model_tree(model)
+    require_markers_beyond_root(tree, X, kept_labels, source)
+    free = undetermined_coordinates(tree, X, kept_labels, coordinate_tasks)  # (n_frames, n_coordinates)
+    lacking = {c: int(n) for c, n in zip(tree.coordinates, free.sum(axis=0)) if n}
+    if lacking and undetermined == "error":
+        raise LoperInputError(
+            f"{source or 'markers'}: no weighted marker present determines coordinate(s) "
+            + ", ".join(f"{c} ({n} of {t.size} frames)" for c, n in lacking.items())
+        )
     table = markers_table(t, X, kept_labels)
     weights = osim.SetMarkerWeights()
     for mk in kept_labels:
@@ -204,7 +235,10 @@ def inverse_kinematics(
     with warnings.catch_warnings():  # a frame without any marker gives NaN, silently
         warnings.simplefilter("ignore", RuntimeWarning)
         rms, mx = np.sqrt(np.nanmean(E * E, axis=1)), np.nanmax(E, axis=1)
-    return IKResult(time_s=t, coordinates=Q[:, perm], coordinate_names=names, marker_rms_m=rms, marker_max_m=mx)
+    coordinates = Q[:, perm]
+    coordinates[free] = np.nan  # the solver left them at a default or the previous frame's value
+    return IKResult(time_s=t, coordinates=coordinates, coordinate_names=names, marker_rms_m=rms, marker_max_m=mx,
+                    undetermined=lacking)
 
 
 def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: float = 1.0,

@@ -23,7 +23,10 @@ Reading (:func:`read_c3d`)
       frames' clock: frame ``k`` of the array is at
       ``(first_frame + k) / POINT:RATE``.
     * Analog values are ezc3d's, i.e. after its SCALE/OFFSET handling.
-      ``ANALOG:RATE`` must be an integer multiple of ``POINT:RATE``.
+      ``ANALOG:RATE`` must be an integer multiple of ``POINT:RATE``, and that
+      multiple must equal the analog samples per frame of the raw header
+      (word 10, which describes the data block); ``POINT:RATE`` must equal
+      the header's frame rate (words 11-12).
     * ezc3d accepts some damaged files silently (a file cut inside its
       parameter section comes back with garbage frames, one cut inside its
       data with fewer frames and a header lowered to match), so the file
@@ -213,6 +216,30 @@ def _point_units_per_m(params, source: str) -> float:
     return LENGTH_UNITS_PER_M[unit]
 
 
+def _raw_header(path: Path) -> dict:
+    """Words of the raw C3D header (first 512 bytes) that ezc3d may adjust in its own copy.
+
+    ``analog_words`` (word 3: analog values per frame, all channels),
+    ``first``/``last`` (words 4, 5: 1-based frames), ``samples_per_frame``
+    (word 10: analog samples per frame and channel) and ``point_rate_hz``
+    (words 11-12, float; DEC floats converted).
+    """
+    with path.open("rb") as fh:
+        head = fh.read(512)
+        fh.seek(max(head[0] - 1, 0) * 512 + 3)
+        processor = fh.read(1)
+    big = processor == bytes([86])  # 84 Intel, 85 DEC: little-endian integers; 86 MIPS
+    order = ">" if big else "<"
+    analog_words, first, last = struct.unpack(order + "HHH", head[4:10])
+    (samples_per_frame,) = struct.unpack(order + "H", head[18:20])
+    if processor == bytes([85]):  # DEC F-float: 16-bit halves swapped, exponent bias 2 higher
+        rate = struct.unpack("<f", head[22:24] + head[20:22])[0] / 4.0
+    else:
+        rate = struct.unpack(order + "f", head[20:24])[0]
+    return {"analog_words": analog_words, "first": first, "last": last, "samples_per_frame": samples_per_frame,
+            "point_rate_hz": float(rate)}
+
+
 def _header_frames(path: Path) -> int | None:
     """Frame count from the raw C3D header (words 4 and 5, 1-based first and last frame).
 
@@ -220,15 +247,41 @@ def _header_frames(path: Path) -> int | None:
     truncated file cannot be recognised from ezc3d's header. None when the
     header cannot tell (last frame saturated at 65535 in long files).
     """
-    with path.open("rb") as fh:
-        head = fh.read(512)
-        fh.seek(max(head[0] - 1, 0) * 512 + 3)
-        processor = fh.read(1)
-    byte_order = ">" if processor == bytes([86]) else "<"  # 84 Intel, 85 DEC: little-endian integers; 86 MIPS
-    first, last = struct.unpack(byte_order + "HH", head[6:10])
+    head = _raw_header(path)
+    first, last = head["first"], head["last"]
     if last >= 0xFFFF or last < first:
         return None
     return last - first + 1
+
+
+def _check_rates(path: Path, point_rate: float, analog_rate: float, ratio: int, n_channels: int) -> None:
+    """Refuse ``POINT:RATE``, ``ANALOG:RATE`` or ``ANALOG:USED`` that disagree with the header's data layout.
+
+    ezc3d splits the analog block by ``ANALOG:RATE``: a wrong but integer
+    ratio (512 Hz declared, 1024 Hz recorded) reads every other sample as the
+    next frame's without complaint.
+    """
+    source = str(path)
+    head = _raw_header(path)
+    rate = head["point_rate_hz"]
+    if np.isfinite(rate) and rate > 0 and abs(rate - point_rate) > 1e-3 * point_rate:
+        raise LoperInputError(
+            f"{source}: POINT:RATE = {point_rate:g} Hz disagrees with the header's frame rate {rate:g} Hz"
+        )
+    if not n_channels:
+        return
+    per_frame = head["samples_per_frame"] or (head["analog_words"] // n_channels if head["analog_words"] else 0)
+    if per_frame and per_frame != ratio:
+        raise LoperInputError(
+            f"{source}: ANALOG:RATE = {analog_rate:g} Hz gives {ratio} analog samples per frame at POINT:RATE = "
+            f"{point_rate:g} Hz, but the data block holds {per_frame} per frame (header word 10; "
+            f"{per_frame * point_rate:g} Hz)"
+        )
+    if head["analog_words"] and head["analog_words"] != n_channels * ratio:
+        raise LoperInputError(
+            f"{source}: ANALOG:USED = {n_channels} channels at {ratio} samples per frame disagrees with the "
+            f"header's {head['analog_words']} analog values per frame (header word 3)"
+        )
 
 
 def _check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> None:
@@ -335,9 +388,12 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
     LoperInputError
         Missing file; not a C3D file, damaged or truncated (ezc3d's exception
         is quoted); ``POINT:UNITS`` not declared or unknown (markers
-        present); ``POINT:RATE`` missing; too few labels; ``ANALOG:RATE`` not
-        an integer multiple of ``POINT:RATE`` ("mismatched analog/point
-        rates"); malformed ``EVENT:TIMES``. The message names the file.
+        present); ``POINT:RATE`` missing or unlike the header's frame rate;
+        too few labels; ``ANALOG:RATE`` not an integer multiple of
+        ``POINT:RATE`` ("mismatched analog/point rates") or giving another
+        number of samples per frame than the header (word 10) and the data
+        block hold; ``ANALOG:USED`` unlike the header's analog values per
+        frame (word 3); malformed ``EVENT:TIMES``. The message names the file.
     """
     path = Path(path)
     source = str(path)
@@ -349,6 +405,7 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
     units_per_m = _point_units_per_m(params, source) if n_markers else 1.0
     analog_rate, ratio, analog_labels, analog_units, samples = _analogs_from(c3d, point_rate, source)
     n_channels = samples.shape[1]
+    _check_rates(path, point_rate, analog_rate, ratio, n_channels)
     n_frames = int(np.shape(c3d["data"]["points"])[2]) if n_markers else samples.shape[0] // ratio
     if n_channels and samples.shape[0] != n_frames * ratio:
         raise LoperInputError(

@@ -24,14 +24,26 @@ def quiet_opensim():
 def read_model(path: str | os.PathLike):
     """An ``opensim.Model`` from a .osim file.
 
+    The file must be an XML document holding a ``<Model>`` element (an
+    ``<OpenSimDocument>`` with a ``<Model>``, or a bare ``<Model>``): checked
+    before OpenSim reads it, since OpenSim fails on other files with
+    messages that do not name them, or not at all.
+
     Raises
     ------
     LoperInputError
-        The file is missing or OpenSim cannot read it (OpenSim's message is quoted).
+        The file is missing, is not XML, holds no ``<Model>``, or OpenSim
+        cannot read it (OpenSim's message is quoted). The message names the file.
     """
     path = Path(path)
     if not path.is_file():
         raise LoperInputError(f"model file not found: {path}")
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError, UnicodeDecodeError) as exc:
+        raise LoperInputError(f"{path}: not an OpenSim model: not an XML file ({exc})") from None
+    if root.tag != "Model" and root.find("Model") is None:
+        raise LoperInputError(f"{path}: not an OpenSim model: its <{root.tag}> element holds no <Model>")
     osim = quiet_opensim()
     try:
         return osim.Model(str(path))

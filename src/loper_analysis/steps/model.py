@@ -39,20 +39,35 @@ def generic_model(out_osim: PathLike, height_m: float, mass_kg: float) -> None:
     log.info("generic model for %s m, %s kg: %s", height_m, mass_kg, out_osim)
 
 
+def _check_factors(model, measurements, times, X, labels, time_range_s, static_trc, factor_range) -> None:
+    """Refuse scale factors outside ``factor_range`` (:func:`loper_analysis.plausibility.require_scale_factors`)."""
+    import numpy as np
+
+    from ..plausibility import measurement_scale_factors, require_scale_factors
+
+    t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
+    sel = (times >= t0 - 1e-9) & (times <= t1 + 1e-9)
+    factors = measurement_scale_factors(model, measurements, np.asarray(X)[sel], labels)
+    require_scale_factors(factors, str(static_trc), factor_range)
+
+
 def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float,
-                 time_range_s: tuple[float, float] | None = None) -> None:
+                 time_range_s: tuple[float, float] | None = None,
+                 factor_range: Sequence[float] = (0.5, 2.0)) -> None:
     """Personalise the generic model with OpenSim's ScaleTool from a static trial (TRC).
 
     Each body is scaled uniformly by the ratio of the marker-pair distances in
     the static trial to those of the model
     (:data:`loper_analysis.model.SCALE_MEASUREMENTS`); the mass distribution
     is preserved at ``mass_kg``. The static markers must be complete
-    (:func:`loper_analysis.model.static_marker_problem`).
+    (:func:`loper_analysis.model.static_marker_problem`) and every factor must
+    lie in ``factor_range`` (a factor near 10 or 1000 means markers in
+    another unit than the TRC declares); nothing is written otherwise.
     """
     from pathlib import Path
 
     from ..io.opensim_tables import read_markers
-    from ..io.osim import quiet_opensim
+    from ..io.osim import quiet_opensim, read_model
     from ..model import SCALE_MEASUREMENTS, static_marker_problem
 
     generic_osim, static_trc = Path(generic_osim), Path(static_trc)
@@ -63,6 +78,8 @@ def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLik
         raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
     times, X, labels = read_markers(static_trc)
     static_marker_problem(times, X, labels, time_range_s, source=str(static_trc))
+    _check_factors(read_model(generic_osim), SCALE_MEASUREMENTS, times, X, labels, time_range_s, static_trc,
+                   factor_range)
     t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
     osim = quiet_opensim()
     tool = osim.ScaleTool()
@@ -104,13 +121,16 @@ def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLik
 
 
 def scale(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float,
-          setup_xml: PathLike | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None) -> None:
+          setup_xml: PathLike | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None,
+          factor_range: Sequence[float] = (0.5, 2.0)) -> None:
     """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when ``setup_xml``
-    is given, else with the generated model's marker-pair measurements (:func:`scaled_model`)."""
+    is given, else with the generated model's marker-pair measurements (:func:`scaled_model`); scale factors
+    outside ``factor_range`` are refused."""
     if setup_xml is None:
-        scaled_model(generic_osim, static_trc, out_osim, mass_kg)
+        scaled_model(generic_osim, static_trc, out_osim, mass_kg, factor_range=factor_range)
     else:
-        scale_with_setup(generic_osim, setup_xml, static_trc, mass_kg, out_osim, segment_bodies=segment_bodies)
+        scale_with_setup(generic_osim, setup_xml, static_trc, mass_kg, out_osim, segment_bodies=segment_bodies,
+                         factor_range=factor_range)
 
 
 def segments_from_model_file(model_osim: PathLike, out_tsv: PathLike, side: str = "left",
@@ -162,7 +182,8 @@ def anthropometric_segments(out_tsv: PathLike, height_m: float, mass_kg: float,
 
 def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: PathLike, mass_kg: float,
                      out_osim: PathLike, time_range_s: tuple[float, float] | None = None,
-                     segment_bodies: Mapping[str, Sequence[str]] | None = None) -> None:
+                     segment_bodies: Mapping[str, Sequence[str]] | None = None,
+                     factor_range: Sequence[float] = (0.5, 2.0)) -> None:
     """Scale a generic OpenSim model with a lab's own ScaleTool setup and a static trial (TRC).
 
     The setup (``opensim.ScaleTool(setup_xml)``) keeps its measurements,
@@ -191,6 +212,10 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
     segment_bodies : mapping, optional
         The bodies the segment table will need (``opensim.segment_bodies``);
         the scaled model must have them on both sides.
+    factor_range : (float, float)
+        Least and largest plausible factor of a measurement (static-trial
+        marker distance over the model's at its default pose, averaged over
+        the measurement's pairs; :func:`loper_analysis.plausibility.measurement_scale_factors`).
 
     Raises
     ------
@@ -201,7 +226,9 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         frame of the time range (ScaleTool would crash or scale with a wrong
         factor; markers used only by the marker placer may have gaps, OpenSim
         leaves such a marker where it is); a scaled model without the
-        configured bodies; ScaleTool failing. Nothing is written then.
+        configured bodies; a measurement's scale factor outside
+        ``factor_range`` (markers in another unit than the TRC declares);
+        ScaleTool failing. Nothing is written then.
     """
     from ..io.opensim_tables import read_markers
     from ..io.osim import quiet_opensim, read_marker_set, read_model, read_scale_setup
@@ -222,9 +249,10 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
     if marker_set is not None and not marker_set.is_file():
         raise LoperInputError(f"{setup_xml}: GenericModelMaker/marker_set_file {maker.getMarkerSetFileName()} "
                               f"not found (looked for {marker_set})")
-    model_markers = set(_names(read_model(generic_osim).getMarkerSet()))
+    generic = read_model(generic_osim)
     if marker_set is not None:
-        model_markers |= set(_names(read_marker_set(marker_set)))
+        generic.updateMarkerSet(read_marker_set(marker_set))  # as ScaleTool does: the set's markers replace or add
+    model_markers = set(_names(generic.getMarkerSet()))
     needed = _measurement_markers(tool)
     lacking = sorted(needed - model_markers)
     if lacking:
@@ -239,6 +267,7 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         raise LoperInputError(f"{static_trc}: time_range_s {time_range_s} lies outside the trial "
                               f"({times[0]:.3f} .. {times[-1]:.3f} s) or is reversed")
     static_marker_problem(times, X, labels, (t0, t1), source=str(static_trc), needed=needed)
+    _check_factors(generic, _measurement_pairs(tool), times, X, labels, (t0, t1), static_trc, factor_range)
 
     osim = quiet_opensim()
     tool.setPathToSubject("")  # OpenSim prefixes the setup's folder to every file name; ours are absolute
@@ -287,18 +316,22 @@ def _setup_file(name: str, setup_xml: Path) -> Path | None:
     return (path if path.is_absolute() else setup_xml.parent / path).resolve()
 
 
-def _measurement_markers(tool) -> set[str]:
-    """Markers of the applied measurements of a ScaleTool (empty when its model scaler does not measure)."""
+def _measurement_pairs(tool) -> dict[str, list[tuple[str, str]]]:
+    """Marker pairs of each applied measurement of a ScaleTool (empty when its model scaler does not measure)."""
     scaler = tool.getModelScaler()
     order = scaler.getScalingOrder()
     if not scaler.getApply() or "measurements" not in [order.get(i) for i in range(order.getSize())]:
-        return set()
-    out: set[str] = set()
+        return {}
+    out: dict[str, list[tuple[str, str]]] = {}
     measurements = scaler.getMeasurementSet()
     for i in range(measurements.getSize()):
         m = measurements.get(i)
         if m.getApply():
-            for j in range(m.getNumMarkerPairs()):
-                pair = m.getMarkerPair(j)
-                out |= {pair.getMarkerName(0), pair.getMarkerName(1)}
+            pairs = [m.getMarkerPair(j) for j in range(m.getNumMarkerPairs())]
+            out[m.getName()] = [(p.getMarkerName(0), p.getMarkerName(1)) for p in pairs]
     return out
+
+
+def _measurement_markers(tool) -> set[str]:
+    """Markers of the applied measurements of a ScaleTool (empty when its model scaler does not measure)."""
+    return {m for pairs in _measurement_pairs(tool).values() for pair in pairs for m in pair}

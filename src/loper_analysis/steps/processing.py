@@ -36,7 +36,7 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
             rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), max_gap_frames: int = 10,
             cutoff_hz: float | None = 40.0, order: int = 4, duration_s: float | None = None,
             label_map: Mapping[str, str] | PathLike | None = None, required_markers: Sequence[str] | None = None,
-            summary_out: PathLike | None = None) -> pd.DataFrame:
+            summary_out: PathLike | None = None, extent_range_m: Sequence[float] = (0.1, 5.0)) -> pd.DataFrame:
     """C3D markers -> model names -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
 
     Labels lose their subject prefix (``Subject:LASI`` -> ``LASI``) and are
@@ -49,7 +49,10 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     backward; None or 0: no filter) runs over each run of present frames on
     its own (:func:`loper_analysis.filtering.lowpass_finite_runs`). Times
     are the file's own, ``(first_frame + k) / rate``; ``duration_s`` keeps
-    the first ``duration_s`` seconds of the trial (static trials).
+    the first ``duration_s`` seconds of the trial (static trials). Markers
+    whose spread lies outside ``extent_range_m`` (m) are refused as numbers in
+    another unit than ``POINT:UNITS`` declares
+    (:func:`loper_analysis.plausibility.require_marker_extent`).
 
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
     row per gap, :data:`loper_analysis.markers.GAP_REPORT_COLUMNS`). The
@@ -63,6 +66,7 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     from ..io.opensim_tables import write_trc
     from ..marker_names import model_marker_names, require_model_markers
     from ..markers import fill_gaps, gap_summary, rotate_markers
+    from ..plausibility import require_marker_extent
 
     source = str(c3d_path)
     rec = read_c3d(c3d_path)
@@ -73,6 +77,7 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     if duration_s is not None:
         keep = time_s < time_s[0] + duration_s - 1e-9
         time_s, raw = time_s[keep], raw[keep]
+    require_marker_extent(raw, source, extent_range_m)
     filled, gaps = fill_gaps(raw, max_gap_frames, names, source=source, unfillable="keep")
     X = rotate_markers(filled, rotation_deg)
     unfiltered = None
