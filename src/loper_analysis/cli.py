@@ -131,7 +131,7 @@ def _ik(args: argparse.Namespace) -> None:
     from .steps.ik import ik_file
 
     result = ik_file(args.model, args.markers, args.out, args.tasks, args.start, args.end, args.rotate_deg,
-                     args.accuracy)
+                     args.accuracy, max_marker_rms_m=args.max_marker_rms_m, max_rms_fraction=args.max_rms_fraction)
     print(
         f"{args.out}: {len(result.time_s)} frames, marker error RMS {1e3 * np.nanmean(result.marker_rms_m):.2f} mm "
         f"(max {1e3 * np.nanmax(result.marker_max_m):.2f} mm)"
@@ -219,6 +219,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--end", type=float, help="last time (s) to solve")
     _rotate_option(p)
     p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
+    p.add_argument("--max-marker-rms-m", type=float, default=0.02,
+                   help="a frame whose marker RMS error exceeds this (m) counts as failed")
+    p.add_argument("--max-rms-fraction", type=float, default=0.1, help="fail when more frames than this share fail")
     p.set_defaults(func=_ik)
 
     p = sub.add_parser("validate", help="one chunk of the validation study (the study's design)")

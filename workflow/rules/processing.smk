@@ -32,6 +32,7 @@ rule markers:
         order=FILTER["order"],
         duration_s=lambda wc: config["markers"]["static_duration_s"] if wc.trial == TRIALS["static"] else None,
         label_map=LABEL_MAP or None,
+        extent_range_m=config["markers"]["extent_range_m"],
     log:
         "results/logs/markers/{subject}/{trial}.log",
     benchmark:
@@ -70,6 +71,7 @@ rule model_scaled:
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
         scale_setup=OPENSIM["scale_setup"],
         segment_bodies=OPENSIM["segment_bodies"],
+        factor_range=OPENSIM["scale_factor_range"],
     log:
         "results/logs/model_scaled/{subject}.log",
     benchmark:
@@ -100,6 +102,8 @@ IK_SETTINGS = dict(
     marker_weights=OPENSIM["marker_weights"],
     coordinate_tasks=OPENSIM["coordinate_tasks"],
     accuracy=OPENSIM["accuracy"],
+    max_marker_rms_m=OPENSIM["max_marker_rms_m"],
+    max_rms_fraction=OPENSIM["max_rms_fraction"],
 )
 
 if OPENSIM["ik_chunks"] == 1:

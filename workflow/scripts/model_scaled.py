@@ -3,4 +3,4 @@ from loper_analysis.steps import model, rule_log
 p = snakemake.params
 with rule_log(snakemake.log[0]):
     model.scale(snakemake.input.generic, snakemake.input.static, snakemake.output[0], p.mass_kg, p.scale_setup,
-                p.segment_bodies)
+                p.segment_bodies, tuple(p.factor_range))
