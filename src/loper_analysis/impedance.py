@@ -270,7 +270,11 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
         strides give the null pairs (e.g. all the subject's walking trials
         with the device; the onset's own trials when empty). Used with
         ``identification.noise_model`` ``null_pairs``: the white fit first,
-        then :func:`loper_analysis.identification.refit_with_null_pairs`.
+        then :func:`loper_analysis.identification.refit_with_null_pairs`. A
+        trial whose null pairs deviate more than
+        ``identification.max_null_trial_ratio`` times the other trials' is
+        left out of them (:func:`loper_analysis.responses.deviant_trials`);
+        the rows' reason names it.
     response, identification : settings
 
     Returns
