@@ -7,12 +7,17 @@ the brace normal. A row per joint reports K, D, their 95 % confidence
 intervals, the VAF, the number of strides, the truth of a synthetic subject
 and a status (``docs/identification.md``):
 
-* ``ok``;
-* ``not_identifiable``: the 95 % CI of K or D spans more than
-  ``max_ci_fraction`` of its bound range (typically the ankle, whose small
-  torques barely move the prediction error);
+* ``ok`` (also with an estimate on a lower bound of zero: no measurable K or D);
+* ``not_identifiable``: K or D on its upper bound (or on a lower bound
+  above zero), or its 95 % CI spans more than ``max_ci_fraction`` of its
+  bound range (typically the ankle, whose small torques barely move the
+  prediction error);
 * ``missing``: no trial of that onset;
-* ``failed``: too few strides, or the optimiser did not converge; ``reason`` says why.
+* ``failed``: too few strides (the reason names ``identification.window_after_s``
+  when strides were too short for the window), the optimiser did not
+  converge, or the joint's VAF is below ``min_vaf_pct``; ``reason`` says why.
+
+The rules of a fitted row are :func:`loper_analysis.identification.joint_status`.
 """
 
 from __future__ import annotations
@@ -28,13 +33,21 @@ from .constants import JOINTS, parameter_column
 from .dynamics import SegmentParameters
 from .errors import LoperInputError, TooFewStridesWarning
 from .identification import (
+    AT_BOUND_FRACTION,
+    MIN_VAF_PCT,
     ImpedanceFit,
     identify_impedance,
+    joint_status,
     prepare_window,
     refit_with_null_pairs,
 )
 from .reference import LITERATURE
-from .responses import ResponseSettings, null_pair_windows, subject_onset_response
+from .responses import (
+    MAX_TRIAL_DEVIATION_RATIO,
+    ResponseSettings,
+    null_pair_windows,
+    subject_onset_response,
+)
 
 __all__ = [
     "IMPEDANCE_COLUMNS",
@@ -44,6 +57,7 @@ __all__ = [
     "brace_force_direction",
     "impedance_rows",
     "status_rows",
+    "too_short_reason",
     "fit_onset",
     "impedance_summary",
     "literature_table",
@@ -67,7 +81,12 @@ NOISE_MODELS: tuple[str, ...] = ("null_pairs", "white")
 
 @dataclass(frozen=True)
 class IdentificationSettings:
-    """How K and D are fitted (config ``identification``; bounds in N·m/rad and N·m·s/rad)."""
+    """How K and D are fitted and judged (config ``identification``; bounds in N·m/rad and N·m·s/rad).
+
+    ``min_vaf_pct``: a joint whose VAF (%) is below it is ``failed``;
+    ``max_null_trial_ratio``: a trial whose null pairs deviate more than this
+    multiple of the other trials' is left out of the null pairs (None: never).
+    """
 
     noise_model: str = "null_pairs"
     null_pair_components: int = 6
@@ -80,6 +99,8 @@ class IdentificationSettings:
     stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
     damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
     max_ci_fraction: float = 0.5
+    min_vaf_pct: float = MIN_VAF_PCT
+    max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
     seed: int = 0
 
     def __post_init__(self):
@@ -153,16 +174,19 @@ def _truth_columns(row: dict, truth: Mapping | None, joint: str) -> None:
 
 def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: int, truth: Mapping | None = None,
                    lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 0.5,
-                   noise_model: str = "white", n_null_pairs: int = 0, note: str = "") -> pd.DataFrame:
+                   noise_model: str = "white", n_null_pairs: int = 0, note: str = "", *,
+                   min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION) -> pd.DataFrame:
     """One row per joint from an :class:`~loper_analysis.identification.ImpedanceFit` (columns :data:`IMPEDANCE_COLUMNS`).
 
     ``truth``: ``{joint: {"K": .., "D": ..}}`` of a synthetic subject (errors
-    = estimate - truth), None for a recorded one. ``noise_model`` (``white`` |
-    ``null_pairs``) and ``n_null_pairs`` say how the fit weighted its errors;
-    ``note`` is appended to every row's reason.
+    = estimate - truth), None for a recorded one. ``lower``, ``upper``: the
+    bounds of (K, D). ``noise_model`` (``white`` | ``null_pairs``) and
+    ``n_null_pairs`` say how the fit weighted its errors; ``note`` is appended
+    to every row's reason. Status and reason per joint:
+    :func:`loper_analysis.identification.joint_status` with ``max_ci_fraction``,
+    ``min_vaf_pct`` and ``at_bound_fraction``.
     """
     rows = []
-    span = np.array(upper, float) - np.array(lower, float)
     for j, joint in enumerate(JOINTS):
         k, d = 2 * j, 2 * j + 1
         row = {
@@ -179,14 +203,10 @@ def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: in
             row[parameter_column("K", "error")] = row[_K] - truth[joint]["K"]
             row[parameter_column("D", "error")] = row[_D] - truth[joint]["D"]
         widths = np.array([fit.ci95_high[k] - fit.ci95_low[k], fit.ci95_high[d] - fit.ci95_low[d]])
-        if not fit.success:
-            row.update(status="failed", reason=f"optimiser did not converge: {fit.message}")
-        elif not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
-            row.update(status="not_identifiable",
-                       reason=f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "
-                              f"{max_ci_fraction:g} of the bounds")
-        else:
-            row.update(status="ok", reason="")
+        status, reason = joint_status(joint, fit.estimate[[k, d]], widths, fit.vaf_pct[j], lower, upper,
+                                      success=fit.success, message=fit.message, max_ci_fraction=max_ci_fraction,
+                                      min_vaf_pct=min_vaf_pct, at_bound_fraction=at_bound_fraction)
+        row.update(status=status, reason=reason)
         if note:
             row["reason"] = "; ".join(r for r in (row["reason"], note) if r)
         rows.append(row)
@@ -203,6 +223,20 @@ def status_rows(subject: str, onset_ms: int, status: str, reason: str, n_strides
         _truth_columns(row, truth, joint)
         rows.append(row)
     return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
+
+
+def too_short_reason(n_short: int, n_perturbed: int, onset_ms: float, window_after_s: float,
+                     longest_after_onset_s: float) -> str:
+    """Why perturbed strides were dropped as too short, naming ``identification.window_after_s`` and its value.
+
+    ``longest_after_onset_s``: the most swing time (s) any perturbed stride leaves after its onset,
+    the longest window that keeps a stride.
+    """
+    text = (f"{n_short} of {n_perturbed} perturbed stride(s) too short for the fit window: their swing ends "
+            f"before onset {onset_ms:g} ms + identification.window_after_s = {window_after_s:g} s")
+    if np.isfinite(longest_after_onset_s):
+        text += f" (the longest swing leaves {max(longest_after_onset_s, 0.0):.3g} s after the onset)"
+    return text
 
 
 def _no_curves() -> pd.DataFrame:
@@ -236,7 +270,11 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
         strides give the null pairs (e.g. all the subject's walking trials
         with the device; the onset's own trials when empty). Used with
         ``identification.noise_model`` ``null_pairs``: the white fit first,
-        then :func:`loper_analysis.identification.refit_with_null_pairs`.
+        then :func:`loper_analysis.identification.refit_with_null_pairs`. A
+        trial whose null pairs deviate more than
+        ``identification.max_null_trial_ratio`` times the other trials' is
+        left out of them (:func:`loper_analysis.responses.deviant_trials`);
+        the rows' reason names it.
     response, identification : settings
 
     Returns
@@ -264,8 +302,11 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     total = counts[counts["trial"] == "total"].iloc[0]
     n_kept = int(total["n_kept"])
     if n_kept < r.min_strides:
-        rows = status_rows(subject, onset_ms, "failed",
-                           f"{n_kept} valid perturbed stride(s), fewer than {r.min_strides}: not fitted", n_kept, truth)
+        reason = f"{n_kept} valid perturbed stride(s), fewer than {r.min_strides}: not fitted"
+        if int(total["n_too_short"]):
+            reason += "; " + too_short_reason(int(total["n_too_short"]), int(total["n_perturbed"]), onset_ms,
+                                              r.window_after_s, counts.attrs["longest_swing_after_onset_s"])
+        rows = status_rows(subject, onset_ms, "failed", reason, n_kept, truth)
         return OnsetFit(mean, counts, rows, _no_curves())
     ident = identification
     window = prepare_window(
@@ -281,14 +322,15 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     if ident.noise_model == "null_pairs":
         loaded = {i["name"]: i for i in inputs}
         pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
-        null = null_pair_windows(pool, onset_ms, r, source=subject)
+        null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
         refit = refit_with_null_pairs(window, fit, null, n_kept, ident.null_pair_components, ident.min_null_pairs,
                                       **ident.fit_options())
-        fit, used, n_null, note = refit.fit, refit.noise_model, refit.n_null_pairs, refit.note
+        fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
+        note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
     rows = impedance_rows(fit, subject, onset_ms, n_kept, truth,
                           (ident.stiffness_bounds_nm_per_rad[0], ident.damping_bounds_nms_per_rad[0]),
                           (ident.stiffness_bounds_nm_per_rad[1], ident.damping_bounds_nms_per_rad[1]),
-                          ident.max_ci_fraction, used, n_null, note)
+                          ident.max_ci_fraction, used, n_null, note, min_vaf_pct=ident.min_vaf_pct)
     curves = pd.DataFrame({"time_s": fit.time_s,
                            **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
                            **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)}})

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from .checks import number
 from .constants import JOINTS, PARAMETERS
 from .dynamics import SegmentParameters, segment_coordinates
 from .errors import LoperInputError
@@ -32,6 +33,7 @@ from .reference import STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
 
 __all__ = [
     "ValidationSettings",
+    "check_window_in_swing",
     "impedance_grid",
     "chunk_combinations",
     "nominal_swing",
@@ -73,6 +75,46 @@ class ValidationSettings:
     seed: int = 2024
     lower: tuple[float, ...] = tuple(DEFAULT_LOWER)
     upper: tuple[float, ...] = tuple(DEFAULT_UPPER)
+
+    def __post_init__(self):
+        check_window_in_swing(self.onset_s, self.window_before_s, self.window_after_s, self.swing_duration_s)
+
+
+def check_window_in_swing(onset_s: float, window_before_s: float, window_after_s: float,
+                          swing_duration_s: float) -> None:
+    """Refuse a fit window that does not lie inside the simulated swing ``0 .. swing_duration_s`` (s after toe-off).
+
+    The window runs from ``onset_s - window_before_s`` to ``onset_s + window_after_s``. Outside the
+    swing :func:`nominal_swing` holds the toe-off or heel-strike posture, which is no swing at all, so a
+    fit there says nothing about the identification. The message names the config keys
+    (``identification.window_*``, ``validation.*``), the value and the limit.
+
+    Raises
+    ------
+    LoperInputError
+        A non-finite or non-positive swing, an onset outside ``0 .. swing_duration_s``, a window
+        starting before toe-off or ending after the heel strike.
+    """
+    swing_duration_s = number("validation.swing_duration_s", swing_duration_s)
+    onset_s = number("validation.onset_s", onset_s)
+    window_before_s = number("identification.window_before_s", window_before_s, minimum=0.0)
+    window_after_s = number("identification.window_after_s", window_after_s, minimum=0.0)
+    if swing_duration_s <= 0:
+        raise LoperInputError(f"validation.swing_duration_s must be positive, got {swing_duration_s:g} s")
+    if not 0 <= onset_s < swing_duration_s:
+        raise LoperInputError(f"validation.onset_s = {onset_s:g} s lies outside the simulated swing "
+                              f"0 .. {swing_duration_s:g} s (validation.swing_duration_s)")
+    room_after = swing_duration_s - onset_s
+    if window_after_s > room_after + 1e-12:
+        raise LoperInputError(
+            f"identification.window_after_s = {window_after_s:g} s does not fit in the simulated swing of the "
+            f"validation study: the window must end by the heel strike, so it may be at most {room_after:g} s "
+            f"(validation.swing_duration_s = {swing_duration_s:g} s - validation.onset_s = {onset_s:g} s)")
+    if window_before_s > onset_s + 1e-12:
+        raise LoperInputError(
+            f"identification.window_before_s = {window_before_s:g} s does not fit in the simulated swing of the "
+            f"validation study: the window must start after toe-off, so it may be at most {onset_s:g} s "
+            f"(validation.onset_s)")
 
 
 def impedance_grid(stiffness_levels, damping_levels) -> np.ndarray:

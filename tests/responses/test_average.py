@@ -139,3 +139,15 @@ def test_subject_inputs_are_checked(rng):
         subject_onset_response([bad], 100)
     with pytest.raises(LoperInputError, match="S01: trial name 'walk-1' appears twice"):
         subject_onset_response([trial.inputs(), trial.inputs()], 100, source="S01")
+
+
+def test_counts_carry_the_longest_swing_after_an_onset(rng):
+    """Perturbed swings of 60, 62, 59 and 61 frames, onsets 13 frames after toe-off: 49 frames are left at most;
+    a nominal onset later than the planted one counts instead (240 ms: 62 / 128 - 0.24 s, all too short)."""
+    trial, _ = twin_trial(rng)
+    _, counts, _ = subject_onset_response([trial.inputs()], 100, ResponseSettings(min_strides=4))
+    assert counts.attrs["longest_swing_after_onset_s"] == pytest.approx(49 / RATE, abs=1e-12)
+    with pytest.warns(TooFewStridesWarning):
+        _, late, _ = subject_onset_response([trial.inputs()], 240, ResponseSettings(min_strides=4))
+    assert late.attrs["longest_swing_after_onset_s"] == pytest.approx(62 / RATE - 0.24, abs=1e-12)
+    assert late.set_index("trial").loc["total", "n_too_short"] == 4

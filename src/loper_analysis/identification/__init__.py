@@ -19,7 +19,8 @@
    intervals, the correlation matrix and the VAF per joint.
 
 Beyond the study, :mod:`.null_pairs` weights the prediction error by the
-stride-to-stride deviation that null pairs show.
+stride-to-stride deviation that null pairs show, and :mod:`.status` judges
+each joint's fit (convergence, VAF floor, bounds, interval widths).
 """
 
 from .fit import (
@@ -38,6 +39,7 @@ from .null_pairs import (
     null_pair_errors,
     refit_with_null_pairs,
 )
+from .status import AT_BOUND_FRACTION, MIN_VAF_PCT, joint_status
 from .window import (
     PreparedWindow,
     prediction_error,
@@ -64,4 +66,7 @@ __all__ = [
     "null_pair_errors",
     "nuisance_projection",
     "refit_with_null_pairs",
+    "MIN_VAF_PCT",
+    "AT_BOUND_FRACTION",
+    "joint_status",
 ]

@@ -18,7 +18,8 @@ identification (:func:`loper_analysis.identification.prepare_window`) fits.
   the stride counts and the averaged series for the identification;
 * :mod:`.null_pairs` - :func:`null_pair_windows`: unperturbed strides paired
   the same way, the stride-to-stride noise the identification weights its
-  errors by;
+  errors by (a trial whose null pairs deviate far more than the other
+  trials' is left out: :func:`deviant_trials`);
 * :mod:`.inputs` and :mod:`.sampling` - the trial inputs (frames) and the
   spline sampling the others share.
 
@@ -39,7 +40,12 @@ Conventions
 
 from .average import COUNT_COLUMNS, subject_onset_response
 from .matching import MATCH_COLUMNS, match_unperturbed, too_short
-from .null_pairs import null_pair_windows
+from .null_pairs import (
+    MAX_TRIAL_DEVIATION_RATIO,
+    deviant_trials,
+    null_pair_windows,
+    trial_deviation_rad,
+)
 from .windows import (
     MIN_PAIRS_FOR_OUTLIERS,
     ResponseSettings,
@@ -60,4 +66,7 @@ __all__ = [
     "window_outliers",
     "subject_onset_response",
     "null_pair_windows",
+    "MAX_TRIAL_DEVIATION_RATIO",
+    "trial_deviation_rad",
+    "deviant_trials",
 ]

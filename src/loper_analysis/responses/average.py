@@ -124,7 +124,10 @@ def subject_onset_response(
         ``status`` (``ok`` | ``too_few_strides``: ``n_kept < min_strides``) and
         ``reason``. ``attrs["pairs"]``: one row per pair (``trial``,
         ``stride``, ``matched_stride``, ``onset_s``, ``matched_anchor_s``,
-        ``rmsd_rad``, ``removed``, ``reason``); ``attrs["outliers_judged"]``.
+        ``rmsd_rad``, ``removed``, ``reason``); ``attrs["outliers_judged"]``;
+        ``attrs["longest_swing_after_onset_s"]``: the most swing time any
+        perturbed stride leaves after its onset (s; the longest
+        ``window_after_s`` that keeps a stride, NaN without perturbed strides).
     series : dict
         Means over kept pairs on the grid, named like the arguments of
         :func:`loper_analysis.identification.prepare_window`: ``time_s``
@@ -147,14 +150,17 @@ def subject_onset_response(
     min_n = int(number("min_strides", settings.min_strides, source, minimum=0.0))
     rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
 
-    per_trial, pairs, windows = [], [], []
+    per_trial, pairs, windows, rooms = [], [], [], []
     for k, trial in enumerate(trials):
         name, where_s, t, columns, strides = _trial_inputs(trial, k, side, source)
         if any(rec["trial"] == name for rec in per_trial):
             raise LoperInputError(f"{where(source)}trial name {name!r} appears twice; names must be unique")
         table = stride_table(strides, where_s)
-        n_perturbed = int(bool_column(table, "perturbed", where_s, what="strides").sum())
+        perturbed = bool_column(table, "perturbed", where_s, what="strides")
+        n_perturbed = int(perturbed.sum())
         n_short = int(too_short(table, onset_s, after, source=where_s).sum())
+        delay = np.fmax(table["onset_s"].to_numpy(float) - table["toe_off_s"].to_numpy(float), onset_s)
+        rooms.extend((table["swing_s"].to_numpy(float) - delay)[perturbed].tolist())
         matches = match_unperturbed(
             t, columns["joints"], table, before, source=where_s, span_s=(start, after),
             onset_after_toe_off_s=onset_s, window_after_s=after, candidate_within_swing=candidate_within_swing,
@@ -205,7 +211,9 @@ def subject_onset_response(
         r["reason"] = "; ".join(parts)
     counts = pd.DataFrame(rows, columns=list(COUNT_COLUMNS))
     check_enough_strides(n_pairs, label or "perturbation response", min_n)
-    counts.attrs = {"pairs": pair_table, "outliers_judged": judged, "onset_ms": float(onset_ms), "source": source}
+    finite_rooms = [r for r in rooms if np.isfinite(r)]
+    counts.attrs = {"pairs": pair_table, "outliers_judged": judged, "onset_ms": float(onset_ms), "source": source,
+                    "longest_swing_after_onset_s": max(finite_rooms) if finite_rooms else float("nan")}
     log.info("%s: %d perturbed, %d too short, %d without match, %d outliers, %d kept", label, total["n_perturbed"],
              total["n_too_short"], total["n_no_match"], total["n_outliers"], total["n_kept"])
 

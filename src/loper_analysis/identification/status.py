@@ -1,0 +1,91 @@
+"""The status of one joint's fitted row: convergence, goodness of fit, bounds, interval widths.
+
+Rules (``docs/identification.md``, section "Fit status"), judged in this order:
+
+1. the optimiser did not converge: ``failed``;
+2. the joint's VAF is below ``min_vaf_pct`` (or undefined, a response of
+   zero): ``failed`` - the model does not describe the measured response;
+3. K or D lies on its upper bound, or on a lower bound above zero (within
+   ``at_bound_fraction`` of the bound range): ``not_identifiable`` - the
+   data ask for a value the bounds exclude, and the estimate is the bound;
+4. the 95 % interval of K or D spans more than ``max_ci_fraction`` of the
+   bound range, or is infinite: ``not_identifiable``.
+
+Every finding of 2-4 is named in the reason (parameter or key, value and
+limit); the status is the most severe. An estimate on a lower bound of zero
+is a valid estimate (no measurable stiffness or damping, e.g. the knee's K
+early in swing): the row stays ``ok`` with nothing added to its reason; the
+0 in the estimate column and an interval reaching below zero show it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import LoperInputError
+
+__all__ = ["MIN_VAF_PCT", "AT_BOUND_FRACTION", "joint_status"]
+
+#: VAF (%) below which a joint's fit is ``failed``: below 0 the model explains less than no response at all.
+MIN_VAF_PCT: float = 0.0
+#: An estimate within this fraction of its bound range of a bound lies on the bound.
+AT_BOUND_FRACTION: float = 1e-6
+
+_PARAMETERS = (("K", "N·m/rad", "identification.stiffness_bounds_nm_per_rad", "stiffness"),
+               ("D", "N·m·s/rad", "identification.damping_bounds_nms_per_rad", "damping"))
+
+
+def joint_status(joint: str, estimate, ci_width, vaf_pct: float, lower, upper, *, success: bool = True,
+                 message: str = "", max_ci_fraction: float = 0.5, min_vaf_pct: float = MIN_VAF_PCT,
+                 at_bound_fraction: float = AT_BOUND_FRACTION) -> tuple[str, str]:
+    """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
+
+    Parameters
+    ----------
+    joint : str
+        Joint name, quoted in the reason (``K_knee``).
+    estimate, ci_width : (2,) array_like
+        K (N·m/rad) and D (N·m·s/rad), and the widths of their 95 % intervals.
+    vaf_pct : float
+        The joint's VAF (%); NaN when the measured response is zero.
+    lower, upper : (2,) array_like
+        Bounds of K and D.
+    success, message : the optimiser's convergence flag and message.
+    max_ci_fraction, min_vaf_pct, at_bound_fraction : the thresholds (see the module docstring).
+
+    Returns
+    -------
+    (str, str)
+        The status and the reason ("" for a plain ``ok``).
+    """
+    est = np.asarray(estimate, dtype=float)
+    widths = np.asarray(ci_width, dtype=float)
+    lb, ub = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+    for name, a in (("estimate", est), ("ci_width", widths), ("lower", lb), ("upper", ub)):
+        if a.shape != (2,):
+            raise LoperInputError(f"{joint}: {name} must hold K and D (2 values), got shape {a.shape}")
+    if not (0 <= at_bound_fraction < 0.5):
+        raise LoperInputError(f"at_bound_fraction must lie in [0, 0.5), got {at_bound_fraction}")
+    if not success:
+        return "failed", f"optimiser did not converge: {message}"
+    failed, unidentifiable = [], []
+    if not np.isfinite(vaf_pct):
+        failed.append(f"VAF of the {joint} undefined: its measured response is zero over the fit window")
+    elif vaf_pct < min_vaf_pct:
+        failed.append(f"VAF {vaf_pct:.3g} % below identification.min_vaf_pct = {min_vaf_pct:g} %: "
+                      f"the model does not describe the {joint} response")
+    span = ub - lb
+    for i, (p, unit, key, what) in enumerate(_PARAMETERS):
+        tol = at_bound_fraction * span[i]
+        name = f"{p}_{joint} = {est[i]:.6g} {unit}"
+        if est[i] >= ub[i] - tol:
+            unidentifiable.append(f"{name} at its upper bound {ub[i]:g} {unit} ({key}): the data ask for more "
+                                  f"{what} than the bounds allow")
+        elif est[i] <= lb[i] + tol and lb[i] != 0:
+            unidentifiable.append(f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
+                                  f"less {what} than the bounds allow")
+    if not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
+        unidentifiable.append(f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "
+                              f"{max_ci_fraction:g} of the bounds")
+    status = "failed" if failed else ("not_identifiable" if unidentifiable else "ok")
+    return status, "; ".join(failed + unidentifiable)
