@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import ast
+import re
 import shutil
 import subprocess
 import sys
@@ -200,6 +202,55 @@ def test_bad_subject_sheet_is_refused(tmp_path):
     assert res.returncode != 0
     out = res.stdout + res.stderr
     assert "subjects.tsv" in out and "S_01" in out
+
+
+def _rule_blocks() -> dict[str, str]:
+    """{rule name: its text} of every rule in workflow/rules/*.smk."""
+    blocks = {}
+    for smk in sorted((ROOT / "workflow/rules").glob("*.smk")):
+        parts = re.split(r"^\s*rule (\w+):\s*$", smk.read_text(), flags=re.M)
+        blocks.update(zip(parts[1::2], parts[2::2]))
+    return blocks
+
+
+def test_every_job_runs_its_step_inside_its_log():
+    """Each rule has a log and a script (no run: or shell:); each script imports only rule_log before entering
+    it, so an import error, a missing parameter or a failing step all end up in the job's log."""
+    blocks = _rule_blocks()
+    assert len(blocks) >= 30
+    scripts = set()
+    for name, body in blocks.items():
+        assert re.search(r"^\s+log:\s*$", body, re.M), name
+        assert not re.search(r"^\s+(run|shell):", body, re.M), name
+        scripts.add(re.search(r'^\s+script:\s*\n\s+"\.\./scripts/(\w+\.py)"', body, re.M).group(1))
+    assert scripts == {p.name for p in (ROOT / "workflow/scripts").glob("*.py")}
+    for name in scripts:
+        tree = ast.parse((ROOT / "workflow/scripts" / name).read_text())
+        first, second, *rest = tree.body
+        assert ast.unparse(first) == "from loper_analysis.steps import rule_log", name
+        assert isinstance(second, ast.With) and not rest, name
+        assert ast.unparse(second.items[0].context_expr) == "rule_log(snakemake.log[0])", name
+        assert isinstance(second.body[0], ast.ImportFrom) and second.body[0].module == "loper_analysis.steps", name
+
+
+def test_a_failed_job_leaves_its_message_and_traceback_in_its_log(tmp_path):
+    """A truncated C3D: the console shows the cause in one line, the job's log the message and the traceback."""
+    work = _project(tmp_path, device__subject="R01")
+    (work / "config/subjects.tsv").write_text("subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.8\t72\n")
+    raw = work / "data/raw/R01"
+    raw.mkdir(parents=True)
+    (raw / "static.c3d").write_bytes((ROOT / "tests/data/opensim-core/walking5.c3d").read_bytes()[:30_000])
+    res = _snakemake(work, "results/markers/R01/static.trc")
+    assert res.returncode != 0
+    message = "data/raw/R01/static.c3d: truncated file: the header declares 1103 frames but only 22 could be read"
+    console = res.stdout + res.stderr
+    assert console.count(message) == 1 and "Traceback" not in console
+    assert "results/logs/markers/R01/static.log (check log file(s) for error details)" in console
+    log = (work / "results/logs/markers/R01/static.log").read_text()
+    assert f"ERROR loper_analysis.rule: LoperInputError: {message}" in log
+    assert "Traceback (most recent call last)" in log and 'in read_c3d' in log
+    assert log.rstrip().endswith(f"loper_analysis.errors.LoperInputError: {message}")
+    assert not (work / "results/markers").exists()  # nothing half-written
 
 
 def test_device_outputs_from_the_default_run(finished_run):
