@@ -53,6 +53,20 @@ def test_staged_moves_the_finished_file_and_leaves_nothing_else(tmp_path):
     assert _entries(target.parent) == ["table.tsv"]
 
 
+def test_staging_left_by_a_killed_writer_is_removed_when_the_target_is_written_again(tmp_path):
+    target, other = tmp_path / "strides.tsv", tmp_path / "cycles.tsv"
+    stale = tmp_path / ".strides.tsv.k3x9_q2a.partial"  # what a writer killed halfway leaves
+    stale.mkdir()
+    (stale / "strides.tsv").write_text("stride\n0\n1\n")
+    busy = tmp_path / ".cycles.tsv.a1b2c3d4.partial"  # another target's: not touched
+    busy.mkdir()
+    write_text(target, "stride\n0\n1\n2\n")
+    assert target.read_text() == "stride\n0\n1\n2\n"
+    assert _entries(tmp_path) == [".cycles.tsv.a1b2c3d4.partial", "strides.tsv"]
+    write_text(other, "x\n")
+    assert _entries(tmp_path) == ["cycles.tsv", "strides.tsv"]
+
+
 def test_staged_keeps_the_old_file_when_the_writer_fails_halfway(tmp_path):
     target = tmp_path / "data.bin"
     target.write_bytes(b"old")

@@ -6,4 +6,4 @@ with rule_log(snakemake.log[0]):
     inp, out = snakemake.input, snakemake.output
     transparency.transparency(snakemake.params.subjects, inp.no_device_strides, inp.no_device_cycles,
                               inp.device_strides, inp.device_cycles, out.rmsd, out.force, out.figure,
-                              snakemake.params.side)
+                              snakemake.params.side, snakemake.params.min_strides)
