@@ -147,17 +147,17 @@ def test_impedance_table_from_the_default_run(finished_run):
 @pytest.mark.parametrize(
     ("changes", "expected"),
     [
-        ({"identification__n_stars": 3}, "n_stars"),
-        ({"identification__n_starts": "ten"}, "ten"),
-        ({"validation__n_chunks": 0}, "n_chunks"),
-        ({"subjects": "config/nowhere.tsv"}, "config/nowhere.tsv"),
+        ({"identification__n_stars": 3}, "key 'identification.n_stars'"),
+        ({"identification__n_starts": "ten"}, "key 'identification.n_starts': 'ten'"),
+        ({"validation__n_chunks": 0}, "key 'validation.n_chunks': 0"),
+        ({"subjects": "config/nowhere.tsv"}, "key 'subjects': file 'config/nowhere.tsv' not found"),
     ],
 )
 def test_bad_config_is_refused_with_its_key(tmp_path, changes, expected):
     work = _project(tmp_path, **changes)
     res = _snakemake(work, "-n")
     assert res.returncode != 0
-    assert expected in res.stdout + res.stderr
+    assert f"config/config.yaml: {expected}" in res.stdout + res.stderr
 
 
 @pytest.mark.parametrize(
@@ -282,6 +282,87 @@ def test_recorded_subject_without_a_trial_reports_that_onset_missing(finished_ru
     assert (table.status == "missing").all() and (table.reason == "no trial of this onset").all()
     assert table[["K_nm_per_rad", "D_nms_per_rad", "K_true_nm_per_rad", "D_true_nms_per_rad"]].isna().all().all()
     assert not (work / "results/ik").exists()  # nothing was processed for an onset without trials
+
+
+def _copy_of(project: Path, dest: Path) -> Path:
+    """A copy of a finished project with its files' times and Snakemake's records: only what changes reruns."""
+    shutil.copytree(project, dest, symlinks=True)
+    return dest
+
+
+def _cut_c3d(path: Path, seconds: float) -> None:
+    """Keep the first ``seconds`` of a C3D (markers and analogs), as a recording stopped early."""
+    from dataclasses import replace
+
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.c3d_writer import write_recording
+
+    rec = read_c3d(path)
+    n = int(round(seconds * rec.point_rate_hz))
+    write_recording(path, replace(rec, markers_m=rec.markers_m[:n], analogs=rec.analogs[:n * rec.samples_per_frame]))
+
+
+def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_run, tmp_path):
+    """walk-device and pert050-1 cut to 5 s (2 complete left strides each, no perturbation yet): warnings and
+    flagged rows, transparency without the subject, the fit failed with its reason; the run ends normally."""
+    work = _copy_of(finished_run, tmp_path / "short")
+    for trial in ("walk-device", "pert050-1"):
+        _cut_c3d(work / f"data/raw/S01/{trial}.c3d", 5.0)
+    res = _snakemake(work)
+    assert res.returncode == 0, res.stderr[-3000:]
+    summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t").set_index("trial")
+    assert summary.loc["walk-nodevice", "status"] == "ok"
+    for trial in ("walk-device", "pert050-1"):
+        assert summary.loc[trial, ["n_strides", "n_kept", "status"]].tolist() == [2, 2, "too_few_strides"], trial
+        strides = pd.read_csv(work / f"results/strides/S01/{trial}.strides.tsv", sep="\t")
+        assert len(strides) == 2 and not strides.removed.any()
+        assert strides.filter(like="fraction_outlying_").isna().all().all()
+        log = (work / f"results/logs/strides/S01/{trial}.log").read_text()
+        assert "2 complete unperturbed left stride(s)" in log and "the outlier rule needs at least 4" in log
+    rmsd = pd.read_csv(work / "results/transparency/rmsd.tsv", sep="\t")
+    assert len(rmsd) == 12 and (rmsd.n_strides_device == [2] * 6 + [0] * 6).all()
+    assert rmsd[["rmsd_rad", "isv_ave_rad", "transparent"]].isna().all().all()
+    assert "subject S01: " in (work / "results/logs/transparency/transparency.log").read_text()
+    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+    assert (table.status == "failed").all() and table.reason.str.startswith("0 valid perturbed stride(s)").all()
+    counts = pd.read_csv(work / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
+    assert counts.loc["total", ["n_perturbed", "status"]].tolist() == [0, "too_few_strides"]
+
+
+def test_a_killed_run_recovers_to_the_bytes_of_an_uninterrupted_one(finished_run, tmp_path):
+    """The README's recovery: kill the whole run (SIGKILL) after some jobs, `--unlock`, `--rerun-incomplete`."""
+    import os
+    import signal
+    import time
+
+    work = _copy_of(finished_run, tmp_path / "killed")
+    later = time.time() + 1
+    os.utime(work / "data/raw/S01/pert050-1.c3d", (later, later))  # a newer raw trial: its processing reruns
+    console = tmp_path / "killed.out"
+    with console.open("w") as out:
+        run = subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "2"], cwd=work, stdout=out,
+                               stderr=subprocess.STDOUT, start_new_session=True)
+        deadline = time.monotonic() + 300
+        while run.poll() is None and console.read_text().count("Finished jobid") < 3 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        os.killpg(run.pid, signal.SIGKILL)
+        run.wait()
+    text = console.read_text()
+    n_jobs = int(re.search(r"^total\s+(\d+)$", text, re.M).group(1))
+    assert 3 <= text.count("Finished jobid") < n_jobs - 3  # killed halfway
+    assert "locked" in (_snakemake(work).stderr + "").lower()  # the lock stays until --unlock
+    assert _snakemake(work, "--unlock").returncode == 0
+    res = _snakemake(work, "--rerun-incomplete")
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert not list((work / "results").rglob("*.partial"))  # no staging left behind
+
+    def tables(root: Path) -> dict:
+        return {p.relative_to(root): p.read_bytes() for p in (root / "results").rglob("*.tsv")
+                if "benchmarks" not in p.parts}  # job timings differ by nature
+
+    ours, clean = tables(work), tables(finished_run)
+    assert sorted(ours) == sorted(clean) and len(ours) >= 40
+    assert [str(p) for p in ours if ours[p] != clean[p]] == []
 
 
 def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
