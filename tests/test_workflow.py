@@ -208,7 +208,7 @@ def _rule_blocks() -> dict[str, str]:
     """{rule name: its text} of every rule in workflow/rules/*.smk."""
     blocks = {}
     for smk in sorted((ROOT / "workflow/rules").glob("*.smk")):
-        parts = re.split(r"^\s*rule (\w+):\s*$", smk.read_text(), flags=re.M)
+        parts = re.split(r"^\s*rule (\w+):\s*$", smk.read_text(), flags=re.MULTILINE)
         blocks.update(zip(parts[1::2], parts[2::2]))
     return blocks
 
@@ -220,9 +220,9 @@ def test_every_job_runs_its_step_inside_its_log():
     assert len(blocks) >= 30
     scripts = set()
     for name, body in blocks.items():
-        assert re.search(r"^\s+log:\s*$", body, re.M), name
-        assert not re.search(r"^\s+(run|shell):", body, re.M), name
-        scripts.add(re.search(r'^\s+script:\s*\n\s+"\.\./scripts/(\w+\.py)"', body, re.M).group(1))
+        assert re.search(r"^\s+log:\s*$", body, re.MULTILINE), name
+        assert not re.search(r"^\s+(run|shell):", body, re.MULTILINE), name
+        scripts.add(re.search(r'^\s+script:\s*\n\s+"\.\./scripts/(\w+\.py)"', body, re.MULTILINE).group(1))
     assert scripts == {p.name for p in (ROOT / "workflow/scripts").glob("*.py")}
     for name in scripts:
         tree = ast.parse((ROOT / "workflow/scripts" / name).read_text())
@@ -298,7 +298,7 @@ def _cut_c3d(path: Path, seconds: float) -> None:
     from loper_analysis.io.c3d_writer import write_recording
 
     rec = read_c3d(path)
-    n = int(round(seconds * rec.point_rate_hz))
+    n = round(seconds * rec.point_rate_hz)
     write_recording(path, replace(rec, markers_m=rec.markers_m[:n], analogs=rec.analogs[:n * rec.samples_per_frame]))
 
 
@@ -348,7 +348,7 @@ def test_a_killed_run_recovers_to_the_bytes_of_an_uninterrupted_one(finished_run
         os.killpg(run.pid, signal.SIGKILL)
         run.wait()
     text = console.read_text()
-    n_jobs = int(re.search(r"^total\s+(\d+)$", text, re.M).group(1))
+    n_jobs = int(re.search(r"^total\s+(\d+)$", text, re.MULTILINE).group(1))
     assert 3 <= text.count("Finished jobid") < n_jobs - 3  # killed halfway
     assert "locked" in (_snakemake(work).stderr + "").lower()  # the lock stays until --unlock
     assert _snakemake(work, "--unlock").returncode == 0

@@ -35,12 +35,11 @@ def _sets(layer, key_path: Sequence) -> bool:
     """True if ``layer`` holds a value at ``key_path`` (mapping keys and list indices)."""
     node = layer
     for key in key_path:
-        if isinstance(node, Mapping) and key in node:
-            node = node[key]
-        elif isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node):
-            node = node[key]
-        else:
+        found = (isinstance(node, Mapping) and key in node) or (
+            isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node))
+        if not found:
             return False
+        node = node[key]
     return True
 
 

@@ -47,10 +47,10 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     try:
         yield log
     except Exception as exc:
-        log.error("%s: %s", type(exc).__name__, exc, exc_info=True)
+        log.exception("%s: %s", type(exc).__name__, exc)
         failure = exc
     except BaseException as exc:
-        log.error("%s: %s", type(exc).__name__, exc, exc_info=True)
+        log.exception("%s: %s", type(exc).__name__, exc)
         raise
     finally:
         logging.captureWarnings(False)
