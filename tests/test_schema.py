@@ -7,7 +7,7 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.schema import check_config, check_table
+from loper_analysis.schema import check_config, check_table, config_origin
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG_SCHEMA = ROOT / "workflow/schemas/config.schema.yaml"
@@ -41,6 +41,55 @@ def test_bad_config_names_key_and_value(section, key, value, words):
         check_config(cfg, CONFIG_SCHEMA, "config.yaml")
     for w in words:
         assert w in str(info.value), str(info.value)
+
+
+def test_unknown_key_is_named_by_its_full_path():
+    cfg = _config()
+    cfg["identification"]["n_stars"] = 3
+    with pytest.raises(LoperInputError, match=r"^config.yaml: key 'identification.n_stars': .*'n_stars' was unexpected"):
+        check_config(cfg, CONFIG_SCHEMA, "config.yaml")
+
+
+@pytest.mark.parametrize(
+    ("key_path", "origin"),
+    [
+        (["seed"], "--config"),  # the command line wins over every file
+        (["identification", "n_starts"], "late.yaml"),  # the last --configfile wins over an earlier one
+        (["identification", "tolerance"], "early.yaml"),
+        (["trials", "perturbation_onsets_ms", 1], "early.yaml"),  # a list item
+        (["trials", "perturbation_onsets_ms", 5], "config/config.yaml"),  # beyond the list: nobody set it
+        (["validation", "n_chunks"], "config/config.yaml"),
+    ],
+)
+def test_config_origin_is_the_highest_layer_that_sets_the_key(key_path, origin):
+    layers = [("--config", {"seed": 3}),
+              ("late.yaml", {"identification": {"n_starts": 2}}),
+              ("early.yaml", {"identification": {"n_starts": 1, "tolerance": 1e-6}, "trials": {"perturbation_onsets_ms": [50, 175]}})]
+    assert config_origin(key_path, layers, "config/config.yaml") == origin
+
+
+@pytest.mark.parametrize(
+    ("layers", "expected"),
+    [
+        ([("--config", {"identification": {"n_starts": "ten"}})], "--config: key 'identification.n_starts': 'ten'"),
+        ([("--config", {"seed": 1}), ("lab.yaml", {"identification": {"n_starts": "ten"}})],
+         "lab.yaml: key 'identification.n_starts': 'ten'"),
+        ([("lab.yaml", {"seed": 1})], "config/config.yaml: key 'identification.n_starts': 'ten'"),
+    ],
+)
+def test_bad_value_names_the_layer_that_set_it(layers, expected):
+    cfg = _config()
+    cfg["identification"]["n_starts"] = "ten"
+    with pytest.raises(LoperInputError) as info:
+        check_config(cfg, CONFIG_SCHEMA, "config/config.yaml", layers)
+    assert str(info.value).startswith(expected), str(info.value)
+
+
+def test_unknown_key_names_the_layer_that_added_it():
+    cfg = _config()
+    cfg["validation"]["n_chunkz"] = 2
+    with pytest.raises(LoperInputError, match=r"^extra.yaml: key 'validation.n_chunkz'"):
+        check_config(cfg, CONFIG_SCHEMA, "config/config.yaml", [("extra.yaml", {"validation": {"n_chunkz": 2}})])
 
 
 def test_missing_required_key():

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import ast
+import re
 import shutil
 import subprocess
 import sys
@@ -145,17 +147,17 @@ def test_impedance_table_from_the_default_run(finished_run):
 @pytest.mark.parametrize(
     ("changes", "expected"),
     [
-        ({"identification__n_stars": 3}, "n_stars"),
-        ({"identification__n_starts": "ten"}, "ten"),
-        ({"validation__n_chunks": 0}, "n_chunks"),
-        ({"subjects": "config/nowhere.tsv"}, "config/nowhere.tsv"),
+        ({"identification__n_stars": 3}, "key 'identification.n_stars'"),
+        ({"identification__n_starts": "ten"}, "key 'identification.n_starts': 'ten'"),
+        ({"validation__n_chunks": 0}, "key 'validation.n_chunks': 0"),
+        ({"subjects": "config/nowhere.tsv"}, "key 'subjects': file 'config/nowhere.tsv' not found"),
     ],
 )
 def test_bad_config_is_refused_with_its_key(tmp_path, changes, expected):
     work = _project(tmp_path, **changes)
     res = _snakemake(work, "-n")
     assert res.returncode != 0
-    assert expected in res.stdout + res.stderr
+    assert f"config/config.yaml: {expected}" in res.stdout + res.stderr
 
 
 @pytest.mark.parametrize(
@@ -202,6 +204,55 @@ def test_bad_subject_sheet_is_refused(tmp_path):
     assert "subjects.tsv" in out and "S_01" in out
 
 
+def _rule_blocks() -> dict[str, str]:
+    """{rule name: its text} of every rule in workflow/rules/*.smk."""
+    blocks = {}
+    for smk in sorted((ROOT / "workflow/rules").glob("*.smk")):
+        parts = re.split(r"^\s*rule (\w+):\s*$", smk.read_text(), flags=re.MULTILINE)
+        blocks.update(zip(parts[1::2], parts[2::2]))
+    return blocks
+
+
+def test_every_job_runs_its_step_inside_its_log():
+    """Each rule has a log and a script (no run: or shell:); each script imports only rule_log before entering
+    it, so an import error, a missing parameter or a failing step all end up in the job's log."""
+    blocks = _rule_blocks()
+    assert len(blocks) >= 30
+    scripts = set()
+    for name, body in blocks.items():
+        assert re.search(r"^\s+log:\s*$", body, re.MULTILINE), name
+        assert not re.search(r"^\s+(run|shell):", body, re.MULTILINE), name
+        scripts.add(re.search(r'^\s+script:\s*\n\s+"\.\./scripts/(\w+\.py)"', body, re.MULTILINE).group(1))
+    assert scripts == {p.name for p in (ROOT / "workflow/scripts").glob("*.py")}
+    for name in scripts:
+        tree = ast.parse((ROOT / "workflow/scripts" / name).read_text())
+        first, second, *rest = tree.body
+        assert ast.unparse(first) == "from loper_analysis.steps import rule_log", name
+        assert isinstance(second, ast.With) and not rest, name
+        assert ast.unparse(second.items[0].context_expr) == "rule_log(snakemake.log[0])", name
+        assert isinstance(second.body[0], ast.ImportFrom) and second.body[0].module == "loper_analysis.steps", name
+
+
+def test_a_failed_job_leaves_its_message_and_traceback_in_its_log(tmp_path):
+    """A truncated C3D: the console shows the cause in one line, the job's log the message and the traceback."""
+    work = _project(tmp_path, device__subject="R01")
+    (work / "config/subjects.tsv").write_text("subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.8\t72\n")
+    raw = work / "data/raw/R01"
+    raw.mkdir(parents=True)
+    (raw / "static.c3d").write_bytes((ROOT / "tests/data/opensim-core/walking5.c3d").read_bytes()[:30_000])
+    res = _snakemake(work, "results/markers/R01/static.trc")
+    assert res.returncode != 0
+    message = "data/raw/R01/static.c3d: truncated file: the header declares 1103 frames but only 22 could be read"
+    console = res.stdout + res.stderr
+    assert console.count(message) == 1 and "Traceback" not in console
+    assert "results/logs/markers/R01/static.log (check log file(s) for error details)" in console
+    log = (work / "results/logs/markers/R01/static.log").read_text()
+    assert f"ERROR loper_analysis.rule: LoperInputError: {message}" in log
+    assert "Traceback (most recent call last)" in log and 'in read_c3d' in log
+    assert log.rstrip().endswith(f"loper_analysis.errors.LoperInputError: {message}")
+    assert not (work / "results/markers").exists()  # nothing half-written
+
+
 def test_device_outputs_from_the_default_run(finished_run):
     summary = pd.read_csv(finished_run / "results/device/summary.tsv", sep="\t").set_index("metric")
     assert list(summary.columns[:3]) == ["value", "study_value", "unit"]
@@ -231,6 +282,87 @@ def test_recorded_subject_without_a_trial_reports_that_onset_missing(finished_ru
     assert (table.status == "missing").all() and (table.reason == "no trial of this onset").all()
     assert table[["K_nm_per_rad", "D_nms_per_rad", "K_true_nm_per_rad", "D_true_nms_per_rad"]].isna().all().all()
     assert not (work / "results/ik").exists()  # nothing was processed for an onset without trials
+
+
+def _copy_of(project: Path, dest: Path) -> Path:
+    """A copy of a finished project with its files' times and Snakemake's records: only what changes reruns."""
+    shutil.copytree(project, dest, symlinks=True)
+    return dest
+
+
+def _cut_c3d(path: Path, seconds: float) -> None:
+    """Keep the first ``seconds`` of a C3D (markers and analogs), as a recording stopped early."""
+    from dataclasses import replace
+
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.c3d_writer import write_recording
+
+    rec = read_c3d(path)
+    n = round(seconds * rec.point_rate_hz)
+    write_recording(path, replace(rec, markers_m=rec.markers_m[:n], analogs=rec.analogs[:n * rec.samples_per_frame]))
+
+
+def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_run, tmp_path):
+    """walk-device and pert050-1 cut to 5 s (2 complete left strides each, no perturbation yet): warnings and
+    flagged rows, transparency without the subject, the fit failed with its reason; the run ends normally."""
+    work = _copy_of(finished_run, tmp_path / "short")
+    for trial in ("walk-device", "pert050-1"):
+        _cut_c3d(work / f"data/raw/S01/{trial}.c3d", 5.0)
+    res = _snakemake(work)
+    assert res.returncode == 0, res.stderr[-3000:]
+    summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t").set_index("trial")
+    assert summary.loc["walk-nodevice", "status"] == "ok"
+    for trial in ("walk-device", "pert050-1"):
+        assert summary.loc[trial, ["n_strides", "n_kept", "status"]].tolist() == [2, 2, "too_few_strides"], trial
+        strides = pd.read_csv(work / f"results/strides/S01/{trial}.strides.tsv", sep="\t")
+        assert len(strides) == 2 and not strides.removed.any()
+        assert strides.filter(like="fraction_outlying_").isna().all().all()
+        log = (work / f"results/logs/strides/S01/{trial}.log").read_text()
+        assert "2 complete unperturbed left stride(s)" in log and "the outlier rule needs at least 4" in log
+    rmsd = pd.read_csv(work / "results/transparency/rmsd.tsv", sep="\t")
+    assert len(rmsd) == 12 and (rmsd.n_strides_device == [2] * 6 + [0] * 6).all()
+    assert rmsd[["rmsd_rad", "isv_ave_rad", "transparent"]].isna().all().all()
+    assert "subject S01: " in (work / "results/logs/transparency/transparency.log").read_text()
+    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+    assert (table.status == "failed").all() and table.reason.str.startswith("0 valid perturbed stride(s)").all()
+    counts = pd.read_csv(work / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
+    assert counts.loc["total", ["n_perturbed", "status"]].tolist() == [0, "too_few_strides"]
+
+
+def test_a_killed_run_recovers_to_the_bytes_of_an_uninterrupted_one(finished_run, tmp_path):
+    """The README's recovery: kill the whole run (SIGKILL) after some jobs, `--unlock`, `--rerun-incomplete`."""
+    import os
+    import signal
+    import time
+
+    work = _copy_of(finished_run, tmp_path / "killed")
+    later = time.time() + 1
+    os.utime(work / "data/raw/S01/pert050-1.c3d", (later, later))  # a newer raw trial: its processing reruns
+    console = tmp_path / "killed.out"
+    with console.open("w") as out:
+        run = subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "2"], cwd=work, stdout=out,
+                               stderr=subprocess.STDOUT, start_new_session=True)
+        deadline = time.monotonic() + 300
+        while run.poll() is None and console.read_text().count("Finished jobid") < 3 and time.monotonic() < deadline:
+            time.sleep(0.05)
+        os.killpg(run.pid, signal.SIGKILL)
+        run.wait()
+    text = console.read_text()
+    n_jobs = int(re.search(r"^total\s+(\d+)$", text, re.MULTILINE).group(1))
+    assert 3 <= text.count("Finished jobid") < n_jobs - 3  # killed halfway
+    assert "locked" in (_snakemake(work).stderr + "").lower()  # the lock stays until --unlock
+    assert _snakemake(work, "--unlock").returncode == 0
+    res = _snakemake(work, "--rerun-incomplete")
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert not list((work / "results").rglob("*.partial"))  # no staging left behind
+
+    def tables(root: Path) -> dict:
+        return {p.relative_to(root): p.read_bytes() for p in (root / "results").rglob("*.tsv")
+                if "benchmarks" not in p.parts}  # job timings differ by nature
+
+    ours, clean = tables(work), tables(finished_run)
+    assert sorted(ours) == sorted(clean) and len(ours) >= 40
+    assert [str(p) for p in ours if ours[p] != clean[p]] == []
 
 
 def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):

@@ -1,8 +1,8 @@
-"""The one error type of the library, and its one warning."""
+"""The one error type of the library, its one warning, and the one-line form of any error."""
 
 from __future__ import annotations
 
-__all__ = ["LoperInputError", "TooFewStridesWarning"]
+__all__ = ["LoperInputError", "TooFewStridesWarning", "one_line"]
 
 
 class LoperInputError(ValueError):
@@ -11,3 +11,9 @@ class LoperInputError(ValueError):
 
 class TooFewStridesWarning(UserWarning):
     """Fewer valid strides than required remain for an average."""
+
+
+def one_line(exc: BaseException) -> str:
+    """An error as one line: a LoperInputError's message, any other error prefixed with its type's name."""
+    text = " ".join(str(exc).split())
+    return text if isinstance(exc, LoperInputError) else f"{type(exc).__name__}: {text}"

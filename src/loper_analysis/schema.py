@@ -1,7 +1,15 @@
-"""Check configuration data against the workflow's JSON schemas with one short message."""
+"""Check configuration data against the workflow's JSON schemas with one short message.
+
+A workflow's configuration is built in layers: the default file, then each
+``--configfile`` in turn, then the ``--config`` values on the command line
+(each layer overriding the ones before). :func:`check_config` names the layer
+that set an offending key (:func:`config_origin`), so the message points at
+the file or option to fix.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
@@ -9,7 +17,11 @@ import yaml
 
 from .errors import LoperInputError
 
-__all__ = ["check_config", "check_table"]
+__all__ = ["ConfigLayers", "check_config", "check_table", "config_origin"]
+
+#: The configuration's layers, highest priority first: ``(name, mapping)``, e.g.
+#: ``[("--config", {...}), ("my.yaml", {...}), ("config/config.yaml", {...})]``.
+ConfigLayers = Sequence[tuple[str, Mapping]]
 
 
 def _validator(schema_path: str | Path):
@@ -19,14 +31,62 @@ def _validator(schema_path: str | Path):
     return jsonschema.Draft202012Validator(schema)
 
 
-def check_config(data: dict, schema_path: str | Path, source: str = "config") -> None:
-    """Raise LoperInputError naming the first offending key (dotted path) of ``data``."""
+def _sets(layer, key_path: Sequence) -> bool:
+    """True if ``layer`` holds a value at ``key_path`` (mapping keys and list indices)."""
+    node = layer
+    for key in key_path:
+        found = (isinstance(node, Mapping) and key in node) or (
+            isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node))
+        if not found:
+            return False
+        node = node[key]
+    return True
+
+
+def config_origin(key_path: Sequence, layers: ConfigLayers | None, default: str = "config") -> str:
+    """Name of the first layer (highest priority first) that sets ``key_path``; ``default`` when none does.
+
+    Parameters
+    ----------
+    key_path : sequence of str or int
+        Keys from the top of the configuration (``["identification", "n_starts"]``).
+    layers : sequence of (name, mapping), optional
+        The configuration's layers, highest priority first (:data:`ConfigLayers`).
+    default : str
+        The name returned when no layer sets the key (or no layers are given).
+    """
+    for name, layer in layers or ():
+        if _sets(layer, list(key_path)):
+            return name
+    return default
+
+
+def _offending_path(error) -> list:
+    """The key path an error is about; for an unknown key, the unknown key itself."""
+    path = list(error.absolute_path)
+    if error.validator == "additionalProperties" and isinstance(error.instance, Mapping):
+        known = set(error.schema.get("properties", {}))
+        extra = sorted(k for k in error.instance if k not in known)
+        if extra:
+            path.append(extra[0])
+    return path
+
+
+def check_config(data: dict, schema_path: str | Path, source: str = "config",
+                 layers: ConfigLayers | None = None) -> None:
+    """Raise LoperInputError naming the source, the first offending key (dotted path) and the problem.
+
+    ``source`` names the configuration; with ``layers`` (:data:`ConfigLayers`)
+    the message names the layer that set the offending key instead (an unknown
+    key is named itself, a missing one by its parent), falling back to ``source``.
+    """
     errors = sorted(_validator(schema_path).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if errors:
         e = errors[0]
-        key = ".".join(map(str, e.absolute_path)) or "(top level)"
+        path = _offending_path(e)
+        key = ".".join(map(str, path)) or "(top level)"
         more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
-        raise LoperInputError(f"{source}: key '{key}': {e.message}{more}")
+        raise LoperInputError(f"{config_origin(path, layers, source)}: key '{key}': {e.message}{more}")
 
 
 def check_table(table: pd.DataFrame, schema_path: str | Path, source: str) -> None:

@@ -12,6 +12,7 @@ Times in s on the motion-capture clock, angles in rad, force in N.
 from __future__ import annotations
 
 import logging
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -20,7 +21,7 @@ import pandas as pd
 
 from .checks import require_columns, where
 from .constants import JOINTS, PHASES, angle_column
-from .errors import LoperInputError
+from .errors import LoperInputError, TooFewStridesWarning
 from .events import strides as strides_from_events
 from .loadcell import perturbation_onsets
 from .outliers import check_enough_strides, iqr_outliers
@@ -185,13 +186,15 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
         (``stride``, ``phase``, ``point``, ``percent``, the joint angles in rad
         and ``force_n``). Fewer than ``min_valid`` kept strides: a
         :class:`~loper_analysis.errors.TooFewStridesWarning` and
-        ``too_few_strides`` True.
+        ``too_few_strides`` True. Fewer than
+        :data:`MIN_STRIDES_FOR_OUTLIERS` unperturbed strides (none at all
+        included): the outlier rule cannot judge them, so none is removed,
+        their ``fraction_outlying_*`` are NaN and a warning says so.
 
     Raises
     ------
     LoperInputError
-        Missing columns, force frames that differ from the angles', fewer
-        than :data:`MIN_STRIDES_FOR_OUTLIERS` (unperturbed) strides.
+        Missing columns, force frames that differ from the angles'.
     """
     names = {"angles": "angles", "events": "events", "force": "force", **(sources or {})}
     cols = [angle_column(j, side) for j in JOINTS]
@@ -201,11 +204,6 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
     inside = (table["heel_strike_s"] >= t[0]) & (table["end_s"] <= t[-1])
     table = table[inside].reset_index(drop=True)
     table["stride"] = np.arange(len(table))
-    if len(table) < MIN_STRIDES_FOR_OUTLIERS:
-        raise LoperInputError(
-            f"{names['events']}: {len(table)} complete {side} stride(s) inside the kinematics of {names['angles']}; "
-            f"need at least {MIN_STRIDES_FOR_OUTLIERS} for the outlier rule"
-        )
     values = angles[cols].to_numpy(float)
     force_n = None
     if force is not None:
@@ -228,11 +226,18 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
                 table.loc[i, ["perturbed", "onset_s"]] = (True, within[0])
     by_stride = normalise(t, values, table, "stride", n_points, source=names["angles"])
     joint_names = [c.split("_")[0] for c in cols]
-    plain = ~table["perturbed"].to_numpy()  # perturbed strides are the responses, judged in their window later
-    if plain.sum() < MIN_STRIDES_FOR_OUTLIERS:
-        raise LoperInputError(f"{names['angles']}: {int(plain.sum())} unperturbed stride(s); need at least "
-                              f"{MIN_STRIDES_FOR_OUTLIERS} for the outlier rule")
-    verdict = iqr_outliers(by_stride[plain], whisker, max_fraction, names=joint_names, source=names["angles"])
+    plain = ~table["perturbed"].to_numpy(bool)  # perturbed strides are the responses, judged in their window later
+    if plain.sum() >= MIN_STRIDES_FOR_OUTLIERS:
+        verdict = iqr_outliers(by_stride[plain], whisker, max_fraction, names=joint_names, source=names["angles"])
+    else:  # too few to judge: none removed, the trial flagged below
+        warnings.warn(
+            f"{names['angles']}: {int(plain.sum())} complete unperturbed {side} stride(s) with events from "
+            f"{names['events']}; the outlier rule needs at least {MIN_STRIDES_FOR_OUTLIERS}: none judged",
+            TooFewStridesWarning, stacklevel=2,
+        )
+        verdict = pd.DataFrame({"stride": np.arange(int(plain.sum()), dtype=np.int64),
+                                **{f"fraction_outlying_{j}": np.nan for j in joint_names},
+                                "removed": False, "reason": ""})
     verdict["stride"] = table.loc[plain, "stride"].to_numpy()
     out = table.merge(verdict, on="stride", how="left")
     out["removed"] = out["removed"].fillna(False).astype(bool)
@@ -242,6 +247,8 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
         metrics = force_phase_metrics(t, force_n, table, source=names["force"])
         wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
         wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
+        # the same columns without any stride
+        wide = wide.reindex(columns=[f"{m}_{ph}_n" for m in ("rms_force", "max_abs_force") for ph in FORCE_PHASES])
         out = out.merge(wide.reset_index(), on="stride")
     n_kept = int((~out["removed"] & ~out["perturbed"]).sum())
     log.info("%s: %d strides, %d perturbed, %d removed as outliers, %d unperturbed kept", names["angles"], len(out),

@@ -18,6 +18,7 @@ Angles are in rad, forces in N, time in s. Normalised arrays have shape
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -25,7 +26,8 @@ import numpy as np
 import pandas as pd
 
 from .constants import JOINTS, angle_column
-from .errors import LoperInputError
+from .errors import LoperInputError, TooFewStridesWarning
+from .outliers import MIN_VALID_STRIDES
 from .reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
 from .strides import phase_cycles
 
@@ -289,15 +291,42 @@ class TransparencyResults:
     toe_off_pct: dict[str, float]
 
 
+def _kept(strides: pd.DataFrame) -> int:
+    """Kept unperturbed strides of a stride table."""
+    plain = ~strides["perturbed"].astype(bool) if "perturbed" in strides.columns else True
+    return int((~strides["removed"].astype(bool) & plain).sum())
+
+
+def _flagged_rows(subject: str, counts: Mapping[str, int], joints: Sequence[str]) -> list[dict]:
+    """Rows of a subject left out of the comparison: the stride counts, the metrics empty."""
+    return [{"subject": str(subject), "phase": ph, "joint": j, "n_strides_no_device": counts["no_device"],
+             "n_strides_device": counts["device"], "rmsd_rad": np.nan, "sd_rad": np.nan, "isv_ave_rad": np.nan,
+             "transparent": None} for ph in TRANSPARENCY_PHASES for j in joints]
+
+
 def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, pd.DataFrame]]],
-                         side: str = "left") -> TransparencyResults:
+                         side: str = "left", min_strides: int = MIN_VALID_STRIDES) -> TransparencyResults:
     """Transparency of the device from each subject's stride and cycle tables with and without it.
 
     ``trials``: ``{subject: {"no_device": (strides, cycles), "device": (strides, cycles)}}``,
     the tables of :func:`loper_analysis.strides.stride_tables` (kept,
-    unperturbed strides count).
+    unperturbed strides count). A subject with fewer than ``min_strides``
+    (at least 2) kept strides in either condition is left out of the
+    comparison, the group rows and the figure, with a
+    :class:`~loper_analysis.errors.TooFewStridesWarning`: its rows keep the
+    stride counts, their metrics and ``transparent`` are empty. Without any
+    subject left, the group rows are empty too and ``angles_rad`` is ``{}``.
     """
     cols = [angle_column(j, side) for j in JOINTS]
+    least = max(int(min_strides), 2)
+    counts = {subject: {c: _kept(conds[c][0]) for c in CONDITIONS if c in conds} for subject, conds in trials.items()}
+    left_out = {s: n for s, n in counts.items() if len(n) == len(CONDITIONS) and min(n.values()) < least}
+    for subject, n in left_out.items():
+        warnings.warn(f"subject {subject}: {n['no_device']} kept stride(s) without and {n['device']} with the "
+                      f"device, fewer than {least}: left out of the transparency analysis", TooFewStridesWarning,
+                      stacklevel=2)
+    if left_out:
+        return _results_without(trials, left_out, side, least)
     per_subject, force_rows, pooled, pooled_force, toe_off = {}, [], {"no_device": [], "device": []}, [], {}
     for subject, conds in trials.items():
         per_subject[subject] = {}
@@ -337,3 +366,48 @@ def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, p
         force_n=np.concatenate(pooled_force) if pooled_force else None,
         toe_off_pct={c: float(np.mean(v)) for c, v in toe_off.items()},
     )
+
+
+def _results_without(trials: Mapping, left_out: Mapping[str, Mapping[str, int]], side: str,
+                     least: int) -> TransparencyResults:
+    """:func:`transparency_results` of the other subjects, with the rows of those ``left_out`` in subject order."""
+    kept = {s: v for s, v in trials.items() if s not in left_out}
+    if kept:
+        part = transparency_results(kept, side, least)
+        rmsd, force = part.rmsd, part.force
+    else:
+        part = TransparencyResults(pd.DataFrame(columns=list(TRANSPARENCY_COLUMNS)), pd.DataFrame(), {}, None, {})
+        group = [{"subject": "all", "phase": ph, "joint": j, "n_strides_no_device": 0, "n_strides_device": 0,
+                  "rmsd_rad": np.nan, "sd_rad": np.nan, "isv_ave_rad": np.nan, "transparent": None}
+                 for ph in TRANSPARENCY_PHASES for j in JOINTS]
+        rmsd = pd.DataFrame(group)
+        study = pd.DataFrame([{"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}
+                              for (ph, j), (r, isv) in STUDY_TRANSPARENCY_RAD.items()])
+        rmsd = rmsd.merge(study, on=["phase", "joint"], how="left")
+        force = pd.DataFrame()
+    rows, force_rows = [], []
+    for subject in trials:
+        if subject in left_out:
+            rows.append(pd.DataFrame(_flagged_rows(subject, left_out[subject], JOINTS)))
+            force_rows.append(pd.DataFrame([{"subject": subject, "phase": ph, "n_strides": left_out[subject]["device"]}
+                                            for ph in TRANSPARENCY_PHASES]))
+        else:
+            rows.append(rmsd[rmsd["subject"] == str(subject)])
+            if len(force):
+                force_rows.append(force[force["subject"] == subject])
+    rows.append(rmsd[rmsd["subject"] == "all"])
+    out = pd.concat(rows, ignore_index=True)
+    out["transparent"] = out["transparent"].astype(object).where(out["rmsd_rad"].notna(), None)
+    study_cols = [c for c in rmsd.columns if c.startswith("study_")]
+    out = out.drop(columns=study_cols).merge(rmsd[["phase", "joint", *study_cols]].drop_duplicates(),
+                                             on=["phase", "joint"], how="left")
+    force_rows.append(force[force["subject"] == "all"] if len(force) else
+                      pd.DataFrame([{"subject": "all", "phase": ph, "n_strides": 0} for ph in TRANSPARENCY_PHASES]))
+    force_out = pd.concat(force_rows, ignore_index=True)
+    for i, name in enumerate(("study_rms_force_mean_n", "study_rms_force_sd_n", "study_max_abs_force_mean_n",
+                              "study_max_abs_force_sd_n")):
+        force_out[name] = [STUDY_INTERACTION_FORCE_N[ph][i] for ph in force_out["phase"]]
+    force_cols = ["subject", "phase", "n_strides", "rms_force_mean_n", "rms_force_sd_n", "max_abs_force_mean_n",
+                  "max_abs_force_sd_n"]
+    force_out = force_out.reindex(columns=force_cols + [c for c in force_out.columns if c not in force_cols])
+    return TransparencyResults(out, force_out, part.angles_rad, part.force_n, part.toe_off_pct)

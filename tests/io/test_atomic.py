@@ -53,6 +53,20 @@ def test_staged_moves_the_finished_file_and_leaves_nothing_else(tmp_path):
     assert _entries(target.parent) == ["table.tsv"]
 
 
+def test_staging_left_by_a_killed_writer_is_removed_when_the_target_is_written_again(tmp_path):
+    target, other = tmp_path / "strides.tsv", tmp_path / "cycles.tsv"
+    stale = tmp_path / ".strides.tsv.k3x9_q2a.partial"  # what a writer killed halfway leaves
+    stale.mkdir()
+    (stale / "strides.tsv").write_text("stride\n0\n1\n")
+    busy = tmp_path / ".cycles.tsv.a1b2c3d4.partial"  # another target's: not touched
+    busy.mkdir()
+    write_text(target, "stride\n0\n1\n2\n")
+    assert target.read_text() == "stride\n0\n1\n2\n"
+    assert _entries(tmp_path) == [".cycles.tsv.a1b2c3d4.partial", "strides.tsv"]
+    write_text(other, "x\n")
+    assert _entries(tmp_path) == ["cycles.tsv", "strides.tsv"]
+
+
 def test_staged_keeps_the_old_file_when_the_writer_fails_halfway(tmp_path):
     target = tmp_path / "data.bin"
     target.write_bytes(b"old")
@@ -187,7 +201,7 @@ def test_robot_log_writer_refuses_bad_data_before_writing(tmp_path):
 
 def test_rule_log_writes_the_messages_and_the_full_error_when_the_job_fails(tmp_path):
     log_path = tmp_path / "logs" / "job.log"
-    with pytest.raises(LoperInputError, match="pert050-1.c3d: POINT:UNITS"):
+    with pytest.raises(SystemExit) as info:
         with rule_log(log_path) as log:
             log.info("reading the trial")
             logging.getLogger("loper_analysis.steps.processing").warning("a gap of 12 frames")
@@ -198,6 +212,20 @@ def test_rule_log_writes_the_messages_and_the_full_error_when_the_job_fails(tmp_
     assert "ERROR loper_analysis.rule: LoperInputError: pert050-1.c3d: POINT:UNITS not declared" in text
     assert "Traceback (most recent call last)" in text
     assert _entries(log_path.parent) == ["job.log"]
+    # the job ends with the error in one line (what the console shows), the traceback stays in the log
+    assert str(info.value.code) == f"pert050-1.c3d: POINT:UNITS not declared (traceback in {log_path})"
+    assert isinstance(info.value.__cause__, LoperInputError)
+
+
+def test_rule_log_names_the_type_of_an_unexpected_error_and_lets_interruptions_through(tmp_path):
+    with pytest.raises(SystemExit, match=r"^KeyError: 'sync_channel' \(traceback in "):
+        with rule_log(tmp_path / "a.log"):
+            {}["sync_channel"]
+    assert "KeyError: 'sync_channel'" in (tmp_path / "a.log").read_text()
+    with pytest.raises(KeyboardInterrupt):
+        with rule_log(tmp_path / "b.log"):
+            raise KeyboardInterrupt
+    assert "ERROR loper_analysis.rule: KeyboardInterrupt" in (tmp_path / "b.log").read_text()
 
 
 def test_rule_log_captures_warnings(tmp_path):

@@ -182,3 +182,72 @@ def test_transparency_of_a_trial_against_itself(lab, tmp_path):
     np.testing.assert_allclose(force["rms_force_sd_n"].iloc[-2:], 0.0, atol=1e-12)  # identical subjects
     assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert out.angles_rad["device"].shape == (2 * int((~lab["strides"].strides["removed"]).sum()), 101, 3)
+
+
+@pytest.mark.parametrize("n_strides", [0, 3])
+def test_fewer_strides_than_the_outlier_rule_needs_are_kept_unjudged_and_flagged(lab, tmp_path, n_strides):
+    """0 or 3 complete strides: no stop; none removed, fractions empty, two warnings, too_few_strides."""
+    d = lab["dir"]
+    events = pd.read_csv(d / "walk.events.tsv", sep="\t")
+    hs = events[(events.side == "left") & (events.event == "heel_strike")].time_s.to_numpy()
+    events[events.time_s <= hs[n_strides] + 1e-9].to_csv(tmp_path / "short.events.tsv", sep="\t", index=False)
+    with pytest.warns(TooFewStridesWarning) as caught:
+        tables = processing.strides(d / "walk.angles.tsv", tmp_path / "short.events.tsv", tmp_path / "s.strides.tsv",
+                                    tmp_path / "s.cycles.tsv", d / "walk.force.tsv")
+    messages = [str(w.message) for w in caught]
+    assert f"{n_strides} complete unperturbed left stride(s)" in messages[0] and "needs at least 4" in messages[0]
+    assert f"only {n_strides} valid stride(s), fewer than the 5 required" in messages[1]
+    assert tables.too_few_strides
+    written = pd.read_csv(tmp_path / "s.strides.tsv", sep="\t")
+    assert list(written.columns) == list(lab["strides"].strides.columns)  # the same columns, also without strides
+    assert len(written) == n_strides and not written.removed.any()
+    assert written.filter(like="fraction_outlying_").isna().all().all()
+    # the first strides are the trial's own: same times and force as in the whole trial
+    whole = lab["strides"].strides.iloc[:n_strides]
+    cols = ["heel_strike_s", "rms_force_swing_n"]
+    np.testing.assert_allclose(written[cols].to_numpy(float), whole[cols].to_numpy(float), rtol=1e-8)
+    assert len(pd.read_csv(tmp_path / "s.cycles.tsv", sep="\t")) == 3 * 101 * n_strides
+
+
+def test_transparency_leaves_out_a_subject_with_too_few_strides(lab, tmp_path):
+    """S98 with 3 kept strides with the device: its rows keep the counts with empty metrics; the group is S99."""
+    d = lab["dir"]
+    strides = pd.read_csv(d / "walk.strides.tsv", sep="\t")
+    few = strides.copy()
+    few["removed"] = few.index >= 3
+    few.to_csv(tmp_path / "few.strides.tsv", sep="\t", index=False)
+    walk, cycles = d / "walk.strides.tsv", d / "walk.cycles.tsv"
+    with pytest.warns(TooFewStridesWarning, match="subject S98: .* and 3 with the device, fewer than 5"):
+        transparency.transparency(["S98", "S99"], [walk, walk], [cycles, cycles], [tmp_path / "few.strides.tsv", walk],
+                                  [cycles, cycles], tmp_path / "rmsd.tsv", tmp_path / "force.tsv", tmp_path / "t.png")
+    rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
+    n = int((~strides.removed).sum())
+    assert rmsd.subject.tolist() == ["S98"] * 6 + ["S99"] * 6 + ["all"] * 6
+    s98, s99, group = rmsd[rmsd.subject == "S98"], rmsd[rmsd.subject == "S99"], rmsd[rmsd.subject == "all"]
+    assert (s98.n_strides_device == 3).all() and (s98.n_strides_no_device == n).all()
+    assert s98[["rmsd_rad", "sd_rad", "isv_ave_rad", "transparent"]].isna().all().all()
+    np.testing.assert_allclose(s99.rmsd_rad, 0.0, atol=1e-12)
+    assert s99.transparent.all() and (group.n_strides_device == n).all()
+    np.testing.assert_allclose(group.isv_ave_rad, 2 * s99.sd_rad)  # ISV_ave of one subject: 2 sigma
+    force = pd.read_csv(tmp_path / "force.tsv", sep="\t")
+    assert force.subject.tolist() == ["S98", "S98", "S99", "S99", "all", "all"]
+    assert force.loc[force.subject == "S98", "rms_force_mean_n"].isna().all()
+    np.testing.assert_allclose(force.loc[force.subject == "all", "rms_force_mean_n"],
+                               force.loc[force.subject == "S99", "rms_force_mean_n"])
+
+
+def test_transparency_without_any_subject_left_writes_empty_group_rows(lab, tmp_path):
+    d = lab["dir"]
+    strides = pd.read_csv(d / "walk.strides.tsv", sep="\t")
+    strides.iloc[:1].to_csv(tmp_path / "one.strides.tsv", sep="\t", index=False)
+    with pytest.warns(TooFewStridesWarning, match="and 1 with the device, fewer than 5"):
+        transparency.transparency(["S98"], [d / "walk.strides.tsv"], [d / "walk.cycles.tsv"],
+                                  [tmp_path / "one.strides.tsv"], [d / "walk.cycles.tsv"], tmp_path / "rmsd.tsv",
+                                  tmp_path / "force.tsv", tmp_path / "t.png")
+    rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
+    assert rmsd.subject.tolist() == ["S98"] * 6 + ["all"] * 6
+    assert (rmsd.loc[rmsd.subject == "all", ["n_strides_no_device", "n_strides_device"]] == 0).all().all()
+    assert rmsd.rmsd_rad.isna().all() and rmsd.transparent.isna().all() and rmsd.study_rmsd_rad.notna().all()
+    force = pd.read_csv(tmp_path / "force.tsv", sep="\t")
+    assert force.subject.tolist() == ["S98", "S98", "all", "all"] and force.n_strides.tolist() == [1, 1, 0, 0]
+    assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -5,18 +5,42 @@ import pandas as pd
 from snakemake.exceptions import WorkflowError
 from snakemake.utils import validate
 
+from snakemake.common.configfile import load_configfile
+
 from loper_analysis.errors import LoperInputError
-from loper_analysis.schema import check_config, check_table
+from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
+
+
+def _shown(path) -> str:
+    """A config file's name as the user typed it: relative to the working directory when inside it."""
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+# Where each value came from, highest priority first: --config, the --configfile files last to first, the default.
+CONFIG_LAYERS = [("--config", dict(workflow.config_settings.config))] + [
+    (_shown(f), load_configfile(str(f)) or {}) for f in reversed(list(workflow.config_settings.configfiles))
+]
+
+
+def config_source(*key_path) -> str:
+    """The file or command-line option that set a config key (config/config.yaml unless overridden)."""
+    return config_origin(key_path, CONFIG_LAYERS, "config/config.yaml")
+
+
 try:
-    # one short message naming the key, then Snakemake's own validation
-    check_config(config, _SCHEMAS / "config.schema.yaml", "config/config.yaml")
+    # one short message naming the file or option, the key and the value; then Snakemake's own validation
+    check_config(config, _SCHEMAS / "config.schema.yaml", "config/config.yaml", CONFIG_LAYERS)
     validate(config, "../schemas/config.schema.yaml")
     _subjects_path = Path(config["subjects"])
     if not _subjects_path.is_file():
-        raise LoperInputError(f"config key 'subjects': file '{_subjects_path}' not found")
+        raise LoperInputError(f"{config_source('subjects')}: key 'subjects': file '{_subjects_path}' not found")
     subjects = pd.read_csv(_subjects_path, sep="\t", dtype={"subject": str}, comment="#")
     check_table(subjects, _SCHEMAS / "subjects.schema.yaml", str(_subjects_path))
     validate(subjects, "../schemas/subjects.schema.yaml")
@@ -52,14 +76,16 @@ try:
     _onsets = {int(o) for o in config["synthetic"]["stiffness_nm_per_rad"]}
     if not set(config["trials"]["perturbation_onsets_ms"]) <= _onsets:
         raise LoperInputError(
-            f"config key 'synthetic.stiffness_nm_per_rad': no truth for onset(s) "
+            f"{config_source('synthetic', 'stiffness_nm_per_rad')}: key 'synthetic.stiffness_nm_per_rad': "
+            f"no truth for onset(s) "
             f"{sorted(set(config['trials']['perturbation_onsets_ms']) - _onsets)} ms of trials.perturbation_onsets_ms"
         )
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
 if config["device"]["subject"] not in SUBJECT_SOURCE:
     raise WorkflowError(
-        f"config key 'device.subject': subject '{config['device']['subject']}' is not in {_subjects_path}"
+        f"{config_source('device', 'subject')}: key 'device.subject': subject '{config['device']['subject']}' "
+        f"is not in {_subjects_path}"
     )
 _synthetic = [s for s, src in SUBJECT_SOURCE.items() if src == "synthetic"]
 SYNTHETIC_PATTERN = "|".join(_synthetic) if _synthetic else "(?!)"

@@ -298,6 +298,7 @@ rule transparency:
     params:
         subjects=transparency_subjects(),
         side=TRIALS["perturbed_side"],
+        min_strides=config["strides"]["min_valid_strides"],
     log:
         "results/logs/transparency/transparency.log",
     script:

@@ -1,5 +1,7 @@
-from loper_analysis.steps import device, rule_log
+from loper_analysis.steps import rule_log
 
-inp, out = snakemake.input, snakemake.output
 with rule_log(snakemake.log[0]):
+    from loper_analysis.steps import device
+
+    inp, out = snakemake.input, snakemake.output
     device.figures(inp.frf, inp.summary, inp.average, out.bode, out.steps)

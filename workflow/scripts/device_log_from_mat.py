@@ -1,5 +1,7 @@
-from loper_analysis.steps import device, rule_log
+from loper_analysis.steps import rule_log
 
-p = snakemake.params
 with rule_log(snakemake.log[0]):
+    from loper_analysis.steps import device
+
+    p = snakemake.params
     device.log_from_mat(snakemake.input[0], snakemake.output[0], p.column_map, p.sample_rate_hz)

@@ -1,5 +1,7 @@
-from loper_analysis.steps import ik, rule_log
+from loper_analysis.steps import rule_log
 
-p, out = snakemake.params, snakemake.output
 with rule_log(snakemake.log[0]):
+    from loper_analysis.steps import ik
+
+    p, out = snakemake.params, snakemake.output
     ik.ik_trial(snakemake.input.model, snakemake.input.trc, out.mot, out.angles, p.coordinate_map, **p.settings)

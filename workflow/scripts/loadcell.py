@@ -1,6 +1,8 @@
-from loper_analysis.steps import processing, rule_log
+from loper_analysis.steps import rule_log
 
-p = snakemake.params
 with rule_log(snakemake.log[0]):
+    from loper_analysis.steps import processing
+
+    p = snakemake.params
     processing.loadcell(snakemake.input.c3d, snakemake.input.log, snakemake.output[0], p.sync_channel, p.cutoff_hz,
                         p.order)

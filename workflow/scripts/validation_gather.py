@@ -1,5 +1,7 @@
-from loper_analysis.steps import rule_log, validation
+from loper_analysis.steps import rule_log
 
-inp, out = snakemake.input, snakemake.output
 with rule_log(snakemake.log[0]):
+    from loper_analysis.steps import validation
+
+    inp, out = snakemake.input, snakemake.output
     validation.validation_tables(inp.errors, inp.fits, out.errors, out.fits, out.summary)

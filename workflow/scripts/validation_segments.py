@@ -1,5 +1,7 @@
-from loper_analysis.steps import model, rule_log
+from loper_analysis.steps import rule_log
 
-p = snakemake.params
 with rule_log(snakemake.log[0]):
+    from loper_analysis.steps import model
+
+    p = snakemake.params
     model.anthropometric_segments(snakemake.output[0], p.height_m, p.mass_kg, p.attachment_fraction)

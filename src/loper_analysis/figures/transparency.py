@@ -36,8 +36,8 @@ def transparency_figure(
     ----------
     angles_rad : mapping
         ``{"no_device" | "device": array (n_strides >= 2, n_points, n_joints)}``,
-        stride-normalised joint angles in rad (either condition may be absent,
-        not both).
+        stride-normalised joint angles in rad (either condition may be absent;
+        with neither, the figure says that no subject had enough strides).
     force_n : array_like, shape (n_strides >= 2, n_points), optional
         Stride-normalised interaction force in N (device condition).
     toe_off_pct : float or mapping, optional
@@ -53,8 +53,17 @@ def transparency_figure(
     matplotlib.figure.Figure
     """
     conditions = [c for c in CONDITIONS if c in angles_rad]
-    if not conditions or set(angles_rad) - set(CONDITIONS):
+    if set(angles_rad) - set(CONDITIONS):
         raise LoperInputError(f"angles_rad must map some of {CONDITIONS} to arrays, got {sorted(angles_rad)}")
+    if not conditions:
+        fig = pyplot().figure(figsize=(5.5, 2.0))
+        ax = fig.add_subplot()
+        ax.text(0.5, 0.5, "no subject with enough kept strides in both conditions", transform=ax.transAxes,
+                ha="center", va="center", color="0.4", fontsize=11)
+        ax.set_axis_off()
+        if title:
+            fig.suptitle(title)
+        return fig
     joints = [str(j) for j in joints]
     data = {}
     for c in conditions:

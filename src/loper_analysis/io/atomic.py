@@ -17,6 +17,7 @@ themselves.
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import shutil
 import tempfile
@@ -46,6 +47,15 @@ PathLike = str | os.PathLike
 TSV_FLOAT_FORMAT = "%.9g"
 #: Resolution of PNG figures.
 FIGURE_DPI = 110
+#: Random characters in a staging directory's name (those of :func:`tempfile.mkdtemp`).
+_STAGE_RANDOM_CHARS = 8
+
+
+def _remove_stale_stages(path: Path) -> None:
+    """Remove staging directories of ``path`` left by a writer that was killed (one writer per target)."""
+    for stale in path.parent.glob(f".{glob.escape(path.name)}.{'?' * _STAGE_RANDOM_CHARS}.partial"):
+        if stale.is_dir() and not stale.is_symlink():
+            shutil.rmtree(stale, ignore_errors=True)
 
 
 @contextlib.contextmanager
@@ -53,7 +63,9 @@ def staged(path: str | os.PathLike, what: str = "file") -> Iterator[Path]:
     """Yield a temporary path for ``path``; on success move it over ``path``, on failure leave nothing.
 
     The parent directory is created when missing. ``what`` names the kind of
-    file in error messages.
+    file in error messages. Staging directories of the same target left by a
+    writer that was killed (SIGKILL, power loss) are removed first: a target
+    has one writer at a time, so they can only be stale.
 
     Raises
     ------
@@ -65,6 +77,7 @@ def staged(path: str | os.PathLike, what: str = "file") -> Iterator[Path]:
     directory = path.parent
     try:
         directory.mkdir(parents=True, exist_ok=True)
+        _remove_stale_stages(path)
         stage = Path(tempfile.mkdtemp(prefix=f".{path.name}.", suffix=".partial", dir=directory))
     except OSError as exc:
         raise LoperInputError(f"{path}: cannot write {what} ({exc})") from exc

@@ -16,13 +16,15 @@ log = logging.getLogger(__name__)
 def transparency(subjects: Sequence[str], no_device_strides: Sequence[PathLike],
                  no_device_cycles: Sequence[PathLike], device_strides: Sequence[PathLike],
                  device_cycles: Sequence[PathLike], rmsd_out: PathLike, force_out: PathLike, figure_out: PathLike,
-                 side: str = "left"):
+                 side: str = "left", min_strides: int = 5):
     """Transparency of the device from the stride and cycle tables of each subject's two walking trials.
 
     The four lists hold one file per subject, in the order of ``subjects``:
     the stride and cycle tables of walking without and with the device.
     Writes the tables of :func:`loper_analysis.transparency.transparency_results`
     and the figure (kept strides of all subjects pooled); returns the results.
+    A subject with fewer than ``min_strides`` kept strides in either trial is
+    left out of the comparison (its rows keep the counts, with empty metrics).
     """
     from ..figures.transparency import transparency_figure
     from ..transparency import transparency_results
@@ -33,7 +35,7 @@ def transparency(subjects: Sequence[str], no_device_strides: Sequence[PathLike],
                   "device": (read_tsv(ds, "stride table"), read_tsv(dc, "cycle table"))}
         for subject, ns, nc, ds, dc in files
     }
-    results = transparency_results(frames, side)
+    results = transparency_results(frames, side, min_strides)
     write_tsv(results.rmsd, rmsd_out)
     write_tsv(results.force, force_out)
     write_figure(transparency_figure(results.angles_rad, results.force_n, results.toe_off_pct,

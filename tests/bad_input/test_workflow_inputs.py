@@ -1,0 +1,357 @@
+"""Bad input at the workflow level: every refusal names the file, the field and the value, writes nothing
+under results/ or data/ (but the failed job's log) and leaves the results of earlier runs as they were.
+
+One module-wide project holds a recorded subject R01 (a static trial and a walking trial with the device,
+written by the simulated lab) whose markers, events and forces were already processed. Each test breaks
+one input in a copy of it. Where the readers' refusals are tested in detail elsewhere (tests/io,
+tests/steps), this suite runs the rule's file step on the project's paths, with the rule's settings
+from the config; a few cases go through Snakemake itself (real jobs, or dry runs for the checks made
+before any work starts).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+import shutil
+import subprocess
+import sys
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d import read_c3d
+from loper_analysis.io.c3d_writer import write_recording
+from loper_analysis.io.opensim_tables import read_markers, write_trc
+from loper_analysis.steps import ik, processing
+
+ROOT = Path(__file__).resolve().parents[2]
+SUBJECT, HEIGHT_M, MASS_KG = "R01", 1.75, 70.0
+RAW = f"data/raw/{SUBJECT}"
+WALK = "walk-device"
+#: What the project's earlier run made (besides logs and benchmarks).
+GOOD_TARGETS = (f"results/markers/{SUBJECT}/static.trc", f"results/markers/{SUBJECT}/{WALK}.trc",
+                f"results/events/{SUBJECT}/{WALK}.events.tsv", f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
+                f"results/model/{SUBJECT}/generic.osim")
+
+
+def _snakemake(cwd: Path, *args: str) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=cwd, capture_output=True,
+                          text=True, timeout=300, check=False)
+
+
+@pytest.fixture(scope="module")
+def project(tmp_path_factory) -> Path:
+    """The workflow with one recorded subject (8 s of walking) and the results of its first stages."""
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.io.robot_log import write_robot_log
+    from loper_analysis.model import (
+        build_lower_body_model,
+        segment_parameters_from_model,
+    )
+    from loper_analysis.synthetic.trials import (
+        LabSettings,
+        simulate_walking_trial,
+        subject_static_recording,
+        walking_recording,
+    )
+
+    work = tmp_path_factory.mktemp("lab")
+    for item in ("Snakefile", "workflow", "config"):
+        src = ROOT / item
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
+    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    cfg["device"]["subject"] = SUBJECT
+    cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
+    (work / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    (work / "config/subjects.tsv").write_text(
+        f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t{HEIGHT_M}\t{MASS_KG}\n")
+    lab, raw = LabSettings(), work / RAW
+    raw.mkdir(parents=True)
+    write_recording(raw / "static.c3d", subject_static_recording(SUBJECT, HEIGHT_M, MASS_KG, 2.0, lab, 7))
+    model = build_lower_body_model(HEIGHT_M, MASS_KG)
+    for folder, seed in ((raw, 3), (work / "elsewhere", 4)):  # the trial, and one recorded at another time
+        walk = simulate_walking_trial(8.0, lab, seed, HEIGHT_M, segment_parameters_from_model(model), 0.03, 0.05,
+                                      DeviceParameters())
+        folder.mkdir(exist_ok=True)
+        write_recording(folder / f"{WALK}.c3d", walking_recording(model, walk, MASS_KG, lab, seed + 10))
+        write_robot_log(folder / f"{WALK}.loper.tsv", walk.robot, lab.robot_rate_hz, {"clock": "robot"})
+    res = _snakemake(work, *GOOD_TARGETS)
+    assert res.returncode == 0, res.stderr[-3000:]
+    return work
+
+
+@pytest.fixture
+def lab(project, tmp_path, monkeypatch) -> Path:
+    """A copy of the project (files' times kept) as the working directory."""
+    work = tmp_path / "lab"
+    shutil.copytree(project, work, symlinks=True)
+    monkeypatch.chdir(work)
+    return work
+
+
+def _config(work: Path) -> dict:
+    return yaml.safe_load((work / "config/config.yaml").read_text())
+
+
+def _state(work: Path) -> dict[str, tuple[int, str]]:
+    """Every file under results/ and data/ (hidden ones too): modification time and content hash."""
+    return {str(p.relative_to(work)): (p.stat().st_mtime_ns, hashlib.sha256(p.read_bytes()).hexdigest())
+            for top in ("results", "data") for p in sorted((work / top).rglob("*")) if p.is_file()}
+
+
+def _refused(work: Path, run, words, log: str | None = None) -> str:
+    """Run a refusal; check its message names every one of ``words`` and that the files are as they were.
+
+    ``run`` raises LoperInputError (a file step) or returns Snakemake's finished process (then the
+    console's output is the message). ``log``: the failed job's log, the only file allowed to appear.
+    """
+    before = _state(work)
+    assert set(GOOD_TARGETS) <= set(before)
+    try:
+        res = run()
+    except LoperInputError as exc:
+        message = str(exc)
+    else:
+        assert res.returncode != 0
+        message = res.stdout + res.stderr
+    for word in words:
+        assert word in message, (word, message[-2000:])
+    after = _state(work)
+    if log is not None:
+        after.pop(log)
+        text = (work / log).read_text()
+        assert words[0] in text and "Traceback (most recent call last)" in text
+    assert after == before  # nothing new, nothing rewritten, nothing removed
+    return message
+
+
+# --------------------------------------------------------------------------- the steps of the rules
+
+
+def _markers(cfg: dict, c3d: str, label_map=None):
+    """The markers rule's step for the walking trial, with its outputs and the config's settings."""
+    out = f"results/markers/{SUBJECT}/{WALK}"
+    m = cfg["markers"]
+    return processing.markers(c3d, f"{out}.trc", f"{out}.gaps.tsv", m["lab_to_model_rotation_deg"],
+                              m["max_gap_frames"], cfg["filter"]["cutoff_hz"], cfg["filter"]["order"], None,
+                              label_map=label_map or m["label_map"] or None, summary_out=f"{out}.markers.tsv")
+
+
+def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW}/{WALK}.c3d"):
+    return processing.loadcell(c3d, log, f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
+                               cfg["events"]["sync_channel"], cfg["filter"]["cutoff_hz"], cfg["filter"]["order"])
+
+
+def _events(cfg: dict, grf_channels: dict):
+    e = cfg["events"]
+    out = f"results/events/{SUBJECT}/{WALK}"
+    return processing.events(f"{RAW}/{WALK}.c3d", f"{out}.events.tsv", grf_channels, e["threshold_on_n"],
+                             e["threshold_off_n"], e["min_stance_s"], e["min_swing_s"], e["grf_cutoff_hz"],
+                             cfg["filter"]["order"], e["foot_markers"], e["plate_sides"], None,
+                             cfg["markers"]["lab_to_model_rotation_deg"], cfg["grf"]["resting_band_n"],
+                             cfg["grf"]["max_resting_n"], f"{out}.contacts.tsv")
+
+
+def _ik(cfg: dict, trc: Path):
+    o = cfg["opensim"]
+    return ik.ik_trial(f"results/model/{SUBJECT}/generic.osim", trc, f"results/ik/{SUBJECT}/{WALK}.mot",
+                       f"results/ik/{SUBJECT}/{WALK}.angles.tsv", o["coordinate_map"], tasks_file=o["ik_tasks"],
+                       default_weight=o["default_marker_weight"], marker_weights=o["marker_weights"],
+                       coordinate_tasks=o["coordinate_tasks"], accuracy=o["accuracy"])
+
+
+# --------------------------------------------------------------------------- C3D files
+
+
+def _c3d_bytes(work: Path) -> bytes:
+    return (work / RAW / f"{WALK}.c3d").read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "words"),
+    [
+        ("truncated", lambda b, w: b[: len(b) // 2], ["truncated file", "declares 1024 frames but only 511"]),
+        ("foreign", lambda b, w: (w / RAW / f"{WALK}.loper.tsv").read_bytes(),
+         ["not a readable C3D file", "must be a valid c3d file"]),
+        ("empty", lambda b, w: b"", ["not a readable C3D file", "File is empty"]),
+        ("unknown unit", lambda b, w: b.replace(b"\x01\x02mm", b"\x01\x02yd", 1),
+         ["unknown POINT:UNITS 'yd'", "expected one of mm, cm, m"]),
+    ],
+    ids=["truncated", "foreign", "empty", "unknown-unit"],
+)
+def test_unreadable_c3d_is_refused_by_the_markers_step(lab, name, damage, words):
+    c3d = lab / RAW / f"{WALK}.c3d"
+    c3d.write_bytes(damage(c3d.read_bytes(), lab))
+    _refused(lab, lambda: _markers(_config(lab), f"{RAW}/{WALK}.c3d"), [f"{RAW}/{WALK}.c3d: ", *words])
+
+
+def test_truncated_c3d_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab):
+    """Through Snakemake: the console names file and cause in one line; the job's log is the only new file."""
+    (lab / RAW / "pert050-1.c3d").write_bytes(_c3d_bytes(lab)[:300_000])
+    message = _refused(lab, lambda: _snakemake(lab, f"results/markers/{SUBJECT}/pert050-1.trc"),
+                       [f"{RAW}/pert050-1.c3d: truncated file: the header declares 1024 frames but only"],
+                       log=f"results/logs/markers/{SUBJECT}/pert050-1.log")
+    assert "Traceback" not in message
+
+
+def test_label_map_entry_the_file_lacks_is_refused(lab):
+    _refused(lab, lambda: _markers(_config(lab), f"{RAW}/{WALK}.c3d", {"L_FCC": "LHEE"}),
+             [f"{RAW}/{WALK}.c3d: markers.label_map: label(s) L_FCC not in the file", "RASI, LASI"])
+
+
+def test_model_marker_missing_from_the_trial_stops_ik(lab):
+    t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
+    k = labels.index("LKNE")
+    write_trc(lab / "without-LKNE.trc", t, np.delete(X, k, axis=1), labels[:k] + labels[k + 1:])
+    _refused(lab, lambda: _ik(_config(lab), lab / "without-LKNE.trc"),
+             ["without-LKNE.trc: marker(s) ['LKNE'] of the model's marker set are missing"])
+
+
+def test_frames_with_fewer_than_three_markers_stop_ik(lab):
+    t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
+    X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only
+    write_trc(lab / "sparse.trc", t, X, labels)
+    _refused(lab, lambda: _ik(_config(lab), lab / "sparse.trc"),
+             ["sparse.trc: 3 frame(s) hold fewer than 3 of the 36 weighted markers", "frames 100..102",
+              "RPSI, LPSI"])
+
+
+def test_long_gap_is_left_missing_and_counted_not_refused(lab, tmp_path):
+    """Not an error: 60 missing frames of LKNE (limit 10) stay missing in the TRC and are counted."""
+    rec = read_c3d(lab / RAW / f"{WALK}.c3d")
+    X = rec.markers_m.copy()
+    j = rec.marker_labels.index("LKNE")
+    X[300:360, j] = np.nan
+    write_recording(tmp_path / "gap.c3d", replace(rec, markers_m=X))
+    m = _config(lab)["markers"]
+    processing.markers(tmp_path / "gap.c3d", tmp_path / "gap.trc", tmp_path / "gap.gaps.tsv",
+                       m["lab_to_model_rotation_deg"], m["max_gap_frames"], summary_out=tmp_path / "gap.markers.tsv")
+    summary = pd.read_csv(tmp_path / "gap.markers.tsv", sep="\t").set_index("marker")
+    assert summary.loc["LKNE", ["n_missing_frames", "longest_gap_frames"]].tolist() == [60, 60]
+    assert (summary.drop(index="LKNE").n_missing_frames == 0).all()
+    _, trc, labels = read_markers(tmp_path / "gap.trc")
+    assert np.isnan(trc[300:360, labels.index("LKNE")]).all() and np.isfinite(np.delete(trc, j, axis=1)).all()
+
+
+def test_missing_analog_channels_are_refused(lab):
+    cfg = _config(lab)
+    _refused(lab, lambda: _events(cfg, {"left": "Fz_belt3", "right": "Fz_right"}),
+             [f"{RAW}/{WALK}.c3d: no analog channel 'Fz_belt3'", "channels present: Fx_left, Fz_left"])
+    rec = read_c3d(lab / RAW / f"{WALK}.c3d")
+    i = rec.analog_labels.index("sync")
+    write_recording(lab / "no-sync.c3d", replace(rec, analog_labels=rec.analog_labels[:i],
+                                                 analog_units=rec.analog_units[:i], analogs=rec.analogs[:, :i]))
+    _refused(lab, lambda: _loadcell(cfg, c3d="no-sync.c3d"), ["no-sync.c3d: no analog channel 'sync'"])
+
+
+# --------------------------------------------------------------------------- robot logs
+
+
+def _log_lines(work: Path) -> list[str]:
+    return (work / RAW / f"{WALK}.loper.tsv").read_text().splitlines(keepends=True)
+
+
+def _without_column(lines: list[str], col: int) -> list[str]:
+    return [ln if ln.startswith("#") else "\t".join(np.delete(ln.rstrip("\n").split("\t"), col)) + "\n"
+            for ln in lines]
+
+
+def _nan_at(lines: list[str], line: int, col: int) -> list[str]:
+    cells = lines[line].rstrip("\n").split("\t")
+    cells[col] = "nan"
+    return [*lines[:line], "\t".join(cells) + "\n", *lines[line + 1:]]
+
+
+@pytest.mark.parametrize(
+    ("name", "damage", "words"),
+    [
+        ("missing column", lambda ls: _without_column(ls, 1),
+         ["missing column(s) force_desired_n", "a robot log has the columns time_s, force_desired_n"]),
+        ("unordered time", lambda ls: [*ls[:10], ls[11], ls[10], *ls[12:]],
+         ["column 'time_s', sample 7 (t = 0.006 s, line 12): time not strictly increasing"]),
+        ("NaN", lambda ls: _nan_at(ls, 20, 2),
+         ["column 'force_measured_n', sample 16 (t = 0.016 s, line 21): non-finite force nan"]),
+        ("wrong rate", lambda ls: [ln.replace("# sample_rate_hz: 1000", "# sample_rate_hz: 500") for ln in ls],
+         ["column 'time_s', sample 1", "deviates -50 % from 1/sample_rate_hz = 2 ms"]),
+        ("cut line", lambda ls: [*ls[:5000], ls[5000][:20]],
+         ["sample 4996 (line 5001): 4 field(s), expected 8 (one per column)"]),
+    ],
+    ids=["missing-column", "unordered-time", "nan", "wrong-rate", "cut-line"],
+)
+def test_bad_robot_log_is_refused_by_the_loadcell_step(lab, name, damage, words):
+    path = lab / RAW / f"{WALK}.loper.tsv"
+    path.write_text("".join(damage(_log_lines(lab))))
+    _refused(lab, lambda: _loadcell(_config(lab)), [f"{RAW}/{WALK}.loper.tsv: ", *words])
+
+
+def test_robot_log_of_another_trial_is_refused(lab):
+    _refused(lab, lambda: _loadcell(_config(lab), log=f"elsewhere/{WALK}.loper.tsv"),
+             [f"elsewhere/{WALK}.loper.tsv / {RAW}/{WALK}.c3d: no 4 consecutive sync edges of the robot log",
+              "(10 edges)", "of the mocap record (8 edges)"])
+
+
+def test_bad_robot_log_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab):
+    """Through Snakemake: a new perturbation trial whose log holds a NaN."""
+    shutil.copy(lab / RAW / f"{WALK}.c3d", lab / RAW / "pert050-1.c3d")
+    (lab / RAW / "pert050-1.loper.tsv").write_text("".join(_nan_at(_log_lines(lab), 20, 2)))
+    _refused(lab, lambda: _snakemake(lab, f"results/loadcell/{SUBJECT}/pert050-1.force.tsv"),
+             [(f"{RAW}/pert050-1.loper.tsv: column 'force_measured_n', sample 16 (t = 0.016 s, line 21): "
+               "non-finite force nan")], log=f"results/logs/loadcell/{SUBJECT}/pert050-1.log")
+
+
+# --------------------------------------------------------------------------- subjects and config (before any work)
+
+
+def test_recorded_subject_without_a_static_trial_is_refused(lab):
+    (lab / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t1.75\t70\n"
+                                             "R02\trecorded\t1.6\t55\n")
+    (lab / "data/raw/R02").mkdir()
+    shutil.copy(lab / RAW / f"{WALK}.c3d", lab / "data/raw/R02" / f"{WALK}.c3d")
+    _refused(lab, lambda: _snakemake(lab, "-n"),
+             ["config/subjects.tsv: recorded subject 'R02' has no static trial data/raw/R02/static.c3d"])
+
+
+def test_impossible_anthropometrics_are_refused(lab):
+    (lab / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t17.5\t70\n")
+    _refused(lab, lambda: _snakemake(lab, "-n"),
+             ["config/subjects.tsv: row 1, column 'height_m': 17.5 is greater than the maximum of 2.5"])
+
+
+def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
+    """Not an error: only the trials on disk are processed (the onset without a trial is reported missing;
+    the full run is in tests/test_workflow.py)."""
+    before = _state(lab)
+    res = _snakemake(lab, "-n", "results/tables/impedance.tsv", "results/strides/summary.tsv")
+    assert res.returncode == 0, res.stderr[-2000:]
+    trials = set(re.findall(r"^\s+wildcards: subject=R01, trial=(\S+)$", res.stdout, re.MULTILINE))
+    assert trials == {WALK}  # its IK and strides: markers, events and forces are already there
+    assert re.search(r"^\s+wildcards: subject=R01, onset=050$", res.stdout, re.MULTILINE)
+    assert _state(lab) == before
+
+
+@pytest.mark.parametrize(
+    ("files", "args", "words"),
+    [
+        ({"config/lab.yaml": {"identification": {"n_starts": "ten"}}}, ["--configfile", "config/lab.yaml"],
+         ["config/lab.yaml: key 'identification.n_starts': 'ten' is not of type 'integer'"]),
+        ({}, ["--config", "seed=-1"], ["--config: key 'seed': -1 is less than the minimum of 0"]),
+        ({"config/lab.yaml": {"seed": 7}, "config/extra.yaml": {"validation": {"n_chunkz": 2}}},
+         ["--configfile", "config/lab.yaml", "config/extra.yaml"],
+         ["config/extra.yaml: key 'validation.n_chunkz': Additional properties are not allowed ('n_chunkz'"]),
+        ({"config/lab.yaml": {"filter": {"cutoff_hz": -40.0}}}, ["--configfile", "config/lab.yaml", "--config",
+                                                                 "seed=7"],
+         ["config/lab.yaml: key 'filter.cutoff_hz': -40.0"]),
+    ],
+    ids=["type-in-configfile", "range-in-config-option", "unknown-key-in-last-configfile",
+         "configfile-under-config-option"],
+)
+def test_bad_config_names_the_file_or_option_key_and_value(lab, files, args, words):
+    for name, doc in files.items():
+        (lab / name).write_text(yaml.safe_dump(doc))
+    _refused(lab, lambda: _snakemake(lab, "-n", *args), words)
