@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import LoperInputError
+from .errors import LoperInputError, one_line
 
 __all__ = ["main"]
 
@@ -236,11 +236,6 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _one_line(exc: BaseException) -> str:
-    text = " ".join(str(exc).split())
-    return text if isinstance(exc, LoperInputError) else f"{type(exc).__name__}: {text}"
-
-
 def main(argv: list[str] | None = None) -> int:
     """Run one subcommand; 0 on success, 2 with one line on standard error when an input cannot serve."""
     args = _parser().parse_args(argv)
@@ -249,7 +244,7 @@ def main(argv: list[str] | None = None) -> int:
     except Exception as exc:
         if args.traceback:
             raise
-        print(f"loper-analysis {args.command}: {_one_line(exc)}", file=sys.stderr)
+        print(f"loper-analysis {args.command}: {one_line(exc)}", file=sys.stderr)
         return 2
     return 0
 
