@@ -4,7 +4,11 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.ik_determinacy import model_tree, require_markers_beyond_root, undetermined_coordinates
+from loper_analysis.ik_determinacy import (
+    model_tree,
+    require_markers_beyond_root,
+    undetermined_coordinates,
+)
 from loper_analysis.model import COORDINATES, build_lower_body_model
 
 

@@ -25,7 +25,11 @@ import numpy as np
 import pandas as pd
 
 from .errors import LoperInputError
-from .ik_determinacy import model_tree, require_markers_beyond_root, undetermined_coordinates
+from .ik_determinacy import (
+    model_tree,
+    require_markers_beyond_root,
+    undetermined_coordinates,
+)
 from .io.osim import quiet_opensim
 from .markers import require_markers_per_frame
 
