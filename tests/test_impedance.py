@@ -110,3 +110,16 @@ def test_summary_and_literature_rows():
     assert (ours.K_low_nm_per_rad, ours.K_high_nm_per_rad, ours.D_low_nms_per_rad, ours.D_high_nms_per_rad) == (
         55.0, 55.0, 4.0, 4.0)
     assert len(lit) == 9
+
+
+def test_summary_leaves_out_estimates_on_an_upper_bound():
+    """The campaign's case: a bad trial's knee K at the 200 N·m/rad bound would pull the knee mean from 3 to 68."""
+    rows = [status_rows(s, 50, "ok", "").assign(K_nm_per_rad=k, D_nms_per_rad=0.1, vaf_pct=99.0)
+            for s, k in (("S01", 3.0), ("S02", 3.0), ("S03", 200.0))]
+    table = pd.concat(rows, ignore_index=True)
+    table.loc[table.subject == "S03", "status"] = "not_identifiable"
+    knee = impedance_summary(table).set_index("joint").loc["knee"]
+    assert knee.K_mean_nm_per_rad == pytest.approx(206.0 / 3)
+    knee = impedance_summary(table, upper_bounds=(200.0, 10.0)).set_index("joint").loc["knee"]
+    assert knee.n_subjects == 2 and knee.K_mean_nm_per_rad == 3.0
+    assert impedance_summary(table, upper_bounds=(200.0, 0.1)).empty  # every D on its bound: nothing left

@@ -337,8 +337,14 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     return OnsetFit(mean, counts, rows, curves)
 
 
-def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=(0.15, 0.05)) -> pd.DataFrame:
+def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=(0.15, 0.05),
+                      upper_bounds: tuple[float, float] | None = None) -> pd.DataFrame:
     """Across-subject summary per joint and onset of the fitted rows (``ok`` and ``not_identifiable``).
+
+    ``upper_bounds`` (K in N·m/rad, D in N·m·s/rad; the identification's
+    upper bounds): rows whose K or D sits on its upper bound (within
+    :data:`~loper_analysis.identification.AT_BOUND_FRACTION` of the bound)
+    carry no estimate and are left out; None keeps every fitted row.
 
     Columns ``joint, onset_ms, n_subjects``, then per parameter its mean, SD,
     min and max over subjects (``K_mean_nm_per_rad`` ...), ``vaf_pct_mean``;
@@ -347,6 +353,13 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
     ``|error| <= max(rel * |truth|, abs)``) for K and D.
     """
     fitted = table[table["status"].isin(["ok", "not_identifiable"])]
+    if upper_bounds is not None:
+        from .identification import AT_BOUND_FRACTION
+
+        on_bound = np.zeros(len(fitted), dtype=bool)
+        for p, bound in zip(("K", "D"), upper_bounds, strict=True):
+            on_bound |= fitted[parameter_column(p)].to_numpy(float) >= bound * (1.0 - AT_BOUND_FRACTION)
+        fitted = fitted[~on_bound]
     rows = []
     for (joint, onset), g in fitted.groupby(["joint", "onset_ms"], sort=False):
         row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique()}

@@ -116,6 +116,8 @@ rule impedance_summary:
             category="Impedance",
             labels={"table": "literature comparison"},
         ),
+    params:
+        upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
     log:
         "results/logs/impedance_summary/summary.log",
     script:

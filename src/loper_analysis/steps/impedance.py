@@ -87,12 +87,16 @@ def impedance_table(fit_tsvs: Sequence[PathLike], out_tsv: PathLike) -> pd.DataF
     return table
 
 
-def impedance_summary(impedance_tsv: PathLike, summary_out: PathLike, literature_out: PathLike) -> pd.DataFrame:
-    """Across-subject summary per joint and onset and the literature table with our row."""
+def impedance_summary(impedance_tsv: PathLike, summary_out: PathLike, literature_out: PathLike,
+                      upper_bounds: tuple[float, float] | None = None) -> pd.DataFrame:
+    """Across-subject summary per joint and onset and the literature table with our row.
+
+    ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary.
+    """
     from ..impedance import impedance_summary as summarise
     from ..impedance import literature_table
 
-    summary = summarise(read_tsv(impedance_tsv, "impedance table"))
+    summary = summarise(read_tsv(impedance_tsv, "impedance table"), upper_bounds=upper_bounds)
     write_tsv(summary, summary_out)
     write_tsv(literature_table(summary), literature_out)
     log.info("summary:\n%s", summary.to_string(index=False))
