@@ -38,17 +38,22 @@ def read_model(path: str | os.PathLike):
     path = Path(path)
     if not path.is_file():
         raise LoperInputError(f"model file not found: {path}")
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError, UnicodeDecodeError) as exc:
-        raise LoperInputError(f"{path}: not an OpenSim model: not an XML file ({exc})") from None
-    if root.tag != "Model" and root.find("Model") is None:
-        raise LoperInputError(f"{path}: not an OpenSim model: its <{root.tag}> element holds no <Model>")
+    _require_element(path, "Model", "model")
     osim = quiet_opensim()
     try:
         return osim.Model(str(path))
     except Exception as exc:  # OpenSim raises its own exception types for unreadable models
         raise LoperInputError(f"{path}: OpenSim cannot read this model ({exc})") from exc
+
+
+def _require_element(path: Path, element: str, what: str) -> None:
+    """Refuse a file that is not XML, or whose root neither is nor holds ``<element>`` (OpenSim reads any XML)."""
+    try:
+        root = ET.parse(path).getroot()
+    except (ET.ParseError, OSError, UnicodeDecodeError) as exc:
+        raise LoperInputError(f"{path}: not an OpenSim {what}: not an XML file ({exc})") from None
+    if root.tag != element and root.find(element) is None:
+        raise LoperInputError(f"{path}: not an OpenSim {what} (its <{root.tag}> element holds no <{element}>)")
 
 
 def write_model(model, path: str | os.PathLike) -> Path:
@@ -74,12 +79,7 @@ def read_scale_setup(path: str | os.PathLike):
     path = Path(path)
     if not path.is_file():
         raise LoperInputError(f"scale setup file not found: {path}")
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as exc:
-        raise LoperInputError(f"{path}: not an XML file ({exc})") from None
-    if root.tag != "ScaleTool" and root.find("ScaleTool") is None:
-        raise LoperInputError(f"{path}: not an OpenSim ScaleTool setup (its <{root.tag}> element holds no <ScaleTool>)")
+    _require_element(path, "ScaleTool", "ScaleTool setup")
     osim = quiet_opensim()
     try:
         return osim.ScaleTool(str(path))
