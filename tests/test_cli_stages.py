@@ -176,3 +176,26 @@ def test_a_model_without_the_bodies_and_a_file_that_is_no_model(tmp_path, capsys
     assert main(["segments", "--model", str(tmp_path / "not.osim"), "--out", str(out)]) == 2
     _one_line_error(capsys, "not.osim")
     assert not out.exists()
+
+
+def test_ik_command_reads_a_labs_labels(tmp_path, capsys):
+    """Prefixed lab labels with a label map give the same .mot as the model's own names."""
+    from loper_analysis.io.osim import write_model
+    from loper_analysis.model import MARKERS, build_lower_body_model
+
+    generic = build_lower_body_model(1.73, 64.9)
+    model = write_model(generic, tmp_path / "model.osim")
+    t = np.arange(32) / 128.0
+    X = marker_positions(generic, {"pelvis_ty": 0.93 + 0 * t, "hip_flexion_l": 0.3 * np.sin(4 * t),
+                                   "knee_flexion_l": 0.5 + 0.3 * np.sin(4 * t)})
+    lab = np.stack([X[..., 0], -X[..., 2], X[..., 1]], axis=-1)  # model (Y up) -> lab (Z up)
+    write_c3d(tmp_path / "own.c3d", list(MARKERS), lab, 128.0)
+    lab_labels = [f"Anna:{'L_FCC' if m == 'LHEE' else m}" for m in MARKERS]
+    write_c3d(tmp_path / "lab.c3d", lab_labels, lab, 128.0)
+    (tmp_path / "map.tsv").write_text("label\tmarker\nL_FCC\tLHEE\n")
+    assert main(["ik", "--model", str(model), "--markers", str(tmp_path / "own.c3d"), "--out", str(tmp_path / "own.mot")]) == 0
+    assert main(["ik", "--model", str(model), "--markers", str(tmp_path / "lab.c3d"), "--out", str(tmp_path / "lab.mot"),
+                 "--label-map", str(tmp_path / "map.tsv")]) == 0, capsys.readouterr().err
+    own, ours = read_mot(tmp_path / "own.mot"), read_mot(tmp_path / "lab.mot")
+    pd.testing.assert_frame_equal(own, ours)
+    np.testing.assert_allclose(ours["knee_flexion_l"], 0.5 + 0.3 * np.sin(4 * t), atol=1e-4)  # rad; float32 mm in the file

@@ -131,7 +131,8 @@ def _ik(args: argparse.Namespace) -> None:
     from .steps.ik import ik_file
 
     result = ik_file(args.model, args.markers, args.out, args.tasks, args.start, args.end, args.rotate_deg,
-                     args.accuracy, max_marker_rms_m=args.max_marker_rms_m, max_rms_fraction=args.max_rms_fraction)
+                     args.accuracy, max_marker_rms_m=args.max_marker_rms_m, max_rms_fraction=args.max_rms_fraction,
+                     label_map=_label_map(args.label_map))
     print(
         f"{args.out}: {len(result.time_s)} frames, marker error RMS {1e3 * np.nanmean(result.marker_rms_m):.2f} mm "
         f"(max {1e3 * np.nanmax(result.marker_max_m):.2f} mm)"
@@ -217,6 +218,7 @@ def _parser() -> argparse.ArgumentParser:
                    "model marker found in the file, weight 1")
     p.add_argument("--start", type=float, help="first time (s) to solve")
     p.add_argument("--end", type=float, help="last time (s) to solve")
+    _label_map_option(p)
     _rotate_option(p)
     p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
     p.add_argument("--max-marker-rms-m", type=float, default=0.02,

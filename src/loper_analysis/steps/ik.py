@@ -12,7 +12,7 @@ import pandas as pd
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_tsv
 
-__all__ = ["ik_chunk", "ik_trial", "ik_join", "ik_file"]
+__all__ = ["ik_chunk", "ik_file", "ik_join", "ik_trial"]
 
 log = logging.getLogger(__name__)
 
@@ -105,10 +105,13 @@ def ik_join(chunk_mots: Sequence[PathLike], out_mot: PathLike, angles_tsv: PathL
 def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tasks_file=None,
             start_s: float | None = None, end_s: float | None = None,
             rotate_deg: Sequence[float] | None = None, accuracy: float = 1e-6, min_markers: int = 3,
-            max_marker_rms_m: float = 0.02, max_rms_fraction: float = 0.1):
+            max_marker_rms_m: float = 0.02, max_rms_fraction: float = 0.1,
+            label_map: Mapping[str, str] | None = None):
     """IK of a .c3d or .trc marker file to a .mot (degrees), for the command line.
 
-    ``rotate_deg`` turns the markers into the model frame (default -90 0 0
+    Labels lose a subject prefix (``Subject:LASI`` -> ``LASI``) and are
+    renamed by ``label_map`` {lab label: model marker}
+    (:func:`loper_analysis.marker_names.model_marker_names`). ``rotate_deg`` turns the markers into the model frame (default -90 0 0
     for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). Without a
     task file every model marker found in the file gets weight 1. A poor fit
     (marker RMS error above ``max_marker_rms_m`` m in more than
@@ -120,10 +123,12 @@ def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tas
     from ..io.opensim_tables import read_markers, write_mot
     from ..io.osim import read_model
     from ..kinematics import inverse_kinematics
+    from ..marker_names import model_marker_names
     from ..markers import rotate_markers
 
     markers_path = Path(markers_path)
     time_s, markers_m, labels = read_markers(markers_path)
+    labels = model_marker_names(labels, label_map, str(markers_path))
     if rotate_deg is None:
         rotate_deg = (-90.0, 0.0, 0.0) if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
     markers_m = rotate_markers(markers_m, rotate_deg)
