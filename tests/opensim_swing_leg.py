@@ -291,7 +291,8 @@ class PerturbedSwingLeg:
         model.setGravity(osim.Vec3(0.0, -p.gravity_m_per_s2, 0.0))
         cart = osim.Body("cart", p.cart_mass_kg, osim.Vec3(0.0), osim.Inertia(1.0, 1.0, 1.0))
         model.addBody(cart)
-        slider = osim.SliderJoint("slider", model.getGround(), osim.Vec3(0.0), osim.Vec3(0.0), cart, osim.Vec3(0.0), osim.Vec3(0.0))
+        zero = osim.Vec3(0.0)
+        slider = osim.SliderJoint("slider", model.getGround(), zero, zero, cart, zero, zero)
         slider.upd_coordinates(0).setName("x")
         model.addJoint(slider)
         parent, parent_loc = cart, osim.Vec3(0.0)
@@ -373,7 +374,7 @@ class PerturbedSwingLeg:
         """Deviation coordinates psi (3,) rad: hip, knee, ankle (OpenSim sense)."""
         return np.array([self._coordinate(f"{j}_deviation").getValue(s) for j in COORDINATES[1:]])
 
-    def simulate(self, time_s, accuracy: float = 1e-10):
+    def simulate(self, time_s, accuracy: float = 1e-8):
         """Integrate from ``span_s[0]`` on the unperturbed swing; q (n, 4) and rod force vector (n, 2) N at ``time_s``."""
         t0 = self.span_s[0]
         s = self.state
@@ -408,7 +409,7 @@ def pulse_recording(
     force_rate_hz: float = 1000.0,
     before_s: float = 0.13,
     after_s: float = 0.255,
-    accuracy: float = 1e-10,
+    accuracy: float = 1e-8,
 ) -> dict[str, np.ndarray]:
     """What the pipeline would record of one perturbed stride and its matched unperturbed stride.
 
