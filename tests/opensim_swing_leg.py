@@ -440,3 +440,49 @@ def pulse_recording(
         "force_u_n": f_u[j],
         "force_p_n": f_p[j],
     }
+
+
+def stepped_swing(p: SegmentParameters, impedance, onset_s: float, time_s, steps_per_sample: int) -> np.ndarray:
+    """The perturbed swing by the plain :class:`OpenSimLeg`, inputs held over small steps; q (n, 4) at ``time_s``.
+
+    A second construction of :class:`PerturbedSwingLeg`'s motion: ``time_s``
+    uniform, the leg starts on the analytic swing at ``time_s[0]``; each step
+    (``steps_per_sample`` per sample) the Manager integrates with the
+    actuator overrides fixed at their values at mid-step: own forces, joint
+    torques ``T_j = -K_j dtheta_j - D_j dtheta_j'`` (``docs/conventions.md``)
+    from the state extrapolated to mid-step with the last step's mean
+    acceleration, and the rod force perpendicular to the thigh.
+    """
+    imp = np.asarray(impedance, dtype=float)
+    t = np.asarray(time_s, dtype=float)
+    h = (t[1] - t[0]) / steps_per_sample
+    n = (len(t) - 1) * steps_per_sample
+    grid = t[0] + h * np.arange(n + 1)
+    mid = grid[:-1] + 0.5 * h
+    tau = feedforward_torques(p, mid)
+    magnitude = evaluate(time_function(rod_force_expression(onset_s)), mid)
+    phi_u, phid_u, _ = swing_coordinates(mid)
+    phi0, phid0, _ = swing_coordinates(t[:1])
+
+    def theta(q):  # hip, knee, ankle angles, pelvis angle 0
+        return np.array([-q[1], q[2] - q[1], q[2] - q[3]])
+
+    leg = OpenSimLeg(p)
+    q, qd, qdd = A @ phi0[0], A @ phid0[0], np.zeros(4)
+    out = [q]
+    for k in range(n):
+        qm, qdm = q + 0.5 * h * qd + 0.125 * h * h * qdd, qd + 0.5 * h * qdd
+        torque = -imp[0::2] * (theta(qm) - theta(A @ phi_u[k])) - imp[1::2] * (theta(qdm) - theta(A @ phid_u[k]))
+        u_fb = np.array([0.0, -torque[0] - torque[1], torque[1] + torque[2], -torque[2]])
+        leg.set_state(q, qd, A_INV.T @ tau[k] + u_fb, magnitude[k] * thigh_normal(qm[1]))
+        leg.state.setTime(float(grid[k]))
+        manager = osim.Manager(leg.model)
+        manager.setIntegratorAccuracy(1e-12)
+        manager.initialize(leg.state)
+        s = manager.integrate(float(grid[k + 1]))
+        q_new, qd_new = leg.q(s), leg.qd(s)
+        qdd = (qd_new - qd) / h
+        q, qd = q_new, qd_new
+        if (k + 1) % steps_per_sample == 0:
+            out.append(q)
+    return np.array(out)
