@@ -205,9 +205,14 @@ def test_two_opensim_constructions_agree(recordings):
 
 @needs_native_rate
 def test_native_rate_force_reaches_the_bounds(native_errors):
-    """With the force at 1000 Hz: hip and knee K within 0.5 %, D within 2 % of the OpenSim truth."""
+    """With the force at 1000 Hz: hip and knee K within 0.5 %, D within 2 % of the OpenSim truth.
+
+    In fact every parameter, the ankle's too, lands within 0.05 % (measured
+    0.002 % at most): the fit reproduces the second engine's truth.
+    """
     for case, rel in native_errors.items():
         assert np.all(np.abs(rel[HIP_KNEE]) < BOUNDS), f"{case}: {dict(zip(PARAMETERS, 100 * rel))} %"
+        assert np.all(np.abs(rel) < 5e-4), f"{case}: {dict(zip(PARAMETERS, 100 * rel))} %"
 
 
 def _worst_fraction(errors: dict) -> dict:
@@ -222,33 +227,19 @@ def test_128hz_force_path_misses_the_bounds(frame_errors):
     of it), the worst case more than all of it.
     """
     worst = _worst_fraction(frame_errors)
-    print("128 Hz force, largest hip/knee error / bound:", {f"{n} {o * 1000:.0f} ms": round(v, 3) for (n, o), v in worst.items()})
+    print("128 Hz force, largest hip/knee error / bound:", {f"{n} {o * 1000:.0f} ms": round(v, 4) for (n, o), v in worst.items()})
     assert max(worst.values()) > 1.2
     assert min(worst.values()) > 0.2
 
 
 @needs_native_rate
-def test_fine_force_recovers_every_parameter():
-    """With the force at 10 kHz the fit recovers all six parameters, the ankle's too, within 0.1 %.
-
-    What remains at 1000 Hz (D_hip about -0.09 %) is the linear interpolation
-    of the force between its samples; at 10 kHz the chain OpenSim -> pipeline
-    view -> fit is exact to about 0.02 %.
-    """
-    name, on = "soft_knee", 0.175
-    truth = np.array(IMPEDANCE_SETS[name])
-    rec = pulse_recording(WINTER, truth, on, on, force_rate_hz=10_000.0)
-    fit = _fit(rec, on, native=True)
-    assert fit.success, fit.message
-    rel = (fit.estimate - truth) / truth
-    print("10 kHz force:", ", ".join(f"{p} {100 * r:+.4f} %" for p, r in zip(PARAMETERS, rel)))
-    assert np.all(np.abs(rel) < 1e-3)
-
-
-@needs_native_rate
 def test_128hz_force_path_is_worse_than_native_rate(native_errors, frame_errors):
-    """On the same data, the 128 Hz force path's worst hip/knee error is at least 3x that of the 1000 Hz path, per case."""
+    """On the same data, the 128 Hz force path's worst hip/knee error is at least 10x that of the 1000 Hz path, per case.
+
+    Measured: 0.30-1.47 of the error budget against 0.002 at most.
+    """
     native = _worst_fraction(native_errors)
     frames = _worst_fraction(frame_errors)
+    print("largest hip/knee error / bound, 128 Hz and 1000 Hz force:", [(round(frames[c], 4), round(native[c], 5)) for c in CASES])
     for case in CASES:
-        assert frames[case] > 3.0 * native[case], f"{case}: 128 Hz {frames[case]:.3f}, 1000 Hz {native[case]:.3f}"
+        assert frames[case] > 10.0 * native[case], f"{case}: 128 Hz {frames[case]:.3f}, 1000 Hz {native[case]:.3f}"
