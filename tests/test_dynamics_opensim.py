@@ -9,7 +9,7 @@ global, clockwise segment angles ``q``::
 
     phi_x = x,  phi_1 = -q_1,  phi_2 = -(q_2 - q_1),  phi_3 = -(q_3 - q_2)
 
-so ``q = A phi`` with the constant matrix ``A`` below. Then ``q' = A phi'``,
+so ``q = A phi`` with a constant matrix ``A``. Then ``q' = A phi'``,
 ``q'' = A phi''``, the generalised forces map by virtual work as
 ``tau_phi = A^T u`` and the mass matrices as ``M_phi = A^T M_q A``.
 
@@ -17,7 +17,8 @@ Generalised forces enter through CoordinateActuators and the rod force
 ``F = (F_x, F_y)`` through two PointActuators at the body point
 ``(0, -attachment_m)`` of the thigh with the direction fixed in ground; all six
 use optimal force 1 and the actuation override, a discrete state variable that
-holds the value during a Manager integration.
+holds the value during a Manager integration. The OpenSim model is
+:class:`tests.opensim_swing_leg.OpenSimLeg`.
 """
 
 from __future__ import annotations
@@ -37,22 +38,7 @@ from loper_analysis.dynamics import (
     simulate,
 )
 
-osim.Logger.setLevelString("error")
-osim.Logger.removeFileSink()
-
-# q = A phi (phi: OpenSim coordinates in mobility order slider, hip pin, knee pin, ankle pin)
-A = np.array(
-    [
-        [1.0, 0.0, 0.0, 0.0],
-        [0.0, -1.0, 0.0, 0.0],
-        [0.0, -1.0, -1.0, 0.0],
-        [0.0, -1.0, -1.0, -1.0],
-    ]
-)
-A_INV = np.linalg.inv(A)
-
-SEGMENT_NAMES = ("thigh", "shank", "foot")
-
+from tests.opensim_swing_leg import SEGMENT_NAMES, OpenSimLeg
 from tests.parameter_sets import ASYMMETRIC, WINTER
 
 PARAMETER_SETS = {"winter_1.73m_64.9kg": WINTER, "asymmetric": ASYMMETRIC}
@@ -67,129 +53,6 @@ def _run_in_tmp(tmp_path, monkeypatch):
 @pytest.fixture(params=sorted(PARAMETER_SETS))
 def params(request) -> SegmentParameters:
     return PARAMETER_SETS[request.param]
-
-
-class OpenSimLeg:
-    """The swing-leg model built in OpenSim, with conversion to our coordinates."""
-
-    def __init__(self, p: SegmentParameters):
-        model = osim.Model()
-        model.setName("swing_leg")
-        model.setGravity(osim.Vec3(0.0, -p.gravity_m_per_s2, 0.0))
-        # the cart only translates: its inertia is irrelevant but must be valid
-        cart = osim.Body("cart", p.cart_mass_kg, osim.Vec3(0.0), osim.Inertia(1.0, 1.0, 1.0))
-        model.addBody(cart)
-        model.addJoint(
-            osim.SliderJoint("slider", model.getGround(), osim.Vec3(0.0), osim.Vec3(0.0), cart, osim.Vec3(0.0), osim.Vec3(0.0))
-        )
-        parent, parent_loc = cart, osim.Vec3(0.0)
-        for i, name in enumerate(SEGMENT_NAMES):
-            body = osim.Body(
-                name,
-                p.mass_kg[i],
-                osim.Vec3(p.com_x_m[i], p.com_y_m[i], 0.0),
-                # Ixx, Iyy do not matter for planar motion about Z
-                osim.Inertia(0.3, 0.2, p.inertia_kg_m2[i]),
-            )
-            model.addBody(body)
-            model.addJoint(
-                osim.PinJoint(f"{name}_pin", parent, parent_loc, osim.Vec3(0.0), body, osim.Vec3(0.0), osim.Vec3(0.0))
-            )
-            parent, parent_loc = body, osim.Vec3(0.0, -p.length_m[i], 0.0)
-
-        self.coord_actuators = []
-        for k in range(4):
-            coord = model.getJointSet().get(k).get_coordinates(0)
-            act = osim.CoordinateActuator(coord.getName())
-            act.setName(f"tau_{k}")
-            act.setOptimalForce(1.0)
-            act.setMinControl(-np.inf)
-            act.setMaxControl(np.inf)
-            model.addForce(act)
-            self.coord_actuators.append(act)
-        self.force_actuators = []
-        for k, direction in enumerate(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))):
-            act = osim.PointActuator("thigh")
-            act.setName(f"rod_force_{'xy'[k]}")
-            act.set_point(osim.Vec3(0.0, -p.attachment_m, 0.0))
-            act.set_point_is_global(False)
-            act.set_direction(osim.Vec3(*direction))
-            act.set_force_is_global(True)
-            act.setOptimalForce(1.0)
-            act.setMinControl(-np.inf)
-            act.setMaxControl(np.inf)
-            model.addForce(act)
-            self.force_actuators.append(act)
-
-        self.state = model.initSystem()
-        self.model = model
-        self.params = p
-        # mobility order must be slider, hip, knee, ankle for the mapping A
-        names = [model.getCoordinateSet().get(k).getName() for k in range(4)]
-        assert names == [model.getJointSet().get(k).get_coordinates(0).getName() for k in range(4)]
-        for act in (*self.coord_actuators, *self.force_actuators):
-            act.overrideActuation(self.state, True)
-
-    # ------------------------------------------------------------ state
-
-    def set_state(self, q, qd, u=np.zeros(4), force=np.zeros(2)) -> None:
-        s = self.state
-        s.setTime(0.0)
-        s.setQ(osim.Vector([float(v) for v in A_INV @ q]))
-        s.setU(osim.Vector([float(v) for v in A_INV @ qd]))
-        tau = A.T @ np.asarray(u, dtype=float)  # virtual work: tau_phi = (dq/dphi)^T u
-        for act, val in zip(self.coord_actuators, tau):
-            act.setOverrideActuation(s, float(val))
-        for act, val in zip(self.force_actuators, force):
-            act.setOverrideActuation(s, float(val))
-
-    def q(self, s=None) -> np.ndarray:
-        s = self.state if s is None else s
-        return A @ np.array([s.getQ().get(k) for k in range(4)])
-
-    def qd(self, s=None) -> np.ndarray:
-        s = self.state if s is None else s
-        return A @ np.array([s.getU().get(k) for k in range(4)])
-
-    # ------------------------------------------------------------ terms
-
-    def accelerations(self) -> np.ndarray:
-        self.model.realizeAcceleration(self.state)
-        udot = self.state.getUDot()
-        return A @ np.array([udot.get(k) for k in range(4)])
-
-    def mass_matrix(self) -> np.ndarray:
-        self.model.realizePosition(self.state)
-        M = osim.Matrix()
-        self.model.getMatterSubsystem().calcM(self.state, M)
-        M_phi = np.array([[M.get(i, j) for j in range(4)] for i in range(4)])
-        return A_INV.T @ M_phi @ A_INV  # M_q = A^-T M_phi A^-1
-
-    def station_in_ground(self, body: str, point) -> np.ndarray:
-        self.model.realizePosition(self.state)
-        b = self.model.getBodySet().get(body)
-        v = b.findStationLocationInGround(self.state, osim.Vec3(*point))
-        return np.array([v.get(0), v.get(1), v.get(2)])
-
-    def station_velocity_in_ground(self, body: str, point) -> np.ndarray:
-        self.model.realizeVelocity(self.state)
-        b = self.model.getBodySet().get(body)
-        v = b.findStationVelocityInGround(self.state, osim.Vec3(*point))
-        return np.array([v.get(0), v.get(1), v.get(2)])
-
-    # ------------------------------------------------------------ simulation
-
-    def simulate(self, time_s, q0, qd0, u, force) -> np.ndarray:
-        self.set_state(q0, qd0, u, force)
-        self.state.setTime(float(time_s[0]))
-        manager = osim.Manager(self.model)
-        manager.setIntegratorAccuracy(1e-12)
-        manager.initialize(self.state)
-        out = [self.q(self.state)]
-        for t in time_s[1:]:
-            s = manager.integrate(float(t))
-            out.append(self.q(s))
-        return np.array(out)
 
 
 def _random_states(n: int, seed: int):
