@@ -1,7 +1,8 @@
 """Wall time of one identification (10 random starts) on validation-study data.
 
 Usage: python benchmarks/identification_speed.py [n_cases]
-Prints per-case times and the median / max for both noise conditions.
+Prints per-condition median / max times of one identification (prepare_window + 10 starts), once with the
+force at the robot rate (1000 Hz, as the pipeline fits) and once with the same force at the 128 Hz frames.
 """
 
 from __future__ import annotations
@@ -25,28 +26,32 @@ def main(n_cases: int = 40) -> None:
     s = ValidationSettings()
     grid = impedance_grid(s.stiffness_levels_nm_per_rad, s.damping_levels_nms_per_rad)
     cases = np.random.default_rng(7).choice(len(grid), n_cases, replace=False)
-    times = {"no_noise": [], "noise": []}
+    times: dict[tuple[str, str], list[float]] = {}
     sims = []
     for n, c in enumerate(cases):
-        t, qu, qp, fp, pel = perturbed_trial(params, grid[c], s)
-        for cond in times:
+        t, qu, qp, fp, pel, tf = perturbed_trial(params, grid[c], s)
+        f128 = np.stack([np.interp(t, tf, fp[:, j]) for j in range(2)], axis=-1)
+        for cond in ("no_noise", "noise"):
             if cond == "noise":
                 rng = np.random.default_rng(c)
                 qu_m = qu + rng.uniform(-0.005, 0.005, qu.shape)
                 qp_m = qp + rng.uniform(-0.005, 0.005, qp.shape)
             else:
                 qu_m, qp_m = qu, qp
-            t0 = time.perf_counter()
-            w = prepare_window(t, qu_m, qp_m, params, s.onset_s, force_perturbed_n=fp,
-                               pelvis_angle_unperturbed_rad=pel, pelvis_angle_perturbed_rad=pel, q_reference=qu)
-            fit = identify_impedance(w, n_starts=10, seed=int(c))
-            dt = time.perf_counter() - t0
-            if n > 0:  # the first case includes loading the compiled kernels
-                times[cond].append(dt)
-                sims.append(fit.n_simulations)
-    for cond, v in times.items():
+            for force in ("1000 Hz", "128 Hz"):
+                extra = dict(force_perturbed_n=fp, force_time_s=tf) if force == "1000 Hz" else \
+                    dict(force_perturbed_n=f128)
+                t0 = time.perf_counter()
+                w = prepare_window(t, qu_m, qp_m, params, s.onset_s, pelvis_angle_unperturbed_rad=pel,
+                                   pelvis_angle_perturbed_rad=pel, q_reference=qu, **extra)
+                fit = identify_impedance(w, n_starts=10, seed=int(c))
+                dt = time.perf_counter() - t0
+                if n > 0:  # the first case includes loading the compiled kernels
+                    times.setdefault((force, cond), []).append(dt)
+                    sims.append(fit.n_simulations)
+    for (force, cond), v in times.items():
         v = np.array(v)
-        print(f"{cond:9s} one identification (10 starts): median {np.median(v) * 1e3:.1f} ms, "
+        print(f"force {force:7s} {cond:9s} one identification (10 starts): median {np.median(v) * 1e3:.1f} ms, "
               f"max {v.max() * 1e3:.1f} ms over {len(v)} cases")
     print(f"simulations per identification: median {np.median(sims):.0f}")
 

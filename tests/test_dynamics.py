@@ -383,11 +383,20 @@ def test_compiled_rk4_matches_dop853_for_a_perturbed_swing_with_feedback():
 
 
 def test_perturbed_trial_rk4_converges_at_fourth_order():
-    """Truth RK4 at 16, 32, 64 substeps: differences shrink by 2^4 (measured |32 - 64| = 1.1e-12 rad)."""
+    """Truth RK4 at 16, 32, 64 substeps: differences shrink by 2^4 (measured |32 - 64| = 3.4e-12 rad).
+
+    The pulse's force has a jump in its second derivative where it is switched on and off; with a 125 ms
+    pulse both lie on a step boundary of all three truths, and RK4 keeps its fourth order. The study's
+    100 ms pulse switches off inside a truth step: there the truth at 32 substeps is within 9.2e-10 rad
+    of the one at 64 (measured), far below what the identification resolves.
+    """
     p = PARAMETER_SETS["winter"]
     impedance = [75.0, 2.0, 75.0, 2.0, 75.0, 2.0]
-    q = {n: perturbed_trial(p, impedance, ValidationSettings(truth_substeps=n))[2] for n in (16, 32, 64)}
-    d1 = np.abs(q[16] - q[32]).max()
-    d2 = np.abs(q[32] - q[64]).max()
+    on_grid = {n: perturbed_trial(p, impedance, ValidationSettings(truth_substeps=n, pulse_duration_s=0.125))[2]
+               for n in (16, 32, 64)}
+    d1 = np.abs(on_grid[16] - on_grid[32]).max()
+    d2 = np.abs(on_grid[32] - on_grid[64]).max()
     assert d2 < 1e-11
     np.testing.assert_allclose(d1 / d2, 16.0, rtol=0.25)
+    study = {n: perturbed_trial(p, impedance, ValidationSettings(truth_substeps=n))[2] for n in (32, 64)}
+    assert np.abs(study[32] - study[64]).max() < 2e-9

@@ -8,6 +8,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.loadcell import (
     OUTPUT_COLUMNS,
     perturbation_onsets,
+    robot_log_frames_and_native,
     robot_log_on_mocap_frames,
 )
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
@@ -83,6 +84,29 @@ def test_robot_log_on_mocap_frames_known_signals(offset_s, ppm, robot_t0_s):
     assert np.all(np.abs(onsets - expected) <= 1 / FRAME_HZ)
     widths = np.array([np.sum((frames >= o) & (out["perturbation"] == 1) & (frames < o + 0.2)) for o in onsets])
     assert np.all((widths >= 12) & (widths <= 14))  # 100 ms = 12.8 frames
+
+
+def test_robot_log_at_its_own_rate_on_the_mocap_clock():
+    """The robot-rate table: every robot sample at its mapped time (offset + scale x robot time, within the
+    clock map's 0.2 ms), the filtered force there (the analytic signal within the same tolerance as the frames),
+    the flag unchanged; the 128 Hz frames are its linear interpolation (the same table, bit for bit)."""
+    offset_s, ppm, robot_t0_s = 3.217, 150.0, 0.0
+    scale = 1 + ppm * 1e-6
+    log, sync, frames, onsets_robot = make_trial(offset_s, ppm, robot_t0_s, seed=21)
+    out, native = robot_log_frames_and_native(log, ROBOT_HZ, sync, ANALOG_HZ, frames, source="S01/walk")
+    assert tuple(native.columns) == OUTPUT_COLUMNS and len(native) == len(log)
+    t_robot = log["time_s"].to_numpy()
+    assert np.abs(native["time_s"] - (offset_s + scale * t_robot)).max() < 0.2e-3
+    slope = sum(a * 2 * np.pi * f for a, f, _ in FORCE_COMPONENTS)
+    interior = (t_robot > 0.25) & (t_robot < t_robot[-1] - 0.25)
+    np.testing.assert_allclose(native["force_measured_n"][interior], force(t_robot[interior]),
+                               atol=slope * 0.2e-3 + 0.01)
+    np.testing.assert_array_equal(native["perturbation"], log["perturbation"].to_numpy(float))
+    inside = out["force_measured_n"].notna().to_numpy()
+    np.testing.assert_array_equal(out["force_measured_n"][inside],
+                                  np.interp(frames[inside], native["time_s"], native["force_measured_n"]))
+    pd.testing.assert_frame_equal(out, robot_log_on_mocap_frames(log, ROBOT_HZ, sync, ANALOG_HZ, frames,
+                                                                 source="S01/walk"))
 
 
 def test_robot_log_on_mocap_frames_bad_sync():

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -55,6 +55,8 @@ __all__ = [
     "IdentificationSettings",
     "OnsetFit",
     "brace_force_direction",
+    "FORCE_COLUMNS",
+    "force_table",
     "impedance_rows",
     "status_rows",
     "too_short_reason",
@@ -132,13 +134,34 @@ class OnsetFit:
     fate; ``rows``: one row per joint (:data:`IMPEDANCE_COLUMNS`);
     ``curves``: the measured and model responses of the fit (``time_s``,
     ``{joint}_measured_rad``, ``{joint}_model_rad``; only ``time_s`` when
-    nothing was fitted).
+    nothing was fitted); ``force``: the mean rod forces the model was given
+    (:func:`force_table`; only ``time_s`` when nothing was fitted).
     """
 
     response: pd.DataFrame
     counts: pd.DataFrame
     rows: pd.DataFrame
     curves: pd.DataFrame
+    force: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=["time_s"]))
+
+
+#: Columns of :func:`force_table`.
+FORCE_COLUMNS: tuple[str, ...] = (
+    "time_s", "force_perturbed_x_n", "force_perturbed_y_n", "force_unperturbed_x_n", "force_unperturbed_y_n",
+)
+
+
+def force_table(series: Mapping) -> pd.DataFrame:
+    """The mean rod forces of a response as the fit receives them (columns :data:`FORCE_COLUMNS`).
+
+    ``time_s`` relative to the onset (s): ``series["force_time_s"]`` (the robot rate) when the response
+    carries it, else the response's grid; the perturbed and matched unperturbed mean force vectors (N, world x/y).
+    """
+    t = series.get("force_time_s", series["time_s"])
+    fp, fu = series["force_perturbed_n"], series["force_unperturbed_n"]
+    return pd.DataFrame({"time_s": t, "force_perturbed_x_n": fp[:, 0], "force_perturbed_y_n": fp[:, 1],
+                         "force_unperturbed_x_n": fu[:, 0], "force_unperturbed_y_n": fu[:, 1]},
+                        columns=list(FORCE_COLUMNS))
 
 
 def brace_force_direction(markers_m: np.ndarray, labels: Sequence[str], brace=("LBRA_P", "LBRA_D"),
@@ -254,7 +277,9 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     trials : sequence of mapping
         One per trial of this onset: ``name``, ``angles``, ``strides`` and
         ``force`` (frames of the processing steps, see
-        :mod:`loper_analysis.responses.inputs`) and ``markers``: ``(time_s
+        :mod:`loper_analysis.responses.inputs`), optionally ``force_native``
+        (the load cell at the robot rate: ``time_s``, ``force_measured_n``;
+        the fit then gets the force at that rate) and ``markers``: ``(time_s
         (n,), markers_m (n, n_markers, 3) in the model frame, labels)`` for
         the brace markers. No trial: every output says ``missing``.
     params : SegmentParameters
@@ -294,6 +319,7 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
         inputs.append({
             "name": tr["name"], "angles": angles, "strides": tr["strides"], "force": tr["force"],
             "force_direction": brace_force_direction(X, labels, source=str(tr["name"])),
+            "force_native": tr.get("force_native"),
         })
     r = response
     with warnings.catch_warnings():
@@ -312,6 +338,7 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     window = prepare_window(
         series["time_s"], series["q_unperturbed"], series["q_perturbed"], params, 0.0,
         force_unperturbed_n=series["force_unperturbed_n"], force_perturbed_n=series["force_perturbed_n"],
+        force_time_s=series.get("force_time_s"),
         pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
         pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
         window_before_s=r.window_before_s, window_after_s=r.window_after_s, n_substeps=ident.n_substeps,
@@ -334,7 +361,7 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     curves = pd.DataFrame({"time_s": fit.time_s,
                            **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
                            **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)}})
-    return OnsetFit(mean, counts, rows, curves)
+    return OnsetFit(mean, counts, rows, curves, force_table(series))
 
 
 def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=(0.15, 0.05),

@@ -192,7 +192,10 @@ def feedback_torques(e, ed, dpel, dpeld, p, T):
 
 @njit(cache=True, inline="always")
 def _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, qdd, state):
-    """Acceleration of the deviation e = q - q_ref at stage index k (fills qdd; ``state`` (2, 4) is work space)."""
+    """Acceleration of the deviation e = q - q_ref at stage index k, rod force fp (2,).
+
+    Fills qdd; ``state`` (2, 4) is work space.
+    """
     q = state[0]
     qd = state[1]
     for a in range(4):
@@ -200,10 +203,10 @@ def _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, 
         qd[a] = ref_qd[k, a] + ed[a]
     terms(q, qd, packed, M, h, Ja)
     feedback_torques(e, ed, dpel[k, 0], dpel[k, 1], p, T)
-    rhs[0] = h[0] + w[k, 0] + Ja[0, 0] * fp[k, 0] + Ja[1, 0] * fp[k, 1]
-    rhs[1] = h[1] + w[k, 1] - T[0] - T[1] + Ja[0, 1] * fp[k, 0] + Ja[1, 1] * fp[k, 1]
-    rhs[2] = h[2] + w[k, 2] + T[1] + T[2] + Ja[0, 2] * fp[k, 0] + Ja[1, 2] * fp[k, 1]
-    rhs[3] = h[3] + w[k, 3] - T[2] + Ja[0, 3] * fp[k, 0] + Ja[1, 3] * fp[k, 1]
+    rhs[0] = h[0] + w[k, 0] + Ja[0, 0] * fp[0] + Ja[1, 0] * fp[1]
+    rhs[1] = h[1] + w[k, 1] - T[0] - T[1] + Ja[0, 1] * fp[0] + Ja[1, 1] * fp[1]
+    rhs[2] = h[2] + w[k, 2] + T[1] + T[2] + Ja[0, 2] * fp[0] + Ja[1, 2] * fp[1]
+    rhs[3] = h[3] + w[k, 3] - T[2] + Ja[0, 3] * fp[0] + Ja[1, 3] * fp[1]
     solve4(M, rhs, qdd)
     for a in range(4):
         qdd[a] -= ref_qdd[k, a]
@@ -218,8 +221,8 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
     so e stays exactly 0 without perturbation (q_ref'' is subtracted).
 
     P: (B, 6) parameter sets; stage arrays (ref_q, ref_qd, ref_qdd, w: (2 N + 1, 4);
-    fp: (2 N + 1, 2); dpel: (2 N + 1, 2)) sampled every dt / 2 from the window
-    start; e0, ed0: (4,) initial deviation; n_sub RK4 steps per output sample.
+    dpel: (2 N + 1, 2)) sampled every dt / 2 from the window start; fp (N, 4, 2)
+    the rod force at the four stages of each of the N steps; e0, ed0: (4,) initial deviation; n_sub RK4 steps per output sample.
     Returns E (B, n_out, 4) deviations and Ed (B, n_out, 4) their rates at the
     output samples (sample 0 = initial state).
     """
@@ -253,23 +256,23 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
         for o in range(1, n_out):
             for _ in range(n_sub):
                 k = 2 * st
-                _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k1, state)
+                _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 0], dpel, M, h, Ja, rhs, T, k1, state)
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * ed[a]
                     edt[a] = ed[a] + 0.5 * dt * k1[a]
-                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k2, state)
+                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 1], dpel, M, h, Ja, rhs, T, k2, state)
                 for a in range(4):
                     v2[a] = edt[a]
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * v2[a]
                     edt[a] = ed[a] + 0.5 * dt * k2[a]
-                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k3, state)
+                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 2], dpel, M, h, Ja, rhs, T, k3, state)
                 for a in range(4):
                     v3[a] = edt[a]
                 for a in range(4):
                     et[a] = e[a] + dt * v3[a]
                     edt[a] = ed[a] + dt * k3[a]
-                _deviation_rhs(k + 2, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, k4, state)
+                _deviation_rhs(k + 2, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 3], dpel, M, h, Ja, rhs, T, k4, state)
                 for a in range(4):
                     e[a] += dt / 6.0 * (ed[a] + 2.0 * v2[a] + 2.0 * v3[a] + edt[a])
                     ed[a] += dt / 6.0 * (k1[a] + 2.0 * k2[a] + 2.0 * k3[a] + k4[a])

@@ -6,7 +6,8 @@ edges of the log's ``sync_v`` and of the mocap sync channel -> clock map
 Butterworth of the forces at the robot rate
 (:func:`loper_analysis.filtering.lowpass`) -> robot sample times mapped to
 the mocap clock -> linear interpolation of the forces, nearest-sample pick of
-the perturbation flag, at the mocap frame times (128 Hz).
+the perturbation flag, at the mocap frame times (128 Hz); the same filtered
+forces at every robot sample, on the mocap clock, for the identification.
 """
 
 from __future__ import annotations
@@ -19,9 +20,9 @@ from .clock_sync import clock_map, rising_edges
 from .errors import LoperInputError
 from .filtering import lowpass
 
-__all__ = ["OUTPUT_COLUMNS", "robot_log_on_mocap_frames", "perturbation_onsets"]
+__all__ = ["OUTPUT_COLUMNS", "robot_log_on_mocap_frames", "robot_log_frames_and_native", "perturbation_onsets"]
 
-#: Columns of :func:`robot_log_on_mocap_frames`, in order.
+#: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.
 OUTPUT_COLUMNS: tuple[str, ...] = ("time_s", "force_measured_n", "force_desired_n", "perturbation")
 
 _LOG_COLUMNS = ("time_s", "force_desired_n", "force_measured_n", "sync_v", "perturbation")
@@ -54,6 +55,9 @@ def robot_log_on_mocap_frames(
        interpolated at ``frame_time_s``; ``perturbation`` taken from the
        nearest robot sample (never interpolated), so a flag's onset lands
        within one mocap frame (plus half a robot sample) of its mapped time.
+
+    :func:`robot_log_frames_and_native` also returns the filtered forces at
+    the robot's own samples.
 
     Gap policy: frames outside the robot log's mapped span (first to last
     sample) get NaN in every column but ``time_s``, which is why
@@ -101,6 +105,33 @@ def robot_log_on_mocap_frames(
         either record, a clock map refused by :func:`loper_analysis.clock_sync.clock_map`, no frame
         inside the log's span.
     """
+    return robot_log_frames_and_native(log, log_rate_hz, mocap_sync_v, analog_rate_hz, frame_time_s, cutoff_hz, order,
+                                       source, analog_start_s, max_drift, tolerance_s)[0]
+
+
+def robot_log_frames_and_native(
+    log: pd.DataFrame,
+    log_rate_hz: float,
+    mocap_sync_v,
+    analog_rate_hz: float,
+    frame_time_s,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    source: str = "",
+    analog_start_s: float | None = None,
+    max_drift: float = 1e-3,
+    tolerance_s: float = 3e-3,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`robot_log_on_mocap_frames` and the same forces at the robot log's own samples.
+
+    Returns the frame table of :func:`robot_log_on_mocap_frames` and a table
+    with the same columns at every robot sample (``log_rate_hz``): ``time_s``
+    the sample's time mapped to the mocap clock (s), the low-passed forces (N)
+    and the flag (0.0/1.0). The robot rate keeps the pulse's edges, which the
+    128 Hz frames cut short: the fit takes its force from there
+    (:func:`loper_analysis.identification.prepare_window`, ``force_time_s``).
+    Same parameters and errors as :func:`robot_log_on_mocap_frames`.
+    """
     src = source or "robot log"
     if not isinstance(log, pd.DataFrame):
         raise LoperInputError(f"{src}: log must be a pandas DataFrame, got {type(log).__name__}")
@@ -139,12 +170,14 @@ def robot_log_on_mocap_frames(
             f"the mocap clock ({t_mapped[0]:.6g} .. {t_mapped[-1]:.6g} s)"
         )
     out = {"time_s": frames}
+    native = {"time_s": t_mapped}
     for col in _FORCE_COLUMNS:
         f = log[col].to_numpy(dtype=float, na_value=np.nan)
         try:
             f = lowpass(f, rate, cutoff_hz, order)
         except LoperInputError as exc:
             raise LoperInputError(f"{src}: column '{col}': {exc}") from None
+        native[col] = f
         out[col] = np.interp(frames, t_mapped, f, left=np.nan, right=np.nan)
     flag = log["perturbation"].to_numpy(dtype=float, na_value=np.nan)
     if not np.all(np.isin(flag, (0.0, 1.0))):
@@ -153,9 +186,10 @@ def robot_log_on_mocap_frames(
     pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
     nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
     out["perturbation"] = np.where(inside, flag[nearest], np.nan)
+    native["perturbation"] = flag
     result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
     result.attrs["clock_map"] = cm
-    return result
+    return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
 
 
 def perturbation_onsets(time_s, flag) -> np.ndarray:

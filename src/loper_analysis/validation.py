@@ -2,10 +2,12 @@
 
 For every combination of K in {0, 75, 150} and D in {0, 2, 4} per joint
 (3^6 = 729) a representative subject's swing leg is perturbed by a 40 N,
-100 ms forward pulse; the "measured" perturbed stride is simulated with the
-true impedance by the same equations of motion but a much finer RK4 step
-(``truth_substeps``) than the identification uses, then sampled like motion
-capture. The identification recovers K and D from the samples, once without
+100 ms forward pulse with the robot's rise time and overshoot
+(:func:`loper_analysis.pulse.pulse_force`); the "measured" perturbed stride is
+simulated with the true impedance by the same equations of motion but a much
+finer RK4 step (``truth_substeps``) than the identification uses, then sampled
+like motion capture, and the force like the robot log (``force_rate_hz``). The
+identification recovers K and D from these samples, once without
 and once with uniform noise (0.01 rad or m peak-to-peak) added independently to
 the perturbed and the unperturbed generalised coordinates.
 """
@@ -13,7 +15,7 @@ the perturbed and the unperturbed generalised coordinates.
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import pandas as pd
@@ -26,10 +28,13 @@ from .identification import (
     DEFAULT_LOWER,
     DEFAULT_UPPER,
     identify_impedance,
+    per_step,
     prepare_window,
     simulate_deviation,
+    stage_times_s,
 )
-from .reference import STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
+from .pulse import pulse_force
+from .reference import STUDY_DEVICE, STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
 
 __all__ = [
     "ValidationSettings",
@@ -38,6 +43,8 @@ __all__ = [
     "chunk_combinations",
     "nominal_swing",
     "perturbed_trial",
+    "validation_pulse",
+    "with_pulse_at_stages",
     "validation_window",
     "run_validation_chunk",
     "summarize_errors",
@@ -60,6 +67,9 @@ class ValidationSettings:
     onset_s: float = 0.05
     pulse_force_n: float = 40.0
     pulse_duration_s: float = 0.1
+    pulse_rise_time_s: float = STUDY_DEVICE["rise_time_ms"][0] / 1e3
+    pulse_overshoot_pct: float = STUDY_DEVICE["overshoot_pct"][0]
+    force_rate_hz: float = 1000.0
     force_direction_deg: float = 0.0
     window_before_s: float = 0.025
     window_after_s: float = 0.25
@@ -171,33 +181,69 @@ def nominal_swing(time_s: np.ndarray, swing_duration_s: float) -> tuple[np.ndarr
 def perturbed_trial(params: SegmentParameters, impedance, settings: ValidationSettings):
     """Noise-free unperturbed and perturbed samples for one true impedance.
 
-    Returns (time_s (n,), q_u (n, 4), q_p (n, 4), force_p (n, 2), pelvis (n,)).
-    The data run from 0.1 s before the window to 0.05 s after it.
+    Returns (time_s (n,), q_u (n, 4), q_p (n, 4), force_p (k, 2), pelvis (n,),
+    force_time_s (k,)): the coordinates at ``sample_rate_hz``, the pulse
+    (:func:`loper_analysis.pulse.pulse_force`, commanded at the onset) sampled
+    like the robot log at ``force_rate_hz`` on the same clock. The data run
+    from 0.1 s before the window to 0.05 s after it. The truth is plain RK4
+    with ``truth_substeps`` steps per sample and the pulse itself at every
+    stage (:func:`with_pulse_at_stages`), independent of how the
+    identification turns sampled forces into stage forces.
     """
-    fs = settings.sample_rate_hz
-    t_start = settings.onset_s - settings.window_before_s - 0.1
-    t_end = settings.onset_s + settings.window_after_s + 0.05
-    n = int(np.floor((t_end - t_start) * fs)) + 1
-    t = t_start + np.arange(n) / fs
-    qu, pelvis = nominal_swing(t, settings.swing_duration_s)
-    # the force rises after the onset sample and falls after onset + duration (linear between samples)
-    on = (t > settings.onset_s + 1e-12) & (t <= settings.onset_s + settings.pulse_duration_s + 1e-12)
-    ang = np.deg2rad(settings.force_direction_deg)
-    fp = np.where(on[:, None], settings.pulse_force_n * np.array([np.cos(ang), np.sin(ang)]), 0.0)
-    # truth: the same equations, integrated with a much finer RK4 step
-    window = prepare_window(
-        t, qu, qu, params, settings.onset_s,
-        force_perturbed_n=fp,
-        pelvis_angle_unperturbed_rad=pelvis,
-        pelvis_angle_perturbed_rad=pelvis,
-        window_before_s=settings.window_before_s,
-        window_after_s=t[-1] - settings.onset_s,
-        n_substeps=settings.truth_substeps,
-    )
+    t, qu, pelvis, window = _truth_window(params, settings)
+    n = len(t)
     deviation = simulate_deviation(window, np.asarray(impedance, dtype=float)[None])
     qp = qu.copy()
     qp[n - window.n_samples :] += deviation[0]
-    return t, qu, qp, fp, pelvis
+    t_force = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * settings.force_rate_hz + 1e-9)) + 1) \
+        / settings.force_rate_hz
+    return t, qu, qp, validation_pulse(t_force, settings), pelvis, t_force
+
+
+_TRUTH_WINDOWS: dict = {}
+
+
+def _truth_window(params: SegmentParameters, settings: ValidationSettings):
+    """Sample times, q_u, pelvis angle and the truth's prepared window (it does not depend on the impedance:
+    kept for the last few parameter sets and settings)."""
+    key = (params.packed.tobytes(), settings)
+    if key not in _TRUTH_WINDOWS:
+        fs = settings.sample_rate_hz
+        t_start = settings.onset_s - settings.window_before_s - 0.1
+        t_end = settings.onset_s + settings.window_after_s + 0.05
+        n = int(np.floor((t_end - t_start) * fs)) + 1
+        t = t_start + np.arange(n) / fs
+        qu, pelvis = nominal_swing(t, settings.swing_duration_s)
+        # truth: the same equations, integrated with a much finer plain RK4 step (the pulse itself at every stage)
+        window = prepare_window(
+            t, qu, qu, params, settings.onset_s,
+            pelvis_angle_unperturbed_rad=pelvis,
+            pelvis_angle_perturbed_rad=pelvis,
+            window_before_s=settings.window_before_s,
+            window_after_s=t[-1] - settings.onset_s,
+            n_substeps=settings.truth_substeps,
+        )
+        window = with_pulse_at_stages(window, settings)
+        if len(_TRUTH_WINDOWS) >= 4:
+            _TRUTH_WINDOWS.pop(next(iter(_TRUTH_WINDOWS)))
+        for a in (t, qu, pelvis):
+            a.setflags(write=False)
+        _TRUTH_WINDOWS[key] = (t, qu, pelvis, window)
+    return _TRUTH_WINDOWS[key]
+
+
+def validation_pulse(time_s, settings: ValidationSettings) -> np.ndarray:
+    """The study's pulse (k, 2) in N, world x/y, at ``time_s`` (k,): :func:`loper_analysis.pulse.pulse_force` along
+    ``force_direction_deg``, commanded at ``onset_s`` for ``pulse_duration_s``."""
+    ang = np.deg2rad(settings.force_direction_deg)
+    f = pulse_force(time_s, settings.onset_s, settings.pulse_duration_s, settings.pulse_force_n,
+                    settings.pulse_rise_time_s, settings.pulse_overshoot_pct)
+    return f[:, None] * np.array([np.cos(ang), np.sin(ang)])
+
+
+def with_pulse_at_stages(window, settings: ValidationSettings):
+    """The window with the study's pulse itself at each of its RK4 stage times (plain RK4): how the truth sees it."""
+    return replace(window, force_perturbed_n=per_step(validation_pulse(stage_times_s(window), settings)))
 
 
 def validation_window(
@@ -205,14 +251,17 @@ def validation_window(
 ):
     """The identification window of one validation trial (from :func:`perturbed_trial`).
 
+    The force reaches the identification at ``force_rate_hz``
+    (``force_time_s`` of :func:`prepare_window`).
     ``qu_measured`` / ``qp_measured`` replace the noise-free coordinates in the
     prediction error and the initial state (noise condition); the reference for
     ``u_ff`` stays the noise-free unperturbed stride. ``overrides`` go to
     :func:`prepare_window`.
     """
-    t, qu, qp, fp, pelvis = trial
+    t, qu, qp, fp, pelvis, t_force = trial
     kwargs = dict(
         force_perturbed_n=fp,
+        force_time_s=t_force,
         pelvis_angle_unperturbed_rad=pelvis,
         pelvis_angle_perturbed_rad=pelvis,
         window_before_s=settings.window_before_s,
@@ -250,7 +299,8 @@ def run_validation_chunk(
         if not 0 <= c < len(grid):
             raise LoperInputError(f"combination {c} outside 0 .. {len(grid) - 1}")
         truth = grid[c]
-        t, qu, qp, fp, pelvis = perturbed_trial(params, truth, settings)
+        trial = perturbed_trial(params, truth, settings)
+        t, qu, qp = trial[:3]
         for ci, condition in enumerate(CONDITIONS):
             qu_m, qp_m = qu, qp
             if condition == "noise":
@@ -258,7 +308,7 @@ def run_validation_chunk(
                 a = settings.noise_peak_to_peak / 2
                 qu_m = qu + rng.uniform(-a, a, qu.shape)
                 qp_m = qp + rng.uniform(-a, a, qp.shape)
-            window = validation_window(params, settings, (t, qu, qp, fp, pelvis), qu_m, qp_m)
+            window = validation_window(params, settings, trial, qu_m, qp_m)
             fit = identify_impedance(
                 window,
                 n_starts=settings.n_starts,

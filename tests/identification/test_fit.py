@@ -63,7 +63,7 @@ def test_noise_free_recovery(truth):
 
 
 def noisy_fits(trial, n_rep, settings=SETTINGS, n_starts=3):
-    t, qu, qp, _, _ = trial
+    t, qu, qp, *_ = trial
     a = settings.noise_peak_to_peak / 2
     out = []
     for rep in range(n_rep):
@@ -121,7 +121,7 @@ def test_variance_accounted_for_analytic_cases():
 
 def test_white_fit_cost_is_the_sum_of_squared_prediction_errors(trial_mid):
     """Without residual_weight the minimised cost and the unweighted sum are the same number."""
-    t, qu, qp, _, _ = trial_mid
+    t, qu, qp, *_ = trial_mid
     rng = np.random.default_rng(1)
     window = window_for(trial_mid, qp_measured=qp + rng.uniform(-0.005, 0.005, qp.shape))
     result = fit(window, n_starts=3)
@@ -168,8 +168,8 @@ def test_same_seed_same_result_bitwise(trial_mid):
 
 
 def test_response_jacobian_matches_central_differences(trial_mid):
-    t, qu, qp, fp, pel = trial_mid
-    w = prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp,
+    t, qu, qp, fp, pel, tf = trial_mid
+    w = prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp, force_time_s=tf,
                        pelvis_angle_unperturbed_rad=pel, pelvis_angle_perturbed_rad=pel)
     truth = MID_TRUTH
     J = response_jacobian(w, truth)

@@ -32,7 +32,7 @@ def noisy_window():
     params = segment_parameters_from_anthropometry(1.73, 64.9)
     settings = ValidationSettings()
     trial = perturbed_trial(params, TRUTH, settings)
-    t, qu, qp, fp, pelvis = trial
+    t, qu, qp, fp, pelvis, _ = trial
     rng = np.random.default_rng(11)
     qu_m = qu + rng.uniform(-0.002, 0.002, qu.shape)
     qp_m = qp + rng.uniform(-0.002, 0.002, qp.shape)

@@ -20,6 +20,7 @@ from tests.identification.validation_windows import (
     SETTINGS,
     fit,
     mid_trial,
+    truth_window,
     window_for,
 )
 
@@ -65,7 +66,7 @@ def test_nuisance_projection_is_the_orthogonal_complement_of_the_dominant_shapes
 @pytest.fixture(scope="module")
 def projected(trial_mid):
     """Noise-free response plus a smooth deviation whose shape the null pairs show; white and projected fits."""
-    window = window_for(trial_mid, n_substeps=SETTINGS.truth_substeps)
+    window = truth_window(trial_mid)
     shape = _deviation_shape(window)
     biased = replace(window, measured=window.measured + 0.3 * shape)
     rng = np.random.default_rng(5)
@@ -106,7 +107,7 @@ def test_null_pair_errors_subtract_the_free_response_of_the_initial_state(trial_
     pre-onset span (its joint-angle difference, as no initial state is seen); a small thigh
     offset before the window (its measured difference minus the change of the model's
     response that offset makes, simulated in full by the peer function simulate_response)."""
-    t, qu, _, _, pelvis = trial_mid
+    t, qu, _, _, pelvis, _ = trial_mid
     window = window_for(trial_mid)
     theta = MID_TRUTH
     dq = np.zeros((3,) + qu.shape)
@@ -134,7 +135,7 @@ def test_null_pair_errors_subtract_the_free_response_of_the_initial_state(trial_
 def _shaped_null_pairs(window, trial, n_pairs, seed):
     """Null pairs whose joint-angle differences are random multiples of _deviation_shape (from the onset on)
     plus 1e-5 rad of independent noise on every coordinate."""
-    t, qu, _, _, pelvis = trial
+    t, qu, _, _, pelvis, _ = trial
     tau = np.clip(t - window.onset_s, 0.0, None)
     hip, knee, ankle = 0.3 * tau**2, -0.5 * tau**2 + 0.2 * tau**3, 0.1 * tau**2
     # hip = pelvis - q_thigh, knee = q_shank - q_thigh, ankle = q_shank - q_foot (pelvis unchanged)

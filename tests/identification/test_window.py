@@ -17,6 +17,7 @@ from tests.identification.validation_windows import (
     SETTINGS,
     expect_error,
     mid_trial,
+    truth_window,
     window_for,
 )
 
@@ -31,22 +32,23 @@ def trial_mid():
 
 def test_response_is_exactly_zero_without_perturbation(trial_mid):
     """The deviation dynamics subtract q_ref'': no force, no initial deviation -> e = 0."""
-    t, qu, _, _, pelvis = trial_mid
-    window = window_for((t, qu, qu, np.zeros((len(t), 2)), pelvis))
+    t, qu, _, _, pelvis, _ = trial_mid
+    tf = trial_mid[5]
+    window = window_for((t, qu, qu, np.zeros((len(tf), 2)), pelvis, tf))
     np.testing.assert_allclose(window.measured, 0.0, rtol=0, atol=0)
     P = np.array([[0.0, 0.0, 0.0, 0.0, 0.0, 0.0], [150.0, 4.0, 150.0, 4.0, 150.0, 4.0]])
     np.testing.assert_allclose(simulate_response(window, P), 0.0, rtol=0, atol=1e-15)
 
 
 def test_prediction_error_vanishes_at_the_truth_with_the_truth_step(trial_mid):
-    """Identification with the truth's own step size reproduces the data (round trip); measured 2.4e-16 rad."""
-    window = window_for(trial_mid, n_substeps=SETTINGS.truth_substeps)
+    """Identification with the truth's own step and force reproduces the data (round trip); measured 2.4e-16 rad."""
+    window = truth_window(trial_mid)
     assert np.abs(window.measured).max() > 0.05
     np.testing.assert_allclose(prediction_error(window, MID_TRUTH), 0.0, rtol=0, atol=1e-13)
 
 
 def test_batch_and_single_response_agree_bitwise(trial_mid):
-    window = window_for(trial_mid, n_substeps=SETTINGS.truth_substeps)
+    window = truth_window(trial_mid)
     batch = simulate_response(window, np.stack([MID_TRUTH, MID_TRUTH + 1.0]))
     np.testing.assert_array_equal(batch[0], simulate_response(window, MID_TRUTH))
 
@@ -54,8 +56,8 @@ def test_batch_and_single_response_agree_bitwise(trial_mid):
 def test_simulate_deviation_is_the_perturbed_trial_deviation(trial_mid):
     """perturbed_trial adds simulate_deviation to q_u: with the truth's step and the same window start
     the deviation over the window is the data's q_p - q_u (round trip through the same kernel)."""
-    t, qu, qp, _, _ = trial_mid
-    window = window_for(trial_mid, n_substeps=SETTINGS.truth_substeps)
+    t, qu, qp, *_ = trial_mid
+    window = truth_window(trial_mid)
     deviation = simulate_deviation(window, MID_TRUTH[None])
     assert deviation.shape == (1, window.n_samples, 4)
     i0 = int(np.searchsorted(t, window.time_s[0] - 1e-9))
@@ -66,8 +68,9 @@ def test_simulate_deviation_is_the_perturbed_trial_deviation(trial_mid):
 
 
 def test_prepare_window_rejects_bad_input(trial_mid):
-    t, qu, qp, fp, pelvis = trial_mid
-    kw = dict(force_perturbed_n=fp, pelvis_angle_unperturbed_rad=pelvis, pelvis_angle_perturbed_rad=pelvis)
+    t, qu, qp, fp, pelvis, tf = trial_mid
+    kw = dict(force_perturbed_n=fp, force_time_s=tf, pelvis_angle_unperturbed_rad=pelvis,
+              pelvis_angle_perturbed_rad=pelvis)
     onset = SETTINGS.onset_s
 
     bad = qu.copy()

@@ -17,6 +17,7 @@ from loper_analysis.validation import (
     ValidationSettings,
     perturbed_trial,
     validation_window,
+    with_pulse_at_stages,
 )
 
 PARAMS = segment_parameters_from_anthropometry(1.73, 64.9)
@@ -34,13 +35,18 @@ def _mid_trial():
 
 
 def mid_trial():
-    """(time_s, q_u, q_p, force_p, pelvis) of the mid impedance (computed once, read-only)."""
+    """(time_s, q_u, q_p, force_p, pelvis, force_time_s) of the mid impedance (computed once, read-only)."""
     return _mid_trial()
 
 
 def window_for(trial, settings=SETTINGS, *, qu_measured=None, qp_measured=None, **overrides):
     """The window run_validation_chunk builds (q_reference = noise-free unperturbed coordinates)."""
     return validation_window(PARAMS, settings, trial, qu_measured, qp_measured, **overrides)
+
+
+def truth_window(trial, settings=SETTINGS, **overrides):
+    """The window with the truth's own step and force (the pulse at every RK4 stage): a round trip."""
+    return with_pulse_at_stages(window_for(trial, settings, n_substeps=settings.truth_substeps, **overrides), settings)
 
 
 def fit(window, n_starts=5, seed=0, settings=SETTINGS):

@@ -15,8 +15,9 @@ def null_pair_trials(subject: str) -> list[str]:
 
 
 def fit_inputs(wildcards):
-    """Files of the fit: the onset's trials (angles, strides, force, markers in the order of onset_trials), the
-    null-pair trials (angles, strides in the order of null_pair_trials), the segment table and a synthetic truth."""
+    """Files of the fit: the onset's trials (angles, strides, force at 128 Hz and at the robot rate, markers in the
+    order of onset_trials), the null-pair trials (angles, strides in the order of null_pair_trials), the segment
+    table and a synthetic truth."""
     s = wildcards.subject
     out = {"segments": f"results/model/{s}/segments.tsv"}
     if SUBJECT_SOURCE[s] == "synthetic":
@@ -25,6 +26,7 @@ def fit_inputs(wildcards):
     out["angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in own]
     out["strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in own]
     out["force"] = [f"results/loadcell/{s}/{t}.force.tsv" for t in own]
+    out["force_native"] = [f"results/loadcell/{s}/{t}.force_native.tsv" for t in own]
     out["markers"] = [f"results/markers/{s}/{t}.trc" for t in own]
     null = fit_null_trials(s, wildcards.onset)
     out["null_angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in null]
@@ -47,6 +49,7 @@ rule impedance_fit:
         counts="results/responses/{subject}/{onset}.counts.tsv",
         fit="results/impedance/{subject}/{onset}.tsv",
         curves="results/impedance/{subject}/{onset}.curves.tsv",
+        force="results/responses/{subject}/{onset}.force.tsv",
     wildcard_constraints:
         onset=r"[0-9]{3}",
     params:

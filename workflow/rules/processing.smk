@@ -222,7 +222,8 @@ rule loadcell:
         c3d="data/raw/{subject}/{trial}.c3d",
         log=robot_log,
     output:
-        "results/loadcell/{subject}/{trial}.force.tsv",
+        force="results/loadcell/{subject}/{trial}.force.tsv",
+        native="results/loadcell/{subject}/{trial}.force_native.tsv",
     params:
         sync_channel=EVENTS["sync_channel"],
         cutoff_hz=FILTER["cutoff_hz"],

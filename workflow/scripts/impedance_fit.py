@@ -7,4 +7,4 @@ with rule_log(snakemake.log[0]):
     impedance.fit(p.trials, inp.angles, inp.strides, inp.force, inp.markers, inp.segments,
                   int(snakemake.wildcards.onset), snakemake.wildcards.subject, out.response, out.counts, out.fit,
                   out.curves, inp.get("truth"), p.null_trials, inp.null_angles, inp.null_strides, p.response,
-                  p.identification)
+                  p.identification, force_native=inp.force_native, force_out=out.force)

@@ -42,10 +42,14 @@ from .null_pairs import (
 from .status import AT_BOUND_FRACTION, MIN_VAF_PCT, joint_status
 from .window import (
     PreparedWindow,
+    per_step,
     prediction_error,
     prepare_window,
     simulate_deviation,
     simulate_response,
+    stage_force_means,
+    stage_times_s,
+    step_stage_forces,
 )
 
 __all__ = [
@@ -56,6 +60,10 @@ __all__ = [
     "ImpedanceFit",
     "NullPairFit",
     "prepare_window",
+    "per_step",
+    "stage_times_s",
+    "stage_force_means",
+    "step_stage_forces",
     "simulate_deviation",
     "simulate_response",
     "prediction_error",

@@ -25,6 +25,10 @@ __all__ = [
     "PreparedWindow",
     "prepare_window",
     "initial_state_basis",
+    "stage_force_means",
+    "stage_times_s",
+    "per_step",
+    "step_stage_forces",
     "simulate_deviation",
     "joint_angle_deviation",
     "simulate_response",
@@ -41,7 +45,8 @@ class PreparedWindow:
     and their first and second derivatives (n_stage, 4; m and rad),
     ``feedforward`` = u_ff - Ja(q_u)^T F_u, the inverse dynamics of the
     reference with the unperturbed force (n_stage, 4; N and N·m),
-    ``force_perturbed_n`` (n_stage, 2; N, world x/y) and
+    ``force_perturbed_n`` (n_steps, 4, 2; N, world x/y: the force at the four
+    stages of every RK4 step) and
     ``pelvis_deviation`` (n_stage, 2): the perturbed-minus-unperturbed pelvis
     angle (rad) and its rate (rad/s). ``measured`` (n_out, 3) is the
     measured perturbed-minus-unperturbed joint angle difference (rad) at the
@@ -84,7 +89,7 @@ class PreparedWindow:
         return len(self.time_s)
 
 
-def _column(name: str, value, n: int, width: int) -> np.ndarray:
+def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.ndarray:
     if value is None:
         return np.zeros((n, width))
     a = np.asarray(value, dtype=float)
@@ -92,7 +97,7 @@ def _column(name: str, value, n: int, width: int) -> np.ndarray:
         a = a[:, None]
     a2, _ = finite_rows(name, a, width)
     if a2.shape[0] != n:
-        raise LoperInputError(f"{name} has {a2.shape[0]} samples, expected {n} like time_s")
+        raise LoperInputError(f"{name} has {a2.shape[0]} samples, expected {n} like {like}")
     return a2
 
 
@@ -105,6 +110,7 @@ def prepare_window(
     *,
     force_unperturbed_n=None,
     force_perturbed_n=None,
+    force_time_s=None,
     pelvis_angle_unperturbed_rad=None,
     pelvis_angle_perturbed_rad=None,
     window_before_s: float = 0.025,
@@ -124,7 +130,18 @@ def prepare_window(
         shank, foot (rad)] of the unperturbed and the perturbed stride,
         aligned so that the onset is at ``onset_s`` in both.
     force_unperturbed_n, force_perturbed_n : (n, 2) rod force (N, world x/y)
-        at the attachment point; zero when omitted.
+        at the attachment point; zero when omitted. With ``force_time_s``
+        they are (k, 2) instead, sampled at ``force_time_s``.
+    force_time_s : (k,) optional sample times (s, the clock of ``time_s``)
+        of the forces at their own rate (e.g. the robot log's 1000 Hz). Each
+        force is then the cubic spline through its samples; the feedforward
+        takes ``F_u`` as its mean over each stage's share of the step
+        (:func:`stage_force_means`), and the rod force of the perturbed leg is
+        ``F_u`` plus ``F_p - F_u`` as stage forces that give every RK4 step the
+        exact impulse and timing of the force (:func:`step_stage_forces`), so
+        that a 10 ms edge needs no step shorter than the default. The samples
+        must cover the fit window. Without it the forces are (n, 2) at
+        ``time_s`` and are interpolated linearly at the stage times.
     pelvis_angle_*_rad : (n,) pelvis angle (rad); zero when omitted.
     window_before_s, window_after_s : window around the onset (s).
     n_substeps : RK4 steps per sample (integer >= 1).
@@ -145,7 +162,7 @@ def prepare_window(
     ------
     LoperInputError
         Non-finite or wrongly shaped inputs, non-uniform time, a window
-        outside the data.
+        outside the data, forces at their own rate that do not cover the window.
     """
     t = np.asarray(time_s, dtype=float)
     if t.ndim != 1 or len(t) < 4:
@@ -160,8 +177,13 @@ def prepare_window(
     n = len(t)
     qu = _column("q_unperturbed", q_unperturbed, n, 4)
     qp = _column("q_perturbed", q_perturbed, n, 4)
-    fu = _column("force_unperturbed_n", force_unperturbed_n, n, 2)
-    fpm = _column("force_perturbed_n", force_perturbed_n, n, 2)
+    if force_time_s is None:
+        fu = _column("force_unperturbed_n", force_unperturbed_n, n, 2)
+        fpm = _column("force_perturbed_n", force_perturbed_n, n, 2)
+    else:
+        tf = _force_clock(force_time_s)
+        fu = _column("force_unperturbed_n", force_unperturbed_n, len(tf), 2, "force_time_s")
+        fpm = _column("force_perturbed_n", force_perturbed_n, len(tf), 2, "force_time_s")
     pu = _column("pelvis_angle_unperturbed_rad", pelvis_angle_unperturbed_rad, n, 1)[:, 0]
     pp = _column("pelvis_angle_perturbed_rad", pelvis_angle_perturbed_rad, n, 1)[:, 0]
     for name, v in (("onset_s", onset_s), ("window_before_s", window_before_s), ("window_after_s", window_after_s)):
@@ -205,8 +227,18 @@ def prepare_window(
     ref_q = spline(ts)
     ref_qd = spline(ts, 1)
     ref_qdd = spline(ts, 2)
-    force_u = np.stack([np.interp(ts, t, fu[:, j]) for j in range(2)], axis=-1)
-    force_p = np.stack([np.interp(ts, t, fpm[:, j]) for j in range(2)], axis=-1)
+    if force_time_s is None:
+        force_u = np.stack([np.interp(ts, t, fu[:, j]) for j in range(2)], axis=-1)
+        force_p = per_step(np.stack([np.interp(ts, t, fpm[:, j]) for j in range(2)], axis=-1))
+    else:
+        tol_f = 1e-6 * step
+        if tf[0] > ts[0] + tol_f or tf[-1] < ts[-1] - tol_f:
+            raise LoperInputError(
+                f"the force at its own rate ({tf[0]:.4f} .. {tf[-1]:.4f} s) does not cover the fit window "
+                f"{ts[0]:.4f} .. {ts[-1]:.4f} s"
+            )
+        force_u = stage_force_means(tf, fu, ts)
+        force_p = per_step(force_u) + step_stage_forces(tf, fpm - fu, ts[0], step, n_steps)
     # u_ff - Ja(q_u)^T F_u = inverse dynamics with the unperturbed force
     feedforward = inverse_dynamics(ref_q, ref_qd, ref_qdd, params, force_u)
     dpel_spline = CubicSpline(t, pp - pu)
@@ -256,6 +288,99 @@ def prepare_window(
         initial_state_span_s=float(initial_state_span_s),
         initial_state_degree=int(initial_state_degree),
     )
+
+
+def stage_times_s(window: PreparedWindow) -> np.ndarray:
+    """The RK4 stage times (2 N + 1,) in s of a window: every ``step_s / 2`` from its first sample."""
+    n_steps = (window.n_samples - 1) * window.n_substeps
+    return window.time_s[0] + 0.5 * window.step_s * np.arange(2 * n_steps + 1)
+
+
+def per_step(stage: np.ndarray) -> np.ndarray:
+    """Stage values (2 N + 1, 2) at :func:`stage_times_s` -> the force at the four stages of each step (N, 4, 2).
+
+    Start, middle, middle, end: plain RK4 with the force evaluated at the stage times (the
+    ``force_perturbed_n`` layout of :class:`PreparedWindow`).
+    """
+    return np.stack([stage[:-1:2], stage[1::2], stage[1::2], stage[2::2]], axis=1)
+
+
+def step_stage_forces(force_time_s: np.ndarray, force_n: np.ndarray, start_s: float, step_s: float,
+                      n_steps: int) -> np.ndarray:
+    """Stage forces (n_steps, 4, 2) that give each RK4 step the exact response of a linear system to the force.
+
+    RK4 on ``y' = A y + b F(t)`` adds per step of length h
+    ``h/6 [(1 + hA + h²A²/2 + h³A³/4) F1 + (2 + hA + h²A²/2) F2 + (2 + hA) F3 + F4] b``;
+    the exact forced response is ``sum_j A^j / j! R_j b`` with the moments
+    ``R_j = int_0^h (h - s)^j F(s) ds``. Equating the powers of A up to the
+    third, RK4's own order, gives ``F1 = 4 R3 / h^4``, ``F1 + F2 = 6 R2 / h^3``,
+    ``F1 + F2 + F3 = 6 R1 / h^2`` and ``F1 + 2 F2 + 2 F3 + F4 = 6 R0 / h``: the
+    step then carries the force's impulse and its timing within the step
+    exactly, however fast its edges (a constant force gives F1 = .. = F4 = F).
+    The force is the cubic spline (not-a-knot) through its samples ``force_n``
+    (k, 2) at ``force_time_s`` (k,); the moments are exact (4-point
+    Gauss-Legendre on every piece between samples and step boundaries).
+    """
+    tf = np.asarray(force_time_s, dtype=float)
+    f = np.asarray(force_n, dtype=float)
+    h = float(step_s)
+    bounds = start_s + h * np.arange(n_steps + 1)
+    inner = tf[(tf > bounds[0]) & (tf < bounds[-1])]
+    edges = np.unique(np.concatenate([bounds, inner]))
+    a, b = edges[:-1], edges[1:]
+    keep = b - a > 1e-12 * h
+    a, b = a[keep], b[keep]
+    mid, half = 0.5 * (a + b), 0.5 * (b - a)
+    step_of = np.clip(np.floor((mid - start_s) / h).astype(int), 0, n_steps - 1)
+    nodes, weights = np.polynomial.legendre.leggauss(4)
+    x = mid[:, None] + half[:, None] * nodes
+    wq = half[:, None] * weights
+    fx = CubicSpline(tf, f, axis=0)(x)  # (n_piece, 4, 2)
+    r = bounds[step_of + 1][:, None] - x  # time to the step's end
+    R = np.zeros((4, n_steps, 2))
+    for j in range(4):
+        np.add.at(R[j], step_of, np.sum((wq * r**j)[..., None] * fx, axis=1))
+    F = np.empty((n_steps, 4, 2))
+    F[:, 0] = 4.0 * R[3] / h**4
+    F[:, 1] = 6.0 * R[2] / h**3 - F[:, 0]
+    F[:, 2] = 6.0 * R[1] / h**2 - F[:, 0] - F[:, 1]
+    F[:, 3] = 6.0 * R[0] / h - F[:, 0] - 2.0 * F[:, 1] - 2.0 * F[:, 2]
+    return F
+
+
+def _force_clock(force_time_s) -> np.ndarray:
+    tf = np.asarray(force_time_s, dtype=float)
+    if tf.ndim != 1 or len(tf) < 2:
+        raise LoperInputError(f"force_time_s must be 1-D with >= 2 samples, got shape {tf.shape}")
+    if not np.all(np.isfinite(tf)):
+        raise LoperInputError(f"force_time_s is not finite at sample {int(np.argmax(~np.isfinite(tf)))}")
+    d = np.diff(tf)
+    if np.any(d <= 0):
+        i = int(np.argmax(d <= 0))
+        raise LoperInputError(f"force_time_s must be strictly increasing; step at sample {i} is {d[i]} s")
+    return tf
+
+
+def stage_force_means(force_time_s: np.ndarray, force_n: np.ndarray, stage_time_s: np.ndarray) -> np.ndarray:
+    """Means (n_stage, 2) of a sampled force over the Simpson cells of RK4 stage times.
+
+    ``stage_time_s`` (2 N + 1,) are the RK4 stage times of N steps of length
+    h, every h / 2 from the window start. RK4 weights a step's start, middle
+    and end by 1/6, 4/6 and 1/6 of h; the cells ``[t - h/6, t + h/6]`` around
+    a step boundary and ``[t - h/3, t + h/3]`` around a midpoint (clipped to
+    the window) therefore tile the window, and the mean of the force over
+    each cell makes every step's stage-weighted force equal the force's exact
+    integral over the step. The force is the cubic spline (not-a-knot) through
+    its samples ``force_n`` (k, 2) at ``force_time_s`` (k,), integrated exactly.
+    """
+    ts = np.asarray(stage_time_s, dtype=float)
+    h = 2.0 * (ts[1] - ts[0])
+    half = np.where(np.arange(len(ts)) % 2 == 0, h / 6.0, h / 3.0)
+    lo = np.maximum(ts - half, ts[0])
+    hi = np.minimum(ts + half, ts[-1])
+    spline = CubicSpline(np.asarray(force_time_s, dtype=float), np.asarray(force_n, dtype=float), axis=0)
+    integral = spline.antiderivative()
+    return (integral(hi) - integral(lo)) / (hi - lo)[:, None]
 
 
 def initial_state_basis(tau: np.ndarray, degree: int) -> np.ndarray:

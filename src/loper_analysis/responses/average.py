@@ -17,8 +17,10 @@ from ..constants import JOINTS
 from ..dynamics import segment_coordinates
 from ..errors import LoperInputError
 from ..outliers import check_enough_strides
+from ..resampling import window_times_s
 from .inputs import trial_angles, trial_name, trial_table
 from .matching import match_unperturbed, stride_table, too_short
+from .native_force import native_force_rate_hz, native_force_windows
 from .sampling import TIME_TOLERANCE_S
 from .windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
 
@@ -62,7 +64,11 @@ def _trial_inputs(trial: Mapping, k: int, side: str, source: str):
     magnitude = force["force_measured_n"].to_numpy(float)
     columns["force"] = magnitude
     columns["force_vector"] = magnitude[:, None] * direction  # NaN frames stay NaN
-    return name, where_s, t, columns, strides
+    native = None
+    if trial.get("force_native") is not None:
+        native, where_n = trial_table(trial, "force_native", name, ("time_s", "force_measured_n"))
+        native = (native, where_n, direction)
+    return name, where_s, t, columns, strides, native
 
 
 def subject_onset_response(
@@ -93,7 +99,9 @@ def subject_onset_response(
     ----------
     trials : sequence of mapping
         One per trial of this onset: ``name``, ``angles``, ``strides``,
-        ``force`` and ``force_direction`` (:mod:`loper_analysis.responses.inputs`).
+        ``force`` and ``force_direction`` (:mod:`loper_analysis.responses.inputs`),
+        optionally ``force_native`` (``time_s``, ``force_measured_n`` at the
+        robot rate, mocap clock) in every trial or in none.
     onset_ms : float
         Nominal onset after toe-off, ms (e.g. 300).
     settings : ResponseSettings
@@ -136,7 +144,11 @@ def subject_onset_response(
         :func:`loper_analysis.dynamics.segment_coordinates`,
         ``pelvis_angle_unperturbed_rad`` / ``pelvis_angle_perturbed_rad``
         (n_grid,), ``force_unperturbed_n`` / ``force_perturbed_n`` (n_grid, 2):
-        ``force_measured_n * force_direction`` (N, world x/y); plus
+        ``force_measured_n * force_direction`` (N, world x/y). When the trials
+        hold ``force_native`` (the force table at the robot log's rate,
+        :mod:`loper_analysis.responses.native_force`), the forces are the means
+        at that rate instead, (k, 2) at ``force_time_s`` (k,) relative to the
+        onset (the ``force_time_s`` of ``prepare_window``); plus
         ``window_before_s``, ``window_after_s``, ``initial_state_span_s`` and
         ``n_pairs``. Arrays are NaN when no pair is kept.
 
@@ -150,9 +162,13 @@ def subject_onset_response(
     min_n = int(number("min_strides", settings.min_strides, source, minimum=0.0))
     rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
 
-    per_trial, pairs, windows, rooms = [], [], [], []
+    per_trial, pairs, windows, rooms, force_windows = [], [], [], [], []
+    native_rate = None
     for k, trial in enumerate(trials):
-        name, where_s, t, columns, strides = _trial_inputs(trial, k, side, source)
+        name, where_s, t, columns, strides, native = _trial_inputs(trial, k, side, source)
+        if (native is None) != (native_rate is None) and k:
+            raise LoperInputError(f"{where(source)}{name}: the force at the robot rate (force_native) must be given "
+                                  "for every trial of the onset or for none")
         if any(rec["trial"] == name for rec in per_trial):
             raise LoperInputError(f"{where(source)}trial name {name!r} appears twice; names must be unique")
         table = stride_table(strides, where_s)
@@ -169,6 +185,14 @@ def subject_onset_response(
         for s, why in matches.attrs["unmatched"].items():
             log.info("%s: perturbed stride %s has no match: %s", where_s, s, why)
         windows.append(paired_windows(t, columns, matches, start, after, rate_hz, method=method, source=where_s))
+        if native is not None:
+            table, where_n, direction = native
+            rate_n = native_force_rate_hz(table, where_n)
+            if native_rate is not None and rate_n != native_rate:
+                raise LoperInputError(f"{where_n}: robot rate {rate_n:g} Hz differs from the other trials' "
+                                      f"{native_rate:g} Hz")
+            native_rate = rate_n
+            force_windows.append(native_force_windows(t, direction, table, matches, start, after, rate_n, where_n))
         pairs.append(matches.assign(trial=name))
         per_trial.append({"trial": name, "n_perturbed": n_perturbed, "n_too_short": n_short,
                           "n_no_match": len(matches.attrs["unmatched"])})
@@ -245,6 +269,11 @@ def subject_onset_response(
         series[f"q_{what}"] = mean_and_sd(q)[0]
         series[f"pelvis_angle_{what}_rad"] = mean_and_sd(pel)[0]
         series[f"force_{what}_n"] = mean_and_sd(kept["force_vector"][i])[0]
+    if native_rate is not None:
+        # the force at the robot rate replaces the frames' for the identification
+        series["force_time_s"] = window_times_s(-start, after, native_rate)
+        for i, what in enumerate(("perturbed", "unperturbed")):
+            series[f"force_{what}_n"] = mean_and_sd(np.concatenate([w[i] for w in force_windows])[keep])[0]
     series.update({"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial,
                    "n_pairs": n_pairs})
     return response, counts, series

@@ -35,14 +35,17 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
         response_out: PathLike, counts_out: PathLike, fit_out: PathLike, curves_out: PathLike,
         truth_yaml: PathLike | None = None, null_trials: Sequence[str] = (),
         null_angles: Sequence[PathLike] = (), null_strides: Sequence[PathLike] = (),
-        response: Mapping | None = None, identification: Mapping | None = None) -> pd.DataFrame:
+        response: Mapping | None = None, identification: Mapping | None = None,
+        force_native: Sequence[PathLike] = (), force_out: PathLike | None = None) -> pd.DataFrame:
     """Responses and the impedance fit of one subject at one onset (:func:`loper_analysis.impedance.fit_onset`).
 
     ``trials`` names the onset's trials; ``angles``, ``strides``, ``force``
     (TSV tables of the processing steps) and ``markers`` (TRC, for the brace
     markers) give their files in the same order. ``null_trials`` with
     ``null_angles`` and ``null_strides``: the trials whose unperturbed strides
-    are the null pairs. ``response`` and ``identification`` are the keyword
+    are the null pairs. ``force_native``: the load cell at the robot rate per
+    trial (``{trial}.force_native.tsv``, same order), from which the fit takes
+    its force; ``force_out`` gets the mean forces the model saw. ``response`` and ``identification`` are the keyword
     arguments of :class:`~loper_analysis.responses.ResponseSettings` and
     :class:`~loper_analysis.impedance.IdentificationSettings`. Writes the
     mean response, the stride counts, the fit rows and the fit curves; returns the rows.
@@ -60,13 +63,16 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
         truth = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml)).get(int(onset_ms))
     tables = _Tables()
     inputs = []
-    for name, a, s, f, m in zip(trials, angles, strides, force, markers, strict=True):
+    natives = list(force_native) if len(force_native) else [None] * len(trials)
+    for name, a, s, f, m, fn in zip(trials, angles, strides, force, markers, natives, strict=True):
         angle_table = tables(a, "angle table")
         t, X, labels = read_markers(m)
         if len(t) != len(angle_table) or not np.allclose(t, angle_table["time_s"].to_numpy(), atol=1e-6):
             raise LoperInputError(f"{m}: frames differ from {a}")
         inputs.append({"name": name, "angles": angle_table, "strides": tables(s, "stride table"),
-                       "force": tables(f, "force table"), "markers": (t, X, labels)})
+                       "force": tables(f, "force table"), "markers": (t, X, labels),
+                       "force_native": None if fn is None else read_tsv(fn, "robot-rate force table",
+                                                                         ("time_s", "force_measured_n"))})
     null = [{"name": name, "angles": tables(a, "angle table"), "strides": tables(s, "stride table")}
             for name, a, s in zip(null_trials, null_angles, null_strides, strict=True)]
     params = read_segments(segments_tsv) if inputs else None
@@ -75,6 +81,8 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
     write_tsv(result.counts, counts_out)
     write_tsv(result.rows, fit_out)
     write_tsv(result.curves, curves_out)
+    if force_out is not None:
+        write_tsv(result.force, force_out)
     log.info("impedance:\n%s", result.rows.to_string(index=False))
     return result.rows
 

@@ -191,23 +191,33 @@ def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, thres
     return contact_events(contacts), contacts
 
 
+#: Significant digits of the robot-rate force table: its times need microseconds over long trials.
+NATIVE_FLOAT_FORMAT = "%.12g"
+
+
 def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_channel: str = "sync", cutoff_hz: float = 40.0,
-             order: int = 4) -> pd.DataFrame:
-    """The robot log's forces on the mocap frames (sync-pulse clock map, 40 Hz low-pass, 128 Hz)."""
+             order: int = 4, native_out: PathLike | None = None) -> pd.DataFrame:
+    """The robot log's forces on the mocap frames (sync-pulse clock map, 40 Hz low-pass, 128 Hz).
+
+    ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
+    """
     from ..io.c3d import read_c3d
     from ..io.robot_log import read_robot_log
-    from ..loadcell import robot_log_on_mocap_frames
+    from ..loadcell import robot_log_frames_and_native
 
     rec = read_c3d(c3d_path)
     frame, meta = read_robot_log(log_path)
     rate = float(meta["sample_rate_hz"])
-    out = robot_log_on_mocap_frames(frame, rate, rec.analog(sync_channel), rec.analog_rate_hz, rec.time_s,
-                                    cutoff_hz=cutoff_hz, order=order, source=f"{log_path} / {c3d_path}")
+    out, native = robot_log_frames_and_native(frame, rate, rec.analog(sync_channel), rec.analog_rate_hz, rec.time_s,
+                                              cutoff_hz=cutoff_hz, order=order, source=f"{log_path} / {c3d_path}")
     cm = out.attrs.get("clock_map")
     if cm is not None:
         log.info("%s: clock map %s", log_path, cm)
     write_tsv(out, out_tsv)
     log.info("%d frames on the mocap clock", len(out))
+    if native_out is not None:
+        write_tsv(native, native_out, NATIVE_FLOAT_FORMAT)
+        log.info("%d robot samples on the mocap clock", len(native))
     return out
 
 
