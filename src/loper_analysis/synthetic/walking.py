@@ -7,9 +7,14 @@ at every right heel strike. Stride durations are drawn from a normal
 distribution (CV ``timing_cv``) and ``Phi`` is the monotone piecewise-cubic
 (PCHIP, C1) interpolant through (heel-strike time, stride number), so the
 strides have exactly the drawn durations and the angles have no jumps and no
-velocity steps. Every leg and joint has one amplitude factor per stride
-(normal, mean 1, CV ``amplitude_cv``) that scales the curve about its mean; the
-factors are blended between heel strikes with a raised-cosine (C1) weight.
+velocity steps. In the gentle model every leg and joint has one amplitude
+factor per stride (normal, mean 1, CV ``amplitude_cv``) that scales the curve
+about its mean; the factors are blended between heel strikes with a
+raised-cosine (C1) weight. The study-level model (a
+:class:`~loper_analysis.synthetic.variability.GaitVariability`) modulates
+amplitude, offset and timing of each curve smoothly instead, and a
+:class:`~loper_analysis.synthetic.variability.DeviceAdaptation` changes the
+curves of a trial with the device.
 Gait events are the times at which the phase of a leg passes 0 (heel strike)
 or the stance fraction (toe-off).
 
