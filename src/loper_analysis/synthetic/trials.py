@@ -190,7 +190,7 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
     gait_seed, sync_seed, device_seed, schedule_seed = ss.spawn(4)
     fine, events = walking_with_margins(duration_s, lab, np.random.default_rng(gait_seed), timing_cv, amplitude_cv,
                                         leg_length_from_height(height_m), gait, sample_rate_hz=lab.analog_rate_hz,
-                                        variability=variability, adaptation=adaptation if device else None)
+                                        variability=variability, adaptation=adaptation if device is not None else None)
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     robot_duration = (duration_s + lab.robot_margin_s + lab.clock_offset_s) / scale
     starts = sync_pulse_starts(robot_duration, sync_seed)
