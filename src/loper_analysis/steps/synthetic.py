@@ -43,7 +43,16 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
     config's ``synthetic`` section, ``lab`` the keyword arguments of
     :class:`~loper_analysis.synthetic.trials.LabSettings`, ``device`` those of
     :class:`~loper_analysis.device.controller.DeviceParameters`.
+
+    With ``settings["variability"] == "study"`` the subject walks with the
+    study-level variability (``study_variability``), adapts its gait to the
+    device (``device_adaptation``, drawn per subject) and its left swing leg
+    answers the measured minimal-impedance force with the mean over the
+    onsets of its true K and D (with the onset's own in perturbation trials);
+    ``"gentle"`` is the earlier lab.
     """
+    import numpy as np
+
     from ..device.controller import DeviceParameters
     from ..synthetic.subjects import truth_from_document
     from ..synthetic.trials import (
@@ -52,6 +61,7 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
         subject_static_recording,
         subject_walking_trial,
     )
+    from ..synthetic.variability import GaitVariability, device_adaptation
 
     s = settings
     lab_settings, device_parameters = LabSettings(**lab), DeviceParameters(**device)
@@ -61,6 +71,15 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
     log.info("static trial of %s: %s", subject, static_out)
     true = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml))
     logs = iter(log_outs)
+    variability = adaptation = minimal_impedance = None
+    if s["variability"] == "study":
+        v, a = s["study_variability"], s["device_adaptation"]
+        variability = GaitVariability(v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"],
+                                      v["knots_per_stride"])
+        adaptation = device_adaptation(seed, subject, a["amplitude_change"], a["offset_rad"], a["swing_gain"])
+        minimal_impedance = tuple(float(np.mean([true[o][j][name] for o in true]))
+                                  for j in JOINTS for name in ("K", "D"))
+        log.info("%s: device adaptation %s; minimal-impedance walking with %s", subject, adaptation, minimal_impedance)
     for trial, c3d, onset_ms in zip(trials, c3d_outs, onsets_ms, strict=True):
         perturbation = None
         if onset_ms is not None:
@@ -71,6 +90,7 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
         walk, recording = subject_walking_trial(
             subject, trial, height_m, mass_kg, s["walking_duration_s"], s["timing_cv"], s["amplitude_cv"],
             lab_settings, device_parameters if robot_log is not None else None, seed, perturbation,
+            variability=variability, adaptation=adaptation, minimal_impedance=minimal_impedance,
         )
         write_recording(c3d, recording)
         if robot_log is not None:

@@ -2,8 +2,9 @@
 
 * :mod:`.subjects` - anthropometrics and the true impedance per onset;
 * :mod:`.gait_curves`, :mod:`.walking` - nominal slow walking and stride-variable trials;
+* :mod:`.variability` - study-level stride-to-stride variability and the gait adaptation to the device;
 * :mod:`.treadmill` - split-belt ground reaction forces;
-* :mod:`.response` - the swing leg's answer to a LOPER pulse with the true impedance;
+* :mod:`.response` - the swing leg's answer to a LOPER pulse (and the minimal-impedance force) with the true impedance;
 * :mod:`.sync` - the robot's sync pulse trains;
 * :mod:`.trials` - whole trials: C3D contents and robot logs.
 

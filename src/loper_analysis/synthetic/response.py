@@ -31,7 +31,7 @@ import pandas as pd
 from ..dynamics import SegmentParameters, segment_coordinates
 from ..errors import LoperInputError
 
-__all__ = ["perturbation_schedule", "pulse_train", "thigh_normal", "swing_response"]
+__all__ = ["perturbation_schedule", "pulse_train", "thigh_normal", "swing_response", "swing_responses", "swing_spans"]
 
 
 def perturbation_schedule(events: pd.DataFrame, onset_s: float, rng: np.random.Generator, start_s: float,
@@ -132,3 +132,41 @@ def swing_response(
         if converged:
             break
     return dth
+
+
+def swing_responses(time_s, joint_angles_rad, pelvis_angle_rad, pelvis_x_m, params: SegmentParameters, impedance,
+                    force_n, swings, n_substeps: int = 2) -> np.ndarray:
+    """Joint-angle deviations (n, 3) rad of every swing driven by the measured force, against walking without it.
+
+    Each swing (rows ``toe_off_s``, ``heel_strike_s`` of ``swings``) is
+    simulated from toe-off to heel strike by :func:`swing_response` with the
+    load-cell force ``force_n`` (n,) (N, along the rods) as the perturbing
+    force and zero as the unperturbed one: the leg feels the device's force
+    (its minimal-impedance force, and the pulses where there are any) through
+    the swing-leg dynamics with ``impedance`` (the 6 values of
+    :data:`loper_analysis.constants.PARAMETERS`). Swings whose span
+    (toe-off - 0.3 s .. heel strike + 0.35 s) leaves ``time_s`` are skipped.
+    """
+    t = np.asarray(time_s, float)
+    th = np.asarray(joint_angles_rad, float)
+    before = 0.05
+    delta = np.zeros_like(th)
+    zero = np.zeros_like(t)
+    for toe_off, heel_strike in zip(swings["toe_off_s"], swings["heel_strike_s"]):
+        if toe_off - 0.3 < t[0] or heel_strike + 0.35 > t[-1]:
+            continue
+        sl = slice(int(np.searchsorted(t, toe_off - 0.3)), int(np.searchsorted(t, heel_strike + 0.35)))
+        delta[sl] += swing_response(t[sl], th[sl], np.asarray(pelvis_angle_rad)[sl], np.asarray(pelvis_x_m)[sl],
+                                    params, impedance, np.asarray(force_n)[sl], zero[sl], toe_off + before,
+                                    heel_strike, before_s=before, n_substeps=n_substeps)
+    return delta
+
+
+def swing_spans(events: pd.DataFrame, side: str = "left") -> pd.DataFrame:
+    """Every swing of ``side``: ``toe_off_s`` and the next ``heel_strike_s`` (true events, sorted)."""
+    ev = events[events["side"] == side]
+    to = np.sort(ev.loc[ev["event"] == "toe_off", "time_s"].to_numpy(float))
+    hs = np.sort(ev.loc[ev["event"] == "heel_strike", "time_s"].to_numpy(float))
+    i = np.searchsorted(hs, to, side="right")
+    keep = i < hs.size
+    return pd.DataFrame({"toe_off_s": to[keep], "heel_strike_s": hs[i[keep]]})

@@ -158,7 +158,8 @@ class WalkingTrial:
 
 def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: float, params,
                            timing_cv: float = 0.03, amplitude_cv: float = 0.05, device=None,
-                           perturbation: PerturbationSettings | None = None, gait=None) -> WalkingTrial:
+                           perturbation: PerturbationSettings | None = None, gait=None, variability=None,
+                           adaptation=None, minimal_impedance=None) -> WalkingTrial:
     """Simulate kinematics, device and perturbation responses of one walking trial.
 
     ``params`` is the subject's :class:`~loper_analysis.dynamics.SegmentParameters`
@@ -168,16 +169,28 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
     ``clock_drift_ppm``), driven by the brace motion of the unperturbed
     thigh and the desired pulses; the leg answers the difference of the
     measured force with and without the pulses (:mod:`.response`).
+
+    ``variability`` (:class:`~loper_analysis.synthetic.variability.GaitVariability`)
+    and ``adaptation`` (:class:`~loper_analysis.synthetic.variability.DeviceAdaptation`,
+    trials with the device) select the study-level lab; None: the gentle one.
+    With ``minimal_impedance`` (K, D per joint, as ``perturbation.impedance``)
+    and the device, every left swing answers the measured force itself, the
+    minimal-impedance force and any pulses
+    (:func:`~loper_analysis.synthetic.response.swing_responses`), with the
+    perturbation's impedance in a trial with pulses and ``minimal_impedance``
+    otherwise; None: only the pulses act (their force minus that of a run
+    without them).
     """
     from ..device.controller import simulate_device
-    from .response import perturbation_schedule, pulse_train, swing_response
+    from .response import perturbation_schedule, pulse_train, swing_response, swing_responses, swing_spans
     from .sync import pulse_train_at, sync_pulse_starts
     from .walking import leg_length_from_height
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     gait_seed, sync_seed, device_seed, schedule_seed = ss.spawn(4)
     fine, events = walking_with_margins(duration_s, lab, np.random.default_rng(gait_seed), timing_cv, amplitude_cv,
-                                        leg_length_from_height(height_m), gait, sample_rate_hz=lab.analog_rate_hz)
+                                        leg_length_from_height(height_m), gait, sample_rate_hz=lab.analog_rate_hz,
+                                        variability=variability, adaptation=adaptation if device is not None else None)
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     robot_duration = (duration_s + lab.robot_margin_s + lab.clock_offset_s) / scale
     starts = sync_pulse_starts(robot_duration, sync_seed)
@@ -207,7 +220,19 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
         "perturbation": (np.abs(fd) > 0).astype(np.int64),
         "safety_state": sim["safety_state"].to_numpy().astype(np.int64),
     })
-    if perturbation is not None and len(schedule):
+    if minimal_impedance is not None:
+        fm = np.interp((t_fine + lab.clock_offset_s) / scale, t_robot, robot["force_measured_n"].to_numpy())
+        impedance = perturbation.impedance if perturbation is not None else tuple(minimal_impedance)
+        angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
+        t_span = -lab.clock_offset_s + scale * t_robot[[0, -1]]
+        inside = (t_fine >= t_span[0]) & (t_fine <= t_span[1])
+        delta = swing_responses(t_fine[inside], angles[inside], -fine["pelvis_tilt"].to_numpy()[inside],
+                                fine["pelvis_tx"].to_numpy()[inside], params, impedance, fm[inside],
+                                swing_spans(events, "left"))
+        fine = fine.copy()
+        for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
+            fine.loc[inside, c] = angles[inside, i] + delta[:, i]
+    elif perturbation is not None and len(schedule):
         free = simulate_device(0 * t_robot, device, None, brace_position_m=brace, seed=device_seed)
         to_robot_fine = (t_fine + lab.clock_offset_s) / scale
         fp = np.interp(to_robot_fine, t_robot, robot["force_measured_n"].to_numpy())
@@ -256,17 +281,20 @@ def walking_recording(model, trial: WalkingTrial, body_mass_kg: float, lab: LabS
 
 def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Generator, timing_cv: float,
                          amplitude_cv: float, leg_length_m: float, gait=None,
-                         sample_rate_hz: float | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+                         sample_rate_hz: float | None = None, variability=None,
+                         adaptation=None) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Kinematics and events that cover the robot log's span: from ``clock_offset_s`` (+1 s) before the
     motion capture to ``robot_margin_s`` (+1 s) after it; time 0 is the first motion-capture frame.
-    ``sample_rate_hz`` defaults to the marker rate and must be a multiple of it."""
+    ``sample_rate_hz`` defaults to the marker rate and must be a multiple of it; ``variability`` and
+    ``adaptation`` as in :func:`~loper_analysis.synthetic.walking.walking_kinematics`."""
     from .gait_curves import NominalGait
     from .walking import walking_kinematics
 
     rate = lab.marker_rate_hz if sample_rate_hz is None else sample_rate_hz
     lead = np.ceil((lab.clock_offset_s + 1.0) * lab.marker_rate_hz) / lab.marker_rate_hz
     total = lead + duration_s + lab.robot_margin_s + 1.0
-    coords, events = walking_kinematics(total, rate, gait or NominalGait(), rng, timing_cv, amplitude_cv, leg_length_m)
+    coords, events = walking_kinematics(total, rate, gait or NominalGait(), rng, timing_cv, amplitude_cv, leg_length_m,
+                                        variability=variability, adaptation=adaptation)
     coords = coords.assign(time_s=np.round((coords["time_s"] - lead) * rate) / rate)
     return coords, events.assign(time_s=events["time_s"] - lead)
 
@@ -288,10 +316,13 @@ def subject_static_recording(subject: str, height_m: float, mass_kg: float, dura
 
 def subject_walking_trial(subject: str, trial: str, height_m: float, mass_kg: float, duration_s: float,
                           timing_cv: float, amplitude_cv: float, lab: LabSettings, device, seed: int,
-                          perturbation: PerturbationSettings | None = None) -> tuple[WalkingTrial, C3DRecording]:
+                          perturbation: PerturbationSettings | None = None, variability=None, adaptation=None,
+                          minimal_impedance=None) -> tuple[WalkingTrial, C3DRecording]:
     """One walking trial of a synthetic subject (seeded by subject and trial): the simulation and its C3D contents.
 
-    ``device`` None simulates walking without the device (no robot log).
+    ``device`` None simulates walking without the device (no robot log);
+    ``variability``, ``adaptation`` and ``minimal_impedance`` as in
+    :func:`simulate_walking_trial` (None: the gentle lab).
     """
     from ..model import build_lower_body_model, segment_parameters_from_model
 
@@ -299,5 +330,6 @@ def subject_walking_trial(subject: str, trial: str, height_m: float, mass_kg: fl
     params = segment_parameters_from_model(model)
     sim_seed, file_seed = np.random.SeedSequence(_seed(seed, subject, trial)).spawn(2)
     walk = simulate_walking_trial(duration_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv, device,
-                                  perturbation)
+                                  perturbation, variability=variability, adaptation=adaptation,
+                                  minimal_impedance=minimal_impedance)
     return walk, walking_recording(model, walk, mass_kg, lab, file_seed, f"{subject} {trial}")

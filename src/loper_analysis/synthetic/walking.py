@@ -7,9 +7,14 @@ at every right heel strike. Stride durations are drawn from a normal
 distribution (CV ``timing_cv``) and ``Phi`` is the monotone piecewise-cubic
 (PCHIP, C1) interpolant through (heel-strike time, stride number), so the
 strides have exactly the drawn durations and the angles have no jumps and no
-velocity steps. Every leg and joint has one amplitude factor per stride
-(normal, mean 1, CV ``amplitude_cv``) that scales the curve about its mean; the
-factors are blended between heel strikes with a raised-cosine (C1) weight.
+velocity steps. In the gentle model every leg and joint has one amplitude
+factor per stride (normal, mean 1, CV ``amplitude_cv``) that scales the curve
+about its mean; the factors are blended between heel strikes with a
+raised-cosine (C1) weight. The study-level model (a
+:class:`~loper_analysis.synthetic.variability.GaitVariability`) modulates
+amplitude, offset and timing of each curve smoothly instead, and a
+:class:`~loper_analysis.synthetic.variability.DeviceAdaptation` changes the
+curves of a trial with the device.
 Gait events are the times at which the phase of a leg passes 0 (heel strike)
 or the stance fraction (toe-off).
 
@@ -29,6 +34,7 @@ from ..checks import generator
 from ..errors import LoperInputError
 from ..model import COORDINATES
 from .gait_curves import CURVE_JOINTS, NominalGait
+from .variability import DeviceAdaptation, GaitVariability, smooth_noise, swing_envelope
 
 __all__ = [
     "TRUE_EVENT_COLUMNS",
@@ -110,6 +116,23 @@ def pelvis_height_m(gait: NominalGait, leg_length_m: float | None = None, n_samp
     return float(np.mean(-np.minimum(*lowest)))
 
 
+def _modulations(variability: GaitVariability, joint: int, leg_phase: np.ndarray, first_phase: float,
+                 last_phase: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Amplitude factor, offset (rad) and timing shift (strides) of one leg and joint at ``leg_phase``.
+
+    The knots cover the leg phases ``first_phase .. last_phase`` (the span of
+    the trial's stride knots), so the number of draws depends only on the
+    trial's strides.
+    """
+    n = variability.knots_per_stride
+    first, last = int(np.floor(first_phase * n)) - 1, int(np.ceil(last_phase * n)) + 1
+    g = swing_envelope(leg_phase, variability.swing_gain[joint])
+    a = 1.0 + g * smooth_noise(leg_phase, first, last, n, variability.amplitude_cv[joint], rng)
+    o = g * smooth_noise(leg_phase, first, last, n, variability.offset_sd_rad[joint], rng)
+    tau = g * smooth_noise(leg_phase, first, last, n, variability.timing_sd[joint], rng)
+    return a, o, tau
+
+
 def _solve_phase(phase_of_t: PchipInterpolator, knot_t: np.ndarray, knot_phase0: int, targets: np.ndarray) -> np.ndarray:
     """Times at which the monotone phase reaches ``targets`` (bisection inside the bracketing stride)."""
     k = np.floor(targets).astype(int) - knot_phase0
@@ -131,6 +154,8 @@ def walking_kinematics(
     amplitude_cv: float = 0.05,
     leg_length_m: float | None = None,
     start_phase: float | None = None,
+    variability: GaitVariability | None = None,
+    adaptation: DeviceAdaptation | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Simulate a treadmill walking trial: model coordinates and the true gait events.
 
@@ -158,6 +183,15 @@ def walking_kinematics(
     start_phase : float or None
         Right-leg stride phase at t = 0 in [0, 1); None = drawn uniformly from
         ``rng``.
+    variability : GaitVariability or None
+        None: the gentle model (per-stride amplitude factors of CV
+        ``amplitude_cv``). Otherwise the study-level model of
+        :mod:`loper_analysis.synthetic.variability` (smooth amplitude, offset
+        and timing modulations; ``amplitude_cv`` is then unused). Either way
+        the stride durations are the same for the same ``rng``.
+    adaptation : DeviceAdaptation or None
+        Systematic change of the joint curves with the device (both legs); None:
+        none.
 
     Returns
     -------
@@ -191,6 +225,10 @@ def walking_kinematics(
     leg = _check_leg_length(leg_length_m)
     if start_phase is not None and not 0 <= start_phase < 1:
         raise LoperInputError(f"start_phase must lie in [0, 1), got {start_phase}")
+    if variability is not None and not isinstance(variability, GaitVariability):
+        raise LoperInputError(f"variability must be a GaitVariability or None, got {type(variability).__name__}")
+    if adaptation is not None and not isinstance(adaptation, DeviceAdaptation):
+        raise LoperInputError(f"adaptation must be a DeviceAdaptation or None, got {type(adaptation).__name__}")
 
     T0 = gait.stride_s
     phi0 = float(rng.uniform()) if start_phase is None else float(start_phase)
@@ -219,9 +257,18 @@ def walking_kinematics(
         idx = k.astype(int) - amp_first
         psi = gait.curve_phase(frac)
         for j, joint in enumerate(CURVE_JOINTS):
-            a = amps[i_leg, j, idx] * (1.0 - w) + amps[i_leg, j, idx + 1] * w
             series = gait.joint_series(joint)
-            out[f"{joint}_{side}"] = series.mean + a * (series(psi) - series.mean)
+            if variability is None:
+                a = amps[i_leg, j, idx] * (1.0 - w) + amps[i_leg, j, idx + 1] * w
+                excursion = series(psi) - series.mean
+                o = 0.0
+            else:
+                a, o, tau = _modulations(variability, j, leg_phase, knot_phase[0] - offset, knot_phase[-1] - offset, rng)
+                excursion = series(gait.curve_phase(leg_phase + tau)) - series.mean
+            if adaptation is not None:
+                dev_amp, dev_off = adaptation.factor_and_offset(j, leg_phase)
+                a, o = dev_amp * a, o + dev_off
+            out[f"{joint}_{side}"] = series.mean + a * excursion + o
     coordinates = pd.DataFrame({c: out[c] for c in ("time_s", *COORDINATES)})
 
     s = gait.stance_fraction
