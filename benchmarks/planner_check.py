@@ -48,8 +48,9 @@ def estimates(rows: pd.DataFrame) -> np.ndarray:
 def reported_sd(rows: pd.DataFrame) -> np.ndarray:
     """The SD (6,) the fit itself reports: its 95 % CI half-width over Student's t (102 degrees of freedom)."""
     by_joint = rows.set_index("joint")
-    half = np.array([(by_joint.loc[j, parameter_column(p, "ci95_high")] - by_joint.loc[j, parameter_column(p, "ci95_low")])
-                     / 2 for j in JOINTS for p in ("K", "D")], float)
+    high, low = (by_joint[[parameter_column(p, b) for p in ("K", "D")]].loc[list(JOINTS)].to_numpy(float).ravel()
+                 for b in ("ci95_high", "ci95_low"))
+    half = (high - low) / 2
     return half / student_t.ppf(0.975, 102)
 
 
@@ -120,14 +121,16 @@ def main() -> None:
     t0 = time.perf_counter()
     table = run_check(args.repeats, args.onset_ms, args.strides, args.seed,
                       angle_noise_sd_rad=args.angle_noise_sd_rad)
-    print(f"onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, {args.repeats} repeats, pilot null pairs {table.attrs['n_null_pairs']}, "
+    print(f"onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, {args.repeats} repeats, "
+          f"pilot null pairs {table.attrs['n_null_pairs']}, "
           f"{time.perf_counter() - t0:.0f} s")
     print(markdown_table(table.round(4)))
     hk = table[table["joint"].isin(["hip", "knee"])]
     worst = hk.loc[(hk["ratio_predicted_to_measured"] - 1).abs().idxmax()]
     print(f"hip and knee: ratio predicted/measured {hk['ratio_predicted_to_measured'].min():.3f} .. "
           f"{hk['ratio_predicted_to_measured'].max():.3f} (worst: {worst['joint']} {worst['parameter']} at "
-          f"{worst['n_strides']} strides); within ±25 %: {bool(((hk['ratio_predicted_to_measured'] - 1).abs() <= 0.25).all())}")
+          f"{worst['n_strides']} strides); "
+          f"within ±25 %: {bool(((hk['ratio_predicted_to_measured'] - 1).abs() <= 0.25).all())}")
 
 
 if __name__ == "__main__":

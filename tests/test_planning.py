@@ -140,8 +140,9 @@ def test_repeated_experiments_report_the_predicted_sd(params, pilot):
                 r = fit_onset([c[10]], params, ONSET_MS, f"R{k}", None, [f], ResponseSettings(), ident).rows
                 assert (r["noise_model"] == "null_pairs").all()
                 r = r.set_index("joint")
-                reported.append([(r.loc[j, parameter_column(p, "ci95_high")] - r.loc[j, parameter_column(p, "ci95_low")])
-                                 / 2 / T95_102 for j in JOINTS for p in ("K", "D")])
+                high, low = (r[[parameter_column(p, b) for p in ("K", "D")]].loc[list(JOINTS)].to_numpy().ravel()
+                             for b in ("ci95_high", "ci95_low"))
+                reported.append((high - low) / 2 / T95_102)
                 kept.append(int(r["n_strides"].iloc[0]))
         finally:
             logging.disable(logging.NOTSET)
@@ -170,7 +171,8 @@ def test_pulse_longer_than_the_window_is_refused():
 def test_pilot_without_null_pairs_is_refused(params, pilot):
     _, _, null = pilot
     few = {k: (v[:5] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
-    with pytest.raises(LoperInputError, match=r"pilot: 5 null pair\(s\), fewer than identification.null_pair_components"):
+    with pytest.raises(LoperInputError,
+                       match=r"pilot: 5 null pair\(s\), fewer than identification.null_pair_components"):
         stride_covariance(few, params, TRUTH)
     none = {k: (v[:0] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
     with pytest.raises(LoperInputError, match="no null pairs"):
@@ -207,7 +209,8 @@ def pilot_results(tmp_path_factory, params, pilot):
 
 def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path, capsys):
     out = tmp_path / "plan.tsv"
-    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", "--trials", "pert050-1", "--strides", "10", "40",
+    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", "--trials", "pert050-1",
+                 "--strides", "10", "40",
                  "--target", "hip", "D", "15", "--out", str(out)])
     captured = capsys.readouterr()
     assert code == 0, captured.err
@@ -228,7 +231,8 @@ def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path,
     (["--trials", "pert050-2"], "S09, onset 50 ms: 0 null pair(s), fewer than identification.null_pair_components"),
 ])
 def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
-    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", *(["--trials", "pert050-1"] if "--trials" not in args else []), *args])
+    trials = [] if "--trials" in args else ["--trials", "pert050-1"]
+    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", *trials, *args])
     err = capsys.readouterr().err
     assert code == 2
     assert err.startswith("loper-analysis plan: ") and err.count("\n") == 1

@@ -327,7 +327,8 @@ def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onse
                     "unit": PARAMETER_UNITS[PARAMETERS[i]], "n_strides": n, "planned_value": planned,
                     "predicted_sd": sd, "ci95_half_width": half,
                     "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
-                    "pulse_force_n": float(settings.pulse_force_n), "pulse_duration_s": float(settings.pulse_duration_s),
+                    "pulse_force_n": float(settings.pulse_force_n),
+                    "pulse_duration_s": float(settings.pulse_duration_s),
                     "n_null_pairs": stride_cov.n_null_pairs, "note": stride_cov.note,
                 })
     return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))

@@ -47,8 +47,8 @@ def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: 
         d = row[parameter_column("D")].to_numpy(float)
         if len(row) != 1 or not (np.isfinite(k).all() and np.isfinite(d).all()):
             status = ", ".join(f"{s}: {r}" for s, r in zip(row.get("status", []), row.get("reason", []))) or "no row"
-            raise LoperInputError(f"{source}: no fitted impedance of subject {subject} at onset {onset_ms:g} ms for the "
-                                  f"{joint} ({status}); give the planned impedance explicitly")
+            raise LoperInputError(f"{source}: no fitted impedance of subject {subject} at onset {onset_ms:g} ms "
+                                  f"for the {joint} ({status}); give the planned impedance explicitly")
         values += [float(k[0]), float(d[0])]
     return np.array(values)
 
