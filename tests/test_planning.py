@@ -237,3 +237,25 @@ def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
     assert code == 2
     assert err.startswith("loper-analysis plan: ") and err.count("\n") == 1
     assert message in err
+
+
+def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_results, tmp_path):
+    """A pilot onset without an estimate: ``raise`` names it; ``note`` (the rule) writes rows without a prediction."""
+    from loper_analysis.steps.planning import plan
+
+    failed = pd.DataFrame({"subject": "S09", "onset_ms": 175, "joint": list(JOINTS), parameter_column("K"): np.nan,
+                           parameter_column("D"): np.nan, "status": "failed",
+                           "reason": "3 valid perturbed stride(s), fewer than 5: not fitted"})
+    write_tsv(failed, tmp_path / "175.tsv")
+    root = pilot_results
+    files = dict(trials=["pert050-1"], angles=[root / "ik/S09/pert050-1.angles.tsv"],
+                 strides=[root / "strides/S09/pert050-1.strides.tsv"], segments_tsv=root / "model/S09/segments.tsv",
+                 subject="S09", onsets_ms=[50, 175], n_strides=[10])
+    impedance = [root / "impedance/S09/050.tsv", tmp_path / "175.tsv"]
+    with pytest.raises(LoperInputError, match=r"no fitted impedance of subject S09 at onset 175 ms for the hip "
+                                              r"\(failed: 3 valid perturbed stride"):
+        plan(**files, impedance_tsvs=impedance)
+    table, _ = plan(**files, impedance_tsvs=impedance, without_impedance="note")
+    late = table[table["onset_ms"] == 175]
+    assert len(late) == 6 and late["predicted_sd"].isna().all() and late["note"].str.startswith("not planned").all()
+    assert table.loc[table["onset_ms"] == 50, "predicted_sd"].notna().all()

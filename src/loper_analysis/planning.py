@@ -65,6 +65,7 @@ __all__ = [
     "planning_window",
     "stride_covariance",
     "precision_table",
+    "unplanned_rows",
     "strides_needed",
     "target_answer",
 ]
@@ -331,6 +332,17 @@ def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onse
                     "pulse_duration_s": float(settings.pulse_duration_s),
                     "n_null_pairs": stride_cov.n_null_pairs, "note": stride_cov.note,
                 })
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+
+
+def unplanned_rows(n_strides: Sequence[int], onset_ms: float, note: str, subject: str = "",
+                   settings: PlanSettings = PlanSettings()) -> pd.DataFrame:
+    """Rows of :data:`PLAN_COLUMNS` for an onset that cannot be planned: predictions empty, ``note`` says why."""
+    counts = _counts(n_strides, subject or "plan")
+    rows = [{"subject": subject, "onset_ms": float(onset_ms), "joint": joint, "parameter": kind,
+             "unit": PARAMETER_UNITS[f"{kind}_{joint}"], "n_strides": n, "pulse_force_n": float(settings.pulse_force_n),
+             "pulse_duration_s": float(settings.pulse_duration_s), "note": note}
+            for joint in JOINTS for kind in ("K", "D") for n in counts]
     return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
 
 

@@ -68,7 +68,8 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
          answers_out: PathLike | None = None, *, impedance_tsvs: Sequence[PathLike] = (),
          impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None, targets: Sequence[Mapping] = (),
          pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1, response: Mapping | None = None,
-         identification: Mapping | None = None, device: Mapping | None = None) -> tuple[pd.DataFrame, list[str]]:
+         identification: Mapping | None = None, device: Mapping | None = None,
+         without_impedance: str = "raise") -> tuple[pd.DataFrame, list[str]]:
     """Predicted SD and 95 % CI half-width of K and D for a planned experiment, from a pilot subject.
 
     Parameters
@@ -100,6 +101,11 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         Keyword arguments of :class:`~loper_analysis.responses.ResponseSettings`,
         the identification settings (config ``identification``) and
         :class:`~loper_analysis.device.controller.DeviceParameters`.
+    without_impedance
+        An onset whose pilot fit has no estimate (e.g. ``failed``): ``raise``
+        stops with the onset and the fit's status; ``note`` writes its rows
+        without a prediction, the reason in ``note`` (the workflow's choice:
+        one failed pilot fit does not stop the run).
 
     Returns
     -------
@@ -107,10 +113,12 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         The table and the answers.
     """
     from ..device.controller import DeviceParameters
-    from ..planning import precision_table, stride_covariance, target_answer
+    from ..planning import precision_table, stride_covariance, target_answer, unplanned_rows
     from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
     from .model import read_segments
 
+    if without_impedance not in ("raise", "note"):
+        raise LoperInputError(f"without_impedance must be 'raise' or 'note', got {without_impedance!r}")
     settings = _settings(pulse_force_n, pulse_duration_s, identification)
     counts = list(n_strides)
     for n in counts:  # checked before any work
@@ -133,7 +141,14 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
     for onset in onsets_ms:
         where = f"pilot {subject}, onset {onset:g} ms"
         if impedance is None:
-            values = planned_impedance(rows_table, subject, onset, ", ".join(map(str, impedance_tsvs)))
+            try:
+                values = planned_impedance(rows_table, subject, onset, ", ".join(map(str, impedance_tsvs)))
+            except LoperInputError as exc:
+                if without_impedance == "raise":
+                    raise
+                log.warning("%s: not planned: %s", where, exc)
+                tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
+                continue
         else:
             values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
         null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
