@@ -255,7 +255,7 @@ def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_r
     with pytest.raises(LoperInputError, match=r"no fitted impedance of subject S09 at onset 175 ms for the hip "
                                               r"\(failed: 3 valid perturbed stride"):
         plan(**files, impedance_tsvs=impedance)
-    table, _ = plan(**files, impedance_tsvs=impedance, without_impedance="note")
+    table, _ = plan(**files, impedance_tsvs=impedance, unplannable="note")
     late = table[table["onset_ms"] == 175]
     assert len(late) == 6 and late["predicted_sd"].isna().all() and late["note"].str.startswith("not planned").all()
     assert table.loc[table["onset_ms"] == 50, "predicted_sd"].notna().all()

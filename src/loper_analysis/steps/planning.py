@@ -69,7 +69,7 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
          impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None, targets: Sequence[Mapping] = (),
          pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1, response: Mapping | None = None,
          identification: Mapping | None = None, device: Mapping | None = None,
-         without_impedance: str = "raise") -> tuple[pd.DataFrame, list[str]]:
+         unplannable: str = "raise") -> tuple[pd.DataFrame, list[str]]:
     """Predicted SD and 95 % CI half-width of K and D for a planned experiment, from a pilot subject.
 
     Parameters
@@ -101,11 +101,11 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         Keyword arguments of :class:`~loper_analysis.responses.ResponseSettings`,
         the identification settings (config ``identification``) and
         :class:`~loper_analysis.device.controller.DeviceParameters`.
-    without_impedance
-        An onset whose pilot fit has no estimate (e.g. ``failed``): ``raise``
-        stops with the onset and the fit's status; ``note`` writes its rows
-        without a prediction, the reason in ``note`` (the workflow's choice:
-        one failed pilot fit does not stop the run).
+    unplannable
+        An onset whose pilot fit has no estimate (e.g. ``failed``) or whose
+        null pairs are too few: ``raise`` stops with the onset and the cause;
+        ``note`` writes its rows without a prediction, the cause in ``note``
+        (the workflow's choice: a pilot onset that cannot serve does not stop the run).
 
     Returns
     -------
@@ -117,8 +117,8 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
     from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
     from .model import read_segments
 
-    if without_impedance not in ("raise", "note"):
-        raise LoperInputError(f"without_impedance must be 'raise' or 'note', got {without_impedance!r}")
+    if unplannable not in ("raise", "note"):
+        raise LoperInputError(f"unplannable must be 'raise' or 'note', got {unplannable!r}")
     settings = _settings(pulse_force_n, pulse_duration_s, identification)
     counts = list(n_strides)
     for n in counts:  # checked before any work
@@ -140,19 +140,19 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
     tables, answers = [], []
     for onset in onsets_ms:
         where = f"pilot {subject}, onset {onset:g} ms"
-        if impedance is None:
-            try:
+        try:
+            if impedance is None:
                 values = planned_impedance(rows_table, subject, onset, ", ".join(map(str, impedance_tsvs)))
-            except LoperInputError as exc:
-                if without_impedance == "raise":
-                    raise
-                log.warning("%s: not planned: %s", where, exc)
-                tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
-                continue
-        else:
-            values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
-        null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
-        sc = stride_covariance(null, params, values, settings, dev, source=where)
+            else:
+                values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
+            null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
+            sc = stride_covariance(null, params, values, settings, dev, source=where)
+        except LoperInputError as exc:
+            if unplannable == "raise":
+                raise
+            log.warning("%s: not planned: %s", where, exc)
+            tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
+            continue
         tables.append(precision_table(sc, counts, onset, subject, settings))
         log.info("%s: %d null pairs; planned %s", where, sc.n_null_pairs,
                  ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, values)))
