@@ -16,6 +16,7 @@ include: "workflow/rules/device.smk"
 include: "workflow/rules/processing.smk"
 include: "workflow/rules/synthetic.smk"
 include: "workflow/rules/impedance.smk"
+include: "workflow/rules/planning.smk"
 
 
 rule all:

@@ -384,6 +384,6 @@ def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
     rules = {name for name, _ in jobs}
     assert rules == {"markers", "ik", "events", "loadcell", "strides", "strides_summary",
                      "impedance_fit", "impedance_table", "impedance_summary", "impedance_figures", "impedance_figure",
-                     "tables_markdown", "all"}, rules
+                     "tables_markdown", "planning", "all"}, rules
     trials = {w.split("trial=")[1].split(",")[0] for _, w in jobs if "trial=" in w}
     assert trials == {"pert050-1"}

@@ -9,6 +9,7 @@ scale        scale a generic OpenSim model with a lab's ScaleTool setup and a st
 segments     swing-leg segment table from a scaled model, or from height and mass (Winter's table)
 ik           OpenSim inverse kinematics of a marker file (.c3d or .trc) to a .mot
 validate     run (part of) the validation study and write its tables
+plan         predict the 95 % CI half-width of K and D of a planned experiment from a pilot subject
 
 Every command exits with 0 on success and with 2 and one line on standard
 error naming the file and the cause when an input cannot serve
@@ -127,6 +128,66 @@ def _validate(args: argparse.Namespace) -> None:
                      args.errors, args.fits)
 
 
+def _first_subject(subjects_tsv: str, results: Path) -> str:
+    """The first subject of the subject sheet, else the first subject with joint angles under ``results/ik``."""
+    sheet = Path(subjects_tsv)
+    if sheet.is_file():
+        from .io.readers import read_tsv
+
+        names = read_tsv(sheet, "subject sheet", ["subject"], dtype={"subject": str}, comment="#")["subject"]
+        if len(names):
+            return str(names.iloc[0])
+    found = sorted(p.name for p in (results / "ik").glob("*") if p.is_dir())
+    if not found:
+        raise LoperInputError(f"plan: no subject given, {sheet} not found and no subject under {results / 'ik'}")
+    return found[0]
+
+
+def _plan(args: argparse.Namespace) -> None:
+    from .steps.planning import plan
+
+    results = Path(args.results)
+    subject = args.subject or _first_subject(args.subjects, results)
+    ik_dir = results / "ik" / subject
+    names = args.trials or sorted(p.name.removesuffix(".angles.tsv") for p in ik_dir.glob("*.angles.tsv"))
+    names = [n for n in names if n not in args.exclude_trials]
+    if not names:
+        raise LoperInputError(f"plan: no joint-angle table of a trial with the device in {ik_dir} "
+                              f"(excluded: {', '.join(args.exclude_trials)})")
+    angles = [ik_dir / f"{n}.angles.tsv" for n in names]
+    strides = [results / "strides" / subject / f"{n}.strides.tsv" for n in names]
+    for path in (*angles, *strides):
+        if not path.is_file():
+            raise LoperInputError(f"plan: {path} not found")
+    segments = Path(args.segments) if args.segments else results / "model" / subject / "segments.tsv"
+    impedance_tsvs = [Path(f) for f in args.impedance] if args.impedance else \
+        sorted((results / "impedance" / subject).glob("[0-9][0-9][0-9].tsv"))
+    values = args.impedance_values
+    onsets = args.onset_ms
+    if onsets is None:
+        if values is not None:
+            raise LoperInputError("plan: with --impedance-values give --onset-ms")
+        onsets = [int(p.stem) for p in impedance_tsvs if p.stem.isdigit()]
+        if not onsets:
+            raise LoperInputError(f"plan: no impedance rows of {subject} in {results / 'impedance' / subject}; "
+                                  "give --onset-ms and --impedance or --impedance-values")
+    targets = [{"joint": j, "parameter": p, "percent": float(v)} for j, p, v in args.target or []]
+    targets += [{"joint": j, "parameter": p, "half_width": float(v)} for j, p, v in args.target_half_width or []]
+    table, answers = plan(names, angles, strides, segments, subject, onsets, args.strides, args.out,
+                          impedance_tsvs=impedance_tsvs, impedance=values, targets=targets,
+                          pulse_force_n=args.force_n, pulse_duration_s=args.duration_s)
+    shown = table[["onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
+                   "ci95_half_width", "ci95_half_width_pct"]]
+    print(f"pilot {subject} ({len(names)} trials with the device; null pairs: "
+          f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}); "
+          f"pulse {args.force_n:g} N for {args.duration_s:g} s")
+    print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    for a in answers:
+        print(a)
+    if args.out:
+        print(f"{args.out}: {len(table)} rows")
+
+
 def _ik(args: argparse.Namespace) -> None:
     from .steps.ik import ik_file
 
@@ -235,6 +296,30 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--errors", required=True, help="output TSV, one row per combination x condition x parameter")
     p.add_argument("--fits", required=True, help="output TSV, one row per combination x condition")
     p.set_defaults(func=_validate)
+
+    p = sub.add_parser("plan", help="predicted 95 %% CI half-width of K and D for a planned experiment (pilot subject)")
+    p.add_argument("--results", default="results", help="results folder of the pilot's processed trials")
+    p.add_argument("--subject", help="pilot subject (default: the first of --subjects)")
+    p.add_argument("--subjects", default="config/subjects.tsv", help="subject sheet whose first subject is the default")
+    p.add_argument("--trials", nargs="+", help="the pilot's trials walked with the device (default: every angle "
+                   "table in RESULTS/ik/SUBJECT but --exclude-trials)")
+    p.add_argument("--exclude-trials", nargs="*", default=["walk-nodevice"], help="trials without the device")
+    p.add_argument("--segments", help="segment table of the subject to plan for (default: the pilot's)")
+    p.add_argument("--impedance", nargs="+", help="impedance rows giving the planned impedance (default: "
+                   "RESULTS/impedance/SUBJECT/NNN.tsv)")
+    p.add_argument("--impedance-values", type=float, nargs=6, metavar=("K_HIP", "D_HIP", "K_KNEE", "D_KNEE",
+                   "K_ANKLE", "D_ANKLE"), help="planned impedance (N·m/rad, N·m·s/rad) instead of the pilot's fits")
+    p.add_argument("--onset-ms", type=float, nargs="+", help="onsets after toe-off (ms; default: those of the "
+                   "impedance rows)")
+    p.add_argument("--strides", type=int, nargs="+", default=[10, 20, 40], help="perturbed strides averaged")
+    p.add_argument("--force-n", type=float, default=40.0, help="pulse: desired force (N)")
+    p.add_argument("--duration-s", type=float, default=0.1, help="pulse duration (s)")
+    p.add_argument("--target", nargs=3, action="append", metavar=("JOINT", "PARAM", "PERCENT"),
+                   help="strides needed for a 95 %% CI half-width of PERCENT %% of the planned value, e.g. hip D 15")
+    p.add_argument("--target-half-width", nargs=3, action="append", metavar=("JOINT", "PARAM", "VALUE"),
+                   help="strides needed for an absolute half-width (N·m/rad or N·m·s/rad)")
+    p.add_argument("--out", help="output TSV (one row per onset x joint x parameter x stride count)")
+    p.set_defaults(func=_plan)
     return parser
 
 

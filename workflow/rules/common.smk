@@ -187,6 +187,7 @@ def processing_targets() -> list[str]:
         out += ["results/tables/impedance.tsv", "results/tables/impedance_summary.tsv", "results/tables/literature.tsv",
                 "results/figures/impedance.png", "results/tables/tables.md"]
         out += [f"results/figures/{s}/{f}.png" for s in processed_subjects() for f in ("responses", "fit")]
+        out += ["results/planning/plan.tsv", "results/planning/answers.txt"]
     if transparency_subjects():
         out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",
                 "results/transparency/transparency.png"]

@@ -1,0 +1,137 @@
+"""Does the planner predict the SD of K and D? Predicted against measured over repeated synthetic experiments.
+
+Usage: nice -n 10 python benchmarks/planner_check.py [--repeats 60] [--onset-ms 50] [--strides 10 40] [--seed 2024]
+
+A pilot experiment (one synthetic trial with the device, perturbed at the onset every 3-5 strides, built at
+the coordinate level by :func:`loper_analysis.coordinate_trials.perturbation_experiment`: no markers, no IK)
+gives the null pairs and, from its own fit of all its perturbed strides, the planned impedance; the planner
+(:mod:`loper_analysis.planning`) predicts the SD of every K and D for one stride. Then ``--repeats``
+independent experiments (other seeds) are fitted exactly as the pipeline fits them
+(:func:`loper_analysis.impedance.fit_onset`, null-pair noise model) with their first N perturbed strides,
+for each N of ``--strides``; their null pairs come from the whole trial. The measured SD is the SD of the
+estimates over the repeats; the prediction for the same repeats is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the
+strides each fit kept. Prints the table predicted vs measured (ratio, and the measured SD's own 95 % range).
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import time
+import warnings
+
+import numpy as np
+import pandas as pd
+from scipy.stats import t as student_t
+
+from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
+from loper_analysis.coordinate_trials import perturbation_experiment
+from loper_analysis.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.impedance import IdentificationSettings, fit_onset
+from loper_analysis.markdown import markdown_table
+from loper_analysis.planning import PlanSettings, stride_covariance
+from loper_analysis.responses import ResponseSettings, null_pair_windows
+
+#: The true impedance of the synthetic subject per onset (ms): the default study's group values.
+TRUTH = {50: (55.0, 3.5, 3.0, 0.10, 8.0, 0.3), 175: (38.0, 2.2, 0.5, 0.04, 8.0, 0.3),
+         300: (62.0, 4.2, 2.5, 0.12, 8.0, 0.3)}
+HEIGHT_M, MASS_KG = 1.73, 64.9
+ANGLE_NOISE_SD_RAD = 0.001
+
+
+def estimates(rows: pd.DataFrame) -> np.ndarray:
+    """K, D per joint (6,) in the order of PARAMETERS from the three rows of a fit."""
+    by_joint = rows.set_index("joint")
+    return np.array([by_joint.loc[j, parameter_column(p)] for j in JOINTS for p in ("K", "D")], float)
+
+
+def reported_sd(rows: pd.DataFrame) -> np.ndarray:
+    """The SD (6,) the fit itself reports: its 95 % CI half-width over Student's t (102 degrees of freedom)."""
+    by_joint = rows.set_index("joint")
+    high, low = (by_joint[[parameter_column(p, b) for p in ("K", "D")]].loc[list(JOINTS)].to_numpy(float).ravel()
+                 for b in ("ci95_high", "ci95_low"))
+    half = (high - low) / 2
+    return half / student_t.ppf(0.975, 102)
+
+
+def run_check(repeats: int, onset_ms: int, counts: list[int], seed: int, truth=None, n_starts: int = 10,
+              verbose: bool = True, angle_noise_sd_rad: float = ANGLE_NOISE_SD_RAD) -> pd.DataFrame:
+    """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D)."""
+    truth = TRUTH[onset_ms] if truth is None else truth
+    params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
+    ident = IdentificationSettings(n_starts=n_starts, seed=seed)
+    response = ResponseSettings()
+
+    def experiment(k: int):
+        return perturbation_experiment([seed, k], params, HEIGHT_M, onset_ms, truth, counts,
+                                       angle_noise_sd_rad=angle_noise_sd_rad)
+
+    # the pilot: its null pairs, and its fit of all its perturbed strides as the planned impedance
+    full, cut = experiment(0)
+    pilot_fit = fit_onset([cut[max(counts)]], params, onset_ms, "pilot", None, [full], response, ident)
+    planned = np.clip(estimates(pilot_fit.rows), ident.lower, ident.upper)
+    null = null_pair_windows([full], onset_ms, response, source="pilot")
+    sc = stride_covariance(null, params, planned, PlanSettings())
+    found = {n: [] for n in counts}
+    kept = {n: [] for n in counts}
+    reported = {n: [] for n in counts}
+    t0 = time.perf_counter()
+    for k in range(1, repeats + 1):
+        full, cut = experiment(k)
+        for n in counts:
+            fit = fit_onset([cut[n]], params, onset_ms, f"R{k}", None, [full], response, ident)
+            if fit.rows["noise_model"].iloc[0] != "null_pairs":
+                raise RuntimeError(f"repeat {k}, {n} strides: {fit.rows['reason'].iloc[0]}")
+            found[n].append(estimates(fit.rows))
+            kept[n].append(int(fit.rows["n_strides"].iloc[0]))
+            reported[n].append(reported_sd(fit.rows))
+        if verbose and k % 10 == 0:
+            print(f"  {k} repeats, {time.perf_counter() - t0:.0f} s", flush=True)
+    rows = []
+    for n in counts:
+        est = np.array(found[n])
+        n_kept = np.array(kept[n], float)
+        measured = est.std(axis=0, ddof=1)
+        predicted = sc.sd * np.sqrt(np.mean(1.0 / n_kept))
+        fits_say = np.sqrt(np.mean(np.array(reported[n]) ** 2, axis=0))
+        # 95 % range of a sample SD over `repeats` normal draws, relative
+        rel = 1.96 / np.sqrt(2.0 * (len(est) - 1))
+        for i, name in enumerate(PARAMETERS):
+            p, joint = name.split("_")
+            rows.append({"joint": joint, "parameter": p, "n_strides": n, "mean_n_kept": n_kept.mean(),
+                         "truth": truth[i], "planned": planned[i], "mean_estimate": est[:, i].mean(),
+                         "predicted_sd": predicted[i], "fits_reported_sd": fits_say[i], "measured_sd": measured[i],
+                         "measured_sd_95_low": measured[i] * (1 - rel), "measured_sd_95_high": measured[i] * (1 + rel),
+                         "ratio_predicted_to_measured": predicted[i] / measured[i], "repeats": len(est)})
+    out = pd.DataFrame(rows)
+    out.attrs = {"n_null_pairs": sc.n_null_pairs}
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeats", type=int, default=60)
+    ap.add_argument("--onset-ms", type=int, default=50, choices=sorted(TRUTH))
+    ap.add_argument("--strides", type=int, nargs="+", default=[10, 40])
+    ap.add_argument("--seed", type=int, default=2024)
+    ap.add_argument("--angle-noise-sd-rad", type=float, default=ANGLE_NOISE_SD_RAD)
+    args = ap.parse_args()
+    warnings.simplefilter("ignore")
+    logging.disable(logging.WARNING)
+    t0 = time.perf_counter()
+    table = run_check(args.repeats, args.onset_ms, args.strides, args.seed,
+                      angle_noise_sd_rad=args.angle_noise_sd_rad)
+    print(f"onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, {args.repeats} repeats, "
+          f"pilot null pairs {table.attrs['n_null_pairs']}, "
+          f"{time.perf_counter() - t0:.0f} s")
+    print(markdown_table(table.round(4)))
+    hk = table[table["joint"].isin(["hip", "knee"])]
+    worst = hk.loc[(hk["ratio_predicted_to_measured"] - 1).abs().idxmax()]
+    print(f"hip and knee: ratio predicted/measured {hk['ratio_predicted_to_measured'].min():.3f} .. "
+          f"{hk['ratio_predicted_to_measured'].max():.3f} (worst: {worst['joint']} {worst['parameter']} at "
+          f"{worst['n_strides']} strides); "
+          f"within ±25 %: {bool(((hk['ratio_predicted_to_measured'] - 1).abs() <= 0.25).all())}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,390 @@
+"""Planning an experiment: the precision of K and D before anyone walks (method: ``docs/planning.md``).
+
+The null-pair fit (:mod:`loper_analysis.identification.null_pairs`) takes the
+covariance of its estimate from the stride-to-stride deviation of *null
+pairs*: ``cov = M C M^T`` with ``M = (W J)^+ W``, ``C = cov(E) / N`` (``E``
+the null pairs' prediction errors, ``N`` the perturbed strides averaged, ``W``
+the projection of the deviation's dominant shapes, ``J`` the sensitivity of
+the model response to K and D). Nothing in it needs the perturbed strides
+themselves: from a pilot subject's null pairs, a planned pulse and a planned
+impedance it predicts the SD and the 95 % CI half-width of every K and D for
+any number of perturbed strides, and the number of strides a target
+half-width needs.
+
+* :func:`pulse_force_n` - the force the rods apply for a rectangular desired
+  pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
+  like the load cell;
+* :func:`planning_window` - the identification window of the planned
+  experiment: the pilot's mean unperturbed swing as the reference, the pulse
+  along the thigh normal;
+* :func:`stride_covariance` - the covariance of (K, D) per joint for one
+  perturbed stride (divide by ``N``);
+* :func:`precision_table` - predicted SD and 95 % half-width per joint,
+  parameter and stride count;
+* :func:`strides_needed` and :func:`target_answer` - how many strides a target
+  half-width needs.
+
+The identification's own functions build the window, the Jacobian, the
+null-pair errors and the projection
+(:func:`~loper_analysis.identification.prepare_window`,
+:func:`~loper_analysis.identification.response_jacobian`,
+:func:`~loper_analysis.identification.null_pair_errors`,
+:func:`~loper_analysis.identification.nuisance_projection`), so the
+prediction is the fit's own covariance formula.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+import pandas as pd
+from scipy.stats import t as student_t
+
+from .checks import integer, number
+from .constants import JOINTS, PARAMETER_UNITS, PARAMETERS
+from .dynamics import SegmentParameters
+from .errors import LoperInputError
+from .identification import (
+    DEFAULT_LOWER,
+    DEFAULT_UPPER,
+    PreparedWindow,
+    nuisance_projection,
+    null_pair_errors,
+    prepare_window,
+    response_jacobian,
+)
+
+__all__ = [
+    "PLAN_COLUMNS",
+    "PlanSettings",
+    "StrideCovariance",
+    "pulse_force_n",
+    "planning_window",
+    "stride_covariance",
+    "precision_table",
+    "unplanned_rows",
+    "strides_needed",
+    "target_answer",
+]
+
+#: Columns of the plan table (one row per joint x parameter x onset x stride count).
+PLAN_COLUMNS: tuple[str, ...] = (
+    "subject", "onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
+    "ci95_half_width", "ci95_half_width_pct", "pulse_force_n", "pulse_duration_s", "n_null_pairs", "note",
+)
+
+
+@dataclass(frozen=True)
+class PlanSettings:
+    """The planned pulse and the identification settings the prediction follows (config ``identification``).
+
+    ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
+    onset; ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
+    (s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
+    ``min_null_pairs`` and the bounds (N·m/rad, N·m·s/rad) as the fit uses
+    them; ``force_cutoff_hz`` and ``force_order`` the load cell's low-pass.
+    """
+
+    pulse_force_n: float = 40.0
+    pulse_duration_s: float = 0.1
+    window_before_s: float = 0.025
+    window_after_s: float = 0.25
+    initial_state_span_s: float = 0.1
+    initial_state_degree: int = 1
+    n_substeps: int = 2
+    null_pair_components: int = 6
+    min_null_pairs: int = 30
+    stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
+    damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
+    force_cutoff_hz: float = 40.0
+    force_order: int = 4
+
+    def __post_init__(self):
+        number("pulse_force_n", self.pulse_force_n)
+        d = number("pulse_duration_s", self.pulse_duration_s)
+        after = number("window_after_s", self.window_after_s, minimum=0.0)
+        if d <= 0:
+            raise LoperInputError(f"pulse_duration_s must be > 0 s, got {d:g} s")
+        if d > after:
+            raise LoperInputError(f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
+                                  f"(identification.window_after_s = {after:g} s): the fit would not see its end")
+
+    @property
+    def lower(self) -> np.ndarray:
+        return np.array([self.stiffness_bounds_nm_per_rad[0], self.damping_bounds_nms_per_rad[0]] * 3, float)
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.array([self.stiffness_bounds_nm_per_rad[1], self.damping_bounds_nms_per_rad[1]] * 3, float)
+
+
+@dataclass
+class StrideCovariance:
+    """The covariance (6, 6) of the estimate for one averaged perturbed stride (order :data:`PARAMETERS`).
+
+    ``impedance`` (6,) the planned values it was linearised at; ``dof`` the
+    degrees of freedom of the CI's Student t (as in the fit); ``n_null_pairs``
+    the pilot's null pairs; ``note`` a caveat for the rows (empty when none).
+    """
+
+    covariance: np.ndarray
+    impedance: np.ndarray
+    dof: int
+    n_null_pairs: int
+    note: str = ""
+
+    @property
+    def sd(self) -> np.ndarray:
+        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad)."""
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    @property
+    def t95(self) -> float:
+        """Student's t at 97.5 % with :attr:`dof` degrees of freedom."""
+        return float(student_t.ppf(0.975, self.dof))
+
+
+def pulse_force_n(time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = 40.0,
+                  order: int = 4) -> np.ndarray:
+    """The rod force (N, along the rods) of a rectangular desired pulse, at ``time_s`` (s, onset at 0).
+
+    The desired force ``force_n`` for ``0 <= t < duration_s`` drives the
+    device's closed loop (:func:`loper_analysis.device.controller.simulate_device`
+    with a still brace, no load-cell noise; ``device`` a
+    :class:`~loper_analysis.device.controller.DeviceParameters`, default the
+    study's tuning: about 10 ms rise and 30 % overshoot), minus the loop's
+    output without the pulse; the result is low-passed like the load cell
+    (zero-phase Butterworth, ``cutoff_hz``, ``order``) and sampled at
+    ``time_s``. Zero before the onset.
+    """
+    from .device.controller import DeviceParameters, simulate_device
+    from .filtering import lowpass
+
+    t = np.asarray(time_s, dtype=float)
+    if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)):
+        raise LoperInputError(f"time_s must be a finite 1-D array with >= 2 samples, got shape {t.shape}")
+    f = number("pulse force_n", force_n)
+    d = number("pulse duration_s", duration_s)
+    if d <= 0:
+        raise LoperInputError(f"pulse duration_s must be > 0 s, got {d:g} s")
+    dev = replace(device or DeviceParameters(), loadcell_noise_sd_n=0.0)
+    rate = dev.sample_rate_hz
+    lead = 0.2
+    n = int(math.ceil((max(t[-1], d) + lead + 0.2) * rate)) + 1
+    t_dev = -lead + np.arange(n) / rate
+    desired = np.where((t_dev >= -1e-9) & (t_dev < d - 1e-9), f, 0.0)
+    still = np.zeros(n)
+    on = simulate_device(desired, dev, None, brace_position_m=still)["force_measured_n"].to_numpy()
+    off = simulate_device(0.0 * desired, dev, None, brace_position_m=still)["force_measured_n"].to_numpy()
+    force = lowpass(on - off, rate, cutoff_hz, order)
+    return np.interp(t, t_dev, force, left=0.0, right=float(force[-1]))
+
+
+def _null_arrays(null_pairs: Mapping, source: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+    """Checked grid and arrays of the pilot's null pairs, and how many there are."""
+    missing = [k for k in ("time_s", "q_perturbed", "q_unperturbed", "pelvis_angle_perturbed_rad",
+                           "pelvis_angle_unperturbed_rad") if k not in null_pairs]
+    if missing:
+        raise LoperInputError(f"{source}: null pairs lack {missing}")
+    t = np.asarray(null_pairs["time_s"], dtype=float)
+    arrays = {k: np.asarray(null_pairs[k], dtype=float) for k in ("q_perturbed", "q_unperturbed",
+                                                                   "pelvis_angle_perturbed_rad",
+                                                                   "pelvis_angle_unperturbed_rad")}
+    n = int(arrays["q_unperturbed"].shape[0]) if arrays["q_unperturbed"].ndim == 3 else 0
+    return t, arrays, n
+
+
+def planning_window(null_pairs: Mapping, params: SegmentParameters, settings: PlanSettings = PlanSettings(),
+                    device=None, source: str = "pilot") -> PreparedWindow:
+    """The identification window of the planned experiment (onset at t = 0).
+
+    Reference: the mean of the pilot's unperturbed null-pair strides
+    (``null_pairs["q_unperturbed"]`` (M, n, 4) and
+    ``pelvis_angle_unperturbed_rad`` (M, n), on the grid ``time_s`` (n,)
+    relative to the onset; :func:`loper_analysis.responses.null_pair_windows`),
+    the mean swing a perturbed stride starts from. The perturbed force is
+    :func:`pulse_force_n` along the thigh's forward normal of that swing; the
+    minimal-impedance force and the initial deviation are zero (they average
+    out over the perturbed strides). ``measured`` is zero: only the model's
+    sensitivities are used.
+    """
+    from .synthetic.response import thigh_normal
+
+    t, arrays, n_pairs = _null_arrays(null_pairs, source)
+    if n_pairs < 1:
+        raise LoperInputError(f"{source}: no null pairs: the pilot needs unperturbed strides walked with the device")
+    q_ref = arrays["q_unperturbed"].mean(axis=0)
+    pelvis = arrays["pelvis_angle_unperturbed_rad"].mean(axis=0)
+    force = pulse_force_n(t, settings.pulse_force_n, settings.pulse_duration_s, device, settings.force_cutoff_hz,
+                          settings.force_order)
+    force_vector = force[:, None] * thigh_normal(q_ref[:, 1])
+    return prepare_window(
+        t, q_ref, q_ref, params, 0.0, force_perturbed_n=force_vector,
+        pelvis_angle_unperturbed_rad=pelvis, pelvis_angle_perturbed_rad=pelvis,
+        window_before_s=settings.window_before_s, window_after_s=settings.window_after_s,
+        n_substeps=settings.n_substeps, initial_state_span_s=settings.initial_state_span_s,
+        initial_state_degree=settings.initial_state_degree,
+    )
+
+
+def _impedance(impedance, settings: PlanSettings, source: str) -> np.ndarray:
+    p = np.asarray(impedance, dtype=float)
+    if p.shape != (6,) or not np.all(np.isfinite(p)):
+        raise LoperInputError(f"{source}: the planned impedance must be 6 finite values ({', '.join(PARAMETERS)}), "
+                              f"got {np.asarray(impedance).tolist()}")
+    out = np.flatnonzero((p < settings.lower) | (p > settings.upper))
+    if out.size:
+        i = int(out[0])
+        raise LoperInputError(f"{source}: planned {PARAMETERS[i]} = {p[i]:g} {PARAMETER_UNITS[PARAMETERS[i]]} lies "
+                              f"outside the identification bounds {settings.lower[i]:g} .. {settings.upper[i]:g}")
+    return p
+
+
+def stride_covariance(null_pairs: Mapping, params: SegmentParameters, impedance,
+                      settings: PlanSettings = PlanSettings(), device=None, source: str = "pilot") -> StrideCovariance:
+    """Covariance of (K, D) per joint for a mean response of **one** perturbed stride.
+
+    ``impedance`` (6,): the planned values (order :data:`PARAMETERS`; N·m/rad
+    and N·m·s/rad), e.g. the pilot's estimate. With the window of
+    :func:`planning_window`, ``J`` = :func:`~loper_analysis.identification.response_jacobian`
+    at ``impedance``, the null-pair errors ``E`` =
+    :func:`~loper_analysis.identification.null_pair_errors`, ``W`` =
+    :func:`~loper_analysis.identification.nuisance_projection` of ``E``
+    (``settings.null_pair_components`` shapes) and ``M = (W J)^+ W``:
+    ``cov_1 = M cov(E) M^T``. For ``N`` strides the covariance is ``cov_1 / N``.
+
+    Raises
+    ------
+    LoperInputError
+        No null pairs, fewer than ``null_pair_components + 2`` of them (the
+        projection cannot be estimated), a planned value outside the bounds.
+    """
+    p = _impedance(impedance, settings, source)
+    _, _, n_pairs = _null_arrays(null_pairs, source)
+    r = integer("null_pair_components", settings.null_pair_components, source, minimum=0)
+    need = r + 2
+    if n_pairs < need:
+        raise LoperInputError(
+            f"{source}: {n_pairs} null pair(s), fewer than identification.null_pair_components + 2 = {need}: "
+            "the pilot needs unperturbed strides walked with the device (their deviation is what the prediction "
+            "scales)")
+    note = ""
+    if n_pairs < settings.min_null_pairs:
+        note = (f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+                "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit")
+    window = planning_window(null_pairs, params, settings, device, source)
+    J = response_jacobian(window, p, settings.lower, settings.upper)
+    E = null_pair_errors(window, p, null_pairs)
+    W = nuisance_projection(E, r)
+    WJ = W @ J
+    M = np.linalg.pinv(WJ.T @ WJ, rcond=1e-13) @ WJ.T @ W
+    C = np.atleast_2d(np.cov(E, rowvar=False))
+    cov = M @ C @ M.T
+    dof = max(J.shape[0] - 6, 1)
+    return StrideCovariance(cov, p, dof, n_pairs, note)
+
+
+def _counts(n_strides: Sequence[int], source: str) -> list[int]:
+    values = list(np.atleast_1d(n_strides)) if not isinstance(n_strides, (int, np.integer)) else [n_strides]
+    if not values:
+        raise LoperInputError(f"{source}: no stride count given")
+    out = []
+    for v in values:
+        try:
+            ok = float(v) == int(v)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or int(v) < 1:
+            raise LoperInputError(f"{source}: stride count must be a whole number >= 1 (perturbed strides averaged), "
+                                  f"got {v!r}")
+        out.append(int(v))
+    return out
+
+
+def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onset_ms: float, subject: str = "",
+                    settings: PlanSettings = PlanSettings()) -> pd.DataFrame:
+    """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
+
+    ``predicted_sd = sd_1 / sqrt(N)`` and ``ci95_half_width = t * predicted_sd``
+    (Student's t at 97.5 %, the fit's degrees of freedom), both in ``unit``;
+    ``ci95_half_width_pct`` relative to the planned value (%; NaN for a
+    planned value of 0). Rows: hip, knee, ankle x K, D x ``n_strides``.
+    """
+    counts = _counts(n_strides, subject or "plan")
+    sd1, t95 = stride_cov.sd, stride_cov.t95
+    rows = []
+    for j, joint in enumerate(JOINTS):
+        for k, kind in enumerate(("K", "D")):
+            i = 2 * j + k
+            planned = float(stride_cov.impedance[i])
+            for n in counts:
+                sd = sd1[i] / math.sqrt(n)
+                half = t95 * sd
+                rows.append({
+                    "subject": subject, "onset_ms": float(onset_ms), "joint": joint, "parameter": kind,
+                    "unit": PARAMETER_UNITS[PARAMETERS[i]], "n_strides": n, "planned_value": planned,
+                    "predicted_sd": sd, "ci95_half_width": half,
+                    "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
+                    "pulse_force_n": float(settings.pulse_force_n),
+                    "pulse_duration_s": float(settings.pulse_duration_s),
+                    "n_null_pairs": stride_cov.n_null_pairs, "note": stride_cov.note,
+                })
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+
+
+def unplanned_rows(n_strides: Sequence[int], onset_ms: float, note: str, subject: str = "",
+                   settings: PlanSettings = PlanSettings()) -> pd.DataFrame:
+    """Rows of :data:`PLAN_COLUMNS` for an onset that cannot be planned: predictions empty, ``note`` says why."""
+    counts = _counts(n_strides, subject or "plan")
+    rows = [{"subject": subject, "onset_ms": float(onset_ms), "joint": joint, "parameter": kind,
+             "unit": PARAMETER_UNITS[f"{kind}_{joint}"], "n_strides": n, "pulse_force_n": float(settings.pulse_force_n),
+             "pulse_duration_s": float(settings.pulse_duration_s), "note": note}
+            for joint in JOINTS for kind in ("K", "D") for n in counts]
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+
+
+def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, percent: float | None = None,
+                   half_width: float | None = None) -> int:
+    """Fewest perturbed strides whose 95 % CI half-width on ``parameter`` of ``joint`` meets the target.
+
+    Give either ``percent`` (of the planned value, e.g. 15 for +-15 %) or
+    ``half_width`` (absolute, N·m/rad or N·m·s/rad). ``N = ceil((t sd_1 / target)^2)``.
+    """
+    if joint not in JOINTS:
+        raise LoperInputError(f"target joint must be one of {JOINTS}, got {joint!r}")
+    if parameter not in ("K", "D"):
+        raise LoperInputError(f"target parameter must be 'K' or 'D', got {parameter!r}")
+    if (percent is None) == (half_width is None):
+        raise LoperInputError("give exactly one target: percent or half_width")
+    i = PARAMETERS.index(f"{parameter}_{joint}")
+    planned = float(stride_cov.impedance[i])
+    if percent is not None:
+        pct = number("target percent", percent)
+        if pct <= 0:
+            raise LoperInputError(f"target percent must be > 0, got {pct:g}")
+        if planned == 0:
+            raise LoperInputError(f"a relative target needs a planned {parameter} of the {joint} other than 0; "
+                                  "give an absolute half-width")
+        target = pct / 100.0 * abs(planned)
+    else:
+        target = number("target half_width", half_width)
+        if target <= 0:
+            raise LoperInputError(f"target half_width must be > 0, got {target:g}")
+    sd1 = float(stride_cov.sd[i])
+    return max(1, int(math.ceil((stride_cov.t95 * sd1 / target) ** 2 * (1 - 1e-12))))
+
+
+def target_answer(stride_cov: StrideCovariance, joint: str, parameter: str, onset_ms: float, *,
+                  percent: float | None = None, half_width: float | None = None) -> str:
+    """One sentence: how many perturbed strides a target half-width on ``parameter`` of ``joint`` needs."""
+    n = strides_needed(stride_cov, joint, parameter, percent=percent, half_width=half_width)
+    i = PARAMETERS.index(f"{parameter}_{joint}")
+    unit, planned = PARAMETER_UNITS[PARAMETERS[i]], float(stride_cov.impedance[i])
+    reached = stride_cov.t95 * stride_cov.sd[i] / math.sqrt(n)
+    wanted = f"±{percent:g} %" if percent is not None else f"±{half_width:g} {unit}"
+    return (f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
+            f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "
+            f"±{100 * reached / abs(planned) if planned else float('nan'):.3g} %)")

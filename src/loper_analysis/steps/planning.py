@@ -1,0 +1,171 @@
+"""File step of the experiment planner: a pilot subject's tables in, the predicted precision table out.
+
+:func:`plan` reads the pilot's joint-angle and stride tables (the trials with
+the device, whose unperturbed strides give the null pairs), its segment table
+(or another subject's) and its impedance rows (the planned impedance), and
+writes the table of :func:`loper_analysis.planning.precision_table` for every
+onset and the answers to the targets (method: ``docs/planning.md``).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+import pandas as pd
+
+from ..constants import JOINTS, PARAMETERS, parameter_column
+from ..errors import LoperInputError
+from ..io.atomic import PathLike, write_text, write_tsv
+from ..io.readers import read_tsv
+
+__all__ = ["planned_impedance", "plan"]
+
+log = logging.getLogger(__name__)
+
+#: Identification settings the planner follows (keys of config ``identification``).
+_PLAN_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree", "n_substeps",
+              "null_pair_components", "min_null_pairs", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")
+
+
+def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:
+    """K, D per joint (6,) of ``subject`` at ``onset_ms`` from impedance rows (``results/impedance/...``).
+
+    Raises a :class:`LoperInputError` naming ``source`` when the subject has no
+    row with an estimate of every joint at that onset (e.g. a ``failed`` fit).
+    """
+    need = ["subject", "onset_ms", "joint", parameter_column("K"), parameter_column("D")]
+    missing = [c for c in need if c not in table.columns]
+    if missing:
+        raise LoperInputError(f"{source}: impedance rows lack column(s) {missing}")
+    rows = table[(table["subject"].astype(str) == str(subject)) & (table["onset_ms"].astype(float) == float(onset_ms))]
+    values = []
+    for joint in JOINTS:
+        row = rows[rows["joint"] == joint]
+        k = row[parameter_column("K")].to_numpy(float)
+        d = row[parameter_column("D")].to_numpy(float)
+        if len(row) != 1 or not (np.isfinite(k).all() and np.isfinite(d).all()):
+            status = ", ".join(f"{s}: {r}" for s, r in zip(row.get("status", []), row.get("reason", []))) or "no row"
+            raise LoperInputError(f"{source}: no fitted impedance of subject {subject} at onset {onset_ms:g} ms "
+                                  f"for the {joint} ({status}); give the planned impedance explicitly")
+        values += [float(k[0]), float(d[0])]
+    return np.array(values)
+
+
+def _settings(pulse_force_n: float, pulse_duration_s: float, identification: Mapping | None):
+    from ..planning import PlanSettings
+
+    ident = {k: v for k, v in (identification or {}).items() if k in _PLAN_KEYS}
+    for key in ("stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad"):
+        if key in ident:
+            ident[key] = tuple(ident[key])
+    return PlanSettings(pulse_force_n=pulse_force_n, pulse_duration_s=pulse_duration_s, **ident)
+
+
+def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[PathLike], segments_tsv: PathLike,
+         subject: str, onsets_ms: Sequence[int], n_strides: Sequence[int], out_tsv: PathLike | None = None,
+         answers_out: PathLike | None = None, *, impedance_tsvs: Sequence[PathLike] = (),
+         impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None, targets: Sequence[Mapping] = (),
+         pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1, response: Mapping | None = None,
+         identification: Mapping | None = None, device: Mapping | None = None,
+         unplannable: str = "raise") -> tuple[pd.DataFrame, list[str]]:
+    """Predicted SD and 95 % CI half-width of K and D for a planned experiment, from a pilot subject.
+
+    Parameters
+    ----------
+    trials, angles, strides
+        The pilot's trials walked with the device (names) and their angle and
+        stride tables (TSV, same order): their unperturbed strides are the null pairs.
+    segments_tsv
+        Segment table of the subject to plan for (the pilot's, or another subject's).
+    subject
+        The pilot's ID (rows of the impedance tables, messages).
+    onsets_ms, n_strides
+        Onsets after toe-off (ms) and counts of perturbed strides to predict for.
+    out_tsv, answers_out
+        The table (:data:`loper_analysis.planning.PLAN_COLUMNS`) and the text
+        answers; None writes nothing.
+    impedance_tsvs
+        Impedance rows (``results/impedance/{subject}/{onset}.tsv`` or
+        ``results/tables/impedance.tsv``): the pilot's estimates are the planned impedance.
+    impedance
+        Instead: the planned impedance (6 values, order of ``PARAMETERS``), one
+        set for every onset or ``{onset_ms: values}``.
+    targets
+        Each ``joint``, ``parameter`` (``K``/``D``), ``percent`` or
+        ``half_width`` (N·m/rad, N·m·s/rad) and optionally ``onset_ms`` (else every onset).
+    pulse_force_n, pulse_duration_s
+        The planned pulse (desired force, N; duration, s).
+    response, identification, device
+        Keyword arguments of :class:`~loper_analysis.responses.ResponseSettings`,
+        the identification settings (config ``identification``) and
+        :class:`~loper_analysis.device.controller.DeviceParameters`.
+    unplannable
+        An onset whose pilot fit has no estimate (e.g. ``failed``) or whose
+        null pairs are too few: ``raise`` stops with the onset and the cause;
+        ``note`` writes its rows without a prediction, the cause in ``note``
+        (the workflow's choice: a pilot onset that cannot serve does not stop the run).
+
+    Returns
+    -------
+    (pandas.DataFrame, list of str)
+        The table and the answers.
+    """
+    from ..device.controller import DeviceParameters
+    from ..planning import precision_table, stride_covariance, target_answer, unplanned_rows
+    from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
+    from .model import read_segments
+
+    if unplannable not in ("raise", "note"):
+        raise LoperInputError(f"unplannable must be 'raise' or 'note', got {unplannable!r}")
+    settings = _settings(pulse_force_n, pulse_duration_s, identification)
+    counts = list(n_strides)
+    for n in counts:  # checked before any work
+        if isinstance(n, bool) or not float(n) == int(n) or int(n) < 1:
+            raise LoperInputError(f"stride count must be a whole number >= 1 (perturbed strides averaged), got {n!r}")
+    if not trials:
+        raise LoperInputError(f"pilot {subject}: no trial walked with the device: the null pairs need one")
+    response_settings = ResponseSettings(**(response or {}))
+    ratio = (identification or {}).get("max_null_trial_ratio", MAX_TRIAL_DEVIATION_RATIO)
+    dev = DeviceParameters(**(device or {}))
+    params = read_segments(segments_tsv)
+    pool = [{"name": name, "angles": read_tsv(a, "angle table"), "strides": read_tsv(s, "stride table")}
+            for name, a, s in zip(trials, angles, strides, strict=True)]
+    rows_table = None
+    if impedance is None:
+        if not impedance_tsvs:
+            raise LoperInputError("planned impedance: give the pilot's impedance rows or the values")
+        rows_table = pd.concat([read_tsv(f, "impedance rows") for f in impedance_tsvs], ignore_index=True)
+    tables, answers = [], []
+    for onset in onsets_ms:
+        where = f"pilot {subject}, onset {onset:g} ms"
+        try:
+            if impedance is None:
+                values = planned_impedance(rows_table, subject, onset, ", ".join(map(str, impedance_tsvs)))
+            else:
+                values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
+            null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
+            sc = stride_covariance(null, params, values, settings, dev, source=where)
+        except LoperInputError as exc:
+            if unplannable == "raise":
+                raise
+            log.warning("%s: not planned: %s", where, exc)
+            tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
+            continue
+        tables.append(precision_table(sc, counts, onset, subject, settings))
+        log.info("%s: %d null pairs; planned %s", where, sc.n_null_pairs,
+                 ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, values)))
+        for target in targets:
+            if target.get("onset_ms") is not None and float(target["onset_ms"]) != float(onset):
+                continue
+            answers.append(target_answer(sc, str(target["joint"]), str(target["parameter"]), onset,
+                                         percent=target.get("percent"), half_width=target.get("half_width")))
+    table = pd.concat(tables, ignore_index=True)
+    if out_tsv is not None:
+        write_tsv(table, out_tsv)
+    if answers_out is not None:
+        write_text(answers_out, "".join(a + "\n" for a in answers), "planning answers")
+    for a in answers:
+        log.info("%s", a)
+    return table, answers

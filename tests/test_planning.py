@@ -1,0 +1,261 @@
+"""The experiment planner (loper_analysis.planning, steps.planning, ``loper-analysis plan``).
+
+Known answers: the device loop's step (steady state = the desired force with a still brace, the study's
+~10 ms rise), Student's t and the 1/N law of the prediction, the identification's own sandwich
+covariance (a noise-free fit with the pilot's noise covariance reports the predicted half-width), and
+repeated synthetic experiments whose fits report the SD the planner predicted.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import warnings
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from loper_analysis.cli import main
+from loper_analysis.constants import JOINTS, parameter_column
+from loper_analysis.coordinate_trials import perturbation_experiment
+from loper_analysis.device.analysis import step_metrics
+from loper_analysis.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.errors import LoperInputError
+from loper_analysis.identification import identify_impedance, nuisance_projection, null_pair_errors, simulate_response
+from loper_analysis.impedance import IdentificationSettings, fit_onset
+from loper_analysis.io.atomic import write_tsv
+from loper_analysis.planning import (
+    PlanSettings,
+    planning_window,
+    precision_table,
+    pulse_force_n,
+    stride_covariance,
+    strides_needed,
+    target_answer,
+)
+from loper_analysis.reference import STUDY_DEVICE
+from loper_analysis.responses import ResponseSettings, null_pair_windows
+from loper_analysis.steps.model import write_segments
+
+HEIGHT_M, MASS_KG = 1.73, 64.9
+ONSET_MS = 50
+TRUTH = np.array([55.0, 3.5, 3.0, 0.10, 8.0, 0.3])
+T95_102 = 1.9834953  # Student's t, 97.5 %, 102 degrees of freedom
+
+
+@pytest.fixture(scope="module")
+def params():
+    return segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
+
+
+@pytest.fixture(scope="module")
+def pilot(params):
+    """A coordinate-level pilot: one trial with the device, 12 perturbed strides, and its null pairs."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        full, cut = perturbation_experiment([11, 0], params, HEIGHT_M, ONSET_MS, TRUTH, [12], angle_noise_sd_rad=0.001)
+        null = null_pair_windows([full], ONSET_MS, ResponseSettings(), source="pilot")
+    return full, cut[12], null
+
+
+def test_pulse_is_the_device_step(params):
+    """A long pulse through the device loop with a still brace: settles at the desired force, rises in ~10 ms."""
+    t = np.arange(-0.1, 0.6, 0.001)
+    f = pulse_force_n(t, 40.0, 0.4)
+    m = step_metrics(t, f, 40.0, (0.15, 0.3))
+    np.testing.assert_allclose(m["steady_state_n"], 40.0, rtol=0.01)
+    assert abs(m["rise_time_ms"] - STUDY_DEVICE["rise_time_ms"][0]) < 3.0  # study 10 ms; 12 ms after the 40 Hz low-pass
+    assert 5.0 < m["overshoot_pct"] < STUDY_DEVICE["overshoot_pct"][0]  # the load cell's low-pass trims the overshoot
+    assert np.max(np.abs(f[t < -0.02])) < 0.01 * 40.0  # the zero-phase low-pass rings ahead by < 1 %
+
+
+def test_prediction_follows_one_over_n_and_student_t(params, pilot):
+    _, _, null = pilot
+    sc = stride_covariance(null, params, TRUTH)
+    table = precision_table(sc, [10, 40], ONSET_MS, "P")
+    assert len(table) == 3 * 2 * 2 and sc.dof == 102
+    for (_, _), g in table.groupby(["joint", "parameter"]):
+        sd10, sd40 = g.set_index("n_strides")["predicted_sd"].loc[[10, 40]]
+        np.testing.assert_allclose(sd10 / sd40, 2.0, rtol=1e-12)
+    np.testing.assert_allclose(table["ci95_half_width"] / table["predicted_sd"], T95_102, rtol=1e-6)
+    np.testing.assert_allclose(table["ci95_half_width_pct"],
+                               100 * table["ci95_half_width"] / table["planned_value"].abs(), rtol=1e-12)
+
+
+def test_prediction_is_the_fits_own_sandwich(params, pilot):
+    """A noise-free fit given the pilot's projection and covariance / N reports the predicted half-width."""
+    _, _, null = pilot
+    settings = PlanSettings()
+    sc = stride_covariance(null, params, TRUTH, settings)
+    window = planning_window(null, params, settings)
+    errors = null_pair_errors(window, TRUTH, null)
+    n = 20
+    exact = replace(window, measured=simulate_response(window, TRUTH), residual_weight=nuisance_projection(errors, 6),
+                    noise_cov=np.cov(errors, rowvar=False) / n)
+    fit = identify_impedance(exact, n_starts=2, extra_starts=TRUTH)
+    np.testing.assert_allclose(fit.estimate, TRUTH, rtol=1e-5, atol=1e-6)
+    half = precision_table(sc, [n], ONSET_MS, settings=settings)["ci95_half_width"].to_numpy()
+    np.testing.assert_allclose((fit.ci95_high - fit.ci95_low) / 2, half, rtol=0.02)
+
+
+def test_strides_needed_is_the_smallest_count(params, pilot):
+    _, _, null = pilot
+    sc = stride_covariance(null, params, TRUTH)
+    for joint, p, pct in (("hip", "D", 15.0), ("knee", "K", 15.0), ("hip", "K", 2.0)):
+        n = strides_needed(sc, joint, p, percent=pct)
+        i = ["K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", "D_ankle"].index(f"{p}_{joint}")
+        target = pct / 100 * TRUTH[i]
+        half = lambda k: sc.t95 * sc.sd[i] / math.sqrt(k)  # noqa: E731
+        assert half(n) <= target * (1 + 1e-9) and (n == 1 or half(n - 1) > target)
+    n_abs = strides_needed(sc, "hip", "K", half_width=1.0)
+    assert n_abs == math.ceil((sc.t95 * sc.sd[0] / 1.0) ** 2)
+    text = target_answer(sc, "hip", "D", 175, percent=15)
+    assert text.startswith("hip D at 175 ms: ±15 % (95 % CI) needs ") and "perturbed strides" in text
+
+
+def test_repeated_experiments_report_the_predicted_sd(params, pilot):
+    """Eight new synthetic experiments (10 perturbed strides each): their fits' own CIs match the prediction.
+
+    The planner predicts the SD the null-pair fit reports; over these repeats the RMS of the reported SD of hip
+    and knee K and D lies within 30 % of the prediction (measured: the prediction 7-27 % above; each repeat's
+    fit takes its projection and covariance from its own ~40 null pairs, the prediction from the pilot's 130).
+    benchmarks/planner_check.py compares with the scatter of the estimates themselves over 60 repeats.
+    """
+    full, cut, null = pilot
+    ident = IdentificationSettings(n_starts=3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        logging.disable(logging.WARNING)
+        try:
+            pilot_fit = fit_onset([cut], params, ONSET_MS, "pilot", None, [full], ResponseSettings(), ident)
+            rows = pilot_fit.rows.set_index("joint")
+            planned = np.array([rows.loc[j, parameter_column(p)] for j in JOINTS for p in ("K", "D")])
+            sc = stride_covariance(null, params, np.clip(planned, 0, None))
+            reported, kept = [], []
+            for k in range(1, 9):
+                f, c = perturbation_experiment([11, k], params, HEIGHT_M, ONSET_MS, TRUTH, [10],
+                                               angle_noise_sd_rad=0.001)
+                r = fit_onset([c[10]], params, ONSET_MS, f"R{k}", None, [f], ResponseSettings(), ident).rows
+                assert (r["noise_model"] == "null_pairs").all()
+                r = r.set_index("joint")
+                high, low = (r[[parameter_column(p, b) for p in ("K", "D")]].loc[list(JOINTS)].to_numpy().ravel()
+                             for b in ("ci95_high", "ci95_low"))
+                reported.append((high - low) / 2 / T95_102)
+                kept.append(int(r["n_strides"].iloc[0]))
+        finally:
+            logging.disable(logging.NOTSET)
+    rms_reported = np.sqrt(np.mean(np.square(reported), axis=0))
+    predicted = sc.sd * np.sqrt(np.mean(1.0 / np.array(kept)))
+    ratio = predicted[:4] / rms_reported[:4]  # hip K, hip D, knee K, knee D
+    assert np.all(np.abs(ratio - 1) < 0.3), ratio
+
+
+# --------------------------------------------------------------------------- bad input
+
+
+def test_zero_or_negative_strides_are_refused(params, pilot):
+    _, _, null = pilot
+    sc = stride_covariance(null, params, TRUTH)
+    for bad in (0, -5):
+        with pytest.raises(LoperInputError, match=f"stride count must be a whole number >= 1.*{bad}"):
+            precision_table(sc, [10, bad], ONSET_MS)
+
+
+def test_pulse_longer_than_the_window_is_refused():
+    with pytest.raises(LoperInputError, match=r"pulse_duration_s = 0.3 s is longer than .*window_after_s = 0.25 s"):
+        PlanSettings(pulse_duration_s=0.3)
+
+
+def test_pilot_without_null_pairs_is_refused(params, pilot):
+    _, _, null = pilot
+    few = {k: (v[:5] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
+    with pytest.raises(LoperInputError,
+                       match=r"pilot: 5 null pair\(s\), fewer than identification.null_pair_components"):
+        stride_covariance(few, params, TRUTH)
+    none = {k: (v[:0] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
+    with pytest.raises(LoperInputError, match="no null pairs"):
+        planning_window(none, params)
+
+
+def test_planned_value_outside_bounds_is_refused(params, pilot):
+    _, _, null = pilot
+    with pytest.raises(LoperInputError, match=r"planned D_knee = -0.1 N·m·s/rad lies outside"):
+        stride_covariance(null, params, [55, 3.5, 3, -0.1, 8, 0.3])
+
+
+# --------------------------------------------------------------------------- file layer and command
+
+
+@pytest.fixture(scope="module")
+def pilot_results(tmp_path_factory, params, pilot):
+    """A results folder of a pilot S09: angle and stride tables, segment table, fit rows at 50 ms."""
+    full, _, _ = pilot
+    root = tmp_path_factory.mktemp("pilot") / "results"
+    write_tsv(full["angles"], root / "ik/S09/pert050-1.angles.tsv")
+    write_tsv(full["strides"], root / "strides/S09/pert050-1.strides.tsv")
+    write_tsv(full["angles"], root / "ik/S09/pert050-2.angles.tsv")  # every stride perturbed: no null pair
+    write_tsv(full["strides"].assign(perturbed=True, onset_s=full["strides"]["toe_off_s"] + 0.05),
+              root / "strides/S09/pert050-2.strides.tsv")
+    write_tsv(full["angles"], root / "ik/S09/walk-nodevice.angles.tsv")  # excluded by default
+    write_segments(params, root / "model/S09/segments.tsv")
+    rows = pd.DataFrame({"subject": "S09", "onset_ms": 50, "joint": list(JOINTS),
+                         parameter_column("K"): TRUTH[0::2], parameter_column("D"): TRUTH[1::2], "status": "ok",
+                         "reason": ""})
+    write_tsv(rows, root / "impedance/S09/050.tsv")
+    return root
+
+
+def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path, capsys):
+    out = tmp_path / "plan.tsv"
+    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", "--trials", "pert050-1",
+                 "--strides", "10", "40",
+                 "--target", "hip", "D", "15", "--out", str(out)])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    table = pd.read_csv(out, sep="\t")
+    assert len(table) == 12 and set(table["n_strides"]) == {10, 40} and set(table["onset_ms"]) == {50}
+    _, _, null = pilot
+    sc = stride_covariance(null, params, TRUTH)
+    expected = precision_table(sc, [10, 40], ONSET_MS, "S09")
+    # the pilot's tables went through TSV files (9 significant digits) on the way in
+    np.testing.assert_allclose(table["predicted_sd"], expected["predicted_sd"], rtol=2e-4)
+    n = strides_needed(sc, "hip", "D", percent=15)
+    assert f"hip D at 50 ms: ±15 % (95 % CI) needs {n} perturbed strides" in captured.out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--strides", "0"], "stride count must be a whole number >= 1 (perturbed strides averaged), got 0"),
+    (["--duration-s", "0.5"], "pulse_duration_s = 0.5 s is longer than the fit window"),
+    (["--trials", "pert050-2"], "S09, onset 50 ms: 0 null pair(s), fewer than identification.null_pair_components"),
+])
+def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
+    trials = [] if "--trials" in args else ["--trials", "pert050-1"]
+    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", *trials, *args])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.startswith("loper-analysis plan: ") and err.count("\n") == 1
+    assert message in err
+
+
+def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_results, tmp_path):
+    """A pilot onset without an estimate: ``raise`` names it; ``note`` (the rule) writes rows without a prediction."""
+    from loper_analysis.steps.planning import plan
+
+    failed = pd.DataFrame({"subject": "S09", "onset_ms": 175, "joint": list(JOINTS), parameter_column("K"): np.nan,
+                           parameter_column("D"): np.nan, "status": "failed",
+                           "reason": "3 valid perturbed stride(s), fewer than 5: not fitted"})
+    write_tsv(failed, tmp_path / "175.tsv")
+    root = pilot_results
+    files = dict(trials=["pert050-1"], angles=[root / "ik/S09/pert050-1.angles.tsv"],
+                 strides=[root / "strides/S09/pert050-1.strides.tsv"], segments_tsv=root / "model/S09/segments.tsv",
+                 subject="S09", onsets_ms=[50, 175], n_strides=[10])
+    impedance = [root / "impedance/S09/050.tsv", tmp_path / "175.tsv"]
+    with pytest.raises(LoperInputError, match=r"no fitted impedance of subject S09 at onset 175 ms for the hip "
+                                              r"\(failed: 3 valid perturbed stride"):
+        plan(**files, impedance_tsvs=impedance)
+    table, _ = plan(**files, impedance_tsvs=impedance, unplannable="note")
+    late = table[table["onset_ms"] == 175]
+    assert len(late) == 6 and late["predicted_sd"].isna().all() and late["note"].str.startswith("not planned").all()
+    assert table.loc[table["onset_ms"] == 50, "predicted_sd"].notna().all()
