@@ -20,7 +20,8 @@
 
 Beyond the study, :mod:`.null_pairs` weights the prediction error by the
 stride-to-stride deviation that null pairs show, and :mod:`.status` judges
-each joint's fit (convergence, VAF floor, bounds, interval widths).
+each joint's fit (convergence, VAF floor, bounds, the information in the
+intervals), whose ends :mod:`.intervals` forms.
 """
 
 from .fit import (
@@ -39,7 +40,8 @@ from .null_pairs import (
     null_pair_errors,
     refit_with_null_pairs,
 )
-from .status import AT_BOUND_FRACTION, MIN_VAF_PCT, joint_status
+from .intervals import CI_LEVEL, bounded_interval, t_quantile
+from .status import AT_BOUND_FRACTION, DEFAULT_PLAUSIBLE_RANGES, MIN_VAF_PCT, check_plausible_range, joint_status
 from .window import (
     PreparedWindow,
     prediction_error,
@@ -69,4 +71,9 @@ __all__ = [
     "MIN_VAF_PCT",
     "AT_BOUND_FRACTION",
     "joint_status",
+    "DEFAULT_PLAUSIBLE_RANGES",
+    "check_plausible_range",
+    "CI_LEVEL",
+    "t_quantile",
+    "bounded_interval",
 ]

@@ -29,10 +29,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import t as student_t
 
 from ..constants import PARAMETERS
 from ..errors import LoperInputError
+from .intervals import bounded_interval, sandwich_covariance
 from .window import PreparedWindow, prediction_error, simulate_response
 
 __all__ = [
@@ -301,6 +301,7 @@ def identify_impedance(
     tolerance: float = 1e-6,
     merge_tolerance: float = 1e-2,
     extra_starts=None,
+    ci_dof: int | None = None,
 ) -> ImpedanceFit:
     """Fit K, D per joint to one prepared window (method: ``docs/identification.md``).
 
@@ -318,6 +319,9 @@ def identify_impedance(
         ends with the cost of the start it joined.
     extra_starts : (k, 6) starts tried before the random ones (e.g. a
         previous estimate), clipped to the bounds.
+    ci_dof : degrees of freedom of the intervals' t quantile; None: the
+        residuals' ``m - 6`` (white fit). A fit whose ``noise_cov`` comes from
+        ``N`` null pairs passes ``N - 1`` (:mod:`.intervals`).
 
     Returns
     -------
@@ -328,6 +332,8 @@ def identify_impedance(
     lb, ub = check_bounds(lower, upper)
     if int(n_starts) != n_starts or n_starts < 1:
         raise LoperInputError(f"n_starts must be an integer >= 1, got {n_starts}")
+    if ci_dof is not None and (int(ci_dof) != ci_dof or ci_dof < 1):
+        raise LoperInputError(f"ci_dof must be an integer >= 1, got {ci_dof}")
     rng = np.random.default_rng(seed)
     starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
     if extra_starts is not None:
@@ -376,22 +382,22 @@ def identify_impedance(
             JG = J.T @ initial_state_jacobian(window, estimate)
             cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
         else:
-            M = A @ J.T if batch.weight is None else A @ J.T @ batch.weight
-            cov = M @ np.asarray(window.noise_cov, dtype=float) @ M.T
+            cov = sandwich_covariance(J, window.noise_cov, batch.weight)
         sd = np.sqrt(np.clip(np.diag(cov), 0, None))
         corr = cov / np.outer(sd, sd)
     rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
     if rank < 6:
         sd = np.where(np.diag(JTJ) > 0, sd, np.inf)
-    half = student_t.ppf(0.975, dof) * sd
+    sd = np.where(np.isnan(sd), np.inf, sd)
+    ci_low, ci_high = bounded_interval(estimate, sd, dof if ci_dof is None else int(ci_dof), lb, ub)
     model = window.measured - pe
     vaf = variance_accounted_for(window.measured, model)
     return ImpedanceFit(
         estimate=estimate,
         cost=float(np.sum(r**2)),
         sum_sq_error_rad2=float(np.sum(pe**2)),
-        ci95_low=estimate - half,
-        ci95_high=estimate + half,
+        ci95_low=ci_low,
+        ci95_high=ci_high,
         correlation=corr,
         vaf_pct=vaf,
         success=success,

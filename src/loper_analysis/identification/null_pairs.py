@@ -113,8 +113,10 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     perturbed strides averaged in ``window`` (the null pairs' covariance is
     divided by it). The refit starts from the first estimate and the random
     starts of ``fit_options`` (keyword arguments of :func:`identify_impedance`).
-    With fewer than ``max(min_null_pairs, n_components + 2)`` null pairs the
-    first fit stands and ``note`` says so.
+    The intervals' t quantile has ``N - 1`` degrees of freedom, those of the
+    sample covariance of the ``N`` null pairs (:mod:`.intervals`). With fewer
+    than ``max(min_null_pairs, n_components + 2)`` null pairs the first fit
+    stands and ``note`` says so.
     """
     n_null = int(null_pairs["n_pairs"])
     if n_null < max(int(min_null_pairs), int(n_components) + 2):
@@ -127,5 +129,5 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     weight = nuisance_projection(errors, n_components)
     cov = np.cov(errors, rowvar=False) / n_averaged
     fit = identify_impedance(replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate,
-                             **fit_options)
+                             ci_dof=n_null - 1, **fit_options)
     return NullPairFit(fit, "null_pairs", n_null)
