@@ -368,7 +368,13 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
     :data:`~loper_analysis.identification.AT_BOUND_FRACTION` of the bound)
     carry no estimate and are left out; None keeps every fitted row.
 
-    Columns ``joint, onset_ms, n_subjects``, then per parameter its mean, SD,
+    Rows that are ``not_identifiable`` because an interval holds 0 and the
+    whole plausible range stay in: their estimate is still the fit's best
+    value, and leaving out exactly the estimates near 0 would push the
+    across-subject mean up. ``n_not_identifiable`` counts them, so a mean
+    made mostly of uninformative fits shows as such.
+
+    Columns ``joint, onset_ms, n_subjects, n_not_identifiable``, then per parameter its mean, SD,
     min and max over subjects (``K_mean_nm_per_rad`` ...), ``vaf_pct_mean``;
     where the truth is known also the mean error, the largest absolute error
     and the fraction of subjects within tolerance (``K_fraction_within_tolerance``:
@@ -384,7 +390,8 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
         fitted = fitted[~on_bound]
     rows = []
     for (joint, onset), g in fitted.groupby(["joint", "onset_ms"], sort=False):
-        row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique()}
+        row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique(),
+               "n_not_identifiable": int((g["status"] == "not_identifiable").sum())}
         for p in ("K", "D"):
             v = g[parameter_column(p)]
             row.update({parameter_column(p, "mean"): v.mean(), parameter_column(p, "sd"): v.std(ddof=1),
@@ -400,7 +407,7 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
                             f"{p}_fraction_within_tolerance": float((err.abs() <= tol).mean())})
         rows.append(row)
     order = {j: i for i, j in enumerate(JOINTS)}
-    out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects"])
+    out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects", "n_not_identifiable"])
     if len(out):
         out = out.sort_values(["joint", "onset_ms"], key=lambda c: c.map(order) if c.name == "joint" else c,
                               kind="stable", ignore_index=True)
