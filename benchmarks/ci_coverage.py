@@ -1,7 +1,7 @@
 """How often do the 95 % confidence intervals of the impedance fits hold the truth? A coverage measurement.
 
 Usage: python benchmarks/ci_coverage.py [--mode coordinates|chain] [--subjects N] [--seed S] [--jobs J]
-                                        [--ik-noise-rad SD] [--keep DIR]
+                                        [--ik-noise-scale X] [--keep PATH]
 
 N synthetic subjects (anthropometrics drawn from the study's subjects, true K and D drawn around the
 group values as in the default study; the default design of ``config/config.yaml``: 2 trials of 45 s per
@@ -13,8 +13,9 @@ the truth and prints a Markdown table: fits, CI holds truth, share with its bino
 ``--mode coordinates`` (default, ~10 min for 34 subjects with ``--jobs 2`` on two free cores): the
 same simulated walking trials as the workflow (same seeds: subject C001 here is C001 there), taken at
 the coordinate level. The motion-capture coordinates (128 Hz) become the joint-angle table with
-IK-like noise added (Gaussian, low-passed like the markers, SD ``--ik-noise-rad`` per angle: the
-whole chain's, measured by ``--mode chain --keep DIR`` below); the true gait events make the stride
+IK-like noise added (Gaussian, low-passed like the markers, with the SDs and correlations of the whole
+chain's IK error, :data:`IK_NOISE_SD`, measured by ``--mode chain --keep DIR`` below; times
+``--ik-noise-scale``); the true gait events make the stride
 tables; the robot log goes through the load-cell step's own clock map, filter and resampling; the brace
 markers are the model's; the segment table is the subject's generated model (not scaled from a static
 trial). Then the workflow's :func:`loper_analysis.impedance.fit_onset`. Skips C3D files, markers, IK,
@@ -23,7 +24,7 @@ scaling and event detection.
 ``--mode chain`` (the cross-check, ~35-70 min for 34 subjects): builds a copy of the workflow with the
 N subjects and runs ``snakemake -jJ results/tables/impedance.tsv`` (from the simulated C3D files to
 the fits). With ``--keep DIR`` the project stays, and the script also prints the IK noise of the chain
-(SD of IK angle minus true coordinate, per angle) for ``--ik-noise-rad``.
+(SD of IK angle minus true coordinate, per column) behind :data:`IK_NOISE_SD`.
 """
 
 from __future__ import annotations
@@ -47,10 +48,18 @@ from scipy.stats import beta
 from loper_analysis.markdown import markdown_table
 
 ROOT = Path(__file__).resolve().parents[1]
-#: SD (rad) of IK angle minus true coordinate in the whole chain (``--mode chain --keep``; 0.5 mm marker
-#: noise, 40 Hz marker filter, generated model): the default of ``--ik-noise-rad``.
-IK_NOISE_RAD = 0.0016
-_ANGLES = ("pelvis_angle", "hip_left", "knee_left", "ankle_left")
+#: Columns of the angle table that get IK-like noise, and the noise measured in the whole chain (``--mode chain
+#: --keep``: IK angle minus true coordinate, minimal-impedance trials of C014 and C030, 0.5 mm marker noise,
+#: 40 Hz marker filter, generated model): SD (m, rad) and correlations. The noise is close to white noise
+#: through the 40 Hz marker filter (lag-1 correlation 0.52 in the chain and 0.52 for filtered white noise).
+IK_NOISE_COLUMNS = ("pelvis_x_m", "pelvis_angle_rad", "hip_left_rad", "knee_left_rad", "ankle_left_rad")
+IK_NOISE_SD = np.array([0.000155, 0.001912, 0.002218, 0.001034, 0.001636])
+IK_NOISE_CORR = np.array([[1.00, -0.54, -0.67, -0.52, -0.03],
+                          [-0.54, 1.00, 0.97, 0.26, -0.02],
+                          [-0.67, 0.97, 1.00, 0.46, 0.02],
+                          [-0.52, 0.26, 0.46, 1.00, 0.35],
+                          [-0.03, -0.02, 0.02, 0.35, 1.00]])
+_ANGLES = ("pelvis_x", "pelvis_angle", "hip_left", "knee_left", "ankle_left")
 
 
 def binomial_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
@@ -97,8 +106,9 @@ def _settings(config: dict):
     return response, IdentificationSettings(**{k: ident[k] for k in keys if k in ident}, seed=config["seed"])
 
 
-def _trial_inputs(walk, model, lab, config: dict, noise_sd_rad: float, rng: np.random.Generator) -> dict:
-    """Angle table (IK-like noise), stride table and force table of one simulated trial, as the fit reads them."""
+def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.random.Generator) -> dict:
+    """Angle table (IK-like noise, ``noise_scale`` times the chain's), stride table, force table and brace markers of
+    one simulated trial, as the fit reads them."""
     from loper_analysis.filtering import lowpass
     from loper_analysis.kinematics import marker_positions
     from loper_analysis.loadcell import robot_log_on_mocap_frames
@@ -110,12 +120,13 @@ def _trial_inputs(walk, model, lab, config: dict, noise_sd_rad: float, rng: np.r
     t = coords["time_s"].to_numpy()
     angles = {"time_s": t}
     cutoff, order = config["filter"]["cutoff_hz"], config["filter"]["order"]
+    white = lowpass(rng.normal(size=(t.size, len(IK_NOISE_COLUMNS))), lab.marker_rate_hz, cutoff, order)
+    noise = (white / white.std(axis=0)) @ np.linalg.cholesky(IK_NOISE_CORR).T * IK_NOISE_SD * noise_scale
     for name, entry in config["opensim"]["coordinate_map"].items():
         column = f"{name}_m" if name == "pelvis_x" else f"{name}_rad"
         value = entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
-        if name != "pelvis_x" and noise_sd_rad > 0:
-            noise = lowpass(rng.normal(size=t.size), lab.marker_rate_hz, cutoff, order)
-            value = value + noise_sd_rad * noise / np.std(noise)
+        if column in IK_NOISE_COLUMNS:
+            value = value + noise[:, IK_NOISE_COLUMNS.index(column)]
         angles[column] = value
     angles = pd.DataFrame(angles)
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
@@ -133,7 +144,7 @@ def _trial_inputs(walk, model, lab, config: dict, noise_sd_rad: float, rng: np.r
     return {"angles": angles, "strides": strides, "force": force, "markers": (t, markers, list(BRACE_MARKERS))}
 
 
-def coordinate_subject(subject: str, config: dict, noise_sd_rad: float) -> pd.DataFrame:
+def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.DataFrame:
     """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table)."""
     from loper_analysis.constants import JOINTS
     from loper_analysis.device.controller import DeviceParameters
@@ -166,7 +177,7 @@ def coordinate_subject(subject: str, config: dict, noise_sd_rad: float) -> pd.Da
                                                       zlib.crc32(trial.encode())]).spawn(2)
         walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
                                       syn["timing_cv"], syn["amplitude_cv"], device, perturbation)
-        inputs[trial] = {"name": trial, **_trial_inputs(walk, model, lab, config, noise_sd_rad,
+        inputs[trial] = {"name": trial, **_trial_inputs(walk, model, lab, config, noise_scale,
                                                         np.random.default_rng(file_seed))}
     response, ident = _settings(config)
     null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
@@ -177,17 +188,18 @@ def coordinate_subject(subject: str, config: dict, noise_sd_rad: float) -> pd.Da
     return pd.concat(rows, ignore_index=True)
 
 
-def run_coordinates(names: list[str], config: dict, noise_sd_rad: float, jobs: int) -> pd.DataFrame:
+def run_coordinates(names: list[str], config: dict, noise_scale: float, jobs: int) -> pd.DataFrame:
     """Every subject's rows, ``jobs`` subjects at a time."""
     if jobs <= 1:
-        return pd.concat([coordinate_subject(s, config, noise_sd_rad) for s in names], ignore_index=True)
+        return pd.concat([coordinate_subject(s, config, noise_scale) for s in names], ignore_index=True)
     with ProcessPoolExecutor(jobs) as pool:
-        frames = list(pool.map(coordinate_subject, names, [config] * len(names), [noise_sd_rad] * len(names)))
+        frames = list(pool.map(coordinate_subject, names, [config] * len(names), [noise_scale] * len(names)))
     return pd.concat(frames, ignore_index=True)
 
 
 def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series:
-    """SD (rad) of the chain's IK angles minus the true coordinates, per angle, over the first subjects' trials."""
+    """SD (rad) of the chain's IK angles minus the true coordinates, per angle (minimal-impedance trials of the first
+    ``max_subjects`` subjects that have one)."""
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.io.readers import read_tsv
     from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
@@ -197,11 +209,11 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
     syn, seed = config["synthetic"], int(config["seed"])
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
     diffs: dict[str, list] = {a: [] for a in _ANGLES}
-    subjects = sorted(p.name for p in (work / "results/ik").iterdir())[:max_subjects]
+    trial = config["trials"]["device"]
+    subjects = sorted(p.parent.name for p in (work / "results/ik").glob(f"*/{trial}.angles.tsv"))[:max_subjects]
     for subject in subjects:
         row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
         params = segment_parameters_from_model(build_lower_body_model(row["height_m"], row["mass_kg"]))
-        trial = config["trials"]["device"]
         sim_seed, _ = np.random.SeedSequence([seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]).spawn(2)
         walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
                                       syn["timing_cv"], syn["amplitude_cv"], DeviceParameters(**config["device"]["parameters"]))
@@ -209,9 +221,10 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
         ik = read_tsv(work / f"results/ik/{subject}/{trial}.angles.tsv", "angle table")
         for a in _ANGLES:
             entry = config["opensim"]["coordinate_map"][a]
-            d = ik[f"{a}_rad"].to_numpy(float) - entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
+            column = f"{a}_m" if a == "pelvis_x" else f"{a}_rad"
+            d = ik[column].to_numpy(float) - entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
             diffs[a].append(d[np.isfinite(d)] - np.nanmean(d))
-    return pd.Series({a: float(np.std(np.concatenate(v))) for a, v in diffs.items()}, name="ik_noise_sd_rad")
+    return pd.Series({a: float(np.std(np.concatenate(v))) for a, v in diffs.items()}, name="ik_noise_scale")
 
 
 def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFrame:
@@ -237,7 +250,7 @@ def main() -> None:
     ap.add_argument("--subjects", type=int, default=34)
     ap.add_argument("--seed", type=int, default=2024)
     ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--ik-noise-rad", type=float, default=IK_NOISE_RAD)
+    ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
     ap.add_argument("--keep", type=Path, help="chain: keep the project here; coordinates: write the rows here (TSV)")
     args = ap.parse_args()
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
@@ -245,10 +258,10 @@ def main() -> None:
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     t0 = time.perf_counter()
     if args.mode == "coordinates":
-        table = run_coordinates(names, config, args.ik_noise_rad, args.jobs)
+        table = run_coordinates(names, config, args.ik_noise_scale, args.jobs)
         if args.keep:
             table.to_csv(args.keep, sep="\t", index=False)
-        what = f"coordinate level, IK noise {args.ik_noise_rad:g} rad"
+        what = f"coordinate level, IK noise {args.ik_noise_scale:g} x the chain's"
     else:
         work = args.keep or Path(tempfile.mkdtemp(prefix="ci_coverage_"))
         work.mkdir(parents=True, exist_ok=True)
@@ -262,7 +275,7 @@ def main() -> None:
         if args.keep is None:
             shutil.rmtree(work)
         else:
-            print(markdown_table(chain_ik_noise(work, config).to_frame().reset_index(names="angle")))
+            print(markdown_table(chain_ik_noise(work, config).to_frame().reset_index(names="column")))
 
 
 if __name__ == "__main__":

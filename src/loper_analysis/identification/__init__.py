@@ -36,6 +36,7 @@ from .fit import (
 )
 from .null_pairs import (
     NullPairFit,
+    cross_validated_covariance,
     nuisance_projection,
     null_pair_errors,
     refit_with_null_pairs,
@@ -68,6 +69,7 @@ __all__ = [
     "null_pair_errors",
     "nuisance_projection",
     "refit_with_null_pairs",
+    "cross_validated_covariance",
     "MIN_VAF_PCT",
     "AT_BOUND_FRACTION",
     "joint_status",

@@ -249,6 +249,8 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
                     step[free] = np.linalg.solve(Af + mu[i] * np.diag(d), -g[free])
                 except np.linalg.LinAlgError:
                     step[free] = -g[free] / d
+            if not np.all(np.isfinite(step)):  # a start whose simulation overflowed: no step, its damping grows
+                step = np.zeros(6)
             trial[k] = np.clip(points[i] + step, lb, ub)
         rt, Jt = batch.residuals_and_jacobians(trial)
         ct = np.sum(rt**2, axis=1)
@@ -282,10 +284,12 @@ def starts_at_best(start_costs, relative: float = AT_BEST_RELATIVE) -> int:
     """How many starts ended within ``relative`` above the lowest start cost (at least 1).
 
     A cost of exactly zero (noise-free data fitted to rounding) counts as reached by every start at zero.
+    A cost of +inf (a start whose simulation diverged) never counts; at least one cost must be finite.
     """
     costs = np.asarray(start_costs, dtype=float)
-    if costs.ndim != 1 or costs.size == 0 or not np.all(np.isfinite(costs)) or np.any(costs < 0):
-        raise LoperInputError(f"start costs must be a non-empty finite array >= 0, got {costs}")
+    if costs.ndim != 1 or costs.size == 0 or np.any(np.isnan(costs)) or np.any(costs < 0) \
+            or not np.any(np.isfinite(costs)):
+        raise LoperInputError(f"start costs must be a non-empty array >= 0 (+inf allowed, not all), got {costs}")
     best = costs.min()
     return int(np.sum(costs <= best * (1.0 + relative)))
 
@@ -345,6 +349,9 @@ def identify_impedance(
     if not 0 <= merge_tolerance < 1:
         raise LoperInputError(f"merge_tolerance must lie in [0, 1), got {merge_tolerance}")
     points, costs, converged, _ = multistart_lm(batch, starts, max_iterations, tolerance, merge_tolerance)
+    costs = np.where(np.isfinite(costs), costs, np.inf)  # a start whose simulation diverged (e.g. a stiff ankle)
+    if not np.any(np.isfinite(costs)):
+        raise LoperInputError("identify_impedance: the simulation diverged from every start")
     best = int(np.argmin(costs))
 
     def fun(p):
