@@ -146,7 +146,9 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     divided by it). The refit starts from the first estimate and the random
     starts of ``fit_options`` (keyword arguments of :func:`identify_impedance`).
     The intervals' t quantile has ``N - 1`` degrees of freedom, those of the
-    sample covariance of the ``N`` null pairs (:mod:`.intervals`). With fewer
+    sample covariance of the ``N`` null pairs (:mod:`.intervals`).
+    ``cross_validated``: the intervals from :func:`cross_validated_covariance`
+    instead of the sandwich of the null pairs' covariance. With fewer
     than ``max(min_null_pairs, n_components + 2)`` null pairs the first fit
     stands and ``note`` says so.
     """
