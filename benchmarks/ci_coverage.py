@@ -1,15 +1,30 @@
 """How often do the 95 % confidence intervals of the impedance fits hold the truth? A coverage measurement.
 
-Usage: python benchmarks/ci_coverage.py [--subjects N] [--seed S] [--jobs J] [--keep DIR]
+Usage: python benchmarks/ci_coverage.py [--mode coordinates|chain] [--subjects N] [--seed S] [--jobs J]
+                                        [--ik-noise-scale X] [--keep PATH]
 
-Builds a copy of the workflow with N synthetic subjects (anthropometrics drawn from the study's
-subjects, true K and D drawn around the group values as in the default study, the default design:
-2 trials of 45 s per onset, noise model ``null_pairs``), runs ``snakemake -jJ
-results/tables/impedance.tsv`` (the processing chain from the simulated C3D files to the fits; no
-validation study, no device tests) and counts, per joint and parameter, the fitted rows (``ok`` or
-``not_identifiable``) whose 95 % CI holds the truth. Prints a Markdown table; each subject gives three
-fits (onsets 50, 175, 300 ms), so 34 subjects give 102. ``--keep DIR`` keeps the project (its
-``results/tables/impedance.tsv``) for a closer look.
+N synthetic subjects (anthropometrics drawn from the study's subjects, true K and D drawn around the
+group values as in the default study; the default design of ``config/config.yaml``: 2 trials of 45 s per
+onset, noise model ``null_pairs``), three fits each (onsets 50, 175, 300 ms): 34 subjects give 102 fits.
+Counts, per joint and parameter, the fitted rows (``ok`` or ``not_identifiable``) whose 95 % CI holds
+the truth and prints a Markdown table: fits, CI holds truth, share with its binomial (Clopper-Pearson)
+95 % interval, median CI width, rows ``not_identifiable``.
+
+``--mode coordinates`` (default, ~10 min for 34 subjects with ``--jobs 2`` on two free cores): the
+same simulated walking trials as the workflow (same seeds: subject C001 here is C001 there), taken at
+the coordinate level. The motion-capture coordinates (128 Hz) become the joint-angle table with
+IK-like noise added (Gaussian, low-passed like the markers, with the SDs and correlations of the whole
+chain's IK error, :data:`IK_NOISE_SD`, measured by ``--mode chain --keep DIR`` below; times
+``--ik-noise-scale``); the true gait events make the stride
+tables; the robot log goes through the load-cell step's own clock map, filter and resampling; the brace
+markers are the model's; the segment table is the subject's generated model (not scaled from a static
+trial). Then the workflow's :func:`loper_analysis.impedance.fit_onset`. Skips C3D files, markers, IK,
+scaling and event detection.
+
+``--mode chain`` (the cross-check, ~35-70 min for 34 subjects): builds a copy of the workflow with the
+N subjects and runs ``snakemake -jJ results/tables/impedance.tsv`` (from the simulated C3D files to
+the fits). With ``--keep DIR`` the project stays, and the script also prints the IK noise of the chain
+(SD of IK angle minus true coordinate, per column) behind :data:`IK_NOISE_SD`.
 """
 
 from __future__ import annotations
@@ -20,19 +35,43 @@ import subprocess
 import sys
 import tempfile
 import time
+import warnings
+import zlib
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import yaml
+from scipy.stats import beta
 
 from loper_analysis.markdown import markdown_table
 
 ROOT = Path(__file__).resolve().parents[1]
+#: Columns of the angle table that get IK-like noise, and the noise measured in the whole chain (``--mode chain
+#: --keep``: IK angle minus true coordinate, minimal-impedance trials of C014 and C030, 0.5 mm marker noise,
+#: 40 Hz marker filter, generated model): SD (m, rad) and correlations. The noise is close to white noise
+#: through the 40 Hz marker filter (lag-1 correlation 0.52 in the chain and 0.52 for filtered white noise).
+IK_NOISE_COLUMNS = ("pelvis_x_m", "pelvis_angle_rad", "hip_left_rad", "knee_left_rad", "ankle_left_rad")
+IK_NOISE_SD = np.array([0.000155, 0.001912, 0.002218, 0.001034, 0.001636])
+IK_NOISE_CORR = np.array([[1.00, -0.54, -0.67, -0.52, -0.03],
+                          [-0.54, 1.00, 0.97, 0.26, -0.02],
+                          [-0.67, 0.97, 1.00, 0.46, 0.02],
+                          [-0.52, 0.26, 0.46, 1.00, 0.35],
+                          [-0.03, -0.02, 0.02, 0.35, 1.00]])
+_ANGLES = ("pelvis_x", "pelvis_angle", "hip_left", "knee_left", "ankle_left")
+
+
+def binomial_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Clopper-Pearson interval of a share k / n (0..1)."""
+    a = (1 - level) / 2
+    low = beta.ppf(a, k, n - k + 1) if k > 0 else 0.0
+    high = beta.ppf(1 - a, k + 1, n - k) if k < n else 1.0
+    return float(low), float(high)
 
 
 def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
-    """Per joint and parameter: fitted rows, rows whose CI holds the truth, coverage, median CI width."""
+    """Per joint and parameter: fitted rows, CI holds truth, share (%) with its binomial 95 % interval, median width."""
     fitted = table[table["status"].isin(["ok", "not_identifiable"])]
     rows = []
     for joint in ("hip", "knee", "ankle"):
@@ -42,44 +81,201 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
             truth = g[f"{p}_true_{unit}"]
             has_ci = low.notna() & high.notna()
             inside = has_ci & (low <= truth) & (truth <= high)
-            rows.append({"joint": joint, "parameter": p, "n_fits": int(has_ci.sum()), "n_inside": int(inside.sum()),
-                         "coverage_pct": 100.0 * inside.sum() / max(int(has_ci.sum()), 1),
+            n, k = int(has_ci.sum()), int(inside.sum())
+            lo, hi = binomial_interval(k, n) if n else (np.nan, np.nan)
+            rows.append({"joint": joint, "parameter": p, "n_fits": n, "ci_holds_truth": k,
+                         "coverage_pct": 100.0 * k / max(n, 1), "binomial95_low_pct": 100 * lo,
+                         "binomial95_high_pct": 100 * hi,
                          "median_ci_width": float(np.median((high - low)[has_ci])) if has_ci.any() else np.nan,
                          "n_not_identifiable": int((g["status"] == "not_identifiable").sum())})
     return pd.DataFrame(rows)
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--subjects", type=int, default=34)
-    ap.add_argument("--seed", type=int, default=2024)
-    ap.add_argument("--jobs", type=int, default=2)
-    ap.add_argument("--keep", type=Path)
-    args = ap.parse_args()
-    work = args.keep or Path(tempfile.mkdtemp(prefix="ci_coverage_"))
-    work.mkdir(parents=True, exist_ok=True)
+def _settings(config: dict):
+    """ResponseSettings and IdentificationSettings as the workflow's rule impedance_fit builds them."""
+    from loper_analysis.impedance import IdentificationSettings
+    from loper_analysis.responses import ResponseSettings
+
+    ident, strides = config["identification"], config["strides"]
+    response = ResponseSettings(window_before_s=ident["window_before_s"], window_after_s=ident["window_after_s"],
+                                initial_state_span_s=ident["initial_state_span_s"], whisker=strides["iqr_whisker"],
+                                max_fraction=strides["max_outlier_fraction"], min_strides=strides["min_valid_strides"])
+    keys = ("noise_model", "null_pair_components", "min_null_pairs", "initial_state_degree", "n_starts", "n_substeps",
+            "tolerance", "merge_tolerance", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad",
+            "max_ci_fraction", "plausible_ranges", "min_vaf_pct", "max_null_trial_ratio")
+    return response, IdentificationSettings(**{k: ident[k] for k in keys if k in ident}, seed=config["seed"])
+
+
+def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.random.Generator) -> dict:
+    """Angle table (IK-like noise, ``noise_scale`` times the chain's), stride table, force table and brace markers of
+    one simulated trial, as the fit reads them."""
+    from loper_analysis.filtering import lowpass
+    from loper_analysis.kinematics import marker_positions
+    from loper_analysis.loadcell import robot_log_on_mocap_frames
+    from loper_analysis.model import BRACE_MARKERS
+    from loper_analysis.strides import stride_tables
+    from loper_analysis.synthetic.sync import pulse_train_at
+
+    coords = walk.mocap_coordinates(lab.marker_rate_hz)
+    t = coords["time_s"].to_numpy()
+    angles = {"time_s": t}
+    cutoff, order = config["filter"]["cutoff_hz"], config["filter"]["order"]
+    white = lowpass(rng.normal(size=(t.size, len(IK_NOISE_COLUMNS))), lab.marker_rate_hz, cutoff, order)
+    noise = (white / white.std(axis=0)) @ np.linalg.cholesky(IK_NOISE_CORR).T * IK_NOISE_SD * noise_scale
+    for name, entry in config["opensim"]["coordinate_map"].items():
+        column = f"{name}_m" if name == "pelvis_x" else f"{name}_rad"
+        value = entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
+        if column in IK_NOISE_COLUMNS:
+            value = value + noise[:, IK_NOISE_COLUMNS.index(column)]
+        angles[column] = value
+    angles = pd.DataFrame(angles)
+    scale = 1.0 + 1e-6 * lab.clock_drift_ppm
+    t_analog = np.arange(int(round(walk.duration_s * lab.analog_rate_hz))) / lab.analog_rate_hz
+    sync = pulse_train_at((t_analog + lab.clock_offset_s) / scale, walk.sync_starts_s)
+    force = robot_log_on_mocap_frames(walk.robot, lab.robot_rate_hz, sync, lab.analog_rate_hz, t,
+                                      cutoff_hz=cutoff, order=order)
+    s = config["strides"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        strides = stride_tables(angles, walk.mocap_events(), force, "left", s["n_points"], s["iqr_whisker"],
+                                s["max_outlier_fraction"], s["min_valid_strides"]).strides
+    values = {c: coords[c].to_numpy(float) for c in coords.columns if c != "time_s"}
+    markers = marker_positions(model, values, list(BRACE_MARKERS))
+    return {"angles": angles, "strides": strides, "force": force, "markers": (t, markers, list(BRACE_MARKERS))}
+
+
+def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.DataFrame:
+    """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table)."""
+    from loper_analysis.constants import JOINTS
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.impedance import fit_onset
+    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
+    from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial
+
+    syn, trials, seed = config["synthetic"], config["trials"], int(config["seed"])
+    row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
+    truth = true_impedance(subject, seed, syn["stiffness_nm_per_rad"], syn["damping_nms_per_rad"],
+                           syn["between_subject_cv"], config["identification"]["stiffness_bounds_nm_per_rad"],
+                           config["identification"]["damping_bounds_nms_per_rad"])
+    lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
+    device = DeviceParameters(**config["device"]["parameters"])
+    model = build_lower_body_model(row["height_m"], row["mass_kg"])
+    params = segment_parameters_from_model(model)
+    onsets = [int(o) for o in trials["perturbation_onsets_ms"]]
+    names = [(trials["device"], None)] + [(f"pert{o:03d}-{k}", o) for o in onsets
+                                          for k in range(1, int(trials["perturbation_repeats"]) + 1)]
+    inputs = {}
+    for trial, onset in names:
+        perturbation = None
+        if onset is not None:
+            impedance = tuple(truth[onset][j][p] for j in JOINTS for p in ("K", "D"))
+            perturbation = PerturbationSettings(onset / 1000.0, impedance, syn["pulse_force_n"], syn["pulse_duration_s"],
+                                                tuple(syn["perturb_every_strides"]))
+        # the workflow's seeds (synthetic.trials.subject_walking_trial): the same walking as the whole chain
+        sim_seed, file_seed = np.random.SeedSequence([seed, zlib.crc32(subject.encode()),
+                                                      zlib.crc32(trial.encode())]).spawn(2)
+        walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
+                                      syn["timing_cv"], syn["amplitude_cv"], device, perturbation)
+        inputs[trial] = {"name": trial, **_trial_inputs(walk, model, lab, config, noise_scale,
+                                                        np.random.default_rng(file_seed))}
+    response, ident = _settings(config)
+    null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
+    rows = []
+    for onset in onsets:
+        own = [tr for name, tr in inputs.items() if name.startswith(f"pert{onset:03d}-")]
+        rows.append(fit_onset(own, params, onset, subject, truth[onset], null, response, ident).rows)
+    return pd.concat(rows, ignore_index=True)
+
+
+def run_coordinates(names: list[str], config: dict, noise_scale: float, jobs: int) -> pd.DataFrame:
+    """Every subject's rows, ``jobs`` subjects at a time."""
+    if jobs <= 1:
+        return pd.concat([coordinate_subject(s, config, noise_scale) for s in names], ignore_index=True)
+    with ProcessPoolExecutor(jobs) as pool:
+        frames = list(pool.map(coordinate_subject, names, [config] * len(names), [noise_scale] * len(names)))
+    return pd.concat(frames, ignore_index=True)
+
+
+def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series:
+    """SD (rad) of the chain's IK angles minus the true coordinates, per angle (minimal-impedance trials of the first
+    ``max_subjects`` subjects that have one)."""
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.io.readers import read_tsv
+    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.synthetic.subjects import subject_anthropometry
+    from loper_analysis.synthetic.trials import LabSettings, simulate_walking_trial
+
+    syn, seed = config["synthetic"], int(config["seed"])
+    lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
+    diffs: dict[str, list] = {a: [] for a in _ANGLES}
+    trial = config["trials"]["device"]
+    subjects = sorted(p.parent.name for p in (work / "results/ik").glob(f"*/{trial}.angles.tsv"))[:max_subjects]
+    for subject in subjects:
+        row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
+        params = segment_parameters_from_model(build_lower_body_model(row["height_m"], row["mass_kg"]))
+        sim_seed, _ = np.random.SeedSequence([seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]).spawn(2)
+        walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
+                                      syn["timing_cv"], syn["amplitude_cv"], DeviceParameters(**config["device"]["parameters"]))
+        coords = walk.mocap_coordinates(lab.marker_rate_hz)
+        ik = read_tsv(work / f"results/ik/{subject}/{trial}.angles.tsv", "angle table")
+        for a in _ANGLES:
+            entry = config["opensim"]["coordinate_map"][a]
+            column = f"{a}_m" if a == "pelvis_x" else f"{a}_rad"
+            d = ik[column].to_numpy(float) - entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
+            diffs[a].append(d[np.isfinite(d)] - np.nanmean(d))
+    return pd.Series({a: float(np.std(np.concatenate(v))) for a, v in diffs.items()}, name="ik_noise_scale")
+
+
+def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFrame:
+    """The workflow on a copy of the project: ``results/tables/impedance.tsv``."""
     for item in ("Snakefile", "workflow", "config"):
         target = work / item
         if not target.exists():
             (shutil.copytree if (ROOT / item).is_dir() else shutil.copy)(ROOT / item, target)
-    names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     (work / "config/coverage_subjects.tsv").write_text(
         "subject\tsource\n" + "".join(f"{s}\tsynthetic\n" for s in names))
     (work / "config/coverage.yaml").write_text(yaml.safe_dump({
-        "subjects": "config/coverage_subjects.tsv", "seed": args.seed, "device": {"subject": names[0]}}))
-    t0 = time.perf_counter()
-    res = subprocess.run([sys.executable, "-m", "snakemake", "-j", str(args.jobs), "results/tables/impedance.tsv",
+        "subjects": "config/coverage_subjects.tsv", "seed": seed, "device": {"subject": names[0]}}))
+    res = subprocess.run([sys.executable, "-m", "snakemake", "-j", str(jobs), "results/tables/impedance.tsv",
                           "--configfile", "config/coverage.yaml", "-q"], cwd=work, check=False)
     if res.returncode:
         raise SystemExit(f"snakemake failed in {work} (exit {res.returncode})")
-    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
-    out = coverage_table(table)
-    print(f"{args.subjects} synthetic subjects, {table.groupby(['subject', 'onset_ms']).ngroups} subject x onset fits, "
-          f"seed {args.seed}, {time.perf_counter() - t0:.0f} s with -j{args.jobs}; statuses: "
+    return pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--mode", choices=("coordinates", "chain"), default="coordinates")
+    ap.add_argument("--subjects", type=int, default=34)
+    ap.add_argument("--seed", type=int, default=2024)
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
+    ap.add_argument("--keep", type=Path, help="chain: keep the project here; coordinates: write the rows here (TSV)")
+    args = ap.parse_args()
+    config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    config["seed"] = args.seed
+    names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
+    t0 = time.perf_counter()
+    if args.mode == "coordinates":
+        table = run_coordinates(names, config, args.ik_noise_scale, args.jobs)
+        if args.keep:
+            table.to_csv(args.keep, sep="\t", index=False)
+        what = f"coordinate level, IK noise {args.ik_noise_scale:g} x the chain's"
+    else:
+        work = args.keep or Path(tempfile.mkdtemp(prefix="ci_coverage_"))
+        work.mkdir(parents=True, exist_ok=True)
+        table = run_chain(names, args.seed, args.jobs, work)
+        what = "whole chain"
+    print(f"{what}: {args.subjects} synthetic subjects, {table.groupby(['subject', 'onset_ms']).ngroups} subject x "
+          f"onset fits, seed {args.seed}, {time.perf_counter() - t0:.0f} s with {args.jobs} job(s); statuses: "
           f"{table['status'].value_counts().to_dict()}")
-    print(markdown_table(out.round(3)))
-    if args.keep is None:
-        shutil.rmtree(work)
+    print(markdown_table(coverage_table(table).round(3)))
+    if args.mode == "chain":
+        if args.keep is None:
+            shutil.rmtree(work)
+        else:
+            print(markdown_table(chain_ik_noise(work, config).to_frame().reset_index(names="column")))
 
 
 if __name__ == "__main__":

@@ -123,3 +123,13 @@ def test_summary_leaves_out_estimates_on_an_upper_bound():
     knee = impedance_summary(table, upper_bounds=(200.0, 10.0)).set_index("joint").loc["knee"]
     assert knee.n_subjects == 2 and knee.K_mean_nm_per_rad == 3.0
     assert impedance_summary(table, upper_bounds=(200.0, 0.1)).empty  # every D on its bound: nothing left
+
+
+def test_summary_keeps_uninformative_rows_and_counts_them():
+    """Knee D 0.10, 0.12 (ok) and 0.01 whose interval 0 ... 0.3 holds 0 and the study's range (not_identifiable):
+    the mean stays (0.10 + 0.12 + 0.01) / 3 = 0.0767, not the 0.11 of the informative rows alone, and the count says 1."""
+    rows = [status_rows(s, 175, st, "").assign(K_nm_per_rad=1.0, D_nms_per_rad=d, vaf_pct=99.0)
+            for s, d, st in (("S01", 0.10, "ok"), ("S02", 0.12, "ok"), ("S03", 0.01, "not_identifiable"))]
+    knee = impedance_summary(pd.concat(rows, ignore_index=True), upper_bounds=(200.0, 10.0)).set_index("joint").loc["knee"]
+    assert knee.n_subjects == 3 and knee.n_not_identifiable == 1
+    assert knee.D_mean_nms_per_rad == pytest.approx(0.23 / 3)

@@ -9,9 +9,9 @@ and a status (``docs/identification.md``):
 
 * ``ok`` (also with an estimate on a lower bound of zero: no measurable K or D);
 * ``not_identifiable``: K or D on its upper bound (or on a lower bound
-  above zero), or its 95 % CI spans more than ``max_ci_fraction`` of its
-  bound range (typically the ankle, whose small torques barely move the
-  prediction error);
+  above zero), or its 95 % CI holds both 0 and the upper end of the joint's
+  plausible range (``plausible_ranges``: the data cannot tell its size), or
+  spans more than ``max_ci_fraction`` of its bound range;
 * ``missing``: no trial of that onset;
 * ``failed``: too few strides (the reason names ``identification.window_after_s``
   when strides were too short for the window), the optimiser did not
@@ -34,6 +34,7 @@ from .dynamics import SegmentParameters
 from .errors import LoperInputError, TooFewStridesWarning
 from .identification import (
     AT_BOUND_FRACTION,
+    DEFAULT_PLAUSIBLE_RANGES,
     MIN_VAF_PCT,
     ImpedanceFit,
     identify_impedance,
@@ -86,6 +87,9 @@ class IdentificationSettings:
     """How K and D are fitted and judged (config ``identification``; bounds in N·m/rad and N·m·s/rad).
 
     ``min_vaf_pct``: a joint whose VAF (%) is below it is ``failed``;
+    ``plausible_ranges``: ``{joint: {"stiffness_nm_per_rad": [low, high],
+    "damping_nms_per_rad": [low, high]}}`` for the identifiability rule (None:
+    :data:`~loper_analysis.identification.DEFAULT_PLAUSIBLE_RANGES`);
     ``max_null_trial_ratio``: a trial whose null pairs deviate more than this
     multiple of the other trials' is left out of the null pairs (None: never).
     """
@@ -101,6 +105,7 @@ class IdentificationSettings:
     stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
     damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
     max_ci_fraction: float = 0.5
+    plausible_ranges: Mapping | None = None
     min_vaf_pct: float = MIN_VAF_PCT
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
     seed: int = 0
@@ -195,10 +200,22 @@ def _truth_columns(row: dict, truth: Mapping | None, joint: str) -> None:
         row[parameter_column("D", "true")] = truth[joint]["D"]
 
 
+def _plausible_range(plausible_ranges: Mapping | None, joint: str):
+    """((K low, K high), (D low, D high)) of ``joint`` from config-shaped ``plausible_ranges`` (None: the default)."""
+    if plausible_ranges is None:
+        return DEFAULT_PLAUSIBLE_RANGES[joint]
+    entry = plausible_ranges.get(joint)
+    if not isinstance(entry, Mapping) or not {"stiffness_nm_per_rad", "damping_nms_per_rad"} <= set(entry):
+        raise LoperInputError(f"identification.plausible_ranges: the {joint} needs stiffness_nm_per_rad and "
+                              f"damping_nms_per_rad ([low, high] each), got {entry!r}")
+    return (tuple(entry["stiffness_nm_per_rad"]), tuple(entry["damping_nms_per_rad"]))
+
+
 def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: int, truth: Mapping | None = None,
                    lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 0.5,
                    noise_model: str = "white", n_null_pairs: int = 0, note: str = "", *,
-                   min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION) -> pd.DataFrame:
+                   min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION,
+                   plausible_ranges: Mapping | None = None) -> pd.DataFrame:
     """One row per joint from an :class:`~loper_analysis.identification.ImpedanceFit` (columns :data:`IMPEDANCE_COLUMNS`).
 
     ``truth``: ``{joint: {"K": .., "D": ..}}`` of a synthetic subject (errors
@@ -206,8 +223,11 @@ def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: in
     bounds of (K, D). ``noise_model`` (``white`` | ``null_pairs``) and
     ``n_null_pairs`` say how the fit weighted its errors; ``note`` is appended
     to every row's reason. Status and reason per joint:
-    :func:`loper_analysis.identification.joint_status` with ``max_ci_fraction``,
-    ``min_vaf_pct`` and ``at_bound_fraction``.
+    :func:`loper_analysis.identification.joint_status` with the joint's
+    entry of ``plausible_ranges`` (``{joint: {"stiffness_nm_per_rad": [low,
+    high], "damping_nms_per_rad": [low, high]}}``; None:
+    :data:`~loper_analysis.identification.DEFAULT_PLAUSIBLE_RANGES`),
+    ``max_ci_fraction``, ``min_vaf_pct`` and ``at_bound_fraction``.
     """
     rows = []
     for j, joint in enumerate(JOINTS):
@@ -225,10 +245,11 @@ def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: in
         if truth is not None:
             row[parameter_column("K", "error")] = row[_K] - truth[joint]["K"]
             row[parameter_column("D", "error")] = row[_D] - truth[joint]["D"]
-        widths = np.array([fit.ci95_high[k] - fit.ci95_low[k], fit.ci95_high[d] - fit.ci95_low[d]])
-        status, reason = joint_status(joint, fit.estimate[[k, d]], widths, fit.vaf_pct[j], lower, upper,
-                                      success=fit.success, message=fit.message, max_ci_fraction=max_ci_fraction,
-                                      min_vaf_pct=min_vaf_pct, at_bound_fraction=at_bound_fraction)
+        status, reason = joint_status(joint, fit.estimate[[k, d]], fit.ci95_low[[k, d]], fit.ci95_high[[k, d]],
+                                      fit.vaf_pct[j], lower, upper, success=fit.success, message=fit.message,
+                                      plausible_range=_plausible_range(plausible_ranges, joint),
+                                      max_ci_fraction=max_ci_fraction, min_vaf_pct=min_vaf_pct,
+                                      at_bound_fraction=at_bound_fraction)
         row.update(status=status, reason=reason)
         if note:
             row["reason"] = "; ".join(r for r in (row["reason"], note) if r)
@@ -357,7 +378,8 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     rows = impedance_rows(fit, subject, onset_ms, n_kept, truth,
                           (ident.stiffness_bounds_nm_per_rad[0], ident.damping_bounds_nms_per_rad[0]),
                           (ident.stiffness_bounds_nm_per_rad[1], ident.damping_bounds_nms_per_rad[1]),
-                          ident.max_ci_fraction, used, n_null, note, min_vaf_pct=ident.min_vaf_pct)
+                          ident.max_ci_fraction, used, n_null, note, min_vaf_pct=ident.min_vaf_pct,
+                          plausible_ranges=ident.plausible_ranges)
     curves = pd.DataFrame({"time_s": fit.time_s,
                            **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
                            **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)}})
@@ -373,7 +395,13 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
     :data:`~loper_analysis.identification.AT_BOUND_FRACTION` of the bound)
     carry no estimate and are left out; None keeps every fitted row.
 
-    Columns ``joint, onset_ms, n_subjects``, then per parameter its mean, SD,
+    Rows that are ``not_identifiable`` because an interval holds 0 and the
+    whole plausible range stay in: their estimate is still the fit's best
+    value, and leaving out exactly the estimates near 0 would push the
+    across-subject mean up. ``n_not_identifiable`` counts them, so a mean
+    made mostly of uninformative fits shows as such.
+
+    Columns ``joint, onset_ms, n_subjects, n_not_identifiable``, then per parameter its mean, SD,
     min and max over subjects (``K_mean_nm_per_rad`` ...), ``vaf_pct_mean``;
     where the truth is known also the mean error, the largest absolute error
     and the fraction of subjects within tolerance (``K_fraction_within_tolerance``:
@@ -389,7 +417,8 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
         fitted = fitted[~on_bound]
     rows = []
     for (joint, onset), g in fitted.groupby(["joint", "onset_ms"], sort=False):
-        row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique()}
+        row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique(),
+               "n_not_identifiable": int((g["status"] == "not_identifiable").sum())}
         for p in ("K", "D"):
             v = g[parameter_column(p)]
             row.update({parameter_column(p, "mean"): v.mean(), parameter_column(p, "sd"): v.std(ddof=1),
@@ -405,7 +434,7 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=
                             f"{p}_fraction_within_tolerance": float((err.abs() <= tol).mean())})
         rows.append(row)
     order = {j: i for i, j in enumerate(JOINTS)}
-    out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects"])
+    out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects", "n_not_identifiable"])
     if len(out):
         out = out.sort_values(["joint", "onset_ms"], key=lambda c: c.map(order) if c.name == "joint" else c,
                               kind="stable", ignore_index=True)

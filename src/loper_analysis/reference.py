@@ -13,6 +13,8 @@ __all__ = [
     "STUDY_DEVICE",
     "STUDY_VALIDATION_NO_NOISE",
     "STUDY_VALIDATION_NOISE",
+    "STUDY_SWING_IMPEDANCE",
+    "ANKLE_SWING_IMPEDANCE",
     "LITERATURE",
 ]
 
@@ -67,6 +69,19 @@ STUDY_VALIDATION_NOISE: dict[str, tuple[float, float, float]] = {
     "D_ankle": (-4.0, 10.0, 1.5),
 }
 
+#: The study's swing-phase result: joint -> parameter -> (lowest, highest) across-subject mean over the three
+#: onsets; K in N·m/rad, D in N·m·s/rad. The study reports no ankle values it trusted.
+STUDY_SWING_IMPEDANCE: dict[str, dict[str, tuple[float, float]]] = {
+    "hip": {"K": (34.0, 66.0), "D": (1.9, 4.6)},
+    "knee": {"K": (0.0, 3.5), "D": (0.02, 0.14)},
+}
+
+#: Not a study value: the range of ankle K (N·m/rad) and D (N·m·s/rad) in swing this pipeline treats as
+#: plausible, for the identifiability rule (``docs/identification.md``, "Fit status"): from no stiffness or
+#: damping up to about 2.5 times the default synthetic ankle (8 N·m/rad, 0.3 N·m·s/rad), a little above the
+#: study's knee damping and a third of its lowest hip stiffness.
+ANKLE_SWING_IMPEDANCE: dict[str, tuple[float, float]] = {"K": (0.0, 20.0), "D": (0.0, 0.75)}
+
 #: Joint impedance in the literature (relaxed conditions) and the study's own swing-phase result:
 #: (source, joint, (K low, K high) N·m/rad, (D low, D high) N·m·s/rad); None where not reported.
 LITERATURE: tuple[tuple[str, str, tuple[float, float], tuple[float | None, float | None]], ...] = (
@@ -75,6 +90,6 @@ LITERATURE: tuple[tuple[str, str, tuple[float, float], tuple[float | None, float
     ("position perturbation, static", "hip", (75.0, 318.0), (2.0, 21.0)),
     ("position perturbation, static", "knee", (36.0, 75.0), (1.8, 2.2)),
     ("position perturbation, imposed motion", "knee", (25.0, 30.0), (None, None)),
-    ("the study: swing phase, across-subject mean over onsets", "hip", (34.0, 66.0), (1.9, 4.6)),
-    ("the study: swing phase, across-subject mean over onsets", "knee", (0.0, 3.5), (0.02, 0.14)),
+    *(("the study: swing phase, across-subject mean over onsets", joint, STUDY_SWING_IMPEDANCE[joint]["K"],
+        STUDY_SWING_IMPEDANCE[joint]["D"]) for joint in ("hip", "knee")),
 )

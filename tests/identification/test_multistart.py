@@ -46,9 +46,10 @@ def test_starts_at_best_counts_within_a_tenth_of_a_percent_of_the_lowest_start_c
     assert starts_at_best(costs) == 3
     assert starts_at_best([2.0]) == 1
     assert starts_at_best([0.0, 0.0, 1e-20]) == 2  # an exact fit is reached only by the starts at exactly zero
+    assert starts_at_best([np.inf, 2.0, 2.001]) == 2  # a start whose simulation diverged never counts
 
 
-@pytest.mark.parametrize("bad", [[], [1.0, np.nan], [-1.0], [[1.0]]])
+@pytest.mark.parametrize("bad", [[], [1.0, np.nan], [-1.0], [[1.0]], [np.inf, np.inf]])
 def test_starts_at_best_refuses_what_is_not_a_list_of_costs(bad):
     with pytest.raises(LoperInputError, match="start costs"):
         starts_at_best(bad)

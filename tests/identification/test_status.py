@@ -6,14 +6,17 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import AT_BOUND_FRACTION, MIN_VAF_PCT, joint_status
+from loper_analysis.identification import AT_BOUND_FRACTION, DEFAULT_PLAUSIBLE_RANGES, MIN_VAF_PCT, joint_status
 
 LOWER, UPPER = (0.0, 0.0), (200.0, 10.0)
 NARROW = (1.0, 0.1)
 
 
-def status(estimate, vaf=99.0, widths=NARROW, lower=LOWER, upper=UPPER, **kw):
-    return joint_status("knee", estimate, widths, vaf, lower, upper, **kw)
+def status(estimate, vaf=99.0, widths=NARROW, lower=LOWER, upper=UPPER, joint="knee", **kw):
+    """The status of an interval of ``widths`` centred on ``estimate``, cut at the bounds."""
+    est, half = np.asarray(estimate, float), np.asarray(widths, float) / 2
+    low, high = np.clip(est - half, lower, upper), np.clip(est + half, lower, upper)
+    return joint_status(joint, estimate, low, high, vaf, lower, upper, **kw)
 
 
 def test_defaults():
@@ -37,9 +40,9 @@ def test_the_upper_bound_within_the_tolerance_is_not_identifiable():
 
 
 def test_a_lower_bound_of_zero_is_a_valid_estimate():
-    """The default study's S03 knee at 175 ms: K 2.5e-15 N·m/rad stays ok with an empty reason."""
-    assert status((2.49492168e-15, 0.126), widths=(2.66, 0.26)) == ("ok", "")
-    assert status((3.0, 0.0)) == ("ok", "")
+    """K 2.5e-15 N·m/rad (a knee early in swing) with an interval 0 ... 1.33 below the study's 3.5 stays ok."""
+    assert status((2.49492168e-15, 0.126), widths=(2.66, 0.1)) == ("ok", "")
+    assert status((3.0, 0.0), widths=(1.0, 0.2)) == ("ok", "")
 
 
 def test_a_positive_lower_bound_is_not_identifiable():
@@ -63,7 +66,7 @@ def test_an_undefined_vaf_fails():
 
 def test_findings_add_up_and_the_most_severe_wins():
     """The campaign's case: K on the bound, VAF -118 %, wide interval -> failed, all three named."""
-    s, reason = status((200.0, 8.8), vaf=-118.0, widths=(150.0, 0.5))
+    s, reason = joint_status("knee", (200.0, 8.8), (50.0, 8.55), (200.0, 9.05), -118.0, LOWER, UPPER)
     assert s == "failed"
     parts = reason.split("; ")
     assert [p.split(" ")[0] for p in parts] == ["VAF", "K_knee", "95"]
@@ -77,4 +80,41 @@ def test_not_converged_keeps_its_reason():
 
 def test_bad_shapes_are_refused():
     with pytest.raises(LoperInputError, match="knee: estimate must hold K and D"):
-        joint_status("knee", (1.0, 2.0, 3.0), NARROW, 99.0, LOWER, UPPER)
+        joint_status("knee", (1.0, 2.0, 3.0), (0.5, 0.05), (1.5, 0.15), 99.0, LOWER, UPPER)
+
+
+def test_an_interval_holding_zero_and_the_study_range_is_not_identifiable():
+    """Knee D 0.055, 95 % CI -0.22 ... 0.33 (cut to 0 ... 0.33) holds 0 and the study's 0.02-0.14: no information."""
+    s, reason = joint_status("knee", (2.0, 0.055), (1.0, 0.0), (3.0, 0.33), 99.0, LOWER, UPPER)
+    assert s == "not_identifiable"
+    assert reason == ("D_knee = 0.055 N·m·s/rad, 95 % CI 0 … 0.33 N·m·s/rad: holds both 0 and the plausible range "
+                      "0.02–0.14 N·m·s/rad (identification.plausible_ranges), the data cannot tell the damping from 0")
+
+
+def test_an_interval_clear_of_zero_is_ok():
+    """Hip D 2.0 ... 4.0 around 3.0 and hip K 40 ... 60: both informative."""
+    assert joint_status("hip", (50.0, 3.0), (40.0, 2.0), (60.0, 4.0), 99.0, LOWER, UPPER) == ("ok", "")
+
+
+@pytest.mark.parametrize("low, high, expected", [
+    (0.0, 0.139, "ok"),               # holds 0 but excludes the top of the study's range: says D < 0.14
+    (0.0, 0.14, "not_identifiable"),  # reaches it exactly
+    (9e-6, 0.5, "not_identifiable"),   # within 1e-6 of the bound range (1e-5 N·m·s/rad) of 0
+    (2e-5, 0.5, "ok"),                # clear of 0: the damping is told from none
+])
+def test_the_edges_of_the_information_rule(low, high, expected):
+    assert joint_status("knee", (2.0, 0.05), (1.0, low), (3.0, high), 99.0, LOWER, UPPER)[0] == expected
+
+
+def test_the_plausible_range_can_be_given():
+    """Hip K 0 ... 70: holds 0 and the study's 34-66; with a range up to 100 it would not reach the top."""
+    assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip")[0] == "not_identifiable"
+    assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip", plausible_range=((34.0, 100.0), (1.9, 4.6))) == (
+        "ok", "")
+    with pytest.raises(LoperInputError, match="plausible_ranges of the hip: K and D each need"):
+        status((30.0, 3.0), joint="hip", plausible_range=((66.0, 34.0), (1.9, 4.6)))
+
+
+def test_the_default_ranges_are_the_study_s():
+    assert DEFAULT_PLAUSIBLE_RANGES == {"hip": ((34.0, 66.0), (1.9, 4.6)), "knee": ((0.0, 3.5), (0.02, 0.14)),
+                                        "ankle": ((0.0, 20.0), (0.0, 0.75))}

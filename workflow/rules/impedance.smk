@@ -75,6 +75,7 @@ rule impedance_fit:
             stiffness_bounds_nm_per_rad=IDENT["stiffness_bounds_nm_per_rad"],
             damping_bounds_nms_per_rad=IDENT["damping_bounds_nms_per_rad"],
             max_ci_fraction=IDENT["max_ci_fraction"],
+            plausible_ranges=IDENT["plausible_ranges"],
             min_vaf_pct=IDENT["min_vaf_pct"],
             max_null_trial_ratio=IDENT["max_null_trial_ratio"],
             seed=config["seed"],

@@ -20,7 +20,8 @@
 
 Beyond the study, :mod:`.null_pairs` weights the prediction error by the
 stride-to-stride deviation that null pairs show, and :mod:`.status` judges
-each joint's fit (convergence, VAF floor, bounds, interval widths).
+each joint's fit (convergence, VAF floor, bounds, the information in the
+intervals), whose ends :mod:`.intervals` forms.
 """
 
 from .fit import (
@@ -35,11 +36,13 @@ from .fit import (
 )
 from .null_pairs import (
     NullPairFit,
+    cross_validated_covariance,
     nuisance_projection,
     null_pair_errors,
     refit_with_null_pairs,
 )
-from .status import AT_BOUND_FRACTION, MIN_VAF_PCT, joint_status
+from .intervals import CI_LEVEL, bounded_interval, t_quantile
+from .status import AT_BOUND_FRACTION, DEFAULT_PLAUSIBLE_RANGES, MIN_VAF_PCT, check_plausible_range, joint_status
 from .window import (
     PreparedWindow,
     per_step,
@@ -74,7 +77,13 @@ __all__ = [
     "null_pair_errors",
     "nuisance_projection",
     "refit_with_null_pairs",
+    "cross_validated_covariance",
     "MIN_VAF_PCT",
     "AT_BOUND_FRACTION",
     "joint_status",
+    "DEFAULT_PLAUSIBLE_RANGES",
+    "check_plausible_range",
+    "CI_LEVEL",
+    "t_quantile",
+    "bounded_interval",
 ]

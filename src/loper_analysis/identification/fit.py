@@ -29,10 +29,10 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.stats import t as student_t
 
 from ..constants import PARAMETERS
 from ..errors import LoperInputError
+from .intervals import bounded_interval, sandwich_covariance
 from .window import PreparedWindow, prediction_error, simulate_response
 
 __all__ = [
@@ -249,6 +249,8 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
                     step[free] = np.linalg.solve(Af + mu[i] * np.diag(d), -g[free])
                 except np.linalg.LinAlgError:
                     step[free] = -g[free] / d
+            if not np.all(np.isfinite(step)):  # a start whose simulation overflowed: no step, its damping grows
+                step = np.zeros(6)
             trial[k] = np.clip(points[i] + step, lb, ub)
         rt, Jt = batch.residuals_and_jacobians(trial)
         ct = np.sum(rt**2, axis=1)
@@ -282,10 +284,12 @@ def starts_at_best(start_costs, relative: float = AT_BEST_RELATIVE) -> int:
     """How many starts ended within ``relative`` above the lowest start cost (at least 1).
 
     A cost of exactly zero (noise-free data fitted to rounding) counts as reached by every start at zero.
+    A cost of +inf (a start whose simulation diverged) never counts; at least one cost must be finite.
     """
     costs = np.asarray(start_costs, dtype=float)
-    if costs.ndim != 1 or costs.size == 0 or not np.all(np.isfinite(costs)) or np.any(costs < 0):
-        raise LoperInputError(f"start costs must be a non-empty finite array >= 0, got {costs}")
+    if costs.ndim != 1 or costs.size == 0 or np.any(np.isnan(costs)) or np.any(costs < 0) \
+            or not np.any(np.isfinite(costs)):
+        raise LoperInputError(f"start costs must be a non-empty array >= 0 (+inf allowed, not all), got {costs}")
     best = costs.min()
     return int(np.sum(costs <= best * (1.0 + relative)))
 
@@ -301,6 +305,7 @@ def identify_impedance(
     tolerance: float = 1e-6,
     merge_tolerance: float = 1e-2,
     extra_starts=None,
+    ci_dof: int | None = None,
 ) -> ImpedanceFit:
     """Fit K, D per joint to one prepared window (method: ``docs/identification.md``).
 
@@ -318,6 +323,9 @@ def identify_impedance(
         ends with the cost of the start it joined.
     extra_starts : (k, 6) starts tried before the random ones (e.g. a
         previous estimate), clipped to the bounds.
+    ci_dof : degrees of freedom of the intervals' t quantile; None: the
+        residuals' ``m - 6`` (white fit). A fit whose ``noise_cov`` comes from
+        ``N`` null pairs passes ``N - 1`` (:mod:`.intervals`).
 
     Returns
     -------
@@ -328,6 +336,8 @@ def identify_impedance(
     lb, ub = check_bounds(lower, upper)
     if int(n_starts) != n_starts or n_starts < 1:
         raise LoperInputError(f"n_starts must be an integer >= 1, got {n_starts}")
+    if ci_dof is not None and (int(ci_dof) != ci_dof or ci_dof < 1):
+        raise LoperInputError(f"ci_dof must be an integer >= 1, got {ci_dof}")
     rng = np.random.default_rng(seed)
     starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
     if extra_starts is not None:
@@ -339,6 +349,9 @@ def identify_impedance(
     if not 0 <= merge_tolerance < 1:
         raise LoperInputError(f"merge_tolerance must lie in [0, 1), got {merge_tolerance}")
     points, costs, converged, _ = multistart_lm(batch, starts, max_iterations, tolerance, merge_tolerance)
+    costs = np.where(np.isfinite(costs), costs, np.inf)  # a start whose simulation diverged (e.g. a stiff ankle)
+    if not np.any(np.isfinite(costs)):
+        raise LoperInputError("identify_impedance: the simulation diverged from every start")
     best = int(np.argmin(costs))
 
     def fun(p):
@@ -376,22 +389,22 @@ def identify_impedance(
             JG = J.T @ initial_state_jacobian(window, estimate)
             cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
         else:
-            M = A @ J.T if batch.weight is None else A @ J.T @ batch.weight
-            cov = M @ np.asarray(window.noise_cov, dtype=float) @ M.T
+            cov = sandwich_covariance(J, window.noise_cov, batch.weight)
         sd = np.sqrt(np.clip(np.diag(cov), 0, None))
         corr = cov / np.outer(sd, sd)
     rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
     if rank < 6:
         sd = np.where(np.diag(JTJ) > 0, sd, np.inf)
-    half = student_t.ppf(0.975, dof) * sd
+    sd = np.where(np.isnan(sd), np.inf, sd)
+    ci_low, ci_high = bounded_interval(estimate, sd, dof if ci_dof is None else int(ci_dof), lb, ub)
     model = window.measured - pe
     vaf = variance_accounted_for(window.measured, model)
     return ImpedanceFit(
         estimate=estimate,
         cost=float(np.sum(r**2)),
         sum_sq_error_rad2=float(np.sum(pe**2)),
-        ci95_low=estimate - half,
-        ci95_high=estimate + half,
+        ci95_low=ci_low,
+        ci95_high=ci_high,
         correlation=corr,
         vaf_pct=vaf,
         success=success,

@@ -22,10 +22,12 @@ import numpy as np
 
 from ..dynamics import joint_angles
 from ..errors import LoperInputError
-from .fit import ImpedanceFit, identify_impedance, initial_state_jacobian
+from .fit import DEFAULT_LOWER, DEFAULT_UPPER, ImpedanceFit, identify_impedance, initial_state_jacobian, response_jacobian
+from .intervals import bounded_interval
 from .window import PreparedWindow, initial_state_basis
 
-__all__ = ["NullPairFit", "null_pair_errors", "nuisance_projection", "refit_with_null_pairs"]
+__all__ = ["NullPairFit", "null_pair_errors", "nuisance_projection", "cross_validated_covariance",
+           "refit_with_null_pairs"]
 
 
 @dataclass
@@ -104,8 +106,38 @@ def nuisance_projection(errors, n_components: int) -> np.ndarray:
     return np.eye(E.shape[1]) - vt[:r].T @ vt[:r]
 
 
+def cross_validated_covariance(errors, n_components: int, jacobian, n_averaged: int) -> np.ndarray:
+    """Covariance (p, p) of the projected fit's estimate, each null pair judged by a projection made without it.
+
+    The projection removes the null pairs' largest shapes, found from the
+    same null pairs; their sample covariance then understates the deviation
+    left in the remaining directions (those shapes were chosen because the
+    sample varies most along them). Here each null pair ``i`` plays the
+    perturbed pair's error once: the projection ``W_-i`` and the mean come
+    from the other pairs, its effect on the estimate is
+    ``d_i = (J^T W_-i J)^+ J^T W_-i (e_i - mean_-i)``, and the covariance is
+    ``(N - 1) / N * mean(d_i d_i^T) / n_averaged`` (the factor removes the
+    variance of ``mean_-i``). ``errors`` (N, m) from :func:`null_pair_errors`;
+    ``jacobian`` (m, p): sensitivity of the unweighted model response to the
+    parameters at the estimate.
+    """
+    E = np.asarray(errors, dtype=float)
+    J = np.asarray(jacobian, dtype=float)
+    n = E.shape[0]
+    if E.ndim != 2 or J.ndim != 2 or J.shape[0] != E.shape[1] or n < int(n_components) + 3 or int(n_averaged) < 1:
+        raise LoperInputError(f"cross-validated covariance: errors (N, m) with N >= n_components + 3, jacobian (m, p) "
+                              f"and n_averaged >= 1 expected, got {E.shape}, {J.shape}, {n_components}, {n_averaged}")
+    deltas = np.empty((n, J.shape[1]))
+    for i in range(n):
+        rest = np.delete(E, i, axis=0)
+        JW = nuisance_projection(rest, n_components) @ J
+        deltas[i] = np.linalg.pinv(JW.T @ JW, rcond=1e-13) @ JW.T @ (E[i] - rest.mean(axis=0))
+    return (n - 1) / n * (deltas.T @ deltas) / n / int(n_averaged)
+
+
 def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pairs: dict, n_averaged: int,
-                          n_components: int = 6, min_null_pairs: int = 30, **fit_options) -> NullPairFit:
+                          n_components: int = 6, min_null_pairs: int = 30, cross_validated: bool = False,
+                          **fit_options) -> NullPairFit:
     """Fit again with the null pairs' dominant shapes projected out and CIs from their covariance.
 
     ``first`` is the white-noise fit of ``window``; ``null_pairs`` as for
@@ -113,8 +145,12 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     perturbed strides averaged in ``window`` (the null pairs' covariance is
     divided by it). The refit starts from the first estimate and the random
     starts of ``fit_options`` (keyword arguments of :func:`identify_impedance`).
-    With fewer than ``max(min_null_pairs, n_components + 2)`` null pairs the
-    first fit stands and ``note`` says so.
+    The intervals' t quantile has ``N - 1`` degrees of freedom, those of the
+    sample covariance of the ``N`` null pairs (:mod:`.intervals`).
+    ``cross_validated``: the intervals from :func:`cross_validated_covariance`
+    instead of the sandwich of the null pairs' covariance. With fewer
+    than ``max(min_null_pairs, n_components + 2)`` null pairs the first fit
+    stands and ``note`` says so.
     """
     n_null = int(null_pairs["n_pairs"])
     if n_null < max(int(min_null_pairs), int(n_components) + 2):
@@ -127,5 +163,15 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     weight = nuisance_projection(errors, n_components)
     cov = np.cov(errors, rowvar=False) / n_averaged
     fit = identify_impedance(replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate,
-                             **fit_options)
+                             ci_dof=n_null - 1, **fit_options)
+    if cross_validated:
+        G = response_jacobian(window, fit.estimate, fit_options.get("lower", DEFAULT_LOWER),
+                              fit_options.get("upper", DEFAULT_UPPER))
+        cv = cross_validated_covariance(errors, n_components, G, n_averaged)
+        sd = np.sqrt(np.clip(np.diag(cv), 0, None))
+        sd = np.where(np.diag(G.T @ G) > 0, sd, np.inf)
+        low, high = bounded_interval(fit.estimate, sd, n_null - 1, fit_options.get("lower", DEFAULT_LOWER),
+                                     fit_options.get("upper", DEFAULT_UPPER))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            fit = replace(fit, ci95_low=low, ci95_high=high, correlation=cv / np.outer(sd, sd))
     return NullPairFit(fit, "null_pairs", n_null)

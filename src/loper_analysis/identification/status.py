@@ -1,4 +1,4 @@
-"""The status of one joint's fitted row: convergence, goodness of fit, bounds, interval widths.
+"""The status of one joint's fitted row: convergence, goodness of fit, bounds, information in the intervals.
 
 Rules (``docs/identification.md``, section "Fit status"), judged in this order:
 
@@ -8,14 +8,21 @@ Rules (``docs/identification.md``, section "Fit status"), judged in this order:
 3. K or D lies on its upper bound, or on a lower bound above zero (within
    ``at_bound_fraction`` of the bound range): ``not_identifiable`` - the
    data ask for a value the bounds exclude, and the estimate is the bound;
-4. the 95 % interval of K or D spans more than ``max_ci_fraction`` of the
+4. the 95 % interval of K or D reaches its lower bound (0: the data cannot
+   tell the estimate from no stiffness or damping at all) *and* its upper
+   end reaches the upper end of the joint's plausible range
+   (``plausible_range``; by default the study's range of across-subject
+   means, :data:`DEFAULT_PLAUSIBLE_RANGES`): the interval holds "none" and
+   every plausible size alike, so the data say nothing about the size:
+   ``not_identifiable``;
+5. the 95 % interval of K or D spans more than ``max_ci_fraction`` of the
    bound range, or is infinite: ``not_identifiable``.
 
-Every finding of 2-4 is named in the reason (parameter or key, value and
+Every finding of 2-5 is named in the reason (parameter or key, value and
 limit); the status is the most severe. An estimate on a lower bound of zero
 is a valid estimate (no measurable stiffness or damping, e.g. the knee's K
-early in swing): the row stays ``ok`` with nothing added to its reason; the
-0 in the estimate column and an interval reaching below zero show it.
+early in swing): by itself it adds nothing to the reason; rule 4 judges
+whether its interval says anything.
 """
 
 from __future__ import annotations
@@ -23,34 +30,55 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import LoperInputError
+from ..reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANCE
 
-__all__ = ["MIN_VAF_PCT", "AT_BOUND_FRACTION", "joint_status"]
+__all__ = ["MIN_VAF_PCT", "AT_BOUND_FRACTION", "DEFAULT_PLAUSIBLE_RANGES", "check_plausible_range", "joint_status"]
 
 #: VAF (%) below which a joint's fit is ``failed``: below 0 the model explains less than no response at all.
 MIN_VAF_PCT: float = 0.0
 #: An estimate within this fraction of its bound range of a bound lies on the bound.
 AT_BOUND_FRACTION: float = 1e-6
 
+#: Plausible range per joint, ((K low, K high) N·m/rad, (D low, D high) N·m·s/rad): the study's across-subject
+#: means for hip and knee, a stated choice for the ankle (:data:`loper_analysis.reference.ANKLE_SWING_IMPEDANCE`).
+DEFAULT_PLAUSIBLE_RANGES: dict[str, tuple[tuple[float, float], tuple[float, float]]] = {
+    **{j: (r["K"], r["D"]) for j, r in STUDY_SWING_IMPEDANCE.items()},
+    "ankle": (ANKLE_SWING_IMPEDANCE["K"], ANKLE_SWING_IMPEDANCE["D"]),
+}
+
 _PARAMETERS = (("K", "N·m/rad", "identification.stiffness_bounds_nm_per_rad", "stiffness"),
                ("D", "N·m·s/rad", "identification.damping_bounds_nms_per_rad", "damping"))
 
 
-def joint_status(joint: str, estimate, ci_width, vaf_pct: float, lower, upper, *, success: bool = True,
-                 message: str = "", max_ci_fraction: float = 0.5, min_vaf_pct: float = MIN_VAF_PCT,
-                 at_bound_fraction: float = AT_BOUND_FRACTION) -> tuple[str, str]:
+def check_plausible_range(joint: str, plausible_range) -> np.ndarray:
+    """The plausible range of a joint as a (2, 2) array ``[[K low, K high], [D low, D high]]``, each ``0 <= low < high``."""
+    r = np.asarray(plausible_range, dtype=float)
+    if r.shape != (2, 2) or not np.all(np.isfinite(r)) or np.any(r[:, 0] < 0) or np.any(r[:, 0] >= r[:, 1]):
+        raise LoperInputError(f"identification.plausible_ranges of the {joint}: K and D each need [low, high] with "
+                              f"0 <= low < high, got {np.asarray(plausible_range).tolist()}")
+    return r
+
+
+def joint_status(joint: str, estimate, ci_low, ci_high, vaf_pct: float, lower, upper, *, success: bool = True,
+                 message: str = "", plausible_range=None, max_ci_fraction: float = 0.5,
+                 min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION) -> tuple[str, str]:
     """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
 
     Parameters
     ----------
     joint : str
         Joint name, quoted in the reason (``K_knee``).
-    estimate, ci_width : (2,) array_like
-        K (N·m/rad) and D (N·m·s/rad), and the widths of their 95 % intervals.
+    estimate, ci_low, ci_high : (2,) array_like
+        K (N·m/rad) and D (N·m·s/rad), and the ends of their 95 % intervals.
     vaf_pct : float
         The joint's VAF (%); NaN when the measured response is zero.
     lower, upper : (2,) array_like
         Bounds of K and D.
     success, message : the optimiser's convergence flag and message.
+    plausible_range : (2, 2) array_like, optional
+        ``[[K low, K high], [D low, D high]]`` (rule 4); None: the joint's
+        entry of :data:`DEFAULT_PLAUSIBLE_RANGES` (none for another joint name:
+        rule 4 is skipped).
     max_ci_fraction, min_vaf_pct, at_bound_fraction : the thresholds (see the module docstring).
 
     Returns
@@ -59,13 +87,17 @@ def joint_status(joint: str, estimate, ci_width, vaf_pct: float, lower, upper, *
         The status and the reason ("" for a plain ``ok``).
     """
     est = np.asarray(estimate, dtype=float)
-    widths = np.asarray(ci_width, dtype=float)
+    low, high = np.asarray(ci_low, dtype=float), np.asarray(ci_high, dtype=float)
     lb, ub = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
-    for name, a in (("estimate", est), ("ci_width", widths), ("lower", lb), ("upper", ub)):
+    for name, a in (("estimate", est), ("ci_low", low), ("ci_high", high), ("lower", lb), ("upper", ub)):
         if a.shape != (2,):
             raise LoperInputError(f"{joint}: {name} must hold K and D (2 values), got shape {a.shape}")
     if not (0 <= at_bound_fraction < 0.5):
         raise LoperInputError(f"at_bound_fraction must lie in [0, 0.5), got {at_bound_fraction}")
+    if plausible_range is None:
+        plausible_range = DEFAULT_PLAUSIBLE_RANGES.get(joint)
+    plausible = None if plausible_range is None else check_plausible_range(joint, plausible_range)
+    widths = high - low
     if not success:
         return "failed", f"optimiser did not converge: {message}"
     failed, unidentifiable = [], []
@@ -84,6 +116,15 @@ def joint_status(joint: str, estimate, ci_width, vaf_pct: float, lower, upper, *
         elif est[i] <= lb[i] + tol and lb[i] != 0:
             unidentifiable.append(f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
                                   f"less {what} than the bounds allow")
+    for i, (p, unit, _, what) in enumerate(_PARAMETERS):
+        if plausible is None or np.isnan(low[i]) or np.isnan(high[i]):
+            continue
+        r_low, r_high = plausible[i]
+        if low[i] <= lb[i] + at_bound_fraction * span[i] and high[i] >= r_high:
+            unidentifiable.append(
+                f"{p}_{joint} = {est[i]:.3g} {unit}, 95 % CI {low[i]:.3g} … {high[i]:.3g} {unit}: holds both "
+                f"{lb[i]:g} and the plausible range {r_low:g}–{r_high:g} {unit} (identification.plausible_ranges), "
+                f"the data cannot tell the {what} from {lb[i]:g}")
     if not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
         unidentifiable.append(f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "
                               f"{max_ci_fraction:g} of the bounds")
