@@ -224,7 +224,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
             column = f"{a}_m" if a == "pelvis_x" else f"{a}_rad"
             d = ik[column].to_numpy(float) - entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
             diffs[a].append(d[np.isfinite(d)] - np.nanmean(d))
-    return pd.Series({a: float(np.std(np.concatenate(v))) for a, v in diffs.items()}, name="ik_noise_scale")
+    return pd.Series({a: float(np.std(np.concatenate(v))) for a, v in diffs.items()}, name="ik_noise_sd_m_or_rad")
 
 
 def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFrame:
