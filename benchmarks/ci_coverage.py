@@ -100,7 +100,7 @@ def _settings(config: dict):
     response = ResponseSettings(window_before_s=ident["window_before_s"], window_after_s=ident["window_after_s"],
                                 initial_state_span_s=ident["initial_state_span_s"], whisker=strides["iqr_whisker"],
                                 max_fraction=strides["max_outlier_fraction"], min_strides=strides["min_valid_strides"])
-    keys = ("noise_model", "null_pair_components", "min_null_pairs", "initial_state_degree", "n_starts", "n_substeps",
+    keys = ("noise_model", "interval_scatter", "null_pair_components", "min_null_pairs", "initial_state_degree", "n_starts", "n_substeps",
             "tolerance", "merge_tolerance", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad",
             "max_ci_fraction", "plausible_ranges", "min_vaf_pct", "max_null_trial_ratio")
     return response, IdentificationSettings(**{k: ident[k] for k in keys if k in ident}, seed=config["seed"])
@@ -111,7 +111,7 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     one simulated trial, as the fit reads them."""
     from loper_analysis.filtering import lowpass
     from loper_analysis.kinematics import marker_positions
-    from loper_analysis.loadcell import robot_log_on_mocap_frames
+    from loper_analysis.loadcell import robot_log_frames_and_native
     from loper_analysis.model import BRACE_MARKERS
     from loper_analysis.strides import stride_tables
     from loper_analysis.synthetic.sync import pulse_train_at
@@ -132,8 +132,8 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     t_analog = np.arange(int(round(walk.duration_s * lab.analog_rate_hz))) / lab.analog_rate_hz
     sync = pulse_train_at((t_analog + lab.clock_offset_s) / scale, walk.sync_starts_s)
-    force = robot_log_on_mocap_frames(walk.robot, lab.robot_rate_hz, sync, lab.analog_rate_hz, t,
-                                      cutoff_hz=cutoff, order=order)
+    force, native = robot_log_frames_and_native(walk.robot, lab.robot_rate_hz, sync, lab.analog_rate_hz, t,
+                                                cutoff_hz=cutoff, order=order)
     s = config["strides"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -141,7 +141,8 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
                                 s["max_outlier_fraction"], s["min_valid_strides"]).strides
     values = {c: coords[c].to_numpy(float) for c in coords.columns if c != "time_s"}
     markers = marker_positions(model, values, list(BRACE_MARKERS))
-    return {"angles": angles, "strides": strides, "force": force, "markers": (t, markers, list(BRACE_MARKERS))}
+    return {"angles": angles, "strides": strides, "force": force, "force_native": native,
+            "markers": (t, markers, list(BRACE_MARKERS))}
 
 
 def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.DataFrame:
@@ -152,6 +153,7 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
     from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial
+    from loper_analysis.synthetic.variability import lab_variability
 
     syn, trials, seed = config["synthetic"], config["trials"], int(config["seed"])
     row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
@@ -163,6 +165,7 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     model = build_lower_body_model(row["height_m"], row["mass_kg"])
     params = segment_parameters_from_model(model)
     onsets = [int(o) for o in trials["perturbation_onsets_ms"]]
+    variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
     names = [(trials["device"], None)] + [(f"pert{o:03d}-{k}", o) for o in onsets
                                           for k in range(1, int(trials["perturbation_repeats"]) + 1)]
     inputs = {}
@@ -176,7 +179,9 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
         sim_seed, file_seed = np.random.SeedSequence([seed, zlib.crc32(subject.encode()),
                                                       zlib.crc32(trial.encode())]).spawn(2)
         walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
-                                      syn["timing_cv"], syn["amplitude_cv"], device, perturbation)
+                                      syn["timing_cv"], syn["amplitude_cv"], device, perturbation,
+                                      variability=variability, adaptation=adaptation,
+                                      minimal_impedance=minimal_impedance)
         inputs[trial] = {"name": trial, **_trial_inputs(walk, model, lab, config, noise_scale,
                                                         np.random.default_rng(file_seed))}
     response, ident = _settings(config)
@@ -203,8 +208,9 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.io.readers import read_tsv
     from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
-    from loper_analysis.synthetic.subjects import subject_anthropometry
+    from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
     from loper_analysis.synthetic.trials import LabSettings, simulate_walking_trial
+    from loper_analysis.synthetic.variability import lab_variability
 
     syn, seed = config["synthetic"], int(config["seed"])
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
@@ -215,8 +221,14 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
         row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
         params = segment_parameters_from_model(build_lower_body_model(row["height_m"], row["mass_kg"]))
         sim_seed, _ = np.random.SeedSequence([seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]).spawn(2)
+        truth = true_impedance(subject, seed, syn["stiffness_nm_per_rad"], syn["damping_nms_per_rad"],
+                               syn["between_subject_cv"], config["identification"]["stiffness_bounds_nm_per_rad"],
+                               config["identification"]["damping_bounds_nms_per_rad"])
+        variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
         walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
-                                      syn["timing_cv"], syn["amplitude_cv"], DeviceParameters(**config["device"]["parameters"]))
+                                      syn["timing_cv"], syn["amplitude_cv"], DeviceParameters(**config["device"]["parameters"]),
+                                      variability=variability, adaptation=adaptation,
+                                      minimal_impedance=minimal_impedance)
         coords = walk.mocap_coordinates(lab.marker_rate_hz)
         ik = read_tsv(work / f"results/ik/{subject}/{trial}.angles.tsv", "angle table")
         for a in _ANGLES:
@@ -252,9 +264,13 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
     ap.add_argument("--keep", type=Path, help="chain: keep the project here; coordinates: write the rows here (TSV)")
+    ap.add_argument("--interval-scatter", choices=("perturbed_pairs", "null_pairs"),
+                    help="identification.interval_scatter (coordinates mode; default: the config's)")
     args = ap.parse_args()
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     config["seed"] = args.seed
+    if args.interval_scatter:
+        config["identification"]["interval_scatter"] = args.interval_scatter
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     t0 = time.perf_counter()
     if args.mode == "coordinates":

@@ -91,10 +91,14 @@ class IdentificationSettings:
     "damping_nms_per_rad": [low, high]}}`` for the identifiability rule (None:
     :data:`~loper_analysis.identification.DEFAULT_PLAUSIBLE_RANGES`);
     ``max_null_trial_ratio``: a trial whose null pairs deviate more than this
-    multiple of the other trials' is left out of the null pairs (None: never).
+    multiple of the other trials' is left out of the null pairs (None: never);
+    ``interval_scatter``: with the ``null_pairs`` noise model, whose scatter
+    gives the 95 % intervals: ``perturbed_pairs`` (the averaged pairs
+    themselves) or ``null_pairs`` (:func:`loper_analysis.identification.refit_with_null_pairs`).
     """
 
     noise_model: str = "null_pairs"
+    interval_scatter: str = "perturbed_pairs"
     null_pair_components: int = 6
     min_null_pairs: int = 30
     initial_state_degree: int = 1
@@ -115,6 +119,9 @@ class IdentificationSettings:
             raise LoperInputError(
                 f"identification.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}"
             )
+        if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
+            raise LoperInputError("identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
+                                  f"got {self.interval_scatter!r}")
 
     @property
     def lower(self) -> np.ndarray:
@@ -371,8 +378,9 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
         loaded = {i["name"]: i for i in inputs}
         pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
         null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
+        pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
         refit = refit_with_null_pairs(window, fit, null, n_kept, ident.null_pair_components, ident.min_null_pairs,
-                                      **ident.fit_options())
+                                      perturbed_pairs=pairs, **ident.fit_options())
         fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
         note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
     rows = impedance_rows(fit, subject, onset_ms, n_kept, truth,

@@ -65,6 +65,7 @@ rule impedance_fit:
         ),
         identification=dict(
             noise_model=IDENT["noise_model"],
+            interval_scatter=IDENT["interval_scatter"],
             null_pair_components=IDENT["null_pair_components"],
             min_null_pairs=IDENT["min_null_pairs"],
             initial_state_degree=IDENT["initial_state_degree"],

@@ -137,7 +137,7 @@ def cross_validated_covariance(errors, n_components: int, jacobian, n_averaged: 
 
 def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pairs: dict, n_averaged: int,
                           n_components: int = 6, min_null_pairs: int = 30, cross_validated: bool = False,
-                          **fit_options) -> NullPairFit:
+                          perturbed_pairs: dict | None = None, **fit_options) -> NullPairFit:
     """Fit again with the null pairs' dominant shapes projected out and CIs from their covariance.
 
     ``first`` is the white-noise fit of ``window``; ``null_pairs`` as for
@@ -148,7 +148,16 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     The intervals' t quantile has ``N - 1`` degrees of freedom, those of the
     sample covariance of the ``N`` null pairs (:mod:`.intervals`).
     ``cross_validated``: the intervals from :func:`cross_validated_covariance`
-    instead of the sandwich of the null pairs' covariance. With fewer
+    instead of the sandwich of the null pairs' covariance.
+    ``perturbed_pairs``: the perturbed-minus-matched pairs of ``window``
+    one by one (format of ``null_pairs``, ``series["pairs"]`` of
+    :func:`loper_analysis.responses.subject_onset_response`); when given,
+    the intervals come from *their* scatter about the mean instead: the
+    sandwich of their covariance divided by ``n_averaged``, with
+    ``n_averaged - 1`` degrees of freedom. It holds what the null pairs
+    cannot show - each stride answers the pulse about its own course - and
+    is the t interval of the mean of the per-stride estimates (to first
+    order). The null pairs still shape the fit (the projection). With fewer
     than ``max(min_null_pairs, n_components + 2)`` null pairs the first fit
     stands and ``note`` says so.
     """
@@ -161,16 +170,23 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
         raise LoperInputError(f"n_averaged must be >= 1 (strides in the mean response), got {n_averaged}")
     errors = null_pair_errors(window, first.estimate, null_pairs)
     weight = nuisance_projection(errors, n_components)
-    cov = np.cov(errors, rowvar=False) / n_averaged
+    cov, dof = np.cov(errors, rowvar=False) / n_averaged, n_null - 1
+    if perturbed_pairs is not None:
+        n_pairs = int(perturbed_pairs["n_pairs"])
+        if n_pairs != int(n_averaged) or n_pairs < 3:
+            raise LoperInputError(f"perturbed pairs: {n_pairs} given for a mean of {n_averaged} strides; "
+                                  "the intervals from their scatter need them all, at least 3")
+        cov = np.cov(null_pair_errors(window, first.estimate, perturbed_pairs), rowvar=False) / n_averaged
+        dof = n_pairs - 1
     fit = identify_impedance(replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate,
-                             ci_dof=n_null - 1, **fit_options)
+                             ci_dof=dof, **fit_options)
     if cross_validated:
         G = response_jacobian(window, fit.estimate, fit_options.get("lower", DEFAULT_LOWER),
                               fit_options.get("upper", DEFAULT_UPPER))
         cv = cross_validated_covariance(errors, n_components, G, n_averaged)
         sd = np.sqrt(np.clip(np.diag(cv), 0, None))
         sd = np.where(np.diag(G.T @ G) > 0, sd, np.inf)
-        low, high = bounded_interval(fit.estimate, sd, n_null - 1, fit_options.get("lower", DEFAULT_LOWER),
+        low, high = bounded_interval(fit.estimate, sd, dof, fit_options.get("lower", DEFAULT_LOWER),
                                      fit_options.get("upper", DEFAULT_UPPER))
         with np.errstate(divide="ignore", invalid="ignore"):
             fit = replace(fit, ci95_low=low, ci95_high=high, correlation=cv / np.outer(sd, sd))

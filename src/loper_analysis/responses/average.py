@@ -150,7 +150,10 @@ def subject_onset_response(
         at that rate instead, (k, 2) at ``force_time_s`` (k,) relative to the
         onset (the ``force_time_s`` of ``prepare_window``); plus
         ``window_before_s``, ``window_after_s``, ``initial_state_span_s`` and
-        ``n_pairs``. Arrays are NaN when no pair is kept.
+        ``n_pairs``; ``pairs``: the kept pairs one by one, in the format of
+        :func:`loper_analysis.responses.null_pair_windows` (``time_s``,
+        ``q_perturbed``, ``q_unperturbed`` (n_pairs, n_grid, 4), the pelvis
+        angles (n_pairs, n_grid), ``n_pairs``). Arrays are NaN when no pair is kept.
 
     Raises
     ------
@@ -263,12 +266,15 @@ def subject_onset_response(
                       "after_s": after, "initial_span_s": initial}
 
     series: dict = {"time_s": grid.copy(), "onset_s": 0.0}
+    pair_series: dict = {"time_s": grid.copy(), "n_pairs": n_pairs}
     for what, i in (("perturbed", 0), ("unperturbed", 1)):
         j, pel, x = kept["joints"][i], kept["pelvis_angle"][i], kept["pelvis_x"][i]
         q = segment_coordinates(j.reshape(-1, 3), pel.reshape(-1), x.reshape(-1)).reshape(j.shape[:2] + (4,))
         series[f"q_{what}"] = mean_and_sd(q)[0]
         series[f"pelvis_angle_{what}_rad"] = mean_and_sd(pel)[0]
         series[f"force_{what}_n"] = mean_and_sd(kept["force_vector"][i])[0]
+        pair_series[f"q_{what}"], pair_series[f"pelvis_angle_{what}_rad"] = q, pel
+    series["pairs"] = pair_series
     if native_rate is not None:
         # the force at the robot rate replaces the frames' for the identification
         series["force_time_s"] = window_times_s(-start, after, native_rate)

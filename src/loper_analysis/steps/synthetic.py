@@ -61,7 +61,7 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
         subject_static_recording,
         subject_walking_trial,
     )
-    from ..synthetic.variability import GaitVariability, device_adaptation
+    from ..synthetic.variability import lab_variability
 
     s = settings
     lab_settings, device_parameters = LabSettings(**lab), DeviceParameters(**device)
@@ -71,14 +71,8 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
     log.info("static trial of %s: %s", subject, static_out)
     true = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml))
     logs = iter(log_outs)
-    variability = adaptation = minimal_impedance = None
-    if s["variability"] == "study":
-        v, a = s["study_variability"], s["device_adaptation"]
-        variability = GaitVariability(v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"],
-                                      v["knots_per_stride"])
-        adaptation = device_adaptation(seed, subject, a["amplitude_change"], a["offset_rad"], a["swing_gain"])
-        minimal_impedance = tuple(float(np.mean([true[o][j][name] for o in true]))
-                                  for j in JOINTS for name in ("K", "D"))
+    variability, adaptation, minimal_impedance = lab_variability(s, seed, subject, true)
+    if variability is not None:
         log.info("%s: device adaptation %s; minimal-impedance walking with %s", subject, adaptation, minimal_impedance)
     for trial, c3d, onset_ms in zip(trials, c3d_outs, onsets_ms, strict=True):
         perturbation = None

@@ -35,15 +35,16 @@ configured value.
 from __future__ import annotations
 
 import zlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from ..constants import JOINTS
 from ..errors import LoperInputError
 
-__all__ = ["GaitVariability", "DeviceAdaptation", "device_adaptation", "smooth_noise", "swing_envelope"]
+__all__ = ["GaitVariability", "DeviceAdaptation", "device_adaptation", "lab_variability", "smooth_noise", "swing_envelope"]
 
 #: Leg phases (fraction of the stride from heel strike) of mid-stance and mid-swing (toe-off at 0.65).
 MID_STANCE, MID_SWING = 0.325, 0.825
@@ -176,3 +177,26 @@ def smooth_noise(phase, first_knot: int, last_knot: int, knots_per_stride: int, 
     if phase.size and (phase.min() < x[0] or phase.max() > x[-1]):
         raise LoperInputError(f"smooth_noise: phase {phase.min():.3f} .. {phase.max():.3f} outside the knots")
     return CubicSpline(x, values, bc_type="natural")(phase)
+
+
+def lab_variability(settings: Mapping, seed: int, subject: str, truth: Mapping):
+    """The variability, device adaptation and minimal-impedance walking of one synthetic subject.
+
+    ``settings``: the ``synthetic`` settings (``variability``, ``study_variability``,
+    ``device_adaptation``); ``truth``: ``{onset_ms: {joint: {"K": .., "D": ..}}}``.
+    Returns ``(variability, adaptation, minimal_impedance)`` for
+    :func:`loper_analysis.synthetic.trials.simulate_walking_trial`: all None for
+    the gentle lab; with ``variability: study`` a :class:`GaitVariability`, the
+    subject's :class:`DeviceAdaptation` and the impedance (6,) of its
+    minimal-impedance walking, the mean of its true K and D over the onsets
+    (order hip K, hip D, knee K, ...).
+    """
+    if settings["variability"] != "study":
+        return None, None, None
+    v, a = settings["study_variability"], settings["device_adaptation"]
+    variability = GaitVariability(v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"],
+                                  v["knots_per_stride"])
+    adaptation = device_adaptation(seed, subject, a["amplitude_change"], a["offset_rad"], a["swing_gain"])
+    minimal_impedance = tuple(float(np.mean([truth[o][j][name] for o in truth]))
+                              for j in JOINTS for name in ("K", "D"))
+    return variability, adaptation, minimal_impedance
