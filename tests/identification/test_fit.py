@@ -182,10 +182,20 @@ def test_response_jacobian_matches_central_differences(trial_mid):
 
 
 def test_unconverged_fit_says_so(trial_mid):
+    """One LM iteration and one polish evaluation: no minimum is reached, and the fit says so."""
     window = window_for(trial_mid)
-    result = identify_impedance(window, n_starts=2, seed=0, max_iterations=1)
+    result = identify_impedance(window, n_starts=2, seed=0, max_iterations=1, polish_max_evaluations=1)
     assert not result.success
     assert "not converged" in result.message
     # the estimate is still the best point seen, inside the bounds, with its cost
     assert np.all(result.estimate >= 0) and np.all(result.estimate <= [200, 10, 200, 10, 200, 10])
     np.testing.assert_allclose(result.cost, np.sum(prediction_error(window, result.estimate) ** 2), rtol=1e-12)
+
+
+def test_best_start_polished_to_the_minimum_converges(trial_mid):
+    """Multistart cut after 3 iterations, then the polish: the same minimum as the full fit, reported converged."""
+    window = window_for(trial_mid)
+    full = identify_impedance(window, n_starts=4, seed=0)
+    short = identify_impedance(window, n_starts=4, seed=0, max_iterations=3)
+    assert full.success and short.success, short.message
+    np.testing.assert_allclose(short.estimate, full.estimate, rtol=1e-6, atol=1e-8)
