@@ -1,7 +1,8 @@
 """File step of the experiment planner: a pilot subject's tables in, the predicted precision table out.
 
 :func:`plan` reads the pilot's joint-angle and stride tables (the trials with
-the device, whose unperturbed strides give the null pairs), its segment table
+the device, whose unperturbed strides give the null pairs and whose perturbed
+strides at an onset give that onset's perturbed pairs), its segment table
 (or another subject's) and its impedance rows (the planned impedance), and
 writes the table of :func:`loper_analysis.planning.precision_table` for every
 onset and the answers to the targets (method: ``docs/planning.md``).
@@ -26,7 +27,8 @@ log = logging.getLogger(__name__)
 
 #: Identification settings the planner follows (keys of config ``identification``).
 _PLAN_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree", "n_substeps",
-              "null_pair_components", "min_null_pairs", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")
+              "null_pair_components", "min_null_pairs", "interval_scatter", "stiffness_bounds_nm_per_rad",
+              "damping_bounds_nms_per_rad")
 
 
 def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:
@@ -76,7 +78,11 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
     ----------
     trials, angles, strides
         The pilot's trials walked with the device (names) and their angle and
-        stride tables (TSV, same order): their unperturbed strides are the null pairs.
+        stride tables (TSV, same order): their unperturbed strides are the null
+        pairs; the perturbed strides of the trials at an onset are its
+        perturbed pairs (:func:`loper_analysis.planning.pilot_perturbed_pairs`),
+        whose scatter the prediction takes (the null pairs' when there are
+        none, with a note in the rows).
     segments_tsv
         Segment table of the subject to plan for (the pilot's, or another subject's).
     subject
@@ -113,7 +119,7 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         The table and the answers.
     """
     from ..device.controller import DeviceParameters
-    from ..planning import precision_table, stride_covariance, target_answer, unplanned_rows
+    from ..planning import pilot_perturbed_pairs, precision_table, stride_covariance, target_answer, unplanned_rows
     from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
     from .model import read_segments
 
@@ -146,7 +152,8 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
             else:
                 values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
             null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
-            sc = stride_covariance(null, params, values, settings, dev, source=where)
+            pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
+            sc = stride_covariance(null, params, values, settings, dev, source=where, perturbed_pairs=pairs)
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
@@ -154,7 +161,8 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
             tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
             continue
         tables.append(precision_table(sc, counts, onset, subject, settings))
-        log.info("%s: %d null pairs; planned %s", where, sc.n_null_pairs,
+        log.info("%s: %d null pairs, %d perturbed pairs (scatter of the %s); planned %s", where, sc.n_null_pairs,
+                 sc.n_perturbed_pairs, sc.scatter.replace("_", " "),
                  ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, values)))
         for target in targets:
             if target.get("onset_ms") is not None and float(target["onset_ms"]) != float(onset):
