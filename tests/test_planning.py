@@ -37,8 +37,10 @@ from loper_analysis.io.atomic import write_tsv
 from loper_analysis.planning import (
     MIN_PERTURBED_PAIRS,
     PlanSettings,
+    StrideCovariance,
     pilot_perturbed_pairs,
     planning_window,
+    pool_onsets,
     precision_table,
     pulse_force_n,
     stride_covariance,
@@ -173,6 +175,24 @@ def test_pilot_without_perturbed_pairs_falls_back_to_the_null_pairs(params, pilo
            for k, v in pairs.items()}
     few["n_pairs"] = MIN_PERTURBED_PAIRS - 1
     assert stride_covariance(null, params, TRUTH, perturbed_pairs=few).scatter == "null_pairs"
+
+
+def test_pooled_scatter_is_the_weighted_mean_variance_ratio(stride_cov):
+    """Two onsets: variance ratios 4 (11 pairs) and 1 (31 pairs) -> pooled (10*4 + 30*1) / 40 = 1.75 on every
+    onset's null-pair sandwich, including an onset without perturbed pairs; one onset alone stays as it is."""
+    null = np.diag([4.0, 0.25, 1.0, 0.01, 0.5, 0.002])
+    p = np.array(TRUTH)
+    a = StrideCovariance(4 * null, p, None, 130, "", 11, "perturbed_pairs", null)
+    b = StrideCovariance(2 * null, p, None, 120, "", 31, "perturbed_pairs", 2 * null)
+    c = StrideCovariance(3 * null, p, None, 125, "no perturbed pairs of the pilot at this onset: ...", 0,
+                         "null_pairs", 3 * null)
+    pooled = pool_onsets({50: a, 175: b, 300: c})
+    for onset, base in ((50, null), (175, 2 * null), (300, 3 * null)):
+        np.testing.assert_allclose(pooled[onset].covariance, 1.75 * base, rtol=1e-12)
+        assert pooled[onset].scatter == "pooled_perturbed_pairs"
+        assert pooled[onset].note == "perturbed/null pairs' variance ratio pooled over onsets 50, 175 ms (42 perturbed pairs)"
+    alone = pool_onsets({50: stride_cov})
+    np.testing.assert_array_equal(alone[50].covariance, stride_cov.covariance)
 
 
 def test_repeated_experiments_report_the_predicted_sd(params, pilot):

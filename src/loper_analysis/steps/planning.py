@@ -71,7 +71,7 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
          impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None, targets: Sequence[Mapping] = (),
          pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1, response: Mapping | None = None,
          identification: Mapping | None = None, device: Mapping | None = None,
-         unplannable: str = "raise") -> tuple[pd.DataFrame, list[str]]:
+         unplannable: str = "raise", pool_scatter: bool = True) -> tuple[pd.DataFrame, list[str]]:
     """Predicted SD and 95 % CI half-width of K and D for a planned experiment, from a pilot subject.
 
     Parameters
@@ -112,6 +112,10 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         null pairs are too few: ``raise`` stops with the onset and the cause;
         ``note`` writes its rows without a prediction, the cause in ``note``
         (the workflow's choice: a pilot onset that cannot serve does not stop the run).
+    pool_scatter
+        With perturbed pairs at two or more onsets, their excess scatter over
+        the null pairs is pooled over the onsets
+        (:func:`loper_analysis.planning.pool_onsets`); False: each onset its own.
 
     Returns
     -------
@@ -119,7 +123,14 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         The table and the answers.
     """
     from ..device.controller import DeviceParameters
-    from ..planning import pilot_perturbed_pairs, precision_table, stride_covariance, target_answer, unplanned_rows
+    from ..planning import (
+        pilot_perturbed_pairs,
+        pool_onsets,
+        precision_table,
+        stride_covariance,
+        target_answer,
+        unplanned_rows,
+    )
     from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
     from .model import read_segments
 
@@ -143,7 +154,7 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         if not impedance_tsvs:
             raise LoperInputError("planned impedance: give the pilot's impedance rows or the values")
         rows_table = pd.concat([read_tsv(f, "impedance rows") for f in impedance_tsvs], ignore_index=True)
-    tables, answers = [], []
+    planned, failed = {}, {}
     for onset in onsets_ms:
         where = f"pilot {subject}, onset {onset:g} ms"
         try:
@@ -153,17 +164,25 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
                 values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
             null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
             pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
-            sc = stride_covariance(null, params, values, settings, dev, source=where, perturbed_pairs=pairs)
+            planned[onset] = stride_covariance(null, params, values, settings, dev, source=where,
+                                               perturbed_pairs=pairs)
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
             log.warning("%s: not planned: %s", where, exc)
-            tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
+            failed[onset] = unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings)
+    if pool_scatter:
+        planned = pool_onsets(planned)
+    tables, answers = [], []
+    for onset in onsets_ms:
+        if onset in failed:
+            tables.append(failed[onset])
             continue
+        sc = planned[onset]
         tables.append(precision_table(sc, counts, onset, subject, settings))
-        log.info("%s: %d null pairs, %d perturbed pairs (scatter of the %s); planned %s", where, sc.n_null_pairs,
-                 sc.n_perturbed_pairs, sc.scatter.replace("_", " "),
-                 ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, values)))
+        log.info("pilot %s, onset %g ms: %d null pairs, %d perturbed pairs (scatter: %s); planned %s", subject, onset,
+                 sc.n_null_pairs, sc.n_perturbed_pairs, sc.scatter.replace("_", " "),
+                 ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, sc.impedance)))
         for target in targets:
             if target.get("onset_ms") is not None and float(target["onset_ms"]) != float(onset):
                 continue
