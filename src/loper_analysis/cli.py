@@ -179,7 +179,8 @@ def _plan(args: argparse.Namespace) -> None:
     shown = table[["onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
                    "ci95_half_width", "ci95_half_width_pct"]]
     print(f"pilot {subject} ({len(names)} trials with the device; null pairs: "
-          f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}); "
+          f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}; perturbed pairs: "
+          f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_perturbed_pairs'].first())}); "
           f"pulse {args.force_n:g} N for {args.duration_s:g} s")
     print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     for a in answers:

@@ -11,9 +11,10 @@ builds the same inputs directly:
   (``pelvis_angle_rad = -pelvis_tilt``, ``pelvis_x_m = pelvis_tx``, the joint
   angles), plus optional white noise of ``angle_noise_sd_rad`` on every angle
   (standing in for what markers and IK add);
-* ``force``: the robot log on the motion-capture frames through the sync
-  pulses, exactly as the load-cell step does
-  (:func:`loper_analysis.loadcell.robot_log_on_mocap_frames`);
+* ``force`` and ``force_native``: the robot log on the motion-capture frames
+  and at its own 1000 Hz samples through the sync pulses, exactly as the
+  load-cell step does (:func:`loper_analysis.loadcell.robot_log_frames_and_native`;
+  the fit takes the pulse from the native rate);
 * ``strides``: :func:`loper_analysis.strides.stride_tables` from the true
   events and that force table;
 * ``markers``: two brace markers along the (noisy) thigh, from which
@@ -64,10 +65,11 @@ def trial_inputs(walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=
     Returns
     -------
     dict
-        ``name``, ``angles``, ``strides``, ``force`` (frames) and ``markers``
+        ``name``, ``angles``, ``strides``, ``force`` (frames), ``force_native``
+        (the robot samples on the motion-capture clock) and ``markers``
         ``(time_s, markers_m (n, 2, 3), labels)``.
     """
-    from .loadcell import robot_log_on_mocap_frames
+    from .loadcell import robot_log_frames_and_native
     from .strides import stride_tables
     from .synthetic.sync import pulse_train_at
 
@@ -92,26 +94,29 @@ def trial_inputs(walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=
     t_analog = np.arange(len(t) * ratio) / lab.analog_rate_hz
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     sync_v = pulse_train_at((t_analog + lab.clock_offset_s) / scale, walk.sync_starts_s)
-    force = robot_log_on_mocap_frames(walk.robot, lab.robot_rate_hz, sync_v, lab.analog_rate_hz, t, source=name)
+    force, native = robot_log_frames_and_native(walk.robot, lab.robot_rate_hz, sync_v, lab.analog_rate_hz, t,
+                                                source=name)
     events = walk.mocap_events()
     if end_s is not None:
         keep = t <= end_s + 1e-9
         angles, force = angles[keep].reset_index(drop=True), force[keep].reset_index(drop=True)
+        native = native[native["time_s"].to_numpy(float) <= end_s + 1e-9].reset_index(drop=True)
         events = events[events["time_s"] <= end_s].reset_index(drop=True)
-    force.attrs = {}
+    force.attrs, native.attrs = {}, {}
     strides = stride_tables(angles, events, force, side=side).strides
     joints = angles[[angle_column(j, side) for j in JOINTS]].to_numpy(float)
     q = segment_coordinates(joints, angles["pelvis_angle_rad"].to_numpy(float), angles["pelvis_x_m"].to_numpy(float))
     markers = np.zeros((len(angles), 2, 3))
     markers[:, 0, 0], markers[:, 0, 1] = 0.1 * np.sin(q[:, 1]), 0.1 * np.cos(q[:, 1])  # proximal: up the thigh
-    return {"name": name, "angles": angles, "strides": strides, "force": force,
+    return {"name": name, "angles": angles, "strides": strides, "force": force, "force_native": native,
             "markers": (angles["time_s"].to_numpy(float), markers, list(BRACE_LABELS))}
 
 
 def perturbation_experiment(seed, params, height_m: float, onset_ms: float, impedance, n_strides, *, lab=None,
                             device=None, timing_cv: float = 0.03, amplitude_cv: float = 0.05, force_n: float = 40.0,
                             duration_s: float = 0.1, every_strides: tuple[int, int] = (3, 5),
-                            angle_noise_sd_rad: float = 0.0) -> tuple[dict, dict[int, dict]]:
+                            angle_noise_sd_rad: float = 0.0, variability=None, adaptation=None,
+                            minimal_impedance=None) -> tuple[dict, dict[int, dict]]:
     """One synthetic perturbation experiment: a trial long enough for ``max(n_strides)`` perturbed strides.
 
     One walking trial with the device (:func:`~loper_analysis.synthetic.trials.simulate_walking_trial`,
@@ -121,6 +126,11 @@ def perturbation_experiment(seed, params, height_m: float, onset_ms: float, impe
     named ``full``: its unperturbed strides are the null pairs) and, per count
     ``n`` in ``n_strides``, the trial cut 1 s after the swing of its ``n``-th
     perturbed stride (named ``first{n}``; the whole trial if it holds fewer).
+    ``variability``, ``adaptation`` and ``minimal_impedance``: the lab's
+    stride-to-stride variability, the subject's adaptation to the device and
+    its minimal-impedance walking
+    (:func:`loper_analysis.synthetic.variability.lab_variability`; None: the
+    gentle lab of ``timing_cv`` and ``amplitude_cv`` alone).
     """
     from .device.controller import DeviceParameters
     from .synthetic.gait_curves import NominalGait
@@ -136,7 +146,8 @@ def perturbation_experiment(seed, params, height_m: float, onset_ms: float, impe
     perturbation = PerturbationSettings(onset_ms / 1e3, tuple(float(v) for v in impedance), force_n, duration_s,
                                         tuple(every_strides))
     walk = simulate_walking_trial(trial_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv,
-                                  device or DeviceParameters(), perturbation)
+                                  device or DeviceParameters(), perturbation, variability=variability,
+                                  adaptation=adaptation, minimal_impedance=minimal_impedance)
     full = trial_inputs(walk, lab, "full", angle_noise_sd_rad=angle_noise_sd_rad, seed=noise_seed)
     heel_strikes = walk.schedule["heel_strike_s"].to_numpy(float)
     cut = {}

@@ -1,24 +1,31 @@
 """Planning an experiment: the precision of K and D before anyone walks (method: ``docs/planning.md``).
 
 The null-pair fit (:mod:`loper_analysis.identification.null_pairs`) takes the
-covariance of its estimate from the stride-to-stride deviation of *null
-pairs*: ``cov = M C M^T`` with ``M = (W J)^+ W``, ``C = cov(E) / N`` (``E``
-the null pairs' prediction errors, ``N`` the perturbed strides averaged, ``W``
-the projection of the deviation's dominant shapes, ``J`` the sensitivity of
-the model response to K and D). Nothing in it needs the perturbed strides
-themselves: from a pilot subject's null pairs, a planned pulse and a planned
-impedance it predicts the SD and the 95 % CI half-width of every K and D for
-any number of perturbed strides, and the number of strides a target
-half-width needs.
+covariance of its estimate by the sandwich ``cov = M C M^T`` with
+``M = (W J)^+ W``, ``C = cov(E) / N`` (``E`` the prediction errors of pairs
+one by one, ``N`` the perturbed strides averaged, ``W`` the projection of the
+null pairs' dominant shapes, ``J`` the sensitivity of the model response to K
+and D). ``E`` are the errors of the *perturbed* pairs: each stride answers
+the pulse about its own course, which pairs without a pulse (null pairs)
+cannot show. From a pilot subject's null pairs, its perturbed pairs at the
+onset (when it has them), a planned pulse and a planned impedance the
+planner predicts the SD and the 95 % CI half-width of every K and D for any
+number of perturbed strides, and the number of strides a target half-width
+needs.
 
-* :func:`pulse_force_n` - the force the rods apply for a rectangular desired
+* :func:`pulse_force_n` (from :mod:`.planning_inputs`) - the force the rods apply for a rectangular desired
   pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
   like the load cell;
+* :func:`pilot_perturbed_pairs` (from :mod:`.planning_inputs`) - the pilot's
+  perturbed pairs at an onset, one by one;
 * :func:`planning_window` - the identification window of the planned
   experiment: the pilot's mean unperturbed swing as the reference, the pulse
   along the thigh normal;
 * :func:`stride_covariance` - the covariance of (K, D) per joint for one
-  perturbed stride (divide by ``N``);
+  perturbed stride (divide by ``N``), from the pilot's perturbed pairs (or
+  its null pairs when it has none at the onset);
+* :func:`pool_onsets` - the perturbed pairs' excess scatter pooled over the
+  pilot's onsets (steadier than one onset's dozen pairs);
 * :func:`precision_table` - predicted SD and 95 % half-width per joint,
   parameter and stride count;
 * :func:`strides_needed` and :func:`target_answer` - how many strides a target
@@ -37,7 +44,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -56,14 +63,18 @@ from .identification import (
     prepare_window,
     response_jacobian,
 )
+from .planning_inputs import pilot_perturbed_pairs, pulse_force_n
 
 __all__ = [
     "PLAN_COLUMNS",
+    "MIN_PERTURBED_PAIRS",
     "PlanSettings",
     "StrideCovariance",
     "pulse_force_n",
     "planning_window",
+    "pilot_perturbed_pairs",
     "stride_covariance",
+    "pool_onsets",
     "precision_table",
     "unplanned_rows",
     "strides_needed",
@@ -73,8 +84,12 @@ __all__ = [
 #: Columns of the plan table (one row per joint x parameter x onset x stride count).
 PLAN_COLUMNS: tuple[str, ...] = (
     "subject", "onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
-    "ci95_half_width", "ci95_half_width_pct", "pulse_force_n", "pulse_duration_s", "n_null_pairs", "note",
+    "ci95_half_width", "ci95_half_width_pct", "pulse_force_n", "pulse_duration_s", "n_null_pairs",
+    "n_perturbed_pairs", "scatter", "note",
 )
+
+#: Fewest pilot perturbed pairs whose scatter the prediction takes (fewer: the null pairs' scatter, noted).
+MIN_PERTURBED_PAIRS = 5
 
 
 @dataclass(frozen=True)
@@ -84,8 +99,11 @@ class PlanSettings:
     ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
     onset; ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
     (s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
-    ``min_null_pairs`` and the bounds (N·m/rad, N·m·s/rad) as the fit uses
-    them; ``force_cutoff_hz`` and ``force_order`` the load cell's low-pass.
+    ``min_null_pairs``, ``interval_scatter`` (whose scatter the fit's
+    intervals take, hence their t quantile) and the bounds (N·m/rad,
+    N·m·s/rad) as the fit uses them; ``force_cutoff_hz`` and ``force_order``
+    the load cell's low-pass; ``force_rate_hz`` the rate of the pulse given
+    to the fit (the robot log's).
     """
 
     pulse_force_n: float = 40.0
@@ -97,13 +115,20 @@ class PlanSettings:
     n_substeps: int = 2
     null_pair_components: int = 6
     min_null_pairs: int = 30
+    interval_scatter: str = "perturbed_pairs"
     stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
     damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
     force_cutoff_hz: float = 40.0
     force_order: int = 4
+    force_rate_hz: float = 1000.0
 
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)
+        if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
+            raise LoperInputError("identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
+                                  f"got {self.interval_scatter!r}")
+        if number("force_rate_hz", self.force_rate_hz) <= 0:
+            raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
         d = number("pulse_duration_s", self.pulse_duration_s)
         after = number("window_after_s", self.window_after_s, minimum=0.0)
         if d <= 0:
@@ -126,61 +151,36 @@ class StrideCovariance:
     """The covariance (6, 6) of the estimate for one averaged perturbed stride (order :data:`PARAMETERS`).
 
     ``impedance`` (6,) the planned values it was linearised at; ``dof`` the
-    degrees of freedom of the CI's Student t (as in the fit); ``n_null_pairs``
-    the pilot's null pairs; ``note`` a caveat for the rows (empty when none).
+    degrees of freedom of the CI's Student t as the fit takes them: None for
+    ``N - 1`` (the fit's intervals from the scatter of its ``N`` perturbed
+    pairs), else a fixed count (the null pairs' ``M - 1``); ``n_null_pairs``
+    and ``n_perturbed_pairs`` the pilot's pairs; ``scatter`` whose errors
+    gave the covariance (``perturbed_pairs`` or ``null_pairs``); ``note`` a
+    caveat for the rows (empty when none).
     """
 
     covariance: np.ndarray
     impedance: np.ndarray
-    dof: int
+    dof: int | None
     n_null_pairs: int
     note: str = ""
+    n_perturbed_pairs: int = 0
+    scatter: str = "null_pairs"
+    null_covariance: np.ndarray | None = None
 
     @property
     def sd(self) -> np.ndarray:
         """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad)."""
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
-    @property
-    def t95(self) -> float:
-        """Student's t at 97.5 % with :attr:`dof` degrees of freedom."""
-        return float(student_t.ppf(0.975, self.dof))
+    def t95(self, n_strides: int) -> float:
+        """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof)."""
+        dof = int(n_strides) - 1 if self.dof is None else int(self.dof)
+        return float(student_t.ppf(0.975, dof)) if dof >= 1 else math.inf
 
-
-def pulse_force_n(time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = 40.0,
-                  order: int = 4) -> np.ndarray:
-    """The rod force (N, along the rods) of a rectangular desired pulse, at ``time_s`` (s, onset at 0).
-
-    The desired force ``force_n`` for ``0 <= t < duration_s`` drives the
-    device's closed loop (:func:`loper_analysis.device.controller.simulate_device`
-    with a still brace, no load-cell noise; ``device`` a
-    :class:`~loper_analysis.device.controller.DeviceParameters`, default the
-    study's tuning: about 10 ms rise and 30 % overshoot), minus the loop's
-    output without the pulse; the result is low-passed like the load cell
-    (zero-phase Butterworth, ``cutoff_hz``, ``order``) and sampled at
-    ``time_s``. Zero before the onset.
-    """
-    from .device.controller import DeviceParameters, simulate_device
-    from .filtering import lowpass
-
-    t = np.asarray(time_s, dtype=float)
-    if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)):
-        raise LoperInputError(f"time_s must be a finite 1-D array with >= 2 samples, got shape {t.shape}")
-    f = number("pulse force_n", force_n)
-    d = number("pulse duration_s", duration_s)
-    if d <= 0:
-        raise LoperInputError(f"pulse duration_s must be > 0 s, got {d:g} s")
-    dev = replace(device or DeviceParameters(), loadcell_noise_sd_n=0.0)
-    rate = dev.sample_rate_hz
-    lead = 0.2
-    n = int(math.ceil((max(t[-1], d) + lead + 0.2) * rate)) + 1
-    t_dev = -lead + np.arange(n) / rate
-    desired = np.where((t_dev >= -1e-9) & (t_dev < d - 1e-9), f, 0.0)
-    still = np.zeros(n)
-    on = simulate_device(desired, dev, None, brace_position_m=still)["force_measured_n"].to_numpy()
-    off = simulate_device(0.0 * desired, dev, None, brace_position_m=still)["force_measured_n"].to_numpy()
-    force = lowpass(on - off, rate, cutoff_hz, order)
-    return np.interp(t, t_dev, force, left=0.0, right=float(force[-1]))
+    def half_width(self, n_strides: int) -> np.ndarray:
+        """Predicted 95 % CI half-width (6,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
+        return self.t95(n_strides) * self.sd / math.sqrt(int(n_strides))
 
 
 def _null_arrays(null_pairs: Mapping, source: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
@@ -206,10 +206,12 @@ def planning_window(null_pairs: Mapping, params: SegmentParameters, settings: Pl
     ``pelvis_angle_unperturbed_rad`` (M, n), on the grid ``time_s`` (n,)
     relative to the onset; :func:`loper_analysis.responses.null_pair_windows`),
     the mean swing a perturbed stride starts from. The perturbed force is
-    :func:`pulse_force_n` along the thigh's forward normal of that swing; the
-    minimal-impedance force and the initial deviation are zero (they average
-    out over the perturbed strides). ``measured`` is zero: only the model's
-    sensitivities are used.
+    :func:`pulse_force_n` along the thigh's forward normal of that swing,
+    given to the fit at ``settings.force_rate_hz`` (``force_time_s`` of
+    :func:`~loper_analysis.identification.prepare_window`, as the fit takes
+    the robot log's samples); the minimal-impedance force and the initial
+    deviation are zero (they average out over the perturbed strides).
+    ``measured`` is zero: only the model's sensitivities are used.
     """
     from .synthetic.response import thigh_normal
 
@@ -218,12 +220,14 @@ def planning_window(null_pairs: Mapping, params: SegmentParameters, settings: Pl
         raise LoperInputError(f"{source}: no null pairs: the pilot needs unperturbed strides walked with the device")
     q_ref = arrays["q_unperturbed"].mean(axis=0)
     pelvis = arrays["pelvis_angle_unperturbed_rad"].mean(axis=0)
-    force = pulse_force_n(t, settings.pulse_force_n, settings.pulse_duration_s, device, settings.force_cutoff_hz,
+    rate = float(settings.force_rate_hz)
+    t_force = np.arange(math.ceil(t[0] * rate - 1e-6), math.floor(t[-1] * rate + 1e-6) + 1) / rate
+    force = pulse_force_n(t_force, settings.pulse_force_n, settings.pulse_duration_s, device, settings.force_cutoff_hz,
                           settings.force_order)
-    force_vector = force[:, None] * thigh_normal(q_ref[:, 1])
+    force_vector = force[:, None] * thigh_normal(np.interp(t_force, t, q_ref[:, 1]))
     return prepare_window(
-        t, q_ref, q_ref, params, 0.0, force_perturbed_n=force_vector,
-        pelvis_angle_unperturbed_rad=pelvis, pelvis_angle_perturbed_rad=pelvis,
+        t, q_ref, q_ref, params, 0.0, force_perturbed_n=force_vector, force_unperturbed_n=np.zeros_like(force_vector),
+        force_time_s=t_force, pelvis_angle_unperturbed_rad=pelvis, pelvis_angle_perturbed_rad=pelvis,
         window_before_s=settings.window_before_s, window_after_s=settings.window_after_s,
         n_substeps=settings.n_substeps, initial_state_span_s=settings.initial_state_span_s,
         initial_state_degree=settings.initial_state_degree,
@@ -244,17 +248,30 @@ def _impedance(impedance, settings: PlanSettings, source: str) -> np.ndarray:
 
 
 def stride_covariance(null_pairs: Mapping, params: SegmentParameters, impedance,
-                      settings: PlanSettings = PlanSettings(), device=None, source: str = "pilot") -> StrideCovariance:
+                      settings: PlanSettings = PlanSettings(), device=None, source: str = "pilot",
+                      perturbed_pairs: Mapping | None = None) -> StrideCovariance:
     """Covariance of (K, D) per joint for a mean response of **one** perturbed stride.
 
     ``impedance`` (6,): the planned values (order :data:`PARAMETERS`; N·m/rad
     and N·m·s/rad), e.g. the pilot's estimate. With the window of
     :func:`planning_window`, ``J`` = :func:`~loper_analysis.identification.response_jacobian`
-    at ``impedance``, the null-pair errors ``E`` =
+    at ``impedance``, the null-pair errors ``E0`` =
     :func:`~loper_analysis.identification.null_pair_errors`, ``W`` =
-    :func:`~loper_analysis.identification.nuisance_projection` of ``E``
+    :func:`~loper_analysis.identification.nuisance_projection` of ``E0``
     (``settings.null_pair_components`` shapes) and ``M = (W J)^+ W``:
     ``cov_1 = M cov(E) M^T``. For ``N`` strides the covariance is ``cov_1 / N``.
+
+    ``E`` are the prediction errors of the pilot's ``perturbed_pairs`` (the
+    kept perturbed-minus-matched pairs at this onset one by one, format of
+    ``null_pairs``: ``series["pairs"]`` of
+    :func:`loper_analysis.responses.subject_onset_response`): their scatter
+    holds the stride-to-stride deviation *and* each stride's own answer to
+    the pulse, the scatter the fit's intervals take
+    (``identification.interval_scatter: perturbed_pairs``). Without them, or
+    with fewer than :data:`MIN_PERTURBED_PAIRS`, ``E = E0`` and the note says
+    the prediction lacks the response's variability. The t quantile is the
+    fit's: ``N - 1`` degrees of freedom with ``interval_scatter``
+    ``perturbed_pairs``, else the null pairs' ``M - 1``.
 
     Raises
     ------
@@ -271,20 +288,66 @@ def stride_covariance(null_pairs: Mapping, params: SegmentParameters, impedance,
             f"{source}: {n_pairs} null pair(s), fewer than identification.null_pair_components + 2 = {need}: "
             "the pilot needs unperturbed strides walked with the device (their deviation is what the prediction "
             "scales)")
-    note = ""
+    notes = []
     if n_pairs < settings.min_null_pairs:
-        note = (f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
-                "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit")
+        notes.append(f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+                     "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit")
     window = planning_window(null_pairs, params, settings, device, source)
     J = response_jacobian(window, p, settings.lower, settings.upper)
-    E = null_pair_errors(window, p, null_pairs)
-    W = nuisance_projection(E, r)
+    E0 = null_pair_errors(window, p, null_pairs)
+    W = nuisance_projection(E0, r)
     WJ = W @ J
     M = np.linalg.pinv(WJ.T @ WJ, rcond=1e-13) @ WJ.T @ W
-    C = np.atleast_2d(np.cov(E, rowvar=False))
-    cov = M @ C @ M.T
-    dof = max(J.shape[0] - 6, 1)
-    return StrideCovariance(cov, p, dof, n_pairs, note)
+    n_pert = 0
+    if perturbed_pairs is not None:
+        _, _, n_pert = _null_arrays(perturbed_pairs, f"{source}, perturbed pairs")
+    if n_pert >= MIN_PERTURBED_PAIRS:
+        E, scatter = null_pair_errors(window, p, perturbed_pairs), "perturbed_pairs"
+    else:
+        E, scatter = E0, "null_pairs"
+        notes.append((f"{n_pert} perturbed pair(s) of the pilot at this onset, fewer than {MIN_PERTURBED_PAIRS}"
+                      if perturbed_pairs is not None else "no perturbed pairs of the pilot at this onset")
+                     + ": the null pairs' scatter, without each stride's own answer to the pulse (in the "
+                     "synthetic check the actual SD of hip and knee K and D was 1.4-1.8 times this prediction)")
+
+    def sandwich(errors: np.ndarray) -> np.ndarray:
+        effect = (errors - errors.mean(axis=0)) @ M.T  # each pair's effect on (K, D)
+        return effect.T @ effect / max(errors.shape[0] - 1, 1)
+
+    dof = None if settings.interval_scatter == "perturbed_pairs" else n_pairs - 1
+    return StrideCovariance(sandwich(E), p, dof, n_pairs, "; ".join(notes), n_pert, scatter, sandwich(E0))
+
+
+def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, StrideCovariance]:
+    """The perturbed pairs' excess scatter pooled over the pilot's onsets (``{onset_ms: StrideCovariance}``).
+
+    Per onset ``o`` with the scatter of ``P_o`` perturbed pairs, the ratio
+    ``r_o = diag(cov) / diag(null_covariance)`` (6,) says how much more the
+    perturbed pairs scatter than the null pairs for each K and D. The pooled
+    ratio ``r = sum (P_o - 1) r_o / sum (P_o - 1)`` is applied to every
+    onset's null-pair sandwich, which rests on 100+ pairs:
+    ``cov_o = diag(sqrt r) null_covariance_o diag(sqrt r)`` (``scatter``
+    ``pooled_perturbed_pairs``), onsets without perturbed pairs included. A
+    dozen pairs per onset (the default design) leave each ``r_o`` uncertain
+    by about +-45 % (95 %); pooled over three onsets, +-25 %. With fewer than
+    two onsets with perturbed pairs the covariances are returned unchanged.
+    """
+    own = {o: sc for o, sc in stride_covs.items() if sc.scatter == "perturbed_pairs"}
+    if len(own) < 2:
+        return dict(stride_covs)
+    weights = np.array([sc.n_perturbed_pairs - 1 for sc in own.values()], float)
+    ratios = np.array([np.diag(sc.covariance) / np.diag(sc.null_covariance) for sc in own.values()])
+    r = weights @ ratios / weights.sum()
+    scale = np.sqrt(r)
+    pooled_note = (f"perturbed/null pairs' variance ratio pooled over onsets {', '.join(f'{o:g}' for o in own)} ms "
+                   f"({int(sum(sc.n_perturbed_pairs for sc in own.values()))} perturbed pairs)")
+    out = {}
+    for o, sc in stride_covs.items():
+        notes = [n for n in sc.note.split("; ") if n and "perturbed pair" not in n] + [pooled_note]
+        out[o] = StrideCovariance(scale[:, None] * sc.null_covariance * scale[None, :], sc.impedance, sc.dof,
+                                  sc.n_null_pairs, "; ".join(notes), sc.n_perturbed_pairs, "pooled_perturbed_pairs",
+                                  sc.null_covariance)
+    return out
 
 
 def _counts(n_strides: Sequence[int], source: str) -> list[int]:
@@ -309,12 +372,13 @@ def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onse
     """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
 
     ``predicted_sd = sd_1 / sqrt(N)`` and ``ci95_half_width = t * predicted_sd``
-    (Student's t at 97.5 %, the fit's degrees of freedom), both in ``unit``;
+    (Student's t at 97.5 % with the fit's degrees of freedom,
+    :meth:`StrideCovariance.t95`: ``N - 1`` by default), both in ``unit``;
     ``ci95_half_width_pct`` relative to the planned value (%; NaN for a
     planned value of 0). Rows: hip, knee, ankle x K, D x ``n_strides``.
     """
     counts = _counts(n_strides, subject or "plan")
-    sd1, t95 = stride_cov.sd, stride_cov.t95
+    sd1 = stride_cov.sd
     rows = []
     for j, joint in enumerate(JOINTS):
         for k, kind in enumerate(("K", "D")):
@@ -322,7 +386,7 @@ def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onse
             planned = float(stride_cov.impedance[i])
             for n in counts:
                 sd = sd1[i] / math.sqrt(n)
-                half = t95 * sd
+                half = stride_cov.t95(n) * sd
                 rows.append({
                     "subject": subject, "onset_ms": float(onset_ms), "joint": joint, "parameter": kind,
                     "unit": PARAMETER_UNITS[PARAMETERS[i]], "n_strides": n, "planned_value": planned,
@@ -330,7 +394,8 @@ def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onse
                     "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
                     "pulse_force_n": float(settings.pulse_force_n),
                     "pulse_duration_s": float(settings.pulse_duration_s),
-                    "n_null_pairs": stride_cov.n_null_pairs, "note": stride_cov.note,
+                    "n_null_pairs": stride_cov.n_null_pairs, "n_perturbed_pairs": stride_cov.n_perturbed_pairs,
+                    "scatter": stride_cov.scatter, "note": stride_cov.note,
                 })
     return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
 
@@ -351,7 +416,9 @@ def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, 
     """Fewest perturbed strides whose 95 % CI half-width on ``parameter`` of ``joint`` meets the target.
 
     Give either ``percent`` (of the planned value, e.g. 15 for +-15 %) or
-    ``half_width`` (absolute, N·m/rad or N·m·s/rad). ``N = ceil((t sd_1 / target)^2)``.
+    ``half_width`` (absolute, N·m/rad or N·m·s/rad): the smallest ``N`` with
+    ``t_N sd_1 / sqrt(N) <= target`` (``t_N`` :meth:`StrideCovariance.t95`;
+    with a fixed t, ``N = ceil((t sd_1 / target)^2)``).
     """
     if joint not in JOINTS:
         raise LoperInputError(f"target joint must be one of {JOINTS}, got {joint!r}")
@@ -374,7 +441,18 @@ def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, 
         if target <= 0:
             raise LoperInputError(f"target half_width must be > 0, got {target:g}")
     sd1 = float(stride_cov.sd[i])
-    return max(1, int(math.ceil((stride_cov.t95 * sd1 / target) ** 2 * (1 - 1e-12))))
+
+    def meets(n: int) -> bool:
+        return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
+
+    # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96
+    n = max(1, int(math.ceil((student_t.ppf(0.975, 10 ** 6) * sd1 / target) ** 2 * (1 - 1e-12))))
+    while not meets(n):
+        t = stride_cov.t95(n)
+        n = n + 1 if not math.isfinite(t) else max(n + 1, int(math.ceil((t * sd1 / target) ** 2 * (1 - 1e-12))))
+    while n > 1 and meets(n - 1):
+        n -= 1
+    return n
 
 
 def target_answer(stride_cov: StrideCovariance, joint: str, parameter: str, onset_ms: float, *,
@@ -383,7 +461,7 @@ def target_answer(stride_cov: StrideCovariance, joint: str, parameter: str, onse
     n = strides_needed(stride_cov, joint, parameter, percent=percent, half_width=half_width)
     i = PARAMETERS.index(f"{parameter}_{joint}")
     unit, planned = PARAMETER_UNITS[PARAMETERS[i]], float(stride_cov.impedance[i])
-    reached = stride_cov.t95 * stride_cov.sd[i] / math.sqrt(n)
+    reached = stride_cov.t95(n) * stride_cov.sd[i] / math.sqrt(n)
     wanted = f"±{percent:g} %" if percent is not None else f"±{half_width:g} {unit}"
     return (f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
             f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "

@@ -54,7 +54,7 @@ rule planning:
         ),
         identification={k: IDENT[k] for k in ("window_before_s", "window_after_s", "initial_state_span_s",
                                                 "initial_state_degree", "n_substeps", "null_pair_components",
-                                                "min_null_pairs", "max_null_trial_ratio",
+                                                "min_null_pairs", "max_null_trial_ratio", "interval_scatter",
                                                 "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")},
         device=config["device"]["parameters"],
     log:

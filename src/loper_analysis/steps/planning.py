@@ -1,7 +1,8 @@
 """File step of the experiment planner: a pilot subject's tables in, the predicted precision table out.
 
 :func:`plan` reads the pilot's joint-angle and stride tables (the trials with
-the device, whose unperturbed strides give the null pairs), its segment table
+the device, whose unperturbed strides give the null pairs and whose perturbed
+strides at an onset give that onset's perturbed pairs), its segment table
 (or another subject's) and its impedance rows (the planned impedance), and
 writes the table of :func:`loper_analysis.planning.precision_table` for every
 onset and the answers to the targets (method: ``docs/planning.md``).
@@ -26,7 +27,8 @@ log = logging.getLogger(__name__)
 
 #: Identification settings the planner follows (keys of config ``identification``).
 _PLAN_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree", "n_substeps",
-              "null_pair_components", "min_null_pairs", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")
+              "null_pair_components", "min_null_pairs", "interval_scatter", "stiffness_bounds_nm_per_rad",
+              "damping_bounds_nms_per_rad")
 
 
 def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:
@@ -69,14 +71,18 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
          impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None, targets: Sequence[Mapping] = (),
          pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1, response: Mapping | None = None,
          identification: Mapping | None = None, device: Mapping | None = None,
-         unplannable: str = "raise") -> tuple[pd.DataFrame, list[str]]:
+         unplannable: str = "raise", pool_scatter: bool = True) -> tuple[pd.DataFrame, list[str]]:
     """Predicted SD and 95 % CI half-width of K and D for a planned experiment, from a pilot subject.
 
     Parameters
     ----------
     trials, angles, strides
         The pilot's trials walked with the device (names) and their angle and
-        stride tables (TSV, same order): their unperturbed strides are the null pairs.
+        stride tables (TSV, same order): their unperturbed strides are the null
+        pairs; the perturbed strides of the trials at an onset are its
+        perturbed pairs (:func:`loper_analysis.planning.pilot_perturbed_pairs`),
+        whose scatter the prediction takes (the null pairs' when there are
+        none, with a note in the rows).
     segments_tsv
         Segment table of the subject to plan for (the pilot's, or another subject's).
     subject
@@ -106,6 +112,10 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         null pairs are too few: ``raise`` stops with the onset and the cause;
         ``note`` writes its rows without a prediction, the cause in ``note``
         (the workflow's choice: a pilot onset that cannot serve does not stop the run).
+    pool_scatter
+        With perturbed pairs at two or more onsets, their excess scatter over
+        the null pairs is pooled over the onsets
+        (:func:`loper_analysis.planning.pool_onsets`); False: each onset its own.
 
     Returns
     -------
@@ -113,7 +123,14 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         The table and the answers.
     """
     from ..device.controller import DeviceParameters
-    from ..planning import precision_table, stride_covariance, target_answer, unplanned_rows
+    from ..planning import (
+        pilot_perturbed_pairs,
+        pool_onsets,
+        precision_table,
+        stride_covariance,
+        target_answer,
+        unplanned_rows,
+    )
     from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
     from .model import read_segments
 
@@ -137,7 +154,7 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
         if not impedance_tsvs:
             raise LoperInputError("planned impedance: give the pilot's impedance rows or the values")
         rows_table = pd.concat([read_tsv(f, "impedance rows") for f in impedance_tsvs], ignore_index=True)
-    tables, answers = [], []
+    planned, failed = {}, {}
     for onset in onsets_ms:
         where = f"pilot {subject}, onset {onset:g} ms"
         try:
@@ -146,16 +163,26 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
             else:
                 values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
             null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
-            sc = stride_covariance(null, params, values, settings, dev, source=where)
+            pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
+            planned[onset] = stride_covariance(null, params, values, settings, dev, source=where,
+                                               perturbed_pairs=pairs)
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
             log.warning("%s: not planned: %s", where, exc)
-            tables.append(unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings))
+            failed[onset] = unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings)
+    if pool_scatter:
+        planned = pool_onsets(planned)
+    tables, answers = [], []
+    for onset in onsets_ms:
+        if onset in failed:
+            tables.append(failed[onset])
             continue
+        sc = planned[onset]
         tables.append(precision_table(sc, counts, onset, subject, settings))
-        log.info("%s: %d null pairs; planned %s", where, sc.n_null_pairs,
-                 ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, values)))
+        log.info("pilot %s, onset %g ms: %d null pairs, %d perturbed pairs (scatter: %s); planned %s", subject, onset,
+                 sc.n_null_pairs, sc.n_perturbed_pairs, sc.scatter.replace("_", " "),
+                 ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, sc.impedance)))
         for target in targets:
             if target.get("onset_ms") is not None and float(target["onset_ms"]) != float(onset):
                 continue
