@@ -60,8 +60,13 @@ def test_rows_carry_the_fit_summary(fit):
 
 def test_statuses(fit):
     wide = replace(fit, ci95_low=fit.ci95_low - np.array([0, 0, 0, 0, 150.0, 0]))
-    rows = impedance_rows(wide, "S01", 175, 9)
+    rows = impedance_rows(wide, "S01", 175, 9, max_ci_fraction=0.5)
     assert list(rows.status) == ["ok", "ok", "not_identifiable"] and "CI width K" in rows.reason.iloc[2]
+    # by default only an unbounded interval is too wide; this one is flagged by what it holds (0 and the range)
+    default = impedance_rows(wide, "S01", 175, 9)
+    assert list(default.status) == ["ok", "ok", "not_identifiable"]
+    assert "holds both 0 and the plausible range" in default.reason.iloc[2]
+    assert "CI width" not in default.reason.iloc[2]
     assert rows.K_true_nm_per_rad.isna().all()  # a recorded subject
     failed = impedance_rows(replace(fit, success=False, message="max iterations"), "S01", 175, 9)
     assert (failed.status == "failed").all() and failed.reason.str.contains("max iterations").all()

@@ -108,7 +108,7 @@ class IdentificationSettings:
     merge_tolerance: float = 0.01
     stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
     damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
-    max_ci_fraction: float = 0.5
+    max_ci_fraction: float = 1.0
     plausible_ranges: Mapping | None = None
     min_vaf_pct: float = MIN_VAF_PCT
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
@@ -219,7 +219,7 @@ def _plausible_range(plausible_ranges: Mapping | None, joint: str):
 
 
 def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: int, truth: Mapping | None = None,
-                   lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 0.5,
+                   lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 1.0,
                    noise_model: str = "white", n_null_pairs: int = 0, note: str = "", *,
                    min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION,
                    plausible_ranges: Mapping | None = None) -> pd.DataFrame:

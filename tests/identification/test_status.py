@@ -66,11 +66,15 @@ def test_an_undefined_vaf_fails():
 
 def test_findings_add_up_and_the_most_severe_wins():
     """The campaign's case: K on the bound, VAF -118 %, wide interval -> failed, all three named."""
-    s, reason = joint_status("knee", (200.0, 8.8), (50.0, 8.55), (200.0, 9.05), -118.0, LOWER, UPPER)
+    s, reason = joint_status("knee", (200.0, 8.8), (50.0, 8.55), (200.0, 9.05), -118.0, LOWER, UPPER,
+                             max_ci_fraction=0.5)
     assert s == "failed"
     parts = reason.split("; ")
     assert [p.split(" ")[0] for p in parts] == ["VAF", "K_knee", "95"]
     assert parts[2] == "95 % CI width K 150 N·m/rad, D 0.5 N·m·s/rad exceeds 0.5 of the bounds"
+    # by default (1: only an unbounded interval) the width is no finding of its own
+    s, reason = joint_status("knee", (200.0, 8.8), (50.0, 8.55), (200.0, 9.05), -118.0, LOWER, UPPER)
+    assert s == "failed" and [p.split(" ")[0] for p in reason.split("; ")] == ["VAF", "K_knee"]
 
 
 def test_not_converged_keeps_its_reason():

@@ -60,7 +60,7 @@ def check_plausible_range(joint: str, plausible_range) -> np.ndarray:
 
 
 def joint_status(joint: str, estimate, ci_low, ci_high, vaf_pct: float, lower, upper, *, success: bool = True,
-                 message: str = "", plausible_range=None, max_ci_fraction: float = 0.5,
+                 message: str = "", plausible_range=None, max_ci_fraction: float = 1.0,
                  min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION) -> tuple[str, str]:
     """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
 
