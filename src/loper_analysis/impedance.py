@@ -39,6 +39,7 @@ from .identification import (
     ImpedanceFit,
     identify_impedance,
     joint_status,
+    parameter_bounds,
     prepare_window,
     refit_with_null_pairs,
 )
@@ -125,11 +126,11 @@ class IdentificationSettings:
 
     @property
     def lower(self) -> np.ndarray:
-        return np.array([self.stiffness_bounds_nm_per_rad[0], self.damping_bounds_nms_per_rad[0]] * 3, float)
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
 
     @property
     def upper(self) -> np.ndarray:
-        return np.array([self.stiffness_bounds_nm_per_rad[1], self.damping_bounds_nms_per_rad[1]] * 3, float)
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
 
     def fit_options(self) -> dict:
         """Keyword arguments of :func:`loper_analysis.identification.identify_impedance`."""

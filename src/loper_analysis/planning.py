@@ -60,6 +60,7 @@ from .identification import (
     PreparedWindow,
     nuisance_projection,
     null_pair_errors,
+    parameter_bounds,
     prepare_window,
     response_jacobian,
 )
@@ -139,11 +140,11 @@ class PlanSettings:
 
     @property
     def lower(self) -> np.ndarray:
-        return np.array([self.stiffness_bounds_nm_per_rad[0], self.damping_bounds_nms_per_rad[0]] * 3, float)
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
 
     @property
     def upper(self) -> np.ndarray:
-        return np.array([self.stiffness_bounds_nm_per_rad[1], self.damping_bounds_nms_per_rad[1]] * 3, float)
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
 
 
 @dataclass

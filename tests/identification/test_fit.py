@@ -199,3 +199,11 @@ def test_best_start_polished_to_the_minimum_converges(trial_mid):
     short = identify_impedance(window, n_starts=4, seed=0, max_iterations=3)
     assert full.success and short.success, short.message
     np.testing.assert_allclose(short.estimate, full.estimate, rtol=1e-6, atol=1e-8)
+
+
+def test_parameter_bounds_are_in_the_order_of_the_parameters():
+    from loper_analysis.identification import parameter_bounds
+
+    lower, upper = parameter_bounds((1.0, 200.0), (0.5, 10.0))
+    np.testing.assert_array_equal(lower, [1.0, 0.5, 1.0, 0.5, 1.0, 0.5])
+    np.testing.assert_array_equal(upper, [200.0, 10.0, 200.0, 10.0, 200.0, 10.0])

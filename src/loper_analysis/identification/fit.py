@@ -41,6 +41,7 @@ __all__ = [
     "AT_BEST_RELATIVE",
     "ImpedanceFit",
     "check_bounds",
+    "parameter_bounds",
     "ResidualBatch",
     "initial_state_jacobian",
     "multistart_lm",
@@ -113,6 +114,13 @@ def variance_accounted_for(measured: np.ndarray, model: np.ndarray) -> np.ndarra
     den = np.sum(measured**2, axis=0)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(den > 0, 100.0 * (1.0 - num / den), np.nan)
+
+
+def parameter_bounds(stiffness_bounds, damping_bounds) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds (6,) in the order of :data:`PARAMETERS` from one (low, high) pair for every K
+    (N·m/rad) and one for every D (N·m·s/rad)."""
+    k, d = tuple(stiffness_bounds), tuple(damping_bounds)
+    return np.array([k[0], d[0]] * 3, float), np.array([k[1], d[1]] * 3, float)
 
 
 def check_bounds(lower, upper) -> tuple[np.ndarray, np.ndarray]:
