@@ -66,7 +66,7 @@ def test_no_force_no_response(params):
 
 
 def test_responses_look_like_the_study(trial):
-    """Hip ~0.1 rad and knee ~0.2 rad, peaking ~150 ms after onset (DESIGN.md section 5)."""
+    """Hip ~0.1 rad and knee ~0.2 rad, peaking ~150 ms after onset, as the study reports."""
     fine = trial.fine
     t = fine.time_s.to_numpy()
     assert len(trial.schedule) >= 5
