@@ -42,6 +42,8 @@ rule device_log_from_mat:
         sample_rate_hz=DEVICE_RATE_HZ,
     log:
         "results/logs/device_log_from_mat/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/device_log_from_mat/{subject}/{trial}.tsv"
     script:
         "../scripts/device_log_from_mat.py"
 
@@ -98,6 +100,8 @@ rule device_summary:
         reference_band_hz=DEVICE["analysis"]["bandwidth_reference_band_hz"],
     log:
         "results/logs/device_summary/summary.log",
+    benchmark:
+        "results/benchmarks/device_summary/summary.tsv"
     script:
         "../scripts/device_summary.py"
 
@@ -122,5 +126,7 @@ rule device_figures:
         ),
     log:
         "results/logs/device_figures/figures.log",
+    benchmark:
+        "results/benchmarks/device_figures/figures.tsv"
     script:
         "../scripts/device_figures.py"

@@ -101,6 +101,8 @@ rule impedance_table:
         ),
     log:
         "results/logs/impedance_table/impedance.log",
+    benchmark:
+        "results/benchmarks/impedance_table/impedance.tsv"
     script:
         "../scripts/impedance_table.py"
 
@@ -125,6 +127,8 @@ rule impedance_summary:
         upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
     log:
         "results/logs/impedance_summary/summary.log",
+    benchmark:
+        "results/benchmarks/impedance_summary/summary.tsv"
     script:
         "../scripts/impedance_summary.py"
 
@@ -152,6 +156,8 @@ rule impedance_figures:
         onsets=TRIALS["perturbation_onsets_ms"],
     log:
         "results/logs/impedance_figures/{subject}.log",
+    benchmark:
+        "results/benchmarks/impedance_figures/{subject}.tsv"
     script:
         "../scripts/impedance_figures.py"
 
@@ -168,6 +174,8 @@ rule impedance_figure:
         ),
     log:
         "results/logs/impedance_figure/impedance.log",
+    benchmark:
+        "results/benchmarks/impedance_figure/impedance.tsv"
     script:
         "../scripts/impedance_figure.py"
 
@@ -197,5 +205,7 @@ rule tables_markdown:
         headings=list(markdown_sections()),
     log:
         "results/logs/tables_markdown/tables.log",
+    benchmark:
+        "results/benchmarks/tables_markdown/tables.tsv"
     script:
         "../scripts/tables_markdown.py"

@@ -55,6 +55,8 @@ rule model_generic:
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
     log:
         "results/logs/model_generic/{subject}.log",
+    benchmark:
+        "results/benchmarks/model_generic/{subject}.tsv"
     script:
         "../scripts/model_generic.py"
 
@@ -92,6 +94,8 @@ rule model_segments:
         attachment_fraction=OPENSIM["brace_attachment_fraction"],
     log:
         "results/logs/model_segments/{subject}.log",
+    benchmark:
+        "results/benchmarks/model_segments/{subject}.tsv"
     script:
         "../scripts/model_segments.py"
 
@@ -155,6 +159,8 @@ else:
             coordinate_map=OPENSIM["coordinate_map"],
         log:
             "results/logs/ik_join/{subject}/{trial}.log",
+        benchmark:
+            "results/benchmarks/ik_join/{subject}/{trial}.tsv"
         script:
             "../scripts/ik_join.py"
 
@@ -302,6 +308,8 @@ rule transparency:
         min_strides=config["strides"]["min_valid_strides"],
     log:
         "results/logs/transparency/transparency.log",
+    benchmark:
+        "results/benchmarks/transparency/transparency.tsv"
     script:
         "../scripts/transparency.py"
 
@@ -322,5 +330,7 @@ rule strides_summary:
         min_valid=config["strides"]["min_valid_strides"],
     log:
         "results/logs/strides_summary/summary.log",
+    benchmark:
+        "results/benchmarks/strides_summary/summary.tsv"
     script:
         "../scripts/strides_summary.py"

@@ -32,6 +32,8 @@ rule synthetic_truth:
         seed=config["seed"],
     log:
         "results/logs/synthetic_truth/{subject}.log",
+    benchmark:
+        "results/benchmarks/synthetic_truth/{subject}.tsv"
     script:
         "../scripts/synthetic_truth.py"
 

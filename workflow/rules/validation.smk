@@ -10,6 +10,8 @@ rule validation_segments:
         attachment_fraction=config["validation"]["attachment_fraction_of_thigh"],
     log:
         "results/logs/validation_segments/segments.log",
+    benchmark:
+        "results/benchmarks/validation_segments/segments.tsv"
     script:
         "../scripts/validation_segments.py"
 
@@ -46,6 +48,8 @@ rule validation_gather:
         ),
     log:
         "results/logs/validation_gather/gather.log",
+    benchmark:
+        "results/benchmarks/validation_gather/gather.tsv"
     script:
         "../scripts/validation_gather.py"
 
@@ -62,5 +66,7 @@ rule validation_figure:
         ),
     log:
         "results/logs/validation_figure/figure.log",
+    benchmark:
+        "results/benchmarks/validation_figure/figure.tsv"
     script:
         "../scripts/validation_figure.py"

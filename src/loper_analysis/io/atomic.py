@@ -28,6 +28,7 @@ import pandas as pd
 import yaml
 
 from ..errors import LoperInputError
+from .timing import io_clock
 
 __all__ = [
     "PathLike",
@@ -65,7 +66,8 @@ def staged(path: str | os.PathLike, what: str = "file") -> Iterator[Path]:
     The parent directory is created when missing. ``what`` names the kind of
     file in error messages. Staging directories of the same target left by a
     writer that was killed (SIGKILL, power loss) are removed first: a target
-    has one writer at a time, so they can only be stale.
+    has one writer at a time, so they can only be stale. The body's wall
+    time counts as file I/O (:mod:`loper_analysis.io.timing`).
 
     Raises
     ------
@@ -73,6 +75,13 @@ def staged(path: str | os.PathLike, what: str = "file") -> Iterator[Path]:
         The directory cannot be created or written, or the finished file
         cannot be moved into place (the message names the path and the cause).
     """
+    with io_clock():
+        with _staged(path, what) as tmp:
+            yield tmp
+
+
+@contextlib.contextmanager
+def _staged(path: str | os.PathLike, what: str) -> Iterator[Path]:
     path = Path(path)
     directory = path.parent
     try:

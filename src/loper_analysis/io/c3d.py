@@ -57,6 +57,7 @@ from .c3d_parameters import (
     param_value,
     read_events,
 )
+from .timing import library_import, timed_io
 
 __all__ = [
     "LENGTH_UNITS_PER_M",
@@ -309,7 +310,8 @@ def _check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> Non
 
 def _open_c3d(path: Path):
     """ezc3d's reader with its exceptions turned into LoperInputError."""
-    import ezc3d
+    with library_import():
+        import ezc3d
 
     source = str(path)
     if not path.exists():
@@ -367,6 +369,7 @@ def _force_platforms_used(params) -> int:
 # ---------------------------------------------------------------- reader
 
 
+@timed_io
 def read_c3d(path: str | os.PathLike) -> C3DRecording:
     """Read markers (converted to m) and analog channels of a C3D file.
 

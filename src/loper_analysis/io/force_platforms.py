@@ -42,6 +42,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import LoperInputError
+from .timing import library_import
 from .c3d import LENGTH_UNITS_PER_M
 
 __all__ = [
@@ -117,7 +118,8 @@ def _used(params) -> int:
 
 
 def _open(path: Path, extract: bool):
-    import ezc3d
+    with library_import():
+        import ezc3d
 
     source = str(path)
     if not path.is_file():

@@ -10,10 +10,12 @@ import pandas as pd
 
 from ..errors import LoperInputError
 from .osim import quiet_opensim
+from .timing import timed_io
 
 __all__ = ["read_ik_tasks"]
 
 
+@timed_io
 def read_ik_tasks(path: str | os.PathLike) -> tuple[dict[str, float], dict[str, tuple[float, float | None]]]:
     """Marker weights and coordinate tasks from an OpenSim IK task-set XML or a TSV.
 

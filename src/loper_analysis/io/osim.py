@@ -8,19 +8,22 @@ from pathlib import Path
 
 from ..errors import LoperInputError
 from .atomic import staged
+from .timing import library_import, timed_io
 
 __all__ = ["quiet_opensim", "read_model", "write_model", "read_scale_setup", "read_marker_set"]
 
 
 def quiet_opensim():
     """Import opensim with logging at 'error' and no ``opensim.log`` file in the working directory; returns the module."""
-    import opensim
+    with library_import():
+        import opensim
 
     opensim.Logger.setLevelString("error")
     opensim.Logger.removeFileSink()
     return opensim
 
 
+@timed_io
 def read_model(path: str | os.PathLike):
     """An ``opensim.Model`` from a .osim file.
 
@@ -63,6 +66,7 @@ def write_model(model, path: str | os.PathLike) -> Path:
     return Path(path)
 
 
+@timed_io
 def read_scale_setup(path: str | os.PathLike):
     """An ``opensim.ScaleTool`` from a ScaleTool setup XML file.
 
@@ -87,6 +91,7 @@ def read_scale_setup(path: str | os.PathLike):
         raise LoperInputError(f"{path}: OpenSim cannot read this ScaleTool setup ({exc})") from exc
 
 
+@timed_io
 def read_marker_set(path: str | os.PathLike):
     """An ``opensim.MarkerSet`` from a marker-set XML file.
 

@@ -10,10 +10,12 @@ import pandas as pd
 import yaml
 
 from ..errors import LoperInputError
+from .timing import timed_io
 
 __all__ = ["read_label_map", "read_tsv", "read_yaml"]
 
 
+@timed_io
 def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str] = (), **read_csv) -> pd.DataFrame:
     """A TSV table; an empty file (zero bytes) gives an empty frame.
 
@@ -42,6 +44,7 @@ def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str
     return table
 
 
+@timed_io
 def read_yaml(path: str | os.PathLike, what: str = "YAML file"):
     """The document of a YAML file.
 
@@ -57,6 +60,7 @@ def read_yaml(path: str | os.PathLike, what: str = "YAML file"):
         raise LoperInputError(f"{path}: not a readable {what} ({exc})") from exc
 
 
+@timed_io
 def read_label_map(path: str | os.PathLike) -> dict[str, str]:
     """A marker label map {lab label: model marker} from a TSV or YAML file.
 

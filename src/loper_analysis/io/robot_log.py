@@ -55,6 +55,7 @@ import pandas as pd
 from ..checks import positive
 from ..errors import LoperInputError
 from .atomic import write_bytes
+from .timing import timed_io
 
 __all__ = [
     "FORMAT_NAME",
@@ -368,6 +369,7 @@ def _parse_floats(cells: list[str], column: str, source: str, first_line: int, t
     return out  # pragma: no cover - numpy and float() disagree
 
 
+@timed_io
 def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None) -> tuple[pd.DataFrame, dict]:
     """Read and check a robot log (format ``loper-log 1``).
 

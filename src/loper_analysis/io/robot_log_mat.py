@@ -16,6 +16,7 @@ from ..checks import positive
 from ..errors import LoperInputError
 from .atomic import write_bytes
 from .robot_log import COLUMNS, FORMAT_NAME, validated_log
+from .timing import timed_io
 
 __all__ = ["MAT_HEADER_TEXT", "MAT_OPTIONAL", "read_robot_log_mat", "write_robot_log_mat"]
 
@@ -26,6 +27,7 @@ MAT_HEADER_TEXT = "MATLAB 5.0 MAT-file, robot log written by loper-analysis"
 MAT_OPTIONAL: tuple[str, ...] = ("sync_v", "perturbation", "safety_state")
 
 
+@timed_io
 def read_robot_log_mat(
     path: str | os.PathLike,
     column_map: Mapping[str, str | None],

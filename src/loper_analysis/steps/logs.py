@@ -6,15 +6,28 @@ import contextlib
 import io
 import logging
 import os
+import time
 from collections.abc import Iterator
 
 from ..errors import one_line
 from ..io.atomic import write_text
+from ..io.timing import io_times
 
-__all__ = ["LOG_FORMAT", "rule_log"]
+__all__ = ["LOG_FORMAT", "TIMING_PREFIX", "rule_log", "timing_line"]
 
 #: One line per message: time, level, logger name, message.
 LOG_FORMAT = "%(asctime)s %(levelname)s %(name)s: %(message)s"
+#: Start of the last line of a job's log: where its time went (``benchmarks/rule_times.py`` reads it).
+TIMING_PREFIX = "job time:"
+
+
+def timing_line(end_epoch_s: float | None = None) -> str:
+    """The job's time split: wall seconds from its first file access to now, of which file I/O, and the
+    library imports made inside readers and writers (start-up, not I/O; :mod:`loper_analysis.io.timing`)."""
+    io_s, import_s, first = io_times()
+    end = time.time() if end_epoch_s is None else end_epoch_s
+    after_first = 0.0 if first is None else max(end - first, 0.0)
+    return (f"{TIMING_PREFIX} after_first_io_s={after_first:.3f} io_s={io_s:.3f} library_import_s={import_s:.3f}")
 
 
 @contextlib.contextmanager
@@ -29,6 +42,9 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     cause in one line and points to this file for the traceback. An
     interruption (``KeyboardInterrupt``, ``SystemExit``) is logged and
     propagates unchanged.
+
+    The log ends with :func:`timing_line`: with the job's benchmark file it
+    splits the job's time into start-up, file I/O and compute.
 
     Workflow scripts import only this function before entering it and
     import their step module inside it, so that even an import error ends
@@ -56,6 +72,7 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
         logging.captureWarnings(False)
         root.removeHandler(handler)
         root.setLevel(previous_level)
-        write_text(path, buffer.getvalue(), "log")
+        text = buffer.getvalue() + timing_line() + "\n"
+        write_text(path, text, "log")
     if failure is not None:
         raise SystemExit(f"{one_line(failure)} (traceback in {path})") from failure
