@@ -82,6 +82,40 @@ def test_trc_with_one_marker_round_trips(tmp_path, rng):
     np.testing.assert_allclose(markers_m, X, rtol=2e-15)
 
 
+def _opensim_trc_bytes(path, t, X, labels, unit):
+    """The same markers written by OpenSim's own TRCFileAdapter (the peer of our writer)."""
+    osim = quiet_opensim()
+    pad = [] if len(labels) > 1 else ["PAD"]  # OpenSim 4.6's packVec3 refuses a single marker
+    flat = np.hstack([X.reshape(t.size, -1), np.zeros((t.size, 3 * len(pad)))])
+    cols = [f"{lab}_{a}" for lab in [*labels, *pad] for a in "xyz"]
+    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(flat), cols).packVec3(["_x", "_y", "_z"])
+    for name in pad:
+        table.removeColumn(name)
+    rate = f"{1.0 / np.mean(np.diff(t)):.12g}"
+    table.addTableMetaDataString("DataRate", rate)
+    table.addTableMetaDataString("CameraRate", rate)
+    table.addTableMetaDataString("Units", unit)
+    osim.TRCFileAdapter().write(table, str(path))
+    return path.read_bytes()
+
+
+@pytest.mark.parametrize("rate_hz, first, n_markers, scale, unit", [
+    (128.0, 0, 36, 1.0, "mm"), (100.0, 7, 5, 1e-3, "m"), (120.0, 0, 1, 1e3, "cm"), (200.0, 3, 4, 1e-7, "mm"),
+])
+def test_trc_writer_writes_the_bytes_of_opensims_adapter(tmp_path, rng, rate_hz, first, n_markers, scale, unit):
+    t = (first + np.arange(400)) / rate_hz
+    X = scale * rng.normal(size=(t.size, n_markers, 3))
+    X[5, 0, :] = np.nan  # a missing marker
+    X[9, -1, 1] = -0.0
+    labels = [f"M{i}" for i in range(n_markers)]
+    (tmp_path / "osim").mkdir()
+    ours = write_trc(tmp_path / "m.trc", t, X, labels, unit=unit).read_bytes()
+    theirs = _opensim_trc_bytes(tmp_path / "osim" / "m.trc", t, X * {"mm": 1e3, "cm": 1e2, "m": 1.0}[unit],
+                                labels, unit)
+    theirs = theirs.replace(str(tmp_path / "osim" / "m.trc").encode(), b"m.trc", 1)  # OpenSim prints its path
+    assert ours == theirs
+
+
 def test_trc_writer_is_deterministic_across_directories(tmp_path, rng):
     t = np.arange(N_FRAMES) / POINT_HZ
     X = lab_markers(rng)

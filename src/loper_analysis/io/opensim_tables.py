@@ -1,19 +1,17 @@
 """OpenSim's text formats (TRC markers, MOT/STO coordinates) through OpenSim's own adapters.
 
 TRC (:func:`write_trc`, :func:`read_markers`)
-    Written with ``opensim.TRCFileAdapter``, which needs the table metadata
-    ``DataRate`` and ``Units`` (it refuses to write without them) and fills in
-    ``CameraRate`` (set here equal to ``DataRate``), ``NumFrames``,
-    ``NumMarkers``, ``OrigDataRate``, ``OrigDataStartFrame`` and
-    ``OrigNumFrames`` itself. Missing markers are written as ``nan`` and read
-    back as NaN. OpenSim prints the path it was given in the first line
-    (``PathFileType 4 (X/Y/Z) <path>``); the writer puts the bare file name
-    there so the bytes do not depend on the directory. Reading takes the
-    unit from the ``Units`` metadata (mm, cm or m) and refuses a file
-    without it, since OpenSim itself would silently assume metres.
-    ``TimeSeriesTable.packVec3`` of OpenSim 4.6 fails on a single marker
-    ("Cannot guess the suffix"); the writer packs a padding marker and
-    removes it again.
+    Written byte for byte as ``opensim.TRCFileAdapter`` writes it (header
+    ``DataRate``, ``CameraRate`` = ``DataRate``, ``NumFrames``,
+    ``NumMarkers``, ``Units``, ``OrigDataRate``, ``OrigDataStartFrame`` = 0,
+    ``OrigNumFrames``; values to 16 significant digits, missing markers as
+    ``nan``), but formatted here: the adapter needs OpenSim imported (0.7 s
+    per process) and a table built first, and is slower on long trials;
+    ``tests/io/test_opensim_tables.py`` checks the bytes against OpenSim's
+    adapter. The first line (``PathFileType 4 (X/Y/Z) <name>``) holds the
+    bare file name, so the bytes do not depend on the directory. Reading
+    takes the unit from the ``Units`` metadata (mm, cm or m) and refuses a
+    file without it, since OpenSim itself would silently assume metres.
 
 MOT/STO (:func:`write_mot`, :func:`read_mot`)
     Written with ``opensim.STOFileAdapter`` (header name line
@@ -48,6 +46,7 @@ from ..errors import LoperInputError
 from .atomic import staged
 from .c3d import LENGTH_UNITS_PER_M, read_c3d
 from .osim import quiet_opensim
+from .timing import timed_io
 
 __all__ = [
     "TRANSLATION_SUFFIXES",
@@ -77,21 +76,8 @@ def _open_table(osim, path: Path, kind: str, what: str):
 # ---------------------------------------------------------------- TRC
 
 
-def _vec3_table(osim, t: np.ndarray, X: np.ndarray, labels: list[str]):
-    """``TimeSeriesTableVec3`` from (n,) and (n, m, 3); pads one marker around OpenSim's packVec3 bug."""
-    pad = "PAD"
-    while pad in labels:
-        pad += "_"
-    flat = np.hstack([X.reshape(t.size, -1), np.zeros((t.size, 3))])
-    cols = [f"{lab}_{a}" for lab in [*labels, pad] for a in "xyz"]
-    table = osim.TimeSeriesTable(t.tolist(), osim.Matrix.createFromMat(flat), cols)
-    v3 = table.packVec3(["_x", "_y", "_z"])
-    v3.removeColumn(pad)
-    return v3
-
-
 def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str], unit: str = "mm") -> Path:
-    """Write marker trajectories to a TRC file with OpenSim's ``TRCFileAdapter``, atomically; returns ``path``.
+    """Write marker trajectories to a TRC file as OpenSim's ``TRCFileAdapter`` does, atomically; returns ``path``.
 
     Parameters
     ----------
@@ -127,29 +113,23 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
     labels = unique_names(labels, "labels", source, allow_whitespace=False)
     if np.any(np.isinf(X)):
         raise LoperInputError(f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})")
-    rate = 1.0 / uniform_step_s(t, source)
-    osim = quiet_opensim()
-    table = _vec3_table(osim, t, X * LENGTH_UNITS_PER_M[unit], labels)
-    table.addTableMetaDataString("DataRate", f"{rate:.12g}")
-    table.addTableMetaDataString("CameraRate", f"{rate:.12g}")
-    table.addTableMetaDataString("Units", unit)
-    with staged(path, "TRC file") as tmp:
-        try:
-            osim.TRCFileAdapter().write(table, str(tmp))
-        except Exception as exc:
-            raise LoperInputError(f"{source}: OpenSim could not write the TRC file: {exc}") from exc
-        _name_in_first_line(tmp, path.name)
+    rate = f"{1.0 / uniform_step_s(t, source):.12g}"
+    values = (X * LENGTH_UNITS_PER_M[unit]).reshape(t.size, -1)
+    n, m = t.size, len(labels)
+    head = [
+        f"PathFileType\t4\t(X/Y/Z)\t{path.name}",
+        "DataRate\tCameraRate\tNumFrames\tNumMarkers\tUnits\tOrigDataRate\tOrigDataStartFrame\tOrigNumFrames",
+        f"{rate}\t{rate}\t{n}\t{m}\t{unit}\t{rate}\t0\t{n}",
+        "Frame#\tTime\t" + "".join(f"{label}\t\t\t" for label in labels),
+        "\t\t" + "".join(f"X{i}\tY{i}\tZ{i}\t" for i in range(1, m + 1)),
+        "",
+    ]
+    row = "%d\t%.16g\t" + "%.16g\t" * (3 * m)  # OpenSim's own layout and precision
+    body = [row % (k + 1, t[k], *values[k]) for k in range(n)]
+    with staged(path, "TRC file") as tmp, tmp.open("w", encoding="utf-8", newline="\n") as fh:
+        fh.write("\n".join(head) + "\n")
+        fh.write("\n".join(body) + "\n")
     return path
-
-
-def _name_in_first_line(tmp: Path, name: str) -> None:
-    """Replace the path OpenSim printed in ``PathFileType 4 (X/Y/Z) <path>`` by the bare file name."""
-    data = tmp.read_bytes()
-    first, sep, rest = data.partition(b"\n")
-    fields = first.split(b"\t")
-    if fields and fields[0] == b"PathFileType" and len(fields) >= 4:
-        fields[3] = name.encode("utf-8")
-        tmp.write_bytes(b"\t".join(fields) + sep + rest)
 
 
 def _read_trc_text(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]] | None:
@@ -207,6 +187,7 @@ def _read_trc(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     return t, flat.reshape(t.size, len(labels), 3) / LENGTH_UNITS_PER_M[unit.lower()], labels
 
 
+@timed_io
 def read_markers(path: str | os.PathLike) -> tuple[np.ndarray, np.ndarray, list[str]]:
     """Marker trajectories in metres from a ``.trc`` (OpenSim) or ``.c3d`` (ezc3d) file.
 
@@ -329,6 +310,7 @@ def write_storage(path: Path, time_s: np.ndarray, values: np.ndarray, names: lis
     return path
 
 
+@timed_io
 def read_mot(path: str | os.PathLike) -> pd.DataFrame:
     """Read an OpenSim ``.mot``/``.sto`` coordinate file (any OpenSim version) with angles in rad.
 
