@@ -13,8 +13,6 @@ from numbers import Integral
 
 import numpy as np
 import pandas as pd
-from scipy.interpolate import CubicSpline
-from scipy.spatial.transform import Rotation
 
 from .errors import LoperInputError
 
@@ -124,6 +122,8 @@ def fill_gaps(
         and lists every such marker with its first and last missing frame
         and the gap length.
     """
+    from scipy.interpolate import CubicSpline  # here, not at the top: IK imports this module
+
     where = source or "markers"
     X = _check_markers(markers_m, where)
     labels = [str(lab) for lab in labels]
@@ -302,6 +302,8 @@ def rotate_markers(markers_m, rotation_deg: Sequence[float]) -> np.ndarray:
     LoperInputError
         If the last axis is not 3 or ``rotation_deg`` is not 3 finite numbers.
     """
+    from scipy.spatial.transform import Rotation
+
     X = np.asarray(markers_m, dtype=float)
     if X.ndim < 1 or X.shape[-1] != 3:
         raise LoperInputError(f"markers_m must have shape (..., 3), got {X.shape}")
