@@ -382,7 +382,7 @@ def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
     jobs = [(name, (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0])
             for name, body in zip(blocks[::2], blocks[1::2])]
     rules = {name for name, _ in jobs}
-    assert rules == {"markers", "ik", "events", "loadcell", "strides", "strides_summary",
+    assert rules == {"markers", "ik", "events_loadcell", "strides", "strides_summary",
                      "impedance_fit", "impedance_table", "impedance_summary", "impedance_figures", "impedance_figure",
                      "tables_markdown", "planning", "all"}, rules
     trials = {w.split("trial=")[1].split(",")[0] for _, w in jobs if "trial=" in w}

@@ -302,7 +302,7 @@ def test_bad_robot_log_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab)
     (lab / RAW / "pert050-1.loper.tsv").write_text("".join(_nan_at(_log_lines(lab), 20, 2)))
     _refused(lab, lambda: _snakemake(lab, f"results/loadcell/{SUBJECT}/pert050-1.force.tsv"),
              [(f"{RAW}/pert050-1.loper.tsv: column 'force_measured_n', sample 16 (t = 0.016 s, line 21): "
-               "non-finite force nan")], log=f"results/logs/loadcell/{SUBJECT}/pert050-1.log")
+               "non-finite force nan")], log=f"results/logs/events_loadcell/{SUBJECT}/pert050-1.log")
 
 
 # --------------------------------------------------------------------------- subjects and config (before any work)

@@ -251,3 +251,26 @@ def test_transparency_without_any_subject_left_writes_empty_group_rows(lab, tmp_
     force = pd.read_csv(tmp_path / "force.tsv", sep="\t")
     assert force.subject.tolist() == ["S98", "S98", "all", "all"] and force.n_strides.tolist() == [1, 1, 0, 0]
     assert (tmp_path / "t.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_events_and_loadcell_from_one_reading_write_the_bytes_of_the_two_steps(lab, tmp_path):
+    """The workflow's one-process step for trials with the device against the two steps run on their own."""
+    d = lab["dir"]
+    grf = {"left": "Fz_left", "right": "Fz_right"}
+    processing.events(d / "walk.c3d", tmp_path / "alone.events.tsv", grf, contacts_out=tmp_path / "alone.contacts.tsv")
+    processing.loadcell(d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "alone.force.tsv",
+                        native_out=tmp_path / "alone.native.tsv")
+    table, force = processing.events_loadcell(
+        d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "one.events.tsv", tmp_path / "one.contacts.tsv",
+        tmp_path / "one.force.tsv", tmp_path / "one.native.tsv", {"grf_channels": grf}, {"cutoff_hz": 40.0})
+    for kind in ("events", "contacts", "force", "native"):
+        assert (tmp_path / f"one.{kind}.tsv").read_bytes() == (tmp_path / f"alone.{kind}.tsv").read_bytes(), kind
+    assert len(table) == len(lab["found"]) and len(force) == len(lab["force"])
+
+
+def test_events_and_loadcell_refuse_an_unknown_setting(lab, tmp_path):
+    d = lab["dir"]
+    with pytest.raises(TypeError, match=r"events: unknown setting\(s\) \['treshold_on_n'\]"):
+        processing.events_loadcell(d / "walk.c3d", d / "walk.loper.tsv", *(tmp_path / f"x.{k}" for k in "abcd"),
+                                   {"treshold_on_n": 50.0})
+    assert not list(tmp_path.iterdir())  # nothing written

@@ -14,23 +14,31 @@ def null_pair_trials(subject: str) -> list[str]:
     return [t for t in subject_trials(subject) if t != config["trials"]["no_device"]]
 
 
+ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
+
+
+def fit_trials(subject: str) -> list[str]:
+    """The subject's trials any of its fits reads, in subject_trials order: the onsets' own trials and the
+    null-pair trials."""
+    used = {t for o in ONSETS for t in onset_trials(subject, o) + fit_null_trials(subject, o)}
+    return [t for t in subject_trials(subject) if t in used]
+
+
 def fit_inputs(wildcards):
-    """Files of the fit: the onset's trials (angles, strides, force at 128 Hz and at the robot rate, markers in the
-    order of onset_trials), the null-pair trials (angles, strides in the order of null_pair_trials), the segment
-    table and a synthetic truth."""
+    """Files of a subject's fits: angles and strides of every trial a fit reads (order of fit_trials), the force
+    at 128 Hz and at the robot rate and the markers of the perturbation trials (order of their onsets' trials),
+    the segment table and a synthetic truth."""
     s = wildcards.subject
     out = {"segments": f"results/model/{s}/segments.tsv"}
     if SUBJECT_SOURCE[s] == "synthetic":
         out["truth"] = f"data/raw/{s}/truth.yaml"
-    own = onset_trials(s, wildcards.onset)
-    out["angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in own]
-    out["strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in own]
+    used = fit_trials(s)
+    out["angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in used]
+    out["strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in used]
+    own = [t for o in ONSETS for t in onset_trials(s, o)]
     out["force"] = [f"results/loadcell/{s}/{t}.force.tsv" for t in own]
     out["force_native"] = [f"results/loadcell/{s}/{t}.force_native.tsv" for t in own]
     out["markers"] = [f"results/markers/{s}/{t}.trc" for t in own]
-    null = fit_null_trials(s, wildcards.onset)
-    out["null_angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in null]
-    out["null_strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in null]
     return out
 
 
@@ -42,19 +50,22 @@ def fit_null_trials(subject: str, onset: str) -> list[str]:
 
 
 rule impedance_fit:
+    """Responses and impedance fits of one subject at every onset, in one job: the onsets share the null-pair
+    trials, so a change to any of the subject's trials reruns every onset's fit anyway."""
     input:
         unpack(fit_inputs),
     output:
-        response="results/responses/{subject}/{onset}.response.tsv",
-        counts="results/responses/{subject}/{onset}.counts.tsv",
-        fit="results/impedance/{subject}/{onset}.tsv",
-        curves="results/impedance/{subject}/{onset}.curves.tsv",
-        force="results/responses/{subject}/{onset}.force.tsv",
-    wildcard_constraints:
-        onset=r"[0-9]{3}",
+        response=expand("results/responses/{{subject}}/{onset}.response.tsv", onset=ONSETS),
+        counts=expand("results/responses/{{subject}}/{onset}.counts.tsv", onset=ONSETS),
+        fit=expand("results/impedance/{{subject}}/{onset}.tsv", onset=ONSETS),
+        curves=expand("results/impedance/{{subject}}/{onset}.curves.tsv", onset=ONSETS),
+        force=expand("results/responses/{{subject}}/{onset}.force.tsv", onset=ONSETS),
     params:
-        trials=lambda wc: onset_trials(wc.subject, wc.onset),
-        null_trials=lambda wc: fit_null_trials(wc.subject, wc.onset),
+        onsets_ms=TRIALS["perturbation_onsets_ms"],
+        trials=lambda wc: {o: onset_trials(wc.subject, o) for o in ONSETS},
+        null_trials=lambda wc: {o: fit_null_trials(wc.subject, o) for o in ONSETS},
+        fit_trials=lambda wc: fit_trials(wc.subject),
+        own_trials=lambda wc: [t for o in ONSETS for t in onset_trials(wc.subject, o)],
         response=dict(
             window_before_s=IDENT["window_before_s"],
             window_after_s=IDENT["window_after_s"],
@@ -82,9 +93,9 @@ rule impedance_fit:
             seed=config["seed"],
         ),
     log:
-        "results/logs/impedance_fit/{subject}/{onset}.log",
+        "results/logs/impedance_fit/{subject}.log",
     benchmark:
-        "results/benchmarks/impedance_fit/{subject}/{onset}.tsv"
+        "results/benchmarks/impedance_fit/{subject}.tsv"
     script:
         "../scripts/impedance_fit.py"
 

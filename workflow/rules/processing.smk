@@ -184,36 +184,6 @@ rule grf:
         "../scripts/grf.py"
 
 
-rule events:
-    """Heel strikes and toe-offs: force platforms with the heel markers, or the named GRF channels of each belt."""
-    input:
-        c3d="data/raw/{subject}/{trial}.c3d",
-        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
-    output:
-        events="results/events/{subject}/{trial}.events.tsv",
-        contacts="results/events/{subject}/{trial}.contacts.tsv",
-    params:
-        grf_channels=EVENTS["grf_channels"],
-        threshold_on_n=EVENTS["threshold_on_n"],
-        threshold_off_n=EVENTS["threshold_off_n"],
-        min_stance_s=EVENTS["min_stance_s"],
-        min_swing_s=EVENTS["min_swing_s"],
-        cutoff_hz=EVENTS["grf_cutoff_hz"],
-        order=FILTER["order"],
-        foot_markers=EVENTS["foot_markers"],
-        plate_sides=EVENTS["plate_sides"],
-        label_map=LABEL_MAP or None,
-        rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
-        band_n=config["grf"]["resting_band_n"],
-        max_rest_n=config["grf"]["max_resting_n"],
-    log:
-        "results/logs/events/{subject}/{trial}.log",
-    benchmark:
-        "results/benchmarks/events/{subject}/{trial}.tsv"
-    script:
-        "../scripts/events.py"
-
-
 def robot_log(wildcards):
     """A trial's robot log: data/raw/{subject}/{trial}.loper.tsv, or converted from the MATLAB export {trial}.mat."""
     raw = Path("data/raw") / wildcards.subject
@@ -223,23 +193,69 @@ def robot_log(wildcards):
     return str(raw / f"{wildcards.trial}.loper.tsv")
 
 
-rule loadcell:
+EVENT_SETTINGS = dict(
+    grf_channels=EVENTS["grf_channels"],
+    threshold_on_n=EVENTS["threshold_on_n"],
+    threshold_off_n=EVENTS["threshold_off_n"],
+    min_stance_s=EVENTS["min_stance_s"],
+    min_swing_s=EVENTS["min_swing_s"],
+    cutoff_hz=EVENTS["grf_cutoff_hz"],
+    order=FILTER["order"],
+    foot_markers=EVENTS["foot_markers"],
+    plate_sides=EVENTS["plate_sides"],
+    label_map=LABEL_MAP or None,
+    rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
+    band_n=config["grf"]["resting_band_n"],
+    max_rest_n=config["grf"]["max_resting_n"],
+)
+LOADCELL_SETTINGS = dict(sync_channel=EVENTS["sync_channel"], cutoff_hz=FILTER["cutoff_hz"], order=FILTER["order"])
+
+
+rule events:
+    """Heel strikes and toe-offs of the trial without the device: force platforms with the heel markers, or the
+    named GRF channels of each belt."""
     input:
         c3d="data/raw/{subject}/{trial}.c3d",
+        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
+    output:
+        events="results/events/{subject}/{trial}.events.tsv",
+        contacts="results/events/{subject}/{trial}.contacts.tsv",
+    wildcard_constraints:
+        trial=TRIALS["no_device"],
+    params:
+        settings=EVENT_SETTINGS,
+    log:
+        "results/logs/events/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/events/{subject}/{trial}.tsv"
+    script:
+        "../scripts/events.py"
+
+
+rule events_loadcell:
+    """Gait events and the load cell of a trial with the device, in one process that reads the C3D once: the
+    heel strikes and toe-offs (as rule events), and the robot log's force on the mocap frames and at its own
+    rate. Both feed only the stride table, so a change of either's settings reruns a cheap sibling at most."""
+    input:
+        c3d="data/raw/{subject}/{trial}.c3d",
+        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
         log=robot_log,
     output:
+        events="results/events/{subject}/{trial}.events.tsv",
+        contacts="results/events/{subject}/{trial}.contacts.tsv",
         force="results/loadcell/{subject}/{trial}.force.tsv",
         native="results/loadcell/{subject}/{trial}.force_native.tsv",
+    wildcard_constraints:
+        trial=f"(?!{TRIALS['no_device']}$)[A-Za-z0-9-]+",
     params:
-        sync_channel=EVENTS["sync_channel"],
-        cutoff_hz=FILTER["cutoff_hz"],
-        order=FILTER["order"],
+        events=EVENT_SETTINGS,
+        loadcell=LOADCELL_SETTINGS,
     log:
-        "results/logs/loadcell/{subject}/{trial}.log",
+        "results/logs/events_loadcell/{subject}/{trial}.log",
     benchmark:
-        "results/benchmarks/loadcell/{subject}/{trial}.tsv"
+        "results/benchmarks/events_loadcell/{subject}/{trial}.tsv"
     script:
-        "../scripts/loadcell.py"
+        "../scripts/events_loadcell.py"
 
 
 def stride_force(wildcards):

@@ -4,7 +4,9 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import impedance
 
     inp, out, p = snakemake.input, snakemake.output, snakemake.params
-    impedance.fit(p.trials, inp.angles, inp.strides, inp.force, inp.markers, inp.segments,
-                  int(snakemake.wildcards.onset), snakemake.wildcards.subject, out.response, out.counts, out.fit,
-                  out.curves, inp.get("truth"), p.null_trials, inp.null_angles, inp.null_strides, p.response,
-                  p.identification, force_native=inp.force_native, force_out=out.force)
+    impedance.subject_fits(
+        p.onsets_ms, p.trials, p.null_trials, dict(zip(p.fit_trials, inp.angles, strict=True)),
+        dict(zip(p.fit_trials, inp.strides, strict=True)), dict(zip(p.own_trials, inp.force, strict=True)),
+        dict(zip(p.own_trials, inp.force_native, strict=True)), dict(zip(p.own_trials, inp.markers, strict=True)),
+        inp.segments, snakemake.wildcards.subject, out.response, out.counts, out.fit, out.curves, out.force,
+        inp.get("truth"), p.response, p.identification)

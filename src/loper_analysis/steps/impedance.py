@@ -12,7 +12,7 @@ from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_figure, write_tsv
 from ..io.readers import read_tsv, read_yaml
 
-__all__ = ["fit", "impedance_table", "impedance_summary", "subject_figures", "impedance_figure"]
+__all__ = ["fit", "subject_fits", "impedance_table", "impedance_summary", "subject_figures", "impedance_figure"]
 
 log = logging.getLogger(__name__)
 
@@ -50,6 +50,15 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
     :class:`~loper_analysis.impedance.IdentificationSettings`. Writes the
     mean response, the stride counts, the fit rows and the fit curves; returns the rows.
     """
+    return _fit(trials, angles, strides, force, markers, segments_tsv, onset_ms, subject, response_out, counts_out,
+                fit_out, curves_out, truth_yaml, null_trials, null_angles, null_strides, response, identification,
+                force_native, force_out, _Tables())
+
+
+def _fit(trials, angles, strides, force, markers, segments_tsv, onset_ms, subject, response_out, counts_out, fit_out,
+         curves_out, truth_yaml, null_trials, null_angles, null_strides, response, identification, force_native,
+         force_out, tables: _Tables) -> pd.DataFrame:
+    """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
     from ..impedance import IdentificationSettings, fit_onset
     from ..io.opensim_tables import read_markers
     from ..responses import ResponseSettings
@@ -61,7 +70,6 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
     truth = None
     if truth_yaml:
         truth = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml)).get(int(onset_ms))
-    tables = _Tables()
     inputs = []
     natives = list(force_native) if len(force_native) else [None] * len(trials)
     for name, a, s, f, m, fn in zip(trials, angles, strides, force, markers, natives, strict=True):
@@ -85,6 +93,35 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
         write_tsv(result.force, force_out)
     log.info("impedance:\n%s", result.rows.to_string(index=False))
     return result.rows
+
+
+def subject_fits(onsets_ms: Sequence[int], trials: Mapping[str, Sequence[str]],
+                 null_trials: Mapping[str, Sequence[str]], angles: Mapping[str, PathLike],
+                 strides: Mapping[str, PathLike], force: Mapping[str, PathLike],
+                 force_native: Mapping[str, PathLike], markers: Mapping[str, PathLike], segments_tsv: PathLike,
+                 subject: str, response_outs: Sequence[PathLike], counts_outs: Sequence[PathLike],
+                 fit_outs: Sequence[PathLike], curves_outs: Sequence[PathLike], force_outs: Sequence[PathLike],
+                 truth_yaml: PathLike | None = None, response: Mapping | None = None,
+                 identification: Mapping | None = None) -> pd.DataFrame:
+    """:func:`fit` of one subject at every onset in one process, each table read once.
+
+    ``trials`` and ``null_trials`` map each onset (``"050"``, in the order of
+    ``onsets_ms``) to its own trials and its null-pair trials; ``angles``,
+    ``strides``, ``force``, ``force_native`` and ``markers`` map trial names
+    to their files. The outputs are per onset, in the order of ``onsets_ms``.
+    Returns every onset's fit rows.
+    """
+    tables = _Tables()
+    rows = []
+    for i, onset in enumerate(onsets_ms):
+        key = f"{int(onset):03d}"
+        own, null = list(trials[key]), list(null_trials[key])
+        rows.append(_fit(own, [angles[t] for t in own], [strides[t] for t in own], [force[t] for t in own],
+                         [markers[t] for t in own], segments_tsv, int(onset), subject, response_outs[i],
+                         counts_outs[i], fit_outs[i], curves_outs[i], truth_yaml, null, [angles[t] for t in null],
+                         [strides[t] for t in null], response, identification, [force_native[t] for t in own],
+                         force_outs[i], tables))
+    return pd.concat(rows, ignore_index=True)
 
 
 def impedance_table(fit_tsvs: Sequence[PathLike], out_tsv: PathLike) -> pd.DataFrame:

@@ -13,7 +13,7 @@ from ..errors import one_line
 from ..io.atomic import write_text
 from ..io.timing import io_times
 
-__all__ = ["LOG_FORMAT", "TIMING_PREFIX", "rule_log", "timing_line"]
+__all__ = ["LOG_FORMAT", "PROFILE_VARIABLE", "TIMING_PREFIX", "rule_log", "timing_line"]
 
 #: One line per message: time, level, logger name, message.
 LOG_FORMAT = "%(asctime)s %(levelname)s %(name)s: %(message)s"
@@ -28,6 +28,22 @@ def timing_line(end_epoch_s: float | None = None) -> str:
     end = time.time() if end_epoch_s is None else end_epoch_s
     after_first = 0.0 if first is None else max(end - first, 0.0)
     return (f"{TIMING_PREFIX} after_first_io_s={after_first:.3f} io_s={io_s:.3f} library_import_s={import_s:.3f}")
+
+
+#: Environment variable: when set (to anything but "" or "0"), every job also writes a cProfile of its body
+#: next to its log (``{log}.prof``; read it with ``python -m pstats``).
+PROFILE_VARIABLE = "LOPER_PROFILE"
+
+
+def _profiler():
+    """A running cProfile when :data:`PROFILE_VARIABLE` asks for one, else None."""
+    if os.environ.get(PROFILE_VARIABLE, "") in ("", "0"):
+        return None
+    import cProfile
+
+    profiler = cProfile.Profile()
+    profiler.enable()
+    return profiler
 
 
 @contextlib.contextmanager
@@ -60,6 +76,7 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     logging.captureWarnings(True)
     log = logging.getLogger("loper_analysis.rule")
     failure = None
+    profiler = _profiler()
     try:
         yield log
     except Exception as exc:
@@ -69,6 +86,9 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
         log.exception("%s: %s", type(exc).__name__, exc)
         raise
     finally:
+        if profiler is not None:
+            profiler.disable()
+            profiler.dump_stats(f"{path}.prof")
         logging.captureWarnings(False)
         root.removeHandler(handler)
         root.setLevel(previous_level)

@@ -18,7 +18,7 @@ from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_tsv
 from ..io.readers import read_tsv
 
-__all__ = ["markers", "events", "loadcell", "strides", "strides_summary"]
+__all__ = ["markers", "events", "loadcell", "events_loadcell", "strides", "strides_summary"]
 
 log = logging.getLogger(__name__)
 
@@ -126,10 +126,20 @@ def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str
     low-passes it first (zero-phase Butterworth; None thresholds the raw
     force: a 40 Hz filter moves a 20 N toe-off threshold by about 4.5 ms).
     """
-    from ..contacts import count_flagged
     from ..io.c3d import read_c3d
 
-    rec = read_c3d(c3d_path)
+    return _events_of(read_c3d(c3d_path), out_tsv, grf_channels, threshold_on_n, threshold_off_n, min_stance_s,
+                      min_swing_s, cutoff_hz, order, foot_markers, plate_sides, label_map, rotation_deg, band_n,
+                      max_rest_n, contacts_out)
+
+
+def _events_of(rec, out_tsv, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz,
+               order, foot_markers, plate_sides, label_map, rotation_deg, band_n, max_rest_n,
+               contacts_out) -> pd.DataFrame:
+    """:func:`events` of a C3D already read."""
+    from ..contacts import count_flagged
+
+    c3d_path = rec.source
     if rec.n_force_platforms:
         table, contacts = _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n,
                                         threshold_off_n, min_stance_s, min_swing_s, band_n, max_rest_n)
@@ -202,10 +212,16 @@ def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_cha
     ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
     """
     from ..io.c3d import read_c3d
+
+    return _loadcell_of(read_c3d(c3d_path), log_path, out_tsv, sync_channel, cutoff_hz, order, native_out)
+
+
+def _loadcell_of(rec, log_path, out_tsv, sync_channel, cutoff_hz, order, native_out) -> pd.DataFrame:
+    """:func:`loadcell` of a C3D already read."""
     from ..io.robot_log import read_robot_log
     from ..loadcell import robot_log_frames_and_native
 
-    rec = read_c3d(c3d_path)
+    c3d_path = rec.source
     frame, meta = read_robot_log(log_path)
     rate = float(meta["sample_rate_hz"])
     out, native = robot_log_frames_and_native(frame, rate, rec.analog(sync_channel), rec.analog_rate_hz, rec.time_s,
@@ -219,6 +235,35 @@ def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_cha
         write_tsv(native, native_out, NATIVE_FLOAT_FORMAT)
         log.info("%d robot samples on the mocap clock", len(native))
     return out
+
+
+def events_loadcell(c3d_path: PathLike, log_path: PathLike, events_out: PathLike, contacts_out: PathLike,
+                    force_out: PathLike, native_out: PathLike, events_settings: Mapping | None = None,
+                    loadcell_settings: Mapping | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`events` and :func:`loadcell` of one trial with the device, from one reading of its C3D.
+
+    ``events_settings`` and ``loadcell_settings`` are the keyword arguments of
+    :func:`events` and :func:`loadcell` (without paths). Returns the event
+    table and the force table on the mocap frames.
+    """
+    from ..io.c3d import read_c3d
+
+    e, f = dict(events_settings or {}), dict(loadcell_settings or {})
+    for given, func in ((e, events), (f, loadcell)):
+        unknown = set(given) - set(_keyword_defaults(func)) - {"contacts_out", "native_out"}
+        if unknown:
+            raise TypeError(f"{func.__name__}: unknown setting(s) {sorted(unknown)}")
+    rec = read_c3d(c3d_path)
+    table = _events_of(rec, events_out, **{**_keyword_defaults(events), **e, "contacts_out": contacts_out})
+    force = _loadcell_of(rec, log_path, force_out, **{**_keyword_defaults(loadcell), **f, "native_out": native_out})
+    return table, force
+
+
+def _keyword_defaults(func) -> dict:
+    """Keyword defaults of a step function."""
+    import inspect
+
+    return {k: v.default for k, v in inspect.signature(func).parameters.items() if v.default is not inspect.Parameter.empty}
 
 
 def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, cycles_out: PathLike, force_tsv: PathLike | None = None,
