@@ -23,7 +23,6 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 import pandas as pd
-from scipy.integrate import solve_ivp
 
 from . import kernels
 from .anthropometry import (
@@ -390,6 +389,8 @@ def simulate(
 
     Returns q (n, 4) and q' (n, 4) at ``time_s``.
     """
+    from scipy.integrate import solve_ivp  # here: scipy.integrate costs ~0.4 s, and fits never integrate with it
+
     t = np.asarray(time_s, dtype=float)
     if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise LoperInputError("time_s must be a finite, strictly increasing 1-D array of >= 2 samples")

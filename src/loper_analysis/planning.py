@@ -48,7 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.stats import t as student_t
+from scipy.special import stdtrit  # Student's t quantile, as scipy.stats.t.ppf computes it
 
 from .checks import integer, number
 from .constants import JOINTS, PARAMETER_UNITS, PARAMETERS
@@ -177,7 +177,7 @@ class StrideCovariance:
     def t95(self, n_strides: int) -> float:
         """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof)."""
         dof = int(n_strides) - 1 if self.dof is None else int(self.dof)
-        return float(student_t.ppf(0.975, dof)) if dof >= 1 else math.inf
+        return float(stdtrit(dof, 0.975)) if dof >= 1 else math.inf
 
     def half_width(self, n_strides: int) -> np.ndarray:
         """Predicted 95 % CI half-width (6,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
@@ -447,7 +447,7 @@ def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, 
         return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
 
     # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96
-    n = max(1, int(math.ceil((student_t.ppf(0.975, 10 ** 6) * sd1 / target) ** 2 * (1 - 1e-12))))
+    n = max(1, int(math.ceil((stdtrit(10 ** 6, 0.975) * sd1 / target) ** 2 * (1 - 1e-12))))
     while not meets(n):
         t = stride_cov.t95(n)
         n = n + 1 if not math.isfinite(t) else max(n + 1, int(math.ceil((t * sd1 / target) ** 2 * (1 - 1e-12))))
