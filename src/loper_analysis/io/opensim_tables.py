@@ -76,6 +76,7 @@ def _open_table(osim, path: Path, kind: str, what: str):
 # ---------------------------------------------------------------- TRC
 
 
+@timed_io
 def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str], unit: str = "mm") -> Path:
     """Write marker trajectories to a TRC file as OpenSim's ``TRCFileAdapter`` does, atomically; returns ``path``.
 

@@ -46,7 +46,8 @@ def io_clock() -> Iterator[None]:
 
 @contextlib.contextmanager
 def library_import() -> Iterator[None]:
-    """Count the body (the first import of a file library: OpenSim, ezc3d) as start-up, not I/O."""
+    """Count the body (the first import of a heavy library: OpenSim, ezc3d, scipy.signal) as start-up, not I/O or
+    compute."""
     start = time.perf_counter()
     try:
         yield
