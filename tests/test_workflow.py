@@ -365,6 +365,40 @@ def test_a_killed_run_recovers_to_the_bytes_of_an_uninterrupted_one(finished_run
     assert [str(p) for p in ours if ours[p] != clean[p]] == []
 
 
+def _dry_run_rules(work: Path, *args: str) -> dict[str, set[str]]:
+    """Rules a dry run would run, with the trials of their jobs (empty set for jobs without a trial)."""
+    import re
+
+    res = _snakemake(work, "-n", *args)
+    assert res.returncode == 0, res.stderr[-3000:]
+    blocks = re.split(r"^(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
+    rules: dict[str, set[str]] = {}
+    for name, body in zip(blocks[::2], blocks[1::2]):
+        wildcards = (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0]
+        trial = wildcards.split("trial=")[1].split(",")[0] if "trial=" in wildcards else None
+        rules.setdefault(name, set()).update([trial] if trial else [])
+    return rules
+
+
+@pytest.mark.parametrize("section, key, value, expected", [
+    # a stride setting: the stride tables and what reads them, never IK
+    ("strides", "iqr_whisker", 2.0, {"strides", "strides_summary", "impedance_fit", "transparency"}),
+    # a gait-event setting: events (and their load-cell sibling in the one job of a device trial), then strides
+    ("events", "threshold_on_n", 60.0, {"events", "events_loadcell", "strides", "strides_summary", "impedance_fit",
+                                        "transparency"}),
+    # a setting of the subjects' fits only (the validation study does not use it)
+    ("identification", "min_vaf_pct", 1.0, {"impedance_fit"}),
+])
+def test_a_changed_setting_reruns_only_what_depends_on_it(finished_run, tmp_path, section, key, value, expected):
+    overlay = tmp_path / "overlay.yaml"
+    overlay.write_text(yaml.safe_dump({section: {key: value}}))
+    rules = _dry_run_rules(finished_run, "--configfile", "config/config.yaml", str(overlay))
+    aggregates = {"impedance_table", "impedance_summary", "impedance_figures", "impedance_figure", "tables_markdown",
+                  "planning", "all"}
+    assert set(rules) - aggregates == expected, rules
+    assert not {"markers", "ik", "model_scaled", "synthetic_lab", "validation_chunk"} & set(rules)
+
+
 def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
     """Last in this file: it changes a raw file's time (and restores it)."""
     import os
