@@ -331,7 +331,9 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
     assert res.returncode == 0, res.stderr[-2000:]
     trials = set(re.findall(r"^\s+wildcards: subject=R01, trial=(\S+)$", res.stdout, re.MULTILINE))
     assert trials == {WALK}  # its IK and strides: markers, events and forces are already there
-    assert re.search(r"^\s+wildcards: subject=R01, onset=050$", res.stdout, re.MULTILINE)
+    fit = re.search(r"^rule impedance_fit:$(.*?)^$", res.stdout, re.MULTILINE | re.DOTALL)  # every onset's fit
+    assert fit and re.search(r"^\s+wildcards: subject=R01$", fit.group(1), re.MULTILINE)
+    assert "results/impedance/R01/050.tsv" in fit.group(1)
     assert _state(lab) == before
 
 

@@ -6,6 +6,7 @@ import contextlib
 import io
 import logging
 import os
+import sys
 import time
 from collections.abc import Iterator
 
@@ -59,8 +60,9 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     interruption (``KeyboardInterrupt``, ``SystemExit``) is logged and
     propagates unchanged.
 
-    The log ends with :func:`timing_line`: with the job's benchmark file it
-    splits the job's time into start-up, file I/O and compute.
+    The log of a job that succeeds ends with :func:`timing_line`: with the
+    job's benchmark file it splits the job's time into start-up, file I/O and
+    compute. A failed job's log ends with its error.
 
     Workflow scripts import only this function before entering it and
     import their step module inside it, so that even an import error ends
@@ -92,7 +94,9 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
         logging.captureWarnings(False)
         root.removeHandler(handler)
         root.setLevel(previous_level)
-        text = buffer.getvalue() + timing_line() + "\n"
+        text = buffer.getvalue()
+        if failure is None and not sys.exc_info()[0]:  # a failed job's log ends with its error
+            text += timing_line() + "\n"
         write_text(path, text, "log")
     if failure is not None:
         raise SystemExit(f"{one_line(failure)} (traceback in {path})") from failure
