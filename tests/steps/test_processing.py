@@ -274,3 +274,19 @@ def test_events_and_loadcell_refuse_an_unknown_setting(lab, tmp_path):
         processing.events_loadcell(d / "walk.c3d", d / "walk.loper.tsv", *(tmp_path / f"x.{k}" for k in "abcd"),
                                    {"treshold_on_n": 50.0})
     assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_events_and_loadcell_write_nothing_when_the_robot_log_is_bad(lab, tmp_path):
+    d = lab["dir"]
+    lines = (d / "walk.loper.tsv").read_text().splitlines(keepends=True)
+    header = sum(line.startswith("#") for line in lines) + 1
+    cells = lines[header + 20].split("\t")
+    cells[2] = "nan"  # force_measured_n of one sample
+    lines[header + 20] = "\t".join(cells)
+    bad = tmp_path / "bad.loper.tsv"
+    bad.write_text("".join(lines))
+    out = tmp_path / "out"
+    with pytest.raises(LoperInputError, match=r"bad\.loper\.tsv: column 'force_measured_n', sample 20 .*non-finite"):
+        processing.events_loadcell(d / "walk.c3d", bad, out / "e.tsv", out / "c.tsv", out / "f.tsv", out / "n.tsv",
+                                   {"grf_channels": {"left": "Fz_left", "right": "Fz_right"}})
+    assert not out.exists()  # the events were found, but nothing is written unless both steps succeed

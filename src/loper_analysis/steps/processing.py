@@ -128,36 +128,40 @@ def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str
     """
     from ..io.c3d import read_c3d
 
-    return _events_of(read_c3d(c3d_path), out_tsv, grf_channels, threshold_on_n, threshold_off_n, min_stance_s,
-                      min_swing_s, cutoff_hz, order, foot_markers, plate_sides, label_map, rotation_deg, band_n,
-                      max_rest_n, contacts_out)
+    table, contacts = _events_of(read_c3d(c3d_path), grf_channels, threshold_on_n, threshold_off_n, min_stance_s,
+                                 min_swing_s, cutoff_hz, order, foot_markers, plate_sides, label_map, rotation_deg,
+                                 band_n, max_rest_n)
+    return _write_events(table, contacts, out_tsv, contacts_out)
 
 
-def _events_of(rec, out_tsv, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz,
-               order, foot_markers, plate_sides, label_map, rotation_deg, band_n, max_rest_n,
-               contacts_out) -> pd.DataFrame:
-    """:func:`events` of a C3D already read."""
+def _events_of(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz, order,
+               foot_markers, plate_sides, label_map, rotation_deg, band_n, max_rest_n) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The event table and the contact table (empty without force platforms) of a C3D already read."""
     from ..contacts import count_flagged
 
-    c3d_path = rec.source
     if rec.n_force_platforms:
         table, contacts = _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n,
                                         threshold_off_n, min_stance_s, min_swing_s, band_n, max_rest_n)
-        if contacts_out is not None:
-            write_tsv(contacts, contacts_out)
         log.info("contacts:\n%s", contacts.to_string(index=False))
-    else:
-        if not grf_channels:
-            raise LoperInputError(
-                f"{c3d_path}: no force platforms (FORCE_PLATFORM:USED is 0 or absent) and no GRF channel configured "
-                "(events.grf_channels); cannot detect gait events"
-            )
-        table = _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
-                                cutoff_hz, order)
-        if contacts_out is not None:
-            write_tsv(pd.DataFrame(columns=["plate", "contact", "side", "flag"]), contacts_out)
+        table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"])
+        return table, contacts
+    if not grf_channels:
+        raise LoperInputError(
+            f"{rec.source}: no force platforms (FORCE_PLATFORM:USED is 0 or absent) and no GRF channel configured "
+            "(events.grf_channels); cannot detect gait events"
+        )
+    table = _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
+                            cutoff_hz, order)
+    table.attrs["n_contacts_flagged"] = 0
+    return table, pd.DataFrame(columns=["plate", "contact", "side", "flag"])
+
+
+def _write_events(table: pd.DataFrame, contacts: pd.DataFrame, out_tsv: PathLike,
+                  contacts_out: PathLike | None) -> pd.DataFrame:
+    """Write the event table (and the contact table when asked); returns the event table."""
+    if contacts_out is not None:
+        write_tsv(contacts, contacts_out)
     write_tsv(table, out_tsv)
-    table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"]) if rec.n_force_platforms else 0
     log.info("events per side and kind:\n%s", table.groupby(["side", "event"]).size().to_string())
     return table
 
@@ -213,11 +217,12 @@ def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_cha
     """
     from ..io.c3d import read_c3d
 
-    return _loadcell_of(read_c3d(c3d_path), log_path, out_tsv, sync_channel, cutoff_hz, order, native_out)
+    out, native = _loadcell_of(read_c3d(c3d_path), log_path, sync_channel, cutoff_hz, order)
+    return _write_loadcell(out, native, out_tsv, native_out)
 
 
-def _loadcell_of(rec, log_path, out_tsv, sync_channel, cutoff_hz, order, native_out) -> pd.DataFrame:
-    """:func:`loadcell` of a C3D already read."""
+def _loadcell_of(rec, log_path, sync_channel, cutoff_hz, order) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The forces on the mocap frames and at the robot rate, of a C3D already read and a robot log."""
     from ..io.robot_log import read_robot_log
     from ..loadcell import robot_log_frames_and_native
 
@@ -229,6 +234,12 @@ def _loadcell_of(rec, log_path, out_tsv, sync_channel, cutoff_hz, order, native_
     cm = out.attrs.get("clock_map")
     if cm is not None:
         log.info("%s: clock map %s", log_path, cm)
+    return out, native
+
+
+def _write_loadcell(out: pd.DataFrame, native: pd.DataFrame, out_tsv: PathLike,
+                    native_out: PathLike | None) -> pd.DataFrame:
+    """Write the forces on the mocap frames (and at the robot rate when asked); returns the former."""
     write_tsv(out, out_tsv)
     log.info("%d frames on the mocap clock", len(out))
     if native_out is not None:
@@ -243,8 +254,9 @@ def events_loadcell(c3d_path: PathLike, log_path: PathLike, events_out: PathLike
     """:func:`events` and :func:`loadcell` of one trial with the device, from one reading of its C3D.
 
     ``events_settings`` and ``loadcell_settings`` are the keyword arguments of
-    :func:`events` and :func:`loadcell` (without paths). Returns the event
-    table and the force table on the mocap frames.
+    :func:`events` and :func:`loadcell` (without paths). Nothing is written
+    unless both succeed. Returns the event table and the force table on the
+    mocap frames.
     """
     from ..io.c3d import read_c3d
 
@@ -253,10 +265,13 @@ def events_loadcell(c3d_path: PathLike, log_path: PathLike, events_out: PathLike
         unknown = set(given) - set(_keyword_defaults(func)) - {"contacts_out", "native_out"}
         if unknown:
             raise TypeError(f"{func.__name__}: unknown setting(s) {sorted(unknown)}")
+    e = {k: v for k, v in {**_keyword_defaults(events), **e}.items() if k != "contacts_out"}
+    f = {k: v for k, v in {**_keyword_defaults(loadcell), **f}.items() if k != "native_out"}
     rec = read_c3d(c3d_path)
-    table = _events_of(rec, events_out, **{**_keyword_defaults(events), **e, "contacts_out": contacts_out})
-    force = _loadcell_of(rec, log_path, force_out, **{**_keyword_defaults(loadcell), **f, "native_out": native_out})
-    return table, force
+    table, contacts = _events_of(rec, **e)
+    forces = _loadcell_of(rec, log_path, **f)  # both computed before anything is written
+    _write_events(table, contacts, events_out, contacts_out)
+    return table, _write_loadcell(*forces, force_out, native_out)
 
 
 def _keyword_defaults(func) -> dict:
