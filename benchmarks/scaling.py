@@ -6,8 +6,9 @@ A case ``NxTxJ`` runs ``snakemake -jJ`` from nothing in a fresh copy of the proj
 subjects of ``config/subjects_paper.tsv`` and walking trials of T s (``synthetic.walking_duration_s``;
 everything else as ``config/config.yaml``). Each run's wall time, and the user + system CPU time of
 Snakemake and all its jobs (``os.times`` of the finished children), are printed with the job count and the number of motion-capture
-frames of the walking trials (128 Hz). A least-squares line CPU = a + b * frames over the cases shows the
-per-frame cost and the fixed part (validation study, device tests, start-up of the aggregate jobs).
+frames of the walking trials (128 Hz). A least-squares fit CPU = a + b * frames + c * subjects over the
+cases shows the per-frame cost, the per-subject part (static trial, model, fits, the jobs' start-up) and the
+fixed part (validation study, device tests, aggregate tables and figures).
 """
 
 from __future__ import annotations
@@ -72,10 +73,11 @@ def main() -> None:
               flush=True)
     table = pd.DataFrame(rows)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.0f}"))
-    if len(table) >= 2 and table.walking_frames.nunique() >= 2:
-        b, a = np.polyfit(table.walking_frames, table.cpu_s, 1)
-        fit = a + b * table.walking_frames
-        print(f"CPU = {a:.0f} s + {1e3 * b:.2f} ms per walking frame (largest deviation "
+    if len(table) >= 3 and table.walking_frames.nunique() >= 2 and table.subjects.nunique() >= 2:
+        design = np.column_stack([np.ones(len(table)), table.walking_frames, table.subjects])
+        (a, b, c), *_ = np.linalg.lstsq(design, table.cpu_s.to_numpy(float), rcond=None)
+        fit = design @ np.array([a, b, c])
+        print(f"CPU = {a:.0f} s + {1e3 * b:.3f} ms per walking frame + {c:.1f} s per subject (largest deviation "
               f"{np.max(np.abs(table.cpu_s - fit) / table.cpu_s) * 100:.0f} % of a case's CPU)")
     if args.out:
         table.to_csv(args.out, sep="\t", index=False, float_format="%.1f")
