@@ -228,6 +228,27 @@ def test_rule_log_names_the_type_of_an_unexpected_error_and_lets_interruptions_t
     assert "ERROR loper_analysis.rule: KeyboardInterrupt" in (tmp_path / "b.log").read_text()
 
 
+def test_a_sigterm_ends_the_job_with_its_log_written_and_the_handler_restored(tmp_path):
+    """scancel and SLURM's time limit send SIGTERM: the rule's log must say so before the process ends."""
+    import os
+    import signal
+    import time
+
+    before = signal.getsignal(signal.SIGTERM)
+    with pytest.raises(SystemExit, match=r"^stopped by SIGTERM: the job was cancelled"):
+        with rule_log(tmp_path / "ik.log") as log:
+            log.info("solving 5760 frames")
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(5)  # the signal arrives long before this ends
+            log.info("never reached")
+    text = (tmp_path / "ik.log").read_text()
+    assert "INFO loper_analysis.rule: solving 5760 frames" in text
+    assert "ERROR loper_analysis.rule: SystemExit: stopped by SIGTERM" in text
+    assert "never reached" not in text
+    assert signal.getsignal(signal.SIGTERM) is before
+    assert _entries(tmp_path) == ["ik.log"]
+
+
 def test_rule_log_captures_warnings(tmp_path):
     import warnings
 

@@ -6,7 +6,9 @@ import contextlib
 import io
 import logging
 import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Iterator
 
@@ -47,6 +49,12 @@ def _profiler():
     return profiler
 
 
+def _stop_on_sigterm(signum: int, frame) -> None:
+    """SIGTERM as an error: the job's log is written before the process ends."""
+    raise SystemExit(f"stopped by {signal.Signals(signum).name}: the job was cancelled (scancel, or Snakemake "
+                     "interrupted), or SLURM ended it at its time limit (resource runtime)")
+
+
 @contextlib.contextmanager
 def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     """Collect the job's log records (INFO and up) and warnings; write them to ``path`` when the job ends.
@@ -58,7 +66,9 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     standard error and exits with status 1, so Snakemake's console shows the
     cause in one line and points to this file for the traceback. An
     interruption (``KeyboardInterrupt``, ``SystemExit``) is logged and
-    propagates unchanged.
+    propagates unchanged; so is SIGTERM (what ``scancel``, SLURM's time limit
+    and an interrupted Snakemake send), turned into a :class:`SystemExit`
+    that names it.
 
     The log of a job that succeeds ends with :func:`timing_line`: with the
     job's benchmark file it splits the job's time into start-up, file I/O and
@@ -79,6 +89,8 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
     log = logging.getLogger("loper_analysis.rule")
     failure = None
     profiler = _profiler()
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous_sigterm = signal.signal(signal.SIGTERM, _stop_on_sigterm) if main_thread else None
     try:
         yield log
     except Exception as exc:
@@ -88,6 +100,8 @@ def rule_log(path: str | os.PathLike) -> Iterator[logging.Logger]:
         log.exception("%s: %s", type(exc).__name__, exc)
         raise
     finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous_sigterm)
         if profiler is not None:
             profiler.disable()
             profiler.dump_stats(f"{path}.prof")
