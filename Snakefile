@@ -17,6 +17,7 @@ include: "workflow/rules/processing.smk"
 include: "workflow/rules/synthetic.smk"
 include: "workflow/rules/impedance.smk"
 include: "workflow/rules/planning.smk"
+include: "workflow/rules/report.smk"
 
 
 rule all:

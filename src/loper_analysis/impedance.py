@@ -54,6 +54,7 @@ from .responses import (
 __all__ = [
     "IMPEDANCE_COLUMNS",
     "NOISE_MODELS",
+    "TRUTH_TOLERANCE",
     "IdentificationSettings",
     "OnsetFit",
     "brace_force_direction",
@@ -81,6 +82,9 @@ IMPEDANCE_COLUMNS: tuple[str, ...] = (
 )
 #: How the fit weights its prediction errors: the study's least squares, or with the null pairs' deviation.
 NOISE_MODELS: tuple[str, ...] = ("null_pairs", "white")
+#: An estimate is within tolerance of the truth when ``|error| <= max(relative * |truth|, absolute)``:
+#: parameter -> (relative, absolute in N·m/rad for K, N·m·s/rad for D).
+TRUTH_TOLERANCE: dict[str, tuple[float, float]] = {"K": (0.10, 2.0), "D": (0.15, 0.05)}
 
 
 @dataclass(frozen=True)
@@ -395,7 +399,7 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     return OnsetFit(mean, counts, rows, curves, force_table(series))
 
 
-def impedance_summary(table: pd.DataFrame, k_tolerance=(0.10, 2.0), d_tolerance=(0.15, 0.05),
+def impedance_summary(table: pd.DataFrame, k_tolerance=TRUTH_TOLERANCE["K"], d_tolerance=TRUTH_TOLERANCE["D"],
                       upper_bounds: tuple[float, float] | None = None) -> pd.DataFrame:
     """Across-subject summary per joint and onset of the fitted rows (``ok`` and ``not_identifiable``).
 

@@ -1,4 +1,5 @@
 # Shared set-up: config and subject-sheet validation, target list, settings for rules.
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -7,6 +8,7 @@ from snakemake.utils import validate
 
 from snakemake.common.configfile import load_configfile
 
+from loper_analysis.cluster import check_slurm_submission
 from loper_analysis.errors import LoperInputError
 from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
@@ -205,4 +207,36 @@ def all_targets() -> list[str]:
         "results/device/summary.tsv",
         "results/device/bode.png",
         "results/device/steps.png",
+        "results/report/front_page.html",
     ]
+
+
+def _raw_partition(resource) -> str | None:
+    """A slurm_partition given as plain text in a profile or on the command line (None for a function)."""
+    raw = getattr(resource, "raw", None)
+    return raw.strip("'\"") if isinstance(raw, str) else None
+
+
+onstart:
+    # a SLURM run: check sbatch and the partitions before the first submission (loper_analysis.cluster)
+    if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
+        _settings = workflow.resource_settings
+        _requested = {}
+        if _settings.default_resources is not None and "slurm_partition" in _settings.default_resources.keys():
+            _requested["default-resources"] = _raw_partition(_settings.default_resources.get("slurm_partition"))
+        for _rule, _res in _settings.overwrite_resources.items():
+            if "slurm_partition" in _res.keys():
+                _requested[f"set-resources {_rule}"] = _raw_partition(_res.get("slurm_partition"))
+        try:
+            check_slurm_submission({k: v for k, v in _requested.items() if v is not None})
+        except LoperInputError as exc:
+            raise WorkflowError(str(exc)) from None
+
+
+onerror:
+    # a SLURM run: say which failed jobs SLURM itself ended, and why (memory, time limit, cancel)
+    if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
+        from loper_analysis.steps.cluster import slurm_failure_lines
+
+        for _line in slurm_failure_lines(log):
+            print(_line, file=sys.stderr)

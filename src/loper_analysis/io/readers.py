@@ -1,4 +1,4 @@
-"""Reading the pipeline's tidy TSV tables and YAML documents (writing is :mod:`loper_analysis.io.atomic`)."""
+"""Reading the pipeline's TSV tables, YAML documents and whole files (writing is :mod:`loper_analysis.io.atomic`)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import yaml
 from ..errors import LoperInputError
 from .timing import timed_io
 
-__all__ = ["read_label_map", "read_tsv", "read_yaml"]
+__all__ = ["read_bytes", "read_label_map", "read_tsv", "read_yaml"]
 
 
 @timed_io
@@ -42,6 +42,22 @@ def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str
     if len(table) and missing:
         raise LoperInputError(f"{path}: {what}: column(s) {missing} missing (has {list(table.columns)})")
     return table
+
+
+@timed_io
+def read_bytes(path: str | os.PathLike, what: str = "file") -> bytes:
+    """The whole content of a file (a figure to embed, say).
+
+    Raises
+    ------
+    LoperInputError
+        A missing or unreadable file (naming the file).
+    """
+    path = Path(path)
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise LoperInputError(f"{path}: cannot read the {what} ({exc.strerror or exc})") from None
 
 
 @timed_io

@@ -16,7 +16,8 @@ full error of the job to its log file.
 * :mod:`.validation` - the validation study;
 * :mod:`.device` - device tests: simulated logs, FRF, steps, summary, figures;
 * :mod:`.synthetic` - raw files of synthetic subjects;
-* :mod:`.report` - the Markdown rendering of the result tables.
+* :mod:`.report` - the Markdown rendering of the result tables and the front page of the report;
+* :mod:`.cluster` - why SLURM ended the failed jobs of a run.
 """
 
 from .logs import rule_log
