@@ -1,4 +1,7 @@
-"""The front page of the report (loper_analysis.front_page, the file step, and the report in a real browser)."""
+"""The front page of the report (loper_analysis.front_page, the file step, and the report in a real browser).
+
+The headline tables it shows are tested in test_headline.py.
+"""
 
 from __future__ import annotations
 
@@ -17,19 +20,16 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import JOINTS
-from loper_analysis.errors import LoperInputError
-from loper_analysis.front_page import (
-    RunSettings,
-    ci_coverage_p,
+from loper_analysis.front_page import RunSettings, front_page_html
+from loper_analysis.headline import (
     device_comparison,
-    front_page_html,
     impedance_summary_ci,
     transparency_verdict,
     truth_recovery,
     validation_verdict,
 )
-from loper_analysis.impedance import IMPEDANCE_COLUMNS, impedance_summary
-from loper_analysis.reference import STUDY_DEVICE
+from loper_analysis.impedance import impedance_summary
+from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -41,95 +41,6 @@ SETTINGS = dict(
     synthetic_walking_duration_s=45.0, pulse_force_n=40.0, pulse_duration_s=0.1,
 )
 VERSIONS = {"Python": "3.11.7", "loper_analysis": "0.1.0", "OpenSim": "4.6"}
-#: t(0.975, 2): the 95 % quantile factor of a mean over 3 subjects
-T_975_2 = 4.302652729749464
-
-
-def _row(subject, onset, joint, k, d, k_ci, d_ci, k_true=None, d_true=None, status="ok") -> dict:
-    row = dict.fromkeys(IMPEDANCE_COLUMNS)
-    row.update(subject=subject, onset_ms=onset, joint=joint, K_nm_per_rad=k, D_nms_per_rad=d,
-               K_ci95_low_nm_per_rad=k_ci[0], K_ci95_high_nm_per_rad=k_ci[1], D_ci95_low_nms_per_rad=d_ci[0],
-               D_ci95_high_nms_per_rad=d_ci[1], vaf_pct=90.0, n_strides=10, status=status, reason="")
-    if k_true is not None:
-        row.update(K_true_nm_per_rad=k_true, D_true_nms_per_rad=d_true, K_error_nm_per_rad=k - k_true,
-                   D_error_nms_per_rad=d - d_true)
-    return row
-
-
-def _impedance() -> pd.DataFrame:
-    """Two synthetic subjects (one failed fit) and a recorded one, with known errors."""
-    nan = math.nan
-    return pd.DataFrame([
-        # hip K: error -2 (within 10 % of 52, truth in CI); 15 (outside both). D: -0.6 (outside both); -0.2 (in both)
-        _row("S1", 50, "hip", 50.0, 3.0, (40.0, 60.0), (2.5, 3.5), 52.0, 3.6),
-        _row("S2", 50, "hip", 70.0, 4.0, (60.0, 80.0), (3.0, 5.0), 55.0, 4.2),
-        _row("S1", 175, "hip", nan, nan, (nan, nan), (nan, nan), 40.0, 2.0, status="failed"),
-        # knee K: error -2 = the 2 N·m/rad floor of the tolerance (within); D: -0.02 (within)
-        _row("S1", 50, "knee", 1.0, 0.10, (0.0, 4.0), (0.0, 0.3), 3.0, 0.12, status="not_identifiable"),
-        _row("R1", 50, "hip", 45.0, 3.3, (30.0, 60.0), (2.0, 4.6)),  # recorded: no truth
-    ])
-
-
-def test_ci_of_the_across_subject_mean_is_students_t():
-    summary = pd.DataFrame({"joint": ["hip", "knee"], "onset_ms": [50, 50], "n_subjects": [3, 1],
-                            "n_not_identifiable": [1, 0], "K_mean_nm_per_rad": [10.0, 5.0],
-                            "K_sd_nm_per_rad": [2.0, np.nan], "D_mean_nms_per_rad": [0.3, 0.1],
-                            "D_sd_nms_per_rad": [0.06, np.nan], "vaf_pct_mean": [95.0, 80.0]})
-    ci = impedance_summary_ci(summary, "s.tsv")
-    half_k = T_975_2 * 2.0 / math.sqrt(3)  # 4.968 N·m/rad
-    assert ci.loc[0, "K_ci95_low_nm_per_rad"] == pytest.approx(10.0 - half_k, rel=1e-12)
-    assert ci.loc[0, "K_ci95_high_nm_per_rad"] == pytest.approx(14.968275, abs=1e-6)
-    assert ci.loc[0, "D_ci95_high_nms_per_rad"] == pytest.approx(0.3 + T_975_2 * 0.06 / math.sqrt(3), rel=1e-12)
-    assert math.isnan(ci.loc[1, "K_ci95_low_nm_per_rad"])  # one subject: no interval
-    assert ci.loc[1, "K_mean_nm_per_rad"] == 5.0 and ci.loc[0, "n_not_identifiable"] == 1
-
-
-def test_truth_recovery_counts_the_known_errors():
-    truth = truth_recovery(_impedance(), "i.tsv").set_index("joint")
-    assert list(truth.index) == ["hip", "knee"]  # the recorded subject has no truth, no ankle rows
-    hip = truth.loc["hip"]
-    assert (hip.n_subjects, hip.n_fits, hip.n_failed) == (2, 2, 1)
-    assert hip.K_error_mean_nm_per_rad == pytest.approx(6.5)  # (-2 + 15) / 2
-    assert hip.K_error_median_abs_nm_per_rad == pytest.approx(8.5)
-    assert hip.K_error_median_abs_pct == pytest.approx((2 / 52 + 15 / 55) / 2 * 100)  # 15.56 %
-    assert (hip.K_n_within_tolerance, hip.K_n_truth_in_ci95) == (1, 1)
-    assert hip.D_error_mean_nms_per_rad == pytest.approx(-0.4)
-    assert (hip.D_n_within_tolerance, hip.D_n_truth_in_ci95) == (1, 1)
-    knee = truth.loc["knee"]
-    assert (knee.n_fits, knee.K_n_within_tolerance, knee.K_n_truth_in_ci95, knee.D_n_within_tolerance) == (1, 1, 1, 1)
-    # 4 of 6 intervals hold the truth: P(X <= 4 | n = 6, 0.95) = 1 - 6 * 0.95**5 * 0.05 - 0.95**6
-    assert ci_coverage_p(4, 6) == pytest.approx(1 - 6 * 0.95**5 * 0.05 - 0.95**6, rel=1e-12)
-    assert ci_coverage_p(4, 6) == pytest.approx(0.032774, abs=1e-6)
-
-
-def test_transparency_device_and_validation_verdicts():
-    rmsd = pd.DataFrame({
-        "subject": ["S1", "S2", "all", "S1", "S2", "all"], "phase": ["stance"] * 3 + ["swing"] * 3,
-        "joint": ["hip"] * 6, "rmsd_rad": [0.02, 0.03, 0.025, 0.07, np.nan, 0.07],
-        "isv_ave_rad": [0.04, 0.04, 0.04, 0.06, np.nan, 0.06],
-        "transparent": [True, True, True, False, np.nan, False], "study_rmsd_rad": 0.024, "study_isv_ave_rad": 0.04})
-    tr = transparency_verdict(rmsd, "r.tsv")
-    assert tr.transparent.tolist() == [True, False]
-    assert tr.n_subjects.tolist() == [2, 1] and tr.n_subjects_transparent.tolist() == [2, 0]
-    device = pd.DataFrame({"metric": ["bandwidth_hz", "rise_time_ms", "overshoot_pct", "steady_state_40n_n",
-                                      "rise_time_ms_at_20n"], "value": [42.9, 10.0, 30.5, 36.0, 9.7]})
-    dev = device_comparison(device, "d.tsv").set_index("metric")
-    assert list(dev.index) == list(STUDY_DEVICE)
-    assert dev.loc["bandwidth_hz", "difference_pct"] == pytest.approx(10.0)  # 42.9 Hz against the study's 39
-    assert dev.loc["rise_time_ms", "study_value"] == 10.0
-    val = validation_verdict(_validation(), "v.tsv").set_index("parameter")
-    assert val.loc["K", "max_error"] == 0.02 and val.loc["D", "min_error"] == -0.001
-    assert val.within_study.all() and val.loc["K", "n_combinations"] == 729
-
-
-def _validation() -> pd.DataFrame:
-    return pd.DataFrame({"condition": ["no_noise", "no_noise", "noise"], "parameter": ["K_hip", "D_hip", "K_hip"],
-                         "min_error": [-0.01, -0.001, -70.0], "max_error": [0.02, 0.002, 40.0], "n": 729,
-                         "study_min_error": [-0.87, -0.092, -6.2], "study_max_error": [0.59, 0.047, 6.5]})
-
-
-def _device() -> pd.DataFrame:
-    return pd.DataFrame({"metric": list(STUDY_DEVICE), "value": [38.79, 9.9, 31.5, 35.3]})
 
 
 class _Numbers(HTMLParser):
@@ -168,14 +79,15 @@ def _decimals_shown(text: str) -> int:
 
 def test_fragment_numbers_are_the_tables_numbers():
     """Round trip: every number on the page carries the table's value, and its text rounds that value."""
-    table = _impedance()
+    table = impedance_table()
     summary = impedance_summary(table)
     ci = impedance_summary_ci(summary)
     truth = truth_recovery(table)
     rmsd = pd.DataFrame({"subject": ["S1", "all"], "phase": "swing", "joint": "knee", "rmsd_rad": [0.0958, 0.0679],
                          "isv_ave_rad": [0.1338, 0.1338], "transparent": [True, True], "study_rmsd_rad": 0.071,
                          "study_isv_ave_rad": 0.129})
-    tr, dev, val = transparency_verdict(rmsd), device_comparison(_device()), validation_verdict(_validation())
+    tr, dev = transparency_verdict(rmsd), device_comparison(device_summary())
+    val = validation_verdict(validation_summary())
     page = front_page_html({"S1": "synthetic", "S2": "synthetic", "R1": "recorded"},
                            {"S1": ["a", "b"], "S2": ["a", "b"], "R1": ["a"]}, RunSettings(**SETTINGS), VERSIONS,
                            device=dev, validation=val, summary=ci, truth=truth, figure_png=b"\x89PNG fake",
@@ -224,9 +136,9 @@ def test_fragment_numbers_are_the_tables_numbers():
 
 
 def test_nothing_fitted_and_no_impedance_experiment_are_said():
-    table = pd.DataFrame([_row("S1", 50, j, math.nan, math.nan, (math.nan,) * 2, (math.nan,) * 2, 5.0, 0.1,
-                               status="failed") for j in JOINTS])
-    common = dict(device=device_comparison(_device()), validation=validation_verdict(_validation()))
+    table = pd.DataFrame([impedance_row("S1", 50, j, math.nan, math.nan, (math.nan,) * 2, (math.nan,) * 2, 5.0, 0.1,
+                                        status="failed") for j in JOINTS])
+    common = dict(device=device_comparison(device_summary()), validation=validation_verdict(validation_summary()))
     page = front_page_html({"S1": "synthetic"}, {"S1": ["a"]}, RunSettings(**SETTINGS), VERSIONS,
                            summary=impedance_summary_ci(impedance_summary(table)), truth=truth_recovery(table),
                            impedance_status={"failed": 3}, **common)
@@ -234,30 +146,6 @@ def test_nothing_fitted_and_no_impedance_experiment_are_said():
     assert 'id="lf-truth-recovery"' not in page  # no table of nothing
     page = front_page_html({"S1": "synthetic"}, {}, RunSettings(**SETTINGS), VERSIONS, **common)
     assert "No perturbation trials in this run" in page and "no walking trials processed" in page
-
-
-@pytest.mark.parametrize(("call", "message"), [
-    (lambda: impedance_summary_ci(pd.DataFrame({"joint": ["hip"]}), "s.tsv"),
-     "s.tsv: impedance summary: column(s) ['onset_ms', 'n_subjects'"),
-    (lambda: impedance_summary_ci(pd.DataFrame({
-        "joint": ["hip"], "onset_ms": [50], "n_subjects": [0], "n_not_identifiable": [0], "K_mean_nm_per_rad": [1.0],
-        "K_sd_nm_per_rad": [1.0], "D_mean_nms_per_rad": [1.0], "D_sd_nms_per_rad": [1.0], "vaf_pct_mean": [90.0]}),
-        "s.tsv"), "s.tsv: row 0 (hip 50 ms): n_subjects must be an integer >= 1, got 0"),
-    (lambda: transparency_verdict(pd.DataFrame({
-        "subject": ["all"], "phase": ["swing"], "joint": ["hip"], "rmsd_rad": [0.1], "isv_ave_rad": [0.2],
-        "transparent": ["maybe"], "study_rmsd_rad": [0.1], "study_isv_ave_rad": [0.1]}), "r.tsv"),
-     "r.tsv: row 0: column 'transparent' must be True, False or blank, got 'maybe'"),
-    (lambda: device_comparison(pd.DataFrame({"metric": ["bandwidth_hz"], "value": [39.0]}), "d.tsv"),
-     "d.tsv: device summary: metric 'rise_time_ms' missing"),
-    (lambda: device_comparison(pd.DataFrame({"metric": list(STUDY_DEVICE), "value": ["x", 1, 1, 1]}), "d.tsv"),
-     "d.tsv: value of metric 'bandwidth_hz' must be a number, got 'x'"),
-    (lambda: truth_recovery(_impedance().assign(K_ci95_low_nm_per_rad="?"), "i.tsv"),
-     "i.tsv: fitted rows: column 'K_ci95_low_nm_per_rad', row 0 must be a number, got '?'"),
-])
-def test_bad_tables_are_refused_naming_file_field_and_value(call, message):
-    with pytest.raises(LoperInputError) as err:
-        call()
-    assert message in str(err.value)
 
 
 def _write_results(root: Path) -> None:
@@ -273,7 +161,7 @@ def _write_results(root: Path) -> None:
         for onset in (50, 175, 300):
             for joint, (k, d) in truth.items():
                 ke, de = k * (1 + 0.1 * rng.standard_normal()), d * (1 + 0.1 * rng.standard_normal())
-                rows.append(_row(s, onset, joint, ke, de, (0.8 * ke, 1.2 * ke), (0.8 * de, 1.2 * de), k, d))
+                rows.append(impedance_row(s, onset, joint, ke, de, (0.8 * ke, 1.2 * ke), (0.8 * de, 1.2 * de), k, d))
     tables = root / "results/tables"
     tables.mkdir(parents=True)
     pd.DataFrame(rows).to_csv(tables / "impedance.tsv", sep="\t", index=False)
@@ -284,9 +172,9 @@ def _write_results(root: Path) -> None:
                   "isv_ave_rad": [0.13, 0.13], "transparent": [True, True], "study_rmsd_rad": 0.071,
                   "study_isv_ave_rad": 0.129}).to_csv(root / "results/transparency/rmsd.tsv", sep="\t", index=False)
     (root / "results/device").mkdir(parents=True)
-    _device().to_csv(root / "results/device/summary.tsv", sep="\t", index=False)
+    device_summary().to_csv(root / "results/device/summary.tsv", sep="\t", index=False)
     (root / "results/validation").mkdir(parents=True)
-    _validation().to_csv(root / "results/validation/summary.tsv", sep="\t", index=False)
+    validation_summary().to_csv(root / "results/validation/summary.tsv", sep="\t", index=False)
 
 
 def _front_page(root: Path, versions=VERSIONS) -> str:

@@ -1,18 +1,11 @@
 """The front page of the Snakemake report: what was run, the headline numbers and the main figure, as HTML.
 
-Pure functions from the result tables (pandas frames, as the file step
-:func:`loper_analysis.steps.report.front_page` reads them) to one HTML
-fragment, which ``workflow/report/workflow.rst`` pulls into the report's
-"Workflow" panel above the methods text:
+Renders the headline tables of :mod:`loper_analysis.headline` (as the file
+step :func:`loper_analysis.steps.report.front_page` computes them from the
+result tables) into one HTML fragment, which ``workflow/report/workflow.rst``
+pulls into the report's "Workflow" panel above the methods text:
 
-* :func:`impedance_summary_ci` - the across-subject summary with the 95 %
-  confidence interval of each mean (Student's t, ``n_subjects - 1`` degrees
-  of freedom);
-* :func:`truth_recovery` - estimated against true K and D of the synthetic
-  subjects, per joint;
-* :func:`transparency_verdict`, :func:`device_comparison`,
-  :func:`validation_verdict` - the device's transparency, its force
-  controller against the study, the validation study's extremes;
+* :class:`RunSettings` - the run's settings, as the page lists them;
 * :func:`front_page_html` - the fragment. Its tables carry the ids
   ``lf-impedance-summary``, ``lf-truth-recovery``, ``lf-transparency``,
   ``lf-device`` and ``lf-run``, the figure ``lf-figure``.
@@ -36,27 +29,18 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .checks import integer, number, require_columns, where
-from .constants import JOINTS, PARAMETER_UNITS, parameter_column
+from .constants import PARAMETER_UNITS, parameter_column
 from .errors import LoperInputError
+from .headline import PARAMETER_KINDS, ci_coverage_p
 from .impedance import TRUTH_TOLERANCE
-from .reference import STUDY_DEVICE, STUDY_SWING_IMPEDANCE
+from .reference import STUDY_SWING_IMPEDANCE
 
 __all__ = [
-    "FITTED_STATUSES",
     "SOFTWARE",
     "RunSettings",
-    "impedance_summary_ci",
-    "truth_recovery",
-    "ci_coverage_p",
-    "transparency_verdict",
-    "device_comparison",
-    "validation_verdict",
     "front_page_html",
 ]
 
-#: Fit statuses that carry an estimate (``failed`` and ``missing`` rows do not).
-FITTED_STATUSES: tuple[str, ...] = ("ok", "not_identifiable")
 #: Software the front page lists: label -> distribution name (Python itself is listed first).
 SOFTWARE: dict[str, str] = {
     "loper_analysis": "loper-analysis",
@@ -68,299 +52,9 @@ SOFTWARE: dict[str, str] = {
     "Snakemake": "snakemake",
 }
 
-_PARAMETERS = ("K", "D")
-_UNIT = {p: PARAMETER_UNITS[f"{p}_hip"] for p in _PARAMETERS}
+#: Unit of each parameter kind, as the page writes it.
+_UNIT = {p: PARAMETER_UNITS[f"{p}_hip"] for p in PARAMETER_KINDS}
 _MINUS = "\u2212"
-
-
-# --------------------------------------------------------------------------------------------------- tables
-
-
-def _rows_or_empty(table, columns: Sequence[str], source: str, what: str) -> pd.DataFrame:
-    """The table when it has rows (checked for ``columns``), else an empty frame with those columns."""
-    if isinstance(table, pd.DataFrame) and len(table) == 0:
-        return pd.DataFrame(columns=list(columns))
-    return require_columns(table, columns, source, what)
-
-
-def _numbers(table: pd.DataFrame, column: str, source: str) -> np.ndarray:
-    """A numeric column as floats; a cell that is no finite number names its row, column and value."""
-    return np.array([number(f"column {column!r}, row {i}", value, source)
-                     for i, value in enumerate(table[column].to_numpy())], dtype=float)
-
-
-def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """The across-subject summary with the 95 % confidence interval of each mean.
-
-    Parameters
-    ----------
-    summary : pandas.DataFrame
-        ``results/tables/impedance_summary.tsv``: ``joint, onset_ms,
-        n_subjects, n_not_identifiable``, ``K_mean_nm_per_rad``,
-        ``K_sd_nm_per_rad`` (N·m/rad), ``D_mean_nms_per_rad``,
-        ``D_sd_nms_per_rad`` (N·m·s/rad) and ``vaf_pct_mean`` (%). No rows:
-        nothing was fitted.
-    source : str
-        Where the table came from, for error messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per summary row: ``joint, onset_ms, n_subjects,
-        n_not_identifiable``, per parameter its mean and the bounds of the
-        95 % CI of the mean, ``mean ± t(0.975, n - 1) · sd / sqrt(n)``
-        (``K_ci95_low_nm_per_rad`` ...; NaN for one subject), and
-        ``vaf_pct_mean``.
-
-    Raises
-    ------
-    LoperInputError
-        A column missing, a count that is not an integer >= 1 (or a
-        not-identifiable count above it), a mean that is no finite number,
-        or no SD where two or more subjects were averaged.
-    """
-    from scipy.stats import t as student_t
-
-    needed = ["joint", "onset_ms", "n_subjects", "n_not_identifiable", "vaf_pct_mean",
-              *(parameter_column(p, w) for p in _PARAMETERS for w in ("mean", "sd"))]
-    out_columns = ["joint", "onset_ms", "n_subjects", "n_not_identifiable",
-                   *(parameter_column(p, w) for p in _PARAMETERS for w in ("mean", "ci95_low", "ci95_high")),
-                   "vaf_pct_mean"]
-    table = _rows_or_empty(summary, needed, source, "impedance summary")
-    rows = []
-    for i, r in enumerate(table.to_dict("records")):
-        at = f"{where(source)}row {i} ({r['joint']} {r['onset_ms']} ms)"
-        n = integer("n_subjects", r["n_subjects"], at, minimum=1)
-        n_ni = integer("n_not_identifiable", r["n_not_identifiable"], at, minimum=0)
-        if n_ni > n:
-            raise LoperInputError(f"{at}: n_not_identifiable must be <= n_subjects = {n}, got {n_ni}")
-        row = {"joint": r["joint"], "onset_ms": integer("onset_ms", r["onset_ms"], at), "n_subjects": n,
-               "n_not_identifiable": n_ni}
-        for p in _PARAMETERS:
-            mean = number(parameter_column(p, "mean"), r[parameter_column(p, "mean")], at)
-            if n >= 2:
-                sd = number(parameter_column(p, "sd"), r[parameter_column(p, "sd")], at, minimum=0.0)
-                half = float(student_t.ppf(0.975, n - 1)) * sd / math.sqrt(n)
-                low, high = mean - half, mean + half
-            else:
-                low = high = math.nan
-            row.update({parameter_column(p, "mean"): mean, parameter_column(p, "ci95_low"): low,
-                        parameter_column(p, "ci95_high"): high})
-        row["vaf_pct_mean"] = number("vaf_pct_mean", r["vaf_pct_mean"], at)
-        rows.append(row)
-    return pd.DataFrame(rows, columns=out_columns)
-
-
-def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """Estimated against true K and D of the subjects with a known truth (synthetic), per joint.
-
-    Parameters
-    ----------
-    impedance : pandas.DataFrame
-        ``results/tables/impedance.tsv`` (:data:`loper_analysis.impedance.IMPEDANCE_COLUMNS`):
-        per subject, onset and joint the estimate, its 95 % CI, the truth and
-        the error (estimate - truth; K in N·m/rad, D in N·m·s/rad), and ``status``.
-    source : str
-        Where the table came from, for error messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per joint (:data:`~loper_analysis.constants.JOINTS` order)
-        with a known truth: ``joint``, ``n_subjects``, ``n_fits`` (rows with a
-        status of :data:`FITTED_STATUSES`), ``n_failed`` (the other rows), and
-        per parameter over the fits: ``K_error_mean_nm_per_rad`` (bias),
-        ``K_error_median_abs_nm_per_rad``, ``K_error_median_abs_pct`` (median
-        of ``|error| / |truth|``, %; truths of 0 left out),
-        ``K_n_within_tolerance`` (:data:`loper_analysis.impedance.TRUTH_TOLERANCE`, the rule of the
-        across-subject summary) and
-        ``K_n_truth_in_ci95`` (the truth inside the fit's 95 % CI, bounds
-        included); the same for D. No truth known: no rows.
-
-    Raises
-    ------
-    LoperInputError
-        A column missing, or a fitted row whose estimate, CI bound or error
-        is no finite number (naming the row and the column).
-    """
-    needed = ["subject", "onset_ms", "joint", "status",
-              *(parameter_column(p, w) for p in _PARAMETERS for w in ("", "ci95_low", "ci95_high", "true", "error"))]
-    counts = ["n_fits", "n_failed"]
-    per_p = [(p, w) for p in _PARAMETERS for w in ("error_mean", "error_median_abs")]
-    columns = ["joint", "n_subjects", *counts, *(parameter_column(p, w) for p, w in per_p),
-               *(f"{p}_{w}" for p in _PARAMETERS for w in ("error_median_abs_pct", "n_within_tolerance",
-                                                              "n_truth_in_ci95"))]
-    table = _rows_or_empty(impedance, needed, source, "impedance table")
-    known = table[pd.to_numeric(table[parameter_column("K", "true")], errors="coerce").notna()].reset_index(drop=True)
-    fitted = known[known["status"].isin(FITTED_STATUSES)].reset_index(drop=True)
-    values = {}
-    for p in _PARAMETERS:
-        for w in ("", "ci95_low", "ci95_high", "true", "error"):
-            col = parameter_column(p, w)
-            values[col] = _numbers(fitted, col, f"{where(source)}fitted rows")
-    rows = []
-    for joint in [j for j in JOINTS if j in set(known["joint"])] + sorted(set(known["joint"]) - set(JOINTS)):
-        own = (fitted["joint"] == joint).to_numpy()
-        row = {"joint": joint, "n_subjects": int(known.loc[known["joint"] == joint, "subject"].nunique()),
-               "n_fits": int(own.sum()), "n_failed": int((known["joint"] == joint).sum() - own.sum())}
-        for p in _PARAMETERS:
-            err = values[parameter_column(p, "error")][own]
-            true = values[parameter_column(p, "true")][own]
-            rel, ab = TRUTH_TOLERANCE[p]
-            low, high = values[parameter_column(p, "ci95_low")][own], values[parameter_column(p, "ci95_high")][own]
-            nonzero = true != 0
-            rel_err = np.abs(err[nonzero]) / np.abs(true[nonzero]) * 100.0
-            row.update({
-                parameter_column(p, "error_mean"): float(err.mean()) if err.size else math.nan,
-                parameter_column(p, "error_median_abs"): float(np.median(np.abs(err))) if err.size else math.nan,
-                f"{p}_error_median_abs_pct": float(np.median(rel_err)) if rel_err.size else math.nan,
-                f"{p}_n_within_tolerance": int((np.abs(err) <= np.maximum(rel * np.abs(true), ab)).sum()),
-                f"{p}_n_truth_in_ci95": int(((true >= low) & (true <= high)).sum()),
-            })
-        rows.append(row)
-    return pd.DataFrame(rows, columns=columns)
-
-
-def ci_coverage_p(n_inside: int, n_total: int, level: float = 0.95) -> float:
-    """One-sided binomial p-value of ``n_inside`` or fewer of ``n_total`` intervals holding the truth.
-
-    With nominal coverage ``level``, a small p (below 0.05) says the
-    intervals are too narrow. NaN for ``n_total = 0``.
-    """
-    from scipy.stats import binom
-
-    n_total = integer("n_total", n_total, minimum=0)
-    n_inside = integer("n_inside", n_inside, minimum=0)
-    if n_inside > n_total:
-        raise LoperInputError(f"n_inside must be <= n_total = {n_total}, got {n_inside}")
-    return math.nan if n_total == 0 else float(binom.cdf(n_inside, n_total, level))
-
-
-def _bool_or_none(value, column: str, at: str):
-    """True, False or None (no verdict: a blank cell) from a table cell."""
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return None
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    if value in ("True", "true", 1, 1.0):
-        return True
-    if value in ("False", "false", 0, 0.0):
-        return False
-    raise LoperInputError(f"{at}: column {column!r} must be True, False or blank, got {value!r}")
-
-
-def transparency_verdict(rmsd: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """The group rows of the transparency table with, per phase and joint, how many subjects were transparent.
-
-    Parameters
-    ----------
-    rmsd : pandas.DataFrame
-        ``results/transparency/rmsd.tsv``: ``subject`` (``all`` for the
-        group), ``phase, joint, rmsd_rad, isv_ave_rad, transparent``
-        (RMSD < ISV_ave, blank without strides), ``study_rmsd_rad``,
-        ``study_isv_ave_rad``.
-    source : str
-        Where the table came from, for error messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per group row: ``phase, joint, rmsd_rad, isv_ave_rad,
-        transparent`` (True, False or None), ``study_rmsd_rad,
-        study_isv_ave_rad``, ``n_subjects`` (subjects with a verdict) and
-        ``n_subjects_transparent``.
-    """
-    needed = ["subject", "phase", "joint", "rmsd_rad", "isv_ave_rad", "transparent", "study_rmsd_rad",
-              "study_isv_ave_rad"]
-    columns = ["phase", "joint", "rmsd_rad", "isv_ave_rad", "transparent", "study_rmsd_rad", "study_isv_ave_rad",
-               "n_subjects", "n_subjects_transparent"]
-    table = _rows_or_empty(rmsd, needed, source, "transparency table")
-    verdicts = [_bool_or_none(v, "transparent", f"{where(source)}row {i}")
-                for i, v in enumerate(table["transparent"].to_numpy())]
-    table = table.assign(transparent=verdicts, subject=table["subject"].astype(str))
-    rows = []
-    for i, r in table[table["subject"] == "all"].iterrows():
-        at = f"{where(source)}row {i} (all {r['phase']} {r['joint']})"
-        subjects = table[(table["subject"] != "all") & (table["phase"] == r["phase"])
-                         & (table["joint"] == r["joint"])]["transparent"]
-        judged = [v for v in subjects if v is not None]
-        rows.append({
-            "phase": r["phase"], "joint": r["joint"],
-            **{c: (math.nan if pd.isna(r[c]) else number(c, r[c], at)) for c in ("rmsd_rad", "isv_ave_rad")},
-            "transparent": r["transparent"],
-            **{c: (math.nan if pd.isna(r[c]) else number(c, r[c], at)) for c in ("study_rmsd_rad",
-                                                                                 "study_isv_ave_rad")},
-            "n_subjects": len(judged), "n_subjects_transparent": int(sum(judged)),
-        })
-    return pd.DataFrame(rows, columns=columns)
-
-
-def device_comparison(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """The device figures beside the study's (:data:`loper_analysis.reference.STUDY_DEVICE`).
-
-    Parameters
-    ----------
-    summary : pandas.DataFrame
-        ``results/device/summary.tsv``: ``metric, value`` (and more),
-        holding every metric of the study.
-    source : str
-        Where the table came from, for error messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per study metric (its order): ``metric, value, study_value,
-        unit, difference_pct`` (``(value / study_value - 1) · 100``).
-    """
-    table = require_columns(summary, ["metric", "value"], source, "device summary")
-    by_metric = dict(zip(table["metric"].astype(str), table["value"]))
-    rows = []
-    for metric, (study, unit) in STUDY_DEVICE.items():
-        if metric not in by_metric:
-            raise LoperInputError(f"{where(source)}device summary: metric {metric!r} missing "
-                                  f"(has {sorted(by_metric)})")
-        value = number(f"value of metric {metric!r}", by_metric[metric], source)
-        rows.append({"metric": metric, "value": value, "study_value": study, "unit": unit,
-                     "difference_pct": (value / study - 1.0) * 100.0})
-    return pd.DataFrame(rows, columns=["metric", "value", "study_value", "unit", "difference_pct"])
-
-
-def validation_verdict(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """The validation study without noise: per parameter kind, the error range over joints against the study's.
-
-    Parameters
-    ----------
-    summary : pandas.DataFrame
-        ``results/validation/summary.tsv``: ``condition, parameter`` (``K_hip``
-        ...), ``min_error, max_error, n``, ``study_min_error, study_max_error``.
-    source : str
-        Where the table came from, for error messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        Rows K and D (condition ``no_noise``): ``parameter, n_combinations``,
-        ``min_error, max_error, study_min_error, study_max_error`` (N·m/rad
-        for K, N·m·s/rad for D) and ``within_study`` (the whole range inside
-        the study's).
-    """
-    needed = ["condition", "parameter", "min_error", "max_error", "n", "study_min_error", "study_max_error"]
-    table = _rows_or_empty(summary, needed, source, "validation summary")
-    clean = table[table["condition"] == "no_noise"].reset_index(drop=True)
-    rows = []
-    for p in _PARAMETERS:
-        g = clean[clean["parameter"].astype(str).str.startswith(f"{p}_")]
-        if not len(g):
-            continue
-        at = f"{where(source)}no_noise {p} rows"
-        lo, hi = _numbers(g, "min_error", at), _numbers(g, "max_error", at)
-        s_lo, s_hi = _numbers(g, "study_min_error", at), _numbers(g, "study_max_error", at)
-        rows.append({"parameter": p, "n_combinations": integer("n", int(_numbers(g, "n", at).min()), at),
-                     "min_error": float(lo.min()), "max_error": float(hi.max()),
-                     "study_min_error": float(s_lo.min()), "study_max_error": float(s_hi.max()),
-                     "within_study": bool(lo.min() >= s_lo.min() and hi.max() <= s_hi.max())})
-    return pd.DataFrame(rows, columns=["parameter", "n_combinations", "min_error", "max_error", "study_min_error",
-                                       "study_max_error", "within_study"])
 
 
 # ---------------------------------------------------------------------------------------------- the run
@@ -508,7 +202,7 @@ _STYLE = """<style>
 def _summary_table(ci: pd.DataFrame) -> str:
     """Across-subject mean [95 % CI] of K and D, VAF and counts, per joint and onset."""
     dec = {}
-    for p in _PARAMETERS:
+    for p in PARAMETER_KINDS:
         cols = [parameter_column(p, w) for w in ("mean", "ci95_low", "ci95_high")]
         for joint in set(ci["joint"]):
             dec[p, joint] = _decimals(ci.loc[ci["joint"] == joint, cols].to_numpy().ravel())
@@ -518,7 +212,7 @@ def _summary_table(ci: pd.DataFrame) -> str:
             key = f"impedance-summary|{joint}|{r['onset_ms']}|"
             cells = [f'<td class="lf-l" rowspan="{len(g)}">{html.escape(str(joint))}</td>' if k == 0 else "",
                      f"<td>{_count(r['onset_ms'], key + 'onset_ms')}</td>"]
-            for p in _PARAMETERS:
+            for p in PARAMETER_KINDS:
                 d = dec[p, joint]
                 mean, low, high = (parameter_column(p, w) for w in ("mean", "ci95_low", "ci95_high"))
                 interval = f"[{_num(r[low], d, key + low)}, {_num(r[high], d, key + high)}]"
@@ -545,7 +239,7 @@ def _summary_table(ci: pd.DataFrame) -> str:
 def _truth_table(truth: pd.DataFrame) -> str:
     """Bias, median |error|, within tolerance and truth inside the CI, per parameter and joint."""
     body = []
-    for p in _PARAMETERS:
+    for p in PARAMETER_KINDS:
         bias, median = parameter_column(p, "error_mean"), parameter_column(p, "error_median_abs")
         pct, within, inside = f"{p}_error_median_abs_pct", f"{p}_n_within_tolerance", f"{p}_n_truth_in_ci95"
         d = _decimals(truth[[bias, median]].to_numpy().ravel())
@@ -635,7 +329,7 @@ def _truth_verdict(truth: pd.DataFrame) -> str:
     failed = f", {n_failed} failed" if n_failed else ""
     within = ", ".join(
         f"{q} {_count(int(truth[q + '_n_within_tolerance'].sum()), 'verdict|truth|' + q + '_n_within_tolerance')}"
-        f"/{n_fits}" for q in _PARAMETERS)
+        f"/{n_fits}" for q in PARAMETER_KINDS)
     word = "Truth recovered" if ok else ("Truth missed" if ok is False else "Truth")
     coverage = "no joint fitted"
     if total:
@@ -708,19 +402,20 @@ def front_page_html(subjects: Mapping[str, str], trials: Mapping[str, Sequence[s
     versions : Mapping[str, str]
         Software -> version, in the order to show (Python and :data:`SOFTWARE`).
     device : pandas.DataFrame
-        :func:`device_comparison`.
+        :func:`~loper_analysis.headline.device_comparison`.
     validation : pandas.DataFrame
-        :func:`validation_verdict`.
+        :func:`~loper_analysis.headline.validation_verdict`.
     summary : pandas.DataFrame or None
-        :func:`impedance_summary_ci`; None: the run had no perturbation trials.
+        :func:`~loper_analysis.headline.impedance_summary_ci`; None: the run had no perturbation trials.
     truth : pandas.DataFrame or None
-        :func:`truth_recovery`; None or no rows: no subject with a known truth.
+        :func:`~loper_analysis.headline.truth_recovery`; None or no rows: no subject with a known truth.
     impedance_status : Mapping[str, int] or None
         Status -> number of rows of the impedance table (shown when nothing was fitted).
     figure_png : bytes or None
         The main figure (``results/figures/impedance.png``), embedded as a data URI.
     transparency : pandas.DataFrame or None
-        :func:`transparency_verdict`; None: no subject walked both trials of the transparency pair.
+        :func:`~loper_analysis.headline.transparency_verdict`; None: no subject walked both trials of the
+        transparency pair.
 
     Returns
     -------

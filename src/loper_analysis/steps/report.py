@@ -55,12 +55,14 @@ def front_page(out_html: PathLike, device_tsv: PathLike, validation_tsv: PathLik
     ``subjects``: subject -> source; ``trials``: processed subject -> its
     walking trials; ``settings``: the keyword arguments of
     :class:`~loper_analysis.front_page.RunSettings`; ``versions``: software ->
-    version (default :func:`software_versions`). Writes ``out_html`` and
-    returns the fragment.
+    version (default :func:`software_versions`). The headline tables come
+    from :mod:`loper_analysis.headline`. Writes ``out_html`` and returns the
+    fragment.
     """
     from ..errors import LoperInputError
-    from ..front_page import (RunSettings, device_comparison, front_page_html, impedance_summary_ci,
-                              transparency_verdict, truth_recovery, validation_verdict)
+    from ..front_page import RunSettings, front_page_html
+    from ..headline import (device_comparison, impedance_summary_ci, transparency_verdict, truth_recovery,
+                            validation_verdict)
 
     if (impedance_tsv is None) != (summary_tsv is None):
         raise LoperInputError(f"front page: the impedance table ({impedance_tsv}) and its summary ({summary_tsv}) "
