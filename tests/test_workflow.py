@@ -371,7 +371,7 @@ def _dry_run_rules(work: Path, *args: str) -> dict[str, set[str]]:
 
     res = _snakemake(work, "-n", *args)
     assert res.returncode == 0, res.stderr[-3000:]
-    blocks = re.split(r"^(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
+    blocks = re.split(r"^\s*(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
     rules: dict[str, set[str]] = {}
     for name, body in zip(blocks[::2], blocks[1::2]):
         wildcards = (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0]
@@ -394,7 +394,7 @@ def test_a_changed_setting_reruns_only_what_depends_on_it(finished_run, tmp_path
     overlay.write_text(yaml.safe_dump({section: {key: value}}))
     rules = _dry_run_rules(finished_run, "--configfile", "config/config.yaml", str(overlay))
     aggregates = {"impedance_table", "impedance_summary", "impedance_figures", "impedance_figure", "tables_markdown",
-                  "planning", "all"}
+                  "planning", "front_page", "all"}
     assert set(rules) - aggregates == expected, rules
     assert not {"markers", "ik", "model_scaled", "synthetic_lab", "validation_chunk"} & set(rules)
 
@@ -412,12 +412,12 @@ def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
     finally:
         os.utime(raw, (before.st_atime, before.st_mtime))
     assert res.returncode == 0, res.stderr[-3000:]
-    blocks = re.split(r"^(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
+    blocks = re.split(r"^\s*(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
     jobs = [(name, (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0])
             for name, body in zip(blocks[::2], blocks[1::2])]
     rules = {name for name, _ in jobs}
     assert rules == {"markers", "ik", "events_loadcell", "strides", "strides_summary",
                      "impedance_fit", "impedance_table", "impedance_summary", "impedance_figures", "impedance_figure",
-                     "tables_markdown", "planning", "all"}, rules
+                     "tables_markdown", "planning", "front_page", "all"}, rules
     trials = {w.split("trial=")[1].split(",")[0] for _, w in jobs if "trial=" in w}
     assert trials == {"pert050-1"}

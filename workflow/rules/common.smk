@@ -238,5 +238,6 @@ onerror:
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
         from loper_analysis.steps.cluster import slurm_failure_lines
 
-        for _line in slurm_failure_lines(log):
-            print(_line, file=sys.stderr)
+        for _path in [log] if isinstance(log, (str, Path)) else log:  # Snakemake 9 passes a list of logs
+            for _line in slurm_failure_lines(_path):
+                print(_line, file=sys.stderr)

@@ -1,5 +1,12 @@
 # LOPER device tests: simulated logs for a synthetic device subject, FRF and step analysis from disk.
 
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    device_summary,
+    device_figures,
+
+
 DEVICE = config["device"]
 DEVICE_SUBJECT = DEVICE["subject"]
 DEVICE_RATE_HZ = DEVICE["parameters"]["sample_rate_hz"]
@@ -24,6 +31,8 @@ rule device_trial:
         leg=DEVICE["leg"],
         tests=DEVICE["tests"],
         seed=config["seed"],
+    group:
+        "device"
     log:
         "results/logs/device_trial/{subject}/{trial}.log",
     benchmark:
@@ -57,6 +66,8 @@ rule device_frf:
         sample_rate_hz=DEVICE_RATE_HZ,
         window_samples=DEVICE["analysis"]["welch_window_samples"],
         overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
+    group:
+        "device"
     log:
         "results/logs/device_frf/frf.log",
     benchmark:
@@ -77,6 +88,8 @@ rule device_steps:
         before_s=DEVICE["analysis"]["step_before_s"],
         after_s=DEVICE["analysis"]["step_after_s"],
         steady_window_s=DEVICE["analysis"]["steady_window_s"],
+    group:
+        "device"
     log:
         "results/logs/device_steps/steps.log",
     benchmark:

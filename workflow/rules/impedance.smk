@@ -1,5 +1,15 @@
 # Perturbation analysis: responses (matched strides) and impedance fits per subject and onset, aggregate tables.
 
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    impedance_figures,
+    impedance_table,
+    impedance_summary,
+    impedance_figure,
+    tables_markdown,
+
+
 IDENT = config["identification"]
 
 

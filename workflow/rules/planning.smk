@@ -1,5 +1,11 @@
 # The experiment planner: predicted 95 % CI half-width of K and D from a pilot subject's null pairs and fits.
 
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    planning,
+
+
 PLAN = config["planning"]
 
 

@@ -1,4 +1,14 @@
 # Processing: raw C3D + robot log -> markers (TRC) -> scaled OpenSim model -> IK (chunked) -> events -> forces.
+import re
+
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    transparency,
+    strides_summary,
+    model_generic,
+    model_segments,
+
 
 TRIALS = config["trials"]
 FILTER = config["filter"]
@@ -14,6 +24,12 @@ def subject_model(wildcards):
 
 
 LABEL_MAP = config["markers"]["label_map"]
+
+
+def trial_group(wildcards) -> str:
+    """Cluster job group (ignored locally): a walking trial's markers, IK, events and strides run as one SLURM
+    job ("trial"); the static trial's markers join the subject's scaling ("model")."""
+    return "model" if wildcards.trial == TRIALS["static"] else "trial"
 
 
 rule markers:
@@ -33,6 +49,8 @@ rule markers:
         duration_s=lambda wc: config["markers"]["static_duration_s"] if wc.trial == TRIALS["static"] else None,
         label_map=LABEL_MAP or None,
         extent_range_m=config["markers"]["extent_range_m"],
+    group:
+        trial_group
     log:
         "results/logs/markers/{subject}/{trial}.log",
     benchmark:
@@ -74,6 +92,8 @@ rule model_scaled:
         scale_setup=OPENSIM["scale_setup"],
         segment_bodies=OPENSIM["segment_bodies"],
         factor_range=OPENSIM["scale_factor_range"],
+    group:
+        "model"
     log:
         "results/logs/model_scaled/{subject}.log",
     benchmark:
@@ -123,6 +143,8 @@ if OPENSIM["ik_chunks"] == 1:
         params:
             coordinate_map=OPENSIM["coordinate_map"],
             settings=IK_SETTINGS,
+        group:
+            "trial"
         log:
             "results/logs/ik/{subject}/{trial}.log",
         benchmark:
@@ -142,6 +164,8 @@ else:
         params:
             n_chunks=OPENSIM["ik_chunks"],
             settings=IK_SETTINGS,
+        group:
+            "trial"
         log:
             "results/logs/ik_chunk/{subject}/{trial}.{chunk}.log",
         benchmark:
@@ -157,6 +181,8 @@ else:
             angles="results/ik/{subject}/{trial}.angles.tsv",
         params:
             coordinate_map=OPENSIM["coordinate_map"],
+        group:
+            "trial"
         log:
             "results/logs/ik_join/{subject}/{trial}.log",
         benchmark:
@@ -224,6 +250,8 @@ rule events:
         trial=TRIALS["no_device"],
     params:
         settings=EVENT_SETTINGS,
+    group:
+        "trial"
     log:
         "results/logs/events/{subject}/{trial}.log",
     benchmark:
@@ -246,10 +274,13 @@ rule events_loadcell:
         force="results/loadcell/{subject}/{trial}.force.tsv",
         native="results/loadcell/{subject}/{trial}.force_native.tsv",
     wildcard_constraints:
-        trial=f"(?!{TRIALS['no_device']}$)[A-Za-z0-9-]+",
+        # any trial but the one without the device (the lookahead ends at the wildcard's end, not the path's)
+        trial=f"(?!{re.escape(TRIALS['no_device'])}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
     params:
         events=EVENT_SETTINGS,
         loadcell=LOADCELL_SETTINGS,
+    group:
+        "trial"
     log:
         "results/logs/events_loadcell/{subject}/{trial}.log",
     benchmark:
@@ -279,6 +310,8 @@ rule strides:
         whisker=config["strides"]["iqr_whisker"],
         max_fraction=config["strides"]["max_outlier_fraction"],
         min_valid=config["strides"]["min_valid_strides"],
+    group:
+        "trial"
     log:
         "results/logs/strides/{subject}/{trial}.log",
     benchmark:

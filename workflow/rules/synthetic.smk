@@ -1,5 +1,11 @@
 # The simulated gait lab: raw files of synthetic subjects (never of recorded ones, see SYNTHETIC_PATTERN).
 
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    synthetic_truth,
+
+
 SYNTH = config["synthetic"]
 
 

@@ -1,5 +1,13 @@
 # Validation study of the identification: 729 K/D combinations x {no_noise, noise}.
 
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    validation_segments,
+    validation_gather,
+    validation_figure,
+
+
 
 rule validation_segments:
     output:
