@@ -28,6 +28,7 @@ import pandas as pd
 from .checks import integer, number, require_columns, where
 from .constants import JOINTS, parameter_column
 from .errors import LoperInputError
+from .identification.intervals import t_quantile
 from .impedance import TRUTH_TOLERANCE
 from .reference import STUDY_DEVICE
 
@@ -91,8 +92,6 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
         not-identifiable count above it), a mean that is no finite number,
         or no SD where two or more subjects were averaged.
     """
-    from scipy.stats import t as student_t
-
     needed = ["joint", "onset_ms", "n_subjects", "n_not_identifiable", "vaf_pct_mean",
               *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("mean", "sd"))]
     out_columns = ["joint", "onset_ms", "n_subjects", "n_not_identifiable",
@@ -112,7 +111,7 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
             mean = number(parameter_column(p, "mean"), r[parameter_column(p, "mean")], at)
             if n >= 2:
                 sd = number(parameter_column(p, "sd"), r[parameter_column(p, "sd")], at, minimum=0.0)
-                half = float(student_t.ppf(0.975, n - 1)) * sd / math.sqrt(n)
+                half = t_quantile(n - 1, 0.95) * sd / math.sqrt(n)
                 low, high = mean - half, mean + half
             else:
                 low = high = math.nan
