@@ -376,3 +376,32 @@ def test_count_flagged_leaves_out_contacts_cut_by_the_recording():
 
     assert count_flagged(["ok", "incomplete", "two_feet", "no_foot", "ok", "wrong_belt"]) == 3
     assert count_flagged(pd.Series([], dtype=object)) == 0
+
+
+def test_plates_in_a_y_up_frame_with_corners_either_way_round_give_the_same_contacts(trial, judged):
+    """Corners and heels turned into a Y-up frame ((x, y, z) -> (x, z, -y)), the corners listed the other way
+    round, with up = +Y: every contact, foot, flag and heel distance as in the Z-up frame."""
+    t, raw, tm, heels, _ = trial
+    Q = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+    plates = [PlateForce(p.plate, p.time_s, p.vertical_force_n, (p.corners_m @ Q.T)[::-1]) for p in _plates(t, raw)]
+    turned = foot_contacts(plates, tm, {s: h @ Q.T for s, h in heels.items()}, **SETTINGS, source="S01/walk",
+                           up=(0.0, 1.0, 0.0))
+    pd.testing.assert_frame_equal(turned.drop(columns=[c for c in CONTACT_COLUMNS if c.endswith("_m")]),
+                                  judged.drop(columns=[c for c in CONTACT_COLUMNS if c.endswith("_m")]))
+    heel = [c for c in CONTACT_COLUMNS if c.endswith("_m")]
+    np.testing.assert_allclose(turned[heel].to_numpy(float), judged[heel].to_numpy(float), atol=1e-12)
+
+
+def test_plate_offsets_with_up_either_corner_order_and_a_tilted_plate_refused():
+    c = CORNERS[2]
+    points = [[0.2, 0.5, 0.07], [0.6, 0.5, 0.0], [0.7, 1.9, 0.1]]
+    for corners in (c, c[::-1]):
+        out, height = plate_offsets(points, corners, up=(0.0, 0.0, 1.0))
+        np.testing.assert_allclose(out, [0.0, 0.1, math.hypot(0.2, 0.3)], atol=1e-12)
+        np.testing.assert_allclose(height, [0.07, 0.0, 0.1], atol=1e-12)
+    # up along the plate's own plane: 90 deg from its normal, refused naming the plate
+    refusal = (r"walk: plate 2: the plate does not face up: surface normal \[0\.0, 0\.0, 1\.0\] is 90\.0 deg from the "
+               r"up direction \[0\.0, 1\.0, 0\.0\]")
+    with pytest.raises(LoperInputError, match=refusal):
+        foot_contacts([PlateForce(2, np.arange(10) / 100.0, np.zeros(10), c)], np.arange(2) / 100.0,
+                      {"left": np.zeros((2, 3)), "right": np.zeros((2, 3))}, source="walk", up=(0.0, 1.0, 0.0))

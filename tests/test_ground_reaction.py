@@ -179,3 +179,69 @@ def test_table_refuses_mixed_time_bases(walking5_loads):
     q = plate_loads(2, p.time_s + 0.001, p.force_n, p.moment_nm, p.corners_m)
     with pytest.raises(LoperInputError, match="plate 2 is not on the time base of plate 1"):
         external_loads_table([p, q])
+
+
+# --------------------------------------------------------------------------- the lab's up direction
+
+
+def test_surface_normal_turns_along_the_labs_up_for_either_corner_order():
+    """A Y-up lab (BTS): the floor plate's normal is +Y whichever way round its corners are listed."""
+    c = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 0.0]])  # in the plane y = 0
+    for corners in (c, c[::-1]):
+        np.testing.assert_array_equal(surface_normal(corners, up=(0.0, 1.0, 0.0)), [0.0, 1.0, 0.0])
+        np.testing.assert_array_equal(surface_normal(corners, up=(0.0, 2.0, 0.0)), [0.0, 1.0, 0.0])  # normalised
+    # the default up is lab +Z: the same plate is a wall there, refused with the numbers that tell why
+    with pytest.raises(LoperInputError) as caught:
+        surface_normal(c, "bts.c3d (force platform 2)")
+    assert str(caught.value) == (
+        "bts.c3d (force platform 2): the plate does not face up: surface normal [0.0, -1.0, 0.0] is 90.0 deg from "
+        "the up direction [0.0, 0.0, 1.0] (at most 45 deg); the lab's up is the direction "
+        "markers.lab_to_model_rotation_deg turns into the model's +Y: check that setting for this lab")
+    # 44 deg from up is accepted, 46 deg refused
+    for tilt, ok in ((44.0, True), (46.0, False)):
+        a = np.radians(tilt)
+        tilted = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, np.cos(a), np.sin(a)], [0.0, np.cos(a), np.sin(a)]])
+        if ok:
+            np.testing.assert_allclose(surface_normal(tilted, up=(0, 0, 1)), [0.0, -np.sin(a), np.cos(a)], atol=1e-15)
+        else:
+            with pytest.raises(LoperInputError, match="is 46.0 deg from the up direction"):
+                surface_normal(tilted, up=(0, 0, 1))
+    for bad in ((0.0, 0.0, 0.0), (0.0, np.nan, 1.0), (1.0, 0.0)):
+        with pytest.raises(LoperInputError, match=r"bts\.c3d: up must be 3 finite numbers"):
+            surface_normal(c, "bts.c3d", up=bad)
+
+
+def test_plate_loads_of_a_y_up_lab_are_the_z_up_ones_turned(walking5_loads):
+    """walking5's plates carried into a Y-up lab ((x, y, z) -> (x, z, -y)) with up = +Y: the same resting level,
+    loaded samples, vertical force, COP and free moment, turned; also with the corners listed the other way."""
+    Q = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+    for p in walking5_loads:
+        raw_f, raw_m = p.force_n + p.rest_force_n, p.moment_nm + p.rest_moment_nm
+        for corners in (p.corners_m @ Q.T, (p.corners_m @ Q.T)[::-1]):
+            q = plate_loads(p.number, p.time_s, raw_f @ Q.T, raw_m @ Q.T, corners, THRESHOLD_N, up=(0.0, 1.0, 0.0))
+            np.testing.assert_array_equal(q.loaded, p.loaded)
+            np.testing.assert_array_equal(q.up, [0.0, 1.0, 0.0])
+            np.testing.assert_allclose(q.normal, [0.0, 1.0, 0.0], atol=1e-12)
+            np.testing.assert_allclose(q.rest_force_n, p.rest_force_n @ Q.T, atol=1e-9)
+            np.testing.assert_allclose(q.cop_m, p.cop_m @ Q.T, atol=1e-9)
+            np.testing.assert_allclose(q.free_moment_nm, p.free_moment_nm, atol=1e-9)
+        vl = vertical_loads([q], (0.0, 0.0, 0.0))
+        np.testing.assert_allclose(vl.vertical_n[:, 0], p.force_n[:, 2], atol=1e-9)
+        np.testing.assert_allclose(vl.rest_vertical_n, [p.rest_force_n[2]], atol=1e-9)
+    # read as if Z were up, the Y-up plate is a wall
+    p = walking5_loads[0]
+    with pytest.raises(LoperInputError, match="does not face up"):
+        plate_loads(1, p.time_s, p.force_n @ Q.T, p.moment_nm @ Q.T, p.corners_m @ Q.T, THRESHOLD_N)
+
+
+def test_resting_level_along_up():
+    F, M = _synthetic(noise=2.0)
+    Q = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+    rest_f, rest_m, unloaded = resting_level(F @ Q.T, M @ Q.T, band_n=10.0, up=(0.0, 1.0, 0.0))
+    expected_f, expected_m, expected_unloaded = resting_level(F, M, band_n=10.0)
+    np.testing.assert_array_equal(unloaded, expected_unloaded)
+    np.testing.assert_allclose(rest_f, expected_f @ Q.T, atol=1e-12)
+    np.testing.assert_allclose(rest_m, expected_m @ Q.T, atol=1e-12)
+    loaded_f, loaded_m = _synthetic(n_rest=0, n_load=50)
+    with pytest.raises(LoperInputError, match=r"resting vertical force 440\.0 N exceeds 100 N"):
+        resting_level(loaded_f @ Q.T, loaded_m @ Q.T, up=(0.0, 1.0, 0.0))

@@ -86,3 +86,19 @@ def test_bad_label_map_files_are_named(tmp_path, name, text, match):
     with pytest.raises(LoperInputError, match=match) as err:
         read_label_map(path)
     assert str(path) in str(err.value)
+
+
+def test_labels_with_inner_spaces_are_kept_and_mapped_by_a_key_with_spaces(tmp_path):
+    """BTS labels: a key with spaces renames them (inline, YAML or TSV map); unmapped ones keep their spaces."""
+    bts = ["Anna:r heel", "l heel", "r toe tip"]
+    assert model_marker_names(bts, None, SOURCE) == ["r heel", "l heel", "r toe tip"]
+    yaml_map = tmp_path / "map.yaml"
+    yaml_map.write_text("r heel: RHEE\nl heel: LHEE\n")
+    tsv_map = tmp_path / "map.tsv"
+    tsv_map.write_text("label\tmarker\nr heel\tRHEE\nl heel\tLHEE\n")
+    for label_map in ({"r heel": "RHEE", "l heel": "LHEE"}, read_label_map(yaml_map), read_label_map(tsv_map)):
+        assert model_marker_names(bts, label_map, SOURCE) == ["RHEE", "LHEE", "r toe tip"]
+    with pytest.raises(LoperInputError, match=r"markers\.label_map: label\(s\) r  heel not in the file"):
+        model_marker_names(bts, {"r  heel": "RHEE"}, SOURCE)  # a key matches the label exactly
+    with pytest.raises(LoperInputError, match=r"'r heel' maps to 'R HEE', not a marker name \(non-empty, no spaces"):
+        model_marker_names(bts, {"r heel": "R HEE"}, SOURCE)

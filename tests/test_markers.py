@@ -266,3 +266,29 @@ def test_summary_counts_frames_the_filter_left_unfiltered(trial):
     assert summary[["n_missing_frames", "longest_gap_frames", "n_unfiltered_frames"]].values.tolist() == [
         [0, 0, 0], [145, 135, 5]
     ]
+
+
+@pytest.mark.parametrize("angles, up", [
+    ((-90, 0, 0), [0.0, 0.0, 1.0]),  # Qualisys / Vicon, Z up: exactly, so that Z-up labs keep their numbers
+    ((0, 0, 0), [0.0, 1.0, 0.0]),  # BTS, Y up, already OpenSim's frame
+    ((90, 0, 0), [0.0, 0.0, -1.0]),
+    ((0, 0, 90), [1.0, 0.0, 0.0]),
+    ((-90, 30, 0), [0.0, 0.0, 1.0]),  # a heading turn about the model's vertical (Y) leaves up alone
+    ((-90, 0, 30), [0.5, 0.0, np.sqrt(3) / 2]),  # a tilt about the model's Z moves it
+    ((-80, 0, 0), [0.0, np.sin(np.radians(10)), np.cos(np.radians(10))]),
+])
+def test_lab_up_is_what_the_rotation_turns_into_the_models_plus_y(angles, up):
+    from loper_analysis.markers import MODEL_UP, lab_up
+
+    got = lab_up(angles)
+    np.testing.assert_allclose(got, up, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(rotate_markers(got, angles), MODEL_UP, rtol=0, atol=1e-15)
+    if all(a % 90 == 0 for a in angles):
+        assert got.tolist() == up  # quarter turns give exact axes
+
+
+def test_lab_up_refuses_a_bad_rotation():
+    from loper_analysis.markers import lab_up
+
+    with pytest.raises(LoperInputError, match="rotation_deg must be 3 finite angles"):
+        lab_up((0.0, np.nan, 0.0))

@@ -99,3 +99,164 @@ def test_stride_summary_counts_removed_and_kept_strides():
     assert flagged.status == "too_few_strides" and flagged.n_kept == 3
     assert flagged.n_removed == flagged.n_removed_knee == 5 and flagged.n_removed_hip == 0
     np.testing.assert_allclose(out["mean_stride_s"], 1.2)
+
+
+# --------------------------------------------------------------------------- trials with 0 or 1 strides
+
+#: Columns of a stride table with a force table, in order (the table of any number of strides, 0 included).
+STRIDE_COLUMNS = [
+    "stride", "side", "heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s", "perturbed",
+    "onset_s", "fraction_outlying_hip", "fraction_outlying_knee", "fraction_outlying_ankle", "removed", "reason",
+    "rms_force_stance_n", "rms_force_swing_n", "max_abs_force_stance_n", "max_abs_force_swing_n",
+]
+FORCE_N = -3.5  # a constant interaction force: RMS and max |F| are 3.5 N in every phase
+
+
+def _overground(n_heel_strikes: int, logged_from_s: float = 0.0):
+    """Angles (128 Hz, 7 s), left events with ``n_heel_strikes`` heel strikes 1.2 s apart (each followed by a
+    toe-off 0.72 s later) and a constant force, NaN before ``logged_from_s`` (outside the robot log)."""
+    t = np.arange(0, 7.0, 1 / 128)
+    phase = 2 * np.pi * (t - 0.5) / 1.2
+    angles = pd.DataFrame({"time_s": t, "hip_left_rad": 0.4 * np.sin(phase), "knee_left_rad": 0.6 * np.cos(phase),
+                           "ankle_left_rad": 0.2 * np.sin(phase + 1.0)})
+    hs = 0.5 + 1.2 * np.arange(n_heel_strikes)
+    events = pd.DataFrame({"side": pd.Series(["left"] * 2 * n_heel_strikes, dtype=object),
+                           "event": ["heel_strike", "toe_off"] * n_heel_strikes,
+                           "time_s": np.column_stack([hs, hs + 0.72]).ravel(),
+                           "sample": np.zeros(2 * n_heel_strikes, dtype=np.int64)})
+    force = pd.DataFrame({"time_s": t, "force_measured_n": np.where(t >= logged_from_s, FORCE_N, np.nan),
+                          "perturbation": np.where(t >= logged_from_s, 0.0, np.nan)})
+    return angles, events, force
+
+
+@pytest.mark.parametrize("n_heel_strikes, n_strides", [(0, 0), (1, 0), (2, 1)])
+def test_zero_or_one_stride_gives_the_full_tables_flagged(n_heel_strikes, n_strides):
+    angles, events, force = _overground(n_heel_strikes)
+    with pytest.warns(TooFewStridesWarning) as caught:
+        tables = stride_tables(angles, events, force, side="left")
+    messages = [str(w.message) for w in caught]
+    assert f"{n_strides} complete unperturbed left stride(s)" in messages[0]
+    assert f"only {n_strides} valid stride(s), fewer than the 5 required" in messages[1]
+    assert tables.too_few_strides
+    s = tables.strides
+    assert list(s.columns) == STRIDE_COLUMNS and len(s) == n_strides
+    assert list(tables.cycles.columns) == ["stride", "phase", "point", "percent", "hip_left_rad", "knee_left_rad",
+                                           "ankle_left_rad", "force_n"]
+    assert len(tables.cycles) == 3 * 101 * n_strides
+    if n_strides:
+        row = s.iloc[0]
+        np.testing.assert_allclose(row[["heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s"]]
+                                   .to_numpy(float), [0.5, 1.22, 1.7, 1.2, 0.72, 0.48], rtol=0, atol=1e-12)
+        assert not row.perturbed and not row.removed and row.reason == "" and np.isnan(row.onset_s)
+        assert np.isnan(row[["fraction_outlying_hip", "fraction_outlying_knee", "fraction_outlying_ankle"]]
+                        .to_numpy(float)).all()
+        np.testing.assert_allclose(row[STRIDE_COLUMNS[-4:]].to_numpy(float), 3.5, rtol=1e-12)
+        np.testing.assert_allclose(tables.cycles["force_n"], FORCE_N, rtol=1e-12)
+
+
+def test_strides_outside_the_robot_log_are_left_out_down_to_none():
+    """NaN force before the robot log starts: the strides it does not cover are dropped, the others measured."""
+    angles, events, force = _overground(5, logged_from_s=1.0)  # the first stride starts at 0.5 s, unlogged
+    with pytest.warns(TooFewStridesWarning):
+        tables = stride_tables(angles, events, force, side="left")
+    np.testing.assert_allclose(tables.strides["heel_strike_s"], [1.7, 2.9, 4.1], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(tables.strides[STRIDE_COLUMNS[-4:]].to_numpy(float), 3.5, rtol=1e-12)
+    angles, events, force = _overground(2, logged_from_s=1.0)  # the only stride is unlogged
+    with pytest.warns(TooFewStridesWarning):
+        tables = stride_tables(angles, events, force, side="left")
+    assert list(tables.strides.columns) == STRIDE_COLUMNS and len(tables.strides) == 0
+    angles, events, force = _overground(2, logged_from_s=10.0)  # no robot log at all on these frames
+    with pytest.warns(TooFewStridesWarning):
+        tables = stride_tables(angles, events, force, side="left")
+    assert list(tables.strides.columns) == STRIDE_COLUMNS and len(tables.strides) == 0
+
+
+def test_the_steps_write_and_summarise_trials_with_zero_and_one_stride(tmp_path):
+    """The files of 0 and 1 strides hold every column; read back as strides_summary reads them they give
+    n_strides 0 and 1 and too_few_strides, next to a trial with enough strides."""
+    from loper_analysis.io.atomic import write_tsv
+    from loper_analysis.io.readers import read_tsv
+    from loper_analysis.steps.processing import strides, strides_summary
+
+    files = {}
+    for n_heel_strikes in (1, 2, 6):
+        angles, events, force = _overground(n_heel_strikes)
+        for name, frame in (("angles", angles), ("events", events), ("force", force)):
+            write_tsv(frame, tmp_path / f"{n_heel_strikes}.{name}.tsv")
+        out = tmp_path / f"{n_heel_strikes}.strides.tsv"
+        with pytest.warns(TooFewStridesWarning) if n_heel_strikes < 6 else _no_warning():
+            strides(tmp_path / f"{n_heel_strikes}.angles.tsv", tmp_path / f"{n_heel_strikes}.events.tsv", out,
+                    tmp_path / f"{n_heel_strikes}.cycles.tsv", tmp_path / f"{n_heel_strikes}.force.tsv",
+                    min_valid=5 if n_heel_strikes < 6 else 4)
+        files[n_heel_strikes] = out
+    assert files[1].read_text() == "\t".join(STRIDE_COLUMNS) + "\n"  # the header only, every column
+    assert (tmp_path / "1.cycles.tsv").read_text().splitlines() == [
+        "stride\tphase\tpoint\tpercent\thip_left_rad\tknee_left_rad\tankle_left_rad\tforce_n"]
+    back = read_tsv(files[1], "stride table", keep_default_na=False, na_values=[""])
+    assert list(back.columns) == STRIDE_COLUMNS and len(back) == 0
+    keys = [("S01", "overground-0"), ("S01", "overground-1"), ("S01", "overground-5")]
+    table = strides_summary(keys, [files[1], files[2], files[6]], tmp_path / "summary.tsv", min_valid=4)
+    assert table[["trial", "n_strides", "n_perturbed", "n_removed", "n_kept", "status"]].values.tolist() == [
+        ["overground-0", 0, 0, 0, 0, "too_few_strides"],
+        ["overground-1", 1, 0, 0, 1, "too_few_strides"],
+        ["overground-5", 5, 0, 0, 5, "ok"],
+    ]
+    assert np.isnan(table["mean_stride_s"].iloc[0])
+    np.testing.assert_allclose(table["mean_stride_s"].iloc[1:], 1.2, rtol=0, atol=1e-12)
+    written = pd.read_csv(tmp_path / "summary.tsv", sep="\t")
+    assert written["status"].tolist() == ["too_few_strides", "too_few_strides", "ok"]
+    assert written["n_strides"].tolist() == [0, 1, 5]
+
+
+def test_stride_summary_of_an_untyped_empty_table_and_a_table_without_columns():
+    empty = pd.DataFrame({c: pd.Series([], dtype=object) for c in STRIDE_COLUMNS})  # as read from a header-only TSV
+    row = stride_summary({("S01", "walk"): empty}, min_valid=1).iloc[0]
+    assert (row.n_strides, row.n_perturbed, row.n_removed, row.n_kept, row.status) == (0, 0, 0, 0, "too_few_strides")
+    assert row.n_removed_hip == 0 and np.isnan(row.mean_stride_s)
+    with pytest.raises(LoperInputError, match=r"S01 walk: stride table: column\(s\) \['removed', 'reason', "
+                                              r"'duration_s'\] missing"):
+        stride_summary({("S01", "walk"): pd.DataFrame()})
+
+
+def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
+    """The transparency step on stride tables of 0 and 1 strides (as the strides step writes them): the subject
+    is left out with its counts, nothing crashes; the other subject is compared with itself (RMSD 0)."""
+    from loper_analysis.io.atomic import write_tsv
+    from loper_analysis.steps.processing import strides
+    from loper_analysis.steps.transparency import transparency
+
+    paths = {}
+    for n_heel_strikes in (1, 2, 6):
+        angles, events, force = _overground(n_heel_strikes)
+        for name, frame in (("angles", angles), ("events", events), ("force", force)):
+            write_tsv(frame, tmp_path / f"{n_heel_strikes}.{name}.tsv")
+        with pytest.warns(TooFewStridesWarning) if n_heel_strikes < 6 else _no_warning():
+            strides(tmp_path / f"{n_heel_strikes}.angles.tsv", tmp_path / f"{n_heel_strikes}.events.tsv",
+                    tmp_path / f"{n_heel_strikes}.strides.tsv", tmp_path / f"{n_heel_strikes}.cycles.tsv",
+                    tmp_path / f"{n_heel_strikes}.force.tsv")
+        paths[n_heel_strikes] = (tmp_path / f"{n_heel_strikes}.strides.tsv", tmp_path / f"{n_heel_strikes}.cycles.tsv")
+    pairs = {"S01": (6, 6), "S02": (6, 1), "S03": (2, 6)}  # heel strikes without, with the device
+    with pytest.warns(TooFewStridesWarning) as caught:
+        transparency(list(pairs), [paths[a][0] for a, _ in pairs.values()], [paths[a][1] for a, _ in pairs.values()],
+                     [paths[b][0] for _, b in pairs.values()], [paths[b][1] for _, b in pairs.values()],
+                     tmp_path / "rmsd.tsv", tmp_path / "force.tsv", tmp_path / "t.png")
+    assert sorted(str(w.message).split(":")[0] for w in caught) == ["subject S02", "subject S03"]
+    rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
+    assert rmsd.subject.tolist() == ["S01"] * 6 + ["S02"] * 6 + ["S03"] * 6 + ["all"] * 6
+    counts = rmsd.groupby("subject", sort=False)[["n_strides_no_device", "n_strides_device"]].first()
+    assert counts.loc[["S01", "S02", "S03"]].values.tolist() == [[5, 5], [5, 0], [1, 5]]
+    assert rmsd.loc[rmsd.subject.isin(["S02", "S03"]), "rmsd_rad"].isna().all()
+    np.testing.assert_allclose(rmsd.loc[rmsd.subject == "S01", "rmsd_rad"], 0.0, atol=1e-12)
+
+
+def _no_warning():
+    import contextlib
+    import warnings
+
+    @contextlib.contextmanager
+    def guard():
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", TooFewStridesWarning)
+            yield
+
+    return guard()

@@ -38,6 +38,8 @@ __all__ = [
 ]
 
 _WHITESPACE = re.compile(r"\s")
+#: Whitespace other than the plain space (tabs, line breaks, ...).
+_NOT_SPACE_WHITESPACE = re.compile(r"[^\S ]")
 
 
 def where(source: str) -> str:
@@ -212,18 +214,30 @@ def bool_column(table: pd.DataFrame, name: str, source: str = "", what: str = "t
 
 
 def unique_names(names, what: str, source: str = "", max_chars: int | None = None,
-                 allow_whitespace: bool = True) -> list[str]:
-    """Non-empty, unique strings without leading or trailing blanks (and, if asked, without any whitespace)."""
+                 allow_whitespace: bool = True, allow_spaces: bool = False) -> list[str]:
+    """Non-empty, unique strings without leading or trailing blanks (and, if asked, without any whitespace).
+
+    ``allow_whitespace=False`` refuses every whitespace character; with
+    ``allow_spaces=True`` as well, plain spaces (U+0020) inside a name are
+    accepted (``r heel``) and only other whitespace (tabs, line breaks) is
+    refused: the rule of tab-separated formats such as TRC.
+    """
     names = list(names)
+    inner = _NOT_SPACE_WHITESPACE if allow_spaces else _WHITESPACE
     for name in names:
         bad = not isinstance(name, str) or not name or name != name.strip()
         bad = bad or (max_chars is not None and len(name) > max_chars)
-        bad = bad or (not allow_whitespace and bool(_WHITESPACE.search(name)))
+        bad = bad or (not allow_whitespace and bool(inner.search(name)))
         if bad:
             limits = []
             if max_chars is not None:
                 limits.append(f"at most {max_chars} characters")
-            limits.append("leading/trailing blanks" if allow_whitespace else "whitespace")
+            if allow_whitespace:
+                limits.append("leading/trailing blanks")
+            elif allow_spaces:
+                limits.append("leading/trailing blanks or whitespace other than inner spaces")
+            else:
+                limits.append("whitespace")
             rule = f"non-empty strings of {limits[0]} without {limits[1]}" if len(limits) == 2 \
                 else f"non-empty strings without {limits[0]}"
             raise LoperInputError(f"{where(source)}{what} must be {rule}, got {name!r}")

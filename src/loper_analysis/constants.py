@@ -39,6 +39,8 @@ __all__ = [
     "CONTACT_FLAGS",
     "PHASES",
     "GRAVITY_M_PER_S2",
+    "MIN_IK_MARKERS",
+    "TRIAL_KINDS",
     "angle_column",
     "parameter_column",
 ]
@@ -70,6 +72,10 @@ CONTACT_FLAGS: tuple[str, ...] = ("ok", "incomplete", "heel_missing", "two_feet"
 #: Normalisation phases: the whole stride (HS -> next HS), stance (HS -> TO), swing (TO -> next HS).
 PHASES: tuple[str, ...] = ("stride", "stance", "swing")
 GRAVITY_M_PER_S2: float = 9.81
+#: Fewest weighted markers present in a frame for IK to solve it (three fix one rigid body).
+MIN_IK_MARKERS: int = 3
+#: Kinds of trial, as label maps and spans are keyed (besides the trial's own name).
+TRIAL_KINDS: tuple[str, ...] = ("static", "walking")
 
 
 def angle_column(joint: str, side: str) -> str:

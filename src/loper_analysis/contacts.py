@@ -168,7 +168,8 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
                   plate_sides: Mapping[str, int] | None = None, threshold_on_n: float = 50.0,
                   threshold_off_n: float = 20.0, min_stance_s: float = 0.2, min_swing_s: float = 0.2,
                   delay_s: float = 0.05, dwell_s: float = 0.15, margin_m: float = 0.03, reach_m: float = 0.25,
-                  max_height_m: float = 0.12, vertical_axis: int | None = None, source: str = "") -> pd.DataFrame:
+                  max_height_m: float = 0.12, vertical_axis: int | None = None, source: str = "",
+                  up: Sequence[float] | None = None) -> pd.DataFrame:
     """The contacts of every plate, each with the foot on it (from the heel markers) and a flag.
 
     A heel is **on** a plate at an instant when it lies over the plate's
@@ -225,9 +226,15 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
     max_height_m : float
         Highest heel above the plate's surface that counts as on it, m.
     vertical_axis : {0, 1, 2} or None
-        The vertical coordinate axis; None: each plate's normal.
+        The vertical coordinate axis; None: each plate's normal (from its
+        corners, which may run either way round the plate).
     source : str
         Name of the trial, quoted in messages.
+    up : array_like, shape (3,), optional
+        The up direction in the frame of the corners and heels (the model's
+        +Y, :data:`loper_analysis.markers.MODEL_UP`, for corners rotated like
+        the markers). With ``vertical_axis`` None each plate's normal is turned
+        along it and a plate more than 45 deg from level is refused, naming it.
 
     Returns
     -------
@@ -260,10 +267,10 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
     names = [f"{where(source)}plate {n}" for n in numbers]
     corners = [np.asarray(p.corners_m, dtype=float) for p in plates]
     for name, c in zip(names, corners):
-        plate_axes(c, vertical_axis, name)
+        plate_axes(c, vertical_axis, name, up)
 
-    def on(outside: np.ndarray, up: np.ndarray) -> np.ndarray:
-        return (outside <= margin) & (up <= height)  # NaN: False
+    def on(outside: np.ndarray, above: np.ndarray) -> np.ndarray:
+        return (outside <= margin) & (above <= height)  # NaN: False
 
     rows = []
     for k, (plate, name) in enumerate(zip(plates, names)):
@@ -277,12 +284,12 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
             start_on, on_all, missing, window = {}, {}, {}, {}
             for s in SIDES:
                 xyz = _at(tm, heels[s], times)
-                out, up = plate_offsets(xyz, corners[k], vertical_axis)
-                window[s] = (out, up)
-                start_on[s] = on(out[:1], up[:1])[0]
+                out, above = plate_offsets(xyz, corners[k], vertical_axis, up=up)
+                window[s] = (out, above)
+                start_on[s] = on(out[:1], above[:1])[0]
                 missing[s] = np.isnan(out)
                 # on every plate at the start probe: (n_plates,) outside, height
-                on_all[s] = np.array([on(*plate_offsets(xyz[:1], cc, vertical_axis))[0] for cc in corners])
+                on_all[s] = np.array([on(*plate_offsets(xyz[:1], cc, vertical_axis, up=up))[0] for cc in corners])
             at_start = [s for s in SIDES if start_on[s]]
             side = at_start[0] if len(at_start) == 1 else ""
             others = [s for s in SIDES if s != side]

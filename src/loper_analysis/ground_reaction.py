@@ -3,12 +3,22 @@
 Inputs are the arrays of one plate as read from a C3D file
 (:class:`loper_analysis.io.force_platforms.ForcePlatform`): the force the
 plate exerts on the body (N) and its moment about the centre of the plate's
-top surface (N·m), both (n_samples, 3) in the lab frame (Z up), and the
-plate's corners (4, 3) in m.
+top surface (N·m), both (n_samples, 3) in the lab frame, and the plate's
+corners (4, 3) in m.
+
+The lab's vertical
+    ``up`` is the lab's up direction (unit vector, lab frame): lab +Z by
+    default (:data:`loper_analysis.markers.LAB_Z_UP`, Qualisys and Vicon
+    labs), or the direction the lab-to-model rotation turns into the
+    model's +Y (:func:`loper_analysis.markers.lab_up`; +Y for a Y-up lab
+    such as BTS). The vertical force is ``F . up``. The order in which a file
+    lists a plate's corners (either way round the plate) only sets the sign
+    of the normal their diagonals give; the normal is turned to point along
+    ``up`` (:func:`surface_normal`), so the corner order changes nothing below.
 
 Resting level (:func:`resting_level`)
     Unloaded plates do not read zero (public files read -14 to -71 N). With
-    ``v`` the vertical (lab Z) force, the floor is the 1st percentile of
+    ``v`` the vertical force ``F . up``, the floor is the 1st percentile of
     ``v`` and the unloaded samples are those with ``v <= floor + band_n``;
     the resting level is the median of each force and moment component over
     them. The rule needs the plate to be unloaded for at least about 1 % of
@@ -20,7 +30,9 @@ Centre of pressure and free moment (:func:`centre_of_pressure`)
     centre ``C``, with force ``F`` and moment ``M`` about ``C``:
     ``COP = C + (n x M) / (n . F)`` (a point on the surface) and the free
     moment ``T = n . (M - (COP - C) x F)`` about ``n`` (upward), so that
-    ``M = (COP - C) x F + T n``.
+    ``M = (COP - C) x F + T n``. The COP does not depend on the sign of
+    ``n``; ``T`` is taken about the normal turned up, and the torque ``T n``
+    written to the ``.mot`` does not depend on it either.
 
 Loaded and unloaded samples (:func:`plate_loads`)
     A sample is loaded when the vertical force above the resting level
@@ -40,17 +52,19 @@ Rotation to the model frame (:func:`external_loads_table`)
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from .checks import number, where
 from .errors import LoperInputError
-from .markers import rotate_markers
+from .markers import LAB_Z_UP, rotate_markers
 
 __all__ = [
     "EXTERNAL_LOADS_SUFFIXES",
+    "MAX_TILT_DEG",
+    "ROTATION_SETTING",
     "PlateLoads",
     "VerticalLoads",
     "centre_of_pressure",
@@ -59,6 +73,7 @@ __all__ = [
     "plate_loads",
     "resting_level",
     "surface_normal",
+    "up_vector",
     "vertical_loads",
 ]
 
@@ -71,6 +86,10 @@ EXTERNAL_LOADS_SUFFIXES: tuple[str, ...] = (
 
 #: Percentile of the vertical force taken as the unloaded floor.
 _FLOOR_PERCENTILE = 1.0
+#: Largest angle between a plate's surface normal and the lab's up direction, deg.
+MAX_TILT_DEG = 45.0
+#: Setting that fixes the lab's up direction (named in messages).
+ROTATION_SETTING = "markers.lab_to_model_rotation_deg"
 
 
 @dataclass(frozen=True)
@@ -96,11 +115,13 @@ class PlateLoads:
     rest_force_n, rest_moment_nm : numpy.ndarray
         Shape (3,): the resting level removed (N, N·m).
     normal : numpy.ndarray
-        Shape (3,): upward unit normal of the top surface.
+        Shape (3,): unit normal of the top surface, turned along ``up``.
     corners_m : numpy.ndarray
         Shape (4, 3), m.
     centre_m : numpy.ndarray
         Shape (3,), m.
+    up : numpy.ndarray
+        Shape (3,): the lab's up direction (unit vector) that defines the vertical.
     """
 
     number: int
@@ -115,6 +136,7 @@ class PlateLoads:
     normal: np.ndarray
     corners_m: np.ndarray
     centre_m: np.ndarray
+    up: np.ndarray = field(default_factory=lambda: np.array(LAB_Z_UP))
 
 
 @dataclass(frozen=True)
@@ -126,7 +148,8 @@ class VerticalLoads:
     time_s : numpy.ndarray
         Shape (n,), s, analog rate.
     vertical_n : numpy.ndarray
-        Shape (n, n_plates), N: lab-vertical force on the body above the resting level (positive while loaded).
+        Shape (n, n_plates), N: vertical force (along each plate's ``up``) on the body above the resting level
+        (positive while loaded).
     rest_vertical_n : numpy.ndarray
         Shape (n_plates,), N: the resting vertical level that was removed.
     corners_m : numpy.ndarray
@@ -157,20 +180,71 @@ def _vectors(name: str, values, source: str, n: int | None = None) -> np.ndarray
     return X
 
 
-def surface_normal(corners_m, source: str = "") -> np.ndarray:
-    """Upward unit normal (positive lab Z component) of a plate's top surface from its four corners.
+def up_vector(up: Sequence[float], source: str = "") -> np.ndarray:
+    """The lab's up direction as a unit vector: ``up`` checked and normalised.
 
     Parameters
     ----------
-    corners_m : array_like
-        Shape (4, 3), m, lab frame, in order around the plate.
+    up : array_like
+        Shape (3,): a direction in the lab frame (any length > 0), e.g.
+        :data:`loper_analysis.markers.LAB_Z_UP` or
+        :func:`loper_analysis.markers.lab_up` of the lab-to-model rotation.
+    source : str
+        The file (and plate), quoted in messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3,), unit vector, lab frame (a new array).
 
     Raises
     ------
     LoperInputError
-        Bad shape, degenerate corners, or a plate not facing up (normal
-        within 45 degrees of the horizontal).
+        ``up`` is not 3 finite numbers or is the zero vector.
     """
+    try:
+        u = np.array(up, dtype=float)
+    except (TypeError, ValueError):
+        raise LoperInputError(f"{where(source)}up must be 3 numbers (a direction, lab frame), got {up!r}") from None
+    norm = float(np.linalg.norm(u)) if u.shape == (3,) and np.all(np.isfinite(u)) else 0.0
+    if norm == 0.0:
+        raise LoperInputError(f"{where(source)}up must be 3 finite numbers, not all 0 (a direction, lab frame), "
+                              f"got {up!r}")
+    return u / norm
+
+
+def surface_normal(corners_m, source: str = "", up: Sequence[float] = LAB_Z_UP) -> np.ndarray:
+    """Unit normal of a plate's top surface from its four corners, turned to point along the lab's up direction.
+
+    The normal is the cross product of the diagonals; listing the corners
+    the other way round the plate only flips it, and it is then turned so
+    that ``normal . up > 0``. A plate must lie within :data:`MAX_TILT_DEG`
+    (45 deg) of level: its normal at most that far from ``up``.
+
+    Parameters
+    ----------
+    corners_m : array_like
+        Shape (4, 3), m, lab frame, in order around the plate (either way round).
+    source : str
+        The file and plate, quoted in messages.
+    up : array_like
+        Shape (3,): the lab's up direction, lab frame (normalised here); default
+        lab +Z (:data:`loper_analysis.markers.LAB_Z_UP`). For a lab of another
+        orientation :func:`loper_analysis.markers.lab_up` of the lab-to-model rotation.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3,): unit normal, ``normal . up >= cos(45 deg)``.
+
+    Raises
+    ------
+    LoperInputError
+        Bad shape, degenerate corners, a bad ``up``, or a plate not facing up
+        (normal more than 45 degrees from ``up``; the message names the normal,
+        ``up`` and the setting :data:`ROTATION_SETTING` that fixes ``up``).
+    """
+    u = up_vector(up, source)
     C = np.asarray(corners_m, dtype=float)
     if C.shape != (4, 3) or not np.all(np.isfinite(C)):
         raise LoperInputError(f"{where(source)}corners_m must be 4 finite corners (4, 3), got shape {C.shape}")
@@ -179,26 +253,35 @@ def surface_normal(corners_m, source: str = "") -> np.ndarray:
     if norm == 0.0:
         raise LoperInputError(f"{where(source)}the plate corners {C.tolist()} do not span a surface")
     n = n / norm
-    if n[2] < 0:
+    if n @ u < 0:
         n = -n
-    if n[2] < np.sqrt(0.5):
-        raise LoperInputError(f"{where(source)}the plate does not face up: surface normal {np.round(n, 3).tolist()}")
+    if n @ u < np.cos(np.radians(MAX_TILT_DEG)):
+        angle = float(np.degrees(np.arccos(np.clip(n @ u, -1.0, 1.0))))
+        raise LoperInputError(
+            f"{where(source)}the plate does not face up: surface normal {np.round(n, 3).tolist()} is {angle:.1f} deg "
+            f"from the up direction {np.round(u, 3).tolist()} (at most {MAX_TILT_DEG:g} deg); the lab's up is the "
+            f"direction {ROTATION_SETTING} turns into the model's +Y: check that setting for this lab"
+        )
     return n
 
 
 def resting_level(force_n, moment_nm, band_n: float = 10.0, max_rest_n: float = 100.0,
-                  source: str = "") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                  source: str = "", up: Sequence[float] = LAB_Z_UP) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Resting (unloaded) level of a plate's force and moment.
 
     Parameters
     ----------
     force_n, moment_nm : array_like
-        Shape (n, 3): force on the body (N, lab frame, Z up) and its moment (N·m).
+        Shape (n, 3): force on the body (N, lab frame) and its moment (N·m).
     band_n : float
-        Width above the floor (1st percentile of the vertical force) within
-        which a sample counts as unloaded, N (> 0).
+        Width above the floor (1st percentile of the vertical force
+        ``force_n . up``) within which a sample counts as unloaded, N (> 0).
     max_rest_n : float
         Largest plausible resting vertical force magnitude, N (> 0).
+    source : str
+        The file and plate, quoted in messages.
+    up : array_like
+        Shape (3,): the lab's up direction (see :func:`surface_normal`); default lab +Z.
 
     Returns
     -------
@@ -218,14 +301,16 @@ def resting_level(force_n, moment_nm, band_n: float = 10.0, max_rest_n: float = 
     M = _vectors("moment_nm", moment_nm, source, F.shape[0])
     band = number("band_n", band_n, source, minimum=0.0)
     limit = number("max_rest_n", max_rest_n, source, minimum=0.0)
-    v = F[:, 2]
+    u = up_vector(up, source)
+    v = F @ u
     floor = float(np.percentile(v, _FLOOR_PERCENTILE))
     unloaded = v <= floor + band
     rest_f = np.median(F[unloaded], axis=0)
     rest_m = np.median(M[unloaded], axis=0)
-    if abs(rest_f[2]) > limit:
+    rest_v = float(rest_f @ u)
+    if abs(rest_v) > limit:
         raise LoperInputError(
-            f"{where(source)}resting vertical force {rest_f[2]:.1f} N exceeds {limit:g} N in magnitude: the plate is "
+            f"{where(source)}resting vertical force {rest_v:.1f} N exceeds {limit:g} N in magnitude: the plate is "
             "never unloaded, or its force points down while loaded (force on the plate instead of on the body)"
         )
     return rest_f, rest_m, unloaded
@@ -276,7 +361,8 @@ def _nearest_loaded(loaded: np.ndarray) -> np.ndarray | None:
 
 
 def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, threshold_n: float = 20.0,
-                band_n: float = 10.0, max_rest_n: float = 100.0, source: str = "") -> PlateLoads:
+                band_n: float = 10.0, max_rest_n: float = 100.0, source: str = "",
+                up: Sequence[float] = LAB_Z_UP) -> PlateLoads:
     """Resting level removed, COP and free moment of one plate, with the unloaded policy of the module notes.
 
     Parameters
@@ -294,6 +380,11 @@ def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, thresh
         Vertical force above the resting level from which a sample is loaded, N (> 0).
     band_n, max_rest_n : float
         See :func:`resting_level`.
+    source : str
+        The file and plate, quoted in messages.
+    up : array_like
+        Shape (3,): the lab's up direction, lab frame (see :func:`surface_normal`);
+        default lab +Z. The vertical force is ``force_n . up``.
 
     Raises
     ------
@@ -306,13 +397,14 @@ def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, thresh
     if t.shape != (F.shape[0],) or not np.all(np.isfinite(t)):
         raise LoperInputError(f"{where(source)}time_s must be {F.shape[0]} finite times, got shape {t.shape}")
     threshold = number("threshold_n", threshold_n, source, minimum=0.0)
-    normal = surface_normal(corners_m, source)
+    u = up_vector(up, source)
+    normal = surface_normal(corners_m, source, u)
     corners = np.asarray(corners_m, dtype=float)
     centre = corners.mean(axis=0)
-    rest_f, rest_m, _ = resting_level(F, M, band_n, max_rest_n, source)
+    rest_f, rest_m, _ = resting_level(F, M, band_n, max_rest_n, source, u)
     F = F - rest_f
     M = M - rest_m
-    loaded = F[:, 2] > threshold
+    loaded = F @ u > threshold
     cop, free = centre_of_pressure(F, M, centre, normal)
     nearest = _nearest_loaded(loaded)
     if nearest is None:
@@ -322,7 +414,7 @@ def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, thresh
     free = np.where(loaded, free, 0.0)
     return PlateLoads(number=int(plate_number), time_s=t.copy(), force_n=F, moment_nm=M, cop_m=cop, free_moment_nm=free,
                       loaded=loaded, rest_force_n=rest_f, rest_moment_nm=rest_m, normal=normal, corners_m=corners.copy(),
-                      centre_m=centre)
+                      centre_m=centre, up=u)
 
 
 def external_loads_table(loads: Sequence[PlateLoads], rotation_deg: Sequence[float] = (0.0, 0.0, 0.0)) -> pd.DataFrame:
@@ -372,9 +464,10 @@ def external_loads_table(loads: Sequence[PlateLoads], rotation_deg: Sequence[flo
 def vertical_loads(loads: Sequence[PlateLoads], rotation_deg: Sequence[float] = (0.0, 0.0, 0.0)) -> VerticalLoads:
     """Each plate's lab-vertical force above its resting level, with the corners in the model frame.
 
-    The vertical force is the lab Z component of :attr:`PlateLoads.force_n`
-    at the analog rate, positive while loaded, not zeroed while unloaded (a
-    threshold with hysteresis belongs to the event detection).
+    The vertical force is the component of :attr:`PlateLoads.force_n` along
+    the plate's :attr:`PlateLoads.up` (the lab's up direction) at the analog
+    rate, positive while loaded, not zeroed while unloaded (a threshold with
+    hysteresis belongs to the event detection).
 
     Raises
     ------
@@ -390,8 +483,8 @@ def vertical_loads(loads: Sequence[PlateLoads], rotation_deg: Sequence[float] = 
             raise LoperInputError(f"plate {p.number} is not on the time base of plate {loads[0].number}")
     return VerticalLoads(
         time_s=t.copy(),
-        vertical_n=np.column_stack([p.force_n[:, 2] for p in loads]),
-        rest_vertical_n=np.array([p.rest_force_n[2] for p in loads]),
+        vertical_n=np.column_stack([p.force_n @ p.up for p in loads]),
+        rest_vertical_n=np.array([p.rest_force_n @ p.up for p in loads]),
         corners_m=np.stack([rotate_markers(p.corners_m, rotation_deg) for p in loads]),
         numbers=tuple(p.number for p in loads),
     )

@@ -7,6 +7,12 @@ prefix (everything up to the last ``:``) and then renames labels through the
 ``markers.label_map`` configuration ({lab label: model marker}); labels the
 map does not name keep their stripped name. :func:`require_model_markers`
 refuses a trial in which no label provides a model marker the analysis needs.
+
+Labels with inner spaces (BTS exports ``r heel``) are read, renamed and
+written to the TRC as they are; a map key may hold them (``r heel: RHEE``).
+A map value is a model marker's name and cannot hold whitespace: OpenSim
+refuses whitespace (and ``/ \\ * +``) in the name of any model component, a
+marker included, so a label with a space can only reach IK through the map.
 """
 
 from __future__ import annotations
@@ -49,8 +55,10 @@ def model_marker_names(labels: Sequence[str], label_map: Mapping[str, str] | Non
         The file's marker labels, in file order.
     label_map : mapping of str to str, optional
         {lab label: model marker}. A key matches a file label with or
-        without its subject prefix (``LASIS`` matches ``Subject:LASIS``).
-        Labels not named keep their stripped name.
+        without its subject prefix (``LASIS`` matches ``Subject:LASIS``) and
+        may hold inner spaces (``r heel``); a value is a model marker name,
+        without whitespace (OpenSim's rule for component names). Labels not
+        named keep their stripped name (inner spaces included).
     source : str
         The file (for messages).
 
@@ -73,7 +81,8 @@ def model_marker_names(labels: Sequence[str], label_map: Mapping[str, str] | Non
         for key, value in label_map.items():
             if not isinstance(value, str) or not value.strip() or any(c.isspace() for c in value.strip()):
                 raise LoperInputError(
-                    f"{where}: {LABEL_MAP_FIELD}: '{key}' maps to {value!r}, not a marker name (non-empty, no spaces)"
+                    f"{where}: {LABEL_MAP_FIELD}: '{key}' maps to {value!r}, not a marker name (non-empty, no spaces: "
+                    "OpenSim refuses whitespace in a model marker's name)"
                 )
         # a key naming the full label (with prefix) wins over one naming the stripped label
         by_key: dict[str, int] = {}

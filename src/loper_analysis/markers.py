@@ -19,8 +19,12 @@ from .errors import LoperInputError
 __all__ = [
     "GAP_REPORT_COLUMNS",
     "GAP_SUMMARY_COLUMNS",
+    "LAB_Z_UP",
+    "MODEL_UP",
     "fill_gaps",
+    "frames_with_markers",
     "gap_summary",
+    "lab_up",
     "require_markers_per_frame",
     "rotate_markers",
 ]
@@ -35,6 +39,13 @@ GAP_SUMMARY_COLUMNS: tuple[str, ...] = (
 
 #: Problems listed in one error message before the rest are only counted.
 _MAX_LISTED = 10
+
+#: Up direction of the model frame (OpenSim's +Y), model frame.
+MODEL_UP: tuple[float, float, float] = (0.0, 1.0, 0.0)
+#: Up direction of a Z-up lab (Qualisys, Vicon; what ezc3d assumes), lab frame: ``lab_up((-90, 0, 0))``.
+LAB_Z_UP: tuple[float, float, float] = (0.0, 0.0, 1.0)
+#: Components of :func:`lab_up` smaller than this in magnitude are set to 0 (quarter turns give exact axes).
+_AXIS_ROUND_OFF = 1e-12
 
 
 def _check_markers(markers_m, source: str) -> np.ndarray:
@@ -273,6 +284,50 @@ def require_markers_per_frame(markers_m, labels: Sequence[str], min_markers: int
     )
 
 
+def frames_with_markers(markers_m, labels: Sequence[str], min_markers: int = 3,
+                        root_markers: Sequence[str] = ()) -> np.ndarray:
+    """Frames that IK can solve: ``min_markers`` markers present, enough of them on the root body, one off it.
+
+    The body jointed to the ground (the pelvis) carries every other body: it
+    is placed by its own markers, of which a frame must hold ``min_markers``
+    (three fix a rigid body), or all of them when the marker set has fewer.
+    Otherwise the pelvis pose is left to the limb markers and the joint
+    angles take up its error (a subject entering or leaving the capture
+    volume with a thigh marker in view gives hip angles off by tens of
+    degrees).
+
+    Parameters
+    ----------
+    markers_m : array_like
+        Shape (n_frames, n_markers, 3), metres, NaN where missing: the
+        weighted markers only.
+    labels : sequence of str
+        One name per marker.
+    min_markers : int
+        Least number of markers present (the rule of :func:`require_markers_per_frame`).
+    root_markers : sequence of str
+        Markers on the body jointed to the ground (the pelvis); a frame whose
+        present markers all sit there determines no joint angle. Empty: the
+        root body is not checked (only the count and nothing else).
+
+    Returns
+    -------
+    numpy.ndarray of bool
+        Shape (n_frames,): True where the frame can be solved.
+    """
+    X = np.asarray(markers_m, dtype=float)
+    labels = [str(lab) for lab in labels]
+    if X.ndim != 3 or X.shape[2] != 3 or X.shape[1] != len(labels):
+        raise LoperInputError(f"markers_m must have shape (n_frames, {len(labels)}, 3), got {X.shape}")
+    present = np.all(np.isfinite(X), axis=2)
+    root = np.array([lab in set(root_markers) for lab in labels], dtype=bool)
+    enough = present.sum(axis=1) >= min_markers
+    if not root.any():
+        return enough
+    placed = present[:, root].sum(axis=1) >= min(min_markers, int(root.sum()))
+    return enough & placed & present[:, ~root].any(axis=1)
+
+
 def rotate_markers(markers_m, rotation_deg: Sequence[float]) -> np.ndarray:
     """Rotate lab-frame points into the model frame.
 
@@ -315,3 +370,34 @@ def rotate_markers(markers_m, rotation_deg: Sequence[float]) -> np.ndarray:
         raise LoperInputError(f"rotation_deg must be 3 finite angles in degrees (about X, Y, Z), got {rotation_deg!r}")
     R = Rotation.from_euler("xyz", angles, degrees=True).as_matrix()
     return X @ R.T
+
+
+def lab_up(rotation_deg: Sequence[float]) -> np.ndarray:
+    """The lab's up direction: the unit vector (lab frame) that :func:`rotate_markers` turns into the model's +Y.
+
+    OpenSim's model frame is Y-up (:data:`MODEL_UP`), so the lab's up is
+    ``R.T @ (0, 1, 0)`` for the lab-to-model rotation ``R`` of
+    ``rotation_deg`` (the configuration's ``markers.lab_to_model_rotation_deg``).
+    Components smaller than 1e-12 in magnitude (round-off of the quarter
+    turns' sines and cosines) are set to 0 and the vector normalised again,
+    so that ``(-90, 0, 0)`` (a Z-up lab) gives exactly :data:`LAB_Z_UP` and
+    ``(0, 0, 0)`` (a Y-up lab such as BTS) exactly ``(0, 1, 0)``.
+
+    Parameters
+    ----------
+    rotation_deg : sequence of float
+        Three finite angles (degrees) about X, Y, Z, as :func:`rotate_markers`.
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3,), unit vector, lab frame.
+
+    Raises
+    ------
+    LoperInputError
+        If ``rotation_deg`` is not 3 finite numbers.
+    """
+    up = rotate_markers(np.eye(3), rotation_deg)[:, 1]  # the identity rotated is R.T; R.T @ e_y is its column 1
+    up[np.abs(up) < _AXIS_ROUND_OFF] = 0.0
+    return up / np.linalg.norm(up)

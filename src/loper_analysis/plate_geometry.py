@@ -5,10 +5,16 @@
   above its surface of points such as heel markers.
 
 Positions in m; corners and points in one frame (any orientation: the
-vertical is the plate's normal unless given).
+vertical is the plate's normal unless given). The corners may run either
+way round the plate: that only flips the normal's sign, which the outline
+test and the (unsigned) height do not depend on. With ``up`` (the frame's
+up direction) the normal is turned along it and a plate more than 45 deg
+from level is refused (:func:`loper_analysis.ground_reaction.surface_normal`).
 """
 
 from __future__ import annotations
+
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -18,18 +24,25 @@ from .errors import LoperInputError
 __all__ = ["plate_axes", "plate_offsets"]
 
 
-def plate_axes(corners_m, vertical_axis: int | None, source: str) -> tuple[np.ndarray, np.ndarray]:
+def plate_axes(corners_m, vertical_axis: int | None, source: str,
+               up: Sequence[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Centre and axes of one plate.
 
     Parameters
     ----------
     corners_m : array_like, shape (4, 3)
-        The plate's corners in m, in order around the plate.
+        The plate's corners in m, in order around the plate (either way round).
     vertical_axis : {0, 1, 2} or None
         The vertical coordinate axis; None: the plate's normal (the cross
-        product of its diagonals, turned so that its largest component is positive).
+        product of its diagonals, turned so that its largest component is
+        positive, or along ``up`` when given).
     source : str
         Name quoted in messages.
+    up : array_like, shape (3,), optional
+        The up direction in the frame of the corners (e.g. the model's +Y,
+        :data:`loper_analysis.markers.MODEL_UP`), used when ``vertical_axis``
+        is None: the normal is turned along it, and a plate whose normal lies
+        more than 45 deg from it is refused.
 
     Returns
     -------
@@ -38,6 +51,13 @@ def plate_axes(corners_m, vertical_axis: int | None, source: str) -> tuple[np.nd
     axes : numpy.ndarray, shape (3, 3)
         Rows u, v (unit vectors in the plate's horizontal plane, u along the
         first edge) and n (the vertical), right-handed.
+
+    Raises
+    ------
+    LoperInputError
+        Corners that are not finite (4, 3), enclose no area or whose first
+        edge is vertical; a bad ``vertical_axis`` or ``up``; with ``up``, a
+        plate more than 45 deg from level.
     """
     c = np.asarray(corners_m, dtype=float)
     if c.shape != (4, 3) or not np.isfinite(c).all():
@@ -47,8 +67,13 @@ def plate_axes(corners_m, vertical_axis: int | None, source: str) -> tuple[np.nd
         size = float(np.linalg.norm(n))
         if size < 1e-12:
             raise LoperInputError(f"{where(source)}corners_m enclose no area: {c.tolist()}")
-        n = n / size
-        n = n if n[np.argmax(np.abs(n))] > 0 else -n
+        if up is None:
+            n = n / size
+            n = n if n[np.argmax(np.abs(n))] > 0 else -n
+        else:
+            from .ground_reaction import surface_normal
+
+            n = surface_normal(c, source, up)
     else:
         axis = integer("vertical_axis", vertical_axis, source, minimum=0)
         if axis > 2:
@@ -61,7 +86,8 @@ def plate_axes(corners_m, vertical_axis: int | None, source: str) -> tuple[np.nd
     return c.mean(axis=0), np.vstack([u, np.cross(n, u), n])
 
 
-def plate_offsets(points_m, corners_m, vertical_axis: int | None = None, source: str = "") -> tuple[np.ndarray, np.ndarray]:
+def plate_offsets(points_m, corners_m, vertical_axis: int | None = None, source: str = "",
+                  up: Sequence[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Horizontal distance outside a plate and height above it of points (heel markers).
 
     The horizontal plane is the plate's plane: the normal is inferred from
@@ -79,6 +105,8 @@ def plate_offsets(points_m, corners_m, vertical_axis: int | None = None, source:
         The vertical coordinate axis; None: the plate's normal.
     source : str
         Name quoted in messages.
+    up : array_like, shape (3,), optional
+        The up direction in the frame of the corners (see :func:`plate_axes`).
 
     Returns
     -------
@@ -88,7 +116,7 @@ def plate_offsets(points_m, corners_m, vertical_axis: int | None = None, source:
     height_m : numpy.ndarray, shape (k,)
         Distance of the point from the plate's plane (m, unsigned).
     """
-    centre, axes = plate_axes(corners_m, vertical_axis, source)
+    centre, axes = plate_axes(corners_m, vertical_axis, source, up)
     p = np.atleast_2d(np.asarray(points_m, dtype=float))
     if p.ndim != 2 or p.shape[1] != 3:
         raise LoperInputError(f"{where(source)}points_m must have shape (k, 3), got {np.shape(points_m)}")

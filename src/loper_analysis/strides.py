@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .checks import require_columns, where
+from .checks import bool_column, require_columns, where
 from .constants import JOINTS, PHASES, angle_column
 from .errors import LoperInputError, TooFewStridesWarning
 from .events import strides as strides_from_events
@@ -30,6 +30,7 @@ from .resampling import PHASE_BOUNDS, normalise
 __all__ = [
     "MIN_STRIDES_FOR_OUTLIERS",
     "FORCE_PHASES",
+    "SUMMARY_COLUMNS",
     "StrideTables",
     "force_phase_metrics",
     "stride_tables",
@@ -43,6 +44,8 @@ log = logging.getLogger(__name__)
 MIN_STRIDES_FOR_OUTLIERS = 4
 #: Phases of the interaction-force metrics (half-open sample sets).
 FORCE_PHASES: tuple[str, ...] = ("stance", "swing")
+#: Columns of a stride table that :func:`stride_summary` reads.
+SUMMARY_COLUMNS: tuple[str, ...] = ("removed", "reason", "duration_s")
 
 
 @dataclass
@@ -151,7 +154,8 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
 
     Strides run heel strike to heel strike of ``side`` (``events``:
     :func:`loper_analysis.events.gait_events`), kept only where the joint
-    angles cover them (and, with a force table, the robot log). Outliers:
+    angles cover them without a gap (frames left out of IK are NaN) and,
+    with a force table, where the robot log does. Outliers:
     :func:`loper_analysis.outliers.iqr_outliers` on the stride-normalised
     hip, knee and ankle angles of the unperturbed strides.
 
@@ -203,8 +207,15 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
     t = angles["time_s"].to_numpy(float)
     inside = (table["heel_strike_s"] >= t[0]) & (table["end_s"] <= t[-1])
     table = table[inside].reset_index(drop=True)
-    table["stride"] = np.arange(len(table))
     values = angles[cols].to_numpy(float)
+    # frames left out of IK (too few markers) and angles no marker determined are NaN: such strides cannot be cut
+    complete = np.isfinite(values).all(axis=1)
+    whole = [bool(complete[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
+    if not all(whole):
+        log.info("%s: %d stride(s) with frames left out of IK (NaN angles) dropped", names["angles"],
+                 len(whole) - sum(whole))
+        table = table[whole].reset_index(drop=True)
+    table["stride"] = np.arange(len(table))
     force_n = None
     if force is not None:
         if len(force) != len(angles) or not np.allclose(force["time_s"].to_numpy(float), t, atol=1e-6):
@@ -244,7 +255,13 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
     out.loc[out["perturbed"], "reason"] = "perturbed"
     out["reason"] = out["reason"].fillna("")
     if force_n is not None:
-        metrics = force_phase_metrics(t, force_n, table, source=names["force"])
+        # samples outside the robot log (NaN) belong to no stride kept above: the metrics need only the others
+        logged = np.isfinite(force_n)
+        if logged.sum() >= 2 or len(table):
+            metrics = force_phase_metrics(t[logged], force_n[logged], table, source=names["force"])
+        else:  # no stride and (almost) no robot log: the columns without rows
+            metrics = pd.DataFrame({"stride": np.empty(0, np.int64), "phase": np.empty(0, object),
+                                    "rms_force_n": np.empty(0), "max_abs_force_n": np.empty(0)})
         wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
         wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
         # the same columns without any stride
@@ -273,6 +290,15 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
     return StrideTables(out, pd.concat(cycles, ignore_index=True), too_few)
 
 
+def _mean_duration_s(table: pd.DataFrame, source: str) -> float:
+    """Mean of the ``duration_s`` column (s); NaN without strides (an untyped empty column included)."""
+    try:
+        duration = table["duration_s"].astype(float)
+    except (TypeError, ValueError):
+        raise LoperInputError(f"{where(source)}stride table: column 'duration_s' is not numeric") from None
+    return float(duration.mean())
+
+
 def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: int = 5,
                    contacts: Mapping[tuple[str, str], pd.DataFrame] | None = None) -> pd.DataFrame:
     """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.
@@ -286,21 +312,40 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
     reason (two feet, no foot, off the plate, wrong belt, heel marker missing;
     not the contacts cut by the start or end of the recording). Trials whose
     events came from named GRF channels have an empty table.
+
+    A trial with 0 or 1 strides is a row like any other (``n_strides`` 0 or
+    1, ``mean_stride_s`` empty without strides, status ``too_few_strides``
+    unless ``min_valid`` allows it). A table read back from its TSV without
+    any row holds untyped (object) columns; ``removed`` and ``perturbed`` are
+    read as booleans (:func:`loper_analysis.checks.bool_column`) and
+    ``duration_s`` as a number in s, so such a table gives the same row as
+    the empty table :func:`stride_tables` returned.
+
+    Raises
+    ------
+    LoperInputError
+        A stride table without the columns :data:`SUMMARY_COLUMNS` (naming
+        the subject and trial), with a ``removed``/``perturbed`` cell that is
+        not a boolean or a ``duration_s`` that is not numeric.
     """
     rows = []
     with_contacts = contacts is not None and any(len(c) for c in contacts.values())
     for (subject, trial), table in tables.items():
-        removed = table[table["removed"]]
+        source = f"{subject} {trial}"
+        require_columns(table, SUMMARY_COLUMNS, source, "stride table")
+        removed_mask = bool_column(table, "removed", source, "stride table")
+        removed = table[removed_mask]
         signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
         reasons = removed["reason"].fillna("").astype(str)  # a column without any reason reads as float
         why = {s: int(reasons.str.contains(f"{s}:").sum()) for s in signals}
-        perturbed = table["perturbed"].astype(bool) if "perturbed" in table.columns else pd.Series(False, index=table.index)
-        n_kept = int((~table["removed"] & ~perturbed).sum())
+        perturbed = (bool_column(table, "perturbed", source, "stride table") if "perturbed" in table.columns
+                     else np.zeros(len(table), dtype=bool))
+        n_kept = int((~removed_mask & ~perturbed).sum())
         rows.append({
             "subject": subject, "trial": trial, "n_strides": len(table), "n_perturbed": int(perturbed.sum()),
             "n_removed": len(removed), "n_kept": n_kept,
             **{f"n_removed_{s}": n for s, n in why.items()},
-            "mean_stride_s": table["duration_s"].mean(),
+            "mean_stride_s": _mean_duration_s(table, source),
             "status": "ok" if n_kept >= min_valid else "too_few_strides",
         })
         if with_contacts:

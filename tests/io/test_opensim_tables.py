@@ -251,3 +251,53 @@ def test_opensim_tables_work_after_an_in_process_ezc3d_write(tmp_path):
     proc = subprocess.run([sys.executable, "-c", AFTER_RAW_EZC3D, str(tmp_path)], capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.split() == ["A", "0.5", "0.25"]
+
+
+# ---------------------------------------------------------------- TRC labels with inner spaces (BTS)
+
+SPACED = ["r heel", "l heel", "r  toe tip"]  # a double space stays as it is
+
+
+def test_trc_labels_with_inner_spaces_are_opensims_bytes_and_read_back(tmp_path, rng):
+    """Our writer's bytes equal OpenSim's adapter's for labels with spaces; our fast reader, OpenSim's
+    TimeSeriesTableVec3 and TRCFileAdapter.read give back the same labels and the same numbers."""
+    t = np.arange(N_FRAMES) / POINT_HZ
+    X = lab_markers(rng)
+    (tmp_path / "osim").mkdir()
+    ours = write_trc(tmp_path / "bts.trc", t, X, SPACED, unit="mm")
+    theirs = _opensim_trc_bytes(tmp_path / "osim" / "bts.trc", t, X * 1e3, SPACED, "mm")
+    assert ours.read_bytes() == theirs.replace(str(tmp_path / "osim" / "bts.trc").encode(), b"bts.trc", 1)
+    assert ours.read_text().splitlines()[3] == "Frame#\tTime\tr heel\t\t\tl heel\t\t\tr  toe tip\t\t\t"
+    fast_t, fast_X, fast_labels = read_markers(ours)
+    assert fast_labels == SPACED
+    osim = quiet_opensim()
+    table = osim.TimeSeriesTableVec3(str(ours))
+    assert list(table.getColumnLabels()) == SPACED
+    assert list(osim.TRCFileAdapter().read(str(ours))["markers"].getColumnLabels()) == SPACED
+    flat_table = table.flatten(["_x", "_y", "_z"])
+    matrix = flat_table.getMatrix()
+    np.testing.assert_array_equal(fast_X, np.array(matrix.to_numpy()).reshape(fast_X.shape) / 1000.0)
+    np.testing.assert_allclose(fast_X, X, rtol=2e-15, atol=0)
+    np.testing.assert_array_equal(fast_t, t)
+
+
+@pytest.mark.parametrize("label", ["r\theel", " r heel", "r heel ", "r\nheel"])
+def test_trc_labels_that_would_not_read_back_are_refused(tmp_path, rng, label):
+    """A tab or line break breaks the layout, and OpenSim strips edge blanks: refused, naming file and label."""
+    path = tmp_path / "bad.trc"
+    with pytest.raises(LoperInputError) as caught:
+        write_trc(path, np.arange(N_FRAMES) / POINT_HZ, lab_markers(rng), ["RASI", label, "RKNE"])
+    assert str(caught.value) == (f"{path}: labels must be non-empty strings without leading/trailing blanks or "
+                                 f"whitespace other than inner spaces, got {label!r}")
+    assert not path.exists()
+
+
+def test_fast_trc_reader_strips_edge_blanks_of_labels_as_opensim_does(tmp_path, rng):
+    """A TRC written elsewhere with padded labels: both readers give the stripped labels."""
+    path = write_trc(tmp_path / "padded.trc", np.arange(N_FRAMES) / POINT_HZ, lab_markers(rng), SPACED)
+    lines = path.read_text().splitlines()
+    lines[3] = "Frame#\tTime\t r heel \t\t\tl heel\t\t\tr  toe tip  \t\t\t"
+    padded = tmp_path / "padded_by_hand.trc"
+    padded.write_text("\n".join(lines) + "\n")
+    assert read_markers(padded)[2] == SPACED
+    assert list(quiet_opensim().TimeSeriesTableVec3(str(padded)).getColumnLabels()) == SPACED

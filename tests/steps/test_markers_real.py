@@ -21,7 +21,7 @@ from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers
 from loper_analysis.io.osim import quiet_opensim
 from loper_analysis.markers import GAP_REPORT_COLUMNS, GAP_SUMMARY_COLUMNS
-from loper_analysis.steps.processing import markers
+from loper_analysis.steps.processing import TRIAL_MARKER_COLUMNS, markers
 
 DATA = Path(__file__).parents[1] / "data" / "opensim-core"
 WALKING5 = DATA / "walking5.c3d"
@@ -94,13 +94,19 @@ def test_walking5_through_the_default_chain_keeps_long_gaps_missing(tmp_path):
     still = np.isnan(X).any(axis=2)
     np.testing.assert_array_equal(still, missing_raw & ~expected_filled)
     summary = pd.read_csv(tmp_path / "w5.markers.tsv", sep="\t")
-    assert list(summary.columns) == list(GAP_SUMMARY_COLUMNS)
+    assert list(summary.columns) == ["label", *GAP_SUMMARY_COLUMNS, *TRIAL_MARKER_COLUMNS[1:]]
+    assert summary["label"].tolist() == labels  # the file's labels (no prefix, no label map here)
+    # frames with fewer than 3 markers: 0-134 (the subject outside the capture volume) and 1085-1102
+    assert (summary["n_frames_too_few_markers"] == 153).all()
     np.testing.assert_array_equal(summary["n_filled_frames"], expected_filled.sum(axis=0))
     np.testing.assert_array_equal(summary["n_missing_frames"], still.sum(axis=0))
     assert summary["n_missing_frames"].tolist()[:3] == [57, 218, 269]
     assert summary["longest_gap_frames"].max() == 463
     assert (summary["n_unfiltered_frames"] == 0).all()
-    assert summary.to_dict("records") == gaps.attrs["per_marker"]
+    columns = list(GAP_SUMMARY_COLUMNS)
+    assert summary[columns].to_dict("records") == [{k: r[k] for k in columns} for r in gaps.attrs["per_marker"]]
+    # walking toward -X, 1.6 m/s; left as it is (the step's default rotation is the one given)
+    assert summary["heading_deg"].iloc[0] == pytest.approx(182.37, abs=0.01) and (summary["turn_deg"] == 0).all()
     # the rotation by -90 deg about X took Vicon's Z up to Y up: the pelvis markers sit about 1 m high
     assert 0.8 < np.nanmedian(X[:, labels.index("RASI"), 1]) < 1.2
 
@@ -152,3 +158,45 @@ def test_time_base_of_a_file_not_starting_at_frame_one(prefixed, tmp_path):
     markers(late, tmp_path / "cut.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, duration_s=0.1)
     t, _, _ = read_markers(tmp_path / "cut.trc")
     np.testing.assert_allclose(t, 1.0 + np.arange(10) / 100.0, rtol=0, atol=1e-12)
+
+
+#: Labels as BTS exports them: inner spaces.
+BTS_LABELS = ["r heel", "l heel", "r toe tip", "sacrum"]
+
+
+@pytest.fixture
+def bts(tmp_path):
+    X = np.random.default_rng(12).uniform(-1, 1, size=(60, 4, 3))
+    path = tmp_path / "bts.c3d"
+    write_c3d(path, BTS_LABELS, X, 100.0)
+    return path
+
+
+@pytest.mark.parametrize("label_map, names", [
+    (None, BTS_LABELS),
+    ({"r heel": "RHEE", "l heel": "LHEE"}, ["RHEE", "LHEE", "r toe tip", "sacrum"]),
+])
+def test_labels_with_spaces_through_the_markers_step(bts, tmp_path, label_map, names):
+    """Labels with spaces are read, mapped (a key with spaces) or kept, and written to a TRC that our reader and
+    OpenSim's read back to the same labels and the C3D's numbers."""
+    assert read_c3d(bts).marker_labels == BTS_LABELS
+    markers(bts, tmp_path / "bts.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, label_map=label_map,
+            required_markers=[n for n in names if " " not in n])
+    t, X, labels = read_markers(tmp_path / "bts.trc")
+    assert labels == names
+    np.testing.assert_allclose(t, np.arange(60) / 100.0, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(X, read_c3d(bts).markers_m, rtol=0, atol=1e-12)
+    t_ref, ref_mm, labels_ref = _opensim_trc(tmp_path / "bts.trc")
+    assert labels_ref == names
+    np.testing.assert_array_equal(t_ref, t)
+    np.testing.assert_array_equal(ref_mm / 1000.0, X)
+    osim = quiet_opensim()
+    assert list(osim.TRCFileAdapter().read(str(tmp_path / "bts.trc"))["markers"].getColumnLabels()) == names
+
+
+def test_a_label_map_value_with_a_space_is_refused_naming_the_rule(bts, tmp_path):
+    """OpenSim refuses whitespace in a model marker's name, so a map value cannot hold one."""
+    with pytest.raises(LoperInputError, match=r"bts\.c3d: markers\.label_map: 'r heel' maps to 'R HEE', not a "
+                                              r"marker name \(non-empty, no spaces: OpenSim refuses whitespace"):
+        markers(bts, tmp_path / "bts.trc", label_map={"r heel": "R HEE"})
+    assert not (tmp_path / "bts.trc").exists()

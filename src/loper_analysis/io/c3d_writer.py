@@ -66,7 +66,10 @@ class ForcePlatform:
         (where a force gives no moment) to the geometric centre of the working
         surface, in plate coordinates (m); its z is negative for a sensor origin
         below the surface (C3D format, TYPE-2). Readers take the moments about
-        the surface centre as ``M_centre = M_sensor + F x origin``.
+        the surface centre as ``M_centre = M_sensor + F x origin``. Corners
+        listed the other way round the plate (its z axis up) are written as
+        given; ezc3d then moves the moment the wrong way, which
+        :func:`loper_analysis.io.force_platforms.read_force_platforms` corrects.
     channels : tuple of 6 ints
         ``FORCE_PLATFORM:CHANNEL``: the 1-based analog channel numbers in the
         order Fx, Fy, Fz, Mx, My, Mz (TYPE 4: the calibration matrix's inputs).

@@ -17,13 +17,24 @@ What ezc3d returns (``ezc3d.c3d(path, extract_forceplat_data=True)``,
   corners: ezc3d moves the channel moment from the sensor origin with
   ``ORIGIN`` (whose sign it normalises so that the surface lies at negative
   plate z, i.e. above the sensor).
+* Corner order: ezc3d's normalisation of ``ORIGIN`` puts the surface above
+  the sensor only for a plate whose z axis points down, the usual corner
+  order. A file may list the corners the other way round the plate (z up);
+  its channels are then in that frame, and the surface lies at positive
+  plate z. ezc3d still makes ``ORIGIN``'s z negative, i.e. moves the moment
+  to a point below the sensor, so for such a plate the moment is corrected
+  here: ``M = M_ezc3d - 2 F x (R o)``, with ``o`` ezc3d's ``ORIGIN`` (TYPE 3:
+  only its z, the one ezc3d moves the moment by) and ``R`` the plate frame.
+  "Up" is the lab's up direction ``up`` (lab +Z unless given): a plate
+  frame whose z axis has a positive component along ``up`` points up. The
+  usual corner order gives the moment exactly as ezc3d does.
 * Units: force in ``FORCE_PLATFORM:UNITS`` (N when absent), corners and
   positions in ``POINT:UNITS``, moments in force unit x position unit
   (N·mm for a file in mm). Converted here to N, m and N·m.
 * Sign: the force is the one the plate exerts on the body (ground reaction):
-  its vertical (lab +Z) component is positive while someone stands on the
-  plate (walking5: +480 N in stance, channel ``Fz1`` = -480 N in the
-  plate's downward z). No sign is changed here.
+  its vertical component (along the lab's up, +Z in a Z-up lab) is positive
+  while someone stands on the plate (walking5: +480 N in stance, channel
+  ``Fz1`` = -480 N in the plate's downward z). No sign is changed here.
 * Times: sample k of the analogs is at ``first_frame / point_rate + k /
   analog_rate``, with ezc3d's 0-based ``first_frame``.
 
@@ -36,12 +47,14 @@ from __future__ import annotations
 
 import os
 import re
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import LoperInputError
+from ..markers import LAB_Z_UP
 from .timing import library_import
 from .c3d import LENGTH_UNITS_PER_M
 
@@ -80,7 +93,8 @@ class ForcePlatform:
         (vertical component positive while loaded), resting level included.
     moment_nm : numpy.ndarray
         Shape (n_samples, 3), N·m, lab frame: moment of that force about
-        :attr:`centre_m`, resting level included.
+        :attr:`centre_m`, resting level included (corrected for a plate whose
+        corners are listed the other way round, see the module notes).
     corners_m : numpy.ndarray
         Shape (4, 3), m, lab frame, in ``FORCE_PLATFORM:CORNERS`` order.
     centre_m : numpy.ndarray
@@ -205,13 +219,35 @@ def _moment_unit_check(params, plate: int, chans: tuple[int, ...], kind: int, ex
             )
 
 
-def read_force_platforms(path: str | os.PathLike) -> list[ForcePlatform]:
+def _plate_frame(corners: np.ndarray) -> np.ndarray:
+    """ezc3d's plate frame (3, 3), columns x, y, z in the lab: x = corner 1 - corner 2, y = corner 1 - corner 4
+    made orthogonal, z = x cross y."""
+    x = corners[0] - corners[1]
+    z = np.cross(x, corners[0] - corners[3])
+    y = np.cross(z, x)
+    return np.column_stack([v / np.linalg.norm(v) for v in (x, y, z)])
+
+
+def _lab_up(up: Sequence[float] | None, source: str) -> np.ndarray:
+    """``up`` as a unit vector (3,); lab +Z for None."""
+    u = np.asarray(LAB_Z_UP if up is None else up, dtype=float)
+    norm = float(np.linalg.norm(u)) if u.shape == (3,) and np.all(np.isfinite(u)) else 0.0
+    if norm == 0.0:
+        raise LoperInputError(f"{source}: up must be 3 finite numbers, not all 0 (a direction, lab frame), got {up!r}")
+    return u / norm
+
+
+def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = None) -> list[ForcePlatform]:
     """Every force platform of a C3D file, in file order.
 
     Parameters
     ----------
     path : str or path-like
         The ``.c3d`` file.
+    up : array_like, optional
+        Shape (3,): the lab's up direction, lab frame (normalised here); None:
+        lab +Z (:data:`loper_analysis.markers.LAB_Z_UP`). It decides which
+        plates list their corners the other way round (module notes).
 
     Returns
     -------
@@ -228,10 +264,11 @@ def read_force_platforms(path: str | os.PathLike) -> list[ForcePlatform]:
         first); TYPE not 2, 3 or 4; ``FORCE_PLATFORM:CHANNEL`` pointing at
         analog channels that do not exist; ``POINT:UNITS`` or
         ``FORCE_PLATFORM:UNITS`` unknown; moment channels whose unit
-        disagrees with ``POINT:UNITS``; ezc3d's own refusal (quoted).
+        disagrees with ``POINT:UNITS``; ezc3d's own refusal (quoted); a bad ``up``.
     """
     path = Path(path)
     source = str(path)
+    lab_up = _lab_up(up, source)
     c3d = _open(path, extract=True)
     failure = c3d if isinstance(c3d, Exception) else None
     if failure is not None:
@@ -269,6 +306,12 @@ def read_force_platforms(path: str | os.PathLike) -> list[ForcePlatform]:
         corners = np.asarray(pf["corners"], dtype=float).T / per_m
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(moment)) and np.all(np.isfinite(corners))):
             raise LoperInputError(f"{source}: platform {k + 1} holds non-finite forces, moments or corners")
+        frame = _plate_frame(corners)
+        if frame[:, 2] @ lab_up > 0:  # corners the other way round: the surface lies at positive plate z
+            origin = np.asarray(pf["origin"], dtype=float).ravel() / per_m  # ezc3d's, z <= 0, plate frame, m
+            if kind == 3:
+                origin = np.array([0.0, 0.0, origin[2]])
+            moment = moment - 2.0 * np.cross(force, frame @ origin)
         out.append(ForcePlatform(
             number=k + 1, type=kind, channels=chans, analog_rate_hz=analog_rate,
             time_s=t0 + np.arange(force.shape[0]) / analog_rate, force_n=force, moment_nm=moment,

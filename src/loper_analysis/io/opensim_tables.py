@@ -12,6 +12,13 @@ TRC (:func:`write_trc`, :func:`read_markers`)
     bare file name, so the bytes do not depend on the directory. Reading
     takes the unit from the ``Units`` metadata (mm, cm or m) and refuses a
     file without it, since OpenSim itself would silently assume metres.
+    Labels may hold inner spaces (``r heel``, as BTS exports them): the file
+    is tab-separated, and OpenSim's adapter writes them as they are and reads
+    them back unchanged (it strips only blanks at a label's ends, so labels
+    with edge blanks, tabs or line breaks are refused, and the fast reader
+    strips edge blanks as OpenSim does). OpenSim's model components, markers
+    included, cannot carry a space in their name: such a label names a marker
+    that no model has, until ``markers.label_map`` gives it a model name.
 
 MOT/STO (:func:`write_mot`, :func:`read_mot`)
     Written with ``opensim.STOFileAdapter`` (header name line
@@ -90,7 +97,8 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
     markers_m : array_like
         Shape (n_frames, n_markers, 3), metres; NaN (missing) is written as ``nan``.
     labels : sequence of str
-        One unique marker name per marker, without whitespace.
+        One unique marker name per marker: inner spaces allowed (``r heel``),
+        no tabs, line breaks or blanks at either end.
     unit : {"mm", "cm", "m"}
         Unit of the file (``Units`` metadata); values are converted from m.
 
@@ -111,7 +119,7 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
         raise LoperInputError(
             f"{source}: markers_m must have shape (n_frames = {t.size}, n_labels = {len(labels)} >= 1, 3), got {X.shape}"
         )
-    labels = unique_names(labels, "labels", source, allow_whitespace=False)
+    labels = unique_names(labels, "labels", source, allow_whitespace=False, allow_spaces=True)
     if np.any(np.isinf(X)):
         raise LoperInputError(f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})")
     rate = f"{1.0 / uniform_step_s(t, source):.12g}"
@@ -152,7 +160,7 @@ def _read_trc_text(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]] | Non
         names = head[3].split("\t")
         if unit not in LENGTH_UNITS_PER_M or names[:2] != ["Frame#", "Time"]:
             return None
-        labels = [n for n in names[2:] if n.strip()]
+        labels = [n.strip() for n in names[2:] if n.strip()]  # OpenSim strips a label's edge blanks too
         if len(labels) != n_markers:
             return None
         data = pd.read_csv(path, sep="\t", skiprows=5, header=None, skip_blank_lines=True,

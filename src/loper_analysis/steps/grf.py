@@ -6,6 +6,11 @@ C3D (ezc3d's platform extraction, :mod:`loper_analysis.io.force_platforms`)
 (:func:`loper_analysis.io.external_loads.write_external_loads_mot`), columns
 ``{n}_ground_force_v{x,y,z}`` (N), ``{n}_ground_force_p{x,y,z}`` (m),
 ``{n}_ground_torque_{x,y,z}`` (N·m) for plate n = 1, 2, ...
+
+The vertical is the lab's up direction ``up`` (lab frame): lab +Z unless
+given. A lab that is not Z-up (BTS: Y-up) passes
+``up=loper_analysis.markers.lab_up(rotation_deg)``, the direction its
+lab-to-model rotation turns into the model's +Y.
 """
 
 from __future__ import annotations
@@ -17,25 +22,31 @@ from pathlib import Path
 
 import pandas as pd
 
+from ..errors import LoperInputError
 from ..io.atomic import PathLike
 
-__all__ = ["grf", "plate_vertical_loads"]
+__all__ = ["grf", "trial_grf", "plate_vertical_loads"]
 
 log = logging.getLogger(__name__)
 
 
-def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest_n: float):
-    from ..ground_reaction import plate_loads
+def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest_n: float,
+                 up: Sequence[float] | None):
+    """Every plate of the file read and analysed (:func:`loper_analysis.ground_reaction.plate_loads`), lab frame."""
+    from ..ground_reaction import plate_loads, up_vector
     from ..io.force_platforms import read_force_platforms
+    from ..markers import LAB_Z_UP
 
-    plates = read_force_platforms(c3d_path)
+    lab_up = up_vector(LAB_Z_UP if up is None else up, str(c3d_path))
+    plates = read_force_platforms(c3d_path, lab_up)
     return [plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, threshold_n, band_n, max_rest_n,
-                        source=f"{c3d_path} (force platform {p.number})") for p in plates]
+                        source=f"{c3d_path} (force platform {p.number})", up=lab_up) for p in plates]
 
 
 def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
         threshold_n: float = 20.0, band_n: float = 10.0, max_rest_n: float = 100.0,
-        xml_out: PathLike | None = None, bodies: Mapping[int, str] | None = None) -> pd.DataFrame:
+        xml_out: PathLike | None = None, bodies: Mapping[int, str] | None = None,
+        up: Sequence[float] | None = None) -> pd.DataFrame:
     """C3D force platforms -> ground reaction on the body in the model frame -> external-loads ``.mot``.
 
     ``threshold_n`` is the vertical force above the resting level from which
@@ -43,13 +54,16 @@ def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (
     the COP is held, see :mod:`loper_analysis.ground_reaction`); ``band_n``
     and ``max_rest_n`` set the resting-level rule. With ``xml_out`` and
     ``bodies`` (plate number -> body name) an OpenSim ExternalLoads ``.xml``
-    pointing at ``out_mot`` (path relative to the ``.xml``) is written too. Returns the table written
-    (``time_s`` plus nine columns per plate).
+    pointing at ``out_mot`` (path relative to the ``.xml``) is written too. ``up`` is the lab's up
+    direction (lab frame; None: lab +Z), which the vertical force and the plates' facing are taken
+    along; for a lab that is not Z-up pass ``loper_analysis.markers.lab_up(rotation_deg)``. A plate
+    more than 45 deg from level is refused, naming the file, the plate, its normal and ``up``.
+    Returns the table written (``time_s`` plus nine columns per plate).
     """
     from ..ground_reaction import external_loads_table
     from ..io.external_loads import write_external_loads_mot, write_external_loads_xml
 
-    loads = _plate_loads(c3d_path, threshold_n, band_n, max_rest_n)
+    loads = _plate_loads(c3d_path, threshold_n, band_n, max_rest_n, up)
     table = external_loads_table(loads, rotation_deg)
     write_external_loads_mot(out_mot, table)
     if xml_out is not None and bodies:
@@ -57,17 +71,38 @@ def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (
         write_external_loads_xml(xml_out, bodies, datafile)
     for p in loads:
         log.info("%s: plate %d: resting level %.1f N vertical, loaded %.1f %% of %d samples", c3d_path, p.number,
-                 p.rest_force_n[2], 100.0 * p.loaded.mean(), p.loaded.size)
+                 p.rest_force_n @ p.up, 100.0 * p.loaded.mean(), p.loaded.size)
     return table
 
 
+def trial_grf(c3d_path: PathLike, out_mot: PathLike, markers_summary_tsv: PathLike,
+              base_rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), threshold_n: float = 20.0, band_n: float = 10.0,
+              max_rest_n: float = 100.0) -> pd.DataFrame:
+    """:func:`grf` of a trial in the frame its markers were turned into: the trial's rotation is read from its
+    markers summary (columns ``rotation_{x,y,z}_deg`` written by :func:`loper_analysis.steps.processing.markers`,
+    the configured rotation plus the quarter turn that makes an overground trial walk along +X), so that the
+    ground reactions and the inverse kinematics share one frame. The lab's up direction comes from the configured
+    ``base_rotation_deg`` (:func:`loper_analysis.markers.lab_up`)."""
+    from ..io.readers import read_tsv
+    from ..markers import lab_up
+
+    columns = [f"rotation_{axis}_deg" for axis in "xyz"]
+    summary = read_tsv(markers_summary_tsv, "markers summary", columns)
+    if summary.empty:
+        raise LoperInputError(f"{markers_summary_tsv}: the markers summary holds no row (no marker in the trial)")
+    rotation = tuple(float(v) for v in summary[columns].iloc[0])
+    log.info("%s: rotation %s deg (from %s)", c3d_path, list(rotation), markers_summary_tsv)
+    return grf(c3d_path, out_mot, rotation, threshold_n, band_n, max_rest_n, up=lab_up(base_rotation_deg))
+
+
 def plate_vertical_loads(c3d_path: PathLike, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), band_n: float = 10.0,
-                         max_rest_n: float = 100.0):
+                         max_rest_n: float = 100.0, up: Sequence[float] | None = None):
     """Each plate's lab-vertical force above its resting level at the analog rate, corners in the model frame.
 
+    ``up``: the lab's up direction, lab frame (None: lab +Z), as in :func:`grf`.
     Reads only (writes nothing); returns a
     :class:`loper_analysis.ground_reaction.VerticalLoads`.
     """
     from ..ground_reaction import vertical_loads
 
-    return vertical_loads(_plate_loads(c3d_path, 20.0, band_n, max_rest_n), rotation_deg)
+    return vertical_loads(_plate_loads(c3d_path, 20.0, band_n, max_rest_n, up), rotation_deg)

@@ -13,7 +13,7 @@ from collections.abc import Mapping, Sequence
 
 import pandas as pd
 
-from ..constants import SIDES
+from ..constants import MIN_IK_MARKERS, SIDES
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_tsv
 from ..io.readers import read_tsv
@@ -23,10 +23,18 @@ __all__ = ["markers", "events", "loadcell", "events_loadcell", "strides", "strid
 log = logging.getLogger(__name__)
 
 
-def _label_map(label_map: Mapping[str, str] | PathLike | None) -> Mapping[str, str] | None:
-    """A label map given inline, or read from its file (TSV with columns label, marker, or YAML)."""
+def _label_map(label_map: Mapping[str, str] | PathLike | Sequence[Mapping[str, str] | PathLike] | None
+               ) -> Mapping[str, str] | None:
+    """A label map given inline, read from its file (TSV with columns label, marker, or YAML), or several such
+    maps merged in order (a later map's entry for a label wins): the map of every trial, then its kind's, then
+    its own."""
     if label_map is None or isinstance(label_map, Mapping):
         return label_map
+    if isinstance(label_map, (list, tuple)):
+        merged: dict[str, str] = {}
+        for part in label_map:
+            merged.update(_label_map(part) or {})
+        return merged
     from ..io.readers import read_label_map
 
     return read_label_map(label_map)
@@ -35,33 +43,45 @@ def _label_map(label_map: Mapping[str, str] | PathLike | None) -> Mapping[str, s
 def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = None,
             rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), max_gap_frames: int = 10,
             cutoff_hz: float | None = 40.0, order: int = 4, duration_s: float | None = None,
-            label_map: Mapping[str, str] | PathLike | None = None, required_markers: Sequence[str] | None = None,
-            summary_out: PathLike | None = None, extent_range_m: Sequence[float] = (0.1, 5.0)) -> pd.DataFrame:
+            label_map: Mapping[str, str] | PathLike | Sequence | None = None,
+            required_markers: Sequence[str] | None = None, summary_out: PathLike | None = None,
+            extent_range_m: Sequence[float] = (0.1, 5.0), span_s: Sequence[float] | None = None,
+            walking_direction: str = "fixed", min_travel_speed_m_per_s: float = 0.25) -> pd.DataFrame:
     """C3D markers -> model names -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
 
     Labels lose their subject prefix (``Subject:LASI`` -> ``LASI``) and are
-    renamed by ``label_map`` {lab label: model marker}
-    (:func:`loper_analysis.marker_names.model_marker_names`); every marker of
-    ``required_markers`` must then be among them. Interior gaps of up to
-    ``max_gap_frames`` frames are filled (0: none); longer gaps and gaps at
-    the trial's ends stay NaN and are written to the TRC as missing. The
-    low-pass (``cutoff_hz`` Hz, Butterworth of ``order`` run forward and
-    backward; None or 0: no filter) runs over each run of present frames on
-    its own (:func:`loper_analysis.filtering.lowpass_finite_runs`). Times
-    are the file's own, ``(first_frame + k) / rate``; ``duration_s`` keeps
-    the first ``duration_s`` seconds of the trial (static trials). Markers
-    whose spread lies outside ``extent_range_m`` (m) are refused as numbers in
-    another unit than ``POINT:UNITS`` declares
+    renamed by ``label_map`` {lab label: model marker}, or by several maps
+    merged in order (:func:`loper_analysis.marker_names.model_marker_names`);
+    every marker of ``required_markers`` must then be among them. Interior
+    gaps of up to ``max_gap_frames`` frames are filled (0: none); longer gaps
+    and gaps at the trial's ends stay NaN and are written to the TRC as
+    missing. The low-pass (``cutoff_hz`` Hz, Butterworth of ``order`` run
+    forward and backward; None or 0: no filter) runs over each run of present
+    frames on its own (:func:`loper_analysis.filtering.lowpass_finite_runs`).
+    Times are the file's own, ``(first_frame + k) / rate``; ``duration_s``
+    keeps the first ``duration_s`` seconds of the trial, ``span_s`` (start,
+    end) the frames between two times of the file's clock (a crop set per
+    trial). Markers whose spread lies outside ``extent_range_m`` (m) are
+    refused as numbers in another unit than ``POINT:UNITS`` declares
     (:func:`loper_analysis.plausibility.require_marker_extent`).
+
+    ``walking_direction`` ``"auto"`` turns a trial that travels (overground)
+    about the vertical so that it walks along the model's +X
+    (:func:`loper_analysis.heading.trial_heading`); ``"fixed"`` keeps
+    ``rotation_deg``.
 
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
     row per gap, :data:`loper_analysis.markers.GAP_REPORT_COLUMNS`). The
-    per-marker summary of filled and still missing frames
-    (:func:`loper_analysis.markers.gap_summary`) is written to ``summary_out``
-    when given and kept as a list of row dicts in ``.attrs["per_marker"]``
-    (plain values: pandas compares the attrs of frames it concatenates).
+    per-marker summary (:func:`loper_analysis.markers.gap_summary`, with the
+    lab ``label`` of each marker and the trial's frames with fewer than
+    :data:`~loper_analysis.constants.MIN_IK_MARKERS` markers, its span,
+    heading and rotation: :data:`TRIAL_MARKER_COLUMNS`) is written to
+    ``summary_out`` when given and kept as a list of row dicts in
+    ``.attrs["per_marker"]`` (plain values: pandas compares the attrs of frames
+    it concatenates).
     """
     from ..filtering import lowpass_finite_runs
+    from ..heading import trial_heading
     from ..io.c3d import read_c3d
     from ..io.opensim_tables import write_trc
     from ..marker_names import model_marker_names, require_model_markers
@@ -77,16 +97,24 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     if duration_s is not None:
         keep = time_s < time_s[0] + duration_s - 1e-9
         time_s, raw = time_s[keep], raw[keep]
+    if span_s is not None:
+        time_s, raw = _cropped(time_s, raw, span_s, source)
     require_marker_extent(raw, source, extent_range_m)
+    heading = trial_heading(raw, rec.point_rate_hz, rotation_deg, walking_direction, min_travel_speed_m_per_s,
+                            source)
+    if heading.turn_deg:
+        log.info("%s: walks %.1f deg from the model's +X at %.2f m/s: turned %g deg about the vertical "
+                 "(rotation %s deg)", source, heading.heading_deg, heading.speed_m_per_s, heading.turn_deg,
+                 list(heading.rotation_deg))
     filled, gaps = fill_gaps(raw, max_gap_frames, names, source=source, unfillable="keep")
-    X = rotate_markers(filled, rotation_deg)
+    X = rotate_markers(filled, heading.rotation_deg)
     unfiltered = None
     if cutoff_hz:
         try:
             X, unfiltered = lowpass_finite_runs(X, rec.point_rate_hz, cutoff_hz, order, axis=0)
         except LoperInputError as exc:
             raise LoperInputError(f"{c3d_path}: markers: {exc}") from None
-    summary = gap_summary(raw, X, names, unfiltered)
+    summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), rec.marker_labels, time_s, X, heading)
     log.info("%s: %d frames at %g Hz, %d markers, %d gap(s) filled", c3d_path, len(time_s), rec.point_rate_hz,
              len(names), len(gaps))
     write_trc(trc_out, time_s, X, names)
@@ -98,9 +126,51 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     left = summary[summary.n_missing_frames > 0]
     if len(left):
         log.warning("%s: %d marker(s) still missing in some frames (written as NaN):\n%s", c3d_path, len(left),
-                    left.to_string(index=False))
+                    left[["label", "marker", "n_missing_frames", "longest_gap_frames"]].to_string(index=False))
+    n_sparse = int(summary["n_frames_too_few_markers"].iloc[0]) if len(summary) else 0
+    if n_sparse:
+        log.warning("%s: %d of %d frames hold fewer than %d markers (outside the capture volume?): IK leaves them "
+                    "out", c3d_path, n_sparse, len(time_s), MIN_IK_MARKERS)
     gaps.attrs["per_marker"] = summary.to_dict("records")
     return gaps
+
+
+#: Columns the markers summary adds to :data:`loper_analysis.markers.GAP_SUMMARY_COLUMNS`: the marker's lab label,
+#: then facts of the whole trial repeated on each row (like ``n_frames``).
+TRIAL_MARKER_COLUMNS: tuple[str, ...] = ("label", "n_frames_too_few_markers", "first_time_s", "last_time_s",
+                                         "heading_deg", "speed_m_per_s", "turn_deg", "rotation_x_deg",
+                                         "rotation_y_deg", "rotation_z_deg")
+
+
+def _trial_marker_summary(per_marker: pd.DataFrame, labels: Sequence[str], time_s, markers_m, heading
+                          ) -> pd.DataFrame:
+    """The per-marker gap summary with the lab labels and the trial's facts (:data:`TRIAL_MARKER_COLUMNS`)."""
+    import numpy as np
+
+    present = np.all(np.isfinite(np.asarray(markers_m, float)), axis=2)
+    out = per_marker.copy()
+    out.insert(0, "label", [str(lab) for lab in labels])
+    out["n_frames_too_few_markers"] = int((present.sum(axis=1) < MIN_IK_MARKERS).sum())
+    out["first_time_s"] = float(time_s[0]) if len(time_s) else np.nan
+    out["last_time_s"] = float(time_s[-1]) if len(time_s) else np.nan
+    out["heading_deg"] = heading.heading_deg
+    out["speed_m_per_s"] = heading.speed_m_per_s
+    out["turn_deg"] = heading.turn_deg
+    for axis, angle in zip("xyz", heading.rotation_deg):
+        out[f"rotation_{axis}_deg"] = angle
+    return out
+
+
+def _cropped(time_s, markers_m, span_s: Sequence[float], source: str):
+    """Frames of a trial between ``span_s`` = (start, end) in s on the file's clock; an empty crop is refused."""
+    start, end = (float(v) for v in span_s)
+    keep = (time_s >= start - 1e-9) & (time_s <= end + 1e-9)
+    if end <= start or not keep.any():
+        raise LoperInputError(
+            f"{source}: the trial's span {start:g} .. {end:g} s (markers.trial_spans_s) holds no frame of the file "
+            f"({time_s[0]:.4f} .. {time_s[-1]:.4f} s)"
+        )
+    return time_s[keep], markers_m[keep]
 
 
 def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str] | None = None,
@@ -185,10 +255,16 @@ def _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stan
 
 def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n, threshold_off_n,
                   min_stance_s, min_swing_s, band_n, max_rest_n) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Events and the contact table from the force platforms and the heel markers of a read C3D."""
+    """Events and the contact table from the force platforms and the heel markers of a read C3D.
+
+    The vertical is the lab's up direction that ``rotation_deg`` turns into the model's +Y
+    (:func:`loper_analysis.markers.lab_up`: lab +Z for the default -90 deg about X, +Y for a Y-up lab
+    with no rotation); plates whose corners run either way round are accepted, a plate more than 45 deg
+    from level is refused naming the file, the plate and ``markers.lab_to_model_rotation_deg``.
+    """
     from ..contacts import PlateForce, contact_events, foot_contacts
     from ..marker_names import model_marker_names, require_model_markers
-    from ..markers import rotate_markers
+    from ..markers import MODEL_UP, lab_up, rotate_markers
     from .grf import plate_vertical_loads
 
     source = c3d_path = rec.source
@@ -196,12 +272,13 @@ def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, thres
         raise LoperInputError(f"{source}: force platforms need the heel marker of each foot (events.foot_markers)")
     names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
     require_model_markers(names, [foot_markers[s] for s in SIDES], source, rec.marker_labels)
-    loads = plate_vertical_loads(c3d_path, rotation_deg, band_n, max_rest_n)
+    loads = plate_vertical_loads(c3d_path, rotation_deg, band_n, max_rest_n, up=lab_up(rotation_deg))
     plates = [PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i])
               for i, n in enumerate(loads.numbers)]
     heels = {s: rotate_markers(rec.markers_m[:, names.index(foot_markers[s]), :], rotation_deg) for s in SIDES}
+    # corners and heels are in the model frame, whose up is +Y
     contacts = foot_contacts(plates, rec.time_s, heels, plate_sides, threshold_on_n, threshold_off_n, min_stance_s,
-                             min_swing_s, source=source)
+                             min_swing_s, source=source, up=MODEL_UP)
     return contact_events(contacts), contacts
 
 
@@ -287,7 +364,9 @@ def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, c
     """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
 
     Writes the stride table and the cycles (:func:`loper_analysis.strides.stride_tables`);
-    returns the :class:`~loper_analysis.strides.StrideTables`.
+    returns the :class:`~loper_analysis.strides.StrideTables`. A trial with 0
+    or 1 strides of ``side`` is written like any other (the stride table with
+    all its columns, without rows for 0 strides) and flagged ``too_few_strides``.
     """
     from ..strides import stride_tables
 
@@ -303,24 +382,53 @@ def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, c
 
 
 def strides_summary(subject_trials: Sequence[tuple[str, str]], strides_tsvs: Sequence[PathLike], out_tsv: PathLike,
-                    min_valid: int = 5, contacts_tsvs: Sequence[PathLike] | None = None) -> pd.DataFrame:
+                    min_valid: int = 5, contacts_tsvs: Sequence[PathLike] | None = None,
+                    ik_tsvs: Sequence[PathLike] | None = None,
+                    markers_tsvs: Sequence[PathLike] | None = None) -> pd.DataFrame:
     """One row per subject x trial of the stride tables (:func:`loper_analysis.strides.stride_summary`).
 
     ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
     ``subject_trials``, in order; ``contacts_tsvs`` (optional, same order) the
     force-plate contact tables written by :func:`events`, whose flagged
-    contacts are counted.
+    contacts are counted. A stride table of a trial with 0 strides (its
+    header only, as :func:`strides` writes it) gives ``n_strides`` 0 and the
+    status ``too_few_strides``. ``ik_tsvs`` (the IK summaries of
+    :func:`loper_analysis.steps.ik.ik_trial`) add the frames and those left
+    out of IK, ``markers_tsvs`` (the markers summaries of :func:`markers`) the
+    trial's walking direction and the turn that made it walk along +X.
+
+    Raises
+    ------
+    LoperInputError
+        A stride table without the columns
+        :data:`loper_analysis.strides.SUMMARY_COLUMNS` (naming the file).
     """
-    from ..strides import stride_summary
+    from ..checks import require_columns
+    from ..strides import SUMMARY_COLUMNS, stride_summary
 
     keys = [tuple(key) for key in subject_trials]
-    tables = {key: read_tsv(path, "stride table", keep_default_na=False, na_values=[""])
+    tables = {key: require_columns(read_tsv(path, "stride table", keep_default_na=False, na_values=[""]),
+                                   SUMMARY_COLUMNS, str(path), "stride table")
               for key, path in zip(keys, strides_tsvs, strict=True)}
     contacts = None
     if contacts_tsvs is not None:
         contacts = {key: read_tsv(path, "contact table", ("flag",), keep_default_na=False)
                     for key, path in zip(keys, contacts_tsvs, strict=True)}
     table = stride_summary(tables, min_valid, contacts)
+    extra = []
+    if ik_tsvs is not None:
+        ik = [read_tsv(path, "IK summary", ("n_frames", "n_frames_left_out")).iloc[0]
+              for path in ik_tsvs]
+        extra.append(pd.DataFrame({"n_frames": [int(r.n_frames) for r in ik],
+                                   "n_frames_left_out": [int(r.n_frames_left_out) for r in ik]}))
+    if markers_tsvs is not None:
+        marks = [read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0]
+                 for path in markers_tsvs]
+        extra.append(pd.DataFrame({"heading_deg": [float(r.heading_deg) for r in marks],
+                                   "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
+                                   "turn_deg": [float(r.turn_deg) for r in marks]}))
+    if extra:
+        table = pd.concat([table, *extra], axis=1)
     write_tsv(table, out_tsv)
     for row in table[table.status != "ok"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
