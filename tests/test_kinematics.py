@@ -5,6 +5,8 @@ Also the IK task files (loper_analysis.io.ik_tasks), the time chunks of a trial 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -24,6 +26,7 @@ from loper_analysis.kinematics import (
 from loper_analysis.model import MARKERS, build_lower_body_model
 
 FS = 128.0
+GENERIC_RAJAGOPAL = Path(__file__).resolve().parent / "data" / "rajagopal2016" / "Rajagopal2016.osim"
 
 
 @pytest.fixture(scope="module")
@@ -176,7 +179,7 @@ def test_tsv_tasks_and_bad_input(model, synthetic, tmp_path):
     with pytest.raises(LoperInputError, match="row 1, column kind: 'markr'"):
         read_ik_tasks(bad)
     t, _, X = synthetic
-    with pytest.raises(LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in model"):
+    with pytest.raises(LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in .*model\.osim \(model loper_lower_body\)"):
         inverse_kinematics(model, t, X, list(MARKERS), {"XYZ": 1.0})
     with pytest.raises(LoperInputError, match=r"\['RASI'\] of the IK tasks are not in the marker data"):
         inverse_kinematics(model, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
@@ -233,21 +236,75 @@ def test_nan_marker_is_left_out_of_its_frames_known_angles(model, synthetic):
     assert np.nanmax(res.marker_max_m) < 1e-6
 
 
-def test_frames_with_too_few_markers_stop_ik_before_solving(model, synthetic):
+def test_frames_with_too_few_markers_stop_ik_when_asked(model, synthetic):
     t, _, X = synthetic
     X = X.copy()
     keep = ["LASI", "RASI", "LKNE", "LHEE"]
     X[:, [i for i, m in enumerate(MARKERS) if m not in keep]] = np.nan
     X[100:103, [list(MARKERS).index("LASI"), list(MARKERS).index("LKNE")]] = np.nan
     with pytest.raises(LoperInputError) as err:
-        inverse_kinematics(model, t, X, list(MARKERS), min_markers=3, source="walk.trc")
+        inverse_kinematics(model, t, X, list(MARKERS), min_markers=3, source="walk.trc", sparse_frames="error")
     message = str(err.value)
     assert message.startswith(f"walk.trc: 3 frame(s) hold fewer than 3 of the {len(MARKERS)} weighted markers")
     assert "frames 100..102 (t = 0.7812..0.7969 s); markers missing there: LASI, RPSI, LPSI," in message
     assert message.endswith(", LTHI_AS, and 14 more")  # 34 markers missing in those frames: 20 named
     with pytest.raises(LoperInputError) as err:
-        inverse_kinematics(model, t, X, list(MARKERS), {m: 1.0 for m in keep}, min_markers=3, source="walk.trc")
+        inverse_kinematics(model, t, X, list(MARKERS), {m: 1.0 for m in keep}, min_markers=3, source="walk.trc",
+                           sparse_frames="error")
     assert str(err.value) == (
         "walk.trc: 3 frame(s) hold fewer than 3 of the 4 weighted markers, too few to solve IK: "
         "frames 100..102 (t = 0.7812..0.7969 s); markers missing there: LASI, LKNE"
     )
+
+
+def test_frames_outside_the_capture_volume_are_left_out(model, synthetic):
+    """An overground trial: no marker at the start, a pelvis with 2 of its 4 markers for a few frames: those
+    frames are NaN, the others solved as with every frame present."""
+    t, truth, X = synthetic
+    X = X.copy()
+    X[:10] = np.nan
+    X[50:53, [list(MARKERS).index(m) for m in ("RPSI", "LPSI")]] = np.nan  # pelvis placed by the thighs alone
+    res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=1e-10)
+    expected = np.ones(t.size, bool)
+    expected[:10] = expected[50:53] = False
+    np.testing.assert_array_equal(res.solved, expected)
+    assert res.n_left_out == 13 and res.undetermined == {}
+    assert np.isnan(res.coordinates[~expected]).all() and np.isnan(res.marker_rms_m[~expected]).all()
+    for i, name in enumerate(res.coordinate_names):
+        assert np.abs(res.coordinates[expected, i] - truth[name][expected]).max() < 1e-6, name
+    summary = res.summary(0.02).iloc[0]
+    assert (summary.n_frames, summary.n_frames_solved, summary.n_frames_left_out) == (256, 243, 13)
+    assert summary.first_solved_s == t[10] and summary.last_solved_s == t[-1]
+
+
+def test_a_trial_without_a_frame_to_solve_stops(model, synthetic):
+    t, _, X = synthetic
+    X = X.copy()
+    X[:, [list(MARKERS).index(m) for m in ("RPSI", "LPSI")]] = np.nan
+    with pytest.raises(LoperInputError, match=r"walk\.trc: no frame holds 3 weighted markers with one beyond the "
+                                              r"pelvis: nothing to solve"):
+        inverse_kinematics(model, t, X, list(MARKERS), source="walk.trc")
+
+
+def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
+    """Rajagopal2016 as distributed: locked subtalar, mtp and wrist angles, patella coupled to the knee."""
+    from loper_analysis.io.opensim_tables import read_markers
+    from loper_analysis.io.osim import read_marker_set
+    from tests.rajagopal_lab import IK_SETUP, MARKER_SET, WALK_TRC
+
+    model = read_model(GENERIC_RAJAGOPAL)
+    model.updateMarkerSet(read_marker_set(MARKER_SET))
+    t, X, labels = read_markers(WALK_TRC)
+    weights, coordinates = read_ik_tasks(IK_SETUP)  # the task set of OpenSim's own IK setup
+    assert len(weights) == 39 and weights["R.ASIS"] == 50.0 and coordinates == {}
+    res = inverse_kinematics(model, t[:20], X[:20], labels, weights, coordinates)
+    names = res.coordinate_names
+    assert len(names) == 39 and res.solved.all()
+    for locked in ("subtalar_angle_r", "mtp_angle_l", "wrist_flex_r", "wrist_dev_l"):
+        np.testing.assert_array_equal(res.coordinates[:, names.index(locked)], 0.0)  # held at the default
+    knee, beta = res.coordinates[:, names.index("knee_angle_r")], res.coordinates[:, names.index("knee_angle_r_beta")]
+    np.testing.assert_allclose(beta, knee, atol=1e-8)  # the coupler constraint: beta follows the knee
+    assert np.ptp(knee) > 0.05
+    with pytest.raises(LoperInputError, match=r"coordinate task on 'subtalar': not a coordinate of .*Rajagopal2016\.osim "
+                                              r"\(model Rajagopal2016\)"):
+        inverse_kinematics(model, t[:2], X[:2], labels, weights, {"subtalar": (1.0, None)})

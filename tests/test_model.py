@@ -11,13 +11,11 @@ from loper_analysis.dynamics import (
     segment_parameters_from_anthropometry,
 )
 from loper_analysis.errors import LoperInputError
-from loper_analysis.kinematics import marker_positions
 from loper_analysis.model import (
     BRACE_MARKERS,
     MARKERS,
     build_lower_body_model,
     segment_parameters_from_model,
-    static_marker_problem,
 )
 
 
@@ -63,11 +61,3 @@ def test_opensim_kinematics_match_the_swing_leg_model(model):
 def test_bad_anthropometry():
     with pytest.raises(LoperInputError, match="height_m must lie in 1 .. 2.5 m, got 2.7"):
         build_lower_body_model(2.7, 70)
-
-
-def test_static_trial_with_a_gap_is_refused_naming_marker_and_frame(model):
-    t = np.arange(20) / 128.0
-    X = marker_positions(model, {"pelvis_ty": np.full(t.size, 0.98)})
-    X[7, list(MARKERS).index("LKNE")] = np.nan
-    with pytest.raises(LoperInputError, match="static.trc: marker LKNE is missing at frame 7"):
-        static_marker_problem(t, X, list(MARKERS), source="static.trc")

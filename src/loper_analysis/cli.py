@@ -10,6 +10,7 @@ segments     swing-leg segment table from a scaled model, or from height and mas
 ik           OpenSim inverse kinematics of a marker file (.c3d or .trc) to a .mot
 validate     run (part of) the validation study and write its tables
 plan         predict the 95 % CI half-width of K and D of a planned experiment from a pilot subject
+inspect      what a lab's C3D file holds; labels matched to a model; starter label map and config snippet
 
 Every command exits with 0 on success and with 2 and one line on standard
 error naming the file and the cause when an input cannot serve
@@ -26,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import LoperInputError, one_line
+from .plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
 __all__ = ["main"]
 
@@ -40,6 +42,13 @@ def _rotation(args: argparse.Namespace, path: str) -> tuple[float, float, float]
     return C3D_ROTATION_DEG if str(path).lower().endswith(".c3d") else (0.0, 0.0, 0.0)
 
 
+def _walking_direction(args: argparse.Namespace) -> str:
+    """--walking-direction, else ``fixed`` when --rotate-deg is given (the rotation as typed) and ``auto`` otherwise."""
+    if args.walking_direction is not None:
+        return args.walking_direction
+    return "fixed" if args.rotate_deg is not None else "auto"
+
+
 def _label_map(path: str | None) -> dict[str, str] | None:
     from .io.readers import read_label_map
 
@@ -50,7 +59,8 @@ def _markers(args: argparse.Namespace) -> None:
     from .steps.processing import markers
 
     gaps = markers(args.c3d, args.out, args.gaps, _rotation(args, args.c3d), args.max_gap_frames,
-                   args.cutoff_hz or None, args.order, label_map=_label_map(args.label_map))
+                   args.cutoff_hz or None, args.order, label_map=_label_map(args.label_map),
+                   walking_direction=_walking_direction(args))
     per_marker = gaps.attrs.get("per_marker", [])
     n_frames = per_marker[0]["n_frames"] if per_marker else 0
     missing = sum(row["n_missing_frames"] > 0 for row in per_marker)
@@ -95,16 +105,25 @@ def _scale(args: argparse.Namespace) -> None:
     from .steps.model import scale_with_setup
     from .steps.processing import markers
 
-    static = Path(args.static)
+    static = c3d = Path(args.static)
+    lab_labels = None
     with tempfile.TemporaryDirectory() as tmp:
         if static.suffix.lower() == ".c3d":
             trc = Path(tmp) / (static.stem + ".trc")
-            markers(static, trc, None, _rotation(args, args.static), args.max_gap_frames, args.cutoff_hz or None,
-                    label_map=_label_map(args.label_map))
+            gaps = markers(static, trc, None, _rotation(args, args.static), args.max_gap_frames,
+                           args.cutoff_hz or None, label_map=_label_map(args.label_map))
+            lab_labels = {row["marker"]: row["label"] for row in gaps.attrs["per_marker"]}
             static = trc
+        elif args.mass_kg is None:
+            raise LoperInputError(f"scale: {args.static}: a .trc static trial has no force plates: give --mass-kg")
         time_range = None if args.start is None else (args.start, args.end)
-        scale_with_setup(args.model, args.setup, static, args.mass_kg, args.out, time_range_s=time_range)
-    print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({args.mass_kg:g} kg)")
+        scale_with_setup(args.model, args.setup, static, args.mass_kg, args.out, time_range_s=time_range,
+                         static_c3d=c3d if c3d.suffix.lower() == ".c3d" else None, lab_labels=lab_labels,
+                         rotation_deg=_rotation(args, args.static), report_out=args.report)
+    mass = f"{args.mass_kg:g} kg" if args.mass_kg is not None else "mass from the static trial's force plates"
+    print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({mass})")
+    if args.report:
+        print(f"{args.report}: scale factors and marker errors after scaling")
 
 
 def _segments(args: argparse.Namespace) -> None:
@@ -194,17 +213,32 @@ def _ik(args: argparse.Namespace) -> None:
 
     result = ik_file(args.model, args.markers, args.out, args.tasks, args.start, args.end, args.rotate_deg,
                      args.accuracy, max_marker_rms_m=args.max_marker_rms_m, max_rms_fraction=args.max_rms_fraction,
-                     label_map=_label_map(args.label_map))
+                     label_map=_label_map(args.label_map), warn_marker_rms_m=args.warn_marker_rms_m,
+                     walking_direction=_walking_direction(args))
+    left_out = f", {result.n_left_out} left out (too few markers)" if result.n_left_out else ""
     print(
-        f"{args.out}: {len(result.time_s)} frames, marker error RMS {1e3 * np.nanmean(result.marker_rms_m):.2f} mm "
-        f"(max {1e3 * np.nanmax(result.marker_max_m):.2f} mm)"
+        f"{args.out}: {len(result.time_s)} frames{left_out}, marker error RMS "
+        f"{1e3 * np.nanmean(result.marker_rms_m):.2f} mm (max {1e3 * np.nanmax(result.marker_max_m):.2f} mm)"
     )
+    if result.warning:
+        print(f"warning: {result.warning}", file=sys.stderr)
 
 
-def _rotate_option(p: argparse.ArgumentParser) -> None:
+def _inspect(args: argparse.Namespace) -> None:
+    from .steps.inspect import inspect_c3d
+
+    print(inspect_c3d(args.c3d, args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
+
+
+def _rotate_option(p: argparse.ArgumentParser, heading: bool = False) -> None:
     p.add_argument("--rotate-deg", type=float, nargs=3, metavar=("X", "Y", "Z"),
                    help="rotate lab coordinates about the fixed X, Y, Z axes (degrees) into the model frame; default "
                    "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc")
+    if heading:
+        p.add_argument("--walking-direction", choices=("auto", "fixed"),
+                       help="auto: a trial that travels (overground) is turned by quarter turns about the vertical to "
+                       "walk along the model's +X; fixed: the rotation as it is (default: fixed with --rotate-deg, "
+                       "else auto)")
 
 
 def _label_map_option(p: argparse.ArgumentParser) -> None:
@@ -222,7 +256,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="output .trc")
     p.add_argument("--gaps", help="output TSV: per marker, frames filled and left missing")
     _label_map_option(p)
-    _rotate_option(p)
+    _rotate_option(p, heading=True)
     p.add_argument("--cutoff-hz", type=float, default=40.0, help="zero-phase Butterworth low-pass (Hz); 0: no filter")
     p.add_argument("--order", type=int, default=4, help="designed filter order (run forward and backward)")
     p.add_argument("--max-gap-frames", type=int, default=10, help="fill gaps up to this many frames; 0: no filling")
@@ -252,14 +286,18 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--model", required=True, help="generic OpenSim model (.osim)")
     p.add_argument("--setup", required=True, help="OpenSim ScaleTool setup (.xml)")
     p.add_argument("--static", required=True, help="static trial (.c3d or .trc)")
-    p.add_argument("--mass-kg", type=float, required=True, help="subject's body mass (kg)")
+    p.add_argument("--mass-kg", type=float, help="subject's body mass (kg); default: from the force plates the "
+                   "subject stands on in a .c3d static trial")
     p.add_argument("--out", required=True, help="output scaled model (.osim)")
+    p.add_argument("--report", metavar="SCALE.tsv", help="output TSV: scale factors per body and marker errors after "
+                   "scaling")
     p.add_argument("--start", type=float, help="first time of the static trial to use (s)")
     p.add_argument("--end", type=float, help="last time of the static trial to use (s)")
     _label_map_option(p)
     _rotate_option(p)
     p.add_argument("--cutoff-hz", type=float, default=0.0, help="low-pass of a .c3d static trial (Hz); 0: none")
-    p.add_argument("--max-gap-frames", type=int, default=10, help="fill gaps of a .c3d static trial up to this")
+    p.add_argument("--max-gap-frames", type=int, default=0, help="fill gaps of a .c3d static trial up to this "
+                   "(default 0: each marker is averaged over the frames where it is present)")
     p.set_defaults(func=_scale)
 
     p = sub.add_parser("segments", help="segment table (TSV) from a scaled model, or from height and mass")
@@ -281,11 +319,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--start", type=float, help="first time (s) to solve")
     p.add_argument("--end", type=float, help="last time (s) to solve")
     _label_map_option(p)
-    _rotate_option(p)
+    _rotate_option(p, heading=True)
     p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
-    p.add_argument("--max-marker-rms-m", type=float, default=0.02,
-                   help="a frame whose marker RMS error exceeds this (m) counts as failed")
-    p.add_argument("--max-rms-fraction", type=float, default=0.1, help="fail when more frames than this share fail")
+    p.add_argument("--max-marker-rms-m", type=float, default=IK_STOP_RMS_M,
+                   help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model "
+                   "mistake)")
+    p.add_argument("--warn-marker-rms-m", type=float, default=IK_WARN_RMS_M,
+                   help="a frame whose marker RMS error exceeds this (m) counts as poorly fitted (a warning)")
+    p.add_argument("--max-rms-fraction", type=float, default=IK_MAX_FRACTION,
+                   help="fail (warn) when more frames than this share fail (fit poorly)")
     p.set_defaults(func=_ik)
 
     p = sub.add_parser("validate", help="one chunk of the validation study (the study's design)")
@@ -321,6 +363,16 @@ def _parser() -> argparse.ArgumentParser:
                    help="strides needed for an absolute half-width (N·m/rad or N·m·s/rad)")
     p.add_argument("--out", help="output TSV (one row per onset x joint x parameter x stride count)")
     p.set_defaults(func=_plan)
+
+    p = sub.add_parser("inspect", help="what a lab's C3D file holds; starter label map and config snippet")
+    p.add_argument("c3d", help="the lab's C3D file")
+    p.add_argument("--model", metavar="M.osim", help="OpenSim model whose markers the file's labels are matched to")
+    p.add_argument("--marker-set", metavar="SET.xml", help="OpenSim MarkerSet whose markers are added to the model's")
+    p.add_argument("--label-map-out", metavar="MAP.tsv", help="write the starter label map (label, marker; needs "
+                   "--model)")
+    p.add_argument("--config-out", metavar="SNIPPET.yaml", help="write a config snippet (rotation, label map, heel "
+                   "markers, model) to merge over the configuration")
+    p.set_defaults(func=_inspect)
     return parser
 
 

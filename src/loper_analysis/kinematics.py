@@ -30,11 +30,12 @@ from .ik_determinacy import (
     require_markers_beyond_root,
     undetermined_coordinates,
 )
-from .io.osim import quiet_opensim
-from .markers import require_markers_per_frame
+from .io.osim import model_source, quiet_opensim
+from .markers import frames_with_markers, require_markers_per_frame
 
 __all__ = [
     "IKResult",
+    "IK_SUMMARY_COLUMNS",
     "marker_positions",
     "markers_table",
     "inverse_kinematics",
@@ -47,6 +48,11 @@ __all__ = [
 ]
 
 
+#: Columns of the one-row IK summary of a trial (:meth:`IKResult.summary`).
+IK_SUMMARY_COLUMNS: tuple[str, ...] = ("n_frames", "n_frames_solved", "n_frames_left_out", "first_solved_s",
+                                       "last_solved_s", "marker_rms_mean_m", "marker_rms_max_m", "n_frames_over_warn")
+
+
 @dataclass
 class IKResult:
     """IK output: ``coordinates`` (n_frames, n_coordinates) in rad or m, in model order.
@@ -55,6 +61,11 @@ class IKResult:
     marker distance error per frame (m). ``undetermined`` maps each coordinate
     that no marker, task or model constraint determined in some frames to the
     number of those frames, written as NaN (:mod:`loper_analysis.ik_determinacy`).
+    ``solved`` (n_frames,) is False for the frames left out of the solve (too
+    few markers): every coordinate and error is NaN there.
+    ``marker_errors_m`` (n_frames, n_markers_in_use) holds each weighted
+    marker's distance error (m, NaN where missing), in the order of
+    ``marker_names``. ``warning``: a poor fit's warning, set by the file step.
     """
 
     time_s: np.ndarray
@@ -63,6 +74,35 @@ class IKResult:
     marker_rms_m: np.ndarray
     marker_max_m: np.ndarray
     undetermined: dict[str, int] = field(default_factory=dict)
+    solved: np.ndarray | None = None
+    marker_errors_m: np.ndarray | None = None
+    marker_names: list[str] = field(default_factory=list)
+    warning: str | None = None
+
+    @property
+    def n_left_out(self) -> int:
+        """Frames left out of the solve (too few markers)."""
+        return 0 if self.solved is None else int((~self.solved).sum())
+
+    def summary(self, warn_rms_m: float) -> pd.DataFrame:
+        """One row: frames solved and left out, the solved span (s) and the marker RMS error (m).
+
+        Columns :data:`IK_SUMMARY_COLUMNS`; ``n_frames_over_warn`` counts the
+        frames whose marker RMS error exceeds ``warn_rms_m`` (m).
+        """
+        solved = np.ones(self.time_s.size, bool) if self.solved is None else self.solved
+        rms = self.marker_rms_m[np.isfinite(self.marker_rms_m)]
+        t = self.time_s[solved]
+        return pd.DataFrame([{
+            "n_frames": int(self.time_s.size),
+            "n_frames_solved": int(solved.sum()),
+            "n_frames_left_out": int((~solved).sum()),
+            "first_solved_s": float(t[0]) if t.size else np.nan,
+            "last_solved_s": float(t[-1]) if t.size else np.nan,
+            "marker_rms_mean_m": float(rms.mean()) if rms.size else np.nan,
+            "marker_rms_max_m": float(rms.max()) if rms.size else np.nan,
+            "n_frames_over_warn": int((rms > warn_rms_m).sum()),
+        }], columns=list(IK_SUMMARY_COLUMNS))
 
     def frame(self) -> pd.DataFrame:
         """Tidy-wide table: time_s plus one column per coordinate (rad or m)."""
@@ -89,7 +129,7 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
     names = [cs.get(i).getName() for i in range(cs.getSize())]
     unknown = [c for c in coordinate_values if c not in names]
     if unknown:
-        raise LoperInputError(f"model {model.getName()}: unknown coordinate(s) {unknown}; has {names}")
+        raise LoperInputError(f"{model_source(model)}: unknown coordinate(s) {unknown}; has {names}")
     values = {c: np.atleast_1d(np.asarray(v, float)) for c, v in coordinate_values.items()}
     n = max((len(v) for v in values.values()), default=1)
     uneven = {c: len(v) for c, v in values.items() if len(v) not in (1, n)}
@@ -100,7 +140,7 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
     wanted = list(all_markers if marker_names is None else marker_names)
     missing = [mk for mk in wanted if mk not in all_markers]
     if missing:
-        raise LoperInputError(f"model {model.getName()}: marker(s) {missing} not in the model")
+        raise LoperInputError(f"{model_source(model)}: marker(s) {missing} not in the model")
     # Look the coordinates and markers up once: per-frame lookups through SWIG cost more than the kinematics.
     coordinates = [(cs.get(c), np.broadcast_to(v, (n,))) for c, v in values.items()]
     markers = [ms.get(all_markers.index(mk)) for mk in wanted]
@@ -141,14 +181,21 @@ def inverse_kinematics(
     min_markers: int = 3,
     source: str = "",
     undetermined: str = "nan",
+    sparse_frames: str = "leave_out",
 ) -> IKResult:
     """OpenSim IK of marker trajectories (m) with one reused solver on an ``opensim.Model``.
 
     A marker that is NaN in a frame is left out of that frame's solve (OpenSim's
-    ``MarkersReference`` drops it). Before solving, every frame must hold at
-    least ``min_markers`` weighted markers
-    (:func:`loper_analysis.markers.require_markers_per_frame`) and the
-    weighted markers must not all sit on the body jointed to the ground
+    ``MarkersReference`` drops it). A frame holding fewer than ``min_markers``
+    weighted markers, or weighted markers on the body jointed to the ground
+    only (:func:`loper_analysis.markers.frames_with_markers`), cannot be
+    solved: with ``sparse_frames="leave_out"`` it is left out (every
+    coordinate and error NaN, ``IKResult.solved`` False; a subject outside
+    the capture volume at the start and end of an overground trial), with
+    ``"error"`` the trial is refused
+    (:func:`loper_analysis.markers.require_markers_per_frame`). A trial
+    without any frame to solve is refused either way, and so is one whose
+    weighted markers all sit on the body jointed to the ground
     (:func:`loper_analysis.ik_determinacy.require_markers_beyond_root`);
     ``source`` names the file in messages.
 
@@ -164,11 +211,14 @@ def inverse_kinematics(
     LoperInputError
         A weighted marker missing from the model or from the data, a
         coordinate task on an unknown coordinate, no model marker in the data,
-        a frame with fewer than ``min_markers`` weighted markers present,
-        weighted markers on the pelvis only, undetermined coordinates with
-        ``undetermined="error"``.
+        a frame with fewer than ``min_markers`` weighted markers present
+        (``sparse_frames="error"``) or no frame with enough, weighted markers
+        on the pelvis only, undetermined coordinates with
+        ``undetermined="error"``; a model whose coordinates do not map onto
+        the state (naming the .osim file and the coordinate).
     """
     osim = quiet_opensim()
+    where = f"{source}: " if source else ""
     labels = list(labels)
     t = np.asarray(time_s, float)
     if t.ndim != 1 or t.size < 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
@@ -178,22 +228,33 @@ def inverse_kinematics(
     if marker_weights is None:
         marker_weights = {mk: 1.0 for mk in labels if mk in model_markers}
         if not marker_weights:
-            raise LoperInputError(f"none of the data's markers {labels[:8]}... is in model {model.getName()}")
+            raise LoperInputError(f"{where}none of the data's markers {labels[:8]}... is in {model_source(model)}")
     not_in_model = [mk for mk in marker_weights if mk not in model_markers]
     if not_in_model:
-        raise LoperInputError(f"marker(s) {not_in_model} of the IK tasks are not in model {model.getName()}")
+        raise LoperInputError(f"{where}marker(s) {not_in_model} of the IK tasks are not in {model_source(model)}")
     not_in_data = [mk for mk, w in marker_weights.items() if w > 0 and mk not in labels]
     if not_in_data:
         raise LoperInputError(f"marker(s) {not_in_data} of the IK tasks are not in the marker data")
     keep = [i for i, lab in enumerate(labels) if lab in marker_weights and marker_weights[lab] > 0]
     X = np.asarray(markers_m, float)[:, keep, :]
     kept_labels = [labels[i] for i in keep]
-    require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
     if undetermined not in ("nan", "error"):
         raise LoperInputError(f"undetermined must be 'nan' or 'error', got {undetermined!r}")
+    if sparse_frames not in ("leave_out", "error"):
+        raise LoperInputError(f"sparse_frames must be 'leave_out' or 'error', got {sparse_frames!r}")
+    if sparse_frames == "error":
+        require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
     tree = model_tree(model)
+    solved = frames_with_markers(X, kept_labels, min_markers, root_markers=[
+        lab for lab in kept_labels if tree.marker_bodies.get(lab) in tree.root_bodies])
+    if not solved.any():
+        require_markers_per_frame(X, kept_labels, min_markers, None, t, source)  # names the frames and markers
     require_markers_beyond_root(tree, X, kept_labels, source)
+    if not solved.any():
+        raise LoperInputError(f"{where}no frame holds {min_markers} weighted markers with one beyond the pelvis: "
+                              "nothing to solve")
     free = undetermined_coordinates(tree, X, kept_labels, coordinate_tasks)  # (n_frames, n_coordinates)
+    free[~solved] = False  # frames left out are NaN throughout, not counted as undetermined
     lacking = {c: int(n) for c, n in zip(tree.coordinates, free.sum(axis=0)) if n}
     if lacking and undetermined == "error":
         raise LoperInputError(
@@ -210,31 +271,34 @@ def inverse_kinematics(
     cref = osim.SimTKArrayCoordinateReference()
     for cname, (w, value) in (coordinate_tasks or {}).items():
         if cname not in names:
-            raise LoperInputError(f"coordinate task on '{cname}': not a coordinate of model {model.getName()}; has {names}")
+            raise LoperInputError(f"{where}coordinate task on '{cname}': not a coordinate of {model_source(model)}; "
+                                  f"has {names}")
         v = cs.get(cname).getDefaultValue() if value is None else float(value)
         ref = osim.CoordinateReference(cname, osim.Constant(v))
         ref.setWeight(float(w))
         cref.push_back(ref)
     state = model.initSystem()
+    perm = _q_order(model, state, cs)
     solver = osim.InverseKinematicsSolver(model, mref, cref, float("inf"))
     solver.setAccuracy(float(accuracy))
-    state.setTime(float(t[0]))
+    frames = np.flatnonzero(solved)
+    state.setTime(float(t[frames[0]]))
     solver.assemble(state)
-    perm = _q_order(model, state, cs)
-    Q = np.empty((t.size, state.getNQ()))
+    Q = np.full((t.size, state.getNQ()), np.nan)
     n_m = solver.getNumMarkersInUse()
-    E = np.empty((t.size, n_m))  # marker distance errors (m)
+    E = np.full((t.size, n_m), np.nan)  # marker distance errors (m)
     errs = osim.SimTKArrayDouble()
     get_elt, track, set_time, get_q = errs.getElt, solver.track, state.setTime, state.getQ
     compute_errors, markers_in_use = solver.computeCurrentMarkerErrors, range(n_m)
-    for k in range(t.size):  # the hot loop: one SWIG call per quantity
+    for k in frames:  # the hot loop: one SWIG call per quantity
         set_time(float(t[k]))
         track(state)
         Q[k] = get_q().to_numpy()
         compute_errors(errs)
         E[k] = [get_elt(j) for j in markers_in_use]
     # OpenSim reports 0 (not NaN) for a marker missing in a frame: leave those out of RMS and max
-    in_use = [kept_labels.index(solver.getMarkerNameForIndex(j)) for j in markers_in_use]
+    in_use_names = [solver.getMarkerNameForIndex(j) for j in markers_in_use]
+    in_use = [kept_labels.index(name) for name in in_use_names]
     E[np.isnan(X[:, in_use, :]).any(axis=2)] = np.nan
     with warnings.catch_warnings():  # a frame without any marker gives NaN, silently
         warnings.simplefilter("ignore", RuntimeWarning)
@@ -242,7 +306,7 @@ def inverse_kinematics(
     coordinates = Q[:, perm]
     coordinates[free] = np.nan  # the solver left them at a default or the previous frame's value
     return IKResult(time_s=t, coordinates=coordinates, coordinate_names=names, marker_rms_m=rms, marker_max_m=mx,
-                    undetermined=lacking)
+                    undetermined=lacking, solved=solved, marker_errors_m=E, marker_names=in_use_names)
 
 
 def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: float = 1.0,
@@ -255,7 +319,10 @@ def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: fl
     marker of ``model`` gets ``marker_weights.get(marker, default_weight)`` and
     ``coordinate_tasks`` (``{coordinate: {"weight": w, "value": rad or None}}``)
     are taken as given. A weighted model marker absent from the trial's
-    ``labels`` is an error naming it and ``source``.
+    ``labels`` is an error naming it and ``source`` (a model with more
+    markers than the lab places, such as Rajagopal2016's full-body set:
+    weight 0 in ``marker_weights`` or an IK task file naming the markers to
+    track).
 
     Returns
     -------
@@ -269,25 +336,42 @@ def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: fl
         names = [ms.get(i).getName() for i in range(ms.getSize())]
         extra = sorted(set(marker_weights or {}) - set(names))
         if extra:
-            raise LoperInputError(f"opensim.marker_weights: marker(s) {extra} are not in model {model.getName()}")
+            raise LoperInputError(f"opensim.marker_weights: marker(s) {extra} are not in {model_source(model)}")
         weights = {m: float((marker_weights or {}).get(m, default_weight)) for m in names}
         coords = {c: (float(v["weight"]), v.get("value")) for c, v in (coordinate_tasks or {}).items()}
     missing = [m for m, w in weights.items() if w > 0 and m not in labels]
     if missing:
-        raise LoperInputError(f"{source}: marker(s) {missing} of the model's marker set are missing from the file")
+        raise LoperInputError(f"{source}: marker(s) {missing} of the model's marker set are missing from the file "
+                              "(map the lab's labels to them in markers.label_map, or leave them out of IK: weight 0 "
+                              "in opensim.marker_weights, or an IK task file in opensim.ik_tasks)")
     return weights, coords
 
 
 def _q_order(model, state, cs) -> np.ndarray:
-    """Index into the state's Q of each coordinate of the coordinate set (found by setting distinct values)."""
+    """Index into the state's Q of each coordinate of the coordinate set (found by setting distinct values).
+
+    Locked coordinates (Rajagopal2016's subtalar, mtp and wrist angles) are
+    unlocked in a copy of the state for the probe: a locked coordinate keeps
+    its value when set. Coupled coordinates are set without enforcing their
+    constraints, so every coordinate takes its own probe value.
+    """
     probe = model.initSystem() if state is None else state.__class__(state)
     values = 0.001 * (np.arange(cs.getSize()) + 1)
     for i in range(cs.getSize()):
-        cs.get(i).setValue(probe, float(values[i]), False)
+        coordinate = cs.get(i)
+        if coordinate.getLocked(probe):
+            coordinate.setLocked(probe, False)
+        coordinate.setValue(probe, float(values[i]), False)
     q = probe.getQ().to_numpy()
     perm = np.array([int(np.argmin(np.abs(q - v))) for v in values])
-    if len(set(perm.tolist())) != cs.getSize() or not np.allclose(q[perm], values):
-        raise LoperInputError(f"model {model.getName()}: coordinates do not map one to one onto the state's Q")
+    wrong = [cs.get(i).getName() for i in range(cs.getSize()) if not np.isclose(q[perm[i]], values[i])]
+    shared = sorted({cs.get(i).getName() for i in range(cs.getSize())
+                     for j in range(i) if perm[i] == perm[j]})
+    if wrong or shared:
+        raise LoperInputError(
+            f"{model_source(model)}: coordinate(s) {', '.join(wrong or shared)} do not map one to one onto the "
+            "state's generalised coordinates (Q); IK cannot report them"
+        )
     return perm
 
 

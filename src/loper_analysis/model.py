@@ -44,7 +44,6 @@ from .anthropometry import (
     PELVIS_DEPTH_FRACTION,
     WINTER_SEGMENTS,
 )
-from .checks import where
 from .constants import SEGMENTS, SIDE_SUFFIX
 from .errors import LoperInputError
 from .io.osim import quiet_opensim
@@ -60,7 +59,6 @@ __all__ = [
     "model_dimensions",
     "build_lower_body_model",
     "segment_parameters_from_model",
-    "static_marker_problem",
 ]
 
 #: OpenSim side suffixes in the order the model builds the legs (right leg first).
@@ -269,39 +267,3 @@ SCALE_MEASUREMENTS: dict[str, list[tuple[str, str]]] = {
     **{f"foot_{s}": [(f"{s.upper()}HEE", f"{s.upper()}MT1")] for s in _LEGS},
     "pelvis": [("RASI", "LASI"), ("RASI", "RPSI"), ("LASI", "LPSI")],
 }
-
-
-def static_marker_problem(time_s, markers_m, labels, time_range_s: tuple[float, float] | None = None,
-                          source: str = "", needed=None) -> None:
-    """Refuse a static trial that OpenSim's ScaleTool cannot use: a measurement marker absent, or missing (NaN).
-
-    ``time_s`` (n,), ``markers_m`` (n, n_markers, 3) in m, ``labels`` their
-    names; only frames inside ``time_range_s`` (s, default all) count.
-    ``needed`` names the measurement markers (default: those of
-    :data:`SCALE_MEASUREMENTS`). ScaleTool crashes, or scales with a wrong
-    factor, on NaN markers, so the first missing marker is named with its frame.
-
-    Raises
-    ------
-    LoperInputError
-        A marker of ``needed`` absent from ``labels`` or NaN in a frame.
-    """
-    labels = list(labels)
-    times = np.asarray(time_s, dtype=float)
-    X = np.asarray(markers_m, dtype=float)
-    t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
-    if needed is None:
-        needed = {m for pairs in SCALE_MEASUREMENTS.values() for pair in pairs for m in pair}
-    needed = sorted(set(needed))
-    missing = [m for m in needed if m not in labels]
-    if missing:
-        raise LoperInputError(f"{where(source)}static trial lacks marker(s) {missing} needed for scaling")
-    sel = (times >= t0 - 1e-9) & (times <= t1 + 1e-9)
-    for j, lab in enumerate(labels):
-        if lab in needed:
-            bad = np.flatnonzero(~np.all(np.isfinite(X[:, j]), axis=1) & sel)
-            if bad.size:
-                raise LoperInputError(
-                    f"{where(source)}marker {lab} is missing at frame {bad[0]} (t = {times[bad[0]]:.3f} s) of the "
-                    "static trial; fill the gap or choose another time range"
-                )

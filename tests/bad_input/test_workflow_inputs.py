@@ -210,16 +210,26 @@ def test_model_marker_missing_from_the_trial_stops_ik(lab):
     k = labels.index("LKNE")
     write_trc(lab / "without-LKNE.trc", t, np.delete(X, k, axis=1), labels[:k] + labels[k + 1:])
     _refused(lab, lambda: _ik(_config(lab), lab / "without-LKNE.trc"),
-             ["without-LKNE.trc: marker(s) ['LKNE'] of the model's marker set are missing"])
+             ["without-LKNE.trc with ", "generic.osim: marker(s) ['LKNE'] of the model's marker set are missing",
+              "markers.label_map", "opensim.marker_weights", "opensim.ik_tasks"])
 
 
-def test_frames_with_fewer_than_three_markers_stop_ik(lab):
+def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_any_stops(lab, tmp_path):
     t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
-    X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only
-    write_trc(lab / "sparse.trc", t, X, labels)
-    _refused(lab, lambda: _ik(_config(lab), lab / "sparse.trc"),
-             ["sparse.trc: 3 frame(s) hold fewer than 3 of the 36 weighted markers", "frames 100..102",
-              "RPSI, LPSI"])
+    X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only: left out, the rest solved
+    write_trc(tmp_path / "sparse.trc", t, X, labels)
+    o = _config(lab)["opensim"]
+    angles = ik.ik_trial(f"results/model/{SUBJECT}/generic.osim", tmp_path / "sparse.trc", tmp_path / "sparse.mot",
+                         tmp_path / "sparse.angles.tsv", o["coordinate_map"], summary_tsv=tmp_path / "sparse.ik.tsv")
+    blank = angles.drop(columns="time_s").isna().all(axis=1).to_numpy()
+    assert np.flatnonzero(blank).tolist() == [100, 101, 102] and not angles.iloc[99:104:4].isna().any().any()
+    summary = pd.read_csv(tmp_path / "sparse.ik.tsv", sep="\t").iloc[0]
+    assert (summary.n_frames, summary.n_frames_left_out) == (len(t), 3)
+    X[:, 2:] = np.nan  # no frame holds 3 markers: nothing to solve, nothing written
+    write_trc(lab / "none.trc", t, X, labels)
+    _refused(lab, lambda: _ik(_config(lab), lab / "none.trc"),
+             [f"none.trc with results/model/{SUBJECT}/generic.osim: {len(t)} frame(s) hold fewer than 3 of the 36 "
+              f"weighted markers", f"frames 0..{len(t) - 1}", "RPSI, LPSI"])
 
 
 def test_long_gap_is_left_missing_and_counted_not_refused(lab, tmp_path):

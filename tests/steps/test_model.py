@@ -59,12 +59,27 @@ def test_scale_tool_recovers_a_larger_subject(model_file, taller_subject, tmp_pa
     np.testing.assert_allclose(p.inertia_kg_m2, q.inertia_kg_m2, rtol=1.2e-2)
 
 
-def test_static_trial_with_a_gap_is_refused_and_nothing_written(model_file, taller_subject, tmp_path):
+def test_static_trial_with_gaps_scales_as_the_complete_one(model_file, taller_subject, tmp_path):
+    _, t, X = taller_subject
+    full = _static_trc(tmp_path / "full.trc", t, X)
+    scaled_model(model_file, full, tmp_path / "full.osim", 80.0)
+    Xg = X.copy()
+    Xg[:10, list(MARKERS).index("LKNE")] = np.nan  # hidden while the subject settles
+    Xg[7, list(MARKERS).index("RMT1")] = np.nan
+    gappy = _static_trc(tmp_path / "gappy.trc", t, Xg)
+    scaled_model(model_file, gappy, tmp_path / "gappy.osim", 80.0)
+    p = segment_parameters_from_model(read_model(tmp_path / "gappy.osim"))
+    q = segment_parameters_from_model(read_model(tmp_path / "full.osim"))
+    np.testing.assert_allclose(p.packed, q.packed, rtol=1e-12)  # the markers stand still: their mean is their place
+
+
+def test_static_trial_without_a_measurement_marker_in_its_window_is_refused(model_file, taller_subject, tmp_path):
     _, t, X = taller_subject
     Xg = X.copy()
-    Xg[7, list(MARKERS).index("LKNE")] = np.nan
+    Xg[:, list(MARKERS).index("LKNE")] = np.nan
     gappy = _static_trc(tmp_path / "gappy.trc", t, Xg)
-    with pytest.raises(LoperInputError, match=r"gappy\.trc: marker LKNE is missing at frame 7"):
+    with pytest.raises(LoperInputError, match=r"gappy\.trc: marker\(s\) 'LKNE' missing in every frame of the scaling "
+                                              r"window 0\.0000 \.\. 0\.1484 s \(20 frames\)"):
         scaled_model(model_file, gappy, tmp_path / "never.osim", 80.0)
     assert not (tmp_path / "never.osim").exists()
 

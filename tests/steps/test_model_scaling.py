@@ -139,17 +139,56 @@ def test_markers_the_model_lacks_are_listed(lab, tmp_path):
     assert not (tmp_path / "never.osim").exists()
 
 
-def test_gap_in_a_measurement_marker_is_refused_naming_marker_and_frame(lab, tmp_path):
+def test_markers_missing_in_some_frames_are_averaged_over_the_others(lab, scaled, tmp_path):
+    # as labs record them: knee condyles hidden for the first frames, an ankle marker lost for one frame
     t, X, labels = read_markers(lab / "static.trc")
+    X[:3, labels.index("R.Knee.Lat")] = np.nan
+    X[:4, labels.index("L.Knee.Lat")] = np.nan
     X[6, labels.index("R.Ankle.Lat")] = np.nan
     write_trc(tmp_path / "gappy.trc", t, X, labels)
-    with pytest.raises(LoperInputError, match=r"gappy\.trc: marker R\.Ankle\.Lat is missing at frame 6 \(t = 0\.060 s\)"):
-        scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "never.osim")
-    # outside the chosen time range the gap does not matter
-    scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "early.osim",
-                     time_range_s=(0.0, 0.05))
+    scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "gappy.osim")
+    ours, full = read_model(tmp_path / "gappy.osim"), read_model(scaled)
+    # the markers stand still, so their mean over the present frames is their position: the same model
+    np.testing.assert_allclose(segments_from_model(ours, "r").packed, segments_from_model(full, "r").packed, rtol=1e-12)
+    m1, m2 = ours.getMarkerSet(), full.getMarkerSet()
+    for i in range(m2.getSize()):
+        np.testing.assert_allclose(m1.get(m2.get(i).getName()).get_location().to_numpy(),
+                                   m2.get(i).get_location().to_numpy(), atol=1e-12)
+
+
+def test_marker_absent_from_the_whole_window_is_refused_naming_label_file_and_window(lab, tmp_path):
+    t, X, labels = read_markers(lab / "static.trc")
+    X[:6, labels.index("R.Ankle.Lat")] = np.nan
+    write_trc(tmp_path / "gappy.trc", t, X, labels)
+    with pytest.raises(LoperInputError, match=r"gappy\.trc: marker\(s\) 'RANK' \(model marker R\.Ankle\.Lat\) missing "
+                                              r"in every frame of the scaling window 0\.0000 \.\. 0\.0500 s \(6 frames\)"):
+        scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "never.osim",
+                         time_range_s=(0.0, 0.05), lab_labels={"R.Ankle.Lat": "RANK"})
+    assert not (tmp_path / "never.osim").exists()
+    # a window in which it is present scales: frames 6 .. 9
+    scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "late.osim",
+                     time_range_s=(0.06, 0.09))
+    p = segments_from_model(read_model(tmp_path / "late.osim"), "r")
+    np.testing.assert_allclose(p.length_m[1] / 0.43, 0.95, rtol=1e-9)
+
+
+def test_the_setups_time_range_is_honoured(lab, tmp_path):
+    # a lab's setup that averages 0 .. 0.05 s: the frames after it do not count
+    shutil.copy(lab / MARKER_SET.name, tmp_path / MARKER_SET.name)
+    (tmp_path / "setup.xml").write_text((lab / "scale_setup.xml").read_text().replace("<time_range> -1 -1</time_range>",
+                                                                                       "<time_range> 0 0.05</time_range>"))
+    t, X, labels = read_markers(lab / "static.trc")
+    X[7:, labels.index("R.Ankle.Lat")] += 0.5  # the subject moves after the window: no effect
+    write_trc(tmp_path / "moved.trc", t, X, labels)
+    scale_with_setup(GENERIC, tmp_path / "setup.xml", tmp_path / "moved.trc", MASS_KG, tmp_path / "early.osim")
     p = segments_from_model(read_model(tmp_path / "early.osim"), "r")
     np.testing.assert_allclose(p.length_m[1] / 0.43, 0.95, rtol=1e-9)
+    # a trial starting later holds no frame of it and is refused with both spans
+    write_trc(tmp_path / "late.trc", t + 7.8125, X, labels)
+    with pytest.raises(LoperInputError, match=r"late\.trc: time_range of .*setup\.xml 0 \.\. 0\.05 s holds no frame "
+                                              r"of the static trial \(7\.8125 \.\. 7\.9025 s, the file's clock\)"):
+        scale_with_setup(GENERIC, tmp_path / "setup.xml", tmp_path / "late.trc", MASS_KG, tmp_path / "never.osim")
+    assert not (tmp_path / "never.osim").exists()
 
 
 def test_scaled_model_without_the_configured_bodies_is_refused(lab, tmp_path):

@@ -68,15 +68,25 @@ try:
                            config["synthetic"]["damping_nms_per_rad"], config["synthetic"]["between_subject_cv"],
                            config["identification"]["stiffness_bounds_nm_per_rad"],
                            config["identification"]["damping_bounds_nms_per_rad"])
+        elif "model_osim" in _row:  # an already scaled model: no static trial, no scaling
+            if not Path(_row["model_osim"]).is_file():
+                raise LoperInputError(f"{_subjects_path}: subject '{_s}', column model_osim: file "
+                                      f"'{_row['model_osim']}' not found")
         elif not (Path("data/raw") / _s / f"{config['trials']['static']}.c3d").is_file():
             raise LoperInputError(
                 f"{_subjects_path}: recorded subject '{_s}' has no static trial "
-                f"data/raw/{_s}/{config['trials']['static']}.c3d (raw files are named data/raw/{{subject}}/{{trial}}.c3d)"
+                f"data/raw/{_s}/{config['trials']['static']}.c3d (raw files are named data/raw/{{subject}}/{{trial}}.c3d),"
+                " nor a scaled model (column model_osim)"
             )
-        elif not {"height_m", "mass_kg"} <= set(_row):
-            raise LoperInputError(f"{_subjects_path}: recorded subject '{_s}' needs height_m and mass_kg")
+        elif config["opensim"]["generic_model"] is None and "height_m" not in _row:
+            raise LoperInputError(
+                f"{_subjects_path}: recorded subject '{_s}' needs height_m: the generated model "
+                f"({config_source('opensim', 'generic_model')}: opensim.generic_model null) is built from height "
+                "(a lab's model, such as gait2392, needs none)"
+            )
     _onsets = {int(o) for o in config["synthetic"]["stiffness_nm_per_rad"]}
-    if not set(config["trials"]["perturbation_onsets_ms"]) <= _onsets:
+    if any(r["source"] == "synthetic" for r in SUBJECT_ROWS.values()) and \
+            not set(config["trials"]["perturbation_onsets_ms"]) <= _onsets:
         raise LoperInputError(
             f"{config_source('synthetic', 'stiffness_nm_per_rad')}: key 'synthetic.stiffness_nm_per_rad': "
             f"no truth for onset(s) "
@@ -84,7 +94,7 @@ try:
         )
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
-if config["device"]["subject"] not in SUBJECT_SOURCE:
+if config["device"]["subject"] is not None and config["device"]["subject"] not in SUBJECT_SOURCE:
     raise WorkflowError(
         f"{config_source('device', 'subject')}: key 'device.subject': subject '{config['device']['subject']}' "
         f"is not in {_subjects_path}"
@@ -161,10 +171,40 @@ def subject_trials(subject: str) -> list[str]:
 
 
 def processed_subjects() -> list[str]:
-    """Synthetic subjects and recorded subjects with a static trial on disk: their walking trials are processed."""
+    """Synthetic subjects, and recorded subjects with a static trial on disk or a scaled model: their walking trials
+    are processed."""
     static = config["trials"]["static"]
     return [s for s, src in SUBJECT_SOURCE.items()
-            if src == "synthetic" or (Path("data/raw") / s / f"{static}.c3d").is_file()]
+            if src == "synthetic" or "model_osim" in SUBJECT_ROWS[s] or (Path("data/raw") / s / f"{static}.c3d").is_file()]
+
+
+def trial_kind(trial: str) -> str:
+    """``static`` for the static trial, ``walking`` for every other."""
+    return "static" if trial == config["trials"]["static"] else "walking"
+
+
+def trial_label_maps(trial: str) -> list:
+    """The label maps of a trial, merged in this order: markers.label_map, then its kind's and its own from
+    markers.trial_label_maps (each inline or a file)."""
+    per_trial = config["markers"]["trial_label_maps"]
+    maps = [config["markers"]["label_map"], per_trial.get(trial_kind(trial)), per_trial.get(trial)]
+    return [m for m in maps if m]
+
+
+def label_map_files(wildcards) -> list[str]:
+    """The label-map files among a trial's maps (inputs, so that a changed file reruns the trial)."""
+    return [m for m in trial_label_maps(wildcards.trial) if isinstance(m, str)]
+
+
+def trial_span_s(subject: str, trial: str) -> list[float] | None:
+    """The part of a trial analysed, [start, end] in s on the file's clock (markers.trial_spans_s), or None."""
+    spans = config["markers"]["trial_spans_s"]
+    return spans.get(f"{subject}/{trial}", spans.get(trial))
+
+
+def scaled_subjects() -> list[str]:
+    """Processed subjects whose model is scaled here from their static trial (no model_osim)."""
+    return [s for s in processed_subjects() if "model_osim" not in SUBJECT_ROWS[s]]
 
 
 def transparency_subjects() -> list[str]:
@@ -178,6 +218,8 @@ def processing_targets() -> list[str]:
     out = []
     for s in processed_subjects():
         out.append(f"results/model/{s}/segments.tsv")
+        if s in scaled_subjects():
+            out.append(f"results/model/{s}/scale.tsv")
         if SUBJECT_SOURCE[s] == "synthetic":
             out.append(f"data/raw/{s}/truth.yaml")
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
@@ -204,11 +246,16 @@ def all_targets() -> list[str]:
         "results/validation/errors.tsv",
         "results/validation/fits.tsv",
         "results/validation/errors.png",
-        "results/device/summary.tsv",
-        "results/device/bode.png",
-        "results/device/steps.png",
+        *device_targets(),
         "results/report/front_page.html",
     ]
+
+
+def device_targets() -> list[str]:
+    """The device tests' results: none without a device subject (device.subject null)."""
+    if config["device"]["subject"] is None:
+        return []
+    return ["results/device/summary.tsv", "results/device/bode.png", "results/device/steps.png"]
 
 
 def _raw_partition(resource) -> str | None:

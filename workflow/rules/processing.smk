@@ -23,7 +23,7 @@ def subject_model(wildcards):
     return user if user else f"results/model/{wildcards.subject}/scaled.osim"
 
 
-LABEL_MAP = config["markers"]["label_map"]
+MARKERS = config["markers"]
 
 
 def trial_group(wildcards) -> str:
@@ -33,22 +33,27 @@ def trial_group(wildcards) -> str:
 
 
 rule markers:
-    """Markers of a C3D in the model's names and frame, gaps filled or left missing, low-passed: a TRC (mm)."""
+    """Markers of a C3D in the model's names and frame (each trial turned to walk along +X), gaps filled or left
+    missing, low-passed: a TRC (mm), and per marker its lab label, gaps and the trial's frames, span and rotation."""
     input:
         c3d="data/raw/{subject}/{trial}.c3d",
-        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
+        label_map=label_map_files,
     output:
         trc="results/markers/{subject}/{trial}.trc",
         gaps="results/markers/{subject}/{trial}.gaps.tsv",
         summary="results/markers/{subject}/{trial}.markers.tsv",
     params:
-        rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
-        max_gap_frames=config["markers"]["max_gap_frames"],
-        cutoff_hz=FILTER["cutoff_hz"],
+        rotation_deg=MARKERS["lab_to_model_rotation_deg"],
+        walking_direction=MARKERS["walking_direction"],
+        min_travel_speed_m_per_s=MARKERS["min_travel_speed_m_per_s"],
+        # the static trial is averaged over the scaling window, each marker over the frames it is present in:
+        # neither filled nor filtered (as OpenSim's ScaleTool reads a lab's static trial)
+        max_gap_frames=lambda wc: 0 if wc.trial == TRIALS["static"] else MARKERS["max_gap_frames"],
+        cutoff_hz=lambda wc: None if wc.trial == TRIALS["static"] else FILTER["cutoff_hz"],
         order=FILTER["order"],
-        duration_s=lambda wc: config["markers"]["static_duration_s"] if wc.trial == TRIALS["static"] else None,
-        label_map=LABEL_MAP or None,
-        extent_range_m=config["markers"]["extent_range_m"],
+        span_s=lambda wc: trial_span_s(wc.subject, wc.trial),
+        label_maps=lambda wc: trial_label_maps(wc.trial),
+        extent_range_m=MARKERS["extent_range_m"],
     group:
         trial_group
     log:
@@ -64,13 +69,26 @@ def generic_model(wildcards):
     return OPENSIM["generic_model"] or f"results/model/{wildcards.subject}/generic.osim"
 
 
+def static_c3d_for_mass(wildcards) -> list[str]:
+    """The static trial's C3D when the subject sheet gives no mass (the mass comes from its force plates)."""
+    if "mass_kg" in SUBJECT_ROWS[wildcards.subject]:
+        return []
+    return [f"data/raw/{wildcards.subject}/{TRIALS['static']}.c3d"]
+
+
+STATIC_SETTINGS = dict(duration_s=MARKERS["static_duration_s"], rotation_deg=MARKERS["lab_to_model_rotation_deg"])
+
+
 rule model_generic:
     """The generated sagittal model (used when opensim.generic_model is null)."""
+    input:
+        static_c3d=static_c3d_for_mass,
     output:
         "results/model/{subject}/generic.osim",
     params:
         height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
-        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
+        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
+        static=STATIC_SETTINGS,
     log:
         "results/logs/model_generic/{subject}.log",
     benchmark:
@@ -80,18 +98,30 @@ rule model_generic:
 
 
 rule model_scaled:
-    """The generic model scaled to the static trial (OpenSim's ScaleTool, with opensim.scale_setup when given)."""
+    """The generic model scaled to the static trial (OpenSim's ScaleTool, with opensim.scale_setup when given), and
+    the scale report: scale factors per body, marker errors after scaling, the mass and height used."""
     input:
         generic=generic_model,
         static=f"results/markers/{{subject}}/{TRIALS['static']}.trc",
+        static_summary=f"results/markers/{{subject}}/{TRIALS['static']}.markers.tsv",
+        static_c3d=static_c3d_for_mass,
         setup=[OPENSIM["scale_setup"]] if OPENSIM["scale_setup"] else [],
     output:
-        "results/model/{subject}/scaled.osim",
+        model="results/model/{subject}/scaled.osim",
+        report=report(
+            "results/model/{subject}/scale.tsv",
+            caption="../report/scale_report.rst",
+            category="Model",
+            subcategory="{subject}",
+            labels={"subject": "{subject}", "table": "scaling"},
+        ),
     params:
-        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject]["mass_kg"],
+        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
+        height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
         scale_setup=OPENSIM["scale_setup"],
         segment_bodies=OPENSIM["segment_bodies"],
         factor_range=OPENSIM["scale_factor_range"],
+        static=STATIC_SETTINGS,
     group:
         "model"
     log:
@@ -127,6 +157,7 @@ IK_SETTINGS = dict(
     coordinate_tasks=OPENSIM["coordinate_tasks"],
     accuracy=OPENSIM["accuracy"],
     max_marker_rms_m=OPENSIM["max_marker_rms_m"],
+    warn_marker_rms_m=OPENSIM["warn_marker_rms_m"],
     max_rms_fraction=OPENSIM["max_rms_fraction"],
 )
 
@@ -140,6 +171,7 @@ if OPENSIM["ik_chunks"] == 1:
         output:
             mot="results/ik/{subject}/{trial}.mot",
             angles="results/ik/{subject}/{trial}.angles.tsv",
+            summary="results/ik/{subject}/{trial}.ik.tsv",
         params:
             coordinate_map=OPENSIM["coordinate_map"],
             settings=IK_SETTINGS,
@@ -179,6 +211,7 @@ else:
         output:
             mot="results/ik/{subject}/{trial}.mot",
             angles="results/ik/{subject}/{trial}.angles.tsv",
+            summary="results/ik/{subject}/{trial}.ik.tsv",
         params:
             coordinate_map=OPENSIM["coordinate_map"],
         group:
@@ -192,9 +225,11 @@ else:
 
 
 rule grf:
-    """Ground reaction forces of the C3D's force platforms as an OpenSim external-loads .mot (model frame)."""
+    """Ground reaction forces of the C3D's force platforms as an OpenSim external-loads .mot, in the frame the
+    trial's markers were turned into (its markers summary)."""
     input:
-        "data/raw/{subject}/{trial}.c3d",
+        c3d="data/raw/{subject}/{trial}.c3d",
+        markers="results/markers/{subject}/{trial}.markers.tsv",
     output:
         "results/grf/{subject}/{trial}.grf.mot",
     params:
@@ -229,7 +264,6 @@ EVENT_SETTINGS = dict(
     order=FILTER["order"],
     foot_markers=EVENTS["foot_markers"],
     plate_sides=EVENTS["plate_sides"],
-    label_map=LABEL_MAP or None,
     rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
     band_n=config["grf"]["resting_band_n"],
     max_rest_n=config["grf"]["max_resting_n"],
@@ -242,14 +276,14 @@ rule events:
     named GRF channels of each belt."""
     input:
         c3d="data/raw/{subject}/{trial}.c3d",
-        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
+        label_map=label_map_files,
     output:
         events="results/events/{subject}/{trial}.events.tsv",
         contacts="results/events/{subject}/{trial}.contacts.tsv",
     wildcard_constraints:
         trial=TRIALS["no_device"],
     params:
-        settings=EVENT_SETTINGS,
+        settings=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
     group:
         "trial"
     log:
@@ -266,7 +300,7 @@ rule events_loadcell:
     rate. Both feed only the stride table, so a change of either's settings reruns a cheap sibling at most."""
     input:
         c3d="data/raw/{subject}/{trial}.c3d",
-        label_map=[LABEL_MAP] if isinstance(LABEL_MAP, str) else [],
+        label_map=label_map_files,
         log=robot_log,
     output:
         events="results/events/{subject}/{trial}.events.tsv",
@@ -277,7 +311,7 @@ rule events_loadcell:
         # any trial but the one without the device (the lookahead ends at the wildcard's end, not the path's)
         trial=f"(?!{re.escape(TRIALS['no_device'])}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
     params:
-        events=EVENT_SETTINGS,
+        events=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
         loadcell=LOADCELL_SETTINGS,
     group:
         "trial"
@@ -367,6 +401,8 @@ rule strides_summary:
     input:
         strides=[f"results/strides/{s}/{t}.strides.tsv" for s in processed_subjects() for t in subject_trials(s)],
         contacts=[f"results/events/{s}/{t}.contacts.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        ik=[f"results/ik/{s}/{t}.ik.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        markers=[f"results/markers/{s}/{t}.markers.tsv" for s in processed_subjects() for t in subject_trials(s)],
     output:
         report(
             "results/strides/summary.tsv",

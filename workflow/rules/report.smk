@@ -7,10 +7,12 @@ localrules:
 
 
 def front_page_inputs(wildcards) -> dict:
-    """Tables the front page reads: the device and validation summaries always, the impedance tables and the
-    main figure when the run has perturbation trials, the transparency table when a subject walked both trials
-    of the pair (the targets of processing_targets)."""
-    out = {"device": "results/device/summary.tsv", "validation": "results/validation/summary.tsv"}
+    """Tables the front page reads: the validation summary always, the device summary with device tests, the
+    impedance tables and the main figure when the run has perturbation trials, the transparency table when a
+    subject walked both trials of the pair (the targets of processing_targets)."""
+    out = {"validation": "results/validation/summary.tsv"}
+    if device_targets():
+        out["device"] = "results/device/summary.tsv"
     targets = set(processing_targets())
     if "results/tables/impedance.tsv" in targets:
         out.update(impedance="results/tables/impedance.tsv", summary="results/tables/impedance_summary.tsv",

@@ -3,4 +3,6 @@ from loper_analysis.steps import rule_log
 with rule_log(snakemake.log[0]):
     from loper_analysis.steps import model
 
-    model.generic_model(snakemake.output[0], snakemake.params.height_m, snakemake.params.mass_kg)
+    p = snakemake.params
+    model.generic_model(snakemake.output[0], p.height_m, p.mass_kg,
+                        static_c3d=(snakemake.input.static_c3d or [None])[0], **p.static)

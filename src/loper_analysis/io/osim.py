@@ -10,7 +10,7 @@ from ..errors import LoperInputError
 from .atomic import staged
 from .timing import library_import, timed_io
 
-__all__ = ["quiet_opensim", "read_model", "write_model", "read_scale_setup", "read_marker_set"]
+__all__ = ["quiet_opensim", "read_model", "model_source", "write_model", "read_scale_setup", "read_marker_set"]
 
 
 def quiet_opensim():
@@ -47,6 +47,19 @@ def read_model(path: str | os.PathLike):
         return osim.Model(str(path))
     except Exception as exc:  # OpenSim raises its own exception types for unreadable models
         raise LoperInputError(f"{path}: OpenSim cannot read this model ({exc})") from exc
+
+
+def model_source(model) -> str:
+    """How messages name an ``opensim.Model``: its .osim file (and the model's own name), or the name alone.
+
+    A model read from a file knows the file (``getInputFileName``); a model
+    built in memory has only its name.
+    """
+    path = (model.getInputFileName() or "").strip()
+    name = model.getName()
+    if path and path != "Unassigned":
+        return f"{path} (model {name})"
+    return f"model {name}"
 
 
 def _require_element(path: Path, element: str, what: str) -> None:

@@ -6,13 +6,18 @@ import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
+
+from ..constants import GRAVITY_M_PER_S2
 from ..dynamics import SegmentParameters, segment_parameters_from_anthropometry
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, staged, write_tsv
 from ..io.readers import read_tsv
 
-__all__ = ["SEGMENT_FLOAT_FORMAT", "read_segments", "write_segments", "generic_model", "scaled_model",
-           "scale_with_setup", "scale", "segments_from_model_file", "anthropometric_segments"]
+__all__ = ["SEGMENT_FLOAT_FORMAT", "SCALE_FLOAT_FORMAT", "SCALE_REPORT_COLUMNS", "read_segments", "write_segments",
+           "generic_model", "scaled_model", "scale_with_setup", "scale", "scale_report", "segments_from_model_file",
+           "anthropometric_segments"]
 
 log = logging.getLogger(__name__)
 
@@ -30,71 +35,61 @@ def read_segments(path: PathLike) -> SegmentParameters:
     return SegmentParameters.from_frame(read_tsv(path, "segment table"), source=str(path))
 
 
-def generic_model(out_osim: PathLike, height_m: float, mass_kg: float) -> None:
-    """The generic lower-body model (:func:`loper_analysis.model.build_lower_body_model`) for this subject."""
+def generic_model(out_osim: PathLike, height_m: float, mass_kg: float | None, static_c3d: PathLike | None = None,
+                  duration_s: float | None = None, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0)) -> None:
+    """The generic lower-body model (:func:`loper_analysis.model.build_lower_body_model`) for this subject.
+
+    Without ``mass_kg`` the mass comes from the force plates the subject
+    stands on in the static trial ``static_c3d``, over its first
+    ``duration_s`` seconds (None: all of it; ``rotation_deg`` tells the lab's
+    vertical: :func:`loper_analysis.static_trial.standing_mass_kg`).
+    """
     from ..io.osim import write_model
     from ..model import build_lower_body_model
 
+    if mass_kg is None and static_c3d is not None:
+        from ..io.c3d import read_c3d
+        from ..static_trial import scale_window_s
+
+        window = scale_window_s(read_c3d(static_c3d).time_s, (), duration_s, source=str(static_c3d))
+        mass_kg, source = _subject_mass(None, static_c3d, window, rotation_deg)
+        log.info("mass %.2f kg from the %s", mass_kg, source)
+    mass_kg, _ = _subject_mass(mass_kg, None, (0.0, 0.0), rotation_deg)
     write_model(build_lower_body_model(height_m, mass_kg), out_osim)
     log.info("generic model for %s m, %s kg: %s", height_m, mass_kg, out_osim)
 
 
-def _check_factors(model, measurements, times, X, labels, time_range_s, static_trc, factor_range) -> None:
+def _check_factors(model, measurements, pose, static_trc, factor_range) -> None:
     """Refuse scale factors outside ``factor_range`` (:func:`loper_analysis.plausibility.require_scale_factors`)."""
-    import numpy as np
-
     from ..plausibility import measurement_scale_factors, require_scale_factors
 
-    t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
-    sel = (times >= t0 - 1e-9) & (times <= t1 + 1e-9)
-    factors = measurement_scale_factors(model, measurements, np.asarray(X)[sel], labels)
+    factors = measurement_scale_factors(model, measurements, pose.markers_m, pose.labels)
     require_scale_factors(factors, str(static_trc), factor_range)
 
 
-def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float,
+def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
                  time_range_s: tuple[float, float] | None = None,
-                 factor_range: Sequence[float] = (0.5, 2.0)) -> None:
-    """Personalise the generic model with OpenSim's ScaleTool from a static trial (TRC).
+                 factor_range: Sequence[float] = (0.5, 2.0), **static) -> None:
+    """Personalise the generated model with OpenSim's ScaleTool from a static trial (TRC).
 
     Each body is scaled uniformly by the ratio of the marker-pair distances in
     the static trial to those of the model
     (:data:`loper_analysis.model.SCALE_MEASUREMENTS`); the mass distribution
-    is preserved at ``mass_kg``. The static markers must be complete
-    (:func:`loper_analysis.model.static_marker_problem`) and every factor must
-    lie in ``factor_range`` (a factor near 10 or 1000 means markers in
+    is preserved at ``mass_kg``. The window, the static pose and the
+    keywords ``static`` are those of :func:`scale_with_setup`; every factor
+    must lie in ``factor_range`` (a factor near 10 or 1000 means markers in
     another unit than the TRC declares); nothing is written otherwise.
     """
-    from pathlib import Path
-
-    from ..io.opensim_tables import read_markers
     from ..io.osim import quiet_opensim, read_model
-    from ..model import SCALE_MEASUREMENTS, static_marker_problem
+    from ..model import SCALE_MEASUREMENTS
 
-    generic_osim, static_trc = Path(generic_osim), Path(static_trc)
-    for path in (generic_osim, static_trc):
-        if not path.is_file():
-            raise LoperInputError(f"file not found: {path}")
-    if not 0 < mass_kg <= 300:
-        raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
-    times, X, labels = read_markers(static_trc)
-    static_marker_problem(times, X, labels, time_range_s, source=str(static_trc))
-    _check_factors(read_model(generic_osim), SCALE_MEASUREMENTS, times, X, labels, time_range_s, static_trc,
-                   factor_range)
-    t0, t1 = (times[0], times[-1]) if time_range_s is None else time_range_s
     osim = quiet_opensim()
     tool = osim.ScaleTool()
-    tool.setSubjectMass(float(mass_kg))
-    tool.getGenericModelMaker().setModelFileName(str(generic_osim))
     scaler = tool.getModelScaler()
     scaler.setApply(True)
     order = osim.ArrayStr()
     order.append("measurements")
     scaler.setScalingOrder(order)
-    scaler.setMarkerFileName(str(static_trc))
-    tr = osim.ArrayDouble()
-    tr.append(float(t0))
-    tr.append(float(t1))
-    scaler.setTimeRange(tr)
     scaler.setPreserveMassDist(True)
     measurements = scaler.getMeasurementSet()
     for body, pairs in SCALE_MEASUREMENTS.items():
@@ -112,25 +107,28 @@ def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLik
         m.getBodyScaleSet().cloneAndAppend(scale)
         measurements.cloneAndAppend(m)
     tool.getMarkerPlacer().setApply(False)
-    with staged(out_osim, "OpenSim model") as tmp:
-        scaler.setOutputModelFileName(str(tmp))
-        tool.run()  # returns False when the marker placer is off, even after a good scaling: the file tells
-        if not tmp.is_file():
-            raise LoperInputError(f"OpenSim ScaleTool failed for {static_trc} with {generic_osim}")
-    log.info("scaled %s to %s", generic_osim, static_trc)
+    generic_osim = Path(generic_osim)
+    if not generic_osim.is_file():
+        raise LoperInputError(f"file not found: {generic_osim}")
+    _run_scale_tool(tool, read_model(generic_osim), generic_osim, None, None, static_trc, out_osim, mass_kg,
+                    time_range_s, factor_range, **static)
 
 
-def scale(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float,
+def scale(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
           setup_xml: PathLike | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None,
-          factor_range: Sequence[float] = (0.5, 2.0)) -> None:
+          factor_range: Sequence[float] = (0.5, 2.0), **static) -> None:
     """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when ``setup_xml``
     is given, else with the generated model's marker-pair measurements (:func:`scaled_model`); scale factors
-    outside ``factor_range`` are refused."""
+    outside ``factor_range`` are refused. ``static``: the keywords of the static trial
+    (:func:`scale_with_setup`); its ``lab_labels`` may be the static trial's markers summary (TSV with the
+    columns ``label`` and ``marker``, written by :func:`loper_analysis.steps.processing.markers`)."""
+    if isinstance(static.get("lab_labels"), (str, Path)):
+        static["lab_labels"] = _lab_labels(static["lab_labels"])
     if setup_xml is None:
-        scaled_model(generic_osim, static_trc, out_osim, mass_kg, factor_range=factor_range)
+        scaled_model(generic_osim, static_trc, out_osim, mass_kg, factor_range=factor_range, **static)
     else:
         scale_with_setup(generic_osim, setup_xml, static_trc, mass_kg, out_osim, segment_bodies=segment_bodies,
-                         factor_range=factor_range)
+                         factor_range=factor_range, **static)
 
 
 def segments_from_model_file(model_osim: PathLike, out_tsv: PathLike, side: str = "left",
@@ -180,20 +178,28 @@ def anthropometric_segments(out_tsv: PathLike, height_m: float, mass_kg: float,
     return params
 
 
-def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: PathLike, mass_kg: float,
+def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: PathLike, mass_kg: float | None,
                      out_osim: PathLike, time_range_s: tuple[float, float] | None = None,
                      segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                     factor_range: Sequence[float] = (0.5, 2.0)) -> None:
+                     factor_range: Sequence[float] = (0.5, 2.0), **static) -> None:
     """Scale a generic OpenSim model with a lab's own ScaleTool setup and a static trial (TRC).
 
     The setup (``opensim.ScaleTool(setup_xml)``) keeps its measurements,
-    scale set, scaling order, mass-distribution flag, marker-placer tasks
-    and its marker set file (resolved, like OpenSim does, relative to the
-    setup's folder); replaced are the generic model file, the marker file
-    of the model scaler and the marker placer (``static_trc``), the subject
-    mass, the time range and the output files: only the final model is
-    written, atomically, to ``out_osim`` (the marker placer's model when it
-    applies, else the model scaler's).
+    scale set, scaling order, mass-distribution flag, marker-placer tasks,
+    time ranges and its marker set file (resolved, like OpenSim does,
+    relative to the setup's folder); replaced are the generic model file,
+    the marker file of the model scaler and the marker placer, the subject
+    mass and the output files: only the final model is written, atomically,
+    to ``out_osim`` (the marker placer's model when it applies, else the
+    model scaler's).
+
+    The static trial is averaged over a window
+    (:func:`loper_analysis.static_trial.scale_window_s`): ``time_range_s``
+    when given, else the setup's time ranges where they are set, else the
+    first ``duration_s`` seconds (keyword of ``static``; None: the whole
+    trial). Within it each marker counts where it is present: ScaleTool gets
+    the window with every marker's missing frames holding its mean over the
+    present ones (:func:`loper_analysis.static_trial.static_pose`).
 
     Parameters
     ----------
@@ -203,12 +209,14 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         An OpenSim ScaleTool setup.
     static_trc : path
         The static trial (``.trc``, any length unit OpenSim knows).
-    mass_kg : float
-        Subject mass, kg (0 .. 300).
+    mass_kg : float or None
+        Subject mass, kg (0 .. 300); None: from the force plates of the
+        static trial's C3D (keyword ``static_c3d`` of ``static``:
+        :func:`loper_analysis.static_trial.standing_mass_kg`).
     out_osim : path
         The scaled model.
     time_range_s : (float, float), optional
-        Frames of the static trial used, s (default: the whole trial).
+        The window (s), overriding the setup's time ranges.
     segment_bodies : mapping, optional
         The bodies the segment table will need (``opensim.segment_bodies``);
         the scaled model must have them on both sides.
@@ -216,24 +224,26 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         Least and largest plausible factor of a measurement (static-trial
         marker distance over the model's at its default pose, averaged over
         the measurement's pairs; :func:`loper_analysis.plausibility.measurement_scale_factors`).
+    **static
+        ``duration_s`` (window without a set range, s), ``lab_labels``
+        ({model marker: lab label} for messages), ``static_c3d`` and
+        ``rotation_deg`` (the mass from its force plates), ``height_m`` (the
+        subject's, else estimated from the scaled model), ``report_out`` (the
+        scale report, :func:`scale_report`).
 
     Raises
     ------
     LoperInputError
         A missing file; a file that is not a ScaleTool setup; measurement
         markers that the model (with the setup's marker set) or the static
-        trial lacks (all listed); a measurement marker missing (NaN) in a
-        frame of the time range (ScaleTool would crash or scale with a wrong
-        factor; markers used only by the marker placer may have gaps, OpenSim
-        leaves such a marker where it is); a scaled model without the
-        configured bodies; a measurement's scale factor outside
-        ``factor_range`` (markers in another unit than the TRC declares);
-        ScaleTool failing. Nothing is written then.
+        trial lacks (all listed); a measurement marker absent from every
+        frame of the window (naming its lab label, the file and the window);
+        a window outside the trial; a scaled model without the configured
+        bodies; a measurement's scale factor outside ``factor_range``
+        (markers in another unit than the TRC declares); no mass; ScaleTool
+        failing. Nothing is written then.
     """
-    from ..io.opensim_tables import read_markers
-    from ..io.osim import quiet_opensim, read_marker_set, read_model, read_scale_setup
-    from ..model import static_marker_problem
-    from ..segments_from_model import check_segment_bodies
+    from ..io.osim import read_marker_set, read_model, read_scale_setup
 
     generic_osim, setup_xml, static_trc = Path(generic_osim), Path(setup_xml), Path(static_trc)
     for path in (generic_osim, static_trc):
@@ -241,8 +251,6 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
             raise LoperInputError(f"file not found: {path}")
     if static_trc.suffix.lower() != ".trc":
         raise LoperInputError(f"{static_trc}: ScaleTool reads a static trial as .trc, got '{static_trc.suffix}'")
-    if not 0 < mass_kg <= 300:
-        raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
     tool = read_scale_setup(setup_xml)
     maker = tool.getGenericModelMaker()
     marker_set = _setup_file(maker.getMarkerSetFileName(), setup_xml)
@@ -253,54 +261,232 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
     if marker_set is not None:
         generic.updateMarkerSet(read_marker_set(marker_set))  # as ScaleTool does: the set's markers replace or add
     model_markers = set(_names(generic.getMarkerSet()))
-    needed = _measurement_markers(tool)
-    lacking = sorted(needed - model_markers)
+    lacking = sorted(_measurement_markers(tool) - model_markers)
     if lacking:
         extra = f" with marker set {marker_set}" if marker_set is not None else ""
         raise LoperInputError(f"{setup_xml}: measurement marker(s) {lacking} are not on the model {generic_osim}{extra}")
-    times, X, labels = read_markers(static_trc)
-    lacking = sorted(needed - set(labels))
-    if lacking:
-        raise LoperInputError(f"{setup_xml}: measurement marker(s) {lacking} are not in the static trial {static_trc}")
-    t0, t1 = (float(times[0]), float(times[-1])) if time_range_s is None else map(float, time_range_s)
-    if not (t0 <= t1 and t0 <= times[-1] + 1e-9 and t1 >= times[0] - 1e-9):
-        raise LoperInputError(f"{static_trc}: time_range_s {time_range_s} lies outside the trial "
-                              f"({times[0]:.3f} .. {times[-1]:.3f} s) or is reversed")
-    static_marker_problem(times, X, labels, (t0, t1), source=str(static_trc), needed=needed)
-    _check_factors(generic, _measurement_pairs(tool), times, X, labels, (t0, t1), static_trc, factor_range)
+    _run_scale_tool(tool, generic, generic_osim, setup_xml, marker_set, static_trc, out_osim, mass_kg,
+                    time_range_s, factor_range, segment_bodies=segment_bodies, **static)
 
+
+def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, marker_set: Path | None,
+                    static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
+                    time_range_s: tuple[float, float] | None, factor_range: Sequence[float],
+                    segment_bodies: Mapping[str, Sequence[str]] | None = None, duration_s: float | None = None,
+                    lab_labels: Mapping[str, str] | None = None, static_c3d: PathLike | None = None,
+                    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), height_m: float | None = None,
+                    report_out: PathLike | None = None) -> None:
+    """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report (:func:`scale_with_setup`)."""
+    import tempfile
+
+    from ..io.opensim_tables import read_markers, write_trc
+    from ..io.osim import quiet_opensim, read_model
+    from ..segments_from_model import check_segment_bodies
+    from ..static_trial import scale_window_s, static_pose
+
+    static_trc = Path(static_trc)
+    if not static_trc.is_file():
+        raise LoperInputError(f"file not found: {static_trc}")
+    where = str(setup_xml) if setup_xml is not None else str(static_trc)
+    times, X, labels = read_markers(static_trc)
+    scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
+    ranges = {part: _range(part) for part in (scaler, placer) if part.getApply()}
+    if time_range_s is not None:
+        t0, t1 = map(float, time_range_s)
+        if not (t0 <= t1 and t0 <= times[-1] + 1e-9 and t1 >= times[0] - 1e-9):
+            raise LoperInputError(f"{static_trc}: time_range_s {time_range_s} lies outside the trial "
+                                  f"({times[0]:.3f} .. {times[-1]:.3f} s) or is reversed")
+        window = scale_window_s(times, [(t0, t1)], source=str(static_trc), setting="the time range given")
+        ranges = dict.fromkeys(ranges)
+    else:
+        setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
+        window = scale_window_s(times, list(ranges.values()), duration_s, source=str(static_trc), setting=setting)
+    pairs = _measurement_pairs(tool)
+    needed = sorted({m for p in pairs.values() for pair in p for m in pair})
+    lacking = [m for m in needed if m not in labels]
+    if lacking:
+        raise LoperInputError(f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}")
+    pose = static_pose(times, X, labels, window, needed, lab_labels, source=str(static_trc),
+                       setting=f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s")
+    for marker, n in pose.n_filled.items():
+        log.info("%s: marker %s missing in %d of %d frames of the window: averaged over the others", static_trc,
+                 marker, n, len(pose.time_s))
+    if pose.left_out:
+        log.warning("%s: marker(s) %s missing throughout the window %.4f .. %.4f s: left out of scaling", static_trc,
+                    ", ".join(pose.left_out), *window)
+    _check_factors(generic, pairs, pose, static_trc, factor_range)
+    gravity = float(np.linalg.norm(generic.getGravity().to_numpy()))
+    mass_kg, mass_source = _subject_mass(mass_kg, static_c3d, window, rotation_deg, gravity)
     osim = quiet_opensim()
+    maker = tool.getGenericModelMaker()
     tool.setPathToSubject("")  # OpenSim prefixes the setup's folder to every file name; ours are absolute
     tool.setSubjectMass(mass_kg)
     maker.setModelFileName(str(generic_osim.resolve()))
     maker.setMarkerSetFileName(str(marker_set) if marker_set is not None else "Unassigned")
-    scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
-    time_range = osim.ArrayDouble()
-    time_range.append(t0)
-    time_range.append(t1)
-    trc = str(static_trc.resolve())
-    coordinates = _setup_file(placer.getCoordinateFileName(), setup_xml)
-    placer.setCoordinateFileName(str(coordinates) if coordinates is not None else "Unassigned")
-    for part in (scaler, placer):
-        part.setMarkerFileName(trc)
-        part.setTimeRange(time_range)
-    scaler.setOutputScaleFileName("Unassigned")
-    placer.setOutputMotionFileName("Unassigned")
-    placer.setOutputMarkerFileName("Unassigned")
-    with staged(out_osim, "OpenSim model") as tmp:
-        final, other = (placer, scaler) if placer.getApply() else (scaler, placer)
-        final.setOutputModelFileName(str(tmp))
-        other.setOutputModelFileName("Unassigned")
-        try:
-            tool.run()
-        except Exception as exc:  # OpenSim raises its own exception types
-            raise LoperInputError(f"{setup_xml}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} "
-                                  f"({exc})") from exc
-        if not tmp.is_file():
-            raise LoperInputError(f"{setup_xml}: OpenSim's ScaleTool wrote no model for {static_trc} with "
-                                  f"{generic_osim} (are the model scaler and the marker placer both off?)")
-        check_segment_bodies(read_model(tmp), segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
-    log.info("scaled %s with %s to %s", generic_osim, setup_xml, static_trc)
+    if setup_xml is not None:
+        coordinates = _setup_file(placer.getCoordinateFileName(), setup_xml)
+        placer.setCoordinateFileName(str(coordinates) if coordinates is not None else "Unassigned")
+    with tempfile.TemporaryDirectory(prefix="loper-scale-") as tmp_dir:
+        trc = Path(tmp_dir) / "static_window.trc"
+        write_trc(trc, pose.time_s, pose.markers_m, pose.labels)
+        scale_file = Path(tmp_dir) / "scale_set.xml"
+        for part in (scaler, placer):
+            part.setMarkerFileName(str(trc))
+            own = ranges.get(part)
+            part.setTimeRange(_array(osim, own if own is not None else window))
+        scaler.setOutputScaleFileName(str(scale_file) if scaler.getApply() else "Unassigned")
+        placer.setOutputMotionFileName("Unassigned")
+        placer.setOutputMarkerFileName("Unassigned")
+        with staged(out_osim, "OpenSim model") as tmp:
+            final, other = (placer, scaler) if placer.getApply() else (scaler, placer)
+            final.setOutputModelFileName(str(tmp))
+            other.setOutputModelFileName("Unassigned")
+            try:
+                tool.run()  # False when the marker placer is off, even after a good scaling: the file tells
+            except Exception as exc:  # OpenSim raises its own exception types
+                raise LoperInputError(f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} "
+                                      f"({exc})") from exc
+            if not tmp.is_file():
+                raise LoperInputError(f"{where}: OpenSim's ScaleTool wrote no model for {static_trc} with "
+                                      f"{generic_osim} (are the model scaler and the marker placer both off?)")
+            scaled = read_model(tmp)
+            check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
+            if report_out is not None:
+                report = scale_report(scaled, pose, _scale_factors(scale_file), _placer_tasks(placer),
+                                      mass_kg, mass_source, height_m, segment_bodies, lab_labels)
+                write_tsv(report, report_out, SCALE_FLOAT_FORMAT)
+                log.info("scale report:\n%s", report.to_string(index=False))
+    log.info("scaled %s to %s (window %.4f .. %.4f s, %d frames, %g kg)", generic_osim, static_trc, *window,
+             len(pose.time_s), mass_kg)
+
+
+def _lab_labels(summary_tsv: PathLike) -> dict[str, str]:
+    """Model marker -> the lab's label, from the static trial's markers summary (columns ``label`` and ``marker``)."""
+    table = read_tsv(summary_tsv, "markers summary", ("label", "marker"), dtype=str, keep_default_na=False)
+    return dict(zip(table["marker"], table["label"]))
+
+
+def _range(part) -> tuple[float, float] | None:
+    """A model scaler's or marker placer's time range, None when unset (``-1 -1`` or reversed)."""
+    from ..static_trial import time_range_is_set
+
+    r = part.getTimeRange()
+    pair = (r.get(0), r.get(1)) if r.getSize() >= 2 else None
+    return pair if time_range_is_set(pair) else None
+
+
+def _array(osim, pair) -> object:
+    out = osim.ArrayDouble()
+    for value in pair:
+        out.append(float(value))
+    return out
+
+
+def _subject_mass(mass_kg: float | None, static_c3d: PathLike | None, window: tuple[float, float],
+                  rotation_deg: Sequence[float], gravity_m_per_s2: float = GRAVITY_M_PER_S2) -> tuple[float, str]:
+    """The subject's mass (kg) and where it came from: given, or from the static trial's force plates (weight over
+    the model's gravity)."""
+    from ..io.force_platforms import read_force_platforms
+    from ..markers import lab_up
+    from ..static_trial import standing_mass_kg
+
+    if mass_kg is not None:
+        if not 0 < mass_kg <= 300:
+            raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
+        return float(mass_kg), "given"
+    if static_c3d is None:
+        raise LoperInputError("no body mass: give mass_kg (subject sheet), or a static trial that stands on force "
+                              "plates")
+    plates = read_force_platforms(static_c3d)
+    if not plates:
+        raise LoperInputError(f"{static_c3d}: no body mass: the static trial has no force platforms "
+                              "(FORCE_PLATFORM:USED 0); give mass_kg in the subject sheet")
+    up = lab_up(rotation_deg)
+    vertical = np.column_stack([p.force_n @ up for p in plates])
+    mass = standing_mass_kg(plates[0].time_s, vertical, window, gravity_m_per_s2, source=str(static_c3d))
+    return mass, f"force plates {', '.join(str(p.number) for p in plates)} of {Path(static_c3d).name}"
+
+
+#: Significant digits of the scale report.
+SCALE_FLOAT_FORMAT = "%.8g"
+#: Columns of the scale report (:func:`scale_report`).
+SCALE_REPORT_COLUMNS: tuple[str, ...] = (
+    "kind", "name", "label", "scale_factor_x", "scale_factor_y", "scale_factor_z", "marker_weight",
+    "marker_error_rms_m", "marker_error_max_m", "n_frames", "mass_kg", "height_m", "source")
+
+
+def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
+    """Body -> scale factors (x, y, z) of the ScaleSet OpenSim wrote (empty when it wrote none)."""
+    from ..io.osim import quiet_opensim
+
+    if not scale_file.is_file():
+        return {}
+    osim = quiet_opensim()
+    scales = osim.ScaleSet(str(scale_file))
+    out = {}
+    for i in range(scales.getSize()):
+        sc = scales.get(i)
+        if sc.getApply():
+            f = sc.getScaleFactors()
+            out[sc.getSegmentName()] = (f.get(0), f.get(1), f.get(2))
+    return out
+
+
+def _placer_tasks(placer) -> tuple[dict[str, float], dict] | None:
+    """Marker weights and coordinate tasks of the marker placer (None when it does not apply)."""
+    from ..io.ik_tasks import task_set_tasks
+
+    if not placer.getApply():
+        return None
+    return task_set_tasks(placer.getIKTaskSet(), "MarkerPlacer/IKTaskSet")
+
+
+def scale_report(scaled, pose, factors: Mapping[str, Sequence[float]], tasks, mass_kg: float, mass_source: str,
+                 height_m: float | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None,
+                 lab_labels: Mapping[str, str] | None = None) -> pd.DataFrame:
+    """How good the scaling is: one row per body (scale factors), per marker (error) and for the subject.
+
+    Rows (``kind``): ``subject`` (``mass_kg`` and where it came from,
+    ``height_m`` given or estimated from the scaled model:
+    :func:`loper_analysis.static_trial.model_height_m`), ``body`` (the
+    factors OpenSim's model scaler applied; 1 where it scaled nothing),
+    ``marker`` (each weighted marker's distance to the model's marker after
+    scaling, RMS and largest over the window's frames, m: IK of the static
+    pose on the scaled model with the marker placer's weights, or weight 1
+    for every marker) and ``markers`` (all of them together). Columns
+    :data:`SCALE_REPORT_COLUMNS`.
+    """
+    from ..kinematics import inverse_kinematics
+    from ..segments_from_model import segment_body_names
+    from ..static_trial import model_height_m
+
+    rows = []
+    if height_m is None:
+        thigh = segment_body_names(scaled, "r", segment_bodies)["thigh"][0]
+        height, height_source = model_height_m(scaled, thigh), "estimated from the scaled model"
+    else:
+        height, height_source = float(height_m), "given"
+    rows.append({"kind": "subject", "name": "subject", "mass_kg": mass_kg, "height_m": height,
+                 "source": f"mass: {mass_source}; height: {height_source}"})
+    bodies = scaled.getBodySet()
+    for i in range(bodies.getSize()):
+        name = bodies.get(i).getName()
+        fx, fy, fz = factors.get(name, (1.0, 1.0, 1.0))
+        rows.append({"kind": "body", "name": name, "scale_factor_x": fx, "scale_factor_y": fy, "scale_factor_z": fz})
+    model_markers = set(_names(scaled.getMarkerSet()))
+    weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
+    weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
+    result = inverse_kinematics(scaled, pose.time_s, pose.markers_m, pose.labels, weights, coords)
+    E = result.marker_errors_m
+    for j, name in enumerate(result.marker_names):
+        e = E[:, j][np.isfinite(E[:, j])]
+        rows.append({"kind": "marker", "name": name, "label": (lab_labels or {}).get(name, name),
+                     "marker_weight": weights[name], "marker_error_rms_m": float(np.sqrt(np.mean(e ** 2))),
+                     "marker_error_max_m": float(e.max()), "n_frames": int(e.size)})
+    every = E[np.isfinite(E)]
+    rows.append({"kind": "markers", "name": "all weighted", "marker_error_rms_m": float(np.sqrt(np.mean(every ** 2))),
+                 "marker_error_max_m": float(every.max()), "n_frames": len(pose.time_s)})
+    return pd.DataFrame(rows, columns=list(SCALE_REPORT_COLUMNS))
 
 
 def _names(object_set) -> list[str]:

@@ -41,13 +41,13 @@ def software_versions() -> dict[str, str]:
     return versions
 
 
-def front_page(out_html: PathLike, device_tsv: PathLike, validation_tsv: PathLike, subjects: Mapping[str, str],
+def front_page(out_html: PathLike, device_tsv: PathLike | None, validation_tsv: PathLike, subjects: Mapping[str, str],
                trials: Mapping[str, Sequence[str]], settings: Mapping, impedance_tsv: PathLike | None = None,
                summary_tsv: PathLike | None = None, figure_png: PathLike | None = None,
                rmsd_tsv: PathLike | None = None, versions: Mapping[str, str] | None = None) -> str:
     """The front page of the report (:func:`loper_analysis.front_page.front_page_html`) from the result files.
 
-    ``device_tsv``: ``results/device/summary.tsv``; ``validation_tsv``:
+    ``device_tsv``: ``results/device/summary.tsv`` (None: no device tests); ``validation_tsv``:
     ``results/validation/summary.tsv``; ``impedance_tsv``, ``summary_tsv`` and
     ``figure_png``: the impedance table, its across-subject summary and the
     main figure (None: the run had no perturbation trials); ``rmsd_tsv``: the
@@ -59,6 +59,8 @@ def front_page(out_html: PathLike, device_tsv: PathLike, validation_tsv: PathLik
     from :mod:`loper_analysis.headline`. Writes ``out_html`` and returns the
     fragment.
     """
+    import pandas
+
     from ..errors import LoperInputError
     from ..front_page import RunSettings, front_page_html
     from ..headline import (device_comparison, impedance_summary_ci, transparency_verdict, truth_recovery,
@@ -83,7 +85,8 @@ def front_page(out_html: PathLike, device_tsv: PathLike, validation_tsv: PathLik
         transparency = transparency_verdict(read_tsv(rmsd_tsv, "transparency table"), str(rmsd_tsv))
     text = front_page_html(
         subjects, trials, run, software_versions() if versions is None else versions,
-        device=device_comparison(read_tsv(device_tsv, "device summary"), str(device_tsv)),
+        device=(pandas.DataFrame() if device_tsv is None
+                else device_comparison(read_tsv(device_tsv, "device summary"), str(device_tsv))),
         validation=validation_verdict(read_tsv(validation_tsv, "validation summary"), str(validation_tsv)),
         summary=summary, truth=truth, impedance_status=status, figure_png=figure, transparency=transparency,
     )

@@ -1,0 +1,83 @@
+"""The static trial as scaling uses it (loper_analysis.static_trial): window, pose, mass and height."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.model import build_lower_body_model
+from loper_analysis.static_trial import (
+    HIP_HEIGHT_FRACTION,
+    model_height_m,
+    scale_window_s,
+    standing_mass_kg,
+    static_pose,
+    time_range_is_set,
+)
+
+T = 7.8125 + np.arange(200) / 100.0  # a file whose first frame is not at 0 s
+
+
+def test_the_setups_time_range_wins_and_unset_ranges_are_ignored():
+    assert time_range_is_set((0.0, 0.1)) and not time_range_is_set((-1.0, -1.0)) and not time_range_is_set((1, 0))
+    assert scale_window_s(T, [(8.0, 8.5)], duration_s=1.0) == (T[19], T[68])  # the frames inside it
+    # model scaler and marker placer with their own ranges: the window spans both
+    assert scale_window_s(T, [(8.0, 8.2), (8.3, 8.6), (-1, -1)]) == (T[19], T[78])
+    assert scale_window_s(T, [(-1, -1)], duration_s=1.0) == (T[0], T[99])  # the first second
+    assert scale_window_s(T, [None]) == (T[0], T[-1])  # the whole trial
+
+
+def test_a_range_outside_the_trial_names_it_the_trial_and_the_setting():
+    with pytest.raises(LoperInputError, match=r"s\.trc: time_range of lab\.xml 0 \.\. 1 s holds no frame of the static "
+                                              r"trial \(7\.8125 \.\. 9\.8025 s, the file's clock\)"):
+        scale_window_s(T, [(0.0, 1.0)], source="s.trc", setting="time_range of lab.xml")
+
+
+def _markers():
+    X = np.tile(np.array([[0.0, 1.0, 0.1], [0.0, 0.5, 0.1], [0.2, 0.05, 0.1]]), (10, 1, 1))
+    X += 0.001 * np.arange(10)[:, None, None]  # sway: each frame 1 mm further
+    return np.arange(10) / 100.0, X
+
+
+def test_each_marker_is_averaged_over_the_frames_where_it_is_present():
+    t, X = _markers()
+    X[:4, 1] = np.nan  # knee hidden in the first 4 frames
+    X[7, 2] = np.nan
+    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), needed=["ASIS", "KNEE"])
+    assert pose.n_filled == {"KNEE": 4, "TOE": 1} and pose.left_out == [] and not np.isnan(pose.markers_m).any()
+    np.testing.assert_allclose(pose.markers_m.mean(axis=0)[1], np.nanmean(X[:, 1], axis=0), rtol=1e-15)
+    np.testing.assert_allclose(pose.markers_m[:4, 1], np.tile(np.nanmean(X[4:, 1], axis=0), (4, 1)), rtol=1e-15)
+    np.testing.assert_array_equal(pose.markers_m[4:, 1], X[4:, 1])  # present frames unchanged
+
+
+def test_a_marker_absent_from_the_window_stops_if_needed_and_is_left_out_otherwise():
+    t, X = _markers()
+    X[:6, 1] = np.nan
+    X[:, 2] = np.nan
+    with pytest.raises(LoperInputError, match=r"static\.trc: marker\(s\) 'Subject:RKNE' \(model marker KNEE\) missing "
+                                              r"in every frame of the scaling window 0\.0000 \.\. 0\.0500 s \(6 frames\)"
+                                              r".*scale_setup\.xml"):
+        static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.05), needed=["KNEE"], lab_labels={"KNEE": "Subject:RKNE"},
+                    source="static.trc", setting="time_range of scale_setup.xml")
+    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.06, 0.09), needed=["KNEE"])
+    assert pose.labels == ["ASIS", "KNEE"] and pose.left_out == ["TOE"] and pose.markers_m.shape == (4, 2, 3)
+
+
+def test_standing_mass_is_the_weight_over_gravity():
+    t = np.arange(1000) / 1000.0
+    rng = np.random.default_rng(1)
+    plates = np.column_stack([0.52 * 80.0 * 9.80665 + rng.normal(0, 2, t.size), 0.48 * 80.0 * 9.80665 + 0 * t])
+    plates[:100] = 0.0  # stepping on: outside the window
+    assert standing_mass_kg(t, plates, (0.2, 0.999), 9.80665) == pytest.approx(80.0, abs=0.02)  # 2 N noise
+    with pytest.raises(LoperInputError, match=r"s\.c3d: the force plates carry 0\.0 N on average .*outside 20 \.\. 300 kg"):
+        standing_mass_kg(t, plates, (0.0, 0.05), source="s.c3d")
+    with pytest.raises(LoperInputError, match=r"varies by 71 % .*does not stand still"):
+        standing_mass_kg(t, plates, (0.0, 0.3))  # a third of the window on no plate: SD over mean 0.71
+
+
+def test_height_of_the_generated_model_comes_back():
+    # Winter's proportions: the hip joint centre stands at 0.530 of the height above the metatarsal markers
+    assert HIP_HEIGHT_FRACTION == pytest.approx(0.530, abs=1e-12)
+    for height in (1.55, 1.73, 1.95):
+        assert model_height_m(build_lower_body_model(height, 70.0), "thigh_r") == pytest.approx(height, rel=1e-9)
