@@ -200,3 +200,33 @@ def test_a_label_map_value_with_a_space_is_refused_naming_the_rule(bts, tmp_path
                                               r"marker name \(non-empty, no spaces: OpenSim refuses whitespace"):
         markers(bts, tmp_path / "bts.trc", label_map={"r heel": "R HEE"})
     assert not (tmp_path / "bts.trc").exists()
+
+
+def test_label_maps_merge_in_order_and_a_static_only_label_needs_no_entry_elsewhere(prefixed, tmp_path):
+    # the map of every trial, then the static trial's own: a label only the static trial has maps there
+    static = tmp_path / "static.c3d"
+    X = np.random.default_rng(12).uniform(-1, 1, size=(20, 4, 3))
+    write_c3d(static, ["Anna:LASIS", "Anna:RASIS", "Anna:LHEE", "Anna:L_MED_KNEE"], X, 100.0)
+    every, static_only = {"LASIS": "LASI", "RASIS": "RASI"}, {"L_MED_KNEE": "LKNM", "RASIS": "RASI_static"}
+    markers(static, tmp_path / "s.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every, static_only],
+            summary_out=tmp_path / "s.markers.tsv")
+    assert read_markers(tmp_path / "s.trc")[2] == ["LASI", "RASI_static", "LHEE", "LKNM"]  # the later map wins
+    summary = pd.read_csv(tmp_path / "s.markers.tsv", sep="\t")
+    assert summary["label"].tolist() == ["Anna:LASIS", "Anna:RASIS", "Anna:LHEE", "Anna:L_MED_KNEE"]
+    markers(prefixed, tmp_path / "w.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every])
+    assert read_markers(tmp_path / "w.trc")[2] == ["LASI", "RASI", "LHEE"]
+    with pytest.raises(LoperInputError, match=r"prefixed\.c3d: markers\.label_map: label\(s\) L_MED_KNEE not in the file"):
+        markers(prefixed, tmp_path / "never.trc", label_map=[every, static_only])  # the static map on a walking trial
+
+
+def test_a_span_crops_the_trial_on_the_files_clock(prefixed, tmp_path):
+    markers(prefixed, tmp_path / "c.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, span_s=(0.1, 0.3),
+            summary_out=tmp_path / "c.markers.tsv")
+    t, X, _ = read_markers(tmp_path / "c.trc")
+    np.testing.assert_allclose(t, np.arange(10, 31) / 100.0, atol=1e-12)
+    summary = pd.read_csv(tmp_path / "c.markers.tsv", sep="\t").iloc[0]
+    assert (summary.n_frames, summary.first_time_s, summary.last_time_s) == (21, 0.1, 0.3)
+    with pytest.raises(LoperInputError, match=r"prefixed\.c3d: the trial's span 5 \.\. 6 s \(markers\.trial_spans_s\) "
+                                              r"holds no frame of the file \(0\.0000 \.\. 0\.5900 s\)"):
+        markers(prefixed, tmp_path / "never.trc", span_s=(5.0, 6.0))
+    assert not (tmp_path / "never.trc").exists()
