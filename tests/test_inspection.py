@@ -1,4 +1,4 @@
-"""``loper-analysis inspect`` (loper_analysis.inspection, loper_analysis.steps.inspect) against known answers.
+"""``loper-analysis inspect`` (inspection, lab_frame, label_matching, steps.inspect) against known answers.
 
 Files: walking5.c3d (Vicon, opensim-core's tests: Z up, walking toward -X, two TYPE-2 plates), whose
 numbers are recomputed here with numpy from read_c3d and read_force_platforms; and two files written
@@ -17,21 +17,13 @@ import pytest
 import yaml
 
 from loper_analysis.cli import main
-from loper_analysis.inspection import (
-    config_snippet,
-    heel_markers,
-    lab_to_model_rotation_deg,
-    marker_presence,
-    match_labels,
-    sparse_frames,
-    starter_label_map,
-    vertical_axis,
-    walking_direction,
-)
+from loper_analysis.inspection import config_snippet, marker_presence, sparse_frames
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.readers import read_label_map
+from loper_analysis.lab_frame import lab_to_model_rotation_deg, vertical_axis, walking_direction
+from loper_analysis.label_matching import heel_markers, match_labels, starter_label_map
 from loper_analysis.marker_names import model_marker_names
 from loper_analysis.markers import rotate_markers
 from loper_analysis.schema import check_config

@@ -1,11 +1,13 @@
-"""What a lab's C3D file holds: markers, force platforms, channels, events, lab axes and label matching.
+"""What a lab's C3D file holds: markers, force platforms, channels and events, summarised and printed.
 
 The library side of ``loper-analysis inspect`` (the file side is
 :mod:`loper_analysis.steps.inspect`). Every function takes arrays or
 records already read (:class:`~loper_analysis.io.c3d.C3DRecording`,
 :class:`~loper_analysis.io.force_platforms.ForcePlatform`) and returns new
 objects; :func:`format_summary` and :func:`format_label_match` turn them
-into plain text.
+into plain text and :func:`config_snippet` into YAML. The lab's axes and
+the suggested rotation come from :mod:`loper_analysis.lab_frame`, the
+matching of labels to model markers from :mod:`loper_analysis.label_matching`.
 
 Marker presence (:func:`marker_presence`)
     A marker is present in a frame when its three coordinates are finite
@@ -17,53 +19,18 @@ Marker presence (:func:`marker_presence`)
 
 Force platforms (:func:`plate_summary`)
     The normal is the right-hand normal of the corners in file order
-    (``(c3 - c1) x (c4 - c2)``, unit length): it points down for corners
-    listed clockwise seen from above, the order the C3D format gives (its
-    plate z axis points down), and up for corners listed counter-clockwise.
-    Either order is reported, neither is refused. The resting level is
+    (:func:`loper_analysis.lab_frame.corner_normal`, ``(c3 - c1) x (c4 -
+    c2)``, unit length): it points down for corners listed clockwise seen
+    from above, the order the C3D format gives (its plate z axis points
+    down), and up for corners listed counter-clockwise. Either order is
+    reported, neither is refused. The resting level is
     :func:`loper_analysis.ground_reaction.resting_level` of the force along
     the lab's upward axis; a plate loaded throughout has none.
-
-Lab axes (:func:`vertical_axis`, :func:`walking_direction`)
-    The vertical axis comes from the force platforms when they tell it: the
-    lab axis along the plates' normals, pointing the way the largest force
-    points (the force on the body points up while someone stands on a
-    plate). Otherwise, and as a check, from the markers: the axis along
-    which the markers of a frame spread most (feet to pelvis or head; the
-    median over frames with at least 3 markers), pointing the way most
-    coordinates lie (markers are above the floor). The walking direction is
-    the horizontal axis of the largest travel (median over markers of the
-    last minus the first present position) and its sign; less than
-    ``min_travel_m`` on both horizontal axes is read as treadmill walking
-    or standing.
-
-Rotation into the model frame (:func:`lab_to_model_rotation_deg`)
-    Three angles (degrees) about the fixed X, Y, Z axes as
-    :func:`loper_analysis.markers.rotate_markers` applies them. The
-    suggestion is the smallest turn taking the lab's upward axis to
-    OpenSim's +Y: Z-up lab -> ``(-90, 0, 0)``, Y-up lab -> ``(0, 0, 0)``.
-    Given a walking direction as well, the rotation that also takes it to
-    model +X (OpenSim's forward): among the triples of multiples of 90
-    degrees doing that, the one with the fewest and smallest turns (Z-up
-    lab walking -X -> ``(-90, 180, 0)``).
-
-Label matching (:func:`match_labels`)
-    Lab labels (subject prefix stripped,
-    :func:`loper_analysis.marker_names.strip_subject_prefix`) are matched
-    to model markers in four rounds, each on the labels and markers still
-    free: the same name; the same name ignoring case; the same name
-    ignoring case and every character but letters and digits (``R.ASIS``,
-    ``R_ASIS``, ``RASIS``); the same side (a leading ``L``/``R``,
-    ``Left``/``Right``, or a trailing ``_l``/``_r``) and landmark in
-    :data:`LANDMARK_SYNONYMS`. A label with more than one candidate marker,
-    or two labels wanting one marker, is ambiguous and stays unmatched.
 """
 
 from __future__ import annotations
 
-import itertools
 import json
-import re
 import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -73,67 +40,38 @@ import numpy as np
 import pandas as pd
 
 from .errors import LoperInputError
-from .marker_names import strip_subject_prefix
+from .lab_frame import (
+    AXIS_NAMES,
+    VerticalAxis,
+    WalkingDirection,
+    axis_name,
+    corner_normal,
+    lab_to_model_rotation_deg,
+    vertical_axis,
+    walking_direction,
+)
+from .label_matching import LabelMatch
+from .markers import rotate_markers
 
 if TYPE_CHECKING:  # records only; nothing is read here
     from .io.c3d import C3DRecording
     from .io.force_platforms import ForcePlatform
 
 __all__ = [
-    "AXIS_NAMES",
-    "LANDMARK_SYNONYMS",
     "MIN_MARKERS_PER_FRAME",
-    "LabelMatch",
     "PlateSummary",
     "RecordingSummary",
-    "VerticalAxis",
-    "WalkingDirection",
-    "axis_name",
     "config_snippet",
     "format_label_match",
     "format_summary",
-    "heel_markers",
-    "lab_to_model_rotation_deg",
     "marker_presence",
-    "match_labels",
     "plate_summary",
     "recording_summary",
     "sparse_frames",
-    "starter_label_map",
-    "vertical_axis",
-    "walking_direction",
 ]
 
-#: Names of the lab axes 0, 1, 2.
-AXIS_NAMES: tuple[str, str, str] = ("X", "Y", "Z")
 #: Fewest markers in a frame for inverse kinematics to place the model.
 MIN_MARKERS_PER_FRAME = 3
-
-#: Landmark -> spellings (lowercase letters and digits, side removed) in Vicon Plug-in Gait, Qualisys/CAST
-#: (ISB abbreviations), OpenSim's gait2392 and Rajagopal2016 marker sets. A label and a model marker match
-#: through this table when they share side and landmark.
-LANDMARK_SYNONYMS: dict[str, tuple[str, ...]] = {
-    "asis": ("asi", "asis", "ias"),                                     # LASI, L.ASIS, L_IAS
-    "psis": ("psi", "psis", "ips"),                                     # LPSI, L.PSIS, L_IPS
-    "sacrum": ("sacr", "sacrum", "sacral", "vsacral"),                  # SACR, V.Sacral
-    "heel": ("hee", "heel", "cal", "fcc"),                              # LHEE, L.Heel, LCAL, L_FCC
-    "toe": ("toe", "toetip", "ft2"),                                    # LTOE, L.Toe, L.Toe.Tip, L_FT2
-    "mt1": ("mt1", "met1", "fm1", "toemed"),                            # LMT1, L_FM1, L.Toe.Med
-    "mt5": ("mt5", "met5", "fm5", "toelat"),                            # LMT5, L_FM5, L.Toe.Lat
-    "knee_lateral": ("kne", "knee", "kneelat", "lknee", "lfc", "fle"),  # LKNE, L.Knee(.Lat), LLFC, L_FLE
-    "knee_medial": ("kneemed", "mknee", "mfc", "fme"),                  # L.Knee.Med, L.MKnee, LMFC, L_FME
-    "ankle_lateral": ("ank", "ankle", "anklelat", "lankle", "lmal", "fal"),  # LANK, L.Ankle(.Lat), LLMAL, L_FAL
-    "ankle_medial": ("anklemed", "mankle", "mmal", "tam"),              # L.Ankle.Med, L.MAnkle, LMMAL, L_TAM
-    "acromion": ("sho", "shoulder", "acr", "acromion", "acromium", "sae"),  # LSHO, LACR, L.Acromium, L_SAE
-    "sternum": ("strn", "sternum", "sjn"),                              # STRN, Sternum, SJN
-    "head_top": ("tophead", "headtop", "vertex"),                       # Top.Head, HEAD_TOP
-}
-
-_SPELLING_TO_LANDMARK = {s: name for name, spellings in LANDMARK_SYNONYMS.items() for s in spellings}
-_NOT_ALNUM = re.compile(r"[^0-9a-z]")
-_SIDE_SUFFIX = re.compile(r"[._\-\s]([lr])$", re.IGNORECASE)
-#: Rounds of :func:`match_labels`, in order.
-_RULES = ("exact", "case", "punctuation", "synonym")
 
 
 # ---------------------------------------------------------------- records
@@ -183,40 +121,6 @@ class PlateSummary:
     peak_vertical_n: float
     peak_time_s: float
     loaded_pct: float
-
-
-@dataclass(frozen=True)
-class VerticalAxis:
-    """The lab's upward axis: ``sign`` (+1 or -1) times lab axis ``axis`` (0 X, 1 Y, 2 Z).
-
-    ``basis`` says where the guess comes from (``"force platforms"``,
-    ``"markers"`` or ``"assumed"``); ``marker_axis``/``marker_sign`` and
-    ``marker_spread_m`` (median spread of a frame's markers along each lab
-    axis, m, shape (3,)) are the markers' own answer (None without frames of
-    at least 3 markers).
-    """
-
-    axis: int
-    sign: int
-    basis: str
-    marker_axis: int | None = None
-    marker_sign: int | None = None
-    marker_spread_m: np.ndarray | None = None
-
-
-@dataclass(frozen=True)
-class WalkingDirection:
-    """Where the markers travel: ``sign`` times lab axis ``axis``; axis None when they do not travel.
-
-    ``travel_m`` (shape (3,), m) is the median over markers of the last minus
-    the first present position; ``speed_m_per_s`` the median speed along
-    ``axis`` (NaN when not travelling).
-    """
-
-    axis: int | None
-    sign: int
-    travel_m: np.ndarray
-    speed_m_per_s: float
 
 
 @dataclass(frozen=True)
@@ -288,29 +192,6 @@ class RecordingSummary:
     def first_time_s(self) -> float:
         """Time of the first frame, ``first_frame / point_rate_hz`` (s)."""
         return self.first_frame / self.point_rate_hz
-
-
-@dataclass(frozen=True)
-class LabelMatch:
-    """Lab labels matched to model markers (:func:`match_labels`).
-
-    Attributes
-    ----------
-    pairs : tuple of (label, marker, rule)
-        The file's label (as in the file), the model marker, and the round
-        that matched them (``exact``, ``case``, ``punctuation``, ``synonym``), in file order.
-    unmatched_labels : tuple of str
-        Labels (as in the file) without a marker, ambiguous ones included.
-    ambiguous : dict of str to tuple of str
-        Label -> the markers it could have been (or the one marker two labels wanted).
-    unprovided_markers : tuple of str
-        Model markers no label provides, in model order.
-    """
-
-    pairs: tuple[tuple[str, str, str], ...]
-    unmatched_labels: tuple[str, ...]
-    ambiguous: dict[str, tuple[str, ...]]
-    unprovided_markers: tuple[str, ...]
 
 
 # ---------------------------------------------------------------- markers
@@ -400,196 +281,6 @@ def sparse_frames(markers_m, first_frame: int = 0, min_markers: int = MIN_MARKER
     return np.flatnonzero(count < min_markers) + int(first_frame)
 
 
-# ---------------------------------------------------------------- lab axes
-
-
-def axis_name(axis: int | None, sign: int = 1) -> str:
-    """``"+Z"``, ``"-X"`` ...; ``"none"`` for axis None."""
-    return "none" if axis is None else ("+" if sign >= 0 else "-") + AXIS_NAMES[axis]
-
-
-def _corner_normal(corners_m: np.ndarray) -> np.ndarray:
-    """Right-hand unit normal of four corners in their order (NaN vector when degenerate)."""
-    n = np.cross(corners_m[2] - corners_m[0], corners_m[3] - corners_m[1])
-    norm = float(np.linalg.norm(n))
-    return n / norm if norm > 0 else np.full(3, np.nan)
-
-
-def _plate_vertical(plate: ForcePlatform, min_load_n: float) -> tuple[int | None, int | None]:
-    """(axis, sign) of one plate: axis along its normal, sign of its largest force along it (None: cannot tell)."""
-    n = _corner_normal(np.asarray(plate.corners_m, dtype=float))
-    if not np.all(np.isfinite(n)) or np.max(np.abs(n)) < np.sqrt(0.5):
-        return None, None
-    axis = int(np.argmax(np.abs(n)))
-    f = np.asarray(plate.force_n, dtype=float)[:, axis]
-    if f.size == 0:
-        return axis, None
-    k = int(np.argmax(np.abs(f)))
-    return axis, (int(np.sign(f[k])) if abs(f[k]) >= min_load_n else None)
-
-
-def _marker_vertical(X: np.ndarray) -> tuple[int | None, int | None, np.ndarray | None]:
-    """(axis, sign, median spread (3,) m) from the markers; Nones without frames of at least 3 markers."""
-    present = np.all(np.isfinite(X), axis=2)
-    frames = present.sum(axis=1) >= MIN_MARKERS_PER_FRAME
-    if not np.any(frames):
-        return None, None, None
-    Y = X[frames]
-    spread = np.median(np.nanmax(Y, axis=1) - np.nanmin(Y, axis=1), axis=0)
-    axis = int(np.argmax(spread))
-    values = X[..., axis][present]
-    return axis, (1 if np.median(values) >= 0 else -1), spread
-
-
-def vertical_axis(markers_m, plates: Sequence[ForcePlatform] = (), min_load_n: float = 100.0) -> VerticalAxis:
-    """Guess the lab's upward axis from the force platforms, else from the markers.
-
-    Parameters
-    ----------
-    markers_m : array_like
-        Shape (n_frames, n_markers, 3), m, lab frame; NaN where missing.
-    plates : sequence of ForcePlatform
-        The file's platforms (lab frame); may be empty.
-    min_load_n : float
-        Smallest force magnitude (N) from which a plate's force tells which way is up.
-
-    Returns
-    -------
-    VerticalAxis
-        Axis and sign; the basis is ``"force platforms"`` when the plates
-        agree on an axis (and tell its sign, or the markers do), else
-        ``"markers"``, else ``"assumed"`` (+Z, the C3D habit).
-
-    Raises
-    ------
-    LoperInputError
-        ``markers_m`` not of shape (n_frames, n_markers, 3).
-    """
-    X = _markers_array(markers_m)
-    m_axis, m_sign, spread = _marker_vertical(X)
-    answers = [_plate_vertical(p, min_load_n) for p in plates]
-    axes = {a for a, _ in answers if a is not None}
-    signs = {s for _, s in answers if s is not None}
-    if len(axes) == 1:
-        axis = axes.pop()
-        if len(signs) == 1:
-            return VerticalAxis(axis, signs.pop(), "force platforms", m_axis, m_sign, spread)
-        if m_axis is not None:
-            present = np.all(np.isfinite(X), axis=2)
-            sign = 1 if np.median(X[..., axis][present]) >= 0 else -1
-            return VerticalAxis(axis, sign, "force platforms", m_axis, m_sign, spread)
-    if m_axis is not None:
-        return VerticalAxis(m_axis, m_sign, "markers", m_axis, m_sign, spread)
-    return VerticalAxis(2, 1, "assumed", None, None, None)
-
-
-def walking_direction(markers_m, point_rate_hz: float, up_axis: int, min_travel_m: float = 0.5) -> WalkingDirection:
-    """The horizontal axis and sign along which the markers travel, if they do.
-
-    Parameters
-    ----------
-    markers_m : array_like
-        Shape (n_frames, n_markers, 3), m, lab frame; NaN where missing.
-    point_rate_hz : float
-        Frame rate (Hz).
-    up_axis : int
-        The lab's vertical axis (0, 1, 2), left out.
-    min_travel_m : float
-        Least travel (m) along a horizontal axis to count as walking through the lab.
-
-    Returns
-    -------
-    WalkingDirection
-        Axis None (treadmill or standing) when the median travel is below
-        ``min_travel_m`` on both horizontal axes, or no marker is present twice.
-
-    Raises
-    ------
-    LoperInputError
-        Bad shape, rate or axis.
-    """
-    X = _markers_array(markers_m)
-    if up_axis not in (0, 1, 2):
-        raise LoperInputError(f"markers: up_axis must be 0, 1 or 2, got {up_axis!r}")
-    if not float(point_rate_hz) > 0:
-        raise LoperInputError(f"markers: point_rate_hz must be positive, got {point_rate_hz!r}")
-    present = np.all(np.isfinite(X), axis=2)
-    shifts, durations = [], []
-    for j in range(X.shape[1]):
-        idx = np.flatnonzero(present[:, j])
-        if idx.size >= 2:
-            shifts.append(X[idx[-1], j] - X[idx[0], j])
-            durations.append((idx[-1] - idx[0]) / float(point_rate_hz))
-    if not shifts:
-        return WalkingDirection(None, 0, np.full(3, np.nan), float("nan"))
-    shifts, durations = np.array(shifts), np.array(durations)
-    travel = np.median(shifts, axis=0)
-    horizontal = [a for a in range(3) if a != up_axis]
-    axis = max(horizontal, key=lambda a: abs(travel[a]))
-    if abs(travel[axis]) < min_travel_m:
-        return WalkingDirection(None, 0, travel, float("nan"))
-    sign = 1 if travel[axis] > 0 else -1
-    speed = float(np.median(np.abs(shifts[:, axis]) / durations))
-    return WalkingDirection(axis, sign, travel, speed)
-
-
-def _rotation_matrix(angles_deg: Sequence[float]) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_euler("xyz", angles_deg, degrees=True).as_matrix()
-
-
-def lab_to_model_rotation_deg(up_axis: int, up_sign: int = 1, forward_axis: int | None = None,
-                              forward_sign: int = 1) -> tuple[float, float, float]:
-    """``markers.lab_to_model_rotation_deg`` taking the lab's up to OpenSim's +Y (and forward to +X).
-
-    Parameters
-    ----------
-    up_axis, up_sign : int
-        The lab's upward axis (0 X, 1 Y, 2 Z) and its sign (+1 or -1).
-    forward_axis, forward_sign : int, optional
-        The walking direction (another axis); None: only up is turned, by the smallest rotation.
-
-    Returns
-    -------
-    tuple of 3 float
-        Degrees about the fixed X, Y, Z axes (multiples of 90), as
-        :func:`loper_analysis.markers.rotate_markers` applies them: the
-        triple with the fewest and smallest turns among those that do it.
-
-    Raises
-    ------
-    LoperInputError
-        An axis not 0, 1 or 2, a sign not +1 or -1, or forward along up.
-    """
-    if up_axis not in (0, 1, 2) or (forward_axis is not None and forward_axis not in (0, 1, 2)):
-        raise LoperInputError(f"rotation: axes must be 0, 1 or 2, got up {up_axis!r}, forward {forward_axis!r}")
-    if up_sign not in (1, -1) or forward_sign not in (1, -1):
-        raise LoperInputError(f"rotation: signs must be +1 or -1, got {up_sign!r}, {forward_sign!r}")
-    if forward_axis == up_axis:
-        raise LoperInputError(f"rotation: the walking direction cannot be the vertical axis {AXIS_NAMES[up_axis]}")
-    up = np.zeros(3)
-    up[up_axis] = up_sign
-    forward = None
-    if forward_axis is not None:
-        forward = np.zeros(3)
-        forward[forward_axis] = forward_sign
-    values = (0.0, -90.0, 90.0, 180.0)
-    best, best_key = None, None
-    for index in itertools.product(range(4), repeat=3):
-        angles = tuple(values[i] for i in index)
-        R = np.round(_rotation_matrix(angles))
-        if not np.allclose(R @ up, (0, 1, 0)):
-            continue
-        if forward is not None and not np.allclose(R @ forward, (1, 0, 0)):
-            continue
-        key = (0.0 if forward is not None else -np.trace(R), sum(a != 0 for a in angles),
-               sum(abs(a) for a in angles), index)
-        if best_key is None or key < best_key:
-            best, best_key = angles, key
-    return tuple(float(a) + 0.0 for a in best)  # + 0.0: no -0.0
-
-
 # ---------------------------------------------------------------- force platforms
 
 
@@ -601,7 +292,7 @@ def plate_summary(plate: ForcePlatform, up_axis: int = 2, up_sign: int = 1, thre
     plate : ForcePlatform
         As :func:`loper_analysis.io.force_platforms.read_force_platforms` returns it (lab frame, SI).
     up_axis, up_sign : int
-        The lab's upward axis and sign (:func:`vertical_axis`).
+        The lab's upward axis and sign (:func:`loper_analysis.lab_frame.vertical_axis`).
     threshold_n : float
         A sample is loaded when its upward force exceeds the resting level by more than this (N).
 
@@ -622,7 +313,7 @@ def plate_summary(plate: ForcePlatform, up_axis: int = 2, up_sign: int = 1, thre
     if corners.shape != (4, 3) or F.ndim != 2 or F.shape[1] != 3 or M.shape != F.shape or F.shape[0] == 0:
         raise LoperInputError(f"{plate.source or 'force platform'}: plate {plate.number}: corners (4, 3) and forces "
                               f"(n, 3) expected, got {corners.shape} and {F.shape}")
-    normal = _corner_normal(corners)
+    normal = corner_normal(corners)
     up_component = float(normal[up_axis] * up_sign) if np.all(np.isfinite(normal)) else 0.0
     order = "" if abs(up_component) < np.sqrt(0.5) else ("counter-clockwise" if up_component > 0 else "clockwise")
     # resting_level takes the vertical as column 2: put the upward force there
@@ -668,7 +359,7 @@ def recording_summary(rec: C3DRecording, plates: Sequence[ForcePlatform] = (), p
     plate_problem : str
         Why the platforms could not be read, if so (printed).
     min_travel_m : float
-        Least travel (m) that counts as walking through the lab (:func:`walking_direction`).
+        Least travel (m) that counts as walking through the lab (:func:`loper_analysis.lab_frame.walking_direction`).
 
     Returns
     -------
@@ -695,116 +386,6 @@ def recording_summary(rec: C3DRecording, plates: Sequence[ForcePlatform] = (), p
         analog_units=list(rec.analog_units), events=rec.events.copy(), vertical=vertical, walking=walking,
         rotation_deg=up_only, rotation_forward_deg=forward, channel_owner=owner,
     )
-
-
-# ---------------------------------------------------------------- label matching
-
-
-def _normalised(name: str) -> str:
-    return _NOT_ALNUM.sub("", str(name).lower())
-
-
-def _landmarks(name: str) -> set[tuple[str | None, str]]:
-    """(side, landmark) readings of a name: unsided, leading L/R or Left/Right, trailing _l/_r."""
-    flat = _normalised(name)
-    readings: list[tuple[str | None, str]] = [(None, flat)]
-    for word, side in (("left", "l"), ("right", "r")):
-        if flat.startswith(word):
-            readings.append((side, flat[len(word):]))
-    if flat[:1] in ("l", "r"):
-        readings.append((flat[0], flat[1:]))
-    suffix = _SIDE_SUFFIX.search(str(name).strip())
-    if suffix:
-        readings.append((suffix.group(1).lower(), flat[:-1]))
-    return {(side, _SPELLING_TO_LANDMARK[rest]) for side, rest in readings if rest in _SPELLING_TO_LANDMARK}
-
-
-def _keys(name: str, rule: str) -> set:
-    if rule == "exact":
-        return {name}
-    if rule == "case":
-        return {name.lower()}
-    if rule == "punctuation":
-        flat = _normalised(name)
-        return {flat} if flat else set()
-    return _landmarks(name)
-
-
-def match_labels(labels: Sequence[str], model_markers: Sequence[str]) -> LabelMatch:
-    """Match a file's marker labels to a model's markers by name (rules in the module notes).
-
-    Parameters
-    ----------
-    labels : sequence of str
-        The file's labels, as in the file (a subject prefix ``Name:`` is stripped for matching).
-    model_markers : sequence of str
-        The model's marker names (repeats are ignored).
-
-    Returns
-    -------
-    LabelMatch
-        Pairs in file order; unmatched and ambiguous labels; model markers no label provides.
-    """
-    labels = [str(lab) for lab in labels]
-    names = [strip_subject_prefix(lab) for lab in labels]
-    markers = list(dict.fromkeys(str(m) for m in model_markers))
-    matched: dict[int, tuple[str, str]] = {}
-    ambiguous: dict[int, tuple[str, ...]] = {}
-    for rule in _RULES:
-        free = [m for m in markers if m not in {mk for mk, _ in matched.values()}]
-        by_key: dict = {}
-        for m in free:
-            for key in _keys(m, rule):
-                by_key.setdefault(key, []).append(m)
-        wanted: dict[int, list[str]] = {}
-        for i, name in enumerate(names):
-            if i in matched or i in ambiguous:
-                continue
-            candidates = list(dict.fromkeys(m for key in _keys(name, rule) for m in by_key.get(key, ())))
-            if candidates:
-                wanted[i] = candidates
-        demand: dict[str, int] = {}
-        for candidates in wanted.values():
-            if len(candidates) == 1:
-                demand[candidates[0]] = demand.get(candidates[0], 0) + 1
-        for i, candidates in wanted.items():
-            if len(candidates) == 1 and demand[candidates[0]] == 1:
-                matched[i] = (candidates[0], rule)
-            else:
-                ambiguous[i] = tuple(candidates)
-    taken = {m for m, _ in matched.values()}
-    return LabelMatch(
-        pairs=tuple((labels[i], *matched[i]) for i in sorted(matched)),
-        unmatched_labels=tuple(labels[i] for i in range(len(labels)) if i not in matched),
-        ambiguous={labels[i]: ambiguous[i] for i in sorted(ambiguous)},
-        unprovided_markers=tuple(m for m in markers if m not in taken),
-    )
-
-
-def starter_label_map(match: LabelMatch) -> pd.DataFrame:
-    """The label map rows of a match: columns ``label`` (prefix stripped), ``marker``; only names that differ.
-
-    A label already named like its marker needs no row. The table is what
-    :func:`loper_analysis.io.readers.read_label_map` reads from a TSV.
-    """
-    rows = [(strip_subject_prefix(label), marker) for label, marker, _ in match.pairs
-            if strip_subject_prefix(label) != marker]
-    return pd.DataFrame(rows, columns=["label", "marker"], dtype=object)
-
-
-def heel_markers(names: Sequence[str]) -> dict[str, str] | None:
-    """``{"left": ..., "right": ...}``: the one heel marker of each side among ``names``; None unless both are unique.
-
-    Heel spellings are those of :data:`LANDMARK_SYNONYMS` (``LHEE``, ``L.Heel``, ``LCAL``, ``L_FCC`` ...).
-    """
-    found: dict[str, list[str]] = {"l": [], "r": []}
-    for name in names:
-        for side, landmark in _landmarks(str(name)):
-            if landmark == "heel" and side in found:
-                found[side].append(str(name))
-    if len(found["l"]) != 1 or len(found["r"]) != 1:
-        return None
-    return {"left": found["l"][0], "right": found["r"][0]}
 
 
 # ---------------------------------------------------------------- config snippet
@@ -898,7 +479,7 @@ def _model_axis(rotation_deg: Sequence[float], axis: int, sign: int) -> str:
     """Where the lab direction ``sign`` x axis ``axis`` points after the rotation (``"-X"`` ...)."""
     v = np.zeros(3)
     v[axis] = sign
-    r = np.round(_rotation_matrix(rotation_deg) @ v)
+    r = np.round(rotate_markers(v, rotation_deg))
     k = int(np.argmax(np.abs(r)))
     return axis_name(k, int(r[k]))
 

@@ -4,8 +4,10 @@ Reads the C3D file (:func:`loper_analysis.io.c3d.read_c3d`, its force
 platforms with :func:`loper_analysis.io.force_platforms.read_force_platforms`
 and ``POINT:UNITS``), optionally an OpenSim model and a marker set whose
 markers are added to the model's, and hands the records to
-:mod:`loper_analysis.inspection`. The label map and the config snippet are
-written through the atomic writer (:mod:`loper_analysis.io.atomic`).
+:mod:`loper_analysis.inspection` (the lab's axes from
+:mod:`loper_analysis.lab_frame`, labels matched to the model's markers by
+:mod:`loper_analysis.label_matching`). The label map and the config
+snippet are written through the atomic writer (:mod:`loper_analysis.io.atomic`).
 """
 
 from __future__ import annotations
@@ -14,21 +16,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import LoperInputError, one_line
-from ..inspection import (
-    LabelMatch,
-    RecordingSummary,
-    axis_name,
-    config_snippet,
-    format_label_match,
-    format_summary,
-    heel_markers,
-    match_labels,
-    recording_summary,
-    starter_label_map,
-)
+from ..inspection import RecordingSummary, config_snippet, format_label_match, format_summary, recording_summary
 from ..io.atomic import PathLike, write_text, write_tsv
 from ..io.c3d_parameters import param_strings
 from ..io.timing import library_import, timed_io
+from ..lab_frame import axis_name
+from ..label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
 from ..marker_names import strip_subject_prefix
 
 __all__ = ["Inspection", "inspect_c3d", "model_marker_names_of"]
