@@ -290,7 +290,8 @@ def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, m
     where = str(setup_xml) if setup_xml is not None else str(static_trc)
     times, X, labels = read_markers(static_trc)
     scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
-    ranges = {part: _range(part) for part in (scaler, placer) if part.getApply()}
+    ranges = {part: _range(part) for part in (scaler, placer) if part.getApply()}  # None where unset
+    setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
     if time_range_s is not None:
         t0, t1 = map(float, time_range_s)
         if not (t0 <= t1 and t0 <= times[-1] + 1e-9 and t1 >= times[0] - 1e-9):
@@ -299,15 +300,13 @@ def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, m
         window = scale_window_s(times, [(t0, t1)], source=str(static_trc), setting="the time range given")
         ranges = dict.fromkeys(ranges)
     else:
-        setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
         window = scale_window_s(times, list(ranges.values()), duration_s, source=str(static_trc), setting=setting)
     pairs = _measurement_pairs(tool)
     needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     lacking = [m for m in needed if m not in labels]
     if lacking:
         raise LoperInputError(f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}")
-    pose = static_pose(times, X, labels, window, needed, lab_labels, source=str(static_trc),
-                       setting=f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s")
+    pose = static_pose(times, X, labels, window, needed, lab_labels, source=str(static_trc), setting=setting)
     for marker, n in pose.n_filled.items():
         log.info("%s: marker %s missing in %d of %d frames of the window: averaged over the others", static_trc,
                  marker, n, len(pose.time_s))
