@@ -113,10 +113,11 @@ def test_scale_report_gives_the_mass_from_the_plates(rajagopal):
 
 
 def test_angles_are_opensims_inverse_kinematics_tool(rajagopal, tmp_path):
-    # the lab's IK setup, solved to convergence: at its own accuracy (1e-5) OpenSim's result moves by 0.13-0.30 deg
-    # RMS from the converged one on this unscaled model, whose marker errors leave the optimum flat
+    # the lab's IK setup at the pipeline's accuracy (1e-6): at its own (1e-5) OpenSim's result moves by 0.13-0.30 deg
+    # RMS from the converged one (1e-8) on this unscaled model, whose marker errors leave the optimum flat; at 1e-6
+    # by at most 0.03 deg
     setup = tmp_path / "ik_setup.xml"
-    setup.write_text(IK_SETUP.read_text().replace("<accuracy>1e-05</accuracy>", "<accuracy>1e-08</accuracy>"))
+    setup.write_text(IK_SETUP.read_text().replace("<accuracy>1e-05</accuracy>", "<accuracy>1e-06</accuracy>"))
     peer = opensim_ik_reference(rajagopal / "results/model/R11/scaled.osim", setup, WALK_TRC, tmp_path / "peer.mot")
     ours = read_mot(rajagopal / "results/ik/R11/walk-nodevice.mot")
     assert len(ours) == len(peer) == 238
@@ -124,7 +125,7 @@ def test_angles_are_opensims_inverse_kinematics_tool(rajagopal, tmp_path):
     for name in BODY_COORDINATES:
         scale = 1.0 if name.endswith(("_tx", "_ty", "_tz")) else np.degrees(1.0)  # deg, or m
         rms = np.sqrt(np.mean((scale * (ours[name] - peer[name])) ** 2))
-        assert rms < (0.1 if scale != 1.0 else 2e-4), (name, rms)  # measured at most 0.046 deg (knee)
+        assert rms < (0.1 if scale != 1.0 else 2e-4), (name, rms)
     angles = pd.read_csv(rajagopal / "results/ik/R11/walk-nodevice.angles.tsv", sep="\t")
     np.testing.assert_allclose(angles["knee_left_rad"], ours["knee_angle_l"], rtol=0, atol=1e-8)  # flexion positive
 
@@ -210,7 +211,7 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     coordinate_map = yaml.safe_load((ROOT / "examples/rajagopal2016/config.yaml").read_text())["opensim"]["coordinate_map"]
     angles = {}
     for name, c3d in (("minus_x", WALKING5), ("plus_x", tmp_path / "plus_x.c3d")):
-        markers(c3d, tmp_path / f"{name}.trc", walking_direction="auto", span_s=(1.8, 2.8),
+        markers(c3d, tmp_path / f"{name}.trc", walking_direction="auto", span_s=(2.0, 2.6),
                 summary_out=tmp_path / f"{name}.markers.tsv")
         angles[name] = ik_trial(model, tmp_path / f"{name}.trc", tmp_path / f"{name}.mot",
                                 tmp_path / f"{name}.angles.tsv", coordinate_map, tasks_file=tasks)
@@ -219,4 +220,4 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     difference = np.degrees(angles["plus_x"].drop(columns=["time_s", "pelvis_x_m"]).to_numpy()
                             - angles["minus_x"].drop(columns=["time_s", "pelvis_x_m"]).to_numpy())
     # the markers agree to 1e-12 m; the solver, stopping at accuracy 1e-6 on this unscaled model, to 0.17 deg
-    assert np.isfinite(difference).sum() > 1000 and np.nanmax(np.abs(difference)) < 0.5
+    assert np.isfinite(difference).sum() > 900 and np.nanmax(np.abs(difference)) < 0.5

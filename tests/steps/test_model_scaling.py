@@ -14,6 +14,7 @@ import shutil
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
@@ -199,3 +200,20 @@ def test_scaled_model_without_the_configured_bodies_is_refused(lab, tmp_path):
                          segment_bodies=bodies)
     assert not (tmp_path / "never.osim").exists()
     assert not list(tmp_path.iterdir())
+
+
+def test_scale_report_gives_the_known_factors_and_no_marker_error(lab, tmp_path):
+    scale_with_setup(GENERIC, lab / "scale_setup.xml", lab / "static.trc", MASS_KG, tmp_path / "scaled.osim",
+                     report_out=tmp_path / "scale.tsv", lab_labels={"R.ASIS": "Subject:RASI"})
+    report = pd.read_csv(tmp_path / "scale.tsv", sep="\t")
+    bodies = report[report.kind == "body"].set_index("name")
+    for body, factor in FACTORS.items():
+        for side in ([""] if body in ("pelvis", "torso") else ["_r", "_l"]):
+            np.testing.assert_allclose(bodies.loc[body + side, ["scale_factor_x", "scale_factor_y", "scale_factor_z"]],
+                                       factor, rtol=1e-9)
+    markers = report[report.kind == "marker"].set_index("name")
+    assert markers.loc["R.ASIS", "label"] == "Subject:RASI" and markers.loc["L.ASIS", "label"] == "L.ASIS"
+    # the static trial is the known model's markers: after scaling and placement they coincide
+    assert markers["marker_error_m"].max() < 1e-5
+    subject = report[report.kind == "subject"].iloc[0]
+    assert subject.mass_kg == MASS_KG and subject.source == "mass: given; height: estimated from the scaled model"

@@ -411,7 +411,9 @@ SCALE_FLOAT_FORMAT = "%.8g"
 #: Columns of the scale report (:func:`scale_report`).
 SCALE_REPORT_COLUMNS: tuple[str, ...] = (
     "kind", "name", "label", "scale_factor_x", "scale_factor_y", "scale_factor_z", "marker_weight",
-    "marker_error_rms_m", "marker_error_max_m", "n_frames", "mass_kg", "height_m", "source")
+    "marker_error_m", "marker_error_rms_m", "marker_error_max_m", "n_frames", "mass_kg", "height_m", "source")
+#: IK accuracy of the static pose in the scale report (the pipeline's IK accuracy).
+_REPORT_IK_ACCURACY = 1e-6
 
 
 def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
@@ -450,9 +452,10 @@ def scale_report(scaled, pose, factors: Mapping[str, Sequence[float]], tasks, ma
     :func:`loper_analysis.static_trial.model_height_m`), ``body`` (the
     factors OpenSim's model scaler applied; 1 where it scaled nothing),
     ``marker`` (each weighted marker's distance to the model's marker after
-    scaling, RMS and largest over the window's frames, m: IK of the static
-    pose on the scaled model with the marker placer's weights, or weight 1
-    for every marker) and ``markers`` (all of them together). Columns
+    scaling, ``marker_error_m``: IK of the static pose, the window's mean as
+    OpenSim's marker placer takes it, on the scaled model with the marker
+    placer's weights, or weight 1 for every marker) and ``markers`` (their
+    RMS and the largest, over the ``n_frames`` frames averaged). Columns
     :data:`SCALE_REPORT_COLUMNS`.
     """
     from ..kinematics import inverse_kinematics
@@ -475,16 +478,15 @@ def scale_report(scaled, pose, factors: Mapping[str, Sequence[float]], tasks, ma
     model_markers = set(_names(scaled.getMarkerSet()))
     weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
     weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
-    result = inverse_kinematics(scaled, pose.time_s, pose.markers_m, pose.labels, weights, coords)
-    E = result.marker_errors_m
-    for j, name in enumerate(result.marker_names):
-        e = E[:, j][np.isfinite(E[:, j])]
+    mean_pose = pose.markers_m.mean(axis=0, keepdims=True)  # complete: missing frames hold the mean already
+    result = inverse_kinematics(scaled, pose.time_s[:1], mean_pose, pose.labels, weights, coords,
+                                accuracy=_REPORT_IK_ACCURACY)
+    errors = result.marker_errors_m[0]
+    for name, error in zip(result.marker_names, errors):
         rows.append({"kind": "marker", "name": name, "label": (lab_labels or {}).get(name, name),
-                     "marker_weight": weights[name], "marker_error_rms_m": float(np.sqrt(np.mean(e ** 2))),
-                     "marker_error_max_m": float(e.max()), "n_frames": int(e.size)})
-    every = E[np.isfinite(E)]
-    rows.append({"kind": "markers", "name": "all weighted", "marker_error_rms_m": float(np.sqrt(np.mean(every ** 2))),
-                 "marker_error_max_m": float(every.max()), "n_frames": len(pose.time_s)})
+                     "marker_weight": weights[name], "marker_error_m": float(error)})
+    rows.append({"kind": "markers", "name": "all weighted", "marker_error_rms_m": float(np.sqrt(np.mean(errors ** 2))),
+                 "marker_error_max_m": float(errors.max()), "n_frames": len(pose.time_s)})
     return pd.DataFrame(rows, columns=list(SCALE_REPORT_COLUMNS))
 
 
