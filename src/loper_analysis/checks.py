@@ -21,6 +21,7 @@ from .errors import LoperInputError
 
 __all__ = [
     "where",
+    "marker_array",
     "number",
     "positive",
     "integer",
@@ -178,6 +179,15 @@ def finite_rows(name: str, values, width: int, source: str = "") -> tuple[np.nda
             f"{where(source)}{name} is not finite at row {i[0]}, column {i[1]}: {a2[tuple(i)]}"
         )
     return np.ascontiguousarray(a2), single
+
+
+def marker_array(markers_m, source: str = "") -> np.ndarray:
+    """Markers as a float array of shape (n_frames, n_markers, 3); another shape is refused naming ``source``."""
+    X = np.asarray(markers_m, dtype=float)
+    if X.ndim != 3 or X.shape[2] != 3:
+        raise LoperInputError(f"{source or 'markers'}: markers_m must have shape (n_frames, n_markers, 3), "
+                              f"got {X.shape}")
+    return X
 
 
 def require_columns(table, columns: Sequence[str], source: str = "", what: str = "") -> pd.DataFrame:

@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from .checks import marker_array
 from .errors import LoperInputError
 from .lab_frame import (
     AXIS_NAMES,
@@ -197,14 +198,6 @@ class RecordingSummary:
 # ---------------------------------------------------------------- markers
 
 
-def _markers_array(markers_m, source: str = "") -> np.ndarray:
-    X = np.asarray(markers_m, dtype=float)
-    if X.ndim != 3 or X.shape[2] != 3:
-        raise LoperInputError(f"{source or 'markers'}: markers_m must have shape (n_frames, n_markers, 3), "
-                              f"got {X.shape}")
-    return X
-
-
 def _runs(mask: np.ndarray) -> list[tuple[int, int]]:
     """(start, stop) of every run of True in a 1-D boolean array (stop exclusive)."""
     m = np.concatenate([[False], np.asarray(mask, dtype=bool), [False]])
@@ -240,7 +233,7 @@ def marker_presence(labels: Sequence[str], markers_m, point_rate_hz: float, firs
     LoperInputError
         Bad shape, a label count unlike the markers', or a rate that is not positive.
     """
-    X = _markers_array(markers_m)
+    X = marker_array(markers_m)
     if len(labels) != X.shape[1]:
         raise LoperInputError(f"markers: {len(labels)} label(s) for {X.shape[1]} marker(s)")
     if not float(point_rate_hz) > 0:
@@ -276,7 +269,7 @@ def sparse_frames(markers_m, first_frame: int = 0, min_markers: int = MIN_MARKER
     LoperInputError
         ``markers_m`` not of shape (n_frames, n_markers, 3).
     """
-    X = _markers_array(markers_m)
+    X = marker_array(markers_m)
     count = np.all(np.isfinite(X), axis=2).sum(axis=1)
     return np.flatnonzero(count < min_markers) + int(first_frame)
 

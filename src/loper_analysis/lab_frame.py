@@ -42,6 +42,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .checks import marker_array
 from .errors import LoperInputError
 from .markers import rotate_markers
 
@@ -97,14 +98,6 @@ class WalkingDirection:
     sign: int
     travel_m: np.ndarray
     speed_m_per_s: float
-
-
-def _markers_array(markers_m, source: str = "") -> np.ndarray:
-    X = np.asarray(markers_m, dtype=float)
-    if X.ndim != 3 or X.shape[2] != 3:
-        raise LoperInputError(f"{source or 'markers'}: markers_m must have shape (n_frames, n_markers, 3), "
-                              f"got {X.shape}")
-    return X
 
 
 def axis_name(axis: int | None, sign: int = 1) -> str:
@@ -204,7 +197,7 @@ def vertical_axis(markers_m, plates: Sequence[ForcePlatform] = (), min_load_n: f
     LoperInputError
         ``markers_m`` not of shape (n_frames, n_markers, 3).
     """
-    X = _markers_array(markers_m)
+    X = marker_array(markers_m)
     m_axis, m_sign, spread = _marker_vertical(X)
     answers = [_plate_vertical(p, min_load_n) for p in plates]
     axes = {a for a, _ in answers if a is not None}
@@ -247,7 +240,7 @@ def walking_direction(markers_m, point_rate_hz: float, up_axis: int, min_travel_
     LoperInputError
         Bad shape, rate or axis.
     """
-    X = _markers_array(markers_m)
+    X = marker_array(markers_m)
     if up_axis not in (0, 1, 2):
         raise LoperInputError(f"markers: up_axis must be 0, 1 or 2, got {up_axis!r}")
     if not float(point_rate_hz) > 0:
