@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
@@ -37,8 +38,11 @@ def test_chunks_joined_through_files_equal_the_whole_trial(trial, tmp_path):
     for c, mot in enumerate(mots):
         ik_chunk(model_osim, trc, mot, c, 3, accuracy=1e-8)
     assert [len(read_mot(m)) for m in mots] == [85, 86, 85]
-    joined = ik_join(mots, tmp_path / "joined.mot", tmp_path / "joined.angles.tsv")
+    joined = ik_join(mots, tmp_path / "joined.mot", tmp_path / "joined.angles.tsv", summary_tsv=tmp_path / "j.ik.tsv")
     assert (tmp_path / "joined.mot").is_file() and (tmp_path / "joined.angles.tsv").is_file()
+    summary = pd.read_csv(tmp_path / "j.ik.tsv", sep="\t").iloc[0]  # the chunks keep no marker errors
+    assert (summary.n_frames, summary.n_frames_solved, summary.n_frames_left_out) == (256, 256, 0)
+    assert np.isnan(summary.marker_rms_mean_m) and summary.last_solved_s == whole.time_s.iloc[-1]
     assert list(joined.columns) == list(whole.columns)
     np.testing.assert_allclose(joined.time_s, whole.time_s, atol=1e-9)
     np.testing.assert_allclose(joined.drop(columns="time_s"), whole.drop(columns="time_s"), atol=1e-7)
