@@ -252,7 +252,8 @@ def inverse_kinematics(
     require_markers_beyond_root(tree, X, kept_labels, source)
     if not solved.any():
         raise LoperInputError(f"{where}no frame holds {min_markers} weighted markers with one beyond the pelvis: "
-                              "nothing to solve")
+                              "nothing to solve (are the pelvis markers mapped in markers.label_map and weighted in "
+                              "the IK tasks?)")
     free = undetermined_coordinates(tree, X, kept_labels, coordinate_tasks)  # (n_frames, n_coordinates)
     free[~solved] = False  # frames left out are NaN throughout, not counted as undetermined
     lacking = {c: int(n) for c, n in zip(tree.coordinates, free.sum(axis=0)) if n}
