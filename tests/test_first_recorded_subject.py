@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import pandas as pd
 import pytest
+
+from tests.workflow_copy import copy_workflow
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "first_recorded_subject.md"
@@ -25,9 +26,7 @@ def doc_commands() -> list[str]:
 def walkthrough(tmp_path_factory):
     """A fresh copy of the repository's workflow files; the doc's commands run in it one by one."""
     work = tmp_path_factory.mktemp("walkthrough")
-    for item in ("Snakefile", "workflow", "config", "examples"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
+    copy_workflow(work)
     bin_dir = str(Path(sys.executable).parent)  # loper-analysis and snakemake of this environment
     outputs = []
     for command in doc_commands():

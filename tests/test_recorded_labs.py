@@ -37,6 +37,7 @@ from tests.rajagopal_lab import (
     opensim_scale_reference,
     write_lab_files,
 )
+from tests.workflow_copy import copy_workflow
 
 ROOT = Path(__file__).resolve().parents[1]
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"
@@ -49,9 +50,7 @@ BODY_COORDINATES = ("pelvis_tilt", "pelvis_list", "pelvis_rotation", "pelvis_tx"
 
 def _workflow(tmp_path_factory, name: str, subjects: str, overrides: dict) -> Path:
     work = tmp_path_factory.mktemp(name)
-    for item in ("Snakefile", "workflow", "config", "examples"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
+    copy_workflow(work)
     (work / "config/subjects.tsv").write_text(subjects)
     (work / "config/test.yaml").write_text(yaml.safe_dump({"subjects": "config/subjects.tsv", **overrides}))
     return work

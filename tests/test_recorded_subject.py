@@ -12,7 +12,6 @@ starts at 7.8125 s), robot logs as ``.mat``.
 
 from __future__ import annotations
 
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -29,6 +28,7 @@ from loper_analysis.io.osim import read_model
 from loper_analysis.segments_from_model import segments_from_model
 from loper_analysis.steps.model import read_segments
 from loper_analysis.steps.synthetic import lab_export_session
+from tests.workflow_copy import copy_workflow
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "gait2392"
@@ -49,9 +49,7 @@ def _test_config() -> dict:
 def lab_run(tmp_path_factory):
     """The workflow on one recorded subject: its session (walking with the device, one perturbation trial)."""
     work = tmp_path_factory.mktemp("lab")
-    for item in ("Snakefile", "workflow", "config", "examples"):
-        src = ROOT / item
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
+    copy_workflow(work)
     truth = lab_export_session(work / "data/raw/R01", "R01", GENERIC, EXAMPLE / "gait2392_Scale_MarkerSet.xml",
                                EXAMPLE / "qtm_label_map.tsv", ["walk-device", "pert050-1"], [None, 50],
                                "walk-nodevice", 1.80, MASS_KG, 40.0, seed=7,
