@@ -32,6 +32,13 @@ Reading (:func:`read_c3d`)
       data with fewer frames and a header lowered to match), so the file
       size and the frame count are checked here against the raw header;
       ezc3d's own exceptions are wrapped.
+    * ezc3d reads the data block in the storage format ``POINT:SCALE``
+      declares (negative: 4-byte floats, positive: 16-bit integers) whatever
+      its size. A file whose bytes after ``POINT:DATA_START`` fit the other
+      format (about twice or half the declared size) and not the declared
+      one, allowing for padding to the 512-byte block end and one spare
+      block, is refused naming ``POINT:SCALE`` (zero bytes after declared
+      integer data are taken for padding).
 
 Writing is :func:`loper_analysis.io.c3d_writer.write_c3d`.
 
@@ -71,6 +78,8 @@ LENGTH_UNITS_PER_M: dict[str, float] = {"mm": 1000.0, "cm": 100.0, "m": 1.0}
 
 #: Relative tolerance of the integer analog/point rate ratio.
 _RATIO_TOLERANCE = 1e-6
+#: Size of a C3D block (header, parameter and data sections start on block boundaries), bytes.
+_BLOCK_BYTES = 512
 
 
 @dataclass
@@ -285,21 +294,91 @@ def _check_rates(path: Path, point_rate: float, analog_rate: float, ratio: int, 
         )
 
 
+def _blocks(n_bytes: int) -> int:
+    """``n_bytes`` rounded up to whole 512-byte blocks (C3D sections end on a block boundary)."""
+    return -(-int(n_bytes) // _BLOCK_BYTES) * _BLOCK_BYTES
+
+
+def _fits(present: int, needed: int) -> bool:
+    """Whether ``present`` bytes hold a data block of ``needed`` bytes: at least that many, and at most
+    the block-rounded size plus one spare block (padding, a trailing block)."""
+    return needed <= present <= _blocks(needed) + _BLOCK_BYTES
+
+
+def _tail(path: Path, offset: int) -> bytes:
+    """The bytes of the file from ``offset`` to its end."""
+    with path.open("rb") as fh:
+        fh.seek(offset)
+        return fh.read()
+
+
+def _check_storage_format(path: Path, data_start: int, scale: float, n_frames: int, words_per_frame: int) -> None:
+    """Refuse a data block whose size fits the other storage format than the one ``POINT:SCALE`` declares.
+
+    ``POINT:SCALE`` < 0 declares 4-byte floats, > 0 16-bit integers (every
+    word of a frame, point and analog alike). ezc3d reads the block in the
+    declared format without checking its size: float data declared as
+    integers comes back as garbage frames, integer data declared as floats as
+    half the frames. Refused only when the bytes after ``POINT:DATA_START``
+    fit the other format and not the declared one (:func:`_fits`: files may
+    be padded to a block end and carry one spare block), and, for declared
+    integers, when the bytes after the declared data are not all zero
+    (zeros are padding or spare blocks, not float frames).
+    """
+    words = int(n_frames) * int(words_per_frame)
+    if words <= 0:
+        return
+    as_float = scale < 0
+    declared_bytes, other_bytes = (4, 2) if as_float else (2, 4)
+    data_at = (int(data_start) - 1) * _BLOCK_BYTES
+    present = path.stat().st_size - data_at
+    need, need_other = words * declared_bytes, words * other_bytes
+    if not _fits(present, need_other) or _fits(present, need):
+        return
+    if not as_float and not any(_tail(path, data_at + need)):
+        return  # zeros after the declared block: padding or spare blocks, not float data
+    sizes = (f"{n_frames} frames of {words_per_frame} words need {need} bytes as "
+             f"{'4-byte floats' if as_float else '16-bit integers'} ({need_other} as "
+             f"{'16-bit integers' if as_float else '4-byte floats'}) after POINT:DATA_START = {int(data_start)} "
+             f"(byte {data_at}); the file holds {present} bytes there")
+    if as_float:
+        raise LoperInputError(
+            f"{path}: POINT:SCALE = {scale:g} (negative) declares 4-byte float data, but the data block "
+            f"is the size of 16-bit integer data: {sizes}. POINT:SCALE has the wrong sign (integer data need a "
+            "positive scale), or the file was cut at that size"
+        )
+    raise LoperInputError(
+        f"{path}: POINT:SCALE = {scale:g} (positive) declares 16-bit integer data, but the data block "
+        f"holds twice those bytes, the size of 4-byte float data: {sizes}. POINT:SCALE has the wrong sign "
+        "(float data need a negative scale); read as integers the frames would be garbage"
+    )
+
+
 def _check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> None:
-    """Refuse a file shorter than its header says (ezc3d reads truncated files silently)."""
+    """Refuse a file whose data block does not match its header and ``POINT:SCALE``.
+
+    Checked in this order: the data block's size against the storage format
+    ``POINT:SCALE`` declares (:func:`_check_storage_format`; with the raw
+    header's frame count, which ezc3d lowers in its own copy), then a file
+    shorter than its header says (ezc3d reads truncated files silently).
+    """
     source = str(path)
     declared = _header_frames(path)
-    if declared is not None and n_frames < declared:
-        raise LoperInputError(
-            f"{source}: truncated file: the header declares {declared} frames but only {n_frames} could be read"
-        )
     params = c3d["parameters"]
     start = param_value(params, "POINT", "DATA_START")
     scale = param_value(params, "POINT", "SCALE")
     if start is None or len(start) == 0:
         raise LoperInputError(f"{source}: POINT:DATA_START not declared")
-    word_bytes = 4 if scale is None or len(scale) == 0 or float(scale[0]) < 0 else 2
-    needed = (int(start[0]) - 1) * 512 + n_frames * words_per_frame * word_bytes
+    scale_value = None if scale is None or len(scale) == 0 else float(np.ravel(scale)[0])
+    if scale_value is not None and np.isfinite(scale_value):
+        _check_storage_format(path, int(start[0]), scale_value, n_frames if declared is None else declared,
+                              words_per_frame)
+    if declared is not None and n_frames < declared:
+        raise LoperInputError(
+            f"{source}: truncated file: the header declares {declared} frames but only {n_frames} could be read"
+        )
+    word_bytes = 4 if scale_value is None or scale_value < 0 else 2
+    needed = (int(start[0]) - 1) * _BLOCK_BYTES + n_frames * words_per_frame * word_bytes
     size = path.stat().st_size
     if size < needed:
         raise LoperInputError(
@@ -396,7 +475,9 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         ``POINT:RATE`` ("mismatched analog/point rates") or giving another
         number of samples per frame than the header (word 10) and the data
         block hold; ``ANALOG:USED`` unlike the header's analog values per
-        frame (word 3); malformed ``EVENT:TIMES``. The message names the file.
+        frame (word 3); a data block the size of the other storage format
+        than ``POINT:SCALE`` declares; malformed ``EVENT:TIMES``. The
+        message names the file.
     """
     path = Path(path)
     source = str(path)

@@ -38,6 +38,23 @@ What ezc3d returns (``ezc3d.c3d(path, extract_forceplat_data=True)``,
 * Times: sample k of the analogs is at ``first_frame / point_rate + k /
   analog_rate``, with ezc3d's 0-based ``first_frame``.
 
+Checks beyond ezc3d's (which reads these files without a complaint):
+
+* ``CAL_MATRIX`` of a plate whose TYPE ezc3d applies it to
+  (:data:`CALIBRATED_TYPES`, TYPE 4): declared, of shape (6, 6, n), finite,
+  without an all-zero row or column, without two equal columns, and of full
+  rank 6 (singular values above :data:`CAL_RTOL` times the largest). A
+  singular matrix reads a load as 0 (a zero ``Fz`` row gives no vertical
+  force and no gait event). ezc3d 1.7 ignores ``CAL_MATRIX`` for TYPE 2
+  and 3, so theirs is not checked.
+* Corners listed in the other order than the frame of the channels: the
+  force then points down while someone stands on the plate. A level plate
+  whose vertical force reaches :data:`DOWNWARD_LOAD_N` downward while never
+  :data:`MAX_UPWARD_REST_N` upward is refused naming
+  ``FORCE_PLATFORM:CORNERS``, the plate, its corners and the z axis they
+  give. Plates whose channels are in the frame of their corners pass either
+  way round.
+
 Supported TYPEs are 2, 3 and 4; others (1, 5, 6, 7, 11, 12, 21, ...) are
 refused. Every problem raises :class:`~loper_analysis.errors.LoperInputError`
 naming the file, the field and the value.
@@ -59,6 +76,10 @@ from .timing import library_import
 from .c3d import LENGTH_UNITS_PER_M
 
 __all__ = [
+    "CALIBRATED_TYPES",
+    "CAL_RTOL",
+    "DOWNWARD_LOAD_N",
+    "MAX_UPWARD_REST_N",
     "SUPPORTED_TYPES",
     "ForcePlatform",
     "count_force_platforms",
@@ -70,6 +91,23 @@ SUPPORTED_TYPES: dict[int, int] = {2: 6, 3: 8, 4: 6}
 
 #: Moment units recognised in ``ANALOG:UNITS`` (spelling normalised), as N·m per unit.
 _MOMENT_UNITS: dict[str, float] = {"nmm": 1e-3, "ncm": 1e-2, "nm": 1.0}
+
+#: FORCE_PLATFORM:TYPE values whose ``CAL_MATRIX`` ezc3d applies (6 x 6, ``[F; M] = CAL @ channels``).
+#: ezc3d 1.7 reads TYPE 2 and TYPE 3 plates without it: their CAL_MATRIX, often zeros, is not checked.
+CALIBRATED_TYPES: frozenset[int] = frozenset({4})
+#: Smallest ratio of a calibration matrix's smallest to largest singular value (reciprocal of the largest
+#: condition number): a real plate's matrix (force rows in N/V, moment rows in N·mm/V) stays near 1e-3.
+CAL_RTOL = 1e-8
+#: Outputs of a 6 x 6 calibration matrix, by row.
+_CAL_OUTPUTS = ("Fx", "Fy", "Fz", "Mx", "My", "Mz")
+
+#: A plate's vertical force (N, along the lab's up) whose 1st percentile lies below ``-DOWNWARD_LOAD_N``
+#: while its 99th percentile stays below ``MAX_UPWARD_REST_N`` points down while loaded (read_force_platforms).
+DOWNWARD_LOAD_N = 200.0
+#: See :data:`DOWNWARD_LOAD_N`: the largest upward reading of a plate that carries no upward load, N.
+MAX_UPWARD_REST_N = 100.0
+#: Plates whose normal lies within this angle (deg) of the lab's up or down are checked for a downward force.
+_LEVEL_DEG = 45.0
 
 
 @dataclass(frozen=True)
@@ -197,7 +235,82 @@ def _check_parameters(params, n_analogs: int, source: str) -> tuple[int, list[in
                 f"{bad}, but the file has {n_analogs} analog channel(s)"
             )
         plate_channels.append(chans)
+    _check_calibration(params, [int(t) for t in types[:used]], source)
     return used, [int(t) for t in types[:used]], plate_channels
+
+
+def _format_matrix(cal: np.ndarray) -> str:
+    """A 6 x 6 matrix as rows of 4 significant digits, for messages."""
+    return "[" + ", ".join("[" + ", ".join(f"{v:.4g}" for v in row) + "]" for row in cal) + "]"
+
+
+def _calibration_problems(cal: np.ndarray) -> list[str]:
+    """What makes a 6 x 6 calibration matrix unusable (empty when it is usable).
+
+    Parameters
+    ----------
+    cal : numpy.ndarray
+        Shape (6, 6): ``[F; M] = cal @ channels`` (row = output Fx .. Mz, column = channel).
+
+    Returns
+    -------
+    list of str
+        Non-finite entries; all-zero rows (an output that reads 0 whatever
+        the load) and columns (a channel that is ignored); equal columns
+        (two channels read as one); a rank below 6, the rank counted with
+        the relative tolerance :data:`CAL_RTOL` on the singular values.
+    """
+    cal = np.asarray(cal, dtype=float)
+    if not np.all(np.isfinite(cal)):
+        where = [tuple(int(i) + 1 for i in ij) for ij in np.argwhere(~np.isfinite(cal))]
+        return [f"non-finite entries at (row, column) {where}"]
+    problems = []
+    zero_rows = [i for i in range(6) if not np.any(cal[i])]
+    zero_cols = [j for j in range(6) if not np.any(cal[:, j])]
+    if zero_rows:
+        problems.append("zero row(s) " + ", ".join(f"{i + 1} ({_CAL_OUTPUTS[i]})" for i in zero_rows))
+    if zero_cols:
+        problems.append("zero column(s) " + ", ".join(str(j + 1) for j in zero_cols))
+    equal = [(i, j) for i in range(6) for j in range(i + 1, 6)
+             if np.any(cal[:, i]) and np.array_equal(cal[:, i], cal[:, j])]
+    if equal:
+        problems.append("equal columns " + ", ".join(f"{i + 1} and {j + 1}" for i, j in equal))
+    singular = np.linalg.svd(cal, compute_uv=False)  # descending
+    rank = int(np.count_nonzero(singular > CAL_RTOL * singular[0]))  # numpy's matrix_rank with a relative tolerance
+    if rank < 6:
+        cond = singular[0] / singular[-1] if singular[-1] > 0 else np.inf
+        problems.insert(0, f"rank {rank} of 6 (condition number {cond:.3g}, at most {1.0 / CAL_RTOL:.0e})")
+    return problems
+
+
+def _check_calibration(params, types: list[int], source: str) -> None:
+    """Refuse a missing, misshapen or singular ``FORCE_PLATFORM:CAL_MATRIX`` of a plate whose TYPE ezc3d applies
+    it to (:data:`CALIBRATED_TYPES`): such a matrix zeroes or mixes the plate's outputs without a complaint."""
+    plates = [k for k, kind in enumerate(types) if kind in CALIBRATED_TYPES]
+    if not plates:
+        return
+    first = plates[0] + 1
+    value = _value(params, "CAL_MATRIX")
+    if value is None or value.size == 0:
+        raise LoperInputError(
+            f"{source}: FORCE_PLATFORM:CAL_MATRIX not declared; platform {first} is TYPE {types[first - 1]}, whose "
+            "channels need a 6 x 6 calibration matrix"
+        )
+    if value.ndim < 2 or value.shape[:2] != (6, 6) or value.size < 36 * (plates[-1] + 1):
+        raise LoperInputError(
+            f"{source}: FORCE_PLATFORM:CAL_MATRIX has shape {value.shape}; platform {plates[-1] + 1} is TYPE "
+            f"{types[plates[-1]]}, which needs one 6 x 6 matrix per platform: shape (6, 6, n), n >= {plates[-1] + 1}"
+        )
+    flat = np.asarray(value, dtype=float).ravel(order="F")  # file order: row fastest, then column, then plate
+    for k in plates:
+        cal = flat[36 * k:36 * (k + 1)].reshape(6, 6, order="F")
+        problems = _calibration_problems(cal)
+        if problems:
+            raise LoperInputError(
+                f"{source}: FORCE_PLATFORM:CAL_MATRIX of platform {k + 1} (TYPE {types[k]}) is unusable: "
+                f"{'; '.join(problems)}; [F; M] = CAL_MATRIX @ channels would read a load as 0 or mix channels. "
+                f"CAL_MATRIX[:, :, {k + 1}] = {_format_matrix(cal)}"
+            )
 
 
 def _moment_unit_check(params, plate: int, chans: tuple[int, ...], kind: int, expected_nm: float, source: str) -> None:
@@ -226,6 +339,61 @@ def _plate_frame(corners: np.ndarray) -> np.ndarray:
     z = np.cross(x, corners[0] - corners[3])
     y = np.cross(z, x)
     return np.column_stack([v / np.linalg.norm(v) for v in (x, y, z)])
+
+
+def _check_force_direction(force_n: np.ndarray, z_axis: np.ndarray, up: np.ndarray, corners: np.ndarray, unit: str,
+                           plate: int, source: str) -> None:
+    """Refuse a level plate whose vertical force points down while loaded, naming its corners and their z axis.
+
+    Channels are in the plate frame that ``FORCE_PLATFORM:CORNERS`` defines
+    (z = (corner 1 - corner 2) x (corner 1 - corner 4)); either corner order
+    is read (module notes) as long as the channels are in that frame. Corners
+    listed in the other order than the channels' frame flip the force: the
+    ground reaction then points down while someone stands on the plate. So
+    does a file whose channels hold the force on the plate. Refused when the
+    vertical force ``force_n . up`` reaches ``-DOWNWARD_LOAD_N`` (1st
+    percentile) and stays below ``MAX_UPWARD_REST_N`` (99th percentile), for
+    a plate within 45 deg of level (one that ``up`` does not make a wall).
+
+    Parameters
+    ----------
+    force_n : numpy.ndarray
+        Shape (n, 3), N, lab frame, as read.
+    z_axis : numpy.ndarray
+        Shape (3,): the plate's z axis from the corners (unit, lab frame).
+    up : numpy.ndarray
+        Shape (3,): the lab's up direction (unit, lab frame).
+    corners : numpy.ndarray
+        Shape (4, 3): ``FORCE_PLATFORM:CORNERS`` as stored, in ``unit``.
+    unit : str
+        ``POINT:UNITS`` (the corners' unit).
+    plate : int
+        Plate number, 1-based.
+    source : str
+        The file (for messages).
+    """
+    facing = float(z_axis @ up)
+    if force_n.shape[0] == 0 or abs(facing) < np.cos(np.radians(_LEVEL_DEG)):
+        return
+    vertical = force_n @ up
+    low, high = (float(v) for v in np.percentile(vertical, [1.0, 99.0]))
+    if not (low <= -DOWNWARD_LOAD_N and high < MAX_UPWARD_REST_N):
+        return
+    listed = [[float(f"{v:.6g}") for v in corner] for corner in corners]
+    reading = (f"its vertical force (along up {np.round(up, 3).tolist()}) points down while loaded: {low:.1f} N at "
+               f"the 1st percentile, at most {high:.1f} N at the 99th")
+    if facing > 0:
+        cause = (f"pointing up: the corners are listed the other way round the plate (reversed or permuted) from "
+                 f"the frame of its channels, so {reading}; list them in the order of the channels' frame (the "
+                 "usual order gives a z axis pointing down)")
+    else:
+        cause = (f"pointing down (the usual order), yet {reading}: the channels are in the frame of the corners "
+                 "listed the other way round (the corners were reversed or permuted), or hold the force on the "
+                 "plate instead of on the body")
+    raise LoperInputError(
+        f"{source}: FORCE_PLATFORM:CORNERS of platform {plate} = {listed} {unit} give a plate z axis "
+        f"{np.round(z_axis, 3).tolist()} (lab frame, (corner 1 - corner 2) x (corner 1 - corner 4)), {cause}"
+    )
 
 
 def _lab_up(up: Sequence[float] | None, source: str) -> np.ndarray:
@@ -262,9 +430,14 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
         Missing or unreadable file; ``FORCE_PLATFORM:USED`` absent or 0 (the
         file holds no platforms: use :func:`count_force_platforms` to test
         first); TYPE not 2, 3 or 4; ``FORCE_PLATFORM:CHANNEL`` pointing at
-        analog channels that do not exist; ``POINT:UNITS`` or
+        analog channels that do not exist; a missing, misshapen or unusable
+        ``FORCE_PLATFORM:CAL_MATRIX`` of a TYPE 4 plate (non-finite, a zero
+        row or column, equal columns, rank below 6); ``POINT:UNITS`` or
         ``FORCE_PLATFORM:UNITS`` unknown; moment channels whose unit
-        disagrees with ``POINT:UNITS``; ezc3d's own refusal (quoted); a bad ``up``.
+        disagrees with ``POINT:UNITS``; a level plate whose force points down
+        while loaded (``FORCE_PLATFORM:CORNERS`` in the other order than the
+        channels' frame, or the force on the plate); ezc3d's own refusal
+        (quoted); a bad ``up``.
     """
     path = Path(path)
     source = str(path)
@@ -307,6 +480,8 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(moment)) and np.all(np.isfinite(corners))):
             raise LoperInputError(f"{source}: platform {k + 1} holds non-finite forces, moments or corners")
         frame = _plate_frame(corners)
+        _check_force_direction(force, frame[:, 2], lab_up, np.asarray(pf["corners"], dtype=float).T, unit_pos,
+                               k + 1, source)
         if frame[:, 2] @ lab_up > 0:  # corners the other way round: the surface lies at positive plate z
             origin = np.asarray(pf["origin"], dtype=float).ravel() / per_m  # ezc3d's, z <= 0, plate frame, m
             if kind == 3:
