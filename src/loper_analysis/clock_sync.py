@@ -13,6 +13,14 @@ records (:func:`rising_edges`, :func:`clock_map`); the robot's sync output
 is a pulse train with pseudo-random intervals
 (:func:`loper_analysis.synthetic.sync.sync_pulse_starts` in synthetic trials).
 
+Polarity: the intervals between the rising edges cannot tell a pulse's start
+from its end (an active-low output inverted in one record only has its
+"rising edges" at the pulses' ends, with the same intervals), so a clock map
+built from such records is off by the pulse width. :func:`clock_map` therefore
+also compares each paired pulse's high time (rising to next falling edge,
+:func:`high_times`) in both records when given them, and refuses records that
+disagree.
+
 Edge-time convention: an edge is placed where the straight line between the
 last sample below and the first sample at or above the threshold crosses it,
 so a sharp step sampled at rate f_s is located to within +-0.5 / f_s, without
@@ -33,12 +41,15 @@ import numpy as np
 from .checks import positive
 from .errors import LoperInputError
 
-__all__ = ["MIN_MATCHED_EDGES", "ClockMap", "rising_edges", "clock_map"]
+__all__ = ["MIN_MATCHED_EDGES", "HIGH_TIME_TOLERANCE", "ClockMap", "rising_edges", "high_times", "clock_map"]
 
 #: Fewest edges that must pair up between the two records for a clock map.
 MIN_MATCHED_EDGES = 4
 #: Pairing gate as a multiple of ``tolerance_s`` (edges farther from the line are unpaired).
 _GATE_FACTOR = 10.0
+#: Largest accepted difference of a pulse's high time between the two records, as a share of the pulse's period
+#: (added to ``2 * tolerance_s``): 5 % tells a duty ratio d from 1 - d unless d lies within about 0.47 .. 0.53.
+HIGH_TIME_TOLERANCE = 0.05
 
 
 @dataclass(frozen=True)
@@ -115,6 +126,70 @@ def rising_edges(signal_v, sample_rate_hz: float, threshold_v: float | None = No
     """
     src = source or "sync signal"
     rate = positive("sample_rate_hz", sample_rate_hz, src)
+    x, thr, band = _levels(signal_v, threshold_v, src)
+    c = _upward_crossings(x, thr, band)
+    if c.size < 2:
+        raise LoperInputError(
+            f"{src}: the sync signal has {c.size} rising edge(s) through {thr:.6g} V; at least 2 are needed"
+        )
+    return c / rate
+
+
+def high_times(signal_v, sample_rate_hz: float, rising_s, threshold_v: float | None = None,
+               source: str = "") -> np.ndarray:
+    """How long each pulse stays high: from each rising edge to the next falling edge, s.
+
+    Falling edges are found like :func:`rising_edges` finds rising ones (same
+    threshold, hysteresis band and interpolation, mirrored), so the high time
+    of a sharp pulse is exact to within a sample; the ratio of high time to
+    the interval between rising edges is the duty ratio. A pulse train and its
+    inverse have the same rising-edge intervals but high times of ``w`` and
+    ``period - w``.
+
+    Parameters
+    ----------
+    signal_v : array_like, shape (n,)
+        Sync signal, V (as for :func:`rising_edges`; NaN = missing).
+    sample_rate_hz : float
+        Sampling rate, Hz.
+    rising_s : array_like, shape (n_edges,)
+        Its rising edges, s relative to sample 0, from :func:`rising_edges`
+        with the same ``threshold_v``.
+    threshold_v : float, optional
+        Threshold, V; default halfway between the signal's levels.
+    source : str
+        Names the signal (file, channel) in error messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_edges,)
+        High time of each pulse, s; NaN where no falling edge is seen before
+        the next rising edge (the record ends high, or the edge lies in a gap).
+
+    Raises
+    ------
+    LoperInputError
+        As :func:`rising_edges` for the signal itself.
+    """
+    src = source or "sync signal"
+    rate = positive("sample_rate_hz", sample_rate_hz, src)
+    x, thr, band = _levels(signal_v, threshold_v, src)
+    rising = np.asarray(rising_s, dtype=float).ravel()
+    falling = _upward_crossings(-x, -thr, band) / rate
+    out = np.full(rising.size, np.nan)
+    if not falling.size or not rising.size:
+        return out
+    k = np.searchsorted(falling, rising, side="right")
+    has = k < falling.size
+    f = np.where(has, falling[np.clip(k, None, falling.size - 1)], np.inf)
+    nxt = np.append(rising[1:], np.inf)
+    ok = has & (f < nxt)
+    out[ok] = f[ok] - rising[ok]
+    return out
+
+
+def _levels(signal_v, threshold_v: float | None, src: str) -> tuple[np.ndarray, float, float]:
+    """The signal as a float array, its threshold and hysteresis half-band (V); refuses unusable signals."""
     x = np.asarray(signal_v, dtype=float)
     if x.ndim != 1:
         raise LoperInputError(f"{src}: the sync signal must be 1-D, got shape {x.shape}")
@@ -132,13 +207,17 @@ def rising_edges(signal_v, sample_rate_hz: float, threshold_v: float | None = No
         raise LoperInputError(
             f"{src}: threshold_v = {threshold_v!r} V lies outside the signal's levels ({low:.6g} .. {high:.6g} V)"
         )
-    band = 0.5 * min(thr - low, high - thr)
+    return x, thr, 0.5 * min(thr - low, high - thr)
+
+
+def _upward_crossings(x: np.ndarray, thr: float, band: float) -> np.ndarray:
+    """Upward crossings of ``thr`` with hysteresis ``band`` (see :func:`rising_edges`), in fractional samples."""
     n = x.size
     # state: 0 low (<= thr - band), 1 high (>= thr + band), -1 missing (breaks an edge), 2 undecided
     state = np.full(n, 2, dtype=np.int8)
     state[x <= thr - band] = 0
     state[x >= thr + band] = 1
-    state[~finite] = -1
+    state[~np.isfinite(x)] = -1
     idx = np.arange(n)
     decided = state != 2
     last = np.maximum.accumulate(np.where(decided, idx, -1))
@@ -150,12 +229,8 @@ def rising_edges(signal_v, sample_rate_hz: float, threshold_v: float | None = No
     if c.size:
         key = nxt[c]
         c = c[np.append(key[1:] != key[:-1], True)]  # last crossing of each rise
-    if c.size < 2:
-        raise LoperInputError(
-            f"{src}: the sync signal has {c.size} rising edge(s) through {thr:.6g} V; at least 2 are needed"
-        )
     x0, x1 = x[c - 1], x[c]
-    return (c - 1 + (thr - x0) / (x1 - x0)) / rate
+    return c - 1 + (thr - x0) / (x1 - x0)
 
 
 # ---------------------------------------------------------------------------
@@ -212,6 +287,10 @@ def clock_map(
     max_drift: float = 1e-3,
     source: str = "",
     tolerance_s: float = 3e-3,
+    robot_high_s=None,
+    mocap_high_s=None,
+    robot_name: str = "the robot log",
+    mocap_name: str = "the mocap record",
 ) -> ClockMap:
     """The robot -> mocap clock map from the sync edges seen by both records.
 
@@ -223,6 +302,16 @@ def clock_map(
     robot edge is paired with the nearest mocap edge under the line (within
     ``10 * tolerance_s``, so edges missing from either record, or a train cut
     at either end, are simply unpaired) and the line refitted, twice.
+
+    Polarity (when ``robot_high_s`` and ``mocap_high_s`` are given): the
+    intervals cannot tell a pulse's start from its end, so the pulses' high
+    times (:func:`high_times`) must agree too. Over the paired edges whose
+    high time both records show, the median of ``|scale * robot_high -
+    mocap_high| - HIGH_TIME_TOLERANCE * period`` (:data:`HIGH_TIME_TOLERANCE`,
+    the period to the next mocap edge) must not exceed ``2 * tolerance_s``. A record whose
+    sync is inverted (e.g. an active-low output: high for ``period - w``
+    instead of ``w``) fails this, where the edge intervals alone would give a
+    clock map off by the pulse width ``w``.
 
     Parameters
     ----------
@@ -237,6 +326,12 @@ def clock_map(
     tolerance_s : float
         Largest accepted |residual| of a paired edge about the line, s (a few
         samples of the slower record: 3 ms ~ 3 samples at 1 kHz).
+    robot_high_s, mocap_high_s : array_like, optional
+        High time of the pulse starting at each edge, s (same shapes as the
+        edges, NaN where unknown; :func:`high_times`). Both or neither; without
+        them the polarity is not checked.
+    robot_name, mocap_name : str
+        Name the two sync signals (record and channel) in the polarity message.
 
     Returns
     -------
@@ -250,7 +345,9 @@ def clock_map(
         matches; an ambiguous match (another shift, inconsistent with the
         chosen line, fits at least half as many windows: e.g. a periodic
         train); |scale - 1| beyond ``max_drift``; a residual above
-        ``tolerance_s``.
+        ``tolerance_s``; pulses whose high times disagree between the records
+        (opposite polarity: naming both high times, ms, and the record whose
+        sync looks inverted).
     """
     src = source or "sync edges"
     r = _check_edges(robot_edges_s, "robot_edges_s", src)
@@ -260,6 +357,15 @@ def clock_map(
         raise LoperInputError(f"{src}: max_drift must lie in [0, 0.1), got {max_drift!r}")
     tol = positive("tolerance_s", tolerance_s, src)
     gate = _GATE_FACTOR * tol
+    if (robot_high_s is None) != (mocap_high_s is None):
+        raise LoperInputError(f"{src}: robot_high_s and mocap_high_s must be given together")
+    if robot_high_s is not None:
+        hr = np.asarray(robot_high_s, dtype=float)
+        hm = np.asarray(mocap_high_s, dtype=float)
+        if hr.shape != r.shape or hm.shape != m.shape:
+            raise LoperInputError(
+                f"{src}: high times of shapes {hr.shape} and {hm.shape} do not match the edges' {r.shape} and {m.shape}"
+            )
     w = MIN_MATCHED_EDGES - 1  # intervals per window
 
     dr, dm = np.diff(r), np.diff(m)
@@ -311,6 +417,9 @@ def clock_map(
                 "periods; use pseudo-random intervals, loper_analysis.synthetic.sync.sync_pulse_starts)"
             )
 
+    if robot_high_s is not None:
+        _check_polarity(m, i, j, b, hr, hm, tol, src, robot_name, mocap_name)
+
     res = m[j] - (a + b * r[i])
     rms = float(np.sqrt(np.mean(res**2)))
     worst = int(np.argmax(np.abs(res)))
@@ -326,3 +435,37 @@ def clock_map(
             f"{src}: clock drift {(b - 1) * 1e6:+.1f} ppm exceeds max_drift = {drift * 1e6:.4g} ppm"
         )
     return ClockMap(offset_s=float(a), scale=float(b), rms_residual_s=rms, n_edges=int(i.size))
+
+
+def _check_polarity(m: np.ndarray, i: np.ndarray, j: np.ndarray, scale: float, robot_high: np.ndarray,
+                    mocap_high: np.ndarray, tol: float, src: str, robot_name: str, mocap_name: str) -> None:
+    """Refuse paired pulses whose high times (s) disagree between the records (see :func:`clock_map`).
+
+    Each paired pulse's period is the interval from its mocap edge to the next mocap edge (the paired
+    trains have the same intervals); pulses without a next edge or a high time in either record are
+    left out.
+    """
+    hr = scale * robot_high[i]
+    hm = mocap_high[j]
+    period = np.append(np.diff(m), np.nan)[j]
+    use = np.isfinite(hr) & np.isfinite(hm) & np.isfinite(period)
+    if use.sum() < 2:
+        return  # too few complete pulses to judge (every edge at a gap or a record's end)
+    hr, hm, period = hr[use], hm[use], period[use]
+    if float(np.median(np.abs(hr - hm) - HIGH_TIME_TOLERANCE * period)) <= 2 * tol:
+        return
+    h_r, h_m = float(np.median(hr)), float(np.median(hm))
+    d_r, d_m = float(np.median(hr / period)), float(np.median(hm / period))
+    seen = (f"sync pulses high for {h_r * 1e3:.1f} ms (duty ratio {d_r:.3f}) in {robot_name} but for "
+            f"{h_m * 1e3:.1f} ms (duty ratio {d_m:.3f}) in {mocap_name} (medians over {hr.size} paired pulses; "
+            f"accepted difference 2 x {tol * 1e3:.3g} ms + {HIGH_TIME_TOLERANCE:.0%} of the period)")
+    if (d_r - 0.5) * (d_m - 0.5) < 0:
+        which = ("the robot's sync looks inverted (active-low)" if d_r > d_m else
+                 "the mocap channel sees the sync inverted (active-low)")
+        raise LoperInputError(
+            f"{src}: {seen}: {which}: its rising edges are the pulses' ends, which would put the clock map off by "
+            f"the pulse width (~{min(h_r, h_m) * 1e3:.1f} ms); invert that record's sync signal before the clock map"
+        )
+    raise LoperInputError(
+        f"{src}: {seen}: the two records do not see the same sync pulses (another signal, or a distorted one)"
+    )

@@ -8,25 +8,44 @@ Butterworth of the forces at the robot rate
 the mocap clock -> linear interpolation of the forces, nearest-sample pick of
 the perturbation flag, at the mocap frame times (128 Hz); the same filtered
 forces at every robot sample, on the mocap clock, for the identification.
+
+Two checks guard against records that would give wrong numbers without an
+error (``docs/device.md``, "Checks on the robot's records"): the sync pulses
+must have the same high time in both records (an inverted sync, e.g. an
+active-low robot output, shifts the clock map by the pulse width;
+:func:`loper_analysis.clock_sync.clock_map`), and force pulses in the load
+cell must carry the perturbation flag (:func:`check_perturbation_flags`).
 """
 
 from __future__ import annotations
+
+import logging
 
 import numpy as np
 import pandas as pd
 
 from .checks import positive
-from .clock_sync import clock_map, rising_edges
+from .clock_sync import clock_map, high_times, rising_edges
 from .errors import LoperInputError
 from .filtering import lowpass
+from .pulse import find_force_pulses
 
-__all__ = ["OUTPUT_COLUMNS", "robot_log_on_mocap_frames", "robot_log_frames_and_native", "perturbation_onsets"]
+__all__ = ["OUTPUT_COLUMNS", "MIN_UNFLAGGED_PULSES", "robot_log_on_mocap_frames", "robot_log_frames_and_native",
+           "check_perturbation_flags", "perturbation_onsets"]
+
+log = logging.getLogger(__name__)
 
 #: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.
 OUTPUT_COLUMNS: tuple[str, ...] = ("time_s", "force_measured_n", "force_desired_n", "perturbation")
 
 _LOG_COLUMNS = ("time_s", "force_desired_n", "force_measured_n", "sync_v", "perturbation")
 _FORCE_COLUMNS = ("force_measured_n", "force_desired_n")
+
+#: A log is refused when at least this many force pulses are found and more than half of them carry no flag.
+MIN_UNFLAGGED_PULSES = 3
+#: A force pulse counts as flagged if the flag is 1 anywhere from this long before its start to this long after
+#: its end, s (the load cell follows the flag by the robot's delays, ~15 ms).
+_FLAG_MARGIN_S = 0.1
 
 
 def robot_log_on_mocap_frames(
@@ -41,13 +60,16 @@ def robot_log_on_mocap_frames(
     analog_start_s: float | None = None,
     max_drift: float = 1e-3,
     tolerance_s: float = 3e-3,
+    sync_channel: str = "",
 ) -> pd.DataFrame:
     """The robot log's forces and perturbation flag on the motion-capture frames.
 
     1. Clock map (:func:`loper_analysis.clock_sync.clock_map`) from the rising edges of the log's
        ``sync_v`` (robot clock: ``time_s`` at the interpolated sample index)
        and of ``mocap_sync_v`` (mocap clock: ``analog_start_s + index /
-       analog_rate_hz``).
+       analog_rate_hz``); the pulses' high times
+       (:func:`loper_analysis.clock_sync.high_times`) must agree between the
+       two (same polarity).
     2. ``force_measured_n`` and ``force_desired_n`` low-passed at the robot
        rate (:func:`~loper_analysis.filtering.lowpass`: zero-phase
        Butterworth, ``order``, ``cutoff_hz``) before resampling.
@@ -55,6 +77,8 @@ def robot_log_on_mocap_frames(
        interpolated at ``frame_time_s``; ``perturbation`` taken from the
        nearest robot sample (never interpolated), so a flag's onset lands
        within one mocap frame (plus half a robot sample) of its mapped time.
+    4. Force pulses in the low-passed ``force_measured_n`` must carry the
+       ``perturbation`` flag (:func:`check_perturbation_flags`).
 
     :func:`robot_log_frames_and_native` also returns the filtered forces at
     the robot's own samples.
@@ -88,6 +112,8 @@ def robot_log_on_mocap_frames(
         analog and point data start together).
     max_drift, tolerance_s : float
         Passed to :func:`loper_analysis.clock_sync.clock_map`.
+    sync_channel : str
+        Name of the mocap sync channel, for messages.
 
     Returns
     -------
@@ -102,11 +128,12 @@ def robot_log_on_mocap_frames(
     LoperInputError
         Missing columns, a ``time_s`` step inconsistent with ``log_rate_hz``,
         non-finite forces or frame times, an all-NaN or flat sync signal in
-        either record, a clock map refused by :func:`loper_analysis.clock_sync.clock_map`, no frame
-        inside the log's span.
+        either record, a clock map refused by :func:`loper_analysis.clock_sync.clock_map` (also: sync
+        pulses whose high times disagree between the records, e.g. an inverted robot sync), no frame
+        inside the log's span, force pulses without perturbation flags (:func:`check_perturbation_flags`).
     """
     return robot_log_frames_and_native(log, log_rate_hz, mocap_sync_v, analog_rate_hz, frame_time_s, cutoff_hz, order,
-                                       source, analog_start_s, max_drift, tolerance_s)[0]
+                                       source, analog_start_s, max_drift, tolerance_s, sync_channel)[0]
 
 
 def robot_log_frames_and_native(
@@ -121,6 +148,7 @@ def robot_log_frames_and_native(
     analog_start_s: float | None = None,
     max_drift: float = 1e-3,
     tolerance_s: float = 3e-3,
+    sync_channel: str = "",
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """:func:`robot_log_on_mocap_frames` and the same forces at the robot log's own samples.
 
@@ -156,11 +184,16 @@ def robot_log_frames_and_native(
         raise LoperInputError(f"{src}: frame_time_s must be a non-empty, finite, strictly increasing 1-D array")
     start = frames[0] if analog_start_s is None else float(analog_start_s)
 
-    robot_rel = rising_edges(log["sync_v"].to_numpy(dtype=float, na_value=np.nan), rate,
-                             source=f"{src}: robot log column 'sync_v'")
-    mocap_rel = rising_edges(mocap_sync_v, arate, source=f"{src}: mocap sync channel")
+    robot_name = "robot log column 'sync_v'"
+    mocap_name = f"mocap sync channel '{sync_channel}'" if sync_channel else "mocap sync channel"
+    robot_sync = log["sync_v"].to_numpy(dtype=float, na_value=np.nan)
+    robot_rel = rising_edges(robot_sync, rate, source=f"{src}: {robot_name}")
+    mocap_rel = rising_edges(mocap_sync_v, arate, source=f"{src}: {mocap_name}")
     robot_edges = np.interp(robot_rel * rate, np.arange(t_log.size), t_log)
-    cm = clock_map(robot_edges, start + mocap_rel, max_drift=max_drift, source=src, tolerance_s=tolerance_s)
+    cm = clock_map(robot_edges, start + mocap_rel, max_drift=max_drift, source=src, tolerance_s=tolerance_s,
+                   robot_high_s=high_times(robot_sync, rate, robot_rel),
+                   mocap_high_s=high_times(mocap_sync_v, arate, mocap_rel),
+                   robot_name=robot_name, mocap_name=mocap_name)
 
     t_mapped = cm.to_mocap(t_log)
     inside = (frames >= t_mapped[0]) & (frames <= t_mapped[-1])
@@ -183,6 +216,7 @@ def robot_log_frames_and_native(
     if not np.all(np.isin(flag, (0.0, 1.0))):
         k = int(np.flatnonzero(~np.isin(flag, (0.0, 1.0)))[0])
         raise LoperInputError(f"{src}: column 'perturbation', sample {k}: value {flag[k]!r} is not 0 or 1")
+    check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
     pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
     nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
     out["perturbation"] = np.where(inside, flag[nearest], np.nan)
@@ -190,6 +224,78 @@ def robot_log_frames_and_native(
     result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
     result.attrs["clock_map"] = cm
     return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
+
+
+def check_perturbation_flags(force_n, flag, sample_rate_hz: float, time_s, source: str = "") -> np.ndarray:
+    """Refuse a robot log whose force shows perturbation pulses that its perturbation flag does not mark.
+
+    Pulses are found in the force itself (:func:`loper_analysis.pulse.find_force_pulses`);
+    a pulse is flagged if ``flag`` is 1 anywhere within ``_FLAG_MARGIN_S``
+    (0.1 s) of it. A log with at least :data:`MIN_UNFLAGGED_PULSES` pulses of
+    which more than half are unflagged is refused: its strides could not be
+    sorted into perturbed and unperturbed ones (a perturbation trial would end
+    as ``too_few_strides`` with no error). Fewer unflagged pulses are logged as
+    a warning. Logs without pulses (minimal-impedance trials) pass.
+
+    Parameters
+    ----------
+    force_n : array_like, shape (n,)
+        Measured interaction force at the robot rate, N (low-passed).
+    flag : array_like, shape (n,)
+        The log's ``perturbation`` column, 0/1.
+    sample_rate_hz : float
+        Robot log rate, Hz.
+    time_s : array_like, shape (n,)
+        The log's ``time_s`` (robot clock), s: the times named in messages.
+    source : str
+        Names the robot log in messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_pulses, 3)
+        The pulses found (:func:`loper_analysis.pulse.find_force_pulses`).
+
+    Raises
+    ------
+    LoperInputError
+        Too many unflagged pulses: names the file, the columns ``perturbation``
+        and ``force_measured_n``, the number of flagged pulses in the log, the
+        number of force pulses and the robot-clock times of the first
+        unflagged ones.
+    """
+    src = source or "robot log"
+    rate = positive("sample_rate_hz", sample_rate_hz, src)
+    f = np.asarray(flag, dtype=float)
+    t = np.asarray(time_s, dtype=float)
+    pulses = find_force_pulses(force_n, rate, source=f"{src}: column 'force_measured_n'")
+    if not len(pulses):
+        return pulses
+    on = f == 1
+    n_flags = int(on[0]) + int(np.sum(~on[:-1] & on[1:]))
+    margin = int(round(_FLAG_MARGIN_S * rate))
+    cum = np.concatenate(([0], np.cumsum(on)))
+    a = np.clip(pulses[:, 0].astype(int) - margin, 0, f.size)
+    b = np.clip(pulses[:, 1].astype(int) + margin, 0, f.size)
+    unflagged = cum[b] - cum[a] == 0
+    n_pulses, n_unflagged = len(pulses), int(unflagged.sum())
+    if not n_unflagged:
+        return pulses
+    first = pulses[unflagged, 0].astype(int)
+    times = ", ".join(f"{t[k]:.3f}" for k in first[:5]) + (", ..." if first.size > 5 else "")
+    peak = float(np.median(np.abs(pulses[:, 2])))
+    width_ms = float(np.median(pulses[:, 1] - pulses[:, 0])) / rate * 1e3
+    seen = (f"column 'perturbation' flags {n_flags} pulse(s), but column 'force_measured_n' shows {n_pulses} force "
+            f"pulse(s) (median peak {peak:.0f} N, {width_ms:.0f} ms), {n_unflagged} of them without a flag, at "
+            f"t = {times} s (robot clock)")
+    if n_pulses >= MIN_UNFLAGGED_PULSES and 2 * n_unflagged > n_pulses:
+        what = ("the log has no perturbation flags, so no stride would count as perturbed" if not n_flags else
+                "most pulses lack their perturbation flag, so their strides would count as unperturbed")
+        raise LoperInputError(
+            f"{src}: {seen}: {what}; check the robot's flag channel (a .mat export: device.mat_column_map."
+            "perturbation)"
+        )
+    log.warning("%s: %s: their strides count as unperturbed", src, seen)
+    return pulses
 
 
 def perturbation_onsets(time_s, flag) -> np.ndarray:

@@ -7,6 +7,10 @@ damping ratio gives the overshoot and whose natural frequency gives the 10-90 %
 rise time, e.g. the study's 10 ms and 30.5 % (:data:`loper_analysis.reference.STUDY_DEVICE`).
 The impulse of the pulse is ``force_n * duration_s`` (the two step responses
 settle to the same level), however fast or slow its edges.
+
+:func:`find_force_pulses` finds such pulses in a measured force without the
+robot's perturbation flag: tens of newtons for tens to hundreds of
+milliseconds, against the few newtons of the minimal-impedance force.
 """
 
 from __future__ import annotations
@@ -16,7 +20,20 @@ import numpy as np
 from .checks import positive
 from .errors import LoperInputError
 
-__all__ = ["second_order_parameters", "step_response", "pulse_force"]
+__all__ = ["second_order_parameters", "step_response", "pulse_force", "find_force_pulses",
+           "PULSE_MIN_DURATION_S", "PULSE_MAX_DURATION_S", "PULSE_MIN_THRESHOLD_N", "PULSE_THRESHOLD_SDS"]
+
+#: Shortest and longest run above the threshold that counts as a force pulse, s (the study's pulse: 0.1 s; the
+#: robot's start-up transient rings in half-periods of about 10 ms).
+PULSE_MIN_DURATION_S = 0.02
+PULSE_MAX_DURATION_S = 0.5
+#: Detection threshold on |force - baseline|: at least this many newtons ...
+PULSE_MIN_THRESHOLD_N = 15.0
+#: ... and at least this many robust standard deviations (1.4826 x MAD) of the force about its baseline.
+PULSE_THRESHOLD_SDS = 8.0
+#: Window of the running median that gives the baseline, s, and the blocks it runs over, s.
+_BASELINE_WINDOW_S = 1.0
+_BLOCK_S = 0.01
 
 
 def second_order_parameters(rise_time_s: float, overshoot_pct: float) -> tuple[float, float]:
@@ -63,3 +80,91 @@ def pulse_force(time_s, onset_s: float, duration_s: float, force_n: float, rise_
     t = np.asarray(time_s, dtype=float)
     return force_n * (step_response(t - onset_s, rise_time_s, overshoot_pct)
                       - step_response(t - onset_s - duration, rise_time_s, overshoot_pct))
+
+
+def find_force_pulses(force_n, sample_rate_hz: float, min_duration_s: float = PULSE_MIN_DURATION_S,
+                      max_duration_s: float = PULSE_MAX_DURATION_S, threshold_n: float | None = None,
+                      source: str = "") -> np.ndarray:
+    """Force pulses in a measured force: runs far from its slowly varying baseline, of pulse-like duration.
+
+    The baseline is a running median over ``_BASELINE_WINDOW_S`` (1 s) of 10 ms
+    block means (a 0.1 s pulse barely moves it); a pulse is a run of samples
+    whose ``|force - baseline|`` exceeds the threshold for between
+    ``min_duration_s`` and ``max_duration_s``. The default threshold is the
+    larger of :data:`PULSE_MIN_THRESHOLD_N` and :data:`PULSE_THRESHOLD_SDS`
+    robust standard deviations of ``force - baseline``: a 40 N pulse stands
+    out of a minimal-impedance force of a few newtons, the gait's own
+    force does not, nor does the robot's start-up transient (shorter runs).
+
+    Parameters
+    ----------
+    force_n : array_like, shape (n,)
+        Force, N, sampled uniformly (e.g. the low-passed load cell at the
+        robot rate); NaN samples never belong to a pulse.
+    sample_rate_hz : float
+        Sampling rate, Hz.
+    min_duration_s, max_duration_s : float
+        Accepted duration of a pulse above the threshold, s.
+    threshold_n : float, optional
+        Threshold on ``|force - baseline|``, N (default: see above).
+    source : str
+        Names the signal in error messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_pulses, 3)
+        Per pulse: first sample, one past its last sample (both as float
+        indices) and its signed peak of ``force - baseline``, N.
+
+    Raises
+    ------
+    LoperInputError
+        Not 1-D, a non-positive rate or durations, ``max_duration_s <= min_duration_s``.
+    """
+    src = source or "force"
+    rate = positive("sample_rate_hz", sample_rate_hz, src)
+    lo = positive("min_duration_s", min_duration_s, src)
+    hi = positive("max_duration_s", max_duration_s, src)
+    if not hi > lo:
+        raise LoperInputError(f"{src}: max_duration_s ({hi}) must exceed min_duration_s ({lo})")
+    f = np.asarray(force_n, dtype=float)
+    if f.ndim != 1:
+        raise LoperInputError(f"{src}: the force must be 1-D, got shape {f.shape}")
+    empty = np.empty((0, 3))
+    finite = np.isfinite(f)
+    if finite.sum() < 2:
+        return empty
+    resid = f - _baseline(np.where(finite, f, np.nan), rate)
+    resid[~np.isfinite(resid)] = 0.0
+    if threshold_n is None:
+        sd = 1.4826 * float(np.median(np.abs(resid[finite] - np.median(resid[finite]))))
+        thr = max(PULSE_MIN_THRESHOLD_N, PULSE_THRESHOLD_SDS * sd)
+    else:
+        thr = positive("threshold_n", threshold_n, src)
+    above = np.concatenate(([False], np.abs(resid) > thr, [False]))
+    edges = np.flatnonzero(np.diff(above.astype(np.int8)))
+    starts, stops = edges[0::2], edges[1::2]
+    duration = (stops - starts) / rate
+    keep = (duration >= lo) & (duration <= hi)
+    starts, stops = starts[keep], stops[keep]
+    if not starts.size:
+        return empty
+    peaks = np.array([resid[a + int(np.argmax(np.abs(resid[a:b])))] for a, b in zip(starts, stops)])
+    return np.column_stack([starts, stops, peaks]).astype(float)
+
+
+def _baseline(f: np.ndarray, rate: float) -> np.ndarray:
+    """Running median (about ``_BASELINE_WINDOW_S``) of block means (``_BLOCK_S``) of ``f``, at every sample."""
+    from scipy.ndimage import median_filter
+
+    n = f.size
+    block = max(1, int(round(_BLOCK_S * rate)))
+    nb = n // block
+    if nb < 3:
+        return np.full(n, np.nanmedian(f))
+    means = np.nanmean(f[:nb * block].reshape(nb, block), axis=1)
+    means = np.where(np.isfinite(means), means, np.nanmedian(means))
+    size = 2 * int(round(0.5 * _BASELINE_WINDOW_S / (block / rate))) + 1
+    smooth = median_filter(means, size=min(size, nb - 1 + nb % 2), mode="nearest")  # odd, at most nb
+    centres = (np.arange(nb) + 0.5) * block - 0.5
+    return np.interp(np.arange(n), centres, smooth)
