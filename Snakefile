@@ -1,7 +1,23 @@
 # loper-analysis: swing-phase joint impedance from LOPER perturbation experiments.
+import os
+
 from snakemake.utils import min_version
 
 min_version("9.0")
+
+
+# A syntax error in the config file as one line naming the file, line and column (Snakemake's own message names
+# neither). Files given with --configfile are read by Snakemake while it parses its command line, before this runs.
+if os.path.exists("config/config.yaml"):  # a missing file: Snakemake's own message
+    from snakemake.exceptions import WorkflowError
+
+    from loper_analysis.errors import LoperInputError
+    from loper_analysis.schema import check_yaml_file
+
+    try:
+        check_yaml_file("config/config.yaml")
+    except LoperInputError as exc:
+        raise WorkflowError(str(exc)) from None
 
 
 configfile: "config/config.yaml"

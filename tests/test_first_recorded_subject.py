@@ -40,7 +40,7 @@ def walkthrough(tmp_path_factory):
 def test_the_doc_holds_the_commands_of_each_step():
     commands = doc_commands()
     assert [c.split()[0] for c in commands] == ["mkdir", "loper-analysis", "loper-analysis", "mkdir", "cp",
-                                                 "loper-analysis", "snakemake", "snakemake"]
+                                                 "loper-analysis", "snakemake", "loper-analysis"]
 
 
 def test_inspect_reports_what_the_doc_says(walkthrough):

@@ -4,7 +4,9 @@ A workflow's configuration is built in layers: the default file, then each
 ``--configfile`` in turn, then the ``--config`` values on the command line
 (each layer overriding the ones before). :func:`check_config` names the layer
 that set an offending key (:func:`config_origin`), so the message points at
-the file or option to fix.
+the file or option to fix. :func:`check_yaml_file` reads a configuration
+file before Snakemake does, so that a syntax error names the file, the line
+and the column.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import yaml
 
 from .errors import LoperInputError
 
-__all__ = ["ConfigLayers", "check_config", "check_table", "config_origin"]
+__all__ = ["ConfigLayers", "check_config", "check_table", "check_yaml_file", "config_origin"]
 
 #: The configuration's layers, highest priority first: ``(name, mapping)``, e.g.
 #: ``[("--config", {...}), ("my.yaml", {...}), ("config/config.yaml", {...})]``.
@@ -99,3 +101,57 @@ def check_table(table: pd.DataFrame, schema_path: str | Path, source: str) -> No
             e = errors[0]
             col = ".".join(map(str, e.absolute_path)) or "(row)"
             raise LoperInputError(f"{source}: row {n}, column '{col}': {e.message}")
+
+
+def _mark(mark) -> str:
+    """A YAML position as ``line L, column C`` (1-based)."""
+    return f"line {mark.line + 1}, column {mark.column + 1}"
+
+
+def check_yaml_file(path: str | Path, what: str = "config file") -> None:
+    """Refuse a YAML (or JSON) file that does not parse into a mapping, in one line naming the file and the place.
+
+    Only the syntax is checked (the document is composed, no value is built),
+    so a file this accepts is read by Snakemake's own loader; the values are
+    checked by :func:`check_config`. Snakemake's own message for a syntax
+    error names neither the file nor the line.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file, e.g. ``config/config.yaml``.
+    what : str
+        The kind of file, for the message.
+
+    Raises
+    ------
+    LoperInputError
+        The file cannot be read or is not UTF-8; a YAML syntax error, e.g.
+        ``config/config.yaml: line 73, column 8: YAML syntax error: expected ',' or ']', but got ':'
+        (while parsing a flow sequence that starts at line 72, column 14)``; a file that holds no mapping of
+        keys at its top level.
+    """
+    try:
+        data = Path(path).read_bytes()
+    except OSError as exc:
+        raise LoperInputError(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[:exc.start].count(b"\n") + 1
+        raise LoperInputError(f"{path}: line {line}: the {what} is not UTF-8 text (byte {data[exc.start]:#04x} at "
+                              f"offset {exc.start})") from None
+    try:
+        documents = list(yaml.compose_all(text, Loader=yaml.SafeLoader))
+    except yaml.MarkedYAMLError as exc:
+        where = _mark(exc.problem_mark) if exc.problem_mark is not None else "(unknown place)"
+        context = ""
+        if exc.context:
+            context = f" ({exc.context}" + (
+                f" that starts at {_mark(exc.context_mark)})" if exc.context_mark is not None else ")")
+        raise LoperInputError(f"{path}: {where}: YAML syntax error: {exc.problem}{context}") from None
+    except yaml.YAMLError as exc:
+        raise LoperInputError(f"{path}: YAML syntax error: {' '.join(str(exc).split())}") from None
+    if not documents or not isinstance(documents[0], yaml.MappingNode):
+        found = "nothing" if not documents else f"a {documents[0].id} at {_mark(documents[0].start_mark)}"
+        raise LoperInputError(f"{path}: the {what} must hold keys at its top level (key: value), found {found}")

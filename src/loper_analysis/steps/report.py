@@ -1,15 +1,22 @@
-"""File steps of the report: the result tables in Markdown (``results/tables/tables.md``) and the front page of
-the Snakemake report (``results/report/front_page.html``)."""
+"""File steps of the report: the result tables in Markdown (``results/tables/tables.md``), the front page of
+the Snakemake report (``results/report/front_page.html``) and the report itself (``results/report.html``),
+written beside its target and moved over it whole."""
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping, Sequence
+import signal
+import subprocess
+import sys
+import threading
+from collections.abc import Callable, Mapping, Sequence
+from pathlib import Path
 
 from ..io.atomic import PathLike, write_text
 from ..io.readers import read_bytes, read_tsv
 
-__all__ = ["markdown_tables", "software_versions", "front_page"]
+__all__ = ["markdown_tables", "software_versions", "front_page", "snakemake_report_command",
+           "check_report_complete", "write_report"]
 
 log = logging.getLogger(__name__)
 
@@ -93,3 +100,133 @@ def front_page(out_html: PathLike, device_tsv: PathLike | None, validation_tsv: 
     write_text(out_html, text, "front page")
     log.info("front page: %d bytes (%d kB of figure)", len(text.encode()), len(figure or b"") // 1024)
     return text
+
+
+#: Bytes read from the end of a finished HTML report to find its closing tag.
+_HTML_TAIL_BYTES = 256
+
+
+def snakemake_report_command(snakemake_args: Sequence[str] = ()) -> Callable[[Path], list[str]]:
+    """The command that writes the Snakemake report to a given path: ``python -m snakemake --report PATH ARGS``.
+
+    The interpreter is this one (:data:`sys.executable`), so the report is
+    made by the Snakemake installed beside this package. ``snakemake_args``
+    (e.g. ``["--configfile", "my.yaml"]``) are passed on after the path.
+    """
+    extra = [str(a) for a in snakemake_args]
+    return lambda path: [sys.executable, "-m", "snakemake", "--report", str(path), *extra]
+
+
+def check_report_complete(path: PathLike, target: PathLike | None = None) -> None:
+    """Refuse a report that is not whole: an empty file, an HTML file that does not end with ``</html>``, a
+    ``.zip`` that is not a readable zip archive.
+
+    ``target`` names the report in the message (default ``path``).
+
+    Raises
+    ------
+    LoperInputError
+        The report is missing, empty or cut short (the message names it and its size).
+    """
+    from ..errors import LoperInputError
+
+    path = Path(path)
+    shown = path if target is None else target
+    if not path.is_file():
+        raise LoperInputError(f"{shown}: the report command wrote no file")
+    size = path.stat().st_size
+    if size == 0:
+        raise LoperInputError(f"{shown}: the report command wrote an empty file")
+    if path.suffix.lower() == ".zip":
+        import zipfile
+
+        try:
+            with zipfile.ZipFile(path) as archive:
+                broken = archive.testzip()
+        except (zipfile.BadZipFile, OSError) as exc:
+            raise LoperInputError(f"{shown}: the report ({size} bytes) is no complete zip archive: {exc}") from None
+        if broken is not None:
+            raise LoperInputError(f"{shown}: the report's zip archive has a damaged member {broken!r}")
+        return
+    with open(path, "rb") as f:
+        f.seek(max(size - _HTML_TAIL_BYTES, 0))
+        tail = f.read().rstrip()
+    if not tail.lower().endswith(b"</html>"):
+        raise LoperInputError(f"{shown}: the report ({size} bytes) does not end with </html>: it was cut short")
+
+
+def _stop_on_sigterm(signum: int, frame) -> None:
+    """SIGTERM as an exception, so that the staging directory is removed and the report command stopped."""
+    raise SystemExit(f"stopped by {signal.Signals(signum).name}")
+
+
+def _configfiles(snakemake_args: Sequence[str]) -> list[str]:
+    """The files given with ``--configfile``/``--configfiles`` (one or more each, or ``--configfile=FILE``)."""
+    files, taking = [], False
+    for arg in map(str, snakemake_args):
+        name, eq, value = arg.partition("=")
+        if name in ("--configfile", "--configfiles"):
+            taking = not eq
+            if eq:
+                files.append(value)
+        elif taking and not arg.startswith("-"):
+            files.append(arg)
+        else:
+            taking = False
+    return files
+
+
+def write_report(target: PathLike, command: Callable[[Path], Sequence[str]] | None = None,
+                 snakemake_args: Sequence[str] = (), cwd: PathLike | None = None) -> Path:
+    """Write the Snakemake report beside ``target`` and move it over ``target`` only when it is complete.
+
+    ``command(path)`` is the command line that writes the report to ``path``
+    (default :func:`snakemake_report_command` of ``snakemake_args``); it runs
+    in ``cwd`` (default: the working directory) with this process's standard
+    output and error, and ``path`` is a temporary file with ``target``'s own
+    name in a hidden directory beside ``target``
+    (:func:`loper_analysis.io.atomic.staged`: Snakemake picks the report's
+    format, HTML or zip, from that name). When the command succeeds and its
+    file is complete (:func:`check_report_complete`) the file is moved over
+    ``target`` with :func:`os.replace`; otherwise (a failed command, a
+    truncated file, an interruption, SIGTERM) the previous report stays
+    byte for byte and the temporary file is removed. Returns ``target``.
+    Config files among ``snakemake_args`` are checked first
+    (:func:`loper_analysis.schema.check_yaml_file`): Snakemake's own message
+    for a syntax error names neither the file nor the line.
+
+    Raises
+    ------
+    LoperInputError
+        A config file given in ``snakemake_args`` does not parse; the command
+        failed (its exit status is named), wrote no file or an incomplete one;
+        the report cannot be moved into place.
+    """
+    from ..errors import LoperInputError
+    from ..io.atomic import staged
+    from ..schema import check_yaml_file
+
+    target = Path(target)
+    if command is None:
+        for path in _configfiles(snakemake_args):
+            check_yaml_file(Path(cwd or ".") / path)
+        command = snakemake_report_command(snakemake_args)
+    kept = "the previous report is kept" if target.exists() else "no report was written"
+    main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _stop_on_sigterm) if main_thread else None
+    try:
+        with staged(target, "report") as tmp:
+            argv = [str(a) for a in command(tmp if cwd is None else tmp.resolve())]
+            status = subprocess.run(argv, cwd=cwd).returncode  # the command is killed if this raises
+            if status != 0:
+                raise LoperInputError(f"{target}: the report command failed with exit status {status} (its "
+                                      f"messages are above): {kept}")
+            try:
+                check_report_complete(tmp, target)
+            except LoperInputError as exc:
+                raise LoperInputError(f"{exc}: {kept}") from None
+    finally:
+        if main_thread:
+            signal.signal(signal.SIGTERM, previous)
+    log.info("%s: report written (%d bytes)", target, target.stat().st_size)
+    return target
