@@ -64,6 +64,26 @@ def test_a_marker_absent_from_the_window_stops_if_needed_and_is_left_out_otherwi
     assert pose.labels == ["ASIS", "KNEE"] and pose.left_out == ["TOE"] and pose.markers_m.shape == (4, 2, 3)
 
 
+def test_marker_motion_is_the_rms_distance_from_the_mean_and_a_moving_subject_stops():
+    t = np.arange(10) / 100.0
+    X = np.tile(np.array([[0.0, 1.0, 0.1], [0.0, 0.5, 0.1], [0.2, 0.05, 0.1]]), (10, 1, 1))
+    angle = 2 * np.pi * np.arange(10) / 10  # the toe marker circles a radius of 30 mm: RMS motion 30 mm exactly
+    X[:, 2] += 0.03 * np.column_stack([np.cos(angle), np.sin(angle), 0 * angle])
+    X[3, 2] = np.nan  # an absent frame does not count: the RMS is over the 9 present points
+    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09))
+    present = np.delete(X[:, 2], 3, axis=0)
+    expected = np.sqrt(np.mean(np.sum((present - present.mean(axis=0)) ** 2, axis=1)))
+    assert pose.motion_rms_m["TOE"] == pytest.approx(expected, rel=1e-12) and 0.029 < expected < 0.031
+    assert pose.motion_rms_m["ASIS"] == pytest.approx(0.0, abs=1e-15)  # a still marker
+    assert static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), max_motion_rms_m=0.031).labels  # under the limit
+    with pytest.raises(LoperInputError, match=r"static\.trc: the subject does not stand still in the scaling window "
+                                              r"0\.0000 \.\. 0\.0900 s of the static trial: marker\(s\) 'Subject:RTOE' "
+                                              r"\(model marker TOE\) 30 mm move more than markers\.static_max_motion_rms_m "
+                                              r"0\.02 m RMS"):
+        static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), lab_labels={"TOE": "Subject:RTOE"},
+                    source="static.trc", max_motion_rms_m=0.02)
+
+
 def test_standing_mass_is_the_weight_over_gravity():
     t = np.arange(1000) / 1000.0
     rng = np.random.default_rng(1)

@@ -11,6 +11,7 @@ ik           OpenSim inverse kinematics of a marker file (.c3d or .trc) to a .mo
 validate     run (part of) the validation study and write its tables
 plan         predict the 95 % CI half-width of K and D of a planned experiment from a pilot subject
 inspect      what a lab's C3D file holds; labels matched to a model; starter label map and config snippet
+report       the Snakemake report (``snakemake --report``) written beside its target and moved over it when whole
 
 Every command exits with 0 on success and with 2 and one line on standard
 error naming the file and the cause when an input cannot serve
@@ -119,7 +120,8 @@ def _scale(args: argparse.Namespace) -> None:
         time_range = None if args.start is None else (args.start, args.end)
         scale_with_setup(args.model, args.setup, static, args.mass_kg, args.out, time_range_s=time_range,
                          static_c3d=c3d if c3d.suffix.lower() == ".c3d" else None, lab_labels=lab_labels,
-                         rotation_deg=_rotation(args, args.static), report_out=args.report)
+                         rotation_deg=_rotation(args, args.static), report_out=args.report,
+                         max_motion_rms_m=args.max_motion_rms_m or None)
     mass = f"{args.mass_kg:g} kg" if args.mass_kg is not None else "mass from the static trial's force plates"
     print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({mass})")
     if args.report:
@@ -230,6 +232,13 @@ def _inspect(args: argparse.Namespace) -> None:
     print(inspect_c3d(args.c3d, args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
 
 
+def _report(args: argparse.Namespace) -> None:
+    from .steps.report import write_report
+
+    target = write_report(args.target, snakemake_args=args.snakemake_args)
+    print(f"{target}: report written ({target.stat().st_size / 1e6:.1f} MB)")
+
+
 def _rotate_option(p: argparse.ArgumentParser, heading: bool = False) -> None:
     p.add_argument("--rotate-deg", type=float, nargs=3, metavar=("X", "Y", "Z"),
                    help="rotate lab coordinates about the fixed X, Y, Z axes (degrees) into the model frame; default "
@@ -293,6 +302,8 @@ def _parser() -> argparse.ArgumentParser:
                    "scaling")
     p.add_argument("--start", type=float, help="first time of the static trial to use (s)")
     p.add_argument("--end", type=float, help="last time of the static trial to use (s)")
+    p.add_argument("--max-motion-rms-m", type=float, default=0.05, help="refuse a static trial with a marker moving "
+                   "more than this (m, RMS about its mean over the window; 0: not checked; default 0.05)")
     _label_map_option(p)
     _rotate_option(p)
     p.add_argument("--cutoff-hz", type=float, default=0.0, help="low-pass of a .c3d static trial (Hz); 0: none")
@@ -373,6 +384,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--config-out", metavar="SNIPPET.yaml", help="write a config snippet (rotation, label map, heel "
                    "markers, model) to merge over the configuration")
     p.set_defaults(func=_inspect)
+
+    p = sub.add_parser("report", help="the Snakemake report, written beside its target and moved over it when whole",
+                       description="Run `snakemake --report` (this Python's Snakemake) into a temporary file beside "
+                       "TARGET, check that it is complete (an HTML report ends with </html>) and move it over "
+                       "TARGET; on any failure the previous report stays as it was.")
+    p.add_argument("target", help="the report: .html (one self-contained file) or .zip, e.g. results/report.html")
+    p.add_argument("snakemake_args", nargs=argparse.REMAINDER, metavar="SNAKEMAKE_ARGS",
+                   help="passed on to snakemake after --report, e.g. --configfile my.yaml")
+    p.set_defaults(func=_report)
     return parser
 
 

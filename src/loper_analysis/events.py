@@ -6,7 +6,10 @@
   samples of any vertical force), shared with :mod:`loper_analysis.contacts`;
 * :func:`strides` - the stride table of one side (heel strike -> heel strike,
   with its toe-off), leaving out strides that span a flagged contact;
-* :func:`flagged_contacts` - how many flagged contacts an event table holds.
+* :func:`flagged_contacts` - how many flagged contacts an event table holds;
+* :func:`stance_heels` - for each stance of a belt, whether the heel of that
+  side's foot was the lower one: the check that the belts' channels carry the
+  feet they are named after.
 
 Time is in s, force in N. Side, event and phase names are those of
 :mod:`loper_analysis.constants`.
@@ -24,7 +27,10 @@ from .checks import side as check_side
 from .constants import FLAGGED_EVENTS
 from .errors import LoperInputError
 
-__all__ = ["EVENT_COLUMNS", "STRIDE_COLUMNS", "load_transitions", "gait_events", "strides", "flagged_contacts"]
+__all__ = [
+    "EVENT_COLUMNS", "STRIDE_COLUMNS", "STANCE_HEEL_COLUMNS", "load_transitions", "gait_events", "strides",
+    "flagged_contacts", "stance_heels",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -34,6 +40,8 @@ EVENT_COLUMNS: tuple[str, ...] = ("side", "event", "time_s", "sample")
 STRIDE_COLUMNS: tuple[str, ...] = (
     "stride", "side", "heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s",
 )
+#: Columns of :func:`stance_heels`.
+STANCE_HEEL_COLUMNS: tuple[str, ...] = ("side", "heel_strike_s", "toe_off_s", "own_heel_lower_m", "own_heel_lower")
 _HS, _TO = 1, 0  # state codes: 1 = loaded (stance), 0 = unloaded (swing)
 
 
@@ -360,3 +368,56 @@ def flagged_contacts(events: pd.DataFrame, side: str | None = None) -> int:
     if side is None:
         return int(starts["time_s"].nunique())
     return int((starts["side"] == check_side(side, source)).sum())
+
+
+def stance_heels(events: pd.DataFrame, time_s, heel_height_m) -> pd.DataFrame:
+    """For each stance of each belt, how much lower that side's heel was than the other's at mid-stance.
+
+    On a treadmill the foot on a belt stands while the other foot swings: over
+    the middle half of a stance (heel strike to the side's next toe-off) the
+    standing heel is the lower one. Belt channels swapped between the feet
+    give stances in which the other heel is the lower.
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        Columns ``side``, ``event``, ``time_s`` (:func:`gait_events` of both belts).
+    time_s : array_like, shape (n,)
+        Marker frame times, s.
+    heel_height_m : mapping
+        ``{"left": h, "right": h}``: each heel marker's height along the
+        vertical, m, shape (n,); NaN where the marker is missing.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per stance (:data:`STANCE_HEEL_COLUMNS`): ``side``,
+        ``heel_strike_s``, ``toe_off_s``, ``own_heel_lower_m`` (the other
+        heel's height minus this side's, mean over the middle half of the
+        stance, m; NaN when no frame there has both heels) and
+        ``own_heel_lower`` (``own_heel_lower_m > 0``; False when NaN).
+    """
+    source = str(events.attrs.get("source", "")) if isinstance(events, pd.DataFrame) else ""
+    t = time_vector(time_s, source, item="frame")
+    heights = {s: np.asarray(heel_height_m[s], dtype=float) for s in ("left", "right")}
+    for s, h in heights.items():
+        if h.shape != t.shape:
+            raise LoperInputError(f"{where(source)}heel_height_m[{s!r}]: shape {h.shape}, expected {t.shape}")
+    rows = []
+    for side, other in (("left", "right"), ("right", "left")):
+        mine = events[events["side"] == side]
+        kind, when = mine["event"].to_numpy(), mine["time_s"].to_numpy(dtype=float)
+        hs, to = np.sort(when[kind == "heel_strike"]), np.sort(when[kind == "toe_off"])
+        for start in hs:
+            later = to[to > start]
+            if later.size == 0:
+                continue
+            end = later[0]
+            quarter = 0.25 * (end - start)
+            inside = (t >= start + quarter) & (t <= end - quarter)
+            gap = heights[other][inside] - heights[side][inside]
+            gap = gap[np.isfinite(gap)]
+            lower = float(gap.mean()) if gap.size else np.nan
+            rows.append((side, float(start), float(end), lower, bool(lower > 0)))
+    table = pd.DataFrame(rows, columns=list(STANCE_HEEL_COLUMNS))
+    return table.sort_values("heel_strike_s", kind="stable", ignore_index=True)

@@ -13,7 +13,9 @@ take a missing marker (NaN) in a TRC. Here:
   average of the window is the average over the present frames); a
   measurement marker absent from the whole window stops, naming the lab
   label, the model marker, the file and the window; another marker absent
-  throughout is left out (it cannot place anything);
+  throughout is left out (it cannot place anything); a marker that moves
+  more than a limit (RMS about its mean over the window) stops: the subject
+  did not stand still, and the averaged pose would place markers wrongly;
 * :func:`standing_mass_kg` - body mass from the force plates the subject
   stands on: mean total vertical force over the window divided by gravity;
 * :func:`model_height_m` - stature estimated from a scaled model: the hip
@@ -127,6 +129,8 @@ class StaticPose:
         Marker -> frames of the window filled with its mean (only markers with some).
     left_out : list of str
         Markers absent from the whole window (not measurement markers), left out.
+    motion_rms_m : dict of str to float
+        Kept marker -> RMS distance (m) of its present frames from its mean over the window.
     """
 
     time_s: np.ndarray
@@ -134,6 +138,7 @@ class StaticPose:
     labels: list[str]
     n_filled: dict[str, int]
     left_out: list[str]
+    motion_rms_m: dict[str, float]
 
 
 def _named(marker: str, lab_labels: Mapping[str, str] | None) -> str:
@@ -144,7 +149,7 @@ def _named(marker: str, lab_labels: Mapping[str, str] | None) -> str:
 
 def static_pose(time_s, markers_m, labels: Sequence[str], window_s: tuple[float, float], needed: Sequence[str] = (),
                 lab_labels: Mapping[str, str] | None = None, source: str = "",
-                setting: str = "time_range of the scale setup") -> StaticPose:
+                setting: str = "time_range of the scale setup", max_motion_rms_m: float | None = None) -> StaticPose:
     """The frames of ``window_s`` with every marker complete (module docstring).
 
     Parameters
@@ -163,13 +168,18 @@ def static_pose(time_s, markers_m, labels: Sequence[str], window_s: tuple[float,
         Model marker -> the lab's label in the C3D file, for messages.
     source, setting : str
         The file and the setting that chose the window, for messages.
+    max_motion_rms_m : float, optional
+        Largest RMS motion (m) of a marker about its mean over the window
+        (``markers.static_max_motion_rms_m``); None: not checked.
 
     Raises
     ------
     LoperInputError
         A marker of ``needed`` absent from the data, or from every frame of
         the window; the message names the lab label, the model marker, the
-        file, the window and ``setting``.
+        file, the window and ``setting``. A marker moving more than
+        ``max_motion_rms_m``: the message names the markers, their motion,
+        the window and the limit.
     """
     t = np.asarray(time_s, dtype=float)
     X = np.asarray(markers_m, dtype=float)
@@ -194,13 +204,30 @@ def static_pose(time_s, markers_m, labels: Sequence[str], window_s: tuple[float,
             f"({setting}, or markers.static_duration_s)"
         )
     keep = [j for j in range(len(labels)) if present[:, j].any()]
+    motion = {labels[j]: _motion_rms_m(W[present[:, j], j]) for j in keep}
+    if max_motion_rms_m is not None:
+        moving = sorted((m for m in motion if motion[m] > max_motion_rms_m), key=motion.get, reverse=True)
+        if moving:
+            shown = ", ".join(f"{_named(m, lab_labels)} {motion[m] * 1000:.0f} mm" for m in moving[:5])
+            more = f" and {len(moving) - 5} more" if len(moving) > 5 else ""
+            raise LoperInputError(
+                f"{where(source)}the subject does not stand still in the scaling window {start:.4f} .. {end:.4f} s "
+                f"of the static trial: marker(s) {shown}{more} move more than markers.static_max_motion_rms_m "
+                f"{max_motion_rms_m:g} m RMS about their mean; choose a still window ({setting}, or "
+                "markers.static_duration_s)"
+            )
     filled = {}
     for j in keep:
         gap = ~present[:, j]
         if gap.any():
             W[gap, j] = W[present[:, j], j].mean(axis=0)
             filled[labels[j]] = int(gap.sum())
-    return StaticPose(t[sel], W[:, keep], [labels[j] for j in keep], filled, absent)
+    return StaticPose(t[sel], W[:, keep], [labels[j] for j in keep], filled, absent, motion)
+
+
+def _motion_rms_m(points_m: np.ndarray) -> float:
+    """RMS distance (m) of points (n, 3) from their mean."""
+    return float(np.sqrt(np.mean(np.sum((points_m - points_m.mean(axis=0)) ** 2, axis=1))))
 
 
 def standing_mass_kg(time_s, vertical_force_n, window_s: tuple[float, float],

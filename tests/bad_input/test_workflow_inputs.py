@@ -205,6 +205,38 @@ def test_label_map_entry_the_file_lacks_is_refused(lab):
              [f"{RAW}/{WALK}.c3d: markers.label_map: label(s) L_FCC not in the file", "RASI, LASI"])
 
 
+def test_static_trial_in_which_the_subject_moves_is_refused(lab):
+    """The subject walks off at 0.3 m/s: over the first second (the scaling window) every marker moves 87 mm RMS."""
+    from loper_analysis.steps import model
+
+    t, X, labels = read_markers(f"results/markers/{SUBJECT}/static.trc")
+    X[:, :, 0] += 0.3 * (t - t[0])[:, None]
+    write_trc(lab / "moving.trc", t, X, labels)
+    m = _config(lab)["markers"]
+    _refused(lab, lambda: model.scale(f"results/model/{SUBJECT}/generic.osim", lab / "moving.trc",
+                                      f"results/model/{SUBJECT}/scaled.osim", MASS_KG,
+                                      lab_labels=f"results/markers/{SUBJECT}/static.markers.tsv",
+                                      duration_s=m["static_duration_s"],
+                                      max_motion_rms_m=m["static_max_motion_rms_m"]),
+             ["moving.trc: the subject does not stand still in the scaling window 0.0000 .. 0.9922 s of the static "
+              "trial: marker(s) ", " 87 mm, ", f"and {len(labels) - 5} more move more than "
+              "markers.static_max_motion_rms_m 0.05 m RMS about their mean"])
+
+
+def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
+    """A label mapped to 'LHEEL' (the model's marker is LHEE): not "the static trial lacks LHEE" alone."""
+    from loper_analysis.steps import model
+
+    t, X, labels = read_markers(f"results/markers/{SUBJECT}/static.trc")
+    labels[labels.index("LHEE")] = "LHEEL"
+    write_trc(lab / "typo.trc", t, X, labels)
+    _refused(lab, lambda: model.scale(f"results/model/{SUBJECT}/generic.osim", lab / "typo.trc",
+                                      f"results/model/{SUBJECT}/scaled.osim", MASS_KG, lab_labels={"LHEEL": "L_FCC"}),
+             ["typo.trc: measurement marker(s) ['LHEE'] are not in the static trial",
+              "the trial's marker(s) 'L_FCC' mapped to LHEEL (the model has LHEE) are not on the model: a typo in the "
+              "label map (markers.label_map, markers.trial_label_maps)?"])
+
+
 def test_model_marker_missing_from_the_trial_stops_ik(lab):
     t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
     k = labels.index("LKNE")
@@ -258,6 +290,31 @@ def test_missing_analog_channels_are_refused(lab):
     write_recording(lab / "no-sync.c3d", replace(rec, analog_labels=rec.analog_labels[:i],
                                                  analog_units=rec.analog_units[:i], analogs=rec.analogs[:, :i]))
     _refused(lab, lambda: _loadcell(cfg, c3d="no-sync.c3d"), ["no-sync.c3d: no analog channel 'sync'"])
+
+
+def test_belt_channels_swapped_are_refused_from_the_heel_markers(lab):
+    """The heel markers in the same file say which foot stands on each belt: the standing heel is the lower."""
+    _refused(lab, lambda: _events(_config(lab), {"left": "Fz_right", "right": "Fz_left"}),
+             [f"{RAW}/{WALK}.c3d: events.grf_channels.left: channel Fz_right does not carry the left foot: in 4 of "
+              "its 4 stances the right heel (RHEE) was the lower at mid-stance",
+              "events.grf_channels: {left: Fz_right, right: Fz_left}"])
+    # both names on one belt: the right side's stances are the left foot's
+    _refused(lab, lambda: _events(_config(lab), {"left": "Fz_left", "right": "Fz_left"}),
+             ["events.grf_channels.right: channel Fz_left does not carry the right foot"])
+
+
+def test_belts_feet_that_cannot_be_confirmed_are_warned(lab, tmp_path):
+    rec = read_c3d(lab / RAW / f"{WALK}.c3d")
+    keep = [i for i, name in enumerate(rec.marker_labels) if name not in ("LHEE", "RHEE")]
+    write_recording(tmp_path / "no-heels.c3d", replace(rec, markers_m=rec.markers_m[:, keep],
+                                                       marker_labels=[rec.marker_labels[i] for i in keep]))
+    cfg = _config(lab)
+    e = cfg["events"]
+    with pytest.warns(UserWarning, match="the belts' feet could not be confirmed: heel marker.s. LHEE, RHEE"):
+        table = processing.events(tmp_path / "no-heels.c3d", tmp_path / "e.tsv", e["grf_channels"],
+                                  foot_markers=e["foot_markers"])
+    good = pd.read_csv(f"results/events/{SUBJECT}/{WALK}.events.tsv", sep="\t")
+    assert len(table) == len(good) and np.allclose(table["time_s"], good["time_s"])
 
 
 # --------------------------------------------------------------------------- robot logs
@@ -325,6 +382,50 @@ def test_recorded_subject_without_a_static_trial_is_refused(lab):
     shutil.copy(lab / RAW / f"{WALK}.c3d", lab / "data/raw/R02" / f"{WALK}.c3d")
     _refused(lab, lambda: _snakemake(lab, "-n"),
              ["config/subjects.tsv: recorded subject 'R02' has no static trial data/raw/R02/static.c3d"])
+
+
+@pytest.mark.parametrize(("make", "words"), [
+    (lambda path: path.symlink_to("/mnt/lab-share/R01/pert050-1.c3d"),
+     ["is a broken link (to '/mnt/lab-share/R01/pert050-1.c3d')"]),
+    (lambda path: path.mkdir(), ["is a directory; a trial's raw file must be a file"]),
+], ids=["broken-link", "directory"])
+def test_trial_path_that_is_not_a_file_stops_the_run_naming_it(lab, make, words):
+    """Not "no such trial": the fit would silently use the other trials of the onset."""
+    make(lab / RAW / "pert050-1.c3d")
+    _refused(lab, lambda: _snakemake(lab, "-n"),
+             [f"{RAW}/pert050-1.c3d: the raw file of trial 'pert050-1' of subject '{SUBJECT}' ", *words])
+
+
+def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab):
+    shutil.copy(lab / RAW / f"{WALK}.c3d", lab / RAW / "pert100-1.c3d")  # onsets of the design: 50 ms only
+    (lab / RAW / "pert100-1.loper.tsv").write_text("")
+    before = _state(lab)
+    res = _snakemake(lab, "-n", "results/strides/summary.tsv")
+    assert res.returncode == 0, res.stdout[-2000:]
+    assert (f"warning: {RAW}: pert100-1.c3d, pert100-1.loper.tsv: no trial of the design has this name, not "
+            "analysed (trials: static, walk-nodevice, walk-device, pert050-1, device-frf, device-steps; ") in res.stderr
+    assert "trials.perturbation_onsets_ms [50] and trials.perturbation_repeats 1" in res.stderr
+    assert _state(lab) == before
+
+
+def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(lab):
+    """Not an error: onsets without a synthetic truth (no synthetic subject), and C3D files with one force channel
+    per belt instead of force platforms: events from the channels, no external loads, said in a note."""
+    cfg = _config(lab)
+    cfg["device"]["subject"] = None
+    cfg["trials"]["perturbation_onsets_ms"] = [100]  # the synthetic truth has 50, 175 and 300 ms
+    (lab / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    for suffix in (".c3d", ".loper.tsv"):
+        shutil.copy(lab / RAW / f"{WALK}{suffix}", lab / RAW / f"pert100-1{suffix}")
+    before = _state(lab)
+    res = _snakemake(lab, "-n")
+    assert res.returncode == 0, res.stdout[-3000:]
+    for trial in (WALK, "pert100-1"):
+        assert (f"note: {RAW}/{trial}.c3d: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the "
+                "belt channels (events.grf_channels: {'left': 'Fz_left', 'right': 'Fz_right'}), no OpenSim external "
+                f"loads (results/grf/{SUBJECT}/{trial}.grf.mot)") in res.stderr
+    assert "rule grf:" not in res.stdout and f"results/impedance/{SUBJECT}/100.tsv" in res.stdout
+    assert _state(lab) == before
 
 
 def test_impossible_anthropometrics_are_refused(lab):

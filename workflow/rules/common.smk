@@ -1,5 +1,6 @@
 # Shared set-up: config and subject-sheet validation, target list, settings for rules.
 import sys
+from functools import cache
 from pathlib import Path
 
 import pandas as pd
@@ -10,6 +11,8 @@ from snakemake.common.configfile import load_configfile
 
 from loper_analysis.cluster import check_slurm_submission
 from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d_parameter_section import force_platforms_used
+from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
 from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
@@ -72,7 +75,8 @@ try:
             if not Path(_row["model_osim"]).is_file():
                 raise LoperInputError(f"{_subjects_path}: subject '{_s}', column model_osim: file "
                                       f"'{_row['model_osim']}' not found")
-        elif not (Path("data/raw") / _s / f"{config['trials']['static']}.c3d").is_file():
+        elif not raw_file_present(Path("data/raw") / _s / f"{config['trials']['static']}.c3d",
+                                  f"static trial of subject '{_s}'"):
             raise LoperInputError(
                 f"{_subjects_path}: recorded subject '{_s}' has no static trial "
                 f"data/raw/{_s}/{config['trials']['static']}.c3d (raw files are named data/raw/{{subject}}/{{trial}}.c3d),"
@@ -170,6 +174,36 @@ def subject_trials(subject: str) -> list[str]:
     return [t for t in walking_trials() if (raw / f"{t}.c3d").is_file()]
 
 
+#: Trials of the device tests (rules device_frf, device_steps).
+DEVICE_TRIALS = ("device-frf", "device-steps")
+
+
+def design_trials() -> list[str]:
+    """Every trial the design names: the static trial, the walking trials and the device tests."""
+    return [config["trials"]["static"], *walking_trials(), *DEVICE_TRIALS]
+
+
+try:
+    # a recorded subject's raw files: a path that is not a readable file stops the run (never a trial silently
+    # left out); files that match no trial of the design are named in a warning
+    for _s in (s for s, src in SUBJECT_SOURCE.items() if src == "recorded"):
+        _raw = Path("data/raw") / _s
+        for _t in design_trials():
+            for _suffix in RAW_SUFFIXES:
+                raw_file_present(_raw / f"{_t}{_suffix}", f"raw file of trial '{_t}' of subject '{_s}'")
+        _unmatched = unmatched_raw_files(_raw, design_trials())
+        if _unmatched:
+            _t = config["trials"]
+            print(
+                f"warning: {_raw}: {', '.join(_unmatched)}: no trial of the design has this name, not analysed "
+                f"(trials: {', '.join(design_trials())}; from trials.static, trials.no_device, trials.device, "
+                f"trials.perturbation_onsets_ms {_t['perturbation_onsets_ms']} and trials.perturbation_repeats "
+                f"{_t['perturbation_repeats']})", file=sys.stderr
+            )
+except LoperInputError as exc:
+    raise WorkflowError(str(exc)) from None
+
+
 def processed_subjects() -> list[str]:
     """Synthetic subjects, and recorded subjects with a static trial on disk or a scaled model: their walking trials
     are processed."""
@@ -207,6 +241,25 @@ def scaled_subjects() -> list[str]:
     return [s for s in processed_subjects() if "model_osim" not in SUBJECT_ROWS[s]]
 
 
+@cache
+def has_force_platforms(subject: str, trial: str) -> bool:
+    """Whether a recorded trial's C3D has force platforms (its GRF as OpenSim external loads is made).
+
+    A file with one vertical-force channel per belt instead (events.grf_channels) gives its events from
+    those channels and no external loads: said once in a note.
+    """
+    path = Path("data/raw") / subject / f"{trial}.c3d"
+    try:
+        if force_platforms_used(path):
+            return True
+    except LoperInputError as exc:
+        raise WorkflowError(str(exc)) from None
+    print(f"note: {path}: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the belt channels "
+          f"(events.grf_channels: {config['events']['grf_channels']}), no OpenSim external loads "
+          f"(results/grf/{subject}/{trial}.grf.mot) for this trial", file=sys.stderr)
+    return False
+
+
 def transparency_subjects() -> list[str]:
     """Processed subjects with both walking trials of the transparency experiment."""
     pair = {config["trials"]["no_device"], config["trials"]["device"]}
@@ -224,7 +277,7 @@ def processing_targets() -> list[str]:
             out.append(f"data/raw/{s}/truth.yaml")
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
         if SUBJECT_SOURCE[s] == "recorded":  # lab files: their force platforms as OpenSim external loads
-            out += [f"results/grf/{s}/{t}.grf.mot" for t in subject_trials(s)]
+            out += [f"results/grf/{s}/{t}.grf.mot" for t in subject_trials(s) if has_force_platforms(s, t)]
     if out:
         out.append("results/strides/summary.tsv")
     if any(trial_onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):

@@ -27,7 +27,7 @@ rule device_trial:
         "data/raw/{subject}/{trial}.loper.tsv",
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
-        trial="device-frf|device-steps",
+        trial="|".join(DEVICE_TRIALS),
     params:
         device=DEVICE["parameters"],
         leg=DEVICE["leg"],

@@ -121,7 +121,7 @@ rule model_scaled:
         scale_setup=OPENSIM["scale_setup"],
         segment_bodies=OPENSIM["segment_bodies"],
         factor_range=OPENSIM["scale_factor_range"],
-        static=STATIC_SETTINGS,
+        static={**STATIC_SETTINGS, "max_motion_rms_m": MARKERS["static_max_motion_rms_m"]},
     group:
         "model"
     log:

@@ -229,7 +229,9 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
         ({model marker: lab label} for messages), ``static_c3d`` and
         ``rotation_deg`` (the mass from its force plates), ``height_m`` (the
         subject's, else estimated from the scaled model), ``report_out`` (the
-        scale report, :func:`scale_report`).
+        scale report, :func:`scale_report`), ``max_motion_rms_m`` (largest RMS
+        motion of a marker over the window, m: a subject who does not stand
+        still is refused; None: not checked).
 
     Raises
     ------
@@ -269,13 +271,31 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
                     time_range_s, factor_range, segment_bodies=segment_bodies, **static)
 
 
+def _unknown_markers_hint(labels: Sequence[str], model_markers: Sequence[str],
+                          lab_labels: Mapping[str, str] | None) -> str:
+    """The trial's markers the model does not have, as a hint at a label-map typo ('' when there are none)."""
+    import difflib
+
+    unknown = [m for m in labels if m not in set(model_markers)]
+    if not unknown:
+        return ""
+    shown = []
+    for m in unknown:
+        label = (lab_labels or {}).get(m)
+        close = difflib.get_close_matches(m, model_markers, n=1)
+        shown.append((f"'{label}' mapped to {m}" if label and label != m else f"'{m}'")
+                     + (f" (the model has {close[0]})" if close else ""))
+    return (f"; the trial's marker(s) {', '.join(shown)} are not on the model: a typo in the label map "
+            "(markers.label_map, markers.trial_label_maps)?")
+
+
 def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, marker_set: Path | None,
                     static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
                     time_range_s: tuple[float, float] | None, factor_range: Sequence[float],
                     segment_bodies: Mapping[str, Sequence[str]] | None = None, duration_s: float | None = None,
                     lab_labels: Mapping[str, str] | None = None, static_c3d: PathLike | None = None,
                     rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), height_m: float | None = None,
-                    report_out: PathLike | None = None) -> None:
+                    report_out: PathLike | None = None, max_motion_rms_m: float | None = None) -> None:
     """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report (:func:`scale_with_setup`)."""
     import tempfile
 
@@ -305,8 +325,13 @@ def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, m
     needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     lacking = [m for m in needed if m not in labels]
     if lacking:
-        raise LoperInputError(f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}")
-    pose = static_pose(times, X, labels, window, needed, lab_labels, source=str(static_trc), setting=setting)
+        raise LoperInputError(f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}"
+                              f"{_unknown_markers_hint(labels, _names(generic.getMarkerSet()), lab_labels)}")
+    pose = static_pose(times, X, labels, window, needed, lab_labels, source=str(static_trc), setting=setting,
+                       max_motion_rms_m=max_motion_rms_m)
+    moving = sorted(pose.motion_rms_m, key=pose.motion_rms_m.get, reverse=True)[:3]
+    log.info("%s: largest marker motion over the window (RMS about the mean): %s", static_trc,
+             ", ".join(f"{m} {pose.motion_rms_m[m] * 1000:.1f} mm" for m in moving))
     for marker, n in pose.n_filled.items():
         log.info("%s: marker %s missing in %d of %d frames of the window: averaged over the others", static_trc,
                  marker, n, len(pose.time_s))

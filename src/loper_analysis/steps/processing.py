@@ -9,8 +9,10 @@ frame, zero-phase low-pass, TRC) -> (model and IK: :mod:`.model`, :mod:`.ik`) ->
 from __future__ import annotations
 
 import logging
+import warnings
 from collections.abc import Mapping, Sequence
 
+import numpy as np
 import pandas as pd
 
 from ..constants import MIN_IK_MARKERS, SIDES
@@ -111,7 +113,8 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     unfiltered = None
     if cutoff_hz:
         try:
-            X, unfiltered = lowpass_finite_runs(X, rec.point_rate_hz, cutoff_hz, order, axis=0)
+            X, unfiltered = lowpass_finite_runs(X, rec.point_rate_hz, cutoff_hz, order, axis=0,
+                                                setting="filter.cutoff_hz", rate_name="POINT:RATE")
         except LoperInputError as exc:
             raise LoperInputError(f"{c3d_path}: markers: {exc}") from None
     summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), rec.marker_labels, time_s, X, heading)
@@ -145,8 +148,6 @@ TRIAL_MARKER_COLUMNS: tuple[str, ...] = ("label", "n_frames_too_few_markers", "f
 def _trial_marker_summary(per_marker: pd.DataFrame, labels: Sequence[str], time_s, markers_m, heading
                           ) -> pd.DataFrame:
     """The per-marker gap summary with the lab labels and the trial's facts (:data:`TRIAL_MARKER_COLUMNS`)."""
-    import numpy as np
-
     present = np.all(np.isfinite(np.asarray(markers_m, float)), axis=2)
     out = per_marker.copy()
     out.insert(0, "label", [str(lab) for lab in labels])
@@ -222,6 +223,7 @@ def _events_of(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s,
         )
     table = _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
                             cutoff_hz, order)
+    _check_belt_feet(rec, table, grf_channels, foot_markers, label_map, rotation_deg)
     table.attrs["n_contacts_flagged"] = 0
     return table, pd.DataFrame(columns=["plate", "contact", "side", "flag"])
 
@@ -247,10 +249,69 @@ def _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stan
     for side in SIDES:
         fz = rec.analog(grf_channels[side])
         if cutoff_hz is not None:
-            fz = lowpass(fz, rec.analog_rate_hz, cutoff_hz, order)
+            fz = lowpass(fz, rec.analog_rate_hz, cutoff_hz, order, setting="events.grf_cutoff_hz",
+                         rate_name="ANALOG:RATE", source=f"{c3d_path} (analog channel {grf_channels[side]})")
         tables.append(gait_events(rec.analog_time_s, fz, side, threshold_on_n, threshold_off_n, min_stance_s,
                                   min_swing_s, source=f"{c3d_path} ({grf_channels[side]})"))
     return pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
+
+
+#: Fewest stances of a belt, with both heels seen at mid-stance, that can confirm the belt's foot.
+MIN_JUDGED_STANCES = 3
+#: A belt is taken for the other foot's when its own heel was the lower in at most this fraction of its
+#: stances; between it and 1 - it the belt's foot is unclear (a warning).
+SWAPPED_BELT_FRACTION = 0.25
+
+
+def _check_belt_feet(rec, table: pd.DataFrame, grf_channels, foot_markers, label_map, rotation_deg) -> None:
+    """Confirm from the heel markers that each belt channel carries the foot it is named for.
+
+    Stops when a belt's stances are the other foot's (channels swapped, or both naming one belt); warns when
+    the heel markers cannot tell (missing markers, too few stances, a mixed verdict).
+    """
+    from ..events import stance_heels
+    from ..marker_names import model_marker_names
+    from ..markers import lab_up
+
+    source = rec.source
+    keys = {s: f"events.grf_channels.{s}" for s in SIDES}
+    if not foot_markers or not rec.marker_labels:
+        warnings.warn(f"{source}: the belts' feet ({', '.join(f'{keys[s]} {grf_channels[s]}' for s in SIDES)}) "
+                      "could not be confirmed: no heel markers (events.foot_markers) in the file", stacklevel=2)
+        return
+    names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
+    missing = [foot_markers[s] for s in SIDES if foot_markers[s] not in names]
+    if missing:
+        warnings.warn(f"{source}: the belts' feet could not be confirmed: heel marker(s) {', '.join(missing)} "
+                      "(events.foot_markers) not in the file", stacklevel=2)
+        return
+    up = lab_up(rotation_deg)
+    heights = {s: rec.markers_m[:, names.index(foot_markers[s]), :] @ up for s in SIDES}
+    table.attrs["source"] = source
+    stances = stance_heels(table, rec.time_s, heights)
+    judged = stances[np.isfinite(stances["own_heel_lower_m"])]
+    for side in SIDES:
+        other = "right" if side == "left" else "left"
+        mine = judged[judged["side"] == side]
+        n, own = len(mine), int(mine["own_heel_lower"].sum())
+        if n < MIN_JUDGED_STANCES:
+            warnings.warn(f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) could not be "
+                          f"confirmed: {n} stance(s) with both heels seen at mid-stance (at least "
+                          f"{MIN_JUDGED_STANCES} needed)", stacklevel=2)
+        elif own <= SWAPPED_BELT_FRACTION * n:
+            raise LoperInputError(
+                f"{source}: {keys[side]}: channel {grf_channels[side]} does not carry the {side} foot: in "
+                f"{n - own} of its {n} stances the {other} heel ({foot_markers[other]}) was the lower at "
+                f"mid-stance (by {mine['own_heel_lower_m'].median() * -1000:.0f} mm, median); are the belts' "
+                f"channels swapped (events.grf_channels: {{left: {grf_channels['left']}, right: {grf_channels['right']}}})?"
+            )
+        elif own < (1 - SWAPPED_BELT_FRACTION) * n:
+            warnings.warn(f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) is unclear: its "
+                          f"own heel ({foot_markers[side]}) was the lower at mid-stance in {own} of {n} stances",
+                          stacklevel=2)
+    log.info("belts' feet: own heel the lower at mid-stance in %s", ", ".join(
+        f"{int(judged.loc[judged['side'] == s, 'own_heel_lower'].sum())} of {int((judged['side'] == s).sum())} "
+        f"{s} stances" for s in SIDES))
 
 
 def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n, threshold_off_n,
@@ -291,6 +352,9 @@ def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_cha
     """The robot log's forces on the mocap frames (sync-pulse clock map, 40 Hz low-pass, 128 Hz).
 
     ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
+    Nothing is written when the records are refused, among others for sync pulses whose high times
+    disagree between the robot log and the C3D (an inverted sync) or force pulses without perturbation
+    flags (:func:`loper_analysis.loadcell.robot_log_frames_and_native`).
     """
     from ..io.c3d import read_c3d
 
@@ -306,8 +370,13 @@ def _loadcell_of(rec, log_path, sync_channel, cutoff_hz, order) -> tuple[pd.Data
     c3d_path = rec.source
     frame, meta = read_robot_log(log_path)
     rate = float(meta["sample_rate_hz"])
+    from ..filtering import check_cutoff  # the robot log's forces are low-passed at its own rate
+
+    check_cutoff(rate, cutoff_hz, order, setting="filter.cutoff_hz", rate_name="the log's sample_rate_hz",
+                 source=str(log_path))
     out, native = robot_log_frames_and_native(frame, rate, rec.analog(sync_channel), rec.analog_rate_hz, rec.time_s,
-                                              cutoff_hz=cutoff_hz, order=order, source=f"{log_path} / {c3d_path}")
+                                              cutoff_hz=cutoff_hz, order=order, source=f"{log_path} / {c3d_path}",
+                                              sync_channel=sync_channel)
     cm = out.attrs.get("clock_map")
     if cm is not None:
         log.info("%s: clock map %s", log_path, cm)

@@ -1,0 +1,61 @@
+"""A subject's raw files: which trials of the design are on disk, and which files match none.
+
+Raw files are named ``{trial}{suffix}`` in the subject's folder, with the
+suffixes of :data:`RAW_SUFFIXES`. A path that exists but is not a readable
+file (a broken link, a directory, a file without read permission) is an
+error, not a missing trial: a trial silently left out changes every average
+it would have entered.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+
+from ..errors import LoperInputError
+
+__all__ = ["RAW_SUFFIXES", "raw_file_present", "unmatched_raw_files"]
+
+#: Suffixes of raw files: motion capture, robot log, the robot's MATLAB export.
+RAW_SUFFIXES: tuple[str, ...] = (".c3d", ".loper.tsv", ".mat")
+
+
+def raw_file_present(path: str | os.PathLike, what: str = "raw file") -> bool:
+    """Whether a raw file is there: True for a readable file, False when nothing is at ``path``.
+
+    Raises
+    ------
+    LoperInputError
+        Something is at ``path`` but it is not a readable file: a broken
+        link (naming its target), a directory or other non-file, or a file
+        that cannot be opened for reading.
+    """
+    p = Path(path)
+    if not os.path.lexists(p):
+        return False
+    if p.is_symlink() and not p.exists():
+        raise LoperInputError(f"{p}: the {what} is a broken link (to '{os.readlink(p)}'); "
+                              "restore its target or remove the link")
+    if not p.is_file():
+        kind = "a directory" if p.is_dir() else "not a regular file"
+        raise LoperInputError(f"{p}: the {what} is {kind}; a trial's raw file must be a file")
+    if not os.access(p, os.R_OK):
+        raise LoperInputError(f"{p}: the {what} cannot be read (permission denied)")
+    return True
+
+
+def unmatched_raw_files(folder: str | os.PathLike, trials: Iterable[str]) -> list[str]:
+    """Names of the raw files in ``folder`` (suffixes :data:`RAW_SUFFIXES`) that belong to none of ``trials``.
+
+    Returns
+    -------
+    list of str
+        File names, sorted; empty when the folder does not exist.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    names = {f"{t}{suffix}" for t in trials for suffix in RAW_SUFFIXES}
+    return sorted(p.name for p in folder.iterdir()
+                  if p.name.endswith(RAW_SUFFIXES) and p.name not in names)
