@@ -46,6 +46,7 @@ import yaml
 from scipy.stats import beta
 
 from loper_analysis.markdown import markdown_table
+from loper_analysis.study_design import StudyDesign
 
 ROOT = Path(__file__).resolve().parents[1]
 #: Columns of the angle table that get IK-like noise, and the noise measured in the whole chain (``--mode chain
@@ -164,10 +165,10 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     device = DeviceParameters(**config["device"]["parameters"])
     model = build_lower_body_model(row["height_m"], row["mass_kg"])
     params = segment_parameters_from_model(model)
-    onsets = [int(o) for o in trials["perturbation_onsets_ms"]]
+    design = StudyDesign.from_config(trials)
+    onsets = list(design.perturbation_onsets_ms)
     variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
-    names = [(trials["device"], None)] + [(f"pert{o:03d}-{k}", o) for o in onsets
-                                          for k in range(1, int(trials["perturbation_repeats"]) + 1)]
+    names = [(t, design.onset_ms(t)) for t in (design.device, *design.perturbation_trials())]
     inputs = {}
     for trial, onset in names:
         perturbation = None
@@ -188,7 +189,7 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
     rows = []
     for onset in onsets:
-        own = [tr for name, tr in inputs.items() if name.startswith(f"pert{onset:03d}-")]
+        own = [inputs[name] for name in design.perturbation_trials(onset)]
         rows.append(fit_onset(own, params, onset, subject, truth[onset], null, response, ident).rows)
     return pd.concat(rows, ignore_index=True)
 

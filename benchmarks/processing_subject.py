@@ -22,6 +22,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
+from loper_analysis.study_design import StudyDesign
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -39,10 +41,7 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
         (work / "config/subjects.tsv").write_text(
             "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
         )
-        trials = [cfg["trials"]["no_device"], cfg["trials"]["device"]] + [
-            f"pert{o:03d}-{k}" for o in cfg["trials"]["perturbation_onsets_ms"]
-            for k in range(1, cfg["trials"]["perturbation_repeats"] + 1)
-        ]
+        trials = StudyDesign.from_config(cfg["trials"]).walking_trials()
         raw = [f"data/raw/S01/{cfg['trials']['static']}.c3d"] + [f"data/raw/S01/{t}.c3d" for t in trials]
         def run(*targets: str) -> None:
             res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *targets, "--quiet", "all"], cwd=work,

@@ -14,6 +14,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
 from loper_analysis.schema import check_config, check_table, config_origin
+from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
@@ -150,37 +151,16 @@ def validation_settings() -> dict:
     )
 
 
-def perturbation_trials() -> list[str]:
-    """Trial IDs of the impedance experiment: pert{onset:03d}-{k}."""
-    t = config["trials"]
-    return [f"pert{onset:03d}-{k}" for onset in t["perturbation_onsets_ms"] for k in range(1, t["perturbation_repeats"] + 1)]
-
-
-def trial_onset_ms(trial: str) -> int | None:
-    """Perturbation onset (ms) of a trial pert{onset:03d}-{k}; None for other trials."""
-    return int(trial[4:7]) if trial in perturbation_trials() else None
-
-
-def walking_trials() -> list[str]:
-    """Every walking trial of the design: the transparency pair, then the perturbation trials."""
-    return [config["trials"]["no_device"], config["trials"]["device"], *perturbation_trials()]
+#: The study's trials, their names and onsets (loper_analysis.study_design).
+DESIGN = StudyDesign.from_config(config["trials"])
 
 
 def subject_trials(subject: str) -> list[str]:
     """Walking trials of a subject: all for a synthetic one, those with a raw C3D on disk for a recorded one."""
     if SUBJECT_SOURCE[subject] == "synthetic":
-        return walking_trials()
+        return DESIGN.walking_trials()
     raw = Path("data/raw") / subject
-    return [t for t in walking_trials() if (raw / f"{t}.c3d").is_file()]
-
-
-#: Trials of the device tests (rules device_frf, device_steps).
-DEVICE_TRIALS = ("device-frf", "device-steps")
-
-
-def design_trials() -> list[str]:
-    """Every trial the design names: the static trial, the walking trials and the device tests."""
-    return [config["trials"]["static"], *walking_trials(), *DEVICE_TRIALS]
+    return [t for t in DESIGN.walking_trials() if (raw / f"{t}.c3d").is_file()]
 
 
 try:
@@ -188,15 +168,15 @@ try:
     # left out); files that match no trial of the design are named in a warning
     for _s in (s for s, src in SUBJECT_SOURCE.items() if src == "recorded"):
         _raw = Path("data/raw") / _s
-        for _t in design_trials():
+        for _t in DESIGN.trials():
             for _suffix in RAW_SUFFIXES:
                 raw_file_present(_raw / f"{_t}{_suffix}", f"raw file of trial '{_t}' of subject '{_s}'")
-        _unmatched = unmatched_raw_files(_raw, design_trials())
+        _unmatched = unmatched_raw_files(_raw, DESIGN.trials())
         if _unmatched:
             _t = config["trials"]
             print(
                 f"warning: {_raw}: {', '.join(_unmatched)}: no trial of the design has this name, not analysed "
-                f"(trials: {', '.join(design_trials())}; from trials.static, trials.no_device, trials.device, "
+                f"(trials: {', '.join(DESIGN.trials())}; from trials.static, trials.no_device, trials.device, "
                 f"trials.perturbation_onsets_ms {_t['perturbation_onsets_ms']} and trials.perturbation_repeats "
                 f"{_t['perturbation_repeats']})", file=sys.stderr
             )
@@ -212,16 +192,11 @@ def processed_subjects() -> list[str]:
             if src == "synthetic" or "model_osim" in SUBJECT_ROWS[s] or (Path("data/raw") / s / f"{static}.c3d").is_file()]
 
 
-def trial_kind(trial: str) -> str:
-    """``static`` for the static trial, ``walking`` for every other."""
-    return "static" if trial == config["trials"]["static"] else "walking"
-
-
 def trial_label_maps(trial: str) -> list:
     """The label maps of a trial, merged in this order: markers.label_map, then its kind's and its own from
     markers.trial_label_maps (each inline or a file)."""
     per_trial = config["markers"]["trial_label_maps"]
-    maps = [config["markers"]["label_map"], per_trial.get(trial_kind(trial)), per_trial.get(trial)]
+    maps = [config["markers"]["label_map"], per_trial.get(DESIGN.kind(trial)), per_trial.get(trial)]
     return [m for m in maps if m]
 
 
@@ -280,7 +255,7 @@ def processing_targets() -> list[str]:
             out += [f"results/grf/{s}/{t}.grf.mot" for t in subject_trials(s) if has_force_platforms(s, t)]
     if out:
         out.append("results/strides/summary.tsv")
-    if any(trial_onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
+    if any(DESIGN.onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
         out += ["results/tables/impedance.tsv", "results/tables/impedance_summary.tsv", "results/tables/literature.tsv",
                 "results/figures/impedance.png", "results/tables/tables.md"]
         out += [f"results/figures/{s}/{f}.png" for s in processed_subjects() for f in ("responses", "fit")]

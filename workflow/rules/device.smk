@@ -27,7 +27,7 @@ rule device_trial:
         "data/raw/{subject}/{trial}.loper.tsv",
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
-        trial="|".join(DEVICE_TRIALS),
+        trial="|".join(DEVICE_TESTS),
     params:
         device=DEVICE["parameters"],
         leg=DEVICE["leg"],

@@ -15,7 +15,7 @@ IDENT = config["identification"]
 
 def onset_trials(subject: str, onset: str) -> list[str]:
     """The subject's trials of one onset that are on disk (or generated)."""
-    return [t for t in subject_trials(subject) if trial_onset_ms(t) == int(onset)]
+    return [t for t in subject_trials(subject) if DESIGN.onset_ms(t) == int(onset)]
 
 
 def null_pair_trials(subject: str) -> list[str]:

@@ -52,15 +52,15 @@ rule synthetic_lab:
         truth="data/raw/{subject}/truth.yaml",
     output:
         static=f"data/raw/{{subject}}/{TRIALS['static']}.c3d",
-        c3d=[f"data/raw/{{subject}}/{t}.c3d" for t in walking_trials()],
-        logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in walking_trials() if t != TRIALS["no_device"]],
+        c3d=[f"data/raw/{{subject}}/{t}.c3d" for t in DESIGN.walking_trials()],
+        logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in DESIGN.walking_trials() if t != TRIALS["no_device"]],
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
         row=lambda wc: SUBJECT_ROWS[wc.subject],
-        trials=walking_trials(),
+        trials=DESIGN.walking_trials(),
         no_device=TRIALS["no_device"],
-        onsets_ms=[trial_onset_ms(t) for t in walking_trials()],
+        onsets_ms=[DESIGN.onset_ms(t) for t in DESIGN.walking_trials()],
         settings=SYNTH,
         lab=lab_settings(),
         device=config["device"]["parameters"],
