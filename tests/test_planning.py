@@ -289,7 +289,8 @@ def pilot_results(tmp_path_factory, params, pilot):
     return root
 
 
-def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path, capsys):
+def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no config/config.yaml here: the library's defaults (onsets of the impedance rows)
     out = tmp_path / "plan.tsv"
     code = main(["plan", "--results", str(pilot_results), "--subject", "S09", "--trials", "pert050-1",
                  "--strides", "10", "40",

@@ -21,6 +21,7 @@ error naming the file and the cause when an input cannot serve
 from __future__ import annotations
 
 import argparse
+import copy
 import sys
 import tempfile
 from pathlib import Path
@@ -164,17 +165,71 @@ def _first_subject(subjects_tsv: str, results: Path) -> str:
     return found[0]
 
 
+def _read_config(args: argparse.Namespace) -> tuple[dict | None, str]:
+    """The configuration as the workflow run here would see it, and one line saying which file(s) it came from.
+
+    ``config/config.yaml`` of the working directory when present (the
+    Snakefile's own config file), then each ``--configfile`` over it, as
+    Snakemake layers them (:func:`loper_analysis.config_file.load_config`); a
+    file named twice counts where it was named last. None (and a line saying
+    so) when there is neither: the library's defaults serve.
+    """
+    from .config_file import DEFAULT_CONFIG, load_config
+
+    named = ([DEFAULT_CONFIG] if DEFAULT_CONFIG.is_file() else []) + [Path(f) for f in args.configfile or []]
+    last = {p.resolve(): n for n, p in enumerate(named)}
+    files = [p for n, p in enumerate(named) if last[p.resolve()] == n]
+    if not files:
+        return None, (f"config: none (no {DEFAULT_CONFIG.as_posix()} in {Path.cwd()} and no --configfile): library "
+                      "defaults, which may differ from the workflow's settings")
+    config, used = load_config(files)
+    order = " (later files override earlier ones)" if len(used) > 1 else ""
+    return config, f"config: {', '.join(used)}{order}"
+
+
+def _plan_settings(args: argparse.Namespace, config: dict | None) -> dict:
+    """The planner's settings: options given on the command line, else the config's, else the library's defaults.
+
+    The config's are those of the rule ``planning``
+    (:func:`loper_analysis.steps.planning.planning_settings`); besides them
+    ``subject`` (``planning.pilot_subject``; None: the first of the sheet),
+    ``subjects`` (the subject sheet, config ``subjects``) and
+    ``exclude_trials`` (``trials.no_device``).
+    """
+    from .steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
+
+    if config is None:
+        settings = copy.deepcopy(LIBRARY_PLANNING_SETTINGS)
+        settings.update(subject=None, subjects="config/subjects.tsv", exclude_trials=["walk-nodevice"])
+    else:
+        settings = planning_settings(config)
+        settings.update(subject=config["planning"]["pilot_subject"], subjects=config["subjects"],
+                        exclude_trials=[config["trials"]["no_device"]])
+    given = {"onsets": args.onset_ms, "strides": args.strides, "pulse_force_n": args.force_n,
+             "pulse_duration_s": args.duration_s, "subject": args.subject, "subjects": args.subjects,
+             "exclude_trials": args.exclude_trials}
+    settings.update({k: v for k, v in given.items() if v is not None})
+    if args.target is not None or args.target_half_width is not None:  # the targets given replace the config's
+        settings["targets"] = [{"joint": j, "parameter": p, "percent": float(v)} for j, p, v in args.target or []]
+        settings["targets"] += [{"joint": j, "parameter": p, "half_width": float(v)}
+                                for j, p, v in args.target_half_width or []]
+    return settings
+
+
 def _plan(args: argparse.Namespace) -> None:
     from .steps.planning import plan
 
+    config, line = _read_config(args)
+    print(line)
+    s = _plan_settings(args, config)
     results = Path(args.results)
-    subject = args.subject or _first_subject(args.subjects, results)
+    subject = s["subject"] or _first_subject(s["subjects"], results)
     ik_dir = results / "ik" / subject
     names = args.trials or sorted(p.name.removesuffix(".angles.tsv") for p in ik_dir.glob("*.angles.tsv"))
-    names = [n for n in names if n not in args.exclude_trials]
+    names = [n for n in names if n not in s["exclude_trials"]]
     if not names:
         raise LoperInputError(f"plan: no joint-angle table of a trial with the device in {ik_dir} "
-                              f"(excluded: {', '.join(args.exclude_trials)})")
+                              f"(excluded: {', '.join(s['exclude_trials'])})")
     angles = [ik_dir / f"{n}.angles.tsv" for n in names]
     strides = [results / "strides" / subject / f"{n}.strides.tsv" for n in names]
     for path in (*angles, *strides):
@@ -184,7 +239,7 @@ def _plan(args: argparse.Namespace) -> None:
     impedance_tsvs = [Path(f) for f in args.impedance] if args.impedance else \
         sorted((results / "impedance" / subject).glob("[0-9][0-9][0-9].tsv"))
     values = args.impedance_values
-    onsets = args.onset_ms
+    onsets = s["onsets"]
     if onsets is None:
         if values is not None:
             raise LoperInputError("plan: with --impedance-values give --onset-ms")
@@ -192,17 +247,16 @@ def _plan(args: argparse.Namespace) -> None:
         if not onsets:
             raise LoperInputError(f"plan: no impedance rows of {subject} in {results / 'impedance' / subject}; "
                                   "give --onset-ms and --impedance or --impedance-values")
-    targets = [{"joint": j, "parameter": p, "percent": float(v)} for j, p, v in args.target or []]
-    targets += [{"joint": j, "parameter": p, "half_width": float(v)} for j, p, v in args.target_half_width or []]
-    table, answers = plan(names, angles, strides, segments, subject, onsets, args.strides, args.out,
-                          impedance_tsvs=impedance_tsvs, impedance=values, targets=targets,
-                          pulse_force_n=args.force_n, pulse_duration_s=args.duration_s)
+    table, answers = plan(names, angles, strides, segments, subject, onsets, s["strides"], args.out,
+                          impedance_tsvs=impedance_tsvs, impedance=values, targets=s["targets"],
+                          pulse_force_n=s["pulse_force_n"], pulse_duration_s=s["pulse_duration_s"],
+                          response=s["response"], identification=s["identification"], device=s["device"])
     shown = table[["onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
                    "ci95_half_width", "ci95_half_width_pct"]]
     print(f"pilot {subject} ({len(names)} trials with the device; null pairs: "
           f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}; perturbed pairs: "
           f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_perturbed_pairs'].first())}); "
-          f"pulse {args.force_n:g} N for {args.duration_s:g} s")
+          f"pulse {s['pulse_force_n']:g} N for {s['pulse_duration_s']:g} s")
     print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     for a in answers:
         print(a)
@@ -253,6 +307,12 @@ def _rotate_option(p: argparse.ArgumentParser, heading: bool = False) -> None:
 def _label_map_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--label-map", metavar="MAP", help="TSV (columns label, marker) or YAML mapping: lab label -> "
                    "model marker; subject prefixes (Name:) are stripped first")
+
+
+def _configfile_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--configfile", nargs="+", metavar="FILE", help="config file(s) layered over config/config.yaml "
+                   "of the working directory (when present), each over the ones before, as snakemake --configfile "
+                   "does; default: config/config.yaml alone")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -351,25 +411,40 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--fits", required=True, help="output TSV, one row per combination x condition")
     p.set_defaults(func=_validate)
 
-    p = sub.add_parser("plan", help="predicted 95 %% CI half-width of K and D for a planned experiment (pilot subject)")
+    p = sub.add_parser("plan", help="predicted 95 %% CI half-width of K and D for a planned experiment (pilot subject)",
+                       description="Predict the 95 % CI half-width of K and D of a planned experiment from a pilot "
+                       "subject's processed trials, with the settings of the workflow's rule 'planning'. Settings, "
+                       "highest priority first: (1) options given here; (2) the config: config/config.yaml of the "
+                       "working directory with each --configfile over it, as Snakemake layers them (onsets: "
+                       "trials.perturbation_onsets_ms; strides, targets, pulse and pilot: planning.*; fit window, "
+                       "initial state, bounds and null pairs: identification.*; outliers: strides.iqr_whisker, "
+                       "strides.max_outlier_fraction; device: device.parameters; excluded trial: trials.no_device; "
+                       "subject sheet: subjects); (3) without any config file, the library's defaults (said in the "
+                       "first line printed, which names the config file(s) used).")
+    _configfile_option(p)
     p.add_argument("--results", default="results", help="results folder of the pilot's processed trials")
-    p.add_argument("--subject", help="pilot subject (default: the first of --subjects)")
-    p.add_argument("--subjects", default="config/subjects.tsv", help="subject sheet whose first subject is the default")
+    p.add_argument("--subject", help="pilot subject (default: planning.pilot_subject, else the first of --subjects)")
+    p.add_argument("--subjects", help="subject sheet whose first subject is the default (default: the config's "
+                   "subjects, else config/subjects.tsv)")
     p.add_argument("--trials", nargs="+", help="the pilot's trials walked with the device (default: every angle "
                    "table in RESULTS/ik/SUBJECT but --exclude-trials)")
-    p.add_argument("--exclude-trials", nargs="*", default=["walk-nodevice"], help="trials without the device")
+    p.add_argument("--exclude-trials", nargs="*", help="trials without the device (default: trials.no_device, else "
+                   "walk-nodevice)")
     p.add_argument("--segments", help="segment table of the subject to plan for (default: the pilot's)")
     p.add_argument("--impedance", nargs="+", help="impedance rows giving the planned impedance (default: "
                    "RESULTS/impedance/SUBJECT/NNN.tsv)")
     p.add_argument("--impedance-values", type=float, nargs=6, metavar=("K_HIP", "D_HIP", "K_KNEE", "D_KNEE",
                    "K_ANKLE", "D_ANKLE"), help="planned impedance (N·m/rad, N·m·s/rad) instead of the pilot's fits")
-    p.add_argument("--onset-ms", type=float, nargs="+", help="onsets after toe-off (ms; default: those of the "
-                   "impedance rows)")
-    p.add_argument("--strides", type=int, nargs="+", default=[10, 20, 40], help="perturbed strides averaged")
-    p.add_argument("--force-n", type=float, default=40.0, help="pulse: desired force (N)")
-    p.add_argument("--duration-s", type=float, default=0.1, help="pulse duration (s)")
+    p.add_argument("--onset-ms", type=float, nargs="+", help="onsets after toe-off (ms; default: "
+                   "trials.perturbation_onsets_ms, else those of the impedance rows)")
+    p.add_argument("--strides", type=int, nargs="+", help="perturbed strides averaged (default: planning.strides, "
+                   "else 10 20 40)")
+    p.add_argument("--force-n", type=float, help="pulse: desired force (N; default: planning.pulse_force_n, else 40)")
+    p.add_argument("--duration-s", type=float, help="pulse duration (s; default: planning.pulse_duration_s, else "
+                   "0.1)")
     p.add_argument("--target", nargs=3, action="append", metavar=("JOINT", "PARAM", "PERCENT"),
-                   help="strides needed for a 95 %% CI half-width of PERCENT %% of the planned value, e.g. hip D 15")
+                   help="strides needed for a 95 %% CI half-width of PERCENT %% of the planned value, e.g. hip D 15 "
+                   "(targets given here replace planning.targets)")
     p.add_argument("--target-half-width", nargs=3, action="append", metavar=("JOINT", "PARAM", "VALUE"),
                    help="strides needed for an absolute half-width (N·m/rad or N·m·s/rad)")
     p.add_argument("--out", help="output TSV (one row per onset x joint x parameter x stride count)")

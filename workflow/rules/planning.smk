@@ -1,5 +1,7 @@
 # The experiment planner: predicted 95 % CI half-width of K and D from a pilot subject's null pairs and fits.
 
+from loper_analysis.steps.planning import planning_settings
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -7,6 +9,9 @@ localrules:
 
 
 PLAN = config["planning"]
+#: onsets, strides, targets, pulse, response, identification and device settings: the mapping of config keys that
+#: ``loper-analysis plan`` takes too (one function, so that the command and the rule cannot drift apart)
+PLAN_SETTINGS = planning_settings(config)
 
 
 def planning_pilot() -> str:
@@ -46,23 +51,7 @@ rule planning:
     params:
         subject=lambda wc: planning_pilot(),
         trials=lambda wc: null_pair_trials(planning_pilot()),
-        onsets=TRIALS["perturbation_onsets_ms"],
-        strides=PLAN["strides"],
-        targets=PLAN["targets"],
-        pulse_force_n=PLAN["pulse_force_n"],
-        pulse_duration_s=PLAN["pulse_duration_s"],
-        response=dict(
-            window_before_s=IDENT["window_before_s"],
-            window_after_s=IDENT["window_after_s"],
-            initial_state_span_s=IDENT["initial_state_span_s"],
-            whisker=config["strides"]["iqr_whisker"],
-            max_fraction=config["strides"]["max_outlier_fraction"],
-        ),
-        identification={k: IDENT[k] for k in ("window_before_s", "window_after_s", "initial_state_span_s",
-                                                "initial_state_degree", "n_substeps", "null_pair_components",
-                                                "min_null_pairs", "max_null_trial_ratio", "interval_scatter",
-                                                "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")},
-        device=config["device"]["parameters"],
+        **PLAN_SETTINGS,
     log:
         "results/logs/planning/plan.log",
     benchmark:

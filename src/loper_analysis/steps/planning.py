@@ -10,6 +10,7 @@ onset and the answers to the targets (method: ``docs/planning.md``).
 
 from __future__ import annotations
 
+import copy
 import logging
 from collections.abc import Mapping, Sequence
 
@@ -21,7 +22,7 @@ from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_text, write_tsv
 from ..io.readers import read_tsv
 
-__all__ = ["planned_impedance", "plan"]
+__all__ = ["LIBRARY_PLANNING_SETTINGS", "plan", "planned_impedance", "planning_settings"]
 
 log = logging.getLogger(__name__)
 
@@ -29,6 +30,93 @@ log = logging.getLogger(__name__)
 _PLAN_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree", "n_substeps",
               "null_pair_components", "min_null_pairs", "interval_scatter", "stiffness_bounds_nm_per_rad",
               "damping_bounds_nms_per_rad")
+
+
+#: Identification settings the rule passes to :func:`plan` (keys of config ``identification``): those the planner
+#: follows and the null pairs' trial ratio.
+_RULE_IDENTIFICATION_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree",
+                             "n_substeps", "null_pair_components", "min_null_pairs", "max_null_trial_ratio",
+                             "interval_scatter", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")
+
+#: The settings of :func:`planning_settings` without a configuration (``loper-analysis plan`` with no config file):
+#: ``onsets`` None (those of the pilot's impedance rows), no targets, and the library's own response,
+#: identification and device defaults (None: :class:`~loper_analysis.responses.ResponseSettings`,
+#: :class:`~loper_analysis.planning.PlanSettings`, :class:`~loper_analysis.device.controller.DeviceParameters`).
+LIBRARY_PLANNING_SETTINGS = {"onsets": None, "strides": [10, 20, 40], "targets": [], "pulse_force_n": 40.0,
+                             "pulse_duration_s": 0.1, "response": None, "identification": None, "device": None}
+
+
+def planning_settings(config: Mapping) -> dict:
+    """The planner's settings from the workflow's configuration: the one mapping of config keys to :func:`plan`.
+
+    The rule ``planning`` (its params) and ``loper-analysis plan`` both take
+    their settings from here, so that the two cannot drift apart.
+
+    Parameters
+    ----------
+    config : mapping
+        The validated configuration (``config/config.yaml`` and its layers;
+        :func:`loper_analysis.config_file.load_config`).
+
+    Returns
+    -------
+    dict
+        Keyword arguments of :func:`plan` by the rule's params' names (a copy:
+        changing it leaves ``config`` as it is):
+
+        ``onsets``
+            ``trials.perturbation_onsets_ms`` (ms after toe-off).
+        ``strides``
+            ``planning.strides`` (perturbed strides averaged).
+        ``targets``
+            ``planning.targets`` (``joint``, ``parameter``, ``percent`` or
+            ``half_width`` in N·m/rad or N·m·s/rad, optional ``onset_ms``).
+        ``pulse_force_n``, ``pulse_duration_s``
+            ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s).
+        ``response``
+            :class:`~loper_analysis.responses.ResponseSettings` keywords:
+            ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
+            (s) of ``identification``; ``whisker`` and ``max_fraction`` of
+            ``strides.iqr_whisker`` and ``strides.max_outlier_fraction``.
+        ``identification``
+            The keys of ``identification`` the planner follows: fit window and
+            initial state (s), substeps, projected components, null-pair
+            minimum and trial ratio, interval scatter and the K, D bounds
+            (N·m/rad, N·m·s/rad).
+        ``device``
+            ``device.parameters``
+            (:class:`~loper_analysis.device.controller.DeviceParameters` keywords).
+
+    Raises
+    ------
+    LoperInputError
+        A key the planner needs is missing (naming it).
+    """
+    def get(*keys):
+        node = config
+        for n, key in enumerate(keys):
+            if not isinstance(node, Mapping) or key not in node:
+                raise LoperInputError(f"config: key '{'.'.join(keys[:n + 1])}' missing: the planner needs "
+                                      f"'{'.'.join(keys)}'")
+            node = node[key]
+        return copy.deepcopy(node)
+
+    return {
+        "onsets": get("trials", "perturbation_onsets_ms"),
+        "strides": get("planning", "strides"),
+        "targets": get("planning", "targets"),
+        "pulse_force_n": get("planning", "pulse_force_n"),
+        "pulse_duration_s": get("planning", "pulse_duration_s"),
+        "response": {
+            "window_before_s": get("identification", "window_before_s"),
+            "window_after_s": get("identification", "window_after_s"),
+            "initial_state_span_s": get("identification", "initial_state_span_s"),
+            "whisker": get("strides", "iqr_whisker"),
+            "max_fraction": get("strides", "max_outlier_fraction"),
+        },
+        "identification": {k: get("identification", k) for k in _RULE_IDENTIFICATION_KEYS},
+        "device": get("device", "parameters"),
+    }
 
 
 def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:

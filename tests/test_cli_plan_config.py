@@ -1,0 +1,176 @@
+"""``loper-analysis plan`` reads the workflow's configuration: the rule's settings, layered as Snakemake layers them.
+
+:func:`loper_analysis.config_file.load_config` reads ``config/config.yaml``
+and further files over it; the planner's settings come from one function,
+:func:`loper_analysis.steps.planning.planning_settings`, which both the rule
+``planning`` and the command call.
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+import yaml
+
+from loper_analysis.cli import _parser, _plan_settings, _read_config, main
+from loper_analysis.config_file import find_schema, load_config, update_config
+from loper_analysis.errors import LoperInputError
+from loper_analysis.planning import PlanSettings
+from loper_analysis.steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = ROOT / "config" / "config.yaml"
+SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+
+#: Values that differ from the library's defaults (PlanSettings, LIBRARY_PLANNING_SETTINGS).
+WINDOW_AFTER_S = 0.3
+STRIDES = [7, 14]
+
+
+@pytest.fixture
+def project(tmp_path, monkeypatch):
+    """A project folder (the working directory): config/config.yaml and the schema, as in the repository."""
+    (tmp_path / "config").mkdir()
+    shutil.copy(CONFIG, tmp_path / "config" / "config.yaml")
+    (tmp_path / "workflow" / "schemas").mkdir(parents=True)
+    shutil.copy(SCHEMA, tmp_path / "workflow" / "schemas" / "config.schema.yaml")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def _write(path: Path, data: dict) -> Path:
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+@pytest.fixture
+def second(project) -> Path:
+    """A file layered over config/config.yaml: a wider fit window and other stride counts."""
+    return _write(project / "config" / "mine.yaml", {"identification": {"window_after_s": WINDOW_AFTER_S},
+                                                      "planning": {"strides": STRIDES}})
+
+
+# --------------------------------------------------------------------------- load_config
+
+
+def test_later_file_updates_the_earlier_recursively(project, second):
+    base = yaml.safe_load(CONFIG.read_text())
+    config, used = load_config(["config/config.yaml", second])
+    assert used == ["config/config.yaml", "config/mine.yaml"]
+    assert config["identification"]["window_after_s"] == WINDOW_AFTER_S and config["planning"]["strides"] == STRIDES
+    # keys the second file does not name keep the first file's values, at every depth
+    assert config["identification"]["window_before_s"] == base["identification"]["window_before_s"]
+    assert config["planning"]["targets"] == base["planning"]["targets"]
+    assert config["device"] == base["device"]
+    # overrides come last; the default file is config/config.yaml of the working directory
+    config, used = load_config(overrides={"planning": {"pulse_force_n": 55.0}})
+    assert used == ["config/config.yaml"] and config["planning"]["pulse_force_n"] == 55.0
+    assert config["planning"]["strides"] == base["planning"]["strides"]
+
+
+def test_update_is_snakemakes():
+    snakemake_utils = pytest.importorskip("snakemake.utils")
+    base = {"a": {"b": 1, "c": [1, 2], "d": None}, "e": 2, "f": {"g": 1}}
+    for over in ({"a": {"c": [3]}}, {"a": {"d": {"x": 1}}}, {"f": 5}, {"e": {"h": {"i": 1}}}, {"a": {}}, {}):
+        ours, theirs = copy.deepcopy(base), copy.deepcopy(base)
+        update_config(ours, over)
+        snakemake_utils.update_config(theirs, over)
+        assert ours == theirs, over
+
+
+def test_bad_key_in_the_second_file_is_named_with_that_file(project):
+    bad = _write(project / "second.yaml", {"planning": {"stridez": [3]}})
+    with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'planning\.stridez': Additional properties"):
+        load_config(["config/config.yaml", bad])
+    bad = _write(project / "second.yaml", {"identification": {"window_after_s": -0.1}})
+    with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'identification\.window_after_s': -0\.1 is "):
+        load_config(["config/config.yaml", bad])
+    # a value the first file sets is named with the first file
+    (project / "config" / "config.yaml").write_text(CONFIG.read_text().replace("n_starts: 10 ", "n_starts: ten "))
+    with pytest.raises(LoperInputError, match=r"^config/config\.yaml: key 'identification\.n_starts': 'ten'"):
+        load_config(["config/config.yaml", _write(project / "ok.yaml", {"seed": 1})])
+
+
+def test_yaml_syntax_error_names_the_file_and_line(project):
+    (project / "broken.yaml").write_text("planning:\n  strides: [10, 20\n  pulse_force_n: 40\n")
+    with pytest.raises(LoperInputError, match=r"broken\.yaml: line \d+, column \d+: YAML syntax error"):
+        load_config(["config/config.yaml", "broken.yaml"])
+
+
+def test_schema_of_the_config_files_project_wins(project, tmp_path_factory):
+    other = tmp_path_factory.mktemp("other")
+    (other / "config").mkdir()
+    (other / "workflow" / "schemas").mkdir(parents=True)
+    _write(other / "workflow" / "schemas" / "config.schema.yaml", {"type": "object", "required": ["only_key"]})
+    path = _write(other / "config" / "config.yaml", {"seed": 1})
+    assert find_schema([path]) == other / "workflow" / "schemas" / "config.schema.yaml"
+    with pytest.raises(LoperInputError, match=r"config\.yaml: key '\(top level\)': 'only_key' is a required"):
+        load_config([path])
+    # no project folder beside the file: the working directory's
+    assert find_schema([other / "loose.yaml"]) == project / "workflow" / "schemas" / "config.schema.yaml"
+
+
+# --------------------------------------------------------------------------- one mapping for the rule and the command
+
+
+def test_rule_takes_its_params_from_the_shared_builder():
+    rule = (ROOT / "workflow" / "rules" / "planning.smk").read_text()
+    assert "PLAN_SETTINGS = planning_settings(config)" in rule and "**PLAN_SETTINGS," in rule
+    # every setting the rule's script reads besides the pilot and its trials comes from the builder
+    script = (ROOT / "workflow" / "scripts" / "planning.py").read_text()
+    read = set(re.findall(r"\bp\.(\w+)", script)) - {"subject", "trials"}
+    assert read == set(planning_settings(yaml.safe_load(CONFIG.read_text())))
+
+
+def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
+    config, _ = load_config(["config/config.yaml", second])
+    rule = planning_settings(config)
+    args = _parser().parse_args(["plan", "--configfile", str(second)])
+    read, line = _read_config(args)
+    assert line == "config: config/config.yaml, config/mine.yaml (later files override earlier ones)"
+    command = _plan_settings(args, read)
+    assert {k: command[k] for k in rule} == rule
+    # the config's values, not the library's defaults, reach the planner
+    assert PlanSettings().window_after_s != WINDOW_AFTER_S and LIBRARY_PLANNING_SETTINGS["strides"] != STRIDES
+    assert command["identification"]["window_after_s"] == command["response"]["window_after_s"] == WINDOW_AFTER_S
+    assert command["strides"] == STRIDES
+    assert command["onsets"] == config["trials"]["perturbation_onsets_ms"]
+    assert command["exclude_trials"] == [config["trials"]["no_device"]]
+
+
+def test_options_given_override_the_config(project, second):
+    args = _parser().parse_args(["plan", "--configfile", str(second), "--strides", "5", "--force-n", "30",
+                                 "--onset-ms", "125", "--target", "hip", "K", "10"])
+    settings = _plan_settings(args, _read_config(args)[0])
+    assert settings["strides"] == [5] and settings["pulse_force_n"] == 30.0 and settings["onsets"] == [125.0]
+    assert settings["targets"] == [{"joint": "hip", "parameter": "K", "percent": 10.0}]
+    assert settings["identification"]["window_after_s"] == WINDOW_AFTER_S  # no option: the config's
+
+
+def test_without_a_config_the_library_defaults_serve_and_the_line_says_so(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    args = _parser().parse_args(["plan"])
+    config, line = _read_config(args)
+    assert config is None
+    assert line.startswith("config: none (no config/config.yaml in ") and "library defaults" in line
+    settings = _plan_settings(args, config)
+    assert {k: settings[k] for k in LIBRARY_PLANNING_SETTINGS} == LIBRARY_PLANNING_SETTINGS
+
+
+def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
+    """End to end: the config's fit window (shorter than the planned pulse) reaches the planner, which refuses it."""
+    _write(project / "short.yaml", {"identification": {"window_after_s": 0.05}})
+    results = project / "results"
+    for path in ("ik/S09/pert050-1.angles.tsv", "strides/S09/pert050-1.strides.tsv"):
+        (results / path).parent.mkdir(parents=True, exist_ok=True)
+        (results / path).write_text("")  # refused before any table is read
+    code = main(["plan", "--configfile", "short.yaml", "--results", "results", "--subject", "S09"])
+    captured = capsys.readouterr()
+    assert code == 2
+    assert captured.out == "config: config/config.yaml, short.yaml (later files override earlier ones)\n"
+    assert "pulse_duration_s = 0.1 s is longer than the fit window after the onset" in captured.err
+    assert "0.05" in captured.err
