@@ -12,6 +12,7 @@ import pytest
 
 from tests.workflow_copy import copy_workflow
 
+pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
 DOC = ROOT / "docs" / "first_recorded_subject.md"
 

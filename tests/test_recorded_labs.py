@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -37,8 +36,9 @@ from tests.rajagopal_lab import (
     opensim_scale_reference,
     write_lab_files,
 )
-from tests.workflow_copy import copy_workflow
+from tests.workflow_copy import copy_workflow, snakemake
 
+pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"
 #: Coordinates the study reads and those that carry them (the arms' are left to their markers' whims, below).
@@ -57,9 +57,7 @@ def _workflow(tmp_path_factory, name: str, subjects: str, overrides: dict) -> Pa
 
 
 def _run(work: Path, targets: list[str]) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *targets, "--configfile",
-                           "examples/rajagopal2016/config.yaml", "config/test.yaml"], cwd=work, capture_output=True,
-                          text=True, timeout=900, check=False)
+    return snakemake(work, *targets, "--configfile", "examples/rajagopal2016/config.yaml", "config/test.yaml")
 
 
 @pytest.fixture(scope="module")

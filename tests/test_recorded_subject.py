@@ -12,8 +12,6 @@ starts at 7.8125 s), robot logs as ``.mat``.
 
 from __future__ import annotations
 
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -28,8 +26,9 @@ from loper_analysis.io.osim import read_model
 from loper_analysis.segments_from_model import segments_from_model
 from loper_analysis.steps.model import read_segments
 from loper_analysis.steps.synthetic import lab_export_session
-from tests.workflow_copy import copy_workflow
+from tests.workflow_copy import copy_workflow, snakemake
 
+pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "gait2392"
 GENERIC = EXAMPLE / "gait2392_simbody.osim"
@@ -57,9 +56,7 @@ def lab_run(tmp_path_factory):
                                perturb_every_strides=(2, 3))
     (work / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.80\t{MASS_KG}\n")
     (work / "config/test.yaml").write_text(yaml.safe_dump(_test_config(), sort_keys=False))
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *TARGETS, "--configfile",
-                          "examples/gait2392/config.yaml", "config/test.yaml"], cwd=work,
-                         capture_output=True, text=True, timeout=900, check=False)
+    res = snakemake(work, *TARGETS, "--configfile", "examples/gait2392/config.yaml", "config/test.yaml")
     assert res.returncode == 0, res.stderr[-3000:]
     return work, truth
 

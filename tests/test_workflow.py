@@ -14,6 +14,9 @@ import pandas as pd
 import pytest
 import yaml
 
+from tests.workflow_copy import snakemake
+
+pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -42,10 +45,7 @@ def _project(tmp: Path, **changes) -> Path:
 
 
 def _snakemake(cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "snakemake", "--cores", "2", *args],
-        cwd=cwd, capture_output=True, text=True, timeout=600,
-    )
+    return snakemake(cwd, *args, timeout=600)
 
 
 @pytest.fixture(scope="module")

@@ -1,8 +1,10 @@
-"""A fresh copy of the repository's workflow files, for tests that run Snakemake in a folder of their own."""
+"""A fresh copy of the repository's workflow files, and Snakemake run in it, for the end-to-end tests."""
 
 from __future__ import annotations
 
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -16,3 +18,9 @@ def copy_workflow(work: Path) -> Path:
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
     return work
+
+
+def snakemake(work: Path, *args: str, timeout: float = 900) -> subprocess.CompletedProcess:
+    """``snakemake --cores 2 ARGS`` of this Python in ``work``; its output captured as text, never raising."""
+    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=work, capture_output=True,
+                          text=True, timeout=timeout, check=False)

@@ -32,7 +32,7 @@ from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.schema import check_yaml_file
 from loper_analysis.steps import processing, report
 from loper_analysis.steps.logs import rule_log
-from tests.workflow_copy import copy_workflow
+from tests.workflow_copy import snakemake
 
 ENOSPC = "[Errno 28] No space left on device"
 POINT_RATE, ANALOG_RATE = 128.0, 1024.0
@@ -371,15 +371,14 @@ def test_a_config_file_that_does_not_parse_is_named_with_its_line_and_column(tmp
     assert str(info.value) == f"{path}: {message}"
 
 
-def test_the_configs_the_project_ships_parse():
-    root = Path(__file__).resolve().parents[2]
-    for path in [root / "config/config.yaml", *sorted((root / "examples").glob("*/config.yaml"))]:
+def test_the_configs_the_project_ships_parse(repo_root):
+    for path in [repo_root / "config/config.yaml", *sorted((repo_root / "examples").glob("*/config.yaml"))]:
         check_yaml_file(path)
 
 
-def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_column(tmp_path):
+def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_column(workflow_dir):
     """Snakemake's own message ("Config file is not valid JSON or YAML") names neither the file nor the line."""
-    work = copy_workflow(tmp_path)
+    work = workflow_dir
     config = work / "config/config.yaml"
     lines = config.read_text().splitlines(keepends=True)
     k = next(i for i, line in enumerate(lines) if line.startswith("  cutoff_hz: 40.0"))
@@ -388,8 +387,7 @@ def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_co
     earlier = work / "results/markers/R01/walk.trc"
     earlier.parent.mkdir(parents=True)
     earlier.write_text("an earlier result\n")
-    res = subprocess.run([sys.executable, "-m", "snakemake", "-n"], cwd=work, capture_output=True, text=True,
-                         timeout=120)
+    res = snakemake(work, "-n", timeout=120)
     console = res.stdout + res.stderr
     assert res.returncode == 1, console
     message = (f"config/config.yaml: line {k + 2}, column {lines[k + 1].index(':') + 1}: "

@@ -15,7 +15,6 @@ import hashlib
 import re
 import shutil
 import subprocess
-import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -29,7 +28,9 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.steps import ik, processing
+from tests.workflow_copy import snakemake
 
+pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[2]
 SUBJECT, HEIGHT_M, MASS_KG = "R01", 1.75, 70.0
 RAW = f"data/raw/{SUBJECT}"
@@ -41,8 +42,7 @@ GOOD_TARGETS = (f"results/markers/{SUBJECT}/static.trc", f"results/markers/{SUBJ
 
 
 def _snakemake(cwd: Path, *args: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=cwd, capture_output=True,
-                          text=True, timeout=300, check=False)
+    return snakemake(cwd, *args, timeout=300)
 
 
 @pytest.fixture(scope="module")
