@@ -55,11 +55,15 @@ ROOT = Path(__file__).resolve().parents[1]
 #: through the 40 Hz marker filter (lag-1 correlation 0.52 in the chain and 0.52 for filtered white noise).
 IK_NOISE_COLUMNS = ("pelvis_x_m", "pelvis_angle_rad", "hip_left_rad", "knee_left_rad", "ankle_left_rad")
 IK_NOISE_SD = np.array([0.000155, 0.001912, 0.002218, 0.001034, 0.001636])
-IK_NOISE_CORR = np.array([[1.00, -0.54, -0.67, -0.52, -0.03],
-                          [-0.54, 1.00, 0.97, 0.26, -0.02],
-                          [-0.67, 0.97, 1.00, 0.46, 0.02],
-                          [-0.52, 0.26, 0.46, 1.00, 0.35],
-                          [-0.03, -0.02, 0.02, 0.35, 1.00]])
+IK_NOISE_CORR = np.array(
+    [
+        [1.00, -0.54, -0.67, -0.52, -0.03],
+        [-0.54, 1.00, 0.97, 0.26, -0.02],
+        [-0.67, 0.97, 1.00, 0.46, 0.02],
+        [-0.52, 0.26, 0.46, 1.00, 0.35],
+        [-0.03, -0.02, 0.02, 0.35, 1.00],
+    ]
+)
 _ANGLES = ("pelvis_x", "pelvis_angle", "hip_left", "knee_left", "ankle_left")
 
 
@@ -84,11 +88,19 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
             inside = has_ci & (low <= truth) & (truth <= high)
             n, k = int(has_ci.sum()), int(inside.sum())
             lo, hi = binomial_interval(k, n) if n else (np.nan, np.nan)
-            rows.append({"joint": joint, "parameter": p, "n_fits": n, "ci_holds_truth": k,
-                         "coverage_pct": 100.0 * k / max(n, 1), "binomial95_low_pct": 100 * lo,
-                         "binomial95_high_pct": 100 * hi,
-                         "median_ci_width": float(np.median((high - low)[has_ci])) if has_ci.any() else np.nan,
-                         "n_not_identifiable": int((g["status"] == "not_identifiable").sum())})
+            rows.append(
+                {
+                    "joint": joint,
+                    "parameter": p,
+                    "n_fits": n,
+                    "ci_holds_truth": k,
+                    "coverage_pct": 100.0 * k / max(n, 1),
+                    "binomial95_low_pct": 100 * lo,
+                    "binomial95_high_pct": 100 * hi,
+                    "median_ci_width": float(np.median((high - low)[has_ci])) if has_ci.any() else np.nan,
+                    "n_not_identifiable": int((g["status"] == "not_identifiable").sum()),
+                }
+            )
     return pd.DataFrame(rows)
 
 
@@ -98,12 +110,31 @@ def _settings(config: dict):
     from loper_analysis.responses import ResponseSettings
 
     ident, strides = config["identification"], config["strides"]
-    response = ResponseSettings(window_before_s=ident["window_before_s"], window_after_s=ident["window_after_s"],
-                                initial_state_span_s=ident["initial_state_span_s"], whisker=strides["iqr_whisker"],
-                                max_fraction=strides["max_outlier_fraction"], min_strides=strides["min_valid_strides"])
-    keys = ("noise_model", "interval_scatter", "null_pair_components", "min_null_pairs", "initial_state_degree", "n_starts", "n_substeps",
-            "tolerance", "merge_tolerance", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad",
-            "max_ci_fraction", "plausible_ranges", "min_vaf_pct", "max_null_trial_ratio")
+    response = ResponseSettings(
+        window_before_s=ident["window_before_s"],
+        window_after_s=ident["window_after_s"],
+        initial_state_span_s=ident["initial_state_span_s"],
+        whisker=strides["iqr_whisker"],
+        max_fraction=strides["max_outlier_fraction"],
+        min_strides=strides["min_valid_strides"],
+    )
+    keys = (
+        "noise_model",
+        "interval_scatter",
+        "null_pair_components",
+        "min_null_pairs",
+        "initial_state_degree",
+        "n_starts",
+        "n_substeps",
+        "tolerance",
+        "merge_tolerance",
+        "stiffness_bounds_nm_per_rad",
+        "damping_bounds_nms_per_rad",
+        "max_ci_fraction",
+        "plausible_ranges",
+        "min_vaf_pct",
+        "max_null_trial_ratio",
+    )
     return response, IdentificationSettings(**{k: ident[k] for k in keys if k in ident}, seed=config["seed"])
 
 
@@ -133,17 +164,31 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     t_analog = np.arange(int(round(walk.duration_s * lab.analog_rate_hz))) / lab.analog_rate_hz
     sync = pulse_train_at((t_analog + lab.clock_offset_s) / scale, walk.sync_starts_s)
-    force, native = robot_log_frames_and_native(walk.robot, lab.robot_rate_hz, sync, lab.analog_rate_hz, t,
-                                                cutoff_hz=cutoff, order=order)
+    force, native = robot_log_frames_and_native(
+        walk.robot, lab.robot_rate_hz, sync, lab.analog_rate_hz, t, cutoff_hz=cutoff, order=order
+    )
     s = config["strides"]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        strides = stride_tables(angles, walk.mocap_events(), force, "left", s["n_points"], s["iqr_whisker"],
-                                s["max_outlier_fraction"], s["min_valid_strides"]).strides
+        strides = stride_tables(
+            angles,
+            walk.mocap_events(),
+            force,
+            "left",
+            s["n_points"],
+            s["iqr_whisker"],
+            s["max_outlier_fraction"],
+            s["min_valid_strides"],
+        ).strides
     values = {c: coords[c].to_numpy(float) for c in coords.columns if c != "time_s"}
     markers = marker_positions(model, values, list(BRACE_MARKERS))
-    return {"angles": angles, "strides": strides, "force": force, "force_native": native,
-            "markers": (t, markers, list(BRACE_MARKERS))}
+    return {
+        "angles": angles,
+        "strides": strides,
+        "force": force,
+        "force_native": native,
+        "markers": (t, markers, list(BRACE_MARKERS)),
+    }
 
 
 def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.DataFrame:
@@ -158,9 +203,15 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
 
     syn, trials, seed = config["synthetic"], config["trials"], int(config["seed"])
     row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
-    truth = true_impedance(subject, seed, syn["stiffness_nm_per_rad"], syn["damping_nms_per_rad"],
-                           syn["between_subject_cv"], config["identification"]["stiffness_bounds_nm_per_rad"],
-                           config["identification"]["damping_bounds_nms_per_rad"])
+    truth = true_impedance(
+        subject,
+        seed,
+        syn["stiffness_nm_per_rad"],
+        syn["damping_nms_per_rad"],
+        syn["between_subject_cv"],
+        config["identification"]["stiffness_bounds_nm_per_rad"],
+        config["identification"]["damping_bounds_nms_per_rad"],
+    )
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
     device = DeviceParameters(**config["device"]["parameters"])
     model = build_lower_body_model(row["height_m"], row["mass_kg"])
@@ -174,17 +225,35 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
         perturbation = None
         if onset is not None:
             impedance = tuple(truth[onset][j][p] for j in JOINTS for p in ("K", "D"))
-            perturbation = PerturbationSettings(onset / 1000.0, impedance, syn["pulse_force_n"], syn["pulse_duration_s"],
-                                                tuple(syn["perturb_every_strides"]))
+            perturbation = PerturbationSettings(
+                onset / 1000.0,
+                impedance,
+                syn["pulse_force_n"],
+                syn["pulse_duration_s"],
+                tuple(syn["perturb_every_strides"]),
+            )
         # the workflow's seeds (synthetic.trials.subject_walking_trial): the same walking as the whole chain
-        sim_seed, file_seed = np.random.SeedSequence([seed, zlib.crc32(subject.encode()),
-                                                      zlib.crc32(trial.encode())]).spawn(2)
-        walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
-                                      syn["timing_cv"], syn["amplitude_cv"], device, perturbation,
-                                      variability=variability, adaptation=adaptation,
-                                      minimal_impedance=minimal_impedance)
-        inputs[trial] = {"name": trial, **_trial_inputs(walk, model, lab, config, noise_scale,
-                                                        np.random.default_rng(file_seed))}
+        sim_seed, file_seed = np.random.SeedSequence(
+            [seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]
+        ).spawn(2)
+        walk = simulate_walking_trial(
+            syn["walking_duration_s"],
+            lab,
+            sim_seed,
+            row["height_m"],
+            params,
+            syn["timing_cv"],
+            syn["amplitude_cv"],
+            device,
+            perturbation,
+            variability=variability,
+            adaptation=adaptation,
+            minimal_impedance=minimal_impedance,
+        )
+        inputs[trial] = {
+            "name": trial,
+            **_trial_inputs(walk, model, lab, config, noise_scale, np.random.default_rng(file_seed)),
+        }
     response, ident = _settings(config)
     null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
     rows = []
@@ -222,14 +291,29 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
         row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
         params = segment_parameters_from_model(build_lower_body_model(row["height_m"], row["mass_kg"]))
         sim_seed, _ = np.random.SeedSequence([seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]).spawn(2)
-        truth = true_impedance(subject, seed, syn["stiffness_nm_per_rad"], syn["damping_nms_per_rad"],
-                               syn["between_subject_cv"], config["identification"]["stiffness_bounds_nm_per_rad"],
-                               config["identification"]["damping_bounds_nms_per_rad"])
+        truth = true_impedance(
+            subject,
+            seed,
+            syn["stiffness_nm_per_rad"],
+            syn["damping_nms_per_rad"],
+            syn["between_subject_cv"],
+            config["identification"]["stiffness_bounds_nm_per_rad"],
+            config["identification"]["damping_bounds_nms_per_rad"],
+        )
         variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
-        walk = simulate_walking_trial(syn["walking_duration_s"], lab, sim_seed, row["height_m"], params,
-                                      syn["timing_cv"], syn["amplitude_cv"], DeviceParameters(**config["device"]["parameters"]),
-                                      variability=variability, adaptation=adaptation,
-                                      minimal_impedance=minimal_impedance)
+        walk = simulate_walking_trial(
+            syn["walking_duration_s"],
+            lab,
+            sim_seed,
+            row["height_m"],
+            params,
+            syn["timing_cv"],
+            syn["amplitude_cv"],
+            DeviceParameters(**config["device"]["parameters"]),
+            variability=variability,
+            adaptation=adaptation,
+            minimal_impedance=minimal_impedance,
+        )
         coords = walk.mocap_coordinates(lab.marker_rate_hz)
         ik = read_tsv(work / f"results/ik/{subject}/{trial}.angles.tsv", "angle table")
         for a in _ANGLES:
@@ -247,11 +331,26 @@ def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFram
         if not target.exists():
             (shutil.copytree if (ROOT / item).is_dir() else shutil.copy)(ROOT / item, target)
     (work / "config/coverage_subjects.tsv").write_text(
-        "subject\tsource\n" + "".join(f"{s}\tsynthetic\n" for s in names))
-    (work / "config/coverage.yaml").write_text(yaml.safe_dump({
-        "subjects": "config/coverage_subjects.tsv", "seed": seed, "device": {"subject": names[0]}}))
-    res = subprocess.run([sys.executable, "-m", "snakemake", "-j", str(jobs), "results/tables/impedance.tsv",
-                          "--configfile", "config/coverage.yaml", "-q"], cwd=work, check=False)
+        "subject\tsource\n" + "".join(f"{s}\tsynthetic\n" for s in names)
+    )
+    (work / "config/coverage.yaml").write_text(
+        yaml.safe_dump({"subjects": "config/coverage_subjects.tsv", "seed": seed, "device": {"subject": names[0]}})
+    )
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "snakemake",
+            "-j",
+            str(jobs),
+            "results/tables/impedance.tsv",
+            "--configfile",
+            "config/coverage.yaml",
+            "-q",
+        ],
+        cwd=work,
+        check=False,
+    )
     if res.returncode:
         raise SystemExit(f"snakemake failed in {work} (exit {res.returncode})")
     return pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
@@ -265,8 +364,11 @@ def main() -> None:
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
     ap.add_argument("--keep", type=Path, help="chain: keep the project here; coordinates: write the rows here (TSV)")
-    ap.add_argument("--interval-scatter", choices=("perturbed_pairs", "null_pairs"),
-                    help="identification.interval_scatter (coordinates mode; default: the config's)")
+    ap.add_argument(
+        "--interval-scatter",
+        choices=("perturbed_pairs", "null_pairs"),
+        help="identification.interval_scatter (coordinates mode; default: the config's)",
+    )
     args = ap.parse_args()
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     config["seed"] = args.seed
@@ -284,9 +386,11 @@ def main() -> None:
         work.mkdir(parents=True, exist_ok=True)
         table = run_chain(names, args.seed, args.jobs, work)
         what = "whole chain"
-    print(f"{what}: {args.subjects} synthetic subjects, {table.groupby(['subject', 'onset_ms']).ngroups} subject x "
-          f"onset fits, seed {args.seed}, {time.perf_counter() - t0:.0f} s with {args.jobs} job(s); statuses: "
-          f"{table['status'].value_counts().to_dict()}")
+    print(
+        f"{what}: {args.subjects} synthetic subjects, {table.groupby(['subject', 'onset_ms']).ngroups} subject x "
+        f"onset fits, seed {args.seed}, {time.perf_counter() - t0:.0f} s with {args.jobs} job(s); statuses: "
+        f"{table['status'].value_counts().to_dict()}"
+    )
     print(markdown_table(coverage_table(table).round(3)))
     if args.mode == "chain":
         if args.keep is None:

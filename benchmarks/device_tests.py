@@ -27,22 +27,42 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         # compile once outside the timing (numba caches it for later runs anyway)
-        device.device_trial(tmp / "warm.loper.tsv", "warm", "device-steps", cfg["parameters"], cfg["leg"],
-                            {**cfg["tests"], "step_repetitions": 1}, 0)
+        device.device_trial(
+            tmp / "warm.loper.tsv",
+            "warm",
+            "device-steps",
+            cfg["parameters"],
+            cfg["leg"],
+            {**cfg["tests"], "step_repetitions": 1},
+            0,
+        )
         t0 = time.perf_counter()
         for trial in ("device-frf", "device-steps"):
-            device.device_trial(tmp / f"{trial}.loper.tsv", "S01", trial, cfg["parameters"], cfg["leg"], cfg["tests"],
-                                2024)
+            device.device_trial(
+                tmp / f"{trial}.loper.tsv", "S01", trial, cfg["parameters"], cfg["leg"], cfg["tests"], 2024
+            )
         t1 = time.perf_counter()
-        device.frf(tmp / "device-frf.loper.tsv", tmp / "frf.tsv", rate, a["welch_window_samples"],
-                   a["welch_overlap_samples"])
-        device.steps(tmp / "device-steps.loper.tsv", tmp / "steps.tsv", tmp / "avg.tsv", rate,
-                     cfg["tests"]["step_amplitudes_n"], a["step_before_s"], a["step_after_s"], a["steady_window_s"])
-        summary = device.summary(tmp / "frf.tsv", tmp / "steps.tsv", tmp / "summary.tsv",
-                                 a["bandwidth_reference_band_hz"])
+        device.frf(
+            tmp / "device-frf.loper.tsv", tmp / "frf.tsv", rate, a["welch_window_samples"], a["welch_overlap_samples"]
+        )
+        device.steps(
+            tmp / "device-steps.loper.tsv",
+            tmp / "steps.tsv",
+            tmp / "avg.tsv",
+            rate,
+            cfg["tests"]["step_amplitudes_n"],
+            a["step_before_s"],
+            a["step_after_s"],
+            a["steady_window_s"],
+        )
+        summary = device.summary(
+            tmp / "frf.tsv", tmp / "steps.tsv", tmp / "summary.tsv", a["bandwidth_reference_band_hz"]
+        )
         t2 = time.perf_counter()
-    print(f"simulate + write 2 device trials: {t1 - t0:.2f} s; read + analyse: {t2 - t1:.2f} s; "
-          f"total {t2 - t0:.2f} s (target 10 s)")
+    print(
+        f"simulate + write 2 device trials: {t1 - t0:.2f} s; read + analyse: {t2 - t1:.2f} s; "
+        f"total {t2 - t0:.2f} s (target 10 s)"
+    )
     print(summary.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
 
 

@@ -39,11 +39,21 @@ def main(n_cases: int = 40) -> None:
             else:
                 qu_m, qp_m = qu, qp
             for force in ("1000 Hz", "128 Hz"):
-                extra = dict(force_perturbed_n=fp, force_time_s=tf) if force == "1000 Hz" else \
-                    dict(force_perturbed_n=f128)
+                extra = (
+                    dict(force_perturbed_n=fp, force_time_s=tf) if force == "1000 Hz" else dict(force_perturbed_n=f128)
+                )
                 t0 = time.perf_counter()
-                w = prepare_window(t, qu_m, qp_m, params, s.onset_s, pelvis_angle_unperturbed_rad=pel,
-                                   pelvis_angle_perturbed_rad=pel, q_reference=qu, **extra)
+                w = prepare_window(
+                    t,
+                    qu_m,
+                    qp_m,
+                    params,
+                    s.onset_s,
+                    pelvis_angle_unperturbed_rad=pel,
+                    pelvis_angle_perturbed_rad=pel,
+                    q_reference=qu,
+                    **extra,
+                )
                 fit = identify_impedance(w, n_starts=10, seed=int(c))
                 dt = time.perf_counter() - t0
                 if n > 0:  # the first case includes loading the compiled kernels
@@ -51,8 +61,10 @@ def main(n_cases: int = 40) -> None:
                     sims.append(fit.n_simulations)
     for (force, cond), v in times.items():
         v = np.array(v)
-        print(f"force {force:7s} {cond:9s} one identification (10 starts): median {np.median(v) * 1e3:.1f} ms, "
-              f"max {v.max() * 1e3:.1f} ms over {len(v)} cases")
+        print(
+            f"force {force:7s} {cond:9s} one identification (10 starts): median {np.median(v) * 1e3:.1f} ms, "
+            f"max {v.max() * 1e3:.1f} ms over {len(v)} cases"
+        )
     print(f"simulations per identification: median {np.median(sims):.0f}")
 
 

@@ -34,8 +34,9 @@ def covered(time_s: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:
     return mask
 
 
-def trial_shares(time_s: np.ndarray, strides: pd.DataFrame, onsets_s: list[float], before_s: float, after_s: float,
-                 margin_s: float) -> tuple[float, float]:
+def trial_shares(
+    time_s: np.ndarray, strides: pd.DataFrame, onsets_s: list[float], before_s: float, after_s: float, margin_s: float
+) -> tuple[float, float]:
     """(share read directly, share the fits depend on) of a perturbation trial's frames."""
     pert = strides["perturbed"].astype(bool).to_numpy()
     toe = strides["toe_off_s"].to_numpy(float)
@@ -66,17 +67,32 @@ def main() -> None:
     for table in sorted(Path(args.results, "strides").glob("*/pert*.strides.tsv")):
         subject, trial = table.parent.name, table.name.split(".")[0]
         angles = pd.read_csv(Path(args.results, "ik", subject, f"{trial}.angles.tsv"), sep="\t", usecols=["time_s"])
-        direct, depends = trial_shares(angles["time_s"].to_numpy(), pd.read_csv(table, sep="\t"), onsets_s, before,
-                                       ident["window_after_s"], args.margin_s)
-        rows.append({"subject": subject, "trial": trial, "frames": len(angles), "read_directly_pct": 100 * direct,
-                     "fits_depend_on_pct": 100 * depends})
+        direct, depends = trial_shares(
+            angles["time_s"].to_numpy(),
+            pd.read_csv(table, sep="\t"),
+            onsets_s,
+            before,
+            ident["window_after_s"],
+            args.margin_s,
+        )
+        rows.append(
+            {
+                "subject": subject,
+                "trial": trial,
+                "frames": len(angles),
+                "read_directly_pct": 100 * direct,
+                "fits_depend_on_pct": 100 * depends,
+            }
+        )
     if not rows:
         raise SystemExit(f"{args.results}: no perturbation trials' stride tables")
     frame = pd.DataFrame(rows)
     print(frame.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     w = frame["frames"] / frame["frames"].sum()
-    print(f"all {len(frame)} perturbation trials: read directly {(w * frame.read_directly_pct).sum():.1f} %, "
-          f"fits depend on {(w * frame.fits_depend_on_pct).sum():.1f} % of the frames")
+    print(
+        f"all {len(frame)} perturbation trials: read directly {(w * frame.read_directly_pct).sum():.1f} %, "
+        f"fits depend on {(w * frame.fits_depend_on_pct).sum():.1f} % of the frames"
+    )
 
 
 if __name__ == "__main__":

@@ -40,23 +40,36 @@ def _run(name: str, model, coordinates, angles: dict[str, tuple[str, float]], rn
     seconds = time.perf_counter() - t0
     solved = result.frame()
     errors = {ours: np.degrees(solved[c].to_numpy() - values[c]) for ours, (c, _) in angles.items()}
-    text = ", ".join(f"{k} rms {np.sqrt(np.mean(e ** 2)):.2f} max {np.abs(e).max():.2f} deg" for k, e in errors.items())
-    print(f"{name}: {len(t)} frames, {len(labels)} markers, {model.getCoordinateSet().getSize()} coordinates: "
-          f"{seconds:.1f} s, {1e3 * seconds / len(t):.2f} ms/frame; {text}")
+    text = ", ".join(f"{k} rms {np.sqrt(np.mean(e**2)):.2f} max {np.abs(e).max():.2f} deg" for k, e in errors.items())
+    print(
+        f"{name}: {len(t)} frames, {len(labels)} markers, {model.getCoordinateSet().getSize()} coordinates: "
+        f"{seconds:.1f} s, {1e3 * seconds / len(t):.2f} ms/frame; {text}"
+    )
 
 
 def main(duration_s: float = 240.0) -> None:
     rng = np.random.default_rng(2024)
-    coordinates, _ = walking_kinematics(duration_s, RATE_HZ, NominalGait(), rng, 0.03, 0.05,
-                                        leg_length_from_height(HEIGHT_M))
+    coordinates, _ = walking_kinematics(
+        duration_s, RATE_HZ, NominalGait(), rng, 0.03, 0.05, leg_length_from_height(HEIGHT_M)
+    )
     generated = build_lower_body_model(HEIGHT_M, MASS_KG)
-    _run("generated model", generated, coordinates,
-         {"hip": ("hip_flexion_l", 1), "knee": ("knee_flexion_l", 1), "ankle": ("ankle_dorsiflexion_l", 1)}, rng)
+    _run(
+        "generated model",
+        generated,
+        coordinates,
+        {"hip": ("hip_flexion_l", 1), "knee": ("knee_flexion_l", 1), "ankle": ("ankle_dorsiflexion_l", 1)},
+        rng,
+    )
     gait2392 = read_model(EXAMPLE / "gait2392_simbody.osim")
     gait2392.updateMarkerSet(read_marker_set(EXAMPLE / "gait2392_Scale_MarkerSet.xml"))
     gait2392.initSystem()
-    _run("gait2392", gait2392, gait2392_coordinates(coordinates, 0.05),
-         {"hip": ("hip_flexion_l", 1), "knee": ("knee_angle_l", -1), "ankle": ("ankle_angle_l", 1)}, rng)
+    _run(
+        "gait2392",
+        gait2392,
+        gait2392_coordinates(coordinates, 0.05),
+        {"hip": ("hip_flexion_l", 1), "knee": ("knee_angle_l", -1), "ankle": ("ankle_angle_l", 1)},
+        rng,
+    )
 
 
 if __name__ == "__main__":

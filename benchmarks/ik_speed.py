@@ -22,18 +22,26 @@ def main(n: int = 30720) -> None:
     t = np.arange(n) / 128.0
     w = 2 * np.pi * 0.6
     truth = {
-        "pelvis_tx": 0.02 * np.sin(2 * w * t), "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
+        "pelvis_tx": 0.02 * np.sin(2 * w * t),
+        "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
         "pelvis_tilt": 0.05 * np.sin(w * t),
-        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t), "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
+        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
+        "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
         "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2),
-        "hip_flexion_r": 0.1 - 0.3 * np.sin(w * t), "knee_flexion_r": 0.6 - 0.5 * np.sin(w * t + 1),
+        "hip_flexion_r": 0.1 - 0.3 * np.sin(w * t),
+        "knee_flexion_r": 0.6 - 0.5 * np.sin(w * t + 1),
         "ankle_dorsiflexion_r": -0.1 * np.sin(w * t + 2),
     }
     X = marker_positions(model, truth)
 
     def angle_errors(res):  # (n_frames, n_angles) rad, translations left out
-        return np.column_stack([res.coordinates[:, i] - truth[c] for i, c in enumerate(res.coordinate_names)
-                                if not c.endswith(("_tx", "_ty"))])
+        return np.column_stack(
+            [
+                res.coordinates[:, i] - truth[c]
+                for i, c in enumerate(res.coordinate_names)
+                if not c.endswith(("_tx", "_ty"))
+            ]
+        )
 
     # the pipeline's default (config opensim.accuracy) is 1e-6; looser ones show what speed would cost
     for accuracy in (1e-4, 1e-5, 1e-6, 1e-8):
@@ -41,16 +49,20 @@ def main(n: int = 30720) -> None:
         res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=accuracy)
         dt = time.perf_counter() - t0
         err = angle_errors(res)
-        print(f"IK of {n} frames ({n / 128 / 60:.1f} min at 128 Hz), {len(MARKERS)} markers, accuracy "
-              f"{accuracy:g}: {dt:.1f} s ({dt / n * 1e3:.2f} ms/frame; target 30 s for 30,720 frames); "
-              f"angle error max {np.rad2deg(np.abs(err).max()):.2e} deg, "
-              f"rms {np.rad2deg(np.sqrt(np.mean(err ** 2))):.2e} deg")
+        print(
+            f"IK of {n} frames ({n / 128 / 60:.1f} min at 128 Hz), {len(MARKERS)} markers, accuracy "
+            f"{accuracy:g}: {dt:.1f} s ({dt / n * 1e3:.2f} ms/frame; target 30 s for 30,720 frames); "
+            f"angle error max {np.rad2deg(np.abs(err).max()):.2e} deg, "
+            f"rms {np.rad2deg(np.sqrt(np.mean(err**2))):.2e} deg"
+        )
     # for scale: what the synthetic lab's marker noise (config synthetic.marker_noise_sd_m) does at 1e-8
     noisy = X + np.random.default_rng(0).normal(0.0, 0.5e-3, X.shape)
     res = inverse_kinematics(model, t, noisy, list(MARKERS), accuracy=1e-8)
     err = angle_errors(res)
-    print(f"0.5 mm marker noise, accuracy 1e-8: angle error max {np.rad2deg(np.abs(err).max()):.2e} deg, "
-          f"rms {np.rad2deg(np.sqrt(np.mean(err ** 2))):.2e} deg")
+    print(
+        f"0.5 mm marker noise, accuracy 1e-8: angle error max {np.rad2deg(np.abs(err).max()):.2e} deg, "
+        f"rms {np.rad2deg(np.sqrt(np.mean(err**2))):.2e} deg"
+    )
 
 
 if __name__ == "__main__":

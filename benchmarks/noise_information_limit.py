@@ -27,8 +27,17 @@ def main() -> None:
     for truth in ([0, 0, 0, 0, 0, 0], [75, 2, 0, 0, 0, 0], [75, 2, 75, 2, 75, 2], [150, 4, 150, 4, 150, 4]):
         truth = np.asarray(truth, float)
         t, qu, qp, fp, pel, tf = perturbed_trial(params, truth, s)
-        w = prepare_window(t, qu, qp, params, s.onset_s, force_perturbed_n=fp, force_time_s=tf,
-                           pelvis_angle_unperturbed_rad=pel, pelvis_angle_perturbed_rad=pel)
+        w = prepare_window(
+            t,
+            qu,
+            qp,
+            params,
+            s.onset_s,
+            force_perturbed_n=fp,
+            force_time_s=tf,
+            pelvis_angle_unperturbed_rad=pel,
+            pelvis_angle_perturbed_rad=pel,
+        )
         J = response_jacobian(w, truth + 1e-9)
         crlb = sd_noise * np.sqrt(np.diag(np.linalg.inv(J.T @ J)))
         print(f"CRLB SD at {truth.astype(int).tolist()}".ljust(34) + "".join(f"{v:9.3g}" for v in crlb))

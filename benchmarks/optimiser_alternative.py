@@ -45,11 +45,34 @@ def per_start_least_squares(window, n_starts: int, seed: int, tol: float = 1e-6)
     def jac(p):
         return batch.residuals_and_jacobians(p[None])[1][0]
 
-    fits = [least_squares(fun, s, jac=jac, bounds=(lb, ub), method="trf", x_scale=batch.typical * 100,
-                          ftol=tol, xtol=tol, gtol=tol, max_nfev=180) for s in starts]
+    fits = [
+        least_squares(
+            fun,
+            s,
+            jac=jac,
+            bounds=(lb, ub),
+            method="trf",
+            x_scale=batch.typical * 100,
+            ftol=tol,
+            xtol=tol,
+            gtol=tol,
+            max_nfev=180,
+        )
+        for s in starts
+    ]
     best = min(fits, key=lambda f: f.cost)
-    polish = least_squares(fun, best.x, jac=jac, bounds=(lb, ub), method="trf", x_scale=batch.typical * 100,
-                           ftol=1e-14, xtol=1e-14, gtol=1e-14, max_nfev=200)
+    polish = least_squares(
+        fun,
+        best.x,
+        jac=jac,
+        bounds=(lb, ub),
+        method="trf",
+        x_scale=batch.typical * 100,
+        ftol=1e-14,
+        xtol=1e-14,
+        gtol=1e-14,
+        max_nfev=200,
+    )
     return float(np.sum(polish.fun**2))
 
 
@@ -64,8 +87,13 @@ def main(n_cases: int = 40) -> None:
         trial = perturbed_trial(params, grid[c], settings)
         rng = np.random.default_rng([settings.seed, int(c)])
         qu, qp = trial[1], trial[2]
-        window = validation_window(params, settings, trial, qu + rng.uniform(-0.005, 0.005, qu.shape),
-                                   qp + rng.uniform(-0.005, 0.005, qp.shape))
+        window = validation_window(
+            params,
+            settings,
+            trial,
+            qu + rng.uniform(-0.005, 0.005, qu.shape),
+            qp + rng.uniform(-0.005, 0.005, qp.shape),
+        )
         t0 = time.perf_counter()
         lm = identify_impedance(window, n_starts=10, seed=int(c)).cost
         t1 = time.perf_counter()
@@ -79,9 +107,11 @@ def main(n_cases: int = 40) -> None:
         worse["least_squares per start"] += trf > lm * 1.001
     for name, v in times.items():
         v = np.array(v)
-        print(f"{name:24s} one identification (10 starts, noise): median {1e3 * np.median(v):.0f} ms, "
-              f"max {1e3 * v.max():.0f} ms, total {v.sum():.1f} s; ends > 0.1 % above the other in "
-              f"{worse[name]} of {v.size} fits")
+        print(
+            f"{name:24s} one identification (10 starts, noise): median {1e3 * np.median(v):.0f} ms, "
+            f"max {1e3 * v.max():.0f} ms, total {v.sum():.1f} s; ends > 0.1 % above the other in "
+            f"{worse[name]} of {v.size} fits"
+        )
 
 
 if __name__ == "__main__":

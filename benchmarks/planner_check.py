@@ -42,8 +42,11 @@ from loper_analysis.synthetic.variability import lab_variability
 ROOT = Path(__file__).resolve().parents[1]
 
 #: The true impedance of the synthetic subject per onset (ms): the default study's group values.
-TRUTH = {50: (55.0, 3.5, 3.0, 0.10, 8.0, 0.3), 175: (38.0, 2.2, 0.5, 0.04, 8.0, 0.3),
-         300: (62.0, 4.2, 2.5, 0.12, 8.0, 0.3)}
+TRUTH = {
+    50: (55.0, 3.5, 3.0, 0.10, 8.0, 0.3),
+    175: (38.0, 2.2, 0.5, 0.04, 8.0, 0.3),
+    300: (62.0, 4.2, 2.5, 0.12, 8.0, 0.3),
+}
 HEIGHT_M, MASS_KG = 1.73, 64.9
 ANGLE_NOISE_SD_RAD = 0.001
 
@@ -71,9 +74,17 @@ def lab(variability: str, seed: int, onset_ms: int, truth) -> dict:
     return {"variability": v, "adaptation": a, "minimal_impedance": m}
 
 
-def run_check(repeats: int, onset_ms: int, counts: list[int], seed: int, truth=None, n_starts: int = 10,
-              verbose: bool = True, angle_noise_sd_rad: float = ANGLE_NOISE_SD_RAD,
-              variability: str | None = None) -> pd.DataFrame:
+def run_check(
+    repeats: int,
+    onset_ms: int,
+    counts: list[int],
+    seed: int,
+    truth=None,
+    n_starts: int = 10,
+    verbose: bool = True,
+    angle_noise_sd_rad: float = ANGLE_NOISE_SD_RAD,
+    variability: str | None = None,
+) -> pd.DataFrame:
     """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D)."""
     truth = TRUTH[onset_ms] if truth is None else truth
     params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
@@ -82,8 +93,9 @@ def run_check(repeats: int, onset_ms: int, counts: list[int], seed: int, truth=N
     lab_kwargs = lab(variability, seed, onset_ms, truth)
 
     def experiment(k: int):
-        return perturbation_experiment([seed, k], params, HEIGHT_M, onset_ms, truth, counts,
-                                       angle_noise_sd_rad=angle_noise_sd_rad, **lab_kwargs)
+        return perturbation_experiment(
+            [seed, k], params, HEIGHT_M, onset_ms, truth, counts, angle_noise_sd_rad=angle_noise_sd_rad, **lab_kwargs
+        )
 
     # the pilot: its null pairs, and its fit of all its perturbed strides as the planned impedance
     full, cut = experiment(0)
@@ -127,13 +139,26 @@ def run_check(repeats: int, onset_ms: int, counts: list[int], seed: int, truth=N
         rel = 1.96 / np.sqrt(2.0 * (len(est) - 1))
         for i, name in enumerate(PARAMETERS):
             p, joint = name.split("_")
-            rows.append({"joint": joint, "parameter": p, "n_strides": n, "mean_n_kept": n_kept.mean(),
-                         "truth": truth[i], "planned": planned[i], "mean_estimate": est[:, i].mean(),
-                         "predicted_sd": predicted[i], "null_pairs_predicted_sd": predicted_null[i],
-                         "fits_reported_sd": fits_say[i], "measured_sd": measured[i],
-                         "measured_sd_mad": robust[i],
-                         "measured_sd_95_low": measured[i] * (1 - rel), "measured_sd_95_high": measured[i] * (1 + rel),
-                         "ratio_predicted_to_measured": predicted[i] / measured[i], "repeats": len(est)})
+            rows.append(
+                {
+                    "joint": joint,
+                    "parameter": p,
+                    "n_strides": n,
+                    "mean_n_kept": n_kept.mean(),
+                    "truth": truth[i],
+                    "planned": planned[i],
+                    "mean_estimate": est[:, i].mean(),
+                    "predicted_sd": predicted[i],
+                    "null_pairs_predicted_sd": predicted_null[i],
+                    "fits_reported_sd": fits_say[i],
+                    "measured_sd": measured[i],
+                    "measured_sd_mad": robust[i],
+                    "measured_sd_95_low": measured[i] * (1 - rel),
+                    "measured_sd_95_high": measured[i] * (1 + rel),
+                    "ratio_predicted_to_measured": predicted[i] / measured[i],
+                    "repeats": len(est),
+                }
+            )
     out = pd.DataFrame(rows)
     out.attrs = {"n_null_pairs": sc.n_null_pairs, "n_perturbed_pairs": sc.n_perturbed_pairs, "skipped": skipped}
     return out
@@ -146,26 +171,40 @@ def main() -> None:
     ap.add_argument("--strides", type=int, nargs="+", default=[10, 40])
     ap.add_argument("--seed", type=int, default=2024)
     ap.add_argument("--angle-noise-sd-rad", type=float, default=ANGLE_NOISE_SD_RAD)
-    ap.add_argument("--variability", choices=("study", "gentle"), default=None,
-                    help="the lab's variability (default: config/config.yaml synthetic.variability)")
+    ap.add_argument(
+        "--variability",
+        choices=("study", "gentle"),
+        default=None,
+        help="the lab's variability (default: config/config.yaml synthetic.variability)",
+    )
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     logging.disable(logging.WARNING)
     t0 = time.perf_counter()
-    table = run_check(args.repeats, args.onset_ms, args.strides, args.seed,
-                      angle_noise_sd_rad=args.angle_noise_sd_rad, variability=args.variability)
-    print(f"onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, {args.repeats} repeats, "
-          f"pilot null pairs {table.attrs['n_null_pairs']}, perturbed pairs {table.attrs['n_perturbed_pairs']}, "
-          f"{time.perf_counter() - t0:.0f} s")
+    table = run_check(
+        args.repeats,
+        args.onset_ms,
+        args.strides,
+        args.seed,
+        angle_noise_sd_rad=args.angle_noise_sd_rad,
+        variability=args.variability,
+    )
+    print(
+        f"onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, {args.repeats} repeats, "
+        f"pilot null pairs {table.attrs['n_null_pairs']}, perturbed pairs {table.attrs['n_perturbed_pairs']}, "
+        f"{time.perf_counter() - t0:.0f} s"
+    )
     for line in table.attrs["skipped"]:
         print(f"left out: {line}")
     print(markdown_table(table.round(4)))
     hk = table[table["joint"].isin(["hip", "knee"])]
     worst = hk.loc[(hk["ratio_predicted_to_measured"] - 1).abs().idxmax()]
-    print(f"hip and knee: ratio predicted/measured {hk['ratio_predicted_to_measured'].min():.3f} .. "
-          f"{hk['ratio_predicted_to_measured'].max():.3f} (worst: {worst['joint']} {worst['parameter']} at "
-          f"{worst['n_strides']} strides); "
-          f"within ±25 %: {bool(((hk['ratio_predicted_to_measured'] - 1).abs() <= 0.25).all())}")
+    print(
+        f"hip and knee: ratio predicted/measured {hk['ratio_predicted_to_measured'].min():.3f} .. "
+        f"{hk['ratio_predicted_to_measured'].max():.3f} (worst: {worst['joint']} {worst['parameter']} at "
+        f"{worst['n_strides']} strides); "
+        f"within ±25 %: {bool(((hk['ratio_predicted_to_measured'] - 1).abs() <= 0.25).all())}"
+    )
 
 
 if __name__ == "__main__":

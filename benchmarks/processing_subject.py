@@ -43,9 +43,14 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
         )
         trials = StudyDesign.from_config(cfg["trials"]).walking_trials()
         raw = [f"data/raw/S01/{cfg['trials']['static']}.c3d"] + [f"data/raw/S01/{t}.c3d" for t in trials]
+
         def run(*targets: str) -> None:
-            res = subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *targets, "--quiet", "all"], cwd=work,
-                                 capture_output=True, text=True)
+            res = subprocess.run(
+                [sys.executable, "-m", "snakemake", "--cores", "2", *targets, "--quiet", "all"],
+                cwd=work,
+                capture_output=True,
+                text=True,
+            )
             if res.returncode:
                 sys.exit(res.stderr[-3000:])
 
@@ -63,10 +68,14 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
             rows.append({"rule": rule, "cpu_s": pd.read_csv(tsv, sep="\t")["cpu_time"].iloc[0]})
         cpu = pd.DataFrame(rows).groupby("rule")["cpu_s"].agg(["count", "sum"]).sort_values("sum", ascending=False)
         n_frames = int(duration_s * 128)
-    print(f"raw files of 1 subject, {len(trials)} walking trials of {duration_s:.0f} s ({n_frames} frames each) "
-          f"+ static: {t1 - t0:.1f} s (not part of the target)")
-    print(f"processing (markers, model, IK in {cfg['opensim']['ik_chunks']} chunks/trial, events, load cell, strides, "
-          f"transparency) with -j2: {t2 - t1:.1f} s wall (target 180 s)")
+    print(
+        f"raw files of 1 subject, {len(trials)} walking trials of {duration_s:.0f} s ({n_frames} frames each) "
+        f"+ static: {t1 - t0:.1f} s (not part of the target)"
+    )
+    print(
+        f"processing (markers, model, IK in {cfg['opensim']['ik_chunks']} chunks/trial, events, load cell, strides, "
+        f"transparency) with -j2: {t2 - t1:.1f} s wall (target 180 s)"
+    )
     print("CPU time per rule (s):")
     print(cpu.to_string(float_format=lambda v: f"{v:.1f}"))
 

@@ -35,9 +35,19 @@ WIDTH_PX, HEIGHT_PX = 1400, 900
 FIRST_SCREEN_TABLES = ("lf-impedance-summary", "lf-truth-recovery")
 #: Every table of the front page whose box is measured.
 TABLES = ("lf-impedance-summary", "lf-truth-recovery", "lf-figure", "lf-transparency", "lf-device", "lf-run")
-CHROMIUM_FLAGS = ("--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                  f"--window-size={WIDTH_PX},{HEIGHT_PX}", "--hide-scrollbars", "--mute-audio")
+CHROMIUM_FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    f"--window-size={WIDTH_PX},{HEIGHT_PX}",
+    "--hide-scrollbars",
+    "--mute-audio",
+)
 
 #: Page script: the boxes of the tables and the text of every text node drawn inside the viewport.
 _MEASURE = """(() => {
@@ -85,10 +95,12 @@ class DevTools:
         # close_fds=False: subprocess would close fds 3 and 4 after preexec_fn; Python's own descriptors are
         # not inheritable (PEP 446), so nothing else leaks into Chromium
         self._proc = subprocess.Popen(
-            [chromium, *CHROMIUM_FLAGS, f"--user-data-dir={self._profile}", "--remote-debugging-pipe",
-             "about:blank"],
-            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-            close_fds=False, preexec_fn=_fds,
+            [chromium, *CHROMIUM_FLAGS, f"--user-data-dir={self._profile}", "--remote-debugging-pipe", "about:blank"],
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            close_fds=False,
+            preexec_fn=_fds,
         )
         os.close(to_child_r)
         os.close(from_child_w)
@@ -152,8 +164,9 @@ class DevTools:
         self.close()
 
 
-def first_screen(report_html: Path, screenshot_png: Path | None = None, chromium: str | None = None,
-                 wait_s: float = 30.0) -> dict:
+def first_screen(
+    report_html: Path, screenshot_png: Path | None = None, chromium: str | None = None, wait_s: float = 30.0
+) -> dict:
     """Open the report at 1400×900, wait for the front page, measure it and (optionally) save a screenshot.
 
     Returns ``{"viewport": [w, h], "boxes": {id: {top, bottom, left, right}}, "text": first screen's text,
@@ -163,12 +176,14 @@ def first_screen(report_html: Path, screenshot_png: Path | None = None, chromium
     if chromium is None:
         raise FileNotFoundError("no Chromium: set $CHROMIUM or install /usr/bin/chromium")
     with DevTools(chromium) as browser:
-        browser.call("Emulation.setDeviceMetricsOverride", width=WIDTH_PX, height=HEIGHT_PX, deviceScaleFactor=1,
-                     mobile=False)
+        browser.call(
+            "Emulation.setDeviceMetricsOverride", width=WIDTH_PX, height=HEIGHT_PX, deviceScaleFactor=1, mobile=False
+        )
         start = time.monotonic()
         browser.call("Page.navigate", url=Path(report_html).resolve().as_uri())
-        while not browser.evaluate("!!document.getElementById('lf-impedance-summary') && "
-                                   "document.readyState === 'complete'"):
+        while not browser.evaluate(
+            "!!document.getElementById('lf-impedance-summary') && document.readyState === 'complete'"
+        ):
             if time.monotonic() - start > wait_s:
                 raise TimeoutError(f"{report_html}: the front page did not appear within {wait_s} s")
             time.sleep(0.1)
@@ -195,8 +210,10 @@ def problems(measured: dict) -> list[str]:
         if box is None:
             out.append(f"#{table} is not on the page")
         elif box["top"] < 0 or box["bottom"] > height or box["left"] < 0 or box["right"] > width:
-            out.append(f"#{table} lies at top {box['top']:.0f} … bottom {box['bottom']:.0f} px, left "
-                       f"{box['left']:.0f} … right {box['right']:.0f} px: not within {width}×{height}")
+            out.append(
+                f"#{table} lies at top {box['top']:.0f} … bottom {box['bottom']:.0f} px, left "
+                f"{box['left']:.0f} … right {box['right']:.0f} px: not within {width}×{height}"
+            )
     for words in ("Truth recovered", "Impedance: across-subject mean", "Truth recovery"):
         if words not in measured["text"]:
             out.append(f"the first screen does not show {words!r}")
@@ -205,8 +222,13 @@ def problems(measured: dict) -> list[str]:
 
 def build_report(workdir: Path, out_html: Path) -> None:
     """``snakemake --report out_html`` in ``workdir``."""
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--report", str(out_html)], cwd=workdir,
-                         capture_output=True, text=True, timeout=600)
+    res = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--report", str(out_html)],
+        cwd=workdir,
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
     if res.returncode != 0:
         raise SystemExit(f"snakemake --report failed:\n{res.stderr[-3000:]}")
 
@@ -214,8 +236,12 @@ def build_report(workdir: Path, out_html: Path) -> None:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("report", nargs="?", type=Path, help="report.html (default: build it from ./results)")
-    parser.add_argument("--out", type=Path, default=Path("results/benchmarks/report_first_screen.png"),
-                        help="screenshot (PNG, 1400×900)")
+    parser.add_argument(
+        "--out",
+        type=Path,
+        default=Path("results/benchmarks/report_first_screen.png"),
+        help="screenshot (PNG, 1400×900)",
+    )
     args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
         report = args.report
@@ -227,8 +253,10 @@ def main(argv: list[str] | None = None) -> int:
         measured = first_screen(report, args.out)
     print(f"front page drawn {measured['load_s']:.1f} s after opening; screenshot: {args.out}")
     for table, box in measured["boxes"].items():
-        print(f"  #{table:22s} top {box['top']:6.0f}  bottom {box['bottom']:6.0f}  "
-              f"left {box['left']:5.0f}  right {box['right']:5.0f} px")
+        print(
+            f"  #{table:22s} top {box['top']:6.0f}  bottom {box['bottom']:6.0f}  "
+            f"left {box['left']:5.0f}  right {box['right']:5.0f} px"
+        )
     print(f"first screen's text ({len(measured['text'])} characters):\n  {measured['text'][:1500]}")
     found = problems(measured)
     for p in found:

@@ -42,8 +42,9 @@ ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_PAGE = ROOT / "docs" / "results.md"
 DEFAULT_CONFIG = "config/config.yaml"
 #: An opening marker line, its name, and everything up to the closing marker line (both lines kept).
-BLOCK = re.compile(r"^(<!-- generated: ([A-Za-z0-9_-]+) -->\n)(.*?)^(<!-- end generated -->)$",
-                   re.MULTILINE | re.DOTALL)
+BLOCK = re.compile(
+    r"^(<!-- generated: ([A-Za-z0-9_-]+) -->\n)(.*?)^(<!-- end generated -->)$", re.MULTILINE | re.DOTALL
+)
 OPENING = re.compile(r"^<!-- generated: ", re.MULTILINE)
 CLOSING = re.compile(r"^<!-- end generated -->$", re.MULTILINE)
 MINUS = "\u2212"
@@ -57,6 +58,7 @@ class PageError(Exception):
 
 
 # --- numbers -----------------------------------------------------------------------------------------------
+
 
 def num(x, sig: int = 3) -> str:
     """``x`` with ``sig`` significant digits in fixed notation (a true minus sign); blank or NaN: an em dash."""
@@ -106,6 +108,7 @@ def ordered(values, order) -> list:
 
 
 # --- the run -----------------------------------------------------------------------------------------------
+
 
 def deep_merge(base: dict, top: dict) -> dict:
     """``top`` over ``base``, nested mappings merged key by key (as Snakemake merges --configfile)."""
@@ -165,6 +168,7 @@ def not_in_run(run: Run, *relatives: str) -> str:
 
 # --- the parts ---------------------------------------------------------------------------------------------
 
+
 def block_run(run: Run) -> str:
     """The command, the config files and the design the generated figures come from."""
     cfg = run.config
@@ -193,12 +197,19 @@ def block_run(run: Run) -> str:
         n = trials["perturbation_repeats"]
         design.append(f"{n} trial{'' if n == 1 else 's'} per onset")
     dates = sorted({datetime.date.fromtimestamp(p.stat().st_mtime).isoformat() for p in run.read})
-    written = (f", tables written {dates[0]}" if len(dates) == 1
-               else f", tables written {dates[0]} to {dates[-1]}" if dates else "")
-    return (f"Results of `snakemake -j2{extra}`{written}; page written by "
-            f"`python benchmarks/results_page.py{extra}{results}` in the run's folder.\n"
-            f"Config: {', '.join(files)}.\n"
-            f"Design: {'; '.join(design) if design else 'not stated in the config'}.")
+    written = (
+        f", tables written {dates[0]}"
+        if len(dates) == 1
+        else f", tables written {dates[0]} to {dates[-1]}"
+        if dates
+        else ""
+    )
+    return (
+        f"Results of `snakemake -j2{extra}`{written}; page written by "
+        f"`python benchmarks/results_page.py{extra}{results}` in the run's folder.\n"
+        f"Config: {', '.join(files)}.\n"
+        f"Design: {'; '.join(design) if design else 'not stated in the config'}."
+    )
 
 
 def block_impedance_summary(run: Run) -> str:
@@ -207,18 +218,44 @@ def block_impedance_summary(run: Run) -> str:
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
-    cols = ["joint", "onset_ms", "n_subjects", "n_not_identifiable", "K_mean_nm_per_rad", "K_sd_nm_per_rad",
-            "D_mean_nms_per_rad", "D_sd_nms_per_rad", "vaf_pct_mean"]
+    cols = [
+        "joint",
+        "onset_ms",
+        "n_subjects",
+        "n_not_identifiable",
+        "K_mean_nm_per_rad",
+        "K_sd_nm_per_rad",
+        "D_mean_nms_per_rad",
+        "D_sd_nms_per_rad",
+        "vaf_pct_mean",
+    ]
     s = run.need(s, name, cols)
     rows = []
     for joint in ordered(s["joint"], JOINT_ORDER):
         for _, r in s[s["joint"] == joint].sort_values("onset_ms").iterrows():
-            rows.append([joint, int(r["onset_ms"]), int(r["n_subjects"]), int(r["n_not_identifiable"]),
-                         f"{num(r['K_mean_nm_per_rad'])} ± {num(r['K_sd_nm_per_rad'])}",
-                         f"{num(r['D_mean_nms_per_rad'])} ± {num(r['D_sd_nms_per_rad'])}",
-                         fixed(r["vaf_pct_mean"], 1)])
-    return table(["joint", "onset (ms)", "subjects", "not identifiable", "K mean ± SD (N·m/rad)",
-                  "D mean ± SD (N·m·s/rad)", "mean VAF (%)"], rows)
+            rows.append(
+                [
+                    joint,
+                    int(r["onset_ms"]),
+                    int(r["n_subjects"]),
+                    int(r["n_not_identifiable"]),
+                    f"{num(r['K_mean_nm_per_rad'])} ± {num(r['K_sd_nm_per_rad'])}",
+                    f"{num(r['D_mean_nms_per_rad'])} ± {num(r['D_sd_nms_per_rad'])}",
+                    fixed(r["vaf_pct_mean"], 1),
+                ]
+            )
+    return table(
+        [
+            "joint",
+            "onset (ms)",
+            "subjects",
+            "not identifiable",
+            "K mean ± SD (N·m/rad)",
+            "D mean ± SD (N·m·s/rad)",
+            "mean VAF (%)",
+        ],
+        rows,
+    )
 
 
 def _recovery_row(rows: pd.DataFrame, tolerance: dict) -> list[str]:
@@ -234,8 +271,12 @@ def _recovery_row(rows: pd.DataFrame, tolerance: dict) -> list[str]:
         true = fitted[f"{p}_true_{unit}"].astype(float)
         rel, ab = tolerance[p]
         within = int((err.abs() <= (rel * true.abs()).clip(lower=ab)).sum())
-        held = int(((true >= fitted[f"{p}_ci95_low_{unit}"].astype(float))
-                    & (true <= fitted[f"{p}_ci95_high_{unit}"].astype(float))).sum())
+        held = int(
+            (
+                (true >= fitted[f"{p}_ci95_low_{unit}"].astype(float))
+                & (true <= fitted[f"{p}_ci95_high_{unit}"].astype(float))
+            ).sum()
+        )
         out += [f"{within} / {n}", f"{held} / {n}", num(err.abs().max()) if n else "—"]
     out.append(fixed(fitted["vaf_pct"].astype(float).mean(), 1) if n else "—")
     return out
@@ -250,9 +291,17 @@ def block_truth_recovery(run: Run) -> str:
     if t is None:
         return not_in_run(run, name)
     units = ("nm_per_rad", "nms_per_rad")
-    cols = ["subject", "onset_ms", "joint", "status", "vaf_pct", "n_strides",
-            *(f"{p}_{w}_{u}" for p, u in zip("KD", units) for w in ("true", "error", "ci95_low", "ci95_high")),
-            "K_nm_per_rad", "D_nms_per_rad"]
+    cols = [
+        "subject",
+        "onset_ms",
+        "joint",
+        "status",
+        "vaf_pct",
+        "n_strides",
+        *(f"{p}_{w}_{u}" for p, u in zip("KD", units) for w in ("true", "error", "ci95_low", "ci95_high")),
+        "K_nm_per_rad",
+        "D_nms_per_rad",
+    ]
     t = run.need(t, name, cols)
     t = t[pd.to_numeric(t["K_true_nm_per_rad"], errors="coerce").notna()]
     if not len(t):
@@ -264,14 +313,32 @@ def block_truth_recovery(run: Run) -> str:
             rows.append([joint, int(onset), *_recovery_row(own[own["onset_ms"] == onset], TRUTH_TOLERANCE)])
         rows.append([f"**{joint}**", "all", *_recovery_row(own, TRUTH_TOLERANCE)])
     (k_rel, k_abs), (d_rel, d_abs) = TRUTH_TOLERANCE["K"], TRUTH_TOLERANCE["D"]
-    text = [(f"{t['subject'].nunique()} subjects with a known truth, "
-             f"{plain(t['n_strides'].min())}–{plain(t['n_strides'].max())} perturbed strides per fit. Within "
-             f"tolerance: |error| ≤ {plain(k_rel * 100)} % of the truth or {plain(k_abs)} N·m/rad for K, "
-             f"{plain(d_rel * 100)} % or {plain(d_abs)} N·m·s/rad for D; counts over the fitted rows "
-             f"(`ok` and `not_identifiable`)."), "",
-            table(["joint", "onset (ms)", "rows ok / not identifiable / failed", "K within tolerance",
-                   "K: 95 % CI holds the truth", "largest \\|K error\\| (N·m/rad)", "D within tolerance",
-                   "D: 95 % CI holds the truth", "largest \\|D error\\| (N·m·s/rad)", "mean VAF (%)"], rows), ""]
+    text = [
+        (
+            f"{t['subject'].nunique()} subjects with a known truth, "
+            f"{plain(t['n_strides'].min())}–{plain(t['n_strides'].max())} perturbed strides per fit. Within "
+            f"tolerance: |error| ≤ {plain(k_rel * 100)} % of the truth or {plain(k_abs)} N·m/rad for K, "
+            f"{plain(d_rel * 100)} % or {plain(d_abs)} N·m·s/rad for D; counts over the fitted rows "
+            f"(`ok` and `not_identifiable`)."
+        ),
+        "",
+        table(
+            [
+                "joint",
+                "onset (ms)",
+                "rows ok / not identifiable / failed",
+                "K within tolerance",
+                "K: 95 % CI holds the truth",
+                "largest \\|K error\\| (N·m/rad)",
+                "D within tolerance",
+                "D: 95 % CI holds the truth",
+                "largest \\|D error\\| (N·m·s/rad)",
+                "mean VAF (%)",
+            ],
+            rows,
+        ),
+        "",
+    ]
     misses = []
     ok = t[t["status"] == "ok"]
     for _, r in ok.iterrows():
@@ -280,10 +347,15 @@ def block_truth_recovery(run: Run) -> str:
             rel, ab = TRUTH_TOLERANCE[p]
             low, high = float(r[f"{p}_ci95_low_{unit}"]), float(r[f"{p}_ci95_high_{unit}"])
             if abs(err) > max(rel * abs(true), ab) and not low <= true <= high:
-                misses.append(f"{r['subject']}, {int(r['onset_ms'])} ms, {r['joint']} {p} "
-                              f"{num(r[f'{p}_{unit}'])} for {num(true)} (95 % CI {num(low)}–{num(high)})")
-    text.append("`ok` rows off the truth beyond tolerance with a 95 % CI that misses it: "
-                + ("; ".join(misses) if misses else "none") + ".")
+                misses.append(
+                    f"{r['subject']}, {int(r['onset_ms'])} ms, {r['joint']} {p} "
+                    f"{num(r[f'{p}_{unit}'])} for {num(true)} (95 % CI {num(low)}–{num(high)})"
+                )
+    text.append(
+        "`ok` rows off the truth beyond tolerance with a 95 % CI that misses it: "
+        + ("; ".join(misses) if misses else "none")
+        + "."
+    )
     return "\n".join(text)
 
 
@@ -293,27 +365,54 @@ def block_validation(run: Run) -> str:
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
-    s = run.need(s, name, ["condition", "parameter", "min_error", "max_error", "sd_error", "max_abs_error", "n",
-                           "study_min_error", "study_max_error", "study_sd_error"])
-    clean, noisy = s[s["condition"] == "no_noise"].set_index("parameter"), s[s["condition"] == "noise"].set_index(
-        "parameter")
+    s = run.need(
+        s,
+        name,
+        [
+            "condition",
+            "parameter",
+            "min_error",
+            "max_error",
+            "sd_error",
+            "max_abs_error",
+            "n",
+            "study_min_error",
+            "study_max_error",
+            "study_sd_error",
+        ],
+    )
+    clean, noisy = (
+        s[s["condition"] == "no_noise"].set_index("parameter"),
+        s[s["condition"] == "noise"].set_index("parameter"),
+    )
     rows = []
     for p in ordered(s["parameter"], [f"{k}_{j}" for j in JOINT_ORDER for k in "KD"]):
         unit = " (N·m/rad)" if p == "K_hip" else " (N·m·s/rad)" if p == "D_hip" else ""
         c = clean.loc[p] if p in clean.index else None
         n = noisy.loc[p] if p in noisy.index else None
-        rows.append([f"{p}{unit}",
-                     f"{num(c['min_error'], 2)} … {num(c['max_error'], 2)}" if c is not None else "—",
-                     f"{num(c['study_min_error'], 2)} … {num(c['study_max_error'], 2)}" if c is not None else "—",
-                     num(n["sd_error"]) if n is not None else "—",
-                     num(n["study_sd_error"], 2) if n is not None else "—"])
-    text = [table(["parameter", "no noise: min … max error", "study (no noise)", "noise: SD of error",
-                   "study SD (noise)"], rows), ""]
+        rows.append(
+            [
+                f"{p}{unit}",
+                f"{num(c['min_error'], 2)} … {num(c['max_error'], 2)}" if c is not None else "—",
+                f"{num(c['study_min_error'], 2)} … {num(c['study_max_error'], 2)}" if c is not None else "—",
+                num(n["sd_error"]) if n is not None else "—",
+                num(n["study_sd_error"], 2) if n is not None else "—",
+            ]
+        )
+    text = [
+        table(
+            ["parameter", "no noise: min … max error", "study (no noise)", "noise: SD of error", "study SD (noise)"],
+            rows,
+        ),
+        "",
+    ]
     if len(clean):
         k = clean[clean.index.str.startswith("K_")]["max_abs_error"].max()
         d = clean[clean.index.str.startswith("D_")]["max_abs_error"].max()
-        text.append(f"Without noise every estimate of the {int(clean['n'].min())} combinations is within "
-                    f"|ΔK| ≤ {num(k, 2)} N·m/rad and |ΔD| ≤ {num(d, 2)} N·m·s/rad.")
+        text.append(
+            f"Without noise every estimate of the {int(clean['n'].min())} combinations is within "
+            f"|ΔK| ≤ {num(k, 2)} N·m/rad and |ΔD| ≤ {num(d, 2)} N·m·s/rad."
+        )
     fits = run.tsv("validation/fits.tsv")
     if fits is not None:
         from loper_analysis.identification.fit import AT_BEST_RELATIVE
@@ -325,9 +424,11 @@ def block_validation(run: Run) -> str:
             if len(g):
                 parts.append(f"{int((g['n_starts_at_best'] == g['n_starts']).sum())} of {len(g)} {label} fits")
         starts = sorted(fits["n_starts"].unique())
-        text.append(f"All {'/'.join(str(int(s)) for s in starts)} random starts end within "
-                    f"{plain(AT_BEST_RELATIVE * 100)} % of the best start's cost in {' and in '.join(parts)} "
-                    f"(`results/validation/fits.tsv`, `n_starts_at_best`).")
+        text.append(
+            f"All {'/'.join(str(int(s)) for s in starts)} random starts end within "
+            f"{plain(AT_BEST_RELATIVE * 100)} % of the best start's cost in {' and in '.join(parts)} "
+            f"(`results/validation/fits.tsv`, `n_starts_at_best`)."
+        )
     return "\n".join(text)
 
 
@@ -337,8 +438,22 @@ def block_transparency(run: Run) -> str:
     r = run.tsv(name)
     if r is None:
         return not_in_run(run, name)
-    r = run.need(r, name, ["subject", "phase", "joint", "n_strides_no_device", "n_strides_device", "rmsd_rad",
-                           "isv_ave_rad", "transparent", "study_rmsd_rad", "study_isv_ave_rad"])
+    r = run.need(
+        r,
+        name,
+        [
+            "subject",
+            "phase",
+            "joint",
+            "n_strides_no_device",
+            "n_strides_device",
+            "rmsd_rad",
+            "isv_ave_rad",
+            "transparent",
+            "study_rmsd_rad",
+            "study_isv_ave_rad",
+        ],
+    )
     r = r.assign(subject=r["subject"].astype(str), transparent=r["transparent"].astype(str))
     group, subjects = r[r["subject"] == "all"], r[r["subject"] != "all"]
     rows = []
@@ -347,18 +462,32 @@ def block_transparency(run: Run) -> str:
             g = group[(group["phase"] == phase) & (group["joint"] == joint)].iloc[0]
             own = subjects[(subjects["phase"] == phase) & (subjects["joint"] == joint)]
             judged = own[own["transparent"].isin(["True", "False"])]
-            rows.append([phase, joint, f"{fixed(g['rmsd_rad'], 3)} ({fixed(g['study_rmsd_rad'], 3)})",
-                         f"{fixed(g['isv_ave_rad'], 3)} ({fixed(g['study_isv_ave_rad'], 3)})",
-                         f"{(judged['transparent'] == 'True').sum()} / {len(judged)}"])
+            rows.append(
+                [
+                    phase,
+                    joint,
+                    f"{fixed(g['rmsd_rad'], 3)} ({fixed(g['study_rmsd_rad'], 3)})",
+                    f"{fixed(g['isv_ave_rad'], 3)} ({fixed(g['study_isv_ave_rad'], 3)})",
+                    f"{(judged['transparent'] == 'True').sum()} / {len(judged)}",
+                ]
+            )
     per_subject = subjects.drop_duplicates("subject")
     counts = pd.concat([per_subject["n_strides_no_device"], per_subject["n_strides_device"]]).astype(float)
-    text = [(f"{len(per_subject)} subjects, {plain(counts.min())}–{plain(counts.max())} kept strides per trial; "
-             "RMSD of the mean trajectories with vs without the device and ISV_ave, in rad, ours (study):"), "",
-            table(["phase", "joint", "RMSD", "ISV_ave", "subjects transparent (RMSD < ISV_ave)"], rows), ""]
+    text = [
+        (
+            f"{len(per_subject)} subjects, {plain(counts.min())}–{plain(counts.max())} kept strides per trial; "
+            "RMSD of the mean trajectories with vs without the device and ISV_ave, in rad, ours (study):"
+        ),
+        "",
+        table(["phase", "joint", "RMSD", "ISV_ave", "subjects transparent (RMSD < ISV_ave)"], rows),
+        "",
+    ]
     ratio = (group["isv_ave_rad"].astype(float) / group["study_isv_ave_rad"].astype(float) - 1).abs().max()
     below = int((group["rmsd_rad"].astype(float) < group["isv_ave_rad"].astype(float)).sum())
-    text.append(f"ISV_ave is within {num(ratio * 100, 2)} % of the study's everywhere; {below} of {len(group)} "
-                "group RMSDs lie below their ISV_ave.")
+    text.append(
+        f"ISV_ave is within {num(ratio * 100, 2)} % of the study's everywhere; {below} of {len(group)} "
+        "group RMSDs lie below their ISV_ave."
+    )
     return "\n".join(text)
 
 
@@ -368,15 +497,32 @@ def block_interaction_force(run: Run) -> str:
     f = run.tsv(name)
     if f is None:
         return not_in_run(run, name)
-    f = run.need(f, name, ["subject", "phase", "n_strides", "rms_force_mean_n", "max_abs_force_mean_n",
-                           "study_rms_force_mean_n", "study_max_abs_force_mean_n"])
+    f = run.need(
+        f,
+        name,
+        [
+            "subject",
+            "phase",
+            "n_strides",
+            "rms_force_mean_n",
+            "max_abs_force_mean_n",
+            "study_rms_force_mean_n",
+            "study_max_abs_force_mean_n",
+        ],
+    )
     group = f[f["subject"].astype(str) == "all"]
-    rows = [[r["phase"], int(r["n_strides"]),
-             f"{fixed(r['rms_force_mean_n'], 2)} ({fixed(r['study_rms_force_mean_n'], 2)})",
-             f"{fixed(r['max_abs_force_mean_n'], 2)} ({fixed(r['study_max_abs_force_mean_n'], 2)})"]
-            for _, r in group.iterrows()]
-    return ("Mean over subjects, ours (study):\n\n"
-            + table(["phase", "strides", "RMS force (N)", "largest \\|F\\| (N)"], rows))
+    rows = [
+        [
+            r["phase"],
+            int(r["n_strides"]),
+            f"{fixed(r['rms_force_mean_n'], 2)} ({fixed(r['study_rms_force_mean_n'], 2)})",
+            f"{fixed(r['max_abs_force_mean_n'], 2)} ({fixed(r['study_max_abs_force_mean_n'], 2)})",
+        ]
+        for _, r in group.iterrows()
+    ]
+    return "Mean over subjects, ours (study):\n\n" + table(
+        ["phase", "strides", "RMS force (N)", "largest \\|F\\| (N)"], rows
+    )
 
 
 def block_device(run: Run) -> str:
@@ -386,9 +532,16 @@ def block_device(run: Run) -> str:
     if d is None:
         return not_in_run(run, name)
     d = run.need(d, name, ["metric", "value", "study_value", "unit", "difference_pct"])
-    rows = [[f"`{r['metric']}`", num(r["value"]), plain(r["study_value"]),
-             r["unit"] if isinstance(r["unit"], str) else "", fixed(r["difference_pct"], 1)]
-            for _, r in d.iterrows()]
+    rows = [
+        [
+            f"`{r['metric']}`",
+            num(r["value"]),
+            plain(r["study_value"]),
+            r["unit"] if isinstance(r["unit"], str) else "",
+            fixed(r["difference_pct"], 1),
+        ]
+        for _, r in d.iterrows()
+    ]
     return table(["metric", "ours", "study", "unit", "difference (%)"], rows)
 
 
@@ -403,15 +556,24 @@ def block_strides(run: Run) -> str:
 
     def row(label, g):
         flagged = g[g["status"].astype(str) != "ok"]
-        return [label, len(g), int(g["n_strides"].sum()), int(g["n_perturbed"].sum()), int(g["n_removed"].sum()),
-                int(g["n_kept"].sum()), f"{int(g['n_kept'].min())}–{int(g['n_kept'].max())}",
-                ", ".join(f"{t} ({st})" for t, st in zip(flagged["trial"], flagged["status"])) or "none"]
+        return [
+            label,
+            len(g),
+            int(g["n_strides"].sum()),
+            int(g["n_perturbed"].sum()),
+            int(g["n_removed"].sum()),
+            int(g["n_kept"].sum()),
+            f"{int(g['n_kept'].min())}–{int(g['n_kept'].max())}",
+            ", ".join(f"{t} ({st})" for t, st in zip(flagged["trial"], flagged["status"])) or "none",
+        ]
 
     for subject in ordered(s["subject"].astype(str), ()):
         rows.append(row(subject, s[s["subject"].astype(str) == subject]))
     rows.append(row("**all**", s))
-    return table(["subject", "trials", "strides", "perturbed", "removed (outliers)", "kept", "kept per trial",
-                  "trials flagged"], rows)
+    return table(
+        ["subject", "trials", "strides", "perturbed", "removed (outliers)", "kept", "kept per trial", "trials flagged"],
+        rows,
+    )
 
 
 def block_planning(run: Run) -> str:
@@ -441,13 +603,16 @@ BLOCKS: dict[str, Callable[[Run], str]] = {
 
 # --- the page ----------------------------------------------------------------------------------------------
 
+
 def rewrite(page: str, run: Run, source: str = "page") -> str:
     """``page`` with every generated part rewritten from ``run``; every byte outside the parts kept."""
     found = list(BLOCK.finditer(page))
     if len(OPENING.findall(page)) != len(found) or len(CLOSING.findall(page)) != len(found):
-        raise PageError(f"{source}: every '<!-- generated: NAME -->' line needs its own '<!-- end generated -->' "
-                        f"line below it ({len(OPENING.findall(page))} opening, {len(CLOSING.findall(page))} "
-                        "closing markers)")
+        raise PageError(
+            f"{source}: every '<!-- generated: NAME -->' line needs its own '<!-- end generated -->' "
+            f"line below it ({len(OPENING.findall(page))} opening, {len(CLOSING.findall(page))} "
+            "closing markers)"
+        )
     unknown = sorted({m.group(2) for m in found} - set(BLOCKS))
     if unknown:
         raise PageError(f"{source}: unknown generated part(s) {unknown}; known: {sorted(BLOCKS)}")
@@ -457,7 +622,7 @@ def rewrite(page: str, run: Run, source: str = "page") -> str:
         texts["run"] = block_run(run)
     out, end = [], 0
     for m in found:
-        out += [page[end:m.start()], m.group(1), "\n", texts[m.group(2)], "\n\n", m.group(4)]
+        out += [page[end : m.start()], m.group(1), "\n", texts[m.group(2)], "\n\n", m.group(4)]
         end = m.end()
     out.append(page[end:])
     return "".join(out)
@@ -466,11 +631,17 @@ def rewrite(page: str, run: Run, source: str = "page") -> str:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--results", default="results", help="the run's results folder (default: results)")
-    ap.add_argument("--configfile", action="append", default=[], metavar="FILE",
-                    help="a config file given to Snakemake on top of config/config.yaml (repeat in the same order)")
+    ap.add_argument(
+        "--configfile",
+        action="append",
+        default=[],
+        metavar="FILE",
+        help="a config file given to Snakemake on top of config/config.yaml (repeat in the same order)",
+    )
     ap.add_argument("--page", default=str(DEFAULT_PAGE), help="the page to rewrite (default: docs/results.md)")
-    ap.add_argument("--check", action="store_true",
-                    help="write nothing; exit 1 when the page differs from what would be written")
+    ap.add_argument(
+        "--check", action="store_true", help="write nothing; exit 1 when the page differs from what would be written"
+    )
     args = ap.parse_args(argv)
     page = Path(args.page)
     try:
@@ -485,8 +656,10 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     if args.check:
         if after != before:
-            print(f"results_page: {page} is not that of {args.results}: run without --check to rewrite it",
-                  file=sys.stderr)
+            print(
+                f"results_page: {page} is not that of {args.results}: run without --check to rewrite it",
+                file=sys.stderr,
+            )
             return 1
         return 0
     if after != before:

@@ -52,14 +52,23 @@ def rule_times(results: Path) -> pd.DataFrame:
         rel = path.relative_to(bench)
         log = results / "logs" / rel.with_suffix(".log")
         wall = float(frame["s"].iloc[-1])
-        rows.append({"rule": rel.parts[0], "wall_s": wall,
-                     **job_split(wall, log.read_text() if log.is_file() else None)})
+        rows.append(
+            {"rule": rel.parts[0], "wall_s": wall, **job_split(wall, log.read_text() if log.is_file() else None)}
+        )
     if not rows:
         raise SystemExit(f"{bench}: no benchmark files")
-    table = (pd.DataFrame(rows).groupby("rule")
-             .agg(jobs=("wall_s", "size"), wall_s=("wall_s", "sum"), startup_s=("startup_s", "sum"),
-                  io_s=("io_s", "sum"), compute_s=("compute_s", "sum"))
-             .reset_index())
+    table = (
+        pd.DataFrame(rows)
+        .groupby("rule")
+        .agg(
+            jobs=("wall_s", "size"),
+            wall_s=("wall_s", "sum"),
+            startup_s=("startup_s", "sum"),
+            io_s=("io_s", "sum"),
+            compute_s=("compute_s", "sum"),
+        )
+        .reset_index()
+    )
     table["share_pct"] = 100.0 * table["wall_s"] / table["wall_s"].sum()
     return table.sort_values("wall_s", ascending=False, ignore_index=True)
 
@@ -71,8 +80,10 @@ def main(results: str = "results") -> None:
     table = rule_times(root)
     print(table.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     total = table[["wall_s", "startup_s", "io_s", "compute_s"]].sum()
-    print(f"total: {int(table['jobs'].sum())} jobs, {total['wall_s']:.0f} s of job wall time: start-up "
-          f"{total['startup_s']:.0f} s, I/O {total['io_s']:.0f} s, compute {total['compute_s']:.0f} s")
+    print(
+        f"total: {int(table['jobs'].sum())} jobs, {total['wall_s']:.0f} s of job wall time: start-up "
+        f"{total['startup_s']:.0f} s, I/O {total['io_s']:.0f} s, compute {total['compute_s']:.0f} s"
+    )
 
 
 if __name__ == "__main__":

@@ -33,11 +33,16 @@ import pandas as pd
 
 #: Columns of the impedance table renamed to carry their units: old -> new.
 RENAMED = {
-    "K": "K_nm_per_rad", "D": "D_nms_per_rad",
-    "K_ci95_low": "K_ci95_low_nm_per_rad", "K_ci95_high": "K_ci95_high_nm_per_rad",
-    "D_ci95_low": "D_ci95_low_nms_per_rad", "D_ci95_high": "D_ci95_high_nms_per_rad",
-    "K_true": "K_true_nm_per_rad", "D_true": "D_true_nms_per_rad",
-    "K_error": "K_error_nm_per_rad", "D_error": "D_error_nms_per_rad",
+    "K": "K_nm_per_rad",
+    "D": "D_nms_per_rad",
+    "K_ci95_low": "K_ci95_low_nm_per_rad",
+    "K_ci95_high": "K_ci95_high_nm_per_rad",
+    "D_ci95_low": "D_ci95_low_nms_per_rad",
+    "D_ci95_high": "D_ci95_high_nms_per_rad",
+    "K_true": "K_true_nm_per_rad",
+    "D_true": "D_true_nms_per_rad",
+    "K_error": "K_error_nm_per_rad",
+    "D_error": "D_error_nms_per_rad",
     "cost_rad2": "sum_sq_error_rad2",
 }
 #: Files that must be byte-identical (relative to results/; globs).
@@ -75,8 +80,10 @@ def _same_impedance(base: Path, new: Path) -> list[str]:
     diff = now != old
     print(f"{rel}: {int(diff.to_numpy().sum())} differing cells of {diff.size} after renaming; new columns {extra}")
     rows, cols = diff.to_numpy().nonzero()
-    return [f"{rel}: row {i}, column {old.columns[j]}: {old.iat[i, j]!r} -> {now.iat[i, j]!r}"
-            for i, j in zip(rows[:20], cols[:20])]
+    return [
+        f"{rel}: row {i}, column {old.columns[j]}: {old.iat[i, j]!r} -> {now.iat[i, j]!r}"
+        for i, j in zip(rows[:20], cols[:20])
+    ]
 
 
 def _others(base: Path, new: Path) -> None:
@@ -112,8 +119,9 @@ def build(rev: str, jobs: int) -> int:
         base, new = Path(tmp) / "base", Path(tmp) / "new"
         subprocess.run(["git", "worktree", "add", "--detach", str(base), rev], cwd=root, check=True)
         try:
-            files = subprocess.run(["git", "ls-files", "-co", "--exclude-standard"], cwd=root, check=True,
-                                   capture_output=True, text=True).stdout.split()
+            files = subprocess.run(
+                ["git", "ls-files", "-co", "--exclude-standard"], cwd=root, check=True, capture_output=True, text=True
+            ).stdout.split()
             for f in files:
                 if (root / f).is_file():
                     (new / f).parent.mkdir(parents=True, exist_ok=True)

@@ -27,30 +27,50 @@ def main() -> None:
             src = ROOT / item
             (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
         t0 = time.perf_counter()
-        res = subprocess.run([sys.executable, "-m", "snakemake", "-j2", "results/validation/summary.tsv"],
-                             cwd=work, capture_output=True, text=True)
+        res = subprocess.run(
+            [sys.executable, "-m", "snakemake", "-j2", "results/validation/summary.tsv"],
+            cwd=work,
+            capture_output=True,
+            text=True,
+        )
         wall = time.perf_counter() - t0
         if res.returncode:
             sys.exit(res.stderr[-3000:])
         summary = pd.read_csv(work / "results/validation/summary.tsv", sep="\t")
-        bench = pd.concat(pd.read_csv(p, sep="\t") for p in (work / "results/benchmarks/validation_chunk").glob("*.tsv"))
-    print(f"validation study (729 combinations x 2 conditions x 10 starts), snakemake -j2: {wall:.1f} s wall "
-          f"(chunk jobs {bench.s.sum():.1f} s CPU in all)")
+        bench = pd.concat(
+            pd.read_csv(p, sep="\t") for p in (work / "results/benchmarks/validation_chunk").glob("*.tsv")
+        )
+    print(
+        f"validation study (729 combinations x 2 conditions x 10 starts), snakemake -j2: {wall:.1f} s wall "
+        f"(chunk jobs {bench.s.sum():.1f} s CPU in all)"
+    )
     pd.set_option("display.width", 200)
-    cols = ["condition", "parameter", "min_error", "max_error", "sd_error", "study_min_error", "study_max_error",
-            "study_sd_error"]
+    cols = [
+        "condition",
+        "parameter",
+        "min_error",
+        "max_error",
+        "sd_error",
+        "study_min_error",
+        "study_max_error",
+        "study_sd_error",
+    ]
     print(summary[cols].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     clean = summary[summary.condition == "no_noise"].set_index("parameter")["max_abs_error"]
     k_ok = clean[clean.index.str.startswith("K")].max() <= 0.05
     d_ok = clean[clean.index.str.startswith("D")].max() <= 0.005
-    print(f"no noise: max |dK| {clean[clean.index.str.startswith('K')].max():.4g} (target 0.05) "
-          f"{'ok' if k_ok else 'MISSED'}; max |dD| {clean[clean.index.str.startswith('D')].max():.4g} "
-          f"(target 0.005) {'ok' if d_ok else 'MISSED'}")
+    print(
+        f"no noise: max |dK| {clean[clean.index.str.startswith('K')].max():.4g} (target 0.05) "
+        f"{'ok' if k_ok else 'MISSED'}; max |dD| {clean[clean.index.str.startswith('D')].max():.4g} "
+        f"(target 0.005) {'ok' if d_ok else 'MISSED'}"
+    )
     noisy = summary[summary.condition == "noise"].set_index("parameter")
     for p in ("K_hip", "D_hip", "K_knee", "D_knee"):
         ok = noisy.loc[p, "sd_error"] <= noisy.loc[p, "study_sd_error"]
-        print(f"noise: SD {p} {noisy.loc[p, 'sd_error']:.4g} vs study {noisy.loc[p, 'study_sd_error']:.4g} "
-              f"{'ok' if ok else 'MISSED'}")
+        print(
+            f"noise: SD {p} {noisy.loc[p, 'sd_error']:.4g} vs study {noisy.loc[p, 'study_sd_error']:.4g} "
+            f"{'ok' if ok else 'MISSED'}"
+        )
     print(f"speed: {wall:.1f} s (target 60 s) {'ok' if wall <= 60 else 'MISSED'}")
 
 

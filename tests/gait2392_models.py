@@ -27,7 +27,7 @@ def scaled_gait2392(factors: dict[str, float], mass_kg: float, markers: bool = F
     state = model.initSystem()
     scales = osim.ScaleSet()
     for body, f in factors.items():
-        for name in ([body] if body in ("pelvis", "torso") else [f"{body}_r", f"{body}_l"]):
+        for name in [body] if body in ("pelvis", "torso") else [f"{body}_r", f"{body}_l"]:
             s = osim.Scale()
             s.setSegmentName(name)
             s.setScaleFactors(osim.Vec3(f, f, f))

@@ -28,9 +28,7 @@ impedance feedback, built from OpenSim components only.
 from __future__ import annotations
 
 import numpy as np
-import pytest
-
-osim = pytest.importorskip("opensim")
+import opensim as osim
 
 from loper_analysis.dynamics import SegmentParameters
 
@@ -62,7 +60,9 @@ class OpenSimLeg:
         cart = osim.Body("cart", p.cart_mass_kg, osim.Vec3(0.0), osim.Inertia(1.0, 1.0, 1.0))
         model.addBody(cart)
         model.addJoint(
-            osim.SliderJoint("slider", model.getGround(), osim.Vec3(0.0), osim.Vec3(0.0), cart, osim.Vec3(0.0), osim.Vec3(0.0))
+            osim.SliderJoint(
+                "slider", model.getGround(), osim.Vec3(0.0), osim.Vec3(0.0), cart, osim.Vec3(0.0), osim.Vec3(0.0)
+            )
         )
         parent, parent_loc = cart, osim.Vec3(0.0)
         for i, name in enumerate(SEGMENT_NAMES):
@@ -114,7 +114,9 @@ class OpenSimLeg:
 
     # ------------------------------------------------------------ state
 
-    def set_state(self, q, qd, u=np.zeros(4), force=np.zeros(2)) -> None:
+    def set_state(self, q, qd, u=None, force=None) -> None:
+        u = np.zeros(4) if u is None else u
+        force = np.zeros(2) if force is None else force
         s = self.state
         s.setTime(0.0)
         s.setQ(osim.Vector([float(v) for v in A_INV @ q]))
@@ -214,9 +216,7 @@ def _step_response(tau: str) -> str:
     """Lepton expression of the unit second-order step response at ``tau`` (0 before)."""
     z, wn = PULSE_ZETA, PULSE_OMEGA_N
     wd = wn * float(np.sqrt(1.0 - z * z))
-    return (
-        f"step({tau})*(1 - exp(-{z * wn!r}*({tau}))*(cos({wd!r}*({tau})) + {z * wn / wd!r}*sin({wd!r}*({tau}))))"
-    )
+    return f"step({tau})*(1 - exp(-{z * wn!r}*({tau}))*(cos({wd!r}*({tau})) + {z * wn / wd!r}*sin({wd!r}*({tau}))))"
 
 
 def rod_force_expression(onset_s: float | None) -> str:
@@ -300,24 +300,33 @@ class PerturbedSwingLeg:
         for i, (name, joint) in enumerate(zip(SEGMENT_NAMES, COORDINATES[1:])):
             link = osim.Body(f"{joint}_link", eps, osim.Vec3(0.0), osim.Inertia(eps, eps, eps))
             model.addBody(link)
-            ref = osim.PinJoint(f"{joint}_ref_pin", parent, parent_loc, osim.Vec3(0.0), link, osim.Vec3(0.0), osim.Vec3(0.0))
+            ref = osim.PinJoint(
+                f"{joint}_ref_pin", parent, parent_loc, osim.Vec3(0.0), link, osim.Vec3(0.0), osim.Vec3(0.0)
+            )
             coord = ref.upd_coordinates(0)
             coord.setName(f"{joint}_reference")
             coord.setPrescribedFunction(osim.Sine(*SWING_SINES[joint]))
             coord.setDefaultIsPrescribed(True)
             model.addJoint(ref)
             body = osim.Body(
-                name, p.mass_kg[i], osim.Vec3(p.com_x_m[i], p.com_y_m[i], 0.0), osim.Inertia(0.3, 0.2, p.inertia_kg_m2[i])
+                name,
+                p.mass_kg[i],
+                osim.Vec3(p.com_x_m[i], p.com_y_m[i], 0.0),
+                osim.Inertia(0.3, 0.2, p.inertia_kg_m2[i]),
             )
             model.addBody(body)
-            dev = osim.PinJoint(f"{joint}_dev_pin", link, osim.Vec3(0.0), osim.Vec3(0.0), body, osim.Vec3(0.0), osim.Vec3(0.0))
+            dev = osim.PinJoint(
+                f"{joint}_dev_pin", link, osim.Vec3(0.0), osim.Vec3(0.0), body, osim.Vec3(0.0), osim.Vec3(0.0)
+            )
             dev.upd_coordinates(0).setName(f"{joint}_deviation")
             model.addJoint(dev)
             parent, parent_loc = body, osim.Vec3(0.0, -p.length_m[i], 0.0)
 
         K, D = np.asarray(impedance, dtype=float)[0::2], np.asarray(impedance, dtype=float)[1::2]
         for j, joint in enumerate(COORDINATES[1:]):
-            fb = osim.ExpressionBasedCoordinateForce(f"{joint}_deviation", f"-({float(K[j])!r})*q - ({float(D[j])!r})*qdot")
+            fb = osim.ExpressionBasedCoordinateForce(
+                f"{joint}_deviation", f"-({float(K[j])!r})*q - ({float(D[j])!r})*qdot"
+            )
             fb.setName(f"{joint}_impedance")
             model.addForce(fb)
 
@@ -367,7 +376,9 @@ class PerturbedSwingLeg:
         """OpenSim joint coordinates of the leg (4,): cart x and reference + deviation per joint."""
         v = [self._coordinate("x").getValue(s)]
         for joint in COORDINATES[1:]:
-            v.append(self._coordinate(f"{joint}_reference").getValue(s) + self._coordinate(f"{joint}_deviation").getValue(s))
+            v.append(
+                self._coordinate(f"{joint}_reference").getValue(s) + self._coordinate(f"{joint}_deviation").getValue(s)
+            )
         return np.array(v)
 
     def deviation(self, s) -> np.ndarray:
@@ -375,7 +386,8 @@ class PerturbedSwingLeg:
         return np.array([self._coordinate(f"{j}_deviation").getValue(s) for j in COORDINATES[1:]])
 
     def simulate(self, time_s, accuracy: float = 1e-8):
-        """Integrate from ``span_s[0]`` on the unperturbed swing; q (n, 4) and rod force vector (n, 2) N at ``time_s``."""
+        """Integrate from ``span_s[0]`` on the unperturbed swing; q (n, 4) and rod force vector (n, 2) N at
+        ``time_s``."""
         t0 = self.span_s[0]
         s = self.state
         s.setTime(t0)

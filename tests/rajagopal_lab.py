@@ -147,7 +147,7 @@ def walking_stances(grf_mot=GRF_MOT, walk_trc=WALK_TRC) -> tuple[list[Stance], i
     n = markers.shape[0] * ratio
     if abs(t[first] - time_s[0]) > 1e-9 or first + n > t.size:
         raise ValueError(f"{grf_mot}: does not cover the {markers.shape[0]} frames of {walk_trc}")
-    rows = grf.iloc[first:first + n]
+    rows = grf.iloc[first : first + n]
     stances = []
     for s in _SIDES:
         col = {q: rows[f"ground_force_{s}_{q}"].to_numpy() for q in ("vx", "vy", "vz", "px", "py", "pz")}
@@ -216,9 +216,19 @@ def _write_walk(path: Path, prefix: str, margin_m: float, unloaded_force_n: floa
         rest = wrench_channels(plate, [0.0, 0.0, unloaded_force_n], [0.0, 0.0, 0.0])
         columns.append(plate_channels(plate, force, cop, free) + rest)
     labels, units = _channel_names(len(plates))
-    return write_c3d(path, [prefix + m for m in names], model_to_lab(markers), rate, labels, np.hstack(columns),
-                     units, WALK_ANALOG_RATE_HZ, "mm", first_frame=_first_frame(float(time_s[0]), rate, WALK_TRC),
-                     force_platforms=plates)
+    return write_c3d(
+        path,
+        [prefix + m for m in names],
+        model_to_lab(markers),
+        rate,
+        labels,
+        np.hstack(columns),
+        units,
+        WALK_ANALOG_RATE_HZ,
+        "mm",
+        first_frame=_first_frame(float(time_s[0]), rate, WALK_TRC),
+        force_platforms=plates,
+    )
 
 
 def static_feet(static_trc=STATIC_TRC) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -254,14 +264,31 @@ def _write_static(path: Path, prefix: str, margin_m: float, mass_kg: float, stat
         force = np.tile([0.0, 0.0, share * weight_n], (n, 1))
         columns.append(plate_channels(plate, force, feet[side][1]))
     labels, units = _channel_names(len(plates))
-    return write_c3d(path, [prefix + m for m in names], model_to_lab(markers), rate, labels, np.hstack(columns),
-                     units, STATIC_ANALOG_RATE_HZ, "mm", first_frame=_first_frame(float(time_s[0]), rate, static_trc),
-                     force_platforms=plates)
+    return write_c3d(
+        path,
+        [prefix + m for m in names],
+        model_to_lab(markers),
+        rate,
+        labels,
+        np.hstack(columns),
+        units,
+        STATIC_ANALOG_RATE_HZ,
+        "mm",
+        first_frame=_first_frame(float(time_s[0]), rate, static_trc),
+        force_platforms=plates,
+    )
 
 
-def write_lab_files(out_dir: str | os.PathLike, *, subject_prefix: str = "Subject11:",
-                    mass_kg: float = SUBJECT_MASS_KG, plate_margin_m: float = 0.1, unloaded_force_n: float = -6.0,
-                    static_trc: str | os.PathLike = STATIC_TRC, static_gaps=STATIC_GAPS) -> dict[str, Path]:
+def write_lab_files(
+    out_dir: str | os.PathLike,
+    *,
+    subject_prefix: str = "Subject11:",
+    mass_kg: float = SUBJECT_MASS_KG,
+    plate_margin_m: float = 0.1,
+    unloaded_force_n: float = -6.0,
+    static_trc: str | os.PathLike = STATIC_TRC,
+    static_gaps=STATIC_GAPS,
+) -> dict[str, Path]:
     """Write ``static.c3d`` and ``walk-nodevice.c3d`` of the Rajagopal2016 subject into ``out_dir`` (module notes).
 
     Parameters
@@ -289,16 +316,20 @@ def write_lab_files(out_dir: str | os.PathLike, *, subject_prefix: str = "Subjec
         ``{"static": path, "walk-nodevice": path}``.
     """
     out = Path(out_dir)
-    return {STATIC_TRIAL: _write_static(out / f"{STATIC_TRIAL}.c3d", subject_prefix, plate_margin_m, mass_kg,
-                                        Path(static_trc), static_gaps),
-            WALK_TRIAL: _write_walk(out / f"{WALK_TRIAL}.c3d", subject_prefix, plate_margin_m, unloaded_force_n)}
+    return {
+        STATIC_TRIAL: _write_static(
+            out / f"{STATIC_TRIAL}.c3d", subject_prefix, plate_margin_m, mass_kg, Path(static_trc), static_gaps
+        ),
+        WALK_TRIAL: _write_walk(out / f"{WALK_TRIAL}.c3d", subject_prefix, plate_margin_m, unloaded_force_n),
+    }
 
 
 # ---------------------------------------------------------------- OpenSim's own tools
 
 
-def opensim_scale_reference(generic_osim, setup_xml, static_trc, mass_kg: float, out_osim, *,
-                            marker_set_xml=None) -> Path:
+def opensim_scale_reference(
+    generic_osim, setup_xml, static_trc, mass_kg: float, out_osim, *, marker_set_xml=None
+) -> Path:
     """Run OpenSim's ``ScaleTool(setup_xml)`` as the setup stands; returns ``out_osim``.
 
     Kept from the setup: the scaling order, measurements and scale set, the time ranges, the marker

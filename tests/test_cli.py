@@ -21,7 +21,9 @@ def test_segments_command_writes_winter_table(tmp_path):
     out = tmp_path / "seg.tsv"
     res = subprocess.run(
         ["loper-analysis", "segments", "--height-m", "1.8", "--mass-kg", "70", "--out", str(out)],
-        capture_output=True, text=True, check=False,
+        capture_output=True,
+        text=True,
+        check=False,
     )
     assert res.returncode == 0, res.stderr
     p = read_segments(out)
@@ -45,8 +47,12 @@ def test_ik_command_matches_opensims_tool(tmp_path, capsys):
     model = write_model(generic, tmp_path / "model.osim")
     t = np.arange(64) / 128.0
     w = 2 * np.pi * 0.6
-    truth = {"pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t), "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
-             "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1), "ankle_dorsiflexion_r": -0.1 * np.sin(w * t + 2)}
+    truth = {
+        "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
+        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
+        "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
+        "ankle_dorsiflexion_r": -0.1 * np.sin(w * t + 2),
+    }
     X = marker_positions(generic, truth) + np.random.default_rng(0).normal(0, 0.002, (t.size, len(MARKERS), 3))
     write_trc(tmp_path / "trial.trc", t, X, list(MARKERS))
     lab = np.stack([X[..., 0], -X[..., 2], X[..., 1]], axis=-1)  # model (Y up) -> Qualisys lab (Z up)
@@ -75,9 +81,25 @@ def test_ik_command_matches_opensims_tool(tmp_path, capsys):
     tool.setOutputMotionFileName(str(tmp_path / "tool.mot"))
     tool.set_results_directory(str(tmp_path))
     assert tool.run()
-    code = main(["ik", "--model", str(model), "--markers", str(tmp_path / "trial.c3d"),
-                 "--out", str(tmp_path / "ours.mot"), "--tasks", str(tmp_path / "tasks.xml"), "--start", "0.1",
-                 "--end", "0.4", "--accuracy", "1e-8"])
+    code = main(
+        [
+            "ik",
+            "--model",
+            str(model),
+            "--markers",
+            str(tmp_path / "trial.c3d"),
+            "--out",
+            str(tmp_path / "ours.mot"),
+            "--tasks",
+            str(tmp_path / "tasks.xml"),
+            "--start",
+            "0.1",
+            "--end",
+            "0.4",
+            "--accuracy",
+            "1e-8",
+        ]
+    )
     assert code == 0, capsys.readouterr().err
     ours, ref = read_mot(tmp_path / "ours.mot"), read_mot(tmp_path / "tool.mot")
     assert len(ours) == len(ref) == 39  # frames 0.1 .. 0.4 s at 128 Hz
@@ -90,8 +112,19 @@ def test_ik_command_names_a_missing_marker(tmp_path, capsys):
     model = write_model(build_lower_body_model(1.73, 64.9), tmp_path / "model.osim")
     write_trc(tmp_path / "trial.trc", np.arange(3) / 128.0, np.zeros((3, 1, 3)), ["LASI"])
     (tmp_path / "tasks.tsv").write_text("name\tkind\tweight\nLASI\tmarker\t1\nRASI\tmarker\t1\n")
-    code = main(["ik", "--model", str(model), "--markers", str(tmp_path / "trial.trc"),
-                 "--out", str(tmp_path / "out.mot"), "--tasks", str(tmp_path / "tasks.tsv")])
+    code = main(
+        [
+            "ik",
+            "--model",
+            str(model),
+            "--markers",
+            str(tmp_path / "trial.trc"),
+            "--out",
+            str(tmp_path / "out.mot"),
+            "--tasks",
+            str(tmp_path / "tasks.tsv"),
+        ]
+    )
     assert code == 2
     err = capsys.readouterr().err
     assert "trial.trc" in err and "['RASI']" in err and "not in the marker data" in err

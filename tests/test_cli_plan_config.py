@@ -13,6 +13,7 @@ import re
 import shutil
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
@@ -50,8 +51,10 @@ def _write(path: Path, data: dict) -> Path:
 @pytest.fixture
 def second(project) -> Path:
     """A file layered over config/config.yaml: a wider fit window and other stride counts."""
-    return _write(project / "config" / "mine.yaml", {"identification": {"window_after_s": WINDOW_AFTER_S},
-                                                      "planning": {"strides": STRIDES}})
+    return _write(
+        project / "config" / "mine.yaml",
+        {"identification": {"window_after_s": WINDOW_AFTER_S}, "planning": {"strides": STRIDES}},
+    )
 
 
 # --------------------------------------------------------------------------- load_config
@@ -143,8 +146,23 @@ def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
 
 
 def test_options_given_override_the_config(project, second):
-    args = _parser().parse_args(["plan", "--configfile", str(second), "--strides", "5", "--force-n", "30",
-                                 "--onset-ms", "125", "--target", "hip", "K", "10"])
+    args = _parser().parse_args(
+        [
+            "plan",
+            "--configfile",
+            str(second),
+            "--strides",
+            "5",
+            "--force-n",
+            "30",
+            "--onset-ms",
+            "125",
+            "--target",
+            "hip",
+            "K",
+            "10",
+        ]
+    )
     settings = _plan_settings(args, _read_config(args)[0])
     assert settings["strides"] == [5] and settings["pulse_force_n"] == 30.0 and settings["onsets"] == [125.0]
     assert settings["targets"] == [{"joint": "hip", "parameter": "K", "percent": 10.0}]
@@ -174,3 +192,51 @@ def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
     assert captured.out == "config: config/config.yaml, short.yaml (later files override earlier ones)\n"
     assert "pulse_duration_s = 0.1 s is longer than the fit window after the onset" in captured.err
     assert "0.05" in captured.err
+
+
+def test_validation_defaults_of_the_library_are_the_configs():
+    from loper_analysis.validation import ValidationSettings, validation_settings
+
+    config = yaml.safe_load(CONFIG.read_text())
+    assert ValidationSettings(**validation_settings(config)) == ValidationSettings()
+
+
+def test_validate_command_runs_with_the_configs_settings(project, capsys):
+    """One K/D level (one combination): the config's levels reach the chunk, the option --n-starts wins."""
+    from loper_analysis.steps.model import write_segments
+    from tests.parameter_sets import WINTER
+
+    write_segments(WINTER, project / "segments.tsv")
+    (project / "lab.yaml").write_text(
+        yaml.safe_dump(
+            {
+                "validation": {
+                    "stiffness_levels_nm_per_rad": [75.0],
+                    "damping_levels_nms_per_rad": [2.0],
+                    "n_chunks": 1,
+                },
+                "seed": 11,
+            }
+        )
+    )
+    main(
+        [
+            "validate",
+            "--configfile",
+            "lab.yaml",
+            "--n-starts",
+            "2",
+            "--segments",
+            "segments.tsv",
+            "--errors",
+            "errors.tsv",
+            "--fits",
+            "fits.tsv",
+        ]
+    )
+    assert (
+        capsys.readouterr().out.splitlines()[0]
+        == "config: config/config.yaml, lab.yaml (later files override earlier ones)"
+    )
+    fits = pd.read_csv(project / "fits.tsv", sep="\t")
+    assert fits["combination"].nunique() == 1  # 1 level of K and D per joint: 1 combination, not the default 729

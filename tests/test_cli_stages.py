@@ -59,14 +59,30 @@ def test_grf_command_on_walking5_agrees_with_opensims_reading(tmp_path, capsys):
         loaded = ours[:, 2] != 0.0
         assert loaded.sum() >= 10
         rest = np.median(theirs[~loaded], axis=0)  # the plate's unloaded reading, which our output removes
-        np.testing.assert_allclose(ours[loaded], theirs[loaded] - rest, atol=0.5)  # the resting levels differ by < 0.5 N
+        np.testing.assert_allclose(
+            ours[loaded], theirs[loaded] - rest, atol=0.5
+        )  # the resting levels differ by < 0.5 N
         np.testing.assert_array_equal(ours[~loaded], 0.0)
 
 
 def test_markers_command_on_walking5_equals_opensims_reading(tmp_path, capsys):
     out = tmp_path / "w5.trc"
-    code = main(["markers", str(WALKING5), "--out", str(out), "--rotate-deg", "0", "0", "0", "--cutoff-hz", "0",
-                 "--max-gap-frames", "0"])
+    code = main(
+        [
+            "markers",
+            str(WALKING5),
+            "--out",
+            str(out),
+            "--rotate-deg",
+            "0",
+            "0",
+            "0",
+            "--cutoff-hz",
+            "0",
+            "--max-gap-frames",
+            "0",
+        ]
+    )
     assert code == 0, capsys.readouterr()
     assert "40 markers, 1103 frames; 0 gap(s) filled, 40 marker(s) still missing" in capsys.readouterr().out
     t, X, labels = read_markers(out)
@@ -86,8 +102,10 @@ def test_events_command_on_walking5(tmp_path, capsys):
     assert main(["events", str(WALKING5), "--out", str(out), "--feet", "LCAL", "RCAL"]) == 0, capsys.readouterr()
     events = pd.read_csv(out, sep="\t")
     plain = events[events.event.isin(["heel_strike", "toe_off"])]
-    assert plain[["side", "event", "sample"]].values.tolist() == [["right", "heel_strike", 4767],
-                                                                  ["right", "toe_off", 5954]]
+    assert plain[["side", "event", "sample"]].values.tolist() == [
+        ["right", "heel_strike", 4767],
+        ["right", "toe_off", 5954],
+    ]
     np.testing.assert_allclose(plain["time_s"], [4767 / 2000.0, 5954 / 2000.0], atol=1e-12)
     assert "1 contact(s) flagged" in capsys.readouterr().out
 
@@ -109,12 +127,29 @@ def lab(tmp_path_factory):
 
 def test_scale_command_on_a_c3d_equals_the_step_on_the_trc(lab, tmp_path, capsys):
     out = tmp_path / "scaled.osim"
-    code = main(["scale", "--model", str(GAIT2392 / "gait2392_simbody.osim"), "--setup",
-                 str(GAIT2392 / "scale_setup.xml"), "--static", str(lab / "static.c3d"), "--mass-kg", "80",
-                 "--out", str(out)])
+    code = main(
+        [
+            "scale",
+            "--model",
+            str(GAIT2392 / "gait2392_simbody.osim"),
+            "--setup",
+            str(GAIT2392 / "scale_setup.xml"),
+            "--static",
+            str(lab / "static.c3d"),
+            "--mass-kg",
+            "80",
+            "--out",
+            str(out),
+        ]
+    )
     assert code == 0, capsys.readouterr()
-    scale_with_setup(GAIT2392 / "gait2392_simbody.osim", GAIT2392 / "scale_setup.xml", lab / "static.trc", 80.0,
-                     tmp_path / "step.osim")
+    scale_with_setup(
+        GAIT2392 / "gait2392_simbody.osim",
+        GAIT2392 / "scale_setup.xml",
+        lab / "static.trc",
+        80.0,
+        tmp_path / "step.osim",
+    )
     ours = segments_from_model(read_model(out), "l")
     step = segments_from_model(read_model(tmp_path / "step.osim"), "l")
     generic = segments_from_model(read_model(GAIT2392 / "gait2392_simbody.osim"), "l")
@@ -127,8 +162,23 @@ def test_segments_command_from_a_model(lab, tmp_path, capsys):
     assert main(["segments", "--model", str(GAIT2392 / "gait2392_simbody.osim"), "--out", str(out)]) == 0
     table = read_segments(out)
     np.testing.assert_allclose(table.mass_kg, (9.3014, 3.7075, 1.5666), rtol=1e-9)  # femur; tibia; talus+calcn+toes
-    assert subprocess.run(["loper-analysis", "segments", "--model", str(GAIT2392 / "gait2392_simbody.osim"),
-                           "--side", "right", "--out", str(tmp_path / "r.tsv")], capture_output=True, check=False).returncode == 0
+    assert (
+        subprocess.run(
+            [
+                "loper-analysis",
+                "segments",
+                "--model",
+                str(GAIT2392 / "gait2392_simbody.osim"),
+                "--side",
+                "right",
+                "--out",
+                str(tmp_path / "r.tsv"),
+            ],
+            capture_output=True,
+            check=False,
+        ).returncode
+        == 0
+    )
     np.testing.assert_allclose(read_segments(tmp_path / "r.tsv").mass_kg, table.mass_kg, rtol=1e-12)
 
 
@@ -155,8 +205,24 @@ def test_a_label_map_naming_a_marker_the_file_lacks(tmp_path, capsys):
 def test_a_setup_that_is_not_a_scale_setup(lab, tmp_path, capsys):
     shutil.copy(GAIT2392 / "gait2392_Scale_MarkerSet.xml", tmp_path / "setup.xml")
     out = tmp_path / "scaled.osim"
-    assert main(["scale", "--model", str(GAIT2392 / "gait2392_simbody.osim"), "--setup", str(tmp_path / "setup.xml"),
-                 "--static", str(lab / "static.trc"), "--mass-kg", "80", "--out", str(out)]) == 2
+    assert (
+        main(
+            [
+                "scale",
+                "--model",
+                str(GAIT2392 / "gait2392_simbody.osim"),
+                "--setup",
+                str(tmp_path / "setup.xml"),
+                "--static",
+                str(lab / "static.trc"),
+                "--mass-kg",
+                "80",
+                "--out",
+                str(out),
+            ]
+        )
+        == 2
+    )
     _one_line_error(capsys, "setup.xml")
     assert not out.exists()
 
@@ -186,16 +252,37 @@ def test_ik_command_reads_a_labs_labels(tmp_path, capsys):
     generic = build_lower_body_model(1.73, 64.9)
     model = write_model(generic, tmp_path / "model.osim")
     t = np.arange(32) / 128.0
-    X = marker_positions(generic, {"pelvis_ty": 0.93 + 0 * t, "hip_flexion_l": 0.3 * np.sin(4 * t),
-                                   "knee_flexion_l": 0.5 + 0.3 * np.sin(4 * t)})
+    X = marker_positions(
+        generic,
+        {"pelvis_ty": 0.93 + 0 * t, "hip_flexion_l": 0.3 * np.sin(4 * t), "knee_flexion_l": 0.5 + 0.3 * np.sin(4 * t)},
+    )
     lab = np.stack([X[..., 0], -X[..., 2], X[..., 1]], axis=-1)  # model (Y up) -> lab (Z up)
     write_c3d(tmp_path / "own.c3d", list(MARKERS), lab, 128.0)
     lab_labels = [f"Anna:{'L_FCC' if m == 'LHEE' else m}" for m in MARKERS]
     write_c3d(tmp_path / "lab.c3d", lab_labels, lab, 128.0)
     (tmp_path / "map.tsv").write_text("label\tmarker\nL_FCC\tLHEE\n")
-    assert main(["ik", "--model", str(model), "--markers", str(tmp_path / "own.c3d"), "--out", str(tmp_path / "own.mot")]) == 0
-    assert main(["ik", "--model", str(model), "--markers", str(tmp_path / "lab.c3d"), "--out", str(tmp_path / "lab.mot"),
-                 "--label-map", str(tmp_path / "map.tsv")]) == 0, capsys.readouterr().err
+    assert (
+        main(["ik", "--model", str(model), "--markers", str(tmp_path / "own.c3d"), "--out", str(tmp_path / "own.mot")])
+        == 0
+    )
+    assert (
+        main(
+            [
+                "ik",
+                "--model",
+                str(model),
+                "--markers",
+                str(tmp_path / "lab.c3d"),
+                "--out",
+                str(tmp_path / "lab.mot"),
+                "--label-map",
+                str(tmp_path / "map.tsv"),
+            ]
+        )
+        == 0
+    ), capsys.readouterr().err
     own, ours = read_mot(tmp_path / "own.mot"), read_mot(tmp_path / "lab.mot")
     pd.testing.assert_frame_equal(own, ours)
-    np.testing.assert_allclose(ours["knee_flexion_l"], 0.5 + 0.3 * np.sin(4 * t), atol=1e-4)  # rad; float32 mm in the file
+    np.testing.assert_allclose(
+        ours["knee_flexion_l"], 0.5 + 0.3 * np.sin(4 * t), atol=1e-4
+    )  # rad; float32 mm in the file

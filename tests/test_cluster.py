@@ -9,16 +9,22 @@ from loper_analysis.errors import LoperInputError
 
 
 def test_nothing_stops_a_submission_to_known_partitions():
-    assert submission_problems({"default-resources": "standard", "set-resources ik": "long"},
-                               ["standard", "long"], "/usr/bin/sbatch") == []
+    assert (
+        submission_problems(
+            {"default-resources": "standard", "set-resources ik": "long"}, ["standard", "long"], "/usr/bin/sbatch"
+        )
+        == []
+    )
 
 
 def test_an_unknown_partition_is_named_with_where_it_was_asked_for_and_what_exists():
-    problems = submission_problems({"default-resources": "standard", "set-resources ik": "nosuch"},
-                                   ["standard", "debug"], "/usr/bin/sbatch")
+    problems = submission_problems(
+        {"default-resources": "standard", "set-resources ik": "nosuch"}, ["standard", "debug"], "/usr/bin/sbatch"
+    )
     assert len(problems) == 1
-    assert problems[0] == ("set-resources ik: slurm_partition 'nosuch' is not a partition of this cluster "
-                           "(sinfo lists: debug, standard)")
+    assert problems[0] == (
+        "set-resources ik: slurm_partition 'nosuch' is not a partition of this cluster (sinfo lists: debug, standard)"
+    )
 
 
 def test_a_missing_sbatch_is_one_problem_and_partitions_are_not_guessed():
@@ -30,8 +36,11 @@ def test_a_missing_sbatch_is_one_problem_and_partitions_are_not_guessed():
 def test_without_sbatch_on_path_the_check_raises_before_anything_is_submitted(tmp_path, monkeypatch):
     monkeypatch.setenv("PATH", str(tmp_path))  # an empty folder: no sbatch, no sinfo
     assert shutil.which("sbatch") is None
-    with pytest.raises(LoperInputError, match=r"^cannot submit to SLURM: the SLURM profile submits jobs with "
-                                              r"sbatch, which is not on PATH"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"^cannot submit to SLURM: the SLURM profile submits jobs with "
+        r"sbatch, which is not on PATH",
+    ):
         check_slurm_submission({"default-resources": "standard"})
 
 
@@ -42,19 +51,24 @@ Killed
 slurmstepd-vm: error: Exceeded job memory limit
 slurmstepd-vm: error: StepId=9.batch exceeded memory limit (158093312 > 62914560), being killed
 """
-CGROUP_OOM = "slurmstepd: error: Detected 1 oom-kill event(s) in StepId=4242.batch. Some of your processes may " \
-             "have been killed by the cgroup out-of-memory handler.\n"
+CGROUP_OOM = (
+    "slurmstepd: error: Detected 1 oom-kill event(s) in StepId=4242.batch. Some of your processes may "
+    "have been killed by the cgroup out-of-memory handler.\n"
+)
 CANCELLED = "slurmstepd-vm: error: *** JOB 6 ON vm CANCELLED AT 2026-11-25T17:02:02 ***\n"
 TIME_LIMIT = "slurmstepd: error: *** JOB 77 ON node12 CANCELLED AT 2026-11-25T18:00:00 DUE TO TIME LIMIT ***\n"
 
 
-@pytest.mark.parametrize("output, start", [
-    (MEMORY_KILLED, "killed by SLURM for exceeding its memory"),
-    (CGROUP_OOM, "killed by SLURM for exceeding its memory"),
-    (TIME_LIMIT, "stopped by SLURM at its time limit"),
-    (CANCELLED, "cancelled (scancel)"),
-    ("Error in rule events_loadcell:\n    message: None\n", None),  # the job's own failure: its rule log says why
-])
+@pytest.mark.parametrize(
+    "output, start",
+    [
+        (MEMORY_KILLED, "killed by SLURM for exceeding its memory"),
+        (CGROUP_OOM, "killed by SLURM for exceeding its memory"),
+        (TIME_LIMIT, "stopped by SLURM at its time limit"),
+        (CANCELLED, "cancelled (scancel)"),
+        ("Error in rule events_loadcell:\n    message: None\n", None),  # the job's own failure: its rule log says why
+    ],
+)
 def test_why_slurm_ended_a_job_is_read_from_its_output(output, start):
     reason = slurm_end_reason(output)
     assert (reason is None) if start is None else reason.startswith(start)
@@ -64,7 +78,8 @@ CONSOLE = """Job 0 has been submitted with SLURM jobid 9 (log: /w/.snakemake/slu
 [Wed Nov 25 17:06:17 2026]
 Error in rule synthetic_lab:
     message: SLURM-job '9' failed, SLURM status is: 'FAILED'.
-    log: results/logs/synthetic_lab/S02.log, /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log (check log file(s) for error details)
+    log: results/logs/synthetic_lab/S02.log, /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log \
+(check log file(s) for error details)
 [Wed Nov 25 16:59:27 2026]
     message: Error in group trial
     log: /w/.snakemake/slurm_logs/group_trial_ik_strides/6.log (check log file(s) for error details)
@@ -77,8 +92,10 @@ Error in rule synthetic_lab:
 
 
 def test_the_failed_jobs_slurm_outputs_are_found_in_snakemakes_console_once_each():
-    assert failed_slurm_logs(CONSOLE) == ["/w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log",
-                                          "/w/.snakemake/slurm_logs/group_trial_ik_strides/6.log"]
+    assert failed_slurm_logs(CONSOLE) == [
+        "/w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log",
+        "/w/.snakemake/slurm_logs/group_trial_ik_strides/6.log",
+    ]
 
 
 def test_the_summary_names_job_reason_and_output_only_for_jobs_slurm_ended(tmp_path):
@@ -90,8 +107,11 @@ def test_the_summary_names_job_reason_and_output_only_for_jobs_slurm_ended(tmp_p
     (logs / "rule_events_loadcell").mkdir()
     (logs / "rule_events_loadcell" / "12.log").write_text("LoperInputError: data/raw/S01/pert050-1.loper.tsv\n")
     console = tmp_path / "snakemake.log"
-    console.write_text(CONSOLE.replace("/w/", f"{tmp_path}/")
-                       + f"    log: {logs}/rule_events_loadcell/12.log (check log file(s) for error details)\n")
+    console.write_text(
+        CONSOLE.replace("/w/", f"{tmp_path}/")
+        + f"    log: {logs}/rule_events_loadcell/12.log (check log file(s) for error details)\n"
+    )
     assert slurm_failure_lines(console) == [
-        f"SLURM job 9 (rule_synthetic_lab/S02): killed by SLURM for exceeding its memory: raise the rule's mem_mb under "
-        f"set-resources in the profile (SLURM's output: {logs}/rule_synthetic_lab/S02/9.log)"]
+        f"SLURM job 9 (rule_synthetic_lab/S02): killed by SLURM for exceeding its memory: raise the rule's mem_mb "
+        f"under set-resources in the profile (SLURM's output: {logs}/rule_synthetic_lab/S02/9.log)"
+    ]

@@ -69,8 +69,9 @@ def _heel(side, steps, t):
     for i, (_, plate, hs, to) in enumerate(mine):
         x = CROSSOVER_X if (side == "left" and plate == 2) else HEEL_X[plate]
         stance = (t >= hs) & (t <= to)
-        xyz[stance] = np.column_stack([np.full(stance.sum(), x), 1.1 - 1.0 * (t[stance] - hs),
-                                       np.full(stance.sum(), 0.05)])
+        xyz[stance] = np.column_stack(
+            [np.full(stance.sum(), x), 1.1 - 1.0 * (t[stance] - hs), np.full(stance.sum(), 0.05)]
+        )
         if i + 1 < len(mine):
             nxt = mine[i + 1]
             x2 = CROSSOVER_X if (side == "left" and nxt[1] == 2) else HEEL_X[nxt[1]]
@@ -165,8 +166,18 @@ def test_bad_input_is_named(trial):
     with pytest.raises(LoperInputError, match="walk: plate 2: corners_m must be a finite"):
         foot_contacts([plates[0], PlateForce(2, t, raw[2], np.zeros((3, 3)))], tm, heels, source="walk")
     with pytest.raises(LoperInputError, match="unknown flag"):
-        contact_events(pd.DataFrame({"side": ["left"], "flag": ["fine"], "start_s": [0.0], "end_s": [1.0],
-                                     "start_sample": [0], "end_sample": [9]}))
+        contact_events(
+            pd.DataFrame(
+                {
+                    "side": ["left"],
+                    "flag": ["fine"],
+                    "start_s": [0.0],
+                    "end_s": [1.0],
+                    "start_sample": [0],
+                    "end_sample": [9],
+                }
+            )
+        )
 
 
 def test_plate_offsets_inside_outside_and_height():
@@ -221,7 +232,7 @@ def test_clean_contacts_give_events_at_the_crossings_and_flagged_ones_none(judge
     gait = ev[ev["event"].isin(["heel_strike", "toe_off"])]
     assert len(gait) == 30  # 15 clean contacts
     truth = {}
-    for side, plate, hs, to in _steps():
+    for side, _plate, hs, to in _steps():
         a, b = _crossings(hs, to, PEAK_N)
         truth[(side, "heel_strike", round(hs, 2))] = a
         truth[(side, "toe_off", round(hs, 2))] = b
@@ -359,11 +370,16 @@ def test_walking5_contacts_feet_and_events(walking5):
     for row, plate in zip((p1, p2), plates):
         up, down = _crossing_times(plate.time_s, plate.vertical_force_n)
         assert 0.0 <= row["start_s"] - up < 0.0005 and 0.0 <= row["end_s"] - down < 0.0005
-    np.testing.assert_allclose([p1["start_s"], p1["end_s"], p2["start_s"], p2["end_s"]],
-                               [1.9650, 2.4780, 2.3835, 2.9770], atol=1e-9)
+    np.testing.assert_allclose(
+        [p1["start_s"], p1["end_s"], p2["start_s"], p2["end_s"]], [1.9650, 2.4780, 2.3835, 2.9770], atol=1e-9
+    )
     ev = contact_events(found)
     assert ev[["side", "event"]].values.tolist() == [
-        ["left", "flagged_start"], ["right", "heel_strike"], ["left", "flagged_end"], ["right", "toe_off"]]
+        ["left", "flagged_start"],
+        ["right", "heel_strike"],
+        ["left", "flagged_end"],
+        ["right", "toe_off"],
+    ]
     gait = ev[ev["event"].isin(["heel_strike", "toe_off"])]
     np.testing.assert_allclose(gait["time_s"], [p2["start_s"], p2["end_s"]], atol=0)
     assert gait["sample"].tolist() == [4767, 5954]
@@ -384,10 +400,13 @@ def test_plates_in_a_y_up_frame_with_corners_either_way_round_give_the_same_cont
     t, raw, tm, heels, _ = trial
     Q = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
     plates = [PlateForce(p.plate, p.time_s, p.vertical_force_n, (p.corners_m @ Q.T)[::-1]) for p in _plates(t, raw)]
-    turned = foot_contacts(plates, tm, {s: h @ Q.T for s, h in heels.items()}, **SETTINGS, source="S01/walk",
-                           up=(0.0, 1.0, 0.0))
-    pd.testing.assert_frame_equal(turned.drop(columns=[c for c in CONTACT_COLUMNS if c.endswith("_m")]),
-                                  judged.drop(columns=[c for c in CONTACT_COLUMNS if c.endswith("_m")]))
+    turned = foot_contacts(
+        plates, tm, {s: h @ Q.T for s, h in heels.items()}, **SETTINGS, source="S01/walk", up=(0.0, 1.0, 0.0)
+    )
+    pd.testing.assert_frame_equal(
+        turned.drop(columns=[c for c in CONTACT_COLUMNS if c.endswith("_m")]),
+        judged.drop(columns=[c for c in CONTACT_COLUMNS if c.endswith("_m")]),
+    )
     heel = [c for c in CONTACT_COLUMNS if c.endswith("_m")]
     np.testing.assert_allclose(turned[heel].to_numpy(float), judged[heel].to_numpy(float), atol=1e-12)
 
@@ -400,8 +419,15 @@ def test_plate_offsets_with_up_either_corner_order_and_a_tilted_plate_refused():
         np.testing.assert_allclose(out, [0.0, 0.1, math.hypot(0.2, 0.3)], atol=1e-12)
         np.testing.assert_allclose(height, [0.07, 0.0, 0.1], atol=1e-12)
     # up along the plate's own plane: 90 deg from its normal, refused naming the plate
-    refusal = (r"walk: plate 2: the plate does not face up: surface normal \[0\.0, 0\.0, 1\.0\] is 90\.0 deg from the "
-               r"up direction \[0\.0, 1\.0, 0\.0\]")
+    refusal = (
+        r"walk: plate 2: the plate does not face up: surface normal \[0\.0, 0\.0, 1\.0\] is 90\.0 deg from the "
+        r"up direction \[0\.0, 1\.0, 0\.0\]"
+    )
     with pytest.raises(LoperInputError, match=refusal):
-        foot_contacts([PlateForce(2, np.arange(10) / 100.0, np.zeros(10), c)], np.arange(2) / 100.0,
-                      {"left": np.zeros((2, 3)), "right": np.zeros((2, 3))}, source="walk", up=(0.0, 1.0, 0.0))
+        foot_contacts(
+            [PlateForce(2, np.arange(10) / 100.0, np.zeros(10), c)],
+            np.arange(2) / 100.0,
+            {"left": np.zeros((2, 3)), "right": np.zeros((2, 3))},
+            source="walk",
+            up=(0.0, 1.0, 0.0),
+        )

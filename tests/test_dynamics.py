@@ -350,7 +350,11 @@ def test_compiled_rk4_matches_dop853_for_a_perturbed_swing_with_feedback():
     fp[(t > onset + 1e-12) & (t <= onset + 0.1 + 1e-12), 0] = 40.0
     impedance = np.array([75.0, 2.0, 40.0, 1.0, 20.0, 0.5])
     window = prepare_window(
-        t, qu, qu, p, onset,
+        t,
+        qu,
+        qu,
+        p,
+        onset,
         force_perturbed_n=fp,
         pelvis_angle_unperturbed_rad=pelvis,
         pelvis_angle_perturbed_rad=pelvis,
@@ -392,8 +396,10 @@ def test_perturbed_trial_rk4_converges_at_fourth_order():
     """
     p = PARAMETER_SETS["winter"]
     impedance = [75.0, 2.0, 75.0, 2.0, 75.0, 2.0]
-    on_grid = {n: perturbed_trial(p, impedance, ValidationSettings(truth_substeps=n, pulse_duration_s=0.125))[2]
-               for n in (16, 32, 64)}
+    on_grid = {
+        n: perturbed_trial(p, impedance, ValidationSettings(truth_substeps=n, pulse_duration_s=0.125))[2]
+        for n in (16, 32, 64)
+    }
     d1 = np.abs(on_grid[16] - on_grid[32]).max()
     d2 = np.abs(on_grid[32] - on_grid[64]).max()
     assert d2 < 1e-11

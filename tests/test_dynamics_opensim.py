@@ -26,8 +26,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-osim = pytest.importorskip("opensim")
-
 from loper_analysis.dynamics import (
     SegmentParameters,
     attachment_jacobian,
@@ -37,7 +35,6 @@ from loper_analysis.dynamics import (
     segment_com_positions,
     simulate,
 )
-
 from tests.opensim_swing_leg import SEGMENT_NAMES, OpenSimLeg
 from tests.parameter_sets import ASYMMETRIC, WINTER
 

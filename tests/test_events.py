@@ -38,13 +38,13 @@ def _grf(noise_n=0.0, rng=None):
     j = np.arange(STANCE_SAMPLES + 1)
     starts = FIRST_HUMP + PERIOD_SAMPLES * np.arange(N_HUMPS)
     for s in starts:
-        f[s:s + STANCE_SAMPLES + 1] = PEAK_N * np.sin(np.pi * j / STANCE_SAMPLES)
+        f[s : s + STANCE_SAMPLES + 1] = PEAK_N * np.sin(np.pi * j / STANCE_SAMPLES)
     # swing blip above the on-threshold for 30 ms: a 30 ms "stance", shorter than 0.2 s
-    f[starts[2] + 900:starts[2] + 930] = 80.0
+    f[starts[2] + 900 : starts[2] + 930] = 80.0
     # stance dip below the off-threshold for 20 ms: a 20 ms "swing"
-    f[starts[4] + 350:starts[4] + 370] = 5.0
+    f[starts[4] + 350 : starts[4] + 370] = 5.0
     # swing bump into the dead band only (40 N): no event by hysteresis
-    f[starts[6] + 900:starts[6] + 1000] = 40.0
+    f[starts[6] + 900 : starts[6] + 1000] = 40.0
     if noise_n:
         f = f + rng.normal(0.0, noise_n, f.size)
     return np.arange(N_SAMPLES) / FS, f, starts
@@ -123,12 +123,25 @@ def test_strides_table_durations():
 
 
 def test_strides_without_exactly_one_toe_off_are_dropped():
-    events = pd.DataFrame({
-        "side": "right",
-        "event": ["toe_off", "heel_strike", "toe_off", "heel_strike", "heel_strike", "toe_off", "toe_off",
-                  "heel_strike", "toe_off", "heel_strike", "toe_off"],
-        "time_s": [0.1, 1.0, 1.6, 2.0, 3.0, 3.5, 3.7, 4.0, 4.6, 5.2, 5.8],
-    })
+    events = pd.DataFrame(
+        {
+            "side": "right",
+            "event": [
+                "toe_off",
+                "heel_strike",
+                "toe_off",
+                "heel_strike",
+                "heel_strike",
+                "toe_off",
+                "toe_off",
+                "heel_strike",
+                "toe_off",
+                "heel_strike",
+                "toe_off",
+            ],
+            "time_s": [0.1, 1.0, 1.6, 2.0, 3.0, 3.5, 3.7, 4.0, 4.6, 5.2, 5.8],
+        }
+    )
     st = strides(events, "right")
     # 1.0-2.0 kept; 2.0-3.0 has no toe-off; 3.0-4.0 has two; 4.0-5.2 kept; after 5.2 incomplete
     np.testing.assert_allclose(st["heel_strike_s"], [1.0, 4.0])

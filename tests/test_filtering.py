@@ -71,7 +71,7 @@ def test_runs_filter_equals_whole_signal_filter_away_from_the_gap():
     assert np.isnan(out[700:720, 1]).all() and np.isnan(out).sum() == 20 * 3  # NaN stays NaN, nowhere else
     np.testing.assert_array_equal(out[:, [0, 2]], whole[:, [0, 2]])  # complete markers: exactly lowpass
     # one second (128 frames) off the gap's edges the run's own edge transient has died out
-    far = np.r_[0:700 - 128, 720 + 128:len(X)]
+    far = np.r_[0 : 700 - 128, 720 + 128 : len(X)]
     diff = np.abs(out[far, 1] - whole[far, 1]).max()
     assert diff < 1e-11, diff  # measured 3.8e-13 m
     near = np.abs(out[690:700, 1] - whole[690:700, 1]).max()
@@ -84,12 +84,12 @@ def test_short_runs_are_left_unfiltered_and_flagged():
     assert shortest == 16  # sosfiltfilt pads 3 * (2 * 2 sections + 1) = 15 samples
     gappy = X.copy()
     gappy[100:110] = np.nan
-    gappy[110 + shortest - 1:200] = np.nan  # a run of 15 samples between two gaps: too short
-    gappy[200 + shortest:210] = np.nan  # 16 samples: filtered
+    gappy[110 + shortest - 1 : 200] = np.nan  # a run of 15 samples between two gaps: too short
+    gappy[200 + shortest : 210] = np.nan  # 16 samples: filtered
     out, short = lowpass_finite_runs(gappy, FS, 10.0, 4)
-    np.testing.assert_array_equal(out[110:110 + shortest - 1], X[110:110 + shortest - 1])
+    np.testing.assert_array_equal(out[110 : 110 + shortest - 1], X[110 : 110 + shortest - 1])
     assert short[:, 0, 0].nonzero()[0].tolist() == list(range(110, 110 + shortest - 1))
-    assert not np.array_equal(out[200:200 + shortest], X[200:200 + shortest])
+    assert not np.array_equal(out[200 : 200 + shortest], X[200 : 200 + shortest])
     np.testing.assert_array_equal(np.isnan(out), np.isnan(gappy))
 
 

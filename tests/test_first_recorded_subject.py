@@ -31,8 +31,16 @@ def walkthrough(tmp_path_factory):
     bin_dir = str(Path(sys.executable).parent)  # loper-analysis and snakemake of this environment
     outputs = []
     for command in doc_commands():
-        res = subprocess.run(command, shell=True, cwd=work, capture_output=True, text=True, timeout=900,
-                             env={"PATH": f"{bin_dir}:/usr/bin:/bin", "HOME": str(work)}, executable="/bin/bash")
+        res = subprocess.run(
+            command,
+            shell=True,
+            cwd=work,
+            capture_output=True,
+            text=True,
+            timeout=900,
+            env={"PATH": f"{bin_dir}:/usr/bin:/bin", "HOME": str(work)},
+            executable="/bin/bash",
+        )
         assert res.returncode == 0, (command, res.stderr[-3000:])
         outputs.append((command, res.stdout))
     return work, outputs
@@ -40,8 +48,16 @@ def walkthrough(tmp_path_factory):
 
 def test_the_doc_holds_the_commands_of_each_step():
     commands = doc_commands()
-    assert [c.split()[0] for c in commands] == ["mkdir", "loper-analysis", "loper-analysis", "mkdir", "cp",
-                                                 "loper-analysis", "snakemake", "loper-analysis"]
+    assert [c.split()[0] for c in commands] == [
+        "mkdir",
+        "loper-analysis",
+        "loper-analysis",
+        "mkdir",
+        "cp",
+        "loper-analysis",
+        "snakemake",
+        "loper-analysis",
+    ]
 
 
 def test_inspect_reports_what_the_doc_says(walkthrough):
@@ -80,8 +96,13 @@ def test_markers_ik_and_the_summary_say_what_the_doc_says(walkthrough):
     assert round(1000 * ik.marker_rms_mean_m, 1) == 34.8
     assert "exceeds 20 mm" in (work / "results/logs/ik/R11/walk-nodevice.log").read_text()
     summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t").iloc[0]
-    assert (summary.subject, summary.status, summary.n_frames, summary.n_frames_left_out, summary.turn_deg) == \
-        ("R11", "too_few_strides", 238, 0, 0.0)
+    assert (summary.subject, summary.status, summary.n_frames, summary.n_frames_left_out, summary.turn_deg) == (
+        "R11",
+        "too_few_strides",
+        238,
+        0,
+        0.0,
+    )
     assert (work / "results/grf/R11/walk-nodevice.grf.mot").is_file()
 
 

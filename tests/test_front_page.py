@@ -34,11 +34,23 @@ from tests.headline_tables import device_summary, impedance_row, impedance_table
 ROOT = Path(__file__).resolve().parents[1]
 
 SETTINGS = dict(
-    seed=2024, perturbation_onsets_ms=[50, 175, 300], perturbation_repeats=2, perturbed_side="left",
-    filter_cutoff_hz=40.0, filter_order=4, window_before_s=0.025, window_after_s=0.25,
-    stiffness_bounds_nm_per_rad=[0.0, 200.0], damping_bounds_nms_per_rad=[0.0, 10.0], n_starts=10,
-    noise_model="null_pairs", null_pair_components=6, synthetic_variability="study",
-    synthetic_walking_duration_s=45.0, pulse_force_n=40.0, pulse_duration_s=0.1,
+    seed=2024,
+    perturbation_onsets_ms=[50, 175, 300],
+    perturbation_repeats=2,
+    perturbed_side="left",
+    filter_cutoff_hz=40.0,
+    filter_order=4,
+    window_before_s=0.025,
+    window_after_s=0.25,
+    stiffness_bounds_nm_per_rad=[0.0, 200.0],
+    damping_bounds_nms_per_rad=[0.0, 10.0],
+    n_starts=10,
+    noise_model="null_pairs",
+    null_pair_components=6,
+    synthetic_variability="study",
+    synthetic_walking_duration_s=45.0,
+    pulse_force_n=40.0,
+    pulse_duration_s=0.1,
 )
 VERSIONS = {"Python": "3.11.7", "loper_analysis": "0.1.0", "OpenSim": "4.6"}
 
@@ -83,22 +95,47 @@ def test_fragment_numbers_are_the_tables_numbers():
     summary = impedance_summary(table)
     ci = impedance_summary_ci(summary)
     truth = truth_recovery(table)
-    rmsd = pd.DataFrame({"subject": ["S1", "all"], "phase": "swing", "joint": "knee", "rmsd_rad": [0.0958, 0.0679],
-                         "isv_ave_rad": [0.1338, 0.1338], "transparent": [True, True], "study_rmsd_rad": 0.071,
-                         "study_isv_ave_rad": 0.129})
+    rmsd = pd.DataFrame(
+        {
+            "subject": ["S1", "all"],
+            "phase": "swing",
+            "joint": "knee",
+            "rmsd_rad": [0.0958, 0.0679],
+            "isv_ave_rad": [0.1338, 0.1338],
+            "transparent": [True, True],
+            "study_rmsd_rad": 0.071,
+            "study_isv_ave_rad": 0.129,
+        }
+    )
     tr, dev = transparency_verdict(rmsd), device_comparison(device_summary())
     val = validation_verdict(validation_summary())
-    page = front_page_html({"S1": "synthetic", "S2": "synthetic", "R1": "recorded"},
-                           {"S1": ["a", "b"], "S2": ["a", "b"], "R1": ["a"]}, RunSettings(**SETTINGS), VERSIONS,
-                           device=dev, validation=val, summary=ci, truth=truth, figure_png=b"\x89PNG fake",
-                           transparency=tr)
+    page = front_page_html(
+        {"S1": "synthetic", "S2": "synthetic", "R1": "recorded"},
+        {"S1": ["a", "b"], "S2": ["a", "b"], "R1": ["a"]},
+        RunSettings(**SETTINGS),
+        VERSIONS,
+        device=dev,
+        validation=val,
+        summary=ci,
+        truth=truth,
+        figure_png=b"\x89PNG fake",
+        transparency=tr,
+    )
     parser = _Numbers()
     parser.feed(page)
     found = parser.found
     expected = {}
     for r in ci.to_dict("records"):
-        for col in ("K_mean_nm_per_rad", "K_ci95_low_nm_per_rad", "K_ci95_high_nm_per_rad", "D_mean_nms_per_rad",
-                    "D_ci95_low_nms_per_rad", "D_ci95_high_nms_per_rad", "vaf_pct_mean", "n_subjects"):
+        for col in (
+            "K_mean_nm_per_rad",
+            "K_ci95_low_nm_per_rad",
+            "K_ci95_high_nm_per_rad",
+            "D_mean_nms_per_rad",
+            "D_ci95_low_nms_per_rad",
+            "D_ci95_high_nms_per_rad",
+            "vaf_pct_mean",
+            "n_subjects",
+        ):
             expected[f"impedance-summary|{r['joint']}|{r['onset_ms']}|{col}"] = r[col]
     for r in truth.to_dict("records"):
         for p in ("K", "D"):
@@ -136,12 +173,23 @@ def test_fragment_numbers_are_the_tables_numbers():
 
 
 def test_nothing_fitted_and_no_impedance_experiment_are_said():
-    table = pd.DataFrame([impedance_row("S1", 50, j, math.nan, math.nan, (math.nan,) * 2, (math.nan,) * 2, 5.0, 0.1,
-                                        status="failed") for j in JOINTS])
+    table = pd.DataFrame(
+        [
+            impedance_row("S1", 50, j, math.nan, math.nan, (math.nan,) * 2, (math.nan,) * 2, 5.0, 0.1, status="failed")
+            for j in JOINTS
+        ]
+    )
     common = dict(device=device_comparison(device_summary()), validation=validation_verdict(validation_summary()))
-    page = front_page_html({"S1": "synthetic"}, {"S1": ["a"]}, RunSettings(**SETTINGS), VERSIONS,
-                           summary=impedance_summary_ci(impedance_summary(table)), truth=truth_recovery(table),
-                           impedance_status={"failed": 3}, **common)
+    page = front_page_html(
+        {"S1": "synthetic"},
+        {"S1": ["a"]},
+        RunSettings(**SETTINGS),
+        VERSIONS,
+        summary=impedance_summary_ci(impedance_summary(table)),
+        truth=truth_recovery(table),
+        impedance_status={"failed": 3},
+        **common,
+    )
     assert "no joint was fitted (3 failed;" in page and "(1 synthetic subject, 0 joint fits, 3 failed)" in page
     assert 'id="lf-truth-recovery"' not in page  # no table of nothing
     page = front_page_html({"S1": "synthetic"}, {}, RunSettings(**SETTINGS), VERSIONS, **common)
@@ -168,9 +216,18 @@ def _write_results(root: Path) -> None:
     summary_step(tables / "impedance.tsv", tables / "impedance_summary.tsv", tables / "literature.tsv")
     impedance_figure(tables / "impedance.tsv", root / "results/figures/impedance.png")
     (root / "results/transparency").mkdir(parents=True)
-    pd.DataFrame({"subject": ["S01", "all"], "phase": "swing", "joint": "knee", "rmsd_rad": [0.09, 0.07],
-                  "isv_ave_rad": [0.13, 0.13], "transparent": [True, True], "study_rmsd_rad": 0.071,
-                  "study_isv_ave_rad": 0.129}).to_csv(root / "results/transparency/rmsd.tsv", sep="\t", index=False)
+    pd.DataFrame(
+        {
+            "subject": ["S01", "all"],
+            "phase": "swing",
+            "joint": "knee",
+            "rmsd_rad": [0.09, 0.07],
+            "isv_ave_rad": [0.13, 0.13],
+            "transparent": [True, True],
+            "study_rmsd_rad": 0.071,
+            "study_isv_ave_rad": 0.129,
+        }
+    ).to_csv(root / "results/transparency/rmsd.tsv", sep="\t", index=False)
     (root / "results/device").mkdir(parents=True)
     device_summary().to_csv(root / "results/device/summary.tsv", sep="\t", index=False)
     (root / "results/validation").mkdir(parents=True)
@@ -181,11 +238,19 @@ def _front_page(root: Path, versions=VERSIONS) -> str:
     from loper_analysis.steps.report import front_page
 
     r = root / "results"
-    return front_page(r / "report/front_page.html", r / "device/summary.tsv", r / "validation/summary.tsv",
-                      {s: "synthetic" for s in ("S01", "S02", "S03")},
-                      {s: ["walk-nodevice", "walk-device", "pert050-1"] for s in ("S01", "S02", "S03")}, SETTINGS,
-                      r / "tables/impedance.tsv", r / "tables/impedance_summary.tsv", r / "figures/impedance.png",
-                      r / "transparency/rmsd.tsv", versions=versions)
+    return front_page(
+        r / "report/front_page.html",
+        r / "device/summary.tsv",
+        r / "validation/summary.tsv",
+        {s: "synthetic" for s in ("S01", "S02", "S03")},
+        {s: ["walk-nodevice", "walk-device", "pert050-1"] for s in ("S01", "S02", "S03")},
+        SETTINGS,
+        r / "tables/impedance.tsv",
+        r / "tables/impedance_summary.tsv",
+        r / "figures/impedance.png",
+        r / "transparency/rmsd.tsv",
+        versions=versions,
+    )
 
 
 def test_the_file_step_writes_the_same_bytes_from_the_same_files(tmp_path):
@@ -224,9 +289,15 @@ def test_the_report_shows_the_headline_tables_on_its_first_screen(tmp_path):
     shutil.copy(ROOT / "workflow/report/workflow.rst", tmp_path / "workflow/report/workflow.rst")
     (tmp_path / "Snakefile").write_text(
         'configfile: "config/config.yaml"\n\n\nreport: "workflow/report/workflow.rst"\n\n\n'
-        'rule all:\n    input:\n        "results/report/front_page.html",\n')
-    res = subprocess.run([sys.executable, "-m", "snakemake", "--report", "report.html"], cwd=tmp_path,
-                         capture_output=True, text=True, timeout=120)
+        'rule all:\n    input:\n        "results/report/front_page.html",\n'
+    )
+    res = subprocess.run(
+        [sys.executable, "-m", "snakemake", "--report", "report.html"],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert res.returncode == 0, res.stderr[-3000:]
     measured = screen.first_screen(tmp_path / "report.html", tmp_path / "first_screen.png")
     assert measured["viewport"] == [1400, 900]

@@ -23,8 +23,10 @@ THRESHOLD_N = 20.0
 
 @pytest.fixture(scope="module")
 def walking5_loads():
-    return [plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, THRESHOLD_N)
-            for p in read_force_platforms(WALKING5)]
+    return [
+        plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, THRESHOLD_N)
+        for p in read_force_platforms(WALKING5)
+    ]
 
 
 def test_walking5_resting_level(walking5_loads):
@@ -196,7 +198,8 @@ def test_surface_normal_turns_along_the_labs_up_for_either_corner_order():
     assert str(caught.value) == (
         "bts.c3d (force platform 2): the plate does not face up: surface normal [0.0, -1.0, 0.0] is 90.0 deg from "
         "the up direction [0.0, 0.0, 1.0] (at most 45 deg); the lab's up is the direction "
-        "markers.lab_to_model_rotation_deg turns into the model's +Y: check that setting for this lab")
+        "markers.lab_to_model_rotation_deg turns into the model's +Y: check that setting for this lab"
+    )
     # 44 deg from up is accepted, 46 deg refused
     for tilt, ok in ((44.0, True), (46.0, False)):
         a = np.radians(tilt)

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.heading import trial_heading, travel_velocity_m_per_s
+from loper_analysis.heading import travel_velocity_m_per_s, trial_heading
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.markers import rotate_markers
 
@@ -24,8 +24,9 @@ def walking5():
 
 def test_velocity_is_the_mean_step_of_the_present_markers():
     t = np.arange(5) / 100.0
-    X = np.stack([np.stack([1.2 * t, 0 * t, 0.5 + 0 * t], axis=1), np.stack([1.2 * t + 1, 0 * t, 1 + 0 * t], axis=1)],
-                 axis=1)
+    X = np.stack(
+        [np.stack([1.2 * t, 0 * t, 0.5 + 0 * t], axis=1), np.stack([1.2 * t + 1, 0 * t, 1 + 0 * t], axis=1)], axis=1
+    )
     X[2, 1] = np.nan  # a missing sample drops the two steps touching it, not the marker
     np.testing.assert_allclose(travel_velocity_m_per_s(X, 100.0), [1.2, 0.0, 0.0], rtol=1e-12)
     assert np.isnan(travel_velocity_m_per_s(np.full((3, 2, 3), np.nan), 100.0)).all()
@@ -46,8 +47,9 @@ def test_the_same_walk_in_the_other_direction_gives_the_same_markers_in_the_mode
     turned = X * np.array([-1.0, -1.0, 1.0])  # the lab turned half a turn about its vertical (Z): walks +X
     a, b = trial_heading(X, rate, Z_UP), trial_heading(turned, rate, Z_UP)
     assert b.turn_deg == 0.0 and b.rotation_deg == Z_UP
-    np.testing.assert_allclose(rotate_markers(turned, b.rotation_deg), rotate_markers(X, a.rotation_deg),
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        rotate_markers(turned, b.rotation_deg), rotate_markers(X, a.rotation_deg), rtol=0, atol=1e-12
+    )
 
 
 def test_a_walk_along_lab_y_is_turned_a_quarter_turn(walking5):

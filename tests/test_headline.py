@@ -25,10 +25,19 @@ T_975_2 = 4.302652729749464
 
 
 def test_ci_of_the_across_subject_mean_is_students_t():
-    summary = pd.DataFrame({"joint": ["hip", "knee"], "onset_ms": [50, 50], "n_subjects": [3, 1],
-                            "n_not_identifiable": [1, 0], "K_mean_nm_per_rad": [10.0, 5.0],
-                            "K_sd_nm_per_rad": [2.0, np.nan], "D_mean_nms_per_rad": [0.3, 0.1],
-                            "D_sd_nms_per_rad": [0.06, np.nan], "vaf_pct_mean": [95.0, 80.0]})
+    summary = pd.DataFrame(
+        {
+            "joint": ["hip", "knee"],
+            "onset_ms": [50, 50],
+            "n_subjects": [3, 1],
+            "n_not_identifiable": [1, 0],
+            "K_mean_nm_per_rad": [10.0, 5.0],
+            "K_sd_nm_per_rad": [2.0, np.nan],
+            "D_mean_nms_per_rad": [0.3, 0.1],
+            "D_sd_nms_per_rad": [0.06, np.nan],
+            "vaf_pct_mean": [95.0, 80.0],
+        }
+    )
     ci = impedance_summary_ci(summary, "s.tsv")
     half_k = T_975_2 * 2.0 / math.sqrt(3)  # 4.968 N·m/rad
     assert ci.loc[0, "K_ci95_low_nm_per_rad"] == pytest.approx(10.0 - half_k, rel=1e-12)
@@ -57,16 +66,27 @@ def test_truth_recovery_counts_the_known_errors():
 
 
 def test_transparency_device_and_validation_verdicts():
-    rmsd = pd.DataFrame({
-        "subject": ["S1", "S2", "all", "S1", "S2", "all"], "phase": ["stance"] * 3 + ["swing"] * 3,
-        "joint": ["hip"] * 6, "rmsd_rad": [0.02, 0.03, 0.025, 0.07, np.nan, 0.07],
-        "isv_ave_rad": [0.04, 0.04, 0.04, 0.06, np.nan, 0.06],
-        "transparent": [True, True, True, False, np.nan, False], "study_rmsd_rad": 0.024, "study_isv_ave_rad": 0.04})
+    rmsd = pd.DataFrame(
+        {
+            "subject": ["S1", "S2", "all", "S1", "S2", "all"],
+            "phase": ["stance"] * 3 + ["swing"] * 3,
+            "joint": ["hip"] * 6,
+            "rmsd_rad": [0.02, 0.03, 0.025, 0.07, np.nan, 0.07],
+            "isv_ave_rad": [0.04, 0.04, 0.04, 0.06, np.nan, 0.06],
+            "transparent": [True, True, True, False, np.nan, False],
+            "study_rmsd_rad": 0.024,
+            "study_isv_ave_rad": 0.04,
+        }
+    )
     tr = transparency_verdict(rmsd, "r.tsv")
     assert tr.transparent.tolist() == [True, False]
     assert tr.n_subjects.tolist() == [2, 1] and tr.n_subjects_transparent.tolist() == [2, 0]
-    device = pd.DataFrame({"metric": ["bandwidth_hz", "rise_time_ms", "overshoot_pct", "steady_state_40n_n",
-                                      "rise_time_ms_at_20n"], "value": [42.9, 10.0, 30.5, 36.0, 9.7]})
+    device = pd.DataFrame(
+        {
+            "metric": ["bandwidth_hz", "rise_time_ms", "overshoot_pct", "steady_state_40n_n", "rise_time_ms_at_20n"],
+            "value": [42.9, 10.0, 30.5, 36.0, 9.7],
+        }
+    )
     dev = device_comparison(device, "d.tsv").set_index("metric")
     assert list(dev.index) == list(STUDY_DEVICE)
     assert dev.loc["bandwidth_hz", "difference_pct"] == pytest.approx(10.0)  # 42.9 Hz against the study's 39
@@ -76,24 +96,64 @@ def test_transparency_device_and_validation_verdicts():
     assert val.within_study.all() and val.loc["K", "n_combinations"] == 729
 
 
-@pytest.mark.parametrize(("call", "message"), [
-    (lambda: impedance_summary_ci(pd.DataFrame({"joint": ["hip"]}), "s.tsv"),
-     "s.tsv: impedance summary: column(s) ['onset_ms', 'n_subjects'"),
-    (lambda: impedance_summary_ci(pd.DataFrame({
-        "joint": ["hip"], "onset_ms": [50], "n_subjects": [0], "n_not_identifiable": [0], "K_mean_nm_per_rad": [1.0],
-        "K_sd_nm_per_rad": [1.0], "D_mean_nms_per_rad": [1.0], "D_sd_nms_per_rad": [1.0], "vaf_pct_mean": [90.0]}),
-        "s.tsv"), "s.tsv: row 0 (hip 50 ms): n_subjects must be an integer >= 1, got 0"),
-    (lambda: transparency_verdict(pd.DataFrame({
-        "subject": ["all"], "phase": ["swing"], "joint": ["hip"], "rmsd_rad": [0.1], "isv_ave_rad": [0.2],
-        "transparent": ["maybe"], "study_rmsd_rad": [0.1], "study_isv_ave_rad": [0.1]}), "r.tsv"),
-     "r.tsv: row 0: column 'transparent' must be True, False or blank, got 'maybe'"),
-    (lambda: device_comparison(pd.DataFrame({"metric": ["bandwidth_hz"], "value": [39.0]}), "d.tsv"),
-     "d.tsv: device summary: metric 'rise_time_ms' missing"),
-    (lambda: device_comparison(pd.DataFrame({"metric": list(STUDY_DEVICE), "value": ["x", 1, 1, 1]}), "d.tsv"),
-     "d.tsv: value of metric 'bandwidth_hz' must be a number, got 'x'"),
-    (lambda: truth_recovery(impedance_table().assign(K_ci95_low_nm_per_rad="?"), "i.tsv"),
-     "i.tsv: fitted rows: column 'K_ci95_low_nm_per_rad', row 0 must be a number, got '?'"),
-])
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda: impedance_summary_ci(pd.DataFrame({"joint": ["hip"]}), "s.tsv"),
+            "s.tsv: impedance summary: column(s) ['onset_ms', 'n_subjects'",
+        ),
+        (
+            lambda: impedance_summary_ci(
+                pd.DataFrame(
+                    {
+                        "joint": ["hip"],
+                        "onset_ms": [50],
+                        "n_subjects": [0],
+                        "n_not_identifiable": [0],
+                        "K_mean_nm_per_rad": [1.0],
+                        "K_sd_nm_per_rad": [1.0],
+                        "D_mean_nms_per_rad": [1.0],
+                        "D_sd_nms_per_rad": [1.0],
+                        "vaf_pct_mean": [90.0],
+                    }
+                ),
+                "s.tsv",
+            ),
+            "s.tsv: row 0 (hip 50 ms): n_subjects must be an integer >= 1, got 0",
+        ),
+        (
+            lambda: transparency_verdict(
+                pd.DataFrame(
+                    {
+                        "subject": ["all"],
+                        "phase": ["swing"],
+                        "joint": ["hip"],
+                        "rmsd_rad": [0.1],
+                        "isv_ave_rad": [0.2],
+                        "transparent": ["maybe"],
+                        "study_rmsd_rad": [0.1],
+                        "study_isv_ave_rad": [0.1],
+                    }
+                ),
+                "r.tsv",
+            ),
+            "r.tsv: row 0: column 'transparent' must be True, False or blank, got 'maybe'",
+        ),
+        (
+            lambda: device_comparison(pd.DataFrame({"metric": ["bandwidth_hz"], "value": [39.0]}), "d.tsv"),
+            "d.tsv: device summary: metric 'rise_time_ms' missing",
+        ),
+        (
+            lambda: device_comparison(pd.DataFrame({"metric": list(STUDY_DEVICE), "value": ["x", 1, 1, 1]}), "d.tsv"),
+            "d.tsv: value of metric 'bandwidth_hz' must be a number, got 'x'",
+        ),
+        (
+            lambda: truth_recovery(impedance_table().assign(K_ci95_low_nm_per_rad="?"), "i.tsv"),
+            "i.tsv: fitted rows: column 'K_ci95_low_nm_per_rad', row 0 must be a number, got '?'",
+        ),
+    ],
+)
 def test_bad_tables_are_refused_naming_file_field_and_value(call, message):
     with pytest.raises(LoperInputError) as err:
         call()

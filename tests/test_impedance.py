@@ -98,8 +98,11 @@ def test_onset_without_trials_is_reported_missing():
 def test_summary_and_literature_rows():
     rows = []
     for subject, k, d in (("S01", 50.0, 3.0), ("S02", 60.0, 5.0)):
-        rows.append(status_rows(subject, 50, "ok", "").assign(K_nm_per_rad=k, D_nms_per_rad=d, vaf_pct=99.0,
-                                                               K_true_nm_per_rad=55.0, D_true_nms_per_rad=3.0))
+        rows.append(
+            status_rows(subject, 50, "ok", "").assign(
+                K_nm_per_rad=k, D_nms_per_rad=d, vaf_pct=99.0, K_true_nm_per_rad=55.0, D_true_nms_per_rad=3.0
+            )
+        )
     rows.append(status_rows("S03", 50, "missing", "no trial"))
     table = pd.concat(rows, ignore_index=True)
     table["K_error_nm_per_rad"] = table.K_nm_per_rad - table.K_true_nm_per_rad
@@ -113,14 +116,20 @@ def test_summary_and_literature_rows():
     lit = literature_table(summary)
     ours = lit[lit.source.str.startswith("this pipeline") & (lit.joint == "hip")].iloc[0]
     assert (ours.K_low_nm_per_rad, ours.K_high_nm_per_rad, ours.D_low_nms_per_rad, ours.D_high_nms_per_rad) == (
-        55.0, 55.0, 4.0, 4.0)
+        55.0,
+        55.0,
+        4.0,
+        4.0,
+    )
     assert len(lit) == 9
 
 
 def test_summary_leaves_out_estimates_on_an_upper_bound():
     """The campaign's case: a bad trial's knee K at the 200 N·m/rad bound would pull the knee mean from 3 to 68."""
-    rows = [status_rows(s, 50, "ok", "").assign(K_nm_per_rad=k, D_nms_per_rad=0.1, vaf_pct=99.0)
-            for s, k in (("S01", 3.0), ("S02", 3.0), ("S03", 200.0))]
+    rows = [
+        status_rows(s, 50, "ok", "").assign(K_nm_per_rad=k, D_nms_per_rad=0.1, vaf_pct=99.0)
+        for s, k in (("S01", 3.0), ("S02", 3.0), ("S03", 200.0))
+    ]
     table = pd.concat(rows, ignore_index=True)
     table.loc[table.subject == "S03", "status"] = "not_identifiable"
     knee = impedance_summary(table).set_index("joint").loc["knee"]
@@ -132,9 +141,14 @@ def test_summary_leaves_out_estimates_on_an_upper_bound():
 
 def test_summary_keeps_uninformative_rows_and_counts_them():
     """Knee D 0.10, 0.12 (ok) and 0.01 whose interval 0 ... 0.3 holds 0 and the study's range (not_identifiable):
-    the mean stays (0.10 + 0.12 + 0.01) / 3 = 0.0767, not the 0.11 of the informative rows alone, and the count says 1."""
-    rows = [status_rows(s, 175, st, "").assign(K_nm_per_rad=1.0, D_nms_per_rad=d, vaf_pct=99.0)
-            for s, d, st in (("S01", 0.10, "ok"), ("S02", 0.12, "ok"), ("S03", 0.01, "not_identifiable"))]
-    knee = impedance_summary(pd.concat(rows, ignore_index=True), upper_bounds=(200.0, 10.0)).set_index("joint").loc["knee"]
+    the mean stays (0.10 + 0.12 + 0.01) / 3 = 0.0767, not the 0.11 of the informative rows alone, and the count
+    says 1."""
+    rows = [
+        status_rows(s, 175, st, "").assign(K_nm_per_rad=1.0, D_nms_per_rad=d, vaf_pct=99.0)
+        for s, d, st in (("S01", 0.10, "ok"), ("S02", 0.12, "ok"), ("S03", 0.01, "not_identifiable"))
+    ]
+    knee = (
+        impedance_summary(pd.concat(rows, ignore_index=True), upper_bounds=(200.0, 10.0)).set_index("joint").loc["knee"]
+    )
     assert knee.n_subjects == 3 and knee.n_not_identifiable == 1
     assert knee.D_mean_nms_per_rad == pytest.approx(0.23 / 3)

@@ -39,8 +39,17 @@ RAJAGOPAL = ROOT / "tests" / "data" / "rajagopal2016" / "Rajagopal2016.osim"
 # ---------------------------------------------------------------- files built here
 
 RATE_HZ, RATIO, N_FRAMES, FIRST_FRAME = 100.0, 10, 200, 30
-LABELS = ["Subj:HEAD", "Subj:LASI", "Subj:RASI", "Subj:LKNE", "Subj:RKNE", "Subj:LHEE", "Subj:RHEE", "Subj:LTOE",
-          "Subj:RTOE"]
+LABELS = [
+    "Subj:HEAD",
+    "Subj:LASI",
+    "Subj:RASI",
+    "Subj:LKNE",
+    "Subj:RKNE",
+    "Subj:LHEE",
+    "Subj:RHEE",
+    "Subj:LTOE",
+    "Subj:RTOE",
+]
 SPEED_M_PER_S = 1.2
 CHANNELS = ["Fx1", "Fy1", "Fz1", "Mx1", "My1", "Mz1"]
 
@@ -53,13 +62,23 @@ def _walker() -> np.ndarray:
     """
     t = np.arange(N_FRAMES) / RATE_HZ
     swing = 0.3 * np.sin(2 * np.pi * t)
-    rows = [(0, 0, 1.7), (0.05, 0.12, 0.95), (0.05, -0.12, 0.95), (0.1, 0.1, 0.5), (0.1, -0.1, 0.5),
-            (-0.05, 0.1, 0.05), (-0.05, -0.1, 0.05), (0.15, 0.1, 0.03), (0.15, -0.1, 0.03)]
+    rows = [
+        (0, 0, 1.7),
+        (0.05, 0.12, 0.95),
+        (0.05, -0.12, 0.95),
+        (0.1, 0.1, 0.5),
+        (0.1, -0.1, 0.5),
+        (-0.05, 0.1, 0.05),
+        (-0.05, -0.1, 0.05),
+        (0.15, 0.1, 0.03),
+        (0.15, -0.1, 0.03),
+    ]
     X = np.zeros((N_FRAMES, len(rows), 3))
     for j, (fwd, left, up) in enumerate(rows):
         leg = (swing if left > 0 else -swing) if j >= 3 else 0.0
-        X[:, j] = np.column_stack([0.2 + SPEED_M_PER_S * t + fwd + leg, np.full(N_FRAMES, left),
-                                   up + 0.02 * np.sin(4 * np.pi * t)])
+        X[:, j] = np.column_stack(
+            [0.2 + SPEED_M_PER_S * t + fwd + leg, np.full(N_FRAMES, left), up + 0.02 * np.sin(4 * np.pi * t)]
+        )
     X[50:60, 3] = np.nan
     X[:20, 7] = X[190:, 7] = X[120:123, 7] = np.nan
     X[:5] = np.nan
@@ -79,11 +98,22 @@ def zup_file(tmp_path_factory) -> Path:
     path = tmp_path_factory.mktemp("zup") / "zup.c3d"
     ch = np.zeros((N_FRAMES * RATIO, 6))
     ch[:, 2] = -(_load_n() - 15.0)  # plate z points down: the Fz channel is minus the upward force on the body
-    plate = ForcePlatform(2, [(1.3, 0.1, 0.0), (0.7, 0.1, 0.0), (0.7, 0.5, 0.0), (1.3, 0.5, 0.0)], (0, 0, -0.04),
-                          (1, 2, 3, 4, 5, 6))
-    write_c3d(path, LABELS, _walker(), RATE_HZ, CHANNELS, ch, ["N"] * 3 + ["Nmm"] * 3, RATE_HZ * RATIO,
-              first_frame=FIRST_FRAME, force_platforms=[plate],
-              events=[("Left", "Foot Strike", 0.9), ("Right", "Foot Off", 1.25)])
+    plate = ForcePlatform(
+        2, [(1.3, 0.1, 0.0), (0.7, 0.1, 0.0), (0.7, 0.5, 0.0), (1.3, 0.5, 0.0)], (0, 0, -0.04), (1, 2, 3, 4, 5, 6)
+    )
+    write_c3d(
+        path,
+        LABELS,
+        _walker(),
+        RATE_HZ,
+        CHANNELS,
+        ch,
+        ["N"] * 3 + ["Nmm"] * 3,
+        RATE_HZ * RATIO,
+        first_frame=FIRST_FRAME,
+        force_platforms=[plate],
+        events=[("Left", "Foot Strike", 0.9), ("Right", "Foot Off", 1.25)],
+    )
     return path
 
 
@@ -95,10 +125,21 @@ def yup_file(tmp_path_factory) -> Path:
     X = np.stack([W[..., 0], W[..., 2], -W[..., 1]], axis=-1)
     ch = np.zeros((N_FRAMES * RATIO, 6))
     ch[:, 2] = _load_n() - 12.0
-    plate = ForcePlatform(2, [(1.3, 0.0, 0.1), (0.7, 0.0, 0.1), (0.7, 0.0, 0.5), (1.3, 0.0, 0.5)], (0, 0, 0.04),
-                          (1, 2, 3, 4, 5, 6))
-    write_c3d(path, LABELS, X, RATE_HZ, CHANNELS, ch, ["N"] * 3 + ["Nm"] * 3, RATE_HZ * RATIO, point_unit="m",
-              force_platforms=[plate])
+    plate = ForcePlatform(
+        2, [(1.3, 0.0, 0.1), (0.7, 0.0, 0.1), (0.7, 0.0, 0.5), (1.3, 0.0, 0.5)], (0, 0, 0.04), (1, 2, 3, 4, 5, 6)
+    )
+    write_c3d(
+        path,
+        LABELS,
+        X,
+        RATE_HZ,
+        CHANNELS,
+        ch,
+        ["N"] * 3 + ["Nm"] * 3,
+        RATE_HZ * RATIO,
+        point_unit="m",
+        force_platforms=[plate],
+    )
     return path
 
 
@@ -119,7 +160,7 @@ def _longest_interior_gap(present: np.ndarray) -> int:
     """Longest run of False between the first and last True, counted frame by frame."""
     idx = np.flatnonzero(present)
     best = run = 0
-    for p in present[idx[0]:idx[-1] + 1]:
+    for p in present[idx[0] : idx[-1] + 1]:
         run = 0 if p else run + 1
         best = max(best, run)
     return best
@@ -168,8 +209,9 @@ def test_rotation_takes_up_to_model_y_and_walking_to_model_x(up_axis, up_sign):
         for forward_sign in (1, -1):
             angles = lab_to_model_rotation_deg(up_axis, up_sign, forward_axis, forward_sign)
             forward = np.eye(3)[forward_axis] * forward_sign
-            np.testing.assert_allclose(rotate_markers(np.stack([up, forward]), angles), [[0, 1, 0], [1, 0, 0]],
-                                       atol=1e-12)
+            np.testing.assert_allclose(
+                rotate_markers(np.stack([up, forward]), angles), [[0, 1, 0], [1, 0, 0]], atol=1e-12
+            )
 
 
 def test_rotation_known_values():
@@ -197,8 +239,13 @@ def test_axes_from_markers_alone_and_a_treadmill():
 def test_walking5_summary(walking5):
     rec, plates = walking5
     s = inspect_c3d(WALKING5).summary
-    assert (s.point_rate_hz, s.analog_rate_hz, s.first_frame, s.n_frames, s.point_unit) == (250.0, 2000.0, 0, 1103,
-                                                                                           "mm")
+    assert (s.point_rate_hz, s.analog_rate_hz, s.first_frame, s.n_frames, s.point_unit) == (
+        250.0,
+        2000.0,
+        0,
+        1103,
+        "mm",
+    )
     np.testing.assert_allclose(s.duration_s, 1103 / 250.0, rtol=1e-12)
     assert (s.vertical.axis, s.vertical.sign, s.vertical.basis) == (2, 1, "force platforms")
     assert (s.vertical.marker_axis, s.vertical.marker_sign) == (2, 1)
@@ -227,8 +274,7 @@ def test_zup_file_summary(zup_file):
     (p,) = s.plates
     assert p.corner_order == "clockwise"
     np.testing.assert_allclose(p.normal, [0, 0, -1], atol=1e-9)
-    np.testing.assert_allclose([p.rest_vertical_n, p.peak_vertical_n, p.peak_time_s], [-15.0, 800.0, 1.4],
-                               atol=1e-3)
+    np.testing.assert_allclose([p.rest_vertical_n, p.peak_vertical_n, p.peak_time_s], [-15.0, 800.0, 1.4], atol=1e-3)
     np.testing.assert_allclose(p.side_lengths_m, [0.6, 0.4], atol=1e-6)
     assert list(s.events["label"]) == ["Foot Strike", "Foot Off"]
     np.testing.assert_allclose(s.events["time_s"], [0.9, 1.25], atol=1e-6)
@@ -245,8 +291,7 @@ def test_yup_file_summary(yup_file):
     (p,) = s.plates
     assert p.corner_order == "counter-clockwise"
     np.testing.assert_allclose(p.normal, [0, 1, 0], atol=1e-9)
-    np.testing.assert_allclose([p.rest_vertical_n, p.peak_vertical_n, p.peak_time_s], [-12.0, 800.0, 1.1],
-                               atol=1e-3)
+    np.testing.assert_allclose([p.rest_vertical_n, p.peak_vertical_n, p.peak_time_s], [-12.0, 800.0, 1.1], atol=1e-3)
 
 
 # ---------------------------------------------------------------- label matching
@@ -256,8 +301,9 @@ def test_qtm_labels_match_gait2392_as_the_example_map_says(gait2392_markers):
     qtm = read_label_map(QTM_MAP)
     labels = [f"Subj:{k}" for k in qtm]
     m = match_labels(labels, gait2392_markers)
-    assert {lab: mk for lab, mk, _ in m.pairs} == {f"Subj:{k}": v for k, v in qtm.items()
-                                                    if not any(c in k for c in ("TH", "SK", "FMT", "FB5"))}
+    assert {lab: mk for lab, mk, _ in m.pairs} == {
+        f"Subj:{k}": v for k, v in qtm.items() if not any(c in k for c in ("TH", "SK", "FMT", "FB5"))
+    }
     assert len(m.pairs) == 23 and not m.ambiguous
     assert len(m.unmatched_labels) == 16  # thigh and shank clusters, midfoot markers: lab-specific, left to the user
     assert set(m.unprovided_markers) == {v for k, v in qtm.items() if f"Subj:{k}" in m.unmatched_labels}
@@ -267,19 +313,38 @@ def test_walking5_labels_match_gait2392(walking5, gait2392_markers):
     rec, _ = walking5
     m = match_labels(rec.marker_labels, gait2392_markers)
     pairs = {lab: mk for lab, mk, _ in m.pairs}
-    assert pairs == {"LASI": "L.ASIS", "RASI": "R.ASIS", "LCAL": "L.Heel", "RCAL": "R.Heel", "STRN": "Sternum",
-                     "LMT1": "L.Toe.Med", "RMT1": "R.Toe.Med", "LLFC": "L.Knee.Lat", "RLFC": "R.Knee.Lat",
-                     "LMFC": "L.Knee.Med", "RMFC": "R.Knee.Med", "LLMAL": "L.Ankle.Lat", "RLMAL": "R.Ankle.Lat",
-                     "LMMAL": "L.Ankle.Med", "RMMAL": "R.Ankle.Med"}
+    assert pairs == {
+        "LASI": "L.ASIS",
+        "RASI": "R.ASIS",
+        "LCAL": "L.Heel",
+        "RCAL": "R.Heel",
+        "STRN": "Sternum",
+        "LMT1": "L.Toe.Med",
+        "RMT1": "R.Toe.Med",
+        "LLFC": "L.Knee.Lat",
+        "RLFC": "R.Knee.Lat",
+        "LMFC": "L.Knee.Med",
+        "RMFC": "R.Knee.Med",
+        "LLMAL": "L.Ankle.Lat",
+        "RLMAL": "R.Ankle.Lat",
+        "LMMAL": "L.Ankle.Med",
+        "RMMAL": "R.Ankle.Med",
+    }
     assert len(m.unmatched_labels) == 25 and len(m.unprovided_markers) == 39 - 15
     assert heel_markers([mk for _, mk, _ in m.pairs]) == {"left": "L.Heel", "right": "R.Heel"}
 
 
 def test_matching_rounds_and_ambiguity():
-    m = match_labels(["S:R_ASIS", "r.psis", "LTOE", "LANK", "LHEE", "LCAL", "C7"],
-                     ["R.ASIS", "R.PSIS", "L.Toe", "L.Ankle", "L.Ankle.Lat", "L.Heel", "C7"])
-    assert m.pairs == (("S:R_ASIS", "R.ASIS", "punctuation"), ("r.psis", "R.PSIS", "case"),
-                       ("LTOE", "L.Toe", "punctuation"), ("C7", "C7", "exact"))
+    m = match_labels(
+        ["S:R_ASIS", "r.psis", "LTOE", "LANK", "LHEE", "LCAL", "C7"],
+        ["R.ASIS", "R.PSIS", "L.Toe", "L.Ankle", "L.Ankle.Lat", "L.Heel", "C7"],
+    )
+    assert m.pairs == (
+        ("S:R_ASIS", "R.ASIS", "punctuation"),
+        ("r.psis", "R.PSIS", "case"),
+        ("LTOE", "L.Toe", "punctuation"),
+        ("C7", "C7", "exact"),
+    )
     assert m.ambiguous == {"LANK": ("L.Ankle", "L.Ankle.Lat"), "LHEE": ("L.Heel",), "LCAL": ("L.Heel",)}
     assert m.unmatched_labels == ("LANK", "LHEE", "LCAL")
     assert m.unprovided_markers == ("L.Ankle", "L.Ankle.Lat", "L.Heel")
@@ -303,8 +368,10 @@ def test_walking5_labels_match_rajagopal_by_name(walking5):
 def test_snippet_without_a_map_file_holds_the_map_inline():
     text = config_snippet((-90.0, 0.0, 0.0), {"LASI": "L.ASIS", "a b": "x:y"}, {"left": "L.Heel", "right": "R.Heel"})
     doc = yaml.safe_load(text)
-    assert doc == {"markers": {"lab_to_model_rotation_deg": [-90, 0, 0], "label_map": {"LASI": "L.ASIS", "a b": "x:y"}},
-                   "events": {"foot_markers": {"left": "L.Heel", "right": "R.Heel"}}}
+    assert doc == {
+        "markers": {"lab_to_model_rotation_deg": [-90, 0, 0], "label_map": {"LASI": "L.ASIS", "a b": "x:y"}},
+        "events": {"foot_markers": {"left": "L.Heel", "right": "R.Heel"}},
+    }
 
 
 def _merged(base: dict, over: dict) -> dict:
@@ -317,17 +384,39 @@ def _merged(base: dict, over: dict) -> dict:
 def test_inspect_command_on_walking5(tmp_path, capsys, walking5):
     rec, _ = walking5
     map_tsv, snippet = tmp_path / "out" / "map.tsv", tmp_path / "out" / "snippet.yaml"
-    code = main(["inspect", str(WALKING5), "--model", str(GAIT2392), "--marker-set", str(MARKER_SET),
-                 "--label-map-out", str(map_tsv), "--config-out", str(snippet)])
+    code = main(
+        [
+            "inspect",
+            str(WALKING5),
+            "--model",
+            str(GAIT2392),
+            "--marker-set",
+            str(MARKER_SET),
+            "--label-map-out",
+            str(map_tsv),
+            "--config-out",
+            str(snippet),
+        ]
+    )
     out = capsys.readouterr().out
     assert code == 0
-    for needle in ("250 Hz, POINT:UNITS mm", "2000 Hz (8 samples per frame), 12 channel(s)",
-                   "frames    1103, first frame 0 (0-based) at 0.000 s", "duration 4.412 s",
-                   "frames with fewer than 3 markers: 153 of 1103", "57 of them without any marker",
-                   "resting (unloaded) vertical level -14.", "resting (unloaded) vertical level -18.",
-                   "corners listed clockwise seen from above", "vertical axis: +Z", "walking direction: -X",
-                   "lab_to_model_rotation_deg: [-90, 0, 0]",
-                   "walks toward model -X; [-90, 180, 0] also turns", "LASI  -> L.ASIS", "matched: 15 label(s)"):
+    for needle in (
+        "250 Hz, POINT:UNITS mm",
+        "2000 Hz (8 samples per frame), 12 channel(s)",
+        "frames    1103, first frame 0 (0-based) at 0.000 s",
+        "duration 4.412 s",
+        "frames with fewer than 3 markers: 153 of 1103",
+        "57 of them without any marker",
+        "resting (unloaded) vertical level -14.",
+        "resting (unloaded) vertical level -18.",
+        "corners listed clockwise seen from above",
+        "vertical axis: +Z",
+        "walking direction: -X",
+        "lab_to_model_rotation_deg: [-90, 0, 0]",
+        "walks toward model -X; [-90, 180, 0] also turns",
+        "LASI  -> L.ASIS",
+        "matched: 15 label(s)",
+    ):
         assert needle in out, needle
     label_map = read_label_map(map_tsv)
     assert len(label_map) == 15 and label_map["LCAL"] == "L.Heel"
@@ -347,8 +436,10 @@ def test_inspect_command_on_the_yup_file_without_a_model(yup_file, tmp_path, cap
     assert main(["inspect", str(yup_file), "--config-out", str(snippet)]) == 0
     out = capsys.readouterr().out
     assert "corners listed counter-clockwise seen from above" in out and "vertical axis: +Y" in out
-    assert yaml.safe_load(snippet.read_text()) == {"markers": {"lab_to_model_rotation_deg": [0, 0, 0]},
-                                                   "events": {"foot_markers": {"left": "LHEE", "right": "RHEE"}}}
+    assert yaml.safe_load(snippet.read_text()) == {
+        "markers": {"lab_to_model_rotation_deg": [0, 0, 0]},
+        "events": {"foot_markers": {"left": "LHEE", "right": "RHEE"}},
+    }
 
 
 def test_inspect_command_refuses_a_missing_file_and_a_map_without_model(tmp_path, capsys):
@@ -364,10 +455,21 @@ def test_inspect_command_refuses_a_missing_file_and_a_map_without_model(tmp_path
 def test_plates_that_cannot_be_read_are_reported_not_fatal(tmp_path):
     """Moment channels declared in N·mm in a file in m: the plate reader refuses them, the inspection goes on."""
     path = tmp_path / "badplate.c3d"
-    plate = ForcePlatform(2, [(1.3, 0.1, 0.0), (0.7, 0.1, 0.0), (0.7, 0.5, 0.0), (1.3, 0.5, 0.0)], (0, 0, -0.04),
-                          (1, 2, 3, 4, 5, 6))
-    write_c3d(path, LABELS, _walker(), RATE_HZ, CHANNELS, np.zeros((N_FRAMES * RATIO, 6)), ["N"] * 3 + ["Nmm"] * 3,
-              RATE_HZ * RATIO, point_unit="m", force_platforms=[plate])
+    plate = ForcePlatform(
+        2, [(1.3, 0.1, 0.0), (0.7, 0.1, 0.0), (0.7, 0.5, 0.0), (1.3, 0.5, 0.0)], (0, 0, -0.04), (1, 2, 3, 4, 5, 6)
+    )
+    write_c3d(
+        path,
+        LABELS,
+        _walker(),
+        RATE_HZ,
+        CHANNELS,
+        np.zeros((N_FRAMES * RATIO, 6)),
+        ["N"] * 3 + ["Nmm"] * 3,
+        RATE_HZ * RATIO,
+        point_unit="m",
+        force_platforms=[plate],
+    )
     result = inspect_c3d(path)
     assert result.summary.plates == [] and "ANALOG:UNITS of channel 4" in result.summary.plate_problem
     assert "Force platforms: 1 declared, not readable" in result.text

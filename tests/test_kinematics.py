@@ -43,11 +43,14 @@ def _truth(n=256):
     t = np.arange(n) / FS
     w = 2 * np.pi * 0.6
     return t, {
-        "pelvis_tx": 0.02 * np.sin(2 * w * t), "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
+        "pelvis_tx": 0.02 * np.sin(2 * w * t),
+        "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
         "pelvis_tilt": 0.05 * np.sin(w * t),
-        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t), "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
+        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
+        "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
         "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2),
-        "hip_flexion_r": 0.1 - 0.3 * np.sin(w * t), "knee_flexion_r": 0.6 - 0.5 * np.sin(w * t + 1),
+        "hip_flexion_r": 0.1 - 0.3 * np.sin(w * t),
+        "knee_flexion_r": 0.6 - 0.5 * np.sin(w * t + 1),
         "ankle_dorsiflexion_r": -0.1 * np.sin(w * t + 2),
     }
 
@@ -170,8 +173,10 @@ def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, 
 
 def test_tsv_tasks_and_bad_input(model, synthetic, tmp_path):
     tsv = tmp_path / "tasks.tsv"
-    tsv.write_text("name\tkind\tweight\tvalue\nLASI\tmarker\t2\t\nknee_flexion_r\tcoordinate\t5\t0.3\n"
-                   "ankle_dorsiflexion_r\tcoordinate\t1\t\n")
+    tsv.write_text(
+        "name\tkind\tweight\tvalue\nLASI\tmarker\t2\t\nknee_flexion_r\tcoordinate\t5\t0.3\n"
+        "ankle_dorsiflexion_r\tcoordinate\t1\t\n"
+    )
     w, c = read_ik_tasks(tsv)
     assert w == {"LASI": 2.0} and c == {"knee_flexion_r": (5.0, 0.3), "ankle_dorsiflexion_r": (1.0, None)}
     bad = tmp_path / "bad.tsv"
@@ -179,7 +184,9 @@ def test_tsv_tasks_and_bad_input(model, synthetic, tmp_path):
     with pytest.raises(LoperInputError, match="row 1, column kind: 'markr'"):
         read_ik_tasks(bad)
     t, _, X = synthetic
-    with pytest.raises(LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in .*model\.osim \(model loper_lower_body\)"):
+    with pytest.raises(
+        LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in .*model\.osim \(model loper_lower_body\)"
+    ):
         inverse_kinematics(model, t, X, list(MARKERS), {"XYZ": 1.0})
     with pytest.raises(LoperInputError, match=r"\['RASI'\] of the IK tasks are not in the marker data"):
         inverse_kinematics(model, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
@@ -207,13 +214,21 @@ def test_chunks_join_seamlessly(model, synthetic):
 
 
 def test_joint_angle_table_maps_names_and_signs():
-    coords = pd.DataFrame({"time_s": [0.0, 0.01], "pelvis_tilt": [0.1, 0.2], "pelvis_tx": [0.5, 0.6],
-                           **{c: [0.3, 0.4] for c, _ in list(DEFAULT_COORDINATE_MAP.values())[2:]}})
+    coords = pd.DataFrame(
+        {
+            "time_s": [0.0, 0.01],
+            "pelvis_tilt": [0.1, 0.2],
+            "pelvis_tx": [0.5, 0.6],
+            **{c: [0.3, 0.4] for c, _ in list(DEFAULT_COORDINATE_MAP.values())[2:]},
+        }
+    )
     angles = joint_angle_table(coords)
     np.testing.assert_allclose(angles.pelvis_angle_rad, [-0.1, -0.2])
     np.testing.assert_allclose(angles.knee_left_rad, [0.3, 0.4])
-    gait2392 = {"pelvis_angle": {"coordinate": "pelvis_tilt", "sign": -1},
-                "knee_left": {"coordinate": "knee_angle_l", "sign": -1}}
+    gait2392 = {
+        "pelvis_angle": {"coordinate": "pelvis_tilt", "sign": -1},
+        "knee_left": {"coordinate": "knee_angle_l", "sign": -1},
+    }
     angles = joint_angle_table(coords.rename(columns={"knee_flexion_l": "knee_angle_l"}), gait2392)
     assert list(angles.columns) == ["time_s", "pelvis_angle_rad", "knee_left_rad"]
     np.testing.assert_allclose(angles.knee_left_rad, [-0.3, -0.4])
@@ -249,8 +264,9 @@ def test_frames_with_too_few_markers_stop_ik_when_asked(model, synthetic):
     assert "frames 100..102 (t = 0.7812..0.7969 s); markers missing there: LASI, RPSI, LPSI," in message
     assert message.endswith(", LTHI_AS, and 14 more")  # 34 markers missing in those frames: 20 named
     with pytest.raises(LoperInputError) as err:
-        inverse_kinematics(model, t, X, list(MARKERS), {m: 1.0 for m in keep}, min_markers=3, source="walk.trc",
-                           sparse_frames="error")
+        inverse_kinematics(
+            model, t, X, list(MARKERS), {m: 1.0 for m in keep}, min_markers=3, source="walk.trc", sparse_frames="error"
+        )
     assert str(err.value) == (
         "walk.trc: 3 frame(s) hold fewer than 3 of the 4 weighted markers, too few to solve IK: "
         "frames 100..102 (t = 0.7812..0.7969 s); markers missing there: LASI, LKNE"
@@ -281,8 +297,11 @@ def test_a_trial_without_a_frame_to_solve_stops(model, synthetic):
     t, _, X = synthetic
     X = X.copy()
     X[:, [list(MARKERS).index(m) for m in ("RPSI", "LPSI")]] = np.nan
-    with pytest.raises(LoperInputError, match=r"walk\.trc: no frame holds 3 weighted markers with one beyond the "
-                                              r"pelvis: nothing to solve"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"walk\.trc: no frame holds 3 weighted markers with one beyond the "
+        r"pelvis: nothing to solve",
+    ):
         inverse_kinematics(model, t, X, list(MARKERS), source="walk.trc")
 
 
@@ -305,6 +324,9 @@ def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
     knee, beta = res.coordinates[:, names.index("knee_angle_r")], res.coordinates[:, names.index("knee_angle_r_beta")]
     np.testing.assert_allclose(beta, knee, atol=1e-8)  # the coupler constraint: beta follows the knee
     assert np.ptp(knee) > 0.05
-    with pytest.raises(LoperInputError, match=r"coordinate task on 'subtalar': not a coordinate of .*Rajagopal2016\.osim "
-                                              r"\(model Rajagopal2016\)"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"coordinate task on 'subtalar': not a coordinate of .*Rajagopal2016\.osim "
+        r"\(model Rajagopal2016\)",
+    ):
         inverse_kinematics(model, t[:2], X[:2], labels, weights, {"subtalar": (1.0, None)})

@@ -31,17 +31,20 @@ def make_trial(offset_s, ppm, robot_t0_s, seed, robot_duration_s=60.0, mocap_dur
         k = int(np.ceil((t_on - robot_t0_s) * ROBOT_HZ))
         flag[k : k + 100] = 1  # 100 ms pulse
         onsets.append(t[k])
-    log = pd.DataFrame({
-        "time_s": t,
-        "force_desired_n": 2.0 * np.sin(2 * np.pi * 100.0 * t),  # to be filtered away
-        "force_measured_n": force(t),
-        "motor_angle_rad": 0.0,
-        "motor_velocity_rad_s": 0.0,
-        "sync_v": pulse_train_at(np.arange(int(round(robot_duration_s * ROBOT_HZ))) / ROBOT_HZ,
-                                 sync_pulse_starts(robot_duration_s, seed)),
-        "perturbation": flag,
-        "safety_state": 0,
-    })
+    log = pd.DataFrame(
+        {
+            "time_s": t,
+            "force_desired_n": 2.0 * np.sin(2 * np.pi * 100.0 * t),  # to be filtered away
+            "force_measured_n": force(t),
+            "motor_angle_rad": 0.0,
+            "motor_velocity_rad_s": 0.0,
+            "sync_v": pulse_train_at(
+                np.arange(int(round(robot_duration_s * ROBOT_HZ))) / ROBOT_HZ, sync_pulse_starts(robot_duration_s, seed)
+            ),
+            "perturbation": flag,
+            "safety_state": 0,
+        }
+    )
     starts = sync_pulse_starts(robot_duration_s, seed)
     sync = mocap_view(starts, offset_s, ppm, robot_t0_s, robot_duration_s, mocap_duration_s)
     frames = np.arange(int(mocap_duration_s * FRAME_HZ)) / FRAME_HZ
@@ -99,14 +102,17 @@ def test_robot_log_at_its_own_rate_on_the_mocap_clock():
     assert np.abs(native["time_s"] - (offset_s + scale * t_robot)).max() < 0.2e-3
     slope = sum(a * 2 * np.pi * f for a, f, _ in FORCE_COMPONENTS)
     interior = (t_robot > 0.25) & (t_robot < t_robot[-1] - 0.25)
-    np.testing.assert_allclose(native["force_measured_n"][interior], force(t_robot[interior]),
-                               atol=slope * 0.2e-3 + 0.01)
+    np.testing.assert_allclose(
+        native["force_measured_n"][interior], force(t_robot[interior]), atol=slope * 0.2e-3 + 0.01
+    )
     np.testing.assert_array_equal(native["perturbation"], log["perturbation"].to_numpy(float))
     inside = out["force_measured_n"].notna().to_numpy()
-    np.testing.assert_array_equal(out["force_measured_n"][inside],
-                                  np.interp(frames[inside], native["time_s"], native["force_measured_n"]))
-    pd.testing.assert_frame_equal(out, robot_log_on_mocap_frames(log, ROBOT_HZ, sync, ANALOG_HZ, frames,
-                                                                 source="S01/walk"))
+    np.testing.assert_array_equal(
+        out["force_measured_n"][inside], np.interp(frames[inside], native["time_s"], native["force_measured_n"])
+    )
+    pd.testing.assert_frame_equal(
+        out, robot_log_on_mocap_frames(log, ROBOT_HZ, sync, ANALOG_HZ, frames, source="S01/walk")
+    )
 
 
 def test_robot_log_on_mocap_frames_bad_sync():
@@ -120,8 +126,9 @@ def test_robot_log_on_mocap_frames_bad_sync():
     with pytest.raises(LoperInputError, match=r"S02/walk: robot log column 'sync_v': .*flat"):
         robot_log_on_mocap_frames(flat, ROBOT_HZ, sync, ANALOG_HZ, frames, source="S02/walk")
     with pytest.raises(LoperInputError, match="S02/walk: robot log lacks column.*perturbation"):
-        robot_log_on_mocap_frames(log.drop(columns="perturbation"), ROBOT_HZ, sync, ANALOG_HZ, frames,
-                                  source="S02/walk")
+        robot_log_on_mocap_frames(
+            log.drop(columns="perturbation"), ROBOT_HZ, sync, ANALOG_HZ, frames, source="S02/walk"
+        )
     with pytest.raises(LoperInputError, match="S02/walk: column 'time_s'.*log_rate_hz"):
         robot_log_on_mocap_frames(log, 500.0, sync, ANALOG_HZ, frames, source="S02/walk")
 

@@ -15,9 +15,16 @@ SOURCE = "data/raw/S01/walk01.c3d"
 VICON = ["Anna:LASIS", "Anna:RASIS", "Anna:L_KNEE", "Anna:LHEE", "*12"]
 
 
-@pytest.mark.parametrize("label, name", [
-    ("Subject:LASI", "LASI"), ("LASI", "LASI"), ("Lab:Anna:LASI", "LASI"), (" Anna:RHEE ", "RHEE"), ("*3", "*3"),
-])
+@pytest.mark.parametrize(
+    "label, name",
+    [
+        ("Subject:LASI", "LASI"),
+        ("LASI", "LASI"),
+        ("Lab:Anna:LASI", "LASI"),
+        (" Anna:RHEE ", "RHEE"),
+        ("*3", "*3"),
+    ],
+)
 def test_subject_prefix_is_everything_up_to_the_last_colon(label, name):
     assert strip_subject_prefix(label) == name
 
@@ -36,10 +43,13 @@ def test_map_entry_for_a_label_the_file_lacks_is_named():
     assert "LASIS, RASIS, L_KNEE, LHEE, *12" in message
 
 
-@pytest.mark.parametrize("labels, label_map, detail", [
-    (["A:LASI", "B:LASI"], None, "LASI from A:LASI, B:LASI"),
-    (["LASIS", "LASI"], {"LASIS": "LASI"}, "LASI from LASIS, LASI"),
-])
+@pytest.mark.parametrize(
+    "labels, label_map, detail",
+    [
+        (["A:LASI", "B:LASI"], None, "LASI from A:LASI, B:LASI"),
+        (["LASIS", "LASI"], {"LASIS": "LASI"}, "LASI from LASIS, LASI"),
+    ],
+)
 def test_two_labels_with_one_name_are_refused(labels, label_map, detail):
     with pytest.raises(LoperInputError, match="marker names must be unique") as err:
         model_marker_names(labels, label_map, SOURCE)
@@ -74,12 +84,15 @@ def test_label_map_files_tsv_and_yaml(tmp_path):
     assert model_marker_names(VICON, read_label_map(tsv))[:3] == ["LASI", "RASIS", "LKNE"]
 
 
-@pytest.mark.parametrize("name, text, match", [
-    ("twice.tsv", "label\tmarker\nLASIS\tLASI\nLASIS\tRASI\n", "names label 'LASIS' twice"),
-    ("blank.tsv", "label\tmarker\nLASIS\t\n", "entry 1: 'LASIS' -> '' is not a pair of names"),
-    ("cols.tsv", "lab\tmarker\nLASIS\tLASI\n", r"column\(s\) \['label'\] missing"),
-    ("list.yaml", "- LASIS\n- LASI\n", "must be a YAML mapping"),
-])
+@pytest.mark.parametrize(
+    "name, text, match",
+    [
+        ("twice.tsv", "label\tmarker\nLASIS\tLASI\nLASIS\tRASI\n", "names label 'LASIS' twice"),
+        ("blank.tsv", "label\tmarker\nLASIS\t\n", "entry 1: 'LASIS' -> '' is not a pair of names"),
+        ("cols.tsv", "lab\tmarker\nLASIS\tLASI\n", r"column\(s\) \['label'\] missing"),
+        ("list.yaml", "- LASIS\n- LASI\n", "must be a YAML mapping"),
+    ],
+)
 def test_bad_label_map_files_are_named(tmp_path, name, text, match):
     path = tmp_path / name
     path.write_text(text)

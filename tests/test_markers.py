@@ -25,11 +25,13 @@ def rng():
 
 def cubic_marker(t):
     """A trajectory (n, 3) in m that is a cubic polynomial of time in every coordinate."""
-    return np.column_stack([
-        0.3 + 1.2 * t - 0.4 * t**2 + 0.05 * t**3,
-        0.9 - 0.02 * t**3,
-        -0.1 + 0.2 * t + 0.03 * t**2,
-    ])
+    return np.column_stack(
+        [
+            0.3 + 1.2 * t - 0.4 * t**2 + 0.05 * t**3,
+            0.9 - 0.02 * t**3,
+            -0.1 + 0.2 * t + 0.03 * t**2,
+        ]
+    )
 
 
 def sinusoid_marker(t, f_hz=1.0, amplitude_m=0.1):
@@ -105,10 +107,13 @@ def test_long_gap_error_names_file_marker_and_frames(trial):
     assert "CUB" not in message
 
 
-@pytest.mark.parametrize("frames, edge, text", [
-    (slice(0, 3), "start", "frames 0..2 (3 frames) at the start of the trial"),
-    (slice(N - 1, N), "end", f"frames {N - 1}..{N - 1} (1 frame) at the end of the trial"),
-])
+@pytest.mark.parametrize(
+    "frames, edge, text",
+    [
+        (slice(0, 3), "start", "frames 0..2 (3 frames) at the start of the trial"),
+        (slice(N - 1, N), "end", f"frames {N - 1}..{N - 1} (1 frame) at the end of the trial"),
+    ],
+)
 def test_gap_at_an_edge_cannot_be_interpolated(trial, frames, edge, text):
     gappy = trial.copy()
     gappy[frames, 0] = np.nan
@@ -130,11 +135,14 @@ def test_every_problem_is_listed(trial):
     assert "marker SIN is missing in frames 10..39: a gap of 30 frames exceeds the limit of 5 frames" in message
 
 
-@pytest.mark.parametrize("kwargs, match", [
-    (dict(max_gap_frames=-1), "max_gap_frames must be an integer >= 0, got -1"),
-    (dict(max_gap_frames=2.5), "max_gap_frames must be an integer >= 0, got 2.5"),
-    (dict(labels=["CUB"]), "labels must name 2 markers, got 1"),
-])
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        (dict(max_gap_frames=-1), "max_gap_frames must be an integer >= 0, got -1"),
+        (dict(max_gap_frames=2.5), "max_gap_frames must be an integer >= 0, got 2.5"),
+        (dict(labels=["CUB"]), "labels must name 2 markers, got 1"),
+    ],
+)
 def test_fill_gaps_checks_its_arguments(trial, kwargs, match):
     args = dict(markers_m=trial, max_gap_frames=3, labels=["CUB", "SIN"], source=SOURCE)
     with pytest.raises(LoperInputError, match=match):
@@ -155,12 +163,15 @@ def test_minus_90_about_x_turns_z_up_into_y_up():
     np.testing.assert_allclose(rotate_markers(np.array([1.0, 2.0, 3.0]), (-90, 0, 0)), [1.0, 3.0, -2.0], atol=1e-15)
 
 
-@pytest.mark.parametrize("angles, point, expected", [
-    ((0, 0, 90), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),  # counter-clockwise about Z
-    ((0, 90, 0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),  # counter-clockwise about Y
-    ((90, 90, 0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)),  # X first (y -> z), then Y (z -> x)
-    ((90, 90, 0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0)),  # about fixed axes: X leaves x, then Y takes x -> -z
-])
+@pytest.mark.parametrize(
+    "angles, point, expected",
+    [
+        ((0, 0, 90), (1.0, 0.0, 0.0), (0.0, 1.0, 0.0)),  # counter-clockwise about Z
+        ((0, 90, 0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0)),  # counter-clockwise about Y
+        ((90, 90, 0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0)),  # X first (y -> z), then Y (z -> x)
+        ((90, 90, 0), (1.0, 0.0, 0.0), (0.0, 0.0, -1.0)),  # about fixed axes: X leaves x, then Y takes x -> -z
+    ],
+)
 def test_rotations_about_fixed_axes_in_order_x_y_z(angles, point, expected):
     np.testing.assert_allclose(rotate_markers(np.array(point), angles), expected, atol=1e-15)
 
@@ -177,11 +188,14 @@ def test_rotation_keeps_shape_distances_and_nan(rng):
     np.testing.assert_allclose(back, X, atol=1e-14)
 
 
-@pytest.mark.parametrize("markers, angles, match", [
-    (np.zeros((5, 2)), (0, 0, 0), r"shape \(\.\.\., 3\)"),
-    (np.zeros((5, 3)), (0, 0), "3 finite angles"),
-    (np.zeros((5, 3)), (0, np.nan, 0), "3 finite angles"),
-])
+@pytest.mark.parametrize(
+    "markers, angles, match",
+    [
+        (np.zeros((5, 2)), (0, 0, 0), r"shape \(\.\.\., 3\)"),
+        (np.zeros((5, 3)), (0, 0), "3 finite angles"),
+        (np.zeros((5, 3)), (0, np.nan, 0), "3 finite angles"),
+    ],
+)
 def test_rotation_checks_its_arguments(markers, angles, match):
     with pytest.raises(LoperInputError, match=match):
         rotate_markers(markers, angles)
@@ -195,19 +209,31 @@ def test_keep_fills_short_interior_gaps_and_leaves_the_rest_missing(trial):
     gappy[:4, 0] = np.nan  # start of the trial
     gappy[40:45, 0] = np.nan  # 5 frames: filled
     gappy[100:130, 0] = np.nan  # 30 frames: too long
-    gappy[N - 2:, 1] = np.nan  # end of the trial
+    gappy[N - 2 :, 1] = np.nan  # end of the trial
     filled, report = fill_gaps(gappy, 5, ["CUB", "SIN"], SOURCE, unfillable="keep")
     np.testing.assert_allclose(filled[40:45, 0], trial[40:45, 0], rtol=0, atol=1e-12)  # a cubic comes back
-    assert np.isnan(filled[:4, 0]).all() and np.isnan(filled[100:130, 0]).all() and np.isnan(filled[N - 2:, 1]).all()
+    assert np.isnan(filled[:4, 0]).all() and np.isnan(filled[100:130, 0]).all() and np.isnan(filled[N - 2 :, 1]).all()
     assert np.isnan(filled).any(axis=2).sum() == 4 + 30 + 2
     assert report.to_dict("records") == [{"marker": "CUB", "first_frame": 40, "last_frame": 44, "n_frames": 5}]
     summary = gap_summary(gappy, filled, ["CUB", "SIN"])
     assert list(summary.columns) == list(GAP_SUMMARY_COLUMNS)
     assert summary.to_dict("records") == [
-        {"marker": "CUB", "n_frames": N, "n_filled_frames": 5, "n_missing_frames": 34, "longest_gap_frames": 30,
-         "n_unfiltered_frames": 0},
-        {"marker": "SIN", "n_frames": N, "n_filled_frames": 0, "n_missing_frames": 2, "longest_gap_frames": 2,
-         "n_unfiltered_frames": 0},
+        {
+            "marker": "CUB",
+            "n_frames": N,
+            "n_filled_frames": 5,
+            "n_missing_frames": 34,
+            "longest_gap_frames": 30,
+            "n_unfiltered_frames": 0,
+        },
+        {
+            "marker": "SIN",
+            "n_frames": N,
+            "n_filled_frames": 0,
+            "n_missing_frames": 2,
+            "longest_gap_frames": 2,
+            "n_unfiltered_frames": 0,
+        },
     ]
 
 
@@ -247,9 +273,10 @@ def test_only_weighted_markers_count():
     labels = ["LASI", "RASI", "LKNE", "LHEE"]
     require_markers_per_frame(X, labels, 2, source=SOURCE)  # frame 2 holds LKNE and LHEE
     # ... but LHEE has weight 0: only LKNE counts there
-    with pytest.raises(LoperInputError, match="1 frame.* fewer than 2 of the 3 weighted markers.*frames 2;.*: LASI, RASI$"):
-        require_markers_per_frame(X, labels, 2, weights={"LASI": 1, "LKNE": 1, "LHEE": 0, "RASI": 2},
-                                  source=SOURCE)
+    with pytest.raises(
+        LoperInputError, match="1 frame.* fewer than 2 of the 3 weighted markers.*frames 2;.*: LASI, RASI$"
+    ):
+        require_markers_per_frame(X, labels, 2, weights={"LASI": 1, "LKNE": 1, "LHEE": 0, "RASI": 2}, source=SOURCE)
     with pytest.raises(LoperInputError, match="min_markers must be an integer >= 1, got 0"):
         require_markers_per_frame(X, labels, 0, source=SOURCE)
 
@@ -264,19 +291,23 @@ def test_summary_counts_frames_the_filter_left_unfiltered(trial):
     np.testing.assert_array_equal(filtered[60:65, 1], trial[60:65, 1])
     summary = gap_summary(gappy, filtered, ["CUB", "SIN"], unfiltered)
     assert summary[["n_missing_frames", "longest_gap_frames", "n_unfiltered_frames"]].values.tolist() == [
-        [0, 0, 0], [145, 135, 5]
+        [0, 0, 0],
+        [145, 135, 5],
     ]
 
 
-@pytest.mark.parametrize("angles, up", [
-    ((-90, 0, 0), [0.0, 0.0, 1.0]),  # Qualisys / Vicon, Z up: exactly, so that Z-up labs keep their numbers
-    ((0, 0, 0), [0.0, 1.0, 0.0]),  # BTS, Y up, already OpenSim's frame
-    ((90, 0, 0), [0.0, 0.0, -1.0]),
-    ((0, 0, 90), [1.0, 0.0, 0.0]),
-    ((-90, 30, 0), [0.0, 0.0, 1.0]),  # a heading turn about the model's vertical (Y) leaves up alone
-    ((-90, 0, 30), [0.5, 0.0, np.sqrt(3) / 2]),  # a tilt about the model's Z moves it
-    ((-80, 0, 0), [0.0, np.sin(np.radians(10)), np.cos(np.radians(10))]),
-])
+@pytest.mark.parametrize(
+    "angles, up",
+    [
+        ((-90, 0, 0), [0.0, 0.0, 1.0]),  # Qualisys / Vicon, Z up: exactly, so that Z-up labs keep their numbers
+        ((0, 0, 0), [0.0, 1.0, 0.0]),  # BTS, Y up, already OpenSim's frame
+        ((90, 0, 0), [0.0, 0.0, -1.0]),
+        ((0, 0, 90), [1.0, 0.0, 0.0]),
+        ((-90, 30, 0), [0.0, 0.0, 1.0]),  # a heading turn about the model's vertical (Y) leaves up alone
+        ((-90, 0, 30), [0.5, 0.0, np.sqrt(3) / 2]),  # a tilt about the model's Z moves it
+        ((-80, 0, 0), [0.0, np.sin(np.radians(10)), np.cos(np.radians(10))]),
+    ],
+)
 def test_lab_up_is_what_the_rotation_turns_into_the_models_plus_y(angles, up):
     from loper_analysis.markers import MODEL_UP, lab_up
 

@@ -47,8 +47,14 @@ def test_opensim_kinematics_match_the_swing_leg_model(model):
     for _ in range(10):
         tilt, tx, ty = rng.uniform(-0.2, 0.2), rng.uniform(-0.5, 0.5), rng.uniform(0.8, 1.0)
         hip, knee, ankle = rng.uniform(-0.4, 0.6), rng.uniform(0, 1.2), rng.uniform(-0.4, 0.3)
-        for name, v in (("pelvis_tilt", tilt), ("pelvis_tx", tx), ("pelvis_ty", ty), ("hip_flexion_l", hip),
-                        ("knee_flexion_l", knee), ("ankle_dorsiflexion_l", ankle)):
+        for name, v in (
+            ("pelvis_tilt", tilt),
+            ("pelvis_tx", tx),
+            ("pelvis_ty", ty),
+            ("hip_flexion_l", hip),
+            ("knee_flexion_l", knee),
+            ("ankle_dorsiflexion_l", ankle),
+        ):
             cs.get(name).setValue(state, v, False)
         model.realizePosition(state)
         ours = segment_com_positions(segment_coordinates([hip, knee, ankle], -tilt, tx), params)

@@ -103,8 +103,9 @@ def test_prediction_follows_one_over_n_and_student_t(stride_cov, pilot):
         np.testing.assert_allclose(sd10 / sd40, 2.0, rtol=1e-12)
     t = table["n_strides"].map({10: T95[9], 40: T95[39]})
     np.testing.assert_allclose(table["ci95_half_width"] / table["predicted_sd"], t, rtol=1e-8)
-    np.testing.assert_allclose(table["ci95_half_width_pct"],
-                               100 * table["ci95_half_width"] / table["planned_value"].abs(), rtol=1e-12)
+    np.testing.assert_allclose(
+        table["ci95_half_width_pct"], 100 * table["ci95_half_width"] / table["planned_value"].abs(), rtol=1e-12
+    )
 
 
 def test_prediction_is_the_fits_own_sandwich(params, pilot, stride_cov):
@@ -123,8 +124,12 @@ def test_prediction_is_the_fits_own_sandwich(params, pilot, stride_cov):
     np.testing.assert_allclose(impulse, np.trapezoid(pulse, t_fine, axis=0), rtol=2e-3)
     errors = null_pair_errors(window, TRUTH, null)
     n = 20
-    exact = replace(window, measured=simulate_response(window, TRUTH), residual_weight=nuisance_projection(errors, 6),
-                    noise_cov=np.cov(null_pair_errors(window, TRUTH, pairs), rowvar=False) / n)
+    exact = replace(
+        window,
+        measured=simulate_response(window, TRUTH),
+        residual_weight=nuisance_projection(errors, 6),
+        noise_cov=np.cov(null_pair_errors(window, TRUTH, pairs), rowvar=False) / n,
+    )
     fit = identify_impedance(exact, n_starts=2, extra_starts=TRUTH, ci_dof=n - 1)
     np.testing.assert_allclose(fit.estimate, TRUTH, rtol=1e-5, atol=1e-6)
     half = precision_table(sc, [n], ONSET_MS, settings=settings)["ci95_half_width"].to_numpy()
@@ -140,7 +145,10 @@ def test_strides_needed_is_the_smallest_count(params, pilot, stride_cov):
         n = strides_needed(sc, joint, p, percent=pct)
         i = ["K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", "D_ankle"].index(f"{p}_{joint}")
         target = pct / 100 * TRUTH[i]
-        half = lambda k: student_t.ppf(0.975, k - 1) * sc.sd[i] / math.sqrt(k)  # noqa: E731
+
+        def half(k, i=i):
+            return student_t.ppf(0.975, k - 1) * sc.sd[i] / math.sqrt(k)
+
         assert n == next(k for k in range(2, 100000) if half(k) <= target * (1 + 1e-12))
     # the fit's intervals from the null pairs' scatter: t at their M - 1 degrees of freedom, N = ceil((t sd_1 / h)^2)
     fixed = stride_covariance(null, params, TRUTH, PlanSettings(interval_scatter="null_pairs"), perturbed_pairs=pairs)
@@ -171,8 +179,9 @@ def test_pilot_without_perturbed_pairs_falls_back_to_the_null_pairs(params, pilo
     np.testing.assert_allclose(stride_cov.covariance, M @ np.cov(Ep, rowvar=False) @ M.T, rtol=1e-6, atol=1e-12)
     print("perturbed / null pairs' SD (hip K, hip D, knee K, knee D):", np.round(stride_cov.sd[:4] / sc.sd[:4], 3))
     assert np.all(stride_cov.sd[:4] > 1.1 * sc.sd[:4])  # 1.18-1.55 here
-    few = {k: (v[:MIN_PERTURBED_PAIRS - 1] if isinstance(v, np.ndarray) and v.ndim >= 2 else v)
-           for k, v in pairs.items()}
+    few = {
+        k: (v[: MIN_PERTURBED_PAIRS - 1] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in pairs.items()
+    }
     few["n_pairs"] = MIN_PERTURBED_PAIRS - 1
     assert stride_covariance(null, params, TRUTH, perturbed_pairs=few).scatter == "null_pairs"
 
@@ -184,13 +193,17 @@ def test_pooled_scatter_is_the_weighted_mean_variance_ratio(stride_cov):
     p = np.array(TRUTH)
     a = StrideCovariance(4 * null, p, None, 130, "", 11, "perturbed_pairs", null)
     b = StrideCovariance(2 * null, p, None, 120, "", 31, "perturbed_pairs", 2 * null)
-    c = StrideCovariance(3 * null, p, None, 125, "no perturbed pairs of the pilot at this onset: ...", 0,
-                         "null_pairs", 3 * null)
+    c = StrideCovariance(
+        3 * null, p, None, 125, "no perturbed pairs of the pilot at this onset: ...", 0, "null_pairs", 3 * null
+    )
     pooled = pool_onsets({50: a, 175: b, 300: c})
     for onset, base in ((50, null), (175, 2 * null), (300, 3 * null)):
         np.testing.assert_allclose(pooled[onset].covariance, 1.75 * base, rtol=1e-12)
         assert pooled[onset].scatter == "pooled_perturbed_pairs"
-        assert pooled[onset].note == "perturbed/null pairs' variance ratio pooled over onsets 50, 175 ms (42 perturbed pairs)"
+        assert (
+            pooled[onset].note
+            == "perturbed/null pairs' variance ratio pooled over onsets 50, 175 ms (42 perturbed pairs)"
+        )
     alone = pool_onsets({50: stride_cov})
     np.testing.assert_array_equal(alone[50].covariance, stride_cov.covariance)
 
@@ -215,8 +228,9 @@ def test_repeated_experiments_report_the_predicted_sd(params, pilot):
             sc = stride_covariance(null, params, np.clip(planned, 0, None), perturbed_pairs=pairs)
             reported, kept = [], []
             for k in range(1, 9):
-                f, c = perturbation_experiment([11, k], params, HEIGHT_M, ONSET_MS, TRUTH, [10],
-                                               angle_noise_sd_rad=0.001)
+                f, c = perturbation_experiment(
+                    [11, k], params, HEIGHT_M, ONSET_MS, TRUTH, [10], angle_noise_sd_rad=0.001
+                )
                 r = fit_onset([c[10]], params, ONSET_MS, f"R{k}", None, [f], ResponseSettings(), ident).rows
                 assert (r["noise_model"] == "null_pairs").all()
                 r = r.set_index("joint")
@@ -253,8 +267,9 @@ def test_pulse_longer_than_the_window_is_refused():
 def test_pilot_without_null_pairs_is_refused(params, pilot):
     _, _, null, _ = pilot
     few = {k: (v[:5] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
-    with pytest.raises(LoperInputError,
-                       match=r"pilot: 5 null pair\(s\), fewer than identification.null_pair_components"):
+    with pytest.raises(
+        LoperInputError, match=r"pilot: 5 null pair\(s\), fewer than identification.null_pair_components"
+    ):
         stride_covariance(few, params, TRUTH)
     none = {k: (v[:0] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
     with pytest.raises(LoperInputError, match="no null pairs"):
@@ -278,13 +293,23 @@ def pilot_results(tmp_path_factory, params, pilot):
     write_tsv(full["angles"], root / "ik/S09/pert050-1.angles.tsv")
     write_tsv(full["strides"], root / "strides/S09/pert050-1.strides.tsv")
     write_tsv(full["angles"], root / "ik/S09/pert050-2.angles.tsv")  # every stride perturbed: no null pair
-    write_tsv(full["strides"].assign(perturbed=True, onset_s=full["strides"]["toe_off_s"] + 0.05),
-              root / "strides/S09/pert050-2.strides.tsv")
+    write_tsv(
+        full["strides"].assign(perturbed=True, onset_s=full["strides"]["toe_off_s"] + 0.05),
+        root / "strides/S09/pert050-2.strides.tsv",
+    )
     write_tsv(full["angles"], root / "ik/S09/walk-nodevice.angles.tsv")  # excluded by default
     write_segments(params, root / "model/S09/segments.tsv")
-    rows = pd.DataFrame({"subject": "S09", "onset_ms": 50, "joint": list(JOINTS),
-                         parameter_column("K"): TRUTH[0::2], parameter_column("D"): TRUTH[1::2], "status": "ok",
-                         "reason": ""})
+    rows = pd.DataFrame(
+        {
+            "subject": "S09",
+            "onset_ms": 50,
+            "joint": list(JOINTS),
+            parameter_column("K"): TRUTH[0::2],
+            parameter_column("D"): TRUTH[1::2],
+            "status": "ok",
+            "reason": "",
+        }
+    )
     write_tsv(rows, root / "impedance/S09/050.tsv")
     return root
 
@@ -292,9 +317,26 @@ def pilot_results(tmp_path_factory, params, pilot):
 def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)  # no config/config.yaml here: the library's defaults (onsets of the impedance rows)
     out = tmp_path / "plan.tsv"
-    code = main(["plan", "--results", str(pilot_results), "--subject", "S09", "--trials", "pert050-1",
-                 "--strides", "10", "40",
-                 "--target", "hip", "D", "15", "--out", str(out)])
+    code = main(
+        [
+            "plan",
+            "--results",
+            str(pilot_results),
+            "--subject",
+            "S09",
+            "--trials",
+            "pert050-1",
+            "--strides",
+            "10",
+            "40",
+            "--target",
+            "hip",
+            "D",
+            "15",
+            "--out",
+            str(out),
+        ]
+    )
     captured = capsys.readouterr()
     assert code == 0, captured.err
     table = pd.read_csv(out, sep="\t")
@@ -309,11 +351,14 @@ def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path,
     assert f"hip D at 50 ms: ±15 % (95 % CI) needs {n} perturbed strides" in captured.out
 
 
-@pytest.mark.parametrize("args, message", [
-    (["--strides", "0"], "stride count must be a whole number >= 1 (perturbed strides averaged), got 0"),
-    (["--duration-s", "0.5"], "pulse_duration_s = 0.5 s is longer than the fit window"),
-    (["--trials", "pert050-2"], "S09, onset 50 ms: 0 null pair(s), fewer than identification.null_pair_components"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--strides", "0"], "stride count must be a whole number >= 1 (perturbed strides averaged), got 0"),
+        (["--duration-s", "0.5"], "pulse_duration_s = 0.5 s is longer than the fit window"),
+        (["--trials", "pert050-2"], "S09, onset 50 ms: 0 null pair(s), fewer than identification.null_pair_components"),
+    ],
+)
 def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
     trials = [] if "--trials" in args else ["--trials", "pert050-1"]
     code = main(["plan", "--results", str(pilot_results), "--subject", "S09", *trials, *args])
@@ -327,17 +372,34 @@ def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_r
     """A pilot onset without an estimate: ``raise`` names it; ``note`` (the rule) writes rows without a prediction."""
     from loper_analysis.steps.planning import plan
 
-    failed = pd.DataFrame({"subject": "S09", "onset_ms": 175, "joint": list(JOINTS), parameter_column("K"): np.nan,
-                           parameter_column("D"): np.nan, "status": "failed",
-                           "reason": "3 valid perturbed stride(s), fewer than 5: not fitted"})
+    failed = pd.DataFrame(
+        {
+            "subject": "S09",
+            "onset_ms": 175,
+            "joint": list(JOINTS),
+            parameter_column("K"): np.nan,
+            parameter_column("D"): np.nan,
+            "status": "failed",
+            "reason": "3 valid perturbed stride(s), fewer than 5: not fitted",
+        }
+    )
     write_tsv(failed, tmp_path / "175.tsv")
     root = pilot_results
-    files = dict(trials=["pert050-1"], angles=[root / "ik/S09/pert050-1.angles.tsv"],
-                 strides=[root / "strides/S09/pert050-1.strides.tsv"], segments_tsv=root / "model/S09/segments.tsv",
-                 subject="S09", onsets_ms=[50, 175], n_strides=[10])
+    files = dict(
+        trials=["pert050-1"],
+        angles=[root / "ik/S09/pert050-1.angles.tsv"],
+        strides=[root / "strides/S09/pert050-1.strides.tsv"],
+        segments_tsv=root / "model/S09/segments.tsv",
+        subject="S09",
+        onsets_ms=[50, 175],
+        n_strides=[10],
+    )
     impedance = [root / "impedance/S09/050.tsv", tmp_path / "175.tsv"]
-    with pytest.raises(LoperInputError, match=r"no fitted impedance of subject S09 at onset 175 ms for the hip "
-                                              r"\(failed: 3 valid perturbed stride"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"no fitted impedance of subject S09 at onset 175 ms for the hip "
+        r"\(failed: 3 valid perturbed stride",
+    ):
         plan(**files, impedance_tsvs=impedance)
     table, _ = plan(**files, impedance_tsvs=impedance, unplannable="note")
     late = table[table["onset_ms"] == 175]

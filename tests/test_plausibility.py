@@ -41,8 +41,11 @@ def test_scale_factors_of_markers_spread_by_a_known_factor():
 def test_ik_fit_limit_counts_frames_over_the_rms_limit():
     rms = np.r_[np.full(8, 0.005), 0.03, 0.05, np.nan]
     require_ik_fit(rms, "walk.trc", max_rms_m=0.02, max_fraction=0.2)  # 2 of 10 frames: 20 % allowed
-    with pytest.raises(LoperInputError, match=r"walk\.trc: IK marker RMS error exceeds 20 mm in 2 of 10 frames "
-                                              r"\(20\.0 % > 10 %\); mean RMS 12 mm, largest 50 mm"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"walk\.trc: IK marker RMS error exceeds 20 mm in 2 of 10 frames "
+        r"\(20\.0 % > 10 %\); mean RMS 12 mm, largest 50 mm",
+    ):
         require_ik_fit(rms, "walk.trc", max_rms_m=0.02)
 
 
@@ -50,15 +53,19 @@ def test_ik_fit_warns_at_20_mm_and_stops_at_60_mm_by_default():
     # OpenSim's gait2392 tutorial solves at about 22 mm mean RMS: poor, but the data are right
     tutorial = np.r_[np.full(90, 0.022), np.full(10, 0.035)]
     warning = require_ik_fit(tutorial, "walk1.trc")
-    assert warning.startswith("walk1.trc: IK marker RMS error exceeds 20 mm in 100 of 100 frames (100.0 %); "
-                              "mean RMS 23.3 mm, largest 35 mm")
+    assert warning.startswith(
+        "walk1.trc: IK marker RMS error exceeds 20 mm in 100 of 100 frames (100.0 %); mean RMS 23.3 mm, largest 35 mm"
+    )
     assert "opensim.warn_marker_rms_m" in warning
     assert require_ik_fit(np.full(100, 0.012), "walk1.trc") is None
     assert require_ik_fit(tutorial, "walk1.trc", warn_rms_m=None) is None
     # a unit or label mistake: 97 mm in every frame (a trial walked the other way, before it was turned)
-    with pytest.raises(LoperInputError, match=r"walk\.trc: IK marker RMS error exceeds 60 mm in 100 of 100 frames "
-                                              r"\(100\.0 % > 10 %\); mean RMS 97 mm, largest 97 mm: wrong marker "
-                                              r"unit, labels or model\? \(limit: opensim\.max_marker_rms_m\)"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"walk\.trc: IK marker RMS error exceeds 60 mm in 100 of 100 frames "
+        r"\(100\.0 % > 10 %\); mean RMS 97 mm, largest 97 mm: wrong marker "
+        r"unit, labels or model\? \(limit: opensim\.max_marker_rms_m\)",
+    ):
         require_ik_fit(np.full(100, 0.097), "walk.trc")
     # 10 % of the frames over 60 mm is still allowed (e.g. a marker swapped for a moment), 11 % is not
     require_ik_fit(np.r_[np.full(90, 0.01), np.full(10, 0.08)], "walk.trc")

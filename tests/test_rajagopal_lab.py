@@ -44,7 +44,7 @@ G = 9.80665
 #: Stances of the GRF .mot in the order of the plates: foot, first and last sample with force (s, 2000 Hz).
 STANCES = [("right", 0.2480, 1.0465), ("left", 0.8170, 1.6125), ("right", 1.3925, 2.1910)]
 #: float32 coordinates in mm: a relative rounding error of at most 2**-24 (measured 5.9e-8, 0.12 µm).
-FLOAT32_RTOL = 2.0 ** -24
+FLOAT32_RTOL = 2.0**-24
 
 
 @pytest.fixture(scope="module")
@@ -87,29 +87,32 @@ def test_the_walkway_plates_give_the_mot_back(lab, grf):
     assert rec.analog_units[:6] == ["N", "N", "N", "Nmm", "Nmm", "Nmm"]
     plates = read_force_platforms(lab["walk-nodevice"])
     assert [p.type for p in plates] == [2, 2, 2]
-    rows = grf.iloc[:238 * 20]  # the .mot's rows at the analog samples (k / 2000 s from 0)
+    rows = grf.iloc[: 238 * 20]  # the .mot's rows at the analog samples (k / 2000 s from 0)
     np.testing.assert_allclose(plates[0].time_s, rows["time"], rtol=0, atol=1e-12)
     for plate, (side, t_on, t_off) in zip(plates, STANCES):
         s = side[0]
         on = (rows["time"] >= t_on - 1e-9) & (rows["time"] <= t_off + 1e-9)
         vy = rows[f"ground_force_{s}_vy"].to_numpy()
         first, last = np.flatnonzero(on)[[0, -1]]
-        assert (vy[first:last + 1] > 0).all() and vy[first - 1] == 0 and vy[last + 1] == 0  # the stance's rows
+        assert (vy[first : last + 1] > 0).all() and vy[first - 1] == 0 and vy[last + 1] == 0  # the stance's rows
         loads = plate_loads(plate.number, plate.time_s, plate.force_n, plate.moment_nm, plate.corners_m)
         np.testing.assert_allclose(loads.rest_force_n, [0.0, 0.0, -6.0], atol=1e-5)  # not zeroed: -6 N at rest
-        expected_force = np.column_stack([rows[f"ground_force_{s}_vx"], -rows[f"ground_force_{s}_vz"],
-                                          rows[f"ground_force_{s}_vy"]])
+        expected_force = np.column_stack(
+            [rows[f"ground_force_{s}_vx"], -rows[f"ground_force_{s}_vz"], rows[f"ground_force_{s}_vy"]]
+        )
         expected_force[~on.to_numpy()] = 0.0  # another plate holds the foot's other stance
         np.testing.assert_allclose(loads.force_n[:, 2], expected_force[:, 2], rtol=0, atol=1e-3)
         np.testing.assert_allclose(loads.force_n, expected_force, rtol=0, atol=1e-3)
         assert np.all(loads.force_n[~on.to_numpy()] == 0.0)
         loaded = loads.loaded
         assert loaded.sum() > 0.9 * on.sum() and not loaded[~on.to_numpy()].any()
-        cop = np.column_stack([rows[f"ground_force_{s}_px"], -rows[f"ground_force_{s}_pz"],
-                               rows[f"ground_force_{s}_py"]])  # m, floor at z = 0
+        cop = np.column_stack(
+            [rows[f"ground_force_{s}_px"], -rows[f"ground_force_{s}_pz"], rows[f"ground_force_{s}_py"]]
+        )  # m, floor at z = 0
         np.testing.assert_allclose(loads.cop_m[loaded], cop[loaded], rtol=0, atol=1e-4)  # 0.1 mm
-        np.testing.assert_allclose(loads.free_moment_nm[loaded], rows[f"ground_torque_{s}_y"][loaded], rtol=0,
-                                   atol=1e-4)
+        np.testing.assert_allclose(
+            loads.free_moment_nm[loaded], rows[f"ground_torque_{s}_y"][loaded], rtol=0, atol=1e-4
+        )
         corners = plate.corners_m
         assert np.all(corners[:, 2] == 0.0)
         inside = cop[on.to_numpy()]
@@ -125,8 +128,10 @@ def test_the_pipeline_puts_each_stance_on_its_foot(lab):
     rec = read_c3d(lab["walk-nodevice"])
     plates = read_force_platforms(lab["walk-nodevice"])
     forces = [PlateForce(p.number, p.time_s, p.force_n[:, 2] + 6.0, p.corners_m) for p in plates]
-    heels = {"right": rec.markers_m[:, rec.marker_labels.index("Subject11:R.Heel")],
-             "left": rec.markers_m[:, rec.marker_labels.index("Subject11:L.Heel")]}
+    heels = {
+        "right": rec.markers_m[:, rec.marker_labels.index("Subject11:R.Heel")],
+        "left": rec.markers_m[:, rec.marker_labels.index("Subject11:L.Heel")],
+    }
     contacts = foot_contacts(forces, rec.time_s, heels, vertical_axis=2)
     assert contacts["side"].tolist() == [side for side, _, _ in STANCES]
     assert (contacts["flag"] == "ok").all()
@@ -154,8 +159,11 @@ def test_the_static_plates_carry_the_weight(lab, tmp_path):
     plates = read_force_platforms(lab["static"])
     total = sum(p.force_n for p in plates)
     np.testing.assert_allclose(total, np.tile([0.0, 0.0, SUBJECT_MASS_KG * G], (1530, 1)), rtol=0, atol=1e-3)
-    np.testing.assert_allclose([plates[0].force_n[0, 2], plates[1].force_n[0, 2]],
-                               [0.52 * SUBJECT_MASS_KG * G, 0.48 * SUBJECT_MASS_KG * G], atol=1e-3)
+    np.testing.assert_allclose(
+        [plates[0].force_n[0, 2], plates[1].force_n[0, 2]],
+        [0.52 * SUBJECT_MASS_KG * G, 0.48 * SUBJECT_MASS_KG * G],
+        atol=1e-3,
+    )
     for plate, side in zip(plates, "RL"):  # each plate lies under its foot
         _, X, names = read_markers(STATIC_TRC)
         heel = X[0, names.index(f"{side}.Heel")]
@@ -194,8 +202,14 @@ def test_the_example_raw_files_are_the_generators(lab):
 
 @pytest.fixture(scope="module")
 def scaled(tmp_path_factory):
-    return opensim_scale_reference(GENERIC_OSIM, SCALE_SETUP, STATIC_TRC, 70.0,
-                                   tmp_path_factory.mktemp("scale") / "scaled.osim", marker_set_xml=MARKER_SET)
+    return opensim_scale_reference(
+        GENERIC_OSIM,
+        SCALE_SETUP,
+        STATIC_TRC,
+        70.0,
+        tmp_path_factory.mktemp("scale") / "scaled.osim",
+        marker_set_xml=MARKER_SET,
+    )
 
 
 def test_opensim_scales_the_generic_model_with_the_pipelines_marker_set(scaled, tmp_path):
@@ -222,7 +236,7 @@ def test_opensim_ik_of_the_walking_trial(scaled, tmp_path):
     time_s, _, _ = read_markers(WALK_TRC)
     np.testing.assert_allclose(angles["time_s"], time_s, rtol=0, atol=1e-9)  # the setup's 0 .. 2.37 s: all 238 frames
     lines = out.read_text().splitlines()
-    assert "inDegrees=yes" in lines[:lines.index("endheader")]
+    assert "inDegrees=yes" in lines[: lines.index("endheader")]
     raw = pd.read_csv(out, sep="\t", skiprows=lines.index("endheader") + 1)
     raw.columns = [c.strip() for c in raw.columns]
     np.testing.assert_allclose(np.degrees(angles["knee_angle_r"]), raw["knee_angle_r"], rtol=1e-12)  # file: degrees

@@ -42,10 +42,27 @@ pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not 
 ROOT = Path(__file__).resolve().parents[1]
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"
 #: Coordinates the study reads and those that carry them (the arms' are left to their markers' whims, below).
-BODY_COORDINATES = ("pelvis_tilt", "pelvis_list", "pelvis_rotation", "pelvis_tx", "pelvis_ty", "pelvis_tz",
-                    "hip_flexion_r", "hip_adduction_r", "hip_rotation_r", "knee_angle_r", "ankle_angle_r",
-                    "hip_flexion_l", "hip_adduction_l", "hip_rotation_l", "knee_angle_l", "ankle_angle_l",
-                    "lumbar_extension", "lumbar_bending", "lumbar_rotation")
+BODY_COORDINATES = (
+    "pelvis_tilt",
+    "pelvis_list",
+    "pelvis_rotation",
+    "pelvis_tx",
+    "pelvis_ty",
+    "pelvis_tz",
+    "hip_flexion_r",
+    "hip_adduction_r",
+    "hip_rotation_r",
+    "knee_angle_r",
+    "ankle_angle_r",
+    "hip_flexion_l",
+    "hip_adduction_l",
+    "hip_rotation_l",
+    "knee_angle_l",
+    "ankle_angle_l",
+    "lumbar_extension",
+    "lumbar_bending",
+    "lumbar_rotation",
+)
 
 
 def _workflow(tmp_path_factory, name: str, subjects: str, overrides: dict) -> Path:
@@ -65,8 +82,15 @@ def rajagopal(tmp_path_factory):
     """R11 through the workflow; the lab files' static trial complete (as OpenSim's pipeline has it)."""
     work = _workflow(tmp_path_factory, "rajagopal", "subject\tsource\nR11\trecorded\n", {})
     write_lab_files(work / "data/raw/R11", static_gaps={})
-    res = _run(work, ["results/strides/summary.tsv", "results/model/R11/scale.tsv", "results/grf/R11/walk-nodevice.grf.mot",
-                      "results/model/R11/segments.tsv"])
+    res = _run(
+        work,
+        [
+            "results/strides/summary.tsv",
+            "results/model/R11/scale.tsv",
+            "results/grf/R11/walk-nodevice.grf.mot",
+            "results/model/R11/segments.tsv",
+        ],
+    )
     assert res.returncode == 0, res.stderr[-3000:]
     return work
 
@@ -74,8 +98,11 @@ def rajagopal(tmp_path_factory):
 def test_scaled_model_is_opensims_scale_tool(rajagopal, tmp_path):
     ours = read_model(rajagopal / "results/model/R11/scaled.osim")
     # OpenSim's ScaleTool with the setup as distributed, its pipeline's marker set and the mass the plates carry
-    peer = read_model(opensim_scale_reference(GENERIC_OSIM, SCALE_SETUP, STATIC_TRC, SUBJECT_MASS_KG,
-                                              tmp_path / "peer.osim", marker_set_xml=MARKER_SET))
+    peer = read_model(
+        opensim_scale_reference(
+            GENERIC_OSIM, SCALE_SETUP, STATIC_TRC, SUBJECT_MASS_KG, tmp_path / "peer.osim", marker_set_xml=MARKER_SET
+        )
+    )
     s1, s2 = ours.initSystem(), peer.initSystem()
     # the mass comes from the plates' float32 channels: 85.0668003 kg (3e-9 relative)
     assert ours.getTotalMass(s1) == pytest.approx(peer.getTotalMass(s2), rel=1e-8)
@@ -83,8 +110,9 @@ def test_scaled_model_is_opensims_scale_tool(rajagopal, tmp_path):
         b2 = peer.getBodySet().get(i)
         b1 = ours.getBodySet().get(b2.getName())
         assert b1.getMass() == pytest.approx(b2.getMass(), rel=1e-8)
-        np.testing.assert_allclose(b1.getInertia().getMoments().to_numpy(), b2.getInertia().getMoments().to_numpy(),
-                                   rtol=1e-8)
+        np.testing.assert_allclose(
+            b1.getInertia().getMoments().to_numpy(), b2.getInertia().getMoments().to_numpy(), rtol=1e-8
+        )
     m1, m2 = ours.getMarkerSet(), peer.getMarkerSet()
     assert m1.getSize() == m2.getSize() == 41
     for i in range(m2.getSize()):
@@ -153,10 +181,15 @@ def test_the_trial_summary_flags_the_stride_short_trial(rajagopal):
 @pytest.fixture(scope="module")
 def walking5(tmp_path_factory):
     """W05: walking5.c3d as a recorded subject's walking trial, Rajagopal2016.osim as its model."""
-    work = _workflow(tmp_path_factory, "walking5",
-                     "subject\tsource\tmodel_osim\nW05\trecorded\texamples/rajagopal2016/Rajagopal2016.osim\n",
-                     {"opensim": {"ik_tasks": "examples/rajagopal2016/lower_body_ik_tasks.tsv"},
-                      "events": {"foot_markers": {"left": "LCAL", "right": "RCAL"}}})
+    work = _workflow(
+        tmp_path_factory,
+        "walking5",
+        "subject\tsource\tmodel_osim\nW05\trecorded\texamples/rajagopal2016/Rajagopal2016.osim\n",
+        {
+            "opensim": {"ik_tasks": "examples/rajagopal2016/lower_body_ik_tasks.tsv"},
+            "events": {"foot_markers": {"left": "LCAL", "right": "RCAL"}},
+        },
+    )
     (work / "data/raw/W05").mkdir(parents=True)
     shutil.copy(WALKING5, work / "data/raw/W05/walk-nodevice.c3d")
     res = _run(work, ["results/strides/summary.tsv", "results/grf/W05/walk-nodevice.grf.mot"])
@@ -201,20 +234,36 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     from loper_analysis.steps.processing import markers
 
     rec = read_c3d(WALKING5)
-    write_c3d(tmp_path / "plus_x.c3d", rec.marker_labels, rec.markers_m * np.array([-1.0, -1.0, 1.0]),
-              rec.point_rate_hz)
+    write_c3d(
+        tmp_path / "plus_x.c3d", rec.marker_labels, rec.markers_m * np.array([-1.0, -1.0, 1.0]), rec.point_rate_hz
+    )
     model = ROOT / "examples" / "rajagopal2016" / "Rajagopal2016.osim"
     tasks = ROOT / "examples" / "rajagopal2016" / "lower_body_ik_tasks.tsv"
-    coordinate_map = yaml.safe_load((ROOT / "examples/rajagopal2016/config.yaml").read_text())["opensim"]["coordinate_map"]
+    coordinate_map = yaml.safe_load((ROOT / "examples/rajagopal2016/config.yaml").read_text())["opensim"][
+        "coordinate_map"
+    ]
     angles = {}
     for name, c3d in (("minus_x", WALKING5), ("plus_x", tmp_path / "plus_x.c3d")):
-        markers(c3d, tmp_path / f"{name}.trc", walking_direction="auto", span_s=(2.0, 2.6),
-                summary_out=tmp_path / f"{name}.markers.tsv")
-        angles[name] = ik_trial(model, tmp_path / f"{name}.trc", tmp_path / f"{name}.mot",
-                                tmp_path / f"{name}.angles.tsv", coordinate_map, tasks_file=tasks)
+        markers(
+            c3d,
+            tmp_path / f"{name}.trc",
+            walking_direction="auto",
+            span_s=(2.0, 2.6),
+            summary_out=tmp_path / f"{name}.markers.tsv",
+        )
+        angles[name] = ik_trial(
+            model,
+            tmp_path / f"{name}.trc",
+            tmp_path / f"{name}.mot",
+            tmp_path / f"{name}.angles.tsv",
+            coordinate_map,
+            tasks_file=tasks,
+        )
     turns = [pd.read_csv(tmp_path / f"{n}.markers.tsv", sep="\t")["turn_deg"].iloc[0] for n in ("minus_x", "plus_x")]
     assert turns == [180.0, 0.0]
-    difference = np.degrees(angles["plus_x"].drop(columns=["time_s", "pelvis_x_m"]).to_numpy()
-                            - angles["minus_x"].drop(columns=["time_s", "pelvis_x_m"]).to_numpy())
+    difference = np.degrees(
+        angles["plus_x"].drop(columns=["time_s", "pelvis_x_m"]).to_numpy()
+        - angles["minus_x"].drop(columns=["time_s", "pelvis_x_m"]).to_numpy()
+    )
     # the markers agree to 1e-12 m; the solver, stopping at accuracy 1e-6 on this unscaled model, to 0.17 deg
     assert np.isfinite(difference).sum() > 900 and np.nanmax(np.abs(difference)) < 0.5

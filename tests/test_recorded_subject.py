@@ -40,8 +40,11 @@ TARGETS = ("results/tables/impedance.tsv", "results/strides/summary.tsv", "resul
 
 def _test_config() -> dict:
     """What this test sets on top of the default config and the gait2392 example: one subject, one onset."""
-    return {"subjects": "config/subjects.tsv", "device": {"subject": "R01"},
-            "trials": {"perturbation_onsets_ms": [50], "perturbation_repeats": 1}}
+    return {
+        "subjects": "config/subjects.tsv",
+        "device": {"subject": "R01"},
+        "trials": {"perturbation_onsets_ms": [50], "perturbation_repeats": 1},
+    }
 
 
 @pytest.fixture(scope="module")
@@ -49,11 +52,22 @@ def lab_run(tmp_path_factory):
     """The workflow on one recorded subject: its session (walking with the device, one perturbation trial)."""
     work = tmp_path_factory.mktemp("lab")
     copy_workflow(work)
-    truth = lab_export_session(work / "data/raw/R01", "R01", GENERIC, EXAMPLE / "gait2392_Scale_MarkerSet.xml",
-                               EXAMPLE / "qtm_label_map.tsv", ["walk-device", "pert050-1"], [None, 50],
-                               "walk-nodevice", 1.80, MASS_KG, 40.0, seed=7,
-                               impedance=[v for j in ("hip", "knee", "ankle") for v in TRUE_IMPEDANCE[j]],
-                               perturb_every_strides=(2, 3))
+    truth = lab_export_session(
+        work / "data/raw/R01",
+        "R01",
+        GENERIC,
+        EXAMPLE / "gait2392_Scale_MarkerSet.xml",
+        EXAMPLE / "qtm_label_map.tsv",
+        ["walk-device", "pert050-1"],
+        [None, 50],
+        "walk-nodevice",
+        1.80,
+        MASS_KG,
+        40.0,
+        seed=7,
+        impedance=[v for j in ("hip", "knee", "ankle") for v in TRUE_IMPEDANCE[j]],
+        perturb_every_strides=(2, 3),
+    )
     (work / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.80\t{MASS_KG}\n")
     (work / "config/test.yaml").write_text(yaml.safe_dump(_test_config(), sort_keys=False))
     res = snakemake(work, *TARGETS, "--configfile", "examples/gait2392/config.yaml", "config/test.yaml")
@@ -89,10 +103,13 @@ def test_angles_keep_the_files_clock_and_match_the_simulation(lab_run):
     angles = pd.read_csv(work / "results/ik/R01/pert050-1.angles.tsv", sep="\t")
     assert angles["time_s"].iloc[0] == FIRST_TIME_S
     coordinates = truth["pert050-1"][1].coordinates
-    for ours, theirs, sign in (("hip_left_rad", "hip_flexion_l", 1), ("knee_left_rad", "knee_angle_l", -1),
-                               ("ankle_left_rad", "ankle_angle_l", 1)):
+    for ours, theirs, sign in (
+        ("hip_left_rad", "hip_flexion_l", 1),
+        ("knee_left_rad", "knee_angle_l", -1),
+        ("ankle_left_rad", "ankle_angle_l", 1),
+    ):
         error_deg = np.degrees(angles[ours].to_numpy() - sign * coordinates[theirs].to_numpy())
-        assert np.sqrt(np.mean(error_deg ** 2)) < 0.3, ours  # measured 0.07-0.14 deg
+        assert np.sqrt(np.mean(error_deg**2)) < 0.3, ours  # measured 0.07-0.14 deg
         assert np.abs(error_deg).max() < 1.0, ours  # measured 0.26-0.60 deg
 
 

@@ -22,23 +22,63 @@ synthetic: {walking_duration_s: 30.0, variability: study}
 """
 SUBJECTS = "subject\tsource\nA1\tsynthetic\nB2\tsynthetic\n"
 
-IMPEDANCE_COLUMNS = ["subject", "onset_ms", "joint", "K_nm_per_rad", "D_nms_per_rad", "K_ci95_low_nm_per_rad",
-                     "K_ci95_high_nm_per_rad", "D_ci95_low_nms_per_rad", "D_ci95_high_nms_per_rad", "vaf_pct",
-                     "n_strides", "K_true_nm_per_rad", "D_true_nms_per_rad", "K_error_nm_per_rad",
-                     "D_error_nms_per_rad", "status"]
+IMPEDANCE_COLUMNS = [
+    "subject",
+    "onset_ms",
+    "joint",
+    "K_nm_per_rad",
+    "D_nms_per_rad",
+    "K_ci95_low_nm_per_rad",
+    "K_ci95_high_nm_per_rad",
+    "D_ci95_low_nms_per_rad",
+    "D_ci95_high_nms_per_rad",
+    "vaf_pct",
+    "n_strides",
+    "K_true_nm_per_rad",
+    "D_true_nms_per_rad",
+    "K_error_nm_per_rad",
+    "D_error_nms_per_rad",
+    "status",
+]
 # subject, onset, joint, K, D, K CI, D CI, VAF, strides, truth K, D
 FITS = [
-    ("A1", 50, "hip", 61.0, 3.0, (50.0, 70.0), (2.0, 4.0), 99.1, 11, 60.0, 3.1, "ok"),          # K, D within
-    ("B2", 50, "hip", 80.0, 2.0, (75.0, 85.0), (1.9, 2.1), 98.7, 9, 60.0, 3.0, "ok"),           # off, CI misses
+    ("A1", 50, "hip", 61.0, 3.0, (50.0, 70.0), (2.0, 4.0), 99.1, 11, 60.0, 3.1, "ok"),  # K, D within
+    ("B2", 50, "hip", 80.0, 2.0, (75.0, 85.0), (1.9, 2.1), 98.7, 9, 60.0, 3.0, "ok"),  # off, CI misses
     ("A1", 175, "hip", 30.0, 3.5, (0.0, 90.0), (0.0, 9.0), 97.3, 12, 55.0, 3.5, "not_identifiable"),
-    ("B2", 175, "hip", float("nan"), float("nan"), (float("nan"),) * 2, (float("nan"),) * 2, float("nan"), 10,
-     50.0, 3.0, "failed"),
+    (
+        "B2",
+        175,
+        "hip",
+        float("nan"),
+        float("nan"),
+        (float("nan"),) * 2,
+        (float("nan"),) * 2,
+        float("nan"),
+        10,
+        50.0,
+        3.0,
+        "failed",
+    ),
 ]
-SUMMARY = "\t".join(["joint", "onset_ms", "n_subjects", "n_not_identifiable", "K_mean_nm_per_rad", "K_sd_nm_per_rad",
-                     "D_mean_nms_per_rad", "D_sd_nms_per_rad", "vaf_pct_mean"]) + """
+SUMMARY = (
+    "\t".join(
+        [
+            "joint",
+            "onset_ms",
+            "n_subjects",
+            "n_not_identifiable",
+            "K_mean_nm_per_rad",
+            "K_sd_nm_per_rad",
+            "D_mean_nms_per_rad",
+            "D_sd_nms_per_rad",
+            "vaf_pct_mean",
+        ]
+    )
+    + """
 hip\t50\t2\t0\t70.5\t13.4350288\t2.5\t0.707106781\t98.9
 hip\t175\t1\t1\t30\t\t3.5\t\t97.3
 """
+)
 VALIDATION = """\
 condition\tparameter\tmin_error\tmax_error\tsd_error\tmax_abs_error\tn\tstudy_min_error\tstudy_max_error\tstudy_sd_error
 no_noise\tK_hip\t-0.000123\t0.00456\t0.0007\t0.00456\t729\t-0.87\t0.59\t
@@ -47,12 +87,28 @@ noise\tK_hip\t-70\t47\t13.579\t70\t729\t-6.2\t6.5\t15
 noise\tD_hip\t-4\t8\t1.2345\t8\t729\t-0.57\t0.5\t0.12
 """
 FITS_TSV = "condition\tn_starts\tn_starts_at_best\nno_noise\t10\t10\nno_noise\t10\t9\nnoise\t10\t10\n"
-RMSD = "\t".join(["subject", "phase", "joint", "n_strides_no_device", "n_strides_device", "rmsd_rad", "sd_rad",
-                  "isv_ave_rad", "transparent", "study_rmsd_rad", "study_isv_ave_rad"]) + """
+RMSD = (
+    "\t".join(
+        [
+            "subject",
+            "phase",
+            "joint",
+            "n_strides_no_device",
+            "n_strides_device",
+            "rmsd_rad",
+            "sd_rad",
+            "isv_ave_rad",
+            "transparent",
+            "study_rmsd_rad",
+            "study_isv_ave_rad",
+        ]
+    )
+    + """
 A1\tswing\tknee\t21\t23\t0.0912\t0.05\t0.1234\tTrue\t0.071\t0.129
 B2\tswing\tknee\t22\t20\t0.1500\t0.05\t0.1234\tFalse\t0.071\t0.129
 all\tswing\tknee\t43\t43\t0.0777\t0.05\t0.1234\tTrue\t0.071\t0.129
 """
+)
 FORCE = """\
 subject\tphase\tn_strides\trms_force_mean_n\tmax_abs_force_mean_n\tstudy_rms_force_mean_n\tstudy_max_abs_force_mean_n
 all\tstance\t43\t2.3456\t5.4321\t1.97\t4.46
@@ -97,7 +153,7 @@ Between the parts ✓ (measured on 2026-11-25 with `snakemake -j2`)
 <!-- generated: planning -->
 <!-- end generated -->
 
-Trailing hand-written text   
+Trailing hand-written text\x20\x20\x20
 without a final newline"""
 
 
@@ -113,11 +169,16 @@ def impedance_tsv() -> str:
 def run(tmp_path, monkeypatch):
     """A finished run's folder with a few rows in each table, and a page to rewrite; the current directory."""
     files = {
-        "config/config.yaml": CONFIG, "config/subjects.tsv": SUBJECTS,
-        "results/tables/impedance.tsv": impedance_tsv(), "results/tables/impedance_summary.tsv": SUMMARY,
-        "results/validation/summary.tsv": VALIDATION, "results/validation/fits.tsv": FITS_TSV,
-        "results/transparency/rmsd.tsv": RMSD, "results/transparency/force.tsv": FORCE,
-        "results/device/summary.tsv": DEVICE, "results/strides/summary.tsv": STRIDES,
+        "config/config.yaml": CONFIG,
+        "config/subjects.tsv": SUBJECTS,
+        "results/tables/impedance.tsv": impedance_tsv(),
+        "results/tables/impedance_summary.tsv": SUMMARY,
+        "results/validation/summary.tsv": VALIDATION,
+        "results/validation/fits.tsv": FITS_TSV,
+        "results/transparency/rmsd.tsv": RMSD,
+        "results/transparency/force.tsv": FORCE,
+        "results/device/summary.tsv": DEVICE,
+        "results/strides/summary.tsv": STRIDES,
         "results/planning/answers.txt": ANSWERS,
     }
     for name, text in files.items():
@@ -130,8 +191,9 @@ def run(tmp_path, monkeypatch):
 
 def outside_parts(text: str) -> str:
     """The page with the inside of every generated part cut out (the marker lines kept)."""
-    return re.sub(r"(^<!-- generated: [\w-]+ -->\n).*?(^<!-- end generated -->$)", r"\1\2", text,
-                  flags=re.MULTILINE | re.DOTALL)
+    return re.sub(
+        r"(^<!-- generated: [\w-]+ -->\n).*?(^<!-- end generated -->$)", r"\1\2", text, flags=re.MULTILINE | re.DOTALL
+    )
 
 
 def part(text: str, name: str) -> str:
@@ -162,8 +224,9 @@ def test_the_parts_hold_the_run_and_the_rest_is_kept_byte_for_byte(run, capsys):
     assert "| hip | 175 | 0 / 1 / 1 | 0 / 1 | 1 / 1 | 25.0 | 1 / 1 | 1 / 1 | 0 | 97.3 |" in truth
     assert "| **hip** | all | 2 / 1 / 1 | 1 / 3 | 2 / 3 | 25.0 | 2 / 3 | 2 / 3 | 1.00 | 98.4 |" in truth
     assert "2 subjects with a known truth, 9–12 perturbed strides per fit" in truth
-    assert ("B2, 50 ms, hip K 80.0 for 60.0 (95 % CI 75.0–85.0); "
-            "B2, 50 ms, hip D 2.00 for 3.00 (95 % CI 1.90–2.10).") in truth
+    assert (
+        "B2, 50 ms, hip K 80.0 for 60.0 (95 % CI 75.0–85.0); B2, 50 ms, hip D 2.00 for 3.00 (95 % CI 1.90–2.10)."
+    ) in truth
 
     validation = part(text, "validation")
     assert "| K_hip (N·m/rad) | −0.00012 … 0.0046 | −0.87 … 0.59 | 13.6 | 15 |" in validation
@@ -206,10 +269,13 @@ def test_a_part_without_its_table_and_extra_config_files(run):
     assert "walking trials of 240 s" in stamp and "`synthetic.variability: study`" in stamp
 
 
-@pytest.mark.parametrize("page, message", [
-    ("<!-- generated: nonsense -->\n<!-- end generated -->\n", "unknown generated part(s) ['nonsense']"),
-    ("<!-- generated: run -->\nno end\n", "1 opening, 0 closing markers"),
-])
+@pytest.mark.parametrize(
+    "page, message",
+    [
+        ("<!-- generated: nonsense -->\n<!-- end generated -->\n", "unknown generated part(s) ['nonsense']"),
+        ("<!-- generated: run -->\nno end\n", "1 opening, 0 closing markers"),
+    ],
+)
 def test_a_bad_page_is_named_and_left_alone(run, capsys, page, message):
     (run / "results.md").write_text(page)
     assert results_page.main(["--page", "results.md"]) == 2

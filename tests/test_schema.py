@@ -46,7 +46,9 @@ def test_bad_config_names_key_and_value(section, key, value, words):
 def test_unknown_key_is_named_by_its_full_path():
     cfg = _config()
     cfg["identification"]["n_stars"] = 3
-    with pytest.raises(LoperInputError, match=r"^config.yaml: key 'identification.n_stars': .*'n_stars' was unexpected"):
+    with pytest.raises(
+        LoperInputError, match=r"^config.yaml: key 'identification.n_stars': .*'n_stars' was unexpected"
+    ):
         check_config(cfg, CONFIG_SCHEMA, "config.yaml")
 
 
@@ -62,9 +64,14 @@ def test_unknown_key_is_named_by_its_full_path():
     ],
 )
 def test_config_origin_is_the_highest_layer_that_sets_the_key(key_path, origin):
-    layers = [("--config", {"seed": 3}),
-              ("late.yaml", {"identification": {"n_starts": 2}}),
-              ("early.yaml", {"identification": {"n_starts": 1, "tolerance": 1e-6}, "trials": {"perturbation_onsets_ms": [50, 175]}})]
+    layers = [
+        ("--config", {"seed": 3}),
+        ("late.yaml", {"identification": {"n_starts": 2}}),
+        (
+            "early.yaml",
+            {"identification": {"n_starts": 1, "tolerance": 1e-6}, "trials": {"perturbation_onsets_ms": [50, 175]}},
+        ),
+    ]
     assert config_origin(key_path, layers, "config/config.yaml") == origin
 
 
@@ -72,8 +79,10 @@ def test_config_origin_is_the_highest_layer_that_sets_the_key(key_path, origin):
     ("layers", "expected"),
     [
         ([("--config", {"identification": {"n_starts": "ten"}})], "--config: key 'identification.n_starts': 'ten'"),
-        ([("--config", {"seed": 1}), ("lab.yaml", {"identification": {"n_starts": "ten"}})],
-         "lab.yaml: key 'identification.n_starts': 'ten'"),
+        (
+            [("--config", {"seed": 1}), ("lab.yaml", {"identification": {"n_starts": "ten"}})],
+            "lab.yaml: key 'identification.n_starts': 'ten'",
+        ),
         ([("lab.yaml", {"seed": 1})], "config/config.yaml: key 'identification.n_starts': 'ten'"),
     ],
 )

@@ -54,7 +54,7 @@ def _fmm_spline(x: np.ndarray, y: np.ndarray, at: float) -> float:
     slope = np.diff(y) / h
 
     def third_difference(i):  # f[x_i .. x_i+3]
-        d2 = np.diff(slope[i:i + 3]) / (x[i + 2:i + 4] - x[i:i + 2])
+        d2 = np.diff(slope[i : i + 3]) / (x[i + 2 : i + 4] - x[i : i + 2])
         return (d2[1] - d2[0]) / (x[i + 3] - x[i])
 
     A, b = np.zeros((n, n)), np.zeros(n)
@@ -63,13 +63,17 @@ def _fmm_spline(x: np.ndarray, y: np.ndarray, at: float) -> float:
     A[-1, -2:] = [-1 / h[-1], 1 / h[-1]]
     b[-1] = 6 * third_difference(n - 4)
     for i in range(1, n - 1):
-        A[i, i - 1:i + 2] = [h[i - 1], 2 * (h[i - 1] + h[i]), h[i]]
+        A[i, i - 1 : i + 2] = [h[i - 1], 2 * (h[i - 1] + h[i]), h[i]]
         b[i] = 6 * (slope[i] - slope[i - 1])
     M = np.linalg.solve(A, b)
     i = int(np.clip(np.searchsorted(x, at) - 1, 0, n - 2))
     a, c = x[i + 1] - at, at - x[i]
-    return float(M[i] * a**3 / (6 * h[i]) + M[i + 1] * c**3 / (6 * h[i])
-                 + (y[i] / h[i] - M[i] * h[i] / 6) * a + (y[i + 1] / h[i] - M[i + 1] * h[i] / 6) * c)
+    return float(
+        M[i] * a**3 / (6 * h[i])
+        + M[i + 1] * c**3 / (6 * h[i])
+        + (y[i] / h[i] - M[i] * h[i] / 6) * a
+        + (y[i + 1] / h[i] - M[i + 1] * h[i] / 6) * c
+    )
 
 
 def _function(element, q: float) -> float:
@@ -95,7 +99,11 @@ class HandModel:
         self.bodies = {}
         for b in root.iter("Body"):
             I6 = _vec(b, "inertia")
-            self.bodies[b.get("name")] = {"mass": float(b.find("mass").text), "com": _vec(b, "mass_center"), "izz": I6[2]}
+            self.bodies[b.get("name")] = {
+                "mass": float(b.find("mass").text),
+                "com": _vec(b, "mass_center"),
+                "izz": I6[2],
+            }
         defaults = {c.get("name"): float(c.find("default_value").text) for c in root.iter("Coordinate")}
         self.joints = {}  # child body -> (parent body, child-frame origin in the parent body, its offset in the child)
         for j in root.find("JointSet").find("objects"):
@@ -113,7 +121,10 @@ class HandModel:
                     assert value == 0.0
                 else:
                     shift += value * _vec(axis, "axis")
-            body = lambda f: f.find("socket_parent").text.strip().split("/")[-1]
+
+            def body(f):
+                return f.find("socket_parent").text.strip().split("/")[-1]
+
             self.joints[body(child)] = (body(parent), _vec(parent, "translation") + shift, _vec(child, "translation"))
 
     def centre(self, body: str) -> np.ndarray:
@@ -228,9 +239,14 @@ def test_segment_table_file_of_a_user_model(scaled_model_file, tmp_path):
 
 def test_missing_body_names_file_setting_and_body(tmp_path):
     bodies = {"thigh": ["femur_{s}"], "shank": ["shin_{s}"], "foot": ["talus_{s}", "calcn_{s}"]}
-    with pytest.raises(LoperInputError, match=r"gait2392_simbody\.osim: opensim\.segment_bodies: shank body 'shin_l' "
-                                              r"is not in the model \(its bodies: pelvis, femur_r"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"gait2392_simbody\.osim: opensim\.segment_bodies: shank body 'shin_l' "
+        r"is not in the model \(its bodies: pelvis, femur_r",
+    ):
         segments_from_model_file(GAIT2392, tmp_path / "never.tsv", "left", bodies)
     assert not (tmp_path / "never.tsv").exists()
     with pytest.raises(LoperInputError, match=r"gait2392_simbody\.osim: opensim\.segment_bodies: thigh body 'thigh_l'"):
-        segments_from_model(read_model(GAIT2392), "l", {"thigh": ["thigh_{s}"], "shank": ["tibia_{s}"], "foot": ["toes_{s}"]})
+        segments_from_model(
+            read_model(GAIT2392), "l", {"thigh": ["thigh_{s}"], "shank": ["tibia_{s}"], "foot": ["toes_{s}"]}
+        )

@@ -29,8 +29,11 @@ def test_the_setups_time_range_wins_and_unset_ranges_are_ignored():
 
 
 def test_a_range_outside_the_trial_names_it_the_trial_and_the_setting():
-    with pytest.raises(LoperInputError, match=r"s\.trc: time_range of lab\.xml 0 \.\. 1 s holds no frame of the static "
-                                              r"trial \(7\.8125 \.\. 9\.8025 s, the file's clock\)"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"s\.trc: time_range of lab\.xml 0 \.\. 1 s holds no frame of the static "
+        r"trial \(7\.8125 \.\. 9\.8025 s, the file's clock\)",
+    ):
         scale_window_s(T, [(0.0, 1.0)], source="s.trc", setting="time_range of lab.xml")
 
 
@@ -55,11 +58,22 @@ def test_a_marker_absent_from_the_window_stops_if_needed_and_is_left_out_otherwi
     t, X = _markers()
     X[:6, 1] = np.nan
     X[:, 2] = np.nan
-    with pytest.raises(LoperInputError, match=r"static\.trc: marker\(s\) 'Subject:RKNE' \(model marker KNEE\) missing "
-                                              r"in every frame of the scaling window 0\.0000 \.\. 0\.0500 s \(6 frames\)"
-                                              r".*scale_setup\.xml"):
-        static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.05), needed=["KNEE"], lab_labels={"KNEE": "Subject:RKNE"},
-                    source="static.trc", setting="time_range of scale_setup.xml")
+    with pytest.raises(
+        LoperInputError,
+        match=r"static\.trc: marker\(s\) 'Subject:RKNE' \(model marker KNEE\) missing "
+        r"in every frame of the scaling window 0\.0000 \.\. 0\.0500 s \(6 frames\)"
+        r".*scale_setup\.xml",
+    ):
+        static_pose(
+            t,
+            X,
+            ["ASIS", "KNEE", "TOE"],
+            (0.0, 0.05),
+            needed=["KNEE"],
+            lab_labels={"KNEE": "Subject:RKNE"},
+            source="static.trc",
+            setting="time_range of scale_setup.xml",
+        )
     pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.06, 0.09), needed=["KNEE"])
     assert pose.labels == ["ASIS", "KNEE"] and pose.left_out == ["TOE"] and pose.markers_m.shape == (4, 2, 3)
 
@@ -76,12 +90,22 @@ def test_marker_motion_is_the_rms_distance_from_the_mean_and_a_moving_subject_st
     assert pose.motion_rms_m["TOE"] == pytest.approx(expected, rel=1e-12) and 0.029 < expected < 0.031
     assert pose.motion_rms_m["ASIS"] == pytest.approx(0.0, abs=1e-15)  # a still marker
     assert static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), max_motion_rms_m=0.031).labels  # under the limit
-    with pytest.raises(LoperInputError, match=r"static\.trc: the subject does not stand still in the scaling window "
-                                              r"0\.0000 \.\. 0\.0900 s of the static trial: marker\(s\) 'Subject:RTOE' "
-                                              r"\(model marker TOE\) 30 mm move more than markers\.static_max_motion_rms_m "
-                                              r"0\.02 m RMS"):
-        static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), lab_labels={"TOE": "Subject:RTOE"},
-                    source="static.trc", max_motion_rms_m=0.02)
+    with pytest.raises(
+        LoperInputError,
+        match=r"static\.trc: the subject does not stand still in the scaling window "
+        r"0\.0000 \.\. 0\.0900 s of the static trial: marker\(s\) 'Subject:RTOE' "
+        r"\(model marker TOE\) 30 mm move more than markers\.static_max_motion_rms_m "
+        r"0\.02 m RMS",
+    ):
+        static_pose(
+            t,
+            X,
+            ["ASIS", "KNEE", "TOE"],
+            (0.0, 0.09),
+            lab_labels={"TOE": "Subject:RTOE"},
+            source="static.trc",
+            max_motion_rms_m=0.02,
+        )
 
 
 def test_standing_mass_is_the_weight_over_gravity():
@@ -90,7 +114,9 @@ def test_standing_mass_is_the_weight_over_gravity():
     plates = np.column_stack([0.52 * 80.0 * 9.80665 + rng.normal(0, 2, t.size), 0.48 * 80.0 * 9.80665 + 0 * t])
     plates[:100] = 0.0  # stepping on: outside the window
     assert standing_mass_kg(t, plates, (0.2, 0.999), 9.80665) == pytest.approx(80.0, abs=0.02)  # 2 N noise
-    with pytest.raises(LoperInputError, match=r"s\.c3d: the force plates carry 0\.0 N on average .*outside 20 \.\. 300 kg"):
+    with pytest.raises(
+        LoperInputError, match=r"s\.c3d: the force plates carry 0\.0 N on average .*outside 20 \.\. 300 kg"
+    ):
         standing_mass_kg(t, plates, (0.0, 0.05), source="s.c3d")
     with pytest.raises(LoperInputError, match=r"varies by 71 % .*does not stand still"):
         standing_mass_kg(t, plates, (0.0, 0.3))  # a third of the window on no plate: SD over mean 0.71

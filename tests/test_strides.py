@@ -14,10 +14,16 @@ FS = 1000.0
 def _stride_table():
     # strides of 1 s: stance 0.6 s (3 periods of 5 Hz), swing 0.4 s (2 periods)
     hs = np.array([0.5, 1.5, 2.5])
-    return pd.DataFrame({
-        "stride": [0, 1, 2], "heel_strike_s": hs, "toe_off_s": hs + 0.6, "end_s": hs + 1.0,
-        "stance_s": 0.6, "duration_s": 1.0,
-    })
+    return pd.DataFrame(
+        {
+            "stride": [0, 1, 2],
+            "heel_strike_s": hs,
+            "toe_off_s": hs + 0.6,
+            "end_s": hs + 1.0,
+            "stance_s": 0.6,
+            "duration_s": 1.0,
+        }
+    )
 
 
 # --------------------------------------------------------------------------- force per phase
@@ -71,14 +77,21 @@ def test_fewer_than_five_valid_strides_warn():
     t = np.arange(0, 7.0, 1 / 128)
     heel_strikes = 0.5 + 1.2 * np.arange(5)
     phase = 2 * np.pi * (t - 0.5) / 1.2
-    angles = pd.DataFrame({"time_s": t, "hip_left_rad": 0.4 * np.sin(phase) + 0.01 * t,
-                           "knee_left_rad": 0.6 * np.sin(phase + 1.0) ** 2 + 0.01 * t,
-                           "ankle_left_rad": 0.2 * np.cos(phase) - 0.01 * t})
-    events = pd.DataFrame({
-        "side": "left",
-        "event": ["heel_strike", "toe_off"] * 5,
-        "time_s": np.column_stack([heel_strikes, heel_strikes + 0.72]).ravel(),
-    })
+    angles = pd.DataFrame(
+        {
+            "time_s": t,
+            "hip_left_rad": 0.4 * np.sin(phase) + 0.01 * t,
+            "knee_left_rad": 0.6 * np.sin(phase + 1.0) ** 2 + 0.01 * t,
+            "ankle_left_rad": 0.2 * np.cos(phase) - 0.01 * t,
+        }
+    )
+    events = pd.DataFrame(
+        {
+            "side": "left",
+            "event": ["heel_strike", "toe_off"] * 5,
+            "time_s": np.column_stack([heel_strikes, heel_strikes + 0.72]).ravel(),
+        }
+    )
     with pytest.warns(TooFewStridesWarning, match="only 4 valid stride"):
         tables = stride_tables(angles, events, side="left")
     assert len(tables.strides) == 4 and not tables.strides["removed"].any()
@@ -86,10 +99,17 @@ def test_fewer_than_five_valid_strides_warn():
 
 
 def test_stride_summary_counts_removed_and_kept_strides():
-    base = pd.DataFrame({
-        "stride": range(8), "duration_s": 1.2, "fraction_outlying_hip": 0.0, "fraction_outlying_knee": 0.0,
-        "removed": False, "reason": "", "perturbed": False,
-    })
+    base = pd.DataFrame(
+        {
+            "stride": range(8),
+            "duration_s": 1.2,
+            "fraction_outlying_hip": 0.0,
+            "fraction_outlying_knee": 0.0,
+            "removed": False,
+            "reason": "",
+            "perturbed": False,
+        }
+    )
     few = base.copy()
     few.loc[3:, "removed"] = True
     few.loc[3:, "reason"] = "knee: 30.0 % of samples outside 1.5·IQR"
@@ -105,9 +125,25 @@ def test_stride_summary_counts_removed_and_kept_strides():
 
 #: Columns of a stride table with a force table, in order (the table of any number of strides, 0 included).
 STRIDE_COLUMNS = [
-    "stride", "side", "heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s", "perturbed",
-    "onset_s", "fraction_outlying_hip", "fraction_outlying_knee", "fraction_outlying_ankle", "removed", "reason",
-    "rms_force_stance_n", "rms_force_swing_n", "max_abs_force_stance_n", "max_abs_force_swing_n",
+    "stride",
+    "side",
+    "heel_strike_s",
+    "toe_off_s",
+    "end_s",
+    "duration_s",
+    "stance_s",
+    "swing_s",
+    "perturbed",
+    "onset_s",
+    "fraction_outlying_hip",
+    "fraction_outlying_knee",
+    "fraction_outlying_ankle",
+    "removed",
+    "reason",
+    "rms_force_stance_n",
+    "rms_force_swing_n",
+    "max_abs_force_stance_n",
+    "max_abs_force_swing_n",
 ]
 FORCE_N = -3.5  # a constant interaction force: RMS and max |F| are 3.5 N in every phase
 
@@ -117,15 +153,30 @@ def _overground(n_heel_strikes: int, logged_from_s: float = 0.0):
     toe-off 0.72 s later) and a constant force, NaN before ``logged_from_s`` (outside the robot log)."""
     t = np.arange(0, 7.0, 1 / 128)
     phase = 2 * np.pi * (t - 0.5) / 1.2
-    angles = pd.DataFrame({"time_s": t, "hip_left_rad": 0.4 * np.sin(phase), "knee_left_rad": 0.6 * np.cos(phase),
-                           "ankle_left_rad": 0.2 * np.sin(phase + 1.0)})
+    angles = pd.DataFrame(
+        {
+            "time_s": t,
+            "hip_left_rad": 0.4 * np.sin(phase),
+            "knee_left_rad": 0.6 * np.cos(phase),
+            "ankle_left_rad": 0.2 * np.sin(phase + 1.0),
+        }
+    )
     hs = 0.5 + 1.2 * np.arange(n_heel_strikes)
-    events = pd.DataFrame({"side": pd.Series(["left"] * 2 * n_heel_strikes, dtype=object),
-                           "event": ["heel_strike", "toe_off"] * n_heel_strikes,
-                           "time_s": np.column_stack([hs, hs + 0.72]).ravel(),
-                           "sample": np.zeros(2 * n_heel_strikes, dtype=np.int64)})
-    force = pd.DataFrame({"time_s": t, "force_measured_n": np.where(t >= logged_from_s, FORCE_N, np.nan),
-                          "perturbation": np.where(t >= logged_from_s, 0.0, np.nan)})
+    events = pd.DataFrame(
+        {
+            "side": pd.Series(["left"] * 2 * n_heel_strikes, dtype=object),
+            "event": ["heel_strike", "toe_off"] * n_heel_strikes,
+            "time_s": np.column_stack([hs, hs + 0.72]).ravel(),
+            "sample": np.zeros(2 * n_heel_strikes, dtype=np.int64),
+        }
+    )
+    force = pd.DataFrame(
+        {
+            "time_s": t,
+            "force_measured_n": np.where(t >= logged_from_s, FORCE_N, np.nan),
+            "perturbation": np.where(t >= logged_from_s, 0.0, np.nan),
+        }
+    )
     return angles, events, force
 
 
@@ -140,16 +191,29 @@ def test_zero_or_one_stride_gives_the_full_tables_flagged(n_heel_strikes, n_stri
     assert tables.too_few_strides
     s = tables.strides
     assert list(s.columns) == STRIDE_COLUMNS and len(s) == n_strides
-    assert list(tables.cycles.columns) == ["stride", "phase", "point", "percent", "hip_left_rad", "knee_left_rad",
-                                           "ankle_left_rad", "force_n"]
+    assert list(tables.cycles.columns) == [
+        "stride",
+        "phase",
+        "point",
+        "percent",
+        "hip_left_rad",
+        "knee_left_rad",
+        "ankle_left_rad",
+        "force_n",
+    ]
     assert len(tables.cycles) == 3 * 101 * n_strides
     if n_strides:
         row = s.iloc[0]
-        np.testing.assert_allclose(row[["heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s"]]
-                                   .to_numpy(float), [0.5, 1.22, 1.7, 1.2, 0.72, 0.48], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(
+            row[["heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s"]].to_numpy(float),
+            [0.5, 1.22, 1.7, 1.2, 0.72, 0.48],
+            rtol=0,
+            atol=1e-12,
+        )
         assert not row.perturbed and not row.removed and row.reason == "" and np.isnan(row.onset_s)
-        assert np.isnan(row[["fraction_outlying_hip", "fraction_outlying_knee", "fraction_outlying_ankle"]]
-                        .to_numpy(float)).all()
+        assert np.isnan(
+            row[["fraction_outlying_hip", "fraction_outlying_knee", "fraction_outlying_ankle"]].to_numpy(float)
+        ).all()
         np.testing.assert_allclose(row[STRIDE_COLUMNS[-4:]].to_numpy(float), 3.5, rtol=1e-12)
         np.testing.assert_allclose(tables.cycles["force_n"], FORCE_N, rtol=1e-12)
 
@@ -185,13 +249,19 @@ def test_the_steps_write_and_summarise_trials_with_zero_and_one_stride(tmp_path)
             write_tsv(frame, tmp_path / f"{n_heel_strikes}.{name}.tsv")
         out = tmp_path / f"{n_heel_strikes}.strides.tsv"
         with pytest.warns(TooFewStridesWarning) if n_heel_strikes < 6 else _no_warning():
-            strides(tmp_path / f"{n_heel_strikes}.angles.tsv", tmp_path / f"{n_heel_strikes}.events.tsv", out,
-                    tmp_path / f"{n_heel_strikes}.cycles.tsv", tmp_path / f"{n_heel_strikes}.force.tsv",
-                    min_valid=5 if n_heel_strikes < 6 else 4)
+            strides(
+                tmp_path / f"{n_heel_strikes}.angles.tsv",
+                tmp_path / f"{n_heel_strikes}.events.tsv",
+                out,
+                tmp_path / f"{n_heel_strikes}.cycles.tsv",
+                tmp_path / f"{n_heel_strikes}.force.tsv",
+                min_valid=5 if n_heel_strikes < 6 else 4,
+            )
         files[n_heel_strikes] = out
     assert files[1].read_text() == "\t".join(STRIDE_COLUMNS) + "\n"  # the header only, every column
     assert (tmp_path / "1.cycles.tsv").read_text().splitlines() == [
-        "stride\tphase\tpoint\tpercent\thip_left_rad\tknee_left_rad\tankle_left_rad\tforce_n"]
+        "stride\tphase\tpoint\tpercent\thip_left_rad\tknee_left_rad\tankle_left_rad\tforce_n"
+    ]
     back = read_tsv(files[1], "stride table", keep_default_na=False, na_values=[""])
     assert list(back.columns) == STRIDE_COLUMNS and len(back) == 0
     keys = [("S01", "overground-0"), ("S01", "overground-1"), ("S01", "overground-5")]
@@ -213,8 +283,11 @@ def test_stride_summary_of_an_untyped_empty_table_and_a_table_without_columns():
     row = stride_summary({("S01", "walk"): empty}, min_valid=1).iloc[0]
     assert (row.n_strides, row.n_perturbed, row.n_removed, row.n_kept, row.status) == (0, 0, 0, 0, "too_few_strides")
     assert row.n_removed_hip == 0 and np.isnan(row.mean_stride_s)
-    with pytest.raises(LoperInputError, match=r"S01 walk: stride table: column\(s\) \['removed', 'reason', "
-                                              r"'duration_s'\] missing"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"S01 walk: stride table: column\(s\) \['removed', 'reason', "
+        r"'duration_s'\] missing",
+    ):
         stride_summary({("S01", "walk"): pd.DataFrame()})
 
 
@@ -231,15 +304,26 @@ def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
         for name, frame in (("angles", angles), ("events", events), ("force", force)):
             write_tsv(frame, tmp_path / f"{n_heel_strikes}.{name}.tsv")
         with pytest.warns(TooFewStridesWarning) if n_heel_strikes < 6 else _no_warning():
-            strides(tmp_path / f"{n_heel_strikes}.angles.tsv", tmp_path / f"{n_heel_strikes}.events.tsv",
-                    tmp_path / f"{n_heel_strikes}.strides.tsv", tmp_path / f"{n_heel_strikes}.cycles.tsv",
-                    tmp_path / f"{n_heel_strikes}.force.tsv")
+            strides(
+                tmp_path / f"{n_heel_strikes}.angles.tsv",
+                tmp_path / f"{n_heel_strikes}.events.tsv",
+                tmp_path / f"{n_heel_strikes}.strides.tsv",
+                tmp_path / f"{n_heel_strikes}.cycles.tsv",
+                tmp_path / f"{n_heel_strikes}.force.tsv",
+            )
         paths[n_heel_strikes] = (tmp_path / f"{n_heel_strikes}.strides.tsv", tmp_path / f"{n_heel_strikes}.cycles.tsv")
     pairs = {"S01": (6, 6), "S02": (6, 1), "S03": (2, 6)}  # heel strikes without, with the device
     with pytest.warns(TooFewStridesWarning) as caught:
-        transparency(list(pairs), [paths[a][0] for a, _ in pairs.values()], [paths[a][1] for a, _ in pairs.values()],
-                     [paths[b][0] for _, b in pairs.values()], [paths[b][1] for _, b in pairs.values()],
-                     tmp_path / "rmsd.tsv", tmp_path / "force.tsv", tmp_path / "t.png")
+        transparency(
+            list(pairs),
+            [paths[a][0] for a, _ in pairs.values()],
+            [paths[a][1] for a, _ in pairs.values()],
+            [paths[b][0] for _, b in pairs.values()],
+            [paths[b][1] for _, b in pairs.values()],
+            tmp_path / "rmsd.tsv",
+            tmp_path / "force.tsv",
+            tmp_path / "t.png",
+        )
     assert sorted(str(w.message).split(":")[0] for w in caught) == ["subject S02", "subject S03"]
     rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
     assert rmsd.subject.tolist() == ["S01"] * 6 + ["S02"] * 6 + ["S03"] * 6 + ["all"] * 6

@@ -29,24 +29,38 @@ def test_trials_of_the_default_design():
 
 def test_a_trial_name_gives_its_onset_only_within_the_design():
     d = StudyDesign(perturbation_onsets_ms=(50, 5), perturbation_repeats=3)
-    assert [d.onset_ms(t) for t in ("pert050-1", "pert050-3", "pert005-2", "pert050-4", "pert100-1", "static")] == \
-        [50, 50, 5, None, None, None]
+    assert [d.onset_ms(t) for t in ("pert050-1", "pert050-3", "pert005-2", "pert050-4", "pert100-1", "static")] == [
+        50,
+        50,
+        5,
+        None,
+        None,
+        None,
+    ]
     assert d.onsets_of(["pert005-1", "walk-device", "pert050-2", "pert005-3"]) == [50, 5]  # the design's order
 
 
-@pytest.mark.parametrize(("trial", "condition", "kind", "robot"), [
-    ("static", "static", "static", False), ("walk-nodevice", "no_device", "walking", False),
-    ("walk-device", "device", "walking", True), ("pert300-2", "perturbation", "walking", True),
-    ("device-frf", "device_test", "walking", True),
-])
+@pytest.mark.parametrize(
+    ("trial", "condition", "kind", "robot"),
+    [
+        ("static", "static", "static", False),
+        ("walk-nodevice", "no_device", "walking", False),
+        ("walk-device", "device", "walking", True),
+        ("pert300-2", "perturbation", "walking", True),
+        ("device-frf", "device_test", "walking", True),
+    ],
+)
 def test_conditions(trial, condition, kind, robot):
     d = StudyDesign()
     assert (d.condition(trial), d.kind(trial), d.with_robot(trial)) == (condition, kind, robot)
 
 
 def test_names_outside_the_design_are_refused_by_name():
-    with pytest.raises(LoperInputError, match=r"trial 'pert100-1' is no trial of the design \(static, walk-nodevice, "
-                                              r"walk-device, pert050-1, .*, device-steps\)"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"trial 'pert100-1' is no trial of the design \(static, walk-nodevice, "
+        r"walk-device, pert050-1, .*, device-steps\)",
+    ):
         StudyDesign().condition("pert100-1")
     assert perturbation_trial_name(7, 12) == "pert007-12"
     with pytest.raises(LoperInputError, match=r"onset 1000 ms must lie in 0 \.\. 999"):

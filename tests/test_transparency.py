@@ -1,4 +1,5 @@
-"""loper_analysis.transparency: statistics of normalised strides and the transparency table, against analytic answers."""
+"""loper_analysis.transparency: statistics of normalised strides and the transparency table, against analytic
+answers."""
 
 import numpy as np
 import pandas as pd
@@ -35,8 +36,9 @@ def test_rmsd_of_known_curves():
     # sum_k sin^2(2 pi k / 100) over k = 0..100 is 50: RMSD = c sqrt(50 / 101)
     c = 0.25
     assert rmsd(np.zeros(101), c * a) == pytest.approx(c * np.sqrt(50 / 101), rel=1e-12)
-    np.testing.assert_allclose(rmsd(np.column_stack([a, a]), np.column_stack([a + 0.02, a - 0.05])), [0.02, 0.05],
-                               rtol=1e-12)
+    np.testing.assert_allclose(
+        rmsd(np.column_stack([a, a]), np.column_stack([a + 0.02, a - 0.05])), [0.02, 0.05], rtol=1e-12
+    )
 
 
 def test_isv_ave_of_known_sds():
@@ -57,9 +59,7 @@ def _subject(offsets, sd_no_device, sd_device, n_points=51):
     spread = np.array([-1.0, 0.0, 1.0])[:, None, None]  # SD 1 across the 3 strides
     out = {}
     for condition, shift, sd in (("no_device", 0.0, sd_no_device), ("device", offsets, sd_device)):
-        out[condition] = {
-            phase: base + np.asarray(shift) + spread * np.asarray(sd) for phase in ("stance", "swing")
-        }
+        out[condition] = {phase: base + np.asarray(shift) + spread * np.asarray(sd) for phase in ("stance", "swing")}
     # the swing phase of the device condition carries twice the offset
     out["device"]["swing"] = base + 2 * np.asarray(offsets) + spread * np.asarray(sd_device)
     return out
@@ -75,12 +75,15 @@ def test_transparency_table_known_answers():
     assert len(table) == 2 * 2 * 3 + 2 * 3
     assert list(table["subject"].unique()) == ["S01", "S02", "all"]
     idx = table.set_index(["subject", "phase", "joint"])
-    np.testing.assert_allclose(idx.loc[("S01", "stance"), "rmsd_rad"].loc[["hip", "knee", "ankle"]],
-                               [0.01, 0.02, 0.045], rtol=1e-9)
-    np.testing.assert_allclose(idx.loc[("S01", "swing"), "rmsd_rad"].loc[["hip", "knee", "ankle"]],
-                               [0.02, 0.04, 0.09], rtol=1e-9)
-    np.testing.assert_allclose(idx.loc[("S02", "stance"), "sd_rad"].loc[["hip", "knee", "ankle"]],
-                               [0.04, 0.05, 0.03], rtol=1e-9)
+    np.testing.assert_allclose(
+        idx.loc[("S01", "stance"), "rmsd_rad"].loc[["hip", "knee", "ankle"]], [0.01, 0.02, 0.045], rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        idx.loc[("S01", "swing"), "rmsd_rad"].loc[["hip", "knee", "ankle"]], [0.02, 0.04, 0.09], rtol=1e-9
+    )
+    np.testing.assert_allclose(
+        idx.loc[("S02", "stance"), "sd_rad"].loc[["hip", "knee", "ankle"]], [0.04, 0.05, 0.03], rtol=1e-9
+    )
     assert (table["n_strides_no_device"].iloc[:12] == 3).all()
     summary = idx.loc["all"]
     # mean RMSD over subjects; ISV_ave = (2 / 2) (sigma_S01 + sigma_S02), sigma from the no-device strides
@@ -110,8 +113,9 @@ def test_bad_inputs_are_named():
     with pytest.raises(LoperInputError, match="subject S07: condition 'device' missing"):
         transparency_table({"S07": {"no_device": {"stance": good, "swing": good}}})
     with pytest.raises(LoperInputError, match=r"subject S07, device, swing needs >= 2 strides, got 1"):
-        transparency_table({"S07": {"no_device": {"stance": good, "swing": good},
-                                    "device": {"stance": good, "swing": good[:1]}}})
+        transparency_table(
+            {"S07": {"no_device": {"stance": good, "swing": good}, "device": {"stance": good, "swing": good[:1]}}}
+        )
     with pytest.raises(LoperInputError, match="isv_condition must be one of"):
         transparency_table({"S07": {}}, isv_condition="both")
     with pytest.raises(LoperInputError, match="mean_a .* and mean_b .* must share a shape"):

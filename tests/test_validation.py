@@ -136,22 +136,37 @@ def test_gather_validation_tables_sorts_the_chunks_and_adds_the_study_values():
     """Chunks arrive in any order: rows sort by condition (no_noise first), combination and parameter order."""
 
     def errors(combination, condition, offset):
-        return pd.DataFrame({"condition": condition, "combination": combination, "parameter": list(PARAMETERS)[::-1],
-                             "error": offset + np.arange(6.0)})
+        return pd.DataFrame(
+            {
+                "condition": condition,
+                "combination": combination,
+                "parameter": list(PARAMETERS)[::-1],
+                "error": offset + np.arange(6.0),
+            }
+        )
 
     def fits(combination, condition):
         return pd.DataFrame({"condition": [condition], "combination": [combination], "cost_rad2": [combination]})
 
-    error_chunks = [pd.concat([errors(3, "noise", 10.0), errors(1, "no_noise", 0.0)]),
-                    pd.concat([errors(0, "noise", 20.0), errors(2, "no_noise", 30.0)])]
-    fit_chunks = [pd.concat([fits(3, "noise"), fits(1, "no_noise")]),
-                  pd.concat([fits(0, "noise"), fits(2, "no_noise")])]
+    error_chunks = [
+        pd.concat([errors(3, "noise", 10.0), errors(1, "no_noise", 0.0)]),
+        pd.concat([errors(0, "noise", 20.0), errors(2, "no_noise", 30.0)]),
+    ]
+    fit_chunks = [
+        pd.concat([fits(3, "noise"), fits(1, "no_noise")]),
+        pd.concat([fits(0, "noise"), fits(2, "no_noise")]),
+    ]
     gathered, fit_table, summary = gather_validation_tables(error_chunks, fit_chunks)
-    assert list(zip(fit_table.condition, fit_table.combination)) == [("no_noise", 1), ("no_noise", 2),
-                                                                     ("noise", 0), ("noise", 3)]
+    assert list(zip(fit_table.condition, fit_table.combination)) == [
+        ("no_noise", 1),
+        ("no_noise", 2),
+        ("noise", 0),
+        ("noise", 3),
+    ]
     assert list(gathered.parameter[:6]) == list(PARAMETERS) and len(gathered) == 24
     assert list(zip(gathered.condition[::6], gathered.combination[::6])) == list(
-        zip(fit_table.condition, fit_table.combination))
+        zip(fit_table.condition, fit_table.combination)
+    )
     # the summary is summarize_errors of the gathered errors, with the study's columns beside it
     pd.testing.assert_frame_equal(summary[summarize_errors(gathered).columns], summarize_errors(gathered))
     noise = summary[summary.condition == "noise"]

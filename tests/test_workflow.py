@@ -26,7 +26,9 @@ def _project(tmp: Path, **changes) -> Path:
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp / item)
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    cfg["validation"].update(stiffness_levels_nm_per_rad=[0.0, 150.0], damping_levels_nms_per_rad=[0.0, 4.0], n_chunks=2)
+    cfg["validation"].update(
+        stiffness_levels_nm_per_rad=[0.0, 150.0], damping_levels_nms_per_rad=[0.0, 4.0], n_chunks=2
+    )
     cfg["identification"]["n_starts"] = 3
     # one synthetic subject, short trials, one perturbation trial
     (tmp / "config/subjects.tsv").write_text(
@@ -140,8 +142,10 @@ def test_impedance_table_from_the_default_run(finished_run):
     for fig in ("figures/impedance.png", "figures/S01/responses.png", "figures/S01/fit.png"):
         assert (finished_run / "results" / fig).read_bytes()[:4] == b"\x89PNG", fig
     truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())
-    np.testing.assert_allclose(table.K_true_nm_per_rad, [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"]
-                                              for j in ("hip", "knee", "ankle")])
+    np.testing.assert_allclose(
+        table.K_true_nm_per_rad,
+        [truth["impedance"]["onset_050_ms"][j]["stiffness_nm_per_rad"] for j in ("hip", "knee", "ankle")],
+    )
 
 
 @pytest.mark.parametrize(
@@ -165,10 +169,22 @@ def test_bad_config_is_refused_with_its_key(tmp_path, changes, expected):
     [
         ("subject\tsource\theight_m\nS01\tsynthetic\t2.7\n", {}, "height_m"),
         ("subject\tsource\tmass_kg\nS01\tsynthetic\t-4\n", {}, "mass_kg"),
-        (None, {"synthetic__stiffness_nm_per_rad": {"50": [230.0, 3.0, 8.0], "175": [38.0, 0.5, 8.0],
-                                                    "300": [62.0, 2.5, 8.0]}}, "outside the identification bounds"),
-        ("subject\tsource\theight_m\tmass_kg\nS01\tsynthetic\t1.8\t70\nR01\trecorded\t1.7\t60\n", {},
-         "data/raw/R01/static.c3d"),
+        (
+            None,
+            {
+                "synthetic__stiffness_nm_per_rad": {
+                    "50": [230.0, 3.0, 8.0],
+                    "175": [38.0, 0.5, 8.0],
+                    "300": [62.0, 2.5, 8.0],
+                }
+            },
+            "outside the identification bounds",
+        ),
+        (
+            "subject\tsource\theight_m\tmass_kg\nS01\tsynthetic\t1.8\t70\nR01\trecorded\t1.7\t60\n",
+            {},
+            "data/raw/R01/static.c3d",
+        ),
     ],
 )
 def test_bad_subjects_are_refused_before_any_work(tmp_path, sheet, changes, expected):
@@ -248,7 +264,7 @@ def test_a_failed_job_leaves_its_message_and_traceback_in_its_log(tmp_path):
     assert "results/logs/markers/R01/static.log (check log file(s) for error details)" in console
     log = (work / "results/logs/markers/R01/static.log").read_text()
     assert f"ERROR loper_analysis.rule: LoperInputError: {message}" in log
-    assert "Traceback (most recent call last)" in log and 'in read_c3d' in log
+    assert "Traceback (most recent call last)" in log and "in read_c3d" in log
     assert log.rstrip().endswith(f"loper_analysis.errors.LoperInputError: {message}")
     assert not (work / "results/markers").exists()  # nothing half-written
 
@@ -299,7 +315,7 @@ def _cut_c3d(path: Path, seconds: float) -> None:
 
     rec = read_c3d(path)
     n = round(seconds * rec.point_rate_hz)
-    write_recording(path, replace(rec, markers_m=rec.markers_m[:n], analogs=rec.analogs[:n * rec.samples_per_frame]))
+    write_recording(path, replace(rec, markers_m=rec.markers_m[:n], analogs=rec.analogs[: n * rec.samples_per_frame]))
 
 
 def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_run, tmp_path):
@@ -340,8 +356,13 @@ def test_a_killed_run_recovers_to_the_bytes_of_an_uninterrupted_one(finished_run
     os.utime(work / "data/raw/S01/pert050-1.c3d", (later, later))  # a newer raw trial: its processing reruns
     console = tmp_path / "killed.out"
     with console.open("w") as out:
-        run = subprocess.Popen([sys.executable, "-m", "snakemake", "--cores", "2"], cwd=work, stdout=out,
-                               stderr=subprocess.STDOUT, start_new_session=True)
+        run = subprocess.Popen(
+            [sys.executable, "-m", "snakemake", "--cores", "2"],
+            cwd=work,
+            stdout=out,
+            stderr=subprocess.STDOUT,
+            start_new_session=True,
+        )
         deadline = time.monotonic() + 300
         while run.poll() is None and console.read_text().count("Finished jobid") < 3 and time.monotonic() < deadline:
             time.sleep(0.05)
@@ -357,8 +378,11 @@ def test_a_killed_run_recovers_to_the_bytes_of_an_uninterrupted_one(finished_run
     assert not list((work / "results").rglob("*.partial"))  # no staging left behind
 
     def tables(root: Path) -> dict:
-        return {p.relative_to(root): p.read_bytes() for p in (root / "results").rglob("*.tsv")
-                if "benchmarks" not in p.parts}  # job timings differ by nature
+        return {
+            p.relative_to(root): p.read_bytes()
+            for p in (root / "results").rglob("*.tsv")
+            if "benchmarks" not in p.parts
+        }  # job timings differ by nature
 
     ours, clean = tables(work), tables(finished_run)
     assert sorted(ours) == sorted(clean) and len(ours) >= 40
@@ -380,21 +404,36 @@ def _dry_run_rules(work: Path, *args: str) -> dict[str, set[str]]:
     return rules
 
 
-@pytest.mark.parametrize("section, key, value, expected", [
-    # a stride setting: the stride tables and what reads them, never IK
-    ("strides", "iqr_whisker", 2.0, {"strides", "strides_summary", "impedance_fit", "transparency"}),
-    # a gait-event setting: events (and their load-cell sibling in the one job of a device trial), then strides
-    ("events", "threshold_on_n", 60.0, {"events", "events_loadcell", "strides", "strides_summary", "impedance_fit",
-                                        "transparency"}),
-    # a setting of the subjects' fits only (the validation study does not use it)
-    ("identification", "min_vaf_pct", 1.0, {"impedance_fit"}),
-])
+@pytest.mark.parametrize(
+    "section, key, value, expected",
+    [
+        # a stride setting: the stride tables and what reads them, never IK
+        ("strides", "iqr_whisker", 2.0, {"strides", "strides_summary", "impedance_fit", "transparency"}),
+        # a gait-event setting: events (and their load-cell sibling in the one job of a device trial), then strides
+        (
+            "events",
+            "threshold_on_n",
+            60.0,
+            {"events", "events_loadcell", "strides", "strides_summary", "impedance_fit", "transparency"},
+        ),
+        # a setting of the subjects' fits only (the validation study does not use it)
+        ("identification", "min_vaf_pct", 1.0, {"impedance_fit"}),
+    ],
+)
 def test_a_changed_setting_reruns_only_what_depends_on_it(finished_run, tmp_path, section, key, value, expected):
     overlay = tmp_path / "overlay.yaml"
     overlay.write_text(yaml.safe_dump({section: {key: value}}))
     rules = _dry_run_rules(finished_run, "--configfile", "config/config.yaml", str(overlay))
-    aggregates = {"impedance_table", "impedance_summary", "impedance_figures", "impedance_figure", "tables_markdown",
-                  "planning", "front_page", "all"}
+    aggregates = {
+        "impedance_table",
+        "impedance_summary",
+        "impedance_figures",
+        "impedance_figure",
+        "tables_markdown",
+        "planning",
+        "front_page",
+        "all",
+    }
     assert set(rules) - aggregates == expected, rules
     assert not {"markers", "ik", "model_scaled", "synthetic_lab", "validation_chunk"} & set(rules)
 
@@ -413,11 +452,26 @@ def test_touching_one_raw_file_reruns_only_what_depends_on_it(finished_run):
         os.utime(raw, (before.st_atime, before.st_mtime))
     assert res.returncode == 0, res.stderr[-3000:]
     blocks = re.split(r"^\s*(?:local)?rule (\w+):$", res.stdout, flags=re.M)[1:]
-    jobs = [(name, (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0])
-            for name, body in zip(blocks[::2], blocks[1::2])]
+    jobs = [
+        (name, (re.findall(r"^\s+wildcards: (.*)$", body, re.M) or [""])[0])
+        for name, body in zip(blocks[::2], blocks[1::2])
+    ]
     rules = {name for name, _ in jobs}
-    assert rules == {"markers", "ik", "events_loadcell", "strides", "strides_summary",
-                     "impedance_fit", "impedance_table", "impedance_summary", "impedance_figures", "impedance_figure",
-                     "tables_markdown", "planning", "front_page", "all"}, rules
+    assert rules == {
+        "markers",
+        "ik",
+        "events_loadcell",
+        "strides",
+        "strides_summary",
+        "impedance_fit",
+        "impedance_table",
+        "impedance_summary",
+        "impedance_figures",
+        "impedance_figure",
+        "tables_markdown",
+        "planning",
+        "front_page",
+        "all",
+    }, rules
     trials = {w.split("trial=")[1].split(",")[0] for _, w in jobs if "trial=" in w}
     assert trials == {"pert050-1"}

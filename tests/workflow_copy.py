@@ -22,5 +22,11 @@ def copy_workflow(work: Path) -> Path:
 
 def snakemake(work: Path, *args: str, timeout: float = 900) -> subprocess.CompletedProcess:
     """``snakemake --cores 2 ARGS`` of this Python in ``work``; its output captured as text, never raising."""
-    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=work, capture_output=True,
-                          text=True, timeout=timeout, check=False)
+    return subprocess.run(
+        [sys.executable, "-m", "snakemake", "--cores", "2", *args],
+        cwd=work,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        check=False,
+    )

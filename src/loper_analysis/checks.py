@@ -81,8 +81,12 @@ def positive(name: str, value, source: str = "") -> float:
 
 def integer(name: str, value, source: str = "", minimum: int | None = None) -> int:
     """An integral number (``3`` or ``3.0``, not ``True``), optionally ``>= minimum``."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, bool) and math.isfinite(float(value)) \
+    ok = (
+        isinstance(value, numbers.Real)
+        and not isinstance(value, bool)
+        and math.isfinite(float(value))
         and float(value) == int(value)
+    )
     if not ok or (minimum is not None and int(value) < minimum):
         bound = f" >= {minimum}" if minimum is not None else ""
         raise LoperInputError(f"{where(source)}{name} must be an integer{bound}, got {value!r}")
@@ -111,9 +115,7 @@ def time_vector(time_s, source: str = "", name: str = "time_s", min_count: int =
     """
     t = np.asarray(time_s, dtype=float)
     if t.ndim != 1 or t.size < min_count:
-        raise LoperInputError(
-            f"{where(source)}{name} must be 1-D with >= {min_count} {item}s, got shape {t.shape}"
-        )
+        raise LoperInputError(f"{where(source)}{name} must be 1-D with >= {min_count} {item}s, got shape {t.shape}")
     bad = np.flatnonzero(~np.isfinite(t))
     if bad.size:
         i = int(bad[0])
@@ -147,9 +149,7 @@ def signal(name: str, values, n: int, source: str = "") -> np.ndarray:
     """Samples along axis 0: shape (n,) or (n, k), like a time vector of ``n`` values."""
     v = np.asarray(values, dtype=float)
     if v.ndim not in (1, 2) or v.shape[0] != n:
-        raise LoperInputError(
-            f"{where(source)}{name} must have shape ({n},) or ({n}, k) like time_s, got {v.shape}"
-        )
+        raise LoperInputError(f"{where(source)}{name} must have shape ({n},) or ({n}, k) like time_s, got {v.shape}")
     return v
 
 
@@ -175,9 +175,7 @@ def finite_rows(name: str, values, width: int, source: str = "") -> tuple[np.nda
         raise LoperInputError(f"{where(source)}{name} must have shape ({width},) or (n, {width}), got {a.shape}")
     if not np.all(np.isfinite(a2)):
         i = np.argwhere(~np.isfinite(a2))[0]
-        raise LoperInputError(
-            f"{where(source)}{name} is not finite at row {i[0]}, column {i[1]}: {a2[tuple(i)]}"
-        )
+        raise LoperInputError(f"{where(source)}{name} is not finite at row {i[0]}, column {i[1]}: {a2[tuple(i)]}")
     return np.ascontiguousarray(a2), single
 
 
@@ -185,8 +183,9 @@ def marker_array(markers_m, source: str = "") -> np.ndarray:
     """Markers as a float array of shape (n_frames, n_markers, 3); another shape is refused naming ``source``."""
     X = np.asarray(markers_m, dtype=float)
     if X.ndim != 3 or X.shape[2] != 3:
-        raise LoperInputError(f"{source or 'markers'}: markers_m must have shape (n_frames, n_markers, 3), "
-                              f"got {X.shape}")
+        raise LoperInputError(
+            f"{source or 'markers'}: markers_m must have shape (n_frames, n_markers, 3), got {X.shape}"
+        )
     return X
 
 
@@ -223,8 +222,14 @@ def bool_column(table: pd.DataFrame, name: str, source: str = "", what: str = "t
     return out
 
 
-def unique_names(names, what: str, source: str = "", max_chars: int | None = None,
-                 allow_whitespace: bool = True, allow_spaces: bool = False) -> list[str]:
+def unique_names(
+    names,
+    what: str,
+    source: str = "",
+    max_chars: int | None = None,
+    allow_whitespace: bool = True,
+    allow_spaces: bool = False,
+) -> list[str]:
     """Non-empty, unique strings without leading or trailing blanks (and, if asked, without any whitespace).
 
     ``allow_whitespace=False`` refuses every whitespace character; with
@@ -248,8 +253,11 @@ def unique_names(names, what: str, source: str = "", max_chars: int | None = Non
                 limits.append("leading/trailing blanks or whitespace other than inner spaces")
             else:
                 limits.append("whitespace")
-            rule = f"non-empty strings of {limits[0]} without {limits[1]}" if len(limits) == 2 \
+            rule = (
+                f"non-empty strings of {limits[0]} without {limits[1]}"
+                if len(limits) == 2
                 else f"non-empty strings without {limits[0]}"
+            )
             raise LoperInputError(f"{where(source)}{what} must be {rule}, got {name!r}")
     duplicated = sorted({n for n in names if names.count(n) > 1})
     if duplicated:

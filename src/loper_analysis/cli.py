@@ -33,7 +33,8 @@ from .plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
 __all__ = ["main"]
 
-#: Lab -> model rotation (degrees about X, Y, Z) used for a C3D when --rotate-deg is not given: Qualisys Z-up -> OpenSim Y-up.
+#: Lab -> model rotation (degrees about X, Y, Z) used for a C3D when --rotate-deg is not given:
+#: Qualisys Z-up -> OpenSim Y-up.
 C3D_ROTATION_DEG = (-90.0, 0.0, 0.0)
 
 
@@ -60,14 +61,24 @@ def _label_map(path: str | None) -> dict[str, str] | None:
 def _markers(args: argparse.Namespace) -> None:
     from .steps.processing import markers
 
-    gaps = markers(args.c3d, args.out, args.gaps, _rotation(args, args.c3d), args.max_gap_frames,
-                   args.cutoff_hz or None, args.order, label_map=_label_map(args.label_map),
-                   walking_direction=_walking_direction(args))
+    gaps = markers(
+        args.c3d,
+        args.out,
+        args.gaps,
+        _rotation(args, args.c3d),
+        args.max_gap_frames,
+        args.cutoff_hz or None,
+        args.order,
+        label_map=_label_map(args.label_map),
+        walking_direction=_walking_direction(args),
+    )
     per_marker = gaps.attrs.get("per_marker", [])
     n_frames = per_marker[0]["n_frames"] if per_marker else 0
     missing = sum(row["n_missing_frames"] > 0 for row in per_marker)
-    print(f"{args.out}: {len(per_marker)} markers, {n_frames} frames; {len(gaps)} gap(s) filled, "
-          f"{missing} marker(s) still missing somewhere")
+    print(
+        f"{args.out}: {len(per_marker)} markers, {n_frames} frames; {len(gaps)} gap(s) filled, "
+        f"{missing} marker(s) still missing somewhere"
+    )
 
 
 def _grf(args: argparse.Namespace) -> None:
@@ -95,10 +106,17 @@ def _plates(text: str | None) -> dict[str, int] | None:
 def _events(args: argparse.Namespace) -> None:
     from .steps.processing import events
 
-    table = events(args.c3d, args.out, grf_channels=None, threshold_on_n=args.threshold_on_n,
-                   threshold_off_n=args.threshold_off_n, foot_markers=dict(zip(("left", "right"), args.feet)),
-                   plate_sides=_plates(args.plates), rotation_deg=_rotation(args, args.c3d),
-                   label_map=_label_map(args.label_map))
+    table = events(
+        args.c3d,
+        args.out,
+        grf_channels=None,
+        threshold_on_n=args.threshold_on_n,
+        threshold_off_n=args.threshold_off_n,
+        foot_markers=dict(zip(("left", "right"), args.feet)),
+        plate_sides=_plates(args.plates),
+        rotation_deg=_rotation(args, args.c3d),
+        label_map=_label_map(args.label_map),
+    )
     flagged = table.attrs.get("n_contacts_flagged", 0)
     print(f"{args.out}: {len(table)} events; {flagged} contact(s) flagged and left out")
 
@@ -112,17 +130,33 @@ def _scale(args: argparse.Namespace) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         if static.suffix.lower() == ".c3d":
             trc = Path(tmp) / (static.stem + ".trc")
-            gaps = markers(static, trc, None, _rotation(args, args.static), args.max_gap_frames,
-                           args.cutoff_hz or None, label_map=_label_map(args.label_map))
+            gaps = markers(
+                static,
+                trc,
+                None,
+                _rotation(args, args.static),
+                args.max_gap_frames,
+                args.cutoff_hz or None,
+                label_map=_label_map(args.label_map),
+            )
             lab_labels = {row["marker"]: row["label"] for row in gaps.attrs["per_marker"]}
             static = trc
         elif args.mass_kg is None:
             raise LoperInputError(f"scale: {args.static}: a .trc static trial has no force plates: give --mass-kg")
         time_range = None if args.start is None else (args.start, args.end)
-        scale_with_setup(args.model, args.setup, static, args.mass_kg, args.out, time_range_s=time_range,
-                         static_c3d=c3d if c3d.suffix.lower() == ".c3d" else None, lab_labels=lab_labels,
-                         rotation_deg=_rotation(args, args.static), report_out=args.report,
-                         max_motion_rms_m=args.max_motion_rms_m or None)
+        scale_with_setup(
+            args.model,
+            args.setup,
+            static,
+            args.mass_kg,
+            args.out,
+            time_range_s=time_range,
+            static_c3d=c3d if c3d.suffix.lower() == ".c3d" else None,
+            lab_labels=lab_labels,
+            rotation_deg=_rotation(args, args.static),
+            report_out=args.report,
+            max_motion_rms_m=args.max_motion_rms_m or None,
+        )
     mass = f"{args.mass_kg:g} kg" if args.mass_kg is not None else "mass from the static trial's force plates"
     print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({mass})")
     if args.report:
@@ -145,9 +179,14 @@ def _segments(args: argparse.Namespace) -> None:
 
 def _validate(args: argparse.Namespace) -> None:
     from .steps.validation import validation_chunk
+    from .validation import validation_settings
 
-    validation_chunk(args.segments, {"n_starts": args.n_starts, "seed": args.seed}, args.chunk, args.n_chunks,
-                     args.errors, args.fits)
+    config, line = _read_config(args)
+    print(line)
+    settings = {} if config is None else validation_settings(config)
+    settings.update({k: v for k, v in (("n_starts", args.n_starts), ("seed", args.seed)) if v is not None})
+    n_chunks = args.n_chunks if args.n_chunks is not None else (config or {}).get("validation", {}).get("n_chunks", 1)
+    validation_chunk(args.segments, settings, args.chunk, n_chunks, args.errors, args.fits)
 
 
 def _first_subject(subjects_tsv: str, results: Path) -> str:
@@ -180,8 +219,10 @@ def _read_config(args: argparse.Namespace) -> tuple[dict | None, str]:
     last = {p.resolve(): n for n, p in enumerate(named)}
     files = [p for n, p in enumerate(named) if last[p.resolve()] == n]
     if not files:
-        return None, (f"config: none (no {DEFAULT_CONFIG.as_posix()} in {Path.cwd()} and no --configfile): library "
-                      "defaults, which may differ from the workflow's settings")
+        return None, (
+            f"config: none (no {DEFAULT_CONFIG.as_posix()} in {Path.cwd()} and no --configfile): library "
+            "defaults, which may differ from the workflow's settings"
+        )
     config, used = load_config(files)
     order = " (later files override earlier ones)" if len(used) > 1 else ""
     return config, f"config: {', '.join(used)}{order}"
@@ -203,16 +244,26 @@ def _plan_settings(args: argparse.Namespace, config: dict | None) -> dict:
         settings.update(subject=None, subjects="config/subjects.tsv", exclude_trials=["walk-nodevice"])
     else:
         settings = planning_settings(config)
-        settings.update(subject=config["planning"]["pilot_subject"], subjects=config["subjects"],
-                        exclude_trials=[config["trials"]["no_device"]])
-    given = {"onsets": args.onset_ms, "strides": args.strides, "pulse_force_n": args.force_n,
-             "pulse_duration_s": args.duration_s, "subject": args.subject, "subjects": args.subjects,
-             "exclude_trials": args.exclude_trials}
+        settings.update(
+            subject=config["planning"]["pilot_subject"],
+            subjects=config["subjects"],
+            exclude_trials=[config["trials"]["no_device"]],
+        )
+    given = {
+        "onsets": args.onset_ms,
+        "strides": args.strides,
+        "pulse_force_n": args.force_n,
+        "pulse_duration_s": args.duration_s,
+        "subject": args.subject,
+        "subjects": args.subjects,
+        "exclude_trials": args.exclude_trials,
+    }
     settings.update({k: v for k, v in given.items() if v is not None})
     if args.target is not None or args.target_half_width is not None:  # the targets given replace the config's
         settings["targets"] = [{"joint": j, "parameter": p, "percent": float(v)} for j, p, v in args.target or []]
-        settings["targets"] += [{"joint": j, "parameter": p, "half_width": float(v)}
-                                for j, p, v in args.target_half_width or []]
+        settings["targets"] += [
+            {"joint": j, "parameter": p, "half_width": float(v)} for j, p, v in args.target_half_width or []
+        ]
     return settings
 
 
@@ -228,16 +279,21 @@ def _plan(args: argparse.Namespace) -> None:
     names = args.trials or sorted(p.name.removesuffix(".angles.tsv") for p in ik_dir.glob("*.angles.tsv"))
     names = [n for n in names if n not in s["exclude_trials"]]
     if not names:
-        raise LoperInputError(f"plan: no joint-angle table of a trial with the device in {ik_dir} "
-                              f"(excluded: {', '.join(s['exclude_trials'])})")
+        raise LoperInputError(
+            f"plan: no joint-angle table of a trial with the device in {ik_dir} "
+            f"(excluded: {', '.join(s['exclude_trials'])})"
+        )
     angles = [ik_dir / f"{n}.angles.tsv" for n in names]
     strides = [results / "strides" / subject / f"{n}.strides.tsv" for n in names]
     for path in (*angles, *strides):
         if not path.is_file():
             raise LoperInputError(f"plan: {path} not found")
     segments = Path(args.segments) if args.segments else results / "model" / subject / "segments.tsv"
-    impedance_tsvs = [Path(f) for f in args.impedance] if args.impedance else \
-        sorted((results / "impedance" / subject).glob("[0-9][0-9][0-9].tsv"))
+    impedance_tsvs = (
+        [Path(f) for f in args.impedance]
+        if args.impedance
+        else sorted((results / "impedance" / subject).glob("[0-9][0-9][0-9].tsv"))
+    )
     values = args.impedance_values
     onsets = s["onsets"]
     if onsets is None:
@@ -245,18 +301,47 @@ def _plan(args: argparse.Namespace) -> None:
             raise LoperInputError("plan: with --impedance-values give --onset-ms")
         onsets = [int(p.stem) for p in impedance_tsvs if p.stem.isdigit()]
         if not onsets:
-            raise LoperInputError(f"plan: no impedance rows of {subject} in {results / 'impedance' / subject}; "
-                                  "give --onset-ms and --impedance or --impedance-values")
-    table, answers = plan(names, angles, strides, segments, subject, onsets, s["strides"], args.out,
-                          impedance_tsvs=impedance_tsvs, impedance=values, targets=s["targets"],
-                          pulse_force_n=s["pulse_force_n"], pulse_duration_s=s["pulse_duration_s"],
-                          response=s["response"], identification=s["identification"], device=s["device"])
-    shown = table[["onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
-                   "ci95_half_width", "ci95_half_width_pct"]]
-    print(f"pilot {subject} ({len(names)} trials with the device; null pairs: "
-          f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}; perturbed pairs: "
-          f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_perturbed_pairs'].first())}); "
-          f"pulse {s['pulse_force_n']:g} N for {s['pulse_duration_s']:g} s")
+            raise LoperInputError(
+                f"plan: no impedance rows of {subject} in {results / 'impedance' / subject}; "
+                "give --onset-ms and --impedance or --impedance-values"
+            )
+    table, answers = plan(
+        names,
+        angles,
+        strides,
+        segments,
+        subject,
+        onsets,
+        s["strides"],
+        args.out,
+        impedance_tsvs=impedance_tsvs,
+        impedance=values,
+        targets=s["targets"],
+        pulse_force_n=s["pulse_force_n"],
+        pulse_duration_s=s["pulse_duration_s"],
+        response=s["response"],
+        identification=s["identification"],
+        device=s["device"],
+    )
+    shown = table[
+        [
+            "onset_ms",
+            "joint",
+            "parameter",
+            "unit",
+            "n_strides",
+            "planned_value",
+            "predicted_sd",
+            "ci95_half_width",
+            "ci95_half_width_pct",
+        ]
+    ]
+    print(
+        f"pilot {subject} ({len(names)} trials with the device; null pairs: "
+        f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}; perturbed pairs: "
+        f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_perturbed_pairs'].first())}); "
+        f"pulse {s['pulse_force_n']:g} N for {s['pulse_duration_s']:g} s"
+    )
     print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     for a in answers:
         print(a)
@@ -267,10 +352,21 @@ def _plan(args: argparse.Namespace) -> None:
 def _ik(args: argparse.Namespace) -> None:
     from .steps.ik import ik_file
 
-    result = ik_file(args.model, args.markers, args.out, args.tasks, args.start, args.end, args.rotate_deg,
-                     args.accuracy, max_marker_rms_m=args.max_marker_rms_m, max_rms_fraction=args.max_rms_fraction,
-                     label_map=_label_map(args.label_map), warn_marker_rms_m=args.warn_marker_rms_m,
-                     walking_direction=_walking_direction(args))
+    result = ik_file(
+        args.model,
+        args.markers,
+        args.out,
+        args.tasks,
+        args.start,
+        args.end,
+        args.rotate_deg,
+        args.accuracy,
+        max_marker_rms_m=args.max_marker_rms_m,
+        max_rms_fraction=args.max_rms_fraction,
+        label_map=_label_map(args.label_map),
+        warn_marker_rms_m=args.warn_marker_rms_m,
+        walking_direction=_walking_direction(args),
+    )
     left_out = f", {result.n_left_out} left out (too few markers)" if result.n_left_out else ""
     print(
         f"{args.out}: {len(result.time_s)} frames{left_out}, marker error RMS "
@@ -294,25 +390,42 @@ def _report(args: argparse.Namespace) -> None:
 
 
 def _rotate_option(p: argparse.ArgumentParser, heading: bool = False) -> None:
-    p.add_argument("--rotate-deg", type=float, nargs=3, metavar=("X", "Y", "Z"),
-                   help="rotate lab coordinates about the fixed X, Y, Z axes (degrees) into the model frame; default "
-                   "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc")
+    p.add_argument(
+        "--rotate-deg",
+        type=float,
+        nargs=3,
+        metavar=("X", "Y", "Z"),
+        help="rotate lab coordinates about the fixed X, Y, Z axes (degrees) into the model frame; default "
+        "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc",
+    )
     if heading:
-        p.add_argument("--walking-direction", choices=("auto", "fixed"),
-                       help="auto: a trial that travels (overground) is turned by quarter turns about the vertical to "
-                       "walk along the model's +X; fixed: the rotation as it is (default: fixed with --rotate-deg, "
-                       "else auto)")
+        p.add_argument(
+            "--walking-direction",
+            choices=("auto", "fixed"),
+            help="auto: a trial that travels (overground) is turned by quarter turns about the vertical to "
+            "walk along the model's +X; fixed: the rotation as it is (default: fixed with --rotate-deg, "
+            "else auto)",
+        )
 
 
 def _label_map_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--label-map", metavar="MAP", help="TSV (columns label, marker) or YAML mapping: lab label -> "
-                   "model marker; subject prefixes (Name:) are stripped first")
+    p.add_argument(
+        "--label-map",
+        metavar="MAP",
+        help="TSV (columns label, marker) or YAML mapping: lab label -> "
+        "model marker; subject prefixes (Name:) are stripped first",
+    )
 
 
 def _configfile_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--configfile", nargs="+", metavar="FILE", help="config file(s) layered over config/config.yaml "
-                   "of the working directory (when present), each over the ones before, as snakemake --configfile "
-                   "does; default: config/config.yaml alone")
+    p.add_argument(
+        "--configfile",
+        nargs="+",
+        metavar="FILE",
+        help="config file(s) layered over config/config.yaml "
+        "of the working directory (when present), each over the ones before, as snakemake --configfile "
+        "does; default: config/config.yaml alone",
+    )
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -341,10 +454,16 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("events", help="heel strikes and toe-offs from the force platforms -> TSV")
     p.add_argument("c3d", help="C3D file with force platforms and the feet's heel markers")
     p.add_argument("--out", required=True, help="output TSV (side, event, time_s, sample)")
-    p.add_argument("--feet", nargs=2, metavar=("LEFT_HEEL", "RIGHT_HEEL"), default=("LHEE", "RHEE"),
-                   help="heel marker of each foot (model names, after --label-map)")
-    p.add_argument("--plates", metavar="left=N,right=M", help="belt of each side: a contact on the other foot's "
-                   "plate is flagged")
+    p.add_argument(
+        "--feet",
+        nargs=2,
+        metavar=("LEFT_HEEL", "RIGHT_HEEL"),
+        default=("LHEE", "RHEE"),
+        help="heel marker of each foot (model names, after --label-map)",
+    )
+    p.add_argument(
+        "--plates", metavar="left=N,right=M", help="belt of each side: a contact on the other foot's plate is flagged"
+    )
     _label_map_option(p)
     _rotate_option(p)
     p.add_argument("--threshold-on-n", type=float, default=50.0, help="heel strike: force over rest rises through (N)")
@@ -355,20 +474,34 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--model", required=True, help="generic OpenSim model (.osim)")
     p.add_argument("--setup", required=True, help="OpenSim ScaleTool setup (.xml)")
     p.add_argument("--static", required=True, help="static trial (.c3d or .trc)")
-    p.add_argument("--mass-kg", type=float, help="subject's body mass (kg); default: from the force plates the "
-                   "subject stands on in a .c3d static trial")
+    p.add_argument(
+        "--mass-kg",
+        type=float,
+        help="subject's body mass (kg); default: from the force plates the subject stands on in a .c3d static trial",
+    )
     p.add_argument("--out", required=True, help="output scaled model (.osim)")
-    p.add_argument("--report", metavar="SCALE.tsv", help="output TSV: scale factors per body and marker errors after "
-                   "scaling")
+    p.add_argument(
+        "--report", metavar="SCALE.tsv", help="output TSV: scale factors per body and marker errors after scaling"
+    )
     p.add_argument("--start", type=float, help="first time of the static trial to use (s)")
     p.add_argument("--end", type=float, help="last time of the static trial to use (s)")
-    p.add_argument("--max-motion-rms-m", type=float, default=0.05, help="refuse a static trial with a marker moving "
-                   "more than this (m, RMS about its mean over the window; 0: not checked; default 0.05)")
+    p.add_argument(
+        "--max-motion-rms-m",
+        type=float,
+        default=0.05,
+        help="refuse a static trial with a marker moving "
+        "more than this (m, RMS about its mean over the window; 0: not checked; default 0.05)",
+    )
     _label_map_option(p)
     _rotate_option(p)
     p.add_argument("--cutoff-hz", type=float, default=0.0, help="low-pass of a .c3d static trial (Hz); 0: none")
-    p.add_argument("--max-gap-frames", type=int, default=0, help="fill gaps of a .c3d static trial up to this "
-                   "(default 0: each marker is averaged over the frames where it is present)")
+    p.add_argument(
+        "--max-gap-frames",
+        type=int,
+        default=0,
+        help="fill gaps of a .c3d static trial up to this "
+        "(default 0: each marker is averaged over the frames where it is present)",
+    )
     p.set_defaults(func=_scale)
 
     p = sub.add_parser("segments", help="segment table (TSV) from a scaled model, or from height and mass")
@@ -376,8 +509,12 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--side", default="left", choices=("left", "right"), help="the swing leg (with --model)")
     p.add_argument("--height-m", type=float, help="without --model: Winter's table from height ...")
     p.add_argument("--mass-kg", type=float, help="... and body mass")
-    p.add_argument("--attachment-fraction", type=float, default=0.8,
-                   help="brace position along the thigh (fraction of its length; a model's brace markers win)")
+    p.add_argument(
+        "--attachment-fraction",
+        type=float,
+        default=0.8,
+        help="brace position along the thigh (fraction of its length; a model's brace markers win)",
+    )
     p.add_argument("--out", required=True, help="output TSV")
     p.set_defaults(func=_segments)
 
@@ -385,68 +522,123 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--model", required=True, help="OpenSim model (.osim)")
     p.add_argument("--markers", required=True, help="marker file: .c3d (units from POINT:UNITS) or .trc (Units header)")
     p.add_argument("--out", required=True, help="output .mot (angles in degrees, OpenSim's convention)")
-    p.add_argument("--tasks", help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: every "
-                   "model marker found in the file, weight 1")
+    p.add_argument(
+        "--tasks",
+        help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: every "
+        "model marker found in the file, weight 1",
+    )
     p.add_argument("--start", type=float, help="first time (s) to solve")
     p.add_argument("--end", type=float, help="last time (s) to solve")
     _label_map_option(p)
     _rotate_option(p, heading=True)
     p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
-    p.add_argument("--max-marker-rms-m", type=float, default=IK_STOP_RMS_M,
-                   help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model "
-                   "mistake)")
-    p.add_argument("--warn-marker-rms-m", type=float, default=IK_WARN_RMS_M,
-                   help="a frame whose marker RMS error exceeds this (m) counts as poorly fitted (a warning)")
-    p.add_argument("--max-rms-fraction", type=float, default=IK_MAX_FRACTION,
-                   help="fail (warn) when more frames than this share fail (fit poorly)")
+    p.add_argument(
+        "--max-marker-rms-m",
+        type=float,
+        default=IK_STOP_RMS_M,
+        help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model mistake)",
+    )
+    p.add_argument(
+        "--warn-marker-rms-m",
+        type=float,
+        default=IK_WARN_RMS_M,
+        help="a frame whose marker RMS error exceeds this (m) counts as poorly fitted (a warning)",
+    )
+    p.add_argument(
+        "--max-rms-fraction",
+        type=float,
+        default=IK_MAX_FRACTION,
+        help="fail (warn) when more frames than this share fail (fit poorly)",
+    )
     p.set_defaults(func=_ik)
 
-    p = sub.add_parser("validate", help="one chunk of the validation study (the study's design)")
+    p = sub.add_parser(
+        "validate",
+        help="one chunk of the validation study (the study's design)",
+        description="Simulate and identify one chunk of the validation study with the settings of the workflow's "
+        "validation rules: config/config.yaml of the working directory with each --configfile over it "
+        "(validation.*, identification.*, seed); options given here win; without any config file the "
+        "library's defaults (said in the first line printed).",
+    )
+    _configfile_option(p)
     p.add_argument("--segments", required=True, help="segment table TSV")
     p.add_argument("--chunk", type=int, default=0)
-    p.add_argument("--n-chunks", type=int, default=1)
-    p.add_argument("--n-starts", type=int, default=10)
-    p.add_argument("--seed", type=int, default=2024)
+    p.add_argument("--n-chunks", type=int, help="chunks of the study (default: validation.n_chunks of the config)")
+    p.add_argument("--n-starts", type=int, help="multistart starts (default: identification.n_starts)")
+    p.add_argument("--seed", type=int, help="seed (default: the config's seed)")
     p.add_argument("--errors", required=True, help="output TSV, one row per combination x condition x parameter")
     p.add_argument("--fits", required=True, help="output TSV, one row per combination x condition")
     p.set_defaults(func=_validate)
 
-    p = sub.add_parser("plan", help="predicted 95 %% CI half-width of K and D for a planned experiment (pilot subject)",
-                       description="Predict the 95 % CI half-width of K and D of a planned experiment from a pilot "
-                       "subject's processed trials, with the settings of the workflow's rule 'planning'. Settings, "
-                       "highest priority first: (1) options given here; (2) the config: config/config.yaml of the "
-                       "working directory with each --configfile over it, as Snakemake layers them (onsets: "
-                       "trials.perturbation_onsets_ms; strides, targets, pulse and pilot: planning.*; fit window, "
-                       "initial state, bounds and null pairs: identification.*; outliers: strides.iqr_whisker, "
-                       "strides.max_outlier_fraction; device: device.parameters; excluded trial: trials.no_device; "
-                       "subject sheet: subjects); (3) without any config file, the library's defaults (said in the "
-                       "first line printed, which names the config file(s) used).")
+    p = sub.add_parser(
+        "plan",
+        help="predicted 95 %% CI half-width of K and D for a planned experiment (pilot subject)",
+        description="Predict the 95 % CI half-width of K and D of a planned experiment from a pilot "
+        "subject's processed trials, with the settings of the workflow's rule 'planning'. Settings, "
+        "highest priority first: (1) options given here; (2) the config: config/config.yaml of the "
+        "working directory with each --configfile over it, as Snakemake layers them (onsets: "
+        "trials.perturbation_onsets_ms; strides, targets, pulse and pilot: planning.*; fit window, "
+        "initial state, bounds and null pairs: identification.*; outliers: strides.iqr_whisker, "
+        "strides.max_outlier_fraction; device: device.parameters; excluded trial: trials.no_device; "
+        "subject sheet: subjects); (3) without any config file, the library's defaults (said in the "
+        "first line printed, which names the config file(s) used).",
+    )
     _configfile_option(p)
     p.add_argument("--results", default="results", help="results folder of the pilot's processed trials")
     p.add_argument("--subject", help="pilot subject (default: planning.pilot_subject, else the first of --subjects)")
-    p.add_argument("--subjects", help="subject sheet whose first subject is the default (default: the config's "
-                   "subjects, else config/subjects.tsv)")
-    p.add_argument("--trials", nargs="+", help="the pilot's trials walked with the device (default: every angle "
-                   "table in RESULTS/ik/SUBJECT but --exclude-trials)")
-    p.add_argument("--exclude-trials", nargs="*", help="trials without the device (default: trials.no_device, else "
-                   "walk-nodevice)")
+    p.add_argument(
+        "--subjects",
+        help="subject sheet whose first subject is the default (default: the config's "
+        "subjects, else config/subjects.tsv)",
+    )
+    p.add_argument(
+        "--trials",
+        nargs="+",
+        help="the pilot's trials walked with the device (default: every angle "
+        "table in RESULTS/ik/SUBJECT but --exclude-trials)",
+    )
+    p.add_argument(
+        "--exclude-trials", nargs="*", help="trials without the device (default: trials.no_device, else walk-nodevice)"
+    )
     p.add_argument("--segments", help="segment table of the subject to plan for (default: the pilot's)")
-    p.add_argument("--impedance", nargs="+", help="impedance rows giving the planned impedance (default: "
-                   "RESULTS/impedance/SUBJECT/NNN.tsv)")
-    p.add_argument("--impedance-values", type=float, nargs=6, metavar=("K_HIP", "D_HIP", "K_KNEE", "D_KNEE",
-                   "K_ANKLE", "D_ANKLE"), help="planned impedance (N·m/rad, N·m·s/rad) instead of the pilot's fits")
-    p.add_argument("--onset-ms", type=float, nargs="+", help="onsets after toe-off (ms; default: "
-                   "trials.perturbation_onsets_ms, else those of the impedance rows)")
-    p.add_argument("--strides", type=int, nargs="+", help="perturbed strides averaged (default: planning.strides, "
-                   "else 10 20 40)")
+    p.add_argument(
+        "--impedance",
+        nargs="+",
+        help="impedance rows giving the planned impedance (default: RESULTS/impedance/SUBJECT/NNN.tsv)",
+    )
+    p.add_argument(
+        "--impedance-values",
+        type=float,
+        nargs=6,
+        metavar=("K_HIP", "D_HIP", "K_KNEE", "D_KNEE", "K_ANKLE", "D_ANKLE"),
+        help="planned impedance (N·m/rad, N·m·s/rad) instead of the pilot's fits",
+    )
+    p.add_argument(
+        "--onset-ms",
+        type=float,
+        nargs="+",
+        help="onsets after toe-off (ms; default: trials.perturbation_onsets_ms, else those of the impedance rows)",
+    )
+    p.add_argument(
+        "--strides", type=int, nargs="+", help="perturbed strides averaged (default: planning.strides, else 10 20 40)"
+    )
     p.add_argument("--force-n", type=float, help="pulse: desired force (N; default: planning.pulse_force_n, else 40)")
-    p.add_argument("--duration-s", type=float, help="pulse duration (s; default: planning.pulse_duration_s, else "
-                   "0.1)")
-    p.add_argument("--target", nargs=3, action="append", metavar=("JOINT", "PARAM", "PERCENT"),
-                   help="strides needed for a 95 %% CI half-width of PERCENT %% of the planned value, e.g. hip D 15 "
-                   "(targets given here replace planning.targets)")
-    p.add_argument("--target-half-width", nargs=3, action="append", metavar=("JOINT", "PARAM", "VALUE"),
-                   help="strides needed for an absolute half-width (N·m/rad or N·m·s/rad)")
+    p.add_argument("--duration-s", type=float, help="pulse duration (s; default: planning.pulse_duration_s, else 0.1)")
+    p.add_argument(
+        "--target",
+        nargs=3,
+        action="append",
+        metavar=("JOINT", "PARAM", "PERCENT"),
+        help="strides needed for a 95 %% CI half-width of PERCENT %% of the planned value, e.g. hip D 15 "
+        "(targets given here replace planning.targets)",
+    )
+    p.add_argument(
+        "--target-half-width",
+        nargs=3,
+        action="append",
+        metavar=("JOINT", "PARAM", "VALUE"),
+        help="strides needed for an absolute half-width (N·m/rad or N·m·s/rad)",
+    )
     p.add_argument("--out", help="output TSV (one row per onset x joint x parameter x stride count)")
     p.set_defaults(func=_plan)
 
@@ -454,19 +646,30 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("c3d", help="the lab's C3D file")
     p.add_argument("--model", metavar="M.osim", help="OpenSim model whose markers the file's labels are matched to")
     p.add_argument("--marker-set", metavar="SET.xml", help="OpenSim MarkerSet whose markers are added to the model's")
-    p.add_argument("--label-map-out", metavar="MAP.tsv", help="write the starter label map (label, marker; needs "
-                   "--model)")
-    p.add_argument("--config-out", metavar="SNIPPET.yaml", help="write a config snippet (rotation, label map, heel "
-                   "markers, model) to merge over the configuration")
+    p.add_argument(
+        "--label-map-out", metavar="MAP.tsv", help="write the starter label map (label, marker; needs --model)"
+    )
+    p.add_argument(
+        "--config-out",
+        metavar="SNIPPET.yaml",
+        help="write a config snippet (rotation, label map, heel markers, model) to merge over the configuration",
+    )
     p.set_defaults(func=_inspect)
 
-    p = sub.add_parser("report", help="the Snakemake report, written beside its target and moved over it when whole",
-                       description="Run `snakemake --report` (this Python's Snakemake) into a temporary file beside "
-                       "TARGET, check that it is complete (an HTML report ends with </html>) and move it over "
-                       "TARGET; on any failure the previous report stays as it was.")
+    p = sub.add_parser(
+        "report",
+        help="the Snakemake report, written beside its target and moved over it when whole",
+        description="Run `snakemake --report` (this Python's Snakemake) into a temporary file beside "
+        "TARGET, check that it is complete (an HTML report ends with </html>) and move it over "
+        "TARGET; on any failure the previous report stays as it was.",
+    )
     p.add_argument("target", help="the report: .html (one self-contained file) or .zip, e.g. results/report.html")
-    p.add_argument("snakemake_args", nargs=argparse.REMAINDER, metavar="SNAKEMAKE_ARGS",
-                   help="passed on to snakemake after --report, e.g. --configfile my.yaml")
+    p.add_argument(
+        "snakemake_args",
+        nargs=argparse.REMAINDER,
+        metavar="SNAKEMAKE_ARGS",
+        help="passed on to snakemake after --report, e.g. --configfile my.yaml",
+    )
     p.set_defaults(func=_report)
     return parser
 

@@ -135,8 +135,9 @@ def rising_edges(signal_v, sample_rate_hz: float, threshold_v: float | None = No
     return c / rate
 
 
-def high_times(signal_v, sample_rate_hz: float, rising_s, threshold_v: float | None = None,
-               source: str = "") -> np.ndarray:
+def high_times(
+    signal_v, sample_rate_hz: float, rising_s, threshold_v: float | None = None, source: str = ""
+) -> np.ndarray:
     """How long each pulse stays high: from each rising edge to the next falling edge, s.
 
     Falling edges are found like :func:`rising_edges` finds rising ones (same
@@ -373,7 +374,7 @@ def clock_map(
     nr, nm = dr.size - w + 1, dm.size - w + 1
     win = ok[:nr, :nm].copy()
     for k in range(1, w):
-        win &= ok[k:k + nr, k:k + nm]
+        win &= ok[k : k + nr, k : k + nm]
     ai, aj = np.nonzero(win)
     if ai.size == 0:
         raise LoperInputError(
@@ -431,14 +432,22 @@ def clock_map(
         )
     span = float(r[i[-1]] - r[i[0]])
     if abs(b - 1.0) > drift + 2 * tol / span:
-        raise LoperInputError(
-            f"{src}: clock drift {(b - 1) * 1e6:+.1f} ppm exceeds max_drift = {drift * 1e6:.4g} ppm"
-        )
+        raise LoperInputError(f"{src}: clock drift {(b - 1) * 1e6:+.1f} ppm exceeds max_drift = {drift * 1e6:.4g} ppm")
     return ClockMap(offset_s=float(a), scale=float(b), rms_residual_s=rms, n_edges=int(i.size))
 
 
-def _check_polarity(m: np.ndarray, i: np.ndarray, j: np.ndarray, scale: float, robot_high: np.ndarray,
-                    mocap_high: np.ndarray, tol: float, src: str, robot_name: str, mocap_name: str) -> None:
+def _check_polarity(
+    m: np.ndarray,
+    i: np.ndarray,
+    j: np.ndarray,
+    scale: float,
+    robot_high: np.ndarray,
+    mocap_high: np.ndarray,
+    tol: float,
+    src: str,
+    robot_name: str,
+    mocap_name: str,
+) -> None:
     """Refuse paired pulses whose high times (s) disagree between the records (see :func:`clock_map`).
 
     Each paired pulse's period is the interval from its mocap edge to the next mocap edge (the paired
@@ -456,12 +465,17 @@ def _check_polarity(m: np.ndarray, i: np.ndarray, j: np.ndarray, scale: float, r
         return
     h_r, h_m = float(np.median(hr)), float(np.median(hm))
     d_r, d_m = float(np.median(hr / period)), float(np.median(hm / period))
-    seen = (f"sync pulses high for {h_r * 1e3:.1f} ms (duty ratio {d_r:.3f}) in {robot_name} but for "
-            f"{h_m * 1e3:.1f} ms (duty ratio {d_m:.3f}) in {mocap_name} (medians over {hr.size} paired pulses; "
-            f"accepted difference 2 x {tol * 1e3:.3g} ms + {HIGH_TIME_TOLERANCE:.0%} of the period)")
+    seen = (
+        f"sync pulses high for {h_r * 1e3:.1f} ms (duty ratio {d_r:.3f}) in {robot_name} but for "
+        f"{h_m * 1e3:.1f} ms (duty ratio {d_m:.3f}) in {mocap_name} (medians over {hr.size} paired pulses; "
+        f"accepted difference 2 x {tol * 1e3:.3g} ms + {HIGH_TIME_TOLERANCE:.0%} of the period)"
+    )
     if (d_r - 0.5) * (d_m - 0.5) < 0:
-        which = ("the robot's sync looks inverted (active-low)" if d_r > d_m else
-                 "the mocap channel sees the sync inverted (active-low)")
+        which = (
+            "the robot's sync looks inverted (active-low)"
+            if d_r > d_m
+            else "the mocap channel sees the sync inverted (active-low)"
+        )
         raise LoperInputError(
             f"{src}: {seen}: {which}: its rising edges are the pulses' ends, which would put the clock map off by "
             f"the pulse width (~{min(h_r, h_m) * 1e3:.1f} ms); invert that record's sync signal before the clock map"

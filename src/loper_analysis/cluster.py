@@ -14,23 +14,33 @@ from collections.abc import Collection, Mapping
 
 from .errors import LoperInputError
 
-__all__ = ["available_partitions", "check_slurm_submission", "failed_slurm_logs", "slurm_end_reason",
-           "submission_problems"]
+__all__ = [
+    "available_partitions",
+    "check_slurm_submission",
+    "failed_slurm_logs",
+    "slurm_end_reason",
+    "submission_problems",
+]
 
 #: What slurmstepd writes into a job's output when SLURM ends it, first match wins -> the reason in words.
 _SLURM_ENDS = (
-    (re.compile(r"exceeded (job )?memory limit|oom[-_ ]kill|out of memory", re.I),
-     "killed by SLURM for exceeding its memory: raise the rule's mem_mb under set-resources in the profile"),
-    (re.compile(r"DUE TO TIME LIMIT"),
-     "stopped by SLURM at its time limit: raise the rule's runtime (minutes) under set-resources in the profile"),
+    (
+        re.compile(r"exceeded (job )?memory limit|oom[-_ ]kill|out of memory", re.I),
+        "killed by SLURM for exceeding its memory: raise the rule's mem_mb under set-resources in the profile",
+    ),
+    (
+        re.compile(r"DUE TO TIME LIMIT"),
+        "stopped by SLURM at its time limit: raise the rule's runtime (minutes) under set-resources in the profile",
+    ),
     (re.compile(r"DUE TO NODE FAIL"), "ended by a node failure: run the same command again"),
     (re.compile(r"DUE TO PREEMPTION"), "preempted by another job: run the same command again"),
     (re.compile(r"\*\*\* JOB \d+ ON \S+ CANCELLED"), "cancelled (scancel): run the same command again to finish"),
 )
 
 
-def submission_problems(requested: Mapping[str, str], available: Collection[str] | None,
-                        sbatch: str | None) -> list[str]:
+def submission_problems(
+    requested: Mapping[str, str], available: Collection[str] | None, sbatch: str | None
+) -> list[str]:
     """What stops a SLURM submission, one sentence per problem; empty when nothing does.
 
     Parameters
@@ -44,14 +54,18 @@ def submission_problems(requested: Mapping[str, str], available: Collection[str]
     """
     problems = []
     if sbatch is None:
-        problems.append("the SLURM profile submits jobs with sbatch, which is not on PATH: run snakemake on a "
-                        "node that submits jobs (the login node), or load SLURM first (e.g. `module load slurm`)")
+        problems.append(
+            "the SLURM profile submits jobs with sbatch, which is not on PATH: run snakemake on a "
+            "node that submits jobs (the login node), or load SLURM first (e.g. `module load slurm`)"
+        )
     if available is not None:
         known = sorted(set(available))
         for origin, partition in requested.items():
             if partition not in known:
-                problems.append(f"{origin}: slurm_partition '{partition}' is not a partition of this cluster "
-                                f"(sinfo lists: {', '.join(known) or 'none'})")
+                problems.append(
+                    f"{origin}: slurm_partition '{partition}' is not a partition of this cluster "
+                    f"(sinfo lists: {', '.join(known) or 'none'})"
+                )
     return problems
 
 

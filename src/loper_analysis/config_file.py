@@ -28,8 +28,7 @@ import yaml
 from .errors import LoperInputError
 from .schema import check_config, check_yaml_file
 
-__all__ = ["DEFAULT_CONFIG", "SCHEMA", "find_schema", "load_config", "read_config_file", "shown_path",
-           "update_config"]
+__all__ = ["DEFAULT_CONFIG", "SCHEMA", "find_schema", "load_config", "read_config_file", "shown_path", "update_config"]
 
 #: The workflow's own configuration file, relative to the working directory (the Snakefile's ``configfile:``).
 DEFAULT_CONFIG = Path("config") / "config.yaml"
@@ -111,11 +110,14 @@ def read_config_file(path: str | os.PathLike) -> dict:
         except yaml.YAMLError as exc:  # accepted by the safe composer, refused by the loader (e.g. a Python tag)
             raise LoperInputError(f"{shown}: YAML error: {' '.join(str(exc).split())}") from None
     if not isinstance(data, dict):
-        raise LoperInputError(f"{shown}: the config file must hold keys at its top level (key: value), "
-                              f"found a {type(data).__name__}")
+        raise LoperInputError(
+            f"{shown}: the config file must hold keys at its top level (key: value), found a {type(data).__name__}"
+        )
     if data.get("__use_yte__"):
-        raise LoperInputError(f"{shown}: key '__use_yte__': {data['__use_yte__']!r}: a YTE template is rendered by "
-                              "Snakemake only; give the rendered file")
+        raise LoperInputError(
+            f"{shown}: key '__use_yte__': {data['__use_yte__']!r}: a YTE template is rendered by "
+            "Snakemake only; give the rendered file"
+        )
     data.pop("__use_yte__", None)
     return data
 
@@ -140,12 +142,17 @@ def find_schema(paths: Sequence[str | os.PathLike] = ()) -> Path:
         if candidate.is_file():
             return candidate
     files = ", ".join(shown_path(p) for p in paths) or "the configuration"
-    raise LoperInputError(f"{files}: cannot validate: no {SCHEMA.as_posix()} found (looked in: "
-                          f"{', '.join(str(c) for c in tried)})")
+    raise LoperInputError(
+        f"{files}: cannot validate: no {SCHEMA.as_posix()} found (looked in: {', '.join(str(c) for c in tried)})"
+    )
 
 
-def load_config(paths: Sequence[str | os.PathLike] | None = None, overrides: Mapping | None = None, *,
-                schema: str | os.PathLike | None = None) -> tuple[dict, list[str]]:
+def load_config(
+    paths: Sequence[str | os.PathLike] | None = None,
+    overrides: Mapping | None = None,
+    *,
+    schema: str | os.PathLike | None = None,
+) -> tuple[dict, list[str]]:
     """Read, layer and validate the workflow's configuration.
 
     Parameters

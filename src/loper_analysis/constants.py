@@ -58,9 +58,7 @@ SEGMENTS: tuple[str, ...] = ("thigh", "shank", "foot")
 #: Identified parameters, in the order of every parameter vector.
 PARAMETERS: tuple[str, ...] = ("K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", "D_ankle")
 #: Units of the identified parameters.
-PARAMETER_UNITS: dict[str, str] = {
-    p: ("N·m/rad" if p.startswith("K") else "N·m·s/rad") for p in PARAMETERS
-}
+PARAMETER_UNITS: dict[str, str] = {p: ("N·m/rad" if p.startswith("K") else "N·m·s/rad") for p in PARAMETERS}
 #: Unit suffix of stiffness (K) and damping (D) in column names.
 UNIT_SUFFIX: dict[str, str] = {"K": "nm_per_rad", "D": "nms_per_rad"}
 #: Gait events, in the order they appear in event tables.

@@ -44,7 +44,15 @@ logger = logging.getLogger(__name__)
 PLATE_CONTACT_COLUMNS: tuple[str, ...] = ("contact", "start_sample", "end_sample", "start_s", "end_s", "incomplete")
 #: Columns of :func:`foot_contacts` (the heel columns are measured at the start probe).
 CONTACT_COLUMNS: tuple[str, ...] = (
-    "plate", "contact", "side", "flag", "start_sample", "end_sample", "start_s", "end_s", "belt_side",
+    "plate",
+    "contact",
+    "side",
+    "flag",
+    "start_sample",
+    "end_sample",
+    "start_s",
+    "end_s",
+    "belt_side",
     *(f"{s}_heel_{q}_m" for s in SIDES for q in ("outside", "height")),
 )
 #: Flags whose contact may hide either foot: they block the strides of both sides.
@@ -74,8 +82,15 @@ class PlateForce:
     corners_m: np.ndarray
 
 
-def plate_contacts(time_s, vertical_force_n, threshold_on_n: float = 50.0, threshold_off_n: float = 20.0,
-                   min_stance_s: float = 0.2, min_swing_s: float = 0.2, source: str = "") -> pd.DataFrame:
+def plate_contacts(
+    time_s,
+    vertical_force_n,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    source: str = "",
+) -> pd.DataFrame:
     """Loaded periods (contacts) of one plate from its vertical force above the resting level.
 
     A contact starts at the first sample with force ``>= threshold_on_n``
@@ -113,13 +128,15 @@ def plate_contacts(time_s, vertical_force_n, threshold_on_n: float = 50.0, thres
         As :func:`loper_analysis.events.load_transitions`.
     """
     t = time_vector(time_s, source)
-    samples, loading, dropped = load_transitions(t, vertical_force_n, threshold_on_n, threshold_off_n,
-                                                 min_stance_s, min_swing_s, source)
+    samples, loading, dropped = load_transitions(
+        t, vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, source
+    )
     starts, ends = list(samples[loading]), list(samples[~loading])
     open_start = bool(samples.size) and not loading[0]
     if not samples.size:  # no transition left: loaded throughout or never loaded
-        open_start = _loaded_at_end(np.asarray(vertical_force_n, dtype=float), float(threshold_on_n),
-                                    float(threshold_off_n))
+        open_start = _loaded_at_end(
+            np.asarray(vertical_force_n, dtype=float), float(threshold_on_n), float(threshold_off_n)
+        )
     if open_start:
         starts.insert(0, 0)
     open_end = len(starts) > len(ends)
@@ -131,10 +148,17 @@ def plate_contacts(time_s, vertical_force_n, threshold_on_n: float = 50.0, thres
     if start.size:
         incomplete[0] |= open_start
         incomplete[-1] |= open_end
-    table = pd.DataFrame({
-        "contact": np.arange(start.size, dtype=np.int64), "start_sample": start, "end_sample": end,
-        "start_s": t[start], "end_s": t[end], "incomplete": incomplete,
-    }, columns=list(PLATE_CONTACT_COLUMNS))
+    table = pd.DataFrame(
+        {
+            "contact": np.arange(start.size, dtype=np.int64),
+            "start_sample": start,
+            "end_sample": end,
+            "start_s": t[start],
+            "end_s": t[end],
+            "incomplete": incomplete,
+        },
+        columns=list(PLATE_CONTACT_COLUMNS),
+    )
     table.attrs["dropped"] = dropped
     return table
 
@@ -164,12 +188,24 @@ def _longest_run_s(times: np.ndarray, mask: np.ndarray) -> float:
     return float(np.max(times[last] - times[first]))
 
 
-def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[str, np.ndarray],
-                  plate_sides: Mapping[str, int] | None = None, threshold_on_n: float = 50.0,
-                  threshold_off_n: float = 20.0, min_stance_s: float = 0.2, min_swing_s: float = 0.2,
-                  delay_s: float = 0.05, dwell_s: float = 0.15, margin_m: float = 0.03, reach_m: float = 0.25,
-                  max_height_m: float = 0.12, vertical_axis: int | None = None, source: str = "",
-                  up: Sequence[float] | None = None) -> pd.DataFrame:
+def foot_contacts(
+    plates: Sequence[PlateForce],
+    marker_time_s,
+    heels_m: Mapping[str, np.ndarray],
+    plate_sides: Mapping[str, int] | None = None,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    delay_s: float = 0.05,
+    dwell_s: float = 0.15,
+    margin_m: float = 0.03,
+    reach_m: float = 0.25,
+    max_height_m: float = 0.12,
+    vertical_axis: int | None = None,
+    source: str = "",
+    up: Sequence[float] | None = None,
+) -> pd.DataFrame:
     """The contacts of every plate, each with the foot on it (from the heel markers) and a flag.
 
     A heel is **on** a plate at an instant when it lies over the plate's
@@ -274,8 +310,15 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
 
     rows = []
     for k, (plate, name) in enumerate(zip(plates, names)):
-        found = plate_contacts(plate.time_s, plate.vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s,
-                               min_swing_s, source=name)
+        found = plate_contacts(
+            plate.time_s,
+            plate.vertical_force_n,
+            threshold_on_n,
+            threshold_off_n,
+            min_stance_s,
+            min_swing_s,
+            source=name,
+        )
         for c in found.itertuples():
             mid = 0.5 * (c.start_s + c.end_s)
             ps, pe = min(c.start_s + delay, mid), max(c.end_s - delay, mid)
@@ -294,8 +337,11 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
             side = at_start[0] if len(at_start) == 1 else ""
             others = [s for s in SIDES if s != side]
             dwells = {s for s in others if _longest_run_s(times, on(*window[s])) >= need}
-            undecided = any(missing[s].any() and _longest_run_s(times, on(*window[s]) | missing[s]) >= need
-                            for s in others if s not in dwells)
+            undecided = any(
+                missing[s].any() and _longest_run_s(times, on(*window[s]) | missing[s]) >= need
+                for s in others
+                if s not in dwells
+            )
             present = set(at_start) | dwells
             if c.incomplete:
                 flag = "incomplete"
@@ -305,8 +351,11 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
                 flag = "two_feet"
             elif not at_start:
                 # low heels near this plate that stand on no other plate
-                near = {s: window[s][0][0] for s in SIDES
-                        if window[s][0][0] <= reach and window[s][1][0] <= height and not np.delete(on_all[s], k).any()}
+                near = {
+                    s: window[s][0][0]
+                    for s in SIDES
+                    if window[s][0][0] <= reach and window[s][1][0] <= height and not np.delete(on_all[s], k).any()
+                }
                 side = min(near, key=near.get) if near else ""
                 flag = "no_foot" if not near else ("two_feet" if present - {side} else "off_plate")
                 side = "" if flag == "two_feet" else side
@@ -314,19 +363,46 @@ def foot_contacts(plates: Sequence[PlateForce], marker_time_s, heels_m: Mapping[
                 flag = "wrong_belt"
             else:
                 flag = "ok"
-            rows.append({
-                "plate": numbers[k], "contact": c.contact, "side": side, "flag": flag,
-                "start_sample": c.start_sample, "end_sample": c.end_sample, "start_s": c.start_s, "end_s": c.end_s,
-                "belt_side": belt.get(numbers[k], ""),
-                **{f"{s}_heel_{q}_m": float(window[s][i][0]) for s in SIDES for i, q in enumerate(("outside", "height"))},
-            })
+            rows.append(
+                {
+                    "plate": numbers[k],
+                    "contact": c.contact,
+                    "side": side,
+                    "flag": flag,
+                    "start_sample": c.start_sample,
+                    "end_sample": c.end_sample,
+                    "start_s": c.start_s,
+                    "end_s": c.end_s,
+                    "belt_side": belt.get(numbers[k], ""),
+                    **{
+                        f"{s}_heel_{q}_m": float(window[s][i][0])
+                        for s in SIDES
+                        for i, q in enumerate(("outside", "height"))
+                    },
+                }
+            )
     table = pd.DataFrame(rows, columns=list(CONTACT_COLUMNS))
-    table = table.astype({"plate": np.int64, "contact": np.int64, "start_sample": np.int64, "end_sample": np.int64,
-                          "start_s": float, "end_s": float})
+    table = table.astype(
+        {
+            "plate": np.int64,
+            "contact": np.int64,
+            "start_sample": np.int64,
+            "end_sample": np.int64,
+            "start_s": float,
+            "end_s": float,
+        }
+    )
     table = table.sort_values(["start_s", "plate"], kind="stable", ignore_index=True)
     for r in table[table["flag"] != "ok"].itertuples():
-        logger.info("%splate %d contact %.3f-%.3f s: %s (side %s)", where(source), r.plate, r.start_s, r.end_s,
-                    r.flag, r.side or "unknown")
+        logger.info(
+            "%splate %d contact %.3f-%.3f s: %s (side %s)",
+            where(source),
+            r.plate,
+            r.start_s,
+            r.end_s,
+            r.flag,
+            r.side or "unknown",
+        )
     table.attrs["source"] = source
     return table
 

@@ -40,8 +40,9 @@ BRACE_LABELS: tuple[str, str] = ("LBRA_P", "LBRA_D")
 _COORDINATE = {"hip": "hip_flexion", "knee": "knee_flexion", "ankle": "ankle_dorsiflexion"}
 
 
-def trial_inputs(walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=None, end_s: float | None = None,
-                 side: str = "left") -> dict:
+def trial_inputs(
+    walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=None, end_s: float | None = None, side: str = "left"
+) -> dict:
     """The inputs of the response analysis for one simulated trial with the device.
 
     Parameters
@@ -79,8 +80,13 @@ def trial_inputs(walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=
         raise LoperInputError(f"{name}: side must be one of {SIDES}, got {side!r}")
     coords = walk.mocap_coordinates(lab.marker_rate_hz)
     t = coords["time_s"].to_numpy(float)
-    angles = pd.DataFrame({"time_s": t, "pelvis_x_m": coords["pelvis_tx"].to_numpy(float),
-                           "pelvis_angle_rad": -coords["pelvis_tilt"].to_numpy(float)})
+    angles = pd.DataFrame(
+        {
+            "time_s": t,
+            "pelvis_x_m": coords["pelvis_tx"].to_numpy(float),
+            "pelvis_angle_rad": -coords["pelvis_tilt"].to_numpy(float),
+        }
+    )
     for s in SIDES:
         for joint in JOINTS:
             angles[angle_column(joint, s)] = coords[f"{_COORDINATE[joint]}_{s[0]}"].to_numpy(float)
@@ -94,8 +100,9 @@ def trial_inputs(walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=
     t_analog = np.arange(len(t) * ratio) / lab.analog_rate_hz
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     sync_v = pulse_train_at((t_analog + lab.clock_offset_s) / scale, walk.sync_starts_s)
-    force, native = robot_log_frames_and_native(walk.robot, lab.robot_rate_hz, sync_v, lab.analog_rate_hz, t,
-                                                source=name)
+    force, native = robot_log_frames_and_native(
+        walk.robot, lab.robot_rate_hz, sync_v, lab.analog_rate_hz, t, source=name
+    )
     events = walk.mocap_events()
     if end_s is not None:
         keep = t <= end_s + 1e-9
@@ -108,15 +115,36 @@ def trial_inputs(walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=
     q = segment_coordinates(joints, angles["pelvis_angle_rad"].to_numpy(float), angles["pelvis_x_m"].to_numpy(float))
     markers = np.zeros((len(angles), 2, 3))
     markers[:, 0, 0], markers[:, 0, 1] = 0.1 * np.sin(q[:, 1]), 0.1 * np.cos(q[:, 1])  # proximal: up the thigh
-    return {"name": name, "angles": angles, "strides": strides, "force": force, "force_native": native,
-            "markers": (angles["time_s"].to_numpy(float), markers, list(BRACE_LABELS))}
+    return {
+        "name": name,
+        "angles": angles,
+        "strides": strides,
+        "force": force,
+        "force_native": native,
+        "markers": (angles["time_s"].to_numpy(float), markers, list(BRACE_LABELS)),
+    }
 
 
-def perturbation_experiment(seed, params, height_m: float, onset_ms: float, impedance, n_strides, *, lab=None,
-                            device=None, timing_cv: float = 0.03, amplitude_cv: float = 0.05, force_n: float = 40.0,
-                            duration_s: float = 0.1, every_strides: tuple[int, int] = (3, 5),
-                            angle_noise_sd_rad: float = 0.0, variability=None, adaptation=None,
-                            minimal_impedance=None) -> tuple[dict, dict[int, dict]]:
+def perturbation_experiment(
+    seed,
+    params,
+    height_m: float,
+    onset_ms: float,
+    impedance,
+    n_strides,
+    *,
+    lab=None,
+    device=None,
+    timing_cv: float = 0.03,
+    amplitude_cv: float = 0.05,
+    force_n: float = 40.0,
+    duration_s: float = 0.1,
+    every_strides: tuple[int, int] = (3, 5),
+    angle_noise_sd_rad: float = 0.0,
+    variability=None,
+    adaptation=None,
+    minimal_impedance=None,
+) -> tuple[dict, dict[int, dict]]:
     """One synthetic perturbation experiment: a trial long enough for ``max(n_strides)`` perturbed strides.
 
     One walking trial with the device (:func:`~loper_analysis.synthetic.trials.simulate_walking_trial`,
@@ -143,16 +171,27 @@ def perturbation_experiment(seed, params, height_m: float, onset_ms: float, impe
     mean_every = 0.5 * (every_strides[0] + every_strides[1])
     trial_s = (counts[-1] + 3) * mean_every * NominalGait().stride_s * 1.1 + 2.0
     sim_seed, noise_seed = np.random.SeedSequence(seed).spawn(2)
-    perturbation = PerturbationSettings(onset_ms / 1e3, tuple(float(v) for v in impedance), force_n, duration_s,
-                                        tuple(every_strides))
-    walk = simulate_walking_trial(trial_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv,
-                                  device or DeviceParameters(), perturbation, variability=variability,
-                                  adaptation=adaptation, minimal_impedance=minimal_impedance)
+    perturbation = PerturbationSettings(
+        onset_ms / 1e3, tuple(float(v) for v in impedance), force_n, duration_s, tuple(every_strides)
+    )
+    walk = simulate_walking_trial(
+        trial_s,
+        lab,
+        sim_seed,
+        height_m,
+        params,
+        timing_cv,
+        amplitude_cv,
+        device or DeviceParameters(),
+        perturbation,
+        variability=variability,
+        adaptation=adaptation,
+        minimal_impedance=minimal_impedance,
+    )
     full = trial_inputs(walk, lab, "full", angle_noise_sd_rad=angle_noise_sd_rad, seed=noise_seed)
     heel_strikes = walk.schedule["heel_strike_s"].to_numpy(float)
     cut = {}
     for n in counts:
         end = heel_strikes[n - 1] + 1.0 if n <= heel_strikes.size else None
-        cut[n] = trial_inputs(walk, lab, f"first{n}", angle_noise_sd_rad=angle_noise_sd_rad, seed=noise_seed,
-                              end_s=end)
+        cut[n] = trial_inputs(walk, lab, f"first{n}", angle_noise_sd_rad=angle_noise_sd_rad, seed=noise_seed, end_s=end)
     return full, cut

@@ -128,7 +128,7 @@ class SegmentParameters:
     def leg_mass_kg(self) -> float:
         return float(sum(self.mass_kg))
 
-    def replace(self, **changes) -> "SegmentParameters":
+    def replace(self, **changes) -> SegmentParameters:
         """A copy with some fields changed."""
         values = {k: v for k, v in asdict(self).items() if k != "_packed"}
         values.update(changes)
@@ -149,8 +149,9 @@ class SegmentParameters:
         return pd.DataFrame(rows)
 
     @classmethod
-    def from_frame(cls, df: pd.DataFrame, source: str = "segment table") -> "SegmentParameters":
-        """Parameters from the table of :meth:`to_frame` (rows cart, thigh, shank, foot); ``source`` names it in errors."""
+    def from_frame(cls, df: pd.DataFrame, source: str = "segment table") -> SegmentParameters:
+        """Parameters from the table of :meth:`to_frame` (rows cart, thigh, shank, foot); ``source`` names it in
+        errors."""
         need = {"segment", *_SEGMENT_COLUMNS, "attachment_m"}
         missing = need - set(df.columns)
         if missing:

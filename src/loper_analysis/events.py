@@ -28,8 +28,14 @@ from .constants import FLAGGED_EVENTS
 from .errors import LoperInputError
 
 __all__ = [
-    "EVENT_COLUMNS", "STRIDE_COLUMNS", "STANCE_HEEL_COLUMNS", "load_transitions", "gait_events", "strides",
-    "flagged_contacts", "stance_heels",
+    "EVENT_COLUMNS",
+    "STRIDE_COLUMNS",
+    "STANCE_HEEL_COLUMNS",
+    "load_transitions",
+    "gait_events",
+    "strides",
+    "flagged_contacts",
+    "stance_heels",
 ]
 
 logger = logging.getLogger(__name__)
@@ -38,7 +44,14 @@ logger = logging.getLogger(__name__)
 EVENT_COLUMNS: tuple[str, ...] = ("side", "event", "time_s", "sample")
 #: Columns of the stride table.
 STRIDE_COLUMNS: tuple[str, ...] = (
-    "stride", "side", "heel_strike_s", "toe_off_s", "end_s", "duration_s", "stance_s", "swing_s",
+    "stride",
+    "side",
+    "heel_strike_s",
+    "toe_off_s",
+    "end_s",
+    "duration_s",
+    "stance_s",
+    "swing_s",
 )
 #: Columns of :func:`stance_heels`.
 STANCE_HEEL_COLUMNS: tuple[str, ...] = ("side", "heel_strike_s", "toe_off_s", "own_heel_lower_m", "own_heel_lower")
@@ -71,14 +84,16 @@ def _drop_short_periods(
         if not short.size:
             break
         i = short[np.argmin(duration[short])]
-        dropped.append({
-            "phase": "stance" if kinds[i] == _HS else "swing",
-            "start_s": float(t[i]),
-            "end_s": float(t[i + 1]),
-            "duration_s": float(duration[i]),
-            "start_sample": int(samples[i]),
-            "end_sample": int(samples[i + 1]),
-        })
+        dropped.append(
+            {
+                "phase": "stance" if kinds[i] == _HS else "swing",
+                "start_s": float(t[i]),
+                "end_s": float(t[i + 1]),
+                "duration_s": float(duration[i]),
+                "start_sample": int(samples[i]),
+                "end_sample": int(samples[i + 1]),
+            }
+        )
         samples = np.delete(samples, [i, i + 1])
         kinds = np.delete(kinds, [i, i + 1])
     return samples, kinds, dropped
@@ -139,9 +154,7 @@ def load_transitions(
     t = time_vector(time_s, source)
     f = np.asarray(vertical_force_n, dtype=float)
     if f.ndim != 1 or f.size != t.size:
-        raise LoperInputError(
-            f"{where(source)}vertical_force_n has shape {f.shape}; time_s has {t.size} samples"
-        )
+        raise LoperInputError(f"{where(source)}vertical_force_n has shape {f.shape}; time_s has {t.size} samples")
     bad = np.flatnonzero(~np.isfinite(f))
     if bad.size:
         raise LoperInputError(f"{where(source)}vertical_force_n is not finite at sample {bad[0]}: {f[bad[0]]}")
@@ -224,30 +237,45 @@ def gait_events(
     """
     side = check_side(side, source)
     t = time_vector(time_s, source)
-    samples, loading, dropped = load_transitions(t, vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s,
-                                                 min_swing_s, source)
+    samples, loading, dropped = load_transitions(
+        t, vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, source
+    )
     f = np.asarray(vertical_force_n, dtype=float)
     on, off = float(threshold_on_n), float(threshold_off_n)  # checked by load_transitions
     for d in dropped:
         logger.info(
             "%s%s side: dropped a %.3f s %s period (%.3f-%.3f s), shorter than the minimum",
-            where(source), side, d["duration_s"], d["phase"], d["start_s"], d["end_s"],
+            where(source),
+            side,
+            d["duration_s"],
+            d["phase"],
+            d["start_s"],
+            d["end_s"],
         )
     if not samples.size:
         raise LoperInputError(
             f"{where(source)}no gait event in vertical_force_n ({side} side): the force never crosses "
             f"{off} N and {on} N in turn (range {f.min():.1f} .. {f.max():.1f} N)"
         )
-    events = pd.DataFrame({
-        "side": side,
-        "event": np.where(loading, "heel_strike", "toe_off"),
-        "time_s": t[samples],
-        "sample": samples.astype(np.int64),
-    })
-    events.attrs.update({
-        "source": source, "side": side, "threshold_on_n": on, "threshold_off_n": off,
-        "min_stance_s": float(min_stance_s), "min_swing_s": float(min_swing_s), "dropped": dropped,
-    })
+    events = pd.DataFrame(
+        {
+            "side": side,
+            "event": np.where(loading, "heel_strike", "toe_off"),
+            "time_s": t[samples],
+            "sample": samples.astype(np.int64),
+        }
+    )
+    events.attrs.update(
+        {
+            "source": source,
+            "side": side,
+            "threshold_on_n": on,
+            "threshold_off_n": off,
+            "min_stance_s": float(min_stance_s),
+            "min_swing_s": float(min_swing_s),
+            "dropped": dropped,
+        }
+    )
     return events
 
 
@@ -313,21 +341,28 @@ def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
         overlaps = (flag_start[None, :] < end[:, None]) & (flag_end[None, :] > swing_start[:, None])
         spanning = keep & overlaps.any(axis=1)
         if spanning.any():
-            logger.info("%s%s side: %d stride(s) whose swing overlaps a flagged contact are left out",
-                        where(source), side, int(spanning.sum()))
+            logger.info(
+                "%s%s side: %d stride(s) whose swing overlaps a flagged contact are left out",
+                where(source),
+                side,
+                int(spanning.sum()),
+            )
         keep &= ~spanning
     start, end = start[keep], end[keep]
     toe_off = to[first[keep]] if to.size else np.empty(0)
-    return pd.DataFrame({
-        "stride": np.arange(start.size, dtype=np.int64),
-        "side": side,
-        "heel_strike_s": start,
-        "toe_off_s": toe_off,
-        "end_s": end,
-        "duration_s": end - start,
-        "stance_s": toe_off - start,
-        "swing_s": end - toe_off,
-    }, columns=list(STRIDE_COLUMNS))
+    return pd.DataFrame(
+        {
+            "stride": np.arange(start.size, dtype=np.int64),
+            "side": side,
+            "heel_strike_s": start,
+            "toe_off_s": toe_off,
+            "end_s": end,
+            "duration_s": end - start,
+            "stance_s": toe_off - start,
+            "swing_s": end - toe_off,
+        },
+        columns=list(STRIDE_COLUMNS),
+    )
 
 
 def _flagged_spans(mine: pd.DataFrame, t: np.ndarray, side: str, source: str) -> tuple[np.ndarray, np.ndarray]:

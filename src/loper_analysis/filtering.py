@@ -6,8 +6,7 @@ import numpy as np
 
 from .errors import LoperInputError
 
-__all__ = ["DC_GAIN_TOLERANCE", "check_cutoff", "lowpass", "lowpass_finite_runs", "lowpass_gain",
-           "min_run_samples"]
+__all__ = ["DC_GAIN_TOLERANCE", "check_cutoff", "lowpass", "lowpass_finite_runs", "lowpass_gain", "min_run_samples"]
 
 
 #: Largest relative error of the designed filter's gain at 0 Hz: beyond it a cut-off is too low for the rate
@@ -21,8 +20,15 @@ def _prefixed(source: str, message: str) -> str:
     return f"{source}: {message}" if source else message
 
 
-def check_cutoff(sample_rate_hz: float, cutoff_hz: float, order: int = 4, *, setting: str = "cutoff_hz",
-                 rate_name: str = "sample_rate_hz", source: str = "") -> np.ndarray:
+def check_cutoff(
+    sample_rate_hz: float,
+    cutoff_hz: float,
+    order: int = 4,
+    *,
+    setting: str = "cutoff_hz",
+    rate_name: str = "sample_rate_hz",
+    source: str = "",
+) -> np.ndarray:
     """Refuse a cut-off the zero-phase Butterworth low-pass cannot use at this rate; returns the filter (SOS).
 
     A cut-off must be a positive, finite frequency below the Nyquist
@@ -74,8 +80,12 @@ def check_cutoff(sample_rate_hz: float, cutoff_hz: float, order: int = 4, *, set
         rate = float("nan")
     if not np.isfinite(rate) or rate <= 0:
         raise LoperInputError(_prefixed(source, f"{rate_name} must be a positive, finite rate, got {sample_rate_hz!r}"))
-    if isinstance(order, bool) or not isinstance(order, (int, float, np.integer, np.floating)) \
-            or int(order) != order or order < 1:
+    if (
+        isinstance(order, bool)
+        or not isinstance(order, (int, float, np.integer, np.floating))
+        or int(order) != order
+        or order < 1
+    ):
         raise LoperInputError(_prefixed(source, f"order must be an integer >= 1, got {order!r}"))
     nyq = 0.5 * rate
     rate_text = f"{rate_name} = {rate:g} Hz"
@@ -84,11 +94,20 @@ def check_cutoff(sample_rate_hz: float, cutoff_hz: float, order: int = 4, *, set
     except (TypeError, ValueError):
         raise LoperInputError(_prefixed(source, f"{setting} must be a frequency in Hz, got {cutoff_hz!r}")) from None
     if not np.isfinite(value) or value <= 0:
-        raise LoperInputError(_prefixed(source, f"{setting} must be a positive, finite frequency below the Nyquist "
-                                                f"frequency {nyq:g} Hz of {rate_text}, got {cutoff_hz!r}"))
+        raise LoperInputError(
+            _prefixed(
+                source,
+                f"{setting} must be a positive, finite frequency below the Nyquist "
+                f"frequency {nyq:g} Hz of {rate_text}, got {cutoff_hz!r}",
+            )
+        )
     if value >= nyq:
-        raise LoperInputError(_prefixed(source, f"{setting} must lie in 0 .. {nyq:g} Hz (below the Nyquist frequency "
-                                                f"of {rate_text}), got {value:g} Hz"))
+        raise LoperInputError(
+            _prefixed(
+                source,
+                f"{setting} must lie in 0 .. {nyq:g} Hz (below the Nyquist frequency of {rate_text}), got {value:g} Hz",
+            )
+        )
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore")  # a singular design divides by zero: refused below, never a warning
         sos = butter(int(order), value / nyq, output="sos")
@@ -100,15 +119,28 @@ def check_cutoff(sample_rate_hz: float, cutoff_hz: float, order: int = 4, *, set
             except np.linalg.LinAlgError:
                 sound = False
     if not sound:
-        raise LoperInputError(_prefixed(
-            source, f"{setting} = {value:g} Hz is too low for {rate_text} (Nyquist {nyq:g} Hz): an order-{int(order)} "
-            f"Butterworth at {value / nyq:.2g} of the Nyquist frequency is numerically unsound (its gain at 0 Hz "
-            f"is {dc_gain:.6g}, not 1); raise {setting}"))
+        raise LoperInputError(
+            _prefixed(
+                source,
+                f"{setting} = {value:g} Hz is too low for {rate_text} (Nyquist {nyq:g} Hz): an order-{int(order)} "
+                f"Butterworth at {value / nyq:.2g} of the Nyquist frequency is numerically unsound (its gain at 0 Hz "
+                f"is {dc_gain:.6g}, not 1); raise {setting}",
+            )
+        )
     return sos
 
 
-def lowpass(signal, sample_rate_hz: float, cutoff_hz: float = 40.0, order: int = 4, axis: int = 0, *,
-            setting: str = "cutoff_hz", rate_name: str = "sample_rate_hz", source: str = "") -> np.ndarray:
+def lowpass(
+    signal,
+    sample_rate_hz: float,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    axis: int = 0,
+    *,
+    setting: str = "cutoff_hz",
+    rate_name: str = "sample_rate_hz",
+    source: str = "",
+) -> np.ndarray:
     """Butterworth low-pass of ``order`` run forward and backward (zero phase).
 
     The forward-backward pass squares the magnitude response: the gain at
@@ -132,20 +164,29 @@ def lowpass(signal, sample_rate_hz: float, cutoff_hz: float = 40.0, order: int =
     bad = np.argwhere(~np.isfinite(x))
     if bad.size:
         idx = tuple(int(i) for i in bad[0])
-        raise LoperInputError(_prefixed(
-            source, f"signal is not finite at sample {idx[axis]} (index {idx}): fill gaps before filtering"))
+        raise LoperInputError(
+            _prefixed(source, f"signal is not finite at sample {idx[axis]} (index {idx}): fill gaps before filtering")
+        )
     sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
     padlen = 3 * (2 * len(sos) + 1)
     if x.shape[axis] <= padlen:
-        raise LoperInputError(_prefixed(source, f"signal has {x.shape[axis]} samples; the filter needs more than "
-                                                f"{padlen}"))
+        raise LoperInputError(
+            _prefixed(source, f"signal has {x.shape[axis]} samples; the filter needs more than {padlen}")
+        )
     from scipy.signal import sosfiltfilt
 
     return sosfiltfilt(sos, x, axis=axis)
 
 
-def min_run_samples(sample_rate_hz: float, cutoff_hz: float = 40.0, order: int = 4, *, setting: str = "cutoff_hz",
-                    rate_name: str = "sample_rate_hz", source: str = "") -> int:
+def min_run_samples(
+    sample_rate_hz: float,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    *,
+    setting: str = "cutoff_hz",
+    rate_name: str = "sample_rate_hz",
+    source: str = "",
+) -> int:
     """Fewest samples :func:`lowpass` accepts: one more than the padding of ``sosfiltfilt`` (3 * (2 * sections + 1))."""
     sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
     return 3 * (2 * len(sos) + 1) + 1
@@ -157,9 +198,17 @@ def _finite_runs(finite: np.ndarray) -> list[tuple[int, int]]:
     return list(zip(np.flatnonzero(edges == 1).tolist(), np.flatnonzero(edges == -1).tolist()))
 
 
-def lowpass_finite_runs(signal, sample_rate_hz: float, cutoff_hz: float = 40.0, order: int = 4,
-                        axis: int = 0, *, setting: str = "cutoff_hz", rate_name: str = "sample_rate_hz",
-                        source: str = "") -> tuple[np.ndarray, np.ndarray]:
+def lowpass_finite_runs(
+    signal,
+    sample_rate_hz: float,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    axis: int = 0,
+    *,
+    setting: str = "cutoff_hz",
+    rate_name: str = "sample_rate_hz",
+    source: str = "",
+) -> tuple[np.ndarray, np.ndarray]:
     """:func:`lowpass` of each run of finite samples on its own; NaN stays NaN and never spreads.
 
     Every 1-D series along ``axis`` (e.g. one coordinate of one marker of
@@ -196,8 +245,10 @@ def lowpass_finite_runs(signal, sample_rate_hz: float, cutoff_hz: float = 40.0, 
         raise LoperInputError(_prefixed(source, f"signal is infinite at sample {idx[axis]} (index {idx})"))
     sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
     if np.all(np.isfinite(x)):  # the whole signal is one run (too short a one is refused, as by lowpass)
-        return (lowpass(x, sample_rate_hz, cutoff_hz, order, axis, setting=setting, rate_name=rate_name, source=source),
-                np.zeros(x.shape, dtype=bool))
+        return (
+            lowpass(x, sample_rate_hz, cutoff_hz, order, axis, setting=setting, rate_name=rate_name, source=source),
+            np.zeros(x.shape, dtype=bool),
+        )
     from scipy.signal import sosfiltfilt
 
     shortest = 3 * (2 * len(sos) + 1) + 1
@@ -218,8 +269,16 @@ def lowpass_finite_runs(signal, sample_rate_hz: float, cutoff_hz: float = 40.0, 
     return np.moveaxis(out.reshape(moved.shape), 0, axis), np.moveaxis(short.reshape(moved.shape), 0, axis)
 
 
-def lowpass_gain(frequency_hz, sample_rate_hz: float, cutoff_hz: float = 40.0, order: int = 4, *,
-                 setting: str = "cutoff_hz", rate_name: str = "sample_rate_hz", source: str = "") -> np.ndarray:
+def lowpass_gain(
+    frequency_hz,
+    sample_rate_hz: float,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    *,
+    setting: str = "cutoff_hz",
+    rate_name: str = "sample_rate_hz",
+    source: str = "",
+) -> np.ndarray:
     """Magnitude response of :func:`lowpass` (the designed filter's gain squared) at ``frequency_hz``."""
     sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
     from scipy.signal import sosfreqz

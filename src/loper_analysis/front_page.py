@@ -87,20 +87,32 @@ class RunSettings:
         onsets = ", ".join(str(int(o)) for o in self.perturbation_onsets_ms)
         k_lo, k_hi = self.stiffness_bounds_nm_per_rad
         d_lo, d_hi = self.damping_bounds_nms_per_rad
-        noise = (f"null pairs ({self.null_pair_components} deviation shapes projected out)"
-                 if self.noise_model == "null_pairs" else f"{self.noise_model} (plain least squares)")
+        noise = (
+            f"null pairs ({self.null_pair_components} deviation shapes projected out)"
+            if self.noise_model == "null_pairs"
+            else f"{self.noise_model} (plain least squares)"
+        )
         return [
-            ("perturbations", f"onsets {onsets} ms after {self.perturbed_side} toe-off, "
-                              f"{self.perturbation_repeats} trials per onset"),
-            ("fit window", f"{_g(self.window_before_s * 1000)} ms before to {_g(self.window_after_s * 1000)} ms "
-                           f"after onset"),
-            ("bounds", f"K {_g(k_lo)}–{_g(k_hi)} N·m/rad, D {_g(d_lo)}–{_g(d_hi)} N·m·s/rad; "
-                       f"{self.n_starts} random starts"),
+            (
+                "perturbations",
+                f"onsets {onsets} ms after {self.perturbed_side} toe-off, {self.perturbation_repeats} trials per onset",
+            ),
+            (
+                "fit window",
+                f"{_g(self.window_before_s * 1000)} ms before to {_g(self.window_after_s * 1000)} ms after onset",
+            ),
+            (
+                "bounds",
+                f"K {_g(k_lo)}–{_g(k_hi)} N·m/rad, D {_g(d_lo)}–{_g(d_hi)} N·m·s/rad; {self.n_starts} random starts",
+            ),
             ("noise model", noise),
             ("filter", f"Butterworth low-pass {_g(self.filter_cutoff_hz)} Hz, order {self.filter_order}, zero phase"),
-            ("synthetic lab", f"{_g(self.synthetic_walking_duration_s)} s per walking trial, pulses of "
-                              f"{_g(self.pulse_force_n)} N for {_g(self.pulse_duration_s * 1000)} ms, "
-                              f"variability '{self.synthetic_variability}'"),
+            (
+                "synthetic lab",
+                f"{_g(self.synthetic_walking_duration_s)} s per walking trial, pulses of "
+                f"{_g(self.pulse_force_n)} N for {_g(self.pulse_duration_s * 1000)} ms, "
+                f"variability '{self.synthetic_variability}'",
+            ),
             ("seed", str(self.seed)),
         ]
 
@@ -210,8 +222,10 @@ def _summary_table(ci: pd.DataFrame) -> str:
     for joint, g in ci.groupby("joint", sort=False):
         for k, r in enumerate(g.to_dict("records")):
             key = f"impedance-summary|{joint}|{r['onset_ms']}|"
-            cells = [f'<td class="lf-l" rowspan="{len(g)}">{html.escape(str(joint))}</td>' if k == 0 else "",
-                     f"<td>{_count(r['onset_ms'], key + 'onset_ms')}</td>"]
+            cells = [
+                f'<td class="lf-l" rowspan="{len(g)}">{html.escape(str(joint))}</td>' if k == 0 else "",
+                f"<td>{_count(r['onset_ms'], key + 'onset_ms')}</td>",
+            ]
             for p in PARAMETER_KINDS:
                 d = dec[p, joint]
                 mean, low, high = (parameter_column(p, w) for w in ("mean", "ci95_low", "ci95_high"))
@@ -224,8 +238,10 @@ def _summary_table(ci: pd.DataFrame) -> str:
             cells.append(f"<td>{n}</td>")
             sep = ' class="lf-sep"' if k == 0 and body else ""
             body.append(f"<tr{sep}>{''.join(cells)}</tr>")
-    study = "; ".join(f"{j} K {_g(v['K'][0])}–{_g(v['K'][1])}, D {_g(v['D'][0])}–{_g(v['D'][1])}"
-                      for j, v in STUDY_SWING_IMPEDANCE.items())
+    study = "; ".join(
+        f"{j} K {_g(v['K'][0])}–{_g(v['K'][1])}, D {_g(v['D'][0])}–{_g(v['D'][1])}"
+        for j, v in STUDY_SWING_IMPEDANCE.items()
+    )
     return (
         '<table id="lf-impedance-summary"><caption>Impedance: across-subject mean [95 % CI of the mean]</caption>'
         '<thead><tr><th class="lf-l">joint</th><th>onset<br>ms</th><th>K<br>N·m/rad</th><th>D<br>N·m·s/rad</th>'
@@ -254,7 +270,8 @@ def _truth_table(truth: pd.DataFrame) -> str:
                 f'<td>{_num(r[median], d, key + median)} <span class="lf-dim">({_num(r[pct], 0, key + pct)} %)'
                 "</span></td>"
                 f"<td>{_count(r[within], key + within)}/{n}</td>"
-                f"<td>{_count(r[inside], key + inside)}/{n}</td></tr>")
+                f"<td>{_count(r[inside], key + inside)}/{n}</td></tr>"
+            )
     k_rel, k_abs = TRUTH_TOLERANCE["K"]
     d_rel, d_abs = TRUTH_TOLERANCE["D"]
     return (
@@ -274,8 +291,10 @@ def _transparency_table(tr: pd.DataFrame) -> str:
     body = []
     for r in tr.to_dict("records"):
         key = f"transparency|{r['phase']}|{r['joint']}|"
-        study = (f"{_num(r['study_rmsd_rad'], d, key + 'study_rmsd_rad')} / "
-                 f"{_num(r['study_isv_ave_rad'], d, key + 'study_isv_ave_rad')}")
+        study = (
+            f"{_num(r['study_rmsd_rad'], d, key + 'study_rmsd_rad')} / "
+            f"{_num(r['study_isv_ave_rad'], d, key + 'study_isv_ave_rad')}"
+        )
         body.append(
             f'<tr><td class="lf-l">{html.escape(str(r["phase"]))}</td>'
             f'<td class="lf-l">{html.escape(str(r["joint"]))}</td>'
@@ -283,18 +302,23 @@ def _transparency_table(tr: pd.DataFrame) -> str:
             f"<td>{_num(r['isv_ave_rad'], d, key + 'isv_ave_rad')}</td>"
             f"<td>{_mark(r['transparent'])}</td>"
             f"<td>{_count(r['n_subjects_transparent'], key + 'n_subjects_transparent')}/{r['n_subjects']}</td>"
-            f'<td class="lf-dim">{study}</td></tr>')
+            f'<td class="lf-dim">{study}</td></tr>'
+        )
     return (
         '<table id="lf-transparency"><caption>Transparency: RMSD with vs without the device (rad)'
         '</caption><thead><tr><th class="lf-l">phase</th><th class="lf-l">joint</th><th>RMSD</th><th>ISV_ave</th>'
-        '<th>RMSD &lt;<br>ISV_ave</th><th>subjects</th><th>study<br>RMSD / ISV_ave</th></tr></thead>'
+        "<th>RMSD &lt;<br>ISV_ave</th><th>subjects</th><th>study<br>RMSD / ISV_ave</th></tr></thead>"
         f"<tbody>{''.join(body)}</tbody></table>"
     )
 
 
 #: How the device table names the study's metrics.
-_DEVICE_NAMES = {"bandwidth_hz": "−3 dB bandwidth", "rise_time_ms": "rise time 10–90 %",
-                 "overshoot_pct": "overshoot", "steady_state_40n_n": "steady state, 40 N steps"}
+_DEVICE_NAMES = {
+    "bandwidth_hz": "−3 dB bandwidth",
+    "rise_time_ms": "rise time 10–90 %",
+    "overshoot_pct": "overshoot",
+    "steady_state_40n_n": "steady state, 40 N steps",
+}
 
 
 def _device_table(dev: pd.DataFrame) -> str:
@@ -307,7 +331,8 @@ def _device_table(dev: pd.DataFrame) -> str:
             f"<td>{_num(r['value'], 1, key + 'value')}</td>"
             f"<td>{_num(r['study_value'], 1, key + 'study_value')}</td>"
             f'<td class="lf-l">{html.escape(r["unit"])}</td>'
-            f"<td>{_num(r['difference_pct'], 1, key + 'difference_pct')}</td></tr>")
+            f"<td>{_num(r['difference_pct'], 1, key + 'difference_pct')}</td></tr>"
+        )
     return (
         '<table id="lf-device"><caption>Device: force controller, free-hanging leg</caption>'
         '<thead><tr><th class="lf-l"></th><th>ours</th><th>study</th><th></th><th>difference<br>%</th></tr>'
@@ -329,16 +354,22 @@ def _truth_verdict(truth: pd.DataFrame) -> str:
     failed = f", {n_failed} failed" if n_failed else ""
     within = ", ".join(
         f"{q} {_count(int(truth[q + '_n_within_tolerance'].sum()), 'verdict|truth|' + q + '_n_within_tolerance')}"
-        f"/{n_fits}" for q in PARAMETER_KINDS)
+        f"/{n_fits}"
+        for q in PARAMETER_KINDS
+    )
     word = "Truth recovered" if ok else ("Truth missed" if ok is False else "Truth")
     coverage = "no joint fitted"
     if total:
         judged = "as expected of 95 %" if ok else "fewer than 95 % allow"
-        coverage = (f"inside the 95 % CI {_count(inside, 'verdict|truth|n_truth_in_ci95')}/{total} "
-                    f"({_pct(inside, total)}, {judged}: binomial p = {p:.2f}); within tolerance {within}")
+        coverage = (
+            f"inside the 95 % CI {_count(inside, 'verdict|truth|n_truth_in_ci95')}/{total} "
+            f"({_pct(inside, total)}, {judged}: binomial p = {p:.2f}); within tolerance {within}"
+        )
     n_subjects = int(truth["n_subjects"].max())
-    return (f"<li>{_mark(ok)}<b>{word}</b> ({n_subjects} synthetic subject{'s' if n_subjects != 1 else ''}, "
-            f"{n_fits} joint fits{failed}): {coverage}.</li>")
+    return (
+        f"<li>{_mark(ok)}<b>{word}</b> ({n_subjects} synthetic subject{'s' if n_subjects != 1 else ''}, "
+        f"{n_fits} joint fits{failed}): {coverage}.</li>"
+    )
 
 
 def _transparency_verdict_line(tr: pd.DataFrame) -> str:
@@ -347,11 +378,15 @@ def _transparency_verdict_line(tr: pd.DataFrame) -> str:
     n_ok = int(sum(judged))
     ok = None if not judged else n_ok == len(judged)
     word = "Transparent" if ok else ("Not transparent everywhere" if ok is False else "Transparency not judged")
-    subjects = (f"{_count(int(tr['n_subjects_transparent'].sum()), 'verdict|transparency|n_subjects_transparent')}"
-                f"/{int(tr['n_subjects'].sum())}")
-    return (f"<li>{_mark(ok)}<b>{word}</b>: RMSD &lt; ISV_ave in "
-            f"{_count(n_ok, 'verdict|transparency|n_transparent')}/{len(tr)} phase × joint, {subjects} per "
-            f"subject.</li>")
+    subjects = (
+        f"{_count(int(tr['n_subjects_transparent'].sum()), 'verdict|transparency|n_subjects_transparent')}"
+        f"/{int(tr['n_subjects'].sum())}"
+    )
+    return (
+        f"<li>{_mark(ok)}<b>{word}</b>: RMSD &lt; ISV_ave in "
+        f"{_count(n_ok, 'verdict|transparency|n_transparent')}/{len(tr)} phase × joint, {subjects} per "
+        f"subject.</li>"
+    )
 
 
 def _device_verdict_line(dev: pd.DataFrame) -> str:
@@ -360,10 +395,14 @@ def _device_verdict_line(dev: pd.DataFrame) -> str:
     band = dev[dev["metric"] == "bandwidth_hz"]
     bandwidth = ""
     if len(band):
-        bandwidth = (f"; bandwidth {_num(band['value'].iloc[0], 1, 'verdict|device|bandwidth_hz')} Hz "
-                     f"(study {_g(band['study_value'].iloc[0])})")
-    return (f"<li>{_mark(None)}<b>Device</b> as in the study: {len(dev)} figures within "
-            f"{_num(worst, 1, 'verdict|device|max_abs_difference_pct')} %{bandwidth}.</li>")
+        bandwidth = (
+            f"; bandwidth {_num(band['value'].iloc[0], 1, 'verdict|device|bandwidth_hz')} Hz "
+            f"(study {_g(band['study_value'].iloc[0])})"
+        )
+    return (
+        f"<li>{_mark(None)}<b>Device</b> as in the study: {len(dev)} figures within "
+        f"{_num(worst, 1, 'verdict|device|max_abs_difference_pct')} %{bandwidth}.</li>"
+    )
 
 
 def _validation_verdict_line(val: pd.DataFrame) -> str:
@@ -377,18 +416,28 @@ def _validation_verdict_line(val: pd.DataFrame) -> str:
         parts.append(f"{_num(worst, d, 'verdict|validation|' + p + '_max_abs_error')} {_UNIT[p]} ({p})")
         study.append(_g(max(abs(r["study_min_error"]), abs(r["study_max_error"]))))
     n = int(val["n_combinations"].min())
-    return (f"<li>{_mark(ok)}<b>Validation</b> without noise ({n} combinations): |error| ≤ {', '.join(parts)}; "
-            f"the study ≤ {' and '.join(study)}.</li>")
+    return (
+        f"<li>{_mark(ok)}<b>Validation</b> without noise ({n} combinations): |error| ≤ {', '.join(parts)}; "
+        f"the study ≤ {' and '.join(study)}.</li>"
+    )
 
 
 # ------------------------------------------------------------------------------------------------ the page
 
 
-def front_page_html(subjects: Mapping[str, str], trials: Mapping[str, Sequence[str]], settings: RunSettings,
-                    versions: Mapping[str, str], device: pd.DataFrame, validation: pd.DataFrame,
-                    summary: pd.DataFrame | None = None, truth: pd.DataFrame | None = None,
-                    impedance_status: Mapping[str, int] | None = None, figure_png: bytes | None = None,
-                    transparency: pd.DataFrame | None = None) -> str:
+def front_page_html(
+    subjects: Mapping[str, str],
+    trials: Mapping[str, Sequence[str]],
+    settings: RunSettings,
+    versions: Mapping[str, str],
+    device: pd.DataFrame,
+    validation: pd.DataFrame,
+    summary: pd.DataFrame | None = None,
+    truth: pd.DataFrame | None = None,
+    impedance_status: Mapping[str, int] | None = None,
+    figure_png: bytes | None = None,
+    transparency: pd.DataFrame | None = None,
+) -> str:
     """The front page as one HTML fragment (a ``<style>`` and a ``<div class="lf">``).
 
     Parameters
@@ -426,9 +475,11 @@ def front_page_html(subjects: Mapping[str, str], trials: Mapping[str, Sequence[s
         raise LoperInputError(f"settings must be a RunSettings, got {type(settings).__name__}")
     parts = [_STYLE, '<div class="lf">']
     onsets = ", ".join(str(int(o)) for o in settings.perturbation_onsets_ms)
-    parts.append(f"<p><b>Run</b>: {_subject_line(subjects, trials)} (onsets {onsets} ms × "
-                 f"{settings.perturbation_repeats} + the transparency pair); seed {settings.seed}; settings and "
-                 "versions at the end.</p>")
+    parts.append(
+        f"<p><b>Run</b>: {_subject_line(subjects, trials)} (onsets {onsets} ms × "
+        f"{settings.perturbation_repeats} + the transparency pair); seed {settings.seed}; settings and "
+        "versions at the end.</p>"
+    )
     verdicts = []
     has_truth = truth is not None and len(truth) > 0
     if has_truth:
@@ -444,29 +495,37 @@ def front_page_html(subjects: Mapping[str, str], trials: Mapping[str, Sequence[s
         parts.append("<p>No perturbation trials in this run: no impedance was identified.</p>")
     elif not len(summary):
         status = ", ".join(f"{n} {html.escape(s)}" for s, n in (impedance_status or {}).items())
-        parts.append(f'<p id="lf-impedance-summary"><b>Impedance</b>: no joint was fitted '
-                     f"({status or 'no rows'}; the reasons are in results/tables/impedance.tsv).</p>")
+        parts.append(
+            f'<p id="lf-impedance-summary"><b>Impedance</b>: no joint was fitted '
+            f"({status or 'no rows'}; the reasons are in results/tables/impedance.tsv).</p>"
+        )
     else:
         parts.append(_summary_table(summary))
     if has_truth and truth["n_fits"].sum() > 0:
         parts.append(_truth_table(truth))
     if figure_png:
         data = base64.b64encode(figure_png).decode("ascii")
-        parts.append('<h2>K and D per onset</h2>'
-                     f'<img id="lf-figure" alt="Stiffness K and damping D per onset: subjects, mean and truth" '
-                     f'src="data:image/png;base64,{data}">'
-                     '<p class="lf-note">Grey: each subject; black: the across-subject mean; open circles: the '
-                     "truth of synthetic subjects.</p>")
+        parts.append(
+            "<h2>K and D per onset</h2>"
+            f'<img id="lf-figure" alt="Stiffness K and damping D per onset: subjects, mean and truth" '
+            f'src="data:image/png;base64,{data}">'
+            '<p class="lf-note">Grey: each subject; black: the across-subject mean; open circles: the '
+            "truth of synthetic subjects.</p>"
+        )
     if transparency is not None and len(transparency):
         parts.append(_transparency_table(transparency))
     if len(device):
         parts.append(_device_table(device))
-    rows = "".join(f'<tr><td class="lf-l">{html.escape(k)}</td><td class="lf-l">{html.escape(v)}</td></tr>'
-                   for k, v in settings.rows())
+    rows = "".join(
+        f'<tr><td class="lf-l">{html.escape(k)}</td><td class="lf-l">{html.escape(v)}</td></tr>'
+        for k, v in settings.rows()
+    )
     software = " · ".join(f"{html.escape(k)} {html.escape(v)}" for k, v in versions.items())
-    parts.append('<table id="lf-run"><caption>What was run</caption><tbody>'
-                 f'<tr><td class="lf-l">subjects</td><td class="lf-l">{_subject_line(subjects, trials)}</td></tr>'
-                 f'{rows}<tr><td class="lf-l">software</td><td class="lf-l" style="white-space:normal">'
-                 f"{software}</td></tr></tbody></table>")
+    parts.append(
+        '<table id="lf-run"><caption>What was run</caption><tbody>'
+        f'<tr><td class="lf-l">subjects</td><td class="lf-l">{_subject_line(subjects, trials)}</td></tr>'
+        f'{rows}<tr><td class="lf-l">software</td><td class="lf-l" style="white-space:normal">'
+        f"{software}</td></tr></tbody></table>"
+    )
     parts.append("</div>")
     return "\n".join(parts) + "\n"

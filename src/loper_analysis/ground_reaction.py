@@ -79,9 +79,15 @@ __all__ = [
 
 #: Column suffixes of one plate in the external-loads table (force N, point m, torque N·m).
 EXTERNAL_LOADS_SUFFIXES: tuple[str, ...] = (
-    "ground_force_vx", "ground_force_vy", "ground_force_vz",
-    "ground_force_px", "ground_force_py", "ground_force_pz",
-    "ground_torque_x", "ground_torque_y", "ground_torque_z",
+    "ground_force_vx",
+    "ground_force_vy",
+    "ground_force_vz",
+    "ground_force_px",
+    "ground_force_py",
+    "ground_force_pz",
+    "ground_torque_x",
+    "ground_torque_y",
+    "ground_torque_z",
 )
 
 #: Percentile of the vertical force taken as the unloaded floor.
@@ -208,8 +214,9 @@ def up_vector(up: Sequence[float], source: str = "") -> np.ndarray:
         raise LoperInputError(f"{where(source)}up must be 3 numbers (a direction, lab frame), got {up!r}") from None
     norm = float(np.linalg.norm(u)) if u.shape == (3,) and np.all(np.isfinite(u)) else 0.0
     if norm == 0.0:
-        raise LoperInputError(f"{where(source)}up must be 3 finite numbers, not all 0 (a direction, lab frame), "
-                              f"got {up!r}")
+        raise LoperInputError(
+            f"{where(source)}up must be 3 finite numbers, not all 0 (a direction, lab frame), got {up!r}"
+        )
     return u / norm
 
 
@@ -265,8 +272,14 @@ def surface_normal(corners_m, source: str = "", up: Sequence[float] = LAB_Z_UP) 
     return n
 
 
-def resting_level(force_n, moment_nm, band_n: float = 10.0, max_rest_n: float = 100.0,
-                  source: str = "", up: Sequence[float] = LAB_Z_UP) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def resting_level(
+    force_n,
+    moment_nm,
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+    source: str = "",
+    up: Sequence[float] = LAB_Z_UP,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Resting (unloaded) level of a plate's force and moment.
 
     Parameters
@@ -360,9 +373,18 @@ def _nearest_loaded(loaded: np.ndarray) -> np.ndarray | None:
     return np.where(use_prev, prv, nxt)
 
 
-def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, threshold_n: float = 20.0,
-                band_n: float = 10.0, max_rest_n: float = 100.0, source: str = "",
-                up: Sequence[float] = LAB_Z_UP) -> PlateLoads:
+def plate_loads(
+    plate_number: int,
+    time_s,
+    force_n,
+    moment_nm,
+    corners_m,
+    threshold_n: float = 20.0,
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+    source: str = "",
+    up: Sequence[float] = LAB_Z_UP,
+) -> PlateLoads:
     """Resting level removed, COP and free moment of one plate, with the unloaded policy of the module notes.
 
     Parameters
@@ -412,9 +434,21 @@ def plate_loads(plate_number: int, time_s, force_n, moment_nm, corners_m, thresh
     else:
         cop = cop[nearest]
     free = np.where(loaded, free, 0.0)
-    return PlateLoads(number=int(plate_number), time_s=t.copy(), force_n=F, moment_nm=M, cop_m=cop, free_moment_nm=free,
-                      loaded=loaded, rest_force_n=rest_f, rest_moment_nm=rest_m, normal=normal, corners_m=corners.copy(),
-                      centre_m=centre, up=u)
+    return PlateLoads(
+        number=int(plate_number),
+        time_s=t.copy(),
+        force_n=F,
+        moment_nm=M,
+        cop_m=cop,
+        free_moment_nm=free,
+        loaded=loaded,
+        rest_force_n=rest_f,
+        rest_moment_nm=rest_m,
+        normal=normal,
+        corners_m=corners.copy(),
+        centre_m=centre,
+        up=u,
+    )
 
 
 def external_loads_table(loads: Sequence[PlateLoads], rotation_deg: Sequence[float] = (0.0, 0.0, 0.0)) -> pd.DataFrame:
@@ -454,8 +488,13 @@ def external_loads_table(loads: Sequence[PlateLoads], rotation_deg: Sequence[flo
     for p in loads:
         force = np.where(p.loaded[:, None], p.force_n, 0.0)
         torque = p.free_moment_nm[:, None] * p.normal
-        block = np.hstack([rotate_markers(force, rotation_deg), rotate_markers(p.cop_m, rotation_deg),
-                           rotate_markers(torque, rotation_deg)])
+        block = np.hstack(
+            [
+                rotate_markers(force, rotation_deg),
+                rotate_markers(p.cop_m, rotation_deg),
+                rotate_markers(torque, rotation_deg),
+            ]
+        )
         for j, name in enumerate(external_loads_columns(p.number)):
             out[name] = block[:, j]
     return pd.DataFrame(out)

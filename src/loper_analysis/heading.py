@@ -85,8 +85,14 @@ def travel_velocity_m_per_s(markers_m, rate_hz: float) -> np.ndarray:
     return step.mean(axis=0) * float(rate_hz)
 
 
-def trial_heading(markers_lab_m, rate_hz: float, base_rotation_deg: Sequence[float], mode: str = "auto",
-                  min_speed_m_per_s: float = 0.25, source: str = "") -> TrialHeading:
+def trial_heading(
+    markers_lab_m,
+    rate_hz: float,
+    base_rotation_deg: Sequence[float],
+    mode: str = "auto",
+    min_speed_m_per_s: float = 0.25,
+    source: str = "",
+) -> TrialHeading:
     """The lab -> model rotation of one trial (module docstring).
 
     Parameters
@@ -111,8 +117,9 @@ def trial_heading(markers_lab_m, rate_hz: float, base_rotation_deg: Sequence[flo
     from scipy.spatial.transform import Rotation
 
     if mode not in HEADING_MODES:
-        raise LoperInputError(f"{source or 'markers'}: markers.walking_direction must be one of {HEADING_MODES}, "
-                              f"got {mode!r}")
+        raise LoperInputError(
+            f"{source or 'markers'}: markers.walking_direction must be one of {HEADING_MODES}, got {mode!r}"
+        )
     base = tuple(float(a) for a in base_rotation_deg)
     v = travel_velocity_m_per_s(rotate_markers(markers_lab_m, base), rate_hz)
     speed = float(np.hypot(v[0], v[2]))

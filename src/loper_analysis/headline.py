@@ -58,8 +58,10 @@ def _rows_or_empty(table, columns: Sequence[str], source: str, what: str) -> pd.
 
 def _numbers(table: pd.DataFrame, column: str, source: str) -> np.ndarray:
     """A numeric column as floats; a cell that is no finite number names its row, column and value."""
-    return np.array([number(f"column {column!r}, row {i}", value, source)
-                     for i, value in enumerate(table[column].to_numpy())], dtype=float)
+    return np.array(
+        [number(f"column {column!r}, row {i}", value, source) for i, value in enumerate(table[column].to_numpy())],
+        dtype=float,
+    )
 
 
 def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
@@ -92,11 +94,22 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
         not-identifiable count above it), a mean that is no finite number,
         or no SD where two or more subjects were averaged.
     """
-    needed = ["joint", "onset_ms", "n_subjects", "n_not_identifiable", "vaf_pct_mean",
-              *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("mean", "sd"))]
-    out_columns = ["joint", "onset_ms", "n_subjects", "n_not_identifiable",
-                   *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("mean", "ci95_low", "ci95_high")),
-                   "vaf_pct_mean"]
+    needed = [
+        "joint",
+        "onset_ms",
+        "n_subjects",
+        "n_not_identifiable",
+        "vaf_pct_mean",
+        *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("mean", "sd")),
+    ]
+    out_columns = [
+        "joint",
+        "onset_ms",
+        "n_subjects",
+        "n_not_identifiable",
+        *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("mean", "ci95_low", "ci95_high")),
+        "vaf_pct_mean",
+    ]
     table = _rows_or_empty(summary, needed, source, "impedance summary")
     rows = []
     for i, r in enumerate(table.to_dict("records")):
@@ -105,8 +118,12 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
         n_ni = integer("n_not_identifiable", r["n_not_identifiable"], at, minimum=0)
         if n_ni > n:
             raise LoperInputError(f"{at}: n_not_identifiable must be <= n_subjects = {n}, got {n_ni}")
-        row = {"joint": r["joint"], "onset_ms": integer("onset_ms", r["onset_ms"], at), "n_subjects": n,
-               "n_not_identifiable": n_ni}
+        row = {
+            "joint": r["joint"],
+            "onset_ms": integer("onset_ms", r["onset_ms"], at),
+            "n_subjects": n,
+            "n_not_identifiable": n_ni,
+        }
         for p in PARAMETER_KINDS:
             mean = number(parameter_column(p, "mean"), r[parameter_column(p, "mean")], at)
             if n >= 2:
@@ -115,8 +132,13 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
                 low, high = mean - half, mean + half
             else:
                 low = high = math.nan
-            row.update({parameter_column(p, "mean"): mean, parameter_column(p, "ci95_low"): low,
-                        parameter_column(p, "ci95_high"): high})
+            row.update(
+                {
+                    parameter_column(p, "mean"): mean,
+                    parameter_column(p, "ci95_low"): low,
+                    parameter_column(p, "ci95_high"): high,
+                }
+            )
         row["vaf_pct_mean"] = number("vaf_pct_mean", r["vaf_pct_mean"], at)
         rows.append(row)
     return pd.DataFrame(rows, columns=out_columns)
@@ -154,14 +176,26 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
         A column missing, or a fitted row whose estimate, CI bound or error
         is no finite number (naming the row and the column).
     """
-    needed = ["subject", "onset_ms", "joint", "status",
-              *(parameter_column(p, w) for p in PARAMETER_KINDS
-                for w in ("", "ci95_low", "ci95_high", "true", "error"))]
+    needed = [
+        "subject",
+        "onset_ms",
+        "joint",
+        "status",
+        *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("", "ci95_low", "ci95_high", "true", "error")),
+    ]
     counts = ["n_fits", "n_failed"]
     per_p = [(p, w) for p in PARAMETER_KINDS for w in ("error_mean", "error_median_abs")]
-    columns = ["joint", "n_subjects", *counts, *(parameter_column(p, w) for p, w in per_p),
-               *(f"{p}_{w}" for p in PARAMETER_KINDS for w in ("error_median_abs_pct", "n_within_tolerance",
-                                                                  "n_truth_in_ci95"))]
+    columns = [
+        "joint",
+        "n_subjects",
+        *counts,
+        *(parameter_column(p, w) for p, w in per_p),
+        *(
+            f"{p}_{w}"
+            for p in PARAMETER_KINDS
+            for w in ("error_median_abs_pct", "n_within_tolerance", "n_truth_in_ci95")
+        ),
+    ]
     table = _rows_or_empty(impedance, needed, source, "impedance table")
     known = table[pd.to_numeric(table[parameter_column("K", "true")], errors="coerce").notna()].reset_index(drop=True)
     fitted = known[known["status"].isin(FITTED_STATUSES)].reset_index(drop=True)
@@ -173,8 +207,12 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
     rows = []
     for joint in [j for j in JOINTS if j in set(known["joint"])] + sorted(set(known["joint"]) - set(JOINTS)):
         own = (fitted["joint"] == joint).to_numpy()
-        row = {"joint": joint, "n_subjects": int(known.loc[known["joint"] == joint, "subject"].nunique()),
-               "n_fits": int(own.sum()), "n_failed": int((known["joint"] == joint).sum() - own.sum())}
+        row = {
+            "joint": joint,
+            "n_subjects": int(known.loc[known["joint"] == joint, "subject"].nunique()),
+            "n_fits": int(own.sum()),
+            "n_failed": int((known["joint"] == joint).sum() - own.sum()),
+        }
         for p in PARAMETER_KINDS:
             err = values[parameter_column(p, "error")][own]
             true = values[parameter_column(p, "true")][own]
@@ -182,13 +220,15 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
             low, high = values[parameter_column(p, "ci95_low")][own], values[parameter_column(p, "ci95_high")][own]
             nonzero = true != 0
             rel_err = np.abs(err[nonzero]) / np.abs(true[nonzero]) * 100.0
-            row.update({
-                parameter_column(p, "error_mean"): float(err.mean()) if err.size else math.nan,
-                parameter_column(p, "error_median_abs"): float(np.median(np.abs(err))) if err.size else math.nan,
-                f"{p}_error_median_abs_pct": float(np.median(rel_err)) if rel_err.size else math.nan,
-                f"{p}_n_within_tolerance": int((np.abs(err) <= np.maximum(rel * np.abs(true), ab)).sum()),
-                f"{p}_n_truth_in_ci95": int(((true >= low) & (true <= high)).sum()),
-            })
+            row.update(
+                {
+                    parameter_column(p, "error_mean"): float(err.mean()) if err.size else math.nan,
+                    parameter_column(p, "error_median_abs"): float(np.median(np.abs(err))) if err.size else math.nan,
+                    f"{p}_error_median_abs_pct": float(np.median(rel_err)) if rel_err.size else math.nan,
+                    f"{p}_n_within_tolerance": int((np.abs(err) <= np.maximum(rel * np.abs(true), ab)).sum()),
+                    f"{p}_n_truth_in_ci95": int(((true >= low) & (true <= high)).sum()),
+                }
+            )
         rows.append(row)
     return pd.DataFrame(rows, columns=columns)
 
@@ -242,28 +282,54 @@ def transparency_verdict(rmsd: pd.DataFrame, source: str = "") -> pd.DataFrame:
         study_isv_ave_rad``, ``n_subjects`` (subjects with a verdict) and
         ``n_subjects_transparent``.
     """
-    needed = ["subject", "phase", "joint", "rmsd_rad", "isv_ave_rad", "transparent", "study_rmsd_rad",
-              "study_isv_ave_rad"]
-    columns = ["phase", "joint", "rmsd_rad", "isv_ave_rad", "transparent", "study_rmsd_rad", "study_isv_ave_rad",
-               "n_subjects", "n_subjects_transparent"]
+    needed = [
+        "subject",
+        "phase",
+        "joint",
+        "rmsd_rad",
+        "isv_ave_rad",
+        "transparent",
+        "study_rmsd_rad",
+        "study_isv_ave_rad",
+    ]
+    columns = [
+        "phase",
+        "joint",
+        "rmsd_rad",
+        "isv_ave_rad",
+        "transparent",
+        "study_rmsd_rad",
+        "study_isv_ave_rad",
+        "n_subjects",
+        "n_subjects_transparent",
+    ]
     table = _rows_or_empty(rmsd, needed, source, "transparency table")
-    verdicts = [_bool_or_none(v, "transparent", f"{where(source)}row {i}")
-                for i, v in enumerate(table["transparent"].to_numpy())]
+    verdicts = [
+        _bool_or_none(v, "transparent", f"{where(source)}row {i}")
+        for i, v in enumerate(table["transparent"].to_numpy())
+    ]
     table = table.assign(transparent=verdicts, subject=table["subject"].astype(str))
     rows = []
     for i, r in table[table["subject"] == "all"].iterrows():
         at = f"{where(source)}row {i} (all {r['phase']} {r['joint']})"
-        subjects = table[(table["subject"] != "all") & (table["phase"] == r["phase"])
-                         & (table["joint"] == r["joint"])]["transparent"]
+        subjects = table[(table["subject"] != "all") & (table["phase"] == r["phase"]) & (table["joint"] == r["joint"])][
+            "transparent"
+        ]
         judged = [v for v in subjects if v is not None]
-        rows.append({
-            "phase": r["phase"], "joint": r["joint"],
-            **{c: (math.nan if pd.isna(r[c]) else number(c, r[c], at)) for c in ("rmsd_rad", "isv_ave_rad")},
-            "transparent": r["transparent"],
-            **{c: (math.nan if pd.isna(r[c]) else number(c, r[c], at)) for c in ("study_rmsd_rad",
-                                                                                 "study_isv_ave_rad")},
-            "n_subjects": len(judged), "n_subjects_transparent": int(sum(judged)),
-        })
+        rows.append(
+            {
+                "phase": r["phase"],
+                "joint": r["joint"],
+                **{c: (math.nan if pd.isna(r[c]) else number(c, r[c], at)) for c in ("rmsd_rad", "isv_ave_rad")},
+                "transparent": r["transparent"],
+                **{
+                    c: (math.nan if pd.isna(r[c]) else number(c, r[c], at))
+                    for c in ("study_rmsd_rad", "study_isv_ave_rad")
+                },
+                "n_subjects": len(judged),
+                "n_subjects_transparent": int(sum(judged)),
+            }
+        )
     return pd.DataFrame(rows, columns=columns)
 
 
@@ -289,11 +355,17 @@ def device_comparison(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
     rows = []
     for metric, (study, unit) in STUDY_DEVICE.items():
         if metric not in by_metric:
-            raise LoperInputError(f"{where(source)}device summary: metric {metric!r} missing "
-                                  f"(has {sorted(by_metric)})")
+            raise LoperInputError(f"{where(source)}device summary: metric {metric!r} missing (has {sorted(by_metric)})")
         value = number(f"value of metric {metric!r}", by_metric[metric], source)
-        rows.append({"metric": metric, "value": value, "study_value": study, "unit": unit,
-                     "difference_pct": (value / study - 1.0) * 100.0})
+        rows.append(
+            {
+                "metric": metric,
+                "value": value,
+                "study_value": study,
+                "unit": unit,
+                "difference_pct": (value / study - 1.0) * 100.0,
+            }
+        )
     return pd.DataFrame(rows, columns=["metric", "value", "study_value", "unit", "difference_pct"])
 
 
@@ -327,10 +399,26 @@ def validation_verdict(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
         at = f"{where(source)}no_noise {p} rows"
         lo, hi = _numbers(g, "min_error", at), _numbers(g, "max_error", at)
         s_lo, s_hi = _numbers(g, "study_min_error", at), _numbers(g, "study_max_error", at)
-        rows.append({"parameter": p, "n_combinations": integer("n", int(_numbers(g, "n", at).min()), at),
-                     "min_error": float(lo.min()), "max_error": float(hi.max()),
-                     "study_min_error": float(s_lo.min()), "study_max_error": float(s_hi.max()),
-                     "within_study": bool(lo.min() >= s_lo.min() and hi.max() <= s_hi.max())})
-    return pd.DataFrame(rows, columns=["parameter", "n_combinations", "min_error", "max_error", "study_min_error",
-                                       "study_max_error", "within_study"])
-
+        rows.append(
+            {
+                "parameter": p,
+                "n_combinations": integer("n", int(_numbers(g, "n", at).min()), at),
+                "min_error": float(lo.min()),
+                "max_error": float(hi.max()),
+                "study_min_error": float(s_lo.min()),
+                "study_max_error": float(s_hi.max()),
+                "within_study": bool(lo.min() >= s_lo.min() and hi.max() <= s_hi.max()),
+            }
+        )
+    return pd.DataFrame(
+        rows,
+        columns=[
+            "parameter",
+            "n_combinations",
+            "min_error",
+            "max_error",
+            "study_min_error",
+            "study_max_error",
+            "within_study",
+        ],
+    )

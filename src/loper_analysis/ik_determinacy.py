@@ -100,13 +100,18 @@ def model_tree(model) -> ModelTree:
         if coupler is not None and coupler.get_isEnforced():
             fixed.add(coupler.getDependentCoordinateName())
     ms = model.getMarkerSet()
-    marker_bodies = {ms.get(i).getName(): ms.get(i).getParentFrame().findBaseFrame().getName()
-                     for i in range(ms.getSize())}
+    marker_bodies = {
+        ms.get(i).getName(): ms.get(i).getParentFrame().findBaseFrame().getName() for i in range(ms.getSize())
+    }
     return ModelTree(names, moved, marker_bodies, frozenset(roots), frozenset(fixed))
 
 
-def undetermined_coordinates(tree: ModelTree, markers_m, labels: Sequence[str],
-                             coordinate_tasks: Mapping[str, tuple[float, float | None]] | None = None) -> np.ndarray:
+def undetermined_coordinates(
+    tree: ModelTree,
+    markers_m,
+    labels: Sequence[str],
+    coordinate_tasks: Mapping[str, tuple[float, float | None]] | None = None,
+) -> np.ndarray:
     """Frames in which each coordinate is determined by no marker, task or model constraint.
 
     Parameters

@@ -72,13 +72,28 @@ _K, _D = parameter_column("K"), parameter_column("D")
 
 #: Columns of ``results/impedance/{subject}/{onset}.tsv`` and ``results/tables/impedance.tsv``.
 IMPEDANCE_COLUMNS: tuple[str, ...] = (
-    "subject", "onset_ms", "joint", _K, _D,
-    parameter_column("K", "ci95_low"), parameter_column("K", "ci95_high"),
-    parameter_column("D", "ci95_low"), parameter_column("D", "ci95_high"),
-    "vaf_pct", "n_strides",
-    parameter_column("K", "true"), parameter_column("D", "true"),
-    parameter_column("K", "error"), parameter_column("D", "error"),
-    "sum_sq_error_rad2", "n_starts", "n_starts_at_best", "noise_model", "n_null_pairs", "status", "reason",
+    "subject",
+    "onset_ms",
+    "joint",
+    _K,
+    _D,
+    parameter_column("K", "ci95_low"),
+    parameter_column("K", "ci95_high"),
+    parameter_column("D", "ci95_low"),
+    parameter_column("D", "ci95_high"),
+    "vaf_pct",
+    "n_strides",
+    parameter_column("K", "true"),
+    parameter_column("D", "true"),
+    parameter_column("K", "error"),
+    parameter_column("D", "error"),
+    "sum_sq_error_rad2",
+    "n_starts",
+    "n_starts_at_best",
+    "noise_model",
+    "n_null_pairs",
+    "status",
+    "reason",
 )
 #: How the fit weights its prediction errors: the study's least squares, or with the null pairs' deviation.
 NOISE_MODELS: tuple[str, ...] = ("null_pairs", "white")
@@ -125,8 +140,10 @@ class IdentificationSettings:
                 f"identification.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}"
             )
         if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
-            raise LoperInputError("identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
-                                  f"got {self.interval_scatter!r}")
+            raise LoperInputError(
+                "identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
+                f"got {self.interval_scatter!r}"
+            )
 
     @property
     def lower(self) -> np.ndarray:
@@ -138,8 +155,14 @@ class IdentificationSettings:
 
     def fit_options(self) -> dict:
         """Keyword arguments of :func:`loper_analysis.identification.identify_impedance`."""
-        return dict(n_starts=self.n_starts, seed=self.seed, lower=self.lower, upper=self.upper,
-                    tolerance=self.tolerance, merge_tolerance=self.merge_tolerance)
+        return dict(
+            n_starts=self.n_starts,
+            seed=self.seed,
+            lower=self.lower,
+            upper=self.upper,
+            tolerance=self.tolerance,
+            merge_tolerance=self.merge_tolerance,
+        )
 
 
 @dataclass
@@ -164,7 +187,11 @@ class OnsetFit:
 
 #: Columns of :func:`force_table`.
 FORCE_COLUMNS: tuple[str, ...] = (
-    "time_s", "force_perturbed_x_n", "force_perturbed_y_n", "force_unperturbed_x_n", "force_unperturbed_y_n",
+    "time_s",
+    "force_perturbed_x_n",
+    "force_perturbed_y_n",
+    "force_unperturbed_x_n",
+    "force_unperturbed_y_n",
 )
 
 
@@ -176,13 +203,21 @@ def force_table(series: Mapping) -> pd.DataFrame:
     """
     t = series.get("force_time_s", series["time_s"])
     fp, fu = series["force_perturbed_n"], series["force_unperturbed_n"]
-    return pd.DataFrame({"time_s": t, "force_perturbed_x_n": fp[:, 0], "force_perturbed_y_n": fp[:, 1],
-                         "force_unperturbed_x_n": fu[:, 0], "force_unperturbed_y_n": fu[:, 1]},
-                        columns=list(FORCE_COLUMNS))
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "force_perturbed_x_n": fp[:, 0],
+            "force_perturbed_y_n": fp[:, 1],
+            "force_unperturbed_x_n": fu[:, 0],
+            "force_unperturbed_y_n": fu[:, 1],
+        },
+        columns=list(FORCE_COLUMNS),
+    )
 
 
-def brace_force_direction(markers_m: np.ndarray, labels: Sequence[str], brace=("LBRA_P", "LBRA_D"),
-                          source: str = "") -> np.ndarray:
+def brace_force_direction(
+    markers_m: np.ndarray, labels: Sequence[str], brace=("LBRA_P", "LBRA_D"), source: str = ""
+) -> np.ndarray:
     """Unit vectors (n, 2), world x/y of the model frame, along which the rods push.
 
     The two brace markers lie on the thigh, proximal and distal; the rods push
@@ -218,17 +253,32 @@ def _plausible_range(plausible_ranges: Mapping | None, joint: str):
         return DEFAULT_PLAUSIBLE_RANGES[joint]
     entry = plausible_ranges.get(joint)
     if not isinstance(entry, Mapping) or not {"stiffness_nm_per_rad", "damping_nms_per_rad"} <= set(entry):
-        raise LoperInputError(f"identification.plausible_ranges: the {joint} needs stiffness_nm_per_rad and "
-                              f"damping_nms_per_rad ([low, high] each), got {entry!r}")
+        raise LoperInputError(
+            f"identification.plausible_ranges: the {joint} needs stiffness_nm_per_rad and "
+            f"damping_nms_per_rad ([low, high] each), got {entry!r}"
+        )
     return (tuple(entry["stiffness_nm_per_rad"]), tuple(entry["damping_nms_per_rad"]))
 
 
-def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: int, truth: Mapping | None = None,
-                   lower=(0.0, 0.0), upper=(200.0, 10.0), max_ci_fraction: float = 1.0,
-                   noise_model: str = "white", n_null_pairs: int = 0, note: str = "", *,
-                   min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION,
-                   plausible_ranges: Mapping | None = None) -> pd.DataFrame:
-    """One row per joint from an :class:`~loper_analysis.identification.ImpedanceFit` (columns :data:`IMPEDANCE_COLUMNS`).
+def impedance_rows(
+    fit: ImpedanceFit,
+    subject: str,
+    onset_ms: int,
+    n_strides: int,
+    truth: Mapping | None = None,
+    lower=(0.0, 0.0),
+    upper=(200.0, 10.0),
+    max_ci_fraction: float = 1.0,
+    noise_model: str = "white",
+    n_null_pairs: int = 0,
+    note: str = "",
+    *,
+    min_vaf_pct: float = MIN_VAF_PCT,
+    at_bound_fraction: float = AT_BOUND_FRACTION,
+    plausible_ranges: Mapping | None = None,
+) -> pd.DataFrame:
+    """One row per joint from an :class:`~loper_analysis.identification.ImpedanceFit` (columns
+    :data:`IMPEDANCE_COLUMNS`).
 
     ``truth``: ``{joint: {"K": .., "D": ..}}`` of a synthetic subject (errors
     = estimate - truth), None for a recorded one. ``lower``, ``upper``: the
@@ -245,23 +295,42 @@ def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: in
     for j, joint in enumerate(JOINTS):
         k, d = 2 * j, 2 * j + 1
         row = {
-            "subject": subject, "onset_ms": int(onset_ms), "joint": joint,
-            _K: fit.estimate[k], _D: fit.estimate[d],
-            parameter_column("K", "ci95_low"): fit.ci95_low[k], parameter_column("K", "ci95_high"): fit.ci95_high[k],
-            parameter_column("D", "ci95_low"): fit.ci95_low[d], parameter_column("D", "ci95_high"): fit.ci95_high[d],
-            "vaf_pct": fit.vaf_pct[j], "n_strides": int(n_strides), "sum_sq_error_rad2": fit.sum_sq_error_rad2,
-            "n_starts": fit.n_starts, "n_starts_at_best": fit.n_starts_at_best,
-            "noise_model": noise_model, "n_null_pairs": int(n_null_pairs),
+            "subject": subject,
+            "onset_ms": int(onset_ms),
+            "joint": joint,
+            _K: fit.estimate[k],
+            _D: fit.estimate[d],
+            parameter_column("K", "ci95_low"): fit.ci95_low[k],
+            parameter_column("K", "ci95_high"): fit.ci95_high[k],
+            parameter_column("D", "ci95_low"): fit.ci95_low[d],
+            parameter_column("D", "ci95_high"): fit.ci95_high[d],
+            "vaf_pct": fit.vaf_pct[j],
+            "n_strides": int(n_strides),
+            "sum_sq_error_rad2": fit.sum_sq_error_rad2,
+            "n_starts": fit.n_starts,
+            "n_starts_at_best": fit.n_starts_at_best,
+            "noise_model": noise_model,
+            "n_null_pairs": int(n_null_pairs),
         }
         _truth_columns(row, truth, joint)
         if truth is not None:
             row[parameter_column("K", "error")] = row[_K] - truth[joint]["K"]
             row[parameter_column("D", "error")] = row[_D] - truth[joint]["D"]
-        status, reason = joint_status(joint, fit.estimate[[k, d]], fit.ci95_low[[k, d]], fit.ci95_high[[k, d]],
-                                      fit.vaf_pct[j], lower, upper, success=fit.success, message=fit.message,
-                                      plausible_range=_plausible_range(plausible_ranges, joint),
-                                      max_ci_fraction=max_ci_fraction, min_vaf_pct=min_vaf_pct,
-                                      at_bound_fraction=at_bound_fraction)
+        status, reason = joint_status(
+            joint,
+            fit.estimate[[k, d]],
+            fit.ci95_low[[k, d]],
+            fit.ci95_high[[k, d]],
+            fit.vaf_pct[j],
+            lower,
+            upper,
+            success=fit.success,
+            message=fit.message,
+            plausible_range=_plausible_range(plausible_ranges, joint),
+            max_ci_fraction=max_ci_fraction,
+            min_vaf_pct=min_vaf_pct,
+            at_bound_fraction=at_bound_fraction,
+        )
         row.update(status=status, reason=reason)
         if note:
             row["reason"] = "; ".join(r for r in (row["reason"], note) if r)
@@ -269,27 +338,37 @@ def impedance_rows(fit: ImpedanceFit, subject: str, onset_ms: int, n_strides: in
     return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
 
 
-def status_rows(subject: str, onset_ms: int, status: str, reason: str, n_strides: int = 0,
-                truth: Mapping | None = None) -> pd.DataFrame:
+def status_rows(
+    subject: str, onset_ms: int, status: str, reason: str, n_strides: int = 0, truth: Mapping | None = None
+) -> pd.DataFrame:
     """Rows without a fit (``missing`` or ``failed``), one per joint, estimates empty."""
     rows = []
     for joint in JOINTS:
-        row = {"subject": subject, "onset_ms": int(onset_ms), "joint": joint, "n_strides": int(n_strides),
-               "status": status, "reason": reason}
+        row = {
+            "subject": subject,
+            "onset_ms": int(onset_ms),
+            "joint": joint,
+            "n_strides": int(n_strides),
+            "status": status,
+            "reason": reason,
+        }
         _truth_columns(row, truth, joint)
         rows.append(row)
     return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
 
 
-def too_short_reason(n_short: int, n_perturbed: int, onset_ms: float, window_after_s: float,
-                     longest_after_onset_s: float) -> str:
+def too_short_reason(
+    n_short: int, n_perturbed: int, onset_ms: float, window_after_s: float, longest_after_onset_s: float
+) -> str:
     """Why perturbed strides were dropped as too short, naming ``identification.window_after_s`` and its value.
 
     ``longest_after_onset_s``: the most swing time (s) any perturbed stride leaves after its onset,
     the longest window that keeps a stride.
     """
-    text = (f"{n_short} of {n_perturbed} perturbed stride(s) too short for the fit window: their swing ends "
-            f"before onset {onset_ms:g} ms + identification.window_after_s = {window_after_s:g} s")
+    text = (
+        f"{n_short} of {n_perturbed} perturbed stride(s) too short for the fit window: their swing ends "
+        f"before onset {onset_ms:g} ms + identification.window_after_s = {window_after_s:g} s"
+    )
     if np.isfinite(longest_after_onset_s):
         text += f" (the longest swing leaves {max(longest_after_onset_s, 0.0):.3g} s after the onset)"
     return text
@@ -299,10 +378,16 @@ def _no_curves() -> pd.DataFrame:
     return pd.DataFrame(columns=["time_s"])
 
 
-def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset_ms: int, subject: str,
-              truth: Mapping | None = None, null_trials: Sequence[Mapping] = (),
-              response: ResponseSettings = ResponseSettings(),
-              identification: IdentificationSettings = IdentificationSettings()) -> OnsetFit:
+def fit_onset(
+    trials: Sequence[Mapping],
+    params: SegmentParameters | None,
+    onset_ms: int,
+    subject: str,
+    truth: Mapping | None = None,
+    null_trials: Sequence[Mapping] = (),
+    response: ResponseSettings = ResponseSettings(),
+    identification: IdentificationSettings = IdentificationSettings(),
+) -> OnsetFit:
     """Responses and the impedance fit of one subject at one onset.
 
     Parameters
@@ -349,11 +434,16 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
         angles = tr["angles"]
         if len(t) != len(angles) or not np.allclose(t, angles["time_s"].to_numpy(), atol=1e-6):
             raise LoperInputError(f"{tr['name']}: marker frames differ from the joint angles' frames")
-        inputs.append({
-            "name": tr["name"], "angles": angles, "strides": tr["strides"], "force": tr["force"],
-            "force_direction": brace_force_direction(X, labels, source=str(tr["name"])),
-            "force_native": tr.get("force_native"),
-        })
+        inputs.append(
+            {
+                "name": tr["name"],
+                "angles": angles,
+                "strides": tr["strides"],
+                "force": tr["force"],
+                "force_direction": brace_force_direction(X, labels, source=str(tr["name"])),
+                "force_native": tr.get("force_native"),
+            }
+        )
     r = response
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TooFewStridesWarning)  # the counts table carries the verdict
@@ -363,19 +453,32 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
     if n_kept < r.min_strides:
         reason = f"{n_kept} valid perturbed stride(s), fewer than {r.min_strides}: not fitted"
         if int(total["n_too_short"]):
-            reason += "; " + too_short_reason(int(total["n_too_short"]), int(total["n_perturbed"]), onset_ms,
-                                              r.window_after_s, counts.attrs["longest_swing_after_onset_s"])
+            reason += "; " + too_short_reason(
+                int(total["n_too_short"]),
+                int(total["n_perturbed"]),
+                onset_ms,
+                r.window_after_s,
+                counts.attrs["longest_swing_after_onset_s"],
+            )
         rows = status_rows(subject, onset_ms, "failed", reason, n_kept, truth)
         return OnsetFit(mean, counts, rows, _no_curves())
     ident = identification
     window = prepare_window(
-        series["time_s"], series["q_unperturbed"], series["q_perturbed"], params, 0.0,
-        force_unperturbed_n=series["force_unperturbed_n"], force_perturbed_n=series["force_perturbed_n"],
+        series["time_s"],
+        series["q_unperturbed"],
+        series["q_perturbed"],
+        params,
+        0.0,
+        force_unperturbed_n=series["force_unperturbed_n"],
+        force_perturbed_n=series["force_perturbed_n"],
         force_time_s=series.get("force_time_s"),
         pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
         pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
-        window_before_s=r.window_before_s, window_after_s=r.window_after_s, n_substeps=ident.n_substeps,
-        initial_state_span_s=r.initial_state_span_s, initial_state_degree=ident.initial_state_degree,
+        window_before_s=r.window_before_s,
+        window_after_s=r.window_after_s,
+        n_substeps=ident.n_substeps,
+        initial_state_span_s=r.initial_state_span_s,
+        initial_state_degree=ident.initial_state_degree,
     )
     fit = identify_impedance(window, **ident.fit_options())
     used, n_null, note = "white", 0, ""
@@ -384,23 +487,49 @@ def fit_onset(trials: Sequence[Mapping], params: SegmentParameters | None, onset
         pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
         null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
         pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
-        refit = refit_with_null_pairs(window, fit, null, n_kept, ident.null_pair_components, ident.min_null_pairs,
-                                      perturbed_pairs=pairs, **ident.fit_options())
+        refit = refit_with_null_pairs(
+            window,
+            fit,
+            null,
+            n_kept,
+            ident.null_pair_components,
+            ident.min_null_pairs,
+            perturbed_pairs=pairs,
+            **ident.fit_options(),
+        )
         fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
         note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
-    rows = impedance_rows(fit, subject, onset_ms, n_kept, truth,
-                          (ident.stiffness_bounds_nm_per_rad[0], ident.damping_bounds_nms_per_rad[0]),
-                          (ident.stiffness_bounds_nm_per_rad[1], ident.damping_bounds_nms_per_rad[1]),
-                          ident.max_ci_fraction, used, n_null, note, min_vaf_pct=ident.min_vaf_pct,
-                          plausible_ranges=ident.plausible_ranges)
-    curves = pd.DataFrame({"time_s": fit.time_s,
-                           **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
-                           **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)}})
+    rows = impedance_rows(
+        fit,
+        subject,
+        onset_ms,
+        n_kept,
+        truth,
+        (ident.stiffness_bounds_nm_per_rad[0], ident.damping_bounds_nms_per_rad[0]),
+        (ident.stiffness_bounds_nm_per_rad[1], ident.damping_bounds_nms_per_rad[1]),
+        ident.max_ci_fraction,
+        used,
+        n_null,
+        note,
+        min_vaf_pct=ident.min_vaf_pct,
+        plausible_ranges=ident.plausible_ranges,
+    )
+    curves = pd.DataFrame(
+        {
+            "time_s": fit.time_s,
+            **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
+            **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)},
+        }
+    )
     return OnsetFit(mean, counts, rows, curves, force_table(series))
 
 
-def impedance_summary(table: pd.DataFrame, k_tolerance=TRUTH_TOLERANCE["K"], d_tolerance=TRUTH_TOLERANCE["D"],
-                      upper_bounds: tuple[float, float] | None = None) -> pd.DataFrame:
+def impedance_summary(
+    table: pd.DataFrame,
+    k_tolerance=TRUTH_TOLERANCE["K"],
+    d_tolerance=TRUTH_TOLERANCE["D"],
+    upper_bounds: tuple[float, float] | None = None,
+) -> pd.DataFrame:
     """Across-subject summary per joint and onset of the fitted rows (``ok`` and ``not_identifiable``).
 
     ``upper_bounds`` (K in N·m/rad, D in N·m·s/rad; the identification's
@@ -430,27 +559,45 @@ def impedance_summary(table: pd.DataFrame, k_tolerance=TRUTH_TOLERANCE["K"], d_t
         fitted = fitted[~on_bound]
     rows = []
     for (joint, onset), g in fitted.groupby(["joint", "onset_ms"], sort=False):
-        row = {"joint": joint, "onset_ms": int(onset), "n_subjects": g["subject"].nunique(),
-               "n_not_identifiable": int((g["status"] == "not_identifiable").sum())}
+        row = {
+            "joint": joint,
+            "onset_ms": int(onset),
+            "n_subjects": g["subject"].nunique(),
+            "n_not_identifiable": int((g["status"] == "not_identifiable").sum()),
+        }
         for p in ("K", "D"):
             v = g[parameter_column(p)]
-            row.update({parameter_column(p, "mean"): v.mean(), parameter_column(p, "sd"): v.std(ddof=1),
-                        parameter_column(p, "min"): v.min(), parameter_column(p, "max"): v.max()})
+            row.update(
+                {
+                    parameter_column(p, "mean"): v.mean(),
+                    parameter_column(p, "sd"): v.std(ddof=1),
+                    parameter_column(p, "min"): v.min(),
+                    parameter_column(p, "max"): v.max(),
+                }
+            )
         row["vaf_pct_mean"] = g["vaf_pct"].mean()
         known = g[g[parameter_column("K", "true")].notna()]
         if len(known):
             for p, (rel, ab) in (("K", k_tolerance), ("D", d_tolerance)):
                 err = known[parameter_column(p, "error")]
                 tol = np.maximum(rel * known[parameter_column(p, "true")].abs(), ab)
-                row.update({parameter_column(p, "error_mean"): err.mean(),
-                            parameter_column(p, "max_abs_error"): err.abs().max(),
-                            f"{p}_fraction_within_tolerance": float((err.abs() <= tol).mean())})
+                row.update(
+                    {
+                        parameter_column(p, "error_mean"): err.mean(),
+                        parameter_column(p, "max_abs_error"): err.abs().max(),
+                        f"{p}_fraction_within_tolerance": float((err.abs() <= tol).mean()),
+                    }
+                )
         rows.append(row)
     order = {j: i for i, j in enumerate(JOINTS)}
     out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects", "n_not_identifiable"])
     if len(out):
-        out = out.sort_values(["joint", "onset_ms"], key=lambda c: c.map(order) if c.name == "joint" else c,
-                              kind="stable", ignore_index=True)
+        out = out.sort_values(
+            ["joint", "onset_ms"],
+            key=lambda c: c.map(order) if c.name == "joint" else c,
+            kind="stable",
+            ignore_index=True,
+        )
     return out
 
 
@@ -459,14 +606,22 @@ def literature_table(summary: pd.DataFrame) -> pd.DataFrame:
     the across-subject mean (N·m/rad, N·m·s/rad)."""
     k_low, k_high = parameter_column("K", "low"), parameter_column("K", "high")
     d_low, d_high = parameter_column("D", "low"), parameter_column("D", "high")
-    rows = [{"source": s, "joint": j, k_low: k[0], k_high: k[1], d_low: d[0], d_high: d[1]}
-            for s, j, k, d in LITERATURE]
+    rows = [
+        {"source": s, "joint": j, k_low: k[0], k_high: k[1], d_low: d[0], d_high: d[1]} for s, j, k, d in LITERATURE
+    ]
     for joint in ("hip", "knee"):
         if "joint" not in summary.columns:  # nothing fitted
             break
         g = summary[summary["joint"] == joint]
         if len(g):
-            rows.append({"source": "this pipeline: swing phase, across-subject mean over onsets", "joint": joint,
-                         k_low: g[parameter_column("K", "mean")].min(), k_high: g[parameter_column("K", "mean")].max(),
-                         d_low: g[parameter_column("D", "mean")].min(), d_high: g[parameter_column("D", "mean")].max()})
+            rows.append(
+                {
+                    "source": "this pipeline: swing phase, across-subject mean over onsets",
+                    "joint": joint,
+                    k_low: g[parameter_column("K", "mean")].min(),
+                    k_high: g[parameter_column("K", "mean")].max(),
+                    d_low: g[parameter_column("D", "mean")].min(),
+                    d_high: g[parameter_column("D", "mean")].max(),
+                }
+            )
     return pd.DataFrame(rows)

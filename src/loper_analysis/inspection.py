@@ -248,14 +248,31 @@ def marker_presence(labels: Sequence[str], markers_m, point_rate_hz: float, firs
             gap = 0
         else:
             first, last = int(idx[0]) + first_frame, int(idx[-1]) + first_frame
-            inner = ~present[idx[0]:idx[-1] + 1, j]
+            inner = ~present[idx[0] : idx[-1] + 1, j]
             gap = max((b - a for a, b in _runs(inner)), default=0)
-        rows.append({"label": str(label), "n_present": int(idx.size),
-                     "present_pct": 100.0 * idx.size / n_frames if n_frames else 0.0,
-                     "first_present_frame": first, "last_present_frame": last,
-                     "longest_gap_frames": int(gap), "longest_gap_s": gap / float(point_rate_hz)})
-    table = pd.DataFrame(rows, columns=["label", "n_present", "present_pct", "first_present_frame",
-                                        "last_present_frame", "longest_gap_frames", "longest_gap_s"])
+        rows.append(
+            {
+                "label": str(label),
+                "n_present": int(idx.size),
+                "present_pct": 100.0 * idx.size / n_frames if n_frames else 0.0,
+                "first_present_frame": first,
+                "last_present_frame": last,
+                "longest_gap_frames": int(gap),
+                "longest_gap_s": gap / float(point_rate_hz),
+            }
+        )
+    table = pd.DataFrame(
+        rows,
+        columns=[
+            "label",
+            "n_present",
+            "present_pct",
+            "first_present_frame",
+            "last_present_frame",
+            "longest_gap_frames",
+            "longest_gap_s",
+        ],
+    )
     for col in ("first_present_frame", "last_present_frame"):
         table[col] = table[col].astype("Int64")
     return table
@@ -304,8 +321,10 @@ def plate_summary(plate: ForcePlatform, up_axis: int = 2, up_sign: int = 1, thre
     F = np.asarray(plate.force_n, dtype=float)
     M = np.asarray(plate.moment_nm, dtype=float)
     if corners.shape != (4, 3) or F.ndim != 2 or F.shape[1] != 3 or M.shape != F.shape or F.shape[0] == 0:
-        raise LoperInputError(f"{plate.source or 'force platform'}: plate {plate.number}: corners (4, 3) and forces "
-                              f"(n, 3) expected, got {corners.shape} and {F.shape}")
+        raise LoperInputError(
+            f"{plate.source or 'force platform'}: plate {plate.number}: corners (4, 3) and forces "
+            f"(n, 3) expected, got {corners.shape} and {F.shape}"
+        )
     normal = corner_normal(corners)
     up_component = float(normal[up_axis] * up_sign) if np.all(np.isfinite(normal)) else 0.0
     order = "" if abs(up_component) < np.sqrt(0.5) else ("counter-clockwise" if up_component > 0 else "clockwise")
@@ -325,20 +344,34 @@ def plate_summary(plate: ForcePlatform, up_axis: int = 2, up_sign: int = 1, thre
     loaded = 100.0 * float(np.mean(above > threshold_n)) if rest is not None else 100.0
     time_s = np.asarray(plate.time_s, dtype=float)
     return PlateSummary(
-        number=int(plate.number), type=int(plate.type), channels=tuple(int(c) for c in plate.channels),
-        corners_m=corners, centre_m=corners.mean(axis=0),
+        number=int(plate.number),
+        type=int(plate.type),
+        channels=tuple(int(c) for c in plate.channels),
+        corners_m=corners,
+        centre_m=corners.mean(axis=0),
         side_lengths_m=(float(np.linalg.norm(corners[0] - corners[1])), float(np.linalg.norm(corners[0] - corners[3]))),
-        normal=normal, corner_order=order, rest_vertical_n=rest, peak_vertical_n=float(above[k]),
-        peak_time_s=float(time_s[k]) if time_s.size == F.shape[0] else float("nan"), loaded_pct=loaded,
+        normal=normal,
+        corner_order=order,
+        rest_vertical_n=rest,
+        peak_vertical_n=float(above[k]),
+        peak_time_s=float(time_s[k]) if time_s.size == F.shape[0] else float("nan"),
+        loaded_pct=loaded,
     )
 
 
-_CHANNEL_NAMES = {6: ("Fx", "Fy", "Fz", "Mx", "My", "Mz"),
-                  8: ("Fx12", "Fx34", "Fy14", "Fy23", "Fz1", "Fz2", "Fz3", "Fz4")}
+_CHANNEL_NAMES = {
+    6: ("Fx", "Fy", "Fz", "Mx", "My", "Mz"),
+    8: ("Fx12", "Fx34", "Fy14", "Fy23", "Fz1", "Fz2", "Fz3", "Fz4"),
+}
 
 
-def recording_summary(rec: C3DRecording, plates: Sequence[ForcePlatform] = (), point_unit: str = "",
-                      plate_problem: str = "", min_travel_m: float = 0.5) -> RecordingSummary:
+def recording_summary(
+    rec: C3DRecording,
+    plates: Sequence[ForcePlatform] = (),
+    point_unit: str = "",
+    plate_problem: str = "",
+    min_travel_m: float = 0.5,
+) -> RecordingSummary:
     """Everything the inspection prints about one recording.
 
     Parameters
@@ -369,15 +402,26 @@ def recording_summary(rec: C3DRecording, plates: Sequence[ForcePlatform] = (), p
         for i, c in enumerate(p.channels):
             owner[c - 1] = f"plate {p.number} {names[i] if i < len(names) else i + 1}"
     return RecordingSummary(
-        source=rec.source, point_unit=point_unit, point_rate_hz=float(rec.point_rate_hz),
-        analog_rate_hz=float(rec.analog_rate_hz), first_frame=int(rec.first_frame), n_frames=int(X.shape[0]),
+        source=rec.source,
+        point_unit=point_unit,
+        point_rate_hz=float(rec.point_rate_hz),
+        analog_rate_hz=float(rec.analog_rate_hz),
+        first_frame=int(rec.first_frame),
+        n_frames=int(X.shape[0]),
         markers=marker_presence(rec.marker_labels, X, rec.point_rate_hz, rec.first_frame),
         sparse_frames=sparse_frames(X, rec.first_frame),
         n_empty_frames=int(sparse_frames(X, rec.first_frame, min_markers=1).size),
-        plates=[plate_summary(p, vertical.axis, vertical.sign) for p in plates], plate_problem=plate_problem,
-        n_plates_declared=int(rec.n_force_platforms), analog_labels=list(rec.analog_labels),
-        analog_units=list(rec.analog_units), events=rec.events.copy(), vertical=vertical, walking=walking,
-        rotation_deg=up_only, rotation_forward_deg=forward, channel_owner=owner,
+        plates=[plate_summary(p, vertical.axis, vertical.sign) for p in plates],
+        plate_problem=plate_problem,
+        n_plates_declared=int(rec.n_force_platforms),
+        analog_labels=list(rec.analog_labels),
+        analog_units=list(rec.analog_units),
+        events=rec.events.copy(),
+        vertical=vertical,
+        walking=walking,
+        rotation_deg=up_only,
+        rotation_forward_deg=forward,
+        channel_owner=owner,
     )
 
 
@@ -395,9 +439,14 @@ def _yaml_scalar(value) -> str:
     return json.dumps(value)
 
 
-def config_snippet(rotation_deg: Sequence[float], label_map: str | Mapping[str, str] | None = None,
-                   foot_markers: Mapping[str, str] | None = None, generic_model: str | None = None,
-                   notes: Mapping[str, str] | None = None, header: Sequence[str] = ()) -> str:
+def config_snippet(
+    rotation_deg: Sequence[float],
+    label_map: str | Mapping[str, str] | None = None,
+    foot_markers: Mapping[str, str] | None = None,
+    generic_model: str | None = None,
+    notes: Mapping[str, str] | None = None,
+    header: Sequence[str] = (),
+) -> str:
     """YAML text setting the keys an inspection can suggest, each with a comment.
 
     Parameters
@@ -437,8 +486,14 @@ def config_snippet(rotation_deg: Sequence[float], label_map: str | Mapping[str, 
     elif label_map is not None:
         out.append(line("label_map", str(label_map), notes.get("label_map", "")))
     if foot_markers:
-        out += ["events:", line("foot_markers", {"left": foot_markers["left"], "right": foot_markers["right"]},
-                                notes.get("foot_markers", ""))]
+        out += [
+            "events:",
+            line(
+                "foot_markers",
+                {"left": foot_markers["left"], "right": foot_markers["right"]},
+                notes.get("foot_markers", ""),
+            ),
+        ]
     if generic_model is not None:
         out += ["opensim:", line("generic_model", str(generic_model), notes.get("generic_model", ""))]
     return "\n".join(out) + "\n"
@@ -448,8 +503,11 @@ def config_snippet(rotation_deg: Sequence[float], label_map: str | Mapping[str, 
 
 
 def _xyz(v, digits: int = 3) -> str:
-    return "(" + ", ".join(f"{float(x) + 0.0:.{digits}f}".replace("-0." + "0" * digits, "0." + "0" * digits)
-                           for x in v) + ")"
+    return (
+        "("
+        + ", ".join(f"{float(x) + 0.0:.{digits}f}".replace("-0." + "0" * digits, "0." + "0" * digits) for x in v)
+        + ")"
+    )
 
 
 def _ranges(frames: np.ndarray, limit: int = 6) -> str:
@@ -493,8 +551,10 @@ def format_summary(s: RecordingSummary) -> str:
     m = s.markers
     width = max([len(lab) for lab in m["label"]] + [5])
     if len(m):
-        lines.append(f"Markers: {len(m)} label(s); present = % of the {s.n_frames} frames; first and last present "
-                     "frame; longest gap = missing frames between them")
+        lines.append(
+            f"Markers: {len(m)} label(s); present = % of the {s.n_frames} frames; first and last present "
+            "frame; longest gap = missing frames between them"
+        )
         lines.append(f"  {'label':<{width}}  present %  first  last   longest gap")
     else:
         lines.append("Markers: none")
@@ -502,19 +562,28 @@ def format_summary(s: RecordingSummary) -> str:
         if row.n_present == 0:
             lines.append(f"  {row.label:<{width}}  {0.0:9.1f}  never present")
             continue
-        gap = "none" if row.longest_gap_frames == 0 else \
-            f"{row.longest_gap_frames} frames ({row.longest_gap_s:.3f} s)"
-        lines.append(f"  {row.label:<{width}}  {row.present_pct:9.1f}  {int(row.first_present_frame):5d}  "
-                     f"{int(row.last_present_frame):5d}  {gap}")
+        gap = "none" if row.longest_gap_frames == 0 else f"{row.longest_gap_frames} frames ({row.longest_gap_s:.3f} s)"
+        lines.append(
+            f"  {row.label:<{width}}  {row.present_pct:9.1f}  {int(row.first_present_frame):5d}  "
+            f"{int(row.last_present_frame):5d}  {gap}"
+        )
     n_sparse = s.sparse_frames.size
-    lines.append(f"  frames with fewer than {MIN_MARKERS_PER_FRAME} markers: {n_sparse} of {s.n_frames}"
-                 + (f" (frames {_ranges(s.sparse_frames)}; {s.n_empty_frames} of them without any marker; "
-                    "inverse kinematics cannot use them)" if n_sparse else ""))
+    lines.append(
+        f"  frames with fewer than {MIN_MARKERS_PER_FRAME} markers: {n_sparse} of {s.n_frames}"
+        + (
+            f" (frames {_ranges(s.sparse_frames)}; {s.n_empty_frames} of them without any marker; "
+            "inverse kinematics cannot use them)"
+            if n_sparse
+            else ""
+        )
+    )
     lines.append("")
 
     if s.plates:
-        lines.append(f"Force platforms: {len(s.plates)} (forces on the body, lab frame; vertical = "
-                     f"{axis_name(s.vertical.axis, s.vertical.sign)})")
+        lines.append(
+            f"Force platforms: {len(s.plates)} (forces on the body, lab frame; vertical = "
+            f"{axis_name(s.vertical.axis, s.vertical.sign)})"
+        )
     elif s.n_plates_declared:
         lines.append(f"Force platforms: {s.n_plates_declared} declared, not readable: {s.plate_problem}")
     else:
@@ -523,17 +592,24 @@ def format_summary(s: RecordingSummary) -> str:
         lines.append(f"  plate {p.number}: TYPE {p.type}, analog channels {', '.join(map(str, p.channels))}")
         lines.append("    corners (lab, m): " + " ".join(_xyz(c) for c in p.corners_m))
         lines.append(f"    size {p.side_lengths_m[0]:.3f} x {p.side_lengths_m[1]:.3f} m, centre {_xyz(p.centre_m)} m")
-        order = f"corners listed {p.corner_order} seen from above" if p.corner_order else \
-            "the plate does not face up or down"
+        order = (
+            f"corners listed {p.corner_order} seen from above"
+            if p.corner_order
+            else "the plate does not face up or down"
+        )
         lines.append(f"    normal from the corners (right-hand rule of their order): {_xyz(p.normal)}: {order}")
         if p.rest_vertical_n is None:
             lines.append("    resting vertical level: none (the plate is loaded throughout)")
             lines.append(f"    peak vertical force {p.peak_vertical_n:.1f} N at {p.peak_time_s:.3f} s (as read)")
         else:
-            lines.append(f"    resting (unloaded) vertical level {p.rest_vertical_n:.1f} N; loaded (> 20 N above it) "
-                         f"{p.loaded_pct:.1f} % of the time")
-            lines.append(f"    peak vertical force {p.peak_vertical_n:.1f} N above rest at {p.peak_time_s:.3f} s "
-                         f"({p.peak_vertical_n + p.rest_vertical_n:.1f} N as read)")
+            lines.append(
+                f"    resting (unloaded) vertical level {p.rest_vertical_n:.1f} N; loaded (> 20 N above it) "
+                f"{p.loaded_pct:.1f} % of the time"
+            )
+            lines.append(
+                f"    peak vertical force {p.peak_vertical_n:.1f} N above rest at {p.peak_time_s:.3f} s "
+                f"({p.peak_vertical_n + p.rest_vertical_n:.1f} N as read)"
+            )
     lines.append("")
 
     lines.append(f"Analog channels: {len(s.analog_labels)}, all at {s.analog_rate_hz:g} Hz")
@@ -554,12 +630,16 @@ def format_summary(s: RecordingSummary) -> str:
 
     v, w = s.vertical, s.walking
     lines.append("Lab frame")
-    text = f"  vertical axis: {axis_name(v.axis, v.sign)} " + \
-        ("(assumed: neither plates nor markers tell)" if v.basis == "assumed" else f"(from the {v.basis})")
+    text = f"  vertical axis: {axis_name(v.axis, v.sign)} " + (
+        "(assumed: neither plates nor markers tell)" if v.basis == "assumed" else f"(from the {v.basis})"
+    )
     if v.marker_axis is not None:
         spread = ", ".join(f"{AXIS_NAMES[a]} {v.marker_spread_m[a]:.2f}" for a in range(3))
-        agree = "agree" if (v.marker_axis, v.marker_sign) == (v.axis, v.sign) else \
-            f"say {axis_name(v.marker_axis, v.marker_sign)}: check"
+        agree = (
+            "agree"
+            if (v.marker_axis, v.marker_sign) == (v.axis, v.sign)
+            else f"say {axis_name(v.marker_axis, v.marker_sign)}: check"
+        )
         text += f"; the markers {agree} (median spread of a frame's markers, m: {spread})"
     lines.append(text)
     if w.axis is None and not np.all(np.isfinite(w.travel_m)):
@@ -568,19 +648,27 @@ def format_summary(s: RecordingSummary) -> str:
         travel = ", ".join(f"{AXIS_NAMES[a]} {w.travel_m[a]:+.2f}" for a in range(3))
         lines.append(f"  walking direction: treadmill/standing (the markers do not travel; median travel, m: {travel})")
     else:
-        lines.append(f"  walking direction: {axis_name(w.axis, w.sign)} (the markers travel "
-                     f"{w.travel_m[w.axis]:+.2f} m along {AXIS_NAMES[w.axis]} at {w.speed_m_per_s:.2f} m/s)")
-    lines.append(f"  suggested markers.lab_to_model_rotation_deg: {_rotation_text(s.rotation_deg)} (degrees about the "
-                 "fixed X, Y, Z: up -> model +Y)")
+        lines.append(
+            f"  walking direction: {axis_name(w.axis, w.sign)} (the markers travel "
+            f"{w.travel_m[w.axis]:+.2f} m along {AXIS_NAMES[w.axis]} at {w.speed_m_per_s:.2f} m/s)"
+        )
+    lines.append(
+        f"  suggested markers.lab_to_model_rotation_deg: {_rotation_text(s.rotation_deg)} (degrees about the "
+        "fixed X, Y, Z: up -> model +Y)"
+    )
     if w.axis is None:
-        lines.append("  (the facing direction is not known: check that the subject faces model +X, OpenSim's forward, "
-                     "after the rotation)")
+        lines.append(
+            "  (the facing direction is not known: check that the subject faces model +X, OpenSim's forward, "
+            "after the rotation)"
+        )
     elif tuple(s.rotation_forward_deg) == tuple(s.rotation_deg):
         lines.append("  (this trial then walks toward model +X, OpenSim's forward)")
     else:
-        lines.append(f"  (this trial then walks toward model {_model_axis(s.rotation_deg, w.axis, w.sign)}; "
-                     f"{_rotation_text(s.rotation_forward_deg)} also turns its walking direction to model +X, "
-                     "OpenSim's forward)")
+        lines.append(
+            f"  (this trial then walks toward model {_model_axis(s.rotation_deg, w.axis, w.sign)}; "
+            f"{_rotation_text(s.rotation_forward_deg)} also turns its walking direction to model +X, "
+            "OpenSim's forward)"
+        )
     return "\n".join(line.rstrip() for line in lines) + "\n"
 
 
@@ -595,12 +683,18 @@ def format_label_match(match: LabelMatch, model_name: str, n_model_markers: int)
     if match.ambiguous:
         lines.append(f"  ambiguous (left unmatched): {len(match.ambiguous)}")
         for label, candidates in match.ambiguous.items():
-            lines.append(f"    {label}: {' or '.join(candidates)}" if len(candidates) > 1 else
-                         f"    {label}: {candidates[0]} (wanted by more than one label)")
-    for title, names in (("labels without a model marker", match.unmatched_labels),
-                         ("model markers no label provides", match.unprovided_markers)):
+            lines.append(
+                f"    {label}: {' or '.join(candidates)}"
+                if len(candidates) > 1
+                else f"    {label}: {candidates[0]} (wanted by more than one label)"
+            )
+    for title, names in (
+        ("labels without a model marker", match.unmatched_labels),
+        ("model markers no label provides", match.unprovided_markers),
+    ):
         lines.append(f"  {title}: {len(names)}")
         if names:
-            lines += textwrap.wrap(", ".join(names), width=100, initial_indent="    ", subsequent_indent="    ",
-                                   break_on_hyphens=False)
+            lines += textwrap.wrap(
+                ", ".join(names), width=100, initial_indent="    ", subsequent_indent="    ", break_on_hyphens=False
+            )
     return "\n".join(lines) + "\n"

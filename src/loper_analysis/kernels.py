@@ -222,7 +222,8 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
 
     P: (B, 6) parameter sets; stage arrays (ref_q, ref_qd, ref_qdd, w: (2 N + 1, 4);
     dpel: (2 N + 1, 2)) sampled every dt / 2 from the window start; fp (N, 4, 2)
-    the rod force at the four stages of each of the N steps; e0, ed0: (4,) initial deviation; n_sub RK4 steps per output sample.
+    the rod force at the four stages of each of the N steps; e0, ed0: (4,) initial deviation; n_sub RK4 steps per
+    output sample.
     Returns E (B, n_out, 4) deviations and Ed (B, n_out, 4) their rates at the
     output samples (sample 0 = initial state).
     """
@@ -256,23 +257,31 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
         for o in range(1, n_out):
             for _ in range(n_sub):
                 k = 2 * st
-                _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 0], dpel, M, h, Ja, rhs, T, k1, state)
+                _deviation_rhs(
+                    k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 0], dpel, M, h, Ja, rhs, T, k1, state
+                )
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * ed[a]
                     edt[a] = ed[a] + 0.5 * dt * k1[a]
-                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 1], dpel, M, h, Ja, rhs, T, k2, state)
+                _deviation_rhs(
+                    k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 1], dpel, M, h, Ja, rhs, T, k2, state
+                )
                 for a in range(4):
                     v2[a] = edt[a]
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * v2[a]
                     edt[a] = ed[a] + 0.5 * dt * k2[a]
-                _deviation_rhs(k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 2], dpel, M, h, Ja, rhs, T, k3, state)
+                _deviation_rhs(
+                    k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 2], dpel, M, h, Ja, rhs, T, k3, state
+                )
                 for a in range(4):
                     v3[a] = edt[a]
                 for a in range(4):
                     et[a] = e[a] + dt * v3[a]
                     edt[a] = ed[a] + dt * k3[a]
-                _deviation_rhs(k + 2, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 3], dpel, M, h, Ja, rhs, T, k4, state)
+                _deviation_rhs(
+                    k + 2, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 3], dpel, M, h, Ja, rhs, T, k4, state
+                )
                 for a in range(4):
                     e[a] += dt / 6.0 * (ed[a] + 2.0 * v2[a] + 2.0 * v3[a] + edt[a])
                     ed[a] += dt / 6.0 * (k1[a] + 2.0 * k2[a] + 2.0 * k3[a] + k4[a])

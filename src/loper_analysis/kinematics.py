@@ -49,8 +49,16 @@ __all__ = [
 
 
 #: Columns of the one-row IK summary of a trial (:meth:`IKResult.summary`).
-IK_SUMMARY_COLUMNS: tuple[str, ...] = ("n_frames", "n_frames_solved", "n_frames_left_out", "first_solved_s",
-                                       "last_solved_s", "marker_rms_mean_m", "marker_rms_max_m", "n_frames_over_warn")
+IK_SUMMARY_COLUMNS: tuple[str, ...] = (
+    "n_frames",
+    "n_frames_solved",
+    "n_frames_left_out",
+    "first_solved_s",
+    "last_solved_s",
+    "marker_rms_mean_m",
+    "marker_rms_max_m",
+    "n_frames_over_warn",
+)
 
 
 @dataclass
@@ -93,16 +101,21 @@ class IKResult:
         solved = np.ones(self.time_s.size, bool) if self.solved is None else self.solved
         rms = self.marker_rms_m[np.isfinite(self.marker_rms_m)]
         t = self.time_s[solved]
-        return pd.DataFrame([{
-            "n_frames": int(self.time_s.size),
-            "n_frames_solved": int(solved.sum()),
-            "n_frames_left_out": int((~solved).sum()),
-            "first_solved_s": float(t[0]) if t.size else np.nan,
-            "last_solved_s": float(t[-1]) if t.size else np.nan,
-            "marker_rms_mean_m": float(rms.mean()) if rms.size else np.nan,
-            "marker_rms_max_m": float(rms.max()) if rms.size else np.nan,
-            "n_frames_over_warn": int((rms > warn_rms_m).sum()),
-        }], columns=list(IK_SUMMARY_COLUMNS))
+        return pd.DataFrame(
+            [
+                {
+                    "n_frames": int(self.time_s.size),
+                    "n_frames_solved": int(solved.sum()),
+                    "n_frames_left_out": int((~solved).sum()),
+                    "first_solved_s": float(t[0]) if t.size else np.nan,
+                    "last_solved_s": float(t[-1]) if t.size else np.nan,
+                    "marker_rms_mean_m": float(rms.mean()) if rms.size else np.nan,
+                    "marker_rms_max_m": float(rms.max()) if rms.size else np.nan,
+                    "n_frames_over_warn": int((rms > warn_rms_m).sum()),
+                }
+            ],
+            columns=list(IK_SUMMARY_COLUMNS),
+        )
 
     def frame(self) -> pd.DataFrame:
         """Tidy-wide table: time_s plus one column per coordinate (rad or m)."""
@@ -245,15 +258,21 @@ def inverse_kinematics(
     if sparse_frames == "error":
         require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
     tree = model_tree(model)
-    solved = frames_with_markers(X, kept_labels, min_markers, root_markers=[
-        lab for lab in kept_labels if tree.marker_bodies.get(lab) in tree.root_bodies])
+    solved = frames_with_markers(
+        X,
+        kept_labels,
+        min_markers,
+        root_markers=[lab for lab in kept_labels if tree.marker_bodies.get(lab) in tree.root_bodies],
+    )
     if not solved.any():
         require_markers_per_frame(X, kept_labels, min_markers, None, t, source)  # names the frames and markers
     require_markers_beyond_root(tree, X, kept_labels, source)
     if not solved.any():
-        raise LoperInputError(f"{where}no frame holds {min_markers} weighted markers with one beyond the pelvis: "
-                              "nothing to solve (are the pelvis markers mapped in markers.label_map and weighted in "
-                              "the IK tasks?)")
+        raise LoperInputError(
+            f"{where}no frame holds {min_markers} weighted markers with one beyond the pelvis: "
+            "nothing to solve (are the pelvis markers mapped in markers.label_map and weighted in "
+            "the IK tasks?)"
+        )
     free = undetermined_coordinates(tree, X, kept_labels, coordinate_tasks)  # (n_frames, n_coordinates)
     free[~solved] = False  # frames left out are NaN throughout, not counted as undetermined
     lacking = {c: int(n) for c, n in zip(tree.coordinates, free.sum(axis=0)) if n}
@@ -272,8 +291,9 @@ def inverse_kinematics(
     cref = osim.SimTKArrayCoordinateReference()
     for cname, (w, value) in (coordinate_tasks or {}).items():
         if cname not in names:
-            raise LoperInputError(f"{where}coordinate task on '{cname}': not a coordinate of {model_source(model)}; "
-                                  f"has {names}")
+            raise LoperInputError(
+                f"{where}coordinate task on '{cname}': not a coordinate of {model_source(model)}; has {names}"
+            )
         v = cs.get(cname).getDefaultValue() if value is None else float(value)
         ref = osim.CoordinateReference(cname, osim.Constant(v))
         ref.setWeight(float(w))
@@ -306,13 +326,28 @@ def inverse_kinematics(
         rms, mx = np.sqrt(np.nanmean(E * E, axis=1)), np.nanmax(E, axis=1)
     coordinates = Q[:, perm]
     coordinates[free] = np.nan  # the solver left them at a default or the previous frame's value
-    return IKResult(time_s=t, coordinates=coordinates, coordinate_names=names, marker_rms_m=rms, marker_max_m=mx,
-                    undetermined=lacking, solved=solved, marker_errors_m=E, marker_names=in_use_names)
+    return IKResult(
+        time_s=t,
+        coordinates=coordinates,
+        coordinate_names=names,
+        marker_rms_m=rms,
+        marker_max_m=mx,
+        undetermined=lacking,
+        solved=solved,
+        marker_errors_m=E,
+        marker_names=in_use_names,
+    )
 
 
-def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: float = 1.0,
-                    marker_weights: Mapping[str, float] | None = None,
-                    coordinate_tasks: Mapping[str, Mapping] | None = None, source: str = ""):
+def ik_task_weights(
+    model,
+    labels: Sequence[str],
+    tasks=None,
+    default_weight: float = 1.0,
+    marker_weights: Mapping[str, float] | None = None,
+    coordinate_tasks: Mapping[str, Mapping] | None = None,
+    source: str = "",
+):
     """Marker weights and coordinate tasks of one trial.
 
     ``tasks`` is ``(marker_weights, coordinate_tasks)`` as read from an IK task
@@ -342,9 +377,11 @@ def ik_task_weights(model, labels: Sequence[str], tasks=None, default_weight: fl
         coords = {c: (float(v["weight"]), v.get("value")) for c, v in (coordinate_tasks or {}).items()}
     missing = [m for m, w in weights.items() if w > 0 and m not in labels]
     if missing:
-        raise LoperInputError(f"{source}: marker(s) {missing} of the model's marker set are missing from the file "
-                              "(map the lab's labels to them in markers.label_map, or leave them out of IK: weight 0 "
-                              "in opensim.marker_weights, or an IK task file in opensim.ik_tasks)")
+        raise LoperInputError(
+            f"{source}: marker(s) {missing} of the model's marker set are missing from the file "
+            "(map the lab's labels to them in markers.label_map, or leave them out of IK: weight 0 "
+            "in opensim.marker_weights, or an IK task file in opensim.ik_tasks)"
+        )
     return weights, coords
 
 
@@ -366,8 +403,7 @@ def _q_order(model, state, cs) -> np.ndarray:
     q = probe.getQ().to_numpy()
     perm = np.array([int(np.argmin(np.abs(q - v))) for v in values])
     wrong = [cs.get(i).getName() for i in range(cs.getSize()) if not np.isclose(q[perm[i]], values[i])]
-    shared = sorted({cs.get(i).getName() for i in range(cs.getSize())
-                     for j in range(i) if perm[i] == perm[j]})
+    shared = sorted({cs.get(i).getName() for i in range(cs.getSize()) for j in range(i) if perm[i] == perm[j]})
     if wrong or shared:
         raise LoperInputError(
             f"{model_source(model)}: coordinate(s) {', '.join(wrong or shared)} do not map one to one onto the "
@@ -414,7 +450,8 @@ def join_chunks(frames: list[pd.DataFrame], sources: list[str] | None = None) ->
     return pd.concat(frames, ignore_index=True)
 
 
-#: Our angle columns (the convention of :mod:`loper_analysis.constants`) -> (model coordinate, sign) for the generic model.
+#: Our angle columns (the convention of :mod:`loper_analysis.constants`) -> (model coordinate, sign) for the generic
+#: model.
 #: ``pelvis_angle`` is the swing-leg model's theta_pelvis (= -pelvis_tilt of the OpenSim model).
 DEFAULT_COORDINATE_MAP: dict[str, tuple[str, float]] = {
     "pelvis_x": ("pelvis_tx", 1.0),

@@ -265,8 +265,9 @@ def walking_direction(markers_m, point_rate_hz: float, up_axis: int, min_travel_
     return WalkingDirection(axis, sign, travel, speed)
 
 
-def lab_to_model_rotation_deg(up_axis: int, up_sign: int = 1, forward_axis: int | None = None,
-                              forward_sign: int = 1) -> tuple[float, float, float]:
+def lab_to_model_rotation_deg(
+    up_axis: int, up_sign: int = 1, forward_axis: int | None = None, forward_sign: int = 1
+) -> tuple[float, float, float]:
     """``markers.lab_to_model_rotation_deg`` taking the lab's up to OpenSim's +Y (and forward to +X).
 
     Parameters
@@ -309,8 +310,12 @@ def lab_to_model_rotation_deg(up_axis: int, up_sign: int = 1, forward_axis: int 
             continue
         if forward is not None and not np.allclose(R @ forward, (1, 0, 0)):
             continue
-        key = (0.0 if forward is not None else -np.trace(R), sum(a != 0 for a in angles),
-               sum(abs(a) for a in angles), index)
+        key = (
+            0.0 if forward is not None else -np.trace(R),
+            sum(a != 0 for a in angles),
+            sum(abs(a) for a in angles),
+            index,
+        )
         if best_key is None or key < best_key:
             best, best_key = angles, key
     return tuple(float(a) + 0.0 for a in best)  # + 0.0: no -0.0

@@ -46,20 +46,20 @@ __all__ = [
 #: (ISB abbreviations), OpenSim's gait2392 and Rajagopal2016 marker sets. A label and a model marker match
 #: through this table when they share side and landmark.
 LANDMARK_SYNONYMS: dict[str, tuple[str, ...]] = {
-    "asis": ("asi", "asis", "ias"),                                     # LASI, L.ASIS, L_IAS
-    "psis": ("psi", "psis", "ips"),                                     # LPSI, L.PSIS, L_IPS
-    "sacrum": ("sacr", "sacrum", "sacral", "vsacral"),                  # SACR, V.Sacral
-    "heel": ("hee", "heel", "cal", "fcc"),                              # LHEE, L.Heel, LCAL, L_FCC
-    "toe": ("toe", "toetip", "ft2"),                                    # LTOE, L.Toe, L.Toe.Tip, L_FT2
-    "mt1": ("mt1", "met1", "fm1", "toemed"),                            # LMT1, L_FM1, L.Toe.Med
-    "mt5": ("mt5", "met5", "fm5", "toelat"),                            # LMT5, L_FM5, L.Toe.Lat
+    "asis": ("asi", "asis", "ias"),  # LASI, L.ASIS, L_IAS
+    "psis": ("psi", "psis", "ips"),  # LPSI, L.PSIS, L_IPS
+    "sacrum": ("sacr", "sacrum", "sacral", "vsacral"),  # SACR, V.Sacral
+    "heel": ("hee", "heel", "cal", "fcc"),  # LHEE, L.Heel, LCAL, L_FCC
+    "toe": ("toe", "toetip", "ft2"),  # LTOE, L.Toe, L.Toe.Tip, L_FT2
+    "mt1": ("mt1", "met1", "fm1", "toemed"),  # LMT1, L_FM1, L.Toe.Med
+    "mt5": ("mt5", "met5", "fm5", "toelat"),  # LMT5, L_FM5, L.Toe.Lat
     "knee_lateral": ("kne", "knee", "kneelat", "lknee", "lfc", "fle"),  # LKNE, L.Knee(.Lat), LLFC, L_FLE
-    "knee_medial": ("kneemed", "mknee", "mfc", "fme"),                  # L.Knee.Med, L.MKnee, LMFC, L_FME
+    "knee_medial": ("kneemed", "mknee", "mfc", "fme"),  # L.Knee.Med, L.MKnee, LMFC, L_FME
     "ankle_lateral": ("ank", "ankle", "anklelat", "lankle", "lmal", "fal"),  # LANK, L.Ankle(.Lat), LLMAL, L_FAL
-    "ankle_medial": ("anklemed", "mankle", "mmal", "tam"),              # L.Ankle.Med, L.MAnkle, LMMAL, L_TAM
+    "ankle_medial": ("anklemed", "mankle", "mmal", "tam"),  # L.Ankle.Med, L.MAnkle, LMMAL, L_TAM
     "acromion": ("sho", "shoulder", "acr", "acromion", "acromium", "sae"),  # LSHO, LACR, L.Acromium, L_SAE
-    "sternum": ("strn", "sternum", "sjn"),                              # STRN, Sternum, SJN
-    "head_top": ("tophead", "headtop", "vertex"),                       # Top.Head, HEAD_TOP
+    "sternum": ("strn", "sternum", "sjn"),  # STRN, Sternum, SJN
+    "head_top": ("tophead", "headtop", "vertex"),  # Top.Head, HEAD_TOP
 }
 
 _SPELLING_TO_LANDMARK = {s: name for name, spellings in LANDMARK_SYNONYMS.items() for s in spellings}
@@ -92,7 +92,6 @@ class LabelMatch:
     unprovided_markers: tuple[str, ...]
 
 
-
 def _normalised(name: str) -> str:
     return _NOT_ALNUM.sub("", str(name).lower())
 
@@ -103,7 +102,7 @@ def _landmarks(name: str) -> set[tuple[str | None, str]]:
     readings: list[tuple[str | None, str]] = [(None, flat)]
     for word, side in (("left", "l"), ("right", "r")):
         if flat.startswith(word):
-            readings.append((side, flat[len(word):]))
+            readings.append((side, flat[len(word) :]))
     if flat[:1] in ("l", "r"):
         readings.append((flat[0], flat[1:]))
     suffix = _SIDE_SUFFIX.search(str(name).strip())
@@ -190,8 +189,11 @@ def starter_label_map(match: LabelMatch) -> pd.DataFrame:
     pandas.DataFrame
         Columns ``label``, ``marker`` (object dtype), one row per pair whose names differ, in file order.
     """
-    rows = [(strip_subject_prefix(label), marker) for label, marker, _ in match.pairs
-            if strip_subject_prefix(label) != marker]
+    rows = [
+        (strip_subject_prefix(label), marker)
+        for label, marker, _ in match.pairs
+        if strip_subject_prefix(label) != marker
+    ]
     return pd.DataFrame(rows, columns=["label", "marker"], dtype=object)
 
 

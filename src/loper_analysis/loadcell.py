@@ -30,8 +30,14 @@ from .errors import LoperInputError
 from .filtering import lowpass
 from .pulse import find_force_pulses
 
-__all__ = ["OUTPUT_COLUMNS", "MIN_UNFLAGGED_PULSES", "robot_log_on_mocap_frames", "robot_log_frames_and_native",
-           "check_perturbation_flags", "perturbation_onsets"]
+__all__ = [
+    "OUTPUT_COLUMNS",
+    "MIN_UNFLAGGED_PULSES",
+    "robot_log_on_mocap_frames",
+    "robot_log_frames_and_native",
+    "check_perturbation_flags",
+    "perturbation_onsets",
+]
 
 log = logging.getLogger(__name__)
 
@@ -132,8 +138,20 @@ def robot_log_on_mocap_frames(
         pulses whose high times disagree between the records, e.g. an inverted robot sync), no frame
         inside the log's span, force pulses without perturbation flags (:func:`check_perturbation_flags`).
     """
-    return robot_log_frames_and_native(log, log_rate_hz, mocap_sync_v, analog_rate_hz, frame_time_s, cutoff_hz, order,
-                                       source, analog_start_s, max_drift, tolerance_s, sync_channel)[0]
+    return robot_log_frames_and_native(
+        log,
+        log_rate_hz,
+        mocap_sync_v,
+        analog_rate_hz,
+        frame_time_s,
+        cutoff_hz,
+        order,
+        source,
+        analog_start_s,
+        max_drift,
+        tolerance_s,
+        sync_channel,
+    )[0]
 
 
 def robot_log_frames_and_native(
@@ -190,10 +208,17 @@ def robot_log_frames_and_native(
     robot_rel = rising_edges(robot_sync, rate, source=f"{src}: {robot_name}")
     mocap_rel = rising_edges(mocap_sync_v, arate, source=f"{src}: {mocap_name}")
     robot_edges = np.interp(robot_rel * rate, np.arange(t_log.size), t_log)
-    cm = clock_map(robot_edges, start + mocap_rel, max_drift=max_drift, source=src, tolerance_s=tolerance_s,
-                   robot_high_s=high_times(robot_sync, rate, robot_rel),
-                   mocap_high_s=high_times(mocap_sync_v, arate, mocap_rel),
-                   robot_name=robot_name, mocap_name=mocap_name)
+    cm = clock_map(
+        robot_edges,
+        start + mocap_rel,
+        max_drift=max_drift,
+        source=src,
+        tolerance_s=tolerance_s,
+        robot_high_s=high_times(robot_sync, rate, robot_rel),
+        mocap_high_s=high_times(mocap_sync_v, arate, mocap_rel),
+        robot_name=robot_name,
+        mocap_name=mocap_name,
+    )
 
     t_mapped = cm.to_mocap(t_log)
     inside = (frames >= t_mapped[0]) & (frames <= t_mapped[-1])
@@ -284,15 +309,19 @@ def check_perturbation_flags(force_n, flag, sample_rate_hz: float, time_s, sourc
     times = ", ".join(f"{t[k]:.3f}" for k in first[:5]) + (", ..." if first.size > 5 else "")
     peak = float(np.median(np.abs(pulses[:, 2])))
     width_ms = float(np.median(pulses[:, 1] - pulses[:, 0])) / rate * 1e3
-    seen = (f"column 'perturbation' flags {n_flags} pulse(s), but column 'force_measured_n' shows {n_pulses} force "
-            f"pulse(s) (median peak {peak:.0f} N, {width_ms:.0f} ms), {n_unflagged} of them without a flag, at "
-            f"t = {times} s (robot clock)")
+    seen = (
+        f"column 'perturbation' flags {n_flags} pulse(s), but column 'force_measured_n' shows {n_pulses} force "
+        f"pulse(s) (median peak {peak:.0f} N, {width_ms:.0f} ms), {n_unflagged} of them without a flag, at "
+        f"t = {times} s (robot clock)"
+    )
     if n_pulses >= MIN_UNFLAGGED_PULSES and 2 * n_unflagged > n_pulses:
-        what = ("the log has no perturbation flags, so no stride would count as perturbed" if not n_flags else
-                "most pulses lack their perturbation flag, so their strides would count as unperturbed")
+        what = (
+            "the log has no perturbation flags, so no stride would count as perturbed"
+            if not n_flags
+            else "most pulses lack their perturbation flag, so their strides would count as unperturbed"
+        )
         raise LoperInputError(
-            f"{src}: {seen}: {what}; check the robot's flag channel (a .mat export: device.mat_column_map."
-            "perturbation)"
+            f"{src}: {seen}: {what}; check the robot's flag channel (a .mat export: device.mat_column_map.perturbation)"
         )
     log.warning("%s: %s: their strides count as unperturbed", src, seen)
     return pulses

@@ -24,8 +24,9 @@ def markdown_table(frame: pd.DataFrame) -> str:
     return "\n".join([header, rule, *rows]) + "\n"
 
 
-def markdown_document(sections: Sequence[tuple[str, str, pd.DataFrame]],
-                      title: str = "loper-analysis: result tables") -> str:
+def markdown_document(
+    sections: Sequence[tuple[str, str, pd.DataFrame]], title: str = "loper-analysis: result tables"
+) -> str:
     """One Markdown document with a section per table: ``(heading, where the table lives, table)``.
 
     A table without columns is shown as ``(empty)``.

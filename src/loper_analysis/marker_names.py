@@ -45,8 +45,9 @@ def _listed(names: Sequence[str]) -> str:
     return ", ".join(names[:_MAX_LISTED]) + (f", ... ({more} more)" if more > 0 else "")
 
 
-def model_marker_names(labels: Sequence[str], label_map: Mapping[str, str] | None = None,
-                       source: str = "") -> list[str]:
+def model_marker_names(
+    labels: Sequence[str], label_map: Mapping[str, str] | None = None, source: str = ""
+) -> list[str]:
     """Model-marker names of a file's labels: subject prefix stripped, then renamed by ``label_map``.
 
     Parameters
@@ -118,8 +119,9 @@ def missing_model_markers(names: Sequence[str], required: Sequence[str]) -> list
     return [m for m in required if m not in have]
 
 
-def require_model_markers(names: Sequence[str], required: Sequence[str], source: str = "",
-                          labels: Sequence[str] | None = None) -> None:
+def require_model_markers(
+    names: Sequence[str], required: Sequence[str], source: str = "", labels: Sequence[str] | None = None
+) -> None:
     """Refuse a trial in which no label provides one of the ``required`` model markers.
 
     ``names`` are the file's model-marker names (:func:`model_marker_names`);

@@ -34,7 +34,12 @@ GAP_REPORT_COLUMNS: tuple[str, ...] = ("marker", "first_frame", "last_frame", "n
 
 #: Columns of the per-marker summary of :func:`gap_summary`.
 GAP_SUMMARY_COLUMNS: tuple[str, ...] = (
-    "marker", "n_frames", "n_filled_frames", "n_missing_frames", "longest_gap_frames", "n_unfiltered_frames"
+    "marker",
+    "n_frames",
+    "n_filled_frames",
+    "n_missing_frames",
+    "longest_gap_frames",
+    "n_unfiltered_frames",
 )
 
 #: Problems listed in one error message before the rest are only counted.
@@ -215,14 +220,29 @@ def gap_summary(raw_m, processed_m, labels: Sequence[str], unfiltered=None) -> p
     rows = []
     for j, label in enumerate(labels):
         runs = _missing_runs(out[:, j])
-        rows.append((label, out.shape[0], int((raw[:, j] & ~out[:, j]).sum()), int(out[:, j].sum()),
-                     max((b - a + 1 for a, b in runs), default=0), int(raw_kept[:, j].sum())))
+        rows.append(
+            (
+                label,
+                out.shape[0],
+                int((raw[:, j] & ~out[:, j]).sum()),
+                int(out[:, j].sum()),
+                max((b - a + 1 for a, b in runs), default=0),
+                int(raw_kept[:, j].sum()),
+            )
+        )
     return pd.DataFrame(rows, columns=list(GAP_SUMMARY_COLUMNS)).astype(
-        {c: (object if c == "marker" else np.int64) for c in GAP_SUMMARY_COLUMNS})
+        {c: (object if c == "marker" else np.int64) for c in GAP_SUMMARY_COLUMNS}
+    )
 
 
-def require_markers_per_frame(markers_m, labels: Sequence[str], min_markers: int = 3,
-                              weights: Mapping[str, float] | None = None, time_s=None, source: str = "") -> None:
+def require_markers_per_frame(
+    markers_m,
+    labels: Sequence[str],
+    min_markers: int = 3,
+    weights: Mapping[str, float] | None = None,
+    time_s=None,
+    source: str = "",
+) -> None:
     """Refuse a trial with a frame in which fewer than ``min_markers`` weighted markers are present.
 
     The rule: IK needs, in every frame, at least ``min_markers`` markers of
@@ -277,15 +297,16 @@ def require_markers_per_frame(markers_m, labels: Sequence[str], min_markers: int
         spans.append(f"and {len(runs) - _MAX_LISTED} more run(s)")
     absent = [labels[used[k]] for k in np.flatnonzero((~present[short]).any(axis=0))]
     if len(absent) > 2 * _MAX_LISTED:
-        absent = absent[:2 * _MAX_LISTED] + [f"and {len(absent) - 2 * _MAX_LISTED} more"]
+        absent = absent[: 2 * _MAX_LISTED] + [f"and {len(absent) - 2 * _MAX_LISTED} more"]
     raise LoperInputError(
         f"{where}: {int(short.sum())} frame(s) hold fewer than {min_markers} of the {len(used)} weighted markers, "
         f"too few to solve IK: frames {', '.join(spans)}; markers missing there: {', '.join(absent) or 'none'}"
     )
 
 
-def frames_with_markers(markers_m, labels: Sequence[str], min_markers: int = 3,
-                        root_markers: Sequence[str] = ()) -> np.ndarray:
+def frames_with_markers(
+    markers_m, labels: Sequence[str], min_markers: int = 3, root_markers: Sequence[str] = ()
+) -> np.ndarray:
     """Frames that IK can solve: ``min_markers`` markers present, enough of them on the root body, one off it.
 
     The body jointed to the ground (the pelvis) carries every other body: it

@@ -65,9 +65,15 @@ __all__ = [
 _LEGS = (SIDE_SUFFIX["right"], SIDE_SUFFIX["left"])
 BRACE_MARKERS = ("LBRA_P", "LBRA_D")
 COORDINATES = (
-    "pelvis_tilt", "pelvis_tx", "pelvis_ty",
-    "hip_flexion_r", "knee_flexion_r", "ankle_dorsiflexion_r",
-    "hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l",
+    "pelvis_tilt",
+    "pelvis_tx",
+    "pelvis_ty",
+    "hip_flexion_r",
+    "knee_flexion_r",
+    "ankle_dorsiflexion_r",
+    "hip_flexion_l",
+    "knee_flexion_l",
+    "ankle_dorsiflexion_l",
 )
 
 
@@ -81,8 +87,12 @@ def model_dimensions(height_m: float, mass_kg: float) -> dict:
     """
     H, M = height_m, mass_kg
     seg = {
-        s: dict(mass=WINTER_SEGMENTS[s].mass * M, length=WINTER_SEGMENTS[s].length * H,
-                com=WINTER_SEGMENTS[s].com, k=WINTER_SEGMENTS[s].gyration)
+        s: dict(
+            mass=WINTER_SEGMENTS[s].mass * M,
+            length=WINTER_SEGMENTS[s].length * H,
+            com=WINTER_SEGMENTS[s].com,
+            k=WINTER_SEGMENTS[s].gyration,
+        )
         for s in SEGMENTS
     }
     leg = sum(s["mass"] for s in seg.values())
@@ -156,8 +166,12 @@ def build_lower_body_model(height_m: float, mass_kg: float, name: str = "loper_l
     def inertia(m, k_xy, k_z):
         return osim.Inertia(m * k_xy**2, m * k_xy**2, m * k_z**2)
 
-    pelvis = osim.Body("pelvis", a["pelvis_mass"], osim.Vec3(0, a["hat_com_height"], 0),
-                       inertia(a["pelvis_mass"], a["hat_k"], a["hat_k"]))
+    pelvis = osim.Body(
+        "pelvis",
+        a["pelvis_mass"],
+        osim.Vec3(0, a["hat_com_height"], 0),
+        inertia(a["pelvis_mass"], a["hat_k"], a["hat_k"]),
+    )
     model.addBody(pelvis)
     pj = osim.PlanarJoint("pelvis_joint", ground, osim.Vec3(0), osim.Vec3(0), pelvis, osim.Vec3(0), osim.Vec3(0))
     for i, cname in enumerate(("pelvis_tilt", "pelvis_tx", "pelvis_ty")):

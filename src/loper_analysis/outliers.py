@@ -65,18 +65,14 @@ def iqr_outliers(
     """
     v = np.asarray(values, dtype=float)
     if v.ndim not in (2, 3):
-        raise LoperInputError(
-            f"{where(source)}values must have shape (n_strides, n_samples[, k]), got {v.shape}"
-        )
+        raise LoperInputError(f"{where(source)}values must have shape (n_strides, n_samples[, k]), got {v.shape}")
     if v.shape[0] < 4:
         raise LoperInputError(f"{where(source)}the IQR rule needs >= 4 strides, got {v.shape[0]}")
     if v.shape[1] < 1 or (v.ndim == 3 and v.shape[2] < 1):
         raise LoperInputError(f"{where(source)}values has no samples: shape {v.shape}")
     bad = np.argwhere(~np.isfinite(v))
     if bad.size:
-        raise LoperInputError(
-            f"{where(source)}values are not finite at stride {bad[0][0]}, sample {bad[0][1]}"
-        )
+        raise LoperInputError(f"{where(source)}values are not finite at stride {bad[0][0]}, sample {bad[0][1]}")
     w = number("whisker", whisker, source, minimum=0.0)
     mf = number("max_fraction", max_fraction, source, minimum=0.0)
     if mf > 1:
@@ -99,8 +95,9 @@ def iqr_outliers(
         table[f"fraction_outlying_{name}"] = fraction[:, j]
     table["removed"] = over.any(axis=1)
     table["reason"] = [
-        "; ".join(f"{names[j]}: {100 * fraction[i, j]:.1f} % of samples outside {w:g}·IQR"
-                  for j in np.flatnonzero(over[i]))
+        "; ".join(
+            f"{names[j]}: {100 * fraction[i, j]:.1f} % of samples outside {w:g}·IQR" for j in np.flatnonzero(over[i])
+        )
         for i in range(x.shape[0])
     ]
     table.attrs.update({"source": source, "whisker": w, "max_fraction": mf})

@@ -55,8 +55,6 @@ from .constants import JOINTS, PARAMETER_UNITS, PARAMETERS
 from .dynamics import SegmentParameters
 from .errors import LoperInputError
 from .identification import (
-    DEFAULT_LOWER,
-    DEFAULT_UPPER,
     PreparedWindow,
     nuisance_projection,
     null_pair_errors,
@@ -84,9 +82,22 @@ __all__ = [
 
 #: Columns of the plan table (one row per joint x parameter x onset x stride count).
 PLAN_COLUMNS: tuple[str, ...] = (
-    "subject", "onset_ms", "joint", "parameter", "unit", "n_strides", "planned_value", "predicted_sd",
-    "ci95_half_width", "ci95_half_width_pct", "pulse_force_n", "pulse_duration_s", "n_null_pairs",
-    "n_perturbed_pairs", "scatter", "note",
+    "subject",
+    "onset_ms",
+    "joint",
+    "parameter",
+    "unit",
+    "n_strides",
+    "planned_value",
+    "predicted_sd",
+    "ci95_half_width",
+    "ci95_half_width_pct",
+    "pulse_force_n",
+    "pulse_duration_s",
+    "n_null_pairs",
+    "n_perturbed_pairs",
+    "scatter",
+    "note",
 )
 
 #: Fewest pilot perturbed pairs whose scatter the prediction takes (fewer: the null pairs' scatter, noted).
@@ -126,8 +137,10 @@ class PlanSettings:
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)
         if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
-            raise LoperInputError("identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
-                                  f"got {self.interval_scatter!r}")
+            raise LoperInputError(
+                "identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
+                f"got {self.interval_scatter!r}"
+            )
         if number("force_rate_hz", self.force_rate_hz) <= 0:
             raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
         d = number("pulse_duration_s", self.pulse_duration_s)
@@ -135,8 +148,10 @@ class PlanSettings:
         if d <= 0:
             raise LoperInputError(f"pulse_duration_s must be > 0 s, got {d:g} s")
         if d > after:
-            raise LoperInputError(f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
-                                  f"(identification.window_after_s = {after:g} s): the fit would not see its end")
+            raise LoperInputError(
+                f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
+                f"(identification.window_after_s = {after:g} s): the fit would not see its end"
+            )
 
     @property
     def lower(self) -> np.ndarray:
@@ -186,20 +201,35 @@ class StrideCovariance:
 
 def _null_arrays(null_pairs: Mapping, source: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
     """Checked grid and arrays of the pilot's null pairs, and how many there are."""
-    missing = [k for k in ("time_s", "q_perturbed", "q_unperturbed", "pelvis_angle_perturbed_rad",
-                           "pelvis_angle_unperturbed_rad") if k not in null_pairs]
+    missing = [
+        k
+        for k in (
+            "time_s",
+            "q_perturbed",
+            "q_unperturbed",
+            "pelvis_angle_perturbed_rad",
+            "pelvis_angle_unperturbed_rad",
+        )
+        if k not in null_pairs
+    ]
     if missing:
         raise LoperInputError(f"{source}: null pairs lack {missing}")
     t = np.asarray(null_pairs["time_s"], dtype=float)
-    arrays = {k: np.asarray(null_pairs[k], dtype=float) for k in ("q_perturbed", "q_unperturbed",
-                                                                   "pelvis_angle_perturbed_rad",
-                                                                   "pelvis_angle_unperturbed_rad")}
+    arrays = {
+        k: np.asarray(null_pairs[k], dtype=float)
+        for k in ("q_perturbed", "q_unperturbed", "pelvis_angle_perturbed_rad", "pelvis_angle_unperturbed_rad")
+    }
     n = int(arrays["q_unperturbed"].shape[0]) if arrays["q_unperturbed"].ndim == 3 else 0
     return t, arrays, n
 
 
-def planning_window(null_pairs: Mapping, params: SegmentParameters, settings: PlanSettings = PlanSettings(),
-                    device=None, source: str = "pilot") -> PreparedWindow:
+def planning_window(
+    null_pairs: Mapping,
+    params: SegmentParameters,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    source: str = "pilot",
+) -> PreparedWindow:
     """The identification window of the planned experiment (onset at t = 0).
 
     Reference: the mean of the pilot's unperturbed null-pair strides
@@ -223,14 +253,30 @@ def planning_window(null_pairs: Mapping, params: SegmentParameters, settings: Pl
     pelvis = arrays["pelvis_angle_unperturbed_rad"].mean(axis=0)
     rate = float(settings.force_rate_hz)
     t_force = np.arange(math.ceil(t[0] * rate - 1e-6), math.floor(t[-1] * rate + 1e-6) + 1) / rate
-    force = pulse_force_n(t_force, settings.pulse_force_n, settings.pulse_duration_s, device, settings.force_cutoff_hz,
-                          settings.force_order)
+    force = pulse_force_n(
+        t_force,
+        settings.pulse_force_n,
+        settings.pulse_duration_s,
+        device,
+        settings.force_cutoff_hz,
+        settings.force_order,
+    )
     force_vector = force[:, None] * thigh_normal(np.interp(t_force, t, q_ref[:, 1]))
     return prepare_window(
-        t, q_ref, q_ref, params, 0.0, force_perturbed_n=force_vector, force_unperturbed_n=np.zeros_like(force_vector),
-        force_time_s=t_force, pelvis_angle_unperturbed_rad=pelvis, pelvis_angle_perturbed_rad=pelvis,
-        window_before_s=settings.window_before_s, window_after_s=settings.window_after_s,
-        n_substeps=settings.n_substeps, initial_state_span_s=settings.initial_state_span_s,
+        t,
+        q_ref,
+        q_ref,
+        params,
+        0.0,
+        force_perturbed_n=force_vector,
+        force_unperturbed_n=np.zeros_like(force_vector),
+        force_time_s=t_force,
+        pelvis_angle_unperturbed_rad=pelvis,
+        pelvis_angle_perturbed_rad=pelvis,
+        window_before_s=settings.window_before_s,
+        window_after_s=settings.window_after_s,
+        n_substeps=settings.n_substeps,
+        initial_state_span_s=settings.initial_state_span_s,
         initial_state_degree=settings.initial_state_degree,
     )
 
@@ -238,19 +284,29 @@ def planning_window(null_pairs: Mapping, params: SegmentParameters, settings: Pl
 def _impedance(impedance, settings: PlanSettings, source: str) -> np.ndarray:
     p = np.asarray(impedance, dtype=float)
     if p.shape != (6,) or not np.all(np.isfinite(p)):
-        raise LoperInputError(f"{source}: the planned impedance must be 6 finite values ({', '.join(PARAMETERS)}), "
-                              f"got {np.asarray(impedance).tolist()}")
+        raise LoperInputError(
+            f"{source}: the planned impedance must be 6 finite values ({', '.join(PARAMETERS)}), "
+            f"got {np.asarray(impedance).tolist()}"
+        )
     out = np.flatnonzero((p < settings.lower) | (p > settings.upper))
     if out.size:
         i = int(out[0])
-        raise LoperInputError(f"{source}: planned {PARAMETERS[i]} = {p[i]:g} {PARAMETER_UNITS[PARAMETERS[i]]} lies "
-                              f"outside the identification bounds {settings.lower[i]:g} .. {settings.upper[i]:g}")
+        raise LoperInputError(
+            f"{source}: planned {PARAMETERS[i]} = {p[i]:g} {PARAMETER_UNITS[PARAMETERS[i]]} lies "
+            f"outside the identification bounds {settings.lower[i]:g} .. {settings.upper[i]:g}"
+        )
     return p
 
 
-def stride_covariance(null_pairs: Mapping, params: SegmentParameters, impedance,
-                      settings: PlanSettings = PlanSettings(), device=None, source: str = "pilot",
-                      perturbed_pairs: Mapping | None = None) -> StrideCovariance:
+def stride_covariance(
+    null_pairs: Mapping,
+    params: SegmentParameters,
+    impedance,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    source: str = "pilot",
+    perturbed_pairs: Mapping | None = None,
+) -> StrideCovariance:
     """Covariance of (K, D) per joint for a mean response of **one** perturbed stride.
 
     ``impedance`` (6,): the planned values (order :data:`PARAMETERS`; N·m/rad
@@ -288,11 +344,14 @@ def stride_covariance(null_pairs: Mapping, params: SegmentParameters, impedance,
         raise LoperInputError(
             f"{source}: {n_pairs} null pair(s), fewer than identification.null_pair_components + 2 = {need}: "
             "the pilot needs unperturbed strides walked with the device (their deviation is what the prediction "
-            "scales)")
+            "scales)"
+        )
     notes = []
     if n_pairs < settings.min_null_pairs:
-        notes.append(f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
-                     "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit")
+        notes.append(
+            f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+            "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit"
+        )
     window = planning_window(null_pairs, params, settings, device, source)
     J = response_jacobian(window, p, settings.lower, settings.upper)
     E0 = null_pair_errors(window, p, null_pairs)
@@ -306,10 +365,15 @@ def stride_covariance(null_pairs: Mapping, params: SegmentParameters, impedance,
         E, scatter = null_pair_errors(window, p, perturbed_pairs), "perturbed_pairs"
     else:
         E, scatter = E0, "null_pairs"
-        notes.append((f"{n_pert} perturbed pair(s) of the pilot at this onset, fewer than {MIN_PERTURBED_PAIRS}"
-                      if perturbed_pairs is not None else "no perturbed pairs of the pilot at this onset")
-                     + ": the null pairs' scatter, without each stride's own answer to the pulse (in the "
-                     "synthetic check the actual SD of hip and knee K and D was 1.4-1.8 times this prediction)")
+        notes.append(
+            (
+                f"{n_pert} perturbed pair(s) of the pilot at this onset, fewer than {MIN_PERTURBED_PAIRS}"
+                if perturbed_pairs is not None
+                else "no perturbed pairs of the pilot at this onset"
+            )
+            + ": the null pairs' scatter, without each stride's own answer to the pulse (in the "
+            "synthetic check the actual SD of hip and knee K and D was 1.4-1.8 times this prediction)"
+        )
 
     def sandwich(errors: np.ndarray) -> np.ndarray:
         effect = (errors - errors.mean(axis=0)) @ M.T  # each pair's effect on (K, D)
@@ -340,14 +404,23 @@ def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, St
     ratios = np.array([np.diag(sc.covariance) / np.diag(sc.null_covariance) for sc in own.values()])
     r = weights @ ratios / weights.sum()
     scale = np.sqrt(r)
-    pooled_note = (f"perturbed/null pairs' variance ratio pooled over onsets {', '.join(f'{o:g}' for o in own)} ms "
-                   f"({int(sum(sc.n_perturbed_pairs for sc in own.values()))} perturbed pairs)")
+    pooled_note = (
+        f"perturbed/null pairs' variance ratio pooled over onsets {', '.join(f'{o:g}' for o in own)} ms "
+        f"({int(sum(sc.n_perturbed_pairs for sc in own.values()))} perturbed pairs)"
+    )
     out = {}
     for o, sc in stride_covs.items():
         notes = [n for n in sc.note.split("; ") if n and "perturbed pair" not in n] + [pooled_note]
-        out[o] = StrideCovariance(scale[:, None] * sc.null_covariance * scale[None, :], sc.impedance, sc.dof,
-                                  sc.n_null_pairs, "; ".join(notes), sc.n_perturbed_pairs, "pooled_perturbed_pairs",
-                                  sc.null_covariance)
+        out[o] = StrideCovariance(
+            scale[:, None] * sc.null_covariance * scale[None, :],
+            sc.impedance,
+            sc.dof,
+            sc.n_null_pairs,
+            "; ".join(notes),
+            sc.n_perturbed_pairs,
+            "pooled_perturbed_pairs",
+            sc.null_covariance,
+        )
     return out
 
 
@@ -362,14 +435,20 @@ def _counts(n_strides: Sequence[int], source: str) -> list[int]:
         except (TypeError, ValueError):
             ok = False
         if not ok or int(v) < 1:
-            raise LoperInputError(f"{source}: stride count must be a whole number >= 1 (perturbed strides averaged), "
-                                  f"got {v!r}")
+            raise LoperInputError(
+                f"{source}: stride count must be a whole number >= 1 (perturbed strides averaged), got {v!r}"
+            )
         out.append(int(v))
     return out
 
 
-def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onset_ms: float, subject: str = "",
-                    settings: PlanSettings = PlanSettings()) -> pd.DataFrame:
+def precision_table(
+    stride_cov: StrideCovariance,
+    n_strides: Sequence[int],
+    onset_ms: float,
+    subject: str = "",
+    settings: PlanSettings = PlanSettings(),
+) -> pd.DataFrame:
     """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
 
     ``predicted_sd = sd_1 / sqrt(N)`` and ``ci95_half_width = t * predicted_sd``
@@ -388,32 +467,61 @@ def precision_table(stride_cov: StrideCovariance, n_strides: Sequence[int], onse
             for n in counts:
                 sd = sd1[i] / math.sqrt(n)
                 half = stride_cov.t95(n) * sd
-                rows.append({
-                    "subject": subject, "onset_ms": float(onset_ms), "joint": joint, "parameter": kind,
-                    "unit": PARAMETER_UNITS[PARAMETERS[i]], "n_strides": n, "planned_value": planned,
-                    "predicted_sd": sd, "ci95_half_width": half,
-                    "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
-                    "pulse_force_n": float(settings.pulse_force_n),
-                    "pulse_duration_s": float(settings.pulse_duration_s),
-                    "n_null_pairs": stride_cov.n_null_pairs, "n_perturbed_pairs": stride_cov.n_perturbed_pairs,
-                    "scatter": stride_cov.scatter, "note": stride_cov.note,
-                })
+                rows.append(
+                    {
+                        "subject": subject,
+                        "onset_ms": float(onset_ms),
+                        "joint": joint,
+                        "parameter": kind,
+                        "unit": PARAMETER_UNITS[PARAMETERS[i]],
+                        "n_strides": n,
+                        "planned_value": planned,
+                        "predicted_sd": sd,
+                        "ci95_half_width": half,
+                        "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
+                        "pulse_force_n": float(settings.pulse_force_n),
+                        "pulse_duration_s": float(settings.pulse_duration_s),
+                        "n_null_pairs": stride_cov.n_null_pairs,
+                        "n_perturbed_pairs": stride_cov.n_perturbed_pairs,
+                        "scatter": stride_cov.scatter,
+                        "note": stride_cov.note,
+                    }
+                )
     return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
 
 
-def unplanned_rows(n_strides: Sequence[int], onset_ms: float, note: str, subject: str = "",
-                   settings: PlanSettings = PlanSettings()) -> pd.DataFrame:
+def unplanned_rows(
+    n_strides: Sequence[int], onset_ms: float, note: str, subject: str = "", settings: PlanSettings = PlanSettings()
+) -> pd.DataFrame:
     """Rows of :data:`PLAN_COLUMNS` for an onset that cannot be planned: predictions empty, ``note`` says why."""
     counts = _counts(n_strides, subject or "plan")
-    rows = [{"subject": subject, "onset_ms": float(onset_ms), "joint": joint, "parameter": kind,
-             "unit": PARAMETER_UNITS[f"{kind}_{joint}"], "n_strides": n, "pulse_force_n": float(settings.pulse_force_n),
-             "pulse_duration_s": float(settings.pulse_duration_s), "note": note}
-            for joint in JOINTS for kind in ("K", "D") for n in counts]
+    rows = [
+        {
+            "subject": subject,
+            "onset_ms": float(onset_ms),
+            "joint": joint,
+            "parameter": kind,
+            "unit": PARAMETER_UNITS[f"{kind}_{joint}"],
+            "n_strides": n,
+            "pulse_force_n": float(settings.pulse_force_n),
+            "pulse_duration_s": float(settings.pulse_duration_s),
+            "note": note,
+        }
+        for joint in JOINTS
+        for kind in ("K", "D")
+        for n in counts
+    ]
     return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
 
 
-def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, percent: float | None = None,
-                   half_width: float | None = None) -> int:
+def strides_needed(
+    stride_cov: StrideCovariance,
+    joint: str,
+    parameter: str,
+    *,
+    percent: float | None = None,
+    half_width: float | None = None,
+) -> int:
     """Fewest perturbed strides whose 95 % CI half-width on ``parameter`` of ``joint`` meets the target.
 
     Give either ``percent`` (of the planned value, e.g. 15 for +-15 %) or
@@ -434,8 +542,10 @@ def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, 
         if pct <= 0:
             raise LoperInputError(f"target percent must be > 0, got {pct:g}")
         if planned == 0:
-            raise LoperInputError(f"a relative target needs a planned {parameter} of the {joint} other than 0; "
-                                  "give an absolute half-width")
+            raise LoperInputError(
+                f"a relative target needs a planned {parameter} of the {joint} other than 0; "
+                "give an absolute half-width"
+            )
         target = pct / 100.0 * abs(planned)
     else:
         target = number("target half_width", half_width)
@@ -447,7 +557,7 @@ def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, 
         return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
 
     # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96
-    n = max(1, int(math.ceil((stdtrit(10 ** 6, 0.975) * sd1 / target) ** 2 * (1 - 1e-12))))
+    n = max(1, int(math.ceil((stdtrit(10**6, 0.975) * sd1 / target) ** 2 * (1 - 1e-12))))
     while not meets(n):
         t = stride_cov.t95(n)
         n = n + 1 if not math.isfinite(t) else max(n + 1, int(math.ceil((t * sd1 / target) ** 2 * (1 - 1e-12))))
@@ -456,14 +566,23 @@ def strides_needed(stride_cov: StrideCovariance, joint: str, parameter: str, *, 
     return n
 
 
-def target_answer(stride_cov: StrideCovariance, joint: str, parameter: str, onset_ms: float, *,
-                  percent: float | None = None, half_width: float | None = None) -> str:
+def target_answer(
+    stride_cov: StrideCovariance,
+    joint: str,
+    parameter: str,
+    onset_ms: float,
+    *,
+    percent: float | None = None,
+    half_width: float | None = None,
+) -> str:
     """One sentence: how many perturbed strides a target half-width on ``parameter`` of ``joint`` needs."""
     n = strides_needed(stride_cov, joint, parameter, percent=percent, half_width=half_width)
     i = PARAMETERS.index(f"{parameter}_{joint}")
     unit, planned = PARAMETER_UNITS[PARAMETERS[i]], float(stride_cov.impedance[i])
     reached = stride_cov.t95(n) * stride_cov.sd[i] / math.sqrt(n)
     wanted = f"±{percent:g} %" if percent is not None else f"±{half_width:g} {unit}"
-    return (f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
-            f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "
-            f"±{100 * reached / abs(planned) if planned else float('nan'):.3g} %)")
+    return (
+        f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
+        f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "
+        f"±{100 * reached / abs(planned) if planned else float('nan'):.3g} %)"
+    )

@@ -25,8 +25,9 @@ from .errors import LoperInputError
 __all__ = ["pulse_force_n", "pilot_perturbed_pairs"]
 
 
-def pulse_force_n(time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = 40.0,
-                  order: int = 4) -> np.ndarray:
+def pulse_force_n(
+    time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = 40.0, order: int = 4
+) -> np.ndarray:
     """The rod force (N, along the rods) of a rectangular desired pulse, at ``time_s`` (s, onset at 0).
 
     The desired force ``force_n`` for ``0 <= t < duration_s`` drives the
@@ -61,8 +62,15 @@ def pulse_force_n(time_s, force_n: float, duration_s: float, device=None, cutoff
     return np.interp(t, t_dev, force, left=0.0, right=float(force[-1]))
 
 
-def pilot_perturbed_pairs(trials: Sequence[Mapping], onset_ms: float, response=None, *, side: str = "left",
-                          onset_tolerance_ms: float = 12.5, source: str = "pilot") -> dict | None:
+def pilot_perturbed_pairs(
+    trials: Sequence[Mapping],
+    onset_ms: float,
+    response=None,
+    *,
+    side: str = "left",
+    onset_tolerance_ms: float = 12.5,
+    source: str = "pilot",
+) -> dict | None:
     """The pilot's kept perturbed pairs at ``onset_ms`` one by one (format of ``null_pairs``), or None.
 
     ``trials``: ``name``, ``angles`` and ``strides`` tables of the pilot's
@@ -88,15 +96,23 @@ def pilot_perturbed_pairs(trials: Sequence[Mapping], onset_ms: float, response=N
         delay_ms = delay_ms[np.isfinite(delay_ms)]
         if delay_ms.size and abs(float(np.median(delay_ms)) - float(onset_ms)) <= onset_tolerance_ms:
             n = len(tr["angles"])
-            own.append({"name": tr["name"], "angles": tr["angles"], "strides": table,
-                        "force": pd.DataFrame({"time_s": tr["angles"]["time_s"].to_numpy(float),
-                                               "force_measured_n": np.zeros(n)}),
-                        "force_direction": np.tile([1.0, 0.0], (n, 1))})
+            own.append(
+                {
+                    "name": tr["name"],
+                    "angles": tr["angles"],
+                    "strides": table,
+                    "force": pd.DataFrame(
+                        {"time_s": tr["angles"]["time_s"].to_numpy(float), "force_measured_n": np.zeros(n)}
+                    ),
+                    "force_direction": np.tile([1.0, 0.0], (n, 1)),
+                }
+            )
     if not own:
         return None
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TooFewStridesWarning)
-        _, _, series = subject_onset_response(own, onset_ms, response or ResponseSettings(), side=side,
-                                              source=f"{source}, perturbed pairs")
+        _, _, series = subject_onset_response(
+            own, onset_ms, response or ResponseSettings(), side=side, source=f"{source}, perturbed pairs"
+        )
     pairs = series["pairs"]
     return pairs if int(pairs["n_pairs"]) > 0 else None

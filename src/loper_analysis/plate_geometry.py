@@ -24,8 +24,9 @@ from .errors import LoperInputError
 __all__ = ["plate_axes", "plate_offsets"]
 
 
-def plate_axes(corners_m, vertical_axis: int | None, source: str,
-               up: Sequence[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def plate_axes(
+    corners_m, vertical_axis: int | None, source: str, up: Sequence[float] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Centre and axes of one plate.
 
     Parameters
@@ -86,8 +87,9 @@ def plate_axes(corners_m, vertical_axis: int | None, source: str,
     return c.mean(axis=0), np.vstack([u, np.cross(n, u), n])
 
 
-def plate_offsets(points_m, corners_m, vertical_axis: int | None = None, source: str = "",
-                  up: Sequence[float] | None = None) -> tuple[np.ndarray, np.ndarray]:
+def plate_offsets(
+    points_m, corners_m, vertical_axis: int | None = None, source: str = "", up: Sequence[float] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """Horizontal distance outside a plate and height above it of points (heel markers).
 
     The horizontal plane is the plate's plane: the normal is inferred from

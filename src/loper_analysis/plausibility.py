@@ -72,8 +72,9 @@ def marker_extent_m(markers_m) -> float:
     return float(np.median(spans)) if spans else float("nan")
 
 
-def require_marker_extent(markers_m, source: str = "", extent_range_m: Sequence[float] = (0.1, 5.0),
-                          unit_field: str = "POINT:UNITS") -> float:
+def require_marker_extent(
+    markers_m, source: str = "", extent_range_m: Sequence[float] = (0.1, 5.0), unit_field: str = "POINT:UNITS"
+) -> float:
     """Refuse markers whose spread (:func:`marker_extent_m`) lies outside ``extent_range_m`` (m); returns it.
 
     A spread 10 or 1000 times too large or too small means the numbers are
@@ -91,8 +92,9 @@ def require_marker_extent(markers_m, source: str = "", extent_range_m: Sequence[
     return extent
 
 
-def measurement_scale_factors(model, measurements: Mapping[str, Sequence[tuple[str, str]]], markers_m,
-                              labels: Sequence[str]) -> dict[str, float]:
+def measurement_scale_factors(
+    model, measurements: Mapping[str, Sequence[tuple[str, str]]], markers_m, labels: Sequence[str]
+) -> dict[str, float]:
     """ScaleTool's factor of each measurement: mean over its marker pairs of data distance / model distance.
 
     Parameters
@@ -133,8 +135,9 @@ def measurement_scale_factors(model, measurements: Mapping[str, Sequence[tuple[s
     return out
 
 
-def require_scale_factors(factors: Mapping[str, float], source: str = "",
-                          factor_range: Sequence[float] = (0.5, 2.0)) -> None:
+def require_scale_factors(
+    factors: Mapping[str, float], source: str = "", factor_range: Sequence[float] = (0.5, 2.0)
+) -> None:
     """Refuse scale factors outside ``factor_range``: the static trial's distances are not the model's kind.
 
     All offending measurements are named with their factor.
@@ -149,8 +152,13 @@ def require_scale_factors(factors: Mapping[str, float], source: str = "",
         )
 
 
-def require_ik_fit(marker_rms_m, source: str = "", max_rms_m: float = IK_STOP_RMS_M,
-                   max_fraction: float = IK_MAX_FRACTION, warn_rms_m: float | None = IK_WARN_RMS_M) -> str | None:
+def require_ik_fit(
+    marker_rms_m,
+    source: str = "",
+    max_rms_m: float = IK_STOP_RMS_M,
+    max_fraction: float = IK_MAX_FRACTION,
+    warn_rms_m: float | None = IK_WARN_RMS_M,
+) -> str | None:
     """Refuse an IK solution whose marker RMS error exceeds ``max_rms_m`` (m) in more than ``max_fraction`` of frames.
 
     ``marker_rms_m`` (n_frames,) is :attr:`loper_analysis.kinematics.IKResult.marker_rms_m`;
@@ -183,7 +191,9 @@ def require_ik_fit(marker_rms_m, source: str = "", max_rms_m: float = IK_STOP_RM
         return None
     poor = rms > float(warn_rms_m)
     if poor.mean() > float(max_fraction):
-        return (f"{where(source)}IK marker RMS error exceeds {1e3 * warn_rms_m:g} mm in {int(poor.sum())} of "
-                f"{rms.size} frames ({100 * poor.mean():.1f} %); {stats}: check the marker placement on the model "
-                "(scaling) and the IK weights (warning level: opensim.warn_marker_rms_m)")
+        return (
+            f"{where(source)}IK marker RMS error exceeds {1e3 * warn_rms_m:g} mm in {int(poor.sum())} of "
+            f"{rms.size} frames ({100 * poor.mean():.1f} %); {stats}: check the marker placement on the model "
+            "(scaling) and the IK weights (warning level: opensim.warn_marker_rms_m)"
+        )
     return None

@@ -20,8 +20,16 @@ import numpy as np
 from .checks import positive
 from .errors import LoperInputError
 
-__all__ = ["second_order_parameters", "step_response", "pulse_force", "find_force_pulses",
-           "PULSE_MIN_DURATION_S", "PULSE_MAX_DURATION_S", "PULSE_MIN_THRESHOLD_N", "PULSE_THRESHOLD_SDS"]
+__all__ = [
+    "second_order_parameters",
+    "step_response",
+    "pulse_force",
+    "find_force_pulses",
+    "PULSE_MIN_DURATION_S",
+    "PULSE_MAX_DURATION_S",
+    "PULSE_MIN_THRESHOLD_N",
+    "PULSE_THRESHOLD_SDS",
+]
 
 #: Shortest and longest run above the threshold that counts as a force pulse, s (the study's pulse: 0.1 s; the
 #: robot's start-up transient rings in half-periods of about 10 ms).
@@ -37,7 +45,8 @@ _BLOCK_S = 0.01
 
 
 def second_order_parameters(rise_time_s: float, overshoot_pct: float) -> tuple[float, float]:
-    """Damping ratio (-) and natural frequency (rad/s) of a step response with this rise time (10-90 %, s) and overshoot (%).
+    """Damping ratio (-) and natural frequency (rad/s) of a step response with this rise time (10-90 %, s) and
+    overshoot (%).
 
     Raises
     ------
@@ -69,8 +78,9 @@ def step_response(time_s, rise_time_s: float, overshoot_pct: float) -> np.ndarra
     return np.where(t > 0.0, _unit_step(wn * t, zeta), 0.0)
 
 
-def pulse_force(time_s, onset_s: float, duration_s: float, force_n: float, rise_time_s: float,
-                overshoot_pct: float) -> np.ndarray:
+def pulse_force(
+    time_s, onset_s: float, duration_s: float, force_n: float, rise_time_s: float, overshoot_pct: float
+) -> np.ndarray:
     """Force (n,) in N of a pulse commanded from ``onset_s`` for ``duration_s`` (s), as the robot delivers it.
 
     ``force_n * (y(t - onset_s) - y(t - onset_s - duration_s))`` with ``y`` the
@@ -78,13 +88,20 @@ def pulse_force(time_s, onset_s: float, duration_s: float, force_n: float, rise_
     """
     duration = positive("duration_s", duration_s)
     t = np.asarray(time_s, dtype=float)
-    return force_n * (step_response(t - onset_s, rise_time_s, overshoot_pct)
-                      - step_response(t - onset_s - duration, rise_time_s, overshoot_pct))
+    return force_n * (
+        step_response(t - onset_s, rise_time_s, overshoot_pct)
+        - step_response(t - onset_s - duration, rise_time_s, overshoot_pct)
+    )
 
 
-def find_force_pulses(force_n, sample_rate_hz: float, min_duration_s: float = PULSE_MIN_DURATION_S,
-                      max_duration_s: float = PULSE_MAX_DURATION_S, threshold_n: float | None = None,
-                      source: str = "") -> np.ndarray:
+def find_force_pulses(
+    force_n,
+    sample_rate_hz: float,
+    min_duration_s: float = PULSE_MIN_DURATION_S,
+    max_duration_s: float = PULSE_MAX_DURATION_S,
+    threshold_n: float | None = None,
+    source: str = "",
+) -> np.ndarray:
     """Force pulses in a measured force: runs far from its slowly varying baseline, of pulse-like duration.
 
     The baseline is a running median over ``_BASELINE_WINDOW_S`` (1 s) of 10 ms
@@ -162,7 +179,7 @@ def _baseline(f: np.ndarray, rate: float) -> np.ndarray:
     nb = n // block
     if nb < 3:
         return np.full(n, np.nanmedian(f))
-    means = np.nanmean(f[:nb * block].reshape(nb, block), axis=1)
+    means = np.nanmean(f[: nb * block].reshape(nb, block), axis=1)
     means = np.where(np.isfinite(means), means, np.nanmedian(means))
     size = 2 * int(round(0.5 * _BASELINE_WINDOW_S / (block / rate))) + 1
     smooth = median_filter(means, size=min(size, nb - 1 + nb % 2), mode="nearest")  # odd, at most nb

@@ -90,6 +90,13 @@ LITERATURE: tuple[tuple[str, str, tuple[float, float], tuple[float | None, float
     ("position perturbation, static", "hip", (75.0, 318.0), (2.0, 21.0)),
     ("position perturbation, static", "knee", (36.0, 75.0), (1.8, 2.2)),
     ("position perturbation, imposed motion", "knee", (25.0, 30.0), (None, None)),
-    *(("the study: swing phase, across-subject mean over onsets", joint, STUDY_SWING_IMPEDANCE[joint]["K"],
-        STUDY_SWING_IMPEDANCE[joint]["D"]) for joint in ("hip", "knee")),
+    *(
+        (
+            "the study: swing phase, across-subject mean over onsets",
+            joint,
+            STUDY_SWING_IMPEDANCE[joint]["K"],
+            STUDY_SWING_IMPEDANCE[joint]["D"],
+        )
+        for joint in ("hip", "knee")
+    ),
 )

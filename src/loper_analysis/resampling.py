@@ -54,7 +54,7 @@ def _interpolate(t: np.ndarray, v: np.ndarray, targets: np.ndarray, source: str)
         hit = np.flatnonzero(cum[last + 1] - cum[first] > 0)
         if hit.size:
             w = hit[0]
-            s = first[w] + np.flatnonzero(bad[first[w]:last[w] + 1])[0]
+            s = first[w] + np.flatnonzero(bad[first[w] : last[w] + 1])[0]
             raise LoperInputError(
                 f"{where(source)}values are not finite at sample {s} (t = {float(t[s])!r} s), inside window {w}"
             )
@@ -102,9 +102,7 @@ def cut(time_s, values, starts_s, ends_s, n_points: int = 101, source: str = "")
     a = np.atleast_1d(np.asarray(starts_s, dtype=float))
     b = np.atleast_1d(np.asarray(ends_s, dtype=float))
     if a.ndim != 1 or a.shape != b.shape:
-        raise LoperInputError(
-            f"{where(source)}starts_s {a.shape} and ends_s {b.shape} must be 1-D of equal length"
-        )
+        raise LoperInputError(f"{where(source)}starts_s {a.shape} and ends_s {b.shape} must be 1-D of equal length")
     wrong = np.flatnonzero(~(np.isfinite(a) & np.isfinite(b) & (a < b)))
     if wrong.size:
         w = wrong[0]
@@ -134,8 +132,7 @@ def normalise(
     missing = {start, end} - set(stride_table.columns)
     if missing:
         raise LoperInputError(f"{where(source)}stride_table lacks column(s) {sorted(missing)}")
-    return cut(time_s, values, stride_table[start].to_numpy(float), stride_table[end].to_numpy(float),
-               n_points, source)
+    return cut(time_s, values, stride_table[start].to_numpy(float), stride_table[end].to_numpy(float), n_points, source)
 
 
 def window_times_s(before_s: float, after_s: float, rate_hz: float) -> np.ndarray:

@@ -38,7 +38,8 @@ def _sets(layer, key_path: Sequence) -> bool:
     node = layer
     for key in key_path:
         found = (isinstance(node, Mapping) and key in node) or (
-            isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node))
+            isinstance(node, list) and isinstance(key, int) and 0 <= key < len(node)
+        )
         if not found:
             return False
         node = node[key]
@@ -74,8 +75,9 @@ def _offending_path(error) -> list:
     return path
 
 
-def check_config(data: dict, schema_path: str | Path, source: str = "config",
-                 layers: ConfigLayers | None = None) -> None:
+def check_config(
+    data: dict, schema_path: str | Path, source: str = "config", layers: ConfigLayers | None = None
+) -> None:
     """Raise LoperInputError naming the source, the first offending key (dotted path) and the problem.
 
     ``source`` names the configuration; with ``layers`` (:data:`ConfigLayers`)
@@ -138,9 +140,10 @@ def check_yaml_file(path: str | Path, what: str = "config file") -> None:
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
-        line = data[:exc.start].count(b"\n") + 1
-        raise LoperInputError(f"{path}: line {line}: the {what} is not UTF-8 text (byte {data[exc.start]:#04x} at "
-                              f"offset {exc.start})") from None
+        line = data[: exc.start].count(b"\n") + 1
+        raise LoperInputError(
+            f"{path}: line {line}: the {what} is not UTF-8 text (byte {data[exc.start]:#04x} at offset {exc.start})"
+        ) from None
     try:
         documents = list(yaml.compose_all(text, Loader=yaml.SafeLoader))
     except yaml.MarkedYAMLError as exc:
@@ -148,7 +151,8 @@ def check_yaml_file(path: str | Path, what: str = "config file") -> None:
         context = ""
         if exc.context:
             context = f" ({exc.context}" + (
-                f" that starts at {_mark(exc.context_mark)})" if exc.context_mark is not None else ")")
+                f" that starts at {_mark(exc.context_mark)})" if exc.context_mark is not None else ")"
+            )
         raise LoperInputError(f"{path}: {where}: YAML syntax error: {exc.problem}{context}") from None
     except yaml.YAMLError as exc:
         raise LoperInputError(f"{path}: YAML syntax error: {' '.join(str(exc).split())}") from None

@@ -95,8 +95,9 @@ def _body_names(model) -> list[str]:
     return [bodies.get(i).getName() for i in range(bodies.getSize())]
 
 
-def segment_body_names(model, side: str, segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                       source: str = "") -> dict[str, list[str]]:
+def segment_body_names(
+    model, side: str, segment_bodies: Mapping[str, Sequence[str]] | None = None, source: str = ""
+) -> dict[str, list[str]]:
     """The bodies of each segment (thigh, shank, foot) of an ``opensim.Model`` for one side (``"l"`` or ``"r"``).
 
     ``segment_bodies`` maps each segment to body names with ``{s}`` for the
@@ -115,14 +116,16 @@ def segment_body_names(model, side: str, segment_bodies: Mapping[str, Sequence[s
         raise LoperInputError(f"side must be 'l' or 'r' (OpenSim suffix), got {side!r}")
     present = _body_names(model)
     if segment_bodies is None:
-        segment_bodies = (GENERATED_MODEL_BODIES if f"thigh_{side}" in present else DEFAULT_SEGMENT_BODIES)
+        segment_bodies = GENERATED_MODEL_BODIES if f"thigh_{side}" in present else DEFAULT_SEGMENT_BODIES
     out: dict[str, list[str]] = {}
     for seg in SEGMENTS:
         names = segment_bodies.get(seg) if isinstance(segment_bodies, Mapping) else None
         if isinstance(names, str):
             names = [names]
         if not names:
-            raise LoperInputError(f"{SEGMENT_BODIES_SETTING}: segment '{seg}' needs a list of body names, got {names!r}")
+            raise LoperInputError(
+                f"{SEGMENT_BODIES_SETTING}: segment '{seg}' needs a list of body names, got {names!r}"
+            )
         chosen = []
         for raw in names:
             optional = str(raw).endswith("?")
@@ -135,15 +138,22 @@ def segment_body_names(model, side: str, segment_bodies: Mapping[str, Sequence[s
                     f"(its bodies: {', '.join(present)})"
                 )
         if not chosen:
-            raise LoperInputError(f"{_model_file(model, source)}: {SEGMENT_BODIES_SETTING}: no body of the {seg} "
-                                  f"({list(names)}) is in the model")
+            raise LoperInputError(
+                f"{_model_file(model, source)}: {SEGMENT_BODIES_SETTING}: no body of the {seg} "
+                f"({list(names)}) is in the model"
+            )
         out[seg] = chosen
     return out
 
 
-def check_segment_bodies(model, segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                         sides: Sequence[str] = ("l", "r"), source: str = "") -> None:
-    """Raise :class:`LoperInputError` unless the model has every configured body on each side (see :func:`segment_body_names`)."""
+def check_segment_bodies(
+    model,
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    sides: Sequence[str] = ("l", "r"),
+    source: str = "",
+) -> None:
+    """Raise :class:`LoperInputError` unless the model has every configured body on each side (see
+    :func:`segment_body_names`)."""
     for side in sides:
         segment_body_names(model, side, segment_bodies, source)
 
@@ -181,7 +191,9 @@ def _inertia(body) -> np.ndarray:
     return np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
 
 
-def _combined(model, state, names: list[str], origin: np.ndarray, to_segment: np.ndarray) -> tuple[float, np.ndarray, float]:
+def _combined(
+    model, state, names: list[str], origin: np.ndarray, to_segment: np.ndarray
+) -> tuple[float, np.ndarray, float]:
     """Mass (kg), COM (x, y) (m) and inertia about z at the COM (kg m^2) of rigidly joined bodies in a segment frame.
 
     ``to_segment`` (3, 3) turns ground vectors into the segment frame, whose
@@ -206,9 +218,14 @@ def _combined(model, state, names: list[str], origin: np.ndarray, to_segment: np
     return total, c, inertia
 
 
-def segments_from_model(model, side: str = "l", segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                        attachment_fraction: float = 0.8, brace_markers: Sequence[str] = BRACE_MARKERS,
-                        source: str = "") -> SegmentParameters:
+def segments_from_model(
+    model,
+    side: str = "l",
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    attachment_fraction: float = 0.8,
+    brace_markers: Sequence[str] = BRACE_MARKERS,
+    source: str = "",
+) -> SegmentParameters:
     """Swing-leg segment table of one leg of a (scaled) ``opensim.Model``, in the model's default pose.
 
     Parameters

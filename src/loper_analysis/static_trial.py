@@ -65,8 +65,13 @@ def time_range_is_set(time_range) -> bool:
     return bool(np.isfinite(a) and np.isfinite(b) and a <= b and not (a < 0 and b < 0))
 
 
-def scale_window_s(time_s, setup_ranges_s: Sequence[Sequence[float] | None] = (), duration_s: float | None = None,
-                   source: str = "", setting: str = "time_range of the scale setup") -> tuple[float, float]:
+def scale_window_s(
+    time_s,
+    setup_ranges_s: Sequence[Sequence[float] | None] = (),
+    duration_s: float | None = None,
+    source: str = "",
+    setting: str = "time_range of the scale setup",
+) -> tuple[float, float]:
     """The span of the static trial that scaling averages (s, the file's clock).
 
     Parameters
@@ -147,9 +152,17 @@ def _named(marker: str, lab_labels: Mapping[str, str] | None) -> str:
     return f"'{label}' (model marker {marker})" if label and label != marker else f"'{marker}'"
 
 
-def static_pose(time_s, markers_m, labels: Sequence[str], window_s: tuple[float, float], needed: Sequence[str] = (),
-                lab_labels: Mapping[str, str] | None = None, source: str = "",
-                setting: str = "time_range of the scale setup", max_motion_rms_m: float | None = None) -> StaticPose:
+def static_pose(
+    time_s,
+    markers_m,
+    labels: Sequence[str],
+    window_s: tuple[float, float],
+    needed: Sequence[str] = (),
+    lab_labels: Mapping[str, str] | None = None,
+    source: str = "",
+    setting: str = "time_range of the scale setup",
+    max_motion_rms_m: float | None = None,
+) -> StaticPose:
     """The frames of ``window_s`` with every marker complete (module docstring).
 
     Parameters
@@ -188,8 +201,10 @@ def static_pose(time_s, markers_m, labels: Sequence[str], window_s: tuple[float,
         raise LoperInputError(f"{where(source)}markers_m must have shape ({t.size}, {len(labels)}, 3), got {X.shape}")
     lacking = [m for m in needed if m not in labels]
     if lacking:
-        raise LoperInputError(f"{where(source)}static trial lacks marker(s) {sorted(set(lacking))} needed for scaling "
-                              "(map the lab's labels to them in markers.label_map)")
+        raise LoperInputError(
+            f"{where(source)}static trial lacks marker(s) {sorted(set(lacking))} needed for scaling "
+            "(map the lab's labels to them in markers.label_map)"
+        )
     start, end = window_s
     sel = (t >= start - 1e-9) & (t <= end + 1e-9)
     W = X[sel].copy()
@@ -230,8 +245,13 @@ def _motion_rms_m(points_m: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((points_m - points_m.mean(axis=0)) ** 2, axis=1))))
 
 
-def standing_mass_kg(time_s, vertical_force_n, window_s: tuple[float, float],
-                     gravity_m_per_s2: float = GRAVITY_M_PER_S2, source: str = "") -> float:
+def standing_mass_kg(
+    time_s,
+    vertical_force_n,
+    window_s: tuple[float, float],
+    gravity_m_per_s2: float = GRAVITY_M_PER_S2,
+    source: str = "",
+) -> float:
     """Body mass (kg) of a subject standing on force plates: mean total vertical force over the window / g.
 
     Parameters
@@ -259,8 +279,10 @@ def standing_mass_kg(time_s, vertical_force_n, window_s: tuple[float, float],
     total = F.sum(axis=1) if F.ndim == 2 else F
     sel = (t >= window_s[0] - 1e-9) & (t <= window_s[1] + 1e-9) & np.isfinite(total)
     if not sel.any():
-        raise LoperInputError(f"{where(source)}no force-plate sample in the window {window_s[0]:.4f} .. "
-                              f"{window_s[1]:.4f} s of the static trial")
+        raise LoperInputError(
+            f"{where(source)}no force-plate sample in the window {window_s[0]:.4f} .. "
+            f"{window_s[1]:.4f} s of the static trial"
+        )
     mean = float(total[sel].mean())
     mass = mean / float(gravity_m_per_s2)
     lo, hi = MASS_RANGE_KG
@@ -280,7 +302,8 @@ def standing_mass_kg(time_s, vertical_force_n, window_s: tuple[float, float],
 
 
 def model_height_m(model, thigh_body: str) -> float:
-    """Stature (m) of a scaled model: its hip joint centre's height over its lowest marker / :data:`HIP_HEIGHT_FRACTION`.
+    """Stature (m) of a scaled model: its hip joint centre's height over its lowest marker /
+    :data:`HIP_HEIGHT_FRACTION`.
 
     ``model`` is an ``opensim.Model`` in its default pose; ``thigh_body``
     the thigh (femur) body, whose origin is the hip joint centre (gait2392,

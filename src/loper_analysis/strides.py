@@ -99,9 +99,7 @@ def force_phase_metrics(time_s, force_n, stride_table: pd.DataFrame, source: str
     t = np.asarray(time_s, dtype=float)
     f = np.asarray(force_n, dtype=float)
     if t.ndim != 1 or f.shape != t.shape or t.size < 2:
-        raise LoperInputError(
-            f"{where(source)}time_s {t.shape} and force_n {f.shape} must be 1-D of equal length >= 2"
-        )
+        raise LoperInputError(f"{where(source)}time_s {t.shape} and force_n {f.shape} must be 1-D of equal length >= 2")
     for name, a in (("time_s", t), ("force_n", f)):
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
@@ -139,17 +137,27 @@ def force_phase_metrics(time_s, force_n, stride_table: pd.DataFrame, source: str
         rms.append(np.sqrt((square[hi] - square[lo]) / (hi - lo)))
         peak.append(np.array([absf[i:j].max() for i, j in zip(lo, hi)]))  # a loop per stride, not per sample
     n_phases = len(FORCE_PHASES)
-    return pd.DataFrame({
-        "stride": np.repeat(stride_table["stride"].to_numpy(), n_phases),
-        "phase": np.tile(FORCE_PHASES, len(stride_table)),
-        "rms_force_n": np.column_stack(rms).ravel(),
-        "max_abs_force_n": np.column_stack(peak).ravel(),
-    })
+    return pd.DataFrame(
+        {
+            "stride": np.repeat(stride_table["stride"].to_numpy(), n_phases),
+            "phase": np.tile(FORCE_PHASES, len(stride_table)),
+            "rms_force_n": np.column_stack(rms).ravel(),
+            "max_abs_force_n": np.column_stack(peak).ravel(),
+        }
+    )
 
 
-def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFrame | None = None,
-                  side: str = "left", n_points: int = 101, whisker: float = 1.5, max_fraction: float = 0.2,
-                  min_valid: int = 5, sources: Mapping[str, str] | None = None) -> StrideTables:
+def stride_tables(
+    angles: pd.DataFrame,
+    events: pd.DataFrame,
+    force: pd.DataFrame | None = None,
+    side: str = "left",
+    n_points: int = 101,
+    whisker: float = 1.5,
+    max_fraction: float = 0.2,
+    min_valid: int = 5,
+    sources: Mapping[str, str] | None = None,
+) -> StrideTables:
     """Strides of one leg, their outlier verdicts and the time-normalised cycles.
 
     Strides run heel strike to heel strike of ``side`` (``events``:
@@ -212,8 +220,9 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
     complete = np.isfinite(values).all(axis=1)
     whole = [bool(complete[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
     if not all(whole):
-        log.info("%s: %d stride(s) with frames left out of IK (NaN angles) dropped", names["angles"],
-                 len(whole) - sum(whole))
+        log.info(
+            "%s: %d stride(s) with frames left out of IK (NaN angles) dropped", names["angles"], len(whole) - sum(whole)
+        )
         table = table[whole].reset_index(drop=True)
     table["stride"] = np.arange(len(table))
     force_n = None
@@ -244,11 +253,17 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
         warnings.warn(
             f"{names['angles']}: {int(plain.sum())} complete unperturbed {side} stride(s) with events from "
             f"{names['events']}; the outlier rule needs at least {MIN_STRIDES_FOR_OUTLIERS}: none judged",
-            TooFewStridesWarning, stacklevel=2,
+            TooFewStridesWarning,
+            stacklevel=2,
         )
-        verdict = pd.DataFrame({"stride": np.arange(int(plain.sum()), dtype=np.int64),
-                                **{f"fraction_outlying_{j}": np.nan for j in joint_names},
-                                "removed": False, "reason": ""})
+        verdict = pd.DataFrame(
+            {
+                "stride": np.arange(int(plain.sum()), dtype=np.int64),
+                **{f"fraction_outlying_{j}": np.nan for j in joint_names},
+                "removed": False,
+                "reason": "",
+            }
+        )
     verdict["stride"] = table.loc[plain, "stride"].to_numpy()
     out = table.merge(verdict, on="stride", how="left")
     out["removed"] = out["removed"].fillna(False).astype(bool)
@@ -260,16 +275,28 @@ def stride_tables(angles: pd.DataFrame, events: pd.DataFrame, force: pd.DataFram
         if logged.sum() >= 2 or len(table):
             metrics = force_phase_metrics(t[logged], force_n[logged], table, source=names["force"])
         else:  # no stride and (almost) no robot log: the columns without rows
-            metrics = pd.DataFrame({"stride": np.empty(0, np.int64), "phase": np.empty(0, object),
-                                    "rms_force_n": np.empty(0), "max_abs_force_n": np.empty(0)})
+            metrics = pd.DataFrame(
+                {
+                    "stride": np.empty(0, np.int64),
+                    "phase": np.empty(0, object),
+                    "rms_force_n": np.empty(0),
+                    "max_abs_force_n": np.empty(0),
+                }
+            )
         wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
         wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
         # the same columns without any stride
         wide = wide.reindex(columns=[f"{m}_{ph}_n" for m in ("rms_force", "max_abs_force") for ph in FORCE_PHASES])
         out = out.merge(wide.reset_index(), on="stride")
     n_kept = int((~out["removed"] & ~out["perturbed"]).sum())
-    log.info("%s: %d strides, %d perturbed, %d removed as outliers, %d unperturbed kept", names["angles"], len(out),
-             int(out["perturbed"].sum()), int(out["removed"].sum()), n_kept)
+    log.info(
+        "%s: %d strides, %d perturbed, %d removed as outliers, %d unperturbed kept",
+        names["angles"],
+        len(out),
+        int(out["perturbed"].sum()),
+        int(out["removed"].sum()),
+        n_kept,
+    )
     for r in out[out["removed"]].itertuples():
         log.info("stride %d removed: %s", r.stride, r.reason)
     too_few = not check_enough_strides(n_kept, names["angles"], min_valid)
@@ -299,8 +326,11 @@ def _mean_duration_s(table: pd.DataFrame, source: str) -> float:
     return float(duration.mean())
 
 
-def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: int = 5,
-                   contacts: Mapping[tuple[str, str], pd.DataFrame] | None = None) -> pd.DataFrame:
+def stride_summary(
+    tables: Mapping[tuple[str, str], pd.DataFrame],
+    min_valid: int = 5,
+    contacts: Mapping[tuple[str, str], pd.DataFrame] | None = None,
+) -> pd.DataFrame:
     """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.
 
     ``tables``: ``{(subject, trial): stride table}`` of :func:`stride_tables`.
@@ -338,16 +368,25 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
         signals = [c.removeprefix("fraction_outlying_") for c in table.columns if c.startswith("fraction_outlying_")]
         reasons = removed["reason"].fillna("").astype(str)  # a column without any reason reads as float
         why = {s: int(reasons.str.contains(f"{s}:").sum()) for s in signals}
-        perturbed = (bool_column(table, "perturbed", source, "stride table") if "perturbed" in table.columns
-                     else np.zeros(len(table), dtype=bool))
+        perturbed = (
+            bool_column(table, "perturbed", source, "stride table")
+            if "perturbed" in table.columns
+            else np.zeros(len(table), dtype=bool)
+        )
         n_kept = int((~removed_mask & ~perturbed).sum())
-        rows.append({
-            "subject": subject, "trial": trial, "n_strides": len(table), "n_perturbed": int(perturbed.sum()),
-            "n_removed": len(removed), "n_kept": n_kept,
-            **{f"n_removed_{s}": n for s, n in why.items()},
-            "mean_stride_s": _mean_duration_s(table, source),
-            "status": "ok" if n_kept >= min_valid else "too_few_strides",
-        })
+        rows.append(
+            {
+                "subject": subject,
+                "trial": trial,
+                "n_strides": len(table),
+                "n_perturbed": int(perturbed.sum()),
+                "n_removed": len(removed),
+                "n_kept": n_kept,
+                **{f"n_removed_{s}": n for s, n in why.items()},
+                "mean_stride_s": _mean_duration_s(table, source),
+                "status": "ok" if n_kept >= min_valid else "too_few_strides",
+            }
+        )
         if with_contacts:
             from .contacts import count_flagged
 
@@ -355,8 +394,14 @@ def stride_summary(tables: Mapping[tuple[str, str], pd.DataFrame], min_valid: in
     return pd.DataFrame(rows)
 
 
-def phase_cycles(cycles: pd.DataFrame, strides: pd.DataFrame, phase: str, columns: Sequence[str],
-                 keep_removed: bool = False, source: str = "cycles") -> np.ndarray:
+def phase_cycles(
+    cycles: pd.DataFrame,
+    strides: pd.DataFrame,
+    phase: str,
+    columns: Sequence[str],
+    keep_removed: bool = False,
+    source: str = "cycles",
+) -> np.ndarray:
     """Normalised cycles of one phase as (n_strides, n_points, len(columns)).
 
     Perturbed strides and (unless ``keep_removed``) outliers are left out.

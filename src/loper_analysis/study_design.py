@@ -31,8 +31,9 @@ _PERTURBATION_NAME = re.compile(r"^pert(\d{3})-([1-9]\d*)$")
 def perturbation_trial_name(onset_ms: int, repeat: int) -> str:
     """The name of the ``repeat``-th (1-based) perturbation trial at onset ``onset_ms`` (0..999 ms)."""
     if not 0 <= int(onset_ms) <= 999 or int(repeat) < 1:
-        raise LoperInputError(f"perturbation trial: onset {onset_ms} ms must lie in 0 .. 999 and repeat {repeat} "
-                              "must be at least 1")
+        raise LoperInputError(
+            f"perturbation trial: onset {onset_ms} ms must lie in 0 .. 999 and repeat {repeat} must be at least 1"
+        )
     return f"pert{int(onset_ms):03d}-{int(repeat)}"
 
 
@@ -62,10 +63,14 @@ class StudyDesign:
     @classmethod
     def from_config(cls, trials: Mapping) -> StudyDesign:
         """The design of the config's ``trials`` section (validated by the schema)."""
-        return cls(static=str(trials["static"]), no_device=str(trials["no_device"]), device=str(trials["device"]),
-                   perturbation_onsets_ms=tuple(int(o) for o in trials["perturbation_onsets_ms"]),
-                   perturbation_repeats=int(trials["perturbation_repeats"]),
-                   perturbed_side=str(trials["perturbed_side"]))
+        return cls(
+            static=str(trials["static"]),
+            no_device=str(trials["no_device"]),
+            device=str(trials["device"]),
+            perturbation_onsets_ms=tuple(int(o) for o in trials["perturbation_onsets_ms"]),
+            perturbation_repeats=int(trials["perturbation_repeats"]),
+            perturbed_side=str(trials["perturbed_side"]),
+        )
 
     def perturbation_trials(self, onset_ms: int | None = None) -> list[str]:
         """Names of the perturbation trials, onset by onset (only ``onset_ms``'s when given)."""
@@ -95,8 +100,13 @@ class StudyDesign:
         LoperInputError
             A name that is no trial of the design (naming the design's trials).
         """
-        named = {self.static: "static", self.no_device: "no_device", self.device: "device",
-                 **dict.fromkeys(DEVICE_TESTS, "device_test"), **dict.fromkeys(self.perturbation_trials(), "perturbation")}
+        named = {
+            self.static: "static",
+            self.no_device: "no_device",
+            self.device: "device",
+            **dict.fromkeys(DEVICE_TESTS, "device_test"),
+            **dict.fromkeys(self.perturbation_trials(), "perturbation"),
+        }
         if trial not in named:
             raise LoperInputError(f"trial '{trial}' is no trial of the design ({', '.join(self.trials())})")
         return named[trial]

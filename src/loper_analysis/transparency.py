@@ -52,9 +52,17 @@ CONDITIONS: tuple[str, ...] = ("no_device", "device")
 TRANSPARENCY_PHASES: tuple[str, ...] = ("stance", "swing")
 #: Columns of :func:`transparency_table`.
 TRANSPARENCY_COLUMNS: tuple[str, ...] = (
-    "subject", "phase", "joint", "n_strides_no_device", "n_strides_device",
-    "rmsd_rad", "sd_rad", "isv_ave_rad", "transparent",
+    "subject",
+    "phase",
+    "joint",
+    "n_strides_no_device",
+    "n_strides_device",
+    "rmsd_rad",
+    "sd_rad",
+    "isv_ave_rad",
+    "transparent",
 )
+
 
 def strides_array(name: str, normalised, min_strides: int = 2) -> np.ndarray:
     """Normalised strides (n_strides >= ``min_strides``, n_points[, k]), finite; ``name`` is quoted in errors."""
@@ -243,12 +251,17 @@ def transparency_table(
         r = rmsd(mean_dev, mean_nod)
         s = within_subject_sd(arrays[isv_condition])
         for j, joint in enumerate(joints):
-            rows.append({
-                "subject": str(subject), "phase": phase, "joint": joint,
-                "n_strides_no_device": arrays["no_device"].shape[0],
-                "n_strides_device": arrays["device"].shape[0],
-                "rmsd_rad": float(r[j]), "sd_rad": float(s[j]),
-            })
+            rows.append(
+                {
+                    "subject": str(subject),
+                    "phase": phase,
+                    "joint": joint,
+                    "n_strides_no_device": arrays["no_device"].shape[0],
+                    "n_strides_device": arrays["device"].shape[0],
+                    "rmsd_rad": float(r[j]),
+                    "sd_rad": float(s[j]),
+                }
+            )
     table = pd.DataFrame(rows)
     group = table.groupby(["phase", "joint"], sort=False)
     summary = group.agg(
@@ -299,13 +312,28 @@ def _kept(strides: pd.DataFrame) -> int:
 
 def _flagged_rows(subject: str, counts: Mapping[str, int], joints: Sequence[str]) -> list[dict]:
     """Rows of a subject left out of the comparison: the stride counts, the metrics empty."""
-    return [{"subject": str(subject), "phase": ph, "joint": j, "n_strides_no_device": counts["no_device"],
-             "n_strides_device": counts["device"], "rmsd_rad": np.nan, "sd_rad": np.nan, "isv_ave_rad": np.nan,
-             "transparent": None} for ph in TRANSPARENCY_PHASES for j in joints]
+    return [
+        {
+            "subject": str(subject),
+            "phase": ph,
+            "joint": j,
+            "n_strides_no_device": counts["no_device"],
+            "n_strides_device": counts["device"],
+            "rmsd_rad": np.nan,
+            "sd_rad": np.nan,
+            "isv_ave_rad": np.nan,
+            "transparent": None,
+        }
+        for ph in TRANSPARENCY_PHASES
+        for j in joints
+    ]
 
 
-def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, pd.DataFrame]]],
-                         side: str = "left", min_strides: int = MIN_VALID_STRIDES) -> TransparencyResults:
+def transparency_results(
+    trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, pd.DataFrame]]],
+    side: str = "left",
+    min_strides: int = MIN_VALID_STRIDES,
+) -> TransparencyResults:
     """Transparency of the device from each subject's stride and cycle tables with and without it.
 
     ``trials``: ``{subject: {"no_device": (strides, cycles), "device": (strides, cycles)}}``,
@@ -322,9 +350,12 @@ def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, p
     counts = {subject: {c: _kept(conds[c][0]) for c in CONDITIONS if c in conds} for subject, conds in trials.items()}
     left_out = {s: n for s, n in counts.items() if len(n) == len(CONDITIONS) and min(n.values()) < least}
     for subject, n in left_out.items():
-        warnings.warn(f"subject {subject}: {n['no_device']} kept stride(s) without and {n['device']} with the "
-                      f"device, fewer than {least}: left out of the transparency analysis", TooFewStridesWarning,
-                      stacklevel=2)
+        warnings.warn(
+            f"subject {subject}: {n['no_device']} kept stride(s) without and {n['device']} with the "
+            f"device, fewer than {least}: left out of the transparency analysis",
+            TooFewStridesWarning,
+            stacklevel=2,
+        )
     if left_out:
         return _results_without(trials, left_out, side, least)
     per_subject, force_rows, pooled, pooled_force, toe_off = {}, [], {"no_device": [], "device": []}, [], {}
@@ -338,26 +369,43 @@ def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, p
             if cond == "device":
                 pooled_force.append(phase_cycles(cycles, strides, "stride", ["force_n"])[:, :, 0])
                 for ph in TRANSPARENCY_PHASES:
-                    force_rows.append({
-                        "subject": subject, "phase": ph, "n_strides": len(kept),
-                        "rms_force_mean_n": kept[f"rms_force_{ph}_n"].mean(),
-                        "rms_force_sd_n": kept[f"rms_force_{ph}_n"].std(ddof=1),
-                        "max_abs_force_mean_n": kept[f"max_abs_force_{ph}_n"].mean(),
-                        "max_abs_force_sd_n": kept[f"max_abs_force_{ph}_n"].std(ddof=1),
-                    })
+                    force_rows.append(
+                        {
+                            "subject": subject,
+                            "phase": ph,
+                            "n_strides": len(kept),
+                            "rms_force_mean_n": kept[f"rms_force_{ph}_n"].mean(),
+                            "rms_force_sd_n": kept[f"rms_force_{ph}_n"].std(ddof=1),
+                            "max_abs_force_mean_n": kept[f"max_abs_force_{ph}_n"].mean(),
+                            "max_abs_force_sd_n": kept[f"max_abs_force_{ph}_n"].std(ddof=1),
+                        }
+                    )
     rmsd = transparency_table(per_subject, JOINTS)
-    study = pd.DataFrame([{"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}
-                          for (ph, j), (r, isv) in STUDY_TRANSPARENCY_RAD.items()])
+    study = pd.DataFrame(
+        [
+            {"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}
+            for (ph, j), (r, isv) in STUDY_TRANSPARENCY_RAD.items()
+        ]
+    )
     rmsd = rmsd.merge(study, on=["phase", "joint"], how="left")
     force = pd.DataFrame(force_rows)
     if len(force):
-        summary = force.groupby("phase", sort=False).agg(
-            n_strides=("n_strides", "sum"), rms_force_mean_n=("rms_force_mean_n", "mean"),
-            rms_force_sd_n=("rms_force_mean_n", "std"), max_abs_force_mean_n=("max_abs_force_mean_n", "mean"),
-            max_abs_force_sd_n=("max_abs_force_mean_n", "std")).reset_index().assign(subject="all")
+        summary = (
+            force.groupby("phase", sort=False)
+            .agg(
+                n_strides=("n_strides", "sum"),
+                rms_force_mean_n=("rms_force_mean_n", "mean"),
+                rms_force_sd_n=("rms_force_mean_n", "std"),
+                max_abs_force_mean_n=("max_abs_force_mean_n", "mean"),
+                max_abs_force_sd_n=("max_abs_force_mean_n", "std"),
+            )
+            .reset_index()
+            .assign(subject="all")
+        )
         force = pd.concat([force, summary[force.columns]], ignore_index=True)
-        for i, name in enumerate(("study_rms_force_mean_n", "study_rms_force_sd_n", "study_max_abs_force_mean_n",
-                                  "study_max_abs_force_sd_n")):
+        for i, name in enumerate(
+            ("study_rms_force_mean_n", "study_rms_force_sd_n", "study_max_abs_force_mean_n", "study_max_abs_force_sd_n")
+        ):
             force[name] = [STUDY_INTERACTION_FORCE_N[ph][i] for ph in force["phase"]]
     return TransparencyResults(
         rmsd=rmsd,
@@ -368,8 +416,9 @@ def transparency_results(trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, p
     )
 
 
-def _results_without(trials: Mapping, left_out: Mapping[str, Mapping[str, int]], side: str,
-                     least: int) -> TransparencyResults:
+def _results_without(
+    trials: Mapping, left_out: Mapping[str, Mapping[str, int]], side: str, least: int
+) -> TransparencyResults:
     """:func:`transparency_results` of the other subjects, with the rows of those ``left_out`` in subject order."""
     kept = {s: v for s, v in trials.items() if s not in left_out}
     if kept:
@@ -377,20 +426,42 @@ def _results_without(trials: Mapping, left_out: Mapping[str, Mapping[str, int]],
         rmsd, force = part.rmsd, part.force
     else:
         part = TransparencyResults(pd.DataFrame(columns=list(TRANSPARENCY_COLUMNS)), pd.DataFrame(), {}, None, {})
-        group = [{"subject": "all", "phase": ph, "joint": j, "n_strides_no_device": 0, "n_strides_device": 0,
-                  "rmsd_rad": np.nan, "sd_rad": np.nan, "isv_ave_rad": np.nan, "transparent": None}
-                 for ph in TRANSPARENCY_PHASES for j in JOINTS]
+        group = [
+            {
+                "subject": "all",
+                "phase": ph,
+                "joint": j,
+                "n_strides_no_device": 0,
+                "n_strides_device": 0,
+                "rmsd_rad": np.nan,
+                "sd_rad": np.nan,
+                "isv_ave_rad": np.nan,
+                "transparent": None,
+            }
+            for ph in TRANSPARENCY_PHASES
+            for j in JOINTS
+        ]
         rmsd = pd.DataFrame(group)
-        study = pd.DataFrame([{"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}
-                              for (ph, j), (r, isv) in STUDY_TRANSPARENCY_RAD.items()])
+        study = pd.DataFrame(
+            [
+                {"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}
+                for (ph, j), (r, isv) in STUDY_TRANSPARENCY_RAD.items()
+            ]
+        )
         rmsd = rmsd.merge(study, on=["phase", "joint"], how="left")
         force = pd.DataFrame()
     rows, force_rows = [], []
     for subject in trials:
         if subject in left_out:
             rows.append(pd.DataFrame(_flagged_rows(subject, left_out[subject], JOINTS)))
-            force_rows.append(pd.DataFrame([{"subject": subject, "phase": ph, "n_strides": left_out[subject]["device"]}
-                                            for ph in TRANSPARENCY_PHASES]))
+            force_rows.append(
+                pd.DataFrame(
+                    [
+                        {"subject": subject, "phase": ph, "n_strides": left_out[subject]["device"]}
+                        for ph in TRANSPARENCY_PHASES
+                    ]
+                )
+            )
         else:
             rows.append(rmsd[rmsd["subject"] == str(subject)])
             if len(force):
@@ -399,15 +470,27 @@ def _results_without(trials: Mapping, left_out: Mapping[str, Mapping[str, int]],
     out = pd.concat(rows, ignore_index=True)
     out["transparent"] = out["transparent"].astype(object).where(out["rmsd_rad"].notna(), None)
     study_cols = [c for c in rmsd.columns if c.startswith("study_")]
-    out = out.drop(columns=study_cols).merge(rmsd[["phase", "joint", *study_cols]].drop_duplicates(),
-                                             on=["phase", "joint"], how="left")
-    force_rows.append(force[force["subject"] == "all"] if len(force) else
-                      pd.DataFrame([{"subject": "all", "phase": ph, "n_strides": 0} for ph in TRANSPARENCY_PHASES]))
+    out = out.drop(columns=study_cols).merge(
+        rmsd[["phase", "joint", *study_cols]].drop_duplicates(), on=["phase", "joint"], how="left"
+    )
+    force_rows.append(
+        force[force["subject"] == "all"]
+        if len(force)
+        else pd.DataFrame([{"subject": "all", "phase": ph, "n_strides": 0} for ph in TRANSPARENCY_PHASES])
+    )
     force_out = pd.concat(force_rows, ignore_index=True)
-    for i, name in enumerate(("study_rms_force_mean_n", "study_rms_force_sd_n", "study_max_abs_force_mean_n",
-                              "study_max_abs_force_sd_n")):
+    for i, name in enumerate(
+        ("study_rms_force_mean_n", "study_rms_force_sd_n", "study_max_abs_force_mean_n", "study_max_abs_force_sd_n")
+    ):
         force_out[name] = [STUDY_INTERACTION_FORCE_N[ph][i] for ph in force_out["phase"]]
-    force_cols = ["subject", "phase", "n_strides", "rms_force_mean_n", "rms_force_sd_n", "max_abs_force_mean_n",
-                  "max_abs_force_sd_n"]
+    force_cols = [
+        "subject",
+        "phase",
+        "n_strides",
+        "rms_force_mean_n",
+        "rms_force_sd_n",
+        "max_abs_force_mean_n",
+        "max_abs_force_sd_n",
+    ]
     force_out = force_out.reindex(columns=force_cols + [c for c in force_out.columns if c not in force_cols])
     return TransparencyResults(out, force_out, part.angles_rad, part.force_n, part.toe_off_pct)

@@ -15,6 +15,7 @@ the perturbed and the unperturbed generalised coordinates.
 from __future__ import annotations
 
 import itertools
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -38,6 +39,7 @@ from .reference import STUDY_DEVICE, STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION
 
 __all__ = [
     "ValidationSettings",
+    "validation_settings",
     "check_window_in_swing",
     "impedance_grid",
     "chunk_combinations",
@@ -90,8 +92,53 @@ class ValidationSettings:
         check_window_in_swing(self.onset_s, self.window_before_s, self.window_after_s, self.swing_duration_s)
 
 
-def check_window_in_swing(onset_s: float, window_before_s: float, window_after_s: float,
-                          swing_duration_s: float) -> None:
+def validation_settings(config: Mapping) -> dict:
+    """Keyword arguments of :class:`ValidationSettings` from a validated config (sections ``validation``,
+    ``identification`` and ``seed``): what the workflow's validation rules and ``loper-analysis validate`` use."""
+    v, ident = config["validation"], config["identification"]
+    k_lo, k_hi = ident["stiffness_bounds_nm_per_rad"]
+    d_lo, d_hi = ident["damping_bounds_nms_per_rad"]
+    return dict(
+        stiffness_levels_nm_per_rad=tuple(v["stiffness_levels_nm_per_rad"]),
+        damping_levels_nms_per_rad=tuple(v["damping_levels_nms_per_rad"]),
+        **{
+            key: v[key]
+            for key in (
+                "sample_rate_hz",
+                "swing_duration_s",
+                "onset_s",
+                "pulse_force_n",
+                "pulse_duration_s",
+                "pulse_rise_time_s",
+                "pulse_overshoot_pct",
+                "force_rate_hz",
+                "force_direction_deg",
+                "noise_peak_to_peak",
+                "truth_substeps",
+            )
+        },
+        seed=config["seed"],
+        **{
+            key: ident[key]
+            for key in (
+                "window_before_s",
+                "window_after_s",
+                "n_starts",
+                "n_substeps",
+                "tolerance",
+                "merge_tolerance",
+                "initial_state_span_s",
+                "initial_state_degree",
+            )
+        },
+        lower=(k_lo, d_lo) * 3,
+        upper=(k_hi, d_hi) * 3,
+    )
+
+
+def check_window_in_swing(
+    onset_s: float, window_before_s: float, window_after_s: float, swing_duration_s: float
+) -> None:
     """Refuse a fit window that does not lie inside the simulated swing ``0 .. swing_duration_s`` (s after toe-off).
 
     The window runs from ``onset_s - window_before_s`` to ``onset_s + window_after_s``. Outside the
@@ -112,19 +159,23 @@ def check_window_in_swing(onset_s: float, window_before_s: float, window_after_s
     if swing_duration_s <= 0:
         raise LoperInputError(f"validation.swing_duration_s must be positive, got {swing_duration_s:g} s")
     if not 0 <= onset_s < swing_duration_s:
-        raise LoperInputError(f"validation.onset_s = {onset_s:g} s lies outside the simulated swing "
-                              f"0 .. {swing_duration_s:g} s (validation.swing_duration_s)")
+        raise LoperInputError(
+            f"validation.onset_s = {onset_s:g} s lies outside the simulated swing "
+            f"0 .. {swing_duration_s:g} s (validation.swing_duration_s)"
+        )
     room_after = swing_duration_s - onset_s
     if window_after_s > room_after + 1e-12:
         raise LoperInputError(
             f"identification.window_after_s = {window_after_s:g} s does not fit in the simulated swing of the "
             f"validation study: the window must end by the heel strike, so it may be at most {room_after:g} s "
-            f"(validation.swing_duration_s = {swing_duration_s:g} s - validation.onset_s = {onset_s:g} s)")
+            f"(validation.swing_duration_s = {swing_duration_s:g} s - validation.onset_s = {onset_s:g} s)"
+        )
     if window_before_s > onset_s + 1e-12:
         raise LoperInputError(
             f"identification.window_before_s = {window_before_s:g} s does not fit in the simulated swing of the "
             f"validation study: the window must start after toe-off, so it may be at most {onset_s:g} s "
-            f"(validation.onset_s)")
+            f"(validation.onset_s)"
+        )
 
 
 def impedance_grid(stiffness_levels, damping_levels) -> np.ndarray:
@@ -195,8 +246,9 @@ def perturbed_trial(params: SegmentParameters, impedance, settings: ValidationSe
     deviation = simulate_deviation(window, np.asarray(impedance, dtype=float)[None])
     qp = qu.copy()
     qp[n - window.n_samples :] += deviation[0]
-    t_force = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * settings.force_rate_hz + 1e-9)) + 1) \
-        / settings.force_rate_hz
+    t_force = (
+        t[0] + np.arange(int(np.floor((t[-1] - t[0]) * settings.force_rate_hz + 1e-9)) + 1) / settings.force_rate_hz
+    )
     return t, qu, qp, validation_pulse(t_force, settings), pelvis, t_force
 
 
@@ -216,7 +268,11 @@ def _truth_window(params: SegmentParameters, settings: ValidationSettings):
         qu, pelvis = nominal_swing(t, settings.swing_duration_s)
         # truth: the same equations, integrated with a much finer plain RK4 step (the pulse itself at every stage)
         window = prepare_window(
-            t, qu, qu, params, settings.onset_s,
+            t,
+            qu,
+            qu,
+            params,
+            settings.onset_s,
             pelvis_angle_unperturbed_rad=pelvis,
             pelvis_angle_perturbed_rad=pelvis,
             window_before_s=settings.window_before_s,
@@ -236,8 +292,14 @@ def validation_pulse(time_s, settings: ValidationSettings) -> np.ndarray:
     """The study's pulse (k, 2) in N, world x/y, at ``time_s`` (k,): :func:`loper_analysis.pulse.pulse_force` along
     ``force_direction_deg``, commanded at ``onset_s`` for ``pulse_duration_s``."""
     ang = np.deg2rad(settings.force_direction_deg)
-    f = pulse_force(time_s, settings.onset_s, settings.pulse_duration_s, settings.pulse_force_n,
-                    settings.pulse_rise_time_s, settings.pulse_overshoot_pct)
+    f = pulse_force(
+        time_s,
+        settings.onset_s,
+        settings.pulse_duration_s,
+        settings.pulse_force_n,
+        settings.pulse_rise_time_s,
+        settings.pulse_overshoot_pct,
+    )
     return f[:, None] * np.array([np.cos(ang), np.sin(ang)])
 
 
@@ -377,8 +439,9 @@ def gather_validation_tables(error_chunks, fit_chunks) -> tuple[pd.DataFrame, pd
 
     def gather(frames, keys):
         df = pd.concat(list(frames), ignore_index=True)
-        return df.sort_values(keys, key=lambda s: s.map(cond) if s.name == "condition" else (
-            s.map(par) if s.name == "parameter" else s)).reset_index(drop=True)
+        return df.sort_values(
+            keys, key=lambda s: s.map(cond) if s.name == "condition" else (s.map(par) if s.name == "parameter" else s)
+        ).reset_index(drop=True)
 
     errors = gather(error_chunks, ["condition", "combination", "parameter"])
     fits = gather(fit_chunks, ["condition", "combination"])

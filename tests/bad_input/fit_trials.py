@@ -22,12 +22,24 @@ def brace_markers(trial) -> tuple[np.ndarray, np.ndarray, list[str]]:
 
 def fit_inputs(trial) -> dict:
     """The mapping :func:`loper_analysis.impedance.fit_onset` takes for one trial."""
-    return {"name": trial.name, "angles": trial.angles, "strides": trial.strides, "force": trial.force,
-            "markers": brace_markers(trial)}
+    return {
+        "name": trial.name,
+        "angles": trial.angles,
+        "strides": trial.strides,
+        "force": trial.force,
+        "markers": brace_markers(trial),
+    }
 
 
-def walking_trial(name: str, seed: int, n_strides: int = 26, swing_frames: int | None = None, spread: float = 0.05,
-                  perturbed=(4, 8, 12, 16), amplitude=(0.02, 0.04, 0.01)):
+def walking_trial(
+    name: str,
+    seed: int,
+    n_strides: int = 26,
+    swing_frames: int | None = None,
+    spread: float = 0.05,
+    perturbed=(4, 8, 12, 16),
+    amplitude=(0.02, 0.04, 0.01),
+):
     """Strides with varied stance and swing (or every swing ``swing_frames`` long), per-stride offsets uniform in
     +-``spread`` rad; the ``perturbed`` strides carry a bump of ``amplitude`` (rad, hip knee ankle)."""
     rng = np.random.default_rng(seed)

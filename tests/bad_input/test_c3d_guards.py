@@ -61,14 +61,14 @@ def parameter_data(data: bytes, group: str, name: str) -> tuple[int, int, tuple[
         n_chars, ident = struct.unpack_from("<bb", data, pos)
         if n_chars == 0:
             break
-        label = bytes(data[pos + 2:pos + 2 + abs(n_chars)]).decode().upper()
+        label = bytes(data[pos + 2 : pos + 2 + abs(n_chars)]).decode().upper()
         at = pos + 2 + abs(n_chars)
         (step,) = struct.unpack_from("<h", data, at)
         if ident < 0:
             groups[label] = -ident
         else:
             kind, n_dims = struct.unpack_from("<bb", data, at + 2)
-            params[(ident, label)] = (at + 4 + n_dims, kind, tuple(data[at + 4:at + 4 + n_dims]))
+            params[(ident, label)] = (at + 4 + n_dims, kind, tuple(data[at + 4 : at + 4 + n_dims]))
         if step == 0:
             break
         pos = at + step
@@ -125,8 +125,9 @@ def write_trial(path: Path, kind: int = 2, order=(0, 1, 2, 3), channels_order=(0
         columns.append(wrench_channels(physical, force, np.zeros_like(force)))
     labels = [f"{q}{k}" for k in (1, 2) for q in ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
     units = (["N"] * 3 + ["Nmm"] * 3) * 2 if kind == 2 else ["V"] * 12
-    return write_c3d(path, ["LHEE", "RHEE"], heels, RATE, labels, np.hstack(columns), units, RATE * RATIO,
-                     force_platforms=plates)
+    return write_c3d(
+        path, ["LHEE", "RHEE"], heels, RATE, labels, np.hstack(columns), units, RATE * RATIO, force_platforms=plates
+    )
 
 
 def heel_strikes_s() -> list[float]:
@@ -183,9 +184,12 @@ def test_float_data_declared_as_integers_is_refused(good, tmp_path):
     assert struct.unpack_from("<f", data, offset) == (-1.0,)  # float data, as written
     assert len(data) - 4 * 512 == N_FRAMES * WORDS * 4  # DATA_START = 5: exactly the float block
     bad = patched(path, tmp_path / "scale_sign.c3d", "POINT", "SCALE", {0: 1.0})
-    expected = ("POINT:SCALE = 1 (positive) declares 16-bit integer data", f"{N_FRAMES} frames of {WORDS} words need "
-                f"{N_FRAMES * WORDS * 2} bytes as 16-bit integers ({N_FRAMES * WORDS * 4} as 4-byte floats) after "
-                f"POINT:DATA_START = 5 (byte 2048); the file holds {N_FRAMES * WORDS * 4} bytes there")
+    expected = (
+        "POINT:SCALE = 1 (positive) declares 16-bit integer data",
+        f"{N_FRAMES} frames of {WORDS} words need "
+        f"{N_FRAMES * WORDS * 2} bytes as 16-bit integers ({N_FRAMES * WORDS * 4} as 4-byte floats) after "
+        f"POINT:DATA_START = 5 (byte 2048); the file holds {N_FRAMES * WORDS * 4} bytes there",
+    )
     with pytest.raises(LoperInputError) as err:
         read_c3d(bad)
     assert str(err.value).startswith(f"{bad}: ") and all(e in str(err.value) for e in expected)
@@ -200,7 +204,7 @@ def integer_copy(path: Path, out: Path, scale: float, n_markers: int, n_words: i
     start = (data[16] | data[17] << 8) * 512 - 512  # header word 9: DATA_START
     block = np.frombuffer(bytes(data[start:]), "<f4", count=n_frames * n_words).reshape(n_frames, n_words)
     block = block.astype(float)
-    points = block[:, :4 * n_markers].reshape(n_frames, n_markers, 4)
+    points = block[:, : 4 * n_markers].reshape(n_frames, n_markers, 4)
     points[:, :, :3] /= scale
     body = np.round(block).astype("<i2").tobytes()
     offset, _, _ = parameter_data(data, "POINT", "SCALE")
@@ -221,9 +225,11 @@ def test_integer_data_declared_as_floats_is_refused(tmp_path):
     assert np.nanmax(np.abs(rec.markers_m - X)) < 0.05e-3 and np.isnan(rec.markers_m).sum() == 3
     np.testing.assert_array_equal(rec.analogs, A)
     bad = patched(ints, tmp_path / "ints_as_floats.c3d", "POINT", "SCALE", {0: -0.1})
-    expected = ("POINT:SCALE = -0.1 (negative) declares 4-byte float data",
-                "40 frames of 28 words need 4480 bytes as 4-byte floats (2240 as 16-bit integers) after "
-                "POINT:DATA_START = 4 (byte 1536); the file holds 2560 bytes there")
+    expected = (
+        "POINT:SCALE = -0.1 (negative) declares 4-byte float data",
+        "40 frames of 28 words need 4480 bytes as 4-byte floats (2240 as 16-bit integers) after "
+        "POINT:DATA_START = 4 (byte 1536); the file holds 2560 bytes there",
+    )
     with pytest.raises(LoperInputError) as err:
         read_c3d(bad)
     assert str(err.value).startswith(f"{bad}: ") and all(e in str(err.value) for e in expected)
@@ -245,8 +251,9 @@ def test_trailing_blocks_pass(good, tmp_path, extra_blocks):
 def test_zero_blocks_after_integer_data_are_padding_not_floats(tmp_path):
     """Integer data followed by zero blocks up to the size floats would need is read, not refused."""
     X = np.full((40, 3, 3), 0.25)
-    floats = write_c3d(tmp_path / "floats.c3d", ["A", "B", "C"], X, 100.0, ["F1", "F2"], np.ones((320, 2)),
-                       ["N", "N"], 800.0)
+    floats = write_c3d(
+        tmp_path / "floats.c3d", ["A", "B", "C"], X, 100.0, ["F1", "F2"], np.ones((320, 2)), ["N", "N"], 800.0
+    )
     ints = integer_copy(floats, tmp_path / "ints.c3d", 0.1, 3, 4 * 3 + 2 * 8, 40)
     padded = tmp_path / "padded.c3d"
     padded.write_bytes(ints.read_bytes() + bytes(4 * 512))  # 2560 + 2048 bytes: the float size, 4480 .. 5120
@@ -292,8 +299,9 @@ def test_unusable_calibration_matrix_is_refused(good, tmp_path, case):
 
 def test_calibration_matrix_of_a_type2_plate_is_not_applied_nor_checked(good, tmp_path):
     """ezc3d reads TYPE 2 channels as they are: a zero CAL_MATRIX (our writer stores the identity) changes nothing."""
-    zero = patched(good["type2"], tmp_path / "zero_cal.c3d", "FORCE_PLATFORM", "CAL_MATRIX",
-                   {i: 0.0 for i in range(72)})
+    zero = patched(
+        good["type2"], tmp_path / "zero_cal.c3d", "FORCE_PLATFORM", "CAL_MATRIX", {i: 0.0 for i in range(72)}
+    )
     for a, b in zip(read_force_platforms(good["type2"]), read_force_platforms(zero)):
         np.testing.assert_array_equal(a.force_n, b.force_n)
     peak = read_force_platforms(zero)[0].force_n[:, 2].max()
@@ -307,10 +315,12 @@ def test_calibration_matrix_of_a_type2_plate_is_not_applied_nor_checked(good, tm
 def test_corners_in_the_other_order_than_the_channels_are_refused_naming_the_corners(tmp_path, order):
     bad = write_trial(tmp_path / "corners.c3d", order=order)
     listed = [[float(f"{v:.6g}") for v in c] for c in 1000.0 * plate_corners(CENTRES[0])[list(order)]]
-    fragments = (f"FORCE_PLATFORM:CORNERS of platform 1 = {listed} mm give a plate z axis [0.0, 0.0, 1.0]",
-                 "pointing up: the corners are listed the other way round the plate",
-                 "its vertical force (along up [0.0, 0.0, 1.0]) points down while loaded: ",
-                 f"N at the 1st percentile, at most {-REST_N[2]:.1f} N at the 99th")
+    fragments = (
+        f"FORCE_PLATFORM:CORNERS of platform 1 = {listed} mm give a plate z axis [0.0, 0.0, 1.0]",
+        "pointing up: the corners are listed the other way round the plate",
+        "its vertical force (along up [0.0, 0.0, 1.0]) points down while loaded: ",
+        f"N at the 1st percentile, at most {-REST_N[2]:.1f} N at the 99th",
+    )
     with pytest.raises(LoperInputError) as err:
         read_force_platforms(bad)
     assert str(err.value).startswith(f"{bad}: ") and all(f in str(err.value) for f in fragments), str(err.value)
@@ -325,10 +335,15 @@ def test_corners_in_the_other_order_than_the_channels_are_refused_naming_the_cor
 def test_force_on_the_plate_with_the_usual_corners_names_both_causes(tmp_path):
     bad = write_trial(tmp_path / "on_plate.c3d", sign=-1.0)
     assert_refused_and_nothing_written(
-        run_events, bad, tmp_path / "events.tsv",
+        run_events,
+        bad,
+        tmp_path / "events.tsv",
         "FORCE_PLATFORM:CORNERS of platform 1 = [[550.0, 50.0, 0.0], [50.0, 50.0, 0.0], [50.0, 450.0, 0.0], "
-        "[550.0, 450.0, 0.0]] mm give a plate z axis [0.0, 0.0, -1.0]", "pointing down (the usual order)",
-        "force on the plate instead of on the body", f"at most {-REST_N[2]:.1f} N at the 99th")
+        "[550.0, 450.0, 0.0]] mm give a plate z axis [0.0, 0.0, -1.0]",
+        "pointing down (the usual order)",
+        "force on the plate instead of on the body",
+        f"at most {-REST_N[2]:.1f} N at the 99th",
+    )
 
 
 @pytest.mark.parametrize("order", [(3, 2, 1, 0), (1, 0, 3, 2)], ids=["reversed", "pairs swapped"])
@@ -345,8 +360,11 @@ def test_corners_either_way_round_pass_when_the_channels_are_in_their_frame(good
 
 def test_repository_files_pass_with_their_known_forces():
     """Peak vertical force (N) of every plate, and walking5's stance value checked against OpenSim elsewhere."""
-    known = {WALKING5: [774.8641, 910.5085], R11 / "static.c3d": [433.7946, 400.4258],
-             R11 / "walk-nodevice.c3d": [937.3806, 925.0706, 935.2106]}
+    known = {
+        WALKING5: [774.8641, 910.5085],
+        R11 / "static.c3d": [433.7946, 400.4258],
+        R11 / "walk-nodevice.c3d": [937.3806, 925.0706, 935.2106],
+    }
     for path, peaks in known.items():
         rec = read_c3d(path)
         plates = read_force_platforms(path)

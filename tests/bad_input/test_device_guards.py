@@ -41,14 +41,21 @@ def _settings() -> tuple[dict, dict]:
     """The keyword settings rule events_loadcell passes to the step (workflow/rules/processing.smk)."""
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     ev = cfg["events"]
-    events = dict(grf_channels=ev["grf_channels"], threshold_on_n=ev["threshold_on_n"],
-                  threshold_off_n=ev["threshold_off_n"], min_stance_s=ev["min_stance_s"],
-                  min_swing_s=ev["min_swing_s"], cutoff_hz=ev["grf_cutoff_hz"], order=cfg["filter"]["order"],
-                  foot_markers=ev["foot_markers"], plate_sides=ev["plate_sides"],
-                  rotation_deg=cfg["markers"]["lab_to_model_rotation_deg"],
-                  band_n=cfg["grf"]["resting_band_n"], max_rest_n=cfg["grf"]["max_resting_n"])
-    loadcell = dict(sync_channel=ev["sync_channel"], cutoff_hz=cfg["filter"]["cutoff_hz"],
-                    order=cfg["filter"]["order"])
+    events = dict(
+        grf_channels=ev["grf_channels"],
+        threshold_on_n=ev["threshold_on_n"],
+        threshold_off_n=ev["threshold_off_n"],
+        min_stance_s=ev["min_stance_s"],
+        min_swing_s=ev["min_swing_s"],
+        cutoff_hz=ev["grf_cutoff_hz"],
+        order=cfg["filter"]["order"],
+        foot_markers=ev["foot_markers"],
+        plate_sides=ev["plate_sides"],
+        rotation_deg=cfg["markers"]["lab_to_model_rotation_deg"],
+        band_n=cfg["grf"]["resting_band_n"],
+        max_rest_n=cfg["grf"]["max_resting_n"],
+    )
+    loadcell = dict(sync_channel=ev["sync_channel"], cutoff_hz=cfg["filter"]["cutoff_hz"], order=cfg["filter"]["order"])
     return events, loadcell
 
 
@@ -80,23 +87,35 @@ def trial(tmp_path_factory):
     write_robot_log(raw / "pert050-1.loper.tsv", walk.robot, lab.robot_rate_hz, {"clock": "robot"})
     write_robot_log(raw / "walk-device.loper.tsv", still.robot, lab.robot_rate_hz, {"clock": "robot"})
     scale = 1 + 1e-6 * lab.clock_drift_ppm
-    return {"raw": raw, "lab": lab, "walk": walk, "still": still, "rec": rec,
-            # t_mocap = offset + scale * t_robot (simulate_walking_trial: t_mocap = -clock_offset_s + scale t_robot)
-            "offset_s": -lab.clock_offset_s, "scale": scale,
-            "onsets_robot_s": (walk.schedule["onset_s"].to_numpy(float) + lab.clock_offset_s) / scale}
+    return {
+        "raw": raw,
+        "lab": lab,
+        "walk": walk,
+        "still": still,
+        "rec": rec,
+        # t_mocap = offset + scale * t_robot (simulate_walking_trial: t_mocap = -clock_offset_s + scale t_robot)
+        "offset_s": -lab.clock_offset_s,
+        "scale": scale,
+        "onsets_robot_s": (walk.schedule["onset_s"].to_numpy(float) + lab.clock_offset_s) / scale,
+    }
 
 
 def _outputs(tmp_path: Path) -> dict[str, Path]:
     out = tmp_path / "results"
-    return {"events": out / "t.events.tsv", "contacts": out / "t.contacts.tsv", "force": out / "t.force.tsv",
-            "native": out / "t.force_native.tsv"}
+    return {
+        "events": out / "t.events.tsv",
+        "contacts": out / "t.contacts.tsv",
+        "force": out / "t.force.tsv",
+        "native": out / "t.force_native.tsv",
+    }
 
 
 def _step(c3d: Path, log: Path, outputs: dict[str, Path]):
     """The file step of rule events_loadcell, with the rule's settings."""
     events, loadcell = _settings()
-    return processing.events_loadcell(c3d, log, outputs["events"], outputs["contacts"], outputs["force"],
-                                      outputs["native"], events, loadcell)
+    return processing.events_loadcell(
+        c3d, log, outputs["events"], outputs["contacts"], outputs["force"], outputs["native"], events, loadcell
+    )
 
 
 def _refused(tmp_path: Path, c3d: Path, log: Path, words) -> str:
@@ -183,8 +202,11 @@ def test_both_records_inverted_pass_with_the_same_clock_map(trial, tmp_path):
 
 
 def _high_times_ms(message: str) -> tuple[float, float]:
-    m = re.search(r"high for ([\d.]+) ms \(duty ratio [\d.]+\) in robot log column 'sync_v' but for ([\d.]+) ms "
-                  r"\(duty ratio [\d.]+\) in mocap sync channel 'sync'", message)
+    m = re.search(
+        r"high for ([\d.]+) ms \(duty ratio [\d.]+\) in robot log column 'sync_v' but for ([\d.]+) ms "
+        r"\(duty ratio [\d.]+\) in mocap sync channel 'sync'",
+        message,
+    )
     assert m, message
     return float(m.group(1)), float(m.group(2))
 
@@ -192,9 +214,18 @@ def _high_times_ms(message: str) -> tuple[float, float]:
 def test_inverted_robot_sync_is_refused(trial, tmp_path):
     """An active-low robot sync output: high ~1 s per pulse in the log against 10 ms in the C3D."""
     log = _log_with(trial, tmp_path, "active-low.loper.tsv", sync_v=5.0 - trial["walk"].robot["sync_v"])
-    message = _refused(tmp_path, trial["raw"] / "pert050-1.c3d", log,
-                       [str(log), "pert050-1.c3d", "robot log column 'sync_v'", "mocap sync channel 'sync'",
-                        "the robot's sync looks inverted (active-low)"])
+    message = _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [
+            str(log),
+            "pert050-1.c3d",
+            "robot log column 'sync_v'",
+            "mocap sync channel 'sync'",
+            "the robot's sync looks inverted (active-low)",
+        ],
+    )
     robot_ms, mocap_ms = _high_times_ms(message)
     assert 490.0 < robot_ms < 1500.0  # the gaps between the 10 ms pulses (0.5 .. 1.5 s)
     assert abs(mocap_ms - 10.0) < 1.0
@@ -204,9 +235,18 @@ def test_inverted_mocap_sync_is_refused(trial, tmp_path):
     """The other way round: the C3D's channel sees the sync inverted; the message says which record."""
     c3d = _inverted_c3d(trial, tmp_path)
     log = trial["raw"] / "pert050-1.loper.tsv"
-    message = _refused(tmp_path, c3d, log, [str(log), str(c3d), "robot log column 'sync_v'",
-                                            "mocap sync channel 'sync'",
-                                            "the mocap channel sees the sync inverted"])
+    message = _refused(
+        tmp_path,
+        c3d,
+        log,
+        [
+            str(log),
+            str(c3d),
+            "robot log column 'sync_v'",
+            "mocap sync channel 'sync'",
+            "the mocap channel sees the sync inverted",
+        ],
+    )
     robot_ms, mocap_ms = _high_times_ms(message)
     assert abs(robot_ms - 10.0) < 1.0 and 490.0 < mocap_ms < 1500.0
 
@@ -235,10 +275,20 @@ def test_clock_map_compares_high_times_only_when_given():
     mocap = pulse_train_at(t, starts, 0.01)  # same clock: the true offset is 0
     r, m = rising_edges(robot, fs), rising_edges(mocap, fs)
     assert abs(clock_map(r, m).offset_s + 0.01) < 0.5e-3
-    with pytest.raises(LoperInputError, match=r"rec A: sync pulses high for \d+\.\d ms .* in robot X but for "
-                                              r"10\.\d ms .* in mocap Y .*the robot's sync looks inverted"):
-        clock_map(r, m, source="rec A", robot_high_s=high_times(robot, fs, r), mocap_high_s=high_times(mocap, fs, m),
-                  robot_name="robot X", mocap_name="mocap Y")
+    with pytest.raises(
+        LoperInputError,
+        match=r"rec A: sync pulses high for \d+\.\d ms .* in robot X but for "
+        r"10\.\d ms .* in mocap Y .*the robot's sync looks inverted",
+    ):
+        clock_map(
+            r,
+            m,
+            source="rec A",
+            robot_high_s=high_times(robot, fs, r),
+            mocap_high_s=high_times(mocap, fs, m),
+            robot_name="robot X",
+            mocap_name="mocap Y",
+        )
     good = clock_map(m, m, robot_high_s=high_times(mocap, fs, m), mocap_high_s=high_times(mocap, fs, m))
     assert abs(good.offset_s) < 1e-9
     wide = pulse_train_at(t, starts, 0.2)  # same edges, 200 ms pulses: not inverted, but not the same pulses
@@ -260,9 +310,17 @@ def test_perturbation_log_without_flags_is_refused(trial, tmp_path):
     and the pulses' first times (each within 30 ms after its true onset on the robot clock)."""
     log = _log_with(trial, tmp_path, "noflags.loper.tsv", perturbation=0)
     n = len(trial["walk"].schedule)
-    message = _refused(tmp_path, trial["raw"] / "pert050-1.c3d", log,
-                       [str(log), "column 'perturbation' flags 0 pulse(s)",
-                        f"column 'force_measured_n' shows {n} force pulse(s)", "no stride would count as perturbed"])
+    message = _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [
+            str(log),
+            "column 'perturbation' flags 0 pulse(s)",
+            f"column 'force_measured_n' shows {n} force pulse(s)",
+            "no stride would count as perturbed",
+        ],
+    )
     times = _times_in(message)
     expected = trial["onsets_robot_s"][: times.size]
     assert times.size == min(n, 5)
@@ -277,9 +335,17 @@ def test_perturbation_log_with_most_flags_missing_is_refused(trial, tmp_path):
     flag[second:] = 0
     log = _log_with(trial, tmp_path, "oneflag.loper.tsv", perturbation=flag)
     n = len(trial["walk"].schedule)
-    message = _refused(tmp_path, trial["raw"] / "pert050-1.c3d", log,
-                       [str(log), "column 'perturbation' flags 1 pulse(s)",
-                        f"shows {n} force pulse(s)", f"{n - 1} of them without a flag"])
+    message = _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [
+            str(log),
+            "column 'perturbation' flags 1 pulse(s)",
+            f"shows {n} force pulse(s)",
+            f"{n - 1} of them without a flag",
+        ],
+    )
     assert abs(_times_in(message)[0] - trial["onsets_robot_s"][1]) < 0.03
 
 
@@ -309,8 +375,12 @@ def test_mat_export_without_its_flag_variable_is_refused(trial, tmp_path):
     write_robot_log_mat(mat, trial["walk"].robot, trial["lab"].robot_rate_hz, names)
     log = tmp_path / "converted" / "pert050-1.loper.tsv"
     log_from_mat(mat, log, column_map, trial["lab"].robot_rate_hz)
-    _refused(tmp_path, trial["raw"] / "pert050-1.c3d", log,
-             [str(log), "column 'perturbation' flags 0 pulse(s)", "device.mat_column_map.perturbation"])
+    _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [str(log), "column 'perturbation' flags 0 pulse(s)", "device.mat_column_map.perturbation"],
+    )
 
 
 def test_force_pulses_of_the_simulated_robot():

@@ -77,10 +77,15 @@ def onset_trials():
 
 def _fit(trials, after, null=(), min_strides=4, **ident):
     settings = IdentificationSettings(**{"n_starts": 3, "min_null_pairs": 20, **ident})
-    return fit_onset([fit_inputs(t) for t in trials], PARAMS, ONSET_MS, "S01",
-                     null_trials=[fit_inputs(t) for t in null],
-                     response=ResponseSettings(window_after_s=after, min_strides=min_strides),
-                     identification=settings)
+    return fit_onset(
+        [fit_inputs(t) for t in trials],
+        PARAMS,
+        ONSET_MS,
+        "S01",
+        null_trials=[fit_inputs(t) for t in null],
+        response=ResponseSettings(window_after_s=after, min_strides=min_strides),
+        identification=settings,
+    )
 
 
 def test_a_window_longer_than_every_swing_names_the_key(onset_trials):
@@ -124,8 +129,10 @@ def test_a_response_of_the_wrong_sign_puts_k_on_its_upper_bound(truth_window):
     assert fit.estimate[2] == pytest.approx(200.0, abs=1e-9)
     rows = impedance_rows(fit, "S01", 50, 12).set_index("joint")
     assert rows.loc["knee", "status"] == "not_identifiable"
-    assert "K_knee = 200 N·m/rad at its upper bound 200 N·m/rad (identification.stiffness_bounds_nm_per_rad)" \
+    assert (
+        "K_knee = 200 N·m/rad at its upper bound 200 N·m/rad (identification.stiffness_bounds_nm_per_rad)"
         in rows.loc["knee", "reason"]
+    )
     assert rows.loc["knee", "vaf_pct"] == pytest.approx(11.03, abs=0.01)
 
 

@@ -41,14 +41,26 @@ def trial(tmp_path_factory):
     model = build_lower_body_model(1.73, 64.9)
     t = np.arange(N) / FS
     w = 2 * np.pi * 0.6
-    truth = {"pelvis_tx": 0.02 * np.sin(2 * w * t), "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
-             "pelvis_tilt": 0.05 * np.sin(w * t), "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
-             "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1), "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2),
-             "hip_flexion_r": -0.1 + 0.2 * np.sin(w * t), "knee_flexion_r": 0.3 + 0.1 * np.sin(w * t)}
+    truth = {
+        "pelvis_tx": 0.02 * np.sin(2 * w * t),
+        "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
+        "pelvis_tilt": 0.05 * np.sin(w * t),
+        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
+        "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
+        "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2),
+        "hip_flexion_r": -0.1 + 0.2 * np.sin(w * t),
+        "knee_flexion_r": 0.3 + 0.1 * np.sin(w * t),
+    }
     X = marker_positions(model, truth)
     osim_path = write_model(model, d / "model.osim")
-    return {"dir": d, "model": osim_path, "t": t, "X": X, "truth": truth,
-            "trc": write_trc(d / "all.trc", t, X, list(MARKERS))}
+    return {
+        "dir": d,
+        "model": osim_path,
+        "t": t,
+        "X": X,
+        "truth": truth,
+        "trc": write_trc(d / "all.trc", t, X, list(MARKERS)),
+    }
 
 
 def subset_trc(trial, path, names):
@@ -93,7 +105,9 @@ def test_lab_setup_scaling_with_a_static_trial_in_the_wrong_unit_is_refused(tmp_
     ms = model.getMarkerSet()
     labels = [ms.get(i).getName() for i in range(ms.getSize())]
     X = np.repeat(marker_positions(model, {}, labels), 4, axis=0)
-    static = write_trc(tmp_path / "static.trc", np.arange(4) / 100.0, 10.0 * X, labels)  # every number 10 times too large
+    static = write_trc(
+        tmp_path / "static.trc", np.arange(4) / 100.0, 10.0 * X, labels
+    )  # every number 10 times too large
     out = tmp_path / "scaled.osim"
     with pytest.raises(LoperInputError) as err:
         scale_with_setup(GAIT2392 / "gait2392_simbody.osim", tmp_path / "scale_setup.xml", static, 75.0, out)
@@ -128,9 +142,9 @@ def test_analog_rate_half_of_the_recorded_one_is_refused(tmp_path):
     assert read_c3d(path).analogs.shape == (80, 2)
     data = bytearray(path.read_bytes())
     start = (data[0] - 1) * 512 + 512  # parameter section, after the header block
-    hits = [i for i in range(512, start + 4096) if data[i:i + 4] == struct.pack("<f", 1024.0)]
+    hits = [i for i in range(512, start + 4096) if data[i : i + 4] == struct.pack("<f", 1024.0)]
     assert len(hits) == 1
-    data[hits[0]:hits[0] + 4] = struct.pack("<f", 512.0)
+    data[hits[0] : hits[0] + 4] = struct.pack("<f", 512.0)
     path.write_bytes(bytes(data))
     with pytest.raises(LoperInputError) as err:
         read_c3d(path)
@@ -175,8 +189,9 @@ def test_full_marker_set_output_is_unchanged(trial, tmp_path):
 
 
 def run_cli(*args):
-    return subprocess.run([sys.executable, "-m", "loper_analysis.cli", *map(str, args)], capture_output=True,
-                          text=True, timeout=300)
+    return subprocess.run(
+        [sys.executable, "-m", "loper_analysis.cli", *map(str, args)], capture_output=True, text=True, timeout=300
+    )
 
 
 def test_pelvis_only_markers_exit_2_with_one_line_instead_of_a_segfault(trial, tmp_path):
@@ -196,11 +211,14 @@ def test_one_marker_is_refused_before_solving(trial, tmp_path):
     assert not (tmp_path / "one.mot").exists()
 
 
-@pytest.mark.parametrize("name, content, field", [
-    ("model.txt", b"pelvis 1.0\n", "not an XML file"),
-    ("binary.osim", bytes(range(256)) * 8, "not an XML file"),
-    ("setup.osim", b'<?xml version="1.0"?><OpenSimDocument><ScaleTool/></OpenSimDocument>', "holds no <Model>"),
-])
+@pytest.mark.parametrize(
+    "name, content, field",
+    [
+        ("model.txt", b"pelvis 1.0\n", "not an XML file"),
+        ("binary.osim", bytes(range(256)) * 8, "not an XML file"),
+        ("setup.osim", b'<?xml version="1.0"?><OpenSimDocument><ScaleTool/></OpenSimDocument>', "holds no <Model>"),
+    ],
+)
 def test_a_model_file_that_is_no_osim_model_is_refused(trial, tmp_path, name, content, field):
     path = tmp_path / name
     path.write_bytes(content)

@@ -99,8 +99,10 @@ def test_a_failed_job_whose_log_cannot_be_written_keeps_its_own_error_first(old_
     with pytest.raises(SystemExit) as info:
         with rule_log(old_log):
             raise LoperInputError("data/raw/R01/walk.c3d: POINT:UNITS not declared")
-    assert str(info.value.code) == (f"data/raw/R01/walk.c3d: POINT:UNITS not declared (traceback above; {old_log}: "
-                                    f"could not write the log: {ENOSPC})")
+    assert str(info.value.code) == (
+        f"data/raw/R01/walk.c3d: POINT:UNITS not declared (traceback above; {old_log}: "
+        f"could not write the log: {ENOSPC})"
+    )
     assert isinstance(info.value.__cause__, LoperInputError)
     assert _digest(old_log) == before
     err = capsys.readouterr().err
@@ -154,9 +156,7 @@ def _python(code: str):
     return lambda path: [sys.executable, "-c", code, str(path)]
 
 
-HALF_THEN_FAIL = ("import sys\n"
-                  "open(sys.argv[1], 'w').write('<!DOCTYPE html><html><body><p>half of the ')\n"
-                  "sys.exit(3)\n")
+HALF_THEN_FAIL = "import sys\nopen(sys.argv[1], 'w').write('<!DOCTYPE html><html><body><p>half of the ')\nsys.exit(3)\n"
 HALF_THEN_SUCCEED = "import sys\nopen(sys.argv[1], 'w').write('<!DOCTYPE html><html><body><p>cut')\n"
 WHOLE = "import sys\nopen(sys.argv[1], 'w').write('<!DOCTYPE html><html><body>new</body></html>\\n')\n"
 
@@ -165,17 +165,23 @@ def test_a_report_command_that_fails_halfway_leaves_the_old_report_and_no_tempor
     before = _digest(old_report)
     with pytest.raises(LoperInputError) as info:
         report.write_report(old_report, _python(HALF_THEN_FAIL))
-    assert str(info.value) == (f"{old_report}: the report command failed with exit status 3 (its messages are "
-                               "above): the previous report is kept")
+    assert str(info.value) == (
+        f"{old_report}: the report command failed with exit status 3 (its messages are "
+        "above): the previous report is kept"
+    )
     assert _digest(old_report) == before
     assert _entries(old_report.parent) == ["report.html"]
 
 
 def test_a_report_cut_short_by_a_command_that_succeeds_is_refused(old_report):
     before = _digest(old_report)
-    with pytest.raises(LoperInputError, match=re.escape(
+    with pytest.raises(
+        LoperInputError,
+        match=re.escape(
             f"{old_report}: the report (33 bytes) does not end with </html>: it was cut short: the previous report "
-            "is kept")):
+            "is kept"
+        ),
+    ):
         report.write_report(old_report, _python(HALF_THEN_SUCCEED))
     assert _digest(old_report) == before
     assert _entries(old_report.parent) == ["report.html"]
@@ -199,6 +205,7 @@ def test_the_report_subcommand_runs_snakemake_report_beside_the_target(old_repor
         def argv(path):
             calls.append(real(path))
             return _python(WHOLE)(path)
+
         return argv
 
     monkeypatch.setattr(report, "snakemake_report_command", command)
@@ -208,7 +215,11 @@ def test_the_report_subcommand_runs_snakemake_report_beside_the_target(old_repor
     (argv,) = calls
     staging = Path(argv[4])
     assert argv[:4] == [sys.executable, "-m", "snakemake", "--report"] and argv[5:] == [
-        "--configfile", str(lab), "--cores", "1"]
+        "--configfile",
+        str(lab),
+        "--cores",
+        "1",
+    ]
     assert staging.name == "report.html" and staging.parent.parent == old_report.parent  # beside the target
     assert staging.parent.name.startswith(".report.html.") and not staging.parent.exists()
     assert old_report.read_text().endswith("new</body></html>\n")
@@ -217,20 +228,22 @@ def test_the_report_subcommand_runs_snakemake_report_beside_the_target(old_repor
     monkeypatch.setattr(report, "snakemake_report_command", lambda args=(): _python(HALF_THEN_FAIL))
     before = _digest(old_report)
     assert cli_main(["report", str(old_report)]) == 2
-    assert capsys.readouterr().err == (f"loper-analysis report: {old_report}: the report command failed with exit "
-                                       "status 3 (its messages are above): the previous report is kept\n")
+    assert capsys.readouterr().err == (
+        f"loper-analysis report: {old_report}: the report command failed with exit "
+        "status 3 (its messages are above): the previous report is kept\n"
+    )
     assert _digest(old_report) == before and _entries(old_report.parent) == ["lab.yaml", "report.html"]
 
 
-def test_the_report_subcommand_names_a_config_file_with_a_syntax_error_before_running_snakemake(old_report,
-                                                                                                 capsys):
+def test_the_report_subcommand_names_a_config_file_with_a_syntax_error_before_running_snakemake(old_report, capsys):
     bad = old_report.parent / "lab.yaml"
     bad.write_text("filter:\n  cutoff_hz: [40.0\n  order: 4\n")
     before = _digest(old_report)
     assert cli_main(["report", str(old_report), "--configfile", str(bad)]) == 2
     assert capsys.readouterr().err == (
         f"loper-analysis report: {bad}: line 3, column 8: YAML syntax error: expected ',' or ']', but got ':' "
-        "(while parsing a flow sequence that starts at line 2, column 14)\n")
+        "(while parsing a flow sequence that starts at line 2, column 14)\n"
+    )
     assert _digest(old_report) == before
 
 
@@ -241,15 +254,27 @@ def test_cutoffs_the_filter_cannot_use_are_refused_naming_the_setting_the_value_
     x = np.random.default_rng(1).normal(size=600)
     kw = {"setting": "filter.cutoff_hz", "rate_name": "POINT:RATE", "source": "walk.c3d"}
     cases = [
-        (1e-9, "walk.c3d: filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz): an "
-               "order-4 Butterworth at 1.6e-11 of the Nyquist frequency is numerically unsound (its gain at 0 Hz is "
-               "inf, not 1); raise filter.cutoff_hz"),
-        (64.0, "walk.c3d: filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = "
-               "128 Hz), got 64 Hz"),
-        (0.0, "walk.c3d: filter.cutoff_hz must be a positive, finite frequency below the Nyquist frequency 64 Hz of "
-              "POINT:RATE = 128 Hz, got 0.0"),
-        (float("inf"), "walk.c3d: filter.cutoff_hz must be a positive, finite frequency below the Nyquist "
-                       "frequency 64 Hz of POINT:RATE = 128 Hz, got inf"),
+        (
+            1e-9,
+            "walk.c3d: filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz): an "
+            "order-4 Butterworth at 1.6e-11 of the Nyquist frequency is numerically unsound (its gain at 0 Hz is "
+            "inf, not 1); raise filter.cutoff_hz",
+        ),
+        (
+            64.0,
+            "walk.c3d: filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = "
+            "128 Hz), got 64 Hz",
+        ),
+        (
+            0.0,
+            "walk.c3d: filter.cutoff_hz must be a positive, finite frequency below the Nyquist frequency 64 Hz of "
+            "POINT:RATE = 128 Hz, got 0.0",
+        ),
+        (
+            float("inf"),
+            "walk.c3d: filter.cutoff_hz must be a positive, finite frequency below the Nyquist "
+            "frequency 64 Hz of POINT:RATE = 128 Hz, got inf",
+        ),
     ]
     for cutoff, message in cases:
         for filt in (lowpass, lowpass_finite_runs):
@@ -287,22 +312,45 @@ def belt_c3d(tmp_path_factory) -> Path:
     d = tmp_path_factory.mktemp("belts")
     n = 256
     t = np.arange(n) / POINT_RATE
-    markers = np.stack([np.stack([0.3 + 0.01 * np.sin(t), 0.2 + 0.0 * t, 0.1 + 0.0 * t], -1),
-                        np.stack([0.3 + 0.0 * t, 0.5 + 0.0 * t, 0.9 + 0.01 * np.cos(t)], -1),
-                        np.stack([0.6 + 0.0 * t, 0.2 + 0.0 * t, 1.0 + 0.0 * t], -1)], axis=1)
+    markers = np.stack(
+        [
+            np.stack([0.3 + 0.01 * np.sin(t), 0.2 + 0.0 * t, 0.1 + 0.0 * t], -1),
+            np.stack([0.3 + 0.0 * t, 0.5 + 0.0 * t, 0.9 + 0.01 * np.cos(t)], -1),
+            np.stack([0.6 + 0.0 * t, 0.2 + 0.0 * t, 1.0 + 0.0 * t], -1),
+        ],
+        axis=1,
+    )
     ta = np.arange(n * 8) / ANALOG_RATE
     fz = 400.0 * np.clip(np.sin(2 * np.pi * ta), 0, None)
-    return write_c3d(d / "walk-nodevice.c3d", ["LASI", "RASI", "LHEE"], markers, POINT_RATE, ["Fz_left", "Fz_right"],
-                     np.stack([fz, fz[::-1]], -1), ["N", "N"], ANALOG_RATE)
+    return write_c3d(
+        d / "walk-nodevice.c3d",
+        ["LASI", "RASI", "LHEE"],
+        markers,
+        POINT_RATE,
+        ["Fz_left", "Fz_right"],
+        np.stack([fz, fz[::-1]], -1),
+        ["N", "N"],
+        ANALOG_RATE,
+    )
 
 
-@pytest.mark.parametrize(("cutoff", "words"), [
-    (600.0, "events.grf_cutoff_hz must lie in 0 .. 512 Hz (below the Nyquist frequency of ANALOG:RATE = 1024 Hz), "
-            "got 600 Hz"),
-    (1e-9, "events.grf_cutoff_hz = 1e-09 Hz is too low for ANALOG:RATE = 1024 Hz (Nyquist 512 Hz): an order-4 "
-           "Butterworth at 2e-12 of the Nyquist frequency is numerically unsound (its gain at 0 Hz is inf, not 1); "
-           "raise events.grf_cutoff_hz"),
-], ids=["above-nyquist", "singular"])
+@pytest.mark.parametrize(
+    ("cutoff", "words"),
+    [
+        (
+            600.0,
+            "events.grf_cutoff_hz must lie in 0 .. 512 Hz (below the Nyquist frequency of ANALOG:RATE = 1024 Hz), "
+            "got 600 Hz",
+        ),
+        (
+            1e-9,
+            "events.grf_cutoff_hz = 1e-09 Hz is too low for ANALOG:RATE = 1024 Hz (Nyquist 512 Hz): an order-4 "
+            "Butterworth at 2e-12 of the Nyquist frequency is numerically unsound (its gain at 0 Hz is inf, not 1); "
+            "raise events.grf_cutoff_hz",
+        ),
+    ],
+    ids=["above-nyquist", "singular"],
+)
 def test_grf_cutoff_is_named_by_its_config_key_and_the_event_table_is_kept(belt_c3d, tmp_path, cutoff, words):
     out = tmp_path / "walk-nodevice.events.tsv"
     out.write_text("side\tevent\ttime_s\tsample\nleft\theel_strike\t0.5\t64\n")
@@ -314,11 +362,17 @@ def test_grf_cutoff_is_named_by_its_config_key_and_the_event_table_is_kept(belt_
     assert _digest(out) == before and _entries(tmp_path) == ["walk-nodevice.events.tsv"]
 
 
-@pytest.mark.parametrize(("cutoff", "words"), [
-    (100.0, "filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = 128 Hz), got "
-            "100 Hz"),
-    (1e-9, "filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz)"),
-], ids=["above-nyquist", "singular"])
+@pytest.mark.parametrize(
+    ("cutoff", "words"),
+    [
+        (
+            100.0,
+            "filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = 128 Hz), got 100 Hz",
+        ),
+        (1e-9, "filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz)"),
+    ],
+    ids=["above-nyquist", "singular"],
+)
 def test_marker_cutoff_is_named_by_its_config_key_and_the_trc_is_kept(belt_c3d, tmp_path, cutoff, words):
     trc = tmp_path / "walk-nodevice.trc"
     trc.write_text("PathFileType\t4\t(X/Y/Z)\twalk-nodevice.trc\n")
@@ -334,35 +388,63 @@ def test_load_cell_cutoff_above_the_robot_logs_nyquist_names_the_log_and_the_con
     rate = 60.0
     n = 120
     log_path = tmp_path / "walk-nodevice.loper.tsv"
-    write_robot_log(log_path, pd.DataFrame({
-        "time_s": np.arange(n) / rate, "force_desired_n": 0.0, "force_measured_n": 0.0, "motor_angle_rad": 0.0,
-        "motor_velocity_rad_s": 0.0, "sync_v": 0.0, "perturbation": 0, "safety_state": 0}), rate)
+    write_robot_log(
+        log_path,
+        pd.DataFrame(
+            {
+                "time_s": np.arange(n) / rate,
+                "force_desired_n": 0.0,
+                "force_measured_n": 0.0,
+                "motor_angle_rad": 0.0,
+                "motor_velocity_rad_s": 0.0,
+                "sync_v": 0.0,
+                "perturbation": 0,
+                "safety_state": 0,
+            }
+        ),
+        rate,
+    )
     out = tmp_path / "walk-nodevice.force.tsv"
     out.write_text("time_s\tforce_measured_n\n0\t0\n")
     before = _digest(out)
     with pytest.raises(LoperInputError) as info:
         processing.loadcell(belt_c3d, log_path, out, sync_channel="Fz_left", cutoff_hz=40.0)
-    assert str(info.value) == (f"{log_path}: filter.cutoff_hz must lie in 0 .. 30 Hz (below the Nyquist frequency of "
-                               "the log's sample_rate_hz = 60 Hz), got 40 Hz")
+    assert str(info.value) == (
+        f"{log_path}: filter.cutoff_hz must lie in 0 .. 30 Hz (below the Nyquist frequency of "
+        "the log's sample_rate_hz = 60 Hz), got 40 Hz"
+    )
     assert _digest(out) == before
 
 
 # ---------------------------------------------------------------- 3c. a YAML syntax error in the configuration
 
 
-@pytest.mark.parametrize(("text", "message"), [
-    ("filter:\n  cutoff_hz: [40.0\n  order: 4\n",
-     "line 3, column 8: YAML syntax error: expected ',' or ']', but got ':' (while parsing a flow sequence that "
-     "starts at line 2, column 14)"),
-    ("seed: 7\n\tsubjects: config/subjects.tsv\n",
-     "line 2, column 1: YAML syntax error: found character '\\t' that cannot start any token (while scanning for "
-     "the next token)"),
-    ("seed: 7\nsubjects: 'config/subjects.tsv\n",
-     "line 3, column 1: YAML syntax error: found unexpected end of stream (while scanning a quoted scalar that "
-     "starts at line 2, column 11)"),
-    ("- seed\n", "the config file must hold keys at its top level (key: value), found a sequence at line 1, column 1"),
-    ("", "the config file must hold keys at its top level (key: value), found nothing"),
-], ids=["unclosed-list", "tab", "unclosed-quote", "a-list", "empty"])
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        (
+            "filter:\n  cutoff_hz: [40.0\n  order: 4\n",
+            "line 3, column 8: YAML syntax error: expected ',' or ']', but got ':' (while parsing a flow sequence that "
+            "starts at line 2, column 14)",
+        ),
+        (
+            "seed: 7\n\tsubjects: config/subjects.tsv\n",
+            "line 2, column 1: YAML syntax error: found character '\\t' that cannot start any token "
+            "(while scanning for the next token)",
+        ),
+        (
+            "seed: 7\nsubjects: 'config/subjects.tsv\n",
+            "line 3, column 1: YAML syntax error: found unexpected end of stream (while scanning a quoted scalar that "
+            "starts at line 2, column 11)",
+        ),
+        (
+            "- seed\n",
+            "the config file must hold keys at its top level (key: value), found a sequence at line 1, column 1",
+        ),
+        ("", "the config file must hold keys at its top level (key: value), found nothing"),
+    ],
+    ids=["unclosed-list", "tab", "unclosed-quote", "a-list", "empty"],
+)
 def test_a_config_file_that_does_not_parse_is_named_with_its_line_and_column(tmp_path, text, message):
     path = tmp_path / "lab.yaml"
     path.write_text(text)
@@ -390,11 +472,16 @@ def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_co
     res = snakemake(work, "-n", timeout=120)
     console = res.stdout + res.stderr
     assert res.returncode == 1, console
-    message = (f"config/config.yaml: line {k + 2}, column {lines[k + 1].index(':') + 1}: "
-               f"YAML syntax error: expected ',' or ']', but got ':' (while parsing a flow sequence that starts at "
-               f"line {k + 1}, column 14)")
+    message = (
+        f"config/config.yaml: line {k + 2}, column {lines[k + 1].index(':') + 1}: "
+        f"YAML syntax error: expected ',' or ']', but got ':' (while parsing a flow sequence that starts at "
+        f"line {k + 1}, column 14)"
+    )
     assert console.count(message) == 1, console
     assert "not valid JSON or YAML" not in console
     assert earlier.read_text() == "an earlier result\n"
     assert sorted(p.relative_to(work / "results").as_posix() for p in (work / "results").rglob("*")) == [
-        "markers", "markers/R01", "markers/R01/walk.trc"]
+        "markers",
+        "markers/R01",
+        "markers/R01/walk.trc",
+    ]

@@ -36,9 +36,13 @@ SUBJECT, HEIGHT_M, MASS_KG = "R01", 1.75, 70.0
 RAW = f"data/raw/{SUBJECT}"
 WALK = "walk-device"
 #: What the project's earlier run made (besides logs and benchmarks).
-GOOD_TARGETS = (f"results/markers/{SUBJECT}/static.trc", f"results/markers/{SUBJECT}/{WALK}.trc",
-                f"results/events/{SUBJECT}/{WALK}.events.tsv", f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
-                f"results/model/{SUBJECT}/generic.osim")
+GOOD_TARGETS = (
+    f"results/markers/{SUBJECT}/static.trc",
+    f"results/markers/{SUBJECT}/{WALK}.trc",
+    f"results/events/{SUBJECT}/{WALK}.events.tsv",
+    f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
+    f"results/model/{SUBJECT}/generic.osim",
+)
 
 
 def _snakemake(cwd: Path, *args: str) -> subprocess.CompletedProcess:
@@ -70,14 +74,16 @@ def project(tmp_path_factory) -> Path:
     cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     (work / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
     (work / "config/subjects.tsv").write_text(
-        f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t{HEIGHT_M}\t{MASS_KG}\n")
+        f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t{HEIGHT_M}\t{MASS_KG}\n"
+    )
     lab, raw = LabSettings(), work / RAW
     raw.mkdir(parents=True)
     write_recording(raw / "static.c3d", subject_static_recording(SUBJECT, HEIGHT_M, MASS_KG, 2.0, lab, 7))
     model = build_lower_body_model(HEIGHT_M, MASS_KG)
     for folder, seed in ((raw, 3), (work / "elsewhere", 4)):  # the trial, and one recorded at another time
-        walk = simulate_walking_trial(8.0, lab, seed, HEIGHT_M, segment_parameters_from_model(model), 0.03, 0.05,
-                                      DeviceParameters())
+        walk = simulate_walking_trial(
+            8.0, lab, seed, HEIGHT_M, segment_parameters_from_model(model), 0.03, 0.05, DeviceParameters()
+        )
         folder.mkdir(exist_ok=True)
         write_recording(folder / f"{WALK}.c3d", walking_recording(model, walk, MASS_KG, lab, seed + 10))
         write_robot_log(folder / f"{WALK}.loper.tsv", walk.robot, lab.robot_rate_hz, {"clock": "robot"})
@@ -101,8 +107,12 @@ def _config(work: Path) -> dict:
 
 def _state(work: Path) -> dict[str, tuple[int, str]]:
     """Every file under results/ and data/ (hidden ones too): modification time and content hash."""
-    return {str(p.relative_to(work)): (p.stat().st_mtime_ns, hashlib.sha256(p.read_bytes()).hexdigest())
-            for top in ("results", "data") for p in sorted((work / top).rglob("*")) if p.is_file()}
+    return {
+        str(p.relative_to(work)): (p.stat().st_mtime_ns, hashlib.sha256(p.read_bytes()).hexdigest())
+        for top in ("results", "data")
+        for p in sorted((work / top).rglob("*"))
+        if p.is_file()
+    }
 
 
 def _refused(work: Path, run, words, log: str | None = None) -> str:
@@ -138,32 +148,68 @@ def _markers(cfg: dict, c3d: str, label_map=None):
     """The markers rule's step for the walking trial, with its outputs and the config's settings."""
     out = f"results/markers/{SUBJECT}/{WALK}"
     m = cfg["markers"]
-    return processing.markers(c3d, f"{out}.trc", f"{out}.gaps.tsv", m["lab_to_model_rotation_deg"],
-                              m["max_gap_frames"], cfg["filter"]["cutoff_hz"], cfg["filter"]["order"], None,
-                              label_map=label_map or m["label_map"] or None, summary_out=f"{out}.markers.tsv")
+    return processing.markers(
+        c3d,
+        f"{out}.trc",
+        f"{out}.gaps.tsv",
+        m["lab_to_model_rotation_deg"],
+        m["max_gap_frames"],
+        cfg["filter"]["cutoff_hz"],
+        cfg["filter"]["order"],
+        None,
+        label_map=label_map or m["label_map"] or None,
+        summary_out=f"{out}.markers.tsv",
+    )
 
 
 def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW}/{WALK}.c3d"):
-    return processing.loadcell(c3d, log, f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
-                               cfg["events"]["sync_channel"], cfg["filter"]["cutoff_hz"], cfg["filter"]["order"])
+    return processing.loadcell(
+        c3d,
+        log,
+        f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
+        cfg["events"]["sync_channel"],
+        cfg["filter"]["cutoff_hz"],
+        cfg["filter"]["order"],
+    )
 
 
 def _events(cfg: dict, grf_channels: dict):
     e = cfg["events"]
     out = f"results/events/{SUBJECT}/{WALK}"
-    return processing.events(f"{RAW}/{WALK}.c3d", f"{out}.events.tsv", grf_channels, e["threshold_on_n"],
-                             e["threshold_off_n"], e["min_stance_s"], e["min_swing_s"], e["grf_cutoff_hz"],
-                             cfg["filter"]["order"], e["foot_markers"], e["plate_sides"], None,
-                             cfg["markers"]["lab_to_model_rotation_deg"], cfg["grf"]["resting_band_n"],
-                             cfg["grf"]["max_resting_n"], f"{out}.contacts.tsv")
+    return processing.events(
+        f"{RAW}/{WALK}.c3d",
+        f"{out}.events.tsv",
+        grf_channels,
+        e["threshold_on_n"],
+        e["threshold_off_n"],
+        e["min_stance_s"],
+        e["min_swing_s"],
+        e["grf_cutoff_hz"],
+        cfg["filter"]["order"],
+        e["foot_markers"],
+        e["plate_sides"],
+        None,
+        cfg["markers"]["lab_to_model_rotation_deg"],
+        cfg["grf"]["resting_band_n"],
+        cfg["grf"]["max_resting_n"],
+        f"{out}.contacts.tsv",
+    )
 
 
 def _ik(cfg: dict, trc: Path):
     o = cfg["opensim"]
-    return ik.ik_trial(f"results/model/{SUBJECT}/generic.osim", trc, f"results/ik/{SUBJECT}/{WALK}.mot",
-                       f"results/ik/{SUBJECT}/{WALK}.angles.tsv", o["coordinate_map"], tasks_file=o["ik_tasks"],
-                       default_weight=o["default_marker_weight"], marker_weights=o["marker_weights"],
-                       coordinate_tasks=o["coordinate_tasks"], accuracy=o["accuracy"])
+    return ik.ik_trial(
+        f"results/model/{SUBJECT}/generic.osim",
+        trc,
+        f"results/ik/{SUBJECT}/{WALK}.mot",
+        f"results/ik/{SUBJECT}/{WALK}.angles.tsv",
+        o["coordinate_map"],
+        tasks_file=o["ik_tasks"],
+        default_weight=o["default_marker_weight"],
+        marker_weights=o["marker_weights"],
+        coordinate_tasks=o["coordinate_tasks"],
+        accuracy=o["accuracy"],
+    )
 
 
 # --------------------------------------------------------------------------- C3D files
@@ -177,11 +223,17 @@ def _c3d_bytes(work: Path) -> bytes:
     ("name", "damage", "words"),
     [
         ("truncated", lambda b, w: b[: len(b) // 2], ["truncated file", "declares 1024 frames but only 511"]),
-        ("foreign", lambda b, w: (w / RAW / f"{WALK}.loper.tsv").read_bytes(),
-         ["not a readable C3D file", "must be a valid c3d file"]),
+        (
+            "foreign",
+            lambda b, w: (w / RAW / f"{WALK}.loper.tsv").read_bytes(),
+            ["not a readable C3D file", "must be a valid c3d file"],
+        ),
         ("empty", lambda b, w: b"", ["not a readable C3D file", "File is empty"]),
-        ("unknown unit", lambda b, w: b.replace(b"\x01\x02mm", b"\x01\x02yd", 1),
-         ["unknown POINT:UNITS 'yd'", "expected one of mm, cm, m"]),
+        (
+            "unknown unit",
+            lambda b, w: b.replace(b"\x01\x02mm", b"\x01\x02yd", 1),
+            ["unknown POINT:UNITS 'yd'", "expected one of mm, cm, m"],
+        ),
     ],
     ids=["truncated", "foreign", "empty", "unknown-unit"],
 )
@@ -194,15 +246,21 @@ def test_unreadable_c3d_is_refused_by_the_markers_step(lab, name, damage, words)
 def test_truncated_c3d_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab):
     """Through Snakemake: the console names file and cause in one line; the job's log is the only new file."""
     (lab / RAW / "pert050-1.c3d").write_bytes(_c3d_bytes(lab)[:300_000])
-    message = _refused(lab, lambda: _snakemake(lab, f"results/markers/{SUBJECT}/pert050-1.trc"),
-                       [f"{RAW}/pert050-1.c3d: truncated file: the header declares 1024 frames but only"],
-                       log=f"results/logs/markers/{SUBJECT}/pert050-1.log")
+    message = _refused(
+        lab,
+        lambda: _snakemake(lab, f"results/markers/{SUBJECT}/pert050-1.trc"),
+        [f"{RAW}/pert050-1.c3d: truncated file: the header declares 1024 frames but only"],
+        log=f"results/logs/markers/{SUBJECT}/pert050-1.log",
+    )
     assert "Traceback" not in message
 
 
 def test_label_map_entry_the_file_lacks_is_refused(lab):
-    _refused(lab, lambda: _markers(_config(lab), f"{RAW}/{WALK}.c3d", {"L_FCC": "LHEE"}),
-             [f"{RAW}/{WALK}.c3d: markers.label_map: label(s) L_FCC not in the file", "RASI, LASI"])
+    _refused(
+        lab,
+        lambda: _markers(_config(lab), f"{RAW}/{WALK}.c3d", {"L_FCC": "LHEE"}),
+        [f"{RAW}/{WALK}.c3d: markers.label_map: label(s) L_FCC not in the file", "RASI, LASI"],
+    )
 
 
 def test_static_trial_in_which_the_subject_moves_is_refused(lab):
@@ -213,14 +271,24 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
     X[:, :, 0] += 0.3 * (t - t[0])[:, None]
     write_trc(lab / "moving.trc", t, X, labels)
     m = _config(lab)["markers"]
-    _refused(lab, lambda: model.scale(f"results/model/{SUBJECT}/generic.osim", lab / "moving.trc",
-                                      f"results/model/{SUBJECT}/scaled.osim", MASS_KG,
-                                      lab_labels=f"results/markers/{SUBJECT}/static.markers.tsv",
-                                      duration_s=m["static_duration_s"],
-                                      max_motion_rms_m=m["static_max_motion_rms_m"]),
-             ["moving.trc: the subject does not stand still in the scaling window 0.0000 .. 0.9922 s of the static "
-              "trial: marker(s) ", " 87 mm, ", f"and {len(labels) - 5} more move more than "
-              "markers.static_max_motion_rms_m 0.05 m RMS about their mean"])
+    _refused(
+        lab,
+        lambda: model.scale(
+            f"results/model/{SUBJECT}/generic.osim",
+            lab / "moving.trc",
+            f"results/model/{SUBJECT}/scaled.osim",
+            MASS_KG,
+            lab_labels=f"results/markers/{SUBJECT}/static.markers.tsv",
+            duration_s=m["static_duration_s"],
+            max_motion_rms_m=m["static_max_motion_rms_m"],
+        ),
+        [
+            "moving.trc: the subject does not stand still in the scaling window 0.0000 .. 0.9922 s of the static "
+            "trial: marker(s) ",
+            " 87 mm, ",
+            f"and {len(labels) - 5} more move more than markers.static_max_motion_rms_m 0.05 m RMS about their mean",
+        ],
+    )
 
 
 def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
@@ -230,20 +298,38 @@ def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
     t, X, labels = read_markers(f"results/markers/{SUBJECT}/static.trc")
     labels[labels.index("LHEE")] = "LHEEL"
     write_trc(lab / "typo.trc", t, X, labels)
-    _refused(lab, lambda: model.scale(f"results/model/{SUBJECT}/generic.osim", lab / "typo.trc",
-                                      f"results/model/{SUBJECT}/scaled.osim", MASS_KG, lab_labels={"LHEEL": "L_FCC"}),
-             ["typo.trc: measurement marker(s) ['LHEE'] are not in the static trial",
-              "the trial's marker(s) 'L_FCC' mapped to LHEEL (the model has LHEE) are not on the model: a typo in the "
-              "label map (markers.label_map, markers.trial_label_maps)?"])
+    _refused(
+        lab,
+        lambda: model.scale(
+            f"results/model/{SUBJECT}/generic.osim",
+            lab / "typo.trc",
+            f"results/model/{SUBJECT}/scaled.osim",
+            MASS_KG,
+            lab_labels={"LHEEL": "L_FCC"},
+        ),
+        [
+            "typo.trc: measurement marker(s) ['LHEE'] are not in the static trial",
+            "the trial's marker(s) 'L_FCC' mapped to LHEEL (the model has LHEE) are not on the model: a typo in the "
+            "label map (markers.label_map, markers.trial_label_maps)?",
+        ],
+    )
 
 
 def test_model_marker_missing_from_the_trial_stops_ik(lab):
     t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
     k = labels.index("LKNE")
-    write_trc(lab / "without-LKNE.trc", t, np.delete(X, k, axis=1), labels[:k] + labels[k + 1:])
-    _refused(lab, lambda: _ik(_config(lab), lab / "without-LKNE.trc"),
-             ["without-LKNE.trc with ", "generic.osim: marker(s) ['LKNE'] of the model's marker set are missing",
-              "markers.label_map", "opensim.marker_weights", "opensim.ik_tasks"])
+    write_trc(lab / "without-LKNE.trc", t, np.delete(X, k, axis=1), labels[:k] + labels[k + 1 :])
+    _refused(
+        lab,
+        lambda: _ik(_config(lab), lab / "without-LKNE.trc"),
+        [
+            "without-LKNE.trc with ",
+            "generic.osim: marker(s) ['LKNE'] of the model's marker set are missing",
+            "markers.label_map",
+            "opensim.marker_weights",
+            "opensim.ik_tasks",
+        ],
+    )
 
 
 def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_any_stops(lab, tmp_path):
@@ -251,17 +337,30 @@ def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_a
     X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only: left out, the rest solved
     write_trc(tmp_path / "sparse.trc", t, X, labels)
     o = _config(lab)["opensim"]
-    angles = ik.ik_trial(f"results/model/{SUBJECT}/generic.osim", tmp_path / "sparse.trc", tmp_path / "sparse.mot",
-                         tmp_path / "sparse.angles.tsv", o["coordinate_map"], summary_tsv=tmp_path / "sparse.ik.tsv")
+    angles = ik.ik_trial(
+        f"results/model/{SUBJECT}/generic.osim",
+        tmp_path / "sparse.trc",
+        tmp_path / "sparse.mot",
+        tmp_path / "sparse.angles.tsv",
+        o["coordinate_map"],
+        summary_tsv=tmp_path / "sparse.ik.tsv",
+    )
     blank = angles.drop(columns="time_s").isna().all(axis=1).to_numpy()
     assert np.flatnonzero(blank).tolist() == [100, 101, 102] and not angles.iloc[99:104:4].isna().any().any()
     summary = pd.read_csv(tmp_path / "sparse.ik.tsv", sep="\t").iloc[0]
     assert (summary.n_frames, summary.n_frames_left_out) == (len(t), 3)
     X[:, 2:] = np.nan  # no frame holds 3 markers: nothing to solve, nothing written
     write_trc(lab / "none.trc", t, X, labels)
-    _refused(lab, lambda: _ik(_config(lab), lab / "none.trc"),
-             [f"none.trc with results/model/{SUBJECT}/generic.osim: {len(t)} frame(s) hold fewer than 3 of the 36 "
-              f"weighted markers", f"frames 0..{len(t) - 1}", "RPSI, LPSI"])
+    _refused(
+        lab,
+        lambda: _ik(_config(lab), lab / "none.trc"),
+        [
+            f"none.trc with results/model/{SUBJECT}/generic.osim: {len(t)} frame(s) hold fewer than 3 of the 36 "
+            f"weighted markers",
+            f"frames 0..{len(t) - 1}",
+            "RPSI, LPSI",
+        ],
+    )
 
 
 def test_long_gap_is_left_missing_and_counted_not_refused(lab, tmp_path):
@@ -272,8 +371,14 @@ def test_long_gap_is_left_missing_and_counted_not_refused(lab, tmp_path):
     X[300:360, j] = np.nan
     write_recording(tmp_path / "gap.c3d", replace(rec, markers_m=X))
     m = _config(lab)["markers"]
-    processing.markers(tmp_path / "gap.c3d", tmp_path / "gap.trc", tmp_path / "gap.gaps.tsv",
-                       m["lab_to_model_rotation_deg"], m["max_gap_frames"], summary_out=tmp_path / "gap.markers.tsv")
+    processing.markers(
+        tmp_path / "gap.c3d",
+        tmp_path / "gap.trc",
+        tmp_path / "gap.gaps.tsv",
+        m["lab_to_model_rotation_deg"],
+        m["max_gap_frames"],
+        summary_out=tmp_path / "gap.markers.tsv",
+    )
     summary = pd.read_csv(tmp_path / "gap.markers.tsv", sep="\t").set_index("marker")
     assert summary.loc["LKNE", ["n_missing_frames", "longest_gap_frames"]].tolist() == [60, 60]
     assert (summary.drop(index="LKNE").n_missing_frames == 0).all()
@@ -283,36 +388,54 @@ def test_long_gap_is_left_missing_and_counted_not_refused(lab, tmp_path):
 
 def test_missing_analog_channels_are_refused(lab):
     cfg = _config(lab)
-    _refused(lab, lambda: _events(cfg, {"left": "Fz_belt3", "right": "Fz_right"}),
-             [f"{RAW}/{WALK}.c3d: no analog channel 'Fz_belt3'", "channels present: Fx_left, Fz_left"])
+    _refused(
+        lab,
+        lambda: _events(cfg, {"left": "Fz_belt3", "right": "Fz_right"}),
+        [f"{RAW}/{WALK}.c3d: no analog channel 'Fz_belt3'", "channels present: Fx_left, Fz_left"],
+    )
     rec = read_c3d(lab / RAW / f"{WALK}.c3d")
     i = rec.analog_labels.index("sync")
-    write_recording(lab / "no-sync.c3d", replace(rec, analog_labels=rec.analog_labels[:i],
-                                                 analog_units=rec.analog_units[:i], analogs=rec.analogs[:, :i]))
+    write_recording(
+        lab / "no-sync.c3d",
+        replace(
+            rec, analog_labels=rec.analog_labels[:i], analog_units=rec.analog_units[:i], analogs=rec.analogs[:, :i]
+        ),
+    )
     _refused(lab, lambda: _loadcell(cfg, c3d="no-sync.c3d"), ["no-sync.c3d: no analog channel 'sync'"])
 
 
 def test_belt_channels_swapped_are_refused_from_the_heel_markers(lab):
     """The heel markers in the same file say which foot stands on each belt: the standing heel is the lower."""
-    _refused(lab, lambda: _events(_config(lab), {"left": "Fz_right", "right": "Fz_left"}),
-             [f"{RAW}/{WALK}.c3d: events.grf_channels.left: channel Fz_right does not carry the left foot: in 4 of "
-              "its 4 stances the right heel (RHEE) was the lower at mid-stance",
-              "events.grf_channels: {left: Fz_right, right: Fz_left}"])
+    _refused(
+        lab,
+        lambda: _events(_config(lab), {"left": "Fz_right", "right": "Fz_left"}),
+        [
+            f"{RAW}/{WALK}.c3d: events.grf_channels.left: channel Fz_right does not carry the left foot: in 4 of "
+            "its 4 stances the right heel (RHEE) was the lower at mid-stance",
+            "events.grf_channels: {left: Fz_right, right: Fz_left}",
+        ],
+    )
     # both names on one belt: the right side's stances are the left foot's
-    _refused(lab, lambda: _events(_config(lab), {"left": "Fz_left", "right": "Fz_left"}),
-             ["events.grf_channels.right: channel Fz_left does not carry the right foot"])
+    _refused(
+        lab,
+        lambda: _events(_config(lab), {"left": "Fz_left", "right": "Fz_left"}),
+        ["events.grf_channels.right: channel Fz_left does not carry the right foot"],
+    )
 
 
 def test_belts_feet_that_cannot_be_confirmed_are_warned(lab, tmp_path):
     rec = read_c3d(lab / RAW / f"{WALK}.c3d")
     keep = [i for i, name in enumerate(rec.marker_labels) if name not in ("LHEE", "RHEE")]
-    write_recording(tmp_path / "no-heels.c3d", replace(rec, markers_m=rec.markers_m[:, keep],
-                                                       marker_labels=[rec.marker_labels[i] for i in keep]))
+    write_recording(
+        tmp_path / "no-heels.c3d",
+        replace(rec, markers_m=rec.markers_m[:, keep], marker_labels=[rec.marker_labels[i] for i in keep]),
+    )
     cfg = _config(lab)
     e = cfg["events"]
     with pytest.warns(UserWarning, match="the belts' feet could not be confirmed: heel marker.s. LHEE, RHEE"):
-        table = processing.events(tmp_path / "no-heels.c3d", tmp_path / "e.tsv", e["grf_channels"],
-                                  foot_markers=e["foot_markers"])
+        table = processing.events(
+            tmp_path / "no-heels.c3d", tmp_path / "e.tsv", e["grf_channels"], foot_markers=e["foot_markers"]
+        )
     good = pd.read_csv(f"results/events/{SUBJECT}/{WALK}.events.tsv", sep="\t")
     assert len(table) == len(good) and np.allclose(table["time_s"], good["time_s"])
 
@@ -325,29 +448,43 @@ def _log_lines(work: Path) -> list[str]:
 
 
 def _without_column(lines: list[str], col: int) -> list[str]:
-    return [ln if ln.startswith("#") else "\t".join(np.delete(ln.rstrip("\n").split("\t"), col)) + "\n"
-            for ln in lines]
+    return [ln if ln.startswith("#") else "\t".join(np.delete(ln.rstrip("\n").split("\t"), col)) + "\n" for ln in lines]
 
 
 def _nan_at(lines: list[str], line: int, col: int) -> list[str]:
     cells = lines[line].rstrip("\n").split("\t")
     cells[col] = "nan"
-    return [*lines[:line], "\t".join(cells) + "\n", *lines[line + 1:]]
+    return [*lines[:line], "\t".join(cells) + "\n", *lines[line + 1 :]]
 
 
 @pytest.mark.parametrize(
     ("name", "damage", "words"),
     [
-        ("missing column", lambda ls: _without_column(ls, 1),
-         ["missing column(s) force_desired_n", "a robot log has the columns time_s, force_desired_n"]),
-        ("unordered time", lambda ls: [*ls[:10], ls[11], ls[10], *ls[12:]],
-         ["column 'time_s', sample 7 (t = 0.006 s, line 12): time not strictly increasing"]),
-        ("NaN", lambda ls: _nan_at(ls, 20, 2),
-         ["column 'force_measured_n', sample 16 (t = 0.016 s, line 21): non-finite force nan"]),
-        ("wrong rate", lambda ls: [ln.replace("# sample_rate_hz: 1000", "# sample_rate_hz: 500") for ln in ls],
-         ["column 'time_s', sample 1", "deviates -50 % from 1/sample_rate_hz = 2 ms"]),
-        ("cut line", lambda ls: [*ls[:5000], ls[5000][:20]],
-         ["sample 4996 (line 5001): 4 field(s), expected 8 (one per column)"]),
+        (
+            "missing column",
+            lambda ls: _without_column(ls, 1),
+            ["missing column(s) force_desired_n", "a robot log has the columns time_s, force_desired_n"],
+        ),
+        (
+            "unordered time",
+            lambda ls: [*ls[:10], ls[11], ls[10], *ls[12:]],
+            ["column 'time_s', sample 7 (t = 0.006 s, line 12): time not strictly increasing"],
+        ),
+        (
+            "NaN",
+            lambda ls: _nan_at(ls, 20, 2),
+            ["column 'force_measured_n', sample 16 (t = 0.016 s, line 21): non-finite force nan"],
+        ),
+        (
+            "wrong rate",
+            lambda ls: [ln.replace("# sample_rate_hz: 1000", "# sample_rate_hz: 500") for ln in ls],
+            ["column 'time_s', sample 1", "deviates -50 % from 1/sample_rate_hz = 2 ms"],
+        ),
+        (
+            "cut line",
+            lambda ls: [*ls[:5000], ls[5000][:20]],
+            ["sample 4996 (line 5001): 4 field(s), expected 8 (one per column)"],
+        ),
     ],
     ids=["missing-column", "unordered-time", "nan", "wrong-rate", "cut-line"],
 )
@@ -358,42 +495,69 @@ def test_bad_robot_log_is_refused_by_the_loadcell_step(lab, name, damage, words)
 
 
 def test_robot_log_of_another_trial_is_refused(lab):
-    _refused(lab, lambda: _loadcell(_config(lab), log=f"elsewhere/{WALK}.loper.tsv"),
-             [f"elsewhere/{WALK}.loper.tsv / {RAW}/{WALK}.c3d: no 4 consecutive sync edges of the robot log",
-              "(10 edges)", "of the mocap record (8 edges)"])
+    _refused(
+        lab,
+        lambda: _loadcell(_config(lab), log=f"elsewhere/{WALK}.loper.tsv"),
+        [
+            f"elsewhere/{WALK}.loper.tsv / {RAW}/{WALK}.c3d: no 4 consecutive sync edges of the robot log",
+            "(10 edges)",
+            "of the mocap record (8 edges)",
+        ],
+    )
 
 
 def test_bad_robot_log_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab):
     """Through Snakemake: a new perturbation trial whose log holds a NaN."""
     shutil.copy(lab / RAW / f"{WALK}.c3d", lab / RAW / "pert050-1.c3d")
     (lab / RAW / "pert050-1.loper.tsv").write_text("".join(_nan_at(_log_lines(lab), 20, 2)))
-    _refused(lab, lambda: _snakemake(lab, f"results/loadcell/{SUBJECT}/pert050-1.force.tsv"),
-             [(f"{RAW}/pert050-1.loper.tsv: column 'force_measured_n', sample 16 (t = 0.016 s, line 21): "
-               "non-finite force nan")], log=f"results/logs/events_loadcell/{SUBJECT}/pert050-1.log")
+    _refused(
+        lab,
+        lambda: _snakemake(lab, f"results/loadcell/{SUBJECT}/pert050-1.force.tsv"),
+        [
+            (
+                f"{RAW}/pert050-1.loper.tsv: column 'force_measured_n', sample 16 (t = 0.016 s, line 21): "
+                "non-finite force nan"
+            )
+        ],
+        log=f"results/logs/events_loadcell/{SUBJECT}/pert050-1.log",
+    )
 
 
 # --------------------------------------------------------------------------- subjects and config (before any work)
 
 
 def test_recorded_subject_without_a_static_trial_is_refused(lab):
-    (lab / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t1.75\t70\n"
-                                             "R02\trecorded\t1.6\t55\n")
+    (lab / "config/subjects.tsv").write_text(
+        f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t1.75\t70\nR02\trecorded\t1.6\t55\n"
+    )
     (lab / "data/raw/R02").mkdir()
     shutil.copy(lab / RAW / f"{WALK}.c3d", lab / "data/raw/R02" / f"{WALK}.c3d")
-    _refused(lab, lambda: _snakemake(lab, "-n"),
-             ["config/subjects.tsv: recorded subject 'R02' has no static trial data/raw/R02/static.c3d"])
+    _refused(
+        lab,
+        lambda: _snakemake(lab, "-n"),
+        ["config/subjects.tsv: recorded subject 'R02' has no static trial data/raw/R02/static.c3d"],
+    )
 
 
-@pytest.mark.parametrize(("make", "words"), [
-    (lambda path: path.symlink_to("/mnt/lab-share/R01/pert050-1.c3d"),
-     ["is a broken link (to '/mnt/lab-share/R01/pert050-1.c3d')"]),
-    (lambda path: path.mkdir(), ["is a directory; a trial's raw file must be a file"]),
-], ids=["broken-link", "directory"])
+@pytest.mark.parametrize(
+    ("make", "words"),
+    [
+        (
+            lambda path: path.symlink_to("/mnt/lab-share/R01/pert050-1.c3d"),
+            ["is a broken link (to '/mnt/lab-share/R01/pert050-1.c3d')"],
+        ),
+        (lambda path: path.mkdir(), ["is a directory; a trial's raw file must be a file"]),
+    ],
+    ids=["broken-link", "directory"],
+)
 def test_trial_path_that_is_not_a_file_stops_the_run_naming_it(lab, make, words):
     """Not "no such trial": the fit would silently use the other trials of the onset."""
     make(lab / RAW / "pert050-1.c3d")
-    _refused(lab, lambda: _snakemake(lab, "-n"),
-             [f"{RAW}/pert050-1.c3d: the raw file of trial 'pert050-1' of subject '{SUBJECT}' ", *words])
+    _refused(
+        lab,
+        lambda: _snakemake(lab, "-n"),
+        [f"{RAW}/pert050-1.c3d: the raw file of trial 'pert050-1' of subject '{SUBJECT}' ", *words],
+    )
 
 
 def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab):
@@ -402,8 +566,10 @@ def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab)
     before = _state(lab)
     res = _snakemake(lab, "-n", "results/strides/summary.tsv")
     assert res.returncode == 0, res.stdout[-2000:]
-    assert (f"warning: {RAW}: pert100-1.c3d, pert100-1.loper.tsv: no trial of the design has this name, not "
-            "analysed (trials: static, walk-nodevice, walk-device, pert050-1, device-frf, device-steps; ") in res.stderr
+    assert (
+        f"warning: {RAW}: pert100-1.c3d, pert100-1.loper.tsv: no trial of the design has this name, not "
+        "analysed (trials: static, walk-nodevice, walk-device, pert050-1, device-frf, device-steps; "
+    ) in res.stderr
     assert "trials.perturbation_onsets_ms [50] and trials.perturbation_repeats 1" in res.stderr
     assert _state(lab) == before
 
@@ -421,17 +587,22 @@ def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(la
     res = _snakemake(lab, "-n")
     assert res.returncode == 0, res.stdout[-3000:]
     for trial in (WALK, "pert100-1"):
-        assert (f"note: {RAW}/{trial}.c3d: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the "
-                "belt channels (events.grf_channels: {'left': 'Fz_left', 'right': 'Fz_right'}), no OpenSim external "
-                f"loads (results/grf/{SUBJECT}/{trial}.grf.mot)") in res.stderr
+        assert (
+            f"note: {RAW}/{trial}.c3d: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the "
+            "belt channels (events.grf_channels: {'left': 'Fz_left', 'right': 'Fz_right'}), no OpenSim external "
+            f"loads (results/grf/{SUBJECT}/{trial}.grf.mot)"
+        ) in res.stderr
     assert "rule grf:" not in res.stdout and f"results/impedance/{SUBJECT}/100.tsv" in res.stdout
     assert _state(lab) == before
 
 
 def test_impossible_anthropometrics_are_refused(lab):
     (lab / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t17.5\t70\n")
-    _refused(lab, lambda: _snakemake(lab, "-n"),
-             ["config/subjects.tsv: row 1, column 'height_m': 17.5 is greater than the maximum of 2.5"])
+    _refused(
+        lab,
+        lambda: _snakemake(lab, "-n"),
+        ["config/subjects.tsv: row 1, column 'height_m': 17.5 is greater than the maximum of 2.5"],
+    )
 
 
 def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
@@ -451,18 +622,29 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
 @pytest.mark.parametrize(
     ("files", "args", "words"),
     [
-        ({"config/lab.yaml": {"identification": {"n_starts": "ten"}}}, ["--configfile", "config/lab.yaml"],
-         ["config/lab.yaml: key 'identification.n_starts': 'ten' is not of type 'integer'"]),
+        (
+            {"config/lab.yaml": {"identification": {"n_starts": "ten"}}},
+            ["--configfile", "config/lab.yaml"],
+            ["config/lab.yaml: key 'identification.n_starts': 'ten' is not of type 'integer'"],
+        ),
         ({}, ["--config", "seed=-1"], ["--config: key 'seed': -1 is less than the minimum of 0"]),
-        ({"config/lab.yaml": {"seed": 7}, "config/extra.yaml": {"validation": {"n_chunkz": 2}}},
-         ["--configfile", "config/lab.yaml", "config/extra.yaml"],
-         ["config/extra.yaml: key 'validation.n_chunkz': Additional properties are not allowed ('n_chunkz'"]),
-        ({"config/lab.yaml": {"filter": {"cutoff_hz": -40.0}}}, ["--configfile", "config/lab.yaml", "--config",
-                                                                 "seed=7"],
-         ["config/lab.yaml: key 'filter.cutoff_hz': -40.0"]),
+        (
+            {"config/lab.yaml": {"seed": 7}, "config/extra.yaml": {"validation": {"n_chunkz": 2}}},
+            ["--configfile", "config/lab.yaml", "config/extra.yaml"],
+            ["config/extra.yaml: key 'validation.n_chunkz': Additional properties are not allowed ('n_chunkz'"],
+        ),
+        (
+            {"config/lab.yaml": {"filter": {"cutoff_hz": -40.0}}},
+            ["--configfile", "config/lab.yaml", "--config", "seed=7"],
+            ["config/lab.yaml: key 'filter.cutoff_hz': -40.0"],
+        ),
     ],
-    ids=["type-in-configfile", "range-in-config-option", "unknown-key-in-last-configfile",
-         "configfile-under-config-option"],
+    ids=[
+        "type-in-configfile",
+        "range-in-config-option",
+        "unknown-key-in-last-configfile",
+        "configfile-under-config-option",
+    ],
 )
 def test_bad_config_names_the_file_or_option_key_and_value(lab, files, args, words):
     for name, doc in files.items():

@@ -1,4 +1,5 @@
-"""Device analysis on signals with known answers, the summary beside the study, and the simulated device against the study."""
+"""Device analysis on signals with known answers, the summary beside the study, and the simulated device against the
+study."""
 
 from __future__ import annotations
 
@@ -107,14 +108,25 @@ def test_device_summary_of_known_tables():
     f = np.geomspace(0.25, 100.0, 161)
     db = np.where(f <= 10.0, 0.0, -6.0 * np.log(f / 10.0) / np.log(4.0))
     frf = pd.DataFrame({"frequency_hz": f, "gain": 10 ** (db / 20), "phase_deg": 0.0, "coherence": 1.0})
-    steps = pd.DataFrame({"amplitude_n": [20.0, 40.0, 60.0], "n_repetitions": 10, "rise_time_ms": [9.0, 10.0, 14.0],
-                          "overshoot_pct": [30.0, 33.0, 36.0], "steady_state_n": [18.0, 36.9, 54.0],
-                          "peak_n": [23.4, 49.1, 73.4]})
+    steps = pd.DataFrame(
+        {
+            "amplitude_n": [20.0, 40.0, 60.0],
+            "n_repetitions": 10,
+            "rise_time_ms": [9.0, 10.0, 14.0],
+            "overshoot_pct": [30.0, 33.0, 36.0],
+            "steady_state_n": [18.0, 36.9, 54.0],
+            "peak_n": [23.4, 49.1, 73.4],
+        }
+    )
     summary = device_summary(frf, steps, (0.5, 2.0))
     s = summary.set_index("metric")
     assert list(summary.columns) == ["metric", "value", "study_value", "unit", "difference_pct"]
-    expected = {"bandwidth_hz": (20.0, 39.0), "rise_time_ms": (11.0, 10.0), "overshoot_pct": (33.0, 30.5),
-                "steady_state_40n_n": (36.9, 36.0)}
+    expected = {
+        "bandwidth_hz": (20.0, 39.0),
+        "rise_time_ms": (11.0, 10.0),
+        "overshoot_pct": (33.0, 30.5),
+        "steady_state_40n_n": (36.9, 36.0),
+    }
     for metric, (value, study) in expected.items():
         np.testing.assert_allclose(s.loc[metric, "value"], value, rtol=1e-9, err_msg=metric)
         assert s.loc[metric, "study_value"] == study
@@ -129,11 +141,16 @@ def test_simulated_device_reproduces_the_study_within_15_percent():
     frf = frequency_response(frf_log.force_desired_n, frf_log.force_measured_n, FS)
     bw = bandwidth_hz(frf.frequency_hz, frf.gain)
     steps = simulate_device_trial("device-steps", dev, leg, tests, 12)
-    tab = step_table(step_averages(steps.force_desired_n, steps.force_measured_n, FS, after_s=0.45),
-                     steady_window_s=(0.15, 0.3))
+    tab = step_table(
+        step_averages(steps.force_desired_n, steps.force_measured_n, FS, after_s=0.45), steady_window_s=(0.15, 0.3)
+    )
     at40 = tab.set_index("amplitude_n").loc[40.0]
-    for value, study in ((bw, 39.0), (tab.rise_time_ms.mean(), 10.0), (tab.overshoot_pct.mean(), 30.5),
-                         (at40.steady_state_n, 36.0)):
+    for value, study in (
+        (bw, 39.0),
+        (tab.rise_time_ms.mean(), 10.0),
+        (tab.overshoot_pct.mean(), 30.5),
+        (at40.steady_state_n, 36.0),
+    ):
         assert abs(value - study) / study <= 0.15, (value, study)
     # minimal-impedance walking: prescribed brace motion of a +-0.3 rad hip swing, 36 strides/min
     t = np.arange(0, 30, 1 / FS)

@@ -86,8 +86,13 @@ def test_runaway_torque_ends_with_motor_off():
 
 
 def test_velocity_cutoff_with_a_misconfigured_limiter():
-    dev = DeviceParameters(velocity_limit_rad_s=20.0, acceleration_limit_rad_s2=5000.0, motor_cutoff_torque_nm=1e4,
-                           loadcell_noise_sd_n=0.0, loadcell_resolution_n=0.0)
+    dev = DeviceParameters(
+        velocity_limit_rad_s=20.0,
+        acceleration_limit_rad_s2=5000.0,
+        motor_cutoff_torque_nm=1e4,
+        loadcell_noise_sd_n=0.0,
+        loadcell_resolution_n=0.0,
+    )
     fd = np.zeros(2000)
     fd[100:] = 200.0
     log = simulate_device(fd, dev, SOFT_LEG)
@@ -97,8 +102,10 @@ def test_velocity_cutoff_with_a_misconfigured_limiter():
     assert abs(log.motor_velocity_rad_s.iloc[k]) > dev.motor_cutoff_velocity_rad_s
 
 
-@pytest.mark.parametrize(("angle", "state"), [(1.32, SAFETY_MOTOR_OFF_POSITION), (-1.32, SAFETY_MOTOR_OFF_POSITION),
-                                               (1.35, SAFETY_SERVO_OFF_POSITION)])
+@pytest.mark.parametrize(
+    ("angle", "state"),
+    [(1.32, SAFETY_MOTOR_OFF_POSITION), (-1.32, SAFETY_MOTOR_OFF_POSITION), (1.35, SAFETY_SERVO_OFF_POSITION)],
+)
 def test_position_cutoffs(angle, state):
     log = simulate_device(np.zeros(200), QUIET, initial_motor_angle_rad=angle)
     assert log.safety_state.iloc[0] == state

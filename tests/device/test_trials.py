@@ -62,8 +62,16 @@ def test_trial_frame_and_determinism():
     a = simulate_device_trial("device-steps", DeviceParameters(), FreeLeg(), s, 7)
     b = simulate_device_trial("device-steps", DeviceParameters(), FreeLeg(), s, 7)
     assert a.equals(b)
-    assert list(a.columns) == ["time_s", "force_desired_n", "force_measured_n", "motor_angle_rad",
-                               "motor_velocity_rad_s", "sync_v", "perturbation", "safety_state"]
+    assert list(a.columns) == [
+        "time_s",
+        "force_desired_n",
+        "force_measured_n",
+        "motor_angle_rad",
+        "motor_velocity_rad_s",
+        "sync_v",
+        "perturbation",
+        "safety_state",
+    ]
     assert len(a) == 3500
     np.testing.assert_array_equal(a.perturbation, (a.force_desired_n != 0).astype(int))
 

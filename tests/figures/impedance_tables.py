@@ -56,21 +56,33 @@ def impedance_table() -> pd.DataFrame:
                 status = "ok"
                 if subject == "S02" and onset == 175:
                     status = "failed"  # broken line; K/D empty
-                rows.append({
-                    "subject": subject, "onset_ms": onset, "joint": joint,
-                    k_col: np.nan if status == "failed" else k, d_col: np.nan if status == "failed" else d,
-                    parameter_column("K", "ci95_low"): k - 1, parameter_column("K", "ci95_high"): k + 1,
-                    parameter_column("D", "ci95_low"): d - 0.1, parameter_column("D", "ci95_high"): d + 0.1,
-                    "vaf_pct": 90.0, "n_strides": 20,
-                    parameter_column("K", "true"): k * 1.05 if synthetic else np.nan,
-                    parameter_column("D", "true"): d * 0.95 if synthetic else np.nan,
-                    parameter_column("K", "error"): -0.05 * k if synthetic else np.nan,
-                    parameter_column("D", "error"): 0.05 * d if synthetic else np.nan,
-                    "sum_sq_error_rad2": 1e-4, "n_starts": 3, "n_starts_at_best": 2,
-                    "status": status, "reason": "" if status == "ok" else "diverged",
-                })
+                rows.append(
+                    {
+                        "subject": subject,
+                        "onset_ms": onset,
+                        "joint": joint,
+                        k_col: np.nan if status == "failed" else k,
+                        d_col: np.nan if status == "failed" else d,
+                        parameter_column("K", "ci95_low"): k - 1,
+                        parameter_column("K", "ci95_high"): k + 1,
+                        parameter_column("D", "ci95_low"): d - 0.1,
+                        parameter_column("D", "ci95_high"): d + 0.1,
+                        "vaf_pct": 90.0,
+                        "n_strides": 20,
+                        parameter_column("K", "true"): k * 1.05 if synthetic else np.nan,
+                        parameter_column("D", "true"): d * 0.95 if synthetic else np.nan,
+                        parameter_column("K", "error"): -0.05 * k if synthetic else np.nan,
+                        parameter_column("D", "error"): 0.05 * d if synthetic else np.nan,
+                        "sum_sq_error_rad2": 1e-4,
+                        "n_starts": 3,
+                        "n_starts_at_best": 2,
+                        "status": status,
+                        "reason": "" if status == "ok" else "diverged",
+                    }
+                )
     table = pd.DataFrame(rows)
-    table.loc[(table.subject == "S01") & (table.onset_ms == 300) & (table.joint == "hip"), "status"] = \
+    table.loc[(table.subject == "S01") & (table.onset_ms == 300) & (table.joint == "hip"), "status"] = (
         "not_identifiable"
+    )
     table.loc[(table.subject == "SYN1") & (table.onset_ms == 50) & (table.joint == "knee"), "status"] = "skipped"
     return table

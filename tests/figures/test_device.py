@@ -1,4 +1,5 @@
-"""Device figures: the Bode plot marks our and the study's bandwidth; the step figure draws one response per amplitude."""
+"""Device figures: the Bode plot marks our and the study's bandwidth; the step figure draws one response per
+amplitude."""
 
 from __future__ import annotations
 
@@ -16,16 +17,26 @@ from loper_analysis.reference import STUDY_DEVICE
 def frf():
     f = np.arange(1, 1001) * 0.2  # 0.2 .. 200 Hz
     h = 1.0 / (1.0 + 1j * f / 40.0)
-    return pd.DataFrame({"frequency_hz": f, "gain": np.abs(h), "phase_deg": np.degrees(np.angle(h)),
-                         "coherence": np.ones(f.size)})
+    return pd.DataFrame(
+        {"frequency_hz": f, "gain": np.abs(h), "phase_deg": np.degrees(np.angle(h)), "coherence": np.ones(f.size)}
+    )
 
 
 @pytest.fixture
 def average():
     t = np.arange(-50, 300) / 1000.0
-    frames = [pd.DataFrame({"amplitude_n": a, "time_s": t, "desired_n": np.where(t >= 0, a, 0.0),
-                            "measured_n": np.where(t >= 0, 0.9 * a, 0.0), "measured_sd_n": 1.0})
-              for a in (20.0, 40.0, 60.0)]
+    frames = [
+        pd.DataFrame(
+            {
+                "amplitude_n": a,
+                "time_s": t,
+                "desired_n": np.where(t >= 0, a, 0.0),
+                "measured_n": np.where(t >= 0, 0.9 * a, 0.0),
+                "measured_sd_n": 1.0,
+            }
+        )
+        for a in (20.0, 40.0, 60.0)
+    ]
     return pd.concat(frames, ignore_index=True)
 
 

@@ -169,8 +169,17 @@ def test_same_seed_same_result_bitwise(trial_mid):
 
 def test_response_jacobian_matches_central_differences(trial_mid):
     t, qu, qp, fp, pel, tf = trial_mid
-    w = prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp, force_time_s=tf,
-                       pelvis_angle_unperturbed_rad=pel, pelvis_angle_perturbed_rad=pel)
+    w = prepare_window(
+        t,
+        qu,
+        qp,
+        PARAMS,
+        SETTINGS.onset_s,
+        force_perturbed_n=fp,
+        force_time_s=tf,
+        pelvis_angle_unperturbed_rad=pel,
+        pelvis_angle_perturbed_rad=pel,
+    )
     truth = MID_TRUTH
     J = response_jacobian(w, truth)
     h = np.array([1e-3, 1e-5] * 3)

@@ -65,14 +65,22 @@ def test_step_stage_forces_give_rk4_the_exact_forced_response(natural_hz, matche
     from scipy.interpolate import CubicSpline
 
     wn, zeta = 2 * np.pi * natural_hz, 0.3
-    A = np.array([[0.0, 1.0], [-wn**2, -2 * zeta * wn]])
+    A = np.array([[0.0, 1.0], [-(wn**2), -2 * zeta * wn]])
     b = np.array([0.0, 1.0])
     tf = np.arange(0.0, 0.4 + 1e-9, 1e-3)
     f = pulse_force(tf, 0.05, 0.1, 40.0, 0.010, 30.5)
     spline = CubicSpline(tf, f)
     h, n_steps = 1 / 256, 89
-    exact = solve_ivp(lambda t, y: A @ y + b * spline(t), (0.0, h * n_steps), [0.0, 0.0], method="DOP853",
-                      rtol=1e-13, atol=1e-16, max_step=2e-4, t_eval=h * np.arange(n_steps + 1)).y.T
+    exact = solve_ivp(
+        lambda t, y: A @ y + b * spline(t),
+        (0.0, h * n_steps),
+        [0.0, 0.0],
+        method="DOP853",
+        rtol=1e-13,
+        atol=1e-16,
+        max_step=2e-4,
+        t_eval=h * np.arange(n_steps + 1),
+    ).y.T
 
     def rk4(stage_f):
         y, out = np.zeros(2), [np.zeros(2)]
@@ -100,8 +108,9 @@ def test_step_stage_forces_give_rk4_the_exact_forced_response(natural_hz, matche
 def test_stage_forces_of_a_constant_force_are_that_force():
     tf = np.arange(0.0, 0.2, 1e-3)
     f = np.tile([3.0, -2.0], (tf.size, 1))
-    np.testing.assert_allclose(step_stage_forces(tf, f, 0.01, 1 / 256, 40), np.broadcast_to([3.0, -2.0], (40, 4, 2)),
-                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        step_stage_forces(tf, f, 0.01, 1 / 256, 40), np.broadcast_to([3.0, -2.0], (40, 4, 2)), rtol=0, atol=1e-12
+    )
     stages = 0.01 + 1 / 512 * np.arange(81)
     np.testing.assert_allclose(stage_force_means(tf, f, stages), np.broadcast_to([3.0, -2.0], (81, 2)), atol=1e-12)
 
@@ -109,16 +118,28 @@ def test_stage_forces_of_a_constant_force_are_that_force():
 def test_force_that_does_not_cover_the_window_is_refused():
     t, qu, qp, fp, pelvis, tf = mid_trial()
     short = tf < SETTINGS.onset_s + 0.2
-    expect_error(lambda: prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp[short],
-                                        force_time_s=tf[short]),
-                 "force at its own rate", f"{tf[0]:.4f} .. {tf[short][-1]:.4f} s", "does not cover the fit window",
-                 "0.0266 .. 0.3000 s")
-    expect_error(lambda: prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp[:-1],
-                                        force_time_s=tf), "force_perturbed_n", "like force_time_s")
+    expect_error(
+        lambda: prepare_window(
+            t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp[short], force_time_s=tf[short]
+        ),
+        "force at its own rate",
+        f"{tf[0]:.4f} .. {tf[short][-1]:.4f} s",
+        "does not cover the fit window",
+        "0.0266 .. 0.3000 s",
+    )
+    expect_error(
+        lambda: prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp[:-1], force_time_s=tf),
+        "force_perturbed_n",
+        "like force_time_s",
+    )
     bad = tf.copy()
     bad[5] = bad[4]
-    expect_error(lambda: prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp, force_time_s=bad),
-                 "force_time_s", "strictly increasing", "sample 4")
+    expect_error(
+        lambda: prepare_window(t, qu, qp, PARAMS, SETTINGS.onset_s, force_perturbed_n=fp, force_time_s=bad),
+        "force_time_s",
+        "strictly increasing",
+        "sample 4",
+    )
 
 
 @pytest.mark.parametrize("truth", [[75.0, 2.0, 75.0, 2.0, 75.0, 2.0], [150.0, 4.0, 150.0, 4.0, 0.0, 0.0]])
@@ -133,11 +154,17 @@ def test_identification_from_1_khz_force_beats_128_hz_samples(truth):
     truth = np.asarray(truth)
     trial = perturbed_trial(PARAMS, truth, SETTINGS)
     fits = {}
-    for rate, overrides in (("1k", {}), ("128", dict(force_time_s=None, force_perturbed_n=validation_pulse(trial[0],
-                                                                                                         SETTINGS)))):
+    for rate, overrides in (
+        ("1k", {}),
+        ("128", dict(force_time_s=None, force_perturbed_n=validation_pulse(trial[0], SETTINGS))),
+    ):
         w = window_for(trial, **overrides)
-        fits[rate] = identify_impedance(w, n_starts=10, seed=0, lower=SETTINGS.lower, upper=SETTINGS.upper,
-                                        tolerance=SETTINGS.tolerance).estimate - truth
+        fits[rate] = (
+            identify_impedance(
+                w, n_starts=10, seed=0, lower=SETTINGS.lower, upper=SETTINGS.upper, tolerance=SETTINGS.tolerance
+            ).estimate
+            - truth
+        )
     k, d = [0, 2], [1, 3]  # hip and knee
     assert np.abs(fits["1k"][k]).max() < 0.005
     assert np.abs(fits["1k"][d]).max() < 0.0005

@@ -53,8 +53,9 @@ def test_the_sandwich_of_a_projection_removes_the_projected_noise():
 
 
 def test_an_interval_is_cut_at_the_bounds():
-    low, high = bounded_interval([0.05, 0.0, 199.0, 3.0], [0.1, 0.1, 5.0, np.inf], 1e12,
-                                 [0.0, 0.0, 0.0, 0.0], [10.0, 10.0, 200.0, 10.0])
+    low, high = bounded_interval(
+        [0.05, 0.0, 199.0, 3.0], [0.1, 0.1, 5.0, np.inf], 1e12, [0.0, 0.0, 0.0, 0.0], [10.0, 10.0, 200.0, 10.0]
+    )
     z = 1.959963984540054
     np.testing.assert_allclose(low, [0.0, 0.0, 199.0 - 5 * z, 0.0], rtol=1e-9)
     np.testing.assert_allclose(high, [0.05 + 0.1 * z, 0.1 * z, 200.0, 10.0], rtol=1e-9)
@@ -75,7 +76,7 @@ def test_coverage_with_the_null_pair_degrees_of_freedom():
     m, N, n, reps = 30, 8, 4, 2000
     t = np.linspace(0, 1, m)
     J = np.column_stack([np.sin(3 * t), t**2])
-    L = np.linalg.cholesky(0.01 * np.exp(-np.subtract.outer(t, t) ** 2 / 0.02) + 1e-4 * np.eye(m))
+    L = np.linalg.cholesky(0.01 * np.exp(-(np.subtract.outer(t, t) ** 2) / 0.02) + 1e-4 * np.eye(m))
     truth = np.array([0.5, 0.02])
     lower, upper = np.array([-10.0, -10.0]), np.array([10.0, 10.0])
     hits = {N - 1: 0, 102: 0}
@@ -116,8 +117,9 @@ def test_cross_validated_covariance_without_projection_is_the_sandwich():
     e_i - mean_-i = N / (N - 1) (e_i - mean))."""
     rng = np.random.default_rng(11)
     E, J = rng.normal(size=(25, 12)), rng.normal(size=(12, 3))
-    np.testing.assert_allclose(cross_validated_covariance(E, 0, J, 4),
-                               sandwich_covariance(J, np.cov(E, rowvar=False) / 4), rtol=1e-10)
+    np.testing.assert_allclose(
+        cross_validated_covariance(E, 0, J, 4), sandwich_covariance(J, np.cov(E, rowvar=False) / 4), rtol=1e-10
+    )
 
 
 def test_cross_validated_covariance_restores_the_coverage_the_projection_takes():
@@ -129,7 +131,7 @@ def test_cross_validated_covariance_restores_the_coverage_the_projection_takes()
     rng = np.random.default_rng(1)
     m, N, n, r, reps = 60, 40, 10, 6, 400
     t = np.linspace(0, 1, m)
-    L = np.linalg.cholesky(0.01 * np.exp(-np.subtract.outer(t, t) ** 2 / 0.01) + 1e-4 * np.eye(m))
+    L = np.linalg.cholesky(0.01 * np.exp(-(np.subtract.outer(t, t) ** 2) / 0.01) + 1e-4 * np.eye(m))
     J = np.column_stack([np.sin(3 * t), t**2])
     truth, bounds = np.array([0.5, 0.2]), (np.full(2, -9.0), np.full(2, 9.0))
     hits = np.zeros(2, int)
@@ -137,8 +139,9 @@ def test_cross_validated_covariance_restores_the_coverage_the_projection_takes()
         E = (L @ rng.normal(size=(m, N))).T
         W = nuisance_projection(E, r)
         est = np.linalg.lstsq(W @ J, W @ (J @ truth + (L @ rng.normal(size=(m, n))).mean(axis=1)), rcond=None)[0]
-        for k, cov in enumerate((sandwich_covariance(W @ J, np.cov(E, rowvar=False) / n, W),
-                                 cross_validated_covariance(E, r, J, n))):
+        for k, cov in enumerate(
+            (sandwich_covariance(W @ J, np.cov(E, rowvar=False) / n, W), cross_validated_covariance(E, r, J, n))
+        ):
             low, high = bounded_interval(est, np.sqrt(np.diag(cov)), N - 1, *bounds)
             hits[k] += bool(low[0] <= truth[0] <= high[0])
     assert hits.tolist() == [349, 379]

@@ -104,8 +104,9 @@ def test_a_weighted_fit_minimises_the_weighted_cost_and_reports_both(noisy_windo
     shapes = np.stack([np.sin(np.linspace(0, np.pi, m)), np.linspace(-1, 1, m)])
     errors = np.random.default_rng(0).normal(size=(20, 2)) @ shapes
     weight = nuisance_projection(errors, 2)
-    fit = identify_impedance(replace(noisy_window, residual_weight=weight), n_starts=4, seed=2,
-                             extra_starts=first.estimate)
+    fit = identify_impedance(
+        replace(noisy_window, residual_weight=weight), n_starts=4, seed=2, extra_starts=first.estimate
+    )
     pe = (fit.measured - fit.model).ravel()
     assert fit.cost == pytest.approx(float(np.sum((weight @ pe) ** 2)), rel=1e-9)
     assert fit.sum_sq_error_rad2 == pytest.approx(float(np.sum(pe**2)), rel=1e-9)

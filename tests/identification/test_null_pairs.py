@@ -41,9 +41,14 @@ def _deviation_shape(window):
 def _null_pairs(window, t, qu, pu, dq):
     """Null pairs on the window's data grid: perturbed = unperturbed + dq (M, n, 4); pelvis unchanged."""
     M = dq.shape[0]
-    return {"time_s": t - window.onset_s, "q_unperturbed": np.broadcast_to(qu, dq.shape).copy(),
-            "q_perturbed": qu + dq, "pelvis_angle_unperturbed_rad": np.broadcast_to(pu, (M, len(t))).copy(),
-            "pelvis_angle_perturbed_rad": np.broadcast_to(pu, (M, len(t))).copy(), "n_pairs": M}
+    return {
+        "time_s": t - window.onset_s,
+        "q_unperturbed": np.broadcast_to(qu, dq.shape).copy(),
+        "q_perturbed": qu + dq,
+        "pelvis_angle_unperturbed_rad": np.broadcast_to(pu, (M, len(t))).copy(),
+        "pelvis_angle_perturbed_rad": np.broadcast_to(pu, (M, len(t))).copy(),
+        "n_pairs": M,
+    }
 
 
 # ---------------------------------------------------------------- projection
@@ -71,8 +76,9 @@ def projected(trial_mid):
     biased = replace(window, measured=window.measured + 0.3 * shape)
     rng = np.random.default_rng(5)
     errors = rng.normal(0.0, 0.3, (40, 1)) * shape.reshape(1, -1) + rng.normal(0.0, 1e-5, (40, shape.size))
-    weighted = replace(biased, residual_weight=nuisance_projection(errors, 1),
-                       noise_cov=np.cov(errors, rowvar=False) / 10)
+    weighted = replace(
+        biased, residual_weight=nuisance_projection(errors, 1), noise_cov=np.cov(errors, rowvar=False) / 10
+    )
     return biased, fit(biased), weighted, fit(weighted)
 
 
@@ -85,7 +91,9 @@ def test_projecting_out_the_deviation_recovers_the_truth_the_white_fit_misses(pr
     truth = MID_TRUTH
     assert abs(white.estimate[1] - truth[1]) > 1.0  # the deviation biases D_hip
     np.testing.assert_allclose(result.estimate[HIP_KNEE], truth[HIP_KNEE], rtol=2e-3)
-    assert np.all(result.ci95_low[HIP_KNEE] <= truth[HIP_KNEE]) and np.all(truth[HIP_KNEE] <= result.ci95_high[HIP_KNEE])
+    assert np.all(result.ci95_low[HIP_KNEE] <= truth[HIP_KNEE]) and np.all(
+        truth[HIP_KNEE] <= result.ci95_high[HIP_KNEE]
+    )
     # the model (and so the VAF) describe the unweighted prediction error
     np.testing.assert_allclose(result.model, biased.measured - prediction_error(biased, result.estimate), atol=0)
 
@@ -121,8 +129,9 @@ def test_null_pair_errors_subtract_the_free_response_of_the_initial_state(trial_
     expected = np.stack([np.zeros(idx.size), dq[1, idx, 2], dq[1, idx, 2]], axis=-1)  # hip, knee, ankle
     np.testing.assert_allclose(errors[1], expected.ravel(), atol=1e-9)
     still = replace(window, initial_deviation=np.zeros(4), initial_rate=np.zeros(4))
-    free = (simulate_response(replace(still, initial_deviation=np.array([0.0, 1e-4, 0.0, 0.0])), theta)
-            - simulate_response(still, theta))
+    free = simulate_response(
+        replace(still, initial_deviation=np.array([0.0, 1e-4, 0.0, 0.0])), theta
+    ) - simulate_response(still, theta)
     measured = np.tile([-1e-4, -1e-4, 0.0], (idx.size, 1))
     # G is linear about theta: 2.6e-9 rad from the full simulation for a 1e-4 rad offset
     np.testing.assert_allclose(errors[2], (measured - free).ravel(), rtol=0, atol=1e-8)
@@ -148,8 +157,18 @@ def _shaped_null_pairs(window, trial, n_pairs, seed):
 def test_refit_with_null_pairs_recovers_the_truth(trial_mid, projected):
     biased, white, _, _ = projected
     null = _shaped_null_pairs(biased, trial_mid, 12, seed=9)
-    refit = refit_with_null_pairs(biased, white, null, n_averaged=10, n_components=1, min_null_pairs=10,
-                                  n_starts=5, seed=0, lower=SETTINGS.lower, upper=SETTINGS.upper)
+    refit = refit_with_null_pairs(
+        biased,
+        white,
+        null,
+        n_averaged=10,
+        n_components=1,
+        min_null_pairs=10,
+        n_starts=5,
+        seed=0,
+        lower=SETTINGS.lower,
+        upper=SETTINGS.upper,
+    )
     assert (refit.noise_model, refit.n_null_pairs, refit.note) == ("null_pairs", 12, "")
     np.testing.assert_allclose(refit.fit.estimate[HIP_KNEE], MID_TRUTH[HIP_KNEE], rtol=2e-3)
 

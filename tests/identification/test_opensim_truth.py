@@ -24,14 +24,12 @@ import inspect
 import numpy as np
 import pytest
 
-osim = pytest.importorskip("opensim")
-
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.identification import identify_impedance, prepare_window
 from tests.opensim_swing_leg import (
-    A,
     A_INV,
     COORDINATES,
+    A,
     OpenSimLeg,
     PerturbedSwingLeg,
     evaluate,
@@ -74,7 +72,9 @@ def recordings() -> dict:
 
 def _fit(rec: dict, onset_s: float, native: bool):
     if native:
-        kw = dict(force_unperturbed_n=rec["force_u_n"], force_perturbed_n=rec["force_p_n"], force_time_s=rec["force_time_s"])
+        kw = dict(
+            force_unperturbed_n=rec["force_u_n"], force_perturbed_n=rec["force_p_n"], force_time_s=rec["force_time_s"]
+        )
     else:  # the force resampled to the 128 Hz frames (linear interpolation, as the pipeline resamples)
         t, tf = rec["time_s"], rec["force_time_s"]
         kw = {
@@ -160,7 +160,10 @@ def test_opensim_truth_is_exact_enough(recordings):
     )
     q_u = A @ phi_u[0]
     q, qd = A @ leg.phi(s), A @ (phid_u[0] + np.r_[-0.2 - phid_u[0, 0], psid])
-    th = lambda q_: np.array([-q_[1], q_[2] - q_[1], q_[2] - q_[3]])  # joint angles, pelvis angle 0
+
+    def th(q_):  # joint angles, pelvis angle 0
+        return np.array([-q_[1], q_[2] - q_[1], q_[2] - q_[3]])
+
     torque = -imp[0::2] * (th(q) - th(q_u)) - imp[1::2] * (th(qd) - th(A @ phid_u[0]))
     u_fb = np.array([0.0, -torque[0] - torque[1], torque[1] + torque[2], -torque[2]])
     plain = OpenSimLeg(WINTER)
@@ -169,7 +172,10 @@ def test_opensim_truth_is_exact_enough(recordings):
     assert force @ thigh_normal(q[1]) > 40.0  # inside the pulse
     plain.set_state(q, qd, A_INV.T @ tau_own + u_fb, force)
     expected = A_INV @ plain.accelerations()
-    print(f"perturbed state: accelerations differ by {np.abs(phidd - expected).max():.2e} (of {np.abs(expected).max():.1f})")
+    print(
+        f"perturbed state: accelerations differ by {np.abs(phidd - expected).max():.2e} "
+        f"(of {np.abs(expected).max():.1f})"
+    )
     np.testing.assert_allclose(phidd, expected, rtol=0, atol=1e-6 * np.abs(expected).max())
 
     # (3) convergence of the integration
@@ -227,19 +233,26 @@ def test_128hz_force_path_misses_the_bounds(frame_errors):
     of it), the worst case more than all of it.
     """
     worst = _worst_fraction(frame_errors)
-    print("128 Hz force, largest hip/knee error / bound:", {f"{n} {o * 1000:.0f} ms": round(v, 4) for (n, o), v in worst.items()})
+    print(
+        "128 Hz force, largest hip/knee error / bound:",
+        {f"{n} {o * 1000:.0f} ms": round(v, 4) for (n, o), v in worst.items()},
+    )
     assert max(worst.values()) > 1.2
     assert min(worst.values()) > 0.2
 
 
 @needs_native_rate
 def test_128hz_force_path_is_worse_than_native_rate(native_errors, frame_errors):
-    """On the same data, the 128 Hz force path's worst hip/knee error is at least 10x that of the 1000 Hz path, per case.
+    """On the same data, the 128 Hz force path's worst hip/knee error is at least 10x that of the 1000 Hz path, per
+    case.
 
     Measured: 0.30-1.47 of the error budget against 0.002 at most.
     """
     native = _worst_fraction(native_errors)
     frames = _worst_fraction(frame_errors)
-    print("largest hip/knee error / bound, 128 Hz and 1000 Hz force:", [(round(frames[c], 4), round(native[c], 5)) for c in CASES])
+    print(
+        "largest hip/knee error / bound, 128 Hz and 1000 Hz force:",
+        [(round(frames[c], 4), round(native[c], 5)) for c in CASES],
+    )
     for case in CASES:
         assert frames[case] > 10.0 * native[case], f"{case}: 128 Hz {frames[case]:.3f}, 1000 Hz {native[case]:.3f}"

@@ -31,12 +31,15 @@ def test_the_upper_bound_within_the_tolerance_is_not_identifiable():
     # 1e-6 of the K range is 2e-4 N·m/rad
     s, reason = status((200.0 - 1.5e-4, 0.1))
     assert s == "not_identifiable"
-    assert reason == ("K_knee = 200 N·m/rad at its upper bound 200 N·m/rad "
-                      "(identification.stiffness_bounds_nm_per_rad): the data ask for more stiffness than the bounds allow")
+    assert reason == (
+        "K_knee = 200 N·m/rad at its upper bound 200 N·m/rad "
+        "(identification.stiffness_bounds_nm_per_rad): the data ask for more stiffness than the bounds allow"
+    )
     assert status((200.0 - 2.5e-4, 0.1)) == ("ok", "")
     s, reason = status((3.0, 10.0))
-    assert s == "not_identifiable" and reason.startswith("D_knee = 10 N·m·s/rad at its upper bound 10 N·m·s/rad "
-                                                         "(identification.damping_bounds_nms_per_rad)")
+    assert s == "not_identifiable" and reason.startswith(
+        "D_knee = 10 N·m·s/rad at its upper bound 10 N·m·s/rad (identification.damping_bounds_nms_per_rad)"
+    )
 
 
 def test_a_lower_bound_of_zero_is_a_valid_estimate():
@@ -55,8 +58,9 @@ def test_the_vaf_floor(vaf, expected):
     s, reason = status((2.5, 0.1), vaf=vaf)
     assert s == expected
     if expected == "failed":
-        assert reason == (f"VAF {vaf:.3g} % below identification.min_vaf_pct = 0 %: "
-                          "the model does not describe the knee response")
+        assert reason == (
+            f"VAF {vaf:.3g} % below identification.min_vaf_pct = 0 %: the model does not describe the knee response"
+        )
 
 
 def test_an_undefined_vaf_fails():
@@ -66,8 +70,9 @@ def test_an_undefined_vaf_fails():
 
 def test_findings_add_up_and_the_most_severe_wins():
     """The campaign's case: K on the bound, VAF -118 %, wide interval -> failed, all three named."""
-    s, reason = joint_status("knee", (200.0, 8.8), (50.0, 8.55), (200.0, 9.05), -118.0, LOWER, UPPER,
-                             max_ci_fraction=0.5)
+    s, reason = joint_status(
+        "knee", (200.0, 8.8), (50.0, 8.55), (200.0, 9.05), -118.0, LOWER, UPPER, max_ci_fraction=0.5
+    )
     assert s == "failed"
     parts = reason.split("; ")
     assert [p.split(" ")[0] for p in parts] == ["VAF", "K_knee", "95"]
@@ -79,7 +84,9 @@ def test_findings_add_up_and_the_most_severe_wins():
 
 def test_not_converged_keeps_its_reason():
     assert status((200.0, 8.8), vaf=-118.0, success=False, message="max iterations") == (
-        "failed", "optimiser did not converge: max iterations")
+        "failed",
+        "optimiser did not converge: max iterations",
+    )
 
 
 def test_bad_shapes_are_refused():
@@ -91,8 +98,10 @@ def test_an_interval_holding_zero_and_the_study_range_is_not_identifiable():
     """Knee D 0.055, 95 % CI -0.22 ... 0.33 (cut to 0 ... 0.33) holds 0 and the study's 0.02-0.14: no information."""
     s, reason = joint_status("knee", (2.0, 0.055), (1.0, 0.0), (3.0, 0.33), 99.0, LOWER, UPPER)
     assert s == "not_identifiable"
-    assert reason == ("D_knee = 0.055 N·m·s/rad, 95 % CI 0 … 0.33 N·m·s/rad: holds both 0 and the plausible range "
-                      "0.02–0.14 N·m·s/rad (identification.plausible_ranges), the data cannot tell the damping from 0")
+    assert reason == (
+        "D_knee = 0.055 N·m·s/rad, 95 % CI 0 … 0.33 N·m·s/rad: holds both 0 and the plausible range "
+        "0.02–0.14 N·m·s/rad (identification.plausible_ranges), the data cannot tell the damping from 0"
+    )
 
 
 def test_an_interval_clear_of_zero_is_ok():
@@ -100,12 +109,15 @@ def test_an_interval_clear_of_zero_is_ok():
     assert joint_status("hip", (50.0, 3.0), (40.0, 2.0), (60.0, 4.0), 99.0, LOWER, UPPER) == ("ok", "")
 
 
-@pytest.mark.parametrize("low, high, expected", [
-    (0.0, 0.139, "ok"),               # holds 0 but excludes the top of the study's range: says D < 0.14
-    (0.0, 0.14, "not_identifiable"),  # reaches it exactly
-    (9e-6, 0.5, "not_identifiable"),   # within 1e-6 of the bound range (1e-5 N·m·s/rad) of 0
-    (2e-5, 0.5, "ok"),                # clear of 0: the damping is told from none
-])
+@pytest.mark.parametrize(
+    "low, high, expected",
+    [
+        (0.0, 0.139, "ok"),  # holds 0 but excludes the top of the study's range: says D < 0.14
+        (0.0, 0.14, "not_identifiable"),  # reaches it exactly
+        (9e-6, 0.5, "not_identifiable"),  # within 1e-6 of the bound range (1e-5 N·m·s/rad) of 0
+        (2e-5, 0.5, "ok"),  # clear of 0: the damping is told from none
+    ],
+)
 def test_the_edges_of_the_information_rule(low, high, expected):
     assert joint_status("knee", (2.0, 0.05), (1.0, low), (3.0, high), 99.0, LOWER, UPPER)[0] == expected
 
@@ -114,11 +126,16 @@ def test_the_plausible_range_can_be_given():
     """Hip K 0 ... 70: holds 0 and the study's 34-66; with a range up to 100 it would not reach the top."""
     assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip")[0] == "not_identifiable"
     assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip", plausible_range=((34.0, 100.0), (1.9, 4.6))) == (
-        "ok", "")
+        "ok",
+        "",
+    )
     with pytest.raises(LoperInputError, match="plausible_ranges of the hip: K and D each need"):
         status((30.0, 3.0), joint="hip", plausible_range=((66.0, 34.0), (1.9, 4.6)))
 
 
 def test_the_default_ranges_are_the_study_s():
-    assert DEFAULT_PLAUSIBLE_RANGES == {"hip": ((34.0, 66.0), (1.9, 4.6)), "knee": ((0.0, 3.5), (0.02, 0.14)),
-                                        "ankle": ((0.0, 20.0), (0.0, 0.75))}
+    assert DEFAULT_PLAUSIBLE_RANGES == {
+        "hip": ((34.0, 66.0), (1.9, 4.6)),
+        "knee": ((0.0, 3.5), (0.02, 0.14)),
+        "ankle": ((0.0, 20.0), (0.0, 0.75)),
+    }

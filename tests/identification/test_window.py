@@ -69,8 +69,9 @@ def test_simulate_deviation_is_the_perturbed_trial_deviation(trial_mid):
 
 def test_prepare_window_rejects_bad_input(trial_mid):
     t, qu, qp, fp, pelvis, tf = trial_mid
-    kw = dict(force_perturbed_n=fp, force_time_s=tf, pelvis_angle_unperturbed_rad=pelvis,
-              pelvis_angle_perturbed_rad=pelvis)
+    kw = dict(
+        force_perturbed_n=fp, force_time_s=tf, pelvis_angle_unperturbed_rad=pelvis, pelvis_angle_perturbed_rad=pelvis
+    )
     onset = SETTINGS.onset_s
 
     bad = qu.copy()
@@ -84,8 +85,12 @@ def test_prepare_window_rejects_bad_input(trial_mid):
     t_bad = t.copy()
     t_bad[10] += 0.002
     expect_error(lambda: prepare_window(t_bad, qu, qp, PARAMS, onset, **kw), "time_s", "uniform", "sample 9")
-    expect_error(lambda: prepare_window(t, qu, qp, PARAMS, onset, window_after_s=1.0, **kw), "window", "longer than the data")
-    expect_error(lambda: prepare_window(t, qu, qp, PARAMS, onset, window_before_s=1.0, **kw), "window", "longer than the data")
+    expect_error(
+        lambda: prepare_window(t, qu, qp, PARAMS, onset, window_after_s=1.0, **kw), "window", "longer than the data"
+    )
+    expect_error(
+        lambda: prepare_window(t, qu, qp, PARAMS, onset, window_before_s=1.0, **kw), "window", "longer than the data"
+    )
     expect_error(lambda: prepare_window(t, qu, qp, PARAMS, onset, n_substeps=2.5, **kw), "n_substeps", "2.5")
     expect_error(lambda: prepare_window(t, qu, qp, PARAMS, onset, n_substeps=0, **kw), "n_substeps", "0")
 

@@ -7,7 +7,7 @@ The "measured" data come from :func:`loper_analysis.validation.perturbed_trial`
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cache
 
 import numpy as np
 
@@ -26,7 +26,7 @@ SETTINGS = ValidationSettings()
 MID_TRUTH = np.array([75.0, 2.0, 75.0, 2.0, 75.0, 2.0])
 
 
-@lru_cache(maxsize=None)
+@cache
 def _mid_trial():
     arrays = perturbed_trial(PARAMS, MID_TRUTH, SETTINGS)
     for a in arrays:

@@ -46,8 +46,9 @@ def channels_for_load(force_n, point_mm, free_moment_nmm: float, centre_mm, orig
     return np.r_[R_PLATE_TO_LAB.T @ F, R_PLATE_TO_LAB.T @ M]
 
 
-def type3_channels(force_n, point_mm, free_moment_nmm: float, centre_mm, a_mm: float, b_mm: float,
-                   depth_mm: float) -> np.ndarray:
+def type3_channels(
+    force_n, point_mm, free_moment_nmm: float, centre_mm, a_mm: float, b_mm: float, depth_mm: float
+) -> np.ndarray:
     """Eight Kistler channels (fx12, fx34, fy14, fy23, fz1..fz4) of a load; sensors at plate (+-a, +-b, depth).
 
     Sensors 1, 2 at plate y = +b, sensors 1, 4 at plate x = +a; the vertical
@@ -55,8 +56,8 @@ def type3_channels(force_n, point_mm, free_moment_nmm: float, centre_mm, a_mm: f
     """
     F = R_PLATE_TO_LAB.T @ np.asarray(force_n, dtype=float)
     p = R_PLATE_TO_LAB.T @ (np.asarray(point_mm, dtype=float) - np.asarray(centre_mm, dtype=float))
-    O = np.array([0.0, 0.0, depth_mm])
-    M = np.cross(p - O, F) + R_PLATE_TO_LAB.T @ np.array([0.0, 0.0, free_moment_nmm])
+    origin = np.array([0.0, 0.0, depth_mm])
+    M = np.cross(p - origin, F) + R_PLATE_TO_LAB.T @ np.array([0.0, 0.0, free_moment_nmm])
     xs = np.array([a_mm, -a_mm, -a_mm, a_mm])
     ys = np.array([b_mm, b_mm, -b_mm, -b_mm])
     A = np.vstack([np.ones(4), ys, -xs])
@@ -107,18 +108,40 @@ c.write(spec["out"])
 """
 
 
-def write_plate_c3d(path, analogs, *, plate_type: int = 2, channel=None, corners_mm=None, origin_mm=(0.0, 0.0, 40.0),
-                    cal=None, used: int = 1, group: bool = True, labels=None, units=None, point_rate: float = 100.0,
-                    ratio: int = 10, point_units: str = "mm") -> Path:
-    """Write a C3D with one force platform; ``analogs`` is (n_samples, n_channels), n_samples a multiple of ``ratio``."""
+def write_plate_c3d(
+    path,
+    analogs,
+    *,
+    plate_type: int = 2,
+    channel=None,
+    corners_mm=None,
+    origin_mm=(0.0, 0.0, 40.0),
+    cal=None,
+    used: int = 1,
+    group: bool = True,
+    labels=None,
+    units=None,
+    point_rate: float = 100.0,
+    ratio: int = 10,
+    point_units: str = "mm",
+) -> Path:
+    """Write a C3D with one force platform; ``analogs`` is (n_samples, n_channels), n_samples a multiple of
+    ``ratio``."""
     path = Path(path)
     A = np.asarray(analogs, dtype=float)
     n_channels = A.shape[1]
     spec = {
-        "out": str(path), "ratio": int(ratio), "point_rate": float(point_rate), "point_units": point_units,
+        "out": str(path),
+        "ratio": int(ratio),
+        "point_rate": float(point_rate),
+        "point_units": point_units,
         "labels": list(labels or [f"ch{i + 1}" for i in range(n_channels)]),
-        "units": list(units or ["N"] * n_channels), "group": bool(group), "used": int(used), "type": int(plate_type),
-        "channel": list(channel or range(1, (8 if plate_type == 3 else 6) + 1)), "origin": list(map(float, origin_mm)),
+        "units": list(units or ["N"] * n_channels),
+        "group": bool(group),
+        "used": int(used),
+        "type": int(plate_type),
+        "channel": list(channel or range(1, (8 if plate_type == 3 else 6) + 1)),
+        "origin": list(map(float, origin_mm)),
     }
     arrays = {"analogs": A.T, "corners": plate_corners_mm() if corners_mm is None else np.asarray(corners_mm, float)}
     if cal is not None:
@@ -127,8 +150,13 @@ def write_plate_c3d(path, analogs, *, plate_type: int = 2, channel=None, corners
     arrays_path = path.with_suffix(".npz")
     spec_path.write_text(json.dumps(spec))
     np.savez(arrays_path, **arrays)
-    proc = subprocess.run([sys.executable, "-c", _CHILD, str(spec_path), str(arrays_path)], capture_output=True,
-                          text=True, timeout=60, check=False)
+    proc = subprocess.run(
+        [sys.executable, "-c", _CHILD, str(spec_path), str(arrays_path)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        check=False,
+    )
     if proc.returncode != 0:
         raise RuntimeError(f"writing {path} failed:\n{proc.stderr}")
     spec_path.unlink()

@@ -5,9 +5,10 @@ import numpy as np
 POINT_HZ = 128.0
 N_FRAMES = 40
 LABELS = ["RASI", "LASI", "RKNE"]
+N_MARKERS = len(LABELS)
 
 
-def lab_markers(rng, n_frames=N_FRAMES, n_markers=len(LABELS)):
+def lab_markers(rng, n_frames=N_FRAMES, n_markers=N_MARKERS):
     """Plausible lab coordinates (m) with two gaps: marker 1 frames 5..7, marker 2 frame 0."""
     X = rng.uniform(-1.5, 1.5, size=(n_frames, n_markers, 3))
     X[5:8, 1] = np.nan

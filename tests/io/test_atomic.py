@@ -191,9 +191,18 @@ def test_model_writer_leaves_no_partial_osim(tmp_path):
 
 def test_robot_log_writer_refuses_bad_data_before_writing(tmp_path):
     target = tmp_path / "trial.loper.tsv"
-    frame = pd.DataFrame({"time_s": [0.0, 0.001], "force_desired_n": [0.0, np.nan], "force_measured_n": [0.0, 0.0],
-                          "motor_angle_rad": 0.0, "motor_velocity_rad_s": 0.0, "sync_v": 0.0, "perturbation": 0,
-                          "safety_state": 0})
+    frame = pd.DataFrame(
+        {
+            "time_s": [0.0, 0.001],
+            "force_desired_n": [0.0, np.nan],
+            "force_measured_n": [0.0, 0.0],
+            "motor_angle_rad": 0.0,
+            "motor_velocity_rad_s": 0.0,
+            "sync_v": 0.0,
+            "perturbation": 0,
+            "safety_state": 0,
+        }
+    )
     with pytest.raises(LoperInputError, match="force_desired_n"):
         write_robot_log(target, frame, 1000.0)
     assert _entries(tmp_path) == []
@@ -254,5 +263,5 @@ def test_rule_log_captures_warnings(tmp_path):
 
     log_path = tmp_path / "job.log"
     with rule_log(log_path):
-        warnings.warn("only 3 valid strides", UserWarning)
+        warnings.warn("only 3 valid strides", UserWarning, stacklevel=1)
     assert "only 3 valid strides" in log_path.read_text()

@@ -26,8 +26,6 @@ def rng():
     return np.random.default_rng(20240611)
 
 
-
-
 #: Raw ezc3d writer, run in a child process like write_c3d does: an in-process
 #: ezc3d write would break OpenSim's std::vector arguments for later tests.
 RAW_WRITER = """
@@ -55,9 +53,14 @@ def raw_c3d(path, labels, points, rate=POINT_HZ, units=("mm",), analogs=None, an
     """A C3D written by raw ezc3d: points (4, n_markers, n_frames) in the file's unit; units None = not declared."""
     payload = path.with_name(path.name + ".npz")
     np.savez(
-        payload, rate=rate, labels=np.array(labels, dtype=str), units=np.array(units or [], dtype=str),
-        points=points, residuals=np.zeros(0) if residuals is None else residuals,
-        analogs=np.zeros(0) if analogs is None else analogs, analog_rate=analog_rate,
+        payload,
+        rate=rate,
+        labels=np.array(labels, dtype=str),
+        units=np.array(units or [], dtype=str),
+        points=points,
+        residuals=np.zeros(0) if residuals is None else residuals,
+        analogs=np.zeros(0) if analogs is None else analogs,
+        analog_rate=analog_rate,
     )
     subprocess.run([sys.executable, "-c", RAW_WRITER, str(payload), str(path)], check=True)
     payload.unlink()
@@ -118,10 +121,12 @@ def test_missing_point_is_stored_as_zero_with_residual_minus_one(tmp_path):
 
 def test_analog_round_trip_at_1024_hz_with_128_hz_points(tmp_path, rng):
     X = lab_markers(rng)
-    A = np.column_stack([
-        rng.normal(0.0, 300.0, N_FRAMES * RATIO),  # a force in N
-        np.sin(2 * np.pi * 5.0 * np.arange(N_FRAMES * RATIO) / ANALOG_HZ),  # a voltage
-    ])
+    A = np.column_stack(
+        [
+            rng.normal(0.0, 300.0, N_FRAMES * RATIO),  # a force in N
+            np.sin(2 * np.pi * 5.0 * np.arange(N_FRAMES * RATIO) / ANALOG_HZ),  # a voltage
+        ]
+    )
     path = write_c3d(tmp_path / "a.c3d", LABELS, X, POINT_HZ, ["Force", "Sync"], A, ["N", "V"], ANALOG_HZ)
     rec = read_c3d(path)
     assert rec.analog_labels == ["Force", "Sync"]
@@ -137,7 +142,9 @@ def test_analog_round_trip_at_1024_hz_with_128_hz_points(tmp_path, rng):
 
 def test_analog_lookup_of_an_absent_channel_names_file_and_channels(tmp_path, rng):
     A = np.zeros((N_FRAMES * RATIO, 2))
-    path = write_c3d(tmp_path / "a.c3d", LABELS, lab_markers(rng), POINT_HZ, ["Force", "Sync"], A, ["N", "V"], ANALOG_HZ)
+    path = write_c3d(
+        tmp_path / "a.c3d", LABELS, lab_markers(rng), POINT_HZ, ["Force", "Sync"], A, ["N", "V"], ANALOG_HZ
+    )
     with pytest.raises(LoperInputError) as err:
         read_c3d(path).analog("Torque")
     assert str(path) in str(err.value) and "'Torque'" in str(err.value) and "Force, Sync" in str(err.value)
@@ -206,8 +213,14 @@ def test_same_inputs_give_identical_bytes(tmp_path, rng):
     # and a read -> write cycle reproduces the file
     rec = read_c3d(tmp_path / "a.c3d")
     rewritten = write_c3d(
-        tmp_path / "c.c3d", rec.marker_labels, rec.markers_m, rec.point_rate_hz,
-        rec.analog_labels, rec.analogs, rec.analog_units, rec.analog_rate_hz,
+        tmp_path / "c.c3d",
+        rec.marker_labels,
+        rec.markers_m,
+        rec.point_rate_hz,
+        rec.analog_labels,
+        rec.analogs,
+        rec.analog_units,
+        rec.analog_rate_hz,
     ).read_bytes()
     assert rewritten == first
 
@@ -299,19 +312,27 @@ def test_writer_refuses_non_integer_rate_ratio_and_leaves_nothing(tmp_path, rng)
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("change, match", [
-    (dict(marker_labels=["RASI", "RASI", "RKNE"]), "duplicated: RASI"),
-    (dict(marker_labels=["A" * 256, "B", "C"]), "at most 255 characters"),
-    (dict(markers_m=np.zeros((N_FRAMES, 2, 3))), r"must name 2 item\(s\), got 3"),
-    (dict(analogs=np.zeros((N_FRAMES * RATIO - 1, 1))), r"shape \(n_frames \* samples per frame = 320"),
-    (dict(analog_units=[]), "one unit per channel"),
-    (dict(point_unit="inch"), "point_unit must be one of mm, cm, m"),
-    (dict(analogs=np.full((N_FRAMES * RATIO, 1), np.inf)), r"analogs\[0, 0\] = inf"),
-])
+@pytest.mark.parametrize(
+    "change, match",
+    [
+        (dict(marker_labels=["RASI", "RASI", "RKNE"]), "duplicated: RASI"),
+        (dict(marker_labels=["A" * 256, "B", "C"]), "at most 255 characters"),
+        (dict(markers_m=np.zeros((N_FRAMES, 2, 3))), r"must name 2 item\(s\), got 3"),
+        (dict(analogs=np.zeros((N_FRAMES * RATIO - 1, 1))), r"shape \(n_frames \* samples per frame = 320"),
+        (dict(analog_units=[]), "one unit per channel"),
+        (dict(point_unit="inch"), "point_unit must be one of mm, cm, m"),
+        (dict(analogs=np.full((N_FRAMES * RATIO, 1), np.inf)), r"analogs\[0, 0\] = inf"),
+    ],
+)
 def test_writer_refusals_keep_the_previous_file(tmp_path, rng, change, match):
     kwargs = dict(
-        marker_labels=LABELS, markers_m=lab_markers(rng), point_rate_hz=POINT_HZ, analog_labels=["F"],
-        analogs=np.ones((N_FRAMES * RATIO, 1)), analog_units=["N"], analog_rate_hz=ANALOG_HZ,
+        marker_labels=LABELS,
+        markers_m=lab_markers(rng),
+        point_rate_hz=POINT_HZ,
+        analog_labels=["F"],
+        analogs=np.ones((N_FRAMES * RATIO, 1)),
+        analog_units=["N"],
+        analog_rate_hz=ANALOG_HZ,
     )
     path = write_c3d(tmp_path / "t.c3d", **kwargs)
     before = path.read_bytes()
@@ -355,7 +376,8 @@ def test_write_c3d_works_after_opensim_used_its_vectors(tmp_path):
     from loper_analysis.io.osim import quiet_opensim
 
     osim = quiet_opensim()
-    osim.TimeSeriesTable(osim.StdVectorDouble([0.0, 1.0]), osim.Matrix.createFromMat(np.ones((2, 1))),
-                         osim.StdVectorString(["a"]))
+    osim.TimeSeriesTable(
+        osim.StdVectorDouble([0.0, 1.0]), osim.Matrix.createFromMat(np.ones((2, 1))), osim.StdVectorString(["a"])
+    )
     rec = read_c3d(write_c3d(tmp_path / "after.c3d", ["A"], np.full((2, 1, 3), 0.125), 100.0))
     np.testing.assert_array_equal(rec.markers_m[1, 0], [0.125, 0.125, 0.125])

@@ -13,8 +13,15 @@ from loper_analysis.io.c3d_parameter_section import force_platforms_used, read_p
 
 ROOT = Path(__file__).resolve().parents[2]
 FILES = [ROOT / "tests/data/opensim-core/walking5.c3d", *sorted((ROOT / "examples/rajagopal2016/raw").rglob("*.c3d"))]
-PARAMETERS = [("FORCE_PLATFORM", "USED"), ("FORCE_PLATFORM", "CORNERS"), ("FORCE_PLATFORM", "ORIGIN"),
-              ("FORCE_PLATFORM", "CHANNEL"), ("POINT", "RATE"), ("POINT", "SCALE"), ("ANALOG", "GEN_SCALE")]
+PARAMETERS = [
+    ("FORCE_PLATFORM", "USED"),
+    ("FORCE_PLATFORM", "CORNERS"),
+    ("FORCE_PLATFORM", "ORIGIN"),
+    ("FORCE_PLATFORM", "CHANNEL"),
+    ("POINT", "RATE"),
+    ("POINT", "SCALE"),
+    ("ANALOG", "GEN_SCALE"),
+]
 
 
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.name)

@@ -56,9 +56,15 @@ def test_utf8_unit_stays_utf8(written, tmp_path):
     assert read_c3d(path).marker_labels == ["L²X", "RASI"]
 
 
-@pytest.mark.parametrize("value, text", [
-    ("mm/s\udcb2", "mm/s²"), (b"mm/s\xb2", "mm/s²"), ("Kraft ²", "Kraft ²"), (b" N\xc2\xb7m ", "N·m"),
-])
+@pytest.mark.parametrize(
+    "value, text",
+    [
+        ("mm/s\udcb2", "mm/s²"),
+        (b"mm/s\xb2", "mm/s²"),
+        ("Kraft ²", "Kraft ²"),
+        (b" N\xc2\xb7m ", "N·m"),
+    ],
+)
 def test_decode_text(value, text):
     assert decode_text(value) == text
 
@@ -83,7 +89,9 @@ def test_events_in_both_time_layouts(written, tmp_path, layout):
     events = read_c3d(out).events
     assert list(events.columns) == list(EVENT_COLUMNS)
     assert events[["context", "label"]].values.tolist() == [
-        ["Left", "Foot Strike"], ["Right", "Foot Off"], ["Left", "Foot Off"]
+        ["Left", "Foot Strike"],
+        ["Right", "Foot Off"],
+        ["Left", "Foot Off"],
     ]
     np.testing.assert_allclose(events["time_s"], [0.05, 0.12, 60.5], rtol=0, atol=1e-6)  # float32 in the file
 
@@ -117,7 +125,10 @@ def test_first_frame_sets_the_time_base(written, tmp_path):
 
 def test_walking5_has_no_events_and_its_units():
     rec = read_c3d(Path(__file__).parents[1] / "data" / "opensim-core" / "walking5.c3d")
-    assert rec.events.equals(pd.DataFrame({"context": pd.Series(dtype=object), "label": pd.Series(dtype=object),
-                                           "time_s": pd.Series(dtype=float)}))
+    assert rec.events.equals(
+        pd.DataFrame(
+            {"context": pd.Series(dtype=object), "label": pd.Series(dtype=object), "time_s": pd.Series(dtype=float)}
+        )
+    )
     assert rec.first_frame == 0 and rec.point_rate_hz == 250.0 and rec.markers_m.shape == (1103, 40, 3)
     assert rec.analog_units == ["N", "N", "N", "Nmm", "Nmm", "Nmm"] * 2

@@ -33,22 +33,32 @@ print(json.dumps([{k: p[k].tolist() for k in ("force", "moment", "center_of_pres
 
 # A TYPE 2 plate turned a quarter turn in the lab (plate x = lab -y) with its sensor origin off-centre,
 # and a TYPE 4 plate (plate x = lab x, y = lab -y, z down) with a full calibration matrix.
-PLATE_2 = ForcePlatform(2, [(0.6, 0.0, 0.0), (0.6, 0.4, 0.0), (0.0, 0.4, 0.0), (0.0, 0.0, 0.0)],
-                        (0.002, -0.003, -0.04), (1, 2, 3, 4, 5, 6))
+PLATE_2 = ForcePlatform(
+    2, [(0.6, 0.0, 0.0), (0.6, 0.4, 0.0), (0.0, 0.4, 0.0), (0.0, 0.0, 0.0)], (0.002, -0.003, -0.04), (1, 2, 3, 4, 5, 6)
+)
 CAL = np.diag([500.0, 500.0, 1000.0, 8e4, 8e4, 4e4]) + 7.0 * np.sin(np.arange(36.0)).reshape(6, 6)
-PLATE_4 = ForcePlatform(4, [(1.2, 0.0, 0.0), (0.7, 0.0, 0.0), (0.7, 0.5, 0.0), (1.2, 0.5, 0.0)],
-                        (0.01, 0.02, -0.05), (8, 9, 10, 11, 12, 7), tuple(map(tuple, CAL)))
+PLATE_4 = ForcePlatform(
+    4,
+    [(1.2, 0.0, 0.0), (0.7, 0.0, 0.0), (0.7, 0.5, 0.0), (1.2, 0.5, 0.0)],
+    (0.01, 0.02, -0.05),
+    (8, 9, 10, 11, 12, 7),
+    tuple(map(tuple, CAL)),
+)
 
 
 def default_files(folder):
     t = np.arange(40)[:, None, None] / 128.0
-    X = np.broadcast_to(0.1 + 0.01 * t + 0.001 * np.arange(3)[None, :, None] + np.array([0.0, 0.5, 1.0]), (40, 3, 3)).copy()
+    X = np.broadcast_to(
+        0.1 + 0.01 * t + 0.001 * np.arange(3)[None, :, None] + np.array([0.0, 0.5, 1.0]), (40, 3, 3)
+    ).copy()
     X[5:8, 1] = np.nan
     k = np.arange(320)
     A = np.column_stack([100.0 * np.sin(k / 17.0), (k % 50 < 5).astype(float)])
     labels = ["RASI", "LASI", "RKNE"]
-    return [write_c3d(folder / "markers.c3d", labels, X, 128.0),
-            write_c3d(folder / "analogs.c3d", labels, X, 128.0, ["Fz_left", "sync"], A, ["N", "V"], 1024.0)]
+    return [
+        write_c3d(folder / "markers.c3d", labels, X, 128.0),
+        write_c3d(folder / "analogs.c3d", labels, X, 128.0, ["Fz_left", "sync"], A, ["N", "V"], 1024.0),
+    ]
 
 
 def test_files_without_extras_keep_their_bytes(tmp_path):
@@ -73,8 +83,18 @@ def plate_file(path, first_frame=0):
     A[:, [7, 8, 9, 10, 11, 6]] = plate_channels(PLATE_4, force, cop_4, free)
     X = np.full((n_frames, 1, 3), 0.3)
     units = ["N"] * 3 + ["Nmm"] * 3 + ["V"] * 6
-    write_c3d(path, ["M"], X, RATE, [f"CH{k}" for k in range(1, 13)], A, units, RATE * RATIO,
-              first_frame=first_frame, force_platforms=[PLATE_2, PLATE_4])
+    write_c3d(
+        path,
+        ["M"],
+        X,
+        RATE,
+        [f"CH{k}" for k in range(1, 13)],
+        A,
+        units,
+        RATE * RATIO,
+        first_frame=first_frame,
+        force_platforms=[PLATE_2, PLATE_4],
+    )
     return force, (cop_2, cop_4), free
 
 
@@ -119,8 +139,18 @@ def test_scales_and_offsets_round_trip_exactly(tmp_path):
     scales = np.array([10.0 / 32768.0, 0.37, 2.5])
     offsets = np.array([0, 2048, 7])
     physical = (stored.astype(float) - offsets) * scales.astype(np.float32)  # the file's SCALE is float32
-    path = write_c3d(tmp_path / "s.c3d", ["M"], np.full((4, 1, 3), 0.2), RATE, ["A", "B", "C"], physical,
-                     ["V", "V", "N"], RATE * RATIO, analog_scales=scales, analog_offsets=offsets)
+    path = write_c3d(
+        tmp_path / "s.c3d",
+        ["M"],
+        np.full((4, 1, 3), 0.2),
+        RATE,
+        ["A", "B", "C"],
+        physical,
+        ["V", "V", "N"],
+        RATE * RATIO,
+        analog_scales=scales,
+        analog_offsets=offsets,
+    )
     rec = read_c3d(path)
     np.testing.assert_array_equal(rec.analogs, physical)  # exact
     params = ezc3d.c3d(str(path))["parameters"]["ANALOG"]
@@ -144,27 +174,50 @@ def test_events_round_trip(tmp_path):
     np.testing.assert_allclose(60.0 * times[0] + times[1], [10.0234375, 75.5, 8.0], rtol=0, atol=1e-5)
 
 
-@pytest.mark.parametrize("extras, match", [
-    ({"force_platforms": [{"TYPE": 3, "CORNERS": np.eye(4, 3), "ORIGIN": (0, 0, 0), "CHANNEL": range(1, 7)}]},
-     "type must be one of"),
-    ({"force_platforms": [{"TYPE": 2, "CORNERS": np.eye(4, 3), "ORIGIN": (0, 0, 0), "CHANNEL": range(2, 8)}]},
-     r"uses channel\(s\) \[7\]"),
-    ({"force_platforms": [{"TYPE": 4, "CORNERS": np.eye(4, 3), "ORIGIN": (0, 0, 0), "CHANNEL": range(1, 7)}]},
-     "needs cal_matrix"),
-    ({"analog_offsets": [0, 0, 0, 0, 0, -4]}, r"analog_offsets must be an integer >= 0, got -4"),
-    ({"analog_scales": [1, 1, 0, 1, 1, 1]}, "analog_scales must be 6 finite, non-zero"),
-    ({"first_frame": 70000}, "first_frame must be at most 65534"),
-    ({"events": [("Left", "", 1.0)]}, "non-empty label"),
-])
+@pytest.mark.parametrize(
+    "extras, match",
+    [
+        (
+            {"force_platforms": [{"TYPE": 3, "CORNERS": np.eye(4, 3), "ORIGIN": (0, 0, 0), "CHANNEL": range(1, 7)}]},
+            "type must be one of",
+        ),
+        (
+            {"force_platforms": [{"TYPE": 2, "CORNERS": np.eye(4, 3), "ORIGIN": (0, 0, 0), "CHANNEL": range(2, 8)}]},
+            r"uses channel\(s\) \[7\]",
+        ),
+        (
+            {"force_platforms": [{"TYPE": 4, "CORNERS": np.eye(4, 3), "ORIGIN": (0, 0, 0), "CHANNEL": range(1, 7)}]},
+            "needs cal_matrix",
+        ),
+        ({"analog_offsets": [0, 0, 0, 0, 0, -4]}, r"analog_offsets must be an integer >= 0, got -4"),
+        ({"analog_scales": [1, 1, 0, 1, 1, 1]}, "analog_scales must be 6 finite, non-zero"),
+        ({"first_frame": 70000}, "first_frame must be at most 65534"),
+        ({"events": [("Left", "", 1.0)]}, "non-empty label"),
+    ],
+)
 def test_bad_extras_are_refused_and_leave_nothing(tmp_path, extras, match):
     path = tmp_path / "bad.c3d"
     with pytest.raises(LoperInputError, match=match):
-        write_c3d(path, ["M"], np.full((4, 1, 3), 0.2), RATE, [f"C{k}" for k in range(6)], np.zeros((40, 6)),
-                  ["V"] * 6, RATE * RATIO, **extras)
+        write_c3d(
+            path,
+            ["M"],
+            np.full((4, 1, 3), 0.2),
+            RATE,
+            [f"C{k}" for k in range(6)],
+            np.zeros((40, 6)),
+            ["V"] * 6,
+            RATE * RATIO,
+            **extras,
+        )
     assert list(tmp_path.iterdir()) == []
 
 
 def test_platform_from_mapping_equals_dataclass():
-    mapping = {"TYPE": 4, "CORNERS": PLATE_4.corners_m, "ORIGIN": PLATE_4.origin_m, "CHANNEL": PLATE_4.channels,
-               "CAL_MATRIX": CAL}
+    mapping = {
+        "TYPE": 4,
+        "CORNERS": PLATE_4.corners_m,
+        "ORIGIN": PLATE_4.origin_m,
+        "CHANNEL": PLATE_4.channels,
+        "CAL_MATRIX": CAL,
+    }
     assert ForcePlatform.from_mapping(mapping) == PLATE_4

@@ -36,7 +36,10 @@ def walking5():
 
 
 def test_walking5_plates_and_time_base(walking5):
-    assert [(p.number, p.type, p.channels) for p in walking5] == [(1, 2, (1, 2, 3, 4, 5, 6)), (2, 2, (7, 8, 9, 10, 11, 12))]
+    assert [(p.number, p.type, p.channels) for p in walking5] == [
+        (1, 2, (1, 2, 3, 4, 5, 6)),
+        (2, 2, (7, 8, 9, 10, 11, 12)),
+    ]
     p = walking5[0]
     assert p.analog_rate_hz == 2000.0
     assert p.force_n.shape == p.moment_nm.shape == (8824, 3)
@@ -77,8 +80,9 @@ def test_type4_calibration_matrix_applied(tmp_path):
     ch = channels_for_load(LOAD_N, POINT_MM, FREE_NMM, CENTRE_MM, origin)
     volts = np.linalg.solve(cal, ch)
     analogs = np.tile(volts, (20, 1))
-    path = write_plate_c3d(tmp_path / "t4.c3d", analogs, plate_type=4, cal=cal, origin_mm=origin,
-                           units=["V"] * 6, ratio=10)
+    path = write_plate_c3d(
+        tmp_path / "t4.c3d", analogs, plate_type=4, cal=cal, origin_mm=origin, units=["V"] * 6, ratio=10
+    )
     (p,) = read_force_platforms(path)
     assert p.type == 4
     np.testing.assert_allclose(p.force_n[0], LOAD_N, atol=1e-3)
@@ -101,8 +105,13 @@ def test_channels_by_number_not_label(tmp_path):
     decoys = np.full(6, 3.3)
     analogs = np.tile(np.r_[decoys, ch], (10, 1))
     labels = ["FP1_FX", "FP1_FY", "FP1_FZ", "FP1_MX", "FP1_MY", "FP1_MZ", "Fx1", "Fy1", "Fz1", "Mx1", "My1", "Mz1"]
-    path = write_plate_c3d(tmp_path / "qtm.c3d", analogs, channel=list(range(7, 13)), labels=labels,
-                           units=["V"] * 6 + ["N"] * 3 + ["Nmm"] * 3)
+    path = write_plate_c3d(
+        tmp_path / "qtm.c3d",
+        analogs,
+        channel=list(range(7, 13)),
+        labels=labels,
+        units=["V"] * 6 + ["N"] * 3 + ["Nmm"] * 3,
+    )
     (p,) = read_force_platforms(path)
     assert p.channels == (7, 8, 9, 10, 11, 12)
     np.testing.assert_allclose(p.force_n[0], LOAD_N, atol=1e-3)
@@ -114,7 +123,9 @@ def test_channels_by_number_not_label(tmp_path):
 def test_no_platforms(tmp_path, kind):
     path = write_plate_c3d(tmp_path / f"{kind}.c3d", np.zeros((10, 6)), used=0, group=kind == "used0")
     assert count_force_platforms(path) == 0
-    with pytest.raises(LoperInputError, match=r"FORCE_PLATFORM:USED (= 0|absent): the file holds no force platforms") as err:
+    with pytest.raises(
+        LoperInputError, match=r"FORCE_PLATFORM:USED (= 0|absent): the file holds no force platforms"
+    ) as err:
         read_force_platforms(path)
     assert str(path) in str(err.value)
 
@@ -131,13 +142,14 @@ def test_channel_pointing_at_missing_analog(tmp_path):
 
 def test_unknown_type(tmp_path):
     path = write_plate_c3d(tmp_path / "t5.c3d", np.zeros((10, 8)), plate_type=5, channel=list(range(1, 9)))
-    with pytest.raises(LoperInputError, match=r"t5\.c3d: FORCE_PLATFORM:TYPE of platform 1 is 5; supported types are 2, 3, 4"):
+    with pytest.raises(
+        LoperInputError, match=r"t5\.c3d: FORCE_PLATFORM:TYPE of platform 1 is 5; supported types are 2, 3, 4"
+    ):
         read_force_platforms(path)
 
 
 def test_moment_unit_disagreeing_with_point_units(tmp_path):
-    path = write_plate_c3d(tmp_path / "units.c3d", np.zeros((10, 6)), point_units="m",
-                           units=["N"] * 3 + ["Nmm"] * 3)
+    path = write_plate_c3d(tmp_path / "units.c3d", np.zeros((10, 6)), point_units="m", units=["N"] * 3 + ["Nmm"] * 3)
     with pytest.raises(LoperInputError, match=r"ANALOG:UNITS of channel 4 .* is 'Nmm'"):
         read_force_platforms(path)
 

@@ -28,8 +28,6 @@ def rng():
     return np.random.default_rng(20240611)
 
 
-
-
 # ---------------------------------------------------------------- TRC (OpenSim TRCFileAdapter)
 
 
@@ -99,9 +97,15 @@ def _opensim_trc_bytes(path, t, X, labels, unit):
     return path.read_bytes()
 
 
-@pytest.mark.parametrize("rate_hz, first, n_markers, scale, unit", [
-    (128.0, 0, 36, 1.0, "mm"), (100.0, 7, 5, 1e-3, "m"), (120.0, 0, 1, 1e3, "cm"), (200.0, 3, 4, 1e-7, "mm"),
-])
+@pytest.mark.parametrize(
+    "rate_hz, first, n_markers, scale, unit",
+    [
+        (128.0, 0, 36, 1.0, "mm"),
+        (100.0, 7, 5, 1e-3, "m"),
+        (120.0, 0, 1, 1e3, "cm"),
+        (200.0, 3, 4, 1e-7, "mm"),
+    ],
+)
 def test_trc_writer_writes_the_bytes_of_opensims_adapter(tmp_path, rng, rate_hz, first, n_markers, scale, unit):
     t = (first + np.arange(400)) / rate_hz
     X = scale * rng.normal(size=(t.size, n_markers, 3))
@@ -110,8 +114,9 @@ def test_trc_writer_writes_the_bytes_of_opensims_adapter(tmp_path, rng, rate_hz,
     labels = [f"M{i}" for i in range(n_markers)]
     (tmp_path / "osim").mkdir()
     ours = write_trc(tmp_path / "m.trc", t, X, labels, unit=unit).read_bytes()
-    theirs = _opensim_trc_bytes(tmp_path / "osim" / "m.trc", t, X * {"mm": 1e3, "cm": 1e2, "m": 1.0}[unit],
-                                labels, unit)
+    theirs = _opensim_trc_bytes(
+        tmp_path / "osim" / "m.trc", t, X * {"mm": 1e3, "cm": 1e2, "m": 1.0}[unit], labels, unit
+    )
     theirs = theirs.replace(str(tmp_path / "osim" / "m.trc").encode(), b"m.trc", 1)  # OpenSim prints its path
     assert ours == theirs
 
@@ -167,13 +172,15 @@ def test_read_markers_refuses_unknown_suffix(tmp_path):
 
 
 def coordinate_frame(rng, n=25):
-    return pd.DataFrame({
-        "time_s": 1.0 + np.arange(n) / 100.0,
-        "pelvis_tilt": rng.normal(0.0, 0.1, n),
-        "pelvis_tx": rng.normal(1.0, 0.5, n),
-        "pelvis_ty": rng.normal(0.9, 0.01, n),
-        "knee_flexion_l": rng.uniform(0.0, 1.2, n),
-    })
+    return pd.DataFrame(
+        {
+            "time_s": 1.0 + np.arange(n) / 100.0,
+            "pelvis_tilt": rng.normal(0.0, 0.1, n),
+            "pelvis_tx": rng.normal(1.0, 0.5, n),
+            "pelvis_ty": rng.normal(0.9, 0.01, n),
+            "knee_flexion_l": rng.uniform(0.0, 1.2, n),
+        }
+    )
 
 
 @pytest.mark.parametrize("in_degrees, flag", [(True, "yes"), (False, "no")])
@@ -287,8 +294,10 @@ def test_trc_labels_that_would_not_read_back_are_refused(tmp_path, rng, label):
     path = tmp_path / "bad.trc"
     with pytest.raises(LoperInputError) as caught:
         write_trc(path, np.arange(N_FRAMES) / POINT_HZ, lab_markers(rng), ["RASI", label, "RKNE"])
-    assert str(caught.value) == (f"{path}: labels must be non-empty strings without leading/trailing blanks or "
-                                 f"whitespace other than inner spaces, got {label!r}")
+    assert str(caught.value) == (
+        f"{path}: labels must be non-empty strings without leading/trailing blanks or "
+        f"whitespace other than inner spaces, got {label!r}"
+    )
     assert not path.exists()
 
 

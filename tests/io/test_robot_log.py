@@ -19,8 +19,6 @@ from tests.io.robot_log_frames import FS, N, make_frame, rounded
 FIRST_LINE = 5
 
 
-
-
 @pytest.fixture
 def log_file(tmp_path):
     path = tmp_path / "good.loper.tsv"
@@ -57,12 +55,34 @@ def refusal(path, **kwargs) -> str:
 
 def test_constants():
     assert FORMAT_NAME == "loper-log 1"
-    assert COLUMNS == ("time_s", "force_desired_n", "force_measured_n", "motor_angle_rad",
-                       "motor_velocity_rad_s", "sync_v", "perturbation", "safety_state")
-    assert UNITS == {"time_s": "s", "force_desired_n": "N", "force_measured_n": "N", "motor_angle_rad": "rad",
-                     "motor_velocity_rad_s": "rad/s", "sync_v": "V", "perturbation": "1", "safety_state": "1"}
-    assert SAFETY_STATES == {0: "ok", 1: "limited", 2: "motor_off_position", 3: "motor_off_velocity",
-                             4: "motor_off_torque", 5: "servo_off_position"}
+    assert COLUMNS == (
+        "time_s",
+        "force_desired_n",
+        "force_measured_n",
+        "motor_angle_rad",
+        "motor_velocity_rad_s",
+        "sync_v",
+        "perturbation",
+        "safety_state",
+    )
+    assert UNITS == {
+        "time_s": "s",
+        "force_desired_n": "N",
+        "force_measured_n": "N",
+        "motor_angle_rad": "rad",
+        "motor_velocity_rad_s": "rad/s",
+        "sync_v": "V",
+        "perturbation": "1",
+        "safety_state": "1",
+    }
+    assert SAFETY_STATES == {
+        0: "ok",
+        1: "limited",
+        2: "motor_off_position",
+        3: "motor_off_velocity",
+        4: "motor_off_torque",
+        5: "servo_off_position",
+    }
 
 
 # ---------------------------------------------------------------------------
@@ -75,8 +95,11 @@ def test_round_trip_exact_to_written_precision_and_same_bytes(tmp_path, log_file
     assert head[4].split("\t")[0] == "12" and head[5].split("\t")[0] == "12.001"
     frame, meta = read_robot_log(log_file, FS)
     assert list(frame.columns) == list(COLUMNS)
-    assert frame.dtypes.to_dict() == {**{c: np.dtype("float64") for c in COLUMNS[:6]},
-                                      "perturbation": np.dtype("int64"), "safety_state": np.dtype("int64")}
+    assert frame.dtypes.to_dict() == {
+        **{c: np.dtype("float64") for c in COLUMNS[:6]},
+        "perturbation": np.dtype("int64"),
+        "safety_state": np.dtype("int64"),
+    }
     assert frame.index.equals(pd.RangeIndex(N))
     pd.testing.assert_frame_equal(frame, rounded(make_frame()), check_exact=True)
     # values differ from the originals by at most the printed precision
@@ -91,11 +114,22 @@ def test_round_trip_exact_to_written_precision_and_same_bytes(tmp_path, log_file
 
 def test_metadata_round_trip(tmp_path):
     path = tmp_path / "meta.loper.tsv"
-    write_robot_log(path, make_frame(), 1000, {"trial": "steps40", "clock": "robot", "operator": "A. B: lab 2",
-                                               "n_steps": 40, "note": ""})
+    write_robot_log(
+        path,
+        make_frame(),
+        1000,
+        {"trial": "steps40", "clock": "robot", "operator": "A. B: lab 2", "n_steps": 40, "note": ""},
+    )
     _, meta = read_robot_log(path)
-    assert meta == {"format": "loper-log 1", "sample_rate_hz": 1000.0, "trial": "steps40", "clock": "robot",
-                    "operator": "A. B: lab 2", "n_steps": "40", "note": ""}
+    assert meta == {
+        "format": "loper-log 1",
+        "sample_rate_hz": 1000.0,
+        "trial": "steps40",
+        "clock": "robot",
+        "operator": "A. B: lab 2",
+        "n_steps": "40",
+        "note": "",
+    }
     assert list(meta) == ["format", "sample_rate_hz", "trial", "clock", "operator", "n_steps", "note"]
     assert isinstance(meta["sample_rate_hz"], float)
 
@@ -138,10 +172,10 @@ def test_missing_format_line_and_other_format(log_file):
 def test_missing_columns_are_named(log_file):
     lines = [line.split("\t") for line in log_file.read_text().splitlines()]
     keep = [j for j, c in enumerate(COLUMNS) if c not in ("force_measured_n", "sync_v")]
-    bad = with_lines(log_file, ["\t".join(r) if r[0].startswith("#") else "\t".join(r[j] for j in keep)
-                                for r in lines])
-    assert refusal(bad) == (f"{bad}: missing column(s) force_measured_n, sync_v; a robot log has the columns "
-                            + ", ".join(COLUMNS))
+    bad = with_lines(log_file, ["\t".join(r) if r[0].startswith("#") else "\t".join(r[j] for j in keep) for r in lines])
+    assert refusal(bad) == (
+        f"{bad}: missing column(s) force_measured_n, sync_v; a robot log has the columns " + ", ".join(COLUMNS)
+    )
 
 
 def test_unknown_columns_are_refused(log_file):
@@ -150,8 +184,9 @@ def test_unknown_columns_are_refused(log_file):
     for i in range(FIRST_LINE - 1, len(lines)):
         lines[i] += "\t21.5\tx"
     bad = with_lines(log_file, lines)
-    assert refusal(bad) == (f"{bad}: unknown column(s) temperature_c, note; a robot log has exactly the columns "
-                            + ", ".join(COLUMNS))
+    assert refusal(bad) == (
+        f"{bad}: unknown column(s) temperature_c, note; a robot log has exactly the columns " + ", ".join(COLUMNS)
+    )
     lines = log_file.read_text().splitlines()
     lines[FIRST_LINE - 2] += "\t"
     bad = with_lines(log_file, lines)
@@ -160,16 +195,22 @@ def test_unknown_columns_are_refused(log_file):
 
 def test_reordered_columns_are_refused(log_file):
     lines = [line.split("\t") for line in log_file.read_text().splitlines()]
-    bad = with_lines(log_file, ["\t".join(r) if r[0].startswith("#") else "\t".join([r[1], r[0], *r[2:]])
-                                for r in lines])
-    assert refusal(bad) == (f"{bad}: line 4: columns in the order force_desired_n, time_s, "
-                            + ", ".join(COLUMNS[2:]) + "; a robot log has them in the order " + ", ".join(COLUMNS))
+    bad = with_lines(
+        log_file, ["\t".join(r) if r[0].startswith("#") else "\t".join([r[1], r[0], *r[2:]]) for r in lines]
+    )
+    assert refusal(bad) == (
+        f"{bad}: line 4: columns in the order force_desired_n, time_s, "
+        + ", ".join(COLUMNS[2:])
+        + "; a robot log has them in the order "
+        + ", ".join(COLUMNS)
+    )
 
 
 def test_non_numeric_cell_names_column_and_sample(log_file):
     bad = with_cell(log_file, 17, "force_measured_n", "12.3N")
-    assert refusal(bad) == (f"{bad}: column 'force_measured_n', sample 17 (t = 12.017 s, line 22): "
-                            f"non-numeric value '12.3N'")
+    assert refusal(bad) == (
+        f"{bad}: column 'force_measured_n', sample 17 (t = 12.017 s, line 22): non-numeric value '12.3N'"
+    )
     bad = with_cell(log_file, 3, "safety_state", "")
     assert refusal(bad) == f"{bad}: column 'safety_state', sample 3 (t = 12.003 s, line 8): non-numeric value ''"
     bad = with_cell(log_file, 4, "time_s", "t4")
@@ -185,7 +226,7 @@ def test_ragged_row(log_file):
 
 def test_blank_line_inside_the_data(log_file):
     lines = log_file.read_text().splitlines()
-    bad = with_lines(log_file, lines[:FIRST_LINE - 1 + 6] + [""] + lines[FIRST_LINE - 1 + 6:])
+    bad = with_lines(log_file, lines[: FIRST_LINE - 1 + 6] + [""] + lines[FIRST_LINE - 1 + 6 :])
     assert refusal(bad) == f"{bad}: sample 6 (line 11): 1 field(s), expected 8 (one per column)"
 
 
@@ -196,23 +237,30 @@ def test_non_finite_time(log_file):
 
 def test_non_monotonic_time_names_the_sample(log_file):
     bad = with_cell(log_file, 30, "time_s", "12.029")
-    assert refusal(bad) == (f"{bad}: column 'time_s', sample 30 (t = 12.029 s, line 35): time not strictly "
-                            f"increasing (sample 29 is at t = 12.029 s)")
+    assert refusal(bad) == (
+        f"{bad}: column 'time_s', sample 30 (t = 12.029 s, line 35): time not strictly "
+        f"increasing (sample 29 is at t = 12.029 s)"
+    )
     bad = with_cell(log_file, 30, "time_s", "12.01")
-    assert refusal(bad) == (f"{bad}: column 'time_s', sample 30 (t = 12.01 s, line 35): time not strictly "
-                            f"increasing (sample 29 is at t = 12.029 s)")
+    assert refusal(bad) == (
+        f"{bad}: column 'time_s', sample 30 (t = 12.01 s, line 35): time not strictly "
+        f"increasing (sample 29 is at t = 12.029 s)"
+    )
 
 
 def test_sample_rate_differs_from_declared(log_file):
     assert refusal(log_file, sample_rate_hz=500) == (
-        f"{log_file}: sample_rate_hz in the file is 1000 Hz but 500 Hz was declared")
+        f"{log_file}: sample_rate_hz in the file is 1000 Hz but 500 Hz was declared"
+    )
     assert read_robot_log(log_file, sample_rate_hz=1000)[1]["sample_rate_hz"] == 1000.0
 
 
 def test_time_steps_inconsistent_with_header_rate(log_file):
     bad = with_cell(log_file, 12, "time_s", "12.0122")  # 1.2 ms after sample 11
-    assert refusal(bad) == (f"{bad}: column 'time_s', sample 12 (t = 12.0122 s, line 17): time step 1.2 ms since "
-                            f"sample 11 deviates +20 % from 1/sample_rate_hz = 1 ms (tolerance 1 %)")
+    assert refusal(bad) == (
+        f"{bad}: column 'time_s', sample 12 (t = 12.0122 s, line 17): time step 1.2 ms since "
+        f"sample 11 deviates +20 % from 1/sample_rate_hz = 1 ms (tolerance 1 %)"
+    )
     # 0.9 % is within the tolerance
     ok = with_cell(log_file, 12, "time_s", "12.012009")
     assert read_robot_log(ok)[0].loc[12, "time_s"] == 12.012009
@@ -220,15 +268,20 @@ def test_time_steps_inconsistent_with_header_rate(log_file):
     lines = log_file.read_text().splitlines()
     lines[1] = "# sample_rate_hz: 500"
     bad = with_lines(log_file, lines)
-    assert refusal(bad) == (f"{bad}: column 'time_s', sample 1 (t = 12.001 s, line 6): time step 1 ms since "
-                            f"sample 0 deviates -50 % from 1/sample_rate_hz = 2 ms (tolerance 1 %)")
+    assert refusal(bad) == (
+        f"{bad}: column 'time_s', sample 1 (t = 12.001 s, line 6): time step 1 ms since "
+        f"sample 0 deviates -50 % from 1/sample_rate_hz = 2 ms (tolerance 1 %)"
+    )
 
 
-@pytest.mark.parametrize("column, sample, text", [
-    ("force_desired_n", 0, "nan"),
-    ("force_measured_n", 41, "inf"),
-    ("force_measured_n", 5, "-inf"),
-])
+@pytest.mark.parametrize(
+    "column, sample, text",
+    [
+        ("force_desired_n", 0, "nan"),
+        ("force_measured_n", 41, "inf"),
+        ("force_measured_n", 5, "-inf"),
+    ],
+)
 def test_non_finite_force_names_column_and_first_bad_sample(log_file, column, sample, text):
     bad = with_cell(log_file, sample, column, text)
     lines = bad.read_text().splitlines()
@@ -237,38 +290,45 @@ def test_non_finite_force_names_column_and_first_bad_sample(log_file, column, sa
     lines[FIRST_LINE + sample] = "\t".join(later)
     bad.write_text("\n".join(lines) + "\n")
     t = f"{12 + sample / 1000:.9g}"
-    assert refusal(bad) == (f"{bad}: column '{column}', sample {sample} (t = {t} s, line {FIRST_LINE + sample}): "
-                            f"non-finite force {float(text)}")
+    assert refusal(bad) == (
+        f"{bad}: column '{column}', sample {sample} (t = {t} s, line {FIRST_LINE + sample}): "
+        f"non-finite force {float(text)}"
+    )
 
 
 def test_infinite_motor_channel(log_file):
     bad = with_cell(log_file, 2, "motor_velocity_rad_s", "inf")
-    assert refusal(bad) == (f"{bad}: column 'motor_velocity_rad_s', sample 2 (t = 12.002 s, line 7): infinite value "
-                            f"inf (missing samples are nan)")
+    assert refusal(bad) == (
+        f"{bad}: column 'motor_velocity_rad_s', sample 2 (t = 12.002 s, line 7): infinite value "
+        f"inf (missing samples are nan)"
+    )
 
 
 def test_fewer_than_two_samples(log_file):
     lines = log_file.read_text().splitlines()
     bad = with_lines(log_file, lines[:FIRST_LINE])
     assert refusal(bad) == f"{bad}: 1 sample(s); a robot log needs at least 2"
-    bad = with_lines(log_file, lines[:FIRST_LINE - 1])
+    bad = with_lines(log_file, lines[: FIRST_LINE - 1])
     assert refusal(bad) == f"{bad}: 0 sample(s); a robot log needs at least 2"
-    bad = with_lines(log_file, lines[:FIRST_LINE - 2])
+    bad = with_lines(log_file, lines[: FIRST_LINE - 2])
     assert refusal(bad) == f"{bad}: no column header row after the '#' header lines"
 
 
 @pytest.mark.parametrize("text, shown", [("2", "2"), ("0.5", "0.5"), ("-1", "-1"), ("nan", "nan")])
 def test_perturbation_not_0_or_1(log_file, text, shown):
     bad = with_cell(log_file, 23, "perturbation", text)
-    assert refusal(bad) == (f"{bad}: column 'perturbation', sample 23 (t = 12.023 s, line 28): "
-                            f"value {shown} is not 0 or 1")
+    assert refusal(bad) == (
+        f"{bad}: column 'perturbation', sample 23 (t = 12.023 s, line 28): value {shown} is not 0 or 1"
+    )
 
 
 def test_unknown_safety_state(log_file):
     bad = with_cell(log_file, 8, "safety_state", "6")
-    assert refusal(bad) == (f"{bad}: column 'safety_state', sample 8 (t = 12.008 s, line 13): unknown safety state 6 "
-                            f"(codes: 0 ok, 1 limited, 2 motor_off_position, 3 motor_off_velocity, "
-                            f"4 motor_off_torque, 5 servo_off_position)")
+    assert refusal(bad) == (
+        f"{bad}: column 'safety_state', sample 8 (t = 12.008 s, line 13): unknown safety state 6 "
+        f"(codes: 0 ok, 1 limited, 2 motor_off_position, 3 motor_off_velocity, "
+        f"4 motor_off_torque, 5 servo_off_position)"
+    )
 
 
 def test_unreadable_file(tmp_path):
@@ -300,8 +360,9 @@ def test_failed_write_leaves_no_file(tmp_path):
     path.parent.mkdir()
     with pytest.raises(LoperInputError) as err:
         write_robot_log(path, frame)
-    assert str(err.value) == (f"refusing to write {path}: column 'force_measured_n', sample 4 (t = 12.004 s): "
-                              f"non-finite force nan")
+    assert str(err.value) == (
+        f"refusing to write {path}: column 'force_measured_n', sample 4 (t = 12.004 s): non-finite force nan"
+    )
     assert list(path.parent.iterdir()) == []
 
 
@@ -344,26 +405,35 @@ def test_writer_refuses_what_the_reader_refuses(tmp_path):
 
     frame = make_frame()
     assert message(frame.drop(columns=["sync_v"])) == (
-        f"{src}: missing column(s) sync_v; a robot log has the columns " + ", ".join(COLUMNS))
+        f"{src}: missing column(s) sync_v; a robot log has the columns " + ", ".join(COLUMNS)
+    )
     assert message(frame.assign(extra=1.0)) == (
-        f"{src}: unknown column(s) extra; a robot log has exactly the columns " + ", ".join(COLUMNS))
+        f"{src}: unknown column(s) extra; a robot log has exactly the columns " + ", ".join(COLUMNS)
+    )
     assert message(frame.iloc[:1]) == f"{src}: 1 sample(s); a robot log needs at least 2"
     assert message(frame, rate=500) == (
         f"{src}: column 'time_s', sample 1 (t = 12.001 s): time step 1 ms since sample 0 deviates -50 % from "
-        f"1/sample_rate_hz = 2 ms (tolerance 1 %)")
+        f"1/sample_rate_hz = 2 ms (tolerance 1 %)"
+    )
     assert message(frame, rate=-1) == f"{src}: sample_rate_hz must be a positive number, got -1"
     assert message(frame.assign(perturbation=2)) == (
-        f"{src}: column 'perturbation', sample 0 (t = 12 s): value 2 is not 0 or 1")
+        f"{src}: column 'perturbation', sample 0 (t = 12 s): value 2 is not 0 or 1"
+    )
     assert message(frame.assign(sync_v=["5V"] * N)) == (
-        f"{src}: column 'sync_v', sample 0 (t = 12 s): non-numeric value '5V'")
+        f"{src}: column 'sync_v', sample 0 (t = 12 s): non-numeric value '5V'"
+    )
     assert message(frame, metadata={"bad key": "x"}) == (
-        f"{src}: metadata key 'bad key' must match [A-Za-z_][A-Za-z0-9_.-]*")
+        f"{src}: metadata key 'bad key' must match [A-Za-z_][A-Za-z0-9_.-]*"
+    )
     assert message(frame, metadata={"note": "two\nlines"}) == (
-        f"{src}: metadata value of 'note' must be one line without leading or trailing whitespace, got 'two\\nlines'")
+        f"{src}: metadata value of 'note' must be one line without leading or trailing whitespace, got 'two\\nlines'"
+    )
     assert message(frame, metadata={"sample_rate_hz": 500.0}) == (
-        f"{src}: metadata sample_rate_hz 500.0 disagrees with sample_rate_hz 1000")
+        f"{src}: metadata sample_rate_hz 500.0 disagrees with sample_rate_hz 1000"
+    )
     assert message(frame, metadata={"format": "loper-log 2"}) == (
-        f"{src}: metadata format 'loper-log 2' is not 'loper-log 1'")
+        f"{src}: metadata format 'loper-log 2' is not 'loper-log 1'"
+    )
 
 
 def test_writer_accepts_any_column_order_and_index(tmp_path, log_file):

@@ -27,15 +27,26 @@ def test_mat_round_trip_equals_tsv_content(tmp_path):
     expected, _ = read_robot_log(tsv)
 
     mat = tmp_path / "rec.mat"
-    savemat(mat, {
-        "t": (1e3 * expected["time_s"].to_numpy())[np.newaxis, :],  # (1, n), milliseconds
-        "Fd": expected["force_desired_n"].to_numpy()[:, np.newaxis],  # (n, 1)
-        "Fm": expected["force_measured_n"].to_numpy()[np.newaxis, :],
-        "theta": expected["motor_angle_rad"].to_numpy()[:, np.newaxis],
-        "omega": expected["motor_velocity_rad_s"].to_numpy(),  # 1-D: savemat stores (1, n)
-    })
-    cmap = {"time_s": "t", "force_desired_n": "Fd", "force_measured_n": "Fm", "motor_angle_rad": "theta",
-            "motor_velocity_rad_s": "omega", "sync_v": None, "perturbation": None, "safety_state": None}
+    savemat(
+        mat,
+        {
+            "t": (1e3 * expected["time_s"].to_numpy())[np.newaxis, :],  # (1, n), milliseconds
+            "Fd": expected["force_desired_n"].to_numpy()[:, np.newaxis],  # (n, 1)
+            "Fm": expected["force_measured_n"].to_numpy()[np.newaxis, :],
+            "theta": expected["motor_angle_rad"].to_numpy()[:, np.newaxis],
+            "omega": expected["motor_velocity_rad_s"].to_numpy(),  # 1-D: savemat stores (1, n)
+        },
+    )
+    cmap = {
+        "time_s": "t",
+        "force_desired_n": "Fd",
+        "force_measured_n": "Fm",
+        "motor_angle_rad": "theta",
+        "motor_velocity_rad_s": "omega",
+        "sync_v": None,
+        "perturbation": None,
+        "safety_state": None,
+    }
     frame, meta = read_robot_log_mat(mat, cmap, FS, time_scale=0.001)
     assert meta == {"format": FORMAT_NAME, "sample_rate_hz": 1000.0, "source": str(mat)}
     assert list(frame.columns) == list(COLUMNS)
@@ -52,12 +63,27 @@ def test_mat_without_time_and_with_optional_channels(tmp_path):
     frame = rounded(make_frame())
     frame["time_s"] = np.arange(N) / FS
     mat = tmp_path / "rec.mat"
-    savemat(mat, {"Fd": frame["force_desired_n"].to_numpy(), "Fm": frame["force_measured_n"].to_numpy(),
-                  "theta": frame["motor_angle_rad"].to_numpy(), "omega": frame["motor_velocity_rad_s"].to_numpy(),
-                  "sync": frame["sync_v"].to_numpy(), "pert": frame["perturbation"].to_numpy().astype(np.uint8),
-                  "safety": frame["safety_state"].to_numpy().astype(np.int32)[:, np.newaxis]})
-    cmap = {"force_desired_n": "Fd", "force_measured_n": "Fm", "motor_angle_rad": "theta",
-            "motor_velocity_rad_s": "omega", "sync_v": "sync", "perturbation": "pert", "safety_state": "safety"}
+    savemat(
+        mat,
+        {
+            "Fd": frame["force_desired_n"].to_numpy(),
+            "Fm": frame["force_measured_n"].to_numpy(),
+            "theta": frame["motor_angle_rad"].to_numpy(),
+            "omega": frame["motor_velocity_rad_s"].to_numpy(),
+            "sync": frame["sync_v"].to_numpy(),
+            "pert": frame["perturbation"].to_numpy().astype(np.uint8),
+            "safety": frame["safety_state"].to_numpy().astype(np.int32)[:, np.newaxis],
+        },
+    )
+    cmap = {
+        "force_desired_n": "Fd",
+        "force_measured_n": "Fm",
+        "motor_angle_rad": "theta",
+        "motor_velocity_rad_s": "omega",
+        "sync_v": "sync",
+        "perturbation": "pert",
+        "safety_state": "safety",
+    }
     got, _ = read_robot_log_mat(mat, cmap, FS)
     pd.testing.assert_frame_equal(got, frame, check_exact=True)
 
@@ -68,17 +94,29 @@ def test_mat_without_time_and_with_optional_channels(tmp_path):
 
 def _mat_frame(tmp_path, **overrides):
     frame = rounded(make_frame())
-    variables = {"t": frame["time_s"].to_numpy(), "Fd": frame["force_desired_n"].to_numpy(),
-                 "Fm": frame["force_measured_n"].to_numpy(), "theta": frame["motor_angle_rad"].to_numpy(),
-                 "omega": frame["motor_velocity_rad_s"].to_numpy()}
+    variables = {
+        "t": frame["time_s"].to_numpy(),
+        "Fd": frame["force_desired_n"].to_numpy(),
+        "Fm": frame["force_measured_n"].to_numpy(),
+        "theta": frame["motor_angle_rad"].to_numpy(),
+        "omega": frame["motor_velocity_rad_s"].to_numpy(),
+    }
     variables.update(overrides)
     mat = tmp_path / "rec.mat"
     savemat(mat, variables)
     return mat
 
 
-CMAP = {"time_s": "t", "force_desired_n": "Fd", "force_measured_n": "Fm", "motor_angle_rad": "theta",
-        "motor_velocity_rad_s": "omega", "sync_v": None, "perturbation": None, "safety_state": None}
+CMAP = {
+    "time_s": "t",
+    "force_desired_n": "Fd",
+    "force_measured_n": "Fm",
+    "motor_angle_rad": "theta",
+    "motor_velocity_rad_s": "omega",
+    "sync_v": None,
+    "perturbation": None,
+    "safety_state": None,
+}
 
 
 def mat_refusal(mat, cmap=CMAP, **kwargs) -> str:
@@ -90,8 +128,10 @@ def mat_refusal(mat, cmap=CMAP, **kwargs) -> str:
 def test_mat_missing_variable(tmp_path):
     mat = _mat_frame(tmp_path)
     cmap = {**CMAP, "force_measured_n": "F_load"}
-    assert mat_refusal(mat, cmap) == (f"{mat}: variable 'F_load' (for column 'force_measured_n') not found; "
-                                      f"variables in the file: Fd, Fm, omega, t, theta")
+    assert mat_refusal(mat, cmap) == (
+        f"{mat}: variable 'F_load' (for column 'force_measured_n') not found; "
+        f"variables in the file: Fd, Fm, omega, t, theta"
+    )
 
 
 def test_mat_unequal_lengths(tmp_path):
@@ -106,27 +146,35 @@ def test_mat_validation_is_shared(tmp_path):
     assert mat_refusal(mat) == f"{mat}: column 'force_measured_n', sample 13 (t = 12.013 s): non-finite force nan"
     # time in ms read without time_scale: steps of 1000 "s"
     mat = _mat_frame(tmp_path, t=1e3 * np.arange(N) / FS)
-    assert mat_refusal(mat) == (f"{mat}: column 'time_s', sample 1 (t = 1 s): time step 1000 ms since sample 0 "
-                                f"deviates +99900 % from 1/sample_rate_hz = 1 ms (tolerance 1 %)")
+    assert mat_refusal(mat) == (
+        f"{mat}: column 'time_s', sample 1 (t = 1 s): time step 1000 ms since sample 0 "
+        f"deviates +99900 % from 1/sample_rate_hz = 1 ms (tolerance 1 %)"
+    )
     mat = _mat_frame(tmp_path, pert=np.full(N, 3.0))
     assert mat_refusal(mat, {**CMAP, "perturbation": "pert"}) == (
-        f"{mat}: column 'perturbation', sample 0 (t = 12 s): value 3 is not 0 or 1")
+        f"{mat}: column 'perturbation', sample 0 (t = 12 s): value 3 is not 0 or 1"
+    )
 
 
 def test_mat_bad_map_and_bad_variables(tmp_path):
     mat = _mat_frame(tmp_path, M=np.ones((N, 3)), name="steps")
     assert mat_refusal(mat, {k: v for k, v in CMAP.items() if k != "force_desired_n"}) == (
-        "column_map: column(s) force_desired_n not mapped to a .mat variable")
+        "column_map: column(s) force_desired_n not mapped to a .mat variable"
+    )
     assert mat_refusal(mat, {**CMAP, "force_n": "Fd"}) == (
-        "column_map: unknown column(s) force_n; columns are " + ", ".join(COLUMNS))
+        "column_map: unknown column(s) force_n; columns are " + ", ".join(COLUMNS)
+    )
     assert mat_refusal(mat, {**CMAP, "force_measured_n": None}) == (
         "column_map: column 'force_measured_n' must map to a .mat variable (only time_s, sync_v, perturbation, "
-        "safety_state may be None)")
+        "safety_state may be None)"
+    )
     assert mat_refusal(mat, {**CMAP, "motor_angle_rad": "M"}) == (
         f"{mat}: variable 'M' (for column 'motor_angle_rad') has shape (60, 3); expected a vector (n,), (n, 1) "
-        f"or (1, n)")
+        f"or (1, n)"
+    )
     assert mat_refusal(mat, {**CMAP, "motor_angle_rad": "name"}) == (
-        f"{mat}: variable 'name' (for column 'motor_angle_rad') is not real numeric (dtype <U5)")
+        f"{mat}: variable 'name' (for column 'motor_angle_rad') is not real numeric (dtype <U5)"
+    )
     with pytest.raises(LoperInputError, match=r"^time_scale must be a positive number, got 0$"):
         read_robot_log_mat(mat, CMAP, FS, time_scale=0)
     junk = tmp_path / "junk.mat"
@@ -138,8 +186,16 @@ def test_mat_bad_map_and_bad_variables(tmp_path):
 # the .mat writer
 
 
-MAT_NAMES = {"time_s": "t_ms", "force_desired_n": "F_des", "force_measured_n": "F_meas", "motor_angle_rad": "theta_m",
-             "motor_velocity_rad_s": "omega_m", "sync_v": "sync", "perturbation": "pert", "safety_state": "safety"}
+MAT_NAMES = {
+    "time_s": "t_ms",
+    "force_desired_n": "F_des",
+    "force_measured_n": "F_meas",
+    "motor_angle_rad": "theta_m",
+    "motor_velocity_rad_s": "omega_m",
+    "sync_v": "sync",
+    "perturbation": "pert",
+    "safety_state": "safety",
+}
 
 
 def test_mat_writer_round_trip_and_fixed_bytes(tmp_path):
@@ -149,10 +205,11 @@ def test_mat_writer_round_trip_and_fixed_bytes(tmp_path):
     mat = write_robot_log_mat(tmp_path / "rec.loper.mat", frame, FS, MAT_NAMES, time_scale=0.001)
     back, meta = read_robot_log_mat(mat, MAT_NAMES, FS, time_scale=0.001)
     assert meta["sample_rate_hz"] == FS
-    pd.testing.assert_frame_equal(back.drop(columns="time_s"), frame.drop(columns="time_s"), check_exact=True,
-                                  check_dtype=False)
+    pd.testing.assert_frame_equal(
+        back.drop(columns="time_s"), frame.drop(columns="time_s"), check_exact=True, check_dtype=False
+    )
     np.testing.assert_allclose(back["time_s"], frame["time_s"], rtol=1e-15, atol=0)  # ms -> s
-    assert mat.read_bytes()[:len(MAT_HEADER_TEXT)] == MAT_HEADER_TEXT.encode()
+    assert mat.read_bytes()[: len(MAT_HEADER_TEXT)] == MAT_HEADER_TEXT.encode()
     again = write_robot_log_mat(tmp_path / "again.loper.mat", frame, FS, MAT_NAMES, time_scale=0.001)
     assert again.read_bytes() == mat.read_bytes()
     plain = write_robot_log_mat(tmp_path / "plain.mat", frame, FS)  # the column names as variable names
@@ -160,11 +217,14 @@ def test_mat_writer_round_trip_and_fixed_bytes(tmp_path):
     pd.testing.assert_frame_equal(got, frame, check_exact=True, check_dtype=False)
 
 
-@pytest.mark.parametrize("names, match", [
-    ({**MAT_NAMES, "sync_v": "2sync"}, "is not a MATLAB name"),
-    ({k: v for k, v in MAT_NAMES.items() if k != "sync_v"}, "missing: sync_v"),
-    ({**MAT_NAMES, "sync_v": "pert"}, "all different"),
-])
+@pytest.mark.parametrize(
+    "names, match",
+    [
+        ({**MAT_NAMES, "sync_v": "2sync"}, "is not a MATLAB name"),
+        ({k: v for k, v in MAT_NAMES.items() if k != "sync_v"}, "missing: sync_v"),
+        ({**MAT_NAMES, "sync_v": "pert"}, "all different"),
+    ],
+)
 def test_mat_writer_refuses_bad_names_and_leaves_nothing(tmp_path, names, match):
     from loper_analysis.io.robot_log_mat import write_robot_log_mat
 

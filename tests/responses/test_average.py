@@ -72,12 +72,17 @@ def test_subject_response_returns_the_planted_bump(rng):
 
     # the series is what prepare_window takes; its measured difference is the mean response
     window = prepare_window(
-        series["time_s"], series["q_unperturbed"], series["q_perturbed"],
-        segment_parameters_from_anthropometry(1.75, 70.0), series["onset_s"],
-        force_unperturbed_n=series["force_unperturbed_n"], force_perturbed_n=series["force_perturbed_n"],
+        series["time_s"],
+        series["q_unperturbed"],
+        series["q_perturbed"],
+        segment_parameters_from_anthropometry(1.75, 70.0),
+        series["onset_s"],
+        force_unperturbed_n=series["force_unperturbed_n"],
+        force_perturbed_n=series["force_perturbed_n"],
         pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
         pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
-        window_before_s=series["window_before_s"], window_after_s=series["window_after_s"],
+        window_before_s=series["window_before_s"],
+        window_after_s=series["window_after_s"],
         initial_state_span_s=series["initial_state_span_s"],
     )
     inside = response[response["analysis_window"]]
@@ -91,11 +96,18 @@ def test_subject_counts_too_short_no_match_outlier(rng):
     amplitudes = {p: BUMP_AMP * a for p, a in good.items()}
     amplitudes[20] = -5.0 * BUMP_AMP  # an outlier, with its twin 18
     amplitudes[22] = BUMP_AMP  # its swing is made too short below
-    trial_a, _ = twin_trial(rng, "walk-1", twins={4: 1, 8: 6, 12: 10, 16: 14, 20: 18}, amplitudes=amplitudes,
-                            short=(22,))
+    trial_a, _ = twin_trial(
+        rng, "walk-1", twins={4: 1, 8: 6, 12: 10, 16: 14, 20: 18}, amplitudes=amplitudes, short=(22,)
+    )
     j = np.arange(8)
-    trial_b = make_trial("walk-2", 88 + j % 3, 60 + j % 2, rng.uniform(-0.05, 0.05, (8, 3)),
-                         {3: BUMP_AMP, 6: BUMP_AMP}, removed=[s for s in range(8) if s not in (3, 6)])
+    trial_b = make_trial(
+        "walk-2",
+        88 + j % 3,
+        60 + j % 2,
+        rng.uniform(-0.05, 0.05, (8, 3)),
+        {3: BUMP_AMP, 6: BUMP_AMP},
+        removed=[s for s in range(8) if s not in (3, 6)],
+    )
     with pytest.warns(TooFewStridesWarning, match="only 4 valid"):
         response, counts, _ = subject_onset_response([trial_a.inputs(), trial_b.inputs()], 100, source="S01")
     assert list(counts.columns) == list(COUNT_COLUMNS)
@@ -109,16 +121,25 @@ def test_subject_counts_too_short_no_match_outlier(rng):
     assert "1 too short" in counts["reason"].iloc[0] and "2 without unperturbed match" in counts["reason"].iloc[1]
     pairs = counts.attrs["pairs"]
     assert pairs["stride"].tolist() == [4, 8, 12, 16, 20] and pairs["removed"].tolist() == [0, 0, 0, 0, 1]
-    np.testing.assert_allclose(response["hip_rad_mean"], np.mean(list(good.values())) * BUMP_AMP[0]
-                               * bump(response["time_s"].to_numpy()), atol=1e-9)
+    np.testing.assert_allclose(
+        response["hip_rad_mean"],
+        np.mean(list(good.values())) * BUMP_AMP[0] * bump(response["time_s"].to_numpy()),
+        atol=1e-9,
+    )
     _, counts, _ = subject_onset_response([trial_a.inputs(), trial_b.inputs()], 100, ResponseSettings(min_strides=4))
     assert counts["status"].tolist() == ["ok", "too_few_strides", "ok"]
 
 
 def test_subject_response_with_no_pair_is_nan_not_a_crash(rng):
     j = np.arange(8)
-    trial = make_trial("walk-2", 88 + j % 3, 60 + j % 2, rng.uniform(-0.05, 0.05, (8, 3)), {3: BUMP_AMP},
-                       removed=[s for s in range(8) if s != 3])
+    trial = make_trial(
+        "walk-2",
+        88 + j % 3,
+        60 + j % 2,
+        rng.uniform(-0.05, 0.05, (8, 3)),
+        {3: BUMP_AMP},
+        removed=[s for s in range(8) if s != 3],
+    )
     with pytest.warns(TooFewStridesWarning):
         response, counts, series = subject_onset_response([trial.inputs()], 100)
     assert response["hip_rad_mean"].isna().all() and (response["n_pairs"] == 0).all()

@@ -24,8 +24,9 @@ def rng():
 
 
 def test_match_picks_exact_twin_at_toe_off_aligned_anchor(rng):
-    trial, offsets = twin_trial(rng, amplitudes={4: BUMP_AMP, 8: BUMP_AMP, 12: BUMP_AMP, 16: BUMP_AMP,
-                                                 20: BUMP_AMP})  # stride 20 has no twin
+    trial, offsets = twin_trial(
+        rng, amplitudes={4: BUMP_AMP, 8: BUMP_AMP, 12: BUMP_AMP, 16: BUMP_AMP, 20: BUMP_AMP}
+    )  # stride 20 has no twin
     t = trial.angles["time_s"].to_numpy()
     m = match_unperturbed(t, trial.angles[JOINT_COLS].to_numpy(), trial.strides, source="walk-1")
     assert list(m.columns) == list(MATCH_COLUMNS)
@@ -38,8 +39,9 @@ def test_match_picks_exact_twin_at_toe_off_aligned_anchor(rng):
     np.testing.assert_allclose(m["rmsd_rad"].iloc[4], want_rmsd, rtol=1e-10)
     # anchor: same time after the candidate's own toe-off (stances differ, so heel strikes would not do)
     to = trial.strides.set_index("stride")["toe_off_s"]
-    np.testing.assert_allclose(m["matched_anchor_s"].to_numpy(),
-                               to[m["matched_stride"]].to_numpy() + DELAY / RATE, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(
+        m["matched_anchor_s"].to_numpy(), to[m["matched_stride"]].to_numpy() + DELAY / RATE, rtol=0, atol=1e-12
+    )
     np.testing.assert_allclose(m["onset_s"] - m["toe_off_s"], DELAY / RATE, atol=1e-12)
     assert (m["n_candidates"] == 26 - 5).all()
 
@@ -83,13 +85,15 @@ def test_match_leaves_out_too_short_strides(rng):
 
 
 def test_too_short_for_the_300_ms_onset():
-    table = pd.DataFrame({
-        "stride": [0, 1, 2, 3, 4],
-        "toe_off_s": [10.0] * 5,
-        "swing_s": [0.5, 0.55, 0.56, 0.3, 0.552],
-        "perturbed": [True, True, True, False, True],
-        "onset_s": [10.3, 10.3, 10.3, np.nan, 10.3046875],  # the last one flagged 4.7 ms late
-    })
+    table = pd.DataFrame(
+        {
+            "stride": [0, 1, 2, 3, 4],
+            "toe_off_s": [10.0] * 5,
+            "swing_s": [0.5, 0.55, 0.56, 0.3, 0.552],
+            "perturbed": [True, True, True, False, True],
+            "onset_s": [10.3, 10.3, 10.3, np.nan, 10.3046875],  # the last one flagged 4.7 ms late
+        }
+    )
     np.testing.assert_array_equal(too_short(table, 0.3, 0.25), [True, False, False, False, True])
     np.testing.assert_array_equal(too_short(table, None, 0.25), [True, False, False, False, True])
     late = table.assign(onset_s=[10.3, 10.3, 10.3, np.nan, 10.3])
@@ -101,8 +105,15 @@ def test_too_short_for_the_300_ms_onset():
 def test_null_pairs_match_each_unperturbed_stride_to_its_twin_never_itself_or_a_perturbed_one(rng):
     trial, twin = null_trial(rng)
     t = trial.angles["time_s"].to_numpy()
-    m = match_unperturbed(t, trial.angles[JOINT_COLS].to_numpy(), trial.strides, onset_after_toe_off_s=DELAY / RATE,
-                          span_s=(-0.125, 0.25), missing="drop", null_pairs=True)
+    m = match_unperturbed(
+        t,
+        trial.angles[JOINT_COLS].to_numpy(),
+        trial.strides,
+        onset_after_toe_off_s=DELAY / RATE,
+        span_s=(-0.125, 0.25),
+        missing="drop",
+        null_pairs=True,
+    )
     assert len(m) >= 12  # every stride but those whose window leaves the data
     assert not set(m["stride"]) & {4, 8} and not set(m["matched_stride"]) & {4, 8}
     for s, u in zip(m["stride"], m["matched_stride"]):

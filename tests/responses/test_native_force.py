@@ -62,5 +62,7 @@ def test_force_at_the_robot_rate_for_every_trial_or_none():
     rng = np.random.default_rng(20240612)
     _, with_native = native_inputs(rng)
     other, _ = twin_trial(rng, name="walk-2")
-    with pytest.raises(LoperInputError, match="walk-2: the force at the robot rate .* every trial of the onset or for none"):
+    with pytest.raises(
+        LoperInputError, match="walk-2: the force at the robot rate .* every trial of the onset or for none"
+    ):
         subject_onset_response([with_native, other.inputs()], 100, ResponseSettings(min_strides=4))

@@ -33,8 +33,10 @@ def test_null_pair_windows_of_twins_are_identical_and_pool_trials(rng):
     np.testing.assert_allclose(out["time_s"], window_times_s(0.125, 0.25, RATE))
     assert out["q_perturbed"].shape == (out["n_pairs"], out["time_s"].size, 4)
     # joint angles and cart agree; the pelvis angle carries 1 mrad per stride number (make_trial)
-    angles = [joint_angles(out[f"q_{w}"].reshape(-1, 4), out[f"pelvis_angle_{w}_rad"].reshape(-1))
-              for w in ("perturbed", "unperturbed")]
+    angles = [
+        joint_angles(out[f"q_{w}"].reshape(-1, 4), out[f"pelvis_angle_{w}_rad"].reshape(-1))
+        for w in ("perturbed", "unperturbed")
+    ]
     np.testing.assert_allclose(angles[0] - angles[1], 0.0, atol=1e-12)
     np.testing.assert_allclose(out["q_perturbed"][..., 0] - out["q_unperturbed"][..., 0], 0.0, atol=1e-12)
     dp = out["pelvis_angle_perturbed_rad"] - out["pelvis_angle_unperturbed_rad"]
@@ -58,8 +60,10 @@ def test_deviant_trials_against_the_median_of_the_others():
     dev = {"a": 0.010, "b": 0.012, "c": 0.011, "bad": 0.04, "empty": float("nan")}
     out = deviant_trials(dev)  # 0.04 > 3 x median(0.010, 0.012, 0.011) = 0.033
     assert list(out) == ["bad"]
-    assert out["bad"] == ("trial bad left out of the null pairs: its null pairs deviate by 0.04 rad (median RMS), "
-                          "3.64 times the other trials' 0.011 rad (limit 3 times)")
+    assert out["bad"] == (
+        "trial bad left out of the null pairs: its null pairs deviate by 0.04 rad (median RMS), "
+        "3.64 times the other trials' 0.011 rad (limit 3 times)"
+    )
     assert deviant_trials(dev, max_ratio=4.0) == {} and deviant_trials(dev, max_ratio=None) == {}
     assert list(deviant_trials({"good": 0.01, "bad": 0.05})) == ["bad"]  # two trials: only the larger can go
     assert deviant_trials({"only": 1.0}) == {}

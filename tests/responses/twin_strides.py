@@ -27,11 +27,14 @@ JOINT_COLS = [f"{j}_left_rad" for j in JOINTS]
 
 def swing_curve(tau):
     """Smooth joint angles (n, 3), rad, as a function of the time since toe-off (s)."""
-    return np.stack([
-        0.4 * np.sin(2 * np.pi * tau / 1.1 + 0.3),
-        0.6 * np.sin(2 * np.pi * tau / 0.9 + 1.0),
-        0.2 * np.sin(2 * np.pi * tau / 1.3 - 0.5),
-    ], axis=-1)
+    return np.stack(
+        [
+            0.4 * np.sin(2 * np.pi * tau / 1.1 + 0.3),
+            0.6 * np.sin(2 * np.pi * tau / 0.9 + 1.0),
+            0.2 * np.sin(2 * np.pi * tau / 1.3 - 0.5),
+        ],
+        axis=-1,
+    )
 
 
 def bump(tau):
@@ -50,8 +53,13 @@ class Trial:
     onset: dict  # perturbed stride -> onset frame
 
     def inputs(self) -> dict:
-        return {"name": self.name, "angles": self.angles, "strides": self.strides, "force": self.force,
-                "force_direction": self.direction}
+        return {
+            "name": self.name,
+            "angles": self.angles,
+            "strides": self.strides,
+            "force": self.force,
+            "force_direction": self.direction,
+        }
 
 
 def make_trial(name, stance, swing, offsets, perturbed, removed=(), lead=40, tail=60) -> Trial:
@@ -79,13 +87,22 @@ def make_trial(name, stance, swing, offsets, perturbed, removed=(), lead=40, tai
         onsets[s] = k0
     q = segment_coordinates(angles, pelvis, pelvis_x)
     direction = thigh_normal(q[:, 1])
-    table = pd.DataFrame({
-        "stride": np.arange(n_strides), "side": "left",
-        "heel_strike_s": t[hs[:-1]], "toe_off_s": t[to], "end_s": t[hs[1:]],
-        "duration_s": (hs[1:] - hs[:-1]) / RATE, "stance_s": stance / RATE, "swing_s": swing / RATE,
-        "perturbed": np.isfinite(onset_s), "onset_s": onset_s,
-        "removed": np.isin(np.arange(n_strides), list(removed)), "reason": "",
-    })
+    table = pd.DataFrame(
+        {
+            "stride": np.arange(n_strides),
+            "side": "left",
+            "heel_strike_s": t[hs[:-1]],
+            "toe_off_s": t[to],
+            "end_s": t[hs[1:]],
+            "duration_s": (hs[1:] - hs[:-1]) / RATE,
+            "stance_s": stance / RATE,
+            "swing_s": swing / RATE,
+            "perturbed": np.isfinite(onset_s),
+            "onset_s": onset_s,
+            "removed": np.isin(np.arange(n_strides), list(removed)),
+            "reason": "",
+        }
+    )
     frame_angles = pd.DataFrame({"time_s": t, "pelvis_x_m": pelvis_x, "pelvis_angle_rad": pelvis})
     for j, c in enumerate(JOINT_COLS):
         frame_angles[c] = angles[:, j]

@@ -1,4 +1,5 @@
-"""Device file steps: simulated logs written and read from disk, tables and figures, bad logs refused with nothing written."""
+"""Device file steps: simulated logs written and read from disk, tables and figures, bad logs refused with nothing
+written."""
 
 from __future__ import annotations
 

@@ -92,8 +92,9 @@ def test_known_point_load_through_the_step(tmp_path):
     offset = channels_for_load([0.5, -1.0, -40.0], centre, 0.0, centre, origin)  # an unloaded plate reading -40 N
     loaded = channels_for_load(load, point, free, centre, origin)
     ch = np.vstack([np.tile(offset, (60, 1)), np.tile(offset + loaded, (40, 1))])
-    c3d = write_plate_c3d(tmp_path / "load.c3d", np.linalg.solve(cal, ch.T).T, plate_type=4, cal=cal,
-                          origin_mm=origin, units=["V"] * 6)
+    c3d = write_plate_c3d(
+        tmp_path / "load.c3d", np.linalg.solve(cal, ch.T).T, plate_type=4, cal=cal, origin_mm=origin, units=["V"] * 6
+    )
     table = grf(c3d, tmp_path / "load.grf.mot", rotation_deg=(0, 0, 0))
     cols = external_loads_columns(1)
     got = table[cols].to_numpy()

@@ -23,9 +23,14 @@ def trial(tmp_path_factory):
     model = build_lower_body_model(1.73, 64.9)
     t = np.arange(256) / FS
     w = 2 * np.pi * 0.6
-    truth = {"pelvis_tx": 0.02 * np.sin(2 * w * t), "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
-             "pelvis_tilt": 0.05 * np.sin(w * t), "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
-             "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1), "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2)}
+    truth = {
+        "pelvis_tx": 0.02 * np.sin(2 * w * t),
+        "pelvis_ty": 0.93 + 0.01 * np.sin(2 * w * t),
+        "pelvis_tilt": 0.05 * np.sin(w * t),
+        "hip_flexion_l": 0.1 + 0.3 * np.sin(w * t),
+        "knee_flexion_l": 0.6 + 0.5 * np.sin(w * t + 1),
+        "ankle_dorsiflexion_l": 0.1 * np.sin(w * t + 2),
+    }
     trc = write_trc(tmp / "trial.trc", t, marker_positions(model, truth), list(MARKERS))
     return write_model(model, tmp / "model.osim"), trc, truth
 

@@ -33,8 +33,11 @@ def _write(table: pd.DataFrame, path):
 
 def test_subject_figures_write_both_pngs_and_return_peaks(tmp_path):
     """300 ms is missing (an empty file); 175 ms was not fitted (a header-only curve table)."""
-    responses = [_write(response_table(1.0), tmp_path / "r50.tsv"), _write(response_table(2.0), tmp_path / "r175.tsv"),
-                 tmp_path / "r300.tsv"]
+    responses = [
+        _write(response_table(1.0), tmp_path / "r50.tsv"),
+        _write(response_table(2.0), tmp_path / "r175.tsv"),
+        tmp_path / "r300.tsv",
+    ]
     responses[2].write_text("")
     curves = [_write(curves_table(), tmp_path / "c50.tsv"), tmp_path / "c175.tsv", tmp_path / "c300.tsv"]
     curves[1].write_text("time_s\n")

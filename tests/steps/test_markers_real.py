@@ -77,8 +77,14 @@ def test_walking5_through_the_default_chain_keeps_long_gaps_missing(tmp_path):
     trial (the subject walks into and out of the volume), so nothing is filled and every gap stays NaN in the
     TRC; the reports count them."""
     raw = read_c3d(WALKING5).markers_m
-    gaps = markers(WALKING5, tmp_path / "w5.trc", tmp_path / "w5.gaps.tsv", cutoff_hz=6.0, max_gap_frames=10,
-                   summary_out=tmp_path / "w5.markers.tsv")
+    gaps = markers(
+        WALKING5,
+        tmp_path / "w5.trc",
+        tmp_path / "w5.gaps.tsv",
+        cutoff_hz=6.0,
+        max_gap_frames=10,
+        summary_out=tmp_path / "w5.markers.tsv",
+    )
     _, X, labels = read_markers(tmp_path / "w5.trc")
     missing_raw = np.isnan(raw).any(axis=2)
     expected_rows, expected_filled = [], np.zeros_like(missing_raw)
@@ -86,7 +92,7 @@ def test_walking5_through_the_default_chain_keeps_long_gaps_missing(tmp_path):
         for a, b in _runs(missing_raw[:, j]):
             if a > 0 and b < len(raw) - 1 and b - a + 1 <= 10:
                 expected_rows.append({"marker": label, "first_frame": a, "last_frame": b, "n_frames": b - a + 1})
-                expected_filled[a:b + 1, j] = True
+                expected_filled[a : b + 1, j] = True
     assert len(expected_rows) == 0
     assert gaps.to_dict("records") == expected_rows
     written = pd.read_csv(tmp_path / "w5.gaps.tsv", sep="\t")
@@ -123,8 +129,14 @@ def prefixed(tmp_path):
 
 
 def test_prefixes_and_label_map_name_the_trc_columns_and_gaps(prefixed, tmp_path):
-    gaps = markers(prefixed, tmp_path / "p.trc", rotation_deg=(0, 0, 0), cutoff_hz=0,
-                   label_map={"LASIS": "LASI", "Anna:RASIS": "RASI"}, required_markers=["LASI", "RASI", "LHEE"])
+    gaps = markers(
+        prefixed,
+        tmp_path / "p.trc",
+        rotation_deg=(0, 0, 0),
+        cutoff_hz=0,
+        label_map={"LASIS": "LASI", "Anna:RASIS": "RASI"},
+        required_markers=["LASI", "RASI", "LHEE"],
+    )
     _, X, labels = read_markers(tmp_path / "p.trc")
     assert labels == ["LASI", "RASI", "LHEE"]
     assert gaps.to_dict("records") == [{"marker": "RASI", "first_frame": 20, "last_frame": 22, "n_frames": 3}]
@@ -133,7 +145,9 @@ def test_prefixes_and_label_map_name_the_trc_columns_and_gaps(prefixed, tmp_path
     np.testing.assert_allclose(X[[10, 59]], raw[[10, 59]], rtol=0, atol=1e-12)
     per_marker = pd.DataFrame(gaps.attrs["per_marker"])
     assert per_marker[["n_filled_frames", "n_missing_frames", "longest_gap_frames"]].values.tolist() == [
-        [0, 4, 4], [3, 0, 0], [0, 12, 12]
+        [0, 4, 4],
+        [3, 0, 0],
+        [0, 12, 12],
     ]
 
 
@@ -172,16 +186,25 @@ def bts(tmp_path):
     return path
 
 
-@pytest.mark.parametrize("label_map, names", [
-    (None, BTS_LABELS),
-    ({"r heel": "RHEE", "l heel": "LHEE"}, ["RHEE", "LHEE", "r toe tip", "sacrum"]),
-])
+@pytest.mark.parametrize(
+    "label_map, names",
+    [
+        (None, BTS_LABELS),
+        ({"r heel": "RHEE", "l heel": "LHEE"}, ["RHEE", "LHEE", "r toe tip", "sacrum"]),
+    ],
+)
 def test_labels_with_spaces_through_the_markers_step(bts, tmp_path, label_map, names):
     """Labels with spaces are read, mapped (a key with spaces) or kept, and written to a TRC that our reader and
     OpenSim's read back to the same labels and the C3D's numbers."""
     assert read_c3d(bts).marker_labels == BTS_LABELS
-    markers(bts, tmp_path / "bts.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, label_map=label_map,
-            required_markers=[n for n in names if " " not in n])
+    markers(
+        bts,
+        tmp_path / "bts.trc",
+        rotation_deg=(0, 0, 0),
+        cutoff_hz=None,
+        label_map=label_map,
+        required_markers=[n for n in names if " " not in n],
+    )
     t, X, labels = read_markers(tmp_path / "bts.trc")
     assert labels == names
     np.testing.assert_allclose(t, np.arange(60) / 100.0, rtol=0, atol=1e-12)
@@ -196,8 +219,11 @@ def test_labels_with_spaces_through_the_markers_step(bts, tmp_path, label_map, n
 
 def test_a_label_map_value_with_a_space_is_refused_naming_the_rule(bts, tmp_path):
     """OpenSim refuses whitespace in a model marker's name, so a map value cannot hold one."""
-    with pytest.raises(LoperInputError, match=r"bts\.c3d: markers\.label_map: 'r heel' maps to 'R HEE', not a "
-                                              r"marker name \(non-empty, no spaces: OpenSim refuses whitespace"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"bts\.c3d: markers\.label_map: 'r heel' maps to 'R HEE', not a "
+        r"marker name \(non-empty, no spaces: OpenSim refuses whitespace",
+    ):
         markers(bts, tmp_path / "bts.trc", label_map={"r heel": "R HEE"})
     assert not (tmp_path / "bts.trc").exists()
 
@@ -208,25 +234,42 @@ def test_label_maps_merge_in_order_and_a_static_only_label_needs_no_entry_elsewh
     X = np.random.default_rng(12).uniform(-1, 1, size=(20, 4, 3))
     write_c3d(static, ["Anna:LASIS", "Anna:RASIS", "Anna:LHEE", "Anna:L_MED_KNEE"], X, 100.0)
     every, static_only = {"LASIS": "LASI", "RASIS": "RASI"}, {"L_MED_KNEE": "LKNM", "RASIS": "RASI_static"}
-    markers(static, tmp_path / "s.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every, static_only],
-            summary_out=tmp_path / "s.markers.tsv")
+    markers(
+        static,
+        tmp_path / "s.trc",
+        rotation_deg=(0, 0, 0),
+        cutoff_hz=0,
+        label_map=[every, static_only],
+        summary_out=tmp_path / "s.markers.tsv",
+    )
     assert read_markers(tmp_path / "s.trc")[2] == ["LASI", "RASI_static", "LHEE", "LKNM"]  # the later map wins
     summary = pd.read_csv(tmp_path / "s.markers.tsv", sep="\t")
     assert summary["label"].tolist() == ["Anna:LASIS", "Anna:RASIS", "Anna:LHEE", "Anna:L_MED_KNEE"]
     markers(prefixed, tmp_path / "w.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every])
     assert read_markers(tmp_path / "w.trc")[2] == ["LASI", "RASI", "LHEE"]
-    with pytest.raises(LoperInputError, match=r"prefixed\.c3d: markers\.label_map: label\(s\) L_MED_KNEE not in the file"):
+    with pytest.raises(
+        LoperInputError, match=r"prefixed\.c3d: markers\.label_map: label\(s\) L_MED_KNEE not in the file"
+    ):
         markers(prefixed, tmp_path / "never.trc", label_map=[every, static_only])  # the static map on a walking trial
 
 
 def test_a_span_crops_the_trial_on_the_files_clock(prefixed, tmp_path):
-    markers(prefixed, tmp_path / "c.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, span_s=(0.1, 0.3),
-            summary_out=tmp_path / "c.markers.tsv")
+    markers(
+        prefixed,
+        tmp_path / "c.trc",
+        rotation_deg=(0, 0, 0),
+        cutoff_hz=0,
+        span_s=(0.1, 0.3),
+        summary_out=tmp_path / "c.markers.tsv",
+    )
     t, X, _ = read_markers(tmp_path / "c.trc")
     np.testing.assert_allclose(t, np.arange(10, 31) / 100.0, atol=1e-12)
     summary = pd.read_csv(tmp_path / "c.markers.tsv", sep="\t").iloc[0]
     assert (summary.n_frames, summary.first_time_s, summary.last_time_s) == (21, 0.1, 0.3)
-    with pytest.raises(LoperInputError, match=r"prefixed\.c3d: the trial's span 5 \.\. 6 s \(markers\.trial_spans_s\) "
-                                              r"holds no frame of the file \(0\.0000 \.\. 0\.5900 s\)"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"prefixed\.c3d: the trial's span 5 \.\. 6 s \(markers\.trial_spans_s\) "
+        r"holds no frame of the file \(0\.0000 \.\. 0\.5900 s\)",
+    ):
         markers(prefixed, tmp_path / "never.trc", span_s=(5.0, 6.0))
     assert not (tmp_path / "never.trc").exists()

@@ -78,8 +78,11 @@ def test_static_trial_without_a_measurement_marker_in_its_window_is_refused(mode
     Xg = X.copy()
     Xg[:, list(MARKERS).index("LKNE")] = np.nan
     gappy = _static_trc(tmp_path / "gappy.trc", t, Xg)
-    with pytest.raises(LoperInputError, match=r"gappy\.trc: marker\(s\) 'LKNE' missing in every frame of the scaling "
-                                              r"window 0\.0000 \.\. 0\.1484 s \(20 frames\)"):
+    with pytest.raises(
+        LoperInputError,
+        match=r"gappy\.trc: marker\(s\) 'LKNE' missing in every frame of the scaling "
+        r"window 0\.0000 \.\. 0\.1484 s \(20 frames\)",
+    ):
         scaled_model(model_file, gappy, tmp_path / "never.osim", 80.0)
     assert not (tmp_path / "never.osim").exists()
 

@@ -102,8 +102,10 @@ def write_trial(path, reversed_order: bool = False, y_up: bool = False, origin_s
     n_frames = round(DURATION_S * RATE)
     tm = np.arange(n_frames) / RATE
     t = np.arange(n_frames * RATIO) / (RATE * RATIO)
-    plates = [_platform(_corners(c, reversed_order), tuple(range(1 + 6 * k, 7 + 6 * k)), origin_sign)
-              for k, c in enumerate(CENTRES)]
+    plates = [
+        _platform(_corners(c, reversed_order), tuple(range(1 + 6 * k, 7 + 6 * k)), origin_sign)
+        for k, c in enumerate(CENTRES)
+    ]
     analogs = _analogs(plates, t)
     heels = _heels(tm)
     if y_up:  # the same plates and channels: only the lab's coordinates turn
@@ -111,8 +113,7 @@ def write_trial(path, reversed_order: bool = False, y_up: bool = False, origin_s
         heels = heels @ Q.T
     labels = [f"{q}{k}" for k in (1, 2) for q in ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
     units = ["N", "N", "N", "Nmm", "Nmm", "Nmm"] * 2
-    return write_c3d(path, ["LHEE", "RHEE"], heels, RATE, labels, analogs, units, RATE * RATIO,
-                     force_platforms=plates)
+    return write_c3d(path, ["LHEE", "RHEE"], heels, RATE, labels, analogs, units, RATE * RATIO, force_platforms=plates)
 
 
 @pytest.fixture(scope="module")
@@ -121,8 +122,7 @@ def files(tmp_path_factory):
     return {
         "z-up": write_trial(d / "zup.c3d"),
         "z-up reversed": write_trial(d / "zup_reversed.c3d", reversed_order=True),
-        "z-up reversed, ORIGIN negated": write_trial(d / "zup_reversed_neg.c3d", reversed_order=True,
-                                                     origin_sign=-1.0),
+        "z-up reversed, ORIGIN negated": write_trial(d / "zup_reversed_neg.c3d", reversed_order=True, origin_sign=-1.0),
         "y-up reversed": write_trial(d / "yup_reversed.c3d", reversed_order=True, y_up=True),
         "y-up": write_trial(d / "yup.c3d", y_up=True),
     }
@@ -151,8 +151,9 @@ def test_reversed_corners_give_the_known_load_and_the_usual_reading(files, tmp_p
         got = other[cols].to_numpy()[loaded]
         np.testing.assert_allclose(got[:, 0:3], force[loaded], rtol=0, atol=2e-3)  # N (float32 channels)
         np.testing.assert_allclose(got[:, 3:6], point[loaded], rtol=0, atol=2e-5)  # m
-        np.testing.assert_allclose(got[:, 6:9], np.column_stack([0 * free, 0 * free, free])[loaded], rtol=0,
-                                   atol=2e-3)  # N·m, about +z
+        np.testing.assert_allclose(
+            got[:, 6:9], np.column_stack([0 * free, 0 * free, free])[loaded], rtol=0, atol=2e-3
+        )  # N·m, about +z
         np.testing.assert_array_equal(other[cols].to_numpy()[~loaded][:, [0, 1, 2, 6, 7, 8]], 0.0)
     vl_usual, vl_other = plate_vertical_loads(files["z-up"], (0, 0, 0)), plate_vertical_loads(files[name], (0, 0, 0))
     np.testing.assert_allclose(vl_other.vertical_n, vl_usual.vertical_n, rtol=0, atol=1e-9)
@@ -169,8 +170,9 @@ def test_without_the_correction_ezc3d_puts_the_moment_below_the_sensor(files):
     wrong = np.asarray(raw["moment"], float)[:, i] / 1000.0
     expected_error = -2.0 * np.cross(usual.force_n[i], CENTRE_FROM_SENSOR)  # moved 2 x 40 mm the wrong way
     np.testing.assert_allclose(wrong - usual.moment_nm[i], expected_error, atol=1e-4)
-    np.testing.assert_allclose(read_force_platforms(files["z-up reversed"])[0].moment_nm[i], usual.moment_nm[i],
-                               atol=1e-9)
+    np.testing.assert_allclose(
+        read_force_platforms(files["z-up reversed"])[0].moment_nm[i], usual.moment_nm[i], atol=1e-9
+    )
 
 
 @pytest.mark.parametrize("name", ["y-up", "y-up reversed"])
@@ -201,14 +203,25 @@ def test_a_y_up_file_read_as_z_up_is_refused_naming_plate_up_and_setting(files, 
     assert "markers.lab_to_model_rotation_deg" in message
     assert not out.exists()
     with pytest.raises(LoperInputError, match=r"yup\.c3d \(force platform 1\): the plate does not face up"):
-        events(files["y-up"], tmp_path / "refused.events.tsv", foot_markers={"left": "LHEE", "right": "RHEE"},
-               rotation_deg=Z_UP_ROTATION)
+        events(
+            files["y-up"],
+            tmp_path / "refused.events.tsv",
+            foot_markers={"left": "LHEE", "right": "RHEE"},
+            rotation_deg=Z_UP_ROTATION,
+        )
 
 
 def _events(path, rotation_deg, tmp_path, name):
-    table = events(path, tmp_path / f"{name}.events.tsv", foot_markers={"left": "LHEE", "right": "RHEE"},
-                   plate_sides={"left": 1, "right": 2}, threshold_on_n=ON_N, threshold_off_n=OFF_N,
-                   rotation_deg=rotation_deg, contacts_out=tmp_path / f"{name}.contacts.tsv")
+    table = events(
+        path,
+        tmp_path / f"{name}.events.tsv",
+        foot_markers={"left": "LHEE", "right": "RHEE"},
+        plate_sides={"left": 1, "right": 2},
+        threshold_on_n=ON_N,
+        threshold_off_n=OFF_N,
+        rotation_deg=rotation_deg,
+        contacts_out=tmp_path / f"{name}.contacts.tsv",
+    )
     return table, pd.read_csv(tmp_path / f"{name}.contacts.tsv", sep="\t")
 
 
@@ -219,7 +232,11 @@ def test_events_from_reversed_and_y_up_plates_equal_the_usual_ones(files, tmp_pa
     rotation = (0.0, 0.0, 0.0) if name.startswith("y-up") else Z_UP_ROTATION
     other, other_contacts = _events(files[name], rotation, tmp_path, "other")
     assert usual[["side", "event"]].values.tolist() == [
-        ["left", "heel_strike"], ["right", "heel_strike"], ["left", "toe_off"], ["right", "toe_off"]]
+        ["left", "heel_strike"],
+        ["right", "heel_strike"],
+        ["left", "toe_off"],
+        ["right", "toe_off"],
+    ]
     pd.testing.assert_frame_equal(other, usual)
     assert other_contacts["flag"].tolist() == ["ok", "ok"] and other_contacts["side"].tolist() == ["left", "right"]
     heel = [c for c in other_contacts.columns if c.endswith("_m")]

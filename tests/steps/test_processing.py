@@ -35,8 +35,9 @@ def lab(tmp_path_factory):
     d = tmp_path_factory.mktemp("lab")
     write_recording(d / "static.c3d", subject_static_recording("S99", HEIGHT, MASS, 2.0, LAB, 7))
     osim_model = build_lower_body_model(HEIGHT, MASS)
-    walk = simulate_walking_trial(20.0, LAB, 3, HEIGHT, segment_parameters_from_model(osim_model), 0.03, 0.05,
-                                  DeviceParameters())
+    walk = simulate_walking_trial(
+        20.0, LAB, 3, HEIGHT, segment_parameters_from_model(osim_model), 0.03, 0.05, DeviceParameters()
+    )
     write_recording(d / "walk.c3d", walking_recording(osim_model, walk, MASS, LAB, 11))
     write_robot_log(d / "walk.loper.tsv", walk.robot, LAB.robot_rate_hz, {"clock": "robot"})
     coords, events = walk.mocap_coordinates(LAB.marker_rate_hz), walk.mocap_events()
@@ -50,10 +51,23 @@ def lab(tmp_path_factory):
     angles = ik.ik_join([d / "walk.0.mot", d / "walk.1.mot"], d / "walk.mot", d / "walk.angles.tsv")
     found = processing.events(d / "walk.c3d", d / "walk.events.tsv", {"left": "Fz_left", "right": "Fz_right"})
     force = processing.loadcell(d / "walk.c3d", d / "walk.loper.tsv", d / "walk.force.tsv")
-    strides = processing.strides(d / "walk.angles.tsv", d / "walk.events.tsv", d / "walk.strides.tsv",
-                                 d / "walk.cycles.tsv", d / "walk.force.tsv")
-    return {"dir": d, "coords": coords, "events": events, "gaps": gaps, "angles": angles, "found": found,
-            "force": force, "strides": strides}
+    strides = processing.strides(
+        d / "walk.angles.tsv",
+        d / "walk.events.tsv",
+        d / "walk.strides.tsv",
+        d / "walk.cycles.tsv",
+        d / "walk.force.tsv",
+    )
+    return {
+        "dir": d,
+        "coords": coords,
+        "events": events,
+        "gaps": gaps,
+        "angles": angles,
+        "found": found,
+        "force": force,
+        "strides": strides,
+    }
 
 
 def test_gaps_written_by_the_lab_are_filled(lab):
@@ -83,8 +97,8 @@ def test_one_job_ik_equals_two_joined_chunks(lab):
     diff = np.abs(whole.drop(columns="time_s").to_numpy() - lab["angles"].drop(columns="time_s").to_numpy())
     seam = len(whole) // 2  # chunk_frames splits 2560 frames at 1280
     assert diff[:seam].max() < 1e-12
-    assert diff[seam:seam + 2].max() < 5e-5
-    assert diff[seam + 2:].max() < 1e-6
+    assert diff[seam : seam + 2].max() < 5e-5
+    assert diff[seam + 2 :].max() < 1e-6
     assert (d / "whole.mot").stat().st_size > 0
 
 
@@ -125,9 +139,12 @@ def test_strides_and_outliers(lab):
 def test_model_marker_missing_from_the_trial_is_named(lab, tmp_path):
     t, X, labels = read_markers(lab["dir"] / "walk.trc")
     i = labels.index("LKNE")
-    write_trc(tmp_path / "cut.trc", t, np.delete(X, i, axis=1), labels[:i] + labels[i + 1:])
-    with pytest.raises(LoperInputError, match=r"cut\.trc with .*scaled\.osim: marker\(s\) \['LKNE'\] of the model's "
-                                              r"marker set are missing"):
+    write_trc(tmp_path / "cut.trc", t, np.delete(X, i, axis=1), labels[:i] + labels[i + 1 :])
+    with pytest.raises(
+        LoperInputError,
+        match=r"cut\.trc with .*scaled\.osim: marker\(s\) \['LKNE'\] of the model's "
+        r"marker set are missing",
+    ):
         ik.ik_chunk(lab["dir"] / "scaled.osim", tmp_path / "cut.trc", tmp_path / "x.mot", 0, 1)
     assert not (tmp_path / "x.mot").exists()
 
@@ -145,8 +162,9 @@ def test_stride_summary_flags_too_few_strides(lab, tmp_path):
     few.loc[3:, "removed"] = True
     few.loc[3:, "reason"] = "knee: 30.0 % of samples outside 1.5·IQR"
     few.to_csv(tmp_path / "few.strides.tsv", sep="\t", index=False)
-    out = processing.strides_summary([("S99", "walk"), ("S99", "few")], [walk, tmp_path / "few.strides.tsv"],
-                                     tmp_path / "summary.tsv", min_valid=5)
+    out = processing.strides_summary(
+        [("S99", "walk"), ("S99", "few")], [walk, tmp_path / "few.strides.tsv"], tmp_path / "summary.tsv", min_valid=5
+    )
     ok, flagged = out.iloc[0], out.iloc[1]
     assert ok.status == "ok" and ok.n_strides == len(table) and ok.n_kept == (~table.removed).sum()
     assert ok.n_perturbed == 0
@@ -163,8 +181,9 @@ def test_fewer_than_five_valid_strides_warn(lab, tmp_path):
     short = events[events.time_s <= hs[4] + 1e-9]
     short.to_csv(tmp_path / "short.events.tsv", sep="\t", index=False)
     with pytest.warns(TooFewStridesWarning, match="4"):
-        tables = processing.strides(d / "walk.angles.tsv", tmp_path / "short.events.tsv",
-                                    tmp_path / "s.strides.tsv", tmp_path / "s.cycles.tsv")
+        tables = processing.strides(
+            d / "walk.angles.tsv", tmp_path / "short.events.tsv", tmp_path / "s.strides.tsv", tmp_path / "s.cycles.tsv"
+        )
     assert len(tables.strides) == 4 and tables.too_few_strides
 
 
@@ -172,8 +191,16 @@ def test_transparency_of_a_trial_against_itself(lab, tmp_path):
     """The same trial as both conditions: RMSD 0 everywhere, so transparent; tables and figure written."""
     d = lab["dir"]
     strides, cycles = [d / "walk.strides.tsv"] * 2, [d / "walk.cycles.tsv"] * 2
-    out = transparency.transparency(["S98", "S99"], strides, cycles, strides, cycles, tmp_path / "rmsd.tsv",
-                                    tmp_path / "force.tsv", tmp_path / "t.png")
+    out = transparency.transparency(
+        ["S98", "S99"],
+        strides,
+        cycles,
+        strides,
+        cycles,
+        tmp_path / "rmsd.tsv",
+        tmp_path / "force.tsv",
+        tmp_path / "t.png",
+    )
     rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
     assert len(rmsd) == 3 * 2 * 3  # (2 subjects + all) x 2 phases x 3 joints
     np.testing.assert_allclose(rmsd["rmsd_rad"], 0.0, atol=1e-12)
@@ -193,8 +220,13 @@ def test_fewer_strides_than_the_outlier_rule_needs_are_kept_unjudged_and_flagged
     hs = events[(events.side == "left") & (events.event == "heel_strike")].time_s.to_numpy()
     events[events.time_s <= hs[n_strides] + 1e-9].to_csv(tmp_path / "short.events.tsv", sep="\t", index=False)
     with pytest.warns(TooFewStridesWarning) as caught:
-        tables = processing.strides(d / "walk.angles.tsv", tmp_path / "short.events.tsv", tmp_path / "s.strides.tsv",
-                                    tmp_path / "s.cycles.tsv", d / "walk.force.tsv")
+        tables = processing.strides(
+            d / "walk.angles.tsv",
+            tmp_path / "short.events.tsv",
+            tmp_path / "s.strides.tsv",
+            tmp_path / "s.cycles.tsv",
+            d / "walk.force.tsv",
+        )
     messages = [str(w.message) for w in caught]
     assert f"{n_strides} complete unperturbed left stride(s)" in messages[0] and "needs at least 4" in messages[0]
     assert f"only {n_strides} valid stride(s), fewer than the 5 required" in messages[1]
@@ -219,8 +251,16 @@ def test_transparency_leaves_out_a_subject_with_too_few_strides(lab, tmp_path):
     few.to_csv(tmp_path / "few.strides.tsv", sep="\t", index=False)
     walk, cycles = d / "walk.strides.tsv", d / "walk.cycles.tsv"
     with pytest.warns(TooFewStridesWarning, match="subject S98: .* and 3 with the device, fewer than 5"):
-        transparency.transparency(["S98", "S99"], [walk, walk], [cycles, cycles], [tmp_path / "few.strides.tsv", walk],
-                                  [cycles, cycles], tmp_path / "rmsd.tsv", tmp_path / "force.tsv", tmp_path / "t.png")
+        transparency.transparency(
+            ["S98", "S99"],
+            [walk, walk],
+            [cycles, cycles],
+            [tmp_path / "few.strides.tsv", walk],
+            [cycles, cycles],
+            tmp_path / "rmsd.tsv",
+            tmp_path / "force.tsv",
+            tmp_path / "t.png",
+        )
     rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
     n = int((~strides.removed).sum())
     assert rmsd.subject.tolist() == ["S98"] * 6 + ["S99"] * 6 + ["all"] * 6
@@ -233,8 +273,9 @@ def test_transparency_leaves_out_a_subject_with_too_few_strides(lab, tmp_path):
     force = pd.read_csv(tmp_path / "force.tsv", sep="\t")
     assert force.subject.tolist() == ["S98", "S98", "S99", "S99", "all", "all"]
     assert force.loc[force.subject == "S98", "rms_force_mean_n"].isna().all()
-    np.testing.assert_allclose(force.loc[force.subject == "all", "rms_force_mean_n"],
-                               force.loc[force.subject == "S99", "rms_force_mean_n"])
+    np.testing.assert_allclose(
+        force.loc[force.subject == "all", "rms_force_mean_n"], force.loc[force.subject == "S99", "rms_force_mean_n"]
+    )
 
 
 def test_transparency_without_any_subject_left_writes_empty_group_rows(lab, tmp_path):
@@ -242,9 +283,16 @@ def test_transparency_without_any_subject_left_writes_empty_group_rows(lab, tmp_
     strides = pd.read_csv(d / "walk.strides.tsv", sep="\t")
     strides.iloc[:1].to_csv(tmp_path / "one.strides.tsv", sep="\t", index=False)
     with pytest.warns(TooFewStridesWarning, match="and 1 with the device, fewer than 5"):
-        transparency.transparency(["S98"], [d / "walk.strides.tsv"], [d / "walk.cycles.tsv"],
-                                  [tmp_path / "one.strides.tsv"], [d / "walk.cycles.tsv"], tmp_path / "rmsd.tsv",
-                                  tmp_path / "force.tsv", tmp_path / "t.png")
+        transparency.transparency(
+            ["S98"],
+            [d / "walk.strides.tsv"],
+            [d / "walk.cycles.tsv"],
+            [tmp_path / "one.strides.tsv"],
+            [d / "walk.cycles.tsv"],
+            tmp_path / "rmsd.tsv",
+            tmp_path / "force.tsv",
+            tmp_path / "t.png",
+        )
     rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
     assert rmsd.subject.tolist() == ["S98"] * 6 + ["all"] * 6
     assert (rmsd.loc[rmsd.subject == "all", ["n_strides_no_device", "n_strides_device"]] == 0).all().all()
@@ -259,11 +307,19 @@ def test_events_and_loadcell_from_one_reading_write_the_bytes_of_the_two_steps(l
     d = lab["dir"]
     grf = {"left": "Fz_left", "right": "Fz_right"}
     processing.events(d / "walk.c3d", tmp_path / "alone.events.tsv", grf, contacts_out=tmp_path / "alone.contacts.tsv")
-    processing.loadcell(d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "alone.force.tsv",
-                        native_out=tmp_path / "alone.native.tsv")
+    processing.loadcell(
+        d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "alone.force.tsv", native_out=tmp_path / "alone.native.tsv"
+    )
     table, force = processing.events_loadcell(
-        d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "one.events.tsv", tmp_path / "one.contacts.tsv",
-        tmp_path / "one.force.tsv", tmp_path / "one.native.tsv", {"grf_channels": grf}, {"cutoff_hz": 40.0})
+        d / "walk.c3d",
+        d / "walk.loper.tsv",
+        tmp_path / "one.events.tsv",
+        tmp_path / "one.contacts.tsv",
+        tmp_path / "one.force.tsv",
+        tmp_path / "one.native.tsv",
+        {"grf_channels": grf},
+        {"cutoff_hz": 40.0},
+    )
     for kind in ("events", "contacts", "force", "native"):
         assert (tmp_path / f"one.{kind}.tsv").read_bytes() == (tmp_path / f"alone.{kind}.tsv").read_bytes(), kind
     assert len(table) == len(lab["found"]) and len(force) == len(lab["force"])
@@ -272,8 +328,9 @@ def test_events_and_loadcell_from_one_reading_write_the_bytes_of_the_two_steps(l
 def test_events_and_loadcell_refuse_an_unknown_setting(lab, tmp_path):
     d = lab["dir"]
     with pytest.raises(TypeError, match=r"events: unknown setting\(s\) \['treshold_on_n'\]"):
-        processing.events_loadcell(d / "walk.c3d", d / "walk.loper.tsv", *(tmp_path / f"x.{k}" for k in "abcd"),
-                                   {"treshold_on_n": 50.0})
+        processing.events_loadcell(
+            d / "walk.c3d", d / "walk.loper.tsv", *(tmp_path / f"x.{k}" for k in "abcd"), {"treshold_on_n": 50.0}
+        )
     assert not list(tmp_path.iterdir())  # nothing written
 
 
@@ -288,6 +345,13 @@ def test_events_and_loadcell_write_nothing_when_the_robot_log_is_bad(lab, tmp_pa
     bad.write_text("".join(lines))
     out = tmp_path / "out"
     with pytest.raises(LoperInputError, match=r"bad\.loper\.tsv: column 'force_measured_n', sample 20 .*non-finite"):
-        processing.events_loadcell(d / "walk.c3d", bad, out / "e.tsv", out / "c.tsv", out / "f.tsv", out / "n.tsv",
-                                   {"grf_channels": {"left": "Fz_left", "right": "Fz_right"}})
+        processing.events_loadcell(
+            d / "walk.c3d",
+            bad,
+            out / "e.tsv",
+            out / "c.tsv",
+            out / "f.tsv",
+            out / "n.tsv",
+            {"grf_channels": {"left": "Fz_left", "right": "Fz_right"}},
+        )
     assert not out.exists()  # the events were found, but nothing is written unless both steps succeed

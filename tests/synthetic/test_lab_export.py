@@ -49,24 +49,39 @@ def gait2392_model():
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
     out = tmp_path_factory.mktemp("qtm")
-    truth = lab_export_session(out, "S01", GAIT2392 / "gait2392_simbody.osim",
-                               GAIT2392 / "gait2392_Scale_MarkerSet.xml", GAIT2392 / "qtm_label_map.tsv",
-                               ["walk-device", "pert050-1"], [None, 50], "walk-nodevice", 1.75, 70.0, 8.0, seed=11)
+    truth = lab_export_session(
+        out,
+        "S01",
+        GAIT2392 / "gait2392_simbody.osim",
+        GAIT2392 / "gait2392_Scale_MarkerSet.xml",
+        GAIT2392 / "qtm_label_map.tsv",
+        ["walk-device", "pert050-1"],
+        [None, 50],
+        "walk-nodevice",
+        1.75,
+        70.0,
+        8.0,
+        seed=11,
+    )
     return out, truth
 
 
 def test_session_files_and_labels(session):
     out, truth = session
-    assert sorted(p.name for p in out.iterdir()) == ["pert050-1.c3d", "pert050-1.mat", "static.c3d",
-                                                     "walk-device.c3d", "walk-device.mat"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        "pert050-1.c3d",
+        "pert050-1.mat",
+        "static.c3d",
+        "walk-device.c3d",
+        "walk-device.mat",
+    ]
     rec = read_c3d(out / "walk-device.c3d")
     labels = pd.read_csv(GAIT2392 / "qtm_label_map.tsv", sep="\t")
     assert rec.marker_labels == [f"Subject:{lab}" for lab in labels["label"]] + ["Subject:LBRA_P", "Subject:LBRA_D"]
     assert rec.first_frame == FIRST_FRAME and rec.time_s[0] == FIRST_FRAME / 128.0 == 7.8125
     assert rec.markers_m.shape == (8 * 128, 41, 3)
     for k in (1, 2):
-        assert [f"FP{k}_{q}" for q in ("FX", "FY", "FZ", "MX", "MY", "MZ")] == \
-            rec.analog_labels[12 * k - 6:12 * k]
+        assert [f"FP{k}_{q}" for q in ("FX", "FY", "FZ", "MX", "MY", "MZ")] == rec.analog_labels[12 * k - 6 : 12 * k]
     assert rec.analog_units[rec.analog_labels.index("FP1_FZ")] == "V"
     # the decoy reads volts, nowhere near the newtons on the belt
     assert np.abs(rec.analog("FP1_FZ")).max() < 10.0 < truth["walk-device"][1].force_n["left"][:, 2].max()
@@ -89,7 +104,8 @@ def test_plates_carry_the_synthetic_force_above_the_resting_load(session, tmp_pa
         np.testing.assert_allclose(force, exported.force_n[side], rtol=0, atol=1e-3)  # N, after calibration
         stance = ~np.isnan(exported.cop_m[side][:, 0])
         assert np.median(plates[f"force{i}"][~stance, 2]) == pytest.approx(
-            exported.resting_force_n[side][2], abs=1.0)  # swing: the plate reads its resting load (not zeroed)
+            exported.resting_force_n[side][2], abs=1.0
+        )  # swing: the plate reads its resting load (not zeroed)
         moment = plates[f"moment{i}"] / 1000.0 - exported.resting_moment_nm[side]  # N·mm -> N·m, about the centre
         centre = np.mean(exported.force_platforms[i].corners_m, axis=0)
         cop = centre[:2] + np.column_stack([-moment[:, 1], moment[:, 0]]) / force[:, 2:3]
@@ -162,24 +178,55 @@ def test_gait2392_coordinate_signs_match_our_model():
     """Each mapped coordinate moves the same segment the same way in both models (OpenSim body kinematics)."""
     ours = build_lower_body_model(1.75, 70.0)
     g = gait2392_model()
-    pairs = {"L.Knee.Lat": "LKNE", "L.Ankle.Lat": "LANK", "L.Toe.Tip": "LMT1", "R.Ankle.Lat": "RANK",
-             "R.Toe.Tip": "RMT1", "L.ASIS": "LASI"}
+    pairs = {
+        "L.Knee.Lat": "LKNE",
+        "L.Ankle.Lat": "LANK",
+        "L.Toe.Tip": "LMT1",
+        "R.Ankle.Lat": "RANK",
+        "R.Toe.Tip": "RMT1",
+        "L.ASIS": "LASI",
+    }
     for g_name, (our_name, sign) in GAIT2392_COORDINATES.items():
         if g_name in ("pelvis_tx", "pelvis_ty"):
             continue
-        g_marker = {"pelvis_tilt": "L.Knee.Lat", "hip_flexion": "L.Ankle.Lat", "knee_angle": "L.Ankle.Lat",
-                    "ankle_angle": "L.Toe.Tip"}[g_name.rsplit("_", 1)[0] if g_name != "pelvis_tilt" else g_name]
+        g_marker = {
+            "pelvis_tilt": "L.Knee.Lat",
+            "hip_flexion": "L.Ankle.Lat",
+            "knee_angle": "L.Ankle.Lat",
+            "ankle_angle": "L.Toe.Tip",
+        }[g_name.rsplit("_", 1)[0] if g_name != "pelvis_tilt" else g_name]
         if g_name.endswith("_r"):
             g_marker = "R" + g_marker[1:]
         delta = []
-        for model, coordinate, value, marker in ((g, g_name, sign * 0.2, g_marker), (ours, our_name, 0.2, pairs[g_marker])):
+        for model, coordinate, value, marker in (
+            (g, g_name, sign * 0.2, g_marker),
+            (ours, our_name, 0.2, pairs[g_marker]),
+        ):
             moved = marker_positions(model, {coordinate: value}, [marker]) - marker_positions(model, {}, [marker])
             delta.append(moved[0, 0, :2])  # sagittal plane (x forward, y up)
         cosine = delta[0] @ delta[1] / np.linalg.norm(delta[0]) / np.linalg.norm(delta[1])
         assert cosine > 0.95, (g_name, delta)
-    frame = gait2392_coordinates(pd.DataFrame({c: [0.1 * k] for k, c in enumerate(
-        ("pelvis_tilt", "pelvis_tx", "pelvis_ty", "hip_flexion_r", "knee_flexion_r", "ankle_dorsiflexion_r",
-         "hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"))}), pelvis_ty_offset_m=0.5)
+    frame = gait2392_coordinates(
+        pd.DataFrame(
+            {
+                c: [0.1 * k]
+                for k, c in enumerate(
+                    (
+                        "pelvis_tilt",
+                        "pelvis_tx",
+                        "pelvis_ty",
+                        "hip_flexion_r",
+                        "knee_flexion_r",
+                        "ankle_dorsiflexion_r",
+                        "hip_flexion_l",
+                        "knee_flexion_l",
+                        "ankle_dorsiflexion_l",
+                    )
+                )
+            }
+        ),
+        pelvis_ty_offset_m=0.5,
+    )
     assert frame["knee_angle_l"][0] == pytest.approx(-0.7) and frame["pelvis_ty"][0] == pytest.approx(0.7)
 
 

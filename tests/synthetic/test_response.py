@@ -1,4 +1,5 @@
-"""Perturbation responses of the synthetic lab: schedule, pulses, size and timing like the study's, and the truth comes back."""
+"""Perturbation responses of the synthetic lab: schedule, pulses, size and timing like the study's, and the truth comes
+back."""
 
 from __future__ import annotations
 
@@ -32,16 +33,27 @@ def params():
 
 @pytest.fixture(scope="module")
 def trial(params):
-    return simulate_walking_trial(40.0, LAB, 5, 1.73, params, 0.03, 0.05, DeviceParameters(),
-                                  PerturbationSettings(onset_s=0.05, impedance=IMPEDANCE))
+    return simulate_walking_trial(
+        40.0,
+        LAB,
+        5,
+        1.73,
+        params,
+        0.03,
+        0.05,
+        DeviceParameters(),
+        PerturbationSettings(onset_s=0.05, impedance=IMPEDANCE),
+    )
 
 
 def test_schedule_every_three_to_five_strides():
     hs = np.arange(0.0, 60.0, 1.6)
-    events = pd.concat([
-        pd.DataFrame({"side": "left", "event": "heel_strike", "time_s": hs}),
-        pd.DataFrame({"side": "left", "event": "toe_off", "time_s": hs + 1.0}),
-    ])
+    events = pd.concat(
+        [
+            pd.DataFrame({"side": "left", "event": "heel_strike", "time_s": hs}),
+            pd.DataFrame({"side": "left", "event": "toe_off", "time_s": hs + 1.0}),
+        ]
+    )
     sched = perturbation_schedule(events, 0.175, np.random.default_rng(1), 0.5, 59.5)
     gaps = np.diff(np.round((sched.toe_off_s.to_numpy() - 1.0) / 1.6))
     assert len(sched) >= 8 and set(gaps) <= {3, 4, 5} and len(set(gaps)) > 1
@@ -71,13 +83,16 @@ def test_responses_look_like_the_study(trial):
     t = fine.time_s.to_numpy()
     assert len(trial.schedule) >= 5
     assert trial.robot.perturbation.sum() / LAB.robot_rate_hz == pytest.approx(0.1 * len(trial.schedule), rel=0.02)
-    free = simulate_walking_trial(40.0, LAB, 5, 1.73, segment_parameters_from_model(build_lower_body_model(1.73, 64.9)),
-                                  0.03, 0.05, None, None).fine
+    free = simulate_walking_trial(
+        40.0, LAB, 5, 1.73, segment_parameters_from_model(build_lower_body_model(1.73, 64.9)), 0.03, 0.05, None, None
+    ).fine
     peaks = []
     for row in trial.schedule.itertuples():
         sel = (t >= row.onset_s) & (t <= row.onset_s + 0.4)
-        d = (fine.loc[sel, ["hip_flexion_l", "knee_flexion_l"]].to_numpy()
-             - free.loc[sel, ["hip_flexion_l", "knee_flexion_l"]].to_numpy())
+        d = (
+            fine.loc[sel, ["hip_flexion_l", "knee_flexion_l"]].to_numpy()
+            - free.loc[sel, ["hip_flexion_l", "knee_flexion_l"]].to_numpy()
+        )
         i = np.abs(d).argmax(axis=0)
         peaks.append([d[i[0], 0], d[i[1], 1], t[sel][i[0]] - row.onset_s, t[sel][i[1]] - row.onset_s])
     hip, knee, t_hip, t_knee = np.mean(peaks, axis=0)
@@ -112,10 +127,16 @@ def test_identification_recovers_the_truth_from_the_simulated_swing(trial, param
     fp = np.interp(tr, trial.robot.time_s, trial.robot.force_measured_n)
     fu = np.interp(tr, free.robot.time_s, free.robot.force_measured_n)
     window = prepare_window(
-        t[sel], qu, qp, params, row.onset_s,
-        force_unperturbed_n=fu[:, None] * thigh_normal(qu[:, 1]), force_perturbed_n=fp[:, None] * thigh_normal(qp[:, 1]),
+        t[sel],
+        qu,
+        qp,
+        params,
+        row.onset_s,
+        force_unperturbed_n=fu[:, None] * thigh_normal(qu[:, 1]),
+        force_perturbed_n=fp[:, None] * thigh_normal(qp[:, 1]),
         pelvis_angle_unperturbed_rad=-free.fine.loc[sel, "pelvis_tilt"].to_numpy(),
-        pelvis_angle_perturbed_rad=-trial.fine.loc[sel, "pelvis_tilt"].to_numpy(), n_substeps=4,
+        pelvis_angle_perturbed_rad=-trial.fine.loc[sel, "pelvis_tilt"].to_numpy(),
+        n_substeps=4,
     )
     fit = identify_impedance(window, n_starts=10, seed=0)
     est = dict(zip(("K_hip", "D_hip", "K_knee", "D_knee"), fit.estimate[:4]))

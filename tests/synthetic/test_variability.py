@@ -35,8 +35,9 @@ GAIT = NominalGait()
 
 def _study_variability() -> GaitVariability:
     v = SYNTH["study_variability"]
-    return GaitVariability(v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"],
-                           v["knots_per_stride"])
+    return GaitVariability(
+        v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"], v["knots_per_stride"]
+    )
 
 
 def _phases(coords, events):
@@ -46,8 +47,11 @@ def _phases(coords, events):
     ev = events[events["side"] == "left"]
     hs = ev.loc[ev["event"] == "heel_strike", "time_s"].to_numpy()
     to = ev.loc[ev["event"] == "toe_off", "time_s"].to_numpy()
-    spans = [(a, to[(to > a) & (to < b)][0], b) for a, b in zip(hs[:-1], hs[1:])
-             if ((to > a) & (to < b)).sum() == 1 and a >= t[0] and b <= t[-1]]
+    spans = [
+        (a, to[(to > a) & (to < b)][0], b)
+        for a, b in zip(hs[:-1], hs[1:])
+        if ((to > a) & (to < b)).sum() == 1 and a >= t[0] and b <= t[-1]
+    ]
     s = np.array(spans)
     return cut(t, v, s[:, 0], s[:, 1]), cut(t, v, s[:, 1], s[:, 2])
 
@@ -61,10 +65,14 @@ def test_smooth_noise_passes_through_its_drawn_knot_values():
     # C1: the slope just left and right of a knot agrees (no velocity step)
     h = 1e-7
     x = knots[3:-3]
-    left = (smooth_noise(x, first, last, n, sd, np.random.default_rng(9))
-            - smooth_noise(x - h, first, last, n, sd, np.random.default_rng(9))) / h
-    right = (smooth_noise(x + h, first, last, n, sd, np.random.default_rng(9))
-             - smooth_noise(x, first, last, n, sd, np.random.default_rng(9))) / h
+    left = (
+        smooth_noise(x, first, last, n, sd, np.random.default_rng(9))
+        - smooth_noise(x - h, first, last, n, sd, np.random.default_rng(9))
+    ) / h
+    right = (
+        smooth_noise(x + h, first, last, n, sd, np.random.default_rng(9))
+        - smooth_noise(x, first, last, n, sd, np.random.default_rng(9))
+    ) / h
     np.testing.assert_allclose(left, right, atol=1e-5)
     with pytest.raises(LoperInputError, match="outside the knots"):
         smooth_noise([10.0], first, last, n, sd, np.random.default_rng(9))
@@ -79,7 +87,9 @@ def test_device_adaptation_is_drawn_per_subject_in_its_range():
     change, offset, gain = (0.05, 0.14, 0.08), (0.009, 0.022, 0.008), (2.4, 1.0, 3.2)
     a = device_adaptation(7, "S01", change, offset, gain)
     assert a == device_adaptation(7, "S01", change, offset, gain)
-    assert a != device_adaptation(7, "S02", change, offset, gain) and a != device_adaptation(8, "S01", change, offset, gain)
+    assert a != device_adaptation(7, "S02", change, offset, gain) and a != device_adaptation(
+        8, "S01", change, offset, gain
+    )
     ratio_amp = np.abs(np.array(a.amplitude_factor) - 1.0) / change
     ratio_off = np.abs(a.offset_rad) / np.array(offset)
     assert np.all((ratio_amp >= 0.7) & (ratio_amp <= 1.3)) and np.all((ratio_off >= 0.7) & (ratio_off <= 1.3))
@@ -96,8 +106,9 @@ def test_adaptation_changes_the_curves_as_its_formula_says():
     zero = GaitVariability()
     rng = lambda: np.random.default_rng(4)  # noqa: E731
     base, _ = walking_kinematics(12.0, FS, GAIT, rng(), timing_cv=0.0, variability=zero, start_phase=0.1)
-    dev, _ = walking_kinematics(12.0, FS, GAIT, rng(), timing_cv=0.0, variability=zero, adaptation=adaptation,
-                                start_phase=0.1)
+    dev, _ = walking_kinematics(
+        12.0, FS, GAIT, rng(), timing_cv=0.0, variability=zero, adaptation=adaptation, start_phase=0.1
+    )
     phase = (0.1 + base["time_s"].to_numpy() / GAIT.stride_s) % 1.0  # the right leg's stride phase
     for j, joint in enumerate(CURVE_JOINTS):
         series = GAIT.joint_series(joint)
@@ -112,8 +123,9 @@ def test_study_variability_reaches_the_studys_isv():
     """ISV_ave = 2·mean σ over 4 long trials within ±20 % of the study's, per joint and phase; smooth angles."""
     sigmas = []
     for seed in range(4):
-        coords, events = walking_kinematics(150.0, FS, GAIT, np.random.default_rng(seed), SYNTH["timing_cv"],
-                                            variability=_study_variability())
+        coords, events = walking_kinematics(
+            150.0, FS, GAIT, np.random.default_rng(seed), SYNTH["timing_cv"], variability=_study_variability()
+        )
         stance, swing = _phases(coords, events)
         sigmas.append([x.std(axis=0, ddof=1).mean(axis=0) for x in (stance, swing)])
         # continuity: no jumps and no velocity steps (second differences of a smooth curve at 128 Hz are small)
@@ -142,9 +154,19 @@ def test_walking_with_the_device_differs_as_in_the_study():
         adaptation = device_adaptation(3, f"S{i:02d}", a["amplitude_change"], a["offset_rad"], a["swing_gain"])
         trials = []
         for k, device in enumerate((None, DeviceParameters())):
-            walk = simulate_walking_trial(45.0, LabSettings(), [i, k], 1.73, params, SYNTH["timing_cv"], 0.05, device,
-                                          variability=_study_variability(), adaptation=adaptation,
-                                          minimal_impedance=impedance)
+            walk = simulate_walking_trial(
+                45.0,
+                LabSettings(),
+                [i, k],
+                1.73,
+                params,
+                SYNTH["timing_cv"],
+                0.05,
+                device,
+                variability=_study_variability(),
+                adaptation=adaptation,
+                minimal_impedance=impedance,
+            )
             trials.append(_phases(walk.mocap_coordinates(FS), walk.mocap_events()))
         rmsd.append([np.sqrt(np.mean((trials[1][p].mean(0) - trials[0][p].mean(0)) ** 2, axis=0)) for p in (0, 1)])
         sigma.append([trials[0][p].std(axis=0, ddof=1).mean(axis=0) for p in (0, 1)])
@@ -166,8 +188,9 @@ def test_pulse_response_rides_on_top_of_the_minimal_impedance_response():
 
     params = segment_parameters_from_model(build_lower_body_model(1.73, 65.0))
     impedance = (55.0, 3.5, 3.0, 0.1, 8.0, 0.3)
-    walk = simulate_walking_trial(12.0, LabSettings(), 11, 1.73, params, 0.03, 0.05, DeviceParameters(),
-                                  variability=_study_variability())
+    walk = simulate_walking_trial(
+        12.0, LabSettings(), 11, 1.73, params, 0.03, 0.05, DeviceParameters(), variability=_study_variability()
+    )
     fine = walk.fine
     t = fine["time_s"].to_numpy()
     angles = fine[[f"{j}_l" for j in CURVE_JOINTS]].to_numpy()
@@ -182,8 +205,18 @@ def test_pulse_response_rides_on_top_of_the_minimal_impedance_response():
     assert 0.003 < np.abs(minimal).max() < 0.1  # the ~2 N force moves the leg by milliradians to centiradians
     sl = slice(int(np.searchsorted(t, onset - 0.3)), int(np.searchsorted(t, swing["heel_strike_s"].iloc[0] + 0.35)))
     pulse = np.zeros_like(angles)
-    pulse[sl] = swing_response(t[sl], angles[sl], pelvis[sl], x[sl], params, impedance, fp[sl], fu[sl], onset,
-                               float(swing["heel_strike_s"].iloc[0]))
+    pulse[sl] = swing_response(
+        t[sl],
+        angles[sl],
+        pelvis[sl],
+        x[sl],
+        params,
+        impedance,
+        fp[sl],
+        fu[sl],
+        onset,
+        float(swing["heel_strike_s"].iloc[0]),
+    )
     assert np.abs(pulse).max() > 0.05
     assert np.abs(whole - minimal - pulse).max() < 0.03 * np.abs(pulse).max()
 

@@ -68,7 +68,8 @@ def test_left_heel_strike_half_a_stride_after_right_and_toe_off_at_stance_fracti
 
 
 def test_trial_toe_offs_follow_a_warped_stance_fraction():
-    """With stance fraction 0.6 the toe-offs come at 0.6 strides, and the knee there is the curves' toe-off value (38 deg)."""
+    """With stance fraction 0.6 the toe-offs come at 0.6 strides, and the knee there is the curves' toe-off value
+    (38 deg)."""
     g = NominalGait(stance_fraction=0.6)
     coords, events = walking_kinematics(20.0, 1024.0, g, np.random.default_rng(0), timing_cv=0.0, amplitude_cv=0.0)
     hs, to = event_times(events, "right", "heel_strike"), event_times(events, "right", "toe_off")
@@ -172,7 +173,7 @@ def test_feet_on_the_floor_in_opensim():
     assert np.abs(sole.min(axis=1)).max() < 0.025
     # right foot: one full stance inside the excerpt; heel down through mid-stance
     t = coords["time_s"].to_numpy()
-    (h, o), = stances(events, "right")
+    ((h, o),) = stances(events, "right")
     l_off = event_times(events, "left", "toe_off")
     l_off = l_off[(l_off > h) & (l_off < o)][0]
     mid = (t >= l_off) & (t <= 0.5 * (l_off + h + 0.5 * (o - h)))  # contralateral toe-off .. half single support

@@ -15,6 +15,7 @@ from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
 from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
+from loper_analysis.validation import validation_settings
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
@@ -68,16 +69,23 @@ try:
         if _row["source"] == "synthetic":
             _row.update(subject_anthropometry(_row, config["seed"]))
             # the truth must lie inside the identification bounds: checked before any work starts
-            true_impedance(_s, config["seed"], config["synthetic"]["stiffness_nm_per_rad"],
-                           config["synthetic"]["damping_nms_per_rad"], config["synthetic"]["between_subject_cv"],
-                           config["identification"]["stiffness_bounds_nm_per_rad"],
-                           config["identification"]["damping_bounds_nms_per_rad"])
+            true_impedance(
+                _s,
+                config["seed"],
+                config["synthetic"]["stiffness_nm_per_rad"],
+                config["synthetic"]["damping_nms_per_rad"],
+                config["synthetic"]["between_subject_cv"],
+                config["identification"]["stiffness_bounds_nm_per_rad"],
+                config["identification"]["damping_bounds_nms_per_rad"],
+            )
         elif "model_osim" in _row:  # an already scaled model: no static trial, no scaling
             if not Path(_row["model_osim"]).is_file():
-                raise LoperInputError(f"{_subjects_path}: subject '{_s}', column model_osim: file "
-                                      f"'{_row['model_osim']}' not found")
-        elif not raw_file_present(Path("data/raw") / _s / f"{config['trials']['static']}.c3d",
-                                  f"static trial of subject '{_s}'"):
+                raise LoperInputError(
+                    f"{_subjects_path}: subject '{_s}', column model_osim: file " f"'{_row['model_osim']}' not found"
+                )
+        elif not raw_file_present(
+            Path("data/raw") / _s / f"{config['trials']['static']}.c3d", f"static trial of subject '{_s}'"
+        ):
             raise LoperInputError(
                 f"{_subjects_path}: recorded subject '{_s}' has no static trial "
                 f"data/raw/{_s}/{config['trials']['static']}.c3d (raw files are named data/raw/{{subject}}/{{trial}}.c3d),"
@@ -90,8 +98,10 @@ try:
                 "(a lab's model, such as gait2392, needs none)"
             )
     _onsets = {int(o) for o in config["synthetic"]["stiffness_nm_per_rad"]}
-    if any(r["source"] == "synthetic" for r in SUBJECT_ROWS.values()) and \
-            not set(config["trials"]["perturbation_onsets_ms"]) <= _onsets:
+    if (
+        any(r["source"] == "synthetic" for r in SUBJECT_ROWS.values())
+        and not set(config["trials"]["perturbation_onsets_ms"]) <= _onsets
+    ):
         raise LoperInputError(
             f"{config_source('synthetic', 'stiffness_nm_per_rad')}: key 'synthetic.stiffness_nm_per_rad': "
             f"no truth for onset(s) "
@@ -115,40 +125,6 @@ wildcard_constraints:
     chunk=r"[0-9]{3}",
     onset=r"[0-9]{3}",
     trial=r"[A-Za-z0-9-]+",
-
-
-def validation_settings() -> dict:
-    """Keyword arguments of loper_analysis.validation.ValidationSettings from the config."""
-    v = config["validation"]
-    ident = config["identification"]
-    k_lo, k_hi = ident["stiffness_bounds_nm_per_rad"]
-    d_lo, d_hi = ident["damping_bounds_nms_per_rad"]
-    return dict(
-        stiffness_levels_nm_per_rad=tuple(v["stiffness_levels_nm_per_rad"]),
-        damping_levels_nms_per_rad=tuple(v["damping_levels_nms_per_rad"]),
-        sample_rate_hz=v["sample_rate_hz"],
-        swing_duration_s=v["swing_duration_s"],
-        onset_s=v["onset_s"],
-        pulse_force_n=v["pulse_force_n"],
-        pulse_duration_s=v["pulse_duration_s"],
-        pulse_rise_time_s=v["pulse_rise_time_s"],
-        pulse_overshoot_pct=v["pulse_overshoot_pct"],
-        force_rate_hz=v["force_rate_hz"],
-        force_direction_deg=v["force_direction_deg"],
-        noise_peak_to_peak=v["noise_peak_to_peak"],
-        truth_substeps=v["truth_substeps"],
-        seed=config["seed"],
-        window_before_s=ident["window_before_s"],
-        window_after_s=ident["window_after_s"],
-        n_starts=ident["n_starts"],
-        n_substeps=ident["n_substeps"],
-        tolerance=ident["tolerance"],
-        merge_tolerance=ident["merge_tolerance"],
-        initial_state_span_s=ident["initial_state_span_s"],
-        initial_state_degree=ident["initial_state_degree"],
-        lower=(k_lo, d_lo) * 3,
-        upper=(k_hi, d_hi) * 3,
-    )
 
 
 #: The study's trials, their names and onsets (loper_analysis.study_design).
@@ -178,7 +154,8 @@ try:
                 f"warning: {_raw}: {', '.join(_unmatched)}: no trial of the design has this name, not analysed "
                 f"(trials: {', '.join(DESIGN.trials())}; from trials.static, trials.no_device, trials.device, "
                 f"trials.perturbation_onsets_ms {_t['perturbation_onsets_ms']} and trials.perturbation_repeats "
-                f"{_t['perturbation_repeats']})", file=sys.stderr
+                f"{_t['perturbation_repeats']})",
+                file=sys.stderr,
             )
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
@@ -188,8 +165,11 @@ def processed_subjects() -> list[str]:
     """Synthetic subjects, and recorded subjects with a static trial on disk or a scaled model: their walking trials
     are processed."""
     static = config["trials"]["static"]
-    return [s for s, src in SUBJECT_SOURCE.items()
-            if src == "synthetic" or "model_osim" in SUBJECT_ROWS[s] or (Path("data/raw") / s / f"{static}.c3d").is_file()]
+    return [
+        s
+        for s, src in SUBJECT_SOURCE.items()
+        if src == "synthetic" or "model_osim" in SUBJECT_ROWS[s] or (Path("data/raw") / s / f"{static}.c3d").is_file()
+    ]
 
 
 def trial_label_maps(trial: str) -> list:
@@ -229,9 +209,12 @@ def has_force_platforms(subject: str, trial: str) -> bool:
             return True
     except LoperInputError as exc:
         raise WorkflowError(str(exc)) from None
-    print(f"note: {path}: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the belt channels "
-          f"(events.grf_channels: {config['events']['grf_channels']}), no OpenSim external loads "
-          f"(results/grf/{subject}/{trial}.grf.mot) for this trial", file=sys.stderr)
+    print(
+        f"note: {path}: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the belt channels "
+        f"(events.grf_channels: {config['events']['grf_channels']}), no OpenSim external loads "
+        f"(results/grf/{subject}/{trial}.grf.mot) for this trial",
+        file=sys.stderr,
+    )
     return False
 
 
@@ -256,13 +239,21 @@ def processing_targets() -> list[str]:
     if out:
         out.append("results/strides/summary.tsv")
     if any(DESIGN.onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
-        out += ["results/tables/impedance.tsv", "results/tables/impedance_summary.tsv", "results/tables/literature.tsv",
-                "results/figures/impedance.png", "results/tables/tables.md"]
+        out += [
+            "results/tables/impedance.tsv",
+            "results/tables/impedance_summary.tsv",
+            "results/tables/literature.tsv",
+            "results/figures/impedance.png",
+            "results/tables/tables.md",
+        ]
         out += [f"results/figures/{s}/{f}.png" for s in processed_subjects() for f in ("responses", "fit")]
         out += ["results/planning/plan.tsv", "results/planning/answers.txt"]
     if transparency_subjects():
-        out += ["results/transparency/rmsd.tsv", "results/transparency/force.tsv",
-                "results/transparency/transparency.png"]
+        out += [
+            "results/transparency/rmsd.tsv",
+            "results/transparency/force.tsv",
+            "results/transparency/transparency.png",
+        ]
     return out
 
 

@@ -1,5 +1,6 @@
 # LOPER device tests: simulated logs for a synthetic device subject, FRF and step analysis from disk.
 
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -25,20 +26,20 @@ def device_log(trial):
 rule device_trial:
     output:
         "data/raw/{subject}/{trial}.loper.tsv",
+    log:
+        "results/logs/device_trial/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/device_trial/{subject}/{trial}.tsv"
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
         trial="|".join(DEVICE_TESTS),
+    group:
+        "device"
     params:
         device=DEVICE["parameters"],
         leg=DEVICE["leg"],
         tests=DEVICE["tests"],
         seed=config["seed"],
-    group:
-        "device"
-    log:
-        "results/logs/device_trial/{subject}/{trial}.log",
-    benchmark:
-        "results/benchmarks/device_trial/{subject}/{trial}.tsv"
     script:
         "../scripts/device_trial.py"
 
@@ -48,13 +49,13 @@ rule device_log_from_mat:
         "data/raw/{subject}/{trial}.mat",
     output:
         "results/device/{subject}/{trial}.loper.tsv",
-    params:
-        column_map=DEVICE["mat_column_map"],
-        sample_rate_hz=DEVICE_RATE_HZ,
     log:
         "results/logs/device_log_from_mat/{subject}/{trial}.log",
     benchmark:
         "results/benchmarks/device_log_from_mat/{subject}/{trial}.tsv"
+    params:
+        column_map=DEVICE["mat_column_map"],
+        sample_rate_hz=DEVICE_RATE_HZ,
     script:
         "../scripts/device_log_from_mat.py"
 
@@ -64,16 +65,16 @@ rule device_frf:
         device_log("device-frf"),
     output:
         "results/device/frf.tsv",
-    params:
-        sample_rate_hz=DEVICE_RATE_HZ,
-        window_samples=DEVICE["analysis"]["welch_window_samples"],
-        overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
-    group:
-        "device"
     log:
         "results/logs/device_frf/frf.log",
     benchmark:
         "results/benchmarks/device_frf/frf.tsv"
+    group:
+        "device"
+    params:
+        sample_rate_hz=DEVICE_RATE_HZ,
+        window_samples=DEVICE["analysis"]["welch_window_samples"],
+        overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
     script:
         "../scripts/device_frf.py"
 
@@ -84,18 +85,18 @@ rule device_steps:
     output:
         metrics="results/device/step_metrics.tsv",
         average="results/device/step_average.tsv",
+    log:
+        "results/logs/device_steps/steps.log",
+    benchmark:
+        "results/benchmarks/device_steps/steps.tsv"
+    group:
+        "device"
     params:
         sample_rate_hz=DEVICE_RATE_HZ,
         amplitudes_n=DEVICE["tests"]["step_amplitudes_n"],
         before_s=DEVICE["analysis"]["step_before_s"],
         after_s=DEVICE["analysis"]["step_after_s"],
         steady_window_s=DEVICE["analysis"]["steady_window_s"],
-    group:
-        "device"
-    log:
-        "results/logs/device_steps/steps.log",
-    benchmark:
-        "results/benchmarks/device_steps/steps.tsv"
     script:
         "../scripts/device_steps.py"
 
@@ -111,12 +112,12 @@ rule device_summary:
             category="Device",
             labels={"table": "device figures vs study"},
         ),
-    params:
-        reference_band_hz=DEVICE["analysis"]["bandwidth_reference_band_hz"],
     log:
         "results/logs/device_summary/summary.log",
     benchmark:
         "results/benchmarks/device_summary/summary.tsv"
+    params:
+        reference_band_hz=DEVICE["analysis"]["bandwidth_reference_band_hz"],
     script:
         "../scripts/device_summary.py"
 

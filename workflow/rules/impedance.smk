@@ -1,5 +1,6 @@
 # Perturbation analysis: responses (matched strides) and impedance fits per subject and onset, aggregate tables.
 
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -70,6 +71,10 @@ rule impedance_fit:
         fit=expand("results/impedance/{{subject}}/{onset}.tsv", onset=ONSETS),
         curves=expand("results/impedance/{{subject}}/{onset}.curves.tsv", onset=ONSETS),
         force=expand("results/responses/{{subject}}/{onset}.force.tsv", onset=ONSETS),
+    log:
+        "results/logs/impedance_fit/{subject}.log",
+    benchmark:
+        "results/benchmarks/impedance_fit/{subject}.tsv"
     params:
         onsets_ms=TRIALS["perturbation_onsets_ms"],
         trials=lambda wc: {o: onset_trials(wc.subject, o) for o in ONSETS},
@@ -102,10 +107,6 @@ rule impedance_fit:
             max_null_trial_ratio=IDENT["max_null_trial_ratio"],
             seed=config["seed"],
         ),
-    log:
-        "results/logs/impedance_fit/{subject}.log",
-    benchmark:
-        "results/benchmarks/impedance_fit/{subject}.tsv"
     script:
         "../scripts/impedance_fit.py"
 
@@ -144,20 +145,24 @@ rule impedance_summary:
             category="Impedance",
             labels={"table": "literature comparison"},
         ),
-    params:
-        upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
     log:
         "results/logs/impedance_summary/summary.log",
     benchmark:
         "results/benchmarks/impedance_summary/summary.tsv"
+    params:
+        upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
     script:
         "../scripts/impedance_summary.py"
 
 
 rule impedance_figures:
     input:
-        responses=lambda wc: [f"results/responses/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]],
-        curves=lambda wc: [f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]],
+        responses=lambda wc: [
+            f"results/responses/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]
+        ],
+        curves=lambda wc: [
+            f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]
+        ],
     output:
         responses=report(
             "results/figures/{subject}/responses.png",
@@ -173,12 +178,12 @@ rule impedance_figures:
             subcategory="{subject}",
             labels={"subject": "{subject}", "figure": "fit vs data"},
         ),
-    params:
-        onsets=TRIALS["perturbation_onsets_ms"],
     log:
         "results/logs/impedance_figures/{subject}.log",
     benchmark:
         "results/benchmarks/impedance_figures/{subject}.tsv"
+    params:
+        onsets=TRIALS["perturbation_onsets_ms"],
     script:
         "../scripts/impedance_figures.py"
 
@@ -222,11 +227,11 @@ rule tables_markdown:
         list(markdown_sections().values()),
     output:
         "results/tables/tables.md",
-    params:
-        headings=list(markdown_sections()),
     log:
         "results/logs/tables_markdown/tables.log",
     benchmark:
         "results/benchmarks/tables_markdown/tables.tsv"
+    params:
+        headings=list(markdown_sections()),
     script:
         "../scripts/tables_markdown.py"

@@ -2,6 +2,7 @@
 
 from loper_analysis.steps.planning import planning_settings
 
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -20,8 +21,10 @@ def planning_pilot() -> str:
     if pilot is None:
         return processed_subjects()[0]
     if pilot not in processed_subjects():
-        raise WorkflowError(f"{config_source('planning', 'pilot_subject')}: key 'planning.pilot_subject': "
-                            f"subject '{pilot}' is not a processed subject of {config['subjects']}")
+        raise WorkflowError(
+            f"{config_source('planning', 'pilot_subject')}: key 'planning.pilot_subject': "
+            f"subject '{pilot}' is not a processed subject of {config['subjects']}"
+        )
     return pilot
 
 
@@ -48,13 +51,13 @@ rule planning:
             labels={"table": "predicted 95 % CI half-width of K and D"},
         ),
         answers="results/planning/answers.txt",
-    params:
-        subject=lambda wc: planning_pilot(),
-        trials=lambda wc: null_pair_trials(planning_pilot()),
-        **PLAN_SETTINGS,
     log:
         "results/logs/planning/plan.log",
     benchmark:
         "results/benchmarks/planning/plan.tsv"
+    params:
+        **PLAN_SETTINGS,
+        subject=lambda wc: planning_pilot(),
+        trials=lambda wc: null_pair_trials(planning_pilot()),
     script:
         "../scripts/planning.py"

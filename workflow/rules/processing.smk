@@ -1,6 +1,7 @@
 # Processing: raw C3D + robot log -> markers (TRC) -> scaled OpenSim model -> IK (chunked) -> events -> forces.
 import re
 
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -42,6 +43,12 @@ rule markers:
         trc="results/markers/{subject}/{trial}.trc",
         gaps="results/markers/{subject}/{trial}.gaps.tsv",
         summary="results/markers/{subject}/{trial}.markers.tsv",
+    log:
+        "results/logs/markers/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/markers/{subject}/{trial}.tsv"
+    group:
+        trial_group
     params:
         rotation_deg=MARKERS["lab_to_model_rotation_deg"],
         walking_direction=MARKERS["walking_direction"],
@@ -54,12 +61,6 @@ rule markers:
         span_s=lambda wc: trial_span_s(wc.subject, wc.trial),
         label_maps=lambda wc: trial_label_maps(wc.trial),
         extent_range_m=MARKERS["extent_range_m"],
-    group:
-        trial_group
-    log:
-        "results/logs/markers/{subject}/{trial}.log",
-    benchmark:
-        "results/benchmarks/markers/{subject}/{trial}.tsv"
     script:
         "../scripts/markers.py"
 
@@ -85,14 +86,14 @@ rule model_generic:
         static_c3d=static_c3d_for_mass,
     output:
         "results/model/{subject}/generic.osim",
-    params:
-        height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
-        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
-        static=STATIC_SETTINGS,
     log:
         "results/logs/model_generic/{subject}.log",
     benchmark:
         "results/benchmarks/model_generic/{subject}.tsv"
+    params:
+        height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
+        mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
+        static=STATIC_SETTINGS,
     script:
         "../scripts/model_generic.py"
 
@@ -115,6 +116,12 @@ rule model_scaled:
             subcategory="{subject}",
             labels={"subject": "{subject}", "table": "scaling"},
         ),
+    log:
+        "results/logs/model_scaled/{subject}.log",
+    benchmark:
+        "results/benchmarks/model_scaled/{subject}.tsv"
+    group:
+        "model"
     params:
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
@@ -122,12 +129,6 @@ rule model_scaled:
         segment_bodies=OPENSIM["segment_bodies"],
         factor_range=OPENSIM["scale_factor_range"],
         static={**STATIC_SETTINGS, "max_motion_rms_m": MARKERS["static_max_motion_rms_m"]},
-    group:
-        "model"
-    log:
-        "results/logs/model_scaled/{subject}.log",
-    benchmark:
-        "results/benchmarks/model_scaled/{subject}.tsv"
     script:
         "../scripts/model_scaled.py"
 
@@ -138,14 +139,14 @@ rule model_segments:
         subject_model,
     output:
         "results/model/{subject}/segments.tsv",
-    params:
-        side=TRIALS["perturbed_side"],
-        segment_bodies=OPENSIM["segment_bodies"],
-        attachment_fraction=OPENSIM["brace_attachment_fraction"],
     log:
         "results/logs/model_segments/{subject}.log",
     benchmark:
         "results/benchmarks/model_segments/{subject}.tsv"
+    params:
+        side=TRIALS["perturbed_side"],
+        segment_bodies=OPENSIM["segment_bodies"],
+        attachment_fraction=OPENSIM["brace_attachment_fraction"],
     script:
         "../scripts/model_segments.py"
 
@@ -172,15 +173,15 @@ if OPENSIM["ik_chunks"] == 1:
             mot="results/ik/{subject}/{trial}.mot",
             angles="results/ik/{subject}/{trial}.angles.tsv",
             summary="results/ik/{subject}/{trial}.ik.tsv",
-        params:
-            coordinate_map=OPENSIM["coordinate_map"],
-            settings=IK_SETTINGS,
-        group:
-            "trial"
         log:
             "results/logs/ik/{subject}/{trial}.log",
         benchmark:
             "results/benchmarks/ik/{subject}/{trial}.tsv"
+        group:
+            "trial"
+        params:
+            coordinate_map=OPENSIM["coordinate_map"],
+            settings=IK_SETTINGS,
         script:
             "../scripts/ik.py"
 
@@ -193,15 +194,15 @@ else:
             trc="results/markers/{subject}/{trial}.trc",
         output:
             temp("results/ik/{subject}/{trial}.chunk{chunk}.mot"),
-        params:
-            n_chunks=OPENSIM["ik_chunks"],
-            settings=IK_SETTINGS,
-        group:
-            "trial"
         log:
             "results/logs/ik_chunk/{subject}/{trial}.{chunk}.log",
         benchmark:
             "results/benchmarks/ik_chunk/{subject}/{trial}.{chunk}.tsv"
+        group:
+            "trial"
+        params:
+            n_chunks=OPENSIM["ik_chunks"],
+            settings=IK_SETTINGS,
         script:
             "../scripts/ik_chunk.py"
 
@@ -212,14 +213,14 @@ else:
             mot="results/ik/{subject}/{trial}.mot",
             angles="results/ik/{subject}/{trial}.angles.tsv",
             summary="results/ik/{subject}/{trial}.ik.tsv",
-        params:
-            coordinate_map=OPENSIM["coordinate_map"],
-        group:
-            "trial"
         log:
             "results/logs/ik_join/{subject}/{trial}.log",
         benchmark:
             "results/benchmarks/ik_join/{subject}/{trial}.tsv"
+        group:
+            "trial"
+        params:
+            coordinate_map=OPENSIM["coordinate_map"],
         script:
             "../scripts/ik_join.py"
 
@@ -232,15 +233,15 @@ rule grf:
         markers="results/markers/{subject}/{trial}.markers.tsv",
     output:
         "results/grf/{subject}/{trial}.grf.mot",
+    log:
+        "results/logs/grf/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/grf/{subject}/{trial}.tsv"
     params:
         rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
         threshold_n=config["grf"]["loaded_threshold_n"],
         band_n=config["grf"]["resting_band_n"],
         max_rest_n=config["grf"]["max_resting_n"],
-    log:
-        "results/logs/grf/{subject}/{trial}.log",
-    benchmark:
-        "results/benchmarks/grf/{subject}/{trial}.tsv"
     script:
         "../scripts/grf.py"
 
@@ -248,8 +249,11 @@ rule grf:
 def robot_log(wildcards):
     """A trial's robot log: data/raw/{subject}/{trial}.loper.tsv, or converted from the MATLAB export {trial}.mat."""
     raw = Path("data/raw") / wildcards.subject
-    if SUBJECT_SOURCE[wildcards.subject] == "recorded" and not (raw / f"{wildcards.trial}.loper.tsv").exists() \
-            and (raw / f"{wildcards.trial}.mat").exists():
+    if (
+        SUBJECT_SOURCE[wildcards.subject] == "recorded"
+        and not (raw / f"{wildcards.trial}.loper.tsv").exists()
+        and (raw / f"{wildcards.trial}.mat").exists()
+    ):
         return f"results/device/{wildcards.subject}/{wildcards.trial}.loper.tsv"
     return str(raw / f"{wildcards.trial}.loper.tsv")
 
@@ -280,16 +284,16 @@ rule events:
     output:
         events="results/events/{subject}/{trial}.events.tsv",
         contacts="results/events/{subject}/{trial}.contacts.tsv",
-    wildcard_constraints:
-        trial=TRIALS["no_device"],
-    params:
-        settings=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
-    group:
-        "trial"
     log:
         "results/logs/events/{subject}/{trial}.log",
     benchmark:
         "results/benchmarks/events/{subject}/{trial}.tsv"
+    wildcard_constraints:
+        trial=TRIALS["no_device"],
+    group:
+        "trial"
+    params:
+        settings=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
     script:
         "../scripts/events.py"
 
@@ -307,18 +311,18 @@ rule events_loadcell:
         contacts="results/events/{subject}/{trial}.contacts.tsv",
         force="results/loadcell/{subject}/{trial}.force.tsv",
         native="results/loadcell/{subject}/{trial}.force_native.tsv",
-    wildcard_constraints:
-        # any trial but the one without the device (the lookahead ends at the wildcard's end, not the path's)
-        trial=f"(?!{re.escape(TRIALS['no_device'])}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
-    params:
-        events=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
-        loadcell=LOADCELL_SETTINGS,
-    group:
-        "trial"
     log:
         "results/logs/events_loadcell/{subject}/{trial}.log",
     benchmark:
         "results/benchmarks/events_loadcell/{subject}/{trial}.tsv"
+    wildcard_constraints:
+        # any trial but the one without the device (the lookahead ends at the wildcard's end, not the path's)
+        trial=f"(?!{re.escape(TRIALS['no_device'])}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
+    group:
+        "trial"
+    params:
+        events=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
+        loadcell=LOADCELL_SETTINGS,
     script:
         "../scripts/events_loadcell.py"
 
@@ -338,18 +342,18 @@ rule strides:
     output:
         strides="results/strides/{subject}/{trial}.strides.tsv",
         cycles="results/strides/{subject}/{trial}.cycles.tsv",
+    log:
+        "results/logs/strides/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/strides/{subject}/{trial}.tsv"
+    group:
+        "trial"
     params:
         side=TRIALS["perturbed_side"],
         n_points=config["strides"]["n_points"],
         whisker=config["strides"]["iqr_whisker"],
         max_fraction=config["strides"]["max_outlier_fraction"],
         min_valid=config["strides"]["min_valid_strides"],
-    group:
-        "trial"
-    log:
-        "results/logs/strides/{subject}/{trial}.log",
-    benchmark:
-        "results/benchmarks/strides/{subject}/{trial}.tsv"
     script:
         "../scripts/strides.py"
 
@@ -385,14 +389,14 @@ rule transparency:
             category="Transparency",
             labels={"figure": "gait cycle with and without LOPER"},
         ),
-    params:
-        subjects=transparency_subjects(),
-        side=TRIALS["perturbed_side"],
-        min_strides=config["strides"]["min_valid_strides"],
     log:
         "results/logs/transparency/transparency.log",
     benchmark:
         "results/benchmarks/transparency/transparency.tsv"
+    params:
+        subjects=transparency_subjects(),
+        side=TRIALS["perturbed_side"],
+        min_strides=config["strides"]["min_valid_strides"],
     script:
         "../scripts/transparency.py"
 
@@ -410,12 +414,12 @@ rule strides_summary:
             category="Processing",
             labels={"table": "strides per trial"},
         ),
-    params:
-        subject_trial=[(s, t) for s in processed_subjects() for t in subject_trials(s)],
-        min_valid=config["strides"]["min_valid_strides"],
     log:
         "results/logs/strides_summary/summary.log",
     benchmark:
         "results/benchmarks/strides_summary/summary.tsv"
+    params:
+        subject_trial=[(s, t) for s in processed_subjects() for t in subject_trials(s)],
+        min_valid=config["strides"]["min_valid_strides"],
     script:
         "../scripts/strides_summary.py"

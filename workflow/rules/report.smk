@@ -1,6 +1,7 @@
 # The report's front page: what was run, the headline numbers and the main figure, as one HTML fragment that
 # workflow/report/workflow.rst pulls in above the methods text.
 
+
 # a small job reading tables: on a cluster it runs in the controlling process, not as a SLURM job
 localrules:
     front_page,
@@ -15,8 +16,11 @@ def front_page_inputs(wildcards) -> dict:
         out["device"] = "results/device/summary.tsv"
     targets = set(processing_targets())
     if "results/tables/impedance.tsv" in targets:
-        out.update(impedance="results/tables/impedance.tsv", summary="results/tables/impedance_summary.tsv",
-                   figure="results/figures/impedance.png")
+        out.update(
+            impedance="results/tables/impedance.tsv",
+            summary="results/tables/impedance_summary.tsv",
+            figure="results/figures/impedance.png",
+        )
     if "results/transparency/rmsd.tsv" in targets:
         out["rmsd"] = "results/transparency/rmsd.tsv"
     return out
@@ -27,6 +31,10 @@ rule front_page:
         unpack(front_page_inputs),
     output:
         "results/report/front_page.html",
+    log:
+        "results/logs/front_page/front_page.log",
+    benchmark:
+        "results/benchmarks/front_page/front_page.tsv"
     params:
         subjects=SUBJECT_SOURCE,
         trials={s: subject_trials(s) for s in processed_subjects()},
@@ -49,9 +57,5 @@ rule front_page:
             pulse_force_n=config["synthetic"]["pulse_force_n"],
             pulse_duration_s=config["synthetic"]["pulse_duration_s"],
         ),
-    log:
-        "results/logs/front_page/front_page.log",
-    benchmark:
-        "results/benchmarks/front_page/front_page.tsv"
     script:
         "../scripts/front_page.py"

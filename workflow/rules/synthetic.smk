@@ -1,5 +1,6 @@
 # The simulated gait lab: raw files of synthetic subjects (never of recorded ones, see SYNTHETIC_PATTERN).
 
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -26,6 +27,10 @@ def lab_settings() -> dict:
 rule synthetic_truth:
     output:
         "data/raw/{subject}/truth.yaml",
+    log:
+        "results/logs/synthetic_truth/{subject}.log",
+    benchmark:
+        "results/benchmarks/synthetic_truth/{subject}.tsv"
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
@@ -36,10 +41,6 @@ rule synthetic_truth:
         stiffness_bounds=config["identification"]["stiffness_bounds_nm_per_rad"],
         damping_bounds=config["identification"]["damping_bounds_nms_per_rad"],
         seed=config["seed"],
-    log:
-        "results/logs/synthetic_truth/{subject}.log",
-    benchmark:
-        "results/benchmarks/synthetic_truth/{subject}.tsv"
     script:
         "../scripts/synthetic_truth.py"
 
@@ -54,6 +55,10 @@ rule synthetic_lab:
         static=f"data/raw/{{subject}}/{TRIALS['static']}.c3d",
         c3d=[f"data/raw/{{subject}}/{t}.c3d" for t in DESIGN.walking_trials()],
         logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in DESIGN.walking_trials() if t != TRIALS["no_device"]],
+    log:
+        "results/logs/synthetic_lab/{subject}.log",
+    benchmark:
+        "results/benchmarks/synthetic_lab/{subject}.tsv"
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
@@ -65,9 +70,5 @@ rule synthetic_lab:
         lab=lab_settings(),
         device=config["device"]["parameters"],
         seed=config["seed"],
-    log:
-        "results/logs/synthetic_lab/{subject}.log",
-    benchmark:
-        "results/benchmarks/synthetic_lab/{subject}.tsv"
     script:
         "../scripts/synthetic_lab.py"

@@ -1,5 +1,6 @@
 # Validation study of the identification: 729 K/D combinations x {no_noise, noise}.
 
+
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
@@ -8,18 +9,17 @@ localrules:
     validation_figure,
 
 
-
 rule validation_segments:
     output:
         "results/validation/segments.tsv",
-    params:
-        height_m=config["validation"]["subject_height_m"],
-        mass_kg=config["validation"]["subject_mass_kg"],
-        attachment_fraction=config["validation"]["attachment_fraction_of_thigh"],
     log:
         "results/logs/validation_segments/segments.log",
     benchmark:
         "results/benchmarks/validation_segments/segments.tsv"
+    params:
+        height_m=config["validation"]["subject_height_m"],
+        mass_kg=config["validation"]["subject_mass_kg"],
+        attachment_fraction=config["validation"]["attachment_fraction_of_thigh"],
     script:
         "../scripts/validation_segments.py"
 
@@ -30,13 +30,13 @@ rule validation_chunk:
     output:
         errors=temp("results/validation/chunks/{chunk}.errors.tsv"),
         fits=temp("results/validation/chunks/{chunk}.fits.tsv"),
-    params:
-        settings=validation_settings(),
-        n_chunks=config["validation"]["n_chunks"],
     log:
         "results/logs/validation_chunk/{chunk}.log",
     benchmark:
         "results/benchmarks/validation_chunk/{chunk}.tsv"
+    params:
+        settings=validation_settings(config),
+        n_chunks=config["validation"]["n_chunks"],
     script:
         "../scripts/validation_chunk.py"
 

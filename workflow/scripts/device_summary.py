@@ -3,4 +3,6 @@ from loper_analysis.steps import rule_log
 with rule_log(snakemake.log[0]):
     from loper_analysis.steps import device
 
-    device.summary(snakemake.input.frf, snakemake.input.metrics, snakemake.output[0], snakemake.params.reference_band_hz)
+    device.summary(
+        snakemake.input.frf, snakemake.input.metrics, snakemake.output[0], snakemake.params.reference_band_hz
+    )

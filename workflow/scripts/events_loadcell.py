@@ -4,5 +4,4 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import processing
 
     inp, out, p = snakemake.input, snakemake.output, snakemake.params
-    processing.events_loadcell(inp.c3d, inp.log, out.events, out.contacts, out.force, out.native, p.events,
-                               p.loadcell)
+    processing.events_loadcell(inp.c3d, inp.log, out.events, out.contacts, out.force, out.native, p.events, p.loadcell)

@@ -4,5 +4,12 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import ik
 
     p, out = snakemake.params, snakemake.output
-    ik.ik_trial(snakemake.input.model, snakemake.input.trc, out.mot, out.angles, p.coordinate_map,
-                summary_tsv=out.summary, **p.settings)
+    ik.ik_trial(
+        snakemake.input.model,
+        snakemake.input.trc,
+        out.mot,
+        out.angles,
+        p.coordinate_map,
+        summary_tsv=out.summary,
+        **p.settings,
+    )

@@ -4,5 +4,6 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import processing
 
     p, i = snakemake.params, snakemake.input
-    processing.strides_summary(p.subject_trial, i.strides, snakemake.output[0], p.min_valid, i.contacts,
-                               ik_tsvs=i.ik, markers_tsvs=i.markers)
+    processing.strides_summary(
+        p.subject_trial, i.strides, snakemake.output[0], p.min_valid, i.contacts, ik_tsvs=i.ik, markers_tsvs=i.markers
+    )

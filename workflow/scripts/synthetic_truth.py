@@ -4,5 +4,6 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import synthetic
 
     p = snakemake.params
-    synthetic.truth(snakemake.output[0], p.row, p.stiffness, p.damping, p.cv, p.stiffness_bounds, p.damping_bounds,
-                    p.seed)
+    synthetic.truth(
+        snakemake.output[0], p.row, p.stiffness, p.damping, p.cv, p.stiffness_bounds, p.damping_bounds, p.seed
+    )

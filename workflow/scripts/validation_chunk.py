@@ -4,5 +4,11 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import validation
 
     out = snakemake.output
-    validation.validation_chunk(snakemake.input.segments, snakemake.params.settings, int(snakemake.wildcards.chunk),
-                                snakemake.params.n_chunks, out.errors, out.fits)
+    validation.validation_chunk(
+        snakemake.input.segments,
+        snakemake.params.settings,
+        int(snakemake.wildcards.chunk),
+        snakemake.params.n_chunks,
+        out.errors,
+        out.fits,
+    )

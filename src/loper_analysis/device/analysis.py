@@ -50,12 +50,14 @@ def frequency_response(
     if np.any(s_dd[1:] <= 0):
         raise LoperInputError("desired_n has no power at some frequencies: is it a broadband signal?")
     h = s_dm[1:] / s_dd[1:]
-    return pd.DataFrame({
-        "frequency_hz": f[1:],
-        "gain": np.abs(h),
-        "phase_deg": np.degrees(np.unwrap(np.angle(h))),
-        "coherence": coh[1:],
-    })
+    return pd.DataFrame(
+        {
+            "frequency_hz": f[1:],
+            "gain": np.abs(h),
+            "phase_deg": np.degrees(np.unwrap(np.angle(h))),
+            "coherence": coh[1:],
+        }
+    )
 
 
 def bandwidth_hz(
@@ -88,9 +90,7 @@ def bandwidth_hz(
     fs_, db = f[sel], 20 * np.log10(g[sel])
     below = np.flatnonzero(db <= ref_db - drop_db)
     if below.size == 0:
-        raise LoperInputError(
-            f"the gain never drops {drop_db} dB below {ref_db:.2f} dB up to {f.max():.1f} Hz"
-        )
+        raise LoperInputError(f"the gain never drops {drop_db} dB below {ref_db:.2f} dB up to {f.max():.1f} Hz")
     i = below[0]
     if i == 0:
         return float(fs_[0])
@@ -139,12 +139,14 @@ def average_step(
         d.append(seg_d - seg_d[:nb].mean())
         m.append(seg_m - seg_m[:nb].mean())
     d, m = np.array(d), np.array(m)
-    return pd.DataFrame({
-        "time_s": (np.arange(-nb, na)) / fs,
-        "desired_n": d.mean(axis=0),
-        "measured_n": m.mean(axis=0),
-        "measured_sd_n": m.std(axis=0, ddof=1) if len(m) > 1 else np.zeros(nb + na),
-    })
+    return pd.DataFrame(
+        {
+            "time_s": (np.arange(-nb, na)) / fs,
+            "desired_n": d.mean(axis=0),
+            "measured_n": m.mean(axis=0),
+            "measured_sd_n": m.std(axis=0, ddof=1) if len(m) > 1 else np.zeros(nb + na),
+        }
+    )
 
 
 def _first_crossing(t: np.ndarray, y: np.ndarray, level: float) -> float:
@@ -205,7 +207,8 @@ def step_averages(
     if far.any():
         i = int(np.flatnonzero(far)[0])
         raise LoperInputError(
-            f"step at sample {onsets[i]} has height {heights[i]:.3g} N, more than 20 % from every amplitude {amps.tolist()}"
+            f"step at sample {onsets[i]} has height {heights[i]:.3g} N, "
+            f"more than 20 % from every amplitude {amps.tolist()}"
         )
     frames = []
     for j, a in enumerate(amps):
@@ -225,14 +228,16 @@ def step_table(averages: pd.DataFrame, steady_window_s: tuple[float, float] = (0
     rows = []
     for a, avg in averages.groupby("amplitude_n", sort=True):
         m = step_metrics(avg["time_s"].to_numpy(), avg["measured_n"].to_numpy(), a, steady_window_s)
-        rows.append({
-            "amplitude_n": a,
-            "n_repetitions": int(avg["n_repetitions"].iloc[0]),
-            "rise_time_ms": m["rise_time_ms"],
-            "overshoot_pct": m["overshoot_pct"],
-            "steady_state_n": m["steady_state_n"],
-            "peak_n": m["peak_n"],
-        })
+        rows.append(
+            {
+                "amplitude_n": a,
+                "n_repetitions": int(avg["n_repetitions"].iloc[0]),
+                "rise_time_ms": m["rise_time_ms"],
+                "overshoot_pct": m["overshoot_pct"],
+                "steady_state_n": m["steady_state_n"],
+                "peak_n": m["peak_n"],
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -245,7 +250,9 @@ def device_summary(frf: pd.DataFrame, steps: pd.DataFrame, reference_band_hz=(0.
     steady state of the 40 N steps, then per amplitude its rise time,
     overshoot and steady state.
     """
-    bw = bandwidth_hz(frf["frequency_hz"].to_numpy(), frf["gain"].to_numpy(), reference_band_hz=tuple(reference_band_hz))
+    bw = bandwidth_hz(
+        frf["frequency_hz"].to_numpy(), frf["gain"].to_numpy(), reference_band_hz=tuple(reference_band_hz)
+    )
     values = {
         "bandwidth_hz": bw,
         "rise_time_ms": float(steps["rise_time_ms"].mean()),
@@ -256,16 +263,38 @@ def device_summary(frf: pd.DataFrame, steps: pd.DataFrame, reference_band_hz=(0.
     rows = []
     for metric, (study, unit) in STUDY_DEVICE.items():
         v = values[metric]
-        rows.append({"metric": metric, "value": v, "study_value": study, "unit": unit,
-                     "difference_pct": 100.0 * (v - study) / study})
+        rows.append(
+            {
+                "metric": metric,
+                "value": v,
+                "study_value": study,
+                "unit": unit,
+                "difference_pct": 100.0 * (v - study) / study,
+            }
+        )
     for _, r in steps.iterrows():
         a = int(round(r["amplitude_n"]))
         rows += [
-            {"metric": f"rise_time_ms_at_{a}n", "value": r["rise_time_ms"], "study_value": np.nan, "unit": "ms",
-             "difference_pct": np.nan},
-            {"metric": f"overshoot_pct_at_{a}n", "value": r["overshoot_pct"], "study_value": np.nan, "unit": "%",
-             "difference_pct": np.nan},
-            {"metric": f"steady_state_n_at_{a}n", "value": r["steady_state_n"], "study_value": np.nan, "unit": "N",
-             "difference_pct": np.nan},
+            {
+                "metric": f"rise_time_ms_at_{a}n",
+                "value": r["rise_time_ms"],
+                "study_value": np.nan,
+                "unit": "ms",
+                "difference_pct": np.nan,
+            },
+            {
+                "metric": f"overshoot_pct_at_{a}n",
+                "value": r["overshoot_pct"],
+                "study_value": np.nan,
+                "unit": "%",
+                "difference_pct": np.nan,
+            },
+            {
+                "metric": f"steady_state_n_at_{a}n",
+                "value": r["steady_state_n"],
+                "study_value": np.nan,
+                "unit": "N",
+                "difference_pct": np.nan,
+            },
         ]
     return pd.DataFrame(rows)

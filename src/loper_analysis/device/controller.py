@@ -126,8 +126,15 @@ class DeviceParameters:
                 raise LoperInputError(f"device parameter {name} must be finite, got {value}")
             if value < 0:
                 raise LoperInputError(f"device parameter {name} must be >= 0, got {value}")
-        for name in ("sample_rate_hz", "virtual_inertia_kg_m2", "lever_arm_m", "prefilter_cutoff_hz",
-                     "servo_bandwidth_hz", "rod_stiffness_n_per_m", "motor_inertia_kg_m2"):
+        for name in (
+            "sample_rate_hz",
+            "virtual_inertia_kg_m2",
+            "lever_arm_m",
+            "prefilter_cutoff_hz",
+            "servo_bandwidth_hz",
+            "rod_stiffness_n_per_m",
+            "motor_inertia_kg_m2",
+        ):
             if getattr(self, name) <= 0:
                 raise LoperInputError(f"device parameter {name} must be positive, got {getattr(self, name)}")
         if not (self.position_bound_rad < self.motor_cutoff_position_rad <= self.servo_cutoff_position_rad):
@@ -223,7 +230,10 @@ def _filter_coefficients(dev: DeviceParameters):
     Iv, Bv, Ka = dev.virtual_inertia_kg_m2, dev.virtual_damping_nms_per_rad, dev.lead_time_s
     b1, a1 = bilinear([1.0], [Iv, Bv], fs)  # e -> v_d
     b2, a2 = bilinear([Ka, 0.0], [Iv, Bv], fs)  # w -> v_d (lead)
-    pad = lambda v: np.pad(np.asarray(v, float), (0, 3 - len(v)))
+
+    def pad(v):
+        return np.pad(np.asarray(v, float), (0, 3 - len(v)))
+
     return np.stack([pad(bF), pad(aF), pad(b1), pad(a1), pad(b2), pad(a2)])
 
 
@@ -257,7 +267,9 @@ def _run(coef, Aon, Bon, Aoff, Boff, consts, fd, noise, xp, vp, ap, free_leg, x0
         if res > 0:
             fm = res * np.round(fm / res)
         # prefilter
-        fr = (coef[0, 0] * fd[k] + coef[0, 1] * fd1 + coef[0, 2] * fd2 - coef[1, 1] * fr1 - coef[1, 2] * fr2) / coef[1, 0]
+        fr = (coef[0, 0] * fd[k] + coef[0, 1] * fd1 + coef[0, 2] * fd2 - coef[1, 1] * fr1 - coef[1, 2] * fr2) / coef[
+            1, 0
+        ]
         fd2, fd1, fr2, fr1 = fd1, fd[k], fr1, fr
         e = r * (fr - fm)
         w = r * (consts[14] * fr - fm)
@@ -369,13 +381,25 @@ def simulate_device(
     (Aon, Bon), (Aoff, Boff) = _plant_matrices(device, leg)
     rng = np.random.default_rng(seed)
     noise = rng.normal(0.0, device.loadcell_noise_sd_n, n) if device.loadcell_noise_sd_n > 0 else np.zeros(n)
-    consts = np.array([
-        device.lever_arm_m, device.rod_stiffness_n_per_m, device.rod_damping_ns_per_m, device.motor_inertia_kg_m2,
-        device.loadcell_resolution_n, device.velocity_limit_rad_s, device.acceleration_limit_rad_s2,
-        device.position_bound_rad, device.motor_cutoff_position_rad, device.motor_cutoff_velocity_rad_s,
-        device.motor_cutoff_torque_nm, device.servo_cutoff_position_rad, T,
-        round(device.servo_delay_s * device.sample_rate_hz), device.setpoint_weight,
-    ])
+    consts = np.array(
+        [
+            device.lever_arm_m,
+            device.rod_stiffness_n_per_m,
+            device.rod_damping_ns_per_m,
+            device.motor_inertia_kg_m2,
+            device.loadcell_resolution_n,
+            device.velocity_limit_rad_s,
+            device.acceleration_limit_rad_s2,
+            device.position_bound_rad,
+            device.motor_cutoff_position_rad,
+            device.motor_cutoff_velocity_rad_s,
+            device.motor_cutoff_torque_nm,
+            device.servo_cutoff_position_rad,
+            T,
+            round(device.servo_delay_s * device.sample_rate_hz),
+            device.setpoint_weight,
+        ]
+    )
     x0 = np.zeros(5)
     x0[0] = initial_motor_angle_rad
     if leg is None:
@@ -384,23 +408,27 @@ def simulate_device(
     fm, th, om, vcmd, state = _run(
         _filter_coefficients(device), Aon, Bon, Aoff, Boff, consts, fd, noise, xp, vp, ap, leg is not None, x0
     )
-    return pd.DataFrame({
-        "time_s": np.arange(n) * T,
-        "force_desired_n": fd,
-        "force_measured_n": fm,
-        "motor_angle_rad": th,
-        "motor_velocity_rad_s": om,
-        "safety_state": state,
-        "velocity_command_rad_s": vcmd,
-    })
+    return pd.DataFrame(
+        {
+            "time_s": np.arange(n) * T,
+            "force_desired_n": fd,
+            "force_measured_n": fm,
+            "motor_angle_rad": th,
+            "motor_velocity_rad_s": om,
+            "safety_state": state,
+            "velocity_command_rad_s": vcmd,
+        }
+    )
 
 
 def safety_events(log: pd.DataFrame) -> pd.DataFrame:
     """When the safety state changed: columns ``time_s``, ``state``, ``name`` (one row per change)."""
     s = log["safety_state"].to_numpy()
     change = np.flatnonzero(np.diff(s, prepend=-1) != 0)
-    return pd.DataFrame({
-        "time_s": log["time_s"].to_numpy()[change],
-        "state": s[change],
-        "name": [_SAFETY_NAMES[int(v)] for v in s[change]],
-    })
+    return pd.DataFrame(
+        {
+            "time_s": log["time_s"].to_numpy()[change],
+            "state": s[change],
+            "name": [_SAFETY_NAMES[int(v)] for v in s[change]],
+        }
+    )

@@ -57,7 +57,9 @@ def broadband_force(settings: DeviceTestSettings, sample_rate_hz: float, rng: np
         raise LoperInputError(f"broadband_duration_s too short: {settings.broadband_duration_s} s")
     nyq = 0.5 * sample_rate_hz
     if not 0 < settings.broadband_bandwidth_hz < nyq:
-        raise LoperInputError(f"broadband_bandwidth_hz must lie in 0 .. {nyq} Hz, got {settings.broadband_bandwidth_hz}")
+        raise LoperInputError(
+            f"broadband_bandwidth_hz must lie in 0 .. {nyq} Hz, got {settings.broadband_bandwidth_hz}"
+        )
     sos = butter(4, settings.broadband_bandwidth_hz / nyq, output="sos")
     return sosfilt(sos, rng.normal(0.0, settings.broadband_sd_n, n))
 
@@ -73,7 +75,9 @@ def step_force(settings: DeviceTestSettings, sample_rate_hz: float, rng: np.rand
     off = int(round(settings.step_off_s * sample_rate_hz))
     on = int(round(settings.step_on_s * sample_rate_hz))
     if off < 1 or on < 1:
-        raise LoperInputError(f"step_on_s and step_off_s must each hold >= 1 sample, got {settings.step_on_s}, {settings.step_off_s}")
+        raise LoperInputError(
+            f"step_on_s and step_off_s must each hold >= 1 sample, got {settings.step_on_s}, {settings.step_off_s}"
+        )
     order = rng.permutation(np.repeat(np.asarray(settings.step_amplitudes_n, float), settings.step_repetitions))
     pieces = [np.concatenate([np.zeros(off), np.full(on, a)]) for a in order]
     return np.concatenate(pieces + [np.zeros(off)])
@@ -102,13 +106,15 @@ def simulate_device_trial(
     fs = device.sample_rate_hz
     fd = broadband_force(settings, fs, rng) if trial == "device-frf" else step_force(settings, fs, rng)
     sim = simulate_device(fd, device, leg, seed=noise_seed)
-    return pd.DataFrame({
-        "time_s": sim["time_s"],
-        "force_desired_n": sim["force_desired_n"],
-        "force_measured_n": sim["force_measured_n"],
-        "motor_angle_rad": sim["motor_angle_rad"],
-        "motor_velocity_rad_s": sim["motor_velocity_rad_s"],
-        "sync_v": sync_signal(len(fd), settings, fs),
-        "perturbation": (np.abs(fd) > 0).astype(np.int64),
-        "safety_state": sim["safety_state"].astype(np.int64),
-    })
+    return pd.DataFrame(
+        {
+            "time_s": sim["time_s"],
+            "force_desired_n": sim["force_desired_n"],
+            "force_measured_n": sim["force_measured_n"],
+            "motor_angle_rad": sim["motor_angle_rad"],
+            "motor_velocity_rad_s": sim["motor_velocity_rad_s"],
+            "sync_v": sync_signal(len(fd), settings, fs),
+            "perturbation": (np.abs(fd) > 0).astype(np.int64),
+            "safety_state": sim["safety_state"].astype(np.int64),
+        }
+    )

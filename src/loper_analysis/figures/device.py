@@ -27,8 +27,9 @@ def bode_figure(frf: pd.DataFrame, bandwidth_hz: float) -> Figure:
     f = frf["frequency_hz"]
     keep = f <= 100
     study = STUDY_DEVICE["bandwidth_hz"][0]
-    fig, axes = plt.subplots(3, 1, figsize=(6.5, 7), sharex=True, constrained_layout=True,
-                             gridspec_kw={"height_ratios": [3, 2, 1]})
+    fig, axes = plt.subplots(
+        3, 1, figsize=(6.5, 7), sharex=True, constrained_layout=True, gridspec_kw={"height_ratios": [3, 2, 1]}
+    )
     axes[0].semilogx(f[keep], 20 * np.log10(frf["gain"][keep]), color="k")
     axes[0].axvline(bandwidth_hz, color="tab:blue", ls="--", label=f"bandwidth {bandwidth_hz:.1f} Hz")
     axes[0].axvline(study, color="tab:red", ls=":", label=f"study {study:g} Hz")
@@ -55,8 +56,9 @@ def steps_figure(average: pd.DataFrame) -> Figure:
     for (a, g), color in zip(average.groupby("amplitude_n"), ("tab:blue", "tab:orange", "tab:green", "tab:red")):
         t = 1e3 * g["time_s"]
         ax.plot(t, g["measured_n"], color=color, label=f"{a:.0f} N")
-        ax.fill_between(t, g["measured_n"] - g["measured_sd_n"], g["measured_n"] + g["measured_sd_n"],
-                        color=color, alpha=0.25, lw=0)
+        ax.fill_between(
+            t, g["measured_n"] - g["measured_sd_n"], g["measured_n"] + g["measured_sd_n"], color=color, alpha=0.25, lw=0
+        )
         ax.axhline(a, color=color, ls="--", lw=0.8)
     ax.set_xlabel("time after step onset (ms)")
     ax.set_ylabel("interaction force (N)")

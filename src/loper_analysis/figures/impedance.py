@@ -52,8 +52,10 @@ IMPEDANCE_STATUSES_SHOWN: tuple[str, ...] = ("ok", "not_identifiable")
 
 _RAD_TO_DEG = 180.0 / np.pi
 #: Columns of a response table (:func:`loper_analysis.responses.subject_onset_response`) that the figure draws.
-RESPONSE_COLUMNS: tuple[str, ...] = ("time_s", *(
-    f"{j}_{kind}" for j in JOINTS for kind in ("rad_mean", "rad_sd", "perturbed_rad_mean", "unperturbed_rad_mean")))
+RESPONSE_COLUMNS: tuple[str, ...] = (
+    "time_s",
+    *(f"{j}_{kind}" for j in JOINTS for kind in ("rad_mean", "rad_sd", "perturbed_rad_mean", "unperturbed_rad_mean")),
+)
 #: Columns of a fit-curve table (measured and model response per joint).
 CURVE_COLUMNS: tuple[str, ...] = ("time_s", *(f"{j}_{kind}_rad" for j in JOINTS for kind in ("measured", "model")))
 _K, _D = parameter_column("K"), parameter_column("D")
@@ -64,7 +66,9 @@ _IMPEDANCE_COLUMNS = ("subject", "onset_ms", "joint", _K, _D, _K_TRUE, _D_TRUE, 
 # --------------------------------------------------------------------------- reading
 
 
-def _usable(table: pd.DataFrame | None, columns: Sequence[str], numeric: Sequence[str], source: str) -> pd.DataFrame | None:
+def _usable(
+    table: pd.DataFrame | None, columns: Sequence[str], numeric: Sequence[str], source: str
+) -> pd.DataFrame | None:
     """The table with ``numeric`` columns as float; None when it has no rows.
 
     Checks that ``columns`` are present (only when there are rows) and that
@@ -80,20 +84,25 @@ def _usable(table: pd.DataFrame | None, columns: Sequence[str], numeric: Sequenc
         values = pd.to_numeric(table[column], errors="coerce")
         bad = values.isna() & table[column].notna()
         if bad.any():
-            raise LoperInputError(
-                f"{source}: column {column!r} must be numeric, got {table[column][bad].iloc[0]!r}"
-            )
+            raise LoperInputError(f"{source}: column {column!r} must be numeric, got {table[column][bad].iloc[0]!r}")
         table[column] = values.astype(float)
     return table
 
 
-def _onset_panels(name: str, tables: Mapping, columns: Sequence[str], sources: Mapping | None, n_rows: int,
-                  row_height_in: float):
+def _onset_panels(
+    name: str, tables: Mapping, columns: Sequence[str], sources: Mapping | None, n_rows: int, row_height_in: float
+):
     """Checked tables by onset (``(onset_ms, table or None)``) and a figure with one column of panels per onset."""
     items = [(o, _usable(t, columns, columns, s)) for o, t, s in _onset_tables(name, tables, sources)]
     n_cols = len(items)
-    fig, axes = pyplot().subplots(n_rows, n_cols, figsize=(3.2 * n_cols + 0.8, row_height_in * n_rows + 0.8),
-                                  sharex="col", constrained_layout=True, squeeze=False)
+    fig, axes = pyplot().subplots(
+        n_rows,
+        n_cols,
+        figsize=(3.2 * n_cols + 0.8, row_height_in * n_rows + 0.8),
+        sharex="col",
+        constrained_layout=True,
+        squeeze=False,
+    )
     return items, fig, axes
 
 
@@ -149,8 +158,9 @@ def response_peaks(tables: Mapping[int, pd.DataFrame], sources: Mapping | None =
     return peaks
 
 
-def responses_figure(tables: Mapping[int, pd.DataFrame], title: str | None = None,
-                     sources: Mapping | None = None) -> Figure:
+def responses_figure(
+    tables: Mapping[int, pd.DataFrame], title: str | None = None, sources: Mapping | None = None
+) -> Figure:
     """Perturbation responses: joint angles with and without perturbation, and their difference.
 
     One column per onset; per joint two rows: the mean perturbed and mean
@@ -205,12 +215,23 @@ def responses_figure(tables: Mapping[int, pd.DataFrame], title: str | None = Non
                 for ax in (ax_a, ax_d):
                     ax.axvspan(lo, hi, color="0.92", lw=0, zorder=0)
                     ax.axvline(0.0, color="0.6", lw=0.6, ls=":")
-                ax_a.plot(t_ms, table[f"{joint}_unperturbed_rad_mean"].to_numpy() * _RAD_TO_DEG,
-                          color="0.35", lw=1.3, label="unperturbed")
-                ax_a.plot(t_ms, table[f"{joint}_perturbed_rad_mean"].to_numpy() * _RAD_TO_DEG,
-                          color="tab:red", lw=1.3, label="perturbed")
-                ax_d.fill_between(t_ms, (diff - sd) * _RAD_TO_DEG, (diff + sd) * _RAD_TO_DEG,
-                                  color="tab:red", alpha=0.2, lw=0)
+                ax_a.plot(
+                    t_ms,
+                    table[f"{joint}_unperturbed_rad_mean"].to_numpy() * _RAD_TO_DEG,
+                    color="0.35",
+                    lw=1.3,
+                    label="unperturbed",
+                )
+                ax_a.plot(
+                    t_ms,
+                    table[f"{joint}_perturbed_rad_mean"].to_numpy() * _RAD_TO_DEG,
+                    color="tab:red",
+                    lw=1.3,
+                    label="perturbed",
+                )
+                ax_d.fill_between(
+                    t_ms, (diff - sd) * _RAD_TO_DEG, (diff + sd) * _RAD_TO_DEG, color="tab:red", alpha=0.2, lw=0
+                )
                 ax_d.plot(t_ms, diff * _RAD_TO_DEG, color="tab:red", lw=1.3)
                 ax_d.axhline(0.0, color="0.6", lw=0.6)
                 if c == 0:
@@ -223,8 +244,7 @@ def responses_figure(tables: Mapping[int, pd.DataFrame], title: str | None = Non
 # --------------------------------------------------------------------------- fit
 
 
-def fit_figure(tables: Mapping[int, pd.DataFrame], title: str | None = None,
-               sources: Mapping | None = None) -> Figure:
+def fit_figure(tables: Mapping[int, pd.DataFrame], title: str | None = None, sources: Mapping | None = None) -> Figure:
     """Measured perturbation response against the model's fit, per onset and joint.
 
     One column per onset, one row per joint (hip, knee, ankle): the measured
@@ -248,10 +268,21 @@ def fit_figure(tables: Mapping[int, pd.DataFrame], title: str | None = None,
             t_ms = table["time_s"].to_numpy() * 1000.0
             for r, joint in enumerate(JOINTS):
                 ax = axes[r, c]
-                ax.plot(t_ms, table[f"{joint}_measured_rad"].to_numpy() * _RAD_TO_DEG,
-                        color="0.35", lw=1.3, label="measured")
-                ax.plot(t_ms, table[f"{joint}_model_rad"].to_numpy() * _RAD_TO_DEG,
-                        color="tab:red", lw=1.3, ls="--", label="model")
+                ax.plot(
+                    t_ms,
+                    table[f"{joint}_measured_rad"].to_numpy() * _RAD_TO_DEG,
+                    color="0.35",
+                    lw=1.3,
+                    label="measured",
+                )
+                ax.plot(
+                    t_ms,
+                    table[f"{joint}_model_rad"].to_numpy() * _RAD_TO_DEG,
+                    color="tab:red",
+                    lw=1.3,
+                    ls="--",
+                    label="model",
+                )
                 ax.axhline(0.0, color="0.7", lw=0.6)
                 if c == 0:
                     ax.set_ylabel(f"{joint} (deg)")
@@ -297,8 +328,14 @@ def _means(long: pd.DataFrame, onsets: np.ndarray) -> pd.DataFrame:
     """Across-subject mean per onset and parameter from the long form of :func:`_impedance_long`."""
     values = long.pivot(index="onset_ms", columns=["parameter", "subject"], values="value")
     mean = pd.DataFrame(
-        {p: (values[p].mean(axis=1, skipna=True) if p in values.columns.get_level_values(0)
-             else pd.Series(np.nan, index=values.index)) for p in PARAMETERS}
+        {
+            p: (
+                values[p].mean(axis=1, skipna=True)
+                if p in values.columns.get_level_values(0)
+                else pd.Series(np.nan, index=values.index)
+            )
+            for p in PARAMETERS
+        }
     ).reindex(onsets)
     mean.index.name = "onset_ms"
     mean.columns.name = None
@@ -345,8 +382,9 @@ def impedance_figure(table: pd.DataFrame, source: str = "impedance table") -> Fi
     mean = _means(long, onsets)
     joints = [j for j in JOINTS if j != "ankle" or mean[[f"K_{j}", f"D_{j}"]].notna().any().any()]
     plt = pyplot()
-    fig, axes = plt.subplots(2, len(joints), figsize=(3.3 * len(joints) + 0.6, 5.8),
-                             sharex=True, constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(
+        2, len(joints), figsize=(3.3 * len(joints) + 0.6, 5.8), sharex=True, constrained_layout=True, squeeze=False
+    )
     with closed_on_error(fig):
         subjects = sorted(long["subject"].unique())
         for c, joint in enumerate(joints):
@@ -355,14 +393,13 @@ def impedance_figure(table: pd.DataFrame, source: str = "impedance table") -> Fi
                 part = long[long["parameter"] == parameter]
                 for s in subjects:
                     one = part[part["subject"] == s].set_index("onset_ms").reindex(onsets)
-                    ax.plot(onsets, one["value"].to_numpy(), color="0.65", lw=0.9, marker="o", ms=3,
-                            zorder=2)
+                    ax.plot(onsets, one["value"].to_numpy(), color="0.65", lw=0.9, marker="o", ms=3, zorder=2)
                     truth = one["truth"].to_numpy()
                     if np.isfinite(truth).any():
-                        ax.plot(onsets, truth, ls="none", marker="o", ms=4.5, mfc="none",
-                                mec="tab:blue", mew=0.9, zorder=3)
-                ax.plot(onsets, mean[parameter].to_numpy(), color="black", lw=2.0, marker="o", ms=5,
-                        zorder=4)
+                        ax.plot(
+                            onsets, truth, ls="none", marker="o", ms=4.5, mfc="none", mec="tab:blue", mew=0.9, zorder=3
+                        )
+                ax.plot(onsets, mean[parameter].to_numpy(), color="black", lw=2.0, marker="o", ms=5, zorder=4)
                 ax.set_title(parameter)
                 ax.set_ylabel(f"{kind} ({PARAMETER_UNITS[parameter]})")
                 ax.set_xticks(onsets)
@@ -370,8 +407,10 @@ def impedance_figure(table: pd.DataFrame, source: str = "impedance table") -> Fi
                     ax.set_xlabel("perturbation onset (ms)")
         from matplotlib.lines import Line2D
 
-        handles = [Line2D([], [], color="0.65", marker="o", ms=3, lw=0.9, label="subject"),
-                   Line2D([], [], color="black", marker="o", ms=5, lw=2.0, label="mean")]
+        handles = [
+            Line2D([], [], color="0.65", marker="o", ms=3, lw=0.9, label="subject"),
+            Line2D([], [], color="black", marker="o", ms=5, lw=2.0, label="mean"),
+        ]
         if long["truth"].notna().any():
             handles.append(Line2D([], [], ls="none", marker="o", mfc="none", mec="tab:blue", label="truth"))
         axes[0, 0].legend(handles=handles, fontsize=7, loc="best")

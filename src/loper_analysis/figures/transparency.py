@@ -58,8 +58,16 @@ def transparency_figure(
     if not conditions:
         fig = pyplot().figure(figsize=(5.5, 2.0))
         ax = fig.add_subplot()
-        ax.text(0.5, 0.5, "no subject with enough kept strides in both conditions", transform=ax.transAxes,
-                ha="center", va="center", color="0.4", fontsize=11)
+        ax.text(
+            0.5,
+            0.5,
+            "no subject with enough kept strides in both conditions",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+            color="0.4",
+            fontsize=11,
+        )
         ax.set_axis_off()
         if title:
             fig.suptitle(title)
@@ -86,11 +94,13 @@ def transparency_figure(
     colors = {"no_device": "0.35", "device": "tab:blue"}
     labels = {"no_device": "without device", "device": "with device"}
     n_panels = len(joints) + (force is not None)
-    fig, axes = plt.subplots(n_panels, 1, figsize=(5.5, 2.0 * n_panels + 0.6), sharex=True,
-                             constrained_layout=True, squeeze=False)
+    fig, axes = plt.subplots(
+        n_panels, 1, figsize=(5.5, 2.0 * n_panels + 0.6), sharex=True, constrained_layout=True, squeeze=False
+    )
     axes = axes[:, 0]
 
     with closed_on_error(fig):
+
         def band(ax, x, color, label):
             m, s = x.mean(axis=0), x.std(axis=0, ddof=1)
             pct = np.linspace(0.0, 100.0, m.size)

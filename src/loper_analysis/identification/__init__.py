@@ -35,6 +35,7 @@ from .fit import (
     starts_at_best,
     variance_accounted_for,
 )
+from .intervals import CI_LEVEL, bounded_interval, t_quantile
 from .null_pairs import (
     NullPairFit,
     cross_validated_covariance,
@@ -42,7 +43,6 @@ from .null_pairs import (
     null_pair_errors,
     refit_with_null_pairs,
 )
-from .intervals import CI_LEVEL, bounded_interval, t_quantile
 from .status import AT_BOUND_FRACTION, DEFAULT_PLAUSIBLE_RANGES, MIN_VAF_PCT, check_plausible_range, joint_status
 from .window import (
     PreparedWindow,

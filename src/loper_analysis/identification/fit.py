@@ -190,8 +190,14 @@ def initial_state_jacobian(window: PreparedWindow, impedance) -> np.ndarray:
     return G
 
 
-def _merge_close(points: np.ndarray, cost: np.ndarray, active: np.ndarray, merged_into: np.ndarray, scale: np.ndarray,
-                 merge_tol: float) -> None:
+def _merge_close(
+    points: np.ndarray,
+    cost: np.ndarray,
+    active: np.ndarray,
+    merged_into: np.ndarray,
+    scale: np.ndarray,
+    merge_tol: float,
+) -> None:
     """Stop each active start within ``merge_tol`` (fraction of ``scale``, every parameter) of a better active one."""
     ids = np.flatnonzero(active)
     if merge_tol <= 0 or ids.size < 2:
@@ -295,8 +301,13 @@ def starts_at_best(start_costs, relative: float = AT_BEST_RELATIVE) -> int:
     A cost of +inf (a start whose simulation diverged) never counts; at least one cost must be finite.
     """
     costs = np.asarray(start_costs, dtype=float)
-    if costs.ndim != 1 or costs.size == 0 or np.any(np.isnan(costs)) or np.any(costs < 0) \
-            or not np.any(np.isfinite(costs)):
+    if (
+        costs.ndim != 1
+        or costs.size == 0
+        or np.any(np.isnan(costs))
+        or np.any(costs < 0)
+        or not np.any(np.isfinite(costs))
+    ):
         raise LoperInputError(f"start costs must be a non-empty array >= 0 (+inf allowed, not all), got {costs}")
     best = costs.min()
     return int(np.sum(costs <= best * (1.0 + relative)))
@@ -374,8 +385,16 @@ def identify_impedance(
         return batch.residuals_and_jacobians(p[None])[1][0]
 
     polish = least_squares(
-        fun, points[best], jac=jac, bounds=(lb, ub), method="trf", x_scale=batch.typical * 100,
-        ftol=1e-14, xtol=1e-14, gtol=1e-14, max_nfev=int(polish_max_evaluations),
+        fun,
+        points[best],
+        jac=jac,
+        bounds=(lb, ub),
+        method="trf",
+        x_scale=batch.typical * 100,
+        ftol=1e-14,
+        xtol=1e-14,
+        gtol=1e-14,
+        max_nfev=int(polish_max_evaluations),
     )
     estimate = np.clip(polish.x, lb, ub)
     if float(np.sum(polish.fun**2)) > costs[best]:  # keep the better of the two (trf steps inside bounds)
@@ -384,8 +403,13 @@ def identify_impedance(
     r, J = r[0], J[0]
     pe = prediction_error(window, estimate)
     success = bool(polish.status > 0)
-    message = polish.message if success else (
-        f"not converged: multistart LM converged={bool(converged[best])}, polish status {polish.status} ({polish.message})"
+    message = (
+        polish.message
+        if success
+        else (
+            f"not converged: multistart LM converged={bool(converged[best])}, "
+            f"polish status {polish.status} ({polish.message})"
+        )
     )
     # confidence intervals and correlations from the Jacobian. Without
     # noise_cov: white residual noise plus the uncertainty of the initial

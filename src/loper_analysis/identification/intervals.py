@@ -19,7 +19,9 @@ covariance (:func:`loper_analysis.identification.refit_with_null_pairs`).
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import stdtrit  # Student's t quantile (what scipy.stats.t.ppf calls; scipy.stats costs ~0.5 s to import)
+from scipy.special import (
+    stdtrit,  # Student's t quantile (what scipy.stats.t.ppf calls; scipy.stats costs ~0.5 s to import)
+)
 
 from ..errors import LoperInputError
 
@@ -59,8 +61,9 @@ def bounded_interval(estimate, sd, dof: float, lower, upper, level: float = CI_L
     est, s = np.asarray(estimate, dtype=float), np.asarray(sd, dtype=float)
     lb, ub = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
     if not (est.shape == s.shape == lb.shape == ub.shape):
-        raise LoperInputError(f"estimate, sd and bounds must have one shape, got {est.shape}, {s.shape}, "
-                              f"{lb.shape}, {ub.shape}")
+        raise LoperInputError(
+            f"estimate, sd and bounds must have one shape, got {est.shape}, {s.shape}, {lb.shape}, {ub.shape}"
+        )
     if np.any(np.isnan(s)) or np.any(s < 0):
         raise LoperInputError(f"standard deviations must be >= 0 (inf allowed), got {s}")
     if np.any(est < lb) or np.any(est > ub):
@@ -84,8 +87,10 @@ def sandwich_covariance(jacobian, noise_cov, weight=None) -> np.ndarray:
     C = np.asarray(noise_cov, dtype=float)
     m = J.shape[0]
     if J.ndim != 2 or C.shape != (m, m) or (weight is not None and np.shape(weight) != (m, m)):
-        raise LoperInputError(f"sandwich: jacobian (m, p), noise_cov and weight (m, m) expected, got {J.shape}, "
-                              f"{C.shape}, {np.shape(weight)}")
+        raise LoperInputError(
+            f"sandwich: jacobian (m, p), noise_cov and weight (m, m) expected, got {J.shape}, "
+            f"{C.shape}, {np.shape(weight)}"
+        )
     M = np.linalg.pinv(J.T @ J, rcond=1e-13) @ J.T
     if weight is not None:
         M = M @ np.asarray(weight, dtype=float)

@@ -22,12 +22,24 @@ import numpy as np
 
 from ..dynamics import joint_angles
 from ..errors import LoperInputError
-from .fit import DEFAULT_LOWER, DEFAULT_UPPER, ImpedanceFit, identify_impedance, initial_state_jacobian, response_jacobian
+from .fit import (
+    DEFAULT_LOWER,
+    DEFAULT_UPPER,
+    ImpedanceFit,
+    identify_impedance,
+    initial_state_jacobian,
+    response_jacobian,
+)
 from .intervals import bounded_interval
 from .window import PreparedWindow, initial_state_basis
 
-__all__ = ["NullPairFit", "null_pair_errors", "nuisance_projection", "cross_validated_covariance",
-           "refit_with_null_pairs"]
+__all__ = [
+    "NullPairFit",
+    "null_pair_errors",
+    "nuisance_projection",
+    "cross_validated_covariance",
+    "refit_with_null_pairs",
+]
 
 
 @dataclass
@@ -61,30 +73,42 @@ def null_pair_errors(window: PreparedWindow, impedance, null_pairs: dict) -> np.
     """
     t = np.asarray(null_pairs["time_s"], dtype=float) + window.onset_s
     qp, qu = (np.asarray(null_pairs[k], dtype=float) for k in ("q_perturbed", "q_unperturbed"))
-    pp, pu = (np.asarray(null_pairs[k], dtype=float) for k in ("pelvis_angle_perturbed_rad",
-                                                               "pelvis_angle_unperturbed_rad"))
+    pp, pu = (
+        np.asarray(null_pairs[k], dtype=float) for k in ("pelvis_angle_perturbed_rad", "pelvis_angle_unperturbed_rad")
+    )
     n_pairs = qp.shape[0]
-    if qp.ndim != 3 or qp.shape != qu.shape or qp.shape[1:] != (t.size, 4) or pp.shape != qp.shape[:2] \
-            or pu.shape != pp.shape:
-        raise LoperInputError(f"null pairs: q arrays must be (M, {t.size}, 4) and pelvis angles (M, {t.size}); got "
-                              f"{qp.shape}, {qu.shape}, {pp.shape}, {pu.shape}")
+    if (
+        qp.ndim != 3
+        or qp.shape != qu.shape
+        or qp.shape[1:] != (t.size, 4)
+        or pp.shape != qp.shape[:2]
+        or pu.shape != pp.shape
+    ):
+        raise LoperInputError(
+            f"null pairs: q arrays must be (M, {t.size}, 4) and pelvis angles (M, {t.size}); got "
+            f"{qp.shape}, {qu.shape}, {pp.shape}, {pu.shape}"
+        )
     m = 3 * window.n_samples
     if n_pairs < 1:
         raise LoperInputError("null pairs: none given")
     tol = 1e-6 * window.step_s * window.n_substeps
     idx = np.searchsorted(t, window.time_s - tol)
     if np.any(idx >= t.size) or np.any(np.abs(t[np.minimum(idx, t.size - 1)] - window.time_s) > tol):
-        raise LoperInputError(f"null pairs: their grid ({t[0]:.4f} .. {t[-1]:.4f} s) does not hold the window's "
-                              f"samples ({window.time_s[0]:.4f} .. {window.time_s[-1]:.4f} s)")
+        raise LoperInputError(
+            f"null pairs: their grid ({t[0]:.4f} .. {t[-1]:.4f} s) does not hold the window's "
+            f"samples ({window.time_s[0]:.4f} .. {window.time_s[-1]:.4f} s)"
+        )
     sel = (t >= window.onset_s - window.initial_state_span_s - tol) & (t <= window.onset_s + tol)
     V = initial_state_basis(t[sel] - window.time_s[0], window.initial_state_degree)
     dq = qp - qu
     coef, *_ = np.linalg.lstsq(V, np.moveaxis(dq[:, sel], 1, 0).reshape(sel.sum(), -1), rcond=None)
     coef = coef.reshape(V.shape[1], n_pairs, 4)
     s0 = np.concatenate([coef[0], coef[1] if window.initial_state_degree >= 1 else np.zeros((n_pairs, 4))], axis=1)
-    eps = np.stack([joint_angles(qp[i, idx], pp[i, idx]) - joint_angles(qu[i, idx], pu[i, idx])
-                    for i in range(n_pairs)]).reshape(n_pairs, m)
+    eps = np.stack(
+        [joint_angles(qp[i, idx], pp[i, idx]) - joint_angles(qu[i, idx], pu[i, idx]) for i in range(n_pairs)]
+    ).reshape(n_pairs, m)
     return eps - s0 @ initial_state_jacobian(window, impedance).T
+
 
 def nuisance_projection(errors, n_components: int) -> np.ndarray:
     """Projection (m, m) that removes the ``n_components`` dominant shapes of ``errors``.
@@ -100,8 +124,10 @@ def nuisance_projection(errors, n_components: int) -> np.ndarray:
         raise LoperInputError(f"errors must be a finite (M, m) array, got shape {E.shape}")
     r = int(n_components)
     if r != n_components or not 0 <= r < min(E.shape):
-        raise LoperInputError(f"n_components must be an integer in 0 .. {min(E.shape) - 1} "
-                              f"(M = {E.shape[0]} null pairs, m = {E.shape[1]}), got {n_components}")
+        raise LoperInputError(
+            f"n_components must be an integer in 0 .. {min(E.shape) - 1} "
+            f"(M = {E.shape[0]} null pairs, m = {E.shape[1]}), got {n_components}"
+        )
     _, _, vt = np.linalg.svd(E - E.mean(axis=0), full_matrices=False)
     return np.eye(E.shape[1]) - vt[:r].T @ vt[:r]
 
@@ -125,8 +151,10 @@ def cross_validated_covariance(errors, n_components: int, jacobian, n_averaged: 
     J = np.asarray(jacobian, dtype=float)
     n = E.shape[0]
     if E.ndim != 2 or J.ndim != 2 or J.shape[0] != E.shape[1] or n < int(n_components) + 3 or int(n_averaged) < 1:
-        raise LoperInputError(f"cross-validated covariance: errors (N, m) with N >= n_components + 3, jacobian (m, p) "
-                              f"and n_averaged >= 1 expected, got {E.shape}, {J.shape}, {n_components}, {n_averaged}")
+        raise LoperInputError(
+            f"cross-validated covariance: errors (N, m) with N >= n_components + 3, jacobian (m, p) "
+            f"and n_averaged >= 1 expected, got {E.shape}, {J.shape}, {n_components}, {n_averaged}"
+        )
     deltas = np.empty((n, J.shape[1]))
     for i in range(n):
         rest = np.delete(E, i, axis=0)
@@ -135,9 +163,17 @@ def cross_validated_covariance(errors, n_components: int, jacobian, n_averaged: 
     return (n - 1) / n * (deltas.T @ deltas) / n / int(n_averaged)
 
 
-def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pairs: dict, n_averaged: int,
-                          n_components: int = 6, min_null_pairs: int = 30, cross_validated: bool = False,
-                          perturbed_pairs: dict | None = None, **fit_options) -> NullPairFit:
+def refit_with_null_pairs(
+    window: PreparedWindow,
+    first: ImpedanceFit,
+    null_pairs: dict,
+    n_averaged: int,
+    n_components: int = 6,
+    min_null_pairs: int = 30,
+    cross_validated: bool = False,
+    perturbed_pairs: dict | None = None,
+    **fit_options,
+) -> NullPairFit:
     """Fit again with the null pairs' dominant shapes projected out and CIs from their covariance.
 
     ``first`` is the white-noise fit of ``window``; ``null_pairs`` as for
@@ -163,8 +199,10 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     """
     n_null = int(null_pairs["n_pairs"])
     if n_null < max(int(min_null_pairs), int(n_components) + 2):
-        note = (f"white-noise fit: {n_null} null pair(s), fewer than min_null_pairs = {min_null_pairs}; "
-                "the CI ignore the stride-to-stride deviation")
+        note = (
+            f"white-noise fit: {n_null} null pair(s), fewer than min_null_pairs = {min_null_pairs}; "
+            "the CI ignore the stride-to-stride deviation"
+        )
         return NullPairFit(first, "white", n_null, note)
     if int(n_averaged) < 1:
         raise LoperInputError(f"n_averaged must be >= 1 (strides in the mean response), got {n_averaged}")
@@ -174,20 +212,25 @@ def refit_with_null_pairs(window: PreparedWindow, first: ImpedanceFit, null_pair
     if perturbed_pairs is not None:
         n_pairs = int(perturbed_pairs["n_pairs"])
         if n_pairs != int(n_averaged) or n_pairs < 3:
-            raise LoperInputError(f"perturbed pairs: {n_pairs} given for a mean of {n_averaged} strides; "
-                                  "the intervals from their scatter need them all, at least 3")
+            raise LoperInputError(
+                f"perturbed pairs: {n_pairs} given for a mean of {n_averaged} strides; "
+                "the intervals from their scatter need them all, at least 3"
+            )
         cov = np.cov(null_pair_errors(window, first.estimate, perturbed_pairs), rowvar=False) / n_averaged
         dof = n_pairs - 1
-    fit = identify_impedance(replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate,
-                             ci_dof=dof, **fit_options)
+    fit = identify_impedance(
+        replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate, ci_dof=dof, **fit_options
+    )
     if cross_validated:
-        G = response_jacobian(window, fit.estimate, fit_options.get("lower", DEFAULT_LOWER),
-                              fit_options.get("upper", DEFAULT_UPPER))
+        G = response_jacobian(
+            window, fit.estimate, fit_options.get("lower", DEFAULT_LOWER), fit_options.get("upper", DEFAULT_UPPER)
+        )
         cv = cross_validated_covariance(errors, n_components, G, n_averaged)
         sd = np.sqrt(np.clip(np.diag(cv), 0, None))
         sd = np.where(np.diag(G.T @ G) > 0, sd, np.inf)
-        low, high = bounded_interval(fit.estimate, sd, dof, fit_options.get("lower", DEFAULT_LOWER),
-                                     fit_options.get("upper", DEFAULT_UPPER))
+        low, high = bounded_interval(
+            fit.estimate, sd, dof, fit_options.get("lower", DEFAULT_LOWER), fit_options.get("upper", DEFAULT_UPPER)
+        )
         with np.errstate(divide="ignore", invalid="ignore"):
             fit = replace(fit, ci95_low=low, ci95_high=high, correlation=cv / np.outer(sd, sd))
     return NullPairFit(fit, "null_pairs", n_null)

@@ -46,22 +46,40 @@ DEFAULT_PLAUSIBLE_RANGES: dict[str, tuple[tuple[float, float], tuple[float, floa
     "ankle": (ANKLE_SWING_IMPEDANCE["K"], ANKLE_SWING_IMPEDANCE["D"]),
 }
 
-_PARAMETERS = (("K", "N·m/rad", "identification.stiffness_bounds_nm_per_rad", "stiffness"),
-               ("D", "N·m·s/rad", "identification.damping_bounds_nms_per_rad", "damping"))
+_PARAMETERS = (
+    ("K", "N·m/rad", "identification.stiffness_bounds_nm_per_rad", "stiffness"),
+    ("D", "N·m·s/rad", "identification.damping_bounds_nms_per_rad", "damping"),
+)
 
 
 def check_plausible_range(joint: str, plausible_range) -> np.ndarray:
-    """The plausible range of a joint as a (2, 2) array ``[[K low, K high], [D low, D high]]``, each ``0 <= low < high``."""
+    """The plausible range of a joint as a (2, 2) array ``[[K low, K high], [D low, D high]]``, each
+    ``0 <= low < high``."""
     r = np.asarray(plausible_range, dtype=float)
     if r.shape != (2, 2) or not np.all(np.isfinite(r)) or np.any(r[:, 0] < 0) or np.any(r[:, 0] >= r[:, 1]):
-        raise LoperInputError(f"identification.plausible_ranges of the {joint}: K and D each need [low, high] with "
-                              f"0 <= low < high, got {np.asarray(plausible_range).tolist()}")
+        raise LoperInputError(
+            f"identification.plausible_ranges of the {joint}: K and D each need [low, high] with "
+            f"0 <= low < high, got {np.asarray(plausible_range).tolist()}"
+        )
     return r
 
 
-def joint_status(joint: str, estimate, ci_low, ci_high, vaf_pct: float, lower, upper, *, success: bool = True,
-                 message: str = "", plausible_range=None, max_ci_fraction: float = 1.0,
-                 min_vaf_pct: float = MIN_VAF_PCT, at_bound_fraction: float = AT_BOUND_FRACTION) -> tuple[str, str]:
+def joint_status(
+    joint: str,
+    estimate,
+    ci_low,
+    ci_high,
+    vaf_pct: float,
+    lower,
+    upper,
+    *,
+    success: bool = True,
+    message: str = "",
+    plausible_range=None,
+    max_ci_fraction: float = 1.0,
+    min_vaf_pct: float = MIN_VAF_PCT,
+    at_bound_fraction: float = AT_BOUND_FRACTION,
+) -> tuple[str, str]:
     """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
 
     Parameters
@@ -104,18 +122,24 @@ def joint_status(joint: str, estimate, ci_low, ci_high, vaf_pct: float, lower, u
     if not np.isfinite(vaf_pct):
         failed.append(f"VAF of the {joint} undefined: its measured response is zero over the fit window")
     elif vaf_pct < min_vaf_pct:
-        failed.append(f"VAF {vaf_pct:.3g} % below identification.min_vaf_pct = {min_vaf_pct:g} %: "
-                      f"the model does not describe the {joint} response")
+        failed.append(
+            f"VAF {vaf_pct:.3g} % below identification.min_vaf_pct = {min_vaf_pct:g} %: "
+            f"the model does not describe the {joint} response"
+        )
     span = ub - lb
     for i, (p, unit, key, what) in enumerate(_PARAMETERS):
         tol = at_bound_fraction * span[i]
         name = f"{p}_{joint} = {est[i]:.6g} {unit}"
         if est[i] >= ub[i] - tol:
-            unidentifiable.append(f"{name} at its upper bound {ub[i]:g} {unit} ({key}): the data ask for more "
-                                  f"{what} than the bounds allow")
+            unidentifiable.append(
+                f"{name} at its upper bound {ub[i]:g} {unit} ({key}): the data ask for more "
+                f"{what} than the bounds allow"
+            )
         elif est[i] <= lb[i] + tol and lb[i] != 0:
-            unidentifiable.append(f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
-                                  f"less {what} than the bounds allow")
+            unidentifiable.append(
+                f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
+                f"less {what} than the bounds allow"
+            )
     for i, (p, unit, _, what) in enumerate(_PARAMETERS):
         if plausible is None or np.isnan(low[i]) or np.isnan(high[i]):
             continue
@@ -124,9 +148,12 @@ def joint_status(joint: str, estimate, ci_low, ci_high, vaf_pct: float, lower, u
             unidentifiable.append(
                 f"{p}_{joint} = {est[i]:.3g} {unit}, 95 % CI {low[i]:.3g} … {high[i]:.3g} {unit}: holds both "
                 f"{lb[i]:g} and the plausible range {r_low:g}–{r_high:g} {unit} (identification.plausible_ranges), "
-                f"the data cannot tell the {what} from {lb[i]:g}")
+                f"the data cannot tell the {what} from {lb[i]:g}"
+            )
     if not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
-        unidentifiable.append(f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "
-                              f"{max_ci_fraction:g} of the bounds")
+        unidentifiable.append(
+            f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "
+            f"{max_ci_fraction:g} of the bounds"
+        )
     status = "failed" if failed else ("not_identifiable" if unidentifiable else "ok")
     return status, "; ".join(failed + unidentifiable)

@@ -1,4 +1,5 @@
-"""The identification window: one perturbed/unperturbed pair prepared for the compiled simulation, and its model response.
+"""The identification window: one perturbed/unperturbed pair prepared for the compiled simulation, and its model
+response.
 
 :func:`prepare_window` checks the inputs of one fit and precomputes the
 reference (a cubic spline of the unperturbed coordinates), the feedforward
@@ -305,8 +306,9 @@ def per_step(stage: np.ndarray) -> np.ndarray:
     return np.stack([stage[:-1:2], stage[1::2], stage[1::2], stage[2::2]], axis=1)
 
 
-def step_stage_forces(force_time_s: np.ndarray, force_n: np.ndarray, start_s: float, step_s: float,
-                      n_steps: int) -> np.ndarray:
+def step_stage_forces(
+    force_time_s: np.ndarray, force_n: np.ndarray, start_s: float, step_s: float, n_steps: int
+) -> np.ndarray:
     """Stage forces (n_steps, 4, 2) that give each RK4 step the exact response of a linear system to the force.
 
     RK4 on ``y' = A y + b F(t)`` adds per step of length h
@@ -416,7 +418,8 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
 
 
 def joint_angle_deviation(deviation: np.ndarray, pelvis_angle_deviation_rad: np.ndarray) -> np.ndarray:
-    """Joint-angle deviations (..., n_out, 3) in rad from coordinate deviations (..., n_out, 4) and the pelvis angle's."""
+    """Joint-angle deviations (..., n_out, 3) in rad from coordinate deviations (..., n_out, 4) and the pelvis
+    angle's."""
     e, dpel = deviation, pelvis_angle_deviation_rad
     return np.stack([dpel - e[..., 1], e[..., 2] - e[..., 1], e[..., 2] - e[..., 3]], axis=-1)
 

@@ -189,8 +189,9 @@ class C3DRecording:
 
 def _no_events() -> pd.DataFrame:
     """An empty event table (columns :data:`~loper_analysis.io.c3d_parameters.EVENT_COLUMNS`)."""
-    return pd.DataFrame({"context": pd.Series(dtype=object), "label": pd.Series(dtype=object),
-                         "time_s": pd.Series(dtype=float)})
+    return pd.DataFrame(
+        {"context": pd.Series(dtype=object), "label": pd.Series(dtype=object), "time_s": pd.Series(dtype=float)}
+    )
 
 
 def rate_ratio(point_rate_hz: float, analog_rate_hz: float, source: str) -> int:
@@ -215,9 +216,7 @@ def _labels_for(params, group: str, n: int, source: str) -> list[str]:
 def _point_units_per_m(params, source: str) -> float:
     units = param_strings(params, "POINT", "UNITS")
     if not units or not units[0]:
-        raise LoperInputError(
-            f"{source}: POINT:UNITS not declared; cannot tell whether markers are in mm, cm or m"
-        )
+        raise LoperInputError(f"{source}: POINT:UNITS not declared; cannot tell whether markers are in mm, cm or m")
     unit = units[0].lower()
     if unit not in LENGTH_UNITS_PER_M:
         raise LoperInputError(
@@ -246,8 +245,13 @@ def _raw_header(path: Path) -> dict:
         rate = struct.unpack("<f", head[22:24] + head[20:22])[0] / 4.0
     else:
         rate = struct.unpack(order + "f", head[20:24])[0]
-    return {"analog_words": analog_words, "first": first, "last": last, "samples_per_frame": samples_per_frame,
-            "point_rate_hz": float(rate)}
+    return {
+        "analog_words": analog_words,
+        "first": first,
+        "last": last,
+        "samples_per_frame": samples_per_frame,
+        "point_rate_hz": float(rate),
+    }
 
 
 def _header_frames(path: Path) -> int | None:
@@ -337,10 +341,12 @@ def _check_storage_format(path: Path, data_start: int, scale: float, n_frames: i
         return
     if not as_float and not any(_tail(path, data_at + need)):
         return  # zeros after the declared block: padding or spare blocks, not float data
-    sizes = (f"{n_frames} frames of {words_per_frame} words need {need} bytes as "
-             f"{'4-byte floats' if as_float else '16-bit integers'} ({need_other} as "
-             f"{'16-bit integers' if as_float else '4-byte floats'}) after POINT:DATA_START = {int(data_start)} "
-             f"(byte {data_at}); the file holds {present} bytes there")
+    sizes = (
+        f"{n_frames} frames of {words_per_frame} words need {need} bytes as "
+        f"{'4-byte floats' if as_float else '16-bit integers'} ({need_other} as "
+        f"{'16-bit integers' if as_float else '4-byte floats'}) after POINT:DATA_START = {int(data_start)} "
+        f"(byte {data_at}); the file holds {present} bytes there"
+    )
     if as_float:
         raise LoperInputError(
             f"{path}: POINT:SCALE = {scale:g} (negative) declares 4-byte float data, but the data block "
@@ -371,8 +377,9 @@ def _check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> Non
         raise LoperInputError(f"{source}: POINT:DATA_START not declared")
     scale_value = None if scale is None or len(scale) == 0 else float(np.ravel(scale)[0])
     if scale_value is not None and np.isfinite(scale_value):
-        _check_storage_format(path, int(start[0]), scale_value, n_frames if declared is None else declared,
-                              words_per_frame)
+        _check_storage_format(
+            path, int(start[0]), scale_value, n_frames if declared is None else declared, words_per_frame
+        )
     if declared is not None and n_frames < declared:
         raise LoperInputError(
             f"{source}: truncated file: the header declares {declared} frames but only {n_frames} could be read"
@@ -401,8 +408,7 @@ def _open_c3d(path: Path):
         return ezc3d.c3d(source)
     except Exception as exc:  # ezc3d raises OSError, RuntimeError, ValueError, ... for damaged files
         raise LoperInputError(
-            f"{source}: not a readable C3D file (truncated, damaged or another format): "
-            f"{type(exc).__name__}: {exc}"
+            f"{source}: not a readable C3D file (truncated, damaged or another format): {type(exc).__name__}: {exc}"
         ) from exc
 
 
@@ -510,5 +516,3 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         events=read_events(params, source),
         n_force_platforms=_force_platforms_used(params),
     )
-
-

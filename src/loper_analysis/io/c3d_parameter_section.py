@@ -27,7 +27,7 @@ _PROCESSORS = {84: "<", 85: "<", 86: ">"}  # Intel, DEC (little-endian integers)
 def _floats(raw: bytes, order: str, dec: bool) -> np.ndarray:
     """4-byte floats: IEEE in the given byte order, or DEC F-floats (16-bit halves swapped, exponent bias 2 higher)."""
     if dec:
-        swapped = b"".join(raw[i + 2:i + 4] + raw[i:i + 2] for i in range(0, len(raw), 4))
+        swapped = b"".join(raw[i + 2 : i + 4] + raw[i : i + 2] for i in range(0, len(raw), 4))
         return np.frombuffer(swapped, "<f4").astype(float) / 4.0
     return np.frombuffer(raw, order + "f4").astype(float)
 
@@ -66,12 +66,12 @@ def read_parameter(path: str | os.PathLike, group: str, name: str):
     pos = 4
     try:
         while pos + 2 <= len(section):
-            n_chars, ident = struct.unpack("bb", section[pos:pos + 2])
+            n_chars, ident = struct.unpack("bb", section[pos : pos + 2])
             if n_chars == 0:
                 break
-            label = section[pos + 2:pos + 2 + abs(n_chars)].decode("latin-1").upper()
+            label = section[pos + 2 : pos + 2 + abs(n_chars)].decode("latin-1").upper()
             here = pos + 2 + abs(n_chars)
-            (step,) = struct.unpack(order + "h", section[here:here + 2])
+            (step,) = struct.unpack(order + "h", section[here : here + 2])
             if ident < 0:
                 groups[-ident] = label
             elif groups.get(ident) == group.upper() and label == name.upper():
@@ -86,12 +86,12 @@ def read_parameter(path: str | os.PathLike, group: str, name: str):
 
 def _value(section: bytes, pos: int, order: str, dec: bool):
     """The value of the parameter record whose type byte is at ``pos``."""
-    kind, n_dims = struct.unpack("bb", section[pos:pos + 2])
-    dims = list(section[pos + 2:pos + 2 + n_dims])
+    kind, n_dims = struct.unpack("bb", section[pos : pos + 2])
+    dims = list(section[pos + 2 : pos + 2 + n_dims])
     data = pos + 2 + n_dims
     count = int(np.prod(dims)) if dims else 1
     size = count * abs(kind)
-    raw = section[data:data + size]
+    raw = section[data : data + size]
     if len(raw) < size:
         raise ValueError(f"parameter data of {size} bytes runs past the section")
     if kind == -1:

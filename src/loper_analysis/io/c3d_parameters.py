@@ -143,5 +143,10 @@ def read_events(params, source: str) -> pd.DataFrame:
             raise LoperInputError(f"{source}: EVENT:USED = {n} but EVENT:TIMES holds {times.size} time(s)")
     contexts = (param_strings(params, "EVENT", "CONTEXTS") + [""] * n)[:n]
     labels = (param_strings(params, "EVENT", "LABELS") + [""] * n)[:n]
-    return pd.DataFrame({"context": pd.Series(contexts, dtype=object), "label": pd.Series(labels, dtype=object),
-                         "time_s": times[:n].astype(float)})
+    return pd.DataFrame(
+        {
+            "context": pd.Series(contexts, dtype=object),
+            "label": pd.Series(labels, dtype=object),
+            "time_s": times[:n].astype(float),
+        }
+    )

@@ -93,7 +93,9 @@ class ForcePlatform:
         if np.linalg.norm(np.cross(x_axis, y_axis)) <= 1e-12 * max(1.0, float(np.abs(corners).max()) ** 2):
             raise LoperInputError(f"{source}: corners_m do not span a plane (corners 1-2 and 1-4 are parallel)")
         origin = _finite_array(self.origin_m, (3,), "origin_m", source)
-        channels = [integer("channels", c, source, minimum=1) for c in np.ravel(np.asarray(self.channels, dtype=object))]
+        channels = [
+            integer("channels", c, source, minimum=1) for c in np.ravel(np.asarray(self.channels, dtype=object))
+        ]
         if len(channels) != _PLATFORM_CHANNELS[kind] or len(set(channels)) != len(channels):
             raise LoperInputError(
                 f"{source}: channels must be {_PLATFORM_CHANNELS[kind]} different 1-based channel numbers, "
@@ -117,8 +119,13 @@ class ForcePlatform:
         """A platform from a mapping with the C3D names ``TYPE``, ``CORNERS`` (m), ``ORIGIN`` (m), ``CHANNEL``
         and, for TYPE 4, ``CAL_MATRIX`` (or with the attribute names)."""
         keys = {str(k).upper(): v for k, v in plate.items()}
-        names = {"TYPE": "TYPE", "CORNERS": "CORNERS_M", "ORIGIN": "ORIGIN_M", "CHANNEL": "CHANNELS",
-                 "CAL_MATRIX": "CAL_MATRIX"}
+        names = {
+            "TYPE": "TYPE",
+            "CORNERS": "CORNERS_M",
+            "ORIGIN": "ORIGIN_M",
+            "CHANNEL": "CHANNELS",
+            "CAL_MATRIX": "CAL_MATRIX",
+        }
         values = {}
         for c3d_name, attribute in names.items():
             for key in (c3d_name, attribute):
@@ -167,7 +174,8 @@ def _points_for_file(markers_m, units_per_m: float, source: str) -> tuple[np.nda
 
 
 def _analogs_for_file(analogs, n_channels: int, n_samples: int, source: str) -> np.ndarray:
-    """ezc3d analogs (1, n_channels, n_samples) from (n_samples, n_channels); refuses wrong shapes and non-finite values."""
+    """ezc3d analogs (1, n_channels, n_samples) from (n_samples, n_channels); refuses wrong shapes and non-finite
+    values."""
     A = np.zeros((n_samples, 0)) if analogs is None else np.asarray(analogs, dtype=float)
     if A.ndim != 2 or A.shape != (n_samples, n_channels):
         raise LoperInputError(
@@ -181,8 +189,9 @@ def _analogs_for_file(analogs, n_channels: int, n_samples: int, source: str) -> 
     return A.T[np.newaxis]
 
 
-def _extras_payload(first_frame, force_platforms, analog_scales, analog_offsets, events, n_ch: int,
-                    units_per_m: float, source: str) -> dict[str, np.ndarray]:
+def _extras_payload(
+    first_frame, force_platforms, analog_scales, analog_offsets, events, n_ch: int, units_per_m: float, source: str
+) -> dict[str, np.ndarray]:
     """Payload entries of the keyword-only extras of :func:`write_c3d` (checked)."""
     first = integer("first_frame", first_frame, source, minimum=0)
     if first > _MAX_FIRST_FRAME:
@@ -192,8 +201,11 @@ def _extras_payload(first_frame, force_platforms, analog_scales, analog_offsets,
         scales = scales.astype(np.float32).astype(float)  # the file holds float32 scales; readers use those
     if scales.shape != (n_ch,) or not np.all(np.isfinite(scales)) or np.any(scales == 0):
         raise LoperInputError(f"{source}: analog_scales must be {n_ch} finite, non-zero numbers, got {analog_scales!r}")
-    offsets = np.zeros(n_ch, dtype=np.int64) if analog_offsets is None else np.asarray(
-        [integer("analog_offsets", v, source, minimum=0) for v in analog_offsets], dtype=np.int64)
+    offsets = (
+        np.zeros(n_ch, dtype=np.int64)
+        if analog_offsets is None
+        else np.asarray([integer("analog_offsets", v, source, minimum=0) for v in analog_offsets], dtype=np.int64)
+    )
     if offsets.shape != (n_ch,) or np.any(offsets > MAX_ANALOG_OFFSET):
         raise LoperInputError(
             f"{source}: analog_offsets must be {n_ch} integers in 0 .. {MAX_ANALOG_OFFSET}, got {analog_offsets!r}"
@@ -241,7 +253,9 @@ def _write_in_child(payload: dict[str, np.ndarray], out: Path, source: str) -> N
     payload_path = out.with_name(out.name + ".payload.npz")
     np.savez(payload_path, **payload)
     proc = subprocess.run(
-        [sys.executable, "-m", "loper_analysis.io.ezc3d_child", str(payload_path), str(out)], capture_output=True, text=True
+        [sys.executable, "-m", "loper_analysis.io.ezc3d_child", str(payload_path), str(out)],
+        capture_output=True,
+        text=True,
     )
     if proc.returncode != 0 or not out.is_file():
         lines = [ln for ln in proc.stderr.strip().splitlines() if ln.strip()]
@@ -339,7 +353,9 @@ def write_c3d(
     source = str(path)
     unit = str(point_unit).lower()
     if unit not in LENGTH_UNITS_PER_M:
-        raise LoperInputError(f"{source}: point_unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {point_unit!r}")
+        raise LoperInputError(
+            f"{source}: point_unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {point_unit!r}"
+        )
     point_rate = positive("point_rate_hz", point_rate_hz, source)
     points, residuals = _points_for_file(markers_m, LENGTH_UNITS_PER_M[unit], source)
     labels = _labels(marker_labels, "marker_labels", points.shape[1], source)
@@ -367,11 +383,26 @@ def write_c3d(
         "analog_units": np.array(a_units if n_ch else [], dtype=str),
         "analogs": samples if n_ch else np.zeros((1, 0, 0)),
     }
-    extras = first_frame != 0 or len(force_platforms) or analog_scales is not None or analog_offsets is not None \
+    extras = (
+        first_frame != 0
+        or len(force_platforms)
+        or analog_scales is not None
+        or analog_offsets is not None
         or len(events)
+    )
     if extras:
-        payload.update(_extras_payload(first_frame, force_platforms, analog_scales, analog_offsets, events, n_ch,
-                                       LENGTH_UNITS_PER_M[unit], source))
+        payload.update(
+            _extras_payload(
+                first_frame,
+                force_platforms,
+                analog_scales,
+                analog_offsets,
+                events,
+                n_ch,
+                LENGTH_UNITS_PER_M[unit],
+                source,
+            )
+        )
         if n_ch:
             stored = samples / payload["analog_scales"][None, :, None] + payload["analog_offsets"][None, :, None]
             _analogs_for_file(stored[0].T, n_ch, samples.shape[2], f"{source} (stored as analogs / scale + offset)")
@@ -386,7 +417,16 @@ def write_recording(path: str | os.PathLike, recording: C3DRecording, point_unit
     ``extras`` are :func:`write_c3d`'s keyword-only arguments but ``first_frame``
     (``force_platforms``, ``analog_scales``, ``analog_offsets``, ``events``).
     """
-    return write_c3d(path, recording.marker_labels, recording.markers_m, recording.point_rate_hz,
-                     recording.analog_labels, recording.analogs if recording.analog_labels else None,
-                     recording.analog_units, recording.analog_rate_hz, point_unit,
-                     first_frame=recording.first_frame, **extras)
+    return write_c3d(
+        path,
+        recording.marker_labels,
+        recording.markers_m,
+        recording.point_rate_hz,
+        recording.analog_labels,
+        recording.analogs if recording.analog_labels else None,
+        recording.analog_units,
+        recording.analog_rate_hz,
+        point_unit,
+        first_frame=recording.first_frame,
+        **extras,
+    )

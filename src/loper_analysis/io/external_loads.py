@@ -53,8 +53,9 @@ def write_external_loads_mot(path: str | os.PathLike, frame: pd.DataFrame) -> Pa
     return write_storage(path, t, values, names, "ExternalLoads", False, "external-loads file")
 
 
-def write_external_loads_xml(path: str | os.PathLike, bodies: Mapping[int, str], datafile: str,
-                             name: str = "ground_reactions") -> Path:
+def write_external_loads_xml(
+    path: str | os.PathLike, bodies: Mapping[int, str], datafile: str, name: str = "ground_reactions"
+) -> Path:
     """Write an OpenSim ``ExternalLoads`` file applying plate n's loads to a body, atomically; returns ``path``.
 
     Parameters

@@ -72,8 +72,8 @@ import numpy as np
 
 from ..errors import LoperInputError
 from ..markers import LAB_Z_UP
-from .timing import library_import
 from .c3d import LENGTH_UNITS_PER_M
+from .timing import library_import
 
 __all__ = [
     "CALIBRATED_TYPES",
@@ -205,8 +205,12 @@ def _check_parameters(params, n_analogs: int, source: str) -> tuple[int, list[in
         raise LoperInputError(f"{source}: FORCE_PLATFORM:USED {value}: the file holds no force platforms")
     types = _value(params, "TYPE")
     channel = _value(params, "CHANNEL")
-    for name, value in (("TYPE", types), ("CHANNEL", channel), ("CORNERS", _value(params, "CORNERS")),
-                        ("ORIGIN", _value(params, "ORIGIN"))):
+    for name, value in (
+        ("TYPE", types),
+        ("CHANNEL", channel),
+        ("CORNERS", _value(params, "CORNERS")),
+        ("ORIGIN", _value(params, "ORIGIN")),
+    ):
         if value is None or value.size == 0:
             raise LoperInputError(f"{source}: FORCE_PLATFORM:{name} not declared for {used} force platform(s)")
     types = np.ravel(types).astype(int)
@@ -271,8 +275,9 @@ def _calibration_problems(cal: np.ndarray) -> list[str]:
         problems.append("zero row(s) " + ", ".join(f"{i + 1} ({_CAL_OUTPUTS[i]})" for i in zero_rows))
     if zero_cols:
         problems.append("zero column(s) " + ", ".join(str(j + 1) for j in zero_cols))
-    equal = [(i, j) for i in range(6) for j in range(i + 1, 6)
-             if np.any(cal[:, i]) and np.array_equal(cal[:, i], cal[:, j])]
+    equal = [
+        (i, j) for i in range(6) for j in range(i + 1, 6) if np.any(cal[:, i]) and np.array_equal(cal[:, i], cal[:, j])
+    ]
     if equal:
         problems.append("equal columns " + ", ".join(f"{i + 1} and {j + 1}" for i, j in equal))
     singular = np.linalg.svd(cal, compute_uv=False)  # descending
@@ -303,7 +308,7 @@ def _check_calibration(params, types: list[int], source: str) -> None:
         )
     flat = np.asarray(value, dtype=float).ravel(order="F")  # file order: row fastest, then column, then plate
     for k in plates:
-        cal = flat[36 * k:36 * (k + 1)].reshape(6, 6, order="F")
+        cal = flat[36 * k : 36 * (k + 1)].reshape(6, 6, order="F")
         problems = _calibration_problems(cal)
         if problems:
             raise LoperInputError(
@@ -341,8 +346,9 @@ def _plate_frame(corners: np.ndarray) -> np.ndarray:
     return np.column_stack([v / np.linalg.norm(v) for v in (x, y, z)])
 
 
-def _check_force_direction(force_n: np.ndarray, z_axis: np.ndarray, up: np.ndarray, corners: np.ndarray, unit: str,
-                           plate: int, source: str) -> None:
+def _check_force_direction(
+    force_n: np.ndarray, z_axis: np.ndarray, up: np.ndarray, corners: np.ndarray, unit: str, plate: int, source: str
+) -> None:
     """Refuse a level plate whose vertical force points down while loaded, naming its corners and their z axis.
 
     Channels are in the plate frame that ``FORCE_PLATFORM:CORNERS`` defines
@@ -380,16 +386,22 @@ def _check_force_direction(force_n: np.ndarray, z_axis: np.ndarray, up: np.ndarr
     if not (low <= -DOWNWARD_LOAD_N and high < MAX_UPWARD_REST_N):
         return
     listed = [[float(f"{v:.6g}") for v in corner] for corner in corners]
-    reading = (f"its vertical force (along up {np.round(up, 3).tolist()}) points down while loaded: {low:.1f} N at "
-               f"the 1st percentile, at most {high:.1f} N at the 99th")
+    reading = (
+        f"its vertical force (along up {np.round(up, 3).tolist()}) points down while loaded: {low:.1f} N at "
+        f"the 1st percentile, at most {high:.1f} N at the 99th"
+    )
     if facing > 0:
-        cause = (f"pointing up: the corners are listed the other way round the plate (reversed or permuted) from "
-                 f"the frame of its channels, so {reading}; list them in the order of the channels' frame (the "
-                 "usual order gives a z axis pointing down)")
+        cause = (
+            f"pointing up: the corners are listed the other way round the plate (reversed or permuted) from "
+            f"the frame of its channels, so {reading}; list them in the order of the channels' frame (the "
+            "usual order gives a z axis pointing down)"
+        )
     else:
-        cause = (f"pointing down (the usual order), yet {reading}: the channels are in the frame of the corners "
-                 "listed the other way round (the corners were reversed or permuted), or hold the force on the "
-                 "plate instead of on the body")
+        cause = (
+            f"pointing down (the usual order), yet {reading}: the channels are in the frame of the corners "
+            "listed the other way round (the corners were reversed or permuted), or hold the force on the "
+            "plate instead of on the body"
+        )
     raise LoperInputError(
         f"{source}: FORCE_PLATFORM:CORNERS of platform {plate} = {listed} {unit} give a plate z axis "
         f"{np.round(z_axis, 3).tolist()} (lab frame, (corner 1 - corner 2) x (corner 1 - corner 4)), {cause}"
@@ -457,12 +469,16 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
         ) from failure
     platforms = c3d["data"]["platform"]
     if len(platforms) != used:
-        raise LoperInputError(f"{source}: ezc3d extracted {len(platforms)} platform(s) for FORCE_PLATFORM:USED = {used}")
+        raise LoperInputError(
+            f"{source}: ezc3d extracted {len(platforms)} platform(s) for FORCE_PLATFORM:USED = {used}"
+        )
     header = c3d["header"]
     point_rate = float(header["points"]["frame_rate"])
     analog_rate = float(header["analogs"]["frame_rate"])
     if not (point_rate > 0 and analog_rate > 0):
-        raise LoperInputError(f"{source}: POINT:RATE = {point_rate:g} and ANALOG:RATE = {analog_rate:g} must be positive")
+        raise LoperInputError(
+            f"{source}: POINT:RATE = {point_rate:g} and ANALOG:RATE = {analog_rate:g} must be positive"
+        )
     t0 = int(header["points"]["first_frame"]) / point_rate
     out = []
     for k, (pf, kind, chans) in enumerate(zip(platforms, types, plate_channels)):
@@ -480,16 +496,26 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
         if not (np.all(np.isfinite(force)) and np.all(np.isfinite(moment)) and np.all(np.isfinite(corners))):
             raise LoperInputError(f"{source}: platform {k + 1} holds non-finite forces, moments or corners")
         frame = _plate_frame(corners)
-        _check_force_direction(force, frame[:, 2], lab_up, np.asarray(pf["corners"], dtype=float).T, unit_pos,
-                               k + 1, source)
+        _check_force_direction(
+            force, frame[:, 2], lab_up, np.asarray(pf["corners"], dtype=float).T, unit_pos, k + 1, source
+        )
         if frame[:, 2] @ lab_up > 0:  # corners the other way round: the surface lies at positive plate z
             origin = np.asarray(pf["origin"], dtype=float).ravel() / per_m  # ezc3d's, z <= 0, plate frame, m
             if kind == 3:
                 origin = np.array([0.0, 0.0, origin[2]])
             moment = moment - 2.0 * np.cross(force, frame @ origin)
-        out.append(ForcePlatform(
-            number=k + 1, type=kind, channels=chans, analog_rate_hz=analog_rate,
-            time_s=t0 + np.arange(force.shape[0]) / analog_rate, force_n=force, moment_nm=moment,
-            corners_m=corners, centre_m=corners.mean(axis=0), source=source,
-        ))
+        out.append(
+            ForcePlatform(
+                number=k + 1,
+                type=kind,
+                channels=chans,
+                analog_rate_hz=analog_rate,
+                time_s=t0 + np.arange(force.shape[0]) / analog_rate,
+                force_n=force,
+                moment_nm=moment,
+                corners_m=corners,
+                centre_m=corners.mean(axis=0),
+                source=source,
+            )
+        )
     return out

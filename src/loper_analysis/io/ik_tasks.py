@@ -42,8 +42,9 @@ def task_set_tasks(task_set, source: str) -> tuple[dict[str, float], dict[str, t
             ct = osim.IKCoordinateTask.safeDownCast(task)
             vt = ct.getValueType()
             if vt == osim.IKCoordinateTask.FromFile:
-                raise LoperInputError(f"{source}: coordinate task {task.getName()} takes its value from a file; "
-                                      "not supported")
+                raise LoperInputError(
+                    f"{source}: coordinate task {task.getName()} takes its value from a file; not supported"
+                )
             value = ct.getValue() if vt == osim.IKCoordinateTask.ManualValue else None
             coords[task.getName()] = (task.getWeight(), value)
     return markers, coords

@@ -66,6 +66,7 @@ __all__ = [
 #: Coordinate-name endings of translations (m), which are never converted to degrees.
 TRANSLATION_SUFFIXES: tuple[str, ...] = ("_tx", "_ty", "_tz")
 
+
 def _is_translation(name: str) -> bool:
     return name.endswith(TRANSLATION_SUFFIXES)
 
@@ -117,11 +118,14 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
     labels = list(labels)
     if X.ndim != 3 or X.shape != (t.size, len(labels), 3) or not labels:
         raise LoperInputError(
-            f"{source}: markers_m must have shape (n_frames = {t.size}, n_labels = {len(labels)} >= 1, 3), got {X.shape}"
+            f"{source}: markers_m must have shape (n_frames = {t.size}, n_labels = {len(labels)} >= 1, 3), "
+            f"got {X.shape}"
         )
     labels = unique_names(labels, "labels", source, allow_whitespace=False, allow_spaces=True)
     if np.any(np.isinf(X)):
-        raise LoperInputError(f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})")
+        raise LoperInputError(
+            f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})"
+        )
     rate = f"{1.0 / uniform_step_s(t, source):.12g}"
     values = (X * LENGTH_UNITS_PER_M[unit]).reshape(t.size, -1)
     n, m = t.size, len(labels)
@@ -163,9 +167,17 @@ def _read_trc_text(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]] | Non
         labels = [n.strip() for n in names[2:] if n.strip()]  # OpenSim strips a label's edge blanks too
         if len(labels) != n_markers:
             return None
-        data = pd.read_csv(path, sep="\t", skiprows=5, header=None, skip_blank_lines=True,
-                           usecols=range(2 + 3 * n_markers), dtype=float, na_values=["nan", "NaN"],
-                           float_precision="round_trip").to_numpy()
+        data = pd.read_csv(
+            path,
+            sep="\t",
+            skiprows=5,
+            header=None,
+            skip_blank_lines=True,
+            usecols=range(2 + 3 * n_markers),
+            dtype=float,
+            na_values=["nan", "NaN"],
+            float_precision="round_trip",
+        ).to_numpy()
     except (OSError, ValueError, KeyError, UnicodeDecodeError, pd.errors.ParserError, pd.errors.EmptyDataError):
         return None
     if data.shape != (n_frames, 2 + 3 * n_markers):
@@ -286,7 +298,9 @@ def storage_columns(path: Path, frame: pd.DataFrame, what: str) -> tuple[np.ndar
         raise LoperInputError(f"{source}: frame must be a DataFrame with a 'time_s' column")
     names = unique_names([c for c in frame.columns if c != "time_s"], what, source, allow_whitespace=False)
     if not names or "time" in names:
-        raise LoperInputError(f"{source}: frame needs {what.split()[0]} column(s) besides time_s (and none named 'time')")
+        raise LoperInputError(
+            f"{source}: frame needs {what.split()[0]} column(s) besides time_s (and none named 'time')"
+        )
     t = time_vector(frame["time_s"].to_numpy(dtype=float), source, min_count=1, item="row")
     values = np.empty((t.size, len(names)))
     for j, name in enumerate(names):
@@ -294,13 +308,16 @@ def storage_columns(path: Path, frame: pd.DataFrame, what: str) -> tuple[np.ndar
             raise LoperInputError(f"{source}: column '{name}' is not numeric ({frame[name].dtype})")
         col = frame[name].to_numpy(dtype=float)
         if np.any(np.isinf(col)):
-            raise LoperInputError(f"{source}: column '{name}' is infinite at row {int(np.flatnonzero(np.isinf(col))[0])}")
+            raise LoperInputError(
+                f"{source}: column '{name}' is infinite at row {int(np.flatnonzero(np.isinf(col))[0])}"
+            )
         values[:, j] = col
     return t, names, values
 
 
-def write_storage(path: Path, time_s: np.ndarray, values: np.ndarray, names: list[str], header: str,
-                  in_degrees: bool, what: str) -> Path:
+def write_storage(
+    path: Path, time_s: np.ndarray, values: np.ndarray, names: list[str], header: str, in_degrees: bool, what: str
+) -> Path:
     """Write checked columns (:func:`storage_columns`) with OpenSim's ``STOFileAdapter``, atomically.
 
     ``header`` is the file's name line (``Coordinates``, ``ExternalLoads``);

@@ -14,7 +14,8 @@ __all__ = ["quiet_opensim", "read_model", "model_source", "write_model", "read_s
 
 
 def quiet_opensim():
-    """Import opensim with logging at 'error' and no ``opensim.log`` file in the working directory; returns the module."""
+    """Import opensim with logging at 'error' and no ``opensim.log`` file in the working directory; returns the
+    module."""
     with library_import():
         import opensim
 

@@ -35,8 +35,9 @@ def raw_file_present(path: str | os.PathLike, what: str = "raw file") -> bool:
     if not os.path.lexists(p):
         return False
     if p.is_symlink() and not p.exists():
-        raise LoperInputError(f"{p}: the {what} is a broken link (to '{os.readlink(p)}'); "
-                              "restore its target or remove the link")
+        raise LoperInputError(
+            f"{p}: the {what} is a broken link (to '{os.readlink(p)}'); restore its target or remove the link"
+        )
     if not p.is_file():
         kind = "a directory" if p.is_dir() else "not a regular file"
         raise LoperInputError(f"{p}: the {what} is {kind}; a trial's raw file must be a file")
@@ -57,5 +58,4 @@ def unmatched_raw_files(folder: str | os.PathLike, trials: Iterable[str]) -> lis
     if not folder.is_dir():
         return []
     names = {f"{t}{suffix}" for t in trials for suffix in RAW_SUFFIXES}
-    return sorted(p.name for p in folder.iterdir()
-                  if p.name.endswith(RAW_SUFFIXES) and p.name not in names)
+    return sorted(p.name for p in folder.iterdir() if p.name.endswith(RAW_SUFFIXES) and p.name not in names)

@@ -97,7 +97,9 @@ def read_label_map(path: str | os.PathLike) -> dict[str, str]:
             raise LoperInputError(f"{path}: label map not found")
         doc = read_yaml(path, "label map")
         if not isinstance(doc, dict):
-            raise LoperInputError(f"{path}: a label map must be a YAML mapping 'label: marker', got {type(doc).__name__}")
+            raise LoperInputError(
+                f"{path}: a label map must be a YAML mapping 'label: marker', got {type(doc).__name__}"
+            )
         pairs = list(doc.items())
     else:
         table = read_tsv(path, "label map", ("label", "marker"), dtype=str, keep_default_na=False)

@@ -314,9 +314,7 @@ def write_robot_log(
         raise LoperInputError(f"{source}: metadata must be a dict of key -> value, got {type(metadata).__name__}")
     for key, value in (metadata or {}).items():
         if not isinstance(key, str) or not _KEY_PATTERN.match(key):
-            raise LoperInputError(
-                f"{source}: metadata key {key!r} must match [A-Za-z_][A-Za-z0-9_.-]*"
-            )
+            raise LoperInputError(f"{source}: metadata key {key!r} must match [A-Za-z_][A-Za-z0-9_.-]*")
         text = str(value)
         if key == "format":
             if text != FORMAT_NAME:
@@ -433,9 +431,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
     rate = positive("header sample_rate_hz", meta["sample_rate_hz"], source)
     meta["sample_rate_hz"] = rate
     if expected is not None and not math.isclose(rate, expected, rel_tol=1e-12):
-        raise LoperInputError(
-            f"{source}: sample_rate_hz in the file is {rate:g} Hz but {expected:g} Hz was declared"
-        )
+        raise LoperInputError(f"{source}: sample_rate_hz in the file is {rate:g} Hz but {expected:g} Hz was declared")
 
     if k >= len(lines):
         raise LoperInputError(f"{source}: no column header row after the '#' header lines")
@@ -448,7 +444,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
             f"the order {', '.join(COLUMNS)}"
         )
 
-    rows = lines[k + 1:]
+    rows = lines[k + 1 :]
     first_line = header_line + 1
     data = _parse_rows(rows, source, first_line)
     frame = validated_log(pd.DataFrame(data), rate, source, first_line)
@@ -460,8 +456,7 @@ def _parse_rows(rows: list[str], source: str, first_line: int) -> dict[str, np.n
     width = len(COLUMNS)
     if rows:  # fast path (C parser); any doubt -> the checking path below
         try:
-            table = np.loadtxt(io.StringIO("\n".join(rows)), delimiter="\t", dtype=np.float64, ndmin=2,
-                               comments=None)
+            table = np.loadtxt(io.StringIO("\n".join(rows)), delimiter="\t", dtype=np.float64, ndmin=2, comments=None)
         except ValueError:
             table = None
         if table is not None and table.shape == (len(rows), width):

@@ -185,8 +185,10 @@ def write_robot_log_mat(
     missing = [c for c in COLUMNS if c not in names]
     unknown = [str(c) for c in names if c not in COLUMNS]
     if missing or unknown:
-        raise LoperInputError(f"{source}: variable_names must name exactly the columns {', '.join(COLUMNS)} "
-                              f"(missing: {', '.join(missing) or 'none'}; unknown: {', '.join(unknown) or 'none'})")
+        raise LoperInputError(
+            f"{source}: variable_names must name exactly the columns {', '.join(COLUMNS)} "
+            f"(missing: {', '.join(missing) or 'none'}; unknown: {', '.join(unknown) or 'none'})"
+        )
     for col, var in names.items():
         if not isinstance(var, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", var):
             raise LoperInputError(f"{source}: variable name {var!r} of column '{col}' is not a MATLAB name")

@@ -30,7 +30,14 @@ log = logging.getLogger(__name__)
 
 #: Columns of the counts table returned by :func:`subject_onset_response`.
 COUNT_COLUMNS: tuple[str, ...] = (
-    "trial", "n_perturbed", "n_too_short", "n_no_match", "n_outliers", "n_kept", "status", "reason",
+    "trial",
+    "n_perturbed",
+    "n_too_short",
+    "n_no_match",
+    "n_outliers",
+    "n_kept",
+    "status",
+    "reason",
 )
 
 
@@ -50,8 +57,9 @@ def _trial_inputs(trial: Mapping, k: int, side: str, source: str):
     force, where_f = trial_table(trial, "force", name, ("time_s", "force_measured_n"))
     tf = force["time_s"].to_numpy(float)
     if tf.shape != t.shape or not np.allclose(tf, t, rtol=0.0, atol=1e-6):
-        raise LoperInputError(f"{where_f}: time_s ({tf.size} frames) differs from the angles' frames in {where_a} "
-                              f"({t.size} frames)")
+        raise LoperInputError(
+            f"{where_f}: time_s ({tf.size} frames) differs from the angles' frames in {where_a} ({t.size} frames)"
+        )
     direction = np.asarray(trial["force_direction"], dtype=float)
     if direction.shape != (t.size, 2):
         raise LoperInputError(f"{name}: force_direction must have shape ({t.size}, 2), got {direction.shape}")
@@ -59,8 +67,9 @@ def _trial_inputs(trial: Mapping, k: int, side: str, source: str):
         off = np.flatnonzero(np.abs(np.hypot(direction[:, 0], direction[:, 1]) - 1.0) > 1e-6)
     if off.size:
         i = int(off[0])
-        raise LoperInputError(f"{name}: force_direction at frame {i} (t = {t[i]:.4f} s) is not a unit vector: "
-                              f"{direction[i].tolist()}")
+        raise LoperInputError(
+            f"{name}: force_direction at frame {i} (t = {t[i]:.4f} s) is not a unit vector: {direction[i].tolist()}"
+        )
     magnitude = force["force_measured_n"].to_numpy(float)
     columns["force"] = magnitude
     columns["force_vector"] = magnitude[:, None] * direction  # NaN frames stay NaN
@@ -170,8 +179,10 @@ def subject_onset_response(
     for k, trial in enumerate(trials):
         name, where_s, t, columns, strides, native = _trial_inputs(trial, k, side, source)
         if (native is None) != (native_rate is None) and k:
-            raise LoperInputError(f"{where(source)}{name}: the force at the robot rate (force_native) must be given "
-                                  "for every trial of the onset or for none")
+            raise LoperInputError(
+                f"{where(source)}{name}: the force at the robot rate (force_native) must be given "
+                "for every trial of the onset or for none"
+            )
         if any(rec["trial"] == name for rec in per_trial):
             raise LoperInputError(f"{where(source)}trial name {name!r} appears twice; names must be unique")
         table = stride_table(strides, where_s)
@@ -181,8 +192,15 @@ def subject_onset_response(
         delay = np.fmax(table["onset_s"].to_numpy(float) - table["toe_off_s"].to_numpy(float), onset_s)
         rooms.extend((table["swing_s"].to_numpy(float) - delay)[perturbed].tolist())
         matches = match_unperturbed(
-            t, columns["joints"], table, before, source=where_s, span_s=(start, after),
-            onset_after_toe_off_s=onset_s, window_after_s=after, candidate_within_swing=candidate_within_swing,
+            t,
+            columns["joints"],
+            table,
+            before,
+            source=where_s,
+            span_s=(start, after),
+            onset_after_toe_off_s=onset_s,
+            window_after_s=after,
+            candidate_within_swing=candidate_within_swing,
             missing="drop",
         )
         for s, why in matches.attrs["unmatched"].items():
@@ -192,13 +210,20 @@ def subject_onset_response(
             table, where_n, direction = native
             rate_n = native_force_rate_hz(table, where_n)
             if native_rate is not None and rate_n != native_rate:
-                raise LoperInputError(f"{where_n}: robot rate {rate_n:g} Hz differs from the other trials' "
-                                      f"{native_rate:g} Hz")
+                raise LoperInputError(
+                    f"{where_n}: robot rate {rate_n:g} Hz differs from the other trials' {native_rate:g} Hz"
+                )
             native_rate = rate_n
             force_windows.append(native_force_windows(t, direction, table, matches, start, after, rate_n, where_n))
         pairs.append(matches.assign(trial=name))
-        per_trial.append({"trial": name, "n_perturbed": n_perturbed, "n_too_short": n_short,
-                          "n_no_match": len(matches.attrs["unmatched"])})
+        per_trial.append(
+            {
+                "trial": name,
+                "n_perturbed": n_perturbed,
+                "n_too_short": n_short,
+                "n_no_match": len(matches.attrs["unmatched"]),
+            }
+        )
 
     win = {key: tuple(np.concatenate([w[key][i] for w in windows]) for i in range(2)) for key in windows[0]}
     joints_p, joints_u = win["joints"]
@@ -218,14 +243,17 @@ def subject_onset_response(
     for rec in per_trial:
         mine = pair_table["trial"].to_numpy() == rec["trial"]
         rows.append({**rec, "n_outliers": int((mine & ~keep).sum()), "n_kept": int((mine & keep).sum())})
-    total = {key: sum(r[key] for r in rows) for key in ("n_perturbed", "n_too_short", "n_no_match", "n_outliers",
-                                                         "n_kept")}
+    total = {
+        key: sum(r[key] for r in rows) for key in ("n_perturbed", "n_too_short", "n_no_match", "n_outliers", "n_kept")
+    }
     rows.append({"trial": "total", **total})
     for r in rows:
         parts = []
         if r["n_kept"] < min_n:
-            parts.append(f"{r['n_kept']} pair(s) kept, fewer than min_strides = {min_n}"
-                         + ("" if r["trial"] == "total" else " (the average pools the trials: see total)"))
+            parts.append(
+                f"{r['n_kept']} pair(s) kept, fewer than min_strides = {min_n}"
+                + ("" if r["trial"] == "total" else " (the average pools the trials: see total)")
+            )
         if r["n_too_short"]:
             parts.append(f"{r['n_too_short']} too short (swing < onset delay + {after * 1e3:g} ms)")
         if r["n_no_match"]:
@@ -239,10 +267,22 @@ def subject_onset_response(
     counts = pd.DataFrame(rows, columns=list(COUNT_COLUMNS))
     check_enough_strides(n_pairs, label or "perturbation response", min_n)
     finite_rooms = [r for r in rooms if np.isfinite(r)]
-    counts.attrs = {"pairs": pair_table, "outliers_judged": judged, "onset_ms": float(onset_ms), "source": source,
-                    "longest_swing_after_onset_s": max(finite_rooms) if finite_rooms else float("nan")}
-    log.info("%s: %d perturbed, %d too short, %d without match, %d outliers, %d kept", label, total["n_perturbed"],
-             total["n_too_short"], total["n_no_match"], total["n_outliers"], total["n_kept"])
+    counts.attrs = {
+        "pairs": pair_table,
+        "outliers_judged": judged,
+        "onset_ms": float(onset_ms),
+        "source": source,
+        "longest_swing_after_onset_s": max(finite_rooms) if finite_rooms else float("nan"),
+    }
+    log.info(
+        "%s: %d perturbed, %d too short, %d without match, %d outliers, %d kept",
+        label,
+        total["n_perturbed"],
+        total["n_too_short"],
+        total["n_no_match"],
+        total["n_outliers"],
+        total["n_kept"],
+    )
 
     # averages over the kept pairs
     kept = {key: (p[keep], u[keep]) for key, (p, u) in win.items()}
@@ -262,8 +302,14 @@ def subject_onset_response(
     response["force_perturbed_n_mean"], response["force_unperturbed_n_mean"] = mean_and_sd(fp)[0], mean_and_sd(fu)[0]
     response["n_pairs"] = n_pairs
     response["analysis_window"] = (grid >= -before - TIME_TOLERANCE_S) & (grid <= after + TIME_TOLERANCE_S)
-    response.attrs = {"onset_ms": float(onset_ms), "n_pairs": n_pairs, "source": source, "before_s": before,
-                      "after_s": after, "initial_span_s": initial}
+    response.attrs = {
+        "onset_ms": float(onset_ms),
+        "n_pairs": n_pairs,
+        "source": source,
+        "before_s": before,
+        "after_s": after,
+        "initial_span_s": initial,
+    }
 
     series: dict = {"time_s": grid.copy(), "onset_s": 0.0}
     pair_series: dict = {"time_s": grid.copy(), "n_pairs": n_pairs}
@@ -280,6 +326,7 @@ def subject_onset_response(
         series["force_time_s"] = window_times_s(-start, after, native_rate)
         for i, what in enumerate(("perturbed", "unperturbed")):
             series[f"force_{what}_n"] = mean_and_sd(np.concatenate([w[i] for w in force_windows])[keep])[0]
-    series.update({"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial,
-                   "n_pairs": n_pairs})
+    series.update(
+        {"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial, "n_pairs": n_pairs}
+    )
     return response, counts, series

@@ -24,8 +24,9 @@ __all__ = ["trial_name", "trial_table", "trial_angles"]
 def trial_name(trial, k: int, keys: tuple[str, ...], source: str = "") -> str:
     """The trial's name (``trial k`` without one); refuses a trial that is not a mapping holding ``keys``."""
     if not isinstance(trial, Mapping):
-        raise LoperInputError(f"{source + ': ' if source else ''}trial {k} must be a mapping with name, "
-                              f"{', '.join(keys)}")
+        raise LoperInputError(
+            f"{source + ': ' if source else ''}trial {k} must be a mapping with name, {', '.join(keys)}"
+        )
     name = str(trial.get("name", f"trial {k}"))
     missing = [key for key in keys if key not in trial]
     if missing:
@@ -40,7 +41,8 @@ def trial_table(trial: Mapping, key: str, name: str, columns=()) -> tuple[pd.Dat
 
 
 def trial_angles(trial: Mapping, name: str, side: str) -> tuple[np.ndarray, dict[str, np.ndarray], str]:
-    """Frame times (s), the signals to window (``joints`` (n, 3) rad, ``pelvis_angle`` rad, ``pelvis_x`` m) and the label."""
+    """Frame times (s), the signals to window (``joints`` (n, 3) rad, ``pelvis_angle`` rad, ``pelvis_x`` m) and the
+    label."""
     joints = [angle_column(j, side) for j in JOINTS]
     angles, label = trial_table(trial, "angles", name, ("time_s", "pelvis_x_m", "pelvis_angle_rad", *joints))
     t = time_vector(angles["time_s"].to_numpy(float), label, min_count=4, item="frame")

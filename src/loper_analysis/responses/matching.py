@@ -26,7 +26,13 @@ __all__ = ["MATCH_COLUMNS", "STRIDE_TABLE_COLUMNS", "stride_table", "too_short",
 
 #: Columns of the table returned by :func:`match_unperturbed`.
 MATCH_COLUMNS: tuple[str, ...] = (
-    "stride", "onset_s", "toe_off_s", "matched_stride", "matched_anchor_s", "rmsd_rad", "n_candidates",
+    "stride",
+    "onset_s",
+    "toe_off_s",
+    "matched_stride",
+    "matched_anchor_s",
+    "rmsd_rad",
+    "n_candidates",
 )
 #: Stride-table columns a response needs (:func:`loper_analysis.strides.stride_tables`).
 STRIDE_TABLE_COLUMNS: tuple[str, ...] = ("stride", "toe_off_s", "swing_s", "perturbed", "onset_s")
@@ -57,8 +63,9 @@ def _perturbed_onsets(table: pd.DataFrame, source: str) -> tuple[np.ndarray, np.
     return perturbed, onset
 
 
-def too_short(strides: pd.DataFrame, onset_after_toe_off_s: float | None = None, window_after_s: float = 0.25,
-              source: str = "") -> np.ndarray:
+def too_short(
+    strides: pd.DataFrame, onset_after_toe_off_s: float | None = None, window_after_s: float = 0.25, source: str = ""
+) -> np.ndarray:
     """Perturbed strides whose swing is too short to hold the window after the onset.
 
     A perturbed stride is too short if ``swing_s < delay + window_after_s``,
@@ -206,12 +213,18 @@ def match_unperturbed(
         if onset_after_toe_off_s is None:
             raise LoperInputError(f"{where(source)}null_pairs needs onset_after_toe_off_s")
         delay = number("onset_after_toe_off_s", onset_after_toe_off_s, source, minimum=0.0)
-        table = table.assign(onset_s=np.where(perturbed, np.nan, table["toe_off_s"].to_numpy(float) + delay),
-                             perturbed=~perturbed & ~removed, removed=removed | perturbed)
+        table = table.assign(
+            onset_s=np.where(perturbed, np.nan, table["toe_off_s"].to_numpy(float) + delay),
+            perturbed=~perturbed & ~removed,
+            removed=removed | perturbed,
+        )
         perturbed, onset = _perturbed_onsets(table, source)
         removed = bool_column(table, "removed", source, what="strides")
-    short = (too_short(table, onset_after_toe_off_s, window_after_s, source) if window_after_s is not None
-             else np.zeros(len(table), dtype=bool))
+    short = (
+        too_short(table, onset_after_toe_off_s, window_after_s, source)
+        if window_after_s is not None
+        else np.zeros(len(table), dtype=bool)
+    )
     stride_no = table["stride"].to_numpy()
     toe_off = table["toe_off_s"].to_numpy(float)
     end = table["end_s"].to_numpy(float)
@@ -266,17 +279,25 @@ def match_unperturbed(
         s, why = next(iter(unmatched.items()))
         raise LoperInputError(f"{where(source)}perturbed stride {s} has no unperturbed match: {why}")
     rows = np.flatnonzero(hit)
-    out = pd.DataFrame({
-        "stride": stride_no[p[rows]],
-        "onset_s": onset_p[rows],
-        "toe_off_s": toe_p[rows],
-        "matched_stride": stride_no[c][best[rows]] if c.size else np.empty(0, dtype=stride_no.dtype),
-        "matched_anchor_s": anchors[rows, best[rows]] if c.size else np.empty(0),
-        "rmsd_rad": rmsd[rows, best[rows]] if c.size else np.empty(0),
-        "n_candidates": n_cand[rows].astype(np.int64),
-    }, columns=list(MATCH_COLUMNS))
-    out.attrs.update({
-        "source": source, "before_s": before, "span_s": (lo_span, hi_span),
-        "too_short": [int(s) for s in stride_no[short]], "unmatched": unmatched,
-    })
+    out = pd.DataFrame(
+        {
+            "stride": stride_no[p[rows]],
+            "onset_s": onset_p[rows],
+            "toe_off_s": toe_p[rows],
+            "matched_stride": stride_no[c][best[rows]] if c.size else np.empty(0, dtype=stride_no.dtype),
+            "matched_anchor_s": anchors[rows, best[rows]] if c.size else np.empty(0),
+            "rmsd_rad": rmsd[rows, best[rows]] if c.size else np.empty(0),
+            "n_candidates": n_cand[rows].astype(np.int64),
+        },
+        columns=list(MATCH_COLUMNS),
+    )
+    out.attrs.update(
+        {
+            "source": source,
+            "before_s": before,
+            "span_s": (lo_span, hi_span),
+            "too_short": [int(s) for s in stride_no[short]],
+            "unmatched": unmatched,
+        }
+    )
     return out

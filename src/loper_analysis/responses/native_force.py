@@ -30,8 +30,16 @@ def native_force_rate_hz(native: pd.DataFrame, source: str = "") -> float:
     return float(round(1.0 / float(np.median(d))))
 
 
-def native_force_windows(frame_time_s, direction, native: pd.DataFrame, matches: pd.DataFrame, start_s: float,
-                         end_s: float, rate_hz: float, source: str = "") -> tuple[np.ndarray, np.ndarray]:
+def native_force_windows(
+    frame_time_s,
+    direction,
+    native: pd.DataFrame,
+    matches: pd.DataFrame,
+    start_s: float,
+    end_s: float,
+    rate_hz: float,
+    source: str = "",
+) -> tuple[np.ndarray, np.ndarray]:
     """Perturbed and matched unperturbed rod-force vectors at the robot rate.
 
     Parameters
@@ -67,12 +75,18 @@ def native_force_windows(frame_time_s, direction, native: pd.DataFrame, matches:
         for i in range(len(anchors)):
             lo, hi = targets[i, 0], targets[i, -1]
             inside = (tn >= lo - 1.0 / rate_hz) & (tn <= hi + 1.0 / rate_hz)
-            if lo < tn[0] - 1e-9 or hi > tn[-1] + 1e-9 or lo < tf[0] - 1e-9 or hi > tf[-1] + 1e-9 \
-                    or not np.all(np.isfinite(fm[inside])):
+            if (
+                lo < tn[0] - 1e-9
+                or hi > tn[-1] + 1e-9
+                or lo < tf[0] - 1e-9
+                or hi > tf[-1] + 1e-9
+                or not np.all(np.isfinite(fm[inside]))
+            ):
                 raise LoperInputError(
                     f"{where(source)}the {what} force window of stride {matches['stride'].iloc[i]} "
                     f"({lo:.4f} .. {hi:.4f} s) leaves the finite force at the robot rate "
-                    f"({tn[0]:.4f} .. {tn[-1]:.4f} s) or the marker frames ({tf[0]:.4f} .. {tf[-1]:.4f} s)")
+                    f"({tn[0]:.4f} .. {tn[-1]:.4f} s) or the marker frames ({tf[0]:.4f} .. {tf[-1]:.4f} s)"
+                )
         magnitude = np.interp(targets, tn, fm)
         d = np.stack([np.interp(targets, tf, u[:, j]) for j in range(2)], axis=-1)
         d /= np.linalg.norm(d, axis=-1, keepdims=True)

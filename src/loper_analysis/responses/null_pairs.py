@@ -66,8 +66,10 @@ def deviant_trials(deviation_rad: dict, max_ratio: float = MAX_TRIAL_DEVIATION_R
         typical = float(np.median(others))
         if value > ratio * typical:
             times = f"{value / typical:.3g} times" if typical > 0 else "more than"
-            out[name] = (f"trial {name} left out of the null pairs: its null pairs deviate by {value:.3g} rad "
-                         f"(median RMS), {times} the other trials' {typical:.3g} rad (limit {ratio:g} times)")
+            out[name] = (
+                f"trial {name} left out of the null pairs: its null pairs deviate by {value:.3g} rad "
+                f"(median RMS), {times} the other trials' {typical:.3g} rad (limit {ratio:g} times)"
+            )
     return out
 
 
@@ -118,9 +120,18 @@ def null_pair_windows(
             raise LoperInputError(f"{where(source)}trial name {name!r} appears twice; names must be unique")
         t, columns, _ = trial_angles(trial, name, side)
         strides, where_s = trial_table(trial, "strides", name)
-        matches = match_unperturbed(t, columns["joints"], strides, before, source=where_s, span_s=(start, after),
-                                    onset_after_toe_off_s=onset_s, window_after_s=after, missing="drop",
-                                    null_pairs=True)
+        matches = match_unperturbed(
+            t,
+            columns["joints"],
+            strides,
+            before,
+            source=where_s,
+            span_s=(start, after),
+            onset_after_toe_off_s=onset_s,
+            window_after_s=after,
+            missing="drop",
+            null_pairs=True,
+        )
         part = paired_windows(t, columns, matches, start, after, rate_hz, source=where_s)
         deviation[name] = trial_deviation_rad(part["joints"][0] - part["joints"][1], grid, before, after)
         parts.append(part)
@@ -136,7 +147,8 @@ def null_pair_windows(
     for what, i in (("perturbed", 0), ("unperturbed", 1)):
         j, pel, x = (win[key][i][keep] for key in ("joints", "pelvis_angle", "pelvis_x"))
         out[f"q_{what}"] = segment_coordinates(j.reshape(-1, 3), pel.reshape(-1), x.reshape(-1)).reshape(
-            j.shape[:2] + (4,))
+            j.shape[:2] + (4,)
+        )
         out[f"pelvis_angle_{what}_rad"] = pel
     out["n_pairs"], out["n_outliers"] = int(keep.sum()), int((~keep).sum())
     out["trial_deviation_rad"], out["trials_left_out"] = deviation, left_out

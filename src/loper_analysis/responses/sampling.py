@@ -26,9 +26,7 @@ def window_span(start_s, end_s, source: str = "") -> tuple[float, float]:
     a = number("start_s", start_s, source)
     b = number("end_s", end_s, source)
     if not a <= 0.0 <= b:
-        raise LoperInputError(
-            f"{where(source)}the window must hold the onset: start_s <= 0 <= end_s, got {a} .. {b} s"
-        )
+        raise LoperInputError(f"{where(source)}the window must hold the onset: start_s <= 0 <= end_s, got {a} .. {b} s")
     return a, b
 
 

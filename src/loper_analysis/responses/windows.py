@@ -133,8 +133,10 @@ def paired_windows(
     need = [c for c in ("stride", "onset_s", "matched_anchor_s") if c not in matches.columns]
     if need:
         raise LoperInputError(f"{where(source)}matches: column(s) {need} missing")
-    anchors = {"perturbed": matches["onset_s"].to_numpy(float),
-               "unperturbed": matches["matched_anchor_s"].to_numpy(float)}
+    anchors = {
+        "perturbed": matches["onset_s"].to_numpy(float),
+        "unperturbed": matches["matched_anchor_s"].to_numpy(float),
+    }
     for what, a in anchors.items():
         bad = np.flatnonzero(~np.isfinite(a))
         if bad.size:
@@ -248,14 +250,22 @@ def window_outliers(
     else:
         bad = np.argwhere(~np.isfinite(d[:, sel]))
         if bad.size:
-            raise LoperInputError(f"{where(source)}differences are not finite at pair {bad[0][0]}, "
-                                  f"window sample {bad[0][1]}")
+            raise LoperInputError(
+                f"{where(source)}differences are not finite at pair {bad[0][0]}, window sample {bad[0][1]}"
+            )
         table = pd.DataFrame({"pair": np.arange(n, dtype=np.int64)})
         for name in names:
             table[f"fraction_outlying_{name}"] = np.full(n, np.nan)
         table["removed"] = np.zeros(n, dtype=bool)
         table["reason"] = f"not judged: {n} pair(s), the IQR rule needs >= {MIN_PAIRS_FOR_OUTLIERS}"
     table["judged"] = judged
-    table.attrs = {"judged": judged, "n_window_samples": int(sel.sum()), "before_s": before, "after_s": after,
-                   "whisker": w, "max_fraction": mf, "source": source}
+    table.attrs = {
+        "judged": judged,
+        "n_window_samples": int(sel.sum()),
+        "before_s": before,
+        "after_s": after,
+        "whisker": w,
+        "max_fraction": mf,
+        "source": source,
+    }
     return table

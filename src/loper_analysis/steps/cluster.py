@@ -23,7 +23,10 @@ def slurm_failure_lines(snakemake_log: PathLike) -> list[str]:
             continue
         reason = slurm_end_reason(path.read_text(errors="replace"))
         if reason is not None:
-            job = "/".join(path.parent.parts[path.parts.index("slurm_logs") + 1:]) if "slurm_logs" in path.parts \
+            job = (
+                "/".join(path.parent.parts[path.parts.index("slurm_logs") + 1 :])
+                if "slurm_logs" in path.parts
                 else path.parent.name
+            )
             lines.append(f"SLURM job {path.stem} ({job}): {reason} (SLURM's output: {path})")
     return lines

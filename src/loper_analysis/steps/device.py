@@ -21,8 +21,9 @@ log = logging.getLogger(__name__)
 DEVICE_FLOAT_FORMAT = "%.10g"
 
 
-def device_trial(out_path: PathLike, subject: str, trial: str, device: Mapping, leg: Mapping, tests: Mapping,
-                 seed: int) -> pd.DataFrame:
+def device_trial(
+    out_path: PathLike, subject: str, trial: str, device: Mapping, leg: Mapping, tests: Mapping, seed: int
+) -> pd.DataFrame:
     """Simulate one device-test trial of a synthetic subject and write it as a robot log.
 
     ``device``, ``leg`` and ``tests`` are the keyword arguments of
@@ -56,21 +57,35 @@ def log_from_mat(mat_path: PathLike, out_path: PathLike, column_map: Mapping, sa
     return frame
 
 
-def frf(log_path: PathLike, out_tsv: PathLike, sample_rate_hz: float, window_samples: int,
-        overlap_samples: int) -> pd.DataFrame:
+def frf(
+    log_path: PathLike, out_tsv: PathLike, sample_rate_hz: float, window_samples: int, overlap_samples: int
+) -> pd.DataFrame:
     """FRF of the broadband trial -> TSV (frequency_hz, gain, phase_deg, coherence)."""
     from ..device.analysis import frequency_response
 
     robot, _ = read_robot_log(log_path, sample_rate_hz)
-    table = frequency_response(robot["force_desired_n"].to_numpy(), robot["force_measured_n"].to_numpy(),
-                               sample_rate_hz, window_samples=window_samples, overlap_samples=overlap_samples)
+    table = frequency_response(
+        robot["force_desired_n"].to_numpy(),
+        robot["force_measured_n"].to_numpy(),
+        sample_rate_hz,
+        window_samples=window_samples,
+        overlap_samples=overlap_samples,
+    )
     write_tsv(table, out_tsv, DEVICE_FLOAT_FORMAT)
     log.info("FRF: %d frequencies", len(table))
     return table
 
 
-def steps(log_path: PathLike, metrics_tsv: PathLike, average_tsv: PathLike, sample_rate_hz: float,
-          amplitudes_n: Sequence[float], before_s: float, after_s: float, steady_window_s) -> pd.DataFrame:
+def steps(
+    log_path: PathLike,
+    metrics_tsv: PathLike,
+    average_tsv: PathLike,
+    sample_rate_hz: float,
+    amplitudes_n: Sequence[float],
+    before_s: float,
+    after_s: float,
+    steady_window_s,
+) -> pd.DataFrame:
     """Step metrics per amplitude and the averaged responses of the step trial."""
     from ..device.analysis import step_averages, step_table
 
@@ -83,8 +98,9 @@ def steps(log_path: PathLike, metrics_tsv: PathLike, average_tsv: PathLike, samp
     except LoperInputError as exc:
         raise LoperInputError(f"{log_path}: {exc}") from exc
     write_tsv(metrics, metrics_tsv, DEVICE_FLOAT_FORMAT)
-    write_tsv(average[["amplitude_n", "time_s", "desired_n", "measured_n", "measured_sd_n"]], average_tsv,
-              DEVICE_FLOAT_FORMAT)
+    write_tsv(
+        average[["amplitude_n", "time_s", "desired_n", "measured_n", "measured_sd_n"]], average_tsv, DEVICE_FLOAT_FORMAT
+    )
     log.info("step metrics:\n%s", metrics.to_string())
     return metrics
 
@@ -93,15 +109,15 @@ def summary(frf_tsv: PathLike, metrics_tsv: PathLike, out_tsv: PathLike, referen
     """The device figures beside the study's (:func:`loper_analysis.device.analysis.device_summary`)."""
     from ..device.analysis import device_summary
 
-    table = device_summary(read_tsv(frf_tsv, "FRF table"), read_tsv(metrics_tsv, "step metrics"),
-                           reference_band_hz)
+    table = device_summary(read_tsv(frf_tsv, "FRF table"), read_tsv(metrics_tsv, "step metrics"), reference_band_hz)
     write_tsv(table, out_tsv, DEVICE_FLOAT_FORMAT)
     log.info("device summary:\n%s", table.to_string())
     return table
 
 
-def figures(frf_tsv: PathLike, summary_tsv: PathLike, average_tsv: PathLike, bode_out: PathLike,
-            steps_out: PathLike) -> None:
+def figures(
+    frf_tsv: PathLike, summary_tsv: PathLike, average_tsv: PathLike, bode_out: PathLike, steps_out: PathLike
+) -> None:
     """The Bode plot (with our and the study's bandwidth) and the averaged step responses."""
     from ..figures.device import bode_figure, steps_figure
 

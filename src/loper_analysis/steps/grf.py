@@ -30,8 +30,7 @@ __all__ = ["grf", "trial_grf", "plate_vertical_loads"]
 log = logging.getLogger(__name__)
 
 
-def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest_n: float,
-                 up: Sequence[float] | None):
+def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest_n: float, up: Sequence[float] | None):
     """Every plate of the file read and analysed (:func:`loper_analysis.ground_reaction.plate_loads`), lab frame."""
     from ..ground_reaction import plate_loads, up_vector
     from ..io.force_platforms import read_force_platforms
@@ -39,14 +38,34 @@ def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest
 
     lab_up = up_vector(LAB_Z_UP if up is None else up, str(c3d_path))
     plates = read_force_platforms(c3d_path, lab_up)
-    return [plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, threshold_n, band_n, max_rest_n,
-                        source=f"{c3d_path} (force platform {p.number})", up=lab_up) for p in plates]
+    return [
+        plate_loads(
+            p.number,
+            p.time_s,
+            p.force_n,
+            p.moment_nm,
+            p.corners_m,
+            threshold_n,
+            band_n,
+            max_rest_n,
+            source=f"{c3d_path} (force platform {p.number})",
+            up=lab_up,
+        )
+        for p in plates
+    ]
 
 
-def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
-        threshold_n: float = 20.0, band_n: float = 10.0, max_rest_n: float = 100.0,
-        xml_out: PathLike | None = None, bodies: Mapping[int, str] | None = None,
-        up: Sequence[float] | None = None) -> pd.DataFrame:
+def grf(
+    c3d_path: PathLike,
+    out_mot: PathLike,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    threshold_n: float = 20.0,
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+    xml_out: PathLike | None = None,
+    bodies: Mapping[int, str] | None = None,
+    up: Sequence[float] | None = None,
+) -> pd.DataFrame:
     """C3D force platforms -> ground reaction on the body in the model frame -> external-loads ``.mot``.
 
     ``threshold_n`` is the vertical force above the resting level from which
@@ -70,14 +89,26 @@ def grf(c3d_path: PathLike, out_mot: PathLike, rotation_deg: Sequence[float] = (
         datafile = os.path.relpath(Path(out_mot).resolve(), Path(xml_out).resolve().parent)
         write_external_loads_xml(xml_out, bodies, datafile)
     for p in loads:
-        log.info("%s: plate %d: resting level %.1f N vertical, loaded %.1f %% of %d samples", c3d_path, p.number,
-                 p.rest_force_n @ p.up, 100.0 * p.loaded.mean(), p.loaded.size)
+        log.info(
+            "%s: plate %d: resting level %.1f N vertical, loaded %.1f %% of %d samples",
+            c3d_path,
+            p.number,
+            p.rest_force_n @ p.up,
+            100.0 * p.loaded.mean(),
+            p.loaded.size,
+        )
     return table
 
 
-def trial_grf(c3d_path: PathLike, out_mot: PathLike, markers_summary_tsv: PathLike,
-              base_rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), threshold_n: float = 20.0, band_n: float = 10.0,
-              max_rest_n: float = 100.0) -> pd.DataFrame:
+def trial_grf(
+    c3d_path: PathLike,
+    out_mot: PathLike,
+    markers_summary_tsv: PathLike,
+    base_rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    threshold_n: float = 20.0,
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+) -> pd.DataFrame:
     """:func:`grf` of a trial in the frame its markers were turned into: the trial's rotation is read from its
     markers summary (columns ``rotation_{x,y,z}_deg`` written by :func:`loper_analysis.steps.processing.markers`,
     the configured rotation plus the quarter turn that makes an overground trial walk along +X), so that the
@@ -95,8 +126,13 @@ def trial_grf(c3d_path: PathLike, out_mot: PathLike, markers_summary_tsv: PathLi
     return grf(c3d_path, out_mot, rotation, threshold_n, band_n, max_rest_n, up=lab_up(base_rotation_deg))
 
 
-def plate_vertical_loads(c3d_path: PathLike, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), band_n: float = 10.0,
-                         max_rest_n: float = 100.0, up: Sequence[float] | None = None):
+def plate_vertical_loads(
+    c3d_path: PathLike,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+    up: Sequence[float] | None = None,
+):
     """Each plate's lab-vertical force above its resting level at the analog rate, corners in the model frame.
 
     ``up``: the lab's up direction, lab frame (None: lab +Z), as in :func:`grf`.

@@ -30,17 +30,38 @@ def _checked(res, source: str, max_marker_rms_m: float, max_rms_fraction: float,
     res.warning = poor
     if res.n_left_out:
         t = res.time_s[res.solved]
-        log.warning("%s: %d of %d frames hold too few markers for IK and are left out (NaN); solved %d frames "
-                    "between %.4f and %.4f s", source, res.n_left_out, len(res.time_s), len(t), t[0], t[-1])
+        log.warning(
+            "%s: %d of %d frames hold too few markers for IK and are left out (NaN); solved %d frames "
+            "between %.4f and %.4f s",
+            source,
+            res.n_left_out,
+            len(res.time_s),
+            len(t),
+            t[0],
+            t[-1],
+        )
     if res.undetermined:
-        log.warning("%s: no weighted marker present determines %s; written as NaN there", source,
-                    ", ".join(f"{c} ({n} of {len(res.time_s)} frames)" for c, n in res.undetermined.items()))
+        log.warning(
+            "%s: no weighted marker present determines %s; written as NaN there",
+            source,
+            ", ".join(f"{c} ({n} of {len(res.time_s)} frames)" for c, n in res.undetermined.items()),
+        )
     return poor
 
 
-def _solve(model_osim: PathLike, time_s: np.ndarray, markers_m: np.ndarray, labels: Sequence[str], tasks_file=None,
-           default_weight: float = 1.0, marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6,
-           source: str = "", min_markers: int = MIN_IK_MARKERS):
+def _solve(
+    model_osim: PathLike,
+    time_s: np.ndarray,
+    markers_m: np.ndarray,
+    labels: Sequence[str],
+    tasks_file=None,
+    default_weight: float = 1.0,
+    marker_weights=None,
+    coordinate_tasks=None,
+    accuracy: float = 1e-6,
+    source: str = "",
+    min_markers: int = MIN_IK_MARKERS,
+):
     """IK of marker arrays with the tasks of a file or of the config; returns the :class:`IKResult`."""
     from ..io.ik_tasks import read_ik_tasks
     from ..io.osim import read_model
@@ -49,15 +70,27 @@ def _solve(model_osim: PathLike, time_s: np.ndarray, markers_m: np.ndarray, labe
     model = read_model(model_osim)
     tasks = read_ik_tasks(tasks_file) if tasks_file else None
     weights, coords = ik_task_weights(model, labels, tasks, default_weight, marker_weights, coordinate_tasks, source)
-    return inverse_kinematics(model, time_s, markers_m, labels, weights, coords, accuracy=accuracy,
-                              min_markers=min_markers, source=source)
+    return inverse_kinematics(
+        model, time_s, markers_m, labels, weights, coords, accuracy=accuracy, min_markers=min_markers, source=source
+    )
 
 
-def ik_chunk(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, chunk: int, n_chunks: int, tasks_file=None,
-             default_weight: float = 1.0, marker_weights: Mapping[str, float] | None = None,
-             coordinate_tasks: Mapping[str, Mapping] | None = None, accuracy: float = 1e-6,
-             min_markers: int = MIN_IK_MARKERS, max_marker_rms_m: float = IK_STOP_RMS_M,
-             max_rms_fraction: float = IK_MAX_FRACTION, warn_marker_rms_m: float | None = IK_WARN_RMS_M):
+def ik_chunk(
+    model_osim: PathLike,
+    trc_path: PathLike,
+    out_mot: PathLike,
+    chunk: int,
+    n_chunks: int,
+    tasks_file=None,
+    default_weight: float = 1.0,
+    marker_weights: Mapping[str, float] | None = None,
+    coordinate_tasks: Mapping[str, Mapping] | None = None,
+    accuracy: float = 1e-6,
+    min_markers: int = MIN_IK_MARKERS,
+    max_marker_rms_m: float = IK_STOP_RMS_M,
+    max_rms_fraction: float = IK_MAX_FRACTION,
+    warn_marker_rms_m: float | None = IK_WARN_RMS_M,
+):
     """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the :class:`IKResult`.
 
     Markers missing (NaN) in a frame are left out of its solve; a frame with
@@ -76,28 +109,71 @@ def ik_chunk(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, chunk:
 
     time_s, X, labels = read_markers(trc_path)
     sel = chunk_frames(len(time_s), n_chunks, chunk)
-    res = _solve(model_osim, time_s[sel], X[sel], labels, tasks_file, default_weight, marker_weights,
-                 coordinate_tasks, accuracy, source=f"{trc_path} with {model_osim}", min_markers=min_markers)
+    res = _solve(
+        model_osim,
+        time_s[sel],
+        X[sel],
+        labels,
+        tasks_file,
+        default_weight,
+        marker_weights,
+        coordinate_tasks,
+        accuracy,
+        source=f"{trc_path} with {model_osim}",
+        min_markers=min_markers,
+    )
     _checked(res, f"{trc_path} with {model_osim}", max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)
-    log.info("%s chunk %d/%d: %d frames (%d solved), marker RMS error mean %.2f mm, max %.2f mm", trc_path, chunk,
-             n_chunks, len(res.time_s), len(res.time_s) - res.n_left_out, 1e3 * np.nanmean(res.marker_rms_m),
-             1e3 * np.nanmax(res.marker_max_m))
+    log.info(
+        "%s chunk %d/%d: %d frames (%d solved), marker RMS error mean %.2f mm, max %.2f mm",
+        trc_path,
+        chunk,
+        n_chunks,
+        len(res.time_s),
+        len(res.time_s) - res.n_left_out,
+        1e3 * np.nanmean(res.marker_rms_m),
+        1e3 * np.nanmax(res.marker_max_m),
+    )
     write_mot(out_mot, res.frame(), in_degrees=True)
     return res
 
 
-def ik_trial(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, angles_tsv: PathLike,
-             coordinate_map: Mapping | None = None, tasks_file=None, default_weight: float = 1.0,
-             marker_weights=None, coordinate_tasks=None, accuracy: float = 1e-6,
-             min_markers: int = MIN_IK_MARKERS, max_marker_rms_m: float = IK_STOP_RMS_M,
-             max_rms_fraction: float = IK_MAX_FRACTION, warn_marker_rms_m: float | None = IK_WARN_RMS_M,
-             summary_tsv: PathLike | None = None) -> pd.DataFrame:
+def ik_trial(
+    model_osim: PathLike,
+    trc_path: PathLike,
+    out_mot: PathLike,
+    angles_tsv: PathLike,
+    coordinate_map: Mapping | None = None,
+    tasks_file=None,
+    default_weight: float = 1.0,
+    marker_weights=None,
+    coordinate_tasks=None,
+    accuracy: float = 1e-6,
+    min_markers: int = MIN_IK_MARKERS,
+    max_marker_rms_m: float = IK_STOP_RMS_M,
+    max_rms_fraction: float = IK_MAX_FRACTION,
+    warn_marker_rms_m: float | None = IK_WARN_RMS_M,
+    summary_tsv: PathLike | None = None,
+) -> pd.DataFrame:
     """IK of a whole TRC in one go: the .mot (degrees), the tidy angle table that :func:`ik_join` gives, and
     (``summary_tsv``) the one-row IK summary (:meth:`loper_analysis.kinematics.IKResult.summary`)."""
     from ..kinematics import joint_angle_table
 
-    res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, tasks_file, default_weight, marker_weights,
-                   coordinate_tasks, accuracy, min_markers, max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)
+    res = ik_chunk(
+        model_osim,
+        trc_path,
+        out_mot,
+        0,
+        1,
+        tasks_file,
+        default_weight,
+        marker_weights,
+        coordinate_tasks,
+        accuracy,
+        min_markers,
+        max_marker_rms_m,
+        max_rms_fraction,
+        warn_marker_rms_m,
+    )
     angles = joint_angle_table(res.frame(), coordinate_map, source=f"{out_mot} (model {model_osim})")
     if summary_tsv is not None:
         write_tsv(res.summary(IK_WARN_RMS_M if warn_marker_rms_m is None else warn_marker_rms_m), summary_tsv)
@@ -106,8 +182,13 @@ def ik_trial(model_osim: PathLike, trc_path: PathLike, out_mot: PathLike, angles
     return angles
 
 
-def ik_join(chunk_mots: Sequence[PathLike], out_mot: PathLike, angles_tsv: PathLike,
-            coordinate_map: Mapping | None = None, summary_tsv: PathLike | None = None) -> pd.DataFrame:
+def ik_join(
+    chunk_mots: Sequence[PathLike],
+    out_mot: PathLike,
+    angles_tsv: PathLike,
+    coordinate_map: Mapping | None = None,
+    summary_tsv: PathLike | None = None,
+) -> pd.DataFrame:
     """Join IK chunks into one .mot and the tidy angle table (rad, m; :data:`kinematics.ANGLE_COLUMNS`).
 
     ``summary_tsv``: the one-row IK summary of the joined trial (frames left
@@ -124,26 +205,37 @@ def ik_join(chunk_mots: Sequence[PathLike], out_mot: PathLike, angles_tsv: PathL
     if summary_tsv is not None:
         values = coords.drop(columns="time_s").to_numpy(float)
         none = np.full(len(coords), np.nan)
-        joined = IKResult(coords["time_s"].to_numpy(float), values, [], none, none,
-                          solved=np.isfinite(values).any(axis=1))
+        joined = IKResult(
+            coords["time_s"].to_numpy(float), values, [], none, none, solved=np.isfinite(values).any(axis=1)
+        )
         write_tsv(joined.summary(IK_WARN_RMS_M), summary_tsv)
     write_tsv(angles, angles_tsv)
     log.info("%d frames, %s", len(angles), list(angles.columns))
     return angles
 
 
-def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tasks_file=None,
-            start_s: float | None = None, end_s: float | None = None,
-            rotate_deg: Sequence[float] | None = None, accuracy: float = 1e-6, min_markers: int = MIN_IK_MARKERS,
-            max_marker_rms_m: float = IK_STOP_RMS_M, max_rms_fraction: float = IK_MAX_FRACTION,
-            label_map: Mapping[str, str] | None = None, warn_marker_rms_m: float | None = IK_WARN_RMS_M,
-            walking_direction: str = "fixed"):
+def ik_file(
+    model_osim: PathLike,
+    markers_path: PathLike,
+    out_mot: PathLike,
+    tasks_file=None,
+    start_s: float | None = None,
+    end_s: float | None = None,
+    rotate_deg: Sequence[float] | None = None,
+    accuracy: float = 1e-6,
+    min_markers: int = MIN_IK_MARKERS,
+    max_marker_rms_m: float = IK_STOP_RMS_M,
+    max_rms_fraction: float = IK_MAX_FRACTION,
+    label_map: Mapping[str, str] | None = None,
+    warn_marker_rms_m: float | None = IK_WARN_RMS_M,
+    walking_direction: str = "fixed",
+):
     """IK of a .c3d or .trc marker file to a .mot (degrees), for the command line.
 
     Labels lose a subject prefix (``Subject:LASI`` -> ``LASI``) and are
     renamed by ``label_map`` {lab label: model marker}
-    (:func:`loper_analysis.marker_names.model_marker_names`). ``rotate_deg`` turns the markers into the model frame (default -90 0 0
-    for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). Without a
+    (:func:`loper_analysis.marker_names.model_marker_names`). ``rotate_deg`` turns the markers into the model frame
+    (default -90 0 0 for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). Without a
     task file every model marker found in the file gets weight 1. Frames with
     too few markers are left out (NaN), with a warning. A fit that only a
     mistake explains (marker RMS error above ``max_marker_rms_m`` m in more
@@ -172,7 +264,9 @@ def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tas
         from ..heading import trial_heading
 
         rate = 1.0 / float(np.median(np.diff(time_s))) if len(time_s) > 1 else 1.0
-        rotate_deg = trial_heading(markers_m, rate, rotate_deg, walking_direction, source=str(markers_path)).rotation_deg
+        rotate_deg = trial_heading(
+            markers_m, rate, rotate_deg, walking_direction, source=str(markers_path)
+        ).rotation_deg
     markers_m = rotate_markers(markers_m, rotate_deg)
     start = time_s[0] if start_s is None else start_s
     end = time_s[-1] if end_s is None else end_s
@@ -187,8 +281,16 @@ def ik_file(model_osim: PathLike, markers_path: PathLike, out_mot: PathLike, tas
         weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
     model = read_model(model_osim)
     try:
-        result = inverse_kinematics(model, time_s[sel], markers_m[sel], labels, weights,
-                                    coordinate_tasks, accuracy=accuracy, min_markers=min_markers)
+        result = inverse_kinematics(
+            model,
+            time_s[sel],
+            markers_m[sel],
+            labels,
+            weights,
+            coordinate_tasks,
+            accuracy=accuracy,
+            min_markers=min_markers,
+        )
     except LoperInputError as exc:
         raise LoperInputError(f"{markers_path} with {model_osim}: {exc}") from None
     _checked(result, f"{markers_path} with {model_osim}", max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)

@@ -30,13 +30,28 @@ class _Tables:
         return self._frames[key]
 
 
-def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[PathLike], force: Sequence[PathLike],
-        markers: Sequence[PathLike], segments_tsv: PathLike, onset_ms: int, subject: str,
-        response_out: PathLike, counts_out: PathLike, fit_out: PathLike, curves_out: PathLike,
-        truth_yaml: PathLike | None = None, null_trials: Sequence[str] = (),
-        null_angles: Sequence[PathLike] = (), null_strides: Sequence[PathLike] = (),
-        response: Mapping | None = None, identification: Mapping | None = None,
-        force_native: Sequence[PathLike] = (), force_out: PathLike | None = None) -> pd.DataFrame:
+def fit(
+    trials: Sequence[str],
+    angles: Sequence[PathLike],
+    strides: Sequence[PathLike],
+    force: Sequence[PathLike],
+    markers: Sequence[PathLike],
+    segments_tsv: PathLike,
+    onset_ms: int,
+    subject: str,
+    response_out: PathLike,
+    counts_out: PathLike,
+    fit_out: PathLike,
+    curves_out: PathLike,
+    truth_yaml: PathLike | None = None,
+    null_trials: Sequence[str] = (),
+    null_angles: Sequence[PathLike] = (),
+    null_strides: Sequence[PathLike] = (),
+    response: Mapping | None = None,
+    identification: Mapping | None = None,
+    force_native: Sequence[PathLike] = (),
+    force_out: PathLike | None = None,
+) -> pd.DataFrame:
     """Responses and the impedance fit of one subject at one onset (:func:`loper_analysis.impedance.fit_onset`).
 
     ``trials`` names the onset's trials; ``angles``, ``strides``, ``force``
@@ -50,14 +65,54 @@ def fit(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pat
     :class:`~loper_analysis.impedance.IdentificationSettings`. Writes the
     mean response, the stride counts, the fit rows and the fit curves; returns the rows.
     """
-    return _fit(trials, angles, strides, force, markers, segments_tsv, onset_ms, subject, response_out, counts_out,
-                fit_out, curves_out, truth_yaml, null_trials, null_angles, null_strides, response, identification,
-                force_native, force_out, _Tables())
+    return _fit(
+        trials,
+        angles,
+        strides,
+        force,
+        markers,
+        segments_tsv,
+        onset_ms,
+        subject,
+        response_out,
+        counts_out,
+        fit_out,
+        curves_out,
+        truth_yaml,
+        null_trials,
+        null_angles,
+        null_strides,
+        response,
+        identification,
+        force_native,
+        force_out,
+        _Tables(),
+    )
 
 
-def _fit(trials, angles, strides, force, markers, segments_tsv, onset_ms, subject, response_out, counts_out, fit_out,
-         curves_out, truth_yaml, null_trials, null_angles, null_strides, response, identification, force_native,
-         force_out, tables: _Tables) -> pd.DataFrame:
+def _fit(
+    trials,
+    angles,
+    strides,
+    force,
+    markers,
+    segments_tsv,
+    onset_ms,
+    subject,
+    response_out,
+    counts_out,
+    fit_out,
+    curves_out,
+    truth_yaml,
+    null_trials,
+    null_angles,
+    null_strides,
+    response,
+    identification,
+    force_native,
+    force_out,
+    tables: _Tables,
+) -> pd.DataFrame:
     """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
     from ..impedance import IdentificationSettings, fit_onset
     from ..io.opensim_tables import read_markers
@@ -77,12 +132,22 @@ def _fit(trials, angles, strides, force, markers, segments_tsv, onset_ms, subjec
         t, X, labels = read_markers(m)
         if len(t) != len(angle_table) or not np.allclose(t, angle_table["time_s"].to_numpy(), atol=1e-6):
             raise LoperInputError(f"{m}: frames differ from {a}")
-        inputs.append({"name": name, "angles": angle_table, "strides": tables(s, "stride table"),
-                       "force": tables(f, "force table"), "markers": (t, X, labels),
-                       "force_native": None if fn is None else read_tsv(fn, "robot-rate force table",
-                                                                         ("time_s", "force_measured_n"))})
-    null = [{"name": name, "angles": tables(a, "angle table"), "strides": tables(s, "stride table")}
-            for name, a, s in zip(null_trials, null_angles, null_strides, strict=True)]
+        inputs.append(
+            {
+                "name": name,
+                "angles": angle_table,
+                "strides": tables(s, "stride table"),
+                "force": tables(f, "force table"),
+                "markers": (t, X, labels),
+                "force_native": None
+                if fn is None
+                else read_tsv(fn, "robot-rate force table", ("time_s", "force_measured_n")),
+            }
+        )
+    null = [
+        {"name": name, "angles": tables(a, "angle table"), "strides": tables(s, "stride table")}
+        for name, a, s in zip(null_trials, null_angles, null_strides, strict=True)
+    ]
     params = read_segments(segments_tsv) if inputs else None
     result = fit_onset(inputs, params, int(onset_ms), subject, truth, null, settings, ident)
     write_tsv(result.response, response_out)
@@ -95,14 +160,26 @@ def _fit(trials, angles, strides, force, markers, segments_tsv, onset_ms, subjec
     return result.rows
 
 
-def subject_fits(onsets_ms: Sequence[int], trials: Mapping[str, Sequence[str]],
-                 null_trials: Mapping[str, Sequence[str]], angles: Mapping[str, PathLike],
-                 strides: Mapping[str, PathLike], force: Mapping[str, PathLike],
-                 force_native: Mapping[str, PathLike], markers: Mapping[str, PathLike], segments_tsv: PathLike,
-                 subject: str, response_outs: Sequence[PathLike], counts_outs: Sequence[PathLike],
-                 fit_outs: Sequence[PathLike], curves_outs: Sequence[PathLike], force_outs: Sequence[PathLike],
-                 truth_yaml: PathLike | None = None, response: Mapping | None = None,
-                 identification: Mapping | None = None) -> pd.DataFrame:
+def subject_fits(
+    onsets_ms: Sequence[int],
+    trials: Mapping[str, Sequence[str]],
+    null_trials: Mapping[str, Sequence[str]],
+    angles: Mapping[str, PathLike],
+    strides: Mapping[str, PathLike],
+    force: Mapping[str, PathLike],
+    force_native: Mapping[str, PathLike],
+    markers: Mapping[str, PathLike],
+    segments_tsv: PathLike,
+    subject: str,
+    response_outs: Sequence[PathLike],
+    counts_outs: Sequence[PathLike],
+    fit_outs: Sequence[PathLike],
+    curves_outs: Sequence[PathLike],
+    force_outs: Sequence[PathLike],
+    truth_yaml: PathLike | None = None,
+    response: Mapping | None = None,
+    identification: Mapping | None = None,
+) -> pd.DataFrame:
     """:func:`fit` of one subject at every onset in one process, each table read once.
 
     ``trials`` and ``null_trials`` map each onset (``"050"``, in the order of
@@ -116,11 +193,31 @@ def subject_fits(onsets_ms: Sequence[int], trials: Mapping[str, Sequence[str]],
     for i, onset in enumerate(onsets_ms):
         key = f"{int(onset):03d}"
         own, null = list(trials[key]), list(null_trials[key])
-        rows.append(_fit(own, [angles[t] for t in own], [strides[t] for t in own], [force[t] for t in own],
-                         [markers[t] for t in own], segments_tsv, int(onset), subject, response_outs[i],
-                         counts_outs[i], fit_outs[i], curves_outs[i], truth_yaml, null, [angles[t] for t in null],
-                         [strides[t] for t in null], response, identification, [force_native[t] for t in own],
-                         force_outs[i], tables))
+        rows.append(
+            _fit(
+                own,
+                [angles[t] for t in own],
+                [strides[t] for t in own],
+                [force[t] for t in own],
+                [markers[t] for t in own],
+                segments_tsv,
+                int(onset),
+                subject,
+                response_outs[i],
+                counts_outs[i],
+                fit_outs[i],
+                curves_outs[i],
+                truth_yaml,
+                null,
+                [angles[t] for t in null],
+                [strides[t] for t in null],
+                response,
+                identification,
+                [force_native[t] for t in own],
+                force_outs[i],
+                tables,
+            )
+        )
     return pd.concat(rows, ignore_index=True)
 
 
@@ -132,8 +229,12 @@ def impedance_table(fit_tsvs: Sequence[PathLike], out_tsv: PathLike) -> pd.DataF
     return table
 
 
-def impedance_summary(impedance_tsv: PathLike, summary_out: PathLike, literature_out: PathLike,
-                      upper_bounds: tuple[float, float] | None = None) -> pd.DataFrame:
+def impedance_summary(
+    impedance_tsv: PathLike,
+    summary_out: PathLike,
+    literature_out: PathLike,
+    upper_bounds: tuple[float, float] | None = None,
+) -> pd.DataFrame:
     """Across-subject summary per joint and onset and the literature table with our row.
 
     ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary.
@@ -148,8 +249,14 @@ def impedance_summary(impedance_tsv: PathLike, summary_out: PathLike, literature
     return summary
 
 
-def subject_figures(onsets_ms: Sequence[int], response_tsvs: Sequence[PathLike], curve_tsvs: Sequence[PathLike],
-                    subject: str, responses_out: PathLike, fit_out: PathLike) -> pd.DataFrame:
+def subject_figures(
+    onsets_ms: Sequence[int],
+    response_tsvs: Sequence[PathLike],
+    curve_tsvs: Sequence[PathLike],
+    subject: str,
+    responses_out: PathLike,
+    fit_out: PathLike,
+) -> pd.DataFrame:
     """A subject's responses figure and fit figure over the onsets; returns the peak responses (rad)."""
     from ..figures.impedance import fit_figure, response_peaks, responses_figure
 

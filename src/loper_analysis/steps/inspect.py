@@ -86,31 +86,47 @@ def model_marker_names_of(model_osim: PathLike, marker_set_xml: PathLike | None 
     return list(dict.fromkeys(names))
 
 
-def _snippet(summary: RecordingSummary, c3d_name: str, snippet_path: str, label_map, feet, model: str | None,
-             with_marker_set: bool) -> str:
+def _snippet(
+    summary: RecordingSummary,
+    c3d_name: str,
+    snippet_path: str,
+    label_map,
+    feet,
+    model: str | None,
+    with_marker_set: bool,
+) -> str:
     """The config snippet's text, a comment on every key."""
     walking = summary.walking
     rotation = f"from {c3d_name}: up {axis_name(summary.vertical.axis, summary.vertical.sign)} -> model +Y"
     if walking.axis is None:
         rotation += "; treadmill/standing: check that the subject faces model +X"
     elif summary.rotation_forward_deg != summary.rotation_deg:
-        rotation += (f"; this trial walks {axis_name(walking.axis, walking.sign)}, "
-                     f"[{', '.join(f'{a:g}' for a in summary.rotation_forward_deg)}] turns it to model +X")
+        rotation += (
+            f"; this trial walks {axis_name(walking.axis, walking.sign)}, "
+            f"[{', '.join(f'{a:g}' for a in summary.rotation_forward_deg)}] turns it to model +X"
+        )
     notes = {
         "rotation": rotation,
         "label_map": "lab label -> model marker; check every row, add the unmatched labels you need",
         "foot_markers": "heel markers (model names) that assign plate contacts to feet",
         "generic_model": "scaled per subject with opensim.scale_setup, your ScaleTool setup"
-                         + (" (it names the marker set)" if with_marker_set else ""),
+        + (" (it names the marker set)" if with_marker_set else ""),
     }
-    header = [f"Starter settings from loper-analysis inspect {c3d_name}. Check them, then run",
-              f"snakemake --configfile {snippet_path} (it goes over config/config.yaml).",
-              "Paths are as given to inspect: relative ones count from where snakemake runs."]
+    header = [
+        f"Starter settings from loper-analysis inspect {c3d_name}. Check them, then run",
+        f"snakemake --configfile {snippet_path} (it goes over config/config.yaml).",
+        "Paths are as given to inspect: relative ones count from where snakemake runs.",
+    ]
     return config_snippet(summary.rotation_deg, label_map, feet, model, notes, header)
 
 
-def inspect_c3d(c3d_path: PathLike, model_osim: PathLike | None = None, marker_set_xml: PathLike | None = None,
-                label_map_out: PathLike | None = None, config_out: PathLike | None = None) -> Inspection:
+def inspect_c3d(
+    c3d_path: PathLike,
+    model_osim: PathLike | None = None,
+    marker_set_xml: PathLike | None = None,
+    label_map_out: PathLike | None = None,
+    config_out: PathLike | None = None,
+) -> Inspection:
     """Inspect a C3D file; optionally match its labels to a model and write a label map and a config snippet.
 
     Parameters
@@ -170,24 +186,40 @@ def inspect_c3d(c3d_path: PathLike, model_osim: PathLike | None = None, marker_s
     table = starter_label_map(match) if match is not None else None
     if label_map_out is not None:
         write_tsv(table, label_map_out)
-        written.append(f"{label_map_out}: label map, {len(table)} row(s) (labels named like their model marker "
-                       "need none; unmatched labels are listed above, not in the map)")
+        written.append(
+            f"{label_map_out}: label map, {len(table)} row(s) (labels named like their model marker "
+            "need none; unmatched labels are listed above, not in the map)"
+        )
     if config_out is not None:
         label_map = None
         if match is not None:
             label_map = str(label_map_out) if label_map_out is not None else dict(zip(table["label"], table["marker"]))
-        names = [m for _, m, _ in match.pairs] if match is not None else \
-            [strip_subject_prefix(lab) for lab in rec.marker_labels]
+        names = (
+            [m for _, m, _ in match.pairs]
+            if match is not None
+            else [strip_subject_prefix(lab) for lab in rec.marker_labels]
+        )
         feet = heel_markers(names)
         model = None if model_osim is None else str(model_osim)
-        write_text(config_out, _snippet(summary, path.name, str(config_out), label_map, feet, model,
-                                        marker_set_xml is not None), "config snippet")
-        written.append(f"{config_out}: config snippet (markers.lab_to_model_rotation_deg"
-                       + (", markers.label_map" if label_map is not None else "")
-                       + (", events.foot_markers" if feet else "")
-                       + (", opensim.generic_model" if model is not None else "") + ")")
+        write_text(
+            config_out,
+            _snippet(summary, path.name, str(config_out), label_map, feet, model, marker_set_xml is not None),
+            "config snippet",
+        )
+        written.append(
+            f"{config_out}: config snippet (markers.lab_to_model_rotation_deg"
+            + (", markers.label_map" if label_map is not None else "")
+            + (", events.foot_markers" if feet else "")
+            + (", opensim.generic_model" if model is not None else "")
+            + ")"
+        )
     if written:
         text += "\n" + "\n".join(written) + "\n"
-    return Inspection(summary, match, model_markers, text,
-                      None if label_map_out is None else Path(label_map_out),
-                      None if config_out is None else Path(config_out))
+    return Inspection(
+        summary,
+        match,
+        model_markers,
+        text,
+        None if label_map_out is None else Path(label_map_out),
+        None if config_out is None else Path(config_out),
+    )

@@ -30,7 +30,7 @@ def timing_line(end_epoch_s: float | None = None) -> str:
     io_s, import_s, first = io_times()
     end = time.time() if end_epoch_s is None else end_epoch_s
     after_first = 0.0 if first is None else max(end - first, 0.0)
-    return (f"{TIMING_PREFIX} after_first_io_s={after_first:.3f} io_s={io_s:.3f} library_import_s={import_s:.3f}")
+    return f"{TIMING_PREFIX} after_first_io_s={after_first:.3f} io_s={io_s:.3f} library_import_s={import_s:.3f}"
 
 
 #: Environment variable: when set (to anything but "" or "0"), every job also writes a cProfile of its body
@@ -51,8 +51,10 @@ def _profiler():
 
 def _stop_on_sigterm(signum: int, frame) -> None:
     """SIGTERM as an error: the job's log is written before the process ends."""
-    raise SystemExit(f"stopped by {signal.Signals(signum).name}: the job was cancelled (scancel, or Snakemake "
-                     "interrupted), or SLURM ended it at its time limit (resource runtime)")
+    raise SystemExit(
+        f"stopped by {signal.Signals(signum).name}: the job was cancelled (scancel, or Snakemake "
+        "interrupted), or SLURM ended it at its time limit (resource runtime)"
+    )
 
 
 def _os_error(exc: BaseException) -> str:

@@ -15,9 +15,20 @@ from ..errors import LoperInputError
 from ..io.atomic import PathLike, staged, write_tsv
 from ..io.readers import read_tsv
 
-__all__ = ["SEGMENT_FLOAT_FORMAT", "SCALE_FLOAT_FORMAT", "SCALE_REPORT_COLUMNS", "read_segments", "write_segments",
-           "generic_model", "scaled_model", "scale_with_setup", "scale", "scale_report", "segments_from_model_file",
-           "anthropometric_segments"]
+__all__ = [
+    "SEGMENT_FLOAT_FORMAT",
+    "SCALE_FLOAT_FORMAT",
+    "SCALE_REPORT_COLUMNS",
+    "read_segments",
+    "write_segments",
+    "generic_model",
+    "scaled_model",
+    "scale_with_setup",
+    "scale",
+    "scale_report",
+    "segments_from_model_file",
+    "anthropometric_segments",
+]
 
 log = logging.getLogger(__name__)
 
@@ -35,8 +46,14 @@ def read_segments(path: PathLike) -> SegmentParameters:
     return SegmentParameters.from_frame(read_tsv(path, "segment table"), source=str(path))
 
 
-def generic_model(out_osim: PathLike, height_m: float, mass_kg: float | None, static_c3d: PathLike | None = None,
-                  duration_s: float | None = None, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0)) -> None:
+def generic_model(
+    out_osim: PathLike,
+    height_m: float,
+    mass_kg: float | None,
+    static_c3d: PathLike | None = None,
+    duration_s: float | None = None,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+) -> None:
     """The generic lower-body model (:func:`loper_analysis.model.build_lower_body_model`) for this subject.
 
     Without ``mass_kg`` the mass comes from the force plates the subject
@@ -67,9 +84,15 @@ def _check_factors(model, measurements, pose, static_trc, factor_range) -> None:
     require_scale_factors(factors, str(static_trc), factor_range)
 
 
-def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
-                 time_range_s: tuple[float, float] | None = None,
-                 factor_range: Sequence[float] = (0.5, 2.0), **static) -> None:
+def scaled_model(
+    generic_osim: PathLike,
+    static_trc: PathLike,
+    out_osim: PathLike,
+    mass_kg: float | None,
+    time_range_s: tuple[float, float] | None = None,
+    factor_range: Sequence[float] = (0.5, 2.0),
+    **static,
+) -> None:
     """Personalise the generated model with OpenSim's ScaleTool from a static trial (TRC).
 
     Each body is scaled uniformly by the ratio of the marker-pair distances in
@@ -110,13 +133,31 @@ def scaled_model(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLik
     generic_osim = Path(generic_osim)
     if not generic_osim.is_file():
         raise LoperInputError(f"file not found: {generic_osim}")
-    _run_scale_tool(tool, read_model(generic_osim), generic_osim, None, None, static_trc, out_osim, mass_kg,
-                    time_range_s, factor_range, **static)
+    _run_scale_tool(
+        tool,
+        read_model(generic_osim),
+        generic_osim,
+        None,
+        None,
+        static_trc,
+        out_osim,
+        mass_kg,
+        time_range_s,
+        factor_range,
+        **static,
+    )
 
 
-def scale(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
-          setup_xml: PathLike | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None,
-          factor_range: Sequence[float] = (0.5, 2.0), **static) -> None:
+def scale(
+    generic_osim: PathLike,
+    static_trc: PathLike,
+    out_osim: PathLike,
+    mass_kg: float | None,
+    setup_xml: PathLike | None = None,
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    factor_range: Sequence[float] = (0.5, 2.0),
+    **static,
+) -> None:
     """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when ``setup_xml``
     is given, else with the generated model's marker-pair measurements (:func:`scaled_model`); scale factors
     outside ``factor_range`` are refused. ``static``: the keywords of the static trial
@@ -127,14 +168,27 @@ def scale(generic_osim: PathLike, static_trc: PathLike, out_osim: PathLike, mass
     if setup_xml is None:
         scaled_model(generic_osim, static_trc, out_osim, mass_kg, factor_range=factor_range, **static)
     else:
-        scale_with_setup(generic_osim, setup_xml, static_trc, mass_kg, out_osim, segment_bodies=segment_bodies,
-                         factor_range=factor_range, **static)
+        scale_with_setup(
+            generic_osim,
+            setup_xml,
+            static_trc,
+            mass_kg,
+            out_osim,
+            segment_bodies=segment_bodies,
+            factor_range=factor_range,
+            **static,
+        )
 
 
-def segments_from_model_file(model_osim: PathLike, out_tsv: PathLike, side: str = "left",
-                             segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                             attachment_fraction: float = 0.8) -> SegmentParameters:
-    """Segment table (TSV) of one leg of an OpenSim model file (:func:`loper_analysis.segments_from_model.segments_from_model`).
+def segments_from_model_file(
+    model_osim: PathLike,
+    out_tsv: PathLike,
+    side: str = "left",
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    attachment_fraction: float = 0.8,
+) -> SegmentParameters:
+    """Segment table (TSV) of one leg of an OpenSim model file
+    (:func:`loper_analysis.segments_from_model.segments_from_model`).
 
     Parameters
     ----------
@@ -162,15 +216,17 @@ def segments_from_model_file(model_osim: PathLike, out_tsv: PathLike, side: str 
     from ..segments_from_model import segments_from_model
 
     check_side(side, str(model_osim))
-    params = segments_from_model(read_model(model_osim), SIDE_SUFFIX[side], segment_bodies, attachment_fraction,
-                                 source=str(model_osim))
+    params = segments_from_model(
+        read_model(model_osim), SIDE_SUFFIX[side], segment_bodies, attachment_fraction, source=str(model_osim)
+    )
     write_segments(params, out_tsv)
     log.info("segment table of %s (%s leg)", model_osim, side)
     return params
 
 
-def anthropometric_segments(out_tsv: PathLike, height_m: float, mass_kg: float,
-                            attachment_fraction: float = 0.8) -> SegmentParameters:
+def anthropometric_segments(
+    out_tsv: PathLike, height_m: float, mass_kg: float, attachment_fraction: float = 0.8
+) -> SegmentParameters:
     """Segment table from height and mass with Winter's table (the validation study's subject, the CLI)."""
     params = segment_parameters_from_anthropometry(height_m, mass_kg, attachment_fraction)
     write_segments(params, out_tsv)
@@ -178,10 +234,17 @@ def anthropometric_segments(out_tsv: PathLike, height_m: float, mass_kg: float,
     return params
 
 
-def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: PathLike, mass_kg: float | None,
-                     out_osim: PathLike, time_range_s: tuple[float, float] | None = None,
-                     segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                     factor_range: Sequence[float] = (0.5, 2.0), **static) -> None:
+def scale_with_setup(
+    generic_osim: PathLike,
+    setup_xml: PathLike,
+    static_trc: PathLike,
+    mass_kg: float | None,
+    out_osim: PathLike,
+    time_range_s: tuple[float, float] | None = None,
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    factor_range: Sequence[float] = (0.5, 2.0),
+    **static,
+) -> None:
     """Scale a generic OpenSim model with a lab's own ScaleTool setup and a static trial (TRC).
 
     The setup (``opensim.ScaleTool(setup_xml)``) keeps its measurements,
@@ -257,8 +320,10 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
     maker = tool.getGenericModelMaker()
     marker_set = _setup_file(maker.getMarkerSetFileName(), setup_xml)
     if marker_set is not None and not marker_set.is_file():
-        raise LoperInputError(f"{setup_xml}: GenericModelMaker/marker_set_file {maker.getMarkerSetFileName()} "
-                              f"not found (looked for {marker_set})")
+        raise LoperInputError(
+            f"{setup_xml}: GenericModelMaker/marker_set_file {maker.getMarkerSetFileName()} "
+            f"not found (looked for {marker_set})"
+        )
     generic = read_model(generic_osim)
     if marker_set is not None:
         generic.updateMarkerSet(read_marker_set(marker_set))  # as ScaleTool does: the set's markers replace or add
@@ -266,13 +331,28 @@ def scale_with_setup(generic_osim: PathLike, setup_xml: PathLike, static_trc: Pa
     lacking = sorted(_measurement_markers(tool) - model_markers)
     if lacking:
         extra = f" with marker set {marker_set}" if marker_set is not None else ""
-        raise LoperInputError(f"{setup_xml}: measurement marker(s) {lacking} are not on the model {generic_osim}{extra}")
-    _run_scale_tool(tool, generic, generic_osim, setup_xml, marker_set, static_trc, out_osim, mass_kg,
-                    time_range_s, factor_range, segment_bodies=segment_bodies, **static)
+        raise LoperInputError(
+            f"{setup_xml}: measurement marker(s) {lacking} are not on the model {generic_osim}{extra}"
+        )
+    _run_scale_tool(
+        tool,
+        generic,
+        generic_osim,
+        setup_xml,
+        marker_set,
+        static_trc,
+        out_osim,
+        mass_kg,
+        time_range_s,
+        factor_range,
+        segment_bodies=segment_bodies,
+        **static,
+    )
 
 
-def _unknown_markers_hint(labels: Sequence[str], model_markers: Sequence[str],
-                          lab_labels: Mapping[str, str] | None) -> str:
+def _unknown_markers_hint(
+    labels: Sequence[str], model_markers: Sequence[str], lab_labels: Mapping[str, str] | None
+) -> str:
     """The trial's markers the model does not have, as a hint at a label-map typo ('' when there are none)."""
     import difflib
 
@@ -283,20 +363,38 @@ def _unknown_markers_hint(labels: Sequence[str], model_markers: Sequence[str],
     for m in unknown:
         label = (lab_labels or {}).get(m)
         close = difflib.get_close_matches(m, model_markers, n=1)
-        shown.append((f"'{label}' mapped to {m}" if label and label != m else f"'{m}'")
-                     + (f" (the model has {close[0]})" if close else ""))
-    return (f"; the trial's marker(s) {', '.join(shown)} are not on the model: a typo in the label map "
-            "(markers.label_map, markers.trial_label_maps)?")
+        shown.append(
+            (f"'{label}' mapped to {m}" if label and label != m else f"'{m}'")
+            + (f" (the model has {close[0]})" if close else "")
+        )
+    return (
+        f"; the trial's marker(s) {', '.join(shown)} are not on the model: a typo in the label map "
+        "(markers.label_map, markers.trial_label_maps)?"
+    )
 
 
-def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, marker_set: Path | None,
-                    static_trc: PathLike, out_osim: PathLike, mass_kg: float | None,
-                    time_range_s: tuple[float, float] | None, factor_range: Sequence[float],
-                    segment_bodies: Mapping[str, Sequence[str]] | None = None, duration_s: float | None = None,
-                    lab_labels: Mapping[str, str] | None = None, static_c3d: PathLike | None = None,
-                    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), height_m: float | None = None,
-                    report_out: PathLike | None = None, max_motion_rms_m: float | None = None) -> None:
-    """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report (:func:`scale_with_setup`)."""
+def _run_scale_tool(
+    tool,
+    generic,
+    generic_osim: Path,
+    setup_xml: Path | None,
+    marker_set: Path | None,
+    static_trc: PathLike,
+    out_osim: PathLike,
+    mass_kg: float | None,
+    time_range_s: tuple[float, float] | None,
+    factor_range: Sequence[float],
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    duration_s: float | None = None,
+    lab_labels: Mapping[str, str] | None = None,
+    static_c3d: PathLike | None = None,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    height_m: float | None = None,
+    report_out: PathLike | None = None,
+    max_motion_rms_m: float | None = None,
+) -> None:
+    """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report
+    (:func:`scale_with_setup`)."""
     import tempfile
 
     from ..io.opensim_tables import read_markers, write_trc
@@ -315,8 +413,10 @@ def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, m
     if time_range_s is not None:
         t0, t1 = map(float, time_range_s)
         if not (t0 <= t1 and t0 <= times[-1] + 1e-9 and t1 >= times[0] - 1e-9):
-            raise LoperInputError(f"{static_trc}: time_range_s {time_range_s} lies outside the trial "
-                                  f"({times[0]:.3f} .. {times[-1]:.3f} s) or is reversed")
+            raise LoperInputError(
+                f"{static_trc}: time_range_s {time_range_s} lies outside the trial "
+                f"({times[0]:.3f} .. {times[-1]:.3f} s) or is reversed"
+            )
         window = scale_window_s(times, [(t0, t1)], source=str(static_trc), setting="the time range given")
         ranges = dict.fromkeys(ranges)
     else:
@@ -325,19 +425,42 @@ def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, m
     needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     lacking = [m for m in needed if m not in labels]
     if lacking:
-        raise LoperInputError(f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}"
-                              f"{_unknown_markers_hint(labels, _names(generic.getMarkerSet()), lab_labels)}")
-    pose = static_pose(times, X, labels, window, needed, lab_labels, source=str(static_trc), setting=setting,
-                       max_motion_rms_m=max_motion_rms_m)
+        raise LoperInputError(
+            f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}"
+            f"{_unknown_markers_hint(labels, _names(generic.getMarkerSet()), lab_labels)}"
+        )
+    pose = static_pose(
+        times,
+        X,
+        labels,
+        window,
+        needed,
+        lab_labels,
+        source=str(static_trc),
+        setting=setting,
+        max_motion_rms_m=max_motion_rms_m,
+    )
     moving = sorted(pose.motion_rms_m, key=pose.motion_rms_m.get, reverse=True)[:3]
-    log.info("%s: largest marker motion over the window (RMS about the mean): %s", static_trc,
-             ", ".join(f"{m} {pose.motion_rms_m[m] * 1000:.1f} mm" for m in moving))
+    log.info(
+        "%s: largest marker motion over the window (RMS about the mean): %s",
+        static_trc,
+        ", ".join(f"{m} {pose.motion_rms_m[m] * 1000:.1f} mm" for m in moving),
+    )
     for marker, n in pose.n_filled.items():
-        log.info("%s: marker %s missing in %d of %d frames of the window: averaged over the others", static_trc,
-                 marker, n, len(pose.time_s))
+        log.info(
+            "%s: marker %s missing in %d of %d frames of the window: averaged over the others",
+            static_trc,
+            marker,
+            n,
+            len(pose.time_s),
+        )
     if pose.left_out:
-        log.warning("%s: marker(s) %s missing throughout the window %.4f .. %.4f s: left out of scaling", static_trc,
-                    ", ".join(pose.left_out), *window)
+        log.warning(
+            "%s: marker(s) %s missing throughout the window %.4f .. %.4f s: left out of scaling",
+            static_trc,
+            ", ".join(pose.left_out),
+            *window,
+        )
     _check_factors(generic, pairs, pose, static_trc, factor_range)
     gravity = float(np.linalg.norm(generic.getGravity().to_numpy()))
     mass_kg, mass_source = _subject_mass(mass_kg, static_c3d, window, rotation_deg, gravity)
@@ -368,20 +491,38 @@ def _run_scale_tool(tool, generic, generic_osim: Path, setup_xml: Path | None, m
             try:
                 tool.run()  # False when the marker placer is off, even after a good scaling: the file tells
             except Exception as exc:  # OpenSim raises its own exception types
-                raise LoperInputError(f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} "
-                                      f"({exc})") from exc
+                raise LoperInputError(
+                    f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} ({exc})"
+                ) from exc
             if not tmp.is_file():
-                raise LoperInputError(f"{where}: OpenSim's ScaleTool wrote no model for {static_trc} with "
-                                      f"{generic_osim} (are the model scaler and the marker placer both off?)")
+                raise LoperInputError(
+                    f"{where}: OpenSim's ScaleTool wrote no model for {static_trc} with "
+                    f"{generic_osim} (are the model scaler and the marker placer both off?)"
+                )
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
             if report_out is not None:
-                report = scale_report(scaled, pose, _scale_factors(scale_file), _placer_tasks(placer),
-                                      mass_kg, mass_source, height_m, segment_bodies, lab_labels)
+                report = scale_report(
+                    scaled,
+                    pose,
+                    _scale_factors(scale_file),
+                    _placer_tasks(placer),
+                    mass_kg,
+                    mass_source,
+                    height_m,
+                    segment_bodies,
+                    lab_labels,
+                )
                 write_tsv(report, report_out, SCALE_FLOAT_FORMAT)
                 log.info("scale report:\n%s", report.to_string(index=False))
-    log.info("scaled %s to %s (window %.4f .. %.4f s, %d frames, %g kg)", generic_osim, static_trc, *window,
-             len(pose.time_s), mass_kg)
+    log.info(
+        "scaled %s to %s (window %.4f .. %.4f s, %d frames, %g kg)",
+        generic_osim,
+        static_trc,
+        *window,
+        len(pose.time_s),
+        mass_kg,
+    )
 
 
 def _lab_labels(summary_tsv: PathLike) -> dict[str, str]:
@@ -406,8 +547,13 @@ def _array(osim, pair) -> object:
     return out
 
 
-def _subject_mass(mass_kg: float | None, static_c3d: PathLike | None, window: tuple[float, float],
-                  rotation_deg: Sequence[float], gravity_m_per_s2: float = GRAVITY_M_PER_S2) -> tuple[float, str]:
+def _subject_mass(
+    mass_kg: float | None,
+    static_c3d: PathLike | None,
+    window: tuple[float, float],
+    rotation_deg: Sequence[float],
+    gravity_m_per_s2: float = GRAVITY_M_PER_S2,
+) -> tuple[float, str]:
     """The subject's mass (kg) and where it came from: given, or from the static trial's force plates (weight over
     the model's gravity)."""
     from ..io.force_platforms import read_force_platforms
@@ -419,12 +565,15 @@ def _subject_mass(mass_kg: float | None, static_c3d: PathLike | None, window: tu
             raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
         return float(mass_kg), "given"
     if static_c3d is None:
-        raise LoperInputError("no body mass: give mass_kg (subject sheet), or a static trial that stands on force "
-                              "plates")
+        raise LoperInputError(
+            "no body mass: give mass_kg (subject sheet), or a static trial that stands on force plates"
+        )
     plates = read_force_platforms(static_c3d)
     if not plates:
-        raise LoperInputError(f"{static_c3d}: no body mass: the static trial has no force platforms "
-                              "(FORCE_PLATFORM:USED 0); give mass_kg in the subject sheet")
+        raise LoperInputError(
+            f"{static_c3d}: no body mass: the static trial has no force platforms "
+            "(FORCE_PLATFORM:USED 0); give mass_kg in the subject sheet"
+        )
     up = lab_up(rotation_deg)
     vertical = np.column_stack([p.force_n @ up for p in plates])
     mass = standing_mass_kg(plates[0].time_s, vertical, window, gravity_m_per_s2, source=str(static_c3d))
@@ -435,8 +584,21 @@ def _subject_mass(mass_kg: float | None, static_c3d: PathLike | None, window: tu
 SCALE_FLOAT_FORMAT = "%.8g"
 #: Columns of the scale report (:func:`scale_report`).
 SCALE_REPORT_COLUMNS: tuple[str, ...] = (
-    "kind", "name", "label", "scale_factor_x", "scale_factor_y", "scale_factor_z", "marker_weight",
-    "marker_error_m", "marker_error_rms_m", "marker_error_max_m", "n_frames", "mass_kg", "height_m", "source")
+    "kind",
+    "name",
+    "label",
+    "scale_factor_x",
+    "scale_factor_y",
+    "scale_factor_z",
+    "marker_weight",
+    "marker_error_m",
+    "marker_error_rms_m",
+    "marker_error_max_m",
+    "n_frames",
+    "mass_kg",
+    "height_m",
+    "source",
+)
 #: IK accuracy of the static pose in the scale report (the pipeline's IK accuracy).
 _REPORT_IK_ACCURACY = 1e-6
 
@@ -467,9 +629,17 @@ def _placer_tasks(placer) -> tuple[dict[str, float], dict] | None:
     return task_set_tasks(placer.getIKTaskSet(), "MarkerPlacer/IKTaskSet")
 
 
-def scale_report(scaled, pose, factors: Mapping[str, Sequence[float]], tasks, mass_kg: float, mass_source: str,
-                 height_m: float | None = None, segment_bodies: Mapping[str, Sequence[str]] | None = None,
-                 lab_labels: Mapping[str, str] | None = None) -> pd.DataFrame:
+def scale_report(
+    scaled,
+    pose,
+    factors: Mapping[str, Sequence[float]],
+    tasks,
+    mass_kg: float,
+    mass_source: str,
+    height_m: float | None = None,
+    segment_bodies: Mapping[str, Sequence[str]] | None = None,
+    lab_labels: Mapping[str, str] | None = None,
+) -> pd.DataFrame:
     """How good the scaling is: one row per body (scale factors), per marker (error) and for the subject.
 
     Rows (``kind``): ``subject`` (``mass_kg`` and where it came from,
@@ -493,8 +663,15 @@ def scale_report(scaled, pose, factors: Mapping[str, Sequence[float]], tasks, ma
         height, height_source = model_height_m(scaled, thigh), "estimated from the scaled model"
     else:
         height, height_source = float(height_m), "given"
-    rows.append({"kind": "subject", "name": "subject", "mass_kg": mass_kg, "height_m": height,
-                 "source": f"mass: {mass_source}; height: {height_source}"})
+    rows.append(
+        {
+            "kind": "subject",
+            "name": "subject",
+            "mass_kg": mass_kg,
+            "height_m": height,
+            "source": f"mass: {mass_source}; height: {height_source}",
+        }
+    )
     bodies = scaled.getBodySet()
     for i in range(bodies.getSize()):
         name = bodies.get(i).getName()
@@ -504,14 +681,29 @@ def scale_report(scaled, pose, factors: Mapping[str, Sequence[float]], tasks, ma
     weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
     weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
     mean_pose = pose.markers_m.mean(axis=0, keepdims=True)  # complete: missing frames hold the mean already
-    result = inverse_kinematics(scaled, pose.time_s[:1], mean_pose, pose.labels, weights, coords,
-                                accuracy=_REPORT_IK_ACCURACY)
+    result = inverse_kinematics(
+        scaled, pose.time_s[:1], mean_pose, pose.labels, weights, coords, accuracy=_REPORT_IK_ACCURACY
+    )
     errors = result.marker_errors_m[0]
     for name, error in zip(result.marker_names, errors):
-        rows.append({"kind": "marker", "name": name, "label": (lab_labels or {}).get(name, name),
-                     "marker_weight": weights[name], "marker_error_m": float(error)})
-    rows.append({"kind": "markers", "name": "all weighted", "marker_error_rms_m": float(np.sqrt(np.mean(errors ** 2))),
-                 "marker_error_max_m": float(errors.max()), "n_frames": len(pose.time_s)})
+        rows.append(
+            {
+                "kind": "marker",
+                "name": name,
+                "label": (lab_labels or {}).get(name, name),
+                "marker_weight": weights[name],
+                "marker_error_m": float(error),
+            }
+        )
+    rows.append(
+        {
+            "kind": "markers",
+            "name": "all weighted",
+            "marker_error_rms_m": float(np.sqrt(np.mean(errors**2))),
+            "marker_error_max_m": float(errors.max()),
+            "n_frames": len(pose.time_s),
+        }
+    )
     return pd.DataFrame(rows, columns=list(SCALE_REPORT_COLUMNS))
 
 

@@ -27,23 +27,50 @@ __all__ = ["LIBRARY_PLANNING_SETTINGS", "plan", "planned_impedance", "planning_s
 log = logging.getLogger(__name__)
 
 #: Identification settings the planner follows (keys of config ``identification``).
-_PLAN_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree", "n_substeps",
-              "null_pair_components", "min_null_pairs", "interval_scatter", "stiffness_bounds_nm_per_rad",
-              "damping_bounds_nms_per_rad")
+_PLAN_KEYS = (
+    "window_before_s",
+    "window_after_s",
+    "initial_state_span_s",
+    "initial_state_degree",
+    "n_substeps",
+    "null_pair_components",
+    "min_null_pairs",
+    "interval_scatter",
+    "stiffness_bounds_nm_per_rad",
+    "damping_bounds_nms_per_rad",
+)
 
 
 #: Identification settings the rule passes to :func:`plan` (keys of config ``identification``): those the planner
 #: follows and the null pairs' trial ratio.
-_RULE_IDENTIFICATION_KEYS = ("window_before_s", "window_after_s", "initial_state_span_s", "initial_state_degree",
-                             "n_substeps", "null_pair_components", "min_null_pairs", "max_null_trial_ratio",
-                             "interval_scatter", "stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad")
+_RULE_IDENTIFICATION_KEYS = (
+    "window_before_s",
+    "window_after_s",
+    "initial_state_span_s",
+    "initial_state_degree",
+    "n_substeps",
+    "null_pair_components",
+    "min_null_pairs",
+    "max_null_trial_ratio",
+    "interval_scatter",
+    "stiffness_bounds_nm_per_rad",
+    "damping_bounds_nms_per_rad",
+)
 
 #: The settings of :func:`planning_settings` without a configuration (``loper-analysis plan`` with no config file):
 #: ``onsets`` None (those of the pilot's impedance rows), no targets, and the library's own response,
 #: identification and device defaults (None: :class:`~loper_analysis.responses.ResponseSettings`,
 #: :class:`~loper_analysis.planning.PlanSettings`, :class:`~loper_analysis.device.controller.DeviceParameters`).
-LIBRARY_PLANNING_SETTINGS = {"onsets": None, "strides": [10, 20, 40], "targets": [], "pulse_force_n": 40.0,
-                             "pulse_duration_s": 0.1, "response": None, "identification": None, "device": None}
+LIBRARY_PLANNING_SETTINGS = {
+    "onsets": None,
+    "strides": [10, 20, 40],
+    "targets": [],
+    "pulse_force_n": 40.0,
+    "pulse_duration_s": 0.1,
+    "response": None,
+    "identification": None,
+    "device": None,
+}
 
 
 def planning_settings(config: Mapping) -> dict:
@@ -92,12 +119,14 @@ def planning_settings(config: Mapping) -> dict:
     LoperInputError
         A key the planner needs is missing (naming it).
     """
+
     def get(*keys):
         node = config
         for n, key in enumerate(keys):
             if not isinstance(node, Mapping) or key not in node:
-                raise LoperInputError(f"config: key '{'.'.join(keys[:n + 1])}' missing: the planner needs "
-                                      f"'{'.'.join(keys)}'")
+                raise LoperInputError(
+                    f"config: key '{'.'.join(keys[: n + 1])}' missing: the planner needs '{'.'.join(keys)}'"
+                )
             node = node[key]
         return copy.deepcopy(node)
 
@@ -137,8 +166,10 @@ def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: 
         d = row[parameter_column("D")].to_numpy(float)
         if len(row) != 1 or not (np.isfinite(k).all() and np.isfinite(d).all()):
             status = ", ".join(f"{s}: {r}" for s, r in zip(row.get("status", []), row.get("reason", []))) or "no row"
-            raise LoperInputError(f"{source}: no fitted impedance of subject {subject} at onset {onset_ms:g} ms "
-                                  f"for the {joint} ({status}); give the planned impedance explicitly")
+            raise LoperInputError(
+                f"{source}: no fitted impedance of subject {subject} at onset {onset_ms:g} ms "
+                f"for the {joint} ({status}); give the planned impedance explicitly"
+            )
         values += [float(k[0]), float(d[0])]
     return np.array(values)
 
@@ -153,13 +184,28 @@ def _settings(pulse_force_n: float, pulse_duration_s: float, identification: Map
     return PlanSettings(pulse_force_n=pulse_force_n, pulse_duration_s=pulse_duration_s, **ident)
 
 
-def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[PathLike], segments_tsv: PathLike,
-         subject: str, onsets_ms: Sequence[int], n_strides: Sequence[int], out_tsv: PathLike | None = None,
-         answers_out: PathLike | None = None, *, impedance_tsvs: Sequence[PathLike] = (),
-         impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None, targets: Sequence[Mapping] = (),
-         pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1, response: Mapping | None = None,
-         identification: Mapping | None = None, device: Mapping | None = None,
-         unplannable: str = "raise", pool_scatter: bool = True) -> tuple[pd.DataFrame, list[str]]:
+def plan(
+    trials: Sequence[str],
+    angles: Sequence[PathLike],
+    strides: Sequence[PathLike],
+    segments_tsv: PathLike,
+    subject: str,
+    onsets_ms: Sequence[int],
+    n_strides: Sequence[int],
+    out_tsv: PathLike | None = None,
+    answers_out: PathLike | None = None,
+    *,
+    impedance_tsvs: Sequence[PathLike] = (),
+    impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None,
+    targets: Sequence[Mapping] = (),
+    pulse_force_n: float = 40.0,
+    pulse_duration_s: float = 0.1,
+    response: Mapping | None = None,
+    identification: Mapping | None = None,
+    device: Mapping | None = None,
+    unplannable: str = "raise",
+    pool_scatter: bool = True,
+) -> tuple[pd.DataFrame, list[str]]:
     """Predicted SD and 95 % CI half-width of K and D for a planned experiment, from a pilot subject.
 
     Parameters
@@ -235,8 +281,10 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
     ratio = (identification or {}).get("max_null_trial_ratio", MAX_TRIAL_DEVIATION_RATIO)
     dev = DeviceParameters(**(device or {}))
     params = read_segments(segments_tsv)
-    pool = [{"name": name, "angles": read_tsv(a, "angle table"), "strides": read_tsv(s, "stride table")}
-            for name, a, s in zip(trials, angles, strides, strict=True)]
+    pool = [
+        {"name": name, "angles": read_tsv(a, "angle table"), "strides": read_tsv(s, "stride table")}
+        for name, a, s in zip(trials, angles, strides, strict=True)
+    ]
     rows_table = None
     if impedance is None:
         if not impedance_tsvs:
@@ -252,8 +300,7 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
                 values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
             null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
             pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
-            planned[onset] = stride_covariance(null, params, values, settings, dev, source=where,
-                                               perturbed_pairs=pairs)
+            planned[onset] = stride_covariance(null, params, values, settings, dev, source=where, perturbed_pairs=pairs)
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
@@ -268,14 +315,28 @@ def plan(trials: Sequence[str], angles: Sequence[PathLike], strides: Sequence[Pa
             continue
         sc = planned[onset]
         tables.append(precision_table(sc, counts, onset, subject, settings))
-        log.info("pilot %s, onset %g ms: %d null pairs, %d perturbed pairs (scatter: %s); planned %s", subject, onset,
-                 sc.n_null_pairs, sc.n_perturbed_pairs, sc.scatter.replace("_", " "),
-                 ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, sc.impedance)))
+        log.info(
+            "pilot %s, onset %g ms: %d null pairs, %d perturbed pairs (scatter: %s); planned %s",
+            subject,
+            onset,
+            sc.n_null_pairs,
+            sc.n_perturbed_pairs,
+            sc.scatter.replace("_", " "),
+            ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, sc.impedance)),
+        )
         for target in targets:
             if target.get("onset_ms") is not None and float(target["onset_ms"]) != float(onset):
                 continue
-            answers.append(target_answer(sc, str(target["joint"]), str(target["parameter"]), onset,
-                                         percent=target.get("percent"), half_width=target.get("half_width")))
+            answers.append(
+                target_answer(
+                    sc,
+                    str(target["joint"]),
+                    str(target["parameter"]),
+                    onset,
+                    percent=target.get("percent"),
+                    half_width=target.get("half_width"),
+                )
+            )
     table = pd.concat(tables, ignore_index=True)
     if out_tsv is not None:
         write_tsv(table, out_tsv)

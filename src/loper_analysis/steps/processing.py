@@ -25,8 +25,9 @@ __all__ = ["markers", "events", "loadcell", "events_loadcell", "strides", "strid
 log = logging.getLogger(__name__)
 
 
-def _label_map(label_map: Mapping[str, str] | PathLike | Sequence[Mapping[str, str] | PathLike] | None
-               ) -> Mapping[str, str] | None:
+def _label_map(
+    label_map: Mapping[str, str] | PathLike | Sequence[Mapping[str, str] | PathLike] | None,
+) -> Mapping[str, str] | None:
     """A label map given inline, read from its file (TSV with columns label, marker, or YAML), or several such
     maps merged in order (a later map's entry for a label wins): the map of every trial, then its kind's, then
     its own."""
@@ -42,13 +43,23 @@ def _label_map(label_map: Mapping[str, str] | PathLike | Sequence[Mapping[str, s
     return read_label_map(label_map)
 
 
-def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = None,
-            rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0), max_gap_frames: int = 10,
-            cutoff_hz: float | None = 40.0, order: int = 4, duration_s: float | None = None,
-            label_map: Mapping[str, str] | PathLike | Sequence | None = None,
-            required_markers: Sequence[str] | None = None, summary_out: PathLike | None = None,
-            extent_range_m: Sequence[float] = (0.1, 5.0), span_s: Sequence[float] | None = None,
-            walking_direction: str = "fixed", min_travel_speed_m_per_s: float = 0.25) -> pd.DataFrame:
+def markers(
+    c3d_path: PathLike,
+    trc_out: PathLike,
+    gaps_out: PathLike | None = None,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    max_gap_frames: int = 10,
+    cutoff_hz: float | None = 40.0,
+    order: int = 4,
+    duration_s: float | None = None,
+    label_map: Mapping[str, str] | PathLike | Sequence | None = None,
+    required_markers: Sequence[str] | None = None,
+    summary_out: PathLike | None = None,
+    extent_range_m: Sequence[float] = (0.1, 5.0),
+    span_s: Sequence[float] | None = None,
+    walking_direction: str = "fixed",
+    min_travel_speed_m_per_s: float = 0.25,
+) -> pd.DataFrame:
     """C3D markers -> model names -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
 
     Labels lose their subject prefix (``Subject:LASI`` -> ``LASI``) and are
@@ -102,24 +113,35 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     if span_s is not None:
         time_s, raw = _cropped(time_s, raw, span_s, source)
     require_marker_extent(raw, source, extent_range_m)
-    heading = trial_heading(raw, rec.point_rate_hz, rotation_deg, walking_direction, min_travel_speed_m_per_s,
-                            source)
+    heading = trial_heading(raw, rec.point_rate_hz, rotation_deg, walking_direction, min_travel_speed_m_per_s, source)
     if heading.turn_deg:
-        log.info("%s: walks %.1f deg from the model's +X at %.2f m/s: turned %g deg about the vertical "
-                 "(rotation %s deg)", source, heading.heading_deg, heading.speed_m_per_s, heading.turn_deg,
-                 list(heading.rotation_deg))
+        log.info(
+            "%s: walks %.1f deg from the model's +X at %.2f m/s: turned %g deg about the vertical (rotation %s deg)",
+            source,
+            heading.heading_deg,
+            heading.speed_m_per_s,
+            heading.turn_deg,
+            list(heading.rotation_deg),
+        )
     filled, gaps = fill_gaps(raw, max_gap_frames, names, source=source, unfillable="keep")
     X = rotate_markers(filled, heading.rotation_deg)
     unfiltered = None
     if cutoff_hz:
         try:
-            X, unfiltered = lowpass_finite_runs(X, rec.point_rate_hz, cutoff_hz, order, axis=0,
-                                                setting="filter.cutoff_hz", rate_name="POINT:RATE")
+            X, unfiltered = lowpass_finite_runs(
+                X, rec.point_rate_hz, cutoff_hz, order, axis=0, setting="filter.cutoff_hz", rate_name="POINT:RATE"
+            )
         except LoperInputError as exc:
             raise LoperInputError(f"{c3d_path}: markers: {exc}") from None
     summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), rec.marker_labels, time_s, X, heading)
-    log.info("%s: %d frames at %g Hz, %d markers, %d gap(s) filled", c3d_path, len(time_s), rec.point_rate_hz,
-             len(names), len(gaps))
+    log.info(
+        "%s: %d frames at %g Hz, %d markers, %d gap(s) filled",
+        c3d_path,
+        len(time_s),
+        rec.point_rate_hz,
+        len(names),
+        len(gaps),
+    )
     write_trc(trc_out, time_s, X, names)
     if gaps_out is not None:
         write_tsv(gaps, gaps_out)
@@ -128,25 +150,42 @@ def markers(c3d_path: PathLike, trc_out: PathLike, gaps_out: PathLike | None = N
     log.info("filled gaps:\n%s", gaps.to_string(index=False))
     left = summary[summary.n_missing_frames > 0]
     if len(left):
-        log.warning("%s: %d marker(s) still missing in some frames (written as NaN):\n%s", c3d_path, len(left),
-                    left[["label", "marker", "n_missing_frames", "longest_gap_frames"]].to_string(index=False))
+        log.warning(
+            "%s: %d marker(s) still missing in some frames (written as NaN):\n%s",
+            c3d_path,
+            len(left),
+            left[["label", "marker", "n_missing_frames", "longest_gap_frames"]].to_string(index=False),
+        )
     n_sparse = int(summary["n_frames_too_few_markers"].iloc[0]) if len(summary) else 0
     if n_sparse:
-        log.warning("%s: %d of %d frames hold fewer than %d markers (outside the capture volume?): IK leaves them "
-                    "out", c3d_path, n_sparse, len(time_s), MIN_IK_MARKERS)
+        log.warning(
+            "%s: %d of %d frames hold fewer than %d markers (outside the capture volume?): IK leaves them out",
+            c3d_path,
+            n_sparse,
+            len(time_s),
+            MIN_IK_MARKERS,
+        )
     gaps.attrs["per_marker"] = summary.to_dict("records")
     return gaps
 
 
 #: Columns the markers summary adds to :data:`loper_analysis.markers.GAP_SUMMARY_COLUMNS`: the marker's lab label,
 #: then facts of the whole trial repeated on each row (like ``n_frames``).
-TRIAL_MARKER_COLUMNS: tuple[str, ...] = ("label", "n_frames_too_few_markers", "first_time_s", "last_time_s",
-                                         "heading_deg", "speed_m_per_s", "turn_deg", "rotation_x_deg",
-                                         "rotation_y_deg", "rotation_z_deg")
+TRIAL_MARKER_COLUMNS: tuple[str, ...] = (
+    "label",
+    "n_frames_too_few_markers",
+    "first_time_s",
+    "last_time_s",
+    "heading_deg",
+    "speed_m_per_s",
+    "turn_deg",
+    "rotation_x_deg",
+    "rotation_y_deg",
+    "rotation_z_deg",
+)
 
 
-def _trial_marker_summary(per_marker: pd.DataFrame, labels: Sequence[str], time_s, markers_m, heading
-                          ) -> pd.DataFrame:
+def _trial_marker_summary(per_marker: pd.DataFrame, labels: Sequence[str], time_s, markers_m, heading) -> pd.DataFrame:
     """The per-marker gap summary with the lab labels and the trial's facts (:data:`TRIAL_MARKER_COLUMNS`)."""
     present = np.all(np.isfinite(np.asarray(markers_m, float)), axis=2)
     out = per_marker.copy()
@@ -174,12 +213,24 @@ def _cropped(time_s, markers_m, span_s: Sequence[float], source: str):
     return time_s[keep], markers_m[keep]
 
 
-def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str] | None = None,
-           threshold_on_n: float = 50.0, threshold_off_n: float = 20.0, min_stance_s: float = 0.2,
-           min_swing_s: float = 0.2, cutoff_hz: float | None = None, order: int = 4,
-           foot_markers: Mapping[str, str] | None = None, plate_sides: Mapping[str, int] | None = None,
-           label_map: Mapping[str, str] | PathLike | None = None, rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
-           band_n: float = 10.0, max_rest_n: float = 100.0, contacts_out: PathLike | None = None) -> pd.DataFrame:
+def events(
+    c3d_path: PathLike,
+    out_tsv: PathLike,
+    grf_channels: Mapping[str, str] | None = None,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    cutoff_hz: float | None = None,
+    order: int = 4,
+    foot_markers: Mapping[str, str] | None = None,
+    plate_sides: Mapping[str, int] | None = None,
+    label_map: Mapping[str, str] | PathLike | None = None,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+    contacts_out: PathLike | None = None,
+) -> pd.DataFrame:
     """Heel strikes and toe-offs of both legs, on the mocap clock (the file's own time base).
 
     A file with force platforms (``FORCE_PLATFORM:USED`` > 0): each plate's
@@ -199,20 +250,58 @@ def events(c3d_path: PathLike, out_tsv: PathLike, grf_channels: Mapping[str, str
     """
     from ..io.c3d import read_c3d
 
-    table, contacts = _events_of(read_c3d(c3d_path), grf_channels, threshold_on_n, threshold_off_n, min_stance_s,
-                                 min_swing_s, cutoff_hz, order, foot_markers, plate_sides, label_map, rotation_deg,
-                                 band_n, max_rest_n)
+    table, contacts = _events_of(
+        read_c3d(c3d_path),
+        grf_channels,
+        threshold_on_n,
+        threshold_off_n,
+        min_stance_s,
+        min_swing_s,
+        cutoff_hz,
+        order,
+        foot_markers,
+        plate_sides,
+        label_map,
+        rotation_deg,
+        band_n,
+        max_rest_n,
+    )
     return _write_events(table, contacts, out_tsv, contacts_out)
 
 
-def _events_of(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz, order,
-               foot_markers, plate_sides, label_map, rotation_deg, band_n, max_rest_n) -> tuple[pd.DataFrame, pd.DataFrame]:
+def _events_of(
+    rec,
+    grf_channels,
+    threshold_on_n,
+    threshold_off_n,
+    min_stance_s,
+    min_swing_s,
+    cutoff_hz,
+    order,
+    foot_markers,
+    plate_sides,
+    label_map,
+    rotation_deg,
+    band_n,
+    max_rest_n,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The event table and the contact table (empty without force platforms) of a C3D already read."""
     from ..contacts import count_flagged
 
     if rec.n_force_platforms:
-        table, contacts = _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n,
-                                        threshold_off_n, min_stance_s, min_swing_s, band_n, max_rest_n)
+        table, contacts = _plate_events(
+            rec,
+            foot_markers,
+            plate_sides,
+            label_map,
+            rotation_deg,
+            threshold_on_n,
+            threshold_off_n,
+            min_stance_s,
+            min_swing_s,
+            band_n,
+            max_rest_n,
+        )
         log.info("contacts:\n%s", contacts.to_string(index=False))
         table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"])
         return table, contacts
@@ -221,15 +310,17 @@ def _events_of(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s,
             f"{rec.source}: no force platforms (FORCE_PLATFORM:USED is 0 or absent) and no GRF channel configured "
             "(events.grf_channels); cannot detect gait events"
         )
-    table = _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s,
-                            cutoff_hz, order)
+    table = _channel_events(
+        rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz, order
+    )
     _check_belt_feet(rec, table, grf_channels, foot_markers, label_map, rotation_deg)
     table.attrs["n_contacts_flagged"] = 0
     return table, pd.DataFrame(columns=["plate", "contact", "side", "flag"])
 
 
-def _write_events(table: pd.DataFrame, contacts: pd.DataFrame, out_tsv: PathLike,
-                  contacts_out: PathLike | None) -> pd.DataFrame:
+def _write_events(
+    table: pd.DataFrame, contacts: pd.DataFrame, out_tsv: PathLike, contacts_out: PathLike | None
+) -> pd.DataFrame:
     """Write the event table (and the contact table when asked); returns the event table."""
     if contacts_out is not None:
         write_tsv(contacts, contacts_out)
@@ -238,8 +329,9 @@ def _write_events(table: pd.DataFrame, contacts: pd.DataFrame, out_tsv: PathLike
     return table
 
 
-def _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz,
-                    order) -> pd.DataFrame:
+def _channel_events(
+    rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz, order
+) -> pd.DataFrame:
     """Events from one named vertical-GRF analog channel per belt of a read C3D."""
     from ..events import gait_events
     from ..filtering import lowpass
@@ -249,10 +341,27 @@ def _channel_events(rec, grf_channels, threshold_on_n, threshold_off_n, min_stan
     for side in SIDES:
         fz = rec.analog(grf_channels[side])
         if cutoff_hz is not None:
-            fz = lowpass(fz, rec.analog_rate_hz, cutoff_hz, order, setting="events.grf_cutoff_hz",
-                         rate_name="ANALOG:RATE", source=f"{c3d_path} (analog channel {grf_channels[side]})")
-        tables.append(gait_events(rec.analog_time_s, fz, side, threshold_on_n, threshold_off_n, min_stance_s,
-                                  min_swing_s, source=f"{c3d_path} ({grf_channels[side]})"))
+            fz = lowpass(
+                fz,
+                rec.analog_rate_hz,
+                cutoff_hz,
+                order,
+                setting="events.grf_cutoff_hz",
+                rate_name="ANALOG:RATE",
+                source=f"{c3d_path} (analog channel {grf_channels[side]})",
+            )
+        tables.append(
+            gait_events(
+                rec.analog_time_s,
+                fz,
+                side,
+                threshold_on_n,
+                threshold_off_n,
+                min_stance_s,
+                min_swing_s,
+                source=f"{c3d_path} ({grf_channels[side]})",
+            )
+        )
     return pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
 
 
@@ -276,14 +385,20 @@ def _check_belt_feet(rec, table: pd.DataFrame, grf_channels, foot_markers, label
     source = rec.source
     keys = {s: f"events.grf_channels.{s}" for s in SIDES}
     if not foot_markers or not rec.marker_labels:
-        warnings.warn(f"{source}: the belts' feet ({', '.join(f'{keys[s]} {grf_channels[s]}' for s in SIDES)}) "
-                      "could not be confirmed: no heel markers (events.foot_markers) in the file", stacklevel=2)
+        warnings.warn(
+            f"{source}: the belts' feet ({', '.join(f'{keys[s]} {grf_channels[s]}' for s in SIDES)}) "
+            "could not be confirmed: no heel markers (events.foot_markers) in the file",
+            stacklevel=2,
+        )
         return
     names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
     missing = [foot_markers[s] for s in SIDES if foot_markers[s] not in names]
     if missing:
-        warnings.warn(f"{source}: the belts' feet could not be confirmed: heel marker(s) {', '.join(missing)} "
-                      "(events.foot_markers) not in the file", stacklevel=2)
+        warnings.warn(
+            f"{source}: the belts' feet could not be confirmed: heel marker(s) {', '.join(missing)} "
+            "(events.foot_markers) not in the file",
+            stacklevel=2,
+        )
         return
     up = lab_up(rotation_deg)
     heights = {s: rec.markers_m[:, names.index(foot_markers[s]), :] @ up for s in SIDES}
@@ -295,27 +410,49 @@ def _check_belt_feet(rec, table: pd.DataFrame, grf_channels, foot_markers, label
         mine = judged[judged["side"] == side]
         n, own = len(mine), int(mine["own_heel_lower"].sum())
         if n < MIN_JUDGED_STANCES:
-            warnings.warn(f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) could not be "
-                          f"confirmed: {n} stance(s) with both heels seen at mid-stance (at least "
-                          f"{MIN_JUDGED_STANCES} needed)", stacklevel=2)
+            warnings.warn(
+                f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) could not be "
+                f"confirmed: {n} stance(s) with both heels seen at mid-stance (at least "
+                f"{MIN_JUDGED_STANCES} needed)",
+                stacklevel=2,
+            )
         elif own <= SWAPPED_BELT_FRACTION * n:
             raise LoperInputError(
                 f"{source}: {keys[side]}: channel {grf_channels[side]} does not carry the {side} foot: in "
                 f"{n - own} of its {n} stances the {other} heel ({foot_markers[other]}) was the lower at "
                 f"mid-stance (by {mine['own_heel_lower_m'].median() * -1000:.0f} mm, median); are the belts' "
-                f"channels swapped (events.grf_channels: {{left: {grf_channels['left']}, right: {grf_channels['right']}}})?"
+                f"channels swapped (events.grf_channels: {{left: {grf_channels['left']}, "
+                f"right: {grf_channels['right']}}})?"
             )
         elif own < (1 - SWAPPED_BELT_FRACTION) * n:
-            warnings.warn(f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) is unclear: its "
-                          f"own heel ({foot_markers[side]}) was the lower at mid-stance in {own} of {n} stances",
-                          stacklevel=2)
-    log.info("belts' feet: own heel the lower at mid-stance in %s", ", ".join(
-        f"{int(judged.loc[judged['side'] == s, 'own_heel_lower'].sum())} of {int((judged['side'] == s).sum())} "
-        f"{s} stances" for s in SIDES))
+            warnings.warn(
+                f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) is unclear: its "
+                f"own heel ({foot_markers[side]}) was the lower at mid-stance in {own} of {n} stances",
+                stacklevel=2,
+            )
+    log.info(
+        "belts' feet: own heel the lower at mid-stance in %s",
+        ", ".join(
+            f"{int(judged.loc[judged['side'] == s, 'own_heel_lower'].sum())} of {int((judged['side'] == s).sum())} "
+            f"{s} stances"
+            for s in SIDES
+        ),
+    )
 
 
-def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, threshold_on_n, threshold_off_n,
-                  min_stance_s, min_swing_s, band_n, max_rest_n) -> tuple[pd.DataFrame, pd.DataFrame]:
+def _plate_events(
+    rec,
+    foot_markers,
+    plate_sides,
+    label_map,
+    rotation_deg,
+    threshold_on_n,
+    threshold_off_n,
+    min_stance_s,
+    min_swing_s,
+    band_n,
+    max_rest_n,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Events and the contact table from the force platforms and the heel markers of a read C3D.
 
     The vertical is the lab's up direction that ``rotation_deg`` turns into the model's +Y
@@ -334,12 +471,23 @@ def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, thres
     names = model_marker_names(rec.marker_labels, _label_map(label_map), source)
     require_model_markers(names, [foot_markers[s] for s in SIDES], source, rec.marker_labels)
     loads = plate_vertical_loads(c3d_path, rotation_deg, band_n, max_rest_n, up=lab_up(rotation_deg))
-    plates = [PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i])
-              for i, n in enumerate(loads.numbers)]
+    plates = [
+        PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i]) for i, n in enumerate(loads.numbers)
+    ]
     heels = {s: rotate_markers(rec.markers_m[:, names.index(foot_markers[s]), :], rotation_deg) for s in SIDES}
     # corners and heels are in the model frame, whose up is +Y
-    contacts = foot_contacts(plates, rec.time_s, heels, plate_sides, threshold_on_n, threshold_off_n, min_stance_s,
-                             min_swing_s, source=source, up=MODEL_UP)
+    contacts = foot_contacts(
+        plates,
+        rec.time_s,
+        heels,
+        plate_sides,
+        threshold_on_n,
+        threshold_off_n,
+        min_stance_s,
+        min_swing_s,
+        source=source,
+        up=MODEL_UP,
+    )
     return contact_events(contacts), contacts
 
 
@@ -347,8 +495,15 @@ def _plate_events(rec, foot_markers, plate_sides, label_map, rotation_deg, thres
 NATIVE_FLOAT_FORMAT = "%.12g"
 
 
-def loadcell(c3d_path: PathLike, log_path: PathLike, out_tsv: PathLike, sync_channel: str = "sync", cutoff_hz: float = 40.0,
-             order: int = 4, native_out: PathLike | None = None) -> pd.DataFrame:
+def loadcell(
+    c3d_path: PathLike,
+    log_path: PathLike,
+    out_tsv: PathLike,
+    sync_channel: str = "sync",
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    native_out: PathLike | None = None,
+) -> pd.DataFrame:
     """The robot log's forces on the mocap frames (sync-pulse clock map, 40 Hz low-pass, 128 Hz).
 
     ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
@@ -372,19 +527,29 @@ def _loadcell_of(rec, log_path, sync_channel, cutoff_hz, order) -> tuple[pd.Data
     rate = float(meta["sample_rate_hz"])
     from ..filtering import check_cutoff  # the robot log's forces are low-passed at its own rate
 
-    check_cutoff(rate, cutoff_hz, order, setting="filter.cutoff_hz", rate_name="the log's sample_rate_hz",
-                 source=str(log_path))
-    out, native = robot_log_frames_and_native(frame, rate, rec.analog(sync_channel), rec.analog_rate_hz, rec.time_s,
-                                              cutoff_hz=cutoff_hz, order=order, source=f"{log_path} / {c3d_path}",
-                                              sync_channel=sync_channel)
+    check_cutoff(
+        rate, cutoff_hz, order, setting="filter.cutoff_hz", rate_name="the log's sample_rate_hz", source=str(log_path)
+    )
+    out, native = robot_log_frames_and_native(
+        frame,
+        rate,
+        rec.analog(sync_channel),
+        rec.analog_rate_hz,
+        rec.time_s,
+        cutoff_hz=cutoff_hz,
+        order=order,
+        source=f"{log_path} / {c3d_path}",
+        sync_channel=sync_channel,
+    )
     cm = out.attrs.get("clock_map")
     if cm is not None:
         log.info("%s: clock map %s", log_path, cm)
     return out, native
 
 
-def _write_loadcell(out: pd.DataFrame, native: pd.DataFrame, out_tsv: PathLike,
-                    native_out: PathLike | None) -> pd.DataFrame:
+def _write_loadcell(
+    out: pd.DataFrame, native: pd.DataFrame, out_tsv: PathLike, native_out: PathLike | None
+) -> pd.DataFrame:
     """Write the forces on the mocap frames (and at the robot rate when asked); returns the former."""
     write_tsv(out, out_tsv)
     log.info("%d frames on the mocap clock", len(out))
@@ -394,9 +559,16 @@ def _write_loadcell(out: pd.DataFrame, native: pd.DataFrame, out_tsv: PathLike,
     return out
 
 
-def events_loadcell(c3d_path: PathLike, log_path: PathLike, events_out: PathLike, contacts_out: PathLike,
-                    force_out: PathLike, native_out: PathLike, events_settings: Mapping | None = None,
-                    loadcell_settings: Mapping | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+def events_loadcell(
+    c3d_path: PathLike,
+    log_path: PathLike,
+    events_out: PathLike,
+    contacts_out: PathLike,
+    force_out: PathLike,
+    native_out: PathLike,
+    events_settings: Mapping | None = None,
+    loadcell_settings: Mapping | None = None,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """:func:`events` and :func:`loadcell` of one trial with the device, from one reading of its C3D.
 
     ``events_settings`` and ``loadcell_settings`` are the keyword arguments of
@@ -424,12 +596,23 @@ def _keyword_defaults(func) -> dict:
     """Keyword defaults of a step function."""
     import inspect
 
-    return {k: v.default for k, v in inspect.signature(func).parameters.items() if v.default is not inspect.Parameter.empty}
+    return {
+        k: v.default for k, v in inspect.signature(func).parameters.items() if v.default is not inspect.Parameter.empty
+    }
 
 
-def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, cycles_out: PathLike, force_tsv: PathLike | None = None,
-            side: str = "left", n_points: int = 101, whisker: float = 1.5, max_fraction: float = 0.2,
-            min_valid: int = 5):
+def strides(
+    angles_tsv: PathLike,
+    events_tsv: PathLike,
+    strides_out: PathLike,
+    cycles_out: PathLike,
+    force_tsv: PathLike | None = None,
+    side: str = "left",
+    n_points: int = 101,
+    whisker: float = 1.5,
+    max_fraction: float = 0.2,
+    min_valid: int = 5,
+):
     """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
 
     Writes the stride table and the cycles (:func:`loper_analysis.strides.stride_tables`);
@@ -441,8 +624,17 @@ def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, c
 
     sources = {"angles": str(angles_tsv), "events": str(events_tsv), "force": str(force_tsv)}
     force = None if force_tsv is None else read_tsv(force_tsv, "force table", ("time_s", "force_measured_n"))
-    tables = stride_tables(read_tsv(angles_tsv, "angle table"), read_tsv(events_tsv, "event table"), force, side,
-                           n_points, whisker, max_fraction, min_valid, sources)
+    tables = stride_tables(
+        read_tsv(angles_tsv, "angle table"),
+        read_tsv(events_tsv, "event table"),
+        force,
+        side,
+        n_points,
+        whisker,
+        max_fraction,
+        min_valid,
+        sources,
+    )
     write_tsv(tables.cycles, cycles_out)
     write_tsv(tables.strides, strides_out)
     s = tables.strides
@@ -450,10 +642,15 @@ def strides(angles_tsv: PathLike, events_tsv: PathLike, strides_out: PathLike, c
     return tables
 
 
-def strides_summary(subject_trials: Sequence[tuple[str, str]], strides_tsvs: Sequence[PathLike], out_tsv: PathLike,
-                    min_valid: int = 5, contacts_tsvs: Sequence[PathLike] | None = None,
-                    ik_tsvs: Sequence[PathLike] | None = None,
-                    markers_tsvs: Sequence[PathLike] | None = None) -> pd.DataFrame:
+def strides_summary(
+    subject_trials: Sequence[tuple[str, str]],
+    strides_tsvs: Sequence[PathLike],
+    out_tsv: PathLike,
+    min_valid: int = 5,
+    contacts_tsvs: Sequence[PathLike] | None = None,
+    ik_tsvs: Sequence[PathLike] | None = None,
+    markers_tsvs: Sequence[PathLike] | None = None,
+) -> pd.DataFrame:
     """One row per subject x trial of the stride tables (:func:`loper_analysis.strides.stride_summary`).
 
     ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
@@ -476,26 +673,44 @@ def strides_summary(subject_trials: Sequence[tuple[str, str]], strides_tsvs: Seq
     from ..strides import SUMMARY_COLUMNS, stride_summary
 
     keys = [tuple(key) for key in subject_trials]
-    tables = {key: require_columns(read_tsv(path, "stride table", keep_default_na=False, na_values=[""]),
-                                   SUMMARY_COLUMNS, str(path), "stride table")
-              for key, path in zip(keys, strides_tsvs, strict=True)}
+    tables = {
+        key: require_columns(
+            read_tsv(path, "stride table", keep_default_na=False, na_values=[""]),
+            SUMMARY_COLUMNS,
+            str(path),
+            "stride table",
+        )
+        for key, path in zip(keys, strides_tsvs, strict=True)
+    }
     contacts = None
     if contacts_tsvs is not None:
-        contacts = {key: read_tsv(path, "contact table", ("flag",), keep_default_na=False)
-                    for key, path in zip(keys, contacts_tsvs, strict=True)}
+        contacts = {
+            key: read_tsv(path, "contact table", ("flag",), keep_default_na=False)
+            for key, path in zip(keys, contacts_tsvs, strict=True)
+        }
     table = stride_summary(tables, min_valid, contacts)
     extra = []
     if ik_tsvs is not None:
-        ik = [read_tsv(path, "IK summary", ("n_frames", "n_frames_left_out")).iloc[0]
-              for path in ik_tsvs]
-        extra.append(pd.DataFrame({"n_frames": [int(r.n_frames) for r in ik],
-                                   "n_frames_left_out": [int(r.n_frames_left_out) for r in ik]}))
+        ik = [read_tsv(path, "IK summary", ("n_frames", "n_frames_left_out")).iloc[0] for path in ik_tsvs]
+        extra.append(
+            pd.DataFrame(
+                {"n_frames": [int(r.n_frames) for r in ik], "n_frames_left_out": [int(r.n_frames_left_out) for r in ik]}
+            )
+        )
     if markers_tsvs is not None:
-        marks = [read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0]
-                 for path in markers_tsvs]
-        extra.append(pd.DataFrame({"heading_deg": [float(r.heading_deg) for r in marks],
-                                   "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
-                                   "turn_deg": [float(r.turn_deg) for r in marks]}))
+        marks = [
+            read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0]
+            for path in markers_tsvs
+        ]
+        extra.append(
+            pd.DataFrame(
+                {
+                    "heading_deg": [float(r.heading_deg) for r in marks],
+                    "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
+                    "turn_deg": [float(r.turn_deg) for r in marks],
+                }
+            )
+        )
     if extra:
         table = pd.concat([table, *extra], axis=1)
     write_tsv(table, out_tsv)

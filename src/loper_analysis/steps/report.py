@@ -15,8 +15,14 @@ from pathlib import Path
 from ..io.atomic import PathLike, write_text
 from ..io.readers import read_bytes, read_tsv
 
-__all__ = ["markdown_tables", "software_versions", "front_page", "snakemake_report_command",
-           "check_report_complete", "write_report"]
+__all__ = [
+    "markdown_tables",
+    "software_versions",
+    "front_page",
+    "snakemake_report_command",
+    "check_report_complete",
+    "write_report",
+]
 
 log = logging.getLogger(__name__)
 
@@ -48,10 +54,19 @@ def software_versions() -> dict[str, str]:
     return versions
 
 
-def front_page(out_html: PathLike, device_tsv: PathLike | None, validation_tsv: PathLike, subjects: Mapping[str, str],
-               trials: Mapping[str, Sequence[str]], settings: Mapping, impedance_tsv: PathLike | None = None,
-               summary_tsv: PathLike | None = None, figure_png: PathLike | None = None,
-               rmsd_tsv: PathLike | None = None, versions: Mapping[str, str] | None = None) -> str:
+def front_page(
+    out_html: PathLike,
+    device_tsv: PathLike | None,
+    validation_tsv: PathLike,
+    subjects: Mapping[str, str],
+    trials: Mapping[str, Sequence[str]],
+    settings: Mapping,
+    impedance_tsv: PathLike | None = None,
+    summary_tsv: PathLike | None = None,
+    figure_png: PathLike | None = None,
+    rmsd_tsv: PathLike | None = None,
+    versions: Mapping[str, str] | None = None,
+) -> str:
     """The front page of the report (:func:`loper_analysis.front_page.front_page_html`) from the result files.
 
     ``device_tsv``: ``results/device/summary.tsv`` (None: no device tests); ``validation_tsv``:
@@ -70,12 +85,18 @@ def front_page(out_html: PathLike, device_tsv: PathLike | None, validation_tsv: 
 
     from ..errors import LoperInputError
     from ..front_page import RunSettings, front_page_html
-    from ..headline import (device_comparison, impedance_summary_ci, transparency_verdict, truth_recovery,
-                            validation_verdict)
+    from ..headline import (
+        device_comparison,
+        impedance_summary_ci,
+        transparency_verdict,
+        truth_recovery,
+        validation_verdict,
+    )
 
     if (impedance_tsv is None) != (summary_tsv is None):
-        raise LoperInputError(f"front page: the impedance table ({impedance_tsv}) and its summary ({summary_tsv}) "
-                              "come together")
+        raise LoperInputError(
+            f"front page: the impedance table ({impedance_tsv}) and its summary ({summary_tsv}) come together"
+        )
     try:
         run = RunSettings(**settings)
     except TypeError as exc:
@@ -91,11 +112,21 @@ def front_page(out_html: PathLike, device_tsv: PathLike | None, validation_tsv: 
     if rmsd_tsv is not None:
         transparency = transparency_verdict(read_tsv(rmsd_tsv, "transparency table"), str(rmsd_tsv))
     text = front_page_html(
-        subjects, trials, run, software_versions() if versions is None else versions,
-        device=(pandas.DataFrame() if device_tsv is None
-                else device_comparison(read_tsv(device_tsv, "device summary"), str(device_tsv))),
+        subjects,
+        trials,
+        run,
+        software_versions() if versions is None else versions,
+        device=(
+            pandas.DataFrame()
+            if device_tsv is None
+            else device_comparison(read_tsv(device_tsv, "device summary"), str(device_tsv))
+        ),
         validation=validation_verdict(read_tsv(validation_tsv, "validation summary"), str(validation_tsv)),
-        summary=summary, truth=truth, impedance_status=status, figure_png=figure, transparency=transparency,
+        summary=summary,
+        truth=truth,
+        impedance_status=status,
+        figure_png=figure,
+        transparency=transparency,
     )
     write_text(out_html, text, "front page")
     log.info("front page: %d bytes (%d kB of figure)", len(text.encode()), len(figure or b"") // 1024)
@@ -176,8 +207,12 @@ def _configfiles(snakemake_args: Sequence[str]) -> list[str]:
     return files
 
 
-def write_report(target: PathLike, command: Callable[[Path], Sequence[str]] | None = None,
-                 snakemake_args: Sequence[str] = (), cwd: PathLike | None = None) -> Path:
+def write_report(
+    target: PathLike,
+    command: Callable[[Path], Sequence[str]] | None = None,
+    snakemake_args: Sequence[str] = (),
+    cwd: PathLike | None = None,
+) -> Path:
     """Write the Snakemake report beside ``target`` and move it over ``target`` only when it is complete.
 
     ``command(path)`` is the command line that writes the report to ``path``
@@ -219,8 +254,9 @@ def write_report(target: PathLike, command: Callable[[Path], Sequence[str]] | No
             argv = [str(a) for a in command(tmp if cwd is None else tmp.resolve())]
             status = subprocess.run(argv, cwd=cwd).returncode  # the command is killed if this raises
             if status != 0:
-                raise LoperInputError(f"{target}: the report command failed with exit status {status} (its "
-                                      f"messages are above): {kept}")
+                raise LoperInputError(
+                    f"{target}: the report command failed with exit status {status} (its messages are above): {kept}"
+                )
             try:
                 check_report_complete(tmp, target)
             except LoperInputError as exc:

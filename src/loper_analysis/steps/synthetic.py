@@ -16,8 +16,16 @@ __all__ = ["lab_export_session", "lab_session", "truth"]
 log = logging.getLogger(__name__)
 
 
-def truth(out_yaml: PathLike, row: Mapping, stiffness_nm_per_rad: Mapping, damping_nms_per_rad: Mapping,
-          between_subject_cv: float, stiffness_bounds, damping_bounds, seed: int) -> dict:
+def truth(
+    out_yaml: PathLike,
+    row: Mapping,
+    stiffness_nm_per_rad: Mapping,
+    damping_nms_per_rad: Mapping,
+    between_subject_cv: float,
+    stiffness_bounds,
+    damping_bounds,
+    seed: int,
+) -> dict:
     """``truth.yaml`` of a synthetic subject: its anthropometrics and true K, D per onset and joint.
 
     ``row`` is the subject's row of the subject sheet with its anthropometrics
@@ -25,16 +33,35 @@ def truth(out_yaml: PathLike, row: Mapping, stiffness_nm_per_rad: Mapping, dampi
     """
     from ..synthetic.subjects import TRUTH_HEADER, true_impedance, truth_document
 
-    impedance = true_impedance(row["subject"], seed, stiffness_nm_per_rad, damping_nms_per_rad, between_subject_cv,
-                               stiffness_bounds, damping_bounds)
+    impedance = true_impedance(
+        row["subject"],
+        seed,
+        stiffness_nm_per_rad,
+        damping_nms_per_rad,
+        between_subject_cv,
+        stiffness_bounds,
+        damping_bounds,
+    )
     write_yaml(out_yaml, truth_document(row, impedance), TRUTH_HEADER)
     log.info("truth of %s: %s", row["subject"], impedance)
     return impedance
 
 
-def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: PathLike, trials: Sequence[str],
-                onsets_ms: Sequence[int | None], c3d_outs: Sequence[PathLike], log_outs: Sequence[PathLike],
-                no_device: str, settings: Mapping, lab: Mapping, device: Mapping, seed: int) -> None:
+def lab_session(
+    subject: str,
+    row: Mapping,
+    truth_yaml: PathLike,
+    static_out: PathLike,
+    trials: Sequence[str],
+    onsets_ms: Sequence[int | None],
+    c3d_outs: Sequence[PathLike],
+    log_outs: Sequence[PathLike],
+    no_device: str,
+    settings: Mapping,
+    lab: Mapping,
+    device: Mapping,
+    seed: int,
+) -> None:
     """One session of the simulated gait lab: the static trial and every walking trial of a synthetic subject.
 
     ``trials`` with their perturbation onsets (ms, None for walking without
@@ -51,7 +78,6 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
     onsets of its true K and D (with the onset's own in perturbation trials);
     ``"gentle"`` is the earlier lab.
     """
-    import numpy as np
 
     from ..device.controller import DeviceParameters
     from ..synthetic.subjects import truth_from_document
@@ -66,8 +92,9 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
     s = settings
     lab_settings, device_parameters = LabSettings(**lab), DeviceParameters(**device)
     height_m, mass_kg = row["height_m"], row["mass_kg"]
-    write_recording(static_out, subject_static_recording(subject, height_m, mass_kg, s["static_duration_s"],
-                                                         lab_settings, seed))
+    write_recording(
+        static_out, subject_static_recording(subject, height_m, mass_kg, s["static_duration_s"], lab_settings, seed)
+    )
     log.info("static trial of %s: %s", subject, static_out)
     true = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml))
     logs = iter(log_outs)
@@ -78,13 +105,29 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
         perturbation = None
         if onset_ms is not None:
             impedance = tuple(true[onset_ms][j][name] for j in JOINTS for name in ("K", "D"))
-            perturbation = PerturbationSettings(onset_ms / 1000.0, impedance, s["pulse_force_n"], s["pulse_duration_s"],
-                                                tuple(s["perturb_every_strides"]))
+            perturbation = PerturbationSettings(
+                onset_ms / 1000.0,
+                impedance,
+                s["pulse_force_n"],
+                s["pulse_duration_s"],
+                tuple(s["perturb_every_strides"]),
+            )
         robot_log = None if trial == no_device else next(logs)
         walk, recording = subject_walking_trial(
-            subject, trial, height_m, mass_kg, s["walking_duration_s"], s["timing_cv"], s["amplitude_cv"],
-            lab_settings, device_parameters if robot_log is not None else None, seed, perturbation,
-            variability=variability, adaptation=adaptation, minimal_impedance=minimal_impedance,
+            subject,
+            trial,
+            height_m,
+            mass_kg,
+            s["walking_duration_s"],
+            s["timing_cv"],
+            s["amplitude_cv"],
+            lab_settings,
+            device_parameters if robot_log is not None else None,
+            seed,
+            perturbation,
+            variability=variability,
+            adaptation=adaptation,
+            minimal_impedance=minimal_impedance,
         )
         write_recording(c3d, recording)
         if robot_log is not None:
@@ -93,14 +136,32 @@ def lab_session(subject: str, row: Mapping, truth_yaml: PathLike, static_out: Pa
         log.info("%s: perturbations:\n%s", trial, walk.schedule.to_string(index=False))
 
 
-def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, marker_set_xml: PathLike,
-                       label_map_tsv: PathLike, trials: Sequence[str], onsets_ms: Sequence[int | None],
-                       no_device: str, height_m: float, mass_kg: float, duration_s: float, seed: int,
-                       impedance: Sequence[float] = (55.0, 3.5, 3.0, 0.1, 8.0, 0.3), static_name: str = "static",
-                       static_duration_s: float = 2.0, lab: Mapping | None = None, device: Mapping | None = None,
-                       export: Mapping | None = None, timing_cv: float = 0.03, amplitude_cv: float = 0.05,
-                       pulse_force_n: float = 40.0, pulse_duration_s: float = 0.1,
-                       perturb_every_strides: Sequence[int] = (3, 5), brace_fraction: float = 0.8) -> dict:
+def lab_export_session(
+    out_dir: PathLike,
+    subject: str,
+    model_osim: PathLike,
+    marker_set_xml: PathLike,
+    label_map_tsv: PathLike,
+    trials: Sequence[str],
+    onsets_ms: Sequence[int | None],
+    no_device: str,
+    height_m: float,
+    mass_kg: float,
+    duration_s: float,
+    seed: int,
+    impedance: Sequence[float] = (55.0, 3.5, 3.0, 0.1, 8.0, 0.3),
+    static_name: str = "static",
+    static_duration_s: float = 2.0,
+    lab: Mapping | None = None,
+    device: Mapping | None = None,
+    export: Mapping | None = None,
+    timing_cv: float = 0.03,
+    amplitude_cv: float = 0.05,
+    pulse_force_n: float = 40.0,
+    pulse_duration_s: float = 0.1,
+    perturb_every_strides: Sequence[int] = (3, 5),
+    brace_fraction: float = 0.8,
+) -> dict:
     """One subject's session as the lab exports it (QTM C3D + MATLAB robot logs), into ``out_dir``.
 
     Writes ``{static_name}.c3d`` and per trial ``{trial}.c3d``, plus
@@ -169,25 +230,43 @@ def lab_export_session(out_dir: PathLike, subject: str, model_osim: PathLike, ma
     add_brace_markers(model, params.attachment_m)
     label_map = {**label_map, **{m: m for m in ("LBRA_P", "LBRA_D") if m not in label_map}}
     results: dict = {}
-    static = qtm_static_export(model, label_map, mass_kg, static_duration_s, lab_settings, seeded("qtm", static_name),
-                               settings, source=f"{subject} {static_name}")
+    static = qtm_static_export(
+        model,
+        label_map,
+        mass_kg,
+        static_duration_s,
+        lab_settings,
+        seeded("qtm", static_name),
+        settings,
+        source=f"{subject} {static_name}",
+    )
     write_recording(out / f"{static_name}.c3d", static.recording, **static.writer_extras())
     results[static_name] = static
     for trial, onset_ms in zip(trials, onsets_ms, strict=True):
         perturbation = None
         if onset_ms is not None:
-            perturbation = PerturbationSettings(onset_ms / 1000.0, tuple(impedance), pulse_force_n, pulse_duration_s,
-                                                tuple(perturb_every_strides))
+            perturbation = PerturbationSettings(
+                onset_ms / 1000.0, tuple(impedance), pulse_force_n, pulse_duration_s, tuple(perturb_every_strides)
+            )
         device_parameters = None if trial == no_device else DeviceParameters(**(device or {}))
         sim_seed, file_seed = seeded("qtm", trial).spawn(2)
-        walk = simulate_walking_trial(duration_s, lab_settings, sim_seed, height_m, params, timing_cv, amplitude_cv,
-                                      device_parameters, perturbation)
-        exported = qtm_walking_export(model, walk, label_map, mass_kg, lab_settings, file_seed, settings,
-                                      f"{subject} {trial}")
+        walk = simulate_walking_trial(
+            duration_s,
+            lab_settings,
+            sim_seed,
+            height_m,
+            params,
+            timing_cv,
+            amplitude_cv,
+            device_parameters,
+            perturbation,
+        )
+        exported = qtm_walking_export(
+            model, walk, label_map, mass_kg, lab_settings, file_seed, settings, f"{subject} {trial}"
+        )
         write_recording(out / f"{trial}.c3d", exported.recording, **exported.writer_extras())
         if walk.robot is not None:
-            write_robot_log_mat(out / f"{trial}.mat", walk.robot, lab_settings.robot_rate_hz,
-                                ROBOT_LOG_MAT_VARIABLES)
+            write_robot_log_mat(out / f"{trial}.mat", walk.robot, lab_settings.robot_rate_hz, ROBOT_LOG_MAT_VARIABLES)
         log.info("%s %s: lab export in %s (first frame %d)", subject, trial, out, settings.first_frame)
         results[trial] = (walk, exported)
     return results

@@ -13,10 +13,18 @@ __all__ = ["transparency"]
 log = logging.getLogger(__name__)
 
 
-def transparency(subjects: Sequence[str], no_device_strides: Sequence[PathLike],
-                 no_device_cycles: Sequence[PathLike], device_strides: Sequence[PathLike],
-                 device_cycles: Sequence[PathLike], rmsd_out: PathLike, force_out: PathLike, figure_out: PathLike,
-                 side: str = "left", min_strides: int = 5):
+def transparency(
+    subjects: Sequence[str],
+    no_device_strides: Sequence[PathLike],
+    no_device_cycles: Sequence[PathLike],
+    device_strides: Sequence[PathLike],
+    device_cycles: Sequence[PathLike],
+    rmsd_out: PathLike,
+    force_out: PathLike,
+    figure_out: PathLike,
+    side: str = "left",
+    min_strides: int = 5,
+):
     """Transparency of the device from the stride and cycle tables of each subject's two walking trials.
 
     The four lists hold one file per subject, in the order of ``subjects``:
@@ -31,14 +39,23 @@ def transparency(subjects: Sequence[str], no_device_strides: Sequence[PathLike],
 
     files = zip(subjects, no_device_strides, no_device_cycles, device_strides, device_cycles, strict=True)
     frames = {
-        subject: {"no_device": (read_tsv(ns, "stride table"), read_tsv(nc, "cycle table")),
-                  "device": (read_tsv(ds, "stride table"), read_tsv(dc, "cycle table"))}
+        subject: {
+            "no_device": (read_tsv(ns, "stride table"), read_tsv(nc, "cycle table")),
+            "device": (read_tsv(ds, "stride table"), read_tsv(dc, "cycle table")),
+        }
         for subject, ns, nc, ds, dc in files
     }
     results = transparency_results(frames, side, min_strides)
     write_tsv(results.rmsd, rmsd_out)
     write_tsv(results.force, force_out)
-    write_figure(transparency_figure(results.angles_rad, results.force_n, results.toe_off_pct,
-                                     title=f"Transparency: {len(frames)} subject(s), kept strides pooled"), figure_out)
+    write_figure(
+        transparency_figure(
+            results.angles_rad,
+            results.force_n,
+            results.toe_off_pct,
+            title=f"Transparency: {len(frames)} subject(s), kept strides pooled",
+        ),
+        figure_out,
+    )
     log.info("transparency:\n%s", results.rmsd.to_string())
     return results

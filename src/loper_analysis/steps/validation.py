@@ -18,8 +18,9 @@ log = logging.getLogger(__name__)
 VALIDATION_FLOAT_FORMAT = "%.15g"
 
 
-def validation_chunk(segments_tsv: PathLike, settings: Mapping, chunk: int, n_chunks: int, errors_out: PathLike,
-                     fits_out: PathLike) -> tuple[pd.DataFrame, pd.DataFrame]:
+def validation_chunk(
+    segments_tsv: PathLike, settings: Mapping, chunk: int, n_chunks: int, errors_out: PathLike, fits_out: PathLike
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Simulate and identify chunk ``chunk`` of ``n_chunks`` of the combinations; write its two tables.
 
     ``settings``: keyword arguments of :class:`~loper_analysis.validation.ValidationSettings`.
@@ -35,19 +36,27 @@ def validation_chunk(segments_tsv: PathLike, settings: Mapping, chunk: int, n_ch
     study = ValidationSettings(**settings)
     log.info("chunk %d of %d with %s", chunk, n_chunks, study)
     grid = impedance_grid(study.stiffness_levels_nm_per_rad, study.damping_levels_nms_per_rad)
-    errors, fits = run_validation_chunk(read_segments(segments_tsv), study, chunk_combinations(len(grid), n_chunks, chunk))
+    errors, fits = run_validation_chunk(
+        read_segments(segments_tsv), study, chunk_combinations(len(grid), n_chunks, chunk)
+    )
     write_tsv(errors, errors_out, VALIDATION_FLOAT_FORMAT)
     write_tsv(fits, fits_out, VALIDATION_FLOAT_FORMAT)
     return errors, fits
 
 
-def validation_tables(error_tsvs: Sequence[PathLike], fit_tsvs: Sequence[PathLike], errors_out: PathLike,
-                      fits_out: PathLike, summary_out: PathLike) -> pd.DataFrame:
+def validation_tables(
+    error_tsvs: Sequence[PathLike],
+    fit_tsvs: Sequence[PathLike],
+    errors_out: PathLike,
+    fits_out: PathLike,
+    summary_out: PathLike,
+) -> pd.DataFrame:
     """Gather the chunks' tables and write them with the summary beside the study's values; returns the summary."""
     from ..validation import gather_validation_tables
 
-    errors, fits, summary = gather_validation_tables([read_tsv(p, "error table") for p in error_tsvs],
-                                                     [read_tsv(p, "fit table") for p in fit_tsvs])
+    errors, fits, summary = gather_validation_tables(
+        [read_tsv(p, "error table") for p in error_tsvs], [read_tsv(p, "fit table") for p in fit_tsvs]
+    )
     write_tsv(errors, errors_out, VALIDATION_FLOAT_FORMAT)
     write_tsv(fits, fits_out, VALIDATION_FLOAT_FORMAT)
     write_tsv(summary, summary_out, VALIDATION_FLOAT_FORMAT)

@@ -75,17 +75,45 @@ N_HARMONICS: int = 8
 #: Key points of the joint-angle curves: (stride fraction, degrees); heel strike at 0, toe-off at 0.65.
 CURVE_KEYPOINTS_DEG: dict[str, tuple[tuple[float, float], ...]] = {
     "hip_flexion": (
-        (0.00, 25.0), (0.10, 24.0), (0.30, 10.0), (0.50, -5.0), (0.58, -10.0),
-        (0.65, -3.0), (0.73, 15.0), (0.83, 27.0), (0.92, 26.5),
+        (0.00, 25.0),
+        (0.10, 24.0),
+        (0.30, 10.0),
+        (0.50, -5.0),
+        (0.58, -10.0),
+        (0.65, -3.0),
+        (0.73, 15.0),
+        (0.83, 27.0),
+        (0.92, 26.5),
     ),
     "knee_flexion": (
-        (0.00, 5.0), (0.06, 10.0), (0.15, 15.0), (0.26, 10.0), (0.40, 5.0), (0.48, 7.0),
-        (0.56, 16.0), (0.65, 38.0), (0.71, 55.0), (0.76, 60.0), (0.80, 57.0), (0.86, 35.0),
-        (0.92, 14.0), (0.97, 6.0),
+        (0.00, 5.0),
+        (0.06, 10.0),
+        (0.15, 15.0),
+        (0.26, 10.0),
+        (0.40, 5.0),
+        (0.48, 7.0),
+        (0.56, 16.0),
+        (0.65, 38.0),
+        (0.71, 55.0),
+        (0.76, 60.0),
+        (0.80, 57.0),
+        (0.86, 35.0),
+        (0.92, 14.0),
+        (0.97, 6.0),
     ),
     "ankle_dorsiflexion": (
-        (0.00, 0.0), (0.07, -5.0), (0.16, -1.0), (0.30, 5.0), (0.47, 10.0), (0.55, 7.0),
-        (0.61, -3.0), (0.68, -12.0), (0.73, -6.0), (0.79, 1.0), (0.87, 3.0), (0.94, 1.0),
+        (0.00, 0.0),
+        (0.07, -5.0),
+        (0.16, -1.0),
+        (0.30, 5.0),
+        (0.47, 10.0),
+        (0.55, 7.0),
+        (0.61, -3.0),
+        (0.68, -12.0),
+        (0.73, -6.0),
+        (0.79, 1.0),
+        (0.87, 3.0),
+        (0.94, 1.0),
     ),
 }
 #: Columns of the events frame.
@@ -253,8 +281,14 @@ class NominalGait:
             value = getattr(self, name)
             if not 0.5 < value < 0.85:
                 raise LoperInputError(f"{name} must lie in 0.5 .. 0.85 (walking), got {value}")
-        for name in ("hip_flexion_rad", "knee_flexion_rad", "ankle_dorsiflexion_rad", "pelvis_tilt_rad",
-                     "pelvis_ty_bob_m", "pelvis_tx_m"):
+        for name in (
+            "hip_flexion_rad",
+            "knee_flexion_rad",
+            "ankle_dorsiflexion_rad",
+            "pelvis_tilt_rad",
+            "pelvis_ty_bob_m",
+            "pelvis_tx_m",
+        ):
             if not isinstance(getattr(self, name), FourierSeries):
                 raise LoperInputError(f"{name} must be a FourierSeries, got {type(getattr(self, name)).__name__}")
 

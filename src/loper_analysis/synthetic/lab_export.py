@@ -60,24 +60,49 @@ __all__ = [
 
 #: gait2392 coordinate <- (our coordinate, sign); the others stay at their defaults (0).
 GAIT2392_COORDINATES: dict[str, tuple[str, float]] = {
-    "pelvis_tilt": ("pelvis_tilt", 1.0), "pelvis_tx": ("pelvis_tx", 1.0), "pelvis_ty": ("pelvis_ty", 1.0),
+    "pelvis_tilt": ("pelvis_tilt", 1.0),
+    "pelvis_tx": ("pelvis_tx", 1.0),
+    "pelvis_ty": ("pelvis_ty", 1.0),
     **{f"hip_flexion_{s}": (f"hip_flexion_{s}", 1.0) for s in "rl"},
     **{f"knee_angle_{s}": (f"knee_flexion_{s}", -1.0) for s in "rl"},
     **{f"ankle_angle_{s}": (f"ankle_dorsiflexion_{s}", 1.0) for s in "rl"},
 }
 
 #: Calibration of the belts' six bridge channels (V) into Fx, Fy, Fz (N) and Mx, My, Mz (N·mm), with 1-2 % crosstalk.
-TREADMILL_CAL_MATRIX: tuple[tuple[float, ...], ...] = tuple(map(tuple, (
-    np.diag([500.0, 500.0, 1000.0, 4.0e5, 4.0e5, 2.0e5])
-    @ (np.eye(6) + 0.01 * np.array([[0, 1, -1, 0, 2, 0], [-1, 0, 1, 1, 0, 0], [1, -1, 0, 0, 0, 1],
-                                    [0, 1, 0, 0, -1, 1], [2, 0, -1, 1, 0, 0], [0, 0, 1, -1, 1, 0]]))
-).tolist()))
+TREADMILL_CAL_MATRIX: tuple[tuple[float, ...], ...] = tuple(
+    map(
+        tuple,
+        (
+            np.diag([500.0, 500.0, 1000.0, 4.0e5, 4.0e5, 2.0e5])
+            @ (
+                np.eye(6)
+                + 0.01
+                * np.array(
+                    [
+                        [0, 1, -1, 0, 2, 0],
+                        [-1, 0, 1, 1, 0, 0],
+                        [1, -1, 0, 0, 0, 1],
+                        [0, 1, 0, 0, -1, 1],
+                        [2, 0, -1, 1, 0, 0],
+                        [0, 0, 1, -1, 1, 0],
+                    ]
+                )
+            )
+        ).tolist(),
+    )
+)
 
 #: Variable names of the robot log in the lab's MATLAB export (our column -> variable; those of the default
 #: ``device.mat_column_map``).
 ROBOT_LOG_MAT_VARIABLES: dict[str, str] = {
-    "time_s": "t", "force_desired_n": "Fd", "force_measured_n": "Fm", "motor_angle_rad": "theta",
-    "motor_velocity_rad_s": "omega", "sync_v": "sync", "perturbation": "pert", "safety_state": "safety",
+    "time_s": "t",
+    "force_desired_n": "Fd",
+    "force_measured_n": "Fm",
+    "motor_angle_rad": "theta",
+    "motor_velocity_rad_s": "omega",
+    "sync_v": "sync",
+    "perturbation": "pert",
+    "safety_state": "safety",
 }
 
 _CONTEXT = {"left": "Left", "right": "Right"}
@@ -142,12 +167,23 @@ class LabExport:
 
     def writer_extras(self) -> dict:
         """Keyword arguments of :func:`loper_analysis.io.c3d_writer.write_recording` beside the recording."""
-        return {"force_platforms": self.force_platforms, "analog_scales": self.analog_scales,
-                "analog_offsets": self.analog_offsets, "events": self.events}
+        return {
+            "force_platforms": self.force_platforms,
+            "analog_scales": self.analog_scales,
+            "analog_offsets": self.analog_offsets,
+            "events": self.events,
+        }
 
 
-def add_brace_markers(model, attachment_m: float, thigh_body: str = "femur_l", knee_body: str = "tibia_l",
-                      spacing_m: float = 0.08, anterior_m: float = 0.07, lateral_m: float = -0.06) -> None:
+def add_brace_markers(
+    model,
+    attachment_m: float,
+    thigh_body: str = "femur_l",
+    knee_body: str = "tibia_l",
+    spacing_m: float = 0.08,
+    anterior_m: float = 0.07,
+    lateral_m: float = -0.06,
+) -> None:
     """Put the LOPER brace markers ``LBRA_P`` and ``LBRA_D`` on the left thigh of an ``opensim.Model`` (in place).
 
     Both lie ``anterior_m`` in front of the hip-knee line (m), ``spacing_m``
@@ -208,8 +244,9 @@ def floor_offset_m(markers_model_m: np.ndarray, labels: Sequence[str], settings:
     return float(-np.mean(np.min(heights, axis=0)))
 
 
-def treadmill_platforms(settings: QTMExportSettings, channels: tuple[Sequence[int], Sequence[int]]
-                        ) -> tuple[ForcePlatform, ForcePlatform]:
+def treadmill_platforms(
+    settings: QTMExportSettings, channels: tuple[Sequence[int], Sequence[int]]
+) -> tuple[ForcePlatform, ForcePlatform]:
     """The two belts (left = plate 1 at lab y > 0, right = plate 2 at y < 0), surfaces at z = 0, centred on x = 0.
 
     Plate axes: x forward (lab +x), y to the right (lab -y), z down; corners
@@ -219,7 +256,10 @@ def treadmill_platforms(settings: QTMExportSettings, channels: tuple[Sequence[in
     half = 0.5 * settings.belt_length_m
     plates = []
     for side_sign, chans in zip((1.0, -1.0), channels):
-        inner, outer = side_sign * 0.5 * settings.belt_gap_m, side_sign * (0.5 * settings.belt_gap_m + settings.belt_width_m)
+        inner, outer = (
+            side_sign * 0.5 * settings.belt_gap_m,
+            side_sign * (0.5 * settings.belt_gap_m + settings.belt_width_m),
+        )
         right_edge, left_edge = min(inner, outer), max(inner, outer)
         corners = [(half, right_edge, 0.0), (-half, right_edge, 0.0), (-half, left_edge, 0.0), (half, left_edge, 0.0)]
         plates.append(ForcePlatform(4, corners, settings.sensor_origin_m, tuple(chans), TREADMILL_CAL_MATRIX))
@@ -245,8 +285,9 @@ def _channel_layout(settings: QTMExportSettings, sync_label: str):
     return labels, units, np.array(scales), np.array(offsets, dtype=np.int64), tuple(plate_channels_1based)
 
 
-def _lab_markers(model, coords2392: pd.DataFrame, label_map: Mapping[str, str], lab: LabSettings,
-                 settings: QTMExportSettings) -> tuple[np.ndarray, list[str], float]:
+def _lab_markers(
+    model, coords2392: pd.DataFrame, label_map: Mapping[str, str], lab: LabSettings, settings: QTMExportSettings
+) -> tuple[np.ndarray, list[str], float]:
     """Exact lab-frame markers (n, m, 3), their model names, and the floor offset applied (m)."""
     from ..kinematics import marker_positions
 
@@ -259,8 +300,9 @@ def _lab_markers(model, coords2392: pd.DataFrame, label_map: Mapping[str, str], 
     return rot.apply(X.reshape(-1, 3)).reshape(X.shape), names, offset
 
 
-def _noise_and_gaps(X: np.ndarray, names: list[str], lab: LabSettings, settings: QTMExportSettings,
-                    rng: np.random.Generator, gaps: bool) -> np.ndarray:
+def _noise_and_gaps(
+    X: np.ndarray, names: list[str], lab: LabSettings, settings: QTMExportSettings, rng: np.random.Generator, gaps: bool
+) -> np.ndarray:
     X = X + rng.normal(0.0, lab.marker_noise_sd_m, X.shape)
     n = X.shape[0]
     if not gaps:
@@ -268,11 +310,11 @@ def _noise_and_gaps(X: np.ndarray, names: list[str], lab: LabSettings, settings:
     for _ in range(settings.n_short_gaps):
         length = int(rng.integers(1, settings.max_short_gap_frames + 1))
         start = int(rng.integers(5, max(6, n - length - 5)))
-        X[start:start + length, int(rng.integers(len(names)))] = np.nan
+        X[start : start + length, int(rng.integers(len(names)))] = np.nan
     for name in settings.long_gap_markers:
         if name in names and n > settings.long_gap_frames + 20:
             start = int(rng.integers(10, n - settings.long_gap_frames - 10))
-            X[start:start + settings.long_gap_frames, names.index(name)] = np.nan
+            X[start : start + settings.long_gap_frames, names.index(name)] = np.nan
     return X
 
 
@@ -309,8 +351,9 @@ def _belt_channels(plates, X_exact, names, frame_t, analog_t, force_by_side, set
     return out
 
 
-def _assemble(model_names, X, X_exact, coords, trial_force, sync_v, label_map, lab, settings, rng, source,
-              events) -> LabExport:
+def _assemble(
+    model_names, X, X_exact, coords, trial_force, sync_v, label_map, lab, settings, rng, source, events
+) -> LabExport:
     rate = lab.marker_rate_hz
     n = X.shape[0]
     frame_t = np.arange(n) / rate
@@ -318,27 +361,47 @@ def _assemble(model_names, X, X_exact, coords, trial_force, sync_v, label_map, l
     analog_t = np.arange(n_a) / lab.analog_rate_hz
     labels, units, scales, offsets, chans = _channel_layout(settings, lab.sync_channel)
     plates = treadmill_platforms(settings, chans)
-    belts = _belt_channels(plates, X_exact, model_names, frame_t, analog_t, trial_force, settings, rng,
-                           lab.grf_noise_sd_n)
+    belts = _belt_channels(
+        plates, X_exact, model_names, frame_t, analog_t, trial_force, settings, rng, lab.grf_noise_sd_n
+    )
     columns = [np.column_stack([belts[s][0], belts[s][1]]) for s in SIDES]
     analogs = np.column_stack([*columns, sync_v[:n_a]])
     t0 = settings.first_frame / rate
     recording = C3DRecording(
-        source=source, marker_labels=[settings.subject_prefix + label_map[m] for m in model_names], markers_m=X,
-        point_rate_hz=rate, first_frame=settings.first_frame, analog_labels=labels, analog_units=units,
-        analogs=analogs, analog_rate_hz=lab.analog_rate_hz,
+        source=source,
+        marker_labels=[settings.subject_prefix + label_map[m] for m in model_names],
+        markers_m=X,
+        point_rate_hz=rate,
+        first_frame=settings.first_frame,
+        analog_labels=labels,
+        analog_units=units,
+        analogs=analogs,
+        analog_rate_hz=lab.analog_rate_hz,
     )
     return LabExport(
-        recording=recording, force_platforms=plates, analog_scales=scales, analog_offsets=offsets, events=events,
+        recording=recording,
+        force_platforms=plates,
+        analog_scales=scales,
+        analog_offsets=offsets,
+        events=events,
         coordinates=coords.assign(time_s=t0 + frame_t),
-        force_n={s: belts[s][2] for s in SIDES}, cop_m={s: belts[s][3] for s in SIDES},
-        resting_force_n={s: belts[s][4] for s in SIDES}, resting_moment_nm={s: belts[s][5] for s in SIDES},
+        force_n={s: belts[s][2] for s in SIDES},
+        cop_m={s: belts[s][3] for s in SIDES},
+        resting_force_n={s: belts[s][4] for s in SIDES},
+        resting_moment_nm={s: belts[s][5] for s in SIDES},
     )
 
 
-def qtm_walking_export(model, trial: WalkingTrial, label_map: Mapping[str, str], body_mass_kg: float,
-                       lab: LabSettings, seed, settings: QTMExportSettings = QTMExportSettings(),
-                       source: str = "walking trial") -> LabExport:
+def qtm_walking_export(
+    model,
+    trial: WalkingTrial,
+    label_map: Mapping[str, str],
+    body_mass_kg: float,
+    lab: LabSettings,
+    seed,
+    settings: QTMExportSettings = QTMExportSettings(),
+    source: str = "walking trial",
+) -> LabExport:
     """The QTM-style C3D contents of a simulated walking trial (module docstring).
 
     Parameters
@@ -365,29 +428,64 @@ def qtm_walking_export(model, trial: WalkingTrial, label_map: Mapping[str, str],
     X_exact, names, offset = _lab_markers(model, coords, label_map, lab, settings)
     coords["pelvis_ty"] += offset
     X = _noise_and_gaps(X_exact, names, lab, settings, np.random.default_rng(marker_seed), gaps=True)
-    grf = treadmill_grf(trial.mocap_events(), trial.duration_s, lab.analog_rate_hz, body_mass_kg,
-                        np.random.default_rng(grf_seed), noise_sd_n=lab.grf_noise_sd_n)
+    grf = treadmill_grf(
+        trial.mocap_events(),
+        trial.duration_s,
+        lab.analog_rate_hz,
+        body_mass_kg,
+        np.random.default_rng(grf_seed),
+        noise_sd_n=lab.grf_noise_sd_n,
+    )
     n_a = X.shape[0] * round(lab.analog_rate_hz / lab.marker_rate_hz)
     if len(grf) < n_a:
-        raise LoperInputError(f"{source}: {len(grf)} force samples for {X.shape[0]} frames; choose a duration that is "
-                              f"a whole number of frames")
+        raise LoperInputError(
+            f"{source}: {len(grf)} force samples for {X.shape[0]} frames; choose a duration that is "
+            f"a whole number of frames"
+        )
     grf = grf.iloc[:n_a]
-    forces = {s: (grf[f"fx_{s}_n"].to_numpy(float), grf[f"fz_{s}_n"].to_numpy(float),
-                  ~np.isnan(grf[f"cop_x_{s}_m"].to_numpy(float))) for s in SIDES}
+    forces = {
+        s: (
+            grf[f"fx_{s}_n"].to_numpy(float),
+            grf[f"fz_{s}_n"].to_numpy(float),
+            ~np.isnan(grf[f"cop_x_{s}_m"].to_numpy(float)),
+        )
+        for s in SIDES
+    }
     drift = 1.0 + 1e-6 * lab.clock_drift_ppm
     sync_v = pulse_train_at((grf["time_s"].to_numpy(float) + lab.clock_offset_s) / drift, trial.sync_starts_s)
     t0 = settings.first_frame / lab.marker_rate_hz
     events = []
     if settings.with_events:
-        events = [(_CONTEXT[r.side], _EVENT_LABEL[r.event], t0 + float(r.time_s))
-                  for r in trial.mocap_events().itertuples()]
-    return _assemble(names, X, X_exact, coords, forces, sync_v, label_map, lab, settings,
-                     np.random.default_rng(plate_seed), source, events)
+        events = [
+            (_CONTEXT[r.side], _EVENT_LABEL[r.event], t0 + float(r.time_s)) for r in trial.mocap_events().itertuples()
+        ]
+    return _assemble(
+        names,
+        X,
+        X_exact,
+        coords,
+        forces,
+        sync_v,
+        label_map,
+        lab,
+        settings,
+        np.random.default_rng(plate_seed),
+        source,
+        events,
+    )
 
 
-def qtm_static_export(model, label_map: Mapping[str, str], body_mass_kg: float, duration_s: float,
-                      lab: LabSettings, seed, settings: QTMExportSettings = QTMExportSettings(),
-                      pelvis_ty_m: float = 0.95, source: str = "static trial") -> LabExport:
+def qtm_static_export(
+    model,
+    label_map: Mapping[str, str],
+    body_mass_kg: float,
+    duration_s: float,
+    lab: LabSettings,
+    seed,
+    settings: QTMExportSettings = QTMExportSettings(),
+    pelvis_ty_m: float = 0.95,
+    source: str = "static trial",
+) -> LabExport:
     """A static trial: standing with every joint at 0, half the body weight on each belt under mid-foot,
     markers with noise and no gaps, the sync channel flat at 0, no events."""
     n = round(duration_s * lab.marker_rate_hz)
@@ -404,10 +502,28 @@ def qtm_static_export(model, label_map: Mapping[str, str], body_mass_kg: float, 
     n_a = n * round(lab.analog_rate_hz / lab.marker_rate_hz)
     rng = np.random.default_rng(plate_seed)
     half_weight = 0.5 * body_mass_kg * GRAVITY_M_PER_S2
-    forces = {s: (rng.normal(0.0, lab.grf_noise_sd_n, n_a), half_weight + rng.normal(0.0, lab.grf_noise_sd_n, n_a),
-                  np.ones(n_a, dtype=bool)) for s in SIDES}
-    return _assemble(names, X, _mid_foot(X_exact, names, settings), coords, forces, np.zeros(n_a), label_map, lab,
-                     replace(settings, cop_roll_fraction=0.0), rng, source, [])
+    forces = {
+        s: (
+            rng.normal(0.0, lab.grf_noise_sd_n, n_a),
+            half_weight + rng.normal(0.0, lab.grf_noise_sd_n, n_a),
+            np.ones(n_a, dtype=bool),
+        )
+        for s in SIDES
+    }
+    return _assemble(
+        names,
+        X,
+        _mid_foot(X_exact, names, settings),
+        coords,
+        forces,
+        np.zeros(n_a),
+        label_map,
+        lab,
+        replace(settings, cop_roll_fraction=0.0),
+        rng,
+        source,
+        [],
+    )
 
 
 def _mid_foot(X_exact: np.ndarray, names: list[str], settings: QTMExportSettings) -> np.ndarray:

@@ -34,8 +34,15 @@ from ..errors import LoperInputError
 __all__ = ["perturbation_schedule", "pulse_train", "thigh_normal", "swing_response", "swing_responses", "swing_spans"]
 
 
-def perturbation_schedule(events: pd.DataFrame, onset_s: float, rng: np.random.Generator, start_s: float,
-                          end_s: float, side: str = "left", every_strides: tuple[int, int] = (3, 5)) -> pd.DataFrame:
+def perturbation_schedule(
+    events: pd.DataFrame,
+    onset_s: float,
+    rng: np.random.Generator,
+    start_s: float,
+    end_s: float,
+    side: str = "left",
+    every_strides: tuple[int, int] = (3, 5),
+) -> pd.DataFrame:
     """Perturbed strides: every 3-5 strides at random (uniform), ``onset_s`` after toe-off.
 
     Returns ``toe_off_s``, ``onset_s``, ``heel_strike_s`` (the next heel
@@ -113,16 +120,24 @@ def swing_response(
         q_thigh = qu[:, 1] - dth[:, 0]  # the pelvis is an input: d(theta_hip) = -d(q_thigh)
         fp = fp_mag[:, None] * thigh_normal(q_thigh)
         window = prepare_window(
-            t, qu, qu, params, onset_s,
-            force_unperturbed_n=fu, force_perturbed_n=fp,
-            pelvis_angle_unperturbed_rad=pel, pelvis_angle_perturbed_rad=pel,
-            window_before_s=before_s, window_after_s=heel_strike_s - onset_s, n_substeps=n_substeps,
+            t,
+            qu,
+            qu,
+            params,
+            onset_s,
+            force_unperturbed_n=fu,
+            force_perturbed_n=fp,
+            pelvis_angle_unperturbed_rad=pel,
+            pelvis_angle_perturbed_rad=pel,
+            window_before_s=before_s,
+            window_after_s=heel_strike_s - onset_s,
+            n_substeps=n_substeps,
             initial_state_span_s=0.04,
         )
         response = simulate_response(window, np.asarray(impedance, float))
         i0 = int(np.searchsorted(t, window.time_s[0] - 1e-9))
         new = np.zeros_like(th)
-        new[i0:i0 + len(response)] = response
+        new[i0 : i0 + len(response)] = response
         tail = slice(i0 + len(response), None)
         after = t[tail] - window.time_s[-1]
         ramp = np.where(after < fade_s, 0.5 * (1 + np.cos(np.pi * after / fade_s)), 0.0)
@@ -134,8 +149,17 @@ def swing_response(
     return dth
 
 
-def swing_responses(time_s, joint_angles_rad, pelvis_angle_rad, pelvis_x_m, params: SegmentParameters, impedance,
-                    force_n, swings, n_substeps: int = 2) -> np.ndarray:
+def swing_responses(
+    time_s,
+    joint_angles_rad,
+    pelvis_angle_rad,
+    pelvis_x_m,
+    params: SegmentParameters,
+    impedance,
+    force_n,
+    swings,
+    n_substeps: int = 2,
+) -> np.ndarray:
     """Joint-angle deviations (n, 3) rad of every swing driven by the measured force, against walking without it.
 
     Each swing (rows ``toe_off_s``, ``heel_strike_s`` of ``swings``) is
@@ -156,9 +180,20 @@ def swing_responses(time_s, joint_angles_rad, pelvis_angle_rad, pelvis_x_m, para
         if toe_off - 0.3 < t[0] or heel_strike + 0.35 > t[-1]:
             continue
         sl = slice(int(np.searchsorted(t, toe_off - 0.3)), int(np.searchsorted(t, heel_strike + 0.35)))
-        delta[sl] += swing_response(t[sl], th[sl], np.asarray(pelvis_angle_rad)[sl], np.asarray(pelvis_x_m)[sl],
-                                    params, impedance, np.asarray(force_n)[sl], zero[sl], toe_off + before,
-                                    heel_strike, before_s=before, n_substeps=n_substeps)
+        delta[sl] += swing_response(
+            t[sl],
+            th[sl],
+            np.asarray(pelvis_angle_rad)[sl],
+            np.asarray(pelvis_x_m)[sl],
+            params,
+            impedance,
+            np.asarray(force_n)[sl],
+            zero[sl],
+            toe_off + before,
+            heel_strike,
+            before_s=before,
+            n_substeps=n_substeps,
+        )
     return delta
 
 

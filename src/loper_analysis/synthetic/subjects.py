@@ -64,9 +64,15 @@ def subject_anthropometry(row: Mapping, seed: int) -> dict:
     return out
 
 
-def true_impedance(subject: str, seed: int, stiffness_nm_per_rad: Mapping, damping_nms_per_rad: Mapping,
-                   between_subject_cv: float, stiffness_bounds: Sequence[float] = (0.0, 200.0),
-                   damping_bounds: Sequence[float] = (0.0, 10.0)) -> dict:
+def true_impedance(
+    subject: str,
+    seed: int,
+    stiffness_nm_per_rad: Mapping,
+    damping_nms_per_rad: Mapping,
+    between_subject_cv: float,
+    stiffness_bounds: Sequence[float] = (0.0, 200.0),
+    damping_bounds: Sequence[float] = (0.0, 10.0),
+) -> dict:
     """True K, D per onset and joint: ``{onset_ms: {joint: {"K": N·m/rad, "D": N·m·s/rad}}}``.
 
     ``stiffness_nm_per_rad`` / ``damping_nms_per_rad`` map an onset (ms, int
@@ -89,7 +95,10 @@ def true_impedance(subject: str, seed: int, stiffness_nm_per_rad: Mapping, dampi
         for j, joint in enumerate(JOINTS):
             factors = np.exp(sigma * rng.standard_normal(2) - 0.5 * sigma**2)
             k, d = float(k_group[j]) * factors[0], float(d_group[j]) * factors[1]
-            for name, value, (lo, hi), unit in (("K", k, stiffness_bounds, "N·m/rad"), ("D", d, damping_bounds, "N·m·s/rad")):
+            for name, value, (lo, hi), unit in (
+                ("K", k, stiffness_bounds, "N·m/rad"),
+                ("D", d, damping_bounds, "N·m·s/rad"),
+            ):
                 if not lo <= value <= hi:
                     raise LoperInputError(
                         f"subject {subject}, onset {onset} ms, {joint}: true {name} = {value:.4g} {unit} lies outside "

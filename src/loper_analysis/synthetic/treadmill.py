@@ -34,13 +34,20 @@ __all__ = ["GRF_COLUMNS", "treadmill_grf"]
 #: Columns of the treadmill force frame (N, N·m, m; belt frame x forward, y left, z up).
 GRF_COLUMNS: tuple[str, ...] = (
     "time_s",
-    "fz_left_n", "fz_right_n",
-    "fx_left_n", "fx_right_n",
-    "mx_left_nm", "mx_right_nm",
-    "my_left_nm", "my_right_nm",
-    "mz_left_nm", "mz_right_nm",
-    "cop_x_left_m", "cop_x_right_m",
-    "cop_y_left_m", "cop_y_right_m",
+    "fz_left_n",
+    "fz_right_n",
+    "fx_left_n",
+    "fx_right_n",
+    "mx_left_nm",
+    "mx_right_nm",
+    "my_left_nm",
+    "my_right_nm",
+    "mz_left_nm",
+    "mz_right_nm",
+    "cop_x_left_m",
+    "cop_x_right_m",
+    "cop_y_left_m",
+    "cop_y_right_m",
 )
 
 
@@ -88,8 +95,15 @@ def _stances(events: pd.DataFrame) -> tuple[dict[str, list[tuple[float, float]]]
 
 #: Normalised vertical-force shape over stance (fraction of stance, body weights), without the edge step.
 _FZ_KNOTS = (
-    (0.0, 0.0), (0.1, 0.35), (0.22, 1.1), (0.36, 0.85), (0.5, 0.72),
-    (0.64, 0.85), (0.78, 1.1), (0.9, 0.35), (1.0, 0.0),
+    (0.0, 0.0),
+    (0.1, 0.35),
+    (0.22, 1.1),
+    (0.36, 0.85),
+    (0.5, 0.72),
+    (0.64, 0.85),
+    (0.78, 1.1),
+    (0.9, 0.35),
+    (1.0, 0.0),
 )
 
 

@@ -92,12 +92,13 @@ def lab_markers(model, coordinates: pd.DataFrame, lab: LabSettings, rng: np.rand
         for _ in range(lab.n_gaps):
             length = int(rng.integers(1, lab.max_gap_frames + 1))
             start = int(rng.integers(5, max(6, n - length - 5)))
-            X[start:start + length, int(rng.integers(len(labels)))] = np.nan
+            X[start : start + length, int(rng.integers(len(labels)))] = np.nan
     return X, labels
 
 
-def static_recording(model, coordinates: pd.DataFrame, duration_s: float, lab: LabSettings, seed,
-                     source: str = "static trial") -> C3DRecording:
+def static_recording(
+    model, coordinates: pd.DataFrame, duration_s: float, lab: LabSettings, seed, source: str = "static trial"
+) -> C3DRecording:
     """A static trial: the first row of ``coordinates`` held for ``duration_s``, markers only (no gaps)."""
     n = int(round(duration_s * lab.marker_rate_hz))
     if n < 2:
@@ -148,7 +149,7 @@ class WalkingTrial:
         step = int(round(1.0 / (marker_rate_hz * (t[1] - t[0]))))
         first = int(np.argmin(np.abs(t)))
         n = int(round(self.duration_s * marker_rate_hz))
-        out = self.fine.iloc[first:first + n * step:step].reset_index(drop=True)
+        out = self.fine.iloc[first : first + n * step : step].reset_index(drop=True)
         return out.assign(time_s=np.arange(n) / marker_rate_hz)
 
     def mocap_events(self) -> pd.DataFrame:
@@ -156,10 +157,21 @@ class WalkingTrial:
         return e[(e["time_s"] >= 0) & (e["time_s"] <= self.duration_s)].reset_index(drop=True)
 
 
-def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: float, params,
-                           timing_cv: float = 0.03, amplitude_cv: float = 0.05, device=None,
-                           perturbation: PerturbationSettings | None = None, gait=None, variability=None,
-                           adaptation=None, minimal_impedance=None) -> WalkingTrial:
+def simulate_walking_trial(
+    duration_s: float,
+    lab: LabSettings,
+    seed,
+    height_m: float,
+    params,
+    timing_cv: float = 0.03,
+    amplitude_cv: float = 0.05,
+    device=None,
+    perturbation: PerturbationSettings | None = None,
+    gait=None,
+    variability=None,
+    adaptation=None,
+    minimal_impedance=None,
+) -> WalkingTrial:
     """Simulate kinematics, device and perturbation responses of one walking trial.
 
     ``params`` is the subject's :class:`~loper_analysis.dynamics.SegmentParameters`
@@ -188,16 +200,32 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     gait_seed, sync_seed, device_seed, schedule_seed = ss.spawn(4)
-    fine, events = walking_with_margins(duration_s, lab, np.random.default_rng(gait_seed), timing_cv, amplitude_cv,
-                                        leg_length_from_height(height_m), gait, sample_rate_hz=lab.analog_rate_hz,
-                                        variability=variability, adaptation=adaptation if device is not None else None)
+    fine, events = walking_with_margins(
+        duration_s,
+        lab,
+        np.random.default_rng(gait_seed),
+        timing_cv,
+        amplitude_cv,
+        leg_length_from_height(height_m),
+        gait,
+        sample_rate_hz=lab.analog_rate_hz,
+        variability=variability,
+        adaptation=adaptation if device is not None else None,
+    )
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     robot_duration = (duration_s + lab.robot_margin_s + lab.clock_offset_s) / scale
     starts = sync_pulse_starts(robot_duration, sync_seed)
     schedule = pd.DataFrame(columns=["toe_off_s", "onset_s", "heel_strike_s"])
     if perturbation is not None:
-        schedule = perturbation_schedule(events, perturbation.onset_s, np.random.default_rng(schedule_seed), 0.5,
-                                         duration_s - 0.5, "left", perturbation.every_strides)
+        schedule = perturbation_schedule(
+            events,
+            perturbation.onset_s,
+            np.random.default_rng(schedule_seed),
+            0.5,
+            duration_s - 0.5,
+            "left",
+            perturbation.every_strides,
+        )
     if device is None:
         return WalkingTrial(duration_s, fine, events, schedule, None, starts)
     t_fine = fine["time_s"].to_numpy()
@@ -208,27 +236,40 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
     brace = np.interp(t_mocap, t_fine, _brace_position_m(fine, params.attachment_m))
     brace -= brace.mean()
     onsets_robot = (schedule["onset_s"].to_numpy(float) + lab.clock_offset_s) / scale
-    fd = pulse_train(t_robot, onsets_robot, perturbation.force_n, perturbation.duration_s) if perturbation else 0 * t_robot
+    fd = (
+        pulse_train(t_robot, onsets_robot, perturbation.force_n, perturbation.duration_s)
+        if perturbation
+        else 0 * t_robot
+    )
     sim = simulate_device(fd, device, None, brace_position_m=brace, seed=device_seed)
-    robot = pd.DataFrame({
-        "time_s": t_robot,
-        "force_desired_n": sim["force_desired_n"].to_numpy(),
-        "force_measured_n": sim["force_measured_n"].to_numpy(),
-        "motor_angle_rad": sim["motor_angle_rad"].to_numpy(),
-        "motor_velocity_rad_s": sim["motor_velocity_rad_s"].to_numpy(),
-        "sync_v": pulse_train_at(t_robot, starts),
-        "perturbation": (np.abs(fd) > 0).astype(np.int64),
-        "safety_state": sim["safety_state"].to_numpy().astype(np.int64),
-    })
+    robot = pd.DataFrame(
+        {
+            "time_s": t_robot,
+            "force_desired_n": sim["force_desired_n"].to_numpy(),
+            "force_measured_n": sim["force_measured_n"].to_numpy(),
+            "motor_angle_rad": sim["motor_angle_rad"].to_numpy(),
+            "motor_velocity_rad_s": sim["motor_velocity_rad_s"].to_numpy(),
+            "sync_v": pulse_train_at(t_robot, starts),
+            "perturbation": (np.abs(fd) > 0).astype(np.int64),
+            "safety_state": sim["safety_state"].to_numpy().astype(np.int64),
+        }
+    )
     if minimal_impedance is not None:
         fm = np.interp((t_fine + lab.clock_offset_s) / scale, t_robot, robot["force_measured_n"].to_numpy())
         impedance = perturbation.impedance if perturbation is not None else tuple(minimal_impedance)
         angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
         t_span = -lab.clock_offset_s + scale * t_robot[[0, -1]]
         inside = (t_fine >= t_span[0]) & (t_fine <= t_span[1])
-        delta = swing_responses(t_fine[inside], angles[inside], -fine["pelvis_tilt"].to_numpy()[inside],
-                                fine["pelvis_tx"].to_numpy()[inside], params, impedance, fm[inside],
-                                swing_spans(events, "left"))
+        delta = swing_responses(
+            t_fine[inside],
+            angles[inside],
+            -fine["pelvis_tilt"].to_numpy()[inside],
+            fine["pelvis_tx"].to_numpy()[inside],
+            params,
+            impedance,
+            fm[inside],
+            swing_spans(events, "left"),
+        )
         fine = fine.copy()
         for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
             fine.loc[inside, c] = angles[inside, i] + delta[:, i]
@@ -241,18 +282,30 @@ def simulate_walking_trial(duration_s: float, lab: LabSettings, seed, height_m: 
         pelvis_angle = -fine["pelvis_tilt"].to_numpy()
         delta = np.zeros_like(angles)
         for row in schedule.itertuples():
-            sl = slice(int(np.searchsorted(t_fine, row.onset_s - 0.3)), int(np.searchsorted(t_fine, row.heel_strike_s + 0.35)))
-            delta[sl] += swing_response(t_fine[sl], angles[sl], pelvis_angle[sl], fine["pelvis_tx"].to_numpy()[sl],
-                                        params, perturbation.impedance, fp[sl], fu[sl], row.onset_s,
-                                        row.heel_strike_s)
+            sl = slice(
+                int(np.searchsorted(t_fine, row.onset_s - 0.3)), int(np.searchsorted(t_fine, row.heel_strike_s + 0.35))
+            )
+            delta[sl] += swing_response(
+                t_fine[sl],
+                angles[sl],
+                pelvis_angle[sl],
+                fine["pelvis_tx"].to_numpy()[sl],
+                params,
+                perturbation.impedance,
+                fp[sl],
+                fu[sl],
+                row.onset_s,
+                row.heel_strike_s,
+            )
         fine = fine.copy()
         for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
             fine[c] = angles[:, i] + delta[:, i]
     return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
 
 
-def walking_recording(model, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings, seed,
-                      source: str = "walking trial") -> C3DRecording:
+def walking_recording(
+    model, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings, seed, source: str = "walking trial"
+) -> C3DRecording:
     """The C3D contents of a walking trial: markers with noise and gaps, GRF per belt and the sync channel."""
     from .sync import pulse_train_at
     from .treadmill import treadmill_grf
@@ -261,8 +314,14 @@ def walking_recording(model, trial: WalkingTrial, body_mass_kg: float, lab: LabS
     marker_seed, grf_seed = ss.spawn(2)
     coords = trial.mocap_coordinates(lab.marker_rate_hz)
     X, labels = lab_markers(model, coords, lab, np.random.default_rng(marker_seed))
-    grf = treadmill_grf(trial.mocap_events(), trial.duration_s, lab.analog_rate_hz, body_mass_kg,
-                        np.random.default_rng(grf_seed), noise_sd_n=lab.grf_noise_sd_n)
+    grf = treadmill_grf(
+        trial.mocap_events(),
+        trial.duration_s,
+        lab.analog_rate_hz,
+        body_mass_kg,
+        np.random.default_rng(grf_seed),
+        noise_sd_n=lab.grf_noise_sd_n,
+    )
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     names, columns, units = [], [], []
     for side, suffix in zip(SIDES, lab.grf_prefix):
@@ -274,15 +333,30 @@ def walking_recording(model, trial: WalkingTrial, body_mass_kg: float, lab: LabS
     names.append(lab.sync_channel)
     columns.append(pulse_train_at((grf["time_s"].to_numpy(float) + lab.clock_offset_s) / scale, trial.sync_starts_s))
     units.append("V")
-    return C3DRecording(source=source, marker_labels=labels, markers_m=X, point_rate_hz=lab.marker_rate_hz,
-                        analog_labels=names, analog_units=units, analogs=np.column_stack(columns),
-                        analog_rate_hz=lab.analog_rate_hz)
+    return C3DRecording(
+        source=source,
+        marker_labels=labels,
+        markers_m=X,
+        point_rate_hz=lab.marker_rate_hz,
+        analog_labels=names,
+        analog_units=units,
+        analogs=np.column_stack(columns),
+        analog_rate_hz=lab.analog_rate_hz,
+    )
 
 
-def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Generator, timing_cv: float,
-                         amplitude_cv: float, leg_length_m: float, gait=None,
-                         sample_rate_hz: float | None = None, variability=None,
-                         adaptation=None) -> tuple[pd.DataFrame, pd.DataFrame]:
+def walking_with_margins(
+    duration_s: float,
+    lab: LabSettings,
+    rng: np.random.Generator,
+    timing_cv: float,
+    amplitude_cv: float,
+    leg_length_m: float,
+    gait=None,
+    sample_rate_hz: float | None = None,
+    variability=None,
+    adaptation=None,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Kinematics and events that cover the robot log's span: from ``clock_offset_s`` (+1 s) before the
     motion capture to ``robot_margin_s`` (+1 s) after it; time 0 is the first motion-capture frame.
     ``sample_rate_hz`` defaults to the marker rate and must be a multiple of it; ``variability`` and
@@ -293,8 +367,17 @@ def walking_with_margins(duration_s: float, lab: LabSettings, rng: np.random.Gen
     rate = lab.marker_rate_hz if sample_rate_hz is None else sample_rate_hz
     lead = np.ceil((lab.clock_offset_s + 1.0) * lab.marker_rate_hz) / lab.marker_rate_hz
     total = lead + duration_s + lab.robot_margin_s + 1.0
-    coords, events = walking_kinematics(total, rate, gait or NominalGait(), rng, timing_cv, amplitude_cv, leg_length_m,
-                                        variability=variability, adaptation=adaptation)
+    coords, events = walking_kinematics(
+        total,
+        rate,
+        gait or NominalGait(),
+        rng,
+        timing_cv,
+        amplitude_cv,
+        leg_length_m,
+        variability=variability,
+        adaptation=adaptation,
+    )
     coords = coords.assign(time_s=np.round((coords["time_s"] - lead) * rate) / rate)
     return coords, events.assign(time_s=events["time_s"] - lead)
 
@@ -303,8 +386,9 @@ def _seed(seed, *names: str) -> list[int]:
     return [int(seed), *(zlib.crc32(n.encode()) for n in names)]
 
 
-def subject_static_recording(subject: str, height_m: float, mass_kg: float, duration_s: float, lab: LabSettings,
-                             seed: int) -> C3DRecording:
+def subject_static_recording(
+    subject: str, height_m: float, mass_kg: float, duration_s: float, lab: LabSettings, seed: int
+) -> C3DRecording:
     """The static trial of a synthetic subject: standing, joints at 0, feet on the floor (seeded by subject)."""
     from ..model import COORDINATES, build_lower_body_model
     from .walking import leg_length_from_height
@@ -314,10 +398,22 @@ def subject_static_recording(subject: str, height_m: float, mass_kg: float, dura
     return static_recording(model, still, duration_s, lab, _seed(seed, subject, "static"), f"{subject} static")
 
 
-def subject_walking_trial(subject: str, trial: str, height_m: float, mass_kg: float, duration_s: float,
-                          timing_cv: float, amplitude_cv: float, lab: LabSettings, device, seed: int,
-                          perturbation: PerturbationSettings | None = None, variability=None, adaptation=None,
-                          minimal_impedance=None) -> tuple[WalkingTrial, C3DRecording]:
+def subject_walking_trial(
+    subject: str,
+    trial: str,
+    height_m: float,
+    mass_kg: float,
+    duration_s: float,
+    timing_cv: float,
+    amplitude_cv: float,
+    lab: LabSettings,
+    device,
+    seed: int,
+    perturbation: PerturbationSettings | None = None,
+    variability=None,
+    adaptation=None,
+    minimal_impedance=None,
+) -> tuple[WalkingTrial, C3DRecording]:
     """One walking trial of a synthetic subject (seeded by subject and trial): the simulation and its C3D contents.
 
     ``device`` None simulates walking without the device (no robot log);
@@ -329,7 +425,18 @@ def subject_walking_trial(subject: str, trial: str, height_m: float, mass_kg: fl
     model = build_lower_body_model(height_m, mass_kg)
     params = segment_parameters_from_model(model)
     sim_seed, file_seed = np.random.SeedSequence(_seed(seed, subject, trial)).spawn(2)
-    walk = simulate_walking_trial(duration_s, lab, sim_seed, height_m, params, timing_cv, amplitude_cv, device,
-                                  perturbation, variability=variability, adaptation=adaptation,
-                                  minimal_impedance=minimal_impedance)
+    walk = simulate_walking_trial(
+        duration_s,
+        lab,
+        sim_seed,
+        height_m,
+        params,
+        timing_cv,
+        amplitude_cv,
+        device,
+        perturbation,
+        variability=variability,
+        adaptation=adaptation,
+        minimal_impedance=minimal_impedance,
+    )
     return walk, walking_recording(model, walk, mass_kg, lab, file_seed, f"{subject} {trial}")

@@ -44,7 +44,14 @@ from scipy.interpolate import CubicSpline
 from ..constants import JOINTS
 from ..errors import LoperInputError
 
-__all__ = ["GaitVariability", "DeviceAdaptation", "device_adaptation", "lab_variability", "smooth_noise", "swing_envelope"]
+__all__ = [
+    "GaitVariability",
+    "DeviceAdaptation",
+    "device_adaptation",
+    "lab_variability",
+    "smooth_noise",
+    "swing_envelope",
+]
 
 #: Leg phases (fraction of the stride from heel strike) of mid-stance and mid-swing (toe-off at 0.65).
 MID_STANCE, MID_SWING = 0.325, 0.825
@@ -114,8 +121,10 @@ class DeviceAdaptation:
         object.__setattr__(self, "swing_gain", _three("swing_gain", self.swing_gain, 1.0, 4.0))
         change = np.abs(np.array(self.amplitude_factor) - 1.0) * np.array(self.swing_gain)
         if np.any(change >= 0.6):
-            raise LoperInputError(f"amplitude_factor {self.amplitude_factor} with swing_gain {self.swing_gain} "
-                                  "changes an amplitude by 60 % or more")
+            raise LoperInputError(
+                f"amplitude_factor {self.amplitude_factor} with swing_gain {self.swing_gain} "
+                "changes an amplitude by 60 % or more"
+            )
 
     def factor_and_offset(self, joint: int, leg_phase) -> tuple[np.ndarray, np.ndarray]:
         """Amplitude factor and offset (rad) of joint ``joint`` (0 hip, 1 knee, 2 ankle) at the leg phase."""
@@ -123,8 +132,13 @@ class DeviceAdaptation:
         return 1.0 + g * (self.amplitude_factor[joint] - 1.0), g * self.offset_rad[joint]
 
 
-def device_adaptation(seed: int, subject: str, amplitude_change: Sequence[float], offset_rad: Sequence[float],
-                      swing_gain: Sequence[float] = (1.0, 1.0, 1.0)) -> DeviceAdaptation:
+def device_adaptation(
+    seed: int,
+    subject: str,
+    amplitude_change: Sequence[float],
+    offset_rad: Sequence[float],
+    swing_gain: Sequence[float] = (1.0, 1.0, 1.0),
+) -> DeviceAdaptation:
     """Draw a subject's adaptation to the device (seeded by ``seed`` and ``subject`` only).
 
     Per joint the amplitude factor is ``1 ± u · amplitude_change`` and the
@@ -158,8 +172,9 @@ def swing_envelope(leg_phase, gain: float) -> np.ndarray:
     return 1.0 + (gain - 1.0) * 0.5 * (1.0 - np.cos(2.0 * np.pi * (x - MID_STANCE)))
 
 
-def smooth_noise(phase, first_knot: int, last_knot: int, knots_per_stride: int, sd: float,
-                 rng: np.random.Generator) -> np.ndarray:
+def smooth_noise(
+    phase, first_knot: int, last_knot: int, knots_per_stride: int, sd: float, rng: np.random.Generator
+) -> np.ndarray:
     """A C2 random function of the stride phase: a cubic spline through independent normal knot values.
 
     Knots lie at ``m / knots_per_stride`` for integers ``first_knot <= m <=
@@ -194,9 +209,9 @@ def lab_variability(settings: Mapping, seed: int, subject: str, truth: Mapping):
     if settings["variability"] != "study":
         return None, None, None
     v, a = settings["study_variability"], settings["device_adaptation"]
-    variability = GaitVariability(v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"],
-                                  v["knots_per_stride"])
+    variability = GaitVariability(
+        v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"], v["knots_per_stride"]
+    )
     adaptation = device_adaptation(seed, subject, a["amplitude_change"], a["offset_rad"], a["swing_gain"])
-    minimal_impedance = tuple(float(np.mean([truth[o][j][name] for o in truth]))
-                              for j in JOINTS for name in ("K", "D"))
+    minimal_impedance = tuple(float(np.mean([truth[o][j][name] for o in truth])) for j in JOINTS for name in ("K", "D"))
     return variability, adaptation, minimal_impedance

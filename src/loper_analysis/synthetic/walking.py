@@ -58,8 +58,10 @@ def _leg_geometry(leg_length_m: float) -> dict[str, float]:
     """Segment lengths (m) of the model whose standing hip height is ``leg_length_m``."""
     height = leg_length_m / leg_length_from_height(1.0)
     return {
-        "thigh": WINTER_SEGMENTS["thigh"].length * height, "shank": WINTER_SEGMENTS["shank"].length * height,
-        "foot": WINTER_SEGMENTS["foot"].length * height, "ankle_height": ANKLE_HEIGHT_FRACTION * height,
+        "thigh": WINTER_SEGMENTS["thigh"].length * height,
+        "shank": WINTER_SEGMENTS["shank"].length * height,
+        "foot": WINTER_SEGMENTS["foot"].length * height,
+        "ankle_height": ANKLE_HEIGHT_FRACTION * height,
     }
 
 
@@ -116,8 +118,14 @@ def pelvis_height_m(gait: NominalGait, leg_length_m: float | None = None, n_samp
     return float(np.mean(-np.minimum(*lowest)))
 
 
-def _modulations(variability: GaitVariability, joint: int, leg_phase: np.ndarray, first_phase: float,
-                 last_phase: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _modulations(
+    variability: GaitVariability,
+    joint: int,
+    leg_phase: np.ndarray,
+    first_phase: float,
+    last_phase: float,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Amplitude factor, offset (rad) and timing shift (strides) of one leg and joint at ``leg_phase``.
 
     The knots cover the leg phases ``first_phase .. last_phase`` (the span of
@@ -133,7 +141,9 @@ def _modulations(variability: GaitVariability, joint: int, leg_phase: np.ndarray
     return a, o, tau
 
 
-def _solve_phase(phase_of_t: PchipInterpolator, knot_t: np.ndarray, knot_phase0: int, targets: np.ndarray) -> np.ndarray:
+def _solve_phase(
+    phase_of_t: PchipInterpolator, knot_t: np.ndarray, knot_phase0: int, targets: np.ndarray
+) -> np.ndarray:
     """Times at which the monotone phase reaches ``targets`` (bisection inside the bracketing stride)."""
     k = np.floor(targets).astype(int) - knot_phase0
     lo, hi = knot_t[k].copy(), knot_t[k + 1].copy()
@@ -263,7 +273,9 @@ def walking_kinematics(
                 excursion = series(psi) - series.mean
                 o = 0.0
             else:
-                a, o, tau = _modulations(variability, j, leg_phase, knot_phase[0] - offset, knot_phase[-1] - offset, rng)
+                a, o, tau = _modulations(
+                    variability, j, leg_phase, knot_phase[0] - offset, knot_phase[-1] - offset, rng
+                )
                 excursion = series(gait.curve_phase(leg_phase + tau)) - series.mean
             if adaptation is not None:
                 dev_amp, dev_off = adaptation.factor_and_offset(j, leg_phase)
@@ -283,5 +295,7 @@ def walking_kinematics(
             if side == "right" and event == "heel_strike":  # exact at the knots
                 times = knot_t[targets.astype(int) - knot_phase0]
             rows += [(side, event, float(tt)) for tt in times if 0.0 <= tt <= duration_s]
-    events = pd.DataFrame(rows, columns=list(TRUE_EVENT_COLUMNS)).sort_values("time_s", kind="stable").reset_index(drop=True)
+    events = (
+        pd.DataFrame(rows, columns=list(TRUE_EVENT_COLUMNS)).sort_values("time_s", kind="stable").reset_index(drop=True)
+    )
     return coordinates, events
