@@ -27,12 +27,19 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
-include: "workflow/rules/validation.smk"
-include: "workflow/rules/device.smk"
-include: "workflow/rules/processing.smk"
+include: "workflow/rules/inputs.smk"
 include: "workflow/rules/synthetic.smk"
+include: "workflow/rules/markers.smk"
+include: "workflow/rules/model.smk"
+include: "workflow/rules/ik.smk"
+include: "workflow/rules/grf.smk"
+include: "workflow/rules/events.smk"
+include: "workflow/rules/strides.smk"
+include: "workflow/rules/transparency.smk"
+include: "workflow/rules/device.smk"
 include: "workflow/rules/impedance.smk"
 include: "workflow/rules/planning.smk"
+include: "workflow/rules/validation.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -1,4 +1,5 @@
 # Shared set-up: config and subject-sheet validation, target list, settings for rules.
+import re
 import sys
 from functools import cache
 from pathlib import Path
@@ -14,6 +15,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
 from loper_analysis.schema import check_config, check_table, config_origin
+from loper_analysis.steps.planning import planning_settings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
 from loper_analysis.validation import validation_settings
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance

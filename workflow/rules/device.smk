@@ -8,21 +8,6 @@ localrules:
     device_figures,
 
 
-DEVICE = config["device"]
-DEVICE_SUBJECT = DEVICE["subject"]
-DEVICE_RATE_HZ = DEVICE["parameters"]["sample_rate_hz"]
-
-
-def device_log(trial):
-    """Robot log of a device trial: generated (synthetic), converted from .mat, or as recorded."""
-    if DEVICE_SUBJECT is None:  # no device tests in this study: the device rules are never asked for
-        return []
-    raw = Path("data/raw") / DEVICE_SUBJECT
-    if SUBJECT_SOURCE[DEVICE_SUBJECT] == "recorded" and (raw / f"{trial}.mat").exists():
-        return f"results/device/{DEVICE_SUBJECT}/{trial}.loper.tsv"
-    return str(raw / f"{trial}.loper.tsv")
-
-
 rule device_trial:
     output:
         "data/raw/{subject}/{trial}.loper.tsv",

@@ -4,60 +4,10 @@
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
 localrules:
-    impedance_figures,
     impedance_table,
     impedance_summary,
+    impedance_figures,
     impedance_figure,
-    tables_markdown,
-
-
-IDENT = config["identification"]
-
-
-def onset_trials(subject: str, onset: str) -> list[str]:
-    """The subject's trials of one onset that are on disk (or generated)."""
-    return [t for t in subject_trials(subject) if DESIGN.onset_ms(t) == int(onset)]
-
-
-def null_pair_trials(subject: str) -> list[str]:
-    """The subject's trials with the device (minimal impedance and perturbation): their unperturbed strides
-    are the null pairs of every onset's fit."""
-    return [t for t in subject_trials(subject) if t != config["trials"]["no_device"]]
-
-
-ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
-
-
-def fit_trials(subject: str) -> list[str]:
-    """The subject's trials any of its fits reads, in subject_trials order: the onsets' own trials and the
-    null-pair trials."""
-    used = {t for o in ONSETS for t in onset_trials(subject, o) + fit_null_trials(subject, o)}
-    return [t for t in subject_trials(subject) if t in used]
-
-
-def fit_inputs(wildcards):
-    """Files of a subject's fits: angles and strides of every trial a fit reads (order of fit_trials), the force
-    at 128 Hz and at the robot rate and the markers of the perturbation trials (order of their onsets' trials),
-    the segment table and a synthetic truth."""
-    s = wildcards.subject
-    out = {"segments": f"results/model/{s}/segments.tsv"}
-    if SUBJECT_SOURCE[s] == "synthetic":
-        out["truth"] = f"data/raw/{s}/truth.yaml"
-    used = fit_trials(s)
-    out["angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in used]
-    out["strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in used]
-    own = [t for o in ONSETS for t in onset_trials(s, o)]
-    out["force"] = [f"results/loadcell/{s}/{t}.force.tsv" for t in own]
-    out["force_native"] = [f"results/loadcell/{s}/{t}.force_native.tsv" for t in own]
-    out["markers"] = [f"results/markers/{s}/{t}.trc" for t in own]
-    return out
-
-
-def fit_null_trials(subject: str, onset: str) -> list[str]:
-    """Null-pair trials of a fit: none for a white-noise fit or a missing onset (reported without any input)."""
-    if IDENT["noise_model"] != "null_pairs" or not onset_trials(subject, onset):
-        return []
-    return null_pair_trials(subject)
 
 
 rule impedance_fit:
@@ -204,34 +154,3 @@ rule impedance_figure:
         "results/benchmarks/impedance_figure/impedance.tsv"
     script:
         "../scripts/impedance_figure.py"
-
-
-def markdown_sections() -> dict:
-    """Every result table of the run, for the Markdown rendering."""
-    sections = {
-        "Impedance per subject, onset and joint": "results/tables/impedance.tsv",
-        "Across-subject summary": "results/tables/impedance_summary.tsv",
-        "Literature": "results/tables/literature.tsv",
-        "Strides per trial": "results/strides/summary.tsv",
-        "Validation study": "results/validation/summary.tsv",
-        "Device": "results/device/summary.tsv",
-    }
-    if transparency_subjects():
-        sections["Transparency: RMSD vs ISV_ave"] = "results/transparency/rmsd.tsv"
-        sections["Transparency: interaction force"] = "results/transparency/force.tsv"
-    return sections
-
-
-rule tables_markdown:
-    input:
-        list(markdown_sections().values()),
-    output:
-        "results/tables/tables.md",
-    log:
-        "results/logs/tables_markdown/tables.log",
-    benchmark:
-        "results/benchmarks/tables_markdown/tables.tsv"
-    params:
-        headings=list(markdown_sections()),
-    script:
-        "../scripts/tables_markdown.py"

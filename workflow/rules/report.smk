@@ -1,29 +1,12 @@
-# The report's front page: what was run, the headline numbers and the main figure, as one HTML fragment that
-# workflow/report/workflow.rst pulls in above the methods text.
+# The report: its front page (what was run, the headline numbers and the main figure, as one HTML fragment
+# that workflow/report/workflow.rst pulls in above the methods text) and every result table in Markdown.
 
 
-# a small job reading tables: on a cluster it runs in the controlling process, not as a SLURM job
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
 localrules:
     front_page,
-
-
-def front_page_inputs(wildcards) -> dict:
-    """Tables the front page reads: the validation summary always, the device summary with device tests, the
-    impedance tables and the main figure when the run has perturbation trials, the transparency table when a
-    subject walked both trials of the pair (the targets of processing_targets)."""
-    out = {"validation": "results/validation/summary.tsv"}
-    if device_targets():
-        out["device"] = "results/device/summary.tsv"
-    targets = set(processing_targets())
-    if "results/tables/impedance.tsv" in targets:
-        out.update(
-            impedance="results/tables/impedance.tsv",
-            summary="results/tables/impedance_summary.tsv",
-            figure="results/figures/impedance.png",
-        )
-    if "results/transparency/rmsd.tsv" in targets:
-        out["rmsd"] = "results/transparency/rmsd.tsv"
-    return out
+    tables_markdown,
 
 
 rule front_page:
@@ -59,3 +42,18 @@ rule front_page:
         ),
     script:
         "../scripts/front_page.py"
+
+
+rule tables_markdown:
+    input:
+        list(markdown_sections().values()),
+    output:
+        "results/tables/tables.md",
+    log:
+        "results/logs/tables_markdown/tables.log",
+    benchmark:
+        "results/benchmarks/tables_markdown/tables.tsv"
+    params:
+        headings=list(markdown_sections()),
+    script:
+        "../scripts/tables_markdown.py"

@@ -7,23 +7,6 @@ localrules:
     synthetic_truth,
 
 
-SYNTH = config["synthetic"]
-
-
-def lab_settings() -> dict:
-    """Keyword arguments of loper_analysis.synthetic.trials.LabSettings from the config."""
-    return dict(
-        marker_noise_sd_m=SYNTH["marker_noise_sd_m"],
-        n_gaps=SYNTH["marker_gaps_per_trial"],
-        max_gap_frames=SYNTH["max_gap_frames"],
-        grf_noise_sd_n=SYNTH["grf_noise_sd_n"],
-        clock_offset_s=SYNTH["clock_offset_s"],
-        clock_drift_ppm=SYNTH["clock_drift_ppm"],
-        lab_to_model_rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
-        sync_channel=config["events"]["sync_channel"],
-    )
-
-
 rule synthetic_truth:
     output:
         "data/raw/{subject}/truth.yaml",

@@ -1,0 +1,55 @@
+# Strides: joint angles and forces cut heel strike to heel strike, the outlier rule, the trials' summary.
+
+
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    strides_summary,
+
+
+rule strides:
+    input:
+        angles="results/ik/{subject}/{trial}.angles.tsv",
+        events="results/events/{subject}/{trial}.events.tsv",
+        force=stride_force,
+    output:
+        strides="results/strides/{subject}/{trial}.strides.tsv",
+        cycles="results/strides/{subject}/{trial}.cycles.tsv",
+    log:
+        "results/logs/strides/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/strides/{subject}/{trial}.tsv"
+    group:
+        "trial"
+    params:
+        side=TRIALS["perturbed_side"],
+        n_points=config["strides"]["n_points"],
+        whisker=config["strides"]["iqr_whisker"],
+        max_fraction=config["strides"]["max_outlier_fraction"],
+        min_valid=config["strides"]["min_valid_strides"],
+    script:
+        "../scripts/strides.py"
+
+
+rule strides_summary:
+    input:
+        strides=[f"results/strides/{s}/{t}.strides.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        contacts=[f"results/events/{s}/{t}.contacts.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        ik=[f"results/ik/{s}/{t}.ik.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        markers=[f"results/markers/{s}/{t}.markers.tsv" for s in processed_subjects() for t in subject_trials(s)],
+    output:
+        report(
+            "results/strides/summary.tsv",
+            caption="../report/strides_summary.rst",
+            category="Processing",
+            labels={"table": "strides per trial"},
+        ),
+    log:
+        "results/logs/strides_summary/summary.log",
+    benchmark:
+        "results/benchmarks/strides_summary/summary.tsv"
+    params:
+        subject_trial=[(s, t) for s in processed_subjects() for t in subject_trials(s)],
+        min_valid=config["strides"]["min_valid_strides"],
+    script:
+        "../scripts/strides_summary.py"

@@ -1,0 +1,41 @@
+# Transparency of the device in minimal-impedance mode: RMSD with vs without it against ISV_ave.
+
+
+# small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
+# controlling process instead of paying a SLURM job's start-up
+localrules:
+    transparency,
+
+
+rule transparency:
+    input:
+        unpack(transparency_inputs),
+    output:
+        rmsd=report(
+            "results/transparency/rmsd.tsv",
+            caption="../report/transparency_rmsd.rst",
+            category="Transparency",
+            labels={"table": "RMSD vs ISV_ave"},
+        ),
+        force=report(
+            "results/transparency/force.tsv",
+            caption="../report/transparency_force.rst",
+            category="Transparency",
+            labels={"table": "interaction force"},
+        ),
+        figure=report(
+            "results/transparency/transparency.png",
+            caption="../report/transparency_figure.rst",
+            category="Transparency",
+            labels={"figure": "gait cycle with and without LOPER"},
+        ),
+    log:
+        "results/logs/transparency/transparency.log",
+    benchmark:
+        "results/benchmarks/transparency/transparency.tsv"
+    params:
+        subjects=transparency_subjects(),
+        side=TRIALS["perturbed_side"],
+        min_strides=config["strides"]["min_valid_strides"],
+    script:
+        "../scripts/transparency.py"
