@@ -38,7 +38,7 @@ OUTPUTS = ("events", "contacts", "force", "native")
 
 
 def _settings() -> tuple[dict, dict]:
-    """The keyword settings rule events_loadcell passes to the step (workflow/rules/events.smk, settings in inputs.smk)."""
+    """The keyword settings rule events_loadcell passes to the step (rules/events.smk, settings in inputs.smk)."""
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     ev = cfg["events"]
     events = dict(
