@@ -121,8 +121,9 @@ def test_schema_of_the_config_files_project_wins(project, tmp_path_factory):
 
 
 def test_rule_takes_its_params_from_the_shared_builder():
-    rule = (ROOT / "workflow" / "rules" / "planning.smk").read_text()
-    assert "PLAN_SETTINGS = planning_settings(config)" in rule and "**PLAN_SETTINGS," in rule
+    rules = ROOT / "workflow" / "rules"
+    assert "PLAN_SETTINGS = planning_settings(config)" in (rules / "inputs.smk").read_text()
+    assert "**PLAN_SETTINGS," in (rules / "planning.smk").read_text()
     # every setting the rule's script reads besides the pilot and its trials comes from the builder
     script = (ROOT / "workflow" / "scripts" / "planning.py").read_text()
     read = set(re.findall(r"\bp\.(\w+)", script)) - {"subject", "trials"}
@@ -203,7 +204,7 @@ def test_validation_defaults_of_the_library_are_the_configs():
 
 def test_validate_command_runs_with_the_configs_settings(project, capsys):
     """One K/D level (one combination): the config's levels reach the chunk, the option --n-starts wins."""
-    from loper_analysis.steps.model import write_segments
+    from loper_analysis.dynamics import write_segments
     from tests.parameter_sets import WINTER
 
     write_segments(WINTER, project / "segments.tsv")
