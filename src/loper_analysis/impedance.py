@@ -34,8 +34,18 @@ from .dynamics import SegmentParameters
 from .errors import LoperInputError, TooFewStridesWarning
 from .identification import (
     AT_BOUND_FRACTION,
+    DAMPING_BOUNDS_NMS_PER_RAD,
     DEFAULT_PLAUSIBLE_RANGES,
+    FIT_TOLERANCE,
+    INITIAL_STATE_DEGREE,
+    MAX_CI_FRACTION,
+    MERGE_TOLERANCE,
+    MIN_NULL_PAIRS,
     MIN_VAF_PCT,
+    N_STARTS,
+    N_SUBSTEPS,
+    NULL_PAIR_COMPONENTS,
+    STIFFNESS_BOUNDS_NM_PER_RAD,
     ImpedanceFit,
     identify_impedance,
     joint_status,
@@ -119,16 +129,16 @@ class IdentificationSettings:
 
     noise_model: str = "null_pairs"
     interval_scatter: str = "perturbed_pairs"
-    null_pair_components: int = 6
-    min_null_pairs: int = 30
-    initial_state_degree: int = 1
-    n_starts: int = 10
-    n_substeps: int = 2
-    tolerance: float = 1e-6
-    merge_tolerance: float = 0.01
-    stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
-    damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
-    max_ci_fraction: float = 1.0
+    null_pair_components: int = NULL_PAIR_COMPONENTS
+    min_null_pairs: int = MIN_NULL_PAIRS
+    initial_state_degree: int = INITIAL_STATE_DEGREE
+    n_starts: int = N_STARTS
+    n_substeps: int = N_SUBSTEPS
+    tolerance: float = FIT_TOLERANCE
+    merge_tolerance: float = MERGE_TOLERANCE
+    stiffness_bounds_nm_per_rad: tuple[float, float] = STIFFNESS_BOUNDS_NM_PER_RAD
+    damping_bounds_nms_per_rad: tuple[float, float] = DAMPING_BOUNDS_NMS_PER_RAD
+    max_ci_fraction: float = MAX_CI_FRACTION
     plausible_ranges: Mapping | None = None
     min_vaf_pct: float = MIN_VAF_PCT
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
@@ -266,9 +276,9 @@ def impedance_rows(
     onset_ms: int,
     n_strides: int,
     truth: Mapping | None = None,
-    lower=(0.0, 0.0),
-    upper=(200.0, 10.0),
-    max_ci_fraction: float = 1.0,
+    lower=(STIFFNESS_BOUNDS_NM_PER_RAD[0], DAMPING_BOUNDS_NMS_PER_RAD[0]),
+    upper=(STIFFNESS_BOUNDS_NM_PER_RAD[1], DAMPING_BOUNDS_NMS_PER_RAD[1]),
+    max_ci_fraction: float = MAX_CI_FRACTION,
     noise_model: str = "white",
     n_null_pairs: int = 0,
     note: str = "",

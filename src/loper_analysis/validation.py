@@ -28,6 +28,14 @@ from .errors import LoperInputError
 from .identification import (
     DEFAULT_LOWER,
     DEFAULT_UPPER,
+    FIT_TOLERANCE,
+    INITIAL_STATE_DEGREE,
+    INITIAL_STATE_SPAN_S,
+    MERGE_TOLERANCE,
+    N_STARTS,
+    N_SUBSTEPS,
+    WINDOW_AFTER_S,
+    WINDOW_BEFORE_S,
     identify_impedance,
     per_step,
     prepare_window,
@@ -73,17 +81,17 @@ class ValidationSettings:
     pulse_overshoot_pct: float = STUDY_DEVICE["overshoot_pct"][0]
     force_rate_hz: float = 1000.0
     force_direction_deg: float = 0.0
-    window_before_s: float = 0.025
-    window_after_s: float = 0.25
+    window_before_s: float = WINDOW_BEFORE_S
+    window_after_s: float = WINDOW_AFTER_S
     noise_peak_to_peak: float = 0.01
-    n_starts: int = 10
-    n_substeps: int = 2
+    n_starts: int = N_STARTS
+    n_substeps: int = N_SUBSTEPS
     truth_substeps: int = 32
-    tolerance: float = 1e-6
-    merge_tolerance: float = 1e-2
+    tolerance: float = FIT_TOLERANCE
+    merge_tolerance: float = MERGE_TOLERANCE
     reference_cutoff_hz: float | None = None
-    initial_state_span_s: float = 0.1
-    initial_state_degree: int = 1
+    initial_state_span_s: float = INITIAL_STATE_SPAN_S
+    initial_state_degree: int = INITIAL_STATE_DEGREE
     seed: int = 2024
     lower: tuple[float, ...] = tuple(DEFAULT_LOWER)
     upper: tuple[float, ...] = tuple(DEFAULT_UPPER)

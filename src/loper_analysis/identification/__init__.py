@@ -26,8 +26,13 @@ intervals), whose ends :mod:`.intervals` forms.
 
 from .fit import (
     AT_BEST_RELATIVE,
+    DAMPING_BOUNDS_NMS_PER_RAD,
     DEFAULT_LOWER,
     DEFAULT_UPPER,
+    FIT_TOLERANCE,
+    MERGE_TOLERANCE,
+    N_STARTS,
+    STIFFNESS_BOUNDS_NM_PER_RAD,
     ImpedanceFit,
     identify_impedance,
     parameter_bounds,
@@ -37,14 +42,28 @@ from .fit import (
 )
 from .intervals import CI_LEVEL, bounded_interval, t_quantile
 from .null_pairs import (
+    MIN_NULL_PAIRS,
+    NULL_PAIR_COMPONENTS,
     NullPairFit,
     cross_validated_covariance,
     nuisance_projection,
     null_pair_errors,
     refit_with_null_pairs,
 )
-from .status import AT_BOUND_FRACTION, DEFAULT_PLAUSIBLE_RANGES, MIN_VAF_PCT, check_plausible_range, joint_status
+from .status import (
+    AT_BOUND_FRACTION,
+    DEFAULT_PLAUSIBLE_RANGES,
+    MAX_CI_FRACTION,
+    MIN_VAF_PCT,
+    check_plausible_range,
+    joint_status,
+)
 from .window import (
+    INITIAL_STATE_DEGREE,
+    INITIAL_STATE_SPAN_S,
+    N_SUBSTEPS,
+    WINDOW_AFTER_S,
+    WINDOW_BEFORE_S,
     PreparedWindow,
     per_step,
     prediction_error,
@@ -60,6 +79,18 @@ __all__ = [
     "AT_BEST_RELATIVE",
     "DEFAULT_LOWER",
     "DEFAULT_UPPER",
+    "STIFFNESS_BOUNDS_NM_PER_RAD",
+    "DAMPING_BOUNDS_NMS_PER_RAD",
+    "N_STARTS",
+    "FIT_TOLERANCE",
+    "MERGE_TOLERANCE",
+    "WINDOW_BEFORE_S",
+    "WINDOW_AFTER_S",
+    "INITIAL_STATE_SPAN_S",
+    "INITIAL_STATE_DEGREE",
+    "N_SUBSTEPS",
+    "NULL_PAIR_COMPONENTS",
+    "MIN_NULL_PAIRS",
     "PreparedWindow",
     "ImpedanceFit",
     "parameter_bounds",
@@ -81,6 +112,7 @@ __all__ = [
     "refit_with_null_pairs",
     "cross_validated_covariance",
     "MIN_VAF_PCT",
+    "MAX_CI_FRACTION",
     "AT_BOUND_FRACTION",
     "joint_status",
     "DEFAULT_PLAUSIBLE_RANGES",

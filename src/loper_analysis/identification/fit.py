@@ -38,6 +38,11 @@ from .window import PreparedWindow, prediction_error, simulate_response
 __all__ = [
     "DEFAULT_LOWER",
     "DEFAULT_UPPER",
+    "STIFFNESS_BOUNDS_NM_PER_RAD",
+    "DAMPING_BOUNDS_NMS_PER_RAD",
+    "N_STARTS",
+    "FIT_TOLERANCE",
+    "MERGE_TOLERANCE",
     "AT_BEST_RELATIVE",
     "ImpedanceFit",
     "check_bounds",
@@ -51,9 +56,19 @@ __all__ = [
     "variance_accounted_for",
 ]
 
-#: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS`.
-DEFAULT_LOWER = np.zeros(6)
-DEFAULT_UPPER = np.array([200.0, 10.0, 200.0, 10.0, 200.0, 10.0])
+#: Default bounds of every K (N·m/rad; ``identification.stiffness_bounds_nm_per_rad``) ...
+STIFFNESS_BOUNDS_NM_PER_RAD: tuple[float, float] = (0.0, 200.0)
+#: ... and of every D (N·m·s/rad; ``identification.damping_bounds_nms_per_rad``).
+DAMPING_BOUNDS_NMS_PER_RAD: tuple[float, float] = (0.0, 10.0)
+#: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS` (:func:`parameter_bounds` of the two above).
+DEFAULT_LOWER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[0], DAMPING_BOUNDS_NMS_PER_RAD[0]] * 3, float)
+DEFAULT_UPPER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[1], DAMPING_BOUNDS_NMS_PER_RAD[1]] * 3, float)
+#: Random starts drawn uniformly inside the bounds (``identification.n_starts``).
+N_STARTS: int = 10
+#: Relative cost/step tolerance of the multistart phase (``identification.tolerance``).
+FIT_TOLERANCE: float = 1e-6
+#: Starts this close (fraction of the bounds, every parameter) continue as one (``identification.merge_tolerance``).
+MERGE_TOLERANCE: float = 1e-2
 #: A start has reached the best when its final cost is within this fraction above the lowest start cost.
 AT_BEST_RELATIVE = 1e-3
 #: Levenberg-Marquardt damping: initial value, factor down after a successful step, factor up after a failed one.
@@ -316,13 +331,13 @@ def starts_at_best(start_costs, relative: float = AT_BEST_RELATIVE) -> int:
 def identify_impedance(
     window: PreparedWindow,
     *,
-    n_starts: int = 10,
+    n_starts: int = N_STARTS,
     seed: int | np.random.SeedSequence | None = 0,
     lower=DEFAULT_LOWER,
     upper=DEFAULT_UPPER,
     max_iterations: int = 60,
-    tolerance: float = 1e-6,
-    merge_tolerance: float = 1e-2,
+    tolerance: float = FIT_TOLERANCE,
+    merge_tolerance: float = MERGE_TOLERANCE,
     extra_starts=None,
     ci_dof: int | None = None,
     polish_max_evaluations: int = 200,

@@ -34,12 +34,19 @@ from .intervals import bounded_interval
 from .window import PreparedWindow, initial_state_basis
 
 __all__ = [
+    "NULL_PAIR_COMPONENTS",
+    "MIN_NULL_PAIRS",
     "NullPairFit",
     "null_pair_errors",
     "nuisance_projection",
     "cross_validated_covariance",
     "refit_with_null_pairs",
 ]
+
+#: Deviation shapes projected out of the prediction error (``identification.null_pair_components``).
+NULL_PAIR_COMPONENTS: int = 6
+#: Fewer null pairs: the white fit stands (``identification.min_null_pairs``).
+MIN_NULL_PAIRS: int = 30
 
 
 @dataclass
@@ -168,8 +175,8 @@ def refit_with_null_pairs(
     first: ImpedanceFit,
     null_pairs: dict,
     n_averaged: int,
-    n_components: int = 6,
-    min_null_pairs: int = 30,
+    n_components: int = NULL_PAIR_COMPONENTS,
+    min_null_pairs: int = MIN_NULL_PAIRS,
     cross_validated: bool = False,
     perturbed_pairs: dict | None = None,
     **fit_options,

@@ -32,12 +32,22 @@ import numpy as np
 from ..errors import LoperInputError
 from ..reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANCE
 
-__all__ = ["MIN_VAF_PCT", "AT_BOUND_FRACTION", "DEFAULT_PLAUSIBLE_RANGES", "check_plausible_range", "joint_status"]
+__all__ = [
+    "MIN_VAF_PCT",
+    "MAX_CI_FRACTION",
+    "AT_BOUND_FRACTION",
+    "DEFAULT_PLAUSIBLE_RANGES",
+    "check_plausible_range",
+    "joint_status",
+]
 
 #: VAF (%) below which a joint's fit is ``failed``: below 0 the model explains less than no response at all.
 MIN_VAF_PCT: float = 0.0
 #: An estimate within this fraction of its bound range of a bound lies on the bound.
 AT_BOUND_FRACTION: float = 1e-6
+#: A K or D whose 95 % CI spans more than this share of its bound range is not identifiable (1: only an unbounded
+#: one; ``identification.max_ci_fraction``).
+MAX_CI_FRACTION: float = 1.0
 
 #: Plausible range per joint, ((K low, K high) N·m/rad, (D low, D high) N·m·s/rad): the study's across-subject
 #: means for hip and knee, a stated choice for the ankle (:data:`loper_analysis.reference.ANKLE_SWING_IMPEDANCE`).
@@ -76,7 +86,7 @@ def joint_status(
     success: bool = True,
     message: str = "",
     plausible_range=None,
-    max_ci_fraction: float = 1.0,
+    max_ci_fraction: float = MAX_CI_FRACTION,
     min_vaf_pct: float = MIN_VAF_PCT,
     at_bound_fraction: float = AT_BOUND_FRACTION,
 ) -> tuple[str, str]:

@@ -23,6 +23,11 @@ from ..dynamics import SegmentParameters, inverse_dynamics, joint_angles
 from ..errors import LoperInputError
 
 __all__ = [
+    "WINDOW_BEFORE_S",
+    "WINDOW_AFTER_S",
+    "INITIAL_STATE_SPAN_S",
+    "INITIAL_STATE_DEGREE",
+    "N_SUBSTEPS",
     "PreparedWindow",
     "prepare_window",
     "initial_state_basis",
@@ -35,6 +40,19 @@ __all__ = [
     "simulate_response",
     "prediction_error",
 ]
+
+# Defaults of the fit window and its initial state (config ``identification.*``, the same values): every default
+# of these settings in the library (responses, identification, validation, impedance) refers to these.
+#: The fit window starts this long before the perturbation onset (s; ``identification.window_before_s``) ...
+WINDOW_BEFORE_S: float = 0.025
+#: ... and ends this long after it (s; ``identification.window_after_s``).
+WINDOW_AFTER_S: float = 0.25
+#: Pre-onset span of the initial-state polynomial (s; ``identification.initial_state_span_s``).
+INITIAL_STATE_SPAN_S: float = 0.1
+#: Degree of that polynomial (1: position and rate; ``identification.initial_state_degree``).
+INITIAL_STATE_DEGREE: int = 1
+#: RK4 steps per sample of the data (``identification.n_substeps``).
+N_SUBSTEPS: int = 2
 
 
 @dataclass(frozen=True)
@@ -80,8 +98,8 @@ class PreparedWindow:
     n_substeps: int
     initial_state_cov: np.ndarray = field(default_factory=lambda: np.zeros((8, 8)))
     onset_s: float = 0.0
-    initial_state_span_s: float = 0.1
-    initial_state_degree: int = 1
+    initial_state_span_s: float = INITIAL_STATE_SPAN_S
+    initial_state_degree: int = INITIAL_STATE_DEGREE
     noise_cov: np.ndarray | None = None
     residual_weight: np.ndarray | None = None
 
@@ -114,13 +132,13 @@ def prepare_window(
     force_time_s=None,
     pelvis_angle_unperturbed_rad=None,
     pelvis_angle_perturbed_rad=None,
-    window_before_s: float = 0.025,
-    window_after_s: float = 0.25,
-    n_substeps: int = 2,
+    window_before_s: float = WINDOW_BEFORE_S,
+    window_after_s: float = WINDOW_AFTER_S,
+    n_substeps: int = N_SUBSTEPS,
     reference_cutoff_hz: float | None = None,
     q_reference=None,
-    initial_state_span_s: float = 0.1,
-    initial_state_degree: int = 1,
+    initial_state_span_s: float = INITIAL_STATE_SPAN_S,
+    initial_state_degree: int = INITIAL_STATE_DEGREE,
 ) -> PreparedWindow:
     """Check the inputs of one fit and precompute reference, inputs and initial state.
 

@@ -20,6 +20,7 @@ import pandas as pd
 
 from ..checks import bool_column, number, require_columns, signal, time_vector, where
 from ..errors import LoperInputError
+from ..identification.window import WINDOW_AFTER_S, WINDOW_BEFORE_S
 from .sampling import TIME_TOLERANCE_S, SplineSampler, window_span
 
 __all__ = ["MATCH_COLUMNS", "STRIDE_TABLE_COLUMNS", "stride_table", "too_short", "match_unperturbed"]
@@ -64,7 +65,10 @@ def _perturbed_onsets(table: pd.DataFrame, source: str) -> tuple[np.ndarray, np.
 
 
 def too_short(
-    strides: pd.DataFrame, onset_after_toe_off_s: float | None = None, window_after_s: float = 0.25, source: str = ""
+    strides: pd.DataFrame,
+    onset_after_toe_off_s: float | None = None,
+    window_after_s: float = WINDOW_AFTER_S,
+    source: str = "",
 ) -> np.ndarray:
     """Perturbed strides whose swing is too short to hold the window after the onset.
 
@@ -119,7 +123,7 @@ def match_unperturbed(
     time_s,
     signals,
     strides: pd.DataFrame,
-    before_s: float = 0.025,
+    before_s: float = WINDOW_BEFORE_S,
     source: str = "",
     *,
     span_s: tuple[float, float] | None = None,

@@ -16,7 +16,8 @@ import pandas as pd
 from ..checks import number, signal, time_vector, where
 from ..constants import JOINTS, SIDES
 from ..errors import LoperInputError
-from ..outliers import iqr_outliers
+from ..identification.window import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
+from ..outliers import MIN_VALID_STRIDES, iqr_outliers
 from ..resampling import window, window_times_s
 from .sampling import TIME_TOLERANCE_S, SplineSampler, window_span
 
@@ -39,12 +40,12 @@ class ResponseSettings:
     """
 
     rate_hz: float = 128.0
-    window_before_s: float = 0.025
-    window_after_s: float = 0.25
-    initial_state_span_s: float = 0.1
+    window_before_s: float = WINDOW_BEFORE_S
+    window_after_s: float = WINDOW_AFTER_S
+    initial_state_span_s: float = INITIAL_STATE_SPAN_S
     whisker: float = 1.5
     max_fraction: float = 0.2
-    min_strides: int = 5
+    min_strides: int = MIN_VALID_STRIDES
 
 
 def analysis_grid(trials, onset_ms, settings: ResponseSettings, side: str, source: str = ""):
@@ -177,8 +178,8 @@ def paired_windows(
 def window_outliers(
     differences,
     rel_time_s,
-    before_s: float = 0.025,
-    after_s: float = 0.25,
+    before_s: float = WINDOW_BEFORE_S,
+    after_s: float = WINDOW_AFTER_S,
     whisker: float = 1.5,
     max_fraction: float = 0.2,
     names: Sequence[str] = JOINTS,
