@@ -16,12 +16,13 @@ import pandas as pd
 import pytest
 
 from loper_analysis.cli import main
+from loper_analysis.dynamics import read_segments
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
 from loper_analysis.kinematics import marker_positions
 from loper_analysis.segments_from_model import segments_from_model
-from loper_analysis.steps.model import read_segments, scale_with_setup
+from loper_analysis.steps.model import scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,8 +15,9 @@ from loper_analysis.contacts import (
     plate_contacts,
 )
 from loper_analysis.errors import LoperInputError
-from loper_analysis.events import EVENT_COLUMNS, flagged_contacts, gait_events, strides
+from loper_analysis.events import EVENT_COLUMNS, flagged_contacts, gait_events
 from loper_analysis.plate_geometry import plate_offsets
+from loper_analysis.strides import strides_from_events
 
 FS = 2000.0  # analog rate, Hz
 MARKER_HZ = 200.0
@@ -261,7 +262,7 @@ def test_strides_leave_out_those_whose_swing_spans_a_flagged_contact(judged):
     def hs(t0):  # analytic heel strike (on-threshold crossing) of the step starting at t0
         return _crossings(t0, t0 + STANCE_S, PEAK_N)[0]
 
-    left, right = strides(ev, "left"), strides(ev, "right")
+    left, right = strides_from_events(ev, "left"), strides_from_events(ev, "right")
     # left steps start at 0.3 + 1.1 k; kept: 0.3, 2.5, 3.6, 6.9, 9.1 s. Left out: 1.4 s (the hand load in its
     # swing), 4.7 -> 6.9 s (the crossover step 5.8 s hides in the merged contact), 8.0 s (the contact with the
     # missing heel may hide the left foot)
@@ -273,16 +274,18 @@ def test_strides_leave_out_those_whose_swing_spans_a_flagged_contact(judged):
     np.testing.assert_allclose(right["end_s"], [hs(t) for t in (1.95, 3.05, 4.15)], atol=0.005)
     # without the flagged spans the toe-off rule alone would keep the strides that hide a step
     for side, start, end in (("left", 4.7, 6.9), ("right", 4.15, 7.45), ("right", 7.45, 9.65)):
-        plain = strides(gait_only, side)
+        plain = strides_from_events(gait_only, side)
         hit = plain[(plain["heel_strike_s"] - hs(start)).abs() < 0.005]
         assert len(hit) == 1 and abs(hit["end_s"].iloc[0] - hs(end)) < 0.005
     # gait_events tables (no flagged rows) are not affected: same strides as before
     t = np.arange(int(4.0 * FS)) / FS
     f = sum(_hump(t, a, a + STANCE_S, PEAK_N) for a in (0.3, 1.4, 2.5))
     ev_belt = gait_events(t, f, "left")
-    assert len(strides(ev_belt, "left")) == 2
+    assert len(strides_from_events(ev_belt, "left")) == 2
     with pytest.raises(LoperInputError, match="do not pair up"):
-        strides(ev.drop(index=ev.index[(ev["event"] == "flagged_end") & (ev["side"] == "left")][:1]), "left")
+        strides_from_events(
+            ev.drop(index=ev.index[(ev["event"] == "flagged_end") & (ev["side"] == "left")][:1]), "left"
+        )
 
 
 def test_belt_map_is_only_a_check(trial, judged):

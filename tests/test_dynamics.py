@@ -30,13 +30,14 @@ from loper_analysis.dynamics import (
     inverse_dynamics,
     joint_angles,
     mass_matrix,
+    read_segments,
     segment_com_positions,
     segment_coordinates,
     simulate,
+    write_segments,
 )
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import prepare_window, simulate_response
-from loper_analysis.steps.model import read_segments, write_segments
 from loper_analysis.validation import ValidationSettings, nominal_swing, perturbed_trial
 from tests.parameter_sets import ASYMMETRIC, WINTER
 

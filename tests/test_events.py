@@ -7,7 +7,8 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.events import EVENT_COLUMNS, STRIDE_COLUMNS, gait_events, strides
+from loper_analysis.events import EVENT_COLUMNS, gait_events
+from loper_analysis.strides import STRIDE_COLUMNS, strides_from_events
 
 FS = 1000.0
 PEAK_N = 700.0
@@ -109,7 +110,7 @@ def test_strides_table_durations():
     t, f, starts = _grf()
     rise, fall = _crossings()
     ev = pd.concat([gait_events(t, f, "left"), gait_events(t, 0.5 * f, "right")], ignore_index=True)
-    st = strides(ev, "left")
+    st = strides_from_events(ev, "left")
     assert list(st.columns) == list(STRIDE_COLUMNS)
     assert len(st) == N_HUMPS - 1
     np.testing.assert_array_equal(st["stride"], np.arange(N_HUMPS - 1))
@@ -142,7 +143,7 @@ def test_strides_without_exactly_one_toe_off_are_dropped():
             "time_s": [0.1, 1.0, 1.6, 2.0, 3.0, 3.5, 3.7, 4.0, 4.6, 5.2, 5.8],
         }
     )
-    st = strides(events, "right")
+    st = strides_from_events(events, "right")
     # 1.0-2.0 kept; 2.0-3.0 has no toe-off; 3.0-4.0 has two; 4.0-5.2 kept; after 5.2 incomplete
     np.testing.assert_allclose(st["heel_strike_s"], [1.0, 4.0])
     np.testing.assert_allclose(st["toe_off_s"], [1.6, 4.6])
@@ -150,7 +151,7 @@ def test_strides_without_exactly_one_toe_off_are_dropped():
     np.testing.assert_allclose(st["stance_s"], [0.6, 0.6], atol=1e-12)
     np.testing.assert_allclose(st["swing_s"], [0.4, 0.6], atol=1e-12)
     np.testing.assert_array_equal(st["stride"], [0, 1])
-    assert len(strides(events, "left")) == 0
+    assert len(strides_from_events(events, "left")) == 0
 
 
 def test_bad_inputs_name_the_source():

@@ -23,7 +23,7 @@ from loper_analysis.cli import main
 from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.coordinate_trials import perturbation_experiment
 from loper_analysis.device.analysis import step_metrics
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.dynamics import segment_parameters_from_anthropometry, write_segments
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
     identify_impedance,
@@ -49,7 +49,6 @@ from loper_analysis.planning import (
 )
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.responses import ResponseSettings, null_pair_windows
-from loper_analysis.steps.model import write_segments
 from loper_analysis.synthetic.response import thigh_normal
 
 HEIGHT_M, MASS_KG = 1.73, 64.9

@@ -19,12 +19,12 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.dynamics import read_segments
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
 from loper_analysis.segments_from_model import segments_from_model
-from loper_analysis.steps.model import read_segments
 from loper_analysis.steps.synthetic import lab_export_session
 from tests.workflow_copy import copy_workflow, snakemake
 

@@ -16,15 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from loper_analysis.dynamics import read_segments, write_segments
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
 from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.segments_from_model import segments_from_model
-from loper_analysis.steps.model import (
-    read_segments,
-    segments_from_model_file,
-    write_segments,
-)
+from loper_analysis.steps.model import segments_from_model_file
 from tests.gait2392_models import scaled_gait2392
 
 DATA = Path(__file__).parents[1] / "examples" / "gait2392"

@@ -459,7 +459,7 @@ def contact_events(contacts: pd.DataFrame) -> pd.DataFrame:
     no gait event but a ``flagged_start`` / ``flagged_end`` pair at the
     contact's start and end, for its side - for both sides when the foot is
     unknown or the flag is ``heel_missing``, ``two_feet`` or ``no_foot`` -
-    so that :func:`loper_analysis.events.strides` leaves out strides that
+    so that :func:`loper_analysis.strides.strides_from_events` leaves out strides that
     span it.
 
     Parameters

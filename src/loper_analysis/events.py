@@ -1,11 +1,9 @@
-"""Gait events and strides from the treadmill's vertical ground reaction force.
+"""Gait events from the treadmill's vertical ground reaction force (their strides: :mod:`loper_analysis.strides`).
 
 * :func:`gait_events` - heel strikes and toe-offs from one belt's vertical
   force, with hysteresis and minimum phase durations;
 * :func:`load_transitions` - the hysteresis itself (loading and unloading
   samples of any vertical force), shared with :mod:`loper_analysis.contacts`;
-* :func:`strides` - the stride table of one side (heel strike -> heel strike,
-  with its toe-off), leaving out strides that span a flagged contact;
 * :func:`flagged_contacts` - how many flagged contacts an event table holds;
 * :func:`stance_heels` - for each stance of a belt, whether the heel of that
   side's foot was the lower one: the check that the belts' channels carry the
@@ -29,11 +27,9 @@ from .errors import LoperInputError
 
 __all__ = [
     "EVENT_COLUMNS",
-    "STRIDE_COLUMNS",
     "STANCE_HEEL_COLUMNS",
     "load_transitions",
     "gait_events",
-    "strides",
     "flagged_contacts",
     "stance_heels",
 ]
@@ -42,17 +38,6 @@ logger = logging.getLogger(__name__)
 
 #: Columns of the event table.
 EVENT_COLUMNS: tuple[str, ...] = ("side", "event", "time_s", "sample")
-#: Columns of the stride table.
-STRIDE_COLUMNS: tuple[str, ...] = (
-    "stride",
-    "side",
-    "heel_strike_s",
-    "toe_off_s",
-    "end_s",
-    "duration_s",
-    "stance_s",
-    "swing_s",
-)
 #: Columns of :func:`stance_heels`.
 STANCE_HEEL_COLUMNS: tuple[str, ...] = ("side", "heel_strike_s", "toe_off_s", "own_heel_lower_m", "own_heel_lower")
 _HS, _TO = 1, 0  # state codes: 1 = loaded (stance), 0 = unloaded (swing)
@@ -277,105 +262,6 @@ def gait_events(
         }
     )
     return events
-
-
-def strides(events: pd.DataFrame, side: str) -> pd.DataFrame:
-    """Stride table of one side from an event table.
-
-    A stride runs from a heel strike to the next heel strike of the same side
-    and must contain exactly one toe-off (strictly between the two); strides
-    without one (or with several) are dropped, as are the incomplete strides
-    before the first and after the last heel strike.
-
-    Event tables of force-plate contacts (:func:`loper_analysis.contacts.contact_events`)
-    also hold ``flagged_start`` / ``flagged_end`` rows: the span of a contact
-    that gave no event. A stride whose swing (toe-off -> next heel strike)
-    overlaps such a span of its side (``flagged_start < end`` and
-    ``flagged_end > toe_off``) is dropped: a contact of that foot may hide in
-    it, so the "stride" may be two. A flagged span during the stride's stance
-    cannot hide a contact of the same foot (it stands on the contact that gave
-    the heel strike) and leaves the stride in. Tables without these rows give
-    the same strides as before.
-
-    Parameters
-    ----------
-    events : pandas.DataFrame
-        Columns ``side``, ``event``, ``time_s`` as returned by :func:`gait_events`
-        (tables of both sides may be concatenated) or
-        :func:`loper_analysis.contacts.contact_events`.
-    side : {"left", "right"}
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per complete stride, in time order: ``stride`` (0, 1, ... over
-        the kept strides), ``side``, ``heel_strike_s`` (start), ``toe_off_s``,
-        ``end_s`` (next heel strike), ``duration_s`` = end - start,
-        ``stance_s`` = toe-off - start, ``swing_s`` = end - toe-off; all in s.
-        Empty (with these columns) when the side has fewer than two heel strikes.
-
-    Raises
-    ------
-    LoperInputError
-        Missing columns, an unknown side, non-finite event times, or
-        ``flagged_start`` / ``flagged_end`` rows that do not pair up.
-    """
-    source = str(events.attrs.get("source", "")) if isinstance(events, pd.DataFrame) else ""
-    if not isinstance(events, pd.DataFrame) or not {"side", "event", "time_s"} <= set(events.columns):
-        raise LoperInputError(f"{where(source)}events must be a table with columns side, event, time_s")
-    side = check_side(side, source)
-    mine = events[events["side"] == side]
-    t = mine["time_s"].to_numpy(dtype=float)
-    if not np.isfinite(t).all():
-        raise LoperInputError(f"{where(source)}events: time_s is not finite for the {side} side")
-    hs = np.sort(t[mine["event"].to_numpy() == "heel_strike"])
-    to = np.sort(t[mine["event"].to_numpy() == "toe_off"])
-    start, end = hs[:-1], hs[1:]
-    first = np.searchsorted(to, start, side="right")  # first toe-off after the start
-    count = np.searchsorted(to, end, side="left") - first  # toe-offs strictly inside
-    keep = count == 1
-    flag_start, flag_end = _flagged_spans(mine, t, side, source)
-    if flag_start.size and keep.any():
-        swing_start = to[np.minimum(first, to.size - 1)]  # the stride's toe-off where keep (keep needs one)
-        # a flagged span overlaps the swing [toe-off, end] when it begins before the end and ends after the toe-off
-        overlaps = (flag_start[None, :] < end[:, None]) & (flag_end[None, :] > swing_start[:, None])
-        spanning = keep & overlaps.any(axis=1)
-        if spanning.any():
-            logger.info(
-                "%s%s side: %d stride(s) whose swing overlaps a flagged contact are left out",
-                where(source),
-                side,
-                int(spanning.sum()),
-            )
-        keep &= ~spanning
-    start, end = start[keep], end[keep]
-    toe_off = to[first[keep]] if to.size else np.empty(0)
-    return pd.DataFrame(
-        {
-            "stride": np.arange(start.size, dtype=np.int64),
-            "side": side,
-            "heel_strike_s": start,
-            "toe_off_s": toe_off,
-            "end_s": end,
-            "duration_s": end - start,
-            "stance_s": toe_off - start,
-            "swing_s": end - toe_off,
-        },
-        columns=list(STRIDE_COLUMNS),
-    )
-
-
-def _flagged_spans(mine: pd.DataFrame, t: np.ndarray, side: str, source: str) -> tuple[np.ndarray, np.ndarray]:
-    """Start and end times (s) of the flagged contacts in one side's event rows, paired in time order."""
-    kind = mine["event"].to_numpy()
-    a = np.sort(t[kind == FLAGGED_EVENTS[0]])
-    b = np.sort(t[kind == FLAGGED_EVENTS[1]])
-    if a.size != b.size or np.any(b < a):
-        raise LoperInputError(
-            f"{where(source)}events: {a.size} {FLAGGED_EVENTS[0]} and {b.size} {FLAGGED_EVENTS[1]} row(s) "
-            f"of the {side} side do not pair up (each flagged contact needs a start and a later end)"
-        )
-    return a, b
 
 
 def flagged_contacts(events: pd.DataFrame, side: str | None = None) -> int:

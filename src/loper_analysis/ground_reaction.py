@@ -47,10 +47,15 @@ Rotation to the model frame (:func:`external_loads_table`)
     Force, COP and torque are rotated with
     :func:`loper_analysis.markers.rotate_markers` (``(-90, 0, 0)`` takes a
     Z-up lab into OpenSim's Y-up frame).
+
+From a C3D file (:func:`read_plate_loads`, :func:`plate_vertical_loads`)
+    Every plate of a file read (:func:`loper_analysis.io.force_platforms.read_force_platforms`)
+    and analysed as above; shared by the ``grf`` and ``events`` steps.
 """
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -71,6 +76,8 @@ __all__ = [
     "external_loads_columns",
     "external_loads_table",
     "plate_loads",
+    "plate_vertical_loads",
+    "read_plate_loads",
     "resting_level",
     "surface_normal",
     "up_vector",
@@ -527,3 +534,53 @@ def vertical_loads(loads: Sequence[PlateLoads], rotation_deg: Sequence[float] = 
         corners_m=np.stack([rotate_markers(p.corners_m, rotation_deg) for p in loads]),
         numbers=tuple(p.number for p in loads),
     )
+
+
+def read_plate_loads(
+    c3d_path: str | os.PathLike,
+    threshold_n: float,
+    band_n: float,
+    max_rest_n: float,
+    up: Sequence[float] | None = None,
+) -> list[PlateLoads]:
+    """Every plate of a C3D file read and analysed (:func:`plate_loads`), lab frame.
+
+    ``up``: the lab's up direction, lab frame (None: lab +Z); a plate more than
+    :data:`MAX_TILT_DEG` from level is refused, naming the file, the plate, its
+    normal and ``up``.
+    """
+    from .io.force_platforms import read_force_platforms
+
+    lab_up = up_vector(LAB_Z_UP if up is None else up, str(c3d_path))
+    plates = read_force_platforms(c3d_path, lab_up)
+    return [
+        plate_loads(
+            p.number,
+            p.time_s,
+            p.force_n,
+            p.moment_nm,
+            p.corners_m,
+            threshold_n,
+            band_n,
+            max_rest_n,
+            source=f"{c3d_path} (force platform {p.number})",
+            up=lab_up,
+        )
+        for p in plates
+    ]
+
+
+def plate_vertical_loads(
+    c3d_path: str | os.PathLike,
+    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    band_n: float = 10.0,
+    max_rest_n: float = 100.0,
+    up: Sequence[float] | None = None,
+) -> VerticalLoads:
+    """Each plate of a C3D file: its lab-vertical force above its resting level at the analog rate, corners in the
+    model frame (:func:`vertical_loads` of :func:`read_plate_loads`).
+
+    ``up``: the lab's up direction, lab frame (None: lab +Z), as in
+    :func:`read_plate_loads`. Reads only (writes nothing).
+    """
+    return vertical_loads(read_plate_loads(c3d_path, 20.0, band_n, max_rest_n, up), rotation_deg)

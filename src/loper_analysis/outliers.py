@@ -11,9 +11,12 @@ import pandas as pd
 from .checks import number, where
 from .errors import LoperInputError, TooFewStridesWarning
 
-__all__ = ["MIN_VALID_STRIDES", "iqr_outliers", "check_enough_strides"]
+__all__ = ["MIN_STRIDES_FOR_OUTLIERS", "MIN_VALID_STRIDES", "iqr_outliers", "check_enough_strides"]
 
-#: Fewest strides per subject and condition that an average is built from (warning below).
+#: Fewest strides the IQR rule judges (:func:`iqr_outliers` refuses fewer; callers keep them all unjudged).
+MIN_STRIDES_FOR_OUTLIERS: int = 4
+#: Fewest strides per subject and condition that an average is built from (warning below); the default of the
+#: config's ``strides.min_valid_strides`` wherever a function takes that setting.
 MIN_VALID_STRIDES: int = 5
 
 
@@ -39,7 +42,7 @@ def iqr_outliers(
     Parameters
     ----------
     values : array_like, shape (n_strides, n_samples) or (n_strides, n_samples, k)
-        Normalised strides (any unit), finite; at least 4 strides.
+        Normalised strides (any unit), finite; at least :data:`MIN_STRIDES_FOR_OUTLIERS` (4) strides.
     whisker : float
         IQR multiple (>= 0).
     max_fraction : float
@@ -61,13 +64,15 @@ def iqr_outliers(
     Raises
     ------
     LoperInputError
-        Fewer than 4 strides, bad shapes or names, non-finite values, bad settings.
+        Fewer than :data:`MIN_STRIDES_FOR_OUTLIERS` strides, bad shapes or names, non-finite values, bad settings.
     """
     v = np.asarray(values, dtype=float)
     if v.ndim not in (2, 3):
         raise LoperInputError(f"{where(source)}values must have shape (n_strides, n_samples[, k]), got {v.shape}")
-    if v.shape[0] < 4:
-        raise LoperInputError(f"{where(source)}the IQR rule needs >= 4 strides, got {v.shape[0]}")
+    if v.shape[0] < MIN_STRIDES_FOR_OUTLIERS:
+        raise LoperInputError(
+            f"{where(source)}the IQR rule needs >= {MIN_STRIDES_FOR_OUTLIERS} strides, got {v.shape[0]}"
+        )
     if v.shape[1] < 1 or (v.ndim == 3 and v.shape[2] < 1):
         raise LoperInputError(f"{where(source)}values has no samples: shape {v.shape}")
     bad = np.argwhere(~np.isfinite(v))

@@ -48,7 +48,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.special import stdtrit  # Student's t quantile, as scipy.stats.t.ppf computes it
 
 from .checks import integer, number
 from .constants import JOINTS, PARAMETER_UNITS, PARAMETERS
@@ -61,6 +60,7 @@ from .identification import (
     parameter_bounds,
     prepare_window,
     response_jacobian,
+    t_quantile,
 )
 from .planning_inputs import pilot_perturbed_pairs, pulse_force_n
 
@@ -190,9 +190,10 @@ class StrideCovariance:
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def t95(self, n_strides: int) -> float:
-        """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof)."""
+        """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof;
+        :func:`~loper_analysis.identification.t_quantile`, the fit's own)."""
         dof = int(n_strides) - 1 if self.dof is None else int(self.dof)
-        return float(stdtrit(dof, 0.975)) if dof >= 1 else math.inf
+        return t_quantile(dof) if dof >= 1 else math.inf
 
     def half_width(self, n_strides: int) -> np.ndarray:
         """Predicted 95 % CI half-width (6,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
@@ -557,7 +558,7 @@ def strides_needed(
         return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
 
     # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96
-    n = max(1, int(math.ceil((stdtrit(10**6, 0.975) * sd1 / target) ** 2 * (1 - 1e-12))))
+    n = max(1, int(math.ceil((t_quantile(10**6) * sd1 / target) ** 2 * (1 - 1e-12))))
     while not meets(n):
         t = stride_cov.t95(n)
         n = n + 1 if not math.isfinite(t) else max(n + 1, int(math.ceil((t * sd1 / target) ** 2 * (1 - 1e-12))))

@@ -124,7 +124,7 @@ def normalise(
 
     ``phase`` picks the window: ``"stride"`` heel strike -> next heel strike,
     ``"stance"`` heel strike -> toe-off, ``"swing"`` toe-off -> next heel
-    strike (columns of :func:`strides`). Returns (n_strides, n_points[, k]).
+    strike (columns of :func:`loper_analysis.strides.strides_from_events`). Returns (n_strides, n_points[, k]).
     """
     if phase not in PHASE_BOUNDS:
         raise LoperInputError(f"{where(source)}phase must be one of {PHASES}, got {phase!r}")

@@ -1,5 +1,8 @@
 """Strides of one leg from the joint angles, the gait events and the interaction force; outliers; cycles.
 
+* :func:`strides_from_events` - the stride table of one side from an event
+  table (heel strike -> heel strike, with its toe-off), leaving out strides
+  that span a flagged contact;
 * :func:`stride_tables` - the stride table (absolute times, perturbed flag,
   outlier verdicts, interaction force per phase) and the time-normalised
   cycles (stride, stance, swing) of one trial;
@@ -20,18 +23,19 @@ import numpy as np
 import pandas as pd
 
 from .checks import bool_column, require_columns, where
-from .constants import JOINTS, PHASES, angle_column
+from .checks import side as check_side
+from .constants import FLAGGED_EVENTS, JOINTS, PHASES, angle_column
 from .errors import LoperInputError, TooFewStridesWarning
-from .events import strides as strides_from_events
 from .loadcell import perturbation_onsets
-from .outliers import check_enough_strides, iqr_outliers
+from .outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, check_enough_strides, iqr_outliers
 from .resampling import PHASE_BOUNDS, normalise
 
 __all__ = [
-    "MIN_STRIDES_FOR_OUTLIERS",
+    "STRIDE_COLUMNS",
     "FORCE_PHASES",
     "SUMMARY_COLUMNS",
     "StrideTables",
+    "strides_from_events",
     "force_phase_metrics",
     "stride_tables",
     "stride_summary",
@@ -40,12 +44,120 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
-#: Fewest (unperturbed) strides the IQR rule needs.
-MIN_STRIDES_FOR_OUTLIERS = 4
+#: Columns of the stride table from the events (:func:`strides_from_events`).
+STRIDE_COLUMNS: tuple[str, ...] = (
+    "stride",
+    "side",
+    "heel_strike_s",
+    "toe_off_s",
+    "end_s",
+    "duration_s",
+    "stance_s",
+    "swing_s",
+)
 #: Phases of the interaction-force metrics (half-open sample sets).
 FORCE_PHASES: tuple[str, ...] = ("stance", "swing")
 #: Columns of a stride table that :func:`stride_summary` reads.
 SUMMARY_COLUMNS: tuple[str, ...] = ("removed", "reason", "duration_s")
+
+
+def strides_from_events(events: pd.DataFrame, side: str) -> pd.DataFrame:
+    """Stride table of one side from an event table.
+
+    A stride runs from a heel strike to the next heel strike of the same side
+    and must contain exactly one toe-off (strictly between the two); strides
+    without one (or with several) are dropped, as are the incomplete strides
+    before the first and after the last heel strike.
+
+    Event tables of force-plate contacts (:func:`loper_analysis.contacts.contact_events`)
+    also hold ``flagged_start`` / ``flagged_end`` rows: the span of a contact
+    that gave no event. A stride whose swing (toe-off -> next heel strike)
+    overlaps such a span of its side (``flagged_start < end`` and
+    ``flagged_end > toe_off``) is dropped: a contact of that foot may hide in
+    it, so the "stride" may be two. A flagged span during the stride's stance
+    cannot hide a contact of the same foot (it stands on the contact that gave
+    the heel strike) and leaves the stride in. Tables without these rows give
+    the same strides as before.
+
+    Parameters
+    ----------
+    events : pandas.DataFrame
+        Columns ``side``, ``event``, ``time_s`` as returned by :func:`loper_analysis.events.gait_events`
+        (tables of both sides may be concatenated) or
+        :func:`loper_analysis.contacts.contact_events`.
+    side : {"left", "right"}
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per complete stride, in time order: ``stride`` (0, 1, ... over
+        the kept strides), ``side``, ``heel_strike_s`` (start), ``toe_off_s``,
+        ``end_s`` (next heel strike), ``duration_s`` = end - start,
+        ``stance_s`` = toe-off - start, ``swing_s`` = end - toe-off; all in s.
+        Empty (with these columns) when the side has fewer than two heel strikes.
+
+    Raises
+    ------
+    LoperInputError
+        Missing columns, an unknown side, non-finite event times, or
+        ``flagged_start`` / ``flagged_end`` rows that do not pair up.
+    """
+    source = str(events.attrs.get("source", "")) if isinstance(events, pd.DataFrame) else ""
+    if not isinstance(events, pd.DataFrame) or not {"side", "event", "time_s"} <= set(events.columns):
+        raise LoperInputError(f"{where(source)}events must be a table with columns side, event, time_s")
+    side = check_side(side, source)
+    mine = events[events["side"] == side]
+    t = mine["time_s"].to_numpy(dtype=float)
+    if not np.isfinite(t).all():
+        raise LoperInputError(f"{where(source)}events: time_s is not finite for the {side} side")
+    hs = np.sort(t[mine["event"].to_numpy() == "heel_strike"])
+    to = np.sort(t[mine["event"].to_numpy() == "toe_off"])
+    start, end = hs[:-1], hs[1:]
+    first = np.searchsorted(to, start, side="right")  # first toe-off after the start
+    count = np.searchsorted(to, end, side="left") - first  # toe-offs strictly inside
+    keep = count == 1
+    flag_start, flag_end = _flagged_spans(mine, t, side, source)
+    if flag_start.size and keep.any():
+        swing_start = to[np.minimum(first, to.size - 1)]  # the stride's toe-off where keep (keep needs one)
+        # a flagged span overlaps the swing [toe-off, end] when it begins before the end and ends after the toe-off
+        overlaps = (flag_start[None, :] < end[:, None]) & (flag_end[None, :] > swing_start[:, None])
+        spanning = keep & overlaps.any(axis=1)
+        if spanning.any():
+            log.info(
+                "%s%s side: %d stride(s) whose swing overlaps a flagged contact are left out",
+                where(source),
+                side,
+                int(spanning.sum()),
+            )
+        keep &= ~spanning
+    start, end = start[keep], end[keep]
+    toe_off = to[first[keep]] if to.size else np.empty(0)
+    return pd.DataFrame(
+        {
+            "stride": np.arange(start.size, dtype=np.int64),
+            "side": side,
+            "heel_strike_s": start,
+            "toe_off_s": toe_off,
+            "end_s": end,
+            "duration_s": end - start,
+            "stance_s": toe_off - start,
+            "swing_s": end - toe_off,
+        },
+        columns=list(STRIDE_COLUMNS),
+    )
+
+
+def _flagged_spans(mine: pd.DataFrame, t: np.ndarray, side: str, source: str) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end times (s) of the flagged contacts in one side's event rows, paired in time order."""
+    kind = mine["event"].to_numpy()
+    a = np.sort(t[kind == FLAGGED_EVENTS[0]])
+    b = np.sort(t[kind == FLAGGED_EVENTS[1]])
+    if a.size != b.size or np.any(b < a):
+        raise LoperInputError(
+            f"{where(source)}events: {a.size} {FLAGGED_EVENTS[0]} and {b.size} {FLAGGED_EVENTS[1]} row(s) "
+            f"of the {side} side do not pair up (each flagged contact needs a start and a later end)"
+        )
+    return a, b
 
 
 @dataclass
@@ -78,7 +190,7 @@ def force_phase_metrics(time_s, force_n, stride_table: pd.DataFrame, source: str
         Interaction force in N, finite.
     stride_table : pandas.DataFrame
         Columns ``stride``, ``heel_strike_s``, ``toe_off_s``, ``end_s``
-        (:func:`loper_analysis.events.strides`); every phase must lie inside
+        (:func:`strides_from_events`); every phase must lie inside
         ``time_s[0] .. time_s[-1]`` and hold at least one sample.
     source : str
         Name of the trial, quoted in error messages.
@@ -155,7 +267,7 @@ def stride_tables(
     n_points: int = 101,
     whisker: float = 1.5,
     max_fraction: float = 0.2,
-    min_valid: int = 5,
+    min_valid: int = MIN_VALID_STRIDES,
     sources: Mapping[str, str] | None = None,
 ) -> StrideTables:
     """Strides of one leg, their outlier verdicts and the time-normalised cycles.
@@ -199,7 +311,7 @@ def stride_tables(
         and ``force_n``). Fewer than ``min_valid`` kept strides: a
         :class:`~loper_analysis.errors.TooFewStridesWarning` and
         ``too_few_strides`` True. Fewer than
-        :data:`MIN_STRIDES_FOR_OUTLIERS` unperturbed strides (none at all
+        :data:`~loper_analysis.outliers.MIN_STRIDES_FOR_OUTLIERS` unperturbed strides (none at all
         included): the outlier rule cannot judge them, so none is removed,
         their ``fraction_outlying_*`` are NaN and a warning says so.
 
@@ -328,7 +440,7 @@ def _mean_duration_s(table: pd.DataFrame, source: str) -> float:
 
 def stride_summary(
     tables: Mapping[tuple[str, str], pd.DataFrame],
-    min_valid: int = 5,
+    min_valid: int = MIN_VALID_STRIDES,
     contacts: Mapping[tuple[str, str], pd.DataFrame] | None = None,
 ) -> pd.DataFrame:
     """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.

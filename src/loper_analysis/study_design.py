@@ -19,12 +19,15 @@ from dataclasses import dataclass
 
 from .errors import LoperInputError
 
-__all__ = ["DEVICE_TESTS", "TRIAL_CONDITIONS", "StudyDesign", "perturbation_trial_name"]
+__all__ = ["DEVICE_TESTS", "TRANSPARENCY_CONDITIONS", "TRIAL_CONDITIONS", "StudyDesign", "perturbation_trial_name"]
 
 #: Trials of the device tests (frequency response and steps), recorded by the device subject.
 DEVICE_TESTS: tuple[str, ...] = ("device-frf", "device-steps")
+#: Conditions of the transparency pair, compared by :mod:`loper_analysis.transparency`: walking without the robot,
+#: and with it in minimal-impedance mode.
+TRANSPARENCY_CONDITIONS: tuple[str, ...] = ("no_device", "device")
 #: A trial's condition (:meth:`StudyDesign.condition`).
-TRIAL_CONDITIONS: tuple[str, ...] = ("static", "no_device", "device", "perturbation", "device_test")
+TRIAL_CONDITIONS: tuple[str, ...] = ("static", *TRANSPARENCY_CONDITIONS, "perturbation", "device_test")
 _PERTURBATION_NAME = re.compile(r"^pert(\d{3})-([1-9]\d*)$")
 
 

@@ -30,9 +30,9 @@ from .errors import LoperInputError, TooFewStridesWarning
 from .outliers import MIN_VALID_STRIDES
 from .reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
 from .strides import phase_cycles
+from .study_design import TRANSPARENCY_CONDITIONS
 
 __all__ = [
-    "CONDITIONS",
     "TRANSPARENCY_PHASES",
     "strides_array",
     "TRANSPARENCY_COLUMNS",
@@ -46,8 +46,6 @@ __all__ = [
     "transparency_results",
 ]
 
-#: Walking conditions of the transparency experiment.
-CONDITIONS: tuple[str, ...] = ("no_device", "device")
 #: Phases compared (normalised separately: stance HS -> TO, swing TO -> next HS).
 TRANSPARENCY_PHASES: tuple[str, ...] = ("stance", "swing")
 #: Columns of :func:`transparency_table`.
@@ -158,7 +156,7 @@ def _subject_arrays(per_subject: Mapping, phases: Sequence[str], k: int):
     for subject, conditions in per_subject.items():
         if str(subject) == "all":
             raise LoperInputError("subject ID 'all' is reserved for the summary rows")
-        for condition in CONDITIONS:
+        for condition in TRANSPARENCY_CONDITIONS:
             if condition not in conditions:
                 raise LoperInputError(f"subject {subject}: condition {condition!r} missing")
             for phase in phases:
@@ -166,7 +164,7 @@ def _subject_arrays(per_subject: Mapping, phases: Sequence[str], k: int):
                     raise LoperInputError(f"subject {subject}: {condition} lacks phase {phase!r}")
         for phase in phases:
             arrays = {}
-            for condition in CONDITIONS:
+            for condition in TRANSPARENCY_CONDITIONS:
                 name = f"subject {subject}, {condition}, {phase}"
                 x = strides_array(name, conditions[condition][phase])
                 if x.ndim != 3 or x.shape[2] != k:
@@ -239,8 +237,8 @@ def transparency_table(
         strides, non-finite angles, the reserved subject ID ``"all"``, an
         unknown ``isv_condition``.
     """
-    if isv_condition not in CONDITIONS:
-        raise LoperInputError(f"isv_condition must be one of {CONDITIONS}, got {isv_condition!r}")
+    if isv_condition not in TRANSPARENCY_CONDITIONS:
+        raise LoperInputError(f"isv_condition must be one of {TRANSPARENCY_CONDITIONS}, got {isv_condition!r}")
     if not per_subject:
         raise LoperInputError("per_subject holds no subject")
     joints = [str(j) for j in joints]
@@ -347,8 +345,11 @@ def transparency_results(
     """
     cols = [angle_column(j, side) for j in JOINTS]
     least = max(int(min_strides), 2)
-    counts = {subject: {c: _kept(conds[c][0]) for c in CONDITIONS if c in conds} for subject, conds in trials.items()}
-    left_out = {s: n for s, n in counts.items() if len(n) == len(CONDITIONS) and min(n.values()) < least}
+    counts = {
+        subject: {c: _kept(conds[c][0]) for c in TRANSPARENCY_CONDITIONS if c in conds}
+        for subject, conds in trials.items()
+    }
+    left_out = {s: n for s, n in counts.items() if len(n) == len(TRANSPARENCY_CONDITIONS) and min(n.values()) < least}
     for subject, n in left_out.items():
         warnings.warn(
             f"subject {subject}: {n['no_device']} kept stride(s) without and {n['device']} with the "

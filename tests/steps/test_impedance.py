@@ -4,17 +4,14 @@ from __future__ import annotations
 
 import pandas as pd
 
-from loper_analysis.io.atomic import write_yaml
+from loper_analysis.io.truth import write_truth
 from loper_analysis.steps.impedance import fit
-from loper_analysis.synthetic.subjects import TRUTH_HEADER, truth_document
 
 
 def test_onset_without_trials_writes_missing_rows(tmp_path):
     anthropometry = {"subject": "S01", "sex": "male", "age_yr": 26, "height_m": 1.8, "mass_kg": 72}
-    write_yaml(
-        tmp_path / "truth.yaml",
-        truth_document(anthropometry, {175: {j: {"K": 40.0, "D": 2.0} for j in ("hip", "knee", "ankle")}}),
-        TRUTH_HEADER,
+    write_truth(
+        tmp_path / "truth.yaml", anthropometry, {175: {j: {"K": 40.0, "D": 2.0} for j in ("hip", "knee", "ankle")}}
     )
     out = [tmp_path / n for n in ("r.tsv", "c.tsv", "f.tsv", "k.tsv")]
     rows = fit([], [], [], [], [], tmp_path / "segments.tsv", 175, "S01", *out, truth_yaml=tmp_path / "truth.yaml")

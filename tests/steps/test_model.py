@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.dynamics import read_segments, segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
 from loper_analysis.kinematics import marker_positions, markers_table
@@ -15,7 +15,6 @@ from loper_analysis.model import (
     segment_parameters_from_model,
 )
 from loper_analysis.steps.model import (
-    read_segments,
     scaled_model,
     segments_from_model_file,
 )

@@ -8,15 +8,9 @@ import pytest
 from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import write_yaml
-from loper_analysis.io.readers import read_yaml
+from loper_analysis.io.truth import TRUTH_HEADER, read_truth, truth_document, truth_from_document, write_truth
 from loper_analysis.steps.synthetic import truth as truth_step
-from loper_analysis.synthetic.subjects import (
-    TRUTH_HEADER,
-    subject_anthropometry,
-    true_impedance,
-    truth_document,
-    truth_from_document,
-)
+from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 K = {50: [55, 3, 8], 175: [38, 0.5, 8]}
 D = {50: [3.5, 0.1, 0.3], 175: [2.2, 0.04, 0.3]}
@@ -61,15 +55,19 @@ def test_truth_document_round_trip(anthropometry, truth):
 
 def test_truth_file_round_trip(tmp_path, anthropometry, truth):
     path = tmp_path / "truth.yaml"
-    write_yaml(path, truth_document(anthropometry, truth), TRUTH_HEADER)
-    assert truth_from_document(read_yaml(path), str(path)) == truth
+    write_truth(path, anthropometry, truth)
+    assert read_truth(path) == truth
+    # the header line, then the document: the bytes the step wrote before the writer moved to io.truth
+    write_yaml(tmp_path / "by_hand.yaml", truth_document(anthropometry, truth), TRUTH_HEADER)
+    assert path.read_bytes() == (tmp_path / "by_hand.yaml").read_bytes()
+    assert path.read_text().startswith(f"# {TRUTH_HEADER}\n")
 
 
 def test_truth_step_writes_the_true_impedance(tmp_path, anthropometry, truth):
     path = tmp_path / "S07" / "truth.yaml"
     returned = truth_step(path, anthropometry, K, D, 0.15, (0.0, 200.0), (0.0, 10.0), 2024)
     assert returned == truth
-    assert truth_from_document(read_yaml(path), str(path)) == truth
+    assert read_truth(path) == truth
 
 
 def test_true_impedance_outside_the_bounds_is_refused():

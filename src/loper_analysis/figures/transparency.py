@@ -9,7 +9,8 @@ import numpy as np
 
 from ..constants import JOINTS
 from ..errors import LoperInputError
-from ..transparency import CONDITIONS, strides_array
+from ..study_design import TRANSPARENCY_CONDITIONS
+from ..transparency import strides_array
 from . import closed_on_error, pyplot
 
 if TYPE_CHECKING:
@@ -52,9 +53,11 @@ def transparency_figure(
     -------
     matplotlib.figure.Figure
     """
-    conditions = [c for c in CONDITIONS if c in angles_rad]
-    if set(angles_rad) - set(CONDITIONS):
-        raise LoperInputError(f"angles_rad must map some of {CONDITIONS} to arrays, got {sorted(angles_rad)}")
+    conditions = [c for c in TRANSPARENCY_CONDITIONS if c in angles_rad]
+    if set(angles_rad) - set(TRANSPARENCY_CONDITIONS):
+        raise LoperInputError(
+            f"angles_rad must map some of {TRANSPARENCY_CONDITIONS} to arrays, got {sorted(angles_rad)}"
+        )
     if not conditions:
         fig = pyplot().figure(figsize=(5.5, 2.0))
         ax = fig.add_subplot()

@@ -7,5 +7,7 @@
 * :mod:`.opensim_tables` - TRC markers, .mot/.sto coordinates and external loads (OpenSim's adapters);
 * :mod:`.osim` - OpenSim models and the quiet import of OpenSim;
 * :mod:`.ik_tasks` - OpenSim IK task files;
-* :mod:`.robot_log`, :mod:`.robot_log_mat` - the LOPER robot log (``loper-log 1``) and MATLAB exports.
+* :mod:`.robot_log`, :mod:`.robot_log_mat` - the LOPER robot log (``loper-log 1``) and MATLAB exports;
+* :mod:`.segment_table` - the swing-leg model's segment table (TSV, 10 significant digits);
+* :mod:`.truth` - a synthetic subject's truth file (``truth.yaml``).
 """

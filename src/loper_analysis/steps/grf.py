@@ -25,34 +25,9 @@ import pandas as pd
 from ..errors import LoperInputError
 from ..io.atomic import PathLike
 
-__all__ = ["grf", "trial_grf", "plate_vertical_loads"]
+__all__ = ["grf", "trial_grf"]
 
 log = logging.getLogger(__name__)
-
-
-def _plate_loads(c3d_path: PathLike, threshold_n: float, band_n: float, max_rest_n: float, up: Sequence[float] | None):
-    """Every plate of the file read and analysed (:func:`loper_analysis.ground_reaction.plate_loads`), lab frame."""
-    from ..ground_reaction import plate_loads, up_vector
-    from ..io.force_platforms import read_force_platforms
-    from ..markers import LAB_Z_UP
-
-    lab_up = up_vector(LAB_Z_UP if up is None else up, str(c3d_path))
-    plates = read_force_platforms(c3d_path, lab_up)
-    return [
-        plate_loads(
-            p.number,
-            p.time_s,
-            p.force_n,
-            p.moment_nm,
-            p.corners_m,
-            threshold_n,
-            band_n,
-            max_rest_n,
-            source=f"{c3d_path} (force platform {p.number})",
-            up=lab_up,
-        )
-        for p in plates
-    ]
 
 
 def grf(
@@ -79,10 +54,10 @@ def grf(
     more than 45 deg from level is refused, naming the file, the plate, its normal and ``up``.
     Returns the table written (``time_s`` plus nine columns per plate).
     """
-    from ..ground_reaction import external_loads_table
+    from ..ground_reaction import external_loads_table, read_plate_loads
     from ..io.external_loads import write_external_loads_mot, write_external_loads_xml
 
-    loads = _plate_loads(c3d_path, threshold_n, band_n, max_rest_n, up)
+    loads = read_plate_loads(c3d_path, threshold_n, band_n, max_rest_n, up)
     table = external_loads_table(loads, rotation_deg)
     write_external_loads_mot(out_mot, table)
     if xml_out is not None and bodies:
@@ -124,21 +99,3 @@ def trial_grf(
     rotation = tuple(float(v) for v in summary[columns].iloc[0])
     log.info("%s: rotation %s deg (from %s)", c3d_path, list(rotation), markers_summary_tsv)
     return grf(c3d_path, out_mot, rotation, threshold_n, band_n, max_rest_n, up=lab_up(base_rotation_deg))
-
-
-def plate_vertical_loads(
-    c3d_path: PathLike,
-    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
-    band_n: float = 10.0,
-    max_rest_n: float = 100.0,
-    up: Sequence[float] | None = None,
-):
-    """Each plate's lab-vertical force above its resting level at the analog rate, corners in the model frame.
-
-    ``up``: the lab's up direction, lab frame (None: lab +Z), as in :func:`grf`.
-    Reads only (writes nothing); returns a
-    :class:`loper_analysis.ground_reaction.VerticalLoads`.
-    """
-    from ..ground_reaction import vertical_loads
-
-    return vertical_loads(_plate_loads(c3d_path, 20.0, band_n, max_rest_n, up), rotation_deg)

@@ -10,7 +10,8 @@ import pandas as pd
 
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_figure, write_tsv
-from ..io.readers import read_tsv, read_yaml
+from ..io.readers import read_tsv
+from ..io.truth import read_truth
 
 __all__ = ["fit", "subject_fits", "impedance_table", "impedance_summary", "subject_figures", "impedance_figure"]
 
@@ -114,17 +115,16 @@ def _fit(
     tables: _Tables,
 ) -> pd.DataFrame:
     """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
+    from ..dynamics import read_segments
     from ..impedance import IdentificationSettings, fit_onset
     from ..io.opensim_tables import read_markers
     from ..responses import ResponseSettings
-    from ..synthetic.subjects import truth_from_document
-    from .model import read_segments
 
     ident = IdentificationSettings(**(identification or {}))
     settings = ResponseSettings(**(response or {}))
     truth = None
     if truth_yaml:
-        truth = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml)).get(int(onset_ms))
+        truth = read_truth(truth_yaml).get(int(onset_ms))
     inputs = []
     natives = list(force_native) if len(force_native) else [None] * len(trials)
     for name, a, s, f, m, fn in zip(trials, angles, strides, force, markers, natives, strict=True):

@@ -10,17 +10,14 @@ import numpy as np
 import pandas as pd
 
 from ..constants import GRAVITY_M_PER_S2
-from ..dynamics import SegmentParameters, segment_parameters_from_anthropometry
+from ..dynamics import SegmentParameters, segment_parameters_from_anthropometry, write_segments
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, staged, write_tsv
 from ..io.readers import read_tsv
 
 __all__ = [
-    "SEGMENT_FLOAT_FORMAT",
     "SCALE_FLOAT_FORMAT",
     "SCALE_REPORT_COLUMNS",
-    "read_segments",
-    "write_segments",
     "generic_model",
     "scaled_model",
     "scale_with_setup",
@@ -31,19 +28,6 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
-
-#: Significant digits of the segment table.
-SEGMENT_FLOAT_FORMAT = "%.10g"
-
-
-def write_segments(params: SegmentParameters, path: PathLike) -> None:
-    """Write the segment table (:meth:`~loper_analysis.dynamics.SegmentParameters.to_frame`) as TSV."""
-    write_tsv(params.to_frame(), path, SEGMENT_FLOAT_FORMAT)
-
-
-def read_segments(path: PathLike) -> SegmentParameters:
-    """The segment table written by :func:`write_segments`."""
-    return SegmentParameters.from_frame(read_tsv(path, "segment table"), source=str(path))
 
 
 def generic_model(
@@ -196,7 +180,7 @@ def segments_from_model_file(
         A (scaled) ``.osim`` model: gait2392, Rajagopal2016, our generated
         model or any model whose bodies ``segment_bodies`` names.
     out_tsv : path
-        The table (:func:`write_segments`), written atomically.
+        The table (:func:`loper_analysis.dynamics.write_segments`), written atomically.
     side : {"left", "right"}
         The swing leg.
     segment_bodies : mapping, optional

@@ -257,6 +257,7 @@ def plan(
         The table and the answers.
     """
     from ..device.controller import DeviceParameters
+    from ..dynamics import read_segments
     from ..planning import (
         pilot_perturbed_pairs,
         pool_onsets,
@@ -266,7 +267,6 @@ def plan(
         unplanned_rows,
     )
     from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
-    from .model import read_segments
 
     if unplannable not in ("raise", "note"):
         raise LoperInputError(f"unplannable must be 'raise' or 'note', got {unplannable!r}")

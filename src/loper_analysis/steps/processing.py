@@ -19,6 +19,7 @@ from ..constants import MIN_IK_MARKERS, SIDES
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_tsv
 from ..io.readers import read_tsv
+from ..outliers import MIN_VALID_STRIDES
 
 __all__ = ["markers", "events", "loadcell", "events_loadcell", "strides", "strides_summary"]
 
@@ -461,9 +462,9 @@ def _plate_events(
     from level is refused naming the file, the plate and ``markers.lab_to_model_rotation_deg``.
     """
     from ..contacts import PlateForce, contact_events, foot_contacts
+    from ..ground_reaction import plate_vertical_loads
     from ..marker_names import model_marker_names, require_model_markers
     from ..markers import MODEL_UP, lab_up, rotate_markers
-    from .grf import plate_vertical_loads
 
     source = c3d_path = rec.source
     if not foot_markers:
@@ -611,7 +612,7 @@ def strides(
     n_points: int = 101,
     whisker: float = 1.5,
     max_fraction: float = 0.2,
-    min_valid: int = 5,
+    min_valid: int = MIN_VALID_STRIDES,
 ):
     """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
 
@@ -646,7 +647,7 @@ def strides_summary(
     subject_trials: Sequence[tuple[str, str]],
     strides_tsvs: Sequence[PathLike],
     out_tsv: PathLike,
-    min_valid: int = 5,
+    min_valid: int = MIN_VALID_STRIDES,
     contacts_tsvs: Sequence[PathLike] | None = None,
     ik_tsvs: Sequence[PathLike] | None = None,
     markers_tsvs: Sequence[PathLike] | None = None,

@@ -6,10 +6,10 @@ import logging
 from collections.abc import Mapping, Sequence
 
 from ..constants import JOINTS
-from ..io.atomic import PathLike, write_yaml
+from ..io.atomic import PathLike
 from ..io.c3d_writer import write_recording
-from ..io.readers import read_yaml
 from ..io.robot_log import write_robot_log
+from ..io.truth import read_truth, write_truth
 
 __all__ = ["lab_export_session", "lab_session", "truth"]
 
@@ -31,7 +31,7 @@ def truth(
     ``row`` is the subject's row of the subject sheet with its anthropometrics
     (:func:`loper_analysis.synthetic.subjects.subject_anthropometry`).
     """
-    from ..synthetic.subjects import TRUTH_HEADER, true_impedance, truth_document
+    from ..synthetic.subjects import true_impedance
 
     impedance = true_impedance(
         row["subject"],
@@ -42,7 +42,7 @@ def truth(
         stiffness_bounds,
         damping_bounds,
     )
-    write_yaml(out_yaml, truth_document(row, impedance), TRUTH_HEADER)
+    write_truth(out_yaml, row, impedance)
     log.info("truth of %s: %s", row["subject"], impedance)
     return impedance
 
@@ -80,7 +80,6 @@ def lab_session(
     """
 
     from ..device.controller import DeviceParameters
-    from ..synthetic.subjects import truth_from_document
     from ..synthetic.trials import (
         LabSettings,
         PerturbationSettings,
@@ -96,7 +95,7 @@ def lab_session(
         static_out, subject_static_recording(subject, height_m, mass_kg, s["static_duration_s"], lab_settings, seed)
     )
     log.info("static trial of %s: %s", subject, static_out)
-    true = truth_from_document(read_yaml(truth_yaml, "truth file"), str(truth_yaml))
+    true = read_truth(truth_yaml)
     logs = iter(log_outs)
     variability, adaptation, minimal_impedance = lab_variability(s, seed, subject, true)
     if variability is not None:

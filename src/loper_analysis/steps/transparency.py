@@ -7,6 +7,7 @@ from collections.abc import Sequence
 
 from ..io.atomic import PathLike, write_figure, write_tsv
 from ..io.readers import read_tsv
+from ..outliers import MIN_VALID_STRIDES
 
 __all__ = ["transparency"]
 
@@ -23,7 +24,7 @@ def transparency(
     force_out: PathLike,
     figure_out: PathLike,
     side: str = "left",
-    min_strides: int = 5,
+    min_strides: int = MIN_VALID_STRIDES,
 ):
     """Transparency of the device from the stride and cycle tables of each subject's two walking trials.
 

@@ -25,13 +25,13 @@ def validation_chunk(
 
     ``settings``: keyword arguments of :class:`~loper_analysis.validation.ValidationSettings`.
     """
+    from ..dynamics import read_segments
     from ..validation import (
         ValidationSettings,
         chunk_combinations,
         impedance_grid,
         run_validation_chunk,
     )
-    from .model import read_segments
 
     study = ValidationSettings(**settings)
     log.info("chunk %d of %d with %s", chunk, n_chunks, study)

@@ -8,8 +8,8 @@ clipped to ± 2 SD), seeded by the master seed and the subject ID, so adding a
 subject never changes the others. The true stiffness and damping per joint
 and onset are the config's group values times a per-subject factor
 (log-normal with the configured between-subject CV, one factor per joint,
-parameter and onset); :func:`truth_document` is what
-``data/raw/{subject}/truth.yaml`` holds.
+parameter and onset); ``data/raw/{subject}/truth.yaml`` holds both
+(:mod:`loper_analysis.io.truth`).
 """
 
 from __future__ import annotations
@@ -23,10 +23,7 @@ from ..constants import JOINTS
 from ..errors import LoperInputError
 from ..reference import STUDY_SUBJECTS
 
-__all__ = ["TRUTH_HEADER", "subject_anthropometry", "true_impedance", "truth_document", "truth_from_document"]
-
-#: First line of a truth file.
-TRUTH_HEADER = "true impedance of a synthetic subject (loper-analysis)"
+__all__ = ["subject_anthropometry", "true_impedance"]
 
 
 def _rng(seed: int, subject: str, what: str) -> np.random.Generator:
@@ -107,34 +104,3 @@ def true_impedance(
             entry[joint] = {"K": round(float(k), 6), "D": round(float(d), 6)}
         out[int(onset)] = entry
     return out
-
-
-def truth_document(anthropometry: Mapping, impedance: Mapping) -> dict:
-    """The contents of ``truth.yaml``: anthropometrics and K, D per onset and joint (units in the keys)."""
-    return {
-        "subject": anthropometry["subject"],
-        "sex": anthropometry["sex"],
-        "age_yr": anthropometry["age_yr"],
-        "height_m": anthropometry["height_m"],
-        "mass_kg": anthropometry["mass_kg"],
-        "impedance": {
-            f"onset_{int(onset):03d}_ms": {
-                joint: {"stiffness_nm_per_rad": v["K"], "damping_nms_per_rad": v["D"]} for joint, v in joints.items()
-            }
-            for onset, joints in impedance.items()
-        },
-    }
-
-
-def truth_from_document(doc, source: str = "truth file") -> dict:
-    """``{onset_ms: {joint: {"K": ..., "D": ...}}}`` from the contents of a ``truth.yaml``."""
-    try:
-        return {
-            int(key.split("_")[1]): {
-                joint: {"K": float(v["stiffness_nm_per_rad"]), "D": float(v["damping_nms_per_rad"])}
-                for joint, v in joints.items()
-            }
-            for key, joints in doc["impedance"].items()
-        }
-    except (KeyError, TypeError, ValueError, IndexError, AttributeError) as exc:
-        raise LoperInputError(f"{source}: not a readable truth file ({exc})") from exc

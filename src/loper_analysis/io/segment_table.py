@@ -1,0 +1,32 @@
+"""The segment table of the swing-leg model (``results/model/{subject}/segments.tsv``): TSV, 10 significant digits.
+
+One row per segment (cart, thigh, shank, foot), the columns of
+:meth:`loper_analysis.dynamics.SegmentParameters.to_frame`; the typed reader
+and writer are :func:`loper_analysis.dynamics.read_segments` and
+:func:`loper_analysis.dynamics.write_segments`.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pandas as pd
+
+from .atomic import write_tsv
+from .readers import read_tsv
+
+__all__ = ["SEGMENT_FLOAT_FORMAT", "read_segment_table", "write_segment_table"]
+
+#: Significant digits of the segment table.
+SEGMENT_FLOAT_FORMAT = "%.10g"
+
+
+def write_segment_table(table: pd.DataFrame, path: str | os.PathLike) -> Path:
+    """Write a segment table as TSV atomically, floats by :data:`SEGMENT_FLOAT_FORMAT`."""
+    return write_tsv(table, path, SEGMENT_FLOAT_FORMAT)
+
+
+def read_segment_table(path: str | os.PathLike) -> pd.DataFrame:
+    """The rows of a segment table file (LoperInputError naming the file when missing or unreadable)."""
+    return read_tsv(path, "segment table")
