@@ -110,3 +110,20 @@ def test_step_modules_do_not_import_each_other():
                 names = [node.module] if node.module else [a.name for a in node.names]
                 found += [f"{path.stem} -> {n}" for n in names if n and n.split(".")[0] in steps]
     assert found == []
+
+
+def test_the_iqr_rule_s_whisker_and_fraction_are_the_config_s_and_every_default():
+    from loper_analysis.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION
+    from loper_analysis.responses import ResponseSettings
+    from loper_analysis.responses.windows import window_outliers
+    from loper_analysis.steps import processing
+
+    assert (IQR_WHISKER, MAX_OUTLIER_FRACTION) == (
+        CONFIG["strides"]["iqr_whisker"],
+        CONFIG["strides"]["max_outlier_fraction"],
+    )
+    for function in (iqr_outliers, strides.stride_tables, processing.strides, window_outliers):
+        defaults = inspect.signature(function).parameters
+        assert (defaults["whisker"].default, defaults["max_fraction"].default) == (IQR_WHISKER, MAX_OUTLIER_FRACTION)
+    settings = ResponseSettings()
+    assert (settings.whisker, settings.max_fraction) == (IQR_WHISKER, MAX_OUTLIER_FRACTION)

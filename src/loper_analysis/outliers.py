@@ -11,19 +11,30 @@ import pandas as pd
 from .checks import number, where
 from .errors import LoperInputError, TooFewStridesWarning
 
-__all__ = ["MIN_STRIDES_FOR_OUTLIERS", "MIN_VALID_STRIDES", "iqr_outliers", "check_enough_strides"]
+__all__ = [
+    "IQR_WHISKER",
+    "MAX_OUTLIER_FRACTION",
+    "MIN_STRIDES_FOR_OUTLIERS",
+    "MIN_VALID_STRIDES",
+    "iqr_outliers",
+    "check_enough_strides",
+]
 
 #: Fewest strides the IQR rule judges (:func:`iqr_outliers` refuses fewer; callers keep them all unjudged).
 MIN_STRIDES_FOR_OUTLIERS: int = 4
 #: Fewest strides per subject and condition that an average is built from (warning below); the default of the
 #: config's ``strides.min_valid_strides`` wherever a function takes that setting.
 MIN_VALID_STRIDES: int = 5
+#: The IQR rule's whisker (outlier beyond Q1 - w IQR or Q3 + w IQR; config ``strides.iqr_whisker``).
+IQR_WHISKER: float = 1.5
+#: A stride with more outlying samples than this fraction is an outlier (config ``strides.max_outlier_fraction``).
+MAX_OUTLIER_FRACTION: float = 0.2
 
 
 def iqr_outliers(
     values,
-    whisker: float = 1.5,
-    max_fraction: float = 0.2,
+    whisker: float = IQR_WHISKER,
+    max_fraction: float = MAX_OUTLIER_FRACTION,
     names: Sequence[str] | None = None,
     source: str = "",
 ) -> pd.DataFrame:

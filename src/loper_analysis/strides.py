@@ -27,7 +27,14 @@ from .checks import side as check_side
 from .constants import FLAGGED_EVENTS, JOINTS, PHASES, angle_column
 from .errors import LoperInputError, TooFewStridesWarning
 from .loadcell import perturbation_onsets
-from .outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, check_enough_strides, iqr_outliers
+from .outliers import (
+    IQR_WHISKER,
+    MAX_OUTLIER_FRACTION,
+    MIN_STRIDES_FOR_OUTLIERS,
+    MIN_VALID_STRIDES,
+    check_enough_strides,
+    iqr_outliers,
+)
 from .resampling import PHASE_BOUNDS, normalise
 
 __all__ = [
@@ -265,8 +272,8 @@ def stride_tables(
     force: pd.DataFrame | None = None,
     side: str = "left",
     n_points: int = 101,
-    whisker: float = 1.5,
-    max_fraction: float = 0.2,
+    whisker: float = IQR_WHISKER,
+    max_fraction: float = MAX_OUTLIER_FRACTION,
     min_valid: int = MIN_VALID_STRIDES,
     sources: Mapping[str, str] | None = None,
 ) -> StrideTables:

@@ -17,14 +17,20 @@ from ..checks import number, signal, time_vector, where
 from ..constants import JOINTS, SIDES
 from ..errors import LoperInputError
 from ..identification.window import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
-from ..outliers import MIN_VALID_STRIDES, iqr_outliers
+from ..outliers import (
+    IQR_WHISKER,
+    MAX_OUTLIER_FRACTION,
+    MIN_STRIDES_FOR_OUTLIERS,
+    MIN_VALID_STRIDES,
+    iqr_outliers,
+)
 from ..resampling import window, window_times_s
 from .sampling import TIME_TOLERANCE_S, SplineSampler, window_span
 
 __all__ = ["MIN_PAIRS_FOR_OUTLIERS", "ResponseSettings", "analysis_grid", "paired_windows", "window_outliers"]
 
 #: Fewest pairs the IQR rule judges (:func:`loper_analysis.outliers.iqr_outliers`); fewer are all kept.
-MIN_PAIRS_FOR_OUTLIERS: int = 4
+MIN_PAIRS_FOR_OUTLIERS: int = MIN_STRIDES_FOR_OUTLIERS
 
 
 @dataclass(frozen=True)
@@ -43,8 +49,8 @@ class ResponseSettings:
     window_before_s: float = WINDOW_BEFORE_S
     window_after_s: float = WINDOW_AFTER_S
     initial_state_span_s: float = INITIAL_STATE_SPAN_S
-    whisker: float = 1.5
-    max_fraction: float = 0.2
+    whisker: float = IQR_WHISKER
+    max_fraction: float = MAX_OUTLIER_FRACTION
     min_strides: int = MIN_VALID_STRIDES
 
 
@@ -180,8 +186,8 @@ def window_outliers(
     rel_time_s,
     before_s: float = WINDOW_BEFORE_S,
     after_s: float = WINDOW_AFTER_S,
-    whisker: float = 1.5,
-    max_fraction: float = 0.2,
+    whisker: float = IQR_WHISKER,
+    max_fraction: float = MAX_OUTLIER_FRACTION,
     names: Sequence[str] = JOINTS,
     source: str = "",
 ) -> pd.DataFrame:

@@ -19,7 +19,7 @@ from ..constants import MIN_IK_MARKERS, SIDES
 from ..errors import LoperInputError
 from ..io.atomic import PathLike, write_tsv
 from ..io.readers import read_tsv
-from ..outliers import MIN_VALID_STRIDES
+from ..outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
 
 __all__ = ["markers", "events", "loadcell", "events_loadcell", "strides", "strides_summary"]
 
@@ -610,8 +610,8 @@ def strides(
     force_tsv: PathLike | None = None,
     side: str = "left",
     n_points: int = 101,
-    whisker: float = 1.5,
-    max_fraction: float = 0.2,
+    whisker: float = IQR_WHISKER,
+    max_fraction: float = MAX_OUTLIER_FRACTION,
     min_valid: int = MIN_VALID_STRIDES,
 ):
     """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
