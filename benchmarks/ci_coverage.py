@@ -18,7 +18,7 @@ chain's IK error, :data:`IK_NOISE_SD`, measured by ``--mode chain --keep DIR`` b
 ``--ik-noise-scale``); the true gait events make the stride
 tables; the robot log goes through the load-cell step's own clock map, filter and resampling; the brace
 markers are the model's; the segment table is the subject's generated model (not scaled from a static
-trial). Then the workflow's :func:`loper_analysis.impedance.fit_onset`. Skips C3D files, markers, IK,
+trial). Then the workflow's :func:`loper_analysis.identification.impedance.fit_onset`. Skips C3D files, markers, IK,
 scaling and event detection.
 
 ``--mode chain`` (the cross-check, ~35-70 min for 34 subjects): builds a copy of the workflow with the
@@ -45,7 +45,7 @@ import pandas as pd
 import yaml
 from scipy.stats import beta
 
-from loper_analysis.markdown import markdown_table
+from loper_analysis.report.markdown import markdown_table
 from loper_analysis.study_design import StudyDesign
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -106,7 +106,7 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def _settings(config: dict):
     """ResponseSettings and IdentificationSettings as the workflow's rule impedance_fit builds them."""
-    from loper_analysis.impedance import IdentificationSettings
+    from loper_analysis.identification.impedance import IdentificationSettings
     from loper_analysis.responses import ResponseSettings
 
     ident, strides = config["identification"], config["strides"]
@@ -141,11 +141,11 @@ def _settings(config: dict):
 def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.random.Generator) -> dict:
     """Angle table (IK-like noise, ``noise_scale`` times the chain's), stride table, force table and brace markers of
     one simulated trial, as the fit reads them."""
-    from loper_analysis.filtering import lowpass
-    from loper_analysis.kinematics import marker_positions
-    from loper_analysis.loadcell import robot_log_frames_and_native
-    from loper_analysis.model import BRACE_MARKERS
-    from loper_analysis.strides import stride_tables
+    from loper_analysis.device.loadcell import robot_log_frames_and_native
+    from loper_analysis.gait.strides import stride_tables
+    from loper_analysis.motion.filtering import lowpass
+    from loper_analysis.motion.ik import marker_positions
+    from loper_analysis.motion.model import BRACE_MARKERS
     from loper_analysis.synthetic.sync import pulse_train_at
 
     coords = walk.mocap_coordinates(lab.marker_rate_hz)
@@ -195,8 +195,8 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table)."""
     from loper_analysis.constants import JOINTS
     from loper_analysis.device.controller import DeviceParameters
-    from loper_analysis.impedance import fit_onset
-    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.identification.impedance import fit_onset
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
     from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial
     from loper_analysis.synthetic.variability import lab_variability
@@ -277,7 +277,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
     ``max_subjects`` subjects that have one)."""
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.io.readers import read_tsv
-    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
     from loper_analysis.synthetic.trials import LabSettings, simulate_walking_trial
     from loper_analysis.synthetic.variability import lab_variability

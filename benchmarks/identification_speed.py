@@ -12,13 +12,13 @@ import time
 
 import numpy as np
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.identification import identify_impedance, prepare_window
-from loper_analysis.validation import (
+from loper_analysis.identification.validation import (
     ValidationSettings,
     impedance_grid,
     perturbed_trial,
 )
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 
 def main(n_cases: int = 40) -> None:

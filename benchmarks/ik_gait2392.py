@@ -18,8 +18,8 @@ from pathlib import Path
 import numpy as np
 
 from loper_analysis.io.osim import read_marker_set, read_model
-from loper_analysis.kinematics import inverse_kinematics, marker_positions
-from loper_analysis.model import build_lower_body_model
+from loper_analysis.motion.ik import inverse_kinematics, marker_positions
+from loper_analysis.motion.model import build_lower_body_model
 from loper_analysis.synthetic.gait_curves import NominalGait
 from loper_analysis.synthetic.lab_export import gait2392_coordinates
 from loper_analysis.synthetic.walking import leg_length_from_height, walking_kinematics

@@ -13,8 +13,8 @@ import time
 
 import numpy as np
 
-from loper_analysis.kinematics import inverse_kinematics, marker_positions
-from loper_analysis.model import MARKERS, build_lower_body_model
+from loper_analysis.motion.ik import inverse_kinematics, marker_positions
+from loper_analysis.motion.model import MARKERS, build_lower_body_model
 
 
 def main(n: int = 30720) -> None:

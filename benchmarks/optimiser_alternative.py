@@ -18,19 +18,19 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.identification import (
     DEFAULT_LOWER,
     DEFAULT_UPPER,
     identify_impedance,
 )
 from loper_analysis.identification.fit import ResidualBatch
-from loper_analysis.validation import (
+from loper_analysis.identification.validation import (
     ValidationSettings,
     impedance_grid,
     perturbed_trial,
     validation_window,
 )
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 
 def per_start_least_squares(window, n_starts: int, seed: int, tol: float = 1e-6) -> float:

@@ -4,13 +4,13 @@ Usage: nice -n 10 python benchmarks/planner_check.py [--repeats 60] [--onset-ms 
                                                      [--variability study|gentle]
 
 A pilot experiment (one synthetic trial with the device, perturbed at the onset every 3-5 strides, built at
-the coordinate level by :func:`loper_analysis.coordinate_trials.perturbation_experiment`: no markers, no IK;
+the coordinate level by :func:`loper_analysis.synthetic.coordinate_trials.perturbation_experiment`: no markers, no IK;
 the force at the robot's 1000 Hz as the fit takes it; the lab's variability of ``config/config.yaml``
 ``synthetic`` unless ``--variability`` says otherwise) gives the null pairs, its perturbed pairs and, from its
-own fit of all its perturbed strides, the planned impedance; the planner (:mod:`loper_analysis.planning`)
+own fit of all its perturbed strides, the planned impedance; the planner (:mod:`loper_analysis.planning.precision`)
 predicts the SD of every K and D for one stride from the perturbed pairs' scatter. Then ``--repeats``
 independent experiments (other seeds, same subject) are fitted exactly as the pipeline fits them
-(:func:`loper_analysis.impedance.fit_onset`, null-pair noise model, intervals from the perturbed pairs'
+(:func:`loper_analysis.identification.impedance.fit_onset`, null-pair noise model, intervals from the perturbed pairs'
 scatter) with their first N perturbed strides, for each N of ``--strides``; their null pairs come from the
 whole trial. The measured SD is the SD of the estimates over the repeats; the prediction for the same repeats
 is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the table predicted vs measured
@@ -31,12 +31,12 @@ import yaml
 from scipy.stats import t as student_t
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
-from loper_analysis.coordinate_trials import perturbation_experiment
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
-from loper_analysis.impedance import IdentificationSettings, fit_onset
-from loper_analysis.markdown import markdown_table
-from loper_analysis.planning import PlanSettings, pilot_perturbed_pairs, stride_covariance
+from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
+from loper_analysis.planning.precision import PlanSettings, pilot_perturbed_pairs, stride_covariance
+from loper_analysis.report.markdown import markdown_table
 from loper_analysis.responses import ResponseSettings, null_pair_windows
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.variability import lab_variability
 
 ROOT = Path(__file__).resolve().parents[1]

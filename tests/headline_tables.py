@@ -1,4 +1,4 @@
-"""Shared test data: small result tables in the shapes the headline tables read (loper_analysis.headline)."""
+"""Shared test data: small result tables in the shapes the headline tables read (loper_analysis.report.headline)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import math
 
 import pandas as pd
 
-from loper_analysis.impedance import IMPEDANCE_COLUMNS
+from loper_analysis.identification.impedance import IMPEDANCE_COLUMNS
 from loper_analysis.reference import STUDY_DEVICE
 
 

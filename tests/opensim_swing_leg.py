@@ -30,7 +30,7 @@ from __future__ import annotations
 import numpy as np
 import opensim as osim
 
-from loper_analysis.dynamics import SegmentParameters
+from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 osim.Logger.setLevelString("error")
 osim.Logger.removeFileSink()

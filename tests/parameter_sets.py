@@ -1,6 +1,6 @@
 """Shared test data: segment parameter sets."""
 
-from loper_analysis.dynamics import (
+from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     segment_parameters_from_anthropometry,
 )

@@ -9,7 +9,7 @@ the source files.
 Lab files (:func:`write_lab_files`)
     * Lab frame Z up: a point ``(x, y, z)`` of OpenSim's Y-up frame is ``(x, -z, y)`` in the lab
       (:data:`MODEL_TO_LAB`), so that the lab-to-model rotation ``(-90, 0, 0)``
-      (:func:`loper_analysis.markers.rotate_markers`) gives the TRC's coordinates back.
+      (:func:`loper_analysis.motion.markers.rotate_markers`) gives the TRC's coordinates back.
     * Markers: the TRC's, in mm, labelled ``<subject_prefix><TRC name>`` (``Subject11:R.ASIS``); a marker
       missing (NaN) in the TRC is missing in the file. Frames keep the TRC's clock: ``first_frame`` is
       ``round(t0 * rate)`` with ``t0`` the TRC's first time.

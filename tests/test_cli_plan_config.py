@@ -20,7 +20,7 @@ import yaml
 from loper_analysis.cli import _parser, _plan_settings, _read_config, main
 from loper_analysis.config_file import find_schema, load_config, update_config
 from loper_analysis.errors import LoperInputError
-from loper_analysis.planning import PlanSettings
+from loper_analysis.planning.precision import PlanSettings
 from loper_analysis.steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -196,7 +196,7 @@ def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
 
 
 def test_validation_defaults_of_the_library_are_the_configs():
-    from loper_analysis.validation import ValidationSettings, validation_settings
+    from loper_analysis.identification.validation import ValidationSettings, validation_settings
 
     config = yaml.safe_load(CONFIG.read_text())
     assert ValidationSettings(**validation_settings(config)) == ValidationSettings()
@@ -204,7 +204,7 @@ def test_validation_defaults_of_the_library_are_the_configs():
 
 def test_validate_command_runs_with_the_configs_settings(project, capsys):
     """One K/D level (one combination): the config's levels reach the chunk, the option --n-starts wins."""
-    from loper_analysis.dynamics import write_segments
+    from loper_analysis.swing_leg.dynamics import write_segments
     from tests.parameter_sets import WINTER
 
     write_segments(WINTER, project / "segments.tsv")

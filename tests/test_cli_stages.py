@@ -16,13 +16,13 @@ import pandas as pd
 import pytest
 
 from loper_analysis.cli import main
-from loper_analysis.dynamics import read_segments
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
-from loper_analysis.kinematics import marker_positions
-from loper_analysis.segments_from_model import segments_from_model
+from loper_analysis.motion.ik import marker_positions
+from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.steps.model import scale_with_setup
+from loper_analysis.swing_leg.dynamics import read_segments
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -230,7 +230,7 @@ def test_a_setup_that_is_not_a_scale_setup(lab, tmp_path, capsys):
 
 def test_a_model_without_the_bodies_and_a_file_that_is_no_model(tmp_path, capsys):
     from loper_analysis.io.osim import write_model
-    from loper_analysis.model import build_lower_body_model
+    from loper_analysis.motion.model import build_lower_body_model
 
     model = build_lower_body_model(1.7, 70.0)
     model.setName("renamed")
@@ -248,7 +248,7 @@ def test_a_model_without_the_bodies_and_a_file_that_is_no_model(tmp_path, capsys
 def test_ik_command_reads_a_labs_labels(tmp_path, capsys):
     """Prefixed lab labels with a label map give the same .mot as the model's own names."""
     from loper_analysis.io.osim import write_model
-    from loper_analysis.model import MARKERS, build_lower_body_model
+    from loper_analysis.motion.model import MARKERS, build_lower_body_model
 
     generic = build_lower_body_model(1.73, 64.9)
     model = write_model(generic, tmp_path / "model.osim")

@@ -1,9 +1,10 @@
-"""loper_analysis.clock_sync: rising edges of sync pulses and the robot -> mocap clock map, against known clocks."""
+"""loper_analysis.device.clock_sync: rising edges of sync pulses and the robot -> mocap clock map, against known
+clocks."""
 
 import numpy as np
 import pytest
 
-from loper_analysis.clock_sync import (
+from loper_analysis.device.clock_sync import (
     MIN_MATCHED_EDGES,
     ClockMap,
     clock_map,

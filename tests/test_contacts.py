@@ -7,17 +7,17 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import CONTACT_FLAGS
-from loper_analysis.contacts import (
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.contacts import (
     CONTACT_COLUMNS,
     PlateForce,
     contact_events,
     foot_contacts,
     plate_contacts,
 )
-from loper_analysis.errors import LoperInputError
-from loper_analysis.events import EVENT_COLUMNS, flagged_contacts, gait_events
-from loper_analysis.plate_geometry import plate_offsets
-from loper_analysis.strides import strides_from_events
+from loper_analysis.gait.events import EVENT_COLUMNS, flagged_contacts, gait_events
+from loper_analysis.gait.plate_geometry import plate_offsets
+from loper_analysis.gait.strides import strides_from_events
 
 FS = 2000.0  # analog rate, Hz
 MARKER_HZ = 200.0
@@ -391,7 +391,7 @@ def test_walking5_contacts_feet_and_events(walking5):
 
 
 def test_count_flagged_leaves_out_contacts_cut_by_the_recording():
-    from loper_analysis.contacts import count_flagged
+    from loper_analysis.gait.contacts import count_flagged
 
     assert count_flagged(["ok", "incomplete", "two_feet", "no_foot", "ok", "wrong_belt"]) == 3
     assert count_flagged(pd.Series([], dtype=object)) == 0

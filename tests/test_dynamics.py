@@ -10,7 +10,7 @@ Known answers used here:
 * virtual work of the joint torques;
 * the segment table: frame and TSV round trips, and its input checks;
 * the compiled RK4 of :mod:`loper_analysis.identification` against SciPy's
-  DOP853 in :func:`loper_analysis.dynamics.simulate`.
+  DOP853 in :func:`loper_analysis.swing_leg.dynamics.simulate`.
 """
 
 from __future__ import annotations
@@ -19,7 +19,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.dynamics import (
+from loper_analysis.errors import LoperInputError
+from loper_analysis.identification import prepare_window, simulate_response
+from loper_analysis.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
+from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     attachment_jacobian,
     attachment_position,
@@ -36,9 +39,6 @@ from loper_analysis.dynamics import (
     simulate,
     write_segments,
 )
-from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import prepare_window, simulate_response
-from loper_analysis.validation import ValidationSettings, nominal_swing, perturbed_trial
 from tests.parameter_sets import ASYMMETRIC, WINTER
 
 PARAMETER_SETS = {"winter": WINTER, "asymmetric": ASYMMETRIC}

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import (
+from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     attachment_jacobian,
     attachment_position,

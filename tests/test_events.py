@@ -7,8 +7,8 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.events import EVENT_COLUMNS, gait_events
-from loper_analysis.strides import STRIDE_COLUMNS, strides_from_events
+from loper_analysis.gait.events import EVENT_COLUMNS, gait_events
+from loper_analysis.gait.strides import STRIDE_COLUMNS, strides_from_events
 
 FS = 1000.0
 PEAK_N = 700.0

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.filtering import (
+from loper_analysis.motion.filtering import (
     lowpass,
     lowpass_finite_runs,
     lowpass_gain,

@@ -1,4 +1,4 @@
-"""The front page of the report (loper_analysis.front_page, the file step, and the report in a real browser).
+"""The front page of the report (loper_analysis.report.front_page, the file step, and the report in a real browser).
 
 The headline tables it shows are tested in test_headline.py.
 """
@@ -20,15 +20,15 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import JOINTS
-from loper_analysis.front_page import RunSettings, front_page_html
-from loper_analysis.headline import (
+from loper_analysis.identification.impedance import impedance_summary
+from loper_analysis.report.front_page import RunSettings, front_page_html
+from loper_analysis.report.headline import (
     device_comparison,
     impedance_summary_ci,
     transparency_verdict,
     truth_recovery,
     validation_verdict,
 )
-from loper_analysis.impedance import impedance_summary
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.ground_reaction import (
+from loper_analysis.gait.grf import (
     centre_of_pressure,
     external_loads_columns,
     external_loads_table,

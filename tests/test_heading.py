@@ -1,4 +1,4 @@
-"""The walking direction of a trial and the rotation chosen for it (loper_analysis.heading)."""
+"""The walking direction of a trial and the rotation chosen for it (loper_analysis.motion.heading)."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.heading import travel_velocity_m_per_s, trial_heading
 from loper_analysis.io.c3d import read_c3d
-from loper_analysis.markers import rotate_markers
+from loper_analysis.motion.heading import travel_velocity_m_per_s, trial_heading
+from loper_analysis.motion.markers import rotate_markers
 
 WALKING5 = Path(__file__).resolve().parent / "data" / "opensim-core" / "walking5.c3d"
 Z_UP = (-90.0, 0.0, 0.0)

@@ -1,4 +1,4 @@
-"""The headline tables of a run (loper_analysis.headline): CIs, truth recovery, verdicts, and bad tables."""
+"""The headline tables of a run (loper_analysis.report.headline): CIs, truth recovery, verdicts, and bad tables."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.headline import (
+from loper_analysis.reference import STUDY_DEVICE
+from loper_analysis.report.headline import (
     ci_coverage_p,
     device_comparison,
     impedance_summary_ci,
@@ -17,7 +18,6 @@ from loper_analysis.headline import (
     truth_recovery,
     validation_verdict,
 )
-from loper_analysis.reference import STUDY_DEVICE
 from tests.headline_tables import impedance_table, validation_summary
 
 #: t(0.975, 2): the 95 % quantile factor of a mean over 3 subjects

@@ -1,15 +1,15 @@
-"""Which coordinates a marker subset determines (loper_analysis.ik_determinacy), on the generated model."""
+"""Which coordinates a marker subset determines (loper_analysis.motion.ik_determinacy), on the generated model."""
 
 import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.ik_determinacy import (
+from loper_analysis.motion.ik_determinacy import (
     model_tree,
     require_markers_beyond_root,
     undetermined_coordinates,
 )
-from loper_analysis.model import COORDINATES, build_lower_body_model
+from loper_analysis.motion.model import COORDINATES, build_lower_body_model
 
 
 @pytest.fixture(scope="module")

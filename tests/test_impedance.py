@@ -1,5 +1,5 @@
-"""Impedance table rows (loper_analysis.impedance): estimates, truth, statuses, the brace force direction,
-an onset without trials, and the across-subject summary with the literature rows."""
+"""Impedance table rows (loper_analysis.identification.impedance): estimates, truth, statuses, the brace force
+direction, an onset without trials, and the across-subject summary with the literature rows."""
 
 from __future__ import annotations
 
@@ -9,10 +9,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import identify_impedance
-from loper_analysis.impedance import (
+from loper_analysis.identification.impedance import (
     IMPEDANCE_COLUMNS,
     brace_force_direction,
     fit_onset,
@@ -21,11 +20,12 @@ from loper_analysis.impedance import (
     literature_table,
     status_rows,
 )
-from loper_analysis.validation import (
+from loper_analysis.identification.validation import (
     ValidationSettings,
     perturbed_trial,
     validation_window,
 )
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 TRUTH = (60.0, 3.0, 5.0, 0.2, 20.0, 0.5)
 TRUTH_BY_JOINT = {"hip": {"K": 60.0, "D": 3.0}, "knee": {"K": 5.0, "D": 0.2}, "ankle": {"K": 20.0, "D": 0.5}}

@@ -22,10 +22,10 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.readers import read_label_map
-from loper_analysis.lab_frame import lab_to_model_rotation_deg, vertical_axis, walking_direction
-from loper_analysis.label_matching import heel_markers, match_labels, starter_label_map
-from loper_analysis.marker_names import model_marker_names
-from loper_analysis.markers import rotate_markers
+from loper_analysis.motion.lab_frame import lab_to_model_rotation_deg, vertical_axis, walking_direction
+from loper_analysis.motion.label_matching import heel_markers, match_labels, starter_label_map
+from loper_analysis.motion.marker_names import model_marker_names
+from loper_analysis.motion.markers import rotate_markers
 from loper_analysis.schema import check_config
 from loper_analysis.steps.inspect import inspect_c3d, model_marker_names_of
 

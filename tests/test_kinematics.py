@@ -1,4 +1,4 @@
-"""Inverse kinematics (loper_analysis.kinematics) against known joint angles and OpenSim's InverseKinematicsTool.
+"""Inverse kinematics (loper_analysis.motion.ik) against known joint angles and OpenSim's InverseKinematicsTool.
 
 Also the IK task files (loper_analysis.io.ik_tasks), the time chunks of a trial and the joint-angle table.
 """
@@ -14,7 +14,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.ik_tasks import read_ik_tasks
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
-from loper_analysis.kinematics import (
+from loper_analysis.motion.ik import (
     DEFAULT_COORDINATE_MAP,
     chunk_frames,
     inverse_kinematics,
@@ -23,7 +23,7 @@ from loper_analysis.kinematics import (
     marker_positions,
     markers_table,
 )
-from loper_analysis.model import MARKERS, build_lower_body_model
+from loper_analysis.motion.model import MARKERS, build_lower_body_model
 
 FS = 128.0
 GENERIC_RAJAGOPAL = Path(__file__).resolve().parent / "data" / "rajagopal2016" / "Rajagopal2016.osim"

@@ -1,16 +1,17 @@
-"""loper_analysis.loadcell: the robot log's forces and perturbation flag on the mocap frames, against known clocks."""
+"""loper_analysis.device.loadcell: the robot log's forces and perturbation flag on the mocap frames, against
+known clocks."""
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.errors import LoperInputError
-from loper_analysis.loadcell import (
+from loper_analysis.device.loadcell import (
     OUTPUT_COLUMNS,
     perturbation_onsets,
     robot_log_frames_and_native,
     robot_log_on_mocap_frames,
 )
+from loper_analysis.errors import LoperInputError
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 from tests.sync_records import ANALOG_HZ, ROBOT_HZ, mocap_view
 

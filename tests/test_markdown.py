@@ -1,8 +1,8 @@
-"""Markdown rendering of result tables (loper_analysis.markdown)."""
+"""Markdown rendering of result tables (loper_analysis.report.markdown)."""
 
 import pandas as pd
 
-from loper_analysis.markdown import markdown_document, markdown_table
+from loper_analysis.report.markdown import markdown_document, markdown_table
 
 
 def test_markdown_table_formats_numbers_and_gaps():

@@ -1,10 +1,10 @@
-"""Lab labels to model-marker names (loper_analysis.marker_names) and the label-map file reader."""
+"""Lab labels to model-marker names (loper_analysis.motion.marker_names) and the label-map file reader."""
 
 import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.readers import read_label_map
-from loper_analysis.marker_names import (
+from loper_analysis.motion.marker_names import (
     missing_model_markers,
     model_marker_names,
     require_model_markers,

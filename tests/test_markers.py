@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.markers import (
+from loper_analysis.motion.markers import (
     GAP_REPORT_COLUMNS,
     GAP_SUMMARY_COLUMNS,
     fill_gaps,
@@ -282,7 +282,7 @@ def test_only_weighted_markers_count():
 
 
 def test_summary_counts_frames_the_filter_left_unfiltered(trial):
-    from loper_analysis.filtering import lowpass_finite_runs
+    from loper_analysis.motion.filtering import lowpass_finite_runs
 
     gappy = trial.copy()
     gappy[50:60, 1] = np.nan
@@ -309,7 +309,7 @@ def test_summary_counts_frames_the_filter_left_unfiltered(trial):
     ],
 )
 def test_lab_up_is_what_the_rotation_turns_into_the_models_plus_y(angles, up):
-    from loper_analysis.markers import MODEL_UP, lab_up
+    from loper_analysis.motion.markers import MODEL_UP, lab_up
 
     got = lab_up(angles)
     np.testing.assert_allclose(got, up, rtol=0, atol=1e-15)
@@ -319,7 +319,7 @@ def test_lab_up_is_what_the_rotation_turns_into_the_models_plus_y(angles, up):
 
 
 def test_lab_up_refuses_a_bad_rotation():
-    from loper_analysis.markers import lab_up
+    from loper_analysis.motion.markers import lab_up
 
     with pytest.raises(LoperInputError, match="rotation_deg must be 3 finite angles"):
         lab_up((0.0, np.nan, 0.0))

@@ -1,21 +1,21 @@
-"""The generic OpenSim lower-body model (loper_analysis.model) against our swing-leg model."""
+"""The generic OpenSim lower-body model (loper_analysis.motion.model) against our swing-leg model."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import (
-    segment_com_positions,
-    segment_coordinates,
-    segment_parameters_from_anthropometry,
-)
 from loper_analysis.errors import LoperInputError
-from loper_analysis.model import (
+from loper_analysis.motion.model import (
     BRACE_MARKERS,
     MARKERS,
     build_lower_body_model,
     segment_parameters_from_model,
+)
+from loper_analysis.swing_leg.dynamics import (
+    segment_com_positions,
+    segment_coordinates,
+    segment_parameters_from_anthropometry,
 )
 
 

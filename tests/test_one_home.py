@@ -16,18 +16,19 @@ import pytest
 import yaml
 from scipy.special import stdtrit
 
-from loper_analysis import events, outliers, strides, transparency
-from loper_analysis.dynamics import read_segments, write_segments
+from loper_analysis import transparency
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait import events, outliers, strides
+from loper_analysis.gait.outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, iqr_outliers
 from loper_analysis.identification import t_quantile
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT
-from loper_analysis.outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, iqr_outliers
-from loper_analysis.planning import StrideCovariance
+from loper_analysis.planning.precision import StrideCovariance
 from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.steps import processing
 from loper_analysis.steps import transparency as transparency_step
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
+from loper_analysis.swing_leg.dynamics import read_segments, write_segments
 from tests.parameter_sets import ASYMMETRIC
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -113,7 +114,7 @@ def test_step_modules_do_not_import_each_other():
 
 
 def test_the_iqr_rule_s_whisker_and_fraction_are_the_config_s_and_every_default():
-    from loper_analysis.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION
+    from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION
     from loper_analysis.responses import ResponseSettings
     from loper_analysis.responses.windows import window_outliers
     from loper_analysis.steps import processing

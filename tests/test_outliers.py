@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
-from loper_analysis.outliers import (
+from loper_analysis.gait.outliers import (
     MIN_VALID_STRIDES,
     check_enough_strides,
     iqr_outliers,

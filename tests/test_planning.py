@@ -1,4 +1,4 @@
-"""The experiment planner (loper_analysis.planning, steps.planning, ``loper-analysis plan``).
+"""The experiment planner (loper_analysis.planning.precision, steps.planning, ``loper-analysis plan``).
 
 Known answers: the device loop's step (steady state = the desired force with a still brace, the study's
 ~10 ms rise), Student's t with N - 1 degrees of freedom and the 1/N law of the prediction, the
@@ -21,9 +21,7 @@ from scipy.stats import t as student_t
 
 from loper_analysis.cli import main
 from loper_analysis.constants import JOINTS, parameter_column
-from loper_analysis.coordinate_trials import perturbation_experiment
 from loper_analysis.device.analysis import step_metrics
-from loper_analysis.dynamics import segment_parameters_from_anthropometry, write_segments
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
     identify_impedance,
@@ -32,9 +30,9 @@ from loper_analysis.identification import (
     response_jacobian,
     simulate_response,
 )
-from loper_analysis.impedance import IdentificationSettings, fit_onset
+from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
 from loper_analysis.io.atomic import write_tsv
-from loper_analysis.planning import (
+from loper_analysis.planning.precision import (
     MIN_PERTURBED_PAIRS,
     PlanSettings,
     StrideCovariance,
@@ -49,6 +47,8 @@ from loper_analysis.planning import (
 )
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.responses import ResponseSettings, null_pair_windows
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry, write_segments
+from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.response import thigh_normal
 
 HEIGHT_M, MASS_KG = 1.73, 64.9

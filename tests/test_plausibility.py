@@ -1,12 +1,12 @@
-"""Human-range checks of marker data (loper_analysis.plausibility) against known answers."""
+"""Human-range checks of marker data (loper_analysis.motion.plausibility) against known answers."""
 
 import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.kinematics import marker_positions
-from loper_analysis.model import MARKERS, SCALE_MEASUREMENTS, build_lower_body_model
-from loper_analysis.plausibility import (
+from loper_analysis.motion.ik import marker_positions
+from loper_analysis.motion.model import MARKERS, SCALE_MEASUREMENTS, build_lower_body_model
+from loper_analysis.motion.plausibility import (
     marker_extent_m,
     measurement_scale_factors,
     require_ik_fit,

@@ -14,13 +14,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.contacts import PlateForce, foot_contacts
-from loper_analysis.ground_reaction import plate_loads
+from loper_analysis.gait.contacts import PlateForce, foot_contacts
+from loper_analysis.gait.grf import plate_loads
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.io.osim import quiet_opensim
-from loper_analysis.markers import rotate_markers
+from loper_analysis.motion.markers import rotate_markers
 from tests.rajagopal_lab import (
     GENERIC_OSIM,
     GRF_MOT,

@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.resampling import (
+from loper_analysis.gait.resampling import (
     PHASE_BOUNDS,
     cut,
     normalise,

@@ -1,4 +1,4 @@
-"""The segment table from any OpenSim model (loper_analysis.segments_from_model) against a hand computation.
+"""The segment table from any OpenSim model (loper_analysis.motion.segments) against a hand computation.
 
 The reference reads the scaled gait2392 ``.osim`` with ``xml.etree`` only:
 body masses, mass centres and inertias, the joints' offset frames and the
@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import read_segments, write_segments
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
-from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
-from loper_analysis.segments_from_model import segments_from_model
+from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
+from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.steps.model import segments_from_model_file
+from loper_analysis.swing_leg.dynamics import read_segments, write_segments
 from tests.gait2392_models import scaled_gait2392
 
 DATA = Path(__file__).parents[1] / "examples" / "gait2392"

@@ -29,11 +29,11 @@ from loper_analysis.identification import (
     prepare_window,
     refit_with_null_pairs,
 )
-from loper_analysis.impedance import IdentificationSettings, impedance_rows
-from loper_analysis.planning import PlanSettings
+from loper_analysis.identification.impedance import IdentificationSettings, impedance_rows
+from loper_analysis.identification.validation import ValidationSettings, validation_settings
+from loper_analysis.planning.precision import PlanSettings
 from loper_analysis.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
-from loper_analysis.validation import ValidationSettings, validation_settings
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

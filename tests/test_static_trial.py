@@ -1,4 +1,4 @@
-"""The static trial as scaling uses it (loper_analysis.static_trial): window, pose, mass and height."""
+"""The static trial as scaling uses it (loper_analysis.motion.static_trial): window, pose, mass and height."""
 
 from __future__ import annotations
 
@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.model import build_lower_body_model
-from loper_analysis.static_trial import (
+from loper_analysis.motion.model import build_lower_body_model
+from loper_analysis.motion.static_trial import (
     HIP_HEIGHT_FRACTION,
     model_height_m,
     scale_window_s,

@@ -1,4 +1,4 @@
-"""loper_analysis.strides on frames: interaction-force metrics per phase, the stride tables of a short trial
+"""loper_analysis.gait.strides on frames: interaction-force metrics per phase, the stride tables of a short trial
 and the per-trial summary, against known answers."""
 
 import numpy as np
@@ -6,7 +6,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
-from loper_analysis.strides import force_phase_metrics, stride_summary, stride_tables
+from loper_analysis.gait.strides import force_phase_metrics, stride_summary, stride_tables
 
 FS = 1000.0
 

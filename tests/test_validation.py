@@ -1,4 +1,4 @@
-"""The validation study (loper_analysis.validation): the impedance grid, chunking, the error summary,
+"""The validation study (loper_analysis.identification.validation): the impedance grid, chunking, the error summary,
 the gathered tables and one small chunk run."""
 
 from __future__ import annotations
@@ -10,9 +10,8 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import JOINTS, PARAMETERS
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
-from loper_analysis.validation import (
+from loper_analysis.identification.validation import (
     CONDITIONS,
     ValidationSettings,
     chunk_combinations,
@@ -21,6 +20,7 @@ from loper_analysis.validation import (
     run_validation_chunk,
     summarize_errors,
 )
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 K_LEVELS = (0.0, 75.0, 150.0)
 D_LEVELS = (0.0, 2.0, 4.0)

@@ -16,8 +16,8 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from .constants import SIDES
-from .errors import LoperInputError
+from loper_analysis.constants import SIDES
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "where",

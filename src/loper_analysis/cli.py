@@ -28,8 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import LoperInputError, one_line
-from .plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
+from loper_analysis.errors import LoperInputError, one_line
+from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
 __all__ = ["main"]
 
@@ -53,13 +53,13 @@ def _walking_direction(args: argparse.Namespace) -> str:
 
 
 def _label_map(path: str | None) -> dict[str, str] | None:
-    from .io.readers import read_label_map
+    from loper_analysis.io.readers import read_label_map
 
     return None if path is None else read_label_map(path)
 
 
 def _markers(args: argparse.Namespace) -> None:
-    from .steps.processing import markers
+    from loper_analysis.steps.processing import markers
 
     gaps = markers(
         args.c3d,
@@ -82,7 +82,7 @@ def _markers(args: argparse.Namespace) -> None:
 
 
 def _grf(args: argparse.Namespace) -> None:
-    from .steps.grf import grf
+    from loper_analysis.steps.grf import grf
 
     table = grf(args.c3d, args.out, _rotation(args, args.c3d), args.threshold_n)
     n_plates = (table.shape[1] - 1) // 9
@@ -104,7 +104,7 @@ def _plates(text: str | None) -> dict[str, int] | None:
 
 
 def _events(args: argparse.Namespace) -> None:
-    from .steps.processing import events
+    from loper_analysis.steps.processing import events
 
     table = events(
         args.c3d,
@@ -122,8 +122,8 @@ def _events(args: argparse.Namespace) -> None:
 
 
 def _scale(args: argparse.Namespace) -> None:
-    from .steps.model import scale_with_setup
-    from .steps.processing import markers
+    from loper_analysis.steps.model import scale_with_setup
+    from loper_analysis.steps.processing import markers
 
     static = c3d = Path(args.static)
     lab_labels = None
@@ -164,7 +164,7 @@ def _scale(args: argparse.Namespace) -> None:
 
 
 def _segments(args: argparse.Namespace) -> None:
-    from .steps.model import anthropometric_segments, segments_from_model_file
+    from loper_analysis.steps.model import anthropometric_segments, segments_from_model_file
 
     if args.model is not None:
         if args.height_m is not None or args.mass_kg is not None:
@@ -178,8 +178,8 @@ def _segments(args: argparse.Namespace) -> None:
 
 
 def _validate(args: argparse.Namespace) -> None:
-    from .steps.validation import validation_chunk
-    from .validation import validation_settings
+    from loper_analysis.identification.validation import validation_settings
+    from loper_analysis.steps.validation import validation_chunk
 
     config, line = _read_config(args)
     print(line)
@@ -193,7 +193,7 @@ def _first_subject(subjects_tsv: str, results: Path) -> str:
     """The first subject of the subject sheet, else the first subject with joint angles under ``results/ik``."""
     sheet = Path(subjects_tsv)
     if sheet.is_file():
-        from .io.readers import read_tsv
+        from loper_analysis.io.readers import read_tsv
 
         names = read_tsv(sheet, "subject sheet", ["subject"], dtype={"subject": str}, comment="#")["subject"]
         if len(names):
@@ -213,7 +213,7 @@ def _read_config(args: argparse.Namespace) -> tuple[dict | None, str]:
     file named twice counts where it was named last. None (and a line saying
     so) when there is neither: the library's defaults serve.
     """
-    from .config_file import DEFAULT_CONFIG, load_config
+    from loper_analysis.config_file import DEFAULT_CONFIG, load_config
 
     named = ([DEFAULT_CONFIG] if DEFAULT_CONFIG.is_file() else []) + [Path(f) for f in args.configfile or []]
     last = {p.resolve(): n for n, p in enumerate(named)}
@@ -237,7 +237,7 @@ def _plan_settings(args: argparse.Namespace, config: dict | None) -> dict:
     ``subjects`` (the subject sheet, config ``subjects``) and
     ``exclude_trials`` (``trials.no_device``).
     """
-    from .steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
+    from loper_analysis.steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
 
     if config is None:
         settings = copy.deepcopy(LIBRARY_PLANNING_SETTINGS)
@@ -268,7 +268,7 @@ def _plan_settings(args: argparse.Namespace, config: dict | None) -> dict:
 
 
 def _plan(args: argparse.Namespace) -> None:
-    from .steps.planning import plan
+    from loper_analysis.steps.planning import plan
 
     config, line = _read_config(args)
     print(line)
@@ -350,7 +350,7 @@ def _plan(args: argparse.Namespace) -> None:
 
 
 def _ik(args: argparse.Namespace) -> None:
-    from .steps.ik import ik_file
+    from loper_analysis.steps.ik import ik_file
 
     result = ik_file(
         args.model,
@@ -377,13 +377,13 @@ def _ik(args: argparse.Namespace) -> None:
 
 
 def _inspect(args: argparse.Namespace) -> None:
-    from .steps.inspect import inspect_c3d
+    from loper_analysis.steps.inspect import inspect_c3d
 
     print(inspect_c3d(args.c3d, args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
 
 
 def _report(args: argparse.Namespace) -> None:
-    from .steps.report import write_report
+    from loper_analysis.steps.report import write_report
 
     target = write_report(args.target, snakemake_args=args.snakemake_args)
     print(f"{target}: report written ({target.stat().st_size / 1e6:.1f} MB)")

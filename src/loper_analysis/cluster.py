@@ -12,7 +12,7 @@ import shutil
 import subprocess
 from collections.abc import Collection, Mapping
 
-from .errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "available_partitions",

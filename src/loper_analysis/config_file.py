@@ -25,8 +25,8 @@ from pathlib import Path
 
 import yaml
 
-from .errors import LoperInputError
-from .schema import check_config, check_yaml_file
+from loper_analysis.errors import LoperInputError
+from loper_analysis.schema import check_config, check_yaml_file
 
 __all__ = ["DEFAULT_CONFIG", "SCHEMA", "find_schema", "load_config", "read_config_file", "shown_path", "update_config"]
 

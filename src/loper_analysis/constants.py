@@ -38,6 +38,7 @@ __all__ = [
     "FLAGGED_EVENTS",
     "CONTACT_FLAGS",
     "PHASES",
+    "LAB_Z_UP",
     "GRAVITY_M_PER_S2",
     "MIN_IK_MARKERS",
     "TRIAL_KINDS",
@@ -70,6 +71,9 @@ CONTACT_FLAGS: tuple[str, ...] = ("ok", "incomplete", "heel_missing", "two_feet"
 #: Normalisation phases: the whole stride (HS -> next HS), stance (HS -> TO), swing (TO -> next HS).
 PHASES: tuple[str, ...] = ("stride", "stance", "swing")
 GRAVITY_M_PER_S2: float = 9.81
+#: Up direction of a Z-up lab (Qualisys, Vicon; what ezc3d assumes), lab frame:
+#: :func:`loper_analysis.motion.markers.lab_up` of ``(-90, 0, 0)``.
+LAB_Z_UP: tuple[float, float, float] = (0.0, 0.0, 1.0)
 #: Fewest weighted markers present in a frame for IK to solve it (three fix one rigid body).
 MIN_IK_MARKERS: int = 3
 #: Kinds of trial, as label maps and spans are keyed (besides the trial's own name).

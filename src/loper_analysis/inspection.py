@@ -6,8 +6,8 @@ records already read (:class:`~loper_analysis.io.c3d.C3DRecording`,
 :class:`~loper_analysis.io.force_platforms.ForcePlatform`) and returns new
 objects; :func:`format_summary` and :func:`format_label_match` turn them
 into plain text and :func:`config_snippet` into YAML. The lab's axes and
-the suggested rotation come from :mod:`loper_analysis.lab_frame`, the
-matching of labels to model markers from :mod:`loper_analysis.label_matching`.
+the suggested rotation come from :mod:`loper_analysis.motion.lab_frame`, the
+matching of labels to model markers from :mod:`loper_analysis.motion.label_matching`.
 
 Marker presence (:func:`marker_presence`)
     A marker is present in a frame when its three coordinates are finite
@@ -19,12 +19,12 @@ Marker presence (:func:`marker_presence`)
 
 Force platforms (:func:`plate_summary`)
     The normal is the right-hand normal of the corners in file order
-    (:func:`loper_analysis.lab_frame.corner_normal`, ``(c3 - c1) x (c4 -
+    (:func:`loper_analysis.motion.lab_frame.corner_normal`, ``(c3 - c1) x (c4 -
     c2)``, unit length): it points down for corners listed clockwise seen
     from above, the order the C3D format gives (its plate z axis points
     down), and up for corners listed counter-clockwise. Either order is
     reported, neither is refused. The resting level is
-    :func:`loper_analysis.ground_reaction.resting_level` of the force along
+    :func:`loper_analysis.gait.grf.resting_level` of the force along
     the lab's upward axis; a plate loaded throughout has none.
 """
 
@@ -39,9 +39,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from .checks import marker_array
-from .errors import LoperInputError
-from .lab_frame import (
+from loper_analysis.checks import marker_array
+from loper_analysis.errors import LoperInputError
+from loper_analysis.motion.lab_frame import (
     AXIS_NAMES,
     VerticalAxis,
     WalkingDirection,
@@ -51,12 +51,12 @@ from .lab_frame import (
     vertical_axis,
     walking_direction,
 )
-from .label_matching import LabelMatch
-from .markers import rotate_markers
+from loper_analysis.motion.label_matching import LabelMatch
+from loper_analysis.motion.markers import rotate_markers
 
 if TYPE_CHECKING:  # records only; nothing is read here
-    from .io.c3d import C3DRecording
-    from .io.force_platforms import ForcePlatform
+    from loper_analysis.io.c3d import C3DRecording
+    from loper_analysis.io.force_platforms import ForcePlatform
 
 __all__ = [
     "MIN_MARKERS_PER_FRAME",
@@ -302,7 +302,7 @@ def plate_summary(plate: ForcePlatform, up_axis: int = 2, up_sign: int = 1, thre
     plate : ForcePlatform
         As :func:`loper_analysis.io.force_platforms.read_force_platforms` returns it (lab frame, SI).
     up_axis, up_sign : int
-        The lab's upward axis and sign (:func:`loper_analysis.lab_frame.vertical_axis`).
+        The lab's upward axis and sign (:func:`loper_analysis.motion.lab_frame.vertical_axis`).
     threshold_n : float
         A sample is loaded when its upward force exceeds the resting level by more than this (N).
 
@@ -315,7 +315,7 @@ def plate_summary(plate: ForcePlatform, up_axis: int = 2, up_sign: int = 1, thre
     LoperInputError
         Corners or forces of the wrong shape.
     """
-    from .ground_reaction import resting_level
+    from loper_analysis.gait.grf import resting_level
 
     corners = np.asarray(plate.corners_m, dtype=float)
     F = np.asarray(plate.force_n, dtype=float)
@@ -385,7 +385,8 @@ def recording_summary(
     plate_problem : str
         Why the platforms could not be read, if so (printed).
     min_travel_m : float
-        Least travel (m) that counts as walking through the lab (:func:`loper_analysis.lab_frame.walking_direction`).
+        Least travel (m) that counts as walking through the lab
+        (:func:`loper_analysis.motion.lab_frame.walking_direction`).
 
     Returns
     -------

@@ -17,7 +17,7 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from .errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["ConfigLayers", "check_config", "check_table", "check_yaml_file", "config_origin"]
 

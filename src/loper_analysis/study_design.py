@@ -17,7 +17,7 @@ import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-from .errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["DEVICE_TESTS", "TRANSPARENCY_CONDITIONS", "TRIAL_CONDITIONS", "StudyDesign", "perturbation_trial_name"]
 

@@ -11,9 +11,9 @@ Walking with the device is compared with walking without it:
 * :func:`transparency_results` - all of it for the pipeline's stride and
   cycle tables, with the study's values beside ours.
 
-The study's figure is :func:`loper_analysis.figures.transparency.transparency_figure`.
+The study's figure is :func:`loper_analysis.report.figures.transparency.transparency_figure`.
 Angles are in rad, forces in N, time in s. Normalised arrays have shape
-(n_strides, n_points[, n_joints]) as produced by :func:`loper_analysis.resampling.cut`.
+(n_strides, n_points[, n_joints]) as produced by :func:`loper_analysis.gait.resampling.cut`.
 """
 
 from __future__ import annotations
@@ -25,12 +25,12 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .constants import JOINTS, angle_column
-from .errors import LoperInputError, TooFewStridesWarning
-from .outliers import MIN_VALID_STRIDES
-from .reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
-from .strides import phase_cycles
-from .study_design import TRANSPARENCY_CONDITIONS
+from loper_analysis.constants import JOINTS, angle_column
+from loper_analysis.errors import LoperInputError, TooFewStridesWarning
+from loper_analysis.gait.outliers import MIN_VALID_STRIDES
+from loper_analysis.gait.strides import phase_cycles
+from loper_analysis.reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
+from loper_analysis.study_design import TRANSPARENCY_CONDITIONS
 
 __all__ = [
     "TRANSPARENCY_PHASES",
@@ -198,7 +198,7 @@ def transparency_table(
     per_subject : mapping
         ``{subject: {"device" | "no_device": {"stance" | "swing": array}}}``;
         each array has shape (n_strides >= 2, n_points, n_joints) in rad,
-        phase-normalised (:func:`loper_analysis.resampling.normalise`); the two
+        phase-normalised (:func:`loper_analysis.gait.resampling.normalise`); the two
         conditions of a subject and phase share ``n_points``.
     joints : sequence of str
         Names of the last axis, in order.
@@ -335,7 +335,7 @@ def transparency_results(
     """Transparency of the device from each subject's stride and cycle tables with and without it.
 
     ``trials``: ``{subject: {"no_device": (strides, cycles), "device": (strides, cycles)}}``,
-    the tables of :func:`loper_analysis.strides.stride_tables` (kept,
+    the tables of :func:`loper_analysis.gait.strides.stride_tables` (kept,
     unperturbed strides count). A subject with fewer than ``min_strides``
     (at least 2) kept strides in either condition is left out of the
     comparison, the group rows and the figure, with a

@@ -26,9 +26,9 @@ import numpy as np
 import pytest
 import yaml
 
-from loper_analysis.clock_sync import clock_map, high_times, rising_edges
+from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
+from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
-from loper_analysis.pulse import find_force_pulses
 from loper_analysis.steps import processing
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 
@@ -65,7 +65,7 @@ def trial(tmp_path_factory):
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.io.c3d_writer import write_recording
     from loper_analysis.io.robot_log import write_robot_log
-    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.trials import (
         LabSettings,
         PerturbationSettings,
@@ -163,9 +163,9 @@ def test_good_records_pass(trial, tmp_path, caplog, log_name):
     numbers before the checks), within 1 ms and 50 ppm of the simulated clocks (12 s: ~14 edges); every flag
     kept, nothing warned."""
     outputs = _outputs(tmp_path)
-    with caplog.at_level(logging.WARNING, logger="loper_analysis.loadcell"):
+    with caplog.at_level(logging.WARNING, logger="loper_analysis.device.loadcell"):
         _, force = _step(trial["raw"] / "pert050-1.c3d", trial["raw"] / log_name, outputs)
-    assert not [r for r in caplog.records if r.name == "loper_analysis.loadcell"]
+    assert not [r for r in caplog.records if r.name == "loper_analysis.device.loadcell"]
     assert all(p.is_file() for p in outputs.values())
     cm = force.attrs["clock_map"]
     assert cm == _edges_only_map(trial["raw"] / "pert050-1.c3d", trial["raw"] / log_name)
@@ -356,10 +356,10 @@ def test_one_missing_flag_is_a_warning(trial, tmp_path, caplog):
     last = np.flatnonzero(np.diff(flag) == 1)[-1] + 1
     flag[last:] = 0
     log = _log_with(trial, tmp_path, "lastflag.loper.tsv", perturbation=flag)
-    with caplog.at_level(logging.WARNING, logger="loper_analysis.loadcell"):
+    with caplog.at_level(logging.WARNING, logger="loper_analysis.device.loadcell"):
         _step(trial["raw"] / "pert050-1.c3d", log, _outputs(tmp_path))
     n = len(trial["walk"].schedule)
-    text = "\n".join(r.getMessage() for r in caplog.records if r.name == "loper_analysis.loadcell")
+    text = "\n".join(r.getMessage() for r in caplog.records if r.name == "loper_analysis.device.loadcell")
     assert f"flags {n - 1} pulse(s)" in text and "1 of them without a flag" in text and str(log) in text
 
 

@@ -16,17 +16,17 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import identify_impedance
-from loper_analysis.impedance import IdentificationSettings, fit_onset, impedance_rows
-from loper_analysis.responses import ResponseSettings
-from loper_analysis.steps.validation import validation_chunk
-from loper_analysis.validation import (
+from loper_analysis.identification.impedance import IdentificationSettings, fit_onset, impedance_rows
+from loper_analysis.identification.validation import (
     ValidationSettings,
     perturbed_trial,
     validation_window,
 )
+from loper_analysis.responses import ResponseSettings
+from loper_analysis.steps.validation import validation_chunk
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.bad_input.fit_trials import ONSET_MS, fit_inputs, walking_trial
 
 PARAMS = segment_parameters_from_anthropometry(1.73, 64.9)

@@ -21,8 +21,8 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import read_model, write_model
-from loper_analysis.kinematics import marker_positions
-from loper_analysis.model import MARKERS, build_lower_body_model
+from loper_analysis.motion.ik import marker_positions
+from loper_analysis.motion.model import MARKERS, build_lower_body_model
 from loper_analysis.steps.ik import ik_chunk, ik_file
 from loper_analysis.steps.model import scale_with_setup, scaled_model
 from loper_analysis.steps.processing import markers as markers_step

@@ -26,9 +26,9 @@ import pytest
 
 from loper_analysis.cli import main as cli_main
 from loper_analysis.errors import LoperInputError
-from loper_analysis.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.robot_log import write_robot_log
+from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.schema import check_yaml_file
 from loper_analysis.steps import processing, report
 from loper_analysis.steps.logs import rule_log

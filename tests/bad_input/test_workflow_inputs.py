@@ -54,7 +54,7 @@ def project(tmp_path_factory) -> Path:
     """The workflow with one recorded subject (8 s of walking) and the results of its first stages."""
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.io.robot_log import write_robot_log
-    from loper_analysis.model import (
+    from loper_analysis.motion.model import (
         build_lower_body_model,
         segment_parameters_from_model,
     )

@@ -8,9 +8,9 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from loper_analysis.figures import pyplot
-from loper_analysis.figures.device import bode_figure, steps_figure
 from loper_analysis.reference import STUDY_DEVICE
+from loper_analysis.report.figures import pyplot
+from loper_analysis.report.figures.device import bode_figure, steps_figure
 
 
 @pytest.fixture

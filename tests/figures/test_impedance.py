@@ -1,4 +1,4 @@
-"""The impedance-study figures (loper_analysis.figures.impedance) and their tables, from small known tables."""
+"""The impedance-study figures (loper_analysis.report.figures.impedance) and their tables, from small known tables."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ from matplotlib.figure import Figure
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.figures import pyplot
-from loper_analysis.figures.impedance import (
+from loper_analysis.report.figures import pyplot
+from loper_analysis.report.figures.impedance import (
     fit_figure,
     impedance_figure,
     impedance_means,

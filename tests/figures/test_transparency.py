@@ -1,11 +1,11 @@
-"""loper_analysis.figures.transparency: the transparency figure, written as a PNG."""
+"""loper_analysis.report.figures.transparency: the transparency figure, written as a PNG."""
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from loper_analysis.figures.transparency import transparency_figure
 from loper_analysis.io.atomic import write_figure
+from loper_analysis.report.figures.transparency import transparency_figure
 
 
 def test_figure_writes_a_png(tmp_path):

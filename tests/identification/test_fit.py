@@ -14,7 +14,7 @@ from loper_analysis.identification import (
     simulate_response,
     variance_accounted_for,
 )
-from loper_analysis.validation import perturbed_trial
+from loper_analysis.identification.validation import perturbed_trial
 from tests.identification.validation_windows import (
     MID_TRUTH,
     PARAMS,

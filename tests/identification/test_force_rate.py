@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from loper_analysis.device.pulse import pulse_force, second_order_parameters, step_response
 from loper_analysis.identification import (
     identify_impedance,
     per_step,
@@ -13,8 +14,7 @@ from loper_analysis.identification import (
     stage_force_means,
     step_stage_forces,
 )
-from loper_analysis.pulse import pulse_force, second_order_parameters, step_response
-from loper_analysis.validation import validation_pulse
+from loper_analysis.identification.validation import validation_pulse
 from tests.identification.validation_windows import PARAMS, SETTINGS, expect_error, mid_trial, window_for
 
 
@@ -149,7 +149,7 @@ def test_identification_from_1_khz_force_beats_128_hz_samples(truth):
     0.0005 N·m·s/rad from the pulse's 1 kHz samples (measured: <= 0.0002 and <= 0.00001); from its 128 Hz
     samples, joined by straight lines, the largest hip/knee error is more than 20 times that (measured:
     0.016 / 0.0065 at the middle truth, 0.13 / 0.017 at the stiff one)."""
-    from loper_analysis.validation import perturbed_trial
+    from loper_analysis.identification.validation import perturbed_trial
 
     truth = np.asarray(truth)
     trial = perturbed_trial(PARAMS, truth, SETTINGS)

@@ -7,7 +7,6 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
     DEFAULT_LOWER,
@@ -17,11 +16,12 @@ from loper_analysis.identification import (
     starts_at_best,
 )
 from loper_analysis.identification.fit import ResidualBatch, multistart_lm
-from loper_analysis.validation import (
+from loper_analysis.identification.validation import (
     ValidationSettings,
     perturbed_trial,
     validation_window,
 )
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 TRUTH = np.array([60.0, 3.0, 2.0, 0.1, 8.0, 0.3])
 

@@ -1,8 +1,8 @@
 """Shared inputs of the identification tests: validation trials with a known impedance and their windows.
 
-The "measured" data come from :func:`loper_analysis.validation.perturbed_trial`
+The "measured" data come from :func:`loper_analysis.identification.validation.perturbed_trial`
 (fine-step RK4 of the same model with a known impedance), prepared the way
-:func:`loper_analysis.validation.run_validation_chunk` does it.
+:func:`loper_analysis.identification.validation.run_validation_chunk` does it.
 """
 
 from __future__ import annotations
@@ -11,14 +11,14 @@ from functools import cache
 
 import numpy as np
 
-from loper_analysis.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.identification import identify_impedance
-from loper_analysis.validation import (
+from loper_analysis.identification.validation import (
     ValidationSettings,
     perturbed_trial,
     validation_window,
     with_pulse_at_stages,
 )
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 PARAMS = segment_parameters_from_anthropometry(1.73, 64.9)
 SETTINGS = ValidationSettings()

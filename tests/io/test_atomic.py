@@ -15,7 +15,6 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.figures import pyplot
 from loper_analysis.io.atomic import (
     staged,
     write_bytes,
@@ -28,6 +27,7 @@ from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import write_mot, write_trc
 from loper_analysis.io.osim import write_model
 from loper_analysis.io.robot_log import write_robot_log
+from loper_analysis.report.figures import pyplot
 from loper_analysis.steps.logs import rule_log
 
 

@@ -5,17 +5,17 @@ import numpy as np
 import pytest
 
 from loper_analysis.constants import JOINTS
-from loper_analysis.dynamics import (
-    segment_coordinates,
-    segment_parameters_from_anthropometry,
-)
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
+from loper_analysis.gait.resampling import window_times_s
 from loper_analysis.identification import prepare_window
-from loper_analysis.resampling import window_times_s
 from loper_analysis.responses import (
     COUNT_COLUMNS,
     ResponseSettings,
     subject_onset_response,
+)
+from loper_analysis.swing_leg.dynamics import (
+    segment_coordinates,
+    segment_parameters_from_anthropometry,
 )
 from tests.responses.twin_strides import (
     BUMP_AMP,

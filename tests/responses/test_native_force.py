@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.resampling import window_times_s
+from loper_analysis.gait.resampling import window_times_s
 from loper_analysis.responses import ResponseSettings, subject_onset_response
 from tests.responses.twin_strides import twin_trial
 

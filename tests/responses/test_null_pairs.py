@@ -4,15 +4,15 @@
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import joint_angles
 from loper_analysis.errors import LoperInputError
-from loper_analysis.resampling import window_times_s
+from loper_analysis.gait.resampling import window_times_s
 from loper_analysis.responses import (
     ResponseSettings,
     deviant_trials,
     null_pair_windows,
     trial_deviation_rad,
 )
+from loper_analysis.swing_leg.dynamics import joint_angles
 from tests.responses.twin_strides import DELAY, RATE, null_trial, twin_trial
 
 

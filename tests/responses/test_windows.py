@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.resampling import window_times_s
+from loper_analysis.gait.resampling import window_times_s
 from loper_analysis.responses import match_unperturbed, paired_windows, window_outliers
 from tests.responses.twin_strides import (
     BUMP_AMP,

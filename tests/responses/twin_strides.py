@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import JOINTS
-from loper_analysis.dynamics import segment_coordinates
+from loper_analysis.swing_leg.dynamics import segment_coordinates
 from loper_analysis.synthetic.response import thigh_normal
 
 RATE = 128.0

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.ground_reaction import external_loads_columns, plate_vertical_loads
+from loper_analysis.gait.grf import external_loads_columns, plate_vertical_loads
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.steps.grf import grf
 from tests.io.force_plate_files import (

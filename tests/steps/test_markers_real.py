@@ -20,7 +20,7 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers
 from loper_analysis.io.osim import quiet_opensim
-from loper_analysis.markers import GAP_REPORT_COLUMNS, GAP_SUMMARY_COLUMNS
+from loper_analysis.motion.markers import GAP_REPORT_COLUMNS, GAP_SUMMARY_COLUMNS
 from loper_analysis.steps.processing import TRIAL_MARKER_COLUMNS, markers
 
 DATA = Path(__file__).parents[1] / "data" / "opensim-core"

@@ -5,11 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from loper_analysis.dynamics import read_segments, segment_parameters_from_anthropometry
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
-from loper_analysis.kinematics import marker_positions, markers_table
-from loper_analysis.model import (
+from loper_analysis.motion.ik import marker_positions, markers_table
+from loper_analysis.motion.model import (
     MARKERS,
     build_lower_body_model,
     segment_parameters_from_model,
@@ -18,6 +17,7 @@ from loper_analysis.steps.model import (
     scaled_model,
     segments_from_model_file,
 )
+from loper_analysis.swing_leg.dynamics import read_segments, segment_parameters_from_anthropometry
 
 
 @pytest.fixture(scope="module")

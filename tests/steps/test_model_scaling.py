@@ -20,8 +20,8 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.io.osim import quiet_opensim, read_model
-from loper_analysis.kinematics import marker_positions
-from loper_analysis.segments_from_model import segments_from_model
+from loper_analysis.motion.ik import marker_positions
+from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.steps.model import scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 

@@ -16,8 +16,8 @@ from loper_analysis.errors import LoperInputError, TooFewStridesWarning
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.io.robot_log import write_robot_log
-from loper_analysis.kinematics import joint_angle_table
-from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+from loper_analysis.motion.ik import joint_angle_table
+from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.steps import ik, model, processing, transparency
 from loper_analysis.synthetic.trials import (
     LabSettings,

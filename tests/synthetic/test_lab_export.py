@@ -9,13 +9,13 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from loper_analysis.device.loadcell import robot_log_on_mocap_frames
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.io.robot_log_mat import read_robot_log_mat
-from loper_analysis.kinematics import inverse_kinematics, marker_positions
-from loper_analysis.loadcell import robot_log_on_mocap_frames
-from loper_analysis.markers import rotate_markers
-from loper_analysis.model import build_lower_body_model
+from loper_analysis.motion.ik import inverse_kinematics, marker_positions
+from loper_analysis.motion.markers import rotate_markers
+from loper_analysis.motion.model import build_lower_body_model
 from loper_analysis.steps.synthetic import lab_export_session
 from loper_analysis.synthetic.lab_export import (
     GAIT2392_COORDINATES,

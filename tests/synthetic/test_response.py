@@ -8,7 +8,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.device.controller import DeviceParameters
-from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.synthetic.response import (
     perturbation_schedule,
     pulse_train,
@@ -108,8 +108,8 @@ def test_responses_look_like_the_study(trial):
 
 def test_identification_recovers_the_truth_from_the_simulated_swing(trial, params):
     """The response at the 128 Hz frames, identified with the measured forces: the lab and the fit agree."""
-    from loper_analysis.dynamics import segment_coordinates
     from loper_analysis.identification import identify_impedance, prepare_window
+    from loper_analysis.swing_leg.dynamics import segment_coordinates
 
     free = simulate_walking_trial(40.0, LAB, 5, 1.73, params, 0.03, 0.05, DeviceParameters(), None)
     row = trial.schedule.iloc[2]

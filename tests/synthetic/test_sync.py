@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from loper_analysis.clock_sync import rising_edges
+from loper_analysis.device.clock_sync import rising_edges
 from loper_analysis.errors import LoperInputError
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 

@@ -15,8 +15,8 @@ import yaml
 
 from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.resampling import cut
 from loper_analysis.reference import STUDY_TRANSPARENCY_RAD
-from loper_analysis.resampling import cut
 from loper_analysis.synthetic.gait_curves import CURVE_JOINTS, NominalGait
 from loper_analysis.synthetic.variability import (
     DeviceAdaptation,
@@ -143,7 +143,7 @@ def test_walking_with_the_device_differs_as_in_the_study():
     swing leg, true kinematics): in the study's 0.017-0.071 rad, below ISV_ave and within a factor 1.5 of the
     study's value per joint and phase."""
     from loper_analysis.device.controller import DeviceParameters
-    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.trials import LabSettings, simulate_walking_trial
 
     a = SYNTH["device_adaptation"]
@@ -182,7 +182,7 @@ def test_pulse_response_rides_on_top_of_the_minimal_impedance_response():
     """Superposition: the swing's answer to the whole force (minimal impedance + pulse) equals the answer to the
     minimal-impedance force plus the pulse response of the gentle lab, within 3 % of the pulse response."""
     from loper_analysis.device.controller import DeviceParameters
-    from loper_analysis.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.response import pulse_train, swing_response, swing_responses, swing_spans
     from loper_analysis.synthetic.trials import LabSettings, simulate_walking_trial
 

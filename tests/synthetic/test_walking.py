@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.model import COORDINATES
+from loper_analysis.motion.model import COORDINATES
 from loper_analysis.synthetic.gait_curves import NominalGait
 from loper_analysis.synthetic.walking import (
     TRUE_EVENT_COLUMNS,
@@ -156,8 +156,8 @@ def test_same_seed_same_trial_other_seed_other_trial():
 
 
 def test_feet_on_the_floor_in_opensim():
-    from loper_analysis.kinematics import marker_positions
-    from loper_analysis.model import build_lower_body_model
+    from loper_analysis.motion.ik import marker_positions
+    from loper_analysis.motion.model import build_lower_body_model
 
     height = 1.75
     coords, events = walking_kinematics(

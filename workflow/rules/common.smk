@@ -17,7 +17,7 @@ from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatche
 from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.steps.planning import planning_settings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
-from loper_analysis.validation import validation_settings
+from loper_analysis.identification.validation import validation_settings
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"

@@ -14,9 +14,9 @@ import numpy as np
 import pandas as pd
 from scipy.signal import coherence, csd, welch
 
-from ..checks import finite_vector, positive
-from ..errors import LoperInputError
-from ..reference import STUDY_DEVICE
+from loper_analysis.checks import finite_vector, positive
+from loper_analysis.errors import LoperInputError
+from loper_analysis.reference import STUDY_DEVICE
 
 __all__ = [
     "frequency_response",

@@ -50,7 +50,7 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "DeviceParameters",

@@ -19,8 +19,8 @@ import numpy as np
 import pandas as pd
 from scipy.signal import butter, sosfilt
 
-from ..errors import LoperInputError
-from .controller import DeviceParameters, FreeLeg, simulate_device
+from loper_analysis.device.controller import DeviceParameters, FreeLeg, simulate_device
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "DeviceTestSettings",

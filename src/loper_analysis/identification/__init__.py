@@ -21,10 +21,12 @@
 Beyond the study, :mod:`.null_pairs` weights the prediction error by the
 stride-to-stride deviation that null pairs show, and :mod:`.status` judges
 each joint's fit (convergence, VAF floor, bounds, the information in the
-intervals), whose ends :mod:`.intervals` forms.
+intervals), whose ends :mod:`.intervals` forms. :mod:`.impedance` fits each subject's
+mean response per onset and aggregates the fits; :mod:`.validation` is the
+synthetic validation study of the whole identification.
 """
 
-from .fit import (
+from loper_analysis.identification.fit import (
     AT_BEST_RELATIVE,
     DAMPING_BOUNDS_NMS_PER_RAD,
     DEFAULT_LOWER,
@@ -40,8 +42,8 @@ from .fit import (
     starts_at_best,
     variance_accounted_for,
 )
-from .intervals import CI_LEVEL, bounded_interval, t_quantile
-from .null_pairs import (
+from loper_analysis.identification.intervals import CI_LEVEL, bounded_interval, t_quantile
+from loper_analysis.identification.null_pairs import (
     MIN_NULL_PAIRS,
     NULL_PAIR_COMPONENTS,
     NullPairFit,
@@ -50,7 +52,7 @@ from .null_pairs import (
     null_pair_errors,
     refit_with_null_pairs,
 )
-from .status import (
+from loper_analysis.identification.status import (
     AT_BOUND_FRACTION,
     DEFAULT_PLAUSIBLE_RANGES,
     MAX_CI_FRACTION,
@@ -58,7 +60,7 @@ from .status import (
     check_plausible_range,
     joint_status,
 )
-from .window import (
+from loper_analysis.identification.window import (
     INITIAL_STATE_DEGREE,
     INITIAL_STATE_SPAN_S,
     N_SUBSTEPS,

@@ -30,10 +30,10 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..constants import PARAMETERS
-from ..errors import LoperInputError
-from .intervals import bounded_interval, sandwich_covariance
-from .window import PreparedWindow, prediction_error, simulate_response
+from loper_analysis.constants import PARAMETERS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.identification.intervals import bounded_interval, sandwich_covariance
+from loper_analysis.identification.window import PreparedWindow, prediction_error, simulate_response
 
 __all__ = [
     "DEFAULT_LOWER",

@@ -23,7 +23,7 @@ from scipy.special import (
     stdtrit,  # Student's t quantile (what scipy.stats.t.ppf calls; scipy.stats costs ~0.5 s to import)
 )
 
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["CI_LEVEL", "t_quantile", "bounded_interval", "sandwich_covariance"]
 

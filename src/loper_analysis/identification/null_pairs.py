@@ -20,9 +20,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..dynamics import joint_angles
-from ..errors import LoperInputError
-from .fit import (
+from loper_analysis.errors import LoperInputError
+from loper_analysis.identification.fit import (
     DEFAULT_LOWER,
     DEFAULT_UPPER,
     ImpedanceFit,
@@ -30,8 +29,9 @@ from .fit import (
     initial_state_jacobian,
     response_jacobian,
 )
-from .intervals import bounded_interval
-from .window import PreparedWindow, initial_state_basis
+from loper_analysis.identification.intervals import bounded_interval
+from loper_analysis.identification.window import PreparedWindow, initial_state_basis
+from loper_analysis.swing_leg.dynamics import joint_angles
 
 __all__ = [
     "NULL_PAIR_COMPONENTS",

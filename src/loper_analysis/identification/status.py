@@ -29,8 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import LoperInputError
-from ..reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANCE
+from loper_analysis.errors import LoperInputError
+from loper_analysis.reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANCE
 
 __all__ = [
     "MIN_VAF_PCT",

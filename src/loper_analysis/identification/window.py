@@ -17,10 +17,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from .. import kernels
-from ..checks import finite_rows
-from ..dynamics import SegmentParameters, inverse_dynamics, joint_angles
-from ..errors import LoperInputError
+from loper_analysis.checks import finite_rows
+from loper_analysis.errors import LoperInputError
+from loper_analysis.responses.windows import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
+from loper_analysis.swing_leg import kernels
+from loper_analysis.swing_leg.dynamics import SegmentParameters, inverse_dynamics, joint_angles
 
 __all__ = [
     "WINDOW_BEFORE_S",
@@ -41,14 +42,9 @@ __all__ = [
     "prediction_error",
 ]
 
-# Defaults of the fit window and its initial state (config ``identification.*``, the same values): every default
-# of these settings in the library (responses, identification, validation, impedance) refers to these.
-#: The fit window starts this long before the perturbation onset (s; ``identification.window_before_s``) ...
-WINDOW_BEFORE_S: float = 0.025
-#: ... and ends this long after it (s; ``identification.window_after_s``).
-WINDOW_AFTER_S: float = 0.25
-#: Pre-onset span of the initial-state polynomial (s; ``identification.initial_state_span_s``).
-INITIAL_STATE_SPAN_S: float = 0.1
+# Defaults of the fit's initial state and integration (config ``identification.*``, the same values); the
+# window's span (WINDOW_BEFORE_S, WINDOW_AFTER_S, INITIAL_STATE_SPAN_S) is the responses' own
+# (:mod:`loper_analysis.responses.windows`): the fit covers the window the responses were cut to.
 #: Degree of that polynomial (1: position and rate; ``identification.initial_state_degree``).
 INITIAL_STATE_DEGREE: int = 1
 #: RK4 steps per sample of the data (``identification.n_substeps``).
@@ -412,7 +408,7 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
     """Model coordinate deviations perturbed - unperturbed (B, n_out, 4) at the window's samples (m, rad).
 
     ``impedance_sets``: (B, 6) in the order of :data:`~loper_analysis.constants.PARAMETERS`;
-    one batch of the compiled RK4 (:func:`loper_analysis.kernels.simulate_deviation_batch`).
+    one batch of the compiled RK4 (:func:`loper_analysis.swing_leg.kernels.simulate_deviation_batch`).
     """
     sets = np.ascontiguousarray(np.asarray(impedance_sets, dtype=float))
     if sets.ndim != 2 or sets.shape[1] != 6 or not np.all(np.isfinite(sets)):

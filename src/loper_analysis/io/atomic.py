@@ -27,8 +27,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from ..errors import LoperInputError
-from .timing import io_clock
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.timing import io_clock
 
 __all__ = [
     "PathLike",

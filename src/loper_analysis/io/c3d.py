@@ -56,15 +56,15 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import LoperInputError
-from .c3d_parameters import (
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d_parameters import (
     EVENT_COLUMNS,
     param_float,
     param_strings,
     param_value,
     read_events,
 )
-from .timing import library_import, timed_io
+from loper_analysis.io.timing import library_import, timed_io
 
 __all__ = [
     "LENGTH_UNITS_PER_M",

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["read_parameter", "force_platforms_used"]
 

@@ -23,7 +23,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "EVENT_COLUMNS",

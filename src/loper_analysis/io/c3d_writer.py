@@ -28,10 +28,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..checks import integer, positive, unique_names
-from ..errors import LoperInputError
-from .atomic import staged
-from .c3d import LENGTH_UNITS_PER_M, C3DRecording, rate_ratio
+from loper_analysis.checks import integer, positive, unique_names
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import staged
+from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, C3DRecording, rate_ratio
 
 __all__ = ["MAX_ANALOG_OFFSET", "MAX_LABEL_CHARS", "ForcePlatform", "write_c3d", "write_recording"]
 

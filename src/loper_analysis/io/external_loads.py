@@ -20,10 +20,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import LoperInputError
-from .atomic import staged
-from .opensim_tables import storage_columns, write_storage
-from .osim import quiet_opensim
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import staged
+from loper_analysis.io.opensim_tables import storage_columns, write_storage
+from loper_analysis.io.osim import quiet_opensim
 
 __all__ = ["write_external_loads_mot", "write_external_loads_xml"]
 
@@ -39,7 +39,7 @@ def write_external_loads_mot(path: str | os.PathLike, frame: pd.DataFrame) -> Pa
         Column ``time_s`` (s, finite, strictly increasing, >= 1 row) and the
         load columns, written as they are (no unit conversion): force in N,
         point in m, torque in N·m, e.g. ``1_ground_force_vx`` ...
-        ``1_ground_torque_z`` (:func:`loper_analysis.ground_reaction.external_loads_table`).
+        ``1_ground_torque_z`` (:func:`loper_analysis.gait.grf.external_loads_table`).
         The file's time column is named ``time``; NaN is written as ``nan``.
 
     Raises

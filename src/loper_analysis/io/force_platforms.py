@@ -70,10 +70,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import LoperInputError
-from ..markers import LAB_Z_UP
-from .c3d import LENGTH_UNITS_PER_M
-from .timing import library_import
+from loper_analysis.constants import LAB_Z_UP
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d import LENGTH_UNITS_PER_M
+from loper_analysis.io.timing import library_import
 
 __all__ = [
     "CALIBRATED_TYPES",
@@ -426,7 +426,7 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
         The ``.c3d`` file.
     up : array_like, optional
         Shape (3,): the lab's up direction, lab frame (normalised here); None:
-        lab +Z (:data:`loper_analysis.markers.LAB_Z_UP`). It decides which
+        lab +Z (:data:`loper_analysis.constants.LAB_Z_UP`). It decides which
         plates list their corners the other way round (module notes).
 
     Returns

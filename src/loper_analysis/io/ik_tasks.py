@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..errors import LoperInputError
-from .osim import quiet_opensim
-from .timing import timed_io
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.osim import quiet_opensim
+from loper_analysis.io.timing import timed_io
 
 __all__ = ["read_ik_tasks", "task_set_tasks"]
 

@@ -48,12 +48,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..checks import time_vector, uniform_step_s, unique_names
-from ..errors import LoperInputError
-from .atomic import staged
-from .c3d import LENGTH_UNITS_PER_M, read_c3d
-from .osim import quiet_opensim
-from .timing import timed_io
+from loper_analysis.checks import time_vector, uniform_step_s, unique_names
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import staged
+from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, read_c3d
+from loper_analysis.io.osim import quiet_opensim
+from loper_analysis.io.timing import timed_io
 
 __all__ = [
     "TRANSLATION_SUFFIXES",

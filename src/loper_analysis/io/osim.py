@@ -6,9 +6,9 @@ import os
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-from ..errors import LoperInputError
-from .atomic import staged
-from .timing import library_import, timed_io
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import staged
+from loper_analysis.io.timing import library_import, timed_io
 
 __all__ = ["quiet_opensim", "read_model", "model_source", "write_model", "read_scale_setup", "read_marker_set"]
 

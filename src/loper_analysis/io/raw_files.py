@@ -13,7 +13,7 @@ import os
 from collections.abc import Iterable
 from pathlib import Path
 
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["RAW_SUFFIXES", "raw_file_present", "unmatched_raw_files"]
 

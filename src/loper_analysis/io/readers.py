@@ -9,8 +9,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from ..errors import LoperInputError
-from .timing import timed_io
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.timing import timed_io
 
 __all__ = ["read_bytes", "read_label_map", "read_tsv", "read_yaml"]
 

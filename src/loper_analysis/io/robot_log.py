@@ -52,10 +52,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..checks import positive
-from ..errors import LoperInputError
-from .atomic import write_bytes
-from .timing import timed_io
+from loper_analysis.checks import positive
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import write_bytes
+from loper_analysis.io.timing import timed_io
 
 __all__ = [
     "FORMAT_NAME",

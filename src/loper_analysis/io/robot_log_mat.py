@@ -12,11 +12,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..checks import positive
-from ..errors import LoperInputError
-from .atomic import write_bytes
-from .robot_log import COLUMNS, FORMAT_NAME, validated_log
-from .timing import timed_io
+from loper_analysis.checks import positive
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import write_bytes
+from loper_analysis.io.robot_log import COLUMNS, FORMAT_NAME, validated_log
+from loper_analysis.io.timing import timed_io
 
 __all__ = ["MAT_HEADER_TEXT", "MAT_OPTIONAL", "read_robot_log_mat", "write_robot_log_mat"]
 

@@ -1,9 +1,9 @@
 """The segment table of the swing-leg model (``results/model/{subject}/segments.tsv``): TSV, 10 significant digits.
 
 One row per segment (cart, thigh, shank, foot), the columns of
-:meth:`loper_analysis.dynamics.SegmentParameters.to_frame`; the typed reader
-and writer are :func:`loper_analysis.dynamics.read_segments` and
-:func:`loper_analysis.dynamics.write_segments`.
+:meth:`loper_analysis.swing_leg.dynamics.SegmentParameters.to_frame`; the typed reader
+and writer are :func:`loper_analysis.swing_leg.dynamics.read_segments` and
+:func:`loper_analysis.swing_leg.dynamics.write_segments`.
 """
 
 from __future__ import annotations
@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from .atomic import write_tsv
-from .readers import read_tsv
+from loper_analysis.io.atomic import write_tsv
+from loper_analysis.io.readers import read_tsv
 
 __all__ = ["SEGMENT_FLOAT_FORMAT", "read_segment_table", "write_segment_table"]
 

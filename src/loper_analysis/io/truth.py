@@ -14,9 +14,9 @@ import os
 from collections.abc import Mapping
 from pathlib import Path
 
-from ..errors import LoperInputError
-from .atomic import write_yaml
-from .readers import read_yaml
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import write_yaml
+from loper_analysis.io.readers import read_yaml
 
 __all__ = ["TRUTH_HEADER", "truth_document", "truth_from_document", "write_truth", "read_truth"]
 

@@ -38,15 +38,15 @@ Conventions
   samples (NaN elsewhere, e.g. forces outside the robot log, is allowed).
 """
 
-from .average import COUNT_COLUMNS, subject_onset_response
-from .matching import MATCH_COLUMNS, match_unperturbed, too_short
-from .null_pairs import (
+from loper_analysis.responses.average import COUNT_COLUMNS, subject_onset_response
+from loper_analysis.responses.matching import MATCH_COLUMNS, match_unperturbed, too_short
+from loper_analysis.responses.null_pairs import (
     MAX_TRIAL_DEVIATION_RATIO,
     deviant_trials,
     null_pair_windows,
     trial_deviation_rad,
 )
-from .windows import (
+from loper_analysis.responses.windows import (
     MIN_PAIRS_FOR_OUTLIERS,
     ResponseSettings,
     analysis_grid,

@@ -12,17 +12,17 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from ..checks import bool_column, number, where
-from ..constants import JOINTS
-from ..dynamics import segment_coordinates
-from ..errors import LoperInputError
-from ..outliers import check_enough_strides
-from ..resampling import window_times_s
-from .inputs import trial_angles, trial_name, trial_table
-from .matching import match_unperturbed, stride_table, too_short
-from .native_force import native_force_rate_hz, native_force_windows
-from .sampling import TIME_TOLERANCE_S
-from .windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
+from loper_analysis.checks import bool_column, number, where
+from loper_analysis.constants import JOINTS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.outliers import check_enough_strides
+from loper_analysis.gait.resampling import window_times_s
+from loper_analysis.responses.inputs import trial_angles, trial_name, trial_table
+from loper_analysis.responses.matching import match_unperturbed, stride_table, too_short
+from loper_analysis.responses.native_force import native_force_rate_hz, native_force_windows
+from loper_analysis.responses.sampling import TIME_TOLERANCE_S
+from loper_analysis.responses.windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
+from loper_analysis.swing_leg.dynamics import segment_coordinates
 
 __all__ = ["COUNT_COLUMNS", "mean_and_sd", "subject_onset_response"]
 
@@ -150,7 +150,7 @@ def subject_onset_response(
         :func:`loper_analysis.identification.prepare_window`: ``time_s``
         (n_grid,), ``onset_s`` (0.0), ``q_unperturbed`` / ``q_perturbed``
         (n_grid, 4): [pelvis_x (m), thigh, shank, foot (rad)] from
-        :func:`loper_analysis.dynamics.segment_coordinates`,
+        :func:`loper_analysis.swing_leg.dynamics.segment_coordinates`,
         ``pelvis_angle_unperturbed_rad`` / ``pelvis_angle_perturbed_rad``
         (n_grid,), ``force_unperturbed_n`` / ``force_perturbed_n`` (n_grid, 2):
         ``force_measured_n * force_direction`` (N, world x/y). When the trials

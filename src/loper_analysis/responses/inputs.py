@@ -2,7 +2,7 @@
 
 A trial is a mapping with ``name`` (str), ``angles`` (DataFrame: ``time_s``,
 ``pelvis_x_m``, ``pelvis_angle_rad``, ``{hip,knee,ankle}_<side>_rad``),
-``strides`` (stride table of ``side``, :func:`loper_analysis.strides.stride_tables`)
+``strides`` (stride table of ``side``, :func:`loper_analysis.gait.strides.stride_tables`)
 and, for perturbed trials, ``force`` (``time_s``, ``force_measured_n``) and
 ``force_direction`` (array (n_frames, 2), unit vectors of the rod force).
 """
@@ -14,9 +14,9 @@ from collections.abc import Mapping
 import numpy as np
 import pandas as pd
 
-from ..checks import require_columns, time_vector
-from ..constants import JOINTS, angle_column
-from ..errors import LoperInputError
+from loper_analysis.checks import require_columns, time_vector
+from loper_analysis.constants import JOINTS, angle_column
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["trial_name", "trial_table", "trial_angles"]
 

@@ -18,10 +18,10 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from ..checks import bool_column, number, require_columns, signal, time_vector, where
-from ..errors import LoperInputError
-from ..identification.window import WINDOW_AFTER_S, WINDOW_BEFORE_S
-from .sampling import TIME_TOLERANCE_S, SplineSampler, window_span
+from loper_analysis.checks import bool_column, number, require_columns, signal, time_vector, where
+from loper_analysis.errors import LoperInputError
+from loper_analysis.responses.sampling import TIME_TOLERANCE_S, SplineSampler, window_span
+from loper_analysis.responses.windows import WINDOW_AFTER_S, WINDOW_BEFORE_S
 
 __all__ = ["MATCH_COLUMNS", "STRIDE_TABLE_COLUMNS", "stride_table", "too_short", "match_unperturbed"]
 
@@ -35,7 +35,7 @@ MATCH_COLUMNS: tuple[str, ...] = (
     "rmsd_rad",
     "n_candidates",
 )
-#: Stride-table columns a response needs (:func:`loper_analysis.strides.stride_tables`).
+#: Stride-table columns a response needs (:func:`loper_analysis.gait.strides.stride_tables`).
 STRIDE_TABLE_COLUMNS: tuple[str, ...] = ("stride", "toe_off_s", "swing_s", "perturbed", "onset_s")
 
 
@@ -83,7 +83,7 @@ def too_short(
     Parameters
     ----------
     strides : pandas.DataFrame
-        Stride table (:func:`loper_analysis.strides.stride_tables`): columns
+        Stride table (:func:`loper_analysis.gait.strides.stride_tables`): columns
         ``stride``, ``toe_off_s``, ``swing_s``, ``perturbed`` (bool) and
         ``onset_s`` (s, absolute; finite for perturbed strides).
     onset_after_toe_off_s : float, optional

@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..checks import require_columns, where
-from ..errors import LoperInputError
-from ..resampling import window_times_s
+from loper_analysis.checks import require_columns, where
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.resampling import window_times_s
 
 __all__ = ["native_force_rate_hz", "native_force_windows"]
 
@@ -55,7 +55,7 @@ def native_force_windows(
     Returns
     -------
     (perturbed, unperturbed), each (n_pairs, n_grid, 2) in N on the grid
-    ``loper_analysis.resampling.window_times_s(-start_s, end_s, rate_hz)``.
+    ``loper_analysis.gait.resampling.window_times_s(-start_s, end_s, rate_hz)``.
 
     Raises
     ------

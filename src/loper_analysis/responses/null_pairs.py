@@ -12,14 +12,14 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..checks import number, where
-from ..constants import JOINTS
-from ..dynamics import segment_coordinates
-from ..errors import LoperInputError
-from .inputs import trial_angles, trial_name, trial_table
-from .matching import match_unperturbed
-from .sampling import TIME_TOLERANCE_S
-from .windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
+from loper_analysis.checks import number, where
+from loper_analysis.constants import JOINTS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.responses.inputs import trial_angles, trial_name, trial_table
+from loper_analysis.responses.matching import match_unperturbed
+from loper_analysis.responses.sampling import TIME_TOLERANCE_S
+from loper_analysis.responses.windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
+from loper_analysis.swing_leg.dynamics import segment_coordinates
 
 __all__ = ["MAX_TRIAL_DEVIATION_RATIO", "null_pair_windows", "trial_deviation_rad", "deviant_trials"]
 

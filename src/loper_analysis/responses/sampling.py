@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ..checks import number, where
-from ..errors import LoperInputError
+from loper_analysis.checks import number, where
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["TIME_TOLERANCE_S", "SplineSampler", "window_span"]
 

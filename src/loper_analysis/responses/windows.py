@@ -13,23 +13,40 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..checks import number, signal, time_vector, where
-from ..constants import JOINTS, SIDES
-from ..errors import LoperInputError
-from ..identification.window import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
-from ..outliers import (
+from loper_analysis.checks import number, signal, time_vector, where
+from loper_analysis.constants import JOINTS, SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.outliers import (
     IQR_WHISKER,
     MAX_OUTLIER_FRACTION,
     MIN_STRIDES_FOR_OUTLIERS,
     MIN_VALID_STRIDES,
     iqr_outliers,
 )
-from ..resampling import window, window_times_s
-from .sampling import TIME_TOLERANCE_S, SplineSampler, window_span
+from loper_analysis.gait.resampling import window, window_times_s
+from loper_analysis.responses.sampling import TIME_TOLERANCE_S, SplineSampler, window_span
 
-__all__ = ["MIN_PAIRS_FOR_OUTLIERS", "ResponseSettings", "analysis_grid", "paired_windows", "window_outliers"]
+__all__ = [
+    "INITIAL_STATE_SPAN_S",
+    "WINDOW_AFTER_S",
+    "WINDOW_BEFORE_S",
+    "MIN_PAIRS_FOR_OUTLIERS",
+    "ResponseSettings",
+    "analysis_grid",
+    "paired_windows",
+    "window_outliers",
+]
 
-#: Fewest pairs the IQR rule judges (:func:`loper_analysis.outliers.iqr_outliers`); fewer are all kept.
+# The analysis window around each onset (config ``identification.*``, the same values): every default of these
+# settings in the library (responses, identification, validation, impedance) refers to these.
+#: The window starts this long before the perturbation onset (s; ``identification.window_before_s``) ...
+WINDOW_BEFORE_S: float = 0.025
+#: ... and ends this long after it (s; ``identification.window_after_s``).
+WINDOW_AFTER_S: float = 0.25
+#: Pre-onset span of the fit's initial-state polynomial (s; ``identification.initial_state_span_s``).
+INITIAL_STATE_SPAN_S: float = 0.1
+
+#: Fewest pairs the IQR rule judges (:func:`loper_analysis.gait.outliers.iqr_outliers`); fewer are all kept.
 MIN_PAIRS_FOR_OUTLIERS: int = MIN_STRIDES_FOR_OUTLIERS
 
 
@@ -59,7 +76,7 @@ def analysis_grid(trials, onset_ms, settings: ResponseSettings, side: str, sourc
 
     Returns the onset after toe-off (s), ``before``, ``after`` and the
     initial-state span (s), the window start relative to the onset (s) and
-    the relative time grid (s, :func:`loper_analysis.resampling.window_times_s`).
+    the relative time grid (s, :func:`loper_analysis.gait.resampling.window_times_s`).
     """
     if not isinstance(settings, ResponseSettings):
         raise LoperInputError(f"{where(source)}settings must be ResponseSettings, got {type(settings).__name__}")
@@ -89,7 +106,7 @@ def paired_windows(
 ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """Perturbed and matched unperturbed windows of signals on one relative grid.
 
-    The grid is ``loper_analysis.resampling.window_times_s(-start_s, end_s, rate_hz)`` - steps of
+    The grid is ``loper_analysis.gait.resampling.window_times_s(-start_s, end_s, rate_hz)`` - steps of
     ``1 / rate_hz`` s with the onset (t = 0) a grid point, e.g. 36 points for
     -25 .. 250 ms at 128 Hz. Pair ``i`` (row ``i`` of ``matches``) is sampled
     at ``onset_s + grid`` (perturbed) and ``matched_anchor_s + grid``
@@ -112,7 +129,7 @@ def paired_windows(
         Grid rate, Hz.
     method : {"cubic", "linear"}
         Cubic spline (as in :func:`match_unperturbed`), or linear
-        interpolation by :func:`loper_analysis.resampling.window`.
+        interpolation by :func:`loper_analysis.gait.resampling.window`.
     source : str
         Name of the trial, quoted in error messages.
 
@@ -194,7 +211,7 @@ def window_outliers(
     """The IQR outlier rule on the analysis window of perturbed-minus-unperturbed pairs.
 
     Only samples with ``-before_s <= rel_time_s <= after_s`` count (the
-    study's rule for perturbed strides); the rule is :func:`loper_analysis.outliers.iqr_outliers`
+    study's rule for perturbed strides); the rule is :func:`loper_analysis.gait.outliers.iqr_outliers`
     (``whisker`` x IQR per sample, pair removed if more than
     ``max_fraction`` of its samples are outlying for any signal). With fewer
     than :data:`MIN_PAIRS_FOR_OUTLIERS` pairs the rule cannot be applied:
@@ -209,7 +226,7 @@ def window_outliers(
     before_s, after_s : float
         Analysis window before and after the onset, s (>= 0).
     whisker, max_fraction : float
-        Settings of :func:`loper_analysis.outliers.iqr_outliers`.
+        Settings of :func:`loper_analysis.gait.outliers.iqr_outliers`.
     names : sequence of str
         Signal names (length k), default hip, knee, ankle.
     source : str

@@ -20,6 +20,6 @@ full error of the job to its log file.
 * :mod:`.cluster` - why SLURM ended the failed jobs of a run.
 """
 
-from .logs import rule_log
+from loper_analysis.steps.logs import rule_log
 
 __all__ = ["rule_log"]

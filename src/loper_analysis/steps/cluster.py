@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..cluster import failed_slurm_logs, slurm_end_reason
-from ..io.atomic import PathLike
+from loper_analysis.cluster import failed_slurm_logs, slurm_end_reason
+from loper_analysis.io.atomic import PathLike
 
 __all__ = ["slurm_failure_lines"]
 

@@ -8,10 +8,10 @@ from collections.abc import Mapping, Sequence
 
 import pandas as pd
 
-from ..errors import LoperInputError
-from ..io.atomic import PathLike, write_figure, write_tsv
-from ..io.readers import read_tsv
-from ..io.robot_log import read_robot_log, write_robot_log
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
+from loper_analysis.io.readers import read_tsv
+from loper_analysis.io.robot_log import read_robot_log, write_robot_log
 
 __all__ = ["DEVICE_FLOAT_FORMAT", "device_trial", "log_from_mat", "frf", "steps", "summary", "figures"]
 
@@ -33,8 +33,8 @@ def device_trial(
     derived from ``seed``, the subject and the trial. Returns the safety
     events (time, state, name).
     """
-    from ..device.controller import DeviceParameters, FreeLeg, safety_events
-    from ..device.trials import DeviceTestSettings, simulate_device_trial
+    from loper_analysis.device.controller import DeviceParameters, FreeLeg, safety_events
+    from loper_analysis.device.trials import DeviceTestSettings, simulate_device_trial
 
     parameters = DeviceParameters(**device)
     settings = DeviceTestSettings(**{**tests, "step_amplitudes_n": tuple(tests["step_amplitudes_n"])})
@@ -49,7 +49,7 @@ def device_trial(
 
 def log_from_mat(mat_path: PathLike, out_path: PathLike, column_map: Mapping, sample_rate_hz: float) -> pd.DataFrame:
     """Convert a robot log exported from MATLAB (.mat) into the ``loper-log 1`` format."""
-    from ..io.robot_log_mat import read_robot_log_mat
+    from loper_analysis.io.robot_log_mat import read_robot_log_mat
 
     frame, _ = read_robot_log_mat(mat_path, column_map, sample_rate_hz)
     write_robot_log(out_path, frame, sample_rate_hz, {"source": str(mat_path)})
@@ -61,7 +61,7 @@ def frf(
     log_path: PathLike, out_tsv: PathLike, sample_rate_hz: float, window_samples: int, overlap_samples: int
 ) -> pd.DataFrame:
     """FRF of the broadband trial -> TSV (frequency_hz, gain, phase_deg, coherence)."""
-    from ..device.analysis import frequency_response
+    from loper_analysis.device.analysis import frequency_response
 
     robot, _ = read_robot_log(log_path, sample_rate_hz)
     table = frequency_response(
@@ -87,7 +87,7 @@ def steps(
     steady_window_s,
 ) -> pd.DataFrame:
     """Step metrics per amplitude and the averaged responses of the step trial."""
-    from ..device.analysis import step_averages, step_table
+    from loper_analysis.device.analysis import step_averages, step_table
 
     robot, _ = read_robot_log(log_path, sample_rate_hz)
     fd = robot["force_desired_n"].to_numpy()
@@ -107,7 +107,7 @@ def steps(
 
 def summary(frf_tsv: PathLike, metrics_tsv: PathLike, out_tsv: PathLike, reference_band_hz) -> pd.DataFrame:
     """The device figures beside the study's (:func:`loper_analysis.device.analysis.device_summary`)."""
-    from ..device.analysis import device_summary
+    from loper_analysis.device.analysis import device_summary
 
     table = device_summary(read_tsv(frf_tsv, "FRF table"), read_tsv(metrics_tsv, "step metrics"), reference_band_hz)
     write_tsv(table, out_tsv, DEVICE_FLOAT_FORMAT)
@@ -119,7 +119,7 @@ def figures(
     frf_tsv: PathLike, summary_tsv: PathLike, average_tsv: PathLike, bode_out: PathLike, steps_out: PathLike
 ) -> None:
     """The Bode plot (with our and the study's bandwidth) and the averaged step responses."""
-    from ..figures.device import bode_figure, steps_figure
+    from loper_analysis.report.figures.device import bode_figure, steps_figure
 
     bandwidth = read_tsv(summary_tsv, "device summary").set_index("metric").loc["bandwidth_hz", "value"]
     write_figure(bode_figure(read_tsv(frf_tsv, "FRF table"), bandwidth), bode_out)

@@ -2,14 +2,14 @@
 
 C3D (ezc3d's platform extraction, :mod:`loper_analysis.io.force_platforms`)
 -> resting level removed, COP, free moment, lab -> model rotation
-(:mod:`loper_analysis.ground_reaction`) -> ``.mot`` at the analog rate
+(:mod:`loper_analysis.gait.grf`) -> ``.mot`` at the analog rate
 (:func:`loper_analysis.io.external_loads.write_external_loads_mot`), columns
 ``{n}_ground_force_v{x,y,z}`` (N), ``{n}_ground_force_p{x,y,z}`` (m),
 ``{n}_ground_torque_{x,y,z}`` (N·m) for plate n = 1, 2, ...
 
 The vertical is the lab's up direction ``up`` (lab frame): lab +Z unless
 given. A lab that is not Z-up (BTS: Y-up) passes
-``up=loper_analysis.markers.lab_up(rotation_deg)``, the direction its
+``up=loper_analysis.motion.markers.lab_up(rotation_deg)``, the direction its
 lab-to-model rotation turns into the model's +Y.
 """
 
@@ -22,8 +22,8 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..errors import LoperInputError
-from ..io.atomic import PathLike
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike
 
 __all__ = ["grf", "trial_grf"]
 
@@ -45,17 +45,17 @@ def grf(
 
     ``threshold_n`` is the vertical force above the resting level from which
     a plate counts as loaded (below it force and torque are written as 0 and
-    the COP is held, see :mod:`loper_analysis.ground_reaction`); ``band_n``
+    the COP is held, see :mod:`loper_analysis.gait.grf`); ``band_n``
     and ``max_rest_n`` set the resting-level rule. With ``xml_out`` and
     ``bodies`` (plate number -> body name) an OpenSim ExternalLoads ``.xml``
     pointing at ``out_mot`` (path relative to the ``.xml``) is written too. ``up`` is the lab's up
     direction (lab frame; None: lab +Z), which the vertical force and the plates' facing are taken
-    along; for a lab that is not Z-up pass ``loper_analysis.markers.lab_up(rotation_deg)``. A plate
+    along; for a lab that is not Z-up pass ``loper_analysis.motion.markers.lab_up(rotation_deg)``. A plate
     more than 45 deg from level is refused, naming the file, the plate, its normal and ``up``.
     Returns the table written (``time_s`` plus nine columns per plate).
     """
-    from ..ground_reaction import external_loads_table, read_plate_loads
-    from ..io.external_loads import write_external_loads_mot, write_external_loads_xml
+    from loper_analysis.gait.grf import external_loads_table, read_plate_loads
+    from loper_analysis.io.external_loads import write_external_loads_mot, write_external_loads_xml
 
     loads = read_plate_loads(c3d_path, threshold_n, band_n, max_rest_n, up)
     table = external_loads_table(loads, rotation_deg)
@@ -88,9 +88,9 @@ def trial_grf(
     markers summary (columns ``rotation_{x,y,z}_deg`` written by :func:`loper_analysis.steps.processing.markers`,
     the configured rotation plus the quarter turn that makes an overground trial walk along +X), so that the
     ground reactions and the inverse kinematics share one frame. The lab's up direction comes from the configured
-    ``base_rotation_deg`` (:func:`loper_analysis.markers.lab_up`)."""
-    from ..io.readers import read_tsv
-    from ..markers import lab_up
+    ``base_rotation_deg`` (:func:`loper_analysis.motion.markers.lab_up`)."""
+    from loper_analysis.io.readers import read_tsv
+    from loper_analysis.motion.markers import lab_up
 
     columns = [f"rotation_{axis}_deg" for axis in "xyz"]
     summary = read_tsv(markers_summary_tsv, "markers summary", columns)

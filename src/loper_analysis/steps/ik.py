@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..constants import MIN_IK_MARKERS
-from ..errors import LoperInputError
-from ..io.atomic import PathLike, write_tsv
-from ..plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
+from loper_analysis.constants import MIN_IK_MARKERS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike, write_tsv
+from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
 __all__ = ["ik_chunk", "ik_file", "ik_join", "ik_trial"]
 
@@ -20,9 +20,9 @@ log = logging.getLogger(__name__)
 
 
 def _checked(res, source: str, max_marker_rms_m: float, max_rms_fraction: float, warn_marker_rms_m: float | None):
-    """Refuse a fit that only a mistake explains (:func:`loper_analysis.plausibility.require_ik_fit`); warn about a
-    poor fit, frames left out and coordinates left NaN. Returns the poor-fit warning (or None)."""
-    from ..plausibility import require_ik_fit
+    """Refuse a fit that only a mistake explains (:func:`loper_analysis.motion.plausibility.require_ik_fit`);
+    warn about a poor fit, frames left out and coordinates left NaN. Returns the poor-fit warning (or None)."""
+    from loper_analysis.motion.plausibility import require_ik_fit
 
     poor = require_ik_fit(res.marker_rms_m, source, max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)
     if poor:
@@ -63,9 +63,9 @@ def _solve(
     min_markers: int = MIN_IK_MARKERS,
 ):
     """IK of marker arrays with the tasks of a file or of the config; returns the :class:`IKResult`."""
-    from ..io.ik_tasks import read_ik_tasks
-    from ..io.osim import read_model
-    from ..kinematics import ik_task_weights, inverse_kinematics
+    from loper_analysis.io.ik_tasks import read_ik_tasks
+    from loper_analysis.io.osim import read_model
+    from loper_analysis.motion.ik import ik_task_weights, inverse_kinematics
 
     model = read_model(model_osim)
     tasks = read_ik_tasks(tasks_file) if tasks_file else None
@@ -100,12 +100,12 @@ def ik_chunk(
     stops, naming the frames and the TRC. A marker RMS error above
     ``max_marker_rms_m`` (m) in more than ``max_rms_fraction`` of the frames
     stops it too, writing nothing; above ``warn_marker_rms_m`` the fit is
-    kept with a warning (:func:`loper_analysis.plausibility.require_ik_fit`).
+    kept with a warning (:func:`loper_analysis.motion.plausibility.require_ik_fit`).
     Coordinates no marker determines are written as NaN, with a warning
     naming them.
     """
-    from ..io.opensim_tables import read_markers, write_mot
-    from ..kinematics import chunk_frames
+    from loper_analysis.io.opensim_tables import read_markers, write_mot
+    from loper_analysis.motion.ik import chunk_frames
 
     time_s, X, labels = read_markers(trc_path)
     sel = chunk_frames(len(time_s), n_chunks, chunk)
@@ -155,8 +155,8 @@ def ik_trial(
     summary_tsv: PathLike | None = None,
 ) -> pd.DataFrame:
     """IK of a whole TRC in one go: the .mot (degrees), the tidy angle table that :func:`ik_join` gives, and
-    (``summary_tsv``) the one-row IK summary (:meth:`loper_analysis.kinematics.IKResult.summary`)."""
-    from ..kinematics import joint_angle_table
+    (``summary_tsv``) the one-row IK summary (:meth:`loper_analysis.motion.ik.IKResult.summary`)."""
+    from loper_analysis.motion.ik import joint_angle_table
 
     res = ik_chunk(
         model_osim,
@@ -195,8 +195,8 @@ def ik_join(
     out are those without any coordinate; the chunks keep no marker errors,
     so those columns are NaN).
     """
-    from ..io.opensim_tables import read_mot, write_mot
-    from ..kinematics import IKResult, join_chunks, joint_angle_table
+    from loper_analysis.io.opensim_tables import read_mot, write_mot
+    from loper_analysis.motion.ik import IKResult, join_chunks, joint_angle_table
 
     frames = [read_mot(p) for p in chunk_mots]
     coords = join_chunks(frames, [str(p) for p in chunk_mots])
@@ -234,7 +234,8 @@ def ik_file(
 
     Labels lose a subject prefix (``Subject:LASI`` -> ``LASI``) and are
     renamed by ``label_map`` {lab label: model marker}
-    (:func:`loper_analysis.marker_names.model_marker_names`). ``rotate_deg`` turns the markers into the model frame
+    (:func:`loper_analysis.motion.marker_names.model_marker_names`). ``rotate_deg`` turns the markers into the
+    model frame
     (default -90 0 0 for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). Without a
     task file every model marker found in the file gets weight 1. Frames with
     too few markers are left out (NaN), with a warning. A fit that only a
@@ -244,16 +245,16 @@ def ik_file(
     coordinates no marker determines are NaN, with a warning.
     ``walking_direction`` ``"auto"`` turns a trial that travels about the
     vertical to walk along the model's +X
-    (:func:`loper_analysis.heading.trial_heading`). Returns the
-    :class:`~loper_analysis.kinematics.IKResult`, its ``warning`` the poor-fit
+    (:func:`loper_analysis.motion.heading.trial_heading`). Returns the
+    :class:`~loper_analysis.motion.ik.IKResult`, its ``warning`` the poor-fit
     text (or None).
     """
-    from ..io.ik_tasks import read_ik_tasks
-    from ..io.opensim_tables import read_markers, write_mot
-    from ..io.osim import read_model
-    from ..kinematics import inverse_kinematics
-    from ..marker_names import model_marker_names
-    from ..markers import rotate_markers
+    from loper_analysis.io.ik_tasks import read_ik_tasks
+    from loper_analysis.io.opensim_tables import read_markers, write_mot
+    from loper_analysis.io.osim import read_model
+    from loper_analysis.motion.ik import inverse_kinematics
+    from loper_analysis.motion.marker_names import model_marker_names
+    from loper_analysis.motion.markers import rotate_markers
 
     markers_path = Path(markers_path)
     time_s, markers_m, labels = read_markers(markers_path)
@@ -261,7 +262,7 @@ def ik_file(
     if rotate_deg is None:
         rotate_deg = (-90.0, 0.0, 0.0) if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
     if walking_direction != "fixed":
-        from ..heading import trial_heading
+        from loper_analysis.motion.heading import trial_heading
 
         rate = 1.0 / float(np.median(np.diff(time_s))) if len(time_s) > 1 else 1.0
         rotate_deg = trial_heading(

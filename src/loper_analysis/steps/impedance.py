@@ -8,10 +8,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from ..errors import LoperInputError
-from ..io.atomic import PathLike, write_figure, write_tsv
-from ..io.readers import read_tsv
-from ..io.truth import read_truth
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
+from loper_analysis.io.readers import read_tsv
+from loper_analysis.io.truth import read_truth
 
 __all__ = ["fit", "subject_fits", "impedance_table", "impedance_summary", "subject_figures", "impedance_figure"]
 
@@ -53,7 +53,8 @@ def fit(
     force_native: Sequence[PathLike] = (),
     force_out: PathLike | None = None,
 ) -> pd.DataFrame:
-    """Responses and the impedance fit of one subject at one onset (:func:`loper_analysis.impedance.fit_onset`).
+    """Responses and the impedance fit of one subject at one onset
+    (:func:`loper_analysis.identification.impedance.fit_onset`).
 
     ``trials`` names the onset's trials; ``angles``, ``strides``, ``force``
     (TSV tables of the processing steps) and ``markers`` (TRC, for the brace
@@ -63,7 +64,7 @@ def fit(
     trial (``{trial}.force_native.tsv``, same order), from which the fit takes
     its force; ``force_out`` gets the mean forces the model saw. ``response`` and ``identification`` are the keyword
     arguments of :class:`~loper_analysis.responses.ResponseSettings` and
-    :class:`~loper_analysis.impedance.IdentificationSettings`. Writes the
+    :class:`~loper_analysis.identification.impedance.IdentificationSettings`. Writes the
     mean response, the stride counts, the fit rows and the fit curves; returns the rows.
     """
     return _fit(
@@ -115,10 +116,10 @@ def _fit(
     tables: _Tables,
 ) -> pd.DataFrame:
     """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
-    from ..dynamics import read_segments
-    from ..impedance import IdentificationSettings, fit_onset
-    from ..io.opensim_tables import read_markers
-    from ..responses import ResponseSettings
+    from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
+    from loper_analysis.io.opensim_tables import read_markers
+    from loper_analysis.responses import ResponseSettings
+    from loper_analysis.swing_leg.dynamics import read_segments
 
     ident = IdentificationSettings(**(identification or {}))
     settings = ResponseSettings(**(response or {}))
@@ -239,8 +240,8 @@ def impedance_summary(
 
     ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary.
     """
-    from ..impedance import impedance_summary as summarise
-    from ..impedance import literature_table
+    from loper_analysis.identification.impedance import impedance_summary as summarise
+    from loper_analysis.identification.impedance import literature_table
 
     summary = summarise(read_tsv(impedance_tsv, "impedance table"), upper_bounds=upper_bounds)
     write_tsv(summary, summary_out)
@@ -258,7 +259,7 @@ def subject_figures(
     fit_out: PathLike,
 ) -> pd.DataFrame:
     """A subject's responses figure and fit figure over the onsets; returns the peak responses (rad)."""
-    from ..figures.impedance import fit_figure, response_peaks, responses_figure
+    from loper_analysis.report.figures.impedance import fit_figure, response_peaks, responses_figure
 
     onsets = [int(o) for o in onsets_ms]
     responses = {o: read_tsv(p, "response table") for o, p in zip(onsets, response_tsvs, strict=True)}
@@ -274,8 +275,8 @@ def subject_figures(
 
 def impedance_figure(impedance_tsv: PathLike, out_png: PathLike) -> pd.DataFrame:
     """The study's figure of K and D per onset; returns the across-subject means."""
-    from ..figures.impedance import impedance_figure as draw
-    from ..figures.impedance import impedance_means
+    from loper_analysis.report.figures.impedance import impedance_figure as draw
+    from loper_analysis.report.figures.impedance import impedance_means
 
     table = read_tsv(impedance_tsv, "impedance table")
     mean = impedance_means(table, str(impedance_tsv))

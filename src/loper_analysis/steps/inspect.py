@@ -5,8 +5,8 @@ platforms with :func:`loper_analysis.io.force_platforms.read_force_platforms`
 and ``POINT:UNITS``), optionally an OpenSim model and a marker set whose
 markers are added to the model's, and hands the records to
 :mod:`loper_analysis.inspection` (the lab's axes from
-:mod:`loper_analysis.lab_frame`, labels matched to the model's markers by
-:mod:`loper_analysis.label_matching`). The label map and the config
+:mod:`loper_analysis.motion.lab_frame`, labels matched to the model's markers by
+:mod:`loper_analysis.motion.label_matching`). The label map and the config
 snippet are written through the atomic writer (:mod:`loper_analysis.io.atomic`).
 """
 
@@ -15,14 +15,20 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ..errors import LoperInputError, one_line
-from ..inspection import RecordingSummary, config_snippet, format_label_match, format_summary, recording_summary
-from ..io.atomic import PathLike, write_text, write_tsv
-from ..io.c3d_parameters import param_strings
-from ..io.timing import library_import, timed_io
-from ..lab_frame import axis_name
-from ..label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
-from ..marker_names import strip_subject_prefix
+from loper_analysis.errors import LoperInputError, one_line
+from loper_analysis.inspection import (
+    RecordingSummary,
+    config_snippet,
+    format_label_match,
+    format_summary,
+    recording_summary,
+)
+from loper_analysis.io.atomic import PathLike, write_text, write_tsv
+from loper_analysis.io.c3d_parameters import param_strings
+from loper_analysis.io.timing import library_import, timed_io
+from loper_analysis.motion.lab_frame import axis_name
+from loper_analysis.motion.label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
+from loper_analysis.motion.marker_names import strip_subject_prefix
 
 __all__ = ["Inspection", "inspect_c3d", "model_marker_names_of"]
 
@@ -75,7 +81,7 @@ def model_marker_names_of(model_osim: PathLike, marker_set_xml: PathLike | None 
     LoperInputError
         The model or the marker set is missing or unreadable (naming the file).
     """
-    from ..io.osim import read_marker_set, read_model
+    from loper_analysis.io.osim import read_marker_set, read_model
 
     model = read_model(model_osim)
     ms = model.getMarkerSet()
@@ -157,8 +163,8 @@ def inspect_c3d(
         ``label_map_out`` without ``model_osim``. Force platforms that cannot be read are
         reported in the text instead.
     """
-    from ..io.c3d import read_c3d
-    from ..io.force_platforms import read_force_platforms
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.force_platforms import read_force_platforms
 
     if model_osim is None and marker_set_xml is not None:
         raise LoperInputError(f"{marker_set_xml}: a marker set is added to a model: give --model as well")

@@ -12,9 +12,9 @@ import threading
 import time
 from collections.abc import Iterator
 
-from ..errors import one_line
-from ..io.atomic import write_text
-from ..io.timing import io_times
+from loper_analysis.errors import one_line
+from loper_analysis.io.atomic import write_text
+from loper_analysis.io.timing import io_times
 
 __all__ = ["LOG_FORMAT", "PROFILE_VARIABLE", "TIMING_PREFIX", "rule_log", "timing_line", "write_log"]
 
@@ -82,7 +82,7 @@ def _to_stderr(text: str) -> None:
 
 def _dump_profile(profiler, path: str | os.PathLike) -> str | None:
     """Write the job's cProfile to ``{path}.prof`` atomically; the problem in one line when it cannot be written."""
-    from ..io.atomic import staged
+    from loper_analysis.io.atomic import staged
 
     prof = f"{path}.prof"
     try:

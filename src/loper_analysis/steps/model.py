@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..constants import GRAVITY_M_PER_S2
-from ..dynamics import SegmentParameters, segment_parameters_from_anthropometry, write_segments
-from ..errors import LoperInputError
-from ..io.atomic import PathLike, staged, write_tsv
-from ..io.readers import read_tsv
+from loper_analysis.constants import GRAVITY_M_PER_S2
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike, staged, write_tsv
+from loper_analysis.io.readers import read_tsv
+from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_parameters_from_anthropometry, write_segments
 
 __all__ = [
     "SCALE_FLOAT_FORMAT",
@@ -38,19 +38,19 @@ def generic_model(
     duration_s: float | None = None,
     rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
 ) -> None:
-    """The generic lower-body model (:func:`loper_analysis.model.build_lower_body_model`) for this subject.
+    """The generic lower-body model (:func:`loper_analysis.motion.model.build_lower_body_model`) for this subject.
 
     Without ``mass_kg`` the mass comes from the force plates the subject
     stands on in the static trial ``static_c3d``, over its first
     ``duration_s`` seconds (None: all of it; ``rotation_deg`` tells the lab's
-    vertical: :func:`loper_analysis.static_trial.standing_mass_kg`).
+    vertical: :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
     """
-    from ..io.osim import write_model
-    from ..model import build_lower_body_model
+    from loper_analysis.io.osim import write_model
+    from loper_analysis.motion.model import build_lower_body_model
 
     if mass_kg is None and static_c3d is not None:
-        from ..io.c3d import read_c3d
-        from ..static_trial import scale_window_s
+        from loper_analysis.io.c3d import read_c3d
+        from loper_analysis.motion.static_trial import scale_window_s
 
         window = scale_window_s(read_c3d(static_c3d).time_s, (), duration_s, source=str(static_c3d))
         mass_kg, source = _subject_mass(None, static_c3d, window, rotation_deg)
@@ -61,8 +61,9 @@ def generic_model(
 
 
 def _check_factors(model, measurements, pose, static_trc, factor_range) -> None:
-    """Refuse scale factors outside ``factor_range`` (:func:`loper_analysis.plausibility.require_scale_factors`)."""
-    from ..plausibility import measurement_scale_factors, require_scale_factors
+    """Refuse scale factors outside ``factor_range``
+    (:func:`loper_analysis.motion.plausibility.require_scale_factors`)."""
+    from loper_analysis.motion.plausibility import measurement_scale_factors, require_scale_factors
 
     factors = measurement_scale_factors(model, measurements, pose.markers_m, pose.labels)
     require_scale_factors(factors, str(static_trc), factor_range)
@@ -81,14 +82,14 @@ def scaled_model(
 
     Each body is scaled uniformly by the ratio of the marker-pair distances in
     the static trial to those of the model
-    (:data:`loper_analysis.model.SCALE_MEASUREMENTS`); the mass distribution
+    (:data:`loper_analysis.motion.model.SCALE_MEASUREMENTS`); the mass distribution
     is preserved at ``mass_kg``. The window, the static pose and the
     keywords ``static`` are those of :func:`scale_with_setup`; every factor
     must lie in ``factor_range`` (a factor near 10 or 1000 means markers in
     another unit than the TRC declares); nothing is written otherwise.
     """
-    from ..io.osim import quiet_opensim, read_model
-    from ..model import SCALE_MEASUREMENTS
+    from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.motion.model import SCALE_MEASUREMENTS
 
     osim = quiet_opensim()
     tool = osim.ScaleTool()
@@ -172,7 +173,7 @@ def segments_from_model_file(
     attachment_fraction: float = 0.8,
 ) -> SegmentParameters:
     """Segment table (TSV) of one leg of an OpenSim model file
-    (:func:`loper_analysis.segments_from_model.segments_from_model`).
+    (:func:`loper_analysis.motion.segments.segments_from_model`).
 
     Parameters
     ----------
@@ -180,7 +181,7 @@ def segments_from_model_file(
         A (scaled) ``.osim`` model: gait2392, Rajagopal2016, our generated
         model or any model whose bodies ``segment_bodies`` names.
     out_tsv : path
-        The table (:func:`loper_analysis.dynamics.write_segments`), written atomically.
+        The table (:func:`loper_analysis.swing_leg.dynamics.write_segments`), written atomically.
     side : {"left", "right"}
         The swing leg.
     segment_bodies : mapping, optional
@@ -194,10 +195,10 @@ def segments_from_model_file(
     LoperInputError
         Missing or unreadable model, unknown side, a configured body missing.
     """
-    from ..checks import side as check_side
-    from ..constants import SIDE_SUFFIX
-    from ..io.osim import read_model
-    from ..segments_from_model import segments_from_model
+    from loper_analysis.checks import side as check_side
+    from loper_analysis.constants import SIDE_SUFFIX
+    from loper_analysis.io.osim import read_model
+    from loper_analysis.motion.segments import segments_from_model
 
     check_side(side, str(model_osim))
     params = segments_from_model(
@@ -241,12 +242,12 @@ def scale_with_setup(
     model scaler's).
 
     The static trial is averaged over a window
-    (:func:`loper_analysis.static_trial.scale_window_s`): ``time_range_s``
+    (:func:`loper_analysis.motion.static_trial.scale_window_s`): ``time_range_s``
     when given, else the setup's time ranges where they are set, else the
     first ``duration_s`` seconds (keyword of ``static``; None: the whole
     trial). Within it each marker counts where it is present: ScaleTool gets
     the window with every marker's missing frames holding its mean over the
-    present ones (:func:`loper_analysis.static_trial.static_pose`).
+    present ones (:func:`loper_analysis.motion.static_trial.static_pose`).
 
     Parameters
     ----------
@@ -259,7 +260,7 @@ def scale_with_setup(
     mass_kg : float or None
         Subject mass, kg (0 .. 300); None: from the force plates of the
         static trial's C3D (keyword ``static_c3d`` of ``static``:
-        :func:`loper_analysis.static_trial.standing_mass_kg`).
+        :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
     out_osim : path
         The scaled model.
     time_range_s : (float, float), optional
@@ -270,7 +271,7 @@ def scale_with_setup(
     factor_range : (float, float)
         Least and largest plausible factor of a measurement (static-trial
         marker distance over the model's at its default pose, averaged over
-        the measurement's pairs; :func:`loper_analysis.plausibility.measurement_scale_factors`).
+        the measurement's pairs; :func:`loper_analysis.motion.plausibility.measurement_scale_factors`).
     **static
         ``duration_s`` (window without a set range, s), ``lab_labels``
         ({model marker: lab label} for messages), ``static_c3d`` and
@@ -292,7 +293,7 @@ def scale_with_setup(
         (markers in another unit than the TRC declares); no mass; ScaleTool
         failing. Nothing is written then.
     """
-    from ..io.osim import read_marker_set, read_model, read_scale_setup
+    from loper_analysis.io.osim import read_marker_set, read_model, read_scale_setup
 
     generic_osim, setup_xml, static_trc = Path(generic_osim), Path(setup_xml), Path(static_trc)
     for path in (generic_osim, static_trc):
@@ -381,10 +382,10 @@ def _run_scale_tool(
     (:func:`scale_with_setup`)."""
     import tempfile
 
-    from ..io.opensim_tables import read_markers, write_trc
-    from ..io.osim import quiet_opensim, read_model
-    from ..segments_from_model import check_segment_bodies
-    from ..static_trial import scale_window_s, static_pose
+    from loper_analysis.io.opensim_tables import read_markers, write_trc
+    from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.motion.segments import check_segment_bodies
+    from loper_analysis.motion.static_trial import scale_window_s, static_pose
 
     static_trc = Path(static_trc)
     if not static_trc.is_file():
@@ -517,7 +518,7 @@ def _lab_labels(summary_tsv: PathLike) -> dict[str, str]:
 
 def _range(part) -> tuple[float, float] | None:
     """A model scaler's or marker placer's time range, None when unset (``-1 -1`` or reversed)."""
-    from ..static_trial import time_range_is_set
+    from loper_analysis.motion.static_trial import time_range_is_set
 
     r = part.getTimeRange()
     pair = (r.get(0), r.get(1)) if r.getSize() >= 2 else None
@@ -540,9 +541,9 @@ def _subject_mass(
 ) -> tuple[float, str]:
     """The subject's mass (kg) and where it came from: given, or from the static trial's force plates (weight over
     the model's gravity)."""
-    from ..io.force_platforms import read_force_platforms
-    from ..markers import lab_up
-    from ..static_trial import standing_mass_kg
+    from loper_analysis.io.force_platforms import read_force_platforms
+    from loper_analysis.motion.markers import lab_up
+    from loper_analysis.motion.static_trial import standing_mass_kg
 
     if mass_kg is not None:
         if not 0 < mass_kg <= 300:
@@ -589,7 +590,7 @@ _REPORT_IK_ACCURACY = 1e-6
 
 def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
     """Body -> scale factors (x, y, z) of the ScaleSet OpenSim wrote (empty when it wrote none)."""
-    from ..io.osim import quiet_opensim
+    from loper_analysis.io.osim import quiet_opensim
 
     if not scale_file.is_file():
         return {}
@@ -606,7 +607,7 @@ def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
 
 def _placer_tasks(placer) -> tuple[dict[str, float], dict] | None:
     """Marker weights and coordinate tasks of the marker placer (None when it does not apply)."""
-    from ..io.ik_tasks import task_set_tasks
+    from loper_analysis.io.ik_tasks import task_set_tasks
 
     if not placer.getApply():
         return None
@@ -628,7 +629,7 @@ def scale_report(
 
     Rows (``kind``): ``subject`` (``mass_kg`` and where it came from,
     ``height_m`` given or estimated from the scaled model:
-    :func:`loper_analysis.static_trial.model_height_m`), ``body`` (the
+    :func:`loper_analysis.motion.static_trial.model_height_m`), ``body`` (the
     factors OpenSim's model scaler applied; 1 where it scaled nothing),
     ``marker`` (each weighted marker's distance to the model's marker after
     scaling, ``marker_error_m``: IK of the static pose, the window's mean as
@@ -637,9 +638,9 @@ def scale_report(
     RMS and the largest, over the ``n_frames`` frames averaged). Columns
     :data:`SCALE_REPORT_COLUMNS`.
     """
-    from ..kinematics import inverse_kinematics
-    from ..segments_from_model import segment_body_names
-    from ..static_trial import model_height_m
+    from loper_analysis.motion.ik import inverse_kinematics
+    from loper_analysis.motion.segments import segment_body_names
+    from loper_analysis.motion.static_trial import model_height_m
 
     rows = []
     if height_m is None:

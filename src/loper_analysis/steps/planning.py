@@ -4,7 +4,7 @@
 the device, whose unperturbed strides give the null pairs and whose perturbed
 strides at an onset give that onset's perturbed pairs), its segment table
 (or another subject's) and its impedance rows (the planned impedance), and
-writes the table of :func:`loper_analysis.planning.precision_table` for every
+writes the table of :func:`loper_analysis.planning.precision.precision_table` for every
 onset and the answers to the targets (method: ``docs/planning.md``).
 """
 
@@ -17,10 +17,10 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from ..constants import JOINTS, PARAMETERS, parameter_column
-from ..errors import LoperInputError
-from ..io.atomic import PathLike, write_text, write_tsv
-from ..io.readers import read_tsv
+from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike, write_text, write_tsv
+from loper_analysis.io.readers import read_tsv
 
 __all__ = ["LIBRARY_PLANNING_SETTINGS", "plan", "planned_impedance", "planning_settings"]
 
@@ -60,7 +60,8 @@ _RULE_IDENTIFICATION_KEYS = (
 #: The settings of :func:`planning_settings` without a configuration (``loper-analysis plan`` with no config file):
 #: ``onsets`` None (those of the pilot's impedance rows), no targets, and the library's own response,
 #: identification and device defaults (None: :class:`~loper_analysis.responses.ResponseSettings`,
-#: :class:`~loper_analysis.planning.PlanSettings`, :class:`~loper_analysis.device.controller.DeviceParameters`).
+#: :class:`~loper_analysis.planning.precision.PlanSettings`,
+#: :class:`~loper_analysis.device.controller.DeviceParameters`).
 LIBRARY_PLANNING_SETTINGS = {
     "onsets": None,
     "strides": [10, 20, 40],
@@ -175,7 +176,7 @@ def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: 
 
 
 def _settings(pulse_force_n: float, pulse_duration_s: float, identification: Mapping | None):
-    from ..planning import PlanSettings
+    from loper_analysis.planning.precision import PlanSettings
 
     ident = {k: v for k, v in (identification or {}).items() if k in _PLAN_KEYS}
     for key in ("stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad"):
@@ -214,7 +215,7 @@ def plan(
         The pilot's trials walked with the device (names) and their angle and
         stride tables (TSV, same order): their unperturbed strides are the null
         pairs; the perturbed strides of the trials at an onset are its
-        perturbed pairs (:func:`loper_analysis.planning.pilot_perturbed_pairs`),
+        perturbed pairs (:func:`loper_analysis.planning.precision.pilot_perturbed_pairs`),
         whose scatter the prediction takes (the null pairs' when there are
         none, with a note in the rows).
     segments_tsv
@@ -224,7 +225,7 @@ def plan(
     onsets_ms, n_strides
         Onsets after toe-off (ms) and counts of perturbed strides to predict for.
     out_tsv, answers_out
-        The table (:data:`loper_analysis.planning.PLAN_COLUMNS`) and the text
+        The table (:data:`loper_analysis.planning.precision.PLAN_COLUMNS`) and the text
         answers; None writes nothing.
     impedance_tsvs
         Impedance rows (``results/impedance/{subject}/{onset}.tsv`` or
@@ -249,16 +250,15 @@ def plan(
     pool_scatter
         With perturbed pairs at two or more onsets, their excess scatter over
         the null pairs is pooled over the onsets
-        (:func:`loper_analysis.planning.pool_onsets`); False: each onset its own.
+        (:func:`loper_analysis.planning.precision.pool_onsets`); False: each onset its own.
 
     Returns
     -------
     (pandas.DataFrame, list of str)
         The table and the answers.
     """
-    from ..device.controller import DeviceParameters
-    from ..dynamics import read_segments
-    from ..planning import (
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.planning.precision import (
         pilot_perturbed_pairs,
         pool_onsets,
         precision_table,
@@ -266,7 +266,8 @@ def plan(
         target_answer,
         unplanned_rows,
     )
-    from ..responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
+    from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
+    from loper_analysis.swing_leg.dynamics import read_segments
 
     if unplannable not in ("raise", "note"):
         raise LoperInputError(f"unplannable must be 'raise' or 'note', got {unplannable!r}")

@@ -15,11 +15,11 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import pandas as pd
 
-from ..constants import MIN_IK_MARKERS, SIDES
-from ..errors import LoperInputError
-from ..io.atomic import PathLike, write_tsv
-from ..io.readers import read_tsv
-from ..outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
+from loper_analysis.constants import MIN_IK_MARKERS, SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
+from loper_analysis.io.atomic import PathLike, write_tsv
+from loper_analysis.io.readers import read_tsv
 
 __all__ = ["markers", "events", "loadcell", "events_loadcell", "strides", "strides_summary"]
 
@@ -39,7 +39,7 @@ def _label_map(
         for part in label_map:
             merged.update(_label_map(part) or {})
         return merged
-    from ..io.readers import read_label_map
+    from loper_analysis.io.readers import read_label_map
 
     return read_label_map(label_map)
 
@@ -65,28 +65,28 @@ def markers(
 
     Labels lose their subject prefix (``Subject:LASI`` -> ``LASI``) and are
     renamed by ``label_map`` {lab label: model marker}, or by several maps
-    merged in order (:func:`loper_analysis.marker_names.model_marker_names`);
+    merged in order (:func:`loper_analysis.motion.marker_names.model_marker_names`);
     every marker of ``required_markers`` must then be among them. Interior
     gaps of up to ``max_gap_frames`` frames are filled (0: none); longer gaps
     and gaps at the trial's ends stay NaN and are written to the TRC as
     missing. The low-pass (``cutoff_hz`` Hz, Butterworth of ``order`` run
     forward and backward; None or 0: no filter) runs over each run of present
-    frames on its own (:func:`loper_analysis.filtering.lowpass_finite_runs`).
+    frames on its own (:func:`loper_analysis.motion.filtering.lowpass_finite_runs`).
     Times are the file's own, ``(first_frame + k) / rate``; ``duration_s``
     keeps the first ``duration_s`` seconds of the trial, ``span_s`` (start,
     end) the frames between two times of the file's clock (a crop set per
     trial). Markers whose spread lies outside ``extent_range_m`` (m) are
     refused as numbers in another unit than ``POINT:UNITS`` declares
-    (:func:`loper_analysis.plausibility.require_marker_extent`).
+    (:func:`loper_analysis.motion.plausibility.require_marker_extent`).
 
     ``walking_direction`` ``"auto"`` turns a trial that travels (overground)
     about the vertical so that it walks along the model's +X
-    (:func:`loper_analysis.heading.trial_heading`); ``"fixed"`` keeps
+    (:func:`loper_analysis.motion.heading.trial_heading`); ``"fixed"`` keeps
     ``rotation_deg``.
 
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
-    row per gap, :data:`loper_analysis.markers.GAP_REPORT_COLUMNS`). The
-    per-marker summary (:func:`loper_analysis.markers.gap_summary`, with the
+    row per gap, :data:`loper_analysis.motion.markers.GAP_REPORT_COLUMNS`). The
+    per-marker summary (:func:`loper_analysis.motion.markers.gap_summary`, with the
     lab ``label`` of each marker and the trial's frames with fewer than
     :data:`~loper_analysis.constants.MIN_IK_MARKERS` markers, its span,
     heading and rotation: :data:`TRIAL_MARKER_COLUMNS`) is written to
@@ -94,13 +94,13 @@ def markers(
     ``.attrs["per_marker"]`` (plain values: pandas compares the attrs of frames
     it concatenates).
     """
-    from ..filtering import lowpass_finite_runs
-    from ..heading import trial_heading
-    from ..io.c3d import read_c3d
-    from ..io.opensim_tables import write_trc
-    from ..marker_names import model_marker_names, require_model_markers
-    from ..markers import fill_gaps, gap_summary, rotate_markers
-    from ..plausibility import require_marker_extent
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.opensim_tables import write_trc
+    from loper_analysis.motion.filtering import lowpass_finite_runs
+    from loper_analysis.motion.heading import trial_heading
+    from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
+    from loper_analysis.motion.markers import fill_gaps, gap_summary, rotate_markers
+    from loper_analysis.motion.plausibility import require_marker_extent
 
     source = str(c3d_path)
     rec = read_c3d(c3d_path)
@@ -170,8 +170,8 @@ def markers(
     return gaps
 
 
-#: Columns the markers summary adds to :data:`loper_analysis.markers.GAP_SUMMARY_COLUMNS`: the marker's lab label,
-#: then facts of the whole trial repeated on each row (like ``n_frames``).
+#: Columns the markers summary adds to :data:`loper_analysis.motion.markers.GAP_SUMMARY_COLUMNS`: the marker's lab
+#: label, then facts of the whole trial repeated on each row (like ``n_frames``).
 TRIAL_MARKER_COLUMNS: tuple[str, ...] = (
     "label",
     "n_frames_too_few_markers",
@@ -237,19 +237,19 @@ def events(
     A file with force platforms (``FORCE_PLATFORM:USED`` > 0): each plate's
     contacts from its vertical force above the resting level, each assigned to
     a foot by the heel markers ``foot_markers`` {side: model marker, after
-    ``label_map``} over the plate (:func:`loper_analysis.contacts.foot_contacts`;
+    ``label_map``} over the plate (:func:`loper_analysis.gait.contacts.foot_contacts`;
     ``plate_sides`` {side: plate number} is a check); flagged contacts give no
     heel strike or toe-off but a ``flagged_start``/``flagged_end`` pair that
     keeps strides from spanning them. The contact table goes to
     ``contacts_out`` when given. ``attrs["n_contacts_flagged"]`` counts them
-    (:func:`loper_analysis.contacts.count_flagged`).
+    (:func:`loper_analysis.gait.contacts.count_flagged`).
 
     A file without platforms: the vertical force of each belt from the
     analog channel ``grf_channels[side]`` (N), as recorded; ``cutoff_hz``
     low-passes it first (zero-phase Butterworth; None thresholds the raw
     force: a 40 Hz filter moves a 20 N toe-off threshold by about 4.5 ms).
     """
-    from ..io.c3d import read_c3d
+    from loper_analysis.io.c3d import read_c3d
 
     table, contacts = _events_of(
         read_c3d(c3d_path),
@@ -287,7 +287,7 @@ def _events_of(
     max_rest_n,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The event table and the contact table (empty without force platforms) of a C3D already read."""
-    from ..contacts import count_flagged
+    from loper_analysis.gait.contacts import count_flagged
 
     if rec.n_force_platforms:
         table, contacts = _plate_events(
@@ -334,8 +334,8 @@ def _channel_events(
     rec, grf_channels, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, cutoff_hz, order
 ) -> pd.DataFrame:
     """Events from one named vertical-GRF analog channel per belt of a read C3D."""
-    from ..events import gait_events
-    from ..filtering import lowpass
+    from loper_analysis.gait.events import gait_events
+    from loper_analysis.motion.filtering import lowpass
 
     c3d_path = rec.source
     tables = []
@@ -379,9 +379,9 @@ def _check_belt_feet(rec, table: pd.DataFrame, grf_channels, foot_markers, label
     Stops when a belt's stances are the other foot's (channels swapped, or both naming one belt); warns when
     the heel markers cannot tell (missing markers, too few stances, a mixed verdict).
     """
-    from ..events import stance_heels
-    from ..marker_names import model_marker_names
-    from ..markers import lab_up
+    from loper_analysis.gait.events import stance_heels
+    from loper_analysis.motion.marker_names import model_marker_names
+    from loper_analysis.motion.markers import lab_up
 
     source = rec.source
     keys = {s: f"events.grf_channels.{s}" for s in SIDES}
@@ -457,14 +457,14 @@ def _plate_events(
     """Events and the contact table from the force platforms and the heel markers of a read C3D.
 
     The vertical is the lab's up direction that ``rotation_deg`` turns into the model's +Y
-    (:func:`loper_analysis.markers.lab_up`: lab +Z for the default -90 deg about X, +Y for a Y-up lab
+    (:func:`loper_analysis.motion.markers.lab_up`: lab +Z for the default -90 deg about X, +Y for a Y-up lab
     with no rotation); plates whose corners run either way round are accepted, a plate more than 45 deg
     from level is refused naming the file, the plate and ``markers.lab_to_model_rotation_deg``.
     """
-    from ..contacts import PlateForce, contact_events, foot_contacts
-    from ..ground_reaction import plate_vertical_loads
-    from ..marker_names import model_marker_names, require_model_markers
-    from ..markers import MODEL_UP, lab_up, rotate_markers
+    from loper_analysis.gait.contacts import PlateForce, contact_events, foot_contacts
+    from loper_analysis.gait.grf import plate_vertical_loads
+    from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
+    from loper_analysis.motion.markers import MODEL_UP, lab_up, rotate_markers
 
     source = c3d_path = rec.source
     if not foot_markers:
@@ -510,9 +510,9 @@ def loadcell(
     ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
     Nothing is written when the records are refused, among others for sync pulses whose high times
     disagree between the robot log and the C3D (an inverted sync) or force pulses without perturbation
-    flags (:func:`loper_analysis.loadcell.robot_log_frames_and_native`).
+    flags (:func:`loper_analysis.device.loadcell.robot_log_frames_and_native`).
     """
-    from ..io.c3d import read_c3d
+    from loper_analysis.io.c3d import read_c3d
 
     out, native = _loadcell_of(read_c3d(c3d_path), log_path, sync_channel, cutoff_hz, order)
     return _write_loadcell(out, native, out_tsv, native_out)
@@ -520,13 +520,13 @@ def loadcell(
 
 def _loadcell_of(rec, log_path, sync_channel, cutoff_hz, order) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The forces on the mocap frames and at the robot rate, of a C3D already read and a robot log."""
-    from ..io.robot_log import read_robot_log
-    from ..loadcell import robot_log_frames_and_native
+    from loper_analysis.device.loadcell import robot_log_frames_and_native
+    from loper_analysis.io.robot_log import read_robot_log
 
     c3d_path = rec.source
     frame, meta = read_robot_log(log_path)
     rate = float(meta["sample_rate_hz"])
-    from ..filtering import check_cutoff  # the robot log's forces are low-passed at its own rate
+    from loper_analysis.motion.filtering import check_cutoff  # the robot log's forces are low-passed at its own rate
 
     check_cutoff(
         rate, cutoff_hz, order, setting="filter.cutoff_hz", rate_name="the log's sample_rate_hz", source=str(log_path)
@@ -577,7 +577,7 @@ def events_loadcell(
     unless both succeed. Returns the event table and the force table on the
     mocap frames.
     """
-    from ..io.c3d import read_c3d
+    from loper_analysis.io.c3d import read_c3d
 
     e, f = dict(events_settings or {}), dict(loadcell_settings or {})
     for given, func in ((e, events), (f, loadcell)):
@@ -616,12 +616,12 @@ def strides(
 ):
     """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
 
-    Writes the stride table and the cycles (:func:`loper_analysis.strides.stride_tables`);
-    returns the :class:`~loper_analysis.strides.StrideTables`. A trial with 0
+    Writes the stride table and the cycles (:func:`loper_analysis.gait.strides.stride_tables`);
+    returns the :class:`~loper_analysis.gait.strides.StrideTables`. A trial with 0
     or 1 strides of ``side`` is written like any other (the stride table with
     all its columns, without rows for 0 strides) and flagged ``too_few_strides``.
     """
-    from ..strides import stride_tables
+    from loper_analysis.gait.strides import stride_tables
 
     sources = {"angles": str(angles_tsv), "events": str(events_tsv), "force": str(force_tsv)}
     force = None if force_tsv is None else read_tsv(force_tsv, "force table", ("time_s", "force_measured_n"))
@@ -652,7 +652,7 @@ def strides_summary(
     ik_tsvs: Sequence[PathLike] | None = None,
     markers_tsvs: Sequence[PathLike] | None = None,
 ) -> pd.DataFrame:
-    """One row per subject x trial of the stride tables (:func:`loper_analysis.strides.stride_summary`).
+    """One row per subject x trial of the stride tables (:func:`loper_analysis.gait.strides.stride_summary`).
 
     ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
     ``subject_trials``, in order; ``contacts_tsvs`` (optional, same order) the
@@ -668,10 +668,10 @@ def strides_summary(
     ------
     LoperInputError
         A stride table without the columns
-        :data:`loper_analysis.strides.SUMMARY_COLUMNS` (naming the file).
+        :data:`loper_analysis.gait.strides.SUMMARY_COLUMNS` (naming the file).
     """
-    from ..checks import require_columns
-    from ..strides import SUMMARY_COLUMNS, stride_summary
+    from loper_analysis.checks import require_columns
+    from loper_analysis.gait.strides import SUMMARY_COLUMNS, stride_summary
 
     keys = [tuple(key) for key in subject_trials]
     tables = {

@@ -12,8 +12,8 @@ import threading
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
-from ..io.atomic import PathLike, write_text
-from ..io.readers import read_bytes, read_tsv
+from loper_analysis.io.atomic import PathLike, write_text
+from loper_analysis.io.readers import read_bytes, read_tsv
 
 __all__ = [
     "markdown_tables",
@@ -29,7 +29,7 @@ log = logging.getLogger(__name__)
 
 def markdown_tables(headings: Sequence[str], tsvs: Sequence[PathLike], out_md: PathLike) -> str:
     """Render every table (one TSV per heading, in order) into one Markdown file; an empty TSV says so."""
-    from ..markdown import markdown_document
+    from loper_analysis.report.markdown import markdown_document
 
     sections = [(heading, str(path), read_tsv(path, "table")) for heading, path in zip(headings, tsvs, strict=True)]
     text = markdown_document(sections)
@@ -39,11 +39,11 @@ def markdown_tables(headings: Sequence[str], tsvs: Sequence[PathLike], out_md: P
 
 
 def software_versions() -> dict[str, str]:
-    """Python and the installed version of every package of :data:`loper_analysis.front_page.SOFTWARE`."""
+    """Python and the installed version of every package of :data:`loper_analysis.report.front_page.SOFTWARE`."""
     import importlib.metadata
     import platform
 
-    from ..front_page import SOFTWARE
+    from loper_analysis.report.front_page import SOFTWARE
 
     versions = {"Python": platform.python_version()}
     for label, distribution in SOFTWARE.items():
@@ -67,7 +67,7 @@ def front_page(
     rmsd_tsv: PathLike | None = None,
     versions: Mapping[str, str] | None = None,
 ) -> str:
-    """The front page of the report (:func:`loper_analysis.front_page.front_page_html`) from the result files.
+    """The front page of the report (:func:`loper_analysis.report.front_page.front_page_html`) from the result files.
 
     ``device_tsv``: ``results/device/summary.tsv`` (None: no device tests); ``validation_tsv``:
     ``results/validation/summary.tsv``; ``impedance_tsv``, ``summary_tsv`` and
@@ -76,16 +76,16 @@ def front_page(
     transparency table (None: no subject walked both trials of the pair).
     ``subjects``: subject -> source; ``trials``: processed subject -> its
     walking trials; ``settings``: the keyword arguments of
-    :class:`~loper_analysis.front_page.RunSettings`; ``versions``: software ->
+    :class:`~loper_analysis.report.front_page.RunSettings`; ``versions``: software ->
     version (default :func:`software_versions`). The headline tables come
-    from :mod:`loper_analysis.headline`. Writes ``out_html`` and returns the
+    from :mod:`loper_analysis.report.headline`. Writes ``out_html`` and returns the
     fragment.
     """
     import pandas
 
-    from ..errors import LoperInputError
-    from ..front_page import RunSettings, front_page_html
-    from ..headline import (
+    from loper_analysis.errors import LoperInputError
+    from loper_analysis.report.front_page import RunSettings, front_page_html
+    from loper_analysis.report.headline import (
         device_comparison,
         impedance_summary_ci,
         transparency_verdict,
@@ -159,7 +159,7 @@ def check_report_complete(path: PathLike, target: PathLike | None = None) -> Non
     LoperInputError
         The report is missing, empty or cut short (the message names it and its size).
     """
-    from ..errors import LoperInputError
+    from loper_analysis.errors import LoperInputError
 
     path = Path(path)
     shown = path if target is None else target
@@ -237,9 +237,9 @@ def write_report(
         failed (its exit status is named), wrote no file or an incomplete one;
         the report cannot be moved into place.
     """
-    from ..errors import LoperInputError
-    from ..io.atomic import staged
-    from ..schema import check_yaml_file
+    from loper_analysis.errors import LoperInputError
+    from loper_analysis.io.atomic import staged
+    from loper_analysis.schema import check_yaml_file
 
     target = Path(target)
     if command is None:

@@ -5,11 +5,11 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 
-from ..constants import JOINTS
-from ..io.atomic import PathLike
-from ..io.c3d_writer import write_recording
-from ..io.robot_log import write_robot_log
-from ..io.truth import read_truth, write_truth
+from loper_analysis.constants import JOINTS
+from loper_analysis.io.atomic import PathLike
+from loper_analysis.io.c3d_writer import write_recording
+from loper_analysis.io.robot_log import write_robot_log
+from loper_analysis.io.truth import read_truth, write_truth
 
 __all__ = ["lab_export_session", "lab_session", "truth"]
 
@@ -31,7 +31,7 @@ def truth(
     ``row`` is the subject's row of the subject sheet with its anthropometrics
     (:func:`loper_analysis.synthetic.subjects.subject_anthropometry`).
     """
-    from ..synthetic.subjects import true_impedance
+    from loper_analysis.synthetic.subjects import true_impedance
 
     impedance = true_impedance(
         row["subject"],
@@ -79,14 +79,14 @@ def lab_session(
     ``"gentle"`` is the earlier lab.
     """
 
-    from ..device.controller import DeviceParameters
-    from ..synthetic.trials import (
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.synthetic.trials import (
         LabSettings,
         PerturbationSettings,
         subject_static_recording,
         subject_walking_trial,
     )
-    from ..synthetic.variability import lab_variability
+    from loper_analysis.synthetic.variability import lab_variability
 
     s = settings
     lab_settings, device_parameters = LabSettings(**lab), DeviceParameters(**device)
@@ -175,7 +175,7 @@ def lab_export_session(
     names unless the map lists them); the kinematics are simulated for a
     subject of ``height_m`` and ``mass_kg``, and the perturbation responses
     with the swing-leg segment table of ``model_osim`` itself
-    (:func:`loper_analysis.segments_from_model.segments_from_model`, left leg,
+    (:func:`loper_analysis.motion.segments.segments_from_model`, left leg,
     rod attachment at ``brace_fraction``), so that a fit with the table of the
     same model scaled by factors of 1 meets the exact truth. ``onsets_ms`` gives each trial's
     perturbation onset (ms after left toe-off; None: no pulses), answered with
@@ -197,19 +197,19 @@ def lab_export_session(
 
     import numpy as np
 
-    from ..device.controller import DeviceParameters
-    from ..io.osim import quiet_opensim, read_model
-    from ..io.readers import read_tsv
-    from ..io.robot_log_mat import write_robot_log_mat
-    from ..segments_from_model import segments_from_model
-    from ..synthetic.lab_export import (
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.io.readers import read_tsv
+    from loper_analysis.io.robot_log_mat import write_robot_log_mat
+    from loper_analysis.motion.segments import segments_from_model
+    from loper_analysis.synthetic.lab_export import (
         ROBOT_LOG_MAT_VARIABLES,
         QTMExportSettings,
         add_brace_markers,
         qtm_static_export,
         qtm_walking_export,
     )
-    from ..synthetic.trials import (
+    from loper_analysis.synthetic.trials import (
         LabSettings,
         PerturbationSettings,
         simulate_walking_trial,

@@ -5,9 +5,9 @@ from __future__ import annotations
 import logging
 from collections.abc import Sequence
 
-from ..io.atomic import PathLike, write_figure, write_tsv
-from ..io.readers import read_tsv
-from ..outliers import MIN_VALID_STRIDES
+from loper_analysis.gait.outliers import MIN_VALID_STRIDES
+from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
+from loper_analysis.io.readers import read_tsv
 
 __all__ = ["transparency"]
 
@@ -35,8 +35,8 @@ def transparency(
     A subject with fewer than ``min_strides`` kept strides in either trial is
     left out of the comparison (its rows keep the counts, with empty metrics).
     """
-    from ..figures.transparency import transparency_figure
-    from ..transparency import transparency_results
+    from loper_analysis.report.figures.transparency import transparency_figure
+    from loper_analysis.transparency import transparency_results
 
     files = zip(subjects, no_device_strides, no_device_cycles, device_strides, device_cycles, strict=True)
     frames = {

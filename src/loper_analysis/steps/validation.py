@@ -7,8 +7,8 @@ from collections.abc import Mapping, Sequence
 
 import pandas as pd
 
-from ..io.atomic import PathLike, write_figure, write_tsv
-from ..io.readers import read_tsv
+from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
+from loper_analysis.io.readers import read_tsv
 
 __all__ = ["VALIDATION_FLOAT_FORMAT", "validation_chunk", "validation_tables", "validation_figure"]
 
@@ -23,15 +23,15 @@ def validation_chunk(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Simulate and identify chunk ``chunk`` of ``n_chunks`` of the combinations; write its two tables.
 
-    ``settings``: keyword arguments of :class:`~loper_analysis.validation.ValidationSettings`.
+    ``settings``: keyword arguments of :class:`~loper_analysis.identification.validation.ValidationSettings`.
     """
-    from ..dynamics import read_segments
-    from ..validation import (
+    from loper_analysis.identification.validation import (
         ValidationSettings,
         chunk_combinations,
         impedance_grid,
         run_validation_chunk,
     )
+    from loper_analysis.swing_leg.dynamics import read_segments
 
     study = ValidationSettings(**settings)
     log.info("chunk %d of %d with %s", chunk, n_chunks, study)
@@ -52,7 +52,7 @@ def validation_tables(
     summary_out: PathLike,
 ) -> pd.DataFrame:
     """Gather the chunks' tables and write them with the summary beside the study's values; returns the summary."""
-    from ..validation import gather_validation_tables
+    from loper_analysis.identification.validation import gather_validation_tables
 
     errors, fits, summary = gather_validation_tables(
         [read_tsv(p, "error table") for p in error_tsvs], [read_tsv(p, "fit table") for p in fit_tsvs]
@@ -66,7 +66,7 @@ def validation_tables(
 
 def validation_figure(errors_tsv: PathLike, out_png: PathLike) -> None:
     """Box plots of the estimation errors per parameter and condition."""
-    from ..figures.validation import validation_errors_figure
+    from loper_analysis.report.figures.validation import validation_errors_figure
 
     write_figure(validation_errors_figure(read_tsv(errors_tsv, "error table")), out_png)
     log.info("wrote %s", out_png)

@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import LoperInputError
-from ..io.c3d import LENGTH_UNITS_PER_M
-from ..io.c3d_writer import ForcePlatform
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d import LENGTH_UNITS_PER_M
+from loper_analysis.io.c3d_writer import ForcePlatform
 
 __all__ = ["plate_channels", "plate_frame", "plate_load", "wrench_channels"]
 

@@ -53,7 +53,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "CURVE_KEYPOINTS_DEG",

@@ -37,12 +37,12 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from ..constants import GRAVITY_M_PER_S2, SIDES
-from ..errors import LoperInputError
-from ..io.c3d import C3DRecording
-from ..io.c3d_writer import ForcePlatform
-from .force_plates import plate_channels, plate_frame, wrench_channels
-from .trials import LabSettings, WalkingTrial
+from loper_analysis.constants import GRAVITY_M_PER_S2, SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d import C3DRecording
+from loper_analysis.io.c3d_writer import ForcePlatform
+from loper_analysis.synthetic.force_plates import plate_channels, plate_frame, wrench_channels
+from loper_analysis.synthetic.trials import LabSettings, WalkingTrial
 
 __all__ = [
     "GAIT2392_COORDINATES",
@@ -189,12 +189,12 @@ def add_brace_markers(
     Both lie ``anterior_m`` in front of the hip-knee line (m), ``spacing_m``
     apart along it and centred ``attachment_m`` (m) from the hip, and
     ``lateral_m`` along the body's z axis (negative: lateral on the left leg),
-    as on the generated model (:data:`loper_analysis.model.BRACE_MARKERS`):
+    as on the generated model (:data:`loper_analysis.motion.model.BRACE_MARKERS`):
     their line is parallel to the thigh and the projection of their midpoint
     on it is the rod attachment. The knee is the origin of ``knee_body`` in
     the default pose.
     """
-    from ..io.osim import quiet_opensim
+    from loper_analysis.io.osim import quiet_opensim
 
     osim = quiet_opensim()
     state = model.initSystem()
@@ -212,7 +212,7 @@ def add_brace_markers(
 
 
 def gait2392_coordinates(coordinates: pd.DataFrame, pelvis_ty_offset_m: float = 0.0) -> pd.DataFrame:
-    """gait2392 coordinates (rad, m) from ours (:data:`loper_analysis.model.COORDINATES`), ``time_s`` kept.
+    """gait2392 coordinates (rad, m) from ours (:data:`loper_analysis.motion.model.COORDINATES`), ``time_s`` kept.
 
     ``knee_angle`` is minus our ``knee_flexion``; ``pelvis_ty`` is raised by ``pelvis_ty_offset_m``.
     """
@@ -289,7 +289,7 @@ def _lab_markers(
     model, coords2392: pd.DataFrame, label_map: Mapping[str, str], lab: LabSettings, settings: QTMExportSettings
 ) -> tuple[np.ndarray, list[str], float]:
     """Exact lab-frame markers (n, m, 3), their model names, and the floor offset applied (m)."""
-    from ..kinematics import marker_positions
+    from loper_analysis.motion.ik import marker_positions
 
     names = list(label_map)
     values = {c: coords2392[c].to_numpy(float) for c in GAIT2392_COORDINATES}
@@ -419,8 +419,8 @@ def qtm_walking_export(
     seed : int or numpy.random.SeedSequence
     settings : QTMExportSettings
     """
-    from .sync import pulse_train_at
-    from .treadmill import treadmill_grf
+    from loper_analysis.synthetic.sync import pulse_train_at
+    from loper_analysis.synthetic.treadmill import treadmill_grf
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     marker_seed, grf_seed, plate_seed = ss.spawn(3)

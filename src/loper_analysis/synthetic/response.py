@@ -1,7 +1,7 @@
 """The swing leg's response to a LOPER force pulse, with a known impedance (the synthetic truth).
 
 The perturbed swing follows the swing-leg model (``docs/swing_leg_model.md``; the
-same equations the identification fits, :mod:`loper_analysis.dynamics`):
+same equations the identification fits, :mod:`loper_analysis.swing_leg.dynamics`):
 the unperturbed stride is the reference, its inverse dynamics with the
 minimal-impedance force ``F_u`` is the feedforward, and the perturbed leg
 is driven by ``u_ff + u_fb + Ja(q)^T F_p - Ja(q_u)^T F_u`` with
@@ -28,8 +28,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from ..dynamics import SegmentParameters, segment_coordinates
-from ..errors import LoperInputError
+from loper_analysis.errors import LoperInputError
+from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
 
 __all__ = ["perturbation_schedule", "pulse_train", "thigh_normal", "swing_response", "swing_responses", "swing_spans"]
 
@@ -105,7 +105,7 @@ def swing_response(
     :data:`loper_analysis.constants.PARAMETERS`. Zero before
     ``onset_s - before_s``; simulated to ``heel_strike_s``; faded out after.
     """
-    from ..identification import prepare_window, simulate_response
+    from loper_analysis.identification import prepare_window, simulate_response
 
     t = np.asarray(time_s, float)
     th = np.asarray(joint_angles_rad, float)

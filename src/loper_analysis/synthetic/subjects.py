@@ -19,9 +19,9 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..constants import JOINTS
-from ..errors import LoperInputError
-from ..reference import STUDY_SUBJECTS
+from loper_analysis.constants import JOINTS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.reference import STUDY_SUBJECTS
 
 __all__ = ["subject_anthropometry", "true_impedance"]
 

@@ -4,7 +4,7 @@ A pulse train with a fixed period cannot resolve an offset of whole periods
 between the robot and the motion-capture clocks, so walking trials use a
 train whose pulse-start intervals are drawn at random
 (:func:`sync_pulse_starts`): a window of a few consecutive intervals then
-occurs once only, and :func:`loper_analysis.clock_sync.clock_map` finds the
+occurs once only, and :func:`loper_analysis.device.clock_sync.clock_map` finds the
 offset unambiguously.
 """
 
@@ -14,8 +14,8 @@ import math
 
 import numpy as np
 
-from ..checks import positive
-from ..errors import LoperInputError
+from loper_analysis.checks import positive
+from loper_analysis.errors import LoperInputError
 
 __all__ = ["sync_pulse_starts", "pulse_train_at"]
 

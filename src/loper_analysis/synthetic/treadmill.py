@@ -24,10 +24,10 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import PchipInterpolator
 
-from ..checks import generator
-from ..constants import GRAVITY_M_PER_S2, SIDES
-from ..errors import LoperInputError
-from .walking import TRUE_EVENT_COLUMNS
+from loper_analysis.checks import generator
+from loper_analysis.constants import GRAVITY_M_PER_S2, SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.synthetic.walking import TRUE_EVENT_COLUMNS
 
 __all__ = ["GRF_COLUMNS", "treadmill_grf"]
 

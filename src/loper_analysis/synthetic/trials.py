@@ -3,7 +3,7 @@
 A walking trial is recorded exactly as a lab records it:
 
 * markers: the OpenSim model's markers at the simulated coordinates
-  (:func:`loper_analysis.kinematics.marker_positions`), turned from the model
+  (:func:`loper_analysis.motion.ik.marker_positions`), turned from the model
   frame into the lab frame (the inverse of ``lab_to_model_rotation_deg``,
   Qualisys Z-up), Gaussian measurement noise, a few short gaps (NaN), stored
   in mm;
@@ -13,7 +13,7 @@ A walking trial is recorded exactly as a lab records it:
 * the robot log (trials with the device) on the robot's own clock, which
   starts ``clock_offset_s`` before the motion capture and runs
   ``clock_drift_ppm`` fast: the pipeline must align the two through the sync
-  pulses (:mod:`loper_analysis.loadcell`). Its forces come from the device
+  pulses (:mod:`loper_analysis.device.loadcell`). Its forces come from the device
   simulation in minimal-impedance mode driven by the brace motion of the
   simulated thigh (:func:`loper_analysis.device.controller.simulate_device`).
 
@@ -33,9 +33,9 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from ..constants import SIDES
-from ..errors import LoperInputError
-from ..io.c3d import C3DRecording
+from loper_analysis.constants import SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d import C3DRecording
 
 __all__ = [
     "LabSettings",
@@ -80,7 +80,7 @@ def lab_markers(model, coordinates: pd.DataFrame, lab: LabSettings, rng: np.rand
 
     ``model`` is an ``opensim.Model``; without ``rng`` the markers are exact.
     """
-    from ..kinematics import marker_positions
+    from loper_analysis.motion.ik import marker_positions
 
     ms = model.getMarkerSet()
     labels = [ms.get(i).getName() for i in range(ms.getSize())]
@@ -174,7 +174,7 @@ def simulate_walking_trial(
 ) -> WalkingTrial:
     """Simulate kinematics, device and perturbation responses of one walking trial.
 
-    ``params`` is the subject's :class:`~loper_analysis.dynamics.SegmentParameters`
+    ``params`` is the subject's :class:`~loper_analysis.swing_leg.dynamics.SegmentParameters`
     (its ``attachment_m`` places the brace); ``device`` a
     :class:`~loper_analysis.device.controller.DeviceParameters` or None (no
     device). The device runs on the robot clock (``clock_offset_s``,
@@ -193,10 +193,16 @@ def simulate_walking_trial(
     otherwise; None: only the pulses act (their force minus that of a run
     without them).
     """
-    from ..device.controller import simulate_device
-    from .response import perturbation_schedule, pulse_train, swing_response, swing_responses, swing_spans
-    from .sync import pulse_train_at, sync_pulse_starts
-    from .walking import leg_length_from_height
+    from loper_analysis.device.controller import simulate_device
+    from loper_analysis.synthetic.response import (
+        perturbation_schedule,
+        pulse_train,
+        swing_response,
+        swing_responses,
+        swing_spans,
+    )
+    from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
+    from loper_analysis.synthetic.walking import leg_length_from_height
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     gait_seed, sync_seed, device_seed, schedule_seed = ss.spawn(4)
@@ -307,8 +313,8 @@ def walking_recording(
     model, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings, seed, source: str = "walking trial"
 ) -> C3DRecording:
     """The C3D contents of a walking trial: markers with noise and gaps, GRF per belt and the sync channel."""
-    from .sync import pulse_train_at
-    from .treadmill import treadmill_grf
+    from loper_analysis.synthetic.sync import pulse_train_at
+    from loper_analysis.synthetic.treadmill import treadmill_grf
 
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     marker_seed, grf_seed = ss.spawn(2)
@@ -361,8 +367,8 @@ def walking_with_margins(
     motion capture to ``robot_margin_s`` (+1 s) after it; time 0 is the first motion-capture frame.
     ``sample_rate_hz`` defaults to the marker rate and must be a multiple of it; ``variability`` and
     ``adaptation`` as in :func:`~loper_analysis.synthetic.walking.walking_kinematics`."""
-    from .gait_curves import NominalGait
-    from .walking import walking_kinematics
+    from loper_analysis.synthetic.gait_curves import NominalGait
+    from loper_analysis.synthetic.walking import walking_kinematics
 
     rate = lab.marker_rate_hz if sample_rate_hz is None else sample_rate_hz
     lead = np.ceil((lab.clock_offset_s + 1.0) * lab.marker_rate_hz) / lab.marker_rate_hz
@@ -390,8 +396,8 @@ def subject_static_recording(
     subject: str, height_m: float, mass_kg: float, duration_s: float, lab: LabSettings, seed: int
 ) -> C3DRecording:
     """The static trial of a synthetic subject: standing, joints at 0, feet on the floor (seeded by subject)."""
-    from ..model import COORDINATES, build_lower_body_model
-    from .walking import leg_length_from_height
+    from loper_analysis.motion.model import COORDINATES, build_lower_body_model
+    from loper_analysis.synthetic.walking import leg_length_from_height
 
     model = build_lower_body_model(height_m, mass_kg)
     still = pd.DataFrame({c: [0.0] for c in COORDINATES}).assign(pelvis_ty=leg_length_from_height(height_m))
@@ -420,7 +426,7 @@ def subject_walking_trial(
     ``variability``, ``adaptation`` and ``minimal_impedance`` as in
     :func:`simulate_walking_trial` (None: the gentle lab).
     """
-    from ..model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
 
     model = build_lower_body_model(height_m, mass_kg)
     params = segment_parameters_from_model(model)

@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from ..constants import JOINTS
-from ..errors import LoperInputError
+from loper_analysis.constants import JOINTS
+from loper_analysis.errors import LoperInputError
 
 __all__ = [
     "GaitVariability",

@@ -28,13 +28,13 @@ import numpy as np
 import pandas as pd
 from scipy.interpolate import PchipInterpolator
 
-from ..anthropometry import ANKLE_HEIGHT_FRACTION, WINTER_SEGMENTS
-from ..anthropometry import leg_length_m as standing_leg_length_m
-from ..checks import generator
-from ..errors import LoperInputError
-from ..model import COORDINATES
-from .gait_curves import CURVE_JOINTS, NominalGait
-from .variability import DeviceAdaptation, GaitVariability, smooth_noise, swing_envelope
+from loper_analysis.checks import generator
+from loper_analysis.errors import LoperInputError
+from loper_analysis.motion.model import COORDINATES
+from loper_analysis.swing_leg.anthropometry import ANKLE_HEIGHT_FRACTION, WINTER_SEGMENTS
+from loper_analysis.swing_leg.anthropometry import leg_length_m as standing_leg_length_m
+from loper_analysis.synthetic.gait_curves import CURVE_JOINTS, NominalGait
+from loper_analysis.synthetic.variability import DeviceAdaptation, GaitVariability, smooth_noise, swing_envelope
 
 __all__ = [
     "TRUE_EVENT_COLUMNS",
@@ -206,7 +206,7 @@ def walking_kinematics(
     Returns
     -------
     coordinates : pandas.DataFrame, shape (n_samples, 10)
-        ``time_s`` and the model coordinates :data:`loper_analysis.model.COORDINATES`
+        ``time_s`` and the model coordinates :data:`loper_analysis.motion.model.COORDINATES`
         (rad; ``pelvis_tx``, ``pelvis_ty`` in m).
     events : pandas.DataFrame
         ``side`` (left | right), ``event`` (heel_strike | toe_off), ``time_s``:

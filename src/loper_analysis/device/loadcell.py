@@ -1,0 +1,354 @@
+"""The robot log on the motion-capture clock: forces resampled at the mocap frames, perturbation onsets.
+
+Chain (``docs/processing.md``, :func:`robot_log_on_mocap_frames`): rising
+edges of the log's ``sync_v`` and of the mocap sync channel -> clock map
+(:mod:`loper_analysis.device.clock_sync`) -> zero-phase 4th-order 40 Hz
+Butterworth of the forces at the robot rate
+(:func:`loper_analysis.motion.filtering.lowpass`) -> robot sample times mapped to
+the mocap clock -> linear interpolation of the forces, nearest-sample pick of
+the perturbation flag, at the mocap frame times (128 Hz); the same filtered
+forces at every robot sample, on the mocap clock, for the identification.
+
+Two checks guard against records that would give wrong numbers without an
+error (``docs/device.md``, "Checks on the robot's records"): the sync pulses
+must have the same high time in both records (an inverted sync, e.g. an
+active-low robot output, shifts the clock map by the pulse width;
+:func:`loper_analysis.device.clock_sync.clock_map`), and force pulses in the load
+cell must carry the perturbation flag (:func:`check_perturbation_flags`).
+"""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.checks import positive
+from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
+from loper_analysis.device.pulse import find_force_pulses
+from loper_analysis.errors import LoperInputError
+from loper_analysis.motion.filtering import lowpass
+
+__all__ = [
+    "OUTPUT_COLUMNS",
+    "MIN_UNFLAGGED_PULSES",
+    "robot_log_on_mocap_frames",
+    "robot_log_frames_and_native",
+    "check_perturbation_flags",
+    "perturbation_onsets",
+]
+
+log = logging.getLogger(__name__)
+
+#: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.
+OUTPUT_COLUMNS: tuple[str, ...] = ("time_s", "force_measured_n", "force_desired_n", "perturbation")
+
+_LOG_COLUMNS = ("time_s", "force_desired_n", "force_measured_n", "sync_v", "perturbation")
+_FORCE_COLUMNS = ("force_measured_n", "force_desired_n")
+
+#: A log is refused when at least this many force pulses are found and more than half of them carry no flag.
+MIN_UNFLAGGED_PULSES = 3
+#: A force pulse counts as flagged if the flag is 1 anywhere from this long before its start to this long after
+#: its end, s (the load cell follows the flag by the robot's delays, ~15 ms).
+_FLAG_MARGIN_S = 0.1
+
+
+def robot_log_on_mocap_frames(
+    log: pd.DataFrame,
+    log_rate_hz: float,
+    mocap_sync_v,
+    analog_rate_hz: float,
+    frame_time_s,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    source: str = "",
+    analog_start_s: float | None = None,
+    max_drift: float = 1e-3,
+    tolerance_s: float = 3e-3,
+    sync_channel: str = "",
+) -> pd.DataFrame:
+    """The robot log's forces and perturbation flag on the motion-capture frames.
+
+    1. Clock map (:func:`loper_analysis.device.clock_sync.clock_map`) from the rising edges of the log's
+       ``sync_v`` (robot clock: ``time_s`` at the interpolated sample index)
+       and of ``mocap_sync_v`` (mocap clock: ``analog_start_s + index /
+       analog_rate_hz``); the pulses' high times
+       (:func:`loper_analysis.device.clock_sync.high_times`) must agree between the
+       two (same polarity).
+    2. ``force_measured_n`` and ``force_desired_n`` low-passed at the robot
+       rate (:func:`~loper_analysis.motion.filtering.lowpass`: zero-phase
+       Butterworth, ``order``, ``cutoff_hz``) before resampling.
+    3. Robot sample times mapped to the mocap clock; forces linearly
+       interpolated at ``frame_time_s``; ``perturbation`` taken from the
+       nearest robot sample (never interpolated), so a flag's onset lands
+       within one mocap frame (plus half a robot sample) of its mapped time.
+    4. Force pulses in the low-passed ``force_measured_n`` must carry the
+       ``perturbation`` flag (:func:`check_perturbation_flags`).
+
+    :func:`robot_log_frames_and_native` also returns the filtered forces at
+    the robot's own samples.
+
+    Gap policy: frames outside the robot log's mapped span (first to last
+    sample) get NaN in every column but ``time_s``, which is why
+    ``perturbation`` is float (0.0 / 1.0 / NaN). The filter's start-up
+    transients (odd-extension padding) affect the first and last ~0.1 s of
+    the log; NaN ``sync_v`` samples only cost the edges they hide.
+
+    Parameters
+    ----------
+    log : pandas.DataFrame
+        Robot log (:mod:`loper_analysis.io.robot_log`), at least the columns
+        ``time_s`` (s, robot clock), ``force_desired_n``, ``force_measured_n``
+        (N, finite), ``sync_v`` (V, NaN = missing) and ``perturbation`` (0/1).
+    log_rate_hz : float
+        Robot log rate, Hz (1000).
+    mocap_sync_v : array_like, shape (n_analog,)
+        The mocap analog channel recording the robot's sync output, V.
+    analog_rate_hz : float
+        Mocap analog rate, Hz (1024).
+    frame_time_s : array_like, shape (n_frames,)
+        Mocap frame times, s, strictly increasing (128 Hz).
+    cutoff_hz, order : float, int
+        Force low-pass (the study's: 40 Hz, 4th order).
+    source : str
+        Names the files in error messages.
+    analog_start_s : float, optional
+        Mocap time of analog sample 0, s; default ``frame_time_s[0]`` (C3D:
+        analog and point data start together).
+    max_drift, tolerance_s : float
+        Passed to :func:`loper_analysis.device.clock_sync.clock_map`.
+    sync_channel : str
+        Name of the mocap sync channel, for messages.
+
+    Returns
+    -------
+    pandas.DataFrame, shape (n_frames, 4)
+        Columns :data:`OUTPUT_COLUMNS`: ``time_s`` (s, mocap clock, =
+        ``frame_time_s``), ``force_measured_n``, ``force_desired_n`` (N),
+        ``perturbation`` (0.0/1.0, NaN outside the log). ``attrs["clock_map"]``
+        holds the :class:`loper_analysis.device.clock_sync.ClockMap`.
+
+    Raises
+    ------
+    LoperInputError
+        Missing columns, a ``time_s`` step inconsistent with ``log_rate_hz``,
+        non-finite forces or frame times, an all-NaN or flat sync signal in
+        either record, a clock map refused by :func:`loper_analysis.device.clock_sync.clock_map` (also: sync
+        pulses whose high times disagree between the records, e.g. an inverted robot sync), no frame
+        inside the log's span, force pulses without perturbation flags (:func:`check_perturbation_flags`).
+    """
+    return robot_log_frames_and_native(
+        log,
+        log_rate_hz,
+        mocap_sync_v,
+        analog_rate_hz,
+        frame_time_s,
+        cutoff_hz,
+        order,
+        source,
+        analog_start_s,
+        max_drift,
+        tolerance_s,
+        sync_channel,
+    )[0]
+
+
+def robot_log_frames_and_native(
+    log: pd.DataFrame,
+    log_rate_hz: float,
+    mocap_sync_v,
+    analog_rate_hz: float,
+    frame_time_s,
+    cutoff_hz: float = 40.0,
+    order: int = 4,
+    source: str = "",
+    analog_start_s: float | None = None,
+    max_drift: float = 1e-3,
+    tolerance_s: float = 3e-3,
+    sync_channel: str = "",
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`robot_log_on_mocap_frames` and the same forces at the robot log's own samples.
+
+    Returns the frame table of :func:`robot_log_on_mocap_frames` and a table
+    with the same columns at every robot sample (``log_rate_hz``): ``time_s``
+    the sample's time mapped to the mocap clock (s), the low-passed forces (N)
+    and the flag (0.0/1.0). The robot rate keeps the pulse's edges, which the
+    128 Hz frames cut short: the fit takes its force from there
+    (:func:`loper_analysis.identification.prepare_window`, ``force_time_s``).
+    Same parameters and errors as :func:`robot_log_on_mocap_frames`.
+    """
+    src = source or "robot log"
+    if not isinstance(log, pd.DataFrame):
+        raise LoperInputError(f"{src}: log must be a pandas DataFrame, got {type(log).__name__}")
+    missing = [c for c in _LOG_COLUMNS if c not in log.columns]
+    if missing:
+        raise LoperInputError(f"{src}: robot log lacks column(s) {', '.join(missing)}")
+    rate = positive("log_rate_hz", log_rate_hz, src)
+    arate = positive("analog_rate_hz", analog_rate_hz, src)
+    t_log = log["time_s"].to_numpy(dtype=float)
+    if t_log.size < 2 or not np.all(np.isfinite(t_log)):
+        raise LoperInputError(f"{src}: column 'time_s' must hold >= 2 finite samples")
+    step = np.diff(t_log)
+    bad = np.flatnonzero(np.abs(step * rate - 1.0) > 0.01)
+    if bad.size:
+        k = int(bad[0]) + 1
+        raise LoperInputError(
+            f"{src}: column 'time_s', sample {k} (t = {t_log[k]:.9g} s): step {step[k - 1]:.6g} s is not "
+            f"1 / log_rate_hz = {1 / rate:.6g} s within 1 %"
+        )
+    frames = np.asarray(frame_time_s, dtype=float)
+    if frames.ndim != 1 or frames.size == 0 or not np.all(np.isfinite(frames)) or np.any(np.diff(frames) <= 0):
+        raise LoperInputError(f"{src}: frame_time_s must be a non-empty, finite, strictly increasing 1-D array")
+    start = frames[0] if analog_start_s is None else float(analog_start_s)
+
+    robot_name = "robot log column 'sync_v'"
+    mocap_name = f"mocap sync channel '{sync_channel}'" if sync_channel else "mocap sync channel"
+    robot_sync = log["sync_v"].to_numpy(dtype=float, na_value=np.nan)
+    robot_rel = rising_edges(robot_sync, rate, source=f"{src}: {robot_name}")
+    mocap_rel = rising_edges(mocap_sync_v, arate, source=f"{src}: {mocap_name}")
+    robot_edges = np.interp(robot_rel * rate, np.arange(t_log.size), t_log)
+    cm = clock_map(
+        robot_edges,
+        start + mocap_rel,
+        max_drift=max_drift,
+        source=src,
+        tolerance_s=tolerance_s,
+        robot_high_s=high_times(robot_sync, rate, robot_rel),
+        mocap_high_s=high_times(mocap_sync_v, arate, mocap_rel),
+        robot_name=robot_name,
+        mocap_name=mocap_name,
+    )
+
+    t_mapped = cm.to_mocap(t_log)
+    inside = (frames >= t_mapped[0]) & (frames <= t_mapped[-1])
+    if not inside.any():
+        raise LoperInputError(
+            f"{src}: no mocap frame ({frames[0]:.6g} .. {frames[-1]:.6g} s) lies within the robot log's span on "
+            f"the mocap clock ({t_mapped[0]:.6g} .. {t_mapped[-1]:.6g} s)"
+        )
+    out = {"time_s": frames}
+    native = {"time_s": t_mapped}
+    for col in _FORCE_COLUMNS:
+        f = log[col].to_numpy(dtype=float, na_value=np.nan)
+        try:
+            f = lowpass(f, rate, cutoff_hz, order)
+        except LoperInputError as exc:
+            raise LoperInputError(f"{src}: column '{col}': {exc}") from None
+        native[col] = f
+        out[col] = np.interp(frames, t_mapped, f, left=np.nan, right=np.nan)
+    flag = log["perturbation"].to_numpy(dtype=float, na_value=np.nan)
+    if not np.all(np.isin(flag, (0.0, 1.0))):
+        k = int(np.flatnonzero(~np.isin(flag, (0.0, 1.0)))[0])
+        raise LoperInputError(f"{src}: column 'perturbation', sample {k}: value {flag[k]!r} is not 0 or 1")
+    check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
+    pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
+    nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
+    out["perturbation"] = np.where(inside, flag[nearest], np.nan)
+    native["perturbation"] = flag
+    result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
+    result.attrs["clock_map"] = cm
+    return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
+
+
+def check_perturbation_flags(force_n, flag, sample_rate_hz: float, time_s, source: str = "") -> np.ndarray:
+    """Refuse a robot log whose force shows perturbation pulses that its perturbation flag does not mark.
+
+    Pulses are found in the force itself (:func:`loper_analysis.device.pulse.find_force_pulses`);
+    a pulse is flagged if ``flag`` is 1 anywhere within ``_FLAG_MARGIN_S``
+    (0.1 s) of it. A log with at least :data:`MIN_UNFLAGGED_PULSES` pulses of
+    which more than half are unflagged is refused: its strides could not be
+    sorted into perturbed and unperturbed ones (a perturbation trial would end
+    as ``too_few_strides`` with no error). Fewer unflagged pulses are logged as
+    a warning. Logs without pulses (minimal-impedance trials) pass.
+
+    Parameters
+    ----------
+    force_n : array_like, shape (n,)
+        Measured interaction force at the robot rate, N (low-passed).
+    flag : array_like, shape (n,)
+        The log's ``perturbation`` column, 0/1.
+    sample_rate_hz : float
+        Robot log rate, Hz.
+    time_s : array_like, shape (n,)
+        The log's ``time_s`` (robot clock), s: the times named in messages.
+    source : str
+        Names the robot log in messages.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_pulses, 3)
+        The pulses found (:func:`loper_analysis.device.pulse.find_force_pulses`).
+
+    Raises
+    ------
+    LoperInputError
+        Too many unflagged pulses: names the file, the columns ``perturbation``
+        and ``force_measured_n``, the number of flagged pulses in the log, the
+        number of force pulses and the robot-clock times of the first
+        unflagged ones.
+    """
+    src = source or "robot log"
+    rate = positive("sample_rate_hz", sample_rate_hz, src)
+    f = np.asarray(flag, dtype=float)
+    t = np.asarray(time_s, dtype=float)
+    pulses = find_force_pulses(force_n, rate, source=f"{src}: column 'force_measured_n'")
+    if not len(pulses):
+        return pulses
+    on = f == 1
+    n_flags = int(on[0]) + int(np.sum(~on[:-1] & on[1:]))
+    margin = int(round(_FLAG_MARGIN_S * rate))
+    cum = np.concatenate(([0], np.cumsum(on)))
+    a = np.clip(pulses[:, 0].astype(int) - margin, 0, f.size)
+    b = np.clip(pulses[:, 1].astype(int) + margin, 0, f.size)
+    unflagged = cum[b] - cum[a] == 0
+    n_pulses, n_unflagged = len(pulses), int(unflagged.sum())
+    if not n_unflagged:
+        return pulses
+    first = pulses[unflagged, 0].astype(int)
+    times = ", ".join(f"{t[k]:.3f}" for k in first[:5]) + (", ..." if first.size > 5 else "")
+    peak = float(np.median(np.abs(pulses[:, 2])))
+    width_ms = float(np.median(pulses[:, 1] - pulses[:, 0])) / rate * 1e3
+    seen = (
+        f"column 'perturbation' flags {n_flags} pulse(s), but column 'force_measured_n' shows {n_pulses} force "
+        f"pulse(s) (median peak {peak:.0f} N, {width_ms:.0f} ms), {n_unflagged} of them without a flag, at "
+        f"t = {times} s (robot clock)"
+    )
+    if n_pulses >= MIN_UNFLAGGED_PULSES and 2 * n_unflagged > n_pulses:
+        what = (
+            "the log has no perturbation flags, so no stride would count as perturbed"
+            if not n_flags
+            else "most pulses lack their perturbation flag, so their strides would count as unperturbed"
+        )
+        raise LoperInputError(
+            f"{src}: {seen}: {what}; check the robot's flag channel (a .mat export: device.mat_column_map.perturbation)"
+        )
+    log.warning("%s: %s: their strides count as unperturbed", src, seen)
+    return pulses
+
+
+def perturbation_onsets(time_s, flag) -> np.ndarray:
+    """Times of the 0 -> 1 transitions of a perturbation flag.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n,)
+        Sample times, s.
+    flag : array_like, shape (n,)
+        0/1 flag; NaN samples (e.g. outside the robot log) never start an
+        onset, nor does a flag already 1 at the first sample.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n_onsets,)
+        ``time_s`` of each first sample at 1 after a sample at 0, s.
+    """
+    t = np.asarray(time_s, dtype=float)
+    f = np.asarray(flag, dtype=float)
+    if t.ndim != 1 or f.shape != t.shape:
+        raise LoperInputError(f"time_s and flag must be 1-D of equal length, got shapes {t.shape} and {f.shape}")
+    bad = ~(np.isnan(f) | np.isin(f, (0.0, 1.0)))
+    if bad.any():
+        k = int(np.flatnonzero(bad)[0])
+        raise LoperInputError(f"flag, sample {k}: value {f[k]!r} is not 0, 1 or NaN")
+    return t[1:][(f[:-1] == 0) & (f[1:] == 1)]

@@ -1,0 +1,497 @@
+"""Foot contacts on force plates: contacts per plate, the foot on each, flags and the gait events.
+
+* :func:`plate_contacts` - loaded periods of one plate from its vertical force
+  above the resting level (the hysteresis of :func:`loper_analysis.gait.events.load_transitions`);
+* :func:`foot_contacts` - the contacts of every plate, each given a foot from
+  the heel markers shortly after the contact starts, and a flag
+  (:data:`loper_analysis.constants.CONTACT_FLAGS`);
+* :func:`contact_events` - the event table of the clean contacts, with the
+  spans of the flagged ones that strides must not cross.
+
+Time in s, force in N, positions in m (markers and plate corners in one
+frame). ``docs/events.md`` explains the rules.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.checks import integer, number, time_vector, where
+from loper_analysis.checks import side as check_side
+from loper_analysis.constants import CONTACT_FLAGS, FLAGGED_EVENTS, SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.events import EVENT_COLUMNS, load_transitions
+from loper_analysis.gait.plate_geometry import plate_axes, plate_offsets
+
+__all__ = [
+    "PLATE_CONTACT_COLUMNS",
+    "CONTACT_COLUMNS",
+    "PlateForce",
+    "plate_contacts",
+    "foot_contacts",
+    "contact_events",
+    "count_flagged",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Columns of :func:`plate_contacts`.
+PLATE_CONTACT_COLUMNS: tuple[str, ...] = ("contact", "start_sample", "end_sample", "start_s", "end_s", "incomplete")
+#: Columns of :func:`foot_contacts` (the heel columns are measured at the start probe).
+CONTACT_COLUMNS: tuple[str, ...] = (
+    "plate",
+    "contact",
+    "side",
+    "flag",
+    "start_sample",
+    "end_sample",
+    "start_s",
+    "end_s",
+    "belt_side",
+    *(f"{s}_heel_{q}_m" for s in SIDES for q in ("outside", "height")),
+)
+#: Flags whose contact may hide either foot: they block the strides of both sides.
+_BOTH_SIDES = {"heel_missing", "two_feet", "no_foot"}
+
+
+@dataclass(frozen=True)
+class PlateForce:
+    """One force plate: its vertical force above the resting level and its corners.
+
+    Attributes
+    ----------
+    plate : int
+        Plate number as in the recording (1, 2, ...).
+    time_s : numpy.ndarray, shape (n_samples,)
+        Sample times in s on the marker clock.
+    vertical_force_n : numpy.ndarray, shape (n_samples,)
+        Vertical force in N minus the plate's resting (unloaded) level,
+        positive when loaded.
+    corners_m : numpy.ndarray, shape (4, 3)
+        The plate's corners in m, in order around the plate, in the frame of the markers.
+    """
+
+    plate: int
+    time_s: np.ndarray
+    vertical_force_n: np.ndarray
+    corners_m: np.ndarray
+
+
+def plate_contacts(
+    time_s,
+    vertical_force_n,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    source: str = "",
+) -> pd.DataFrame:
+    """Loaded periods (contacts) of one plate from its vertical force above the resting level.
+
+    A contact starts at the first sample with force ``>= threshold_on_n``
+    (the heel strike of :func:`loper_analysis.gait.events.gait_events`) and ends at
+    the first later sample with force ``<= threshold_off_n`` (the toe-off),
+    with the same hysteresis and minimum durations. A plate loaded when the
+    trial starts (or reaching the loaded state from the dead band first) gives
+    a contact from sample 0, one still loaded at the end a contact to the last
+    sample; both are ``incomplete``. A plate never loaded gives no row.
+
+    Parameters
+    ----------
+    time_s : array_like, shape (n_samples,)
+        Sample times in s, finite and strictly increasing.
+    vertical_force_n : array_like, shape (n_samples,)
+        Vertical force in N above the plate's resting level; finite.
+    threshold_on_n, threshold_off_n : float
+        Loading and unloading thresholds in N above the resting level; on > off.
+    min_stance_s, min_swing_s : float
+        Shortest accepted loaded and unloaded period in s.
+    source : str
+        Name of the trial and plate, quoted in messages.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per contact in time order (:data:`PLATE_CONTACT_COLUMNS`):
+        ``contact`` (0, 1, ...), ``start_sample``, ``end_sample`` (int,
+        indices into ``time_s``), ``start_s``, ``end_s`` (s), ``incomplete``
+        (bool). ``attrs["dropped"]``: the periods removed as too short.
+
+    Raises
+    ------
+    LoperInputError
+        As :func:`loper_analysis.gait.events.load_transitions`.
+    """
+    t = time_vector(time_s, source)
+    samples, loading, dropped = load_transitions(
+        t, vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, source
+    )
+    starts, ends = list(samples[loading]), list(samples[~loading])
+    open_start = bool(samples.size) and not loading[0]
+    if not samples.size:  # no transition left: loaded throughout or never loaded
+        open_start = _loaded_at_end(
+            np.asarray(vertical_force_n, dtype=float), float(threshold_on_n), float(threshold_off_n)
+        )
+    if open_start:
+        starts.insert(0, 0)
+    open_end = len(starts) > len(ends)
+    if open_end:
+        ends.append(t.size - 1)
+    start = np.asarray(starts, dtype=np.int64)
+    end = np.asarray(ends, dtype=np.int64)
+    incomplete = np.zeros(start.size, dtype=bool)
+    if start.size:
+        incomplete[0] |= open_start
+        incomplete[-1] |= open_end
+    table = pd.DataFrame(
+        {
+            "contact": np.arange(start.size, dtype=np.int64),
+            "start_sample": start,
+            "end_sample": end,
+            "start_s": t[start],
+            "end_s": t[end],
+            "incomplete": incomplete,
+        },
+        columns=list(PLATE_CONTACT_COLUMNS),
+    )
+    table.attrs["dropped"] = dropped
+    return table
+
+
+def _loaded_at_end(f: np.ndarray, on: float, off: float) -> bool:
+    """Whether the hysteresis ends loaded: the force last reached ``on`` after it last fell to ``off``."""
+    high, low = np.flatnonzero(f >= on), np.flatnonzero(f <= off)
+    return bool(high.size) and (not low.size or high[-1] > low[-1])
+
+
+def _at(time_s: np.ndarray, xyz: np.ndarray, when: np.ndarray) -> np.ndarray:
+    """Positions (k, 3) at the times ``when`` (k,), linear between frames; NaN outside the frames or next to a gap."""
+    when = np.asarray(when, dtype=float)
+    j = np.clip(np.searchsorted(time_s, when, side="right") - 1, 0, time_s.size - 2)
+    w = ((when - time_s[j]) / (time_s[j + 1] - time_s[j]))[:, None]
+    out = np.where(w == 0.0, xyz[j], (1.0 - w) * xyz[j] + w * xyz[j + 1])  # a frame time needs only its frame
+    out[(when < time_s[0]) | (when > time_s[-1])] = np.nan
+    return out
+
+
+def _longest_run_s(times: np.ndarray, mask: np.ndarray) -> float:
+    """Longest time span (s) of consecutive True samples; -inf without any."""
+    if not mask.any():
+        return -np.inf
+    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
+    return float(np.max(times[last] - times[first]))
+
+
+def foot_contacts(
+    plates: Sequence[PlateForce],
+    marker_time_s,
+    heels_m: Mapping[str, np.ndarray],
+    plate_sides: Mapping[str, int] | None = None,
+    threshold_on_n: float = 50.0,
+    threshold_off_n: float = 20.0,
+    min_stance_s: float = 0.2,
+    min_swing_s: float = 0.2,
+    delay_s: float = 0.05,
+    dwell_s: float = 0.15,
+    margin_m: float = 0.03,
+    reach_m: float = 0.25,
+    max_height_m: float = 0.12,
+    vertical_axis: int | None = None,
+    source: str = "",
+    up: Sequence[float] | None = None,
+) -> pd.DataFrame:
+    """The contacts of every plate, each with the foot on it (from the heel markers) and a flag.
+
+    A heel is **on** a plate at an instant when it lies over the plate's
+    outline (at most ``margin_m`` outside) and at most ``max_height_m`` above
+    its surface. Each contact is judged in its **window**, from the start
+    probe ``start + delay_s`` (the foot that loaded the plate has landed) to
+    the end probe ``end - delay_s`` (both at the contact's middle if it is
+    shorter than ``2 * delay_s``), at the probes and every marker frame
+    between them. The contact's foot is the heel on the plate at the start
+    probe. Another heel **dwells** on the plate when it is on it without a
+    break for ``dwell_s`` (or the whole window, if shorter): a swing foot
+    passing low over a plate does not; a foot standing on it does. Flags,
+    the first that applies:
+
+    * ``incomplete`` - the contact touches the start or end of the recording;
+    * ``heel_missing`` - a heel is missing (NaN, or outside the marker time)
+      at the start probe, or another heel is missing in the window where
+      the gap decides whether it dwells;
+    * ``two_feet`` - both heels on the plate at the start probe, or the
+      other heel dwells on it during the window (it arrived before the first
+      foot left);
+    * ``no_foot`` - no heel on the plate at the start probe and no low heel
+      (at most ``max_height_m`` above it) within ``reach_m`` that is not on
+      another plate: a load no foot explains;
+    * ``off_plate`` - no heel on the plate at the start probe, but the
+      nearest low heel within ``reach_m`` (not on another plate) explains it:
+      that foot (``side``) loaded the plate with its heel off it, so the
+      loading is not its heel strike;
+    * ``wrong_belt`` - ``plate_sides`` gives the plate to the other side;
+    * ``ok`` - one heel on the plate, alone, as configured.
+
+    Parameters
+    ----------
+    plates : sequence of PlateForce
+        The plates, with distinct numbers; force above the resting level.
+    marker_time_s : array_like, shape (n_frames,)
+        Times of the marker frames in s, on the plates' clock.
+    heels_m : mapping
+        ``{"left": (n_frames, 3), "right": (n_frames, 3)}`` heel marker
+        positions in m (NaN where missing), in the frame of the corners.
+    plate_sides : mapping, optional
+        ``{"left": plate, "right": plate}``: the plate (belt) each foot should
+        use. Only a check (``wrong_belt``); the foot always comes from the markers.
+    threshold_on_n, threshold_off_n, min_stance_s, min_swing_s : float
+        Contact detection (:func:`plate_contacts`), N above the resting level and s.
+    delay_s : float
+        Time after the contact's start (before its end) at which the window opens (closes), s.
+    dwell_s : float
+        Shortest unbroken time on the plate that makes a second foot, s.
+    margin_m : float
+        How far outside the outline a heel still counts as over the plate, m.
+    reach_m : float
+        How far outside a low heel may be and still explain a contact (``off_plate``), m.
+    max_height_m : float
+        Highest heel above the plate's surface that counts as on it, m.
+    vertical_axis : {0, 1, 2} or None
+        The vertical coordinate axis; None: each plate's normal (from its
+        corners, which may run either way round the plate).
+    source : str
+        Name of the trial, quoted in messages.
+    up : array_like, shape (3,), optional
+        The up direction in the frame of the corners and heels (the model's
+        +Y, :data:`loper_analysis.motion.markers.MODEL_UP`, for corners rotated like
+        the markers). With ``vertical_axis`` None each plate's normal is turned
+        along it and a plate more than 45 deg from level is refused, naming it.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per contact (:data:`CONTACT_COLUMNS`), ordered by start time
+        then plate: ``plate``, ``contact`` (per plate), ``side`` (the foot;
+        ``""`` if unknown or ambiguous), ``flag``, ``start_sample``,
+        ``end_sample`` (indices into that plate's ``time_s``), ``start_s``,
+        ``end_s`` (s), ``belt_side`` (the side ``plate_sides`` gives the plate,
+        or ``""``), and per side the heel's distance outside the plate and
+        height above it at the start probe (m).
+
+    Raises
+    ------
+    LoperInputError
+        Bad plates, marker shapes, sides, settings or plate numbers in ``plate_sides``.
+    """
+    tm = time_vector(marker_time_s, source, name="marker_time_s", item="frame")
+    heels = _checked_heels(heels_m, tm.size, source)
+    plates = list(plates)
+    numbers = [integer("plate", p.plate, source, minimum=0) for p in plates]
+    if len(set(numbers)) != len(numbers):
+        raise LoperInputError(f"{where(source)}plate numbers must be distinct, got {numbers}")
+    belt = _belt_sides(plate_sides, numbers, source)
+    delay = number("delay_s", delay_s, source, minimum=0.0)
+    dwell = number("dwell_s", dwell_s, source, minimum=0.0)
+    margin = number("margin_m", margin_m, source, minimum=0.0)
+    reach = number("reach_m", reach_m, source, minimum=0.0)
+    height = number("max_height_m", max_height_m, source, minimum=0.0)
+    names = [f"{where(source)}plate {n}" for n in numbers]
+    corners = [np.asarray(p.corners_m, dtype=float) for p in plates]
+    for name, c in zip(names, corners):
+        plate_axes(c, vertical_axis, name, up)
+
+    def on(outside: np.ndarray, above: np.ndarray) -> np.ndarray:
+        return (outside <= margin) & (above <= height)  # NaN: False
+
+    rows = []
+    for k, (plate, name) in enumerate(zip(plates, names)):
+        found = plate_contacts(
+            plate.time_s,
+            plate.vertical_force_n,
+            threshold_on_n,
+            threshold_off_n,
+            min_stance_s,
+            min_swing_s,
+            source=name,
+        )
+        for c in found.itertuples():
+            mid = 0.5 * (c.start_s + c.end_s)
+            ps, pe = min(c.start_s + delay, mid), max(c.end_s - delay, mid)
+            times = np.concatenate([[ps], tm[(tm > ps) & (tm < pe)], [pe] if pe > ps else []])
+            need = min(dwell, pe - ps)
+            start_on, on_all, missing, window = {}, {}, {}, {}
+            for s in SIDES:
+                xyz = _at(tm, heels[s], times)
+                out, above = plate_offsets(xyz, corners[k], vertical_axis, up=up)
+                window[s] = (out, above)
+                start_on[s] = on(out[:1], above[:1])[0]
+                missing[s] = np.isnan(out)
+                # on every plate at the start probe: (n_plates,) outside, height
+                on_all[s] = np.array([on(*plate_offsets(xyz[:1], cc, vertical_axis, up=up))[0] for cc in corners])
+            at_start = [s for s in SIDES if start_on[s]]
+            side = at_start[0] if len(at_start) == 1 else ""
+            others = [s for s in SIDES if s != side]
+            dwells = {s for s in others if _longest_run_s(times, on(*window[s])) >= need}
+            undecided = any(
+                missing[s].any() and _longest_run_s(times, on(*window[s]) | missing[s]) >= need
+                for s in others
+                if s not in dwells
+            )
+            present = set(at_start) | dwells
+            if c.incomplete:
+                flag = "incomplete"
+            elif any(missing[s][0] for s in SIDES) or undecided:
+                flag = "heel_missing"
+            elif len(present) == 2:
+                flag = "two_feet"
+            elif not at_start:
+                # low heels near this plate that stand on no other plate
+                near = {
+                    s: window[s][0][0]
+                    for s in SIDES
+                    if window[s][0][0] <= reach and window[s][1][0] <= height and not np.delete(on_all[s], k).any()
+                }
+                side = min(near, key=near.get) if near else ""
+                flag = "no_foot" if not near else ("two_feet" if present - {side} else "off_plate")
+                side = "" if flag == "two_feet" else side
+            elif belt.get(numbers[k], side) != side:
+                flag = "wrong_belt"
+            else:
+                flag = "ok"
+            rows.append(
+                {
+                    "plate": numbers[k],
+                    "contact": c.contact,
+                    "side": side,
+                    "flag": flag,
+                    "start_sample": c.start_sample,
+                    "end_sample": c.end_sample,
+                    "start_s": c.start_s,
+                    "end_s": c.end_s,
+                    "belt_side": belt.get(numbers[k], ""),
+                    **{
+                        f"{s}_heel_{q}_m": float(window[s][i][0])
+                        for s in SIDES
+                        for i, q in enumerate(("outside", "height"))
+                    },
+                }
+            )
+    table = pd.DataFrame(rows, columns=list(CONTACT_COLUMNS))
+    table = table.astype(
+        {
+            "plate": np.int64,
+            "contact": np.int64,
+            "start_sample": np.int64,
+            "end_sample": np.int64,
+            "start_s": float,
+            "end_s": float,
+        }
+    )
+    table = table.sort_values(["start_s", "plate"], kind="stable", ignore_index=True)
+    for r in table[table["flag"] != "ok"].itertuples():
+        logger.info(
+            "%splate %d contact %.3f-%.3f s: %s (side %s)",
+            where(source),
+            r.plate,
+            r.start_s,
+            r.end_s,
+            r.flag,
+            r.side or "unknown",
+        )
+    table.attrs["source"] = source
+    return table
+
+
+def _checked_heels(heels_m: Mapping[str, np.ndarray], n_frames: int, source: str) -> dict[str, np.ndarray]:
+    """``{side: (n_frames, 3) float array}`` for both sides."""
+    if not isinstance(heels_m, Mapping) or set(heels_m) != set(SIDES):
+        keys = sorted(heels_m) if isinstance(heels_m, Mapping) else type(heels_m).__name__
+        raise LoperInputError(f"{where(source)}heels_m must map each of {SIDES} to a heel trajectory, got {keys}")
+    out = {}
+    for s in SIDES:
+        a = np.asarray(heels_m[s], dtype=float)
+        if a.shape != (n_frames, 3):
+            raise LoperInputError(
+                f"{where(source)}heels_m[{s!r}] must have shape ({n_frames}, 3) like marker_time_s, got {a.shape}"
+            )
+        out[s] = a
+    return out
+
+
+def _belt_sides(plate_sides: Mapping[str, int] | None, numbers: list[int], source: str) -> dict[int, str]:
+    """``{plate number: side}`` from ``{side: plate number}``."""
+    if plate_sides is None:
+        return {}
+    belt = {}
+    for s, n in plate_sides.items():
+        check_side(s, source)
+        n = integer(f"plate_sides[{s!r}]", n, source)
+        if n not in numbers:
+            raise LoperInputError(f"{where(source)}plate_sides[{s!r}] is plate {n}; the plates are {numbers}")
+        if n in belt:
+            raise LoperInputError(f"{where(source)}plate_sides gives plate {n} to both sides")
+        belt[n] = s
+    return belt
+
+
+def count_flagged(flags) -> int:
+    """Number of contacts left out for a reason: flags other than ``ok`` and ``incomplete``.
+
+    ``flags`` is the ``flag`` column of a contact table (:data:`CONTACT_COLUMNS`);
+    contacts cut by the start or end of the recording are not counted (a
+    trial's first and last periods never give events).
+    """
+    flags = pd.Series(flags, dtype=object)
+    return int((~flags.isin(["ok", "incomplete"])).sum())
+
+
+def contact_events(contacts: pd.DataFrame) -> pd.DataFrame:
+    """Event table of a contact table: heel strike and toe-off of each clean contact, spans of the flagged ones.
+
+    A contact flagged ``ok`` gives a ``heel_strike`` at its start (first
+    sample at or above the on-threshold) and a ``toe_off`` at its end (first
+    sample at or below the off-threshold), of its side. Any other flag gives
+    no gait event but a ``flagged_start`` / ``flagged_end`` pair at the
+    contact's start and end, for its side - for both sides when the foot is
+    unknown or the flag is ``heel_missing``, ``two_feet`` or ``no_foot`` -
+    so that :func:`loper_analysis.gait.strides.strides_from_events` leaves out strides that
+    span it.
+
+    Parameters
+    ----------
+    contacts : pandas.DataFrame
+        Columns ``side``, ``flag``, ``start_s``, ``end_s``, ``start_sample``,
+        ``end_sample`` (:func:`foot_contacts`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :data:`loper_analysis.gait.events.EVENT_COLUMNS` (``side``, ``event``,
+        ``time_s``, ``sample``), sorted by time then side.
+    """
+    source = str(contacts.attrs.get("source", "")) if isinstance(contacts, pd.DataFrame) else ""
+    needed = ["side", "flag", "start_s", "end_s", "start_sample", "end_sample"]
+    if not isinstance(contacts, pd.DataFrame) or not set(needed) <= set(contacts.columns):
+        raise LoperInputError(f"{where(source)}contacts must be a table with columns {needed}")
+    unknown = sorted(set(contacts["flag"]) - set(CONTACT_FLAGS))
+    if unknown:
+        raise LoperInputError(f"{where(source)}contacts: unknown flag(s) {unknown}; known: {list(CONTACT_FLAGS)}")
+    rows = []
+    for c in contacts.itertuples():
+        if c.flag == "ok":
+            side = check_side(c.side, source)
+            rows += [(side, "heel_strike", c.start_s, c.start_sample), (side, "toe_off", c.end_s, c.end_sample)]
+            continue
+        sides = SIDES if (c.flag in _BOTH_SIDES or c.side not in SIDES) else (c.side,)
+        for s in sides:
+            rows += [(s, FLAGGED_EVENTS[0], c.start_s, c.start_sample), (s, FLAGGED_EVENTS[1], c.end_s, c.end_sample)]
+    table = pd.DataFrame(rows, columns=list(EVENT_COLUMNS))
+    table = table.astype({"time_s": float, "sample": np.int64})
+    table = table.sort_values(["time_s", "side"], kind="stable", ignore_index=True)
+    table.attrs["source"] = source
+    return table

@@ -1,0 +1,637 @@
+"""Impedance per subject and onset: the fit of the mean response, its table rows, and the aggregates.
+
+:func:`fit_onset` runs the response analysis (:mod:`loper_analysis.responses`)
+and the identification (:mod:`loper_analysis.identification`) for one
+subject and onset, on the subject's segment table and the rod force along
+the brace normal. A row per joint reports K, D, their 95 % confidence
+intervals, the VAF, the number of strides, the truth of a synthetic subject
+and a status (``docs/identification.md``):
+
+* ``ok`` (also with an estimate on a lower bound of zero: no measurable K or D);
+* ``not_identifiable``: K or D on its upper bound (or on a lower bound
+  above zero), or its 95 % CI holds both 0 and the upper end of the joint's
+  plausible range (``plausible_ranges``: the data cannot tell its size), or
+  spans more than ``max_ci_fraction`` of its bound range;
+* ``missing``: no trial of that onset;
+* ``failed``: too few strides (the reason names ``identification.window_after_s``
+  when strides were too short for the window), the optimiser did not
+  converge, or the joint's VAF is below ``min_vaf_pct``; ``reason`` says why.
+
+The rules of a fitted row are :func:`loper_analysis.identification.joint_status`.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.constants import JOINTS, parameter_column
+from loper_analysis.errors import LoperInputError, TooFewStridesWarning
+from loper_analysis.identification import (
+    AT_BOUND_FRACTION,
+    DAMPING_BOUNDS_NMS_PER_RAD,
+    DEFAULT_PLAUSIBLE_RANGES,
+    FIT_TOLERANCE,
+    INITIAL_STATE_DEGREE,
+    MAX_CI_FRACTION,
+    MERGE_TOLERANCE,
+    MIN_NULL_PAIRS,
+    MIN_VAF_PCT,
+    N_STARTS,
+    N_SUBSTEPS,
+    NULL_PAIR_COMPONENTS,
+    STIFFNESS_BOUNDS_NM_PER_RAD,
+    ImpedanceFit,
+    identify_impedance,
+    joint_status,
+    parameter_bounds,
+    prepare_window,
+    refit_with_null_pairs,
+)
+from loper_analysis.reference import LITERATURE
+from loper_analysis.responses import (
+    MAX_TRIAL_DEVIATION_RATIO,
+    ResponseSettings,
+    null_pair_windows,
+    subject_onset_response,
+)
+from loper_analysis.swing_leg.dynamics import SegmentParameters
+
+__all__ = [
+    "IMPEDANCE_COLUMNS",
+    "NOISE_MODELS",
+    "TRUTH_TOLERANCE",
+    "IdentificationSettings",
+    "OnsetFit",
+    "brace_force_direction",
+    "FORCE_COLUMNS",
+    "force_table",
+    "impedance_rows",
+    "status_rows",
+    "too_short_reason",
+    "fit_onset",
+    "impedance_summary",
+    "literature_table",
+]
+
+_K, _D = parameter_column("K"), parameter_column("D")
+
+#: Columns of ``results/impedance/{subject}/{onset}.tsv`` and ``results/tables/impedance.tsv``.
+IMPEDANCE_COLUMNS: tuple[str, ...] = (
+    "subject",
+    "onset_ms",
+    "joint",
+    _K,
+    _D,
+    parameter_column("K", "ci95_low"),
+    parameter_column("K", "ci95_high"),
+    parameter_column("D", "ci95_low"),
+    parameter_column("D", "ci95_high"),
+    "vaf_pct",
+    "n_strides",
+    parameter_column("K", "true"),
+    parameter_column("D", "true"),
+    parameter_column("K", "error"),
+    parameter_column("D", "error"),
+    "sum_sq_error_rad2",
+    "n_starts",
+    "n_starts_at_best",
+    "noise_model",
+    "n_null_pairs",
+    "status",
+    "reason",
+)
+#: How the fit weights its prediction errors: the study's least squares, or with the null pairs' deviation.
+NOISE_MODELS: tuple[str, ...] = ("null_pairs", "white")
+#: An estimate is within tolerance of the truth when ``|error| <= max(relative * |truth|, absolute)``:
+#: parameter -> (relative, absolute in N·m/rad for K, N·m·s/rad for D).
+TRUTH_TOLERANCE: dict[str, tuple[float, float]] = {"K": (0.10, 2.0), "D": (0.15, 0.05)}
+
+
+@dataclass(frozen=True)
+class IdentificationSettings:
+    """How K and D are fitted and judged (config ``identification``; bounds in N·m/rad and N·m·s/rad).
+
+    ``min_vaf_pct``: a joint whose VAF (%) is below it is ``failed``;
+    ``plausible_ranges``: ``{joint: {"stiffness_nm_per_rad": [low, high],
+    "damping_nms_per_rad": [low, high]}}`` for the identifiability rule (None:
+    :data:`~loper_analysis.identification.DEFAULT_PLAUSIBLE_RANGES`);
+    ``max_null_trial_ratio``: a trial whose null pairs deviate more than this
+    multiple of the other trials' is left out of the null pairs (None: never);
+    ``interval_scatter``: with the ``null_pairs`` noise model, whose scatter
+    gives the 95 % intervals: ``perturbed_pairs`` (the averaged pairs
+    themselves) or ``null_pairs`` (:func:`loper_analysis.identification.refit_with_null_pairs`).
+    """
+
+    noise_model: str = "null_pairs"
+    interval_scatter: str = "perturbed_pairs"
+    null_pair_components: int = NULL_PAIR_COMPONENTS
+    min_null_pairs: int = MIN_NULL_PAIRS
+    initial_state_degree: int = INITIAL_STATE_DEGREE
+    n_starts: int = N_STARTS
+    n_substeps: int = N_SUBSTEPS
+    tolerance: float = FIT_TOLERANCE
+    merge_tolerance: float = MERGE_TOLERANCE
+    stiffness_bounds_nm_per_rad: tuple[float, float] = STIFFNESS_BOUNDS_NM_PER_RAD
+    damping_bounds_nms_per_rad: tuple[float, float] = DAMPING_BOUNDS_NMS_PER_RAD
+    max_ci_fraction: float = MAX_CI_FRACTION
+    plausible_ranges: Mapping | None = None
+    min_vaf_pct: float = MIN_VAF_PCT
+    max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
+    seed: int = 0
+
+    def __post_init__(self):
+        if self.noise_model not in NOISE_MODELS:
+            raise LoperInputError(
+                f"identification.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}"
+            )
+        if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
+            raise LoperInputError(
+                "identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
+                f"got {self.interval_scatter!r}"
+            )
+
+    @property
+    def lower(self) -> np.ndarray:
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
+
+    @property
+    def upper(self) -> np.ndarray:
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
+
+    def fit_options(self) -> dict:
+        """Keyword arguments of :func:`loper_analysis.identification.identify_impedance`."""
+        return dict(
+            n_starts=self.n_starts,
+            seed=self.seed,
+            lower=self.lower,
+            upper=self.upper,
+            tolerance=self.tolerance,
+            merge_tolerance=self.merge_tolerance,
+        )
+
+
+@dataclass
+class OnsetFit:
+    """Everything :func:`fit_onset` finds for one subject and onset.
+
+    ``response``: the mean response (:func:`loper_analysis.responses.subject_onset_response`,
+    empty when no trial); ``counts``: perturbed strides per trial and their
+    fate; ``rows``: one row per joint (:data:`IMPEDANCE_COLUMNS`);
+    ``curves``: the measured and model responses of the fit (``time_s``,
+    ``{joint}_measured_rad``, ``{joint}_model_rad``; only ``time_s`` when
+    nothing was fitted); ``force``: the mean rod forces the model was given
+    (:func:`force_table`; only ``time_s`` when nothing was fitted).
+    """
+
+    response: pd.DataFrame
+    counts: pd.DataFrame
+    rows: pd.DataFrame
+    curves: pd.DataFrame
+    force: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=["time_s"]))
+
+
+#: Columns of :func:`force_table`.
+FORCE_COLUMNS: tuple[str, ...] = (
+    "time_s",
+    "force_perturbed_x_n",
+    "force_perturbed_y_n",
+    "force_unperturbed_x_n",
+    "force_unperturbed_y_n",
+)
+
+
+def force_table(series: Mapping) -> pd.DataFrame:
+    """The mean rod forces of a response as the fit receives them (columns :data:`FORCE_COLUMNS`).
+
+    ``time_s`` relative to the onset (s): ``series["force_time_s"]`` (the robot rate) when the response
+    carries it, else the response's grid; the perturbed and matched unperturbed mean force vectors (N, world x/y).
+    """
+    t = series.get("force_time_s", series["time_s"])
+    fp, fu = series["force_perturbed_n"], series["force_unperturbed_n"]
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "force_perturbed_x_n": fp[:, 0],
+            "force_perturbed_y_n": fp[:, 1],
+            "force_unperturbed_x_n": fu[:, 0],
+            "force_unperturbed_y_n": fu[:, 1],
+        },
+        columns=list(FORCE_COLUMNS),
+    )
+
+
+def brace_force_direction(
+    markers_m: np.ndarray, labels: Sequence[str], brace=("LBRA_P", "LBRA_D"), source: str = ""
+) -> np.ndarray:
+    """Unit vectors (n, 2), world x/y of the model frame, along which the rods push.
+
+    The two brace markers lie on the thigh, proximal and distal; the rods push
+    perpendicular to their line, forward: the proximal-minus-distal direction
+    turned by -90 degrees in the sagittal (x, y) plane. ``markers_m`` is
+    (n, n_markers, 3) in the model frame (X forward, Y up), e.g. a TRC of the
+    pipeline.
+    """
+    labels = list(labels)
+    missing = [b for b in brace if b not in labels]
+    if missing:
+        raise LoperInputError(f"{source}: brace marker(s) {missing} not in the marker data")
+    p = markers_m[:, labels.index(brace[0]), :2]
+    d = markers_m[:, labels.index(brace[1]), :2]
+    up = p - d
+    norm = np.linalg.norm(up, axis=1)
+    if not np.all(np.isfinite(norm)) or np.any(norm < 1e-3):
+        bad = int(np.argmax(~np.isfinite(norm) | (norm < 1e-3)))
+        raise LoperInputError(f"{source}: brace markers {brace} missing or coincident at frame {bad}")
+    up /= norm[:, None]
+    return np.stack([up[:, 1], -up[:, 0]], axis=-1)
+
+
+def _truth_columns(row: dict, truth: Mapping | None, joint: str) -> None:
+    if truth is not None:
+        row[parameter_column("K", "true")] = truth[joint]["K"]
+        row[parameter_column("D", "true")] = truth[joint]["D"]
+
+
+def _plausible_range(plausible_ranges: Mapping | None, joint: str):
+    """((K low, K high), (D low, D high)) of ``joint`` from config-shaped ``plausible_ranges`` (None: the default)."""
+    if plausible_ranges is None:
+        return DEFAULT_PLAUSIBLE_RANGES[joint]
+    entry = plausible_ranges.get(joint)
+    if not isinstance(entry, Mapping) or not {"stiffness_nm_per_rad", "damping_nms_per_rad"} <= set(entry):
+        raise LoperInputError(
+            f"identification.plausible_ranges: the {joint} needs stiffness_nm_per_rad and "
+            f"damping_nms_per_rad ([low, high] each), got {entry!r}"
+        )
+    return (tuple(entry["stiffness_nm_per_rad"]), tuple(entry["damping_nms_per_rad"]))
+
+
+def impedance_rows(
+    fit: ImpedanceFit,
+    subject: str,
+    onset_ms: int,
+    n_strides: int,
+    truth: Mapping | None = None,
+    lower=(STIFFNESS_BOUNDS_NM_PER_RAD[0], DAMPING_BOUNDS_NMS_PER_RAD[0]),
+    upper=(STIFFNESS_BOUNDS_NM_PER_RAD[1], DAMPING_BOUNDS_NMS_PER_RAD[1]),
+    max_ci_fraction: float = MAX_CI_FRACTION,
+    noise_model: str = "white",
+    n_null_pairs: int = 0,
+    note: str = "",
+    *,
+    min_vaf_pct: float = MIN_VAF_PCT,
+    at_bound_fraction: float = AT_BOUND_FRACTION,
+    plausible_ranges: Mapping | None = None,
+) -> pd.DataFrame:
+    """One row per joint from an :class:`~loper_analysis.identification.ImpedanceFit` (columns
+    :data:`IMPEDANCE_COLUMNS`).
+
+    ``truth``: ``{joint: {"K": .., "D": ..}}`` of a synthetic subject (errors
+    = estimate - truth), None for a recorded one. ``lower``, ``upper``: the
+    bounds of (K, D). ``noise_model`` (``white`` | ``null_pairs``) and
+    ``n_null_pairs`` say how the fit weighted its errors; ``note`` is appended
+    to every row's reason. Status and reason per joint:
+    :func:`loper_analysis.identification.joint_status` with the joint's
+    entry of ``plausible_ranges`` (``{joint: {"stiffness_nm_per_rad": [low,
+    high], "damping_nms_per_rad": [low, high]}}``; None:
+    :data:`~loper_analysis.identification.DEFAULT_PLAUSIBLE_RANGES`),
+    ``max_ci_fraction``, ``min_vaf_pct`` and ``at_bound_fraction``.
+    """
+    rows = []
+    for j, joint in enumerate(JOINTS):
+        k, d = 2 * j, 2 * j + 1
+        row = {
+            "subject": subject,
+            "onset_ms": int(onset_ms),
+            "joint": joint,
+            _K: fit.estimate[k],
+            _D: fit.estimate[d],
+            parameter_column("K", "ci95_low"): fit.ci95_low[k],
+            parameter_column("K", "ci95_high"): fit.ci95_high[k],
+            parameter_column("D", "ci95_low"): fit.ci95_low[d],
+            parameter_column("D", "ci95_high"): fit.ci95_high[d],
+            "vaf_pct": fit.vaf_pct[j],
+            "n_strides": int(n_strides),
+            "sum_sq_error_rad2": fit.sum_sq_error_rad2,
+            "n_starts": fit.n_starts,
+            "n_starts_at_best": fit.n_starts_at_best,
+            "noise_model": noise_model,
+            "n_null_pairs": int(n_null_pairs),
+        }
+        _truth_columns(row, truth, joint)
+        if truth is not None:
+            row[parameter_column("K", "error")] = row[_K] - truth[joint]["K"]
+            row[parameter_column("D", "error")] = row[_D] - truth[joint]["D"]
+        status, reason = joint_status(
+            joint,
+            fit.estimate[[k, d]],
+            fit.ci95_low[[k, d]],
+            fit.ci95_high[[k, d]],
+            fit.vaf_pct[j],
+            lower,
+            upper,
+            success=fit.success,
+            message=fit.message,
+            plausible_range=_plausible_range(plausible_ranges, joint),
+            max_ci_fraction=max_ci_fraction,
+            min_vaf_pct=min_vaf_pct,
+            at_bound_fraction=at_bound_fraction,
+        )
+        row.update(status=status, reason=reason)
+        if note:
+            row["reason"] = "; ".join(r for r in (row["reason"], note) if r)
+        rows.append(row)
+    return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
+
+
+def status_rows(
+    subject: str, onset_ms: int, status: str, reason: str, n_strides: int = 0, truth: Mapping | None = None
+) -> pd.DataFrame:
+    """Rows without a fit (``missing`` or ``failed``), one per joint, estimates empty."""
+    rows = []
+    for joint in JOINTS:
+        row = {
+            "subject": subject,
+            "onset_ms": int(onset_ms),
+            "joint": joint,
+            "n_strides": int(n_strides),
+            "status": status,
+            "reason": reason,
+        }
+        _truth_columns(row, truth, joint)
+        rows.append(row)
+    return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
+
+
+def too_short_reason(
+    n_short: int, n_perturbed: int, onset_ms: float, window_after_s: float, longest_after_onset_s: float
+) -> str:
+    """Why perturbed strides were dropped as too short, naming ``identification.window_after_s`` and its value.
+
+    ``longest_after_onset_s``: the most swing time (s) any perturbed stride leaves after its onset,
+    the longest window that keeps a stride.
+    """
+    text = (
+        f"{n_short} of {n_perturbed} perturbed stride(s) too short for the fit window: their swing ends "
+        f"before onset {onset_ms:g} ms + identification.window_after_s = {window_after_s:g} s"
+    )
+    if np.isfinite(longest_after_onset_s):
+        text += f" (the longest swing leaves {max(longest_after_onset_s, 0.0):.3g} s after the onset)"
+    return text
+
+
+def _no_curves() -> pd.DataFrame:
+    return pd.DataFrame(columns=["time_s"])
+
+
+def fit_onset(
+    trials: Sequence[Mapping],
+    params: SegmentParameters | None,
+    onset_ms: int,
+    subject: str,
+    truth: Mapping | None = None,
+    null_trials: Sequence[Mapping] = (),
+    response: ResponseSettings = ResponseSettings(),
+    identification: IdentificationSettings = IdentificationSettings(),
+) -> OnsetFit:
+    """Responses and the impedance fit of one subject at one onset.
+
+    Parameters
+    ----------
+    trials : sequence of mapping
+        One per trial of this onset: ``name``, ``angles``, ``strides`` and
+        ``force`` (frames of the processing steps, see
+        :mod:`loper_analysis.responses.inputs`), optionally ``force_native``
+        (the load cell at the robot rate: ``time_s``, ``force_measured_n``;
+        the fit then gets the force at that rate) and ``markers``: ``(time_s
+        (n,), markers_m (n, n_markers, 3) in the model frame, labels)`` for
+        the brace markers. No trial: every output says ``missing``.
+    params : SegmentParameters
+        The subject's segment table (not needed without trials).
+    onset_ms : int
+        Onset after toe-off (ms).
+    subject : str
+        Subject ID, written in the rows and quoted in messages.
+    truth : mapping, optional
+        ``{joint: {"K": .., "D": ..}}`` of a synthetic subject at this onset.
+    null_trials : sequence of mapping
+        ``name``, ``angles``, ``strides`` of the trials whose unperturbed
+        strides give the null pairs (e.g. all the subject's walking trials
+        with the device; the onset's own trials when empty). Used with
+        ``identification.noise_model`` ``null_pairs``: the white fit first,
+        then :func:`loper_analysis.identification.refit_with_null_pairs`. A
+        trial whose null pairs deviate more than
+        ``identification.max_null_trial_ratio`` times the other trials' is
+        left out of them (:func:`loper_analysis.responses.deviant_trials`);
+        the rows' reason names it.
+    response, identification : settings
+
+    Returns
+    -------
+    OnsetFit
+    """
+    if not trials:
+        counts = pd.DataFrame([{"trial": "total", "status": "missing", "reason": "no trial of this onset"}])
+        rows = status_rows(subject, onset_ms, "missing", "no trial of this onset", truth=truth)
+        return OnsetFit(pd.DataFrame(), counts, rows, _no_curves())
+    inputs = []
+    for tr in trials:
+        t, X, labels = tr["markers"]
+        angles = tr["angles"]
+        if len(t) != len(angles) or not np.allclose(t, angles["time_s"].to_numpy(), atol=1e-6):
+            raise LoperInputError(f"{tr['name']}: marker frames differ from the joint angles' frames")
+        inputs.append(
+            {
+                "name": tr["name"],
+                "angles": angles,
+                "strides": tr["strides"],
+                "force": tr["force"],
+                "force_direction": brace_force_direction(X, labels, source=str(tr["name"])),
+                "force_native": tr.get("force_native"),
+            }
+        )
+    r = response
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TooFewStridesWarning)  # the counts table carries the verdict
+        mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
+    total = counts[counts["trial"] == "total"].iloc[0]
+    n_kept = int(total["n_kept"])
+    if n_kept < r.min_strides:
+        reason = f"{n_kept} valid perturbed stride(s), fewer than {r.min_strides}: not fitted"
+        if int(total["n_too_short"]):
+            reason += "; " + too_short_reason(
+                int(total["n_too_short"]),
+                int(total["n_perturbed"]),
+                onset_ms,
+                r.window_after_s,
+                counts.attrs["longest_swing_after_onset_s"],
+            )
+        rows = status_rows(subject, onset_ms, "failed", reason, n_kept, truth)
+        return OnsetFit(mean, counts, rows, _no_curves())
+    ident = identification
+    window = prepare_window(
+        series["time_s"],
+        series["q_unperturbed"],
+        series["q_perturbed"],
+        params,
+        0.0,
+        force_unperturbed_n=series["force_unperturbed_n"],
+        force_perturbed_n=series["force_perturbed_n"],
+        force_time_s=series.get("force_time_s"),
+        pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
+        pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
+        window_before_s=r.window_before_s,
+        window_after_s=r.window_after_s,
+        n_substeps=ident.n_substeps,
+        initial_state_span_s=r.initial_state_span_s,
+        initial_state_degree=ident.initial_state_degree,
+    )
+    fit = identify_impedance(window, **ident.fit_options())
+    used, n_null, note = "white", 0, ""
+    if ident.noise_model == "null_pairs":
+        loaded = {i["name"]: i for i in inputs}
+        pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
+        null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
+        pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
+        refit = refit_with_null_pairs(
+            window,
+            fit,
+            null,
+            n_kept,
+            ident.null_pair_components,
+            ident.min_null_pairs,
+            perturbed_pairs=pairs,
+            **ident.fit_options(),
+        )
+        fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
+        note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
+    rows = impedance_rows(
+        fit,
+        subject,
+        onset_ms,
+        n_kept,
+        truth,
+        (ident.stiffness_bounds_nm_per_rad[0], ident.damping_bounds_nms_per_rad[0]),
+        (ident.stiffness_bounds_nm_per_rad[1], ident.damping_bounds_nms_per_rad[1]),
+        ident.max_ci_fraction,
+        used,
+        n_null,
+        note,
+        min_vaf_pct=ident.min_vaf_pct,
+        plausible_ranges=ident.plausible_ranges,
+    )
+    curves = pd.DataFrame(
+        {
+            "time_s": fit.time_s,
+            **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
+            **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)},
+        }
+    )
+    return OnsetFit(mean, counts, rows, curves, force_table(series))
+
+
+def impedance_summary(
+    table: pd.DataFrame,
+    k_tolerance=TRUTH_TOLERANCE["K"],
+    d_tolerance=TRUTH_TOLERANCE["D"],
+    upper_bounds: tuple[float, float] | None = None,
+) -> pd.DataFrame:
+    """Across-subject summary per joint and onset of the fitted rows (``ok`` and ``not_identifiable``).
+
+    ``upper_bounds`` (K in N·m/rad, D in N·m·s/rad; the identification's
+    upper bounds): rows whose K or D sits on its upper bound (within
+    :data:`~loper_analysis.identification.AT_BOUND_FRACTION` of the bound)
+    carry no estimate and are left out; None keeps every fitted row.
+
+    Rows that are ``not_identifiable`` because an interval holds 0 and the
+    whole plausible range stay in: their estimate is still the fit's best
+    value, and leaving out exactly the estimates near 0 would push the
+    across-subject mean up. ``n_not_identifiable`` counts them, so a mean
+    made mostly of uninformative fits shows as such.
+
+    Columns ``joint, onset_ms, n_subjects, n_not_identifiable``, then per parameter its mean, SD,
+    min and max over subjects (``K_mean_nm_per_rad`` ...), ``vaf_pct_mean``;
+    where the truth is known also the mean error, the largest absolute error
+    and the fraction of subjects within tolerance (``K_fraction_within_tolerance``:
+    ``|error| <= max(rel * |truth|, abs)``) for K and D.
+    """
+    fitted = table[table["status"].isin(["ok", "not_identifiable"])]
+    if upper_bounds is not None:
+        from loper_analysis.identification import AT_BOUND_FRACTION
+
+        on_bound = np.zeros(len(fitted), dtype=bool)
+        for p, bound in zip(("K", "D"), upper_bounds, strict=True):
+            on_bound |= fitted[parameter_column(p)].to_numpy(float) >= bound * (1.0 - AT_BOUND_FRACTION)
+        fitted = fitted[~on_bound]
+    rows = []
+    for (joint, onset), g in fitted.groupby(["joint", "onset_ms"], sort=False):
+        row = {
+            "joint": joint,
+            "onset_ms": int(onset),
+            "n_subjects": g["subject"].nunique(),
+            "n_not_identifiable": int((g["status"] == "not_identifiable").sum()),
+        }
+        for p in ("K", "D"):
+            v = g[parameter_column(p)]
+            row.update(
+                {
+                    parameter_column(p, "mean"): v.mean(),
+                    parameter_column(p, "sd"): v.std(ddof=1),
+                    parameter_column(p, "min"): v.min(),
+                    parameter_column(p, "max"): v.max(),
+                }
+            )
+        row["vaf_pct_mean"] = g["vaf_pct"].mean()
+        known = g[g[parameter_column("K", "true")].notna()]
+        if len(known):
+            for p, (rel, ab) in (("K", k_tolerance), ("D", d_tolerance)):
+                err = known[parameter_column(p, "error")]
+                tol = np.maximum(rel * known[parameter_column(p, "true")].abs(), ab)
+                row.update(
+                    {
+                        parameter_column(p, "error_mean"): err.mean(),
+                        parameter_column(p, "max_abs_error"): err.abs().max(),
+                        f"{p}_fraction_within_tolerance": float((err.abs() <= tol).mean()),
+                    }
+                )
+        rows.append(row)
+    order = {j: i for i, j in enumerate(JOINTS)}
+    out = pd.DataFrame(rows, columns=None if rows else ["joint", "onset_ms", "n_subjects", "n_not_identifiable"])
+    if len(out):
+        out = out.sort_values(
+            ["joint", "onset_ms"],
+            key=lambda c: c.map(order) if c.name == "joint" else c,
+            kind="stable",
+            ignore_index=True,
+        )
+    return out
+
+
+def literature_table(summary: pd.DataFrame) -> pd.DataFrame:
+    """The literature values (:data:`loper_analysis.reference.LITERATURE`) with our row: the range over onsets of
+    the across-subject mean (N·m/rad, N·m·s/rad)."""
+    k_low, k_high = parameter_column("K", "low"), parameter_column("K", "high")
+    d_low, d_high = parameter_column("D", "low"), parameter_column("D", "high")
+    rows = [
+        {"source": s, "joint": j, k_low: k[0], k_high: k[1], d_low: d[0], d_high: d[1]} for s, j, k, d in LITERATURE
+    ]
+    for joint in ("hip", "knee"):
+        if "joint" not in summary.columns:  # nothing fitted
+            break
+        g = summary[summary["joint"] == joint]
+        if len(g):
+            rows.append(
+                {
+                    "source": "this pipeline: swing phase, across-subject mean over onsets",
+                    "joint": joint,
+                    k_low: g[parameter_column("K", "mean")].min(),
+                    k_high: g[parameter_column("K", "mean")].max(),
+                    d_low: g[parameter_column("D", "mean")].min(),
+                    d_high: g[parameter_column("D", "mean")].max(),
+                }
+            )
+    return pd.DataFrame(rows)

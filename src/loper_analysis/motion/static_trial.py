@@ -1,0 +1,319 @@
+"""The static trial as scaling uses it: the window averaged, each marker's pose, the subject's mass and height.
+
+A lab's static trial is rarely complete: markers are hidden for the first
+frames (knee condyles while the subject settles, a forefoot marker behind the
+other foot) or drop out for a few frames. OpenSim's ScaleTool averages the
+static pose over a time range (the setup's ``time_range``), but it cannot
+take a missing marker (NaN) in a TRC. Here:
+
+* :func:`scale_window_s` - the frames averaged: the setup's time range when
+  it sets one, else the first ``duration_s`` of the trial, else all of it;
+* :func:`static_pose` - within the window, each marker's missing frames take
+  the marker's mean over the frames where it is present (so OpenSim's
+  average of the window is the average over the present frames); a
+  measurement marker absent from the whole window stops, naming the lab
+  label, the model marker, the file and the window; another marker absent
+  throughout is left out (it cannot place anything); a marker that moves
+  more than a limit (RMS about its mean over the window) stops: the subject
+  did not stand still, and the averaged pose would place markers wrongly;
+* :func:`standing_mass_kg` - body mass from the force plates the subject
+  stands on: mean total vertical force over the window divided by gravity;
+* :func:`model_height_m` - stature estimated from a scaled model: the hip
+  joint centre's height above the lowest marker in the default pose, over
+  Winter's ratio of that height to stature (0.530).
+
+Times in s on the file's clock, markers (n_frames, n_markers, 3) in m (NaN
+where missing), forces in N.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from loper_analysis.checks import where
+from loper_analysis.constants import GRAVITY_M_PER_S2
+from loper_analysis.errors import LoperInputError
+from loper_analysis.swing_leg.anthropometry import ANKLE_HEIGHT_FRACTION, WINTER_SEGMENTS
+
+__all__ = [
+    "HIP_HEIGHT_FRACTION",
+    "MASS_RANGE_KG",
+    "StaticPose",
+    "time_range_is_set",
+    "scale_window_s",
+    "static_pose",
+    "standing_mass_kg",
+    "model_height_m",
+]
+
+#: Hip joint centre height over stature (Winter's table: thigh + shank + ankle height).
+HIP_HEIGHT_FRACTION: float = WINTER_SEGMENTS["thigh"].length + WINTER_SEGMENTS["shank"].length + ANKLE_HEIGHT_FRACTION
+#: Body masses a standing subject may have (kg): outside, the plates or their units are wrong.
+MASS_RANGE_KG: tuple[float, float] = (20.0, 300.0)
+#: Relative SD of the total vertical force above which a "standing" subject is not standing still.
+_MAX_FORCE_CV = 0.1
+
+
+def time_range_is_set(time_range) -> bool:
+    """Whether a ScaleTool time range is set: two finite times, start <= end, not OpenSim's unset ``-1 -1``."""
+    if time_range is None:
+        return False
+    a, b = (float(v) for v in time_range)
+    return bool(np.isfinite(a) and np.isfinite(b) and a <= b and not (a < 0 and b < 0))
+
+
+def scale_window_s(
+    time_s,
+    setup_ranges_s: Sequence[Sequence[float] | None] = (),
+    duration_s: float | None = None,
+    source: str = "",
+    setting: str = "time_range of the scale setup",
+) -> tuple[float, float]:
+    """The span of the static trial that scaling averages (s, the file's clock).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Shape (n_frames,), s: the static trial's frame times.
+    setup_ranges_s : sequence of (start, end) or None
+        The time ranges a ScaleTool setup sets (model scaler, marker placer);
+        unset ones (None, ``-1 -1`` or start > end) are ignored. The window
+        spans those that are set.
+    duration_s : float, optional
+        Without a set range: the first ``duration_s`` seconds (None: the whole trial).
+    source, setting : str
+        The file and the setting, for messages.
+
+    Returns
+    -------
+    (float, float)
+        First and last time of the window (both frame times of the trial).
+
+    Raises
+    ------
+    LoperInputError
+        A set range that holds no frame of the trial (naming the range, the
+        trial's span, the file and ``setting``).
+    """
+    t = np.asarray(time_s, dtype=float)
+    if t.ndim != 1 or t.size == 0:
+        raise LoperInputError(f"{where(source)}the static trial holds no frame")
+    ranges = [tuple(float(v) for v in r) for r in setup_ranges_s if time_range_is_set(r)]
+    if ranges:
+        start, end = min(r[0] for r in ranges), max(r[1] for r in ranges)
+        inside = t[(t >= start - 1e-9) & (t <= end + 1e-9)]
+        if not inside.size:
+            raise LoperInputError(
+                f"{where(source)}{setting} {start:g} .. {end:g} s holds no frame of the static trial "
+                f"({t[0]:.4f} .. {t[-1]:.4f} s, the file's clock): set it to a span of the trial, or to -1 -1 to "
+                "use markers.static_duration_s"
+            )
+        return float(inside[0]), float(inside[-1])
+    if duration_s is None:
+        return float(t[0]), float(t[-1])
+    inside = t[t < t[0] + float(duration_s) - 1e-9]
+    return float(inside[0]), float(inside[-1])
+
+
+@dataclass(frozen=True)
+class StaticPose:
+    """The static trial's window as ScaleTool gets it (:func:`static_pose`).
+
+    Attributes
+    ----------
+    time_s : numpy.ndarray
+        Shape (n,), s: the window's frames.
+    markers_m : numpy.ndarray
+        Shape (n, n_kept, 3), m: no NaN; a marker's missing frames hold its mean over its present frames.
+    labels : list of str
+        The model names of the kept markers.
+    n_filled : dict of str to int
+        Marker -> frames of the window filled with its mean (only markers with some).
+    left_out : list of str
+        Markers absent from the whole window (not measurement markers), left out.
+    motion_rms_m : dict of str to float
+        Kept marker -> RMS distance (m) of its present frames from its mean over the window.
+    """
+
+    time_s: np.ndarray
+    markers_m: np.ndarray
+    labels: list[str]
+    n_filled: dict[str, int]
+    left_out: list[str]
+    motion_rms_m: dict[str, float]
+
+
+def _named(marker: str, lab_labels: Mapping[str, str] | None) -> str:
+    """A model marker with the lab label that provides it: ``'RKNE' (model marker R.Knee)``."""
+    label = (lab_labels or {}).get(marker)
+    return f"'{label}' (model marker {marker})" if label and label != marker else f"'{marker}'"
+
+
+def static_pose(
+    time_s,
+    markers_m,
+    labels: Sequence[str],
+    window_s: tuple[float, float],
+    needed: Sequence[str] = (),
+    lab_labels: Mapping[str, str] | None = None,
+    source: str = "",
+    setting: str = "time_range of the scale setup",
+    max_motion_rms_m: float | None = None,
+) -> StaticPose:
+    """The frames of ``window_s`` with every marker complete (module docstring).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Shape (n_frames,), s.
+    markers_m : array_like
+        Shape (n_frames, n_markers, 3), m, NaN where missing.
+    labels : sequence of str
+        Model marker names, one per marker.
+    window_s : (float, float)
+        The span averaged (:func:`scale_window_s`).
+    needed : sequence of str
+        Markers scaling cannot do without (the measurements' marker pairs).
+    lab_labels : mapping of str to str, optional
+        Model marker -> the lab's label in the C3D file, for messages.
+    source, setting : str
+        The file and the setting that chose the window, for messages.
+    max_motion_rms_m : float, optional
+        Largest RMS motion (m) of a marker about its mean over the window
+        (``markers.static_max_motion_rms_m``); None: not checked.
+
+    Raises
+    ------
+    LoperInputError
+        A marker of ``needed`` absent from the data, or from every frame of
+        the window; the message names the lab label, the model marker, the
+        file, the window and ``setting``. A marker moving more than
+        ``max_motion_rms_m``: the message names the markers, their motion,
+        the window and the limit.
+    """
+    t = np.asarray(time_s, dtype=float)
+    X = np.asarray(markers_m, dtype=float)
+    labels = [str(lab) for lab in labels]
+    if X.ndim != 3 or X.shape[2] != 3 or X.shape[0] != t.size or X.shape[1] != len(labels):
+        raise LoperInputError(f"{where(source)}markers_m must have shape ({t.size}, {len(labels)}, 3), got {X.shape}")
+    lacking = [m for m in needed if m not in labels]
+    if lacking:
+        raise LoperInputError(
+            f"{where(source)}static trial lacks marker(s) {sorted(set(lacking))} needed for scaling "
+            "(map the lab's labels to them in markers.label_map)"
+        )
+    start, end = window_s
+    sel = (t >= start - 1e-9) & (t <= end + 1e-9)
+    W = X[sel].copy()
+    present = np.all(np.isfinite(W), axis=2)
+    absent = [labels[j] for j in range(len(labels)) if not present[:, j].any()]
+    stop = [m for m in absent if m in set(needed)]
+    if stop:
+        names = ", ".join(_named(m, lab_labels) for m in stop)
+        raise LoperInputError(
+            f"{where(source)}marker(s) {names} missing in every frame of the scaling window {start:.4f} .. "
+            f"{end:.4f} s ({int(sel.sum())} frames) of the static trial: choose a window where they are present "
+            f"({setting}, or markers.static_duration_s)"
+        )
+    keep = [j for j in range(len(labels)) if present[:, j].any()]
+    motion = {labels[j]: _motion_rms_m(W[present[:, j], j]) for j in keep}
+    if max_motion_rms_m is not None:
+        moving = sorted((m for m in motion if motion[m] > max_motion_rms_m), key=motion.get, reverse=True)
+        if moving:
+            shown = ", ".join(f"{_named(m, lab_labels)} {motion[m] * 1000:.0f} mm" for m in moving[:5])
+            more = f" and {len(moving) - 5} more" if len(moving) > 5 else ""
+            raise LoperInputError(
+                f"{where(source)}the subject does not stand still in the scaling window {start:.4f} .. {end:.4f} s "
+                f"of the static trial: marker(s) {shown}{more} move more than markers.static_max_motion_rms_m "
+                f"{max_motion_rms_m:g} m RMS about their mean; choose a still window ({setting}, or "
+                "markers.static_duration_s)"
+            )
+    filled = {}
+    for j in keep:
+        gap = ~present[:, j]
+        if gap.any():
+            W[gap, j] = W[present[:, j], j].mean(axis=0)
+            filled[labels[j]] = int(gap.sum())
+    return StaticPose(t[sel], W[:, keep], [labels[j] for j in keep], filled, absent, motion)
+
+
+def _motion_rms_m(points_m: np.ndarray) -> float:
+    """RMS distance (m) of points (n, 3) from their mean."""
+    return float(np.sqrt(np.mean(np.sum((points_m - points_m.mean(axis=0)) ** 2, axis=1))))
+
+
+def standing_mass_kg(
+    time_s,
+    vertical_force_n,
+    window_s: tuple[float, float],
+    gravity_m_per_s2: float = GRAVITY_M_PER_S2,
+    source: str = "",
+) -> float:
+    """Body mass (kg) of a subject standing on force plates: mean total vertical force over the window / g.
+
+    Parameters
+    ----------
+    time_s : array_like
+        Shape (n_samples,), s: the plates' sample times.
+    vertical_force_n : array_like
+        Shape (n_samples,) or (n_samples, n_plates), N: vertical ground
+        reaction of each plate (up positive), summed over the plates.
+    window_s : (float, float)
+        The span averaged (s).
+    gravity_m_per_s2 : float
+        Gravity (m/s^2).
+
+    Raises
+    ------
+    LoperInputError
+        No sample in the window, a mass outside :data:`MASS_RANGE_KG` (plates
+        not under the subject, or in another unit), or a force that varies by
+        more than 10 % (SD over mean: the subject does not stand still on the
+        plates).
+    """
+    t = np.asarray(time_s, dtype=float)
+    F = np.asarray(vertical_force_n, dtype=float)
+    total = F.sum(axis=1) if F.ndim == 2 else F
+    sel = (t >= window_s[0] - 1e-9) & (t <= window_s[1] + 1e-9) & np.isfinite(total)
+    if not sel.any():
+        raise LoperInputError(
+            f"{where(source)}no force-plate sample in the window {window_s[0]:.4f} .. "
+            f"{window_s[1]:.4f} s of the static trial"
+        )
+    mean = float(total[sel].mean())
+    mass = mean / float(gravity_m_per_s2)
+    lo, hi = MASS_RANGE_KG
+    if not lo <= mass <= hi:
+        raise LoperInputError(
+            f"{where(source)}the force plates carry {mean:.1f} N on average in the static trial's window "
+            f"({mass:.1f} kg), outside {lo:g} .. {hi:g} kg: does the subject stand on the plates? Give mass_kg in the "
+            "subject sheet instead"
+        )
+    cv = float(total[sel].std()) / mean
+    if cv > _MAX_FORCE_CV:
+        raise LoperInputError(
+            f"{where(source)}the total vertical force varies by {100 * cv:.0f} % (SD over mean) in the static trial's "
+            f"window: the subject does not stand still on the plates; give mass_kg in the subject sheet instead"
+        )
+    return mass
+
+
+def model_height_m(model, thigh_body: str) -> float:
+    """Stature (m) of a scaled model: its hip joint centre's height over its lowest marker /
+    :data:`HIP_HEIGHT_FRACTION`.
+
+    ``model`` is an ``opensim.Model`` in its default pose; ``thigh_body``
+    the thigh (femur) body, whose origin is the hip joint centre (gait2392,
+    Rajagopal2016 and the generated model). The vertical is the model's Y.
+    NaN for a model without markers.
+    """
+    state = model.initSystem()
+    hip = model.getBodySet().get(thigh_body).getPositionInGround(state).to_numpy()
+    markers = model.getMarkerSet()
+    heights = [markers.get(i).getLocationInGround(state).to_numpy()[1] for i in range(markers.getSize())]
+    if not heights:
+        return float("nan")
+    return float((hip[1] - min(heights)) / HIP_HEIGHT_FRACTION)

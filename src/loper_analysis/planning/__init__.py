@@ -1,0 +1,5 @@
+"""Planning an experiment: the precision of K and D before anyone walks (the ``planning`` stage).
+
+* :mod:`.inputs` - the planned pulse as the rods deliver it and a pilot's perturbed pairs;
+* :mod:`.precision` - the predicted standard deviation of each parameter and the strides needed.
+"""

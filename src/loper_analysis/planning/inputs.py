@@ -1,0 +1,118 @@
+"""The planner's inputs: the planned pulse as the rods deliver it, and the pilot's perturbed pairs at an onset.
+
+* :func:`pulse_force_n` - the force the rods apply for a rectangular desired
+  pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
+  like the load cell;
+* :func:`pilot_perturbed_pairs` - the pilot's kept perturbed pairs at an onset,
+  one by one, whose scatter the prediction takes.
+
+Used by :mod:`loper_analysis.planning.precision` (method: ``docs/planning.md``).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import replace
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.checks import number
+from loper_analysis.errors import LoperInputError
+
+__all__ = ["pulse_force_n", "pilot_perturbed_pairs"]
+
+
+def pulse_force_n(
+    time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = 40.0, order: int = 4
+) -> np.ndarray:
+    """The rod force (N, along the rods) of a rectangular desired pulse, at ``time_s`` (s, onset at 0).
+
+    The desired force ``force_n`` for ``0 <= t < duration_s`` drives the
+    device's closed loop (:func:`loper_analysis.device.controller.simulate_device`
+    with a still brace, no load-cell noise; ``device`` a
+    :class:`~loper_analysis.device.controller.DeviceParameters`, default the
+    study's tuning: about 10 ms rise and 30 % overshoot), minus the loop's
+    output without the pulse; the result is low-passed like the load cell
+    (zero-phase Butterworth, ``cutoff_hz``, ``order``) and sampled at
+    ``time_s``. Zero before the onset.
+    """
+    from loper_analysis.device.controller import DeviceParameters, simulate_device
+    from loper_analysis.motion.filtering import lowpass
+
+    t = np.asarray(time_s, dtype=float)
+    if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)):
+        raise LoperInputError(f"time_s must be a finite 1-D array with >= 2 samples, got shape {t.shape}")
+    f = number("pulse force_n", force_n)
+    d = number("pulse duration_s", duration_s)
+    if d <= 0:
+        raise LoperInputError(f"pulse duration_s must be > 0 s, got {d:g} s")
+    dev = replace(device or DeviceParameters(), loadcell_noise_sd_n=0.0)
+    rate = dev.sample_rate_hz
+    lead = 0.2
+    n = int(math.ceil((max(t[-1], d) + lead + 0.2) * rate)) + 1
+    t_dev = -lead + np.arange(n) / rate
+    desired = np.where((t_dev >= -1e-9) & (t_dev < d - 1e-9), f, 0.0)
+    still = np.zeros(n)
+    on = simulate_device(desired, dev, None, brace_position_m=still)["force_measured_n"].to_numpy()
+    off = simulate_device(0.0 * desired, dev, None, brace_position_m=still)["force_measured_n"].to_numpy()
+    force = lowpass(on - off, rate, cutoff_hz, order)
+    return np.interp(t, t_dev, force, left=0.0, right=float(force[-1]))
+
+
+def pilot_perturbed_pairs(
+    trials: Sequence[Mapping],
+    onset_ms: float,
+    response=None,
+    *,
+    side: str = "left",
+    onset_tolerance_ms: float = 12.5,
+    source: str = "pilot",
+) -> dict | None:
+    """The pilot's kept perturbed pairs at ``onset_ms`` one by one (format of ``null_pairs``), or None.
+
+    ``trials``: ``name``, ``angles`` and ``strides`` tables of the pilot's
+    trials with the device (:mod:`loper_analysis.responses.inputs`). Those
+    whose perturbed strides' median onset (``onset_s - toe_off_s``) lies
+    within ``onset_tolerance_ms`` of ``onset_ms`` are the onset's; their
+    pairs are matched, windowed and judged for outliers as the fit's
+    (``series["pairs"]`` of :func:`loper_analysis.responses.subject_onset_response`
+    with ``response`` settings). The pairs' angles do not depend on the
+    force, so none is needed (the response gets a zero force). None when no
+    trial is the onset's or no pair is kept.
+    """
+    from loper_analysis.errors import TooFewStridesWarning
+    from loper_analysis.responses import ResponseSettings, subject_onset_response
+
+    own = []
+    for tr in trials:
+        table = tr["strides"]
+        if not {"perturbed", "onset_s", "toe_off_s"} <= set(table.columns):
+            continue
+        pert = table[table["perturbed"].astype(bool)]
+        delay_ms = 1e3 * (pert["onset_s"].to_numpy(float) - pert["toe_off_s"].to_numpy(float))
+        delay_ms = delay_ms[np.isfinite(delay_ms)]
+        if delay_ms.size and abs(float(np.median(delay_ms)) - float(onset_ms)) <= onset_tolerance_ms:
+            n = len(tr["angles"])
+            own.append(
+                {
+                    "name": tr["name"],
+                    "angles": tr["angles"],
+                    "strides": table,
+                    "force": pd.DataFrame(
+                        {"time_s": tr["angles"]["time_s"].to_numpy(float), "force_measured_n": np.zeros(n)}
+                    ),
+                    "force_direction": np.tile([1.0, 0.0], (n, 1)),
+                }
+            )
+    if not own:
+        return None
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TooFewStridesWarning)
+        _, _, series = subject_onset_response(
+            own, onset_ms, response or ResponseSettings(), side=side, source=f"{source}, perturbed pairs"
+        )
+    pairs = series["pairs"]
+    return pairs if int(pairs["n_pairs"]) > 0 else None

@@ -1,0 +1,589 @@
+"""Planning an experiment: the precision of K and D before anyone walks (method: ``docs/planning.md``).
+
+The null-pair fit (:mod:`loper_analysis.identification.null_pairs`) takes the
+covariance of its estimate by the sandwich ``cov = M C M^T`` with
+``M = (W J)^+ W``, ``C = cov(E) / N`` (``E`` the prediction errors of pairs
+one by one, ``N`` the perturbed strides averaged, ``W`` the projection of the
+null pairs' dominant shapes, ``J`` the sensitivity of the model response to K
+and D). ``E`` are the errors of the *perturbed* pairs: each stride answers
+the pulse about its own course, which pairs without a pulse (null pairs)
+cannot show. From a pilot subject's null pairs, its perturbed pairs at the
+onset (when it has them), a planned pulse and a planned impedance the
+planner predicts the SD and the 95 % CI half-width of every K and D for any
+number of perturbed strides, and the number of strides a target half-width
+needs.
+
+* :func:`pulse_force_n` (from :mod:`loper_analysis.planning.inputs`) - the force the rods apply for a rectangular desired
+  pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
+  like the load cell;
+* :func:`pilot_perturbed_pairs` (from :mod:`loper_analysis.planning.inputs`) - the pilot's
+  perturbed pairs at an onset, one by one;
+* :func:`planning_window` - the identification window of the planned
+  experiment: the pilot's mean unperturbed swing as the reference, the pulse
+  along the thigh normal;
+* :func:`stride_covariance` - the covariance of (K, D) per joint for one
+  perturbed stride (divide by ``N``), from the pilot's perturbed pairs (or
+  its null pairs when it has none at the onset);
+* :func:`pool_onsets` - the perturbed pairs' excess scatter pooled over the
+  pilot's onsets (steadier than one onset's dozen pairs);
+* :func:`precision_table` - predicted SD and 95 % half-width per joint,
+  parameter and stride count;
+* :func:`strides_needed` and :func:`target_answer` - how many strides a target
+  half-width needs.
+
+The identification's own functions build the window, the Jacobian, the
+null-pair errors and the projection
+(:func:`~loper_analysis.identification.prepare_window`,
+:func:`~loper_analysis.identification.response_jacobian`,
+:func:`~loper_analysis.identification.null_pair_errors`,
+:func:`~loper_analysis.identification.nuisance_projection`), so the
+prediction is the fit's own covariance formula.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.checks import integer, number
+from loper_analysis.constants import JOINTS, PARAMETER_UNITS, PARAMETERS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.identification import (
+    PreparedWindow,
+    nuisance_projection,
+    null_pair_errors,
+    parameter_bounds,
+    prepare_window,
+    response_jacobian,
+    t_quantile,
+)
+from loper_analysis.planning.inputs import pilot_perturbed_pairs, pulse_force_n
+from loper_analysis.swing_leg.dynamics import SegmentParameters
+
+__all__ = [
+    "PLAN_COLUMNS",
+    "MIN_PERTURBED_PAIRS",
+    "PlanSettings",
+    "StrideCovariance",
+    "pulse_force_n",
+    "planning_window",
+    "pilot_perturbed_pairs",
+    "stride_covariance",
+    "pool_onsets",
+    "precision_table",
+    "unplanned_rows",
+    "strides_needed",
+    "target_answer",
+]
+
+#: Columns of the plan table (one row per joint x parameter x onset x stride count).
+PLAN_COLUMNS: tuple[str, ...] = (
+    "subject",
+    "onset_ms",
+    "joint",
+    "parameter",
+    "unit",
+    "n_strides",
+    "planned_value",
+    "predicted_sd",
+    "ci95_half_width",
+    "ci95_half_width_pct",
+    "pulse_force_n",
+    "pulse_duration_s",
+    "n_null_pairs",
+    "n_perturbed_pairs",
+    "scatter",
+    "note",
+)
+
+#: Fewest pilot perturbed pairs whose scatter the prediction takes (fewer: the null pairs' scatter, noted).
+MIN_PERTURBED_PAIRS = 5
+
+
+@dataclass(frozen=True)
+class PlanSettings:
+    """The planned pulse and the identification settings the prediction follows (config ``identification``).
+
+    ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
+    onset; ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
+    (s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
+    ``min_null_pairs``, ``interval_scatter`` (whose scatter the fit's
+    intervals take, hence their t quantile) and the bounds (N·m/rad,
+    N·m·s/rad) as the fit uses them; ``force_cutoff_hz`` and ``force_order``
+    the load cell's low-pass; ``force_rate_hz`` the rate of the pulse given
+    to the fit (the robot log's).
+    """
+
+    pulse_force_n: float = 40.0
+    pulse_duration_s: float = 0.1
+    window_before_s: float = 0.025
+    window_after_s: float = 0.25
+    initial_state_span_s: float = 0.1
+    initial_state_degree: int = 1
+    n_substeps: int = 2
+    null_pair_components: int = 6
+    min_null_pairs: int = 30
+    interval_scatter: str = "perturbed_pairs"
+    stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
+    damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
+    force_cutoff_hz: float = 40.0
+    force_order: int = 4
+    force_rate_hz: float = 1000.0
+
+    def __post_init__(self):
+        number("pulse_force_n", self.pulse_force_n)
+        if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
+            raise LoperInputError(
+                "identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
+                f"got {self.interval_scatter!r}"
+            )
+        if number("force_rate_hz", self.force_rate_hz) <= 0:
+            raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
+        d = number("pulse_duration_s", self.pulse_duration_s)
+        after = number("window_after_s", self.window_after_s, minimum=0.0)
+        if d <= 0:
+            raise LoperInputError(f"pulse_duration_s must be > 0 s, got {d:g} s")
+        if d > after:
+            raise LoperInputError(
+                f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
+                f"(identification.window_after_s = {after:g} s): the fit would not see its end"
+            )
+
+    @property
+    def lower(self) -> np.ndarray:
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
+
+    @property
+    def upper(self) -> np.ndarray:
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
+
+
+@dataclass
+class StrideCovariance:
+    """The covariance (6, 6) of the estimate for one averaged perturbed stride (order :data:`PARAMETERS`).
+
+    ``impedance`` (6,) the planned values it was linearised at; ``dof`` the
+    degrees of freedom of the CI's Student t as the fit takes them: None for
+    ``N - 1`` (the fit's intervals from the scatter of its ``N`` perturbed
+    pairs), else a fixed count (the null pairs' ``M - 1``); ``n_null_pairs``
+    and ``n_perturbed_pairs`` the pilot's pairs; ``scatter`` whose errors
+    gave the covariance (``perturbed_pairs`` or ``null_pairs``); ``note`` a
+    caveat for the rows (empty when none).
+    """
+
+    covariance: np.ndarray
+    impedance: np.ndarray
+    dof: int | None
+    n_null_pairs: int
+    note: str = ""
+    n_perturbed_pairs: int = 0
+    scatter: str = "null_pairs"
+    null_covariance: np.ndarray | None = None
+
+    @property
+    def sd(self) -> np.ndarray:
+        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad)."""
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    def t95(self, n_strides: int) -> float:
+        """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof;
+        :func:`~loper_analysis.identification.t_quantile`, the fit's own)."""
+        dof = int(n_strides) - 1 if self.dof is None else int(self.dof)
+        return t_quantile(dof) if dof >= 1 else math.inf
+
+    def half_width(self, n_strides: int) -> np.ndarray:
+        """Predicted 95 % CI half-width (6,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
+        return self.t95(n_strides) * self.sd / math.sqrt(int(n_strides))
+
+
+def _null_arrays(null_pairs: Mapping, source: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+    """Checked grid and arrays of the pilot's null pairs, and how many there are."""
+    missing = [
+        k
+        for k in (
+            "time_s",
+            "q_perturbed",
+            "q_unperturbed",
+            "pelvis_angle_perturbed_rad",
+            "pelvis_angle_unperturbed_rad",
+        )
+        if k not in null_pairs
+    ]
+    if missing:
+        raise LoperInputError(f"{source}: null pairs lack {missing}")
+    t = np.asarray(null_pairs["time_s"], dtype=float)
+    arrays = {
+        k: np.asarray(null_pairs[k], dtype=float)
+        for k in ("q_perturbed", "q_unperturbed", "pelvis_angle_perturbed_rad", "pelvis_angle_unperturbed_rad")
+    }
+    n = int(arrays["q_unperturbed"].shape[0]) if arrays["q_unperturbed"].ndim == 3 else 0
+    return t, arrays, n
+
+
+def planning_window(
+    null_pairs: Mapping,
+    params: SegmentParameters,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    source: str = "pilot",
+) -> PreparedWindow:
+    """The identification window of the planned experiment (onset at t = 0).
+
+    Reference: the mean of the pilot's unperturbed null-pair strides
+    (``null_pairs["q_unperturbed"]`` (M, n, 4) and
+    ``pelvis_angle_unperturbed_rad`` (M, n), on the grid ``time_s`` (n,)
+    relative to the onset; :func:`loper_analysis.responses.null_pair_windows`),
+    the mean swing a perturbed stride starts from. The perturbed force is
+    :func:`pulse_force_n` along the thigh's forward normal of that swing,
+    given to the fit at ``settings.force_rate_hz`` (``force_time_s`` of
+    :func:`~loper_analysis.identification.prepare_window`, as the fit takes
+    the robot log's samples); the minimal-impedance force and the initial
+    deviation are zero (they average out over the perturbed strides).
+    ``measured`` is zero: only the model's sensitivities are used.
+    """
+    from loper_analysis.synthetic.response import thigh_normal
+
+    t, arrays, n_pairs = _null_arrays(null_pairs, source)
+    if n_pairs < 1:
+        raise LoperInputError(f"{source}: no null pairs: the pilot needs unperturbed strides walked with the device")
+    q_ref = arrays["q_unperturbed"].mean(axis=0)
+    pelvis = arrays["pelvis_angle_unperturbed_rad"].mean(axis=0)
+    rate = float(settings.force_rate_hz)
+    t_force = np.arange(math.ceil(t[0] * rate - 1e-6), math.floor(t[-1] * rate + 1e-6) + 1) / rate
+    force = pulse_force_n(
+        t_force,
+        settings.pulse_force_n,
+        settings.pulse_duration_s,
+        device,
+        settings.force_cutoff_hz,
+        settings.force_order,
+    )
+    force_vector = force[:, None] * thigh_normal(np.interp(t_force, t, q_ref[:, 1]))
+    return prepare_window(
+        t,
+        q_ref,
+        q_ref,
+        params,
+        0.0,
+        force_perturbed_n=force_vector,
+        force_unperturbed_n=np.zeros_like(force_vector),
+        force_time_s=t_force,
+        pelvis_angle_unperturbed_rad=pelvis,
+        pelvis_angle_perturbed_rad=pelvis,
+        window_before_s=settings.window_before_s,
+        window_after_s=settings.window_after_s,
+        n_substeps=settings.n_substeps,
+        initial_state_span_s=settings.initial_state_span_s,
+        initial_state_degree=settings.initial_state_degree,
+    )
+
+
+def _impedance(impedance, settings: PlanSettings, source: str) -> np.ndarray:
+    p = np.asarray(impedance, dtype=float)
+    if p.shape != (6,) or not np.all(np.isfinite(p)):
+        raise LoperInputError(
+            f"{source}: the planned impedance must be 6 finite values ({', '.join(PARAMETERS)}), "
+            f"got {np.asarray(impedance).tolist()}"
+        )
+    out = np.flatnonzero((p < settings.lower) | (p > settings.upper))
+    if out.size:
+        i = int(out[0])
+        raise LoperInputError(
+            f"{source}: planned {PARAMETERS[i]} = {p[i]:g} {PARAMETER_UNITS[PARAMETERS[i]]} lies "
+            f"outside the identification bounds {settings.lower[i]:g} .. {settings.upper[i]:g}"
+        )
+    return p
+
+
+def stride_covariance(
+    null_pairs: Mapping,
+    params: SegmentParameters,
+    impedance,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    source: str = "pilot",
+    perturbed_pairs: Mapping | None = None,
+) -> StrideCovariance:
+    """Covariance of (K, D) per joint for a mean response of **one** perturbed stride.
+
+    ``impedance`` (6,): the planned values (order :data:`PARAMETERS`; N·m/rad
+    and N·m·s/rad), e.g. the pilot's estimate. With the window of
+    :func:`planning_window`, ``J`` = :func:`~loper_analysis.identification.response_jacobian`
+    at ``impedance``, the null-pair errors ``E0`` =
+    :func:`~loper_analysis.identification.null_pair_errors`, ``W`` =
+    :func:`~loper_analysis.identification.nuisance_projection` of ``E0``
+    (``settings.null_pair_components`` shapes) and ``M = (W J)^+ W``:
+    ``cov_1 = M cov(E) M^T``. For ``N`` strides the covariance is ``cov_1 / N``.
+
+    ``E`` are the prediction errors of the pilot's ``perturbed_pairs`` (the
+    kept perturbed-minus-matched pairs at this onset one by one, format of
+    ``null_pairs``: ``series["pairs"]`` of
+    :func:`loper_analysis.responses.subject_onset_response`): their scatter
+    holds the stride-to-stride deviation *and* each stride's own answer to
+    the pulse, the scatter the fit's intervals take
+    (``identification.interval_scatter: perturbed_pairs``). Without them, or
+    with fewer than :data:`MIN_PERTURBED_PAIRS`, ``E = E0`` and the note says
+    the prediction lacks the response's variability. The t quantile is the
+    fit's: ``N - 1`` degrees of freedom with ``interval_scatter``
+    ``perturbed_pairs``, else the null pairs' ``M - 1``.
+
+    Raises
+    ------
+    LoperInputError
+        No null pairs, fewer than ``null_pair_components + 2`` of them (the
+        projection cannot be estimated), a planned value outside the bounds.
+    """
+    p = _impedance(impedance, settings, source)
+    _, _, n_pairs = _null_arrays(null_pairs, source)
+    r = integer("null_pair_components", settings.null_pair_components, source, minimum=0)
+    need = r + 2
+    if n_pairs < need:
+        raise LoperInputError(
+            f"{source}: {n_pairs} null pair(s), fewer than identification.null_pair_components + 2 = {need}: "
+            "the pilot needs unperturbed strides walked with the device (their deviation is what the prediction "
+            "scales)"
+        )
+    notes = []
+    if n_pairs < settings.min_null_pairs:
+        notes.append(
+            f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+            "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit"
+        )
+    window = planning_window(null_pairs, params, settings, device, source)
+    J = response_jacobian(window, p, settings.lower, settings.upper)
+    E0 = null_pair_errors(window, p, null_pairs)
+    W = nuisance_projection(E0, r)
+    WJ = W @ J
+    M = np.linalg.pinv(WJ.T @ WJ, rcond=1e-13) @ WJ.T @ W
+    n_pert = 0
+    if perturbed_pairs is not None:
+        _, _, n_pert = _null_arrays(perturbed_pairs, f"{source}, perturbed pairs")
+    if n_pert >= MIN_PERTURBED_PAIRS:
+        E, scatter = null_pair_errors(window, p, perturbed_pairs), "perturbed_pairs"
+    else:
+        E, scatter = E0, "null_pairs"
+        notes.append(
+            (
+                f"{n_pert} perturbed pair(s) of the pilot at this onset, fewer than {MIN_PERTURBED_PAIRS}"
+                if perturbed_pairs is not None
+                else "no perturbed pairs of the pilot at this onset"
+            )
+            + ": the null pairs' scatter, without each stride's own answer to the pulse (in the "
+            "synthetic check the actual SD of hip and knee K and D was 1.4-1.8 times this prediction)"
+        )
+
+    def sandwich(errors: np.ndarray) -> np.ndarray:
+        effect = (errors - errors.mean(axis=0)) @ M.T  # each pair's effect on (K, D)
+        return effect.T @ effect / max(errors.shape[0] - 1, 1)
+
+    dof = None if settings.interval_scatter == "perturbed_pairs" else n_pairs - 1
+    return StrideCovariance(sandwich(E), p, dof, n_pairs, "; ".join(notes), n_pert, scatter, sandwich(E0))
+
+
+def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, StrideCovariance]:
+    """The perturbed pairs' excess scatter pooled over the pilot's onsets (``{onset_ms: StrideCovariance}``).
+
+    Per onset ``o`` with the scatter of ``P_o`` perturbed pairs, the ratio
+    ``r_o = diag(cov) / diag(null_covariance)`` (6,) says how much more the
+    perturbed pairs scatter than the null pairs for each K and D. The pooled
+    ratio ``r = sum (P_o - 1) r_o / sum (P_o - 1)`` is applied to every
+    onset's null-pair sandwich, which rests on 100+ pairs:
+    ``cov_o = diag(sqrt r) null_covariance_o diag(sqrt r)`` (``scatter``
+    ``pooled_perturbed_pairs``), onsets without perturbed pairs included. A
+    dozen pairs per onset (the default design) leave each ``r_o`` uncertain
+    by about +-45 % (95 %); pooled over three onsets, +-25 %. With fewer than
+    two onsets with perturbed pairs the covariances are returned unchanged.
+    """
+    own = {o: sc for o, sc in stride_covs.items() if sc.scatter == "perturbed_pairs"}
+    if len(own) < 2:
+        return dict(stride_covs)
+    weights = np.array([sc.n_perturbed_pairs - 1 for sc in own.values()], float)
+    ratios = np.array([np.diag(sc.covariance) / np.diag(sc.null_covariance) for sc in own.values()])
+    r = weights @ ratios / weights.sum()
+    scale = np.sqrt(r)
+    pooled_note = (
+        f"perturbed/null pairs' variance ratio pooled over onsets {', '.join(f'{o:g}' for o in own)} ms "
+        f"({int(sum(sc.n_perturbed_pairs for sc in own.values()))} perturbed pairs)"
+    )
+    out = {}
+    for o, sc in stride_covs.items():
+        notes = [n for n in sc.note.split("; ") if n and "perturbed pair" not in n] + [pooled_note]
+        out[o] = StrideCovariance(
+            scale[:, None] * sc.null_covariance * scale[None, :],
+            sc.impedance,
+            sc.dof,
+            sc.n_null_pairs,
+            "; ".join(notes),
+            sc.n_perturbed_pairs,
+            "pooled_perturbed_pairs",
+            sc.null_covariance,
+        )
+    return out
+
+
+def _counts(n_strides: Sequence[int], source: str) -> list[int]:
+    values = list(np.atleast_1d(n_strides)) if not isinstance(n_strides, (int, np.integer)) else [n_strides]
+    if not values:
+        raise LoperInputError(f"{source}: no stride count given")
+    out = []
+    for v in values:
+        try:
+            ok = float(v) == int(v)
+        except (TypeError, ValueError):
+            ok = False
+        if not ok or int(v) < 1:
+            raise LoperInputError(
+                f"{source}: stride count must be a whole number >= 1 (perturbed strides averaged), got {v!r}"
+            )
+        out.append(int(v))
+    return out
+
+
+def precision_table(
+    stride_cov: StrideCovariance,
+    n_strides: Sequence[int],
+    onset_ms: float,
+    subject: str = "",
+    settings: PlanSettings = PlanSettings(),
+) -> pd.DataFrame:
+    """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
+
+    ``predicted_sd = sd_1 / sqrt(N)`` and ``ci95_half_width = t * predicted_sd``
+    (Student's t at 97.5 % with the fit's degrees of freedom,
+    :meth:`StrideCovariance.t95`: ``N - 1`` by default), both in ``unit``;
+    ``ci95_half_width_pct`` relative to the planned value (%; NaN for a
+    planned value of 0). Rows: hip, knee, ankle x K, D x ``n_strides``.
+    """
+    counts = _counts(n_strides, subject or "plan")
+    sd1 = stride_cov.sd
+    rows = []
+    for j, joint in enumerate(JOINTS):
+        for k, kind in enumerate(("K", "D")):
+            i = 2 * j + k
+            planned = float(stride_cov.impedance[i])
+            for n in counts:
+                sd = sd1[i] / math.sqrt(n)
+                half = stride_cov.t95(n) * sd
+                rows.append(
+                    {
+                        "subject": subject,
+                        "onset_ms": float(onset_ms),
+                        "joint": joint,
+                        "parameter": kind,
+                        "unit": PARAMETER_UNITS[PARAMETERS[i]],
+                        "n_strides": n,
+                        "planned_value": planned,
+                        "predicted_sd": sd,
+                        "ci95_half_width": half,
+                        "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
+                        "pulse_force_n": float(settings.pulse_force_n),
+                        "pulse_duration_s": float(settings.pulse_duration_s),
+                        "n_null_pairs": stride_cov.n_null_pairs,
+                        "n_perturbed_pairs": stride_cov.n_perturbed_pairs,
+                        "scatter": stride_cov.scatter,
+                        "note": stride_cov.note,
+                    }
+                )
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+
+
+def unplanned_rows(
+    n_strides: Sequence[int], onset_ms: float, note: str, subject: str = "", settings: PlanSettings = PlanSettings()
+) -> pd.DataFrame:
+    """Rows of :data:`PLAN_COLUMNS` for an onset that cannot be planned: predictions empty, ``note`` says why."""
+    counts = _counts(n_strides, subject or "plan")
+    rows = [
+        {
+            "subject": subject,
+            "onset_ms": float(onset_ms),
+            "joint": joint,
+            "parameter": kind,
+            "unit": PARAMETER_UNITS[f"{kind}_{joint}"],
+            "n_strides": n,
+            "pulse_force_n": float(settings.pulse_force_n),
+            "pulse_duration_s": float(settings.pulse_duration_s),
+            "note": note,
+        }
+        for joint in JOINTS
+        for kind in ("K", "D")
+        for n in counts
+    ]
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+
+
+def strides_needed(
+    stride_cov: StrideCovariance,
+    joint: str,
+    parameter: str,
+    *,
+    percent: float | None = None,
+    half_width: float | None = None,
+) -> int:
+    """Fewest perturbed strides whose 95 % CI half-width on ``parameter`` of ``joint`` meets the target.
+
+    Give either ``percent`` (of the planned value, e.g. 15 for +-15 %) or
+    ``half_width`` (absolute, N·m/rad or N·m·s/rad): the smallest ``N`` with
+    ``t_N sd_1 / sqrt(N) <= target`` (``t_N`` :meth:`StrideCovariance.t95`;
+    with a fixed t, ``N = ceil((t sd_1 / target)^2)``).
+    """
+    if joint not in JOINTS:
+        raise LoperInputError(f"target joint must be one of {JOINTS}, got {joint!r}")
+    if parameter not in ("K", "D"):
+        raise LoperInputError(f"target parameter must be 'K' or 'D', got {parameter!r}")
+    if (percent is None) == (half_width is None):
+        raise LoperInputError("give exactly one target: percent or half_width")
+    i = PARAMETERS.index(f"{parameter}_{joint}")
+    planned = float(stride_cov.impedance[i])
+    if percent is not None:
+        pct = number("target percent", percent)
+        if pct <= 0:
+            raise LoperInputError(f"target percent must be > 0, got {pct:g}")
+        if planned == 0:
+            raise LoperInputError(
+                f"a relative target needs a planned {parameter} of the {joint} other than 0; "
+                "give an absolute half-width"
+            )
+        target = pct / 100.0 * abs(planned)
+    else:
+        target = number("target half_width", half_width)
+        if target <= 0:
+            raise LoperInputError(f"target half_width must be > 0, got {target:g}")
+    sd1 = float(stride_cov.sd[i])
+
+    def meets(n: int) -> bool:
+        return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
+
+    # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96
+    n = max(1, int(math.ceil((t_quantile(10**6) * sd1 / target) ** 2 * (1 - 1e-12))))
+    while not meets(n):
+        t = stride_cov.t95(n)
+        n = n + 1 if not math.isfinite(t) else max(n + 1, int(math.ceil((t * sd1 / target) ** 2 * (1 - 1e-12))))
+    while n > 1 and meets(n - 1):
+        n -= 1
+    return n
+
+
+def target_answer(
+    stride_cov: StrideCovariance,
+    joint: str,
+    parameter: str,
+    onset_ms: float,
+    *,
+    percent: float | None = None,
+    half_width: float | None = None,
+) -> str:
+    """One sentence: how many perturbed strides a target half-width on ``parameter`` of ``joint`` needs."""
+    n = strides_needed(stride_cov, joint, parameter, percent=percent, half_width=half_width)
+    i = PARAMETERS.index(f"{parameter}_{joint}")
+    unit, planned = PARAMETER_UNITS[PARAMETERS[i]], float(stride_cov.impedance[i])
+    reached = stride_cov.t95(n) * stride_cov.sd[i] / math.sqrt(n)
+    wanted = f"±{percent:g} %" if percent is not None else f"±{half_width:g} {unit}"
+    return (
+        f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
+        f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "
+        f"±{100 * reached / abs(planned) if planned else float('nan'):.3g} %)"
+    )

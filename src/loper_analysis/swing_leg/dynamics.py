@@ -1,0 +1,468 @@
+"""Planar swing-leg model: a cart (pelvis translation) carrying thigh, shank and foot.
+
+Equations of motion (``docs/swing_leg_model.md``)::
+
+    M(q) q'' = -C(q, q') + G(q) + u + Ja(q)^T F
+
+* ``q = [x, q_thigh, q_shank, q_foot]``, joint angles and the generalised
+  forces of joint torques as stated in :mod:`loper_analysis.constants`
+  (flexion and dorsiflexion positive).
+* ``Ja`` is the Jacobian (2 x 4) of the rod attachment point on the thigh, at
+  ``attachment_m`` from the hip along the thigh axis; ``F = (F_x, F_y)`` in N,
+  world frame (x forward, y up).
+
+Segment parameters come from :class:`SegmentParameters` (SI units). The heavy
+lifting is compiled in :mod:`loper_analysis.swing_leg.kernels`; this module offers the
+checked, vectorised NumPy API and a reference forward simulation on SciPy's
+``solve_ivp``.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.checks import finite_rows
+from loper_analysis.constants import GRAVITY_M_PER_S2, SEGMENTS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.swing_leg import kernels
+from loper_analysis.swing_leg.anthropometry import (
+    ANKLE_HEIGHT_FRACTION,
+    HEEL_BEHIND_ANKLE_FRACTION,
+    WINTER_SEGMENTS,
+)
+
+__all__ = [
+    "SegmentParameters",
+    "read_segments",
+    "write_segments",
+    "segment_parameters_from_anthropometry",
+    "mass_matrix",
+    "coriolis_forces",
+    "gravity_forces",
+    "attachment_jacobian",
+    "attachment_position",
+    "segment_com_positions",
+    "inverse_dynamics",
+    "forward_dynamics",
+    "joint_angles",
+    "segment_coordinates",
+    "generalized_joint_forces",
+    "simulate",
+]
+
+_SEGMENT_COLUMNS = ("mass_kg", "inertia_kg_m2", "length_m", "com_x_m", "com_y_m")
+
+
+def _triple(name: str, value) -> tuple[float, float, float]:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3,):
+        raise LoperInputError(f"{name} must have one value per segment {SEGMENTS}, got shape {arr.shape}")
+    if not np.all(np.isfinite(arr)):
+        raise LoperInputError(f"{name} must be finite, got {arr.tolist()}")
+    return tuple(float(v) for v in arr)
+
+
+@dataclass(frozen=True)
+class SegmentParameters:
+    """Inertial and geometric parameters of the swing-leg model (SI units).
+
+    Per-segment tuples are ordered thigh, shank, foot. COM positions are in the
+    segment frame: origin at the proximal joint, x forward, y up in the neutral
+    pose (so a thigh COM 0.18 m below the hip is ``com_y_m = -0.18``). The
+    distal joint of thigh and shank lies at ``(0, -length_m)``.
+    """
+
+    cart_mass_kg: float
+    mass_kg: tuple[float, float, float]
+    inertia_kg_m2: tuple[float, float, float]
+    length_m: tuple[float, float, float]
+    com_x_m: tuple[float, float, float]
+    com_y_m: tuple[float, float, float]
+    attachment_m: float
+    gravity_m_per_s2: float = GRAVITY_M_PER_S2
+    _packed: np.ndarray = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        for name in _SEGMENT_COLUMNS:
+            object.__setattr__(self, name, _triple(name, getattr(self, name)))
+        for name in ("cart_mass_kg", "attachment_m", "gravity_m_per_s2"):
+            v = float(getattr(self, name))
+            if not np.isfinite(v):
+                raise LoperInputError(f"{name} must be finite, got {v}")
+            object.__setattr__(self, name, v)
+        for name in ("mass_kg", "inertia_kg_m2", "length_m"):
+            vals = getattr(self, name)
+            for seg, v in zip(SEGMENTS, vals):
+                if v <= 0:
+                    raise LoperInputError(f"{name} of the {seg} must be positive, got {v}")
+        if self.cart_mass_kg <= 0:
+            raise LoperInputError(f"cart_mass_kg must be positive, got {self.cart_mass_kg}")
+        if not 0 <= self.attachment_m <= self.length_m[0]:
+            raise LoperInputError(
+                f"attachment_m must lie on the thigh (0 .. {self.length_m[0]} m), got {self.attachment_m}"
+            )
+        if self.gravity_m_per_s2 < 0:
+            raise LoperInputError(f"gravity_m_per_s2 must be >= 0, got {self.gravity_m_per_s2}")
+        packed = np.empty(kernels.N_PACKED)
+        packed[kernels.CART_MASS] = self.cart_mass_kg
+        for i in range(3):
+            packed[kernels.segment_slot(i) : kernels.segment_slot(i) + 5] = [
+                self.mass_kg[i],
+                self.inertia_kg_m2[i],
+                self.length_m[i],
+                self.com_x_m[i],
+                self.com_y_m[i],
+            ]
+        packed[kernels.ATTACHMENT] = self.attachment_m
+        packed[kernels.GRAVITY] = self.gravity_m_per_s2
+        packed.setflags(write=False)
+        object.__setattr__(self, "_packed", packed)
+
+    @property
+    def packed(self) -> np.ndarray:
+        """Parameter vector (18,) in the layout of :mod:`loper_analysis.swing_leg.kernels`."""
+        return self._packed
+
+    @property
+    def leg_mass_kg(self) -> float:
+        return float(sum(self.mass_kg))
+
+    def replace(self, **changes) -> SegmentParameters:
+        """A copy with some fields changed."""
+        values = {k: v for k, v in asdict(self).items() if k != "_packed"}
+        values.update(changes)
+        return SegmentParameters(**values)
+
+    def to_frame(self) -> pd.DataFrame:
+        """Tidy table: one row per segment (cart, thigh, shank, foot)."""
+        rows = [
+            {"segment": "cart", "mass_kg": self.cart_mass_kg}
+            | {c: np.nan for c in _SEGMENT_COLUMNS[1:]}
+            | {"attachment_m": np.nan, "gravity_m_per_s2": self.gravity_m_per_s2}
+        ]
+        for i, seg in enumerate(SEGMENTS):
+            row = {"segment": seg} | {c: getattr(self, c)[i] for c in _SEGMENT_COLUMNS}
+            row["attachment_m"] = self.attachment_m if seg == "thigh" else np.nan
+            row["gravity_m_per_s2"] = np.nan
+            rows.append(row)
+        return pd.DataFrame(rows)
+
+    @classmethod
+    def from_frame(cls, df: pd.DataFrame, source: str = "segment table") -> SegmentParameters:
+        """Parameters from the table of :meth:`to_frame` (rows cart, thigh, shank, foot); ``source`` names it in
+        errors."""
+        need = {"segment", *_SEGMENT_COLUMNS, "attachment_m"}
+        missing = need - set(df.columns)
+        if missing:
+            raise LoperInputError(f"{source}: missing column(s) {sorted(missing)}")
+        df = df.set_index("segment")
+        for seg in ("cart", *SEGMENTS):
+            if seg not in df.index:
+                raise LoperInputError(f"{source}: missing row for segment '{seg}'")
+
+        def number(seg: str, col: str) -> float:
+            raw = df.loc[seg, col]
+            value = pd.to_numeric(pd.Series([raw]), errors="coerce").iloc[0]
+            if pd.isna(value):
+                shown = "an empty cell" if pd.isna(raw) else f"value {raw!r}"
+                raise LoperInputError(f"{source}: column {col}, segment {seg}: {shown} is not a number")
+            return float(value)
+
+        values = {c: tuple(number(seg, c) for seg in SEGMENTS) for c in _SEGMENT_COLUMNS}
+        gravity = GRAVITY_M_PER_S2
+        if "gravity_m_per_s2" in df.columns and pd.notna(df.loc["cart", "gravity_m_per_s2"]):
+            gravity = number("cart", "gravity_m_per_s2")
+        try:
+            return cls(
+                cart_mass_kg=number("cart", "mass_kg"),
+                attachment_m=number("thigh", "attachment_m"),
+                gravity_m_per_s2=gravity,
+                **values,
+            )
+        except LoperInputError as exc:
+            raise LoperInputError(f"{source}: {exc}") from exc
+
+
+def write_segments(params: SegmentParameters, path: str | os.PathLike) -> None:
+    """Write the segment table (:meth:`SegmentParameters.to_frame`) as TSV
+    (:func:`loper_analysis.io.segment_table.write_segment_table`)."""
+    from loper_analysis.io.segment_table import write_segment_table
+
+    write_segment_table(params.to_frame(), path)
+
+
+def read_segments(path: str | os.PathLike) -> SegmentParameters:
+    """The segment table written by :func:`write_segments`."""
+    from loper_analysis.io.segment_table import read_segment_table
+
+    return SegmentParameters.from_frame(read_segment_table(path), source=str(path))
+
+
+def segment_parameters_from_anthropometry(
+    height_m: float, body_mass_kg: float, attachment_fraction: float = 0.8
+) -> SegmentParameters:
+    """Segment parameters from height and body mass with Winter's table (:mod:`loper_analysis.swing_leg.anthropometry`).
+
+    Masses, lengths, COM positions and radii of gyration are the table's
+    fractions of body mass and height; the foot COM lies half a foot length
+    from the heel, the heel :data:`~loper_analysis.swing_leg.anthropometry.HEEL_BEHIND_ANKLE_FRACTION`
+    foot lengths behind the ankle, half the ankle height below the ankle.
+    The cart carries the rest of the body. The brace sits at
+    ``attachment_fraction`` of the thigh length from the hip.
+    """
+    if not 1.0 <= height_m <= 2.5:
+        raise LoperInputError(f"height_m must lie in 1 .. 2.5 m, got {height_m}")
+    if not body_mass_kg > 0:
+        raise LoperInputError(f"body_mass_kg must be positive, got {body_mass_kg}")
+    H, Mb = float(height_m), float(body_mass_kg)
+    thigh, shank, foot = (WINTER_SEGMENTS[s] for s in SEGMENTS)
+    m = (thigh.mass * Mb, shank.mass * Mb, foot.mass * Mb)
+    L = (thigh.length * H, shank.length * H, foot.length * H)
+    k = (thigh.gyration * L[0], shank.gyration * L[1], foot.gyration * L[2])
+    inertia = tuple(mi * ki**2 for mi, ki in zip(m, k))
+    ankle_height = ANKLE_HEIGHT_FRACTION * H
+    com_x = (0.0, 0.0, foot.com * L[2] - HEEL_BEHIND_ANKLE_FRACTION * L[2])
+    com_y = (-thigh.com * L[0], -shank.com * L[1], -0.5 * ankle_height)
+    return SegmentParameters(
+        cart_mass_kg=Mb - sum(m),
+        mass_kg=m,
+        inertia_kg_m2=inertia,
+        length_m=L,
+        com_x_m=com_x,
+        com_y_m=com_y,
+        attachment_m=attachment_fraction * L[0],
+    )
+
+
+# ---------------------------------------------------------------- checks
+
+
+def _same_rows(*arrays: tuple[str, np.ndarray]) -> None:
+    n = arrays[0][1].shape[0]
+    for name, a in arrays[1:]:
+        if a.shape[0] != n:
+            raise LoperInputError(f"{name} has {a.shape[0]} rows, expected {n} like {arrays[0][0]}")
+
+
+def _force(force_n, n: int) -> np.ndarray:
+    if force_n is None:
+        return np.zeros((n, 2))
+    f, _ = finite_rows("force_n", force_n, 2)
+    if f.shape[0] == 1 and n > 1:
+        f = np.repeat(f, n, axis=0)
+    _same_rows(("q", np.empty((n, 0))), ("force_n", f))
+    return f
+
+
+def _out(a: np.ndarray, single: bool) -> np.ndarray:
+    return a[0] if single else a
+
+
+# ---------------------------------------------------------------- terms
+
+
+def mass_matrix(q, params: SegmentParameters) -> np.ndarray:
+    """Mass matrix M(q): (4, 4) for one state or (n, 4, 4); kg and kg m^2 (mixed units)."""
+    q2, single = finite_rows("q", q, 4)
+    M, _, _ = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    return _out(M, single)
+
+
+def coriolis_forces(q, qd, params: SegmentParameters) -> np.ndarray:
+    """C(q, q') (n, 4): velocity-product forces, entering as -C (N, N m)."""
+    q2, single = finite_rows("q", q, 4)
+    qd2, _ = finite_rows("qd", qd, 4)
+    _same_rows(("q", q2), ("qd", qd2))
+    no_gravity = params.packed.copy()
+    no_gravity[kernels.GRAVITY] = 0.0
+    _, h, _ = kernels.terms_batch(q2, qd2, no_gravity)
+    return _out(-h, single)
+
+
+def gravity_forces(q, params: SegmentParameters) -> np.ndarray:
+    """G(q) (n, 4): generalised gravity forces, entering as +G (N, N m)."""
+    q2, single = finite_rows("q", q, 4)
+    _, h, _ = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    return _out(h, single)
+
+
+def attachment_jacobian(q, params: SegmentParameters) -> np.ndarray:
+    """Jacobian of the rod attachment point, (2, 4) or (n, 2, 4) (m/m, m/rad)."""
+    q2, single = finite_rows("q", q, 4)
+    _, _, Ja = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    return _out(Ja, single)
+
+
+def _rot(q: np.ndarray, v: tuple[float, float]) -> np.ndarray:
+    """R(-q) v for an array of angles: (n, 2)."""
+    c, s = np.cos(q), np.sin(q)
+    return np.stack([v[0] * c + v[1] * s, -v[0] * s + v[1] * c], axis=-1)
+
+
+def segment_com_positions(q, params: SegmentParameters) -> np.ndarray:
+    """World positions of the thigh, shank and foot COM, (n, 3, 2) in m (hip at (x, 0))."""
+    q2, single = finite_rows("q", q, 4)
+    base = np.stack([q2[:, 0], np.zeros(len(q2))], axis=-1)
+    out = np.empty((len(q2), 3, 2))
+    for i in range(3):
+        out[:, i] = base + _rot(q2[:, 1 + i], (params.com_x_m[i], params.com_y_m[i]))
+        base = base + _rot(q2[:, 1 + i], (0.0, -params.length_m[i]))
+    return _out(out, single)
+
+
+def attachment_position(q, params: SegmentParameters) -> np.ndarray:
+    """World position (n, 2) of the rod attachment point on the thigh (m)."""
+    q2, single = finite_rows("q", q, 4)
+    pos = np.stack([q2[:, 0], np.zeros(len(q2))], axis=-1) + _rot(q2[:, 1], (0.0, -params.attachment_m))
+    return _out(pos, single)
+
+
+# ---------------------------------------------------------------- dynamics
+
+
+def _checked_terms(q, qd, name: str, values, params: SegmentParameters, force_n):
+    """Checked (n, 4) ``values`` and force (n, 2), the terms M, h, Ja at (q, q'), and whether q was one state."""
+    q2, single = finite_rows("q", q, 4)
+    qd2, _ = finite_rows("qd", qd, 4)
+    v2, _ = finite_rows(name, values, 4)
+    _same_rows(("q", q2), ("qd", qd2), (name, v2))
+    M, h, Ja = kernels.terms_batch(q2, qd2, params.packed)
+    return v2, _force(force_n, len(q2)), M, h, Ja, single
+
+
+def inverse_dynamics(q, qd, qdd, params: SegmentParameters, force_n=None) -> np.ndarray:
+    """Generalised forces u (n, 4) that produce q'' at (q, q') under the external force.
+
+    ``u = M q'' + C - G - Ja^T F``; units N (cart) and N m (segments).
+    """
+    qdd2, F, M, h, Ja, single = _checked_terms(q, qd, "qdd", qdd, params, force_n)
+    u = np.einsum("nij,nj->ni", M, qdd2) - h - np.einsum("nji,nj->ni", Ja, F)
+    return _out(u, single)
+
+
+def forward_dynamics(q, qd, u, params: SegmentParameters, force_n=None) -> np.ndarray:
+    """Accelerations q'' (n, 4) from M q'' = -C + G + u + Ja^T F."""
+    u2, F, M, h, Ja, single = _checked_terms(q, qd, "u", u, params, force_n)
+    rhs = h + u2 + np.einsum("nji,nj->ni", Ja, F)
+    return _out(np.linalg.solve(M, rhs[..., None])[..., 0], single)
+
+
+def joint_angles(q, pelvis_angle_rad) -> np.ndarray:
+    """Hip flexion, knee flexion, ankle dorsiflexion (n, 3) in rad from segment angles."""
+    q2, single = finite_rows("q", q, 4)
+    pel = np.broadcast_to(np.asarray(pelvis_angle_rad, dtype=float), (len(q2),))
+    th = np.stack([pel - q2[:, 1], q2[:, 2] - q2[:, 1], q2[:, 2] - q2[:, 3]], axis=-1)
+    return _out(th, single)
+
+
+def segment_coordinates(joint_angles_rad, pelvis_angle_rad, pelvis_x_m) -> np.ndarray:
+    """Inverse of :func:`joint_angles`: q (n, 4) from joint angles, pelvis angle and cart x."""
+    th, single = finite_rows("joint_angles_rad", joint_angles_rad, 3)
+    n = len(th)
+    pel = np.broadcast_to(np.asarray(pelvis_angle_rad, dtype=float), (n,))
+    x = np.broadcast_to(np.asarray(pelvis_x_m, dtype=float), (n,))
+    thigh = pel - th[:, 0]
+    shank = thigh + th[:, 1]
+    foot = shank - th[:, 2]
+    return _out(np.stack([x, thigh, shank, foot], axis=-1), single)
+
+
+def generalized_joint_forces(torques_nm) -> np.ndarray:
+    """Generalised forces (n, 4) of hip, knee, ankle joint torques (n, 3) in N m."""
+    T, single = finite_rows("torques_nm", torques_nm, 3)
+    u = np.stack([np.zeros(len(T)), -T[:, 0] - T[:, 1], T[:, 1] + T[:, 2], -T[:, 2]], axis=-1)
+    return _out(u, single)
+
+
+def _interp_columns(t: float, time_s: np.ndarray, values: np.ndarray) -> np.ndarray:
+    return np.array([np.interp(t, time_s, values[:, j]) for j in range(values.shape[1])])
+
+
+def simulate(
+    time_s,
+    q0,
+    qd0,
+    params: SegmentParameters,
+    *,
+    u_ff=None,
+    force_n=None,
+    impedance=None,
+    reference_joint_angles_rad=None,
+    reference_joint_velocities_rad_s=None,
+    pelvis_angle_rad=None,
+    pelvis_velocity_rad_s=None,
+    rtol: float = 1e-10,
+    atol: float = 1e-12,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Forward simulation with SciPy's DOP853 (the reference integrator).
+
+    Inputs sampled at ``time_s`` (n,) are linearly interpolated: ``u_ff`` (n, 4),
+    ``force_n`` (n, 2) at the attachment point, pelvis angle and rate (n,).
+    With ``impedance = (K_hip, D_hip, K_knee, D_knee, K_ankle, D_ankle)`` the
+    joints get ``T = -K (theta - theta_ref) - D (theta' - theta_ref')`` with
+    the reference angles/rates (n, 3) (zero when omitted).
+
+    Returns q (n, 4) and q' (n, 4) at ``time_s``.
+    """
+    from scipy.integrate import solve_ivp  # here: scipy.integrate costs ~0.4 s, and fits never integrate with it
+
+    t = np.asarray(time_s, dtype=float)
+    if t.ndim != 1 or len(t) < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise LoperInputError("time_s must be a finite, strictly increasing 1-D array of >= 2 samples")
+    n = len(t)
+    x0, _ = finite_rows("q0", q0, 4)
+    v0, _ = finite_rows("qd0", qd0, 4)
+    uff = np.zeros((n, 4)) if u_ff is None else finite_rows("u_ff", u_ff, 4)[0]
+    F = _force(force_n, n)
+    _same_rows(("time_s", t[:, None]), ("u_ff", uff), ("force_n", F))
+
+    def col(name, value, width):
+        if value is None:
+            return np.zeros((n, width))
+        a = np.asarray(value, dtype=float)
+        a2, _ = finite_rows(name, a.reshape(n, width) if a.ndim == 1 and width == 1 else a, width)
+        _same_rows(("time_s", t[:, None]), (name, a2))
+        return a2
+
+    pel = col("pelvis_angle_rad", pelvis_angle_rad, 1)
+    peld = col("pelvis_velocity_rad_s", pelvis_velocity_rad_s, 1)
+    th_ref = col("reference_joint_angles_rad", reference_joint_angles_rad, 3)
+    thd_ref = col("reference_joint_velocities_rad_s", reference_joint_velocities_rad_s, 3)
+    if impedance is not None:
+        p = np.asarray(impedance, dtype=float)
+        if p.shape != (6,) or not np.all(np.isfinite(p)):
+            raise LoperInputError(f"impedance must be 6 finite values (K, D per joint), got {p}")
+    packed = params.packed
+    M = np.empty((4, 4))
+    h = np.empty(4)
+    Ja = np.empty((2, 4))
+    inputs = np.hstack([uff, F, pel, peld, th_ref, thd_ref])
+
+    def rhs(time, y):
+        q, qd = y[:4], y[4:]
+        z = _interp_columns(time, t, inputs)
+        kernels.terms(q, qd, packed, M, h, Ja)
+        r = h + z[:4] + Ja.T @ z[4:6]
+        if impedance is not None:
+            pel_t, peld_t = z[6], z[7]
+            th = np.array([pel_t - q[1], q[2] - q[1], q[2] - q[3]])
+            thd = np.array([peld_t - qd[1], qd[2] - qd[1], qd[2] - qd[3]])
+            T = -p[0::2] * (th - z[8:11]) - p[1::2] * (thd - z[11:14])
+            r = r + generalized_joint_forces(T)
+        return np.concatenate([qd, np.linalg.solve(M, r)])
+
+    # integrate sample to sample so the kinks of the interpolated inputs are honoured
+    y = np.concatenate([x0[0], v0[0]])
+    out = np.empty((n, 8))
+    out[0] = y
+    for k in range(n - 1):
+        sol = solve_ivp(rhs, (t[k], t[k + 1]), y, method="DOP853", rtol=rtol, atol=atol)
+        if not sol.success:
+            raise RuntimeError(f"forward simulation failed at t = {t[k]} s: {sol.message}")
+        y = sol.y[:, -1]
+        out[k + 1] = y
+    return out[:, :4], out[:, 4:]
