@@ -39,6 +39,7 @@ __all__ = [
     "CONTACT_FLAGS",
     "PHASES",
     "LAB_Z_UP",
+    "LAB_TO_MODEL_ROTATION_DEG",
     "GRAVITY_M_PER_S2",
     "MIN_IK_MARKERS",
     "TRIAL_KINDS",
@@ -74,6 +75,9 @@ GRAVITY_M_PER_S2: float = 9.81
 #: Up direction of a Z-up lab (Qualisys, Vicon; what ezc3d assumes), lab frame:
 #: :func:`loper_analysis.motion.markers.lab_up` of ``(-90, 0, 0)``.
 LAB_Z_UP: tuple[float, float, float] = (0.0, 0.0, 1.0)
+#: Lab -> model rotation (degrees about the fixed X, Y, Z axes) of a Z-up lab: Qualisys Z-up -> OpenSim Y-up
+#: (config ``markers.lab_to_model_rotation_deg``).
+LAB_TO_MODEL_ROTATION_DEG: tuple[float, float, float] = (-90.0, 0.0, 0.0)
 #: Fewest weighted markers present in a frame for IK to solve it (three fix one rigid body).
 MIN_IK_MARKERS: int = 3
 #: Kinds of trial, as label maps and spans are keyed (besides the trial's own name).

@@ -19,7 +19,20 @@ from dataclasses import dataclass
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["DEVICE_TESTS", "TRANSPARENCY_CONDITIONS", "TRIAL_CONDITIONS", "StudyDesign", "perturbation_trial_name"]
+__all__ = [
+    "DEVICE_TESTS",
+    "PERTURBED_SIDE",
+    "SEED",
+    "TRANSPARENCY_CONDITIONS",
+    "TRIAL_CONDITIONS",
+    "StudyDesign",
+    "perturbation_trial_name",
+]
+
+#: The leg the robot perturbs, whose swing is identified (config ``trials.perturbed_side``).
+PERTURBED_SIDE: str = "left"
+#: The study's random seed, from which every random number of the pipeline derives (config ``seed``).
+SEED: int = 2024
 
 #: Trials of the device tests (frequency response and steps), recorded by the device subject.
 DEVICE_TESTS: tuple[str, ...] = ("device-frf", "device-steps")
@@ -61,7 +74,7 @@ class StudyDesign:
     device: str = "walk-device"
     perturbation_onsets_ms: tuple[int, ...] = (50, 175, 300)
     perturbation_repeats: int = 2
-    perturbed_side: str = "left"
+    perturbed_side: str = PERTURBED_SIDE
 
     @classmethod
     def from_config(cls, trials: Mapping) -> StudyDesign:

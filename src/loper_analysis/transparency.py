@@ -309,7 +309,8 @@ def _kept(strides: pd.DataFrame) -> int:
 
 
 def _flagged_rows(subject: str, counts: Mapping[str, int], joints: Sequence[str]) -> list[dict]:
-    """Rows of a subject left out of the comparison: the stride counts, the metrics empty."""
+    """Rows with the stride counts and empty metrics: of a subject left out of the comparison, or of the
+    group (``all``) when no subject is left to compare."""
     return [
         {
             "subject": str(subject),
@@ -427,22 +428,7 @@ def _results_without(
         rmsd, force = part.rmsd, part.force
     else:
         part = TransparencyResults(pd.DataFrame(columns=list(TRANSPARENCY_COLUMNS)), pd.DataFrame(), {}, None, {})
-        group = [
-            {
-                "subject": "all",
-                "phase": ph,
-                "joint": j,
-                "n_strides_no_device": 0,
-                "n_strides_device": 0,
-                "rmsd_rad": np.nan,
-                "sd_rad": np.nan,
-                "isv_ave_rad": np.nan,
-                "transparent": None,
-            }
-            for ph in TRANSPARENCY_PHASES
-            for j in JOINTS
-        ]
-        rmsd = pd.DataFrame(group)
+        rmsd = pd.DataFrame(_flagged_rows("all", {"no_device": 0, "device": 0}, JOINTS))
         study = pd.DataFrame(
             [
                 {"phase": ph, "joint": j, "study_rmsd_rad": r, "study_isv_ave_rad": isv}

@@ -27,11 +27,35 @@ __all__ = [
     "step_averages",
     "step_table",
     "device_summary",
+    "WELCH_WINDOW_SAMPLES",
+    "WELCH_OVERLAP_SAMPLES",
+    "BANDWIDTH_REFERENCE_BAND_HZ",
+    "STEP_BEFORE_S",
+    "STEP_AFTER_S",
+    "STEADY_WINDOW_S",
 ]
+
+# Defaults of the device tests' analysis (config ``device.analysis.*``, the same values).
+#: Samples of the Hann window of Welch's method (``welch_window_samples``) ...
+WELCH_WINDOW_SAMPLES: int = 5000
+#: ... and of the windows' overlap (``welch_overlap_samples``).
+WELCH_OVERLAP_SAMPLES: int = 50
+#: Band (Hz) whose mean gain is the reference of the -3 dB bandwidth (``bandwidth_reference_band_hz``).
+BANDWIDTH_REFERENCE_BAND_HZ: tuple[float, float] = (0.5, 2.0)
+#: A step's average runs from this long before its onset (s; ``step_before_s``) ...
+STEP_BEFORE_S: float = 0.05
+#: ... to this long after it (s; ``step_after_s``).
+STEP_AFTER_S: float = 0.45
+#: Span after the onset (s) whose mean is the step's steady state (``steady_window_s``).
+STEADY_WINDOW_S: tuple[float, float] = (0.15, 0.3)
 
 
 def frequency_response(
-    desired_n, measured_n, sample_rate_hz: float, window_samples: int = 5000, overlap_samples: int = 50
+    desired_n,
+    measured_n,
+    sample_rate_hz: float,
+    window_samples: int = WELCH_WINDOW_SAMPLES,
+    overlap_samples: int = WELCH_OVERLAP_SAMPLES,
 ) -> pd.DataFrame:
     """FRF from desired to measured force: columns frequency_hz, gain (N/N), phase_deg, coherence."""
     fs = positive("sample_rate_hz", sample_rate_hz)
@@ -63,7 +87,7 @@ def frequency_response(
 def bandwidth_hz(
     frequency_hz,
     gain,
-    reference_band_hz: tuple[float, float] = (0.5, 2.0),
+    reference_band_hz: tuple[float, float] = BANDWIDTH_REFERENCE_BAND_HZ,
     drop_db: float = 3.0,
     min_coherence: float | None = None,
     coherence=None,
@@ -115,7 +139,7 @@ def step_onsets(desired_n, sample_rate_hz: float, min_step_n: float = 5.0, min_i
 
 
 def average_step(
-    desired_n, measured_n, sample_rate_hz: float, onsets, before_s: float = 0.05, after_s: float = 0.3
+    desired_n, measured_n, sample_rate_hz: float, onsets, before_s: float = STEP_BEFORE_S, after_s: float = STEP_AFTER_S
 ) -> pd.DataFrame:
     """Mean (and SD) over repetitions of the responses around ``onsets`` (baseline removed)."""
     fs = positive("sample_rate_hz", sample_rate_hz)
@@ -159,7 +183,7 @@ def _first_crossing(t: np.ndarray, y: np.ndarray, level: float) -> float:
     return float(t[i - 1] + (level - y[i - 1]) * (t[i] - t[i - 1]) / (y[i] - y[i - 1]))
 
 
-def step_metrics(time_s, response_n, target_n: float, steady_window_s: tuple[float, float] = (0.15, 0.3)) -> dict:
+def step_metrics(time_s, response_n, target_n: float, steady_window_s: tuple[float, float] = STEADY_WINDOW_S) -> dict:
     """Rise time (10-90 % of steady state, ms), overshoot (%), steady state, peak of one step response."""
     t = finite_vector("time_s", time_s)
     y = finite_vector("response_n", response_n)
@@ -191,8 +215,8 @@ def step_averages(
     measured_n,
     sample_rate_hz: float,
     amplitudes_n: tuple[float, ...] = (20.0, 40.0, 60.0),
-    before_s: float = 0.05,
-    after_s: float = 0.3,
+    before_s: float = STEP_BEFORE_S,
+    after_s: float = STEP_AFTER_S,
     min_step_n: float = 5.0,
 ) -> pd.DataFrame:
     """Averaged step responses per amplitude (columns of :func:`average_step` plus
@@ -220,7 +244,7 @@ def step_averages(
     return pd.concat(frames, ignore_index=True)
 
 
-def step_table(averages: pd.DataFrame, steady_window_s: tuple[float, float] = (0.15, 0.3)) -> pd.DataFrame:
+def step_table(averages: pd.DataFrame, steady_window_s: tuple[float, float] = STEADY_WINDOW_S) -> pd.DataFrame:
     """Step metrics (:func:`step_metrics`) of the averaged responses of :func:`step_averages`, one row per amplitude.
 
     Columns amplitude_n, n_repetitions, rise_time_ms, overshoot_pct, steady_state_n, peak_n.
@@ -241,7 +265,9 @@ def step_table(averages: pd.DataFrame, steady_window_s: tuple[float, float] = (0
     return pd.DataFrame(rows)
 
 
-def device_summary(frf: pd.DataFrame, steps: pd.DataFrame, reference_band_hz=(0.5, 2.0)) -> pd.DataFrame:
+def device_summary(
+    frf: pd.DataFrame, steps: pd.DataFrame, reference_band_hz=BANDWIDTH_REFERENCE_BAND_HZ
+) -> pd.DataFrame:
     """Simulated (or recorded) device figures beside the study's.
 
     ``frf`` from :func:`frequency_response`, ``steps`` from :func:`step_table`.

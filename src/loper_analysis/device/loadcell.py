@@ -28,7 +28,7 @@ from loper_analysis.checks import positive
 from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.filtering import lowpass
+from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
 
 __all__ = [
     "OUTPUT_COLUMNS",
@@ -55,20 +55,12 @@ _FLAG_MARGIN_S = 0.1
 
 
 def robot_log_on_mocap_frames(
-    log: pd.DataFrame,
-    log_rate_hz: float,
-    mocap_sync_v,
-    analog_rate_hz: float,
-    frame_time_s,
-    cutoff_hz: float = 40.0,
-    order: int = 4,
-    source: str = "",
-    analog_start_s: float | None = None,
-    max_drift: float = 1e-3,
-    tolerance_s: float = 3e-3,
-    sync_channel: str = "",
+    log: pd.DataFrame, log_rate_hz: float, mocap_sync_v, analog_rate_hz: float, frame_time_s, **options
 ) -> pd.DataFrame:
     """The robot log's forces and perturbation flag on the motion-capture frames.
+
+    ``options`` are the keyword settings of :func:`robot_log_frames_and_native` (``cutoff_hz``, ``order``,
+    ``source``, ``analog_start_s``, ``max_drift``, ``tolerance_s``, ``sync_channel``), described below.
 
     1. Clock map (:func:`loper_analysis.device.clock_sync.clock_map`) from the rising edges of the log's
        ``sync_v`` (robot clock: ``time_s`` at the interpolated sample index)
@@ -138,20 +130,7 @@ def robot_log_on_mocap_frames(
         pulses whose high times disagree between the records, e.g. an inverted robot sync), no frame
         inside the log's span, force pulses without perturbation flags (:func:`check_perturbation_flags`).
     """
-    return robot_log_frames_and_native(
-        log,
-        log_rate_hz,
-        mocap_sync_v,
-        analog_rate_hz,
-        frame_time_s,
-        cutoff_hz,
-        order,
-        source,
-        analog_start_s,
-        max_drift,
-        tolerance_s,
-        sync_channel,
-    )[0]
+    return robot_log_frames_and_native(log, log_rate_hz, mocap_sync_v, analog_rate_hz, frame_time_s, **options)[0]
 
 
 def robot_log_frames_and_native(
@@ -160,8 +139,8 @@ def robot_log_frames_and_native(
     mocap_sync_v,
     analog_rate_hz: float,
     frame_time_s,
-    cutoff_hz: float = 40.0,
-    order: int = 4,
+    cutoff_hz: float = CUTOFF_HZ,
+    order: int = ORDER,
     source: str = "",
     analog_start_s: float | None = None,
     max_drift: float = 1e-3,

@@ -25,7 +25,14 @@ from loper_analysis.checks import integer, number, time_vector, where
 from loper_analysis.checks import side as check_side
 from loper_analysis.constants import CONTACT_FLAGS, FLAGGED_EVENTS, SIDES
 from loper_analysis.errors import LoperInputError
-from loper_analysis.gait.events import EVENT_COLUMNS, load_transitions
+from loper_analysis.gait.events import (
+    EVENT_COLUMNS,
+    MIN_STANCE_S,
+    MIN_SWING_S,
+    THRESHOLD_OFF_N,
+    THRESHOLD_ON_N,
+    load_transitions,
+)
 from loper_analysis.gait.plate_geometry import plate_axes, plate_offsets
 
 __all__ = [
@@ -85,10 +92,10 @@ class PlateForce:
 def plate_contacts(
     time_s,
     vertical_force_n,
-    threshold_on_n: float = 50.0,
-    threshold_off_n: float = 20.0,
-    min_stance_s: float = 0.2,
-    min_swing_s: float = 0.2,
+    threshold_on_n: float = THRESHOLD_ON_N,
+    threshold_off_n: float = THRESHOLD_OFF_N,
+    min_stance_s: float = MIN_STANCE_S,
+    min_swing_s: float = MIN_SWING_S,
     source: str = "",
 ) -> pd.DataFrame:
     """Loaded periods (contacts) of one plate from its vertical force above the resting level.
@@ -193,10 +200,10 @@ def foot_contacts(
     marker_time_s,
     heels_m: Mapping[str, np.ndarray],
     plate_sides: Mapping[str, int] | None = None,
-    threshold_on_n: float = 50.0,
-    threshold_off_n: float = 20.0,
-    min_stance_s: float = 0.2,
-    min_swing_s: float = 0.2,
+    threshold_on_n: float = THRESHOLD_ON_N,
+    threshold_off_n: float = THRESHOLD_OFF_N,
+    min_stance_s: float = MIN_STANCE_S,
+    min_swing_s: float = MIN_SWING_S,
     delay_s: float = 0.05,
     dwell_s: float = 0.15,
     margin_m: float = 0.03,

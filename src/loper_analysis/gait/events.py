@@ -38,6 +38,14 @@ logger = logging.getLogger(__name__)
 
 #: Columns of the event table.
 EVENT_COLUMNS: tuple[str, ...] = ("side", "event", "time_s", "sample")
+#: Heel strike: the vertical force rises through this (N; config ``events.threshold_on_n``) ...
+THRESHOLD_ON_N: float = 50.0
+#: ... toe-off: it falls through this (N; ``events.threshold_off_n``): a hysteresis.
+THRESHOLD_OFF_N: float = 20.0
+#: Shorter stances (s; ``events.min_stance_s``) ...
+MIN_STANCE_S: float = 0.2
+#: ... and swings (s; ``events.min_swing_s``) are noise.
+MIN_SWING_S: float = 0.2
 #: Columns of :func:`stance_heels`.
 STANCE_HEEL_COLUMNS: tuple[str, ...] = ("side", "heel_strike_s", "toe_off_s", "own_heel_lower_m", "own_heel_lower")
 _HS, _TO = 1, 0  # state codes: 1 = loaded (stance), 0 = unloaded (swing)
@@ -87,10 +95,10 @@ def _drop_short_periods(
 def load_transitions(
     time_s,
     vertical_force_n,
-    threshold_on_n: float = 50.0,
-    threshold_off_n: float = 20.0,
-    min_stance_s: float = 0.2,
-    min_swing_s: float = 0.2,
+    threshold_on_n: float = THRESHOLD_ON_N,
+    threshold_off_n: float = THRESHOLD_OFF_N,
+    min_stance_s: float = MIN_STANCE_S,
+    min_swing_s: float = MIN_SWING_S,
     source: str = "",
 ) -> tuple[np.ndarray, np.ndarray, list[dict]]:
     """Loading and unloading samples of one vertical force: the hysteresis of :func:`gait_events`.
@@ -160,10 +168,10 @@ def gait_events(
     time_s,
     vertical_force_n,
     side: str,
-    threshold_on_n: float = 50.0,
-    threshold_off_n: float = 20.0,
-    min_stance_s: float = 0.2,
-    min_swing_s: float = 0.2,
+    threshold_on_n: float = THRESHOLD_ON_N,
+    threshold_off_n: float = THRESHOLD_OFF_N,
+    min_stance_s: float = MIN_STANCE_S,
+    min_swing_s: float = MIN_SWING_S,
     source: str = "",
 ) -> pd.DataFrame:
     """Heel strikes and toe-offs from one belt's vertical ground-reaction force.

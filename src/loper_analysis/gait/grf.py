@@ -85,6 +85,13 @@ __all__ = [
     "vertical_loads",
 ]
 
+#: A plate is loaded above this vertical force over its resting level (N; config ``grf.loaded_threshold_n``).
+LOADED_THRESHOLD_N: float = 20.0
+#: Samples within this of a plate's lowest vertical force are unloaded (N; config ``grf.resting_band_n``) ...
+RESTING_BAND_N: float = 10.0
+#: ... and their median, the resting level, must lie within +- this (N; ``grf.max_resting_n``).
+MAX_RESTING_N: float = 100.0
+
 #: Column suffixes of one plate in the external-loads table (force N, point m, torque N·m).
 EXTERNAL_LOADS_SUFFIXES: tuple[str, ...] = (
     "ground_force_vx",
@@ -283,8 +290,8 @@ def surface_normal(corners_m, source: str = "", up: Sequence[float] = LAB_Z_UP) 
 def resting_level(
     force_n,
     moment_nm,
-    band_n: float = 10.0,
-    max_rest_n: float = 100.0,
+    band_n: float = RESTING_BAND_N,
+    max_rest_n: float = MAX_RESTING_N,
     source: str = "",
     up: Sequence[float] = LAB_Z_UP,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -387,9 +394,9 @@ def plate_loads(
     force_n,
     moment_nm,
     corners_m,
-    threshold_n: float = 20.0,
-    band_n: float = 10.0,
-    max_rest_n: float = 100.0,
+    threshold_n: float = LOADED_THRESHOLD_N,
+    band_n: float = RESTING_BAND_N,
+    max_rest_n: float = MAX_RESTING_N,
     source: str = "",
     up: Sequence[float] = LAB_Z_UP,
 ) -> PlateLoads:
@@ -574,8 +581,8 @@ def read_plate_loads(
 def plate_vertical_loads(
     c3d_path: str | os.PathLike,
     rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
-    band_n: float = 10.0,
-    max_rest_n: float = 100.0,
+    band_n: float = RESTING_BAND_N,
+    max_rest_n: float = MAX_RESTING_N,
     up: Sequence[float] | None = None,
 ) -> VerticalLoads:
     """Each plate of a C3D file: its lab-vertical force above its resting level at the analog rate, corners in the

@@ -22,6 +22,9 @@ from loper_analysis.errors import LoperInputError
 
 __all__ = ["PHASE_BOUNDS", "cut", "normalise", "window_times_s", "window"]
 
+#: Samples of a time-normalised stride, stance or swing (config ``strides.n_points``).
+N_POINTS: int = 101
+
 #: Stride-table columns bounding each phase.
 PHASE_BOUNDS: dict[str, tuple[str, str]] = {
     "stride": ("heel_strike_s", "end_s"),
@@ -64,7 +67,7 @@ def _interpolate(t: np.ndarray, v: np.ndarray, targets: np.ndarray, source: str)
     return out.reshape((n_windows, n_points) + v.shape[1:])
 
 
-def cut(time_s, values, starts_s, ends_s, n_points: int = 101, source: str = "") -> np.ndarray:
+def cut(time_s, values, starts_s, ends_s, n_points: int = N_POINTS, source: str = "") -> np.ndarray:
     """Time-normalise windows of a signal by linear interpolation.
 
     Window ``i`` is resampled onto ``n_points`` equally spaced times from
@@ -118,7 +121,7 @@ def cut(time_s, values, starts_s, ends_s, n_points: int = 101, source: str = "")
 
 
 def normalise(
-    time_s, values, stride_table: pd.DataFrame, phase: str = "stride", n_points: int = 101, source: str = ""
+    time_s, values, stride_table: pd.DataFrame, phase: str = "stride", n_points: int = N_POINTS, source: str = ""
 ) -> np.ndarray:
     """:func:`cut` over the strides of a stride table for one phase.
 

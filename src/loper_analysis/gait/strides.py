@@ -35,7 +35,7 @@ from loper_analysis.gait.outliers import (
     check_enough_strides,
     iqr_outliers,
 )
-from loper_analysis.gait.resampling import PHASE_BOUNDS, normalise
+from loper_analysis.gait.resampling import N_POINTS, PHASE_BOUNDS, normalise
 
 __all__ = [
     "STRIDE_COLUMNS",
@@ -271,7 +271,7 @@ def stride_tables(
     events: pd.DataFrame,
     force: pd.DataFrame | None = None,
     side: str = "left",
-    n_points: int = 101,
+    n_points: int = N_POINTS,
     whisker: float = IQR_WHISKER,
     max_fraction: float = MAX_OUTLIER_FRACTION,
     min_valid: int = MIN_VALID_STRIDES,

@@ -35,6 +35,7 @@ from loper_analysis.identification.fit import (
     MERGE_TOLERANCE,
     N_STARTS,
     STIFFNESS_BOUNDS_NM_PER_RAD,
+    FitBounds,
     ImpedanceFit,
     identify_impedance,
     parameter_bounds,
@@ -44,9 +45,11 @@ from loper_analysis.identification.fit import (
 )
 from loper_analysis.identification.intervals import CI_LEVEL, bounded_interval, t_quantile
 from loper_analysis.identification.null_pairs import (
+    INTERVAL_SCATTERS,
     MIN_NULL_PAIRS,
     NULL_PAIR_COMPONENTS,
     NullPairFit,
+    check_interval_scatter,
     cross_validated_covariance,
     nuisance_projection,
     null_pair_errors,
@@ -75,6 +78,7 @@ from loper_analysis.identification.window import (
     stage_force_means,
     stage_times_s,
     step_stage_forces,
+    window_options,
 )
 
 __all__ = [
@@ -96,8 +100,12 @@ __all__ = [
     "PreparedWindow",
     "ImpedanceFit",
     "parameter_bounds",
+    "FitBounds",
     "NullPairFit",
+    "INTERVAL_SCATTERS",
+    "check_interval_scatter",
     "prepare_window",
+    "window_options",
     "per_step",
     "stage_times_s",
     "stage_force_means",

@@ -47,6 +47,7 @@ __all__ = [
     "ImpedanceFit",
     "check_bounds",
     "parameter_bounds",
+    "FitBounds",
     "ResidualBatch",
     "initial_state_jacobian",
     "multistart_lm",
@@ -136,6 +137,26 @@ def parameter_bounds(stiffness_bounds, damping_bounds) -> tuple[np.ndarray, np.n
     (N·m/rad) and one for every D (N·m·s/rad)."""
     k, d = tuple(stiffness_bounds), tuple(damping_bounds)
     return np.array([k[0], d[0]] * 3, float), np.array([k[1], d[1]] * 3, float)
+
+
+class FitBounds:
+    """Base of a settings dataclass that holds the fit's bounds: its K and D bound vectors.
+
+    The subclass has the fields ``stiffness_bounds_nm_per_rad`` (low, high; N·m/rad, every K) and
+    ``damping_bounds_nms_per_rad`` (low, high; N·m·s/rad, every D); :attr:`lower` and :attr:`upper` are
+    the bounds (6,) in the order of :data:`PARAMETERS` (:func:`parameter_bounds`).
+    """
+
+    stiffness_bounds_nm_per_rad: tuple[float, float]
+    damping_bounds_nms_per_rad: tuple[float, float]
+
+    @property
+    def lower(self) -> np.ndarray:
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
+
+    @property
+    def upper(self) -> np.ndarray:
+        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
 
 
 def check_bounds(lower, upper) -> tuple[np.ndarray, np.ndarray]:

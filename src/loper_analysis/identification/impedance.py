@@ -45,10 +45,11 @@ from loper_analysis.identification import (
     N_SUBSTEPS,
     NULL_PAIR_COMPONENTS,
     STIFFNESS_BOUNDS_NM_PER_RAD,
+    FitBounds,
     ImpedanceFit,
+    check_interval_scatter,
     identify_impedance,
     joint_status,
-    parameter_bounds,
     prepare_window,
     refit_with_null_pairs,
 )
@@ -80,7 +81,7 @@ __all__ = [
 
 _K, _D = parameter_column("K"), parameter_column("D")
 
-#: Columns of ``results/impedance/{subject}/{onset}.tsv`` and ``results/tables/impedance.tsv``.
+#: Columns of ``results/impedance/{subject}/{onset}.tsv`` and ``results/impedance/impedance.tsv``.
 IMPEDANCE_COLUMNS: tuple[str, ...] = (
     "subject",
     "onset_ms",
@@ -113,7 +114,7 @@ TRUTH_TOLERANCE: dict[str, tuple[float, float]] = {"K": (0.10, 2.0), "D": (0.15,
 
 
 @dataclass(frozen=True)
-class IdentificationSettings:
+class IdentificationSettings(FitBounds):
     """How K and D are fitted and judged (config ``identification``; bounds in N·m/rad and N·m·s/rad).
 
     ``min_vaf_pct``: a joint whose VAF (%) is below it is ``failed``;
@@ -149,19 +150,7 @@ class IdentificationSettings:
             raise LoperInputError(
                 f"identification.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}"
             )
-        if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
-            raise LoperInputError(
-                "identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
-                f"got {self.interval_scatter!r}"
-            )
-
-    @property
-    def lower(self) -> np.ndarray:
-        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
-
-    @property
-    def upper(self) -> np.ndarray:
-        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
+        check_interval_scatter(self.interval_scatter)
 
     def fit_options(self) -> dict:
         """Keyword arguments of :func:`loper_analysis.identification.identify_impedance`."""

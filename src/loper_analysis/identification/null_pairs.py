@@ -36,6 +36,8 @@ from loper_analysis.swing_leg.dynamics import joint_angles
 __all__ = [
     "NULL_PAIR_COMPONENTS",
     "MIN_NULL_PAIRS",
+    "INTERVAL_SCATTERS",
+    "check_interval_scatter",
     "NullPairFit",
     "null_pair_errors",
     "nuisance_projection",
@@ -47,6 +49,18 @@ __all__ = [
 NULL_PAIR_COMPONENTS: int = 6
 #: Fewer null pairs: the white fit stands (``identification.min_null_pairs``).
 MIN_NULL_PAIRS: int = 30
+#: Whose scatter gives the refit's 95 % intervals (``identification.interval_scatter``): the perturbed pairs
+#: averaged in the window, or the null pairs (:func:`refit_with_null_pairs`).
+INTERVAL_SCATTERS: tuple[str, ...] = ("perturbed_pairs", "null_pairs")
+
+
+def check_interval_scatter(value: str) -> str:
+    """``value`` when it is one of :data:`INTERVAL_SCATTERS`, else a LoperInputError naming the config key."""
+    if value not in INTERVAL_SCATTERS:
+        raise LoperInputError(
+            f"identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', got {value!r}"
+        )
+    return value
 
 
 @dataclass

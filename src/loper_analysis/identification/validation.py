@@ -41,8 +41,10 @@ from loper_analysis.identification import (
     prepare_window,
     simulate_deviation,
     stage_times_s,
+    window_options,
 )
 from loper_analysis.reference import STUDY_DEVICE, STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
+from loper_analysis.study_design import SEED
 from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
 
 __all__ = [
@@ -92,7 +94,7 @@ class ValidationSettings:
     reference_cutoff_hz: float | None = None
     initial_state_span_s: float = INITIAL_STATE_SPAN_S
     initial_state_degree: int = INITIAL_STATE_DEGREE
-    seed: int = 2024
+    seed: int = SEED
     lower: tuple[float, ...] = tuple(DEFAULT_LOWER)
     upper: tuple[float, ...] = tuple(DEFAULT_UPPER)
 
@@ -335,13 +337,9 @@ def validation_window(
         force_time_s=t_force,
         pelvis_angle_unperturbed_rad=pelvis,
         pelvis_angle_perturbed_rad=pelvis,
-        window_before_s=settings.window_before_s,
-        window_after_s=settings.window_after_s,
-        n_substeps=settings.n_substeps,
         q_reference=qu,
         reference_cutoff_hz=settings.reference_cutoff_hz,
-        initial_state_span_s=settings.initial_state_span_s,
-        initial_state_degree=settings.initial_state_degree,
+        **window_options(settings),
     )
     kwargs.update(overrides)
     return prepare_window(

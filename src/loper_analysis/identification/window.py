@@ -24,6 +24,8 @@ from loper_analysis.swing_leg import kernels
 from loper_analysis.swing_leg.dynamics import SegmentParameters, inverse_dynamics, joint_angles
 
 __all__ = [
+    "WINDOW_FIELDS",
+    "window_options",
     "WINDOW_BEFORE_S",
     "WINDOW_AFTER_S",
     "INITIAL_STATE_SPAN_S",
@@ -116,6 +118,22 @@ def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.nd
     return a2
 
 
+#: Fields of a settings object (:class:`~loper_analysis.identification.validation.ValidationSettings`,
+#: :class:`~loper_analysis.planning.precision.PlanSettings`) that :func:`prepare_window` takes by name.
+WINDOW_FIELDS: tuple[str, ...] = (
+    "window_before_s",
+    "window_after_s",
+    "n_substeps",
+    "initial_state_span_s",
+    "initial_state_degree",
+)
+
+
+def window_options(settings) -> dict:
+    """:func:`prepare_window`'s window keywords (:data:`WINDOW_FIELDS`) from a settings object holding them."""
+    return {name: getattr(settings, name) for name in WINDOW_FIELDS}
+
+
 def prepare_window(
     time_s,
     q_unperturbed,
@@ -179,11 +197,7 @@ def prepare_window(
         Non-finite or wrongly shaped inputs, non-uniform time, a window
         outside the data, forces at their own rate that do not cover the window.
     """
-    t = np.asarray(time_s, dtype=float)
-    if t.ndim != 1 or len(t) < 4:
-        raise LoperInputError(f"time_s must be 1-D with >= 4 samples, got shape {t.shape}")
-    if not np.all(np.isfinite(t)):
-        raise LoperInputError(f"time_s is not finite at sample {int(np.argmax(~np.isfinite(t)))}")
+    t = _finite_times("time_s", time_s, 4)
     dts = np.diff(t)
     dt = float(np.mean(dts))
     if dt <= 0 or np.max(np.abs(dts - dt)) > 1e-6 * dt:
@@ -364,12 +378,18 @@ def step_stage_forces(
     return F
 
 
+def _finite_times(name: str, value, min_samples: int) -> np.ndarray:
+    """Sample times (s) as a 1-D float array of at least ``min_samples`` finite values; ``name`` in messages."""
+    t = np.asarray(value, dtype=float)
+    if t.ndim != 1 or len(t) < min_samples:
+        raise LoperInputError(f"{name} must be 1-D with >= {min_samples} samples, got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise LoperInputError(f"{name} is not finite at sample {int(np.argmax(~np.isfinite(t)))}")
+    return t
+
+
 def _force_clock(force_time_s) -> np.ndarray:
-    tf = np.asarray(force_time_s, dtype=float)
-    if tf.ndim != 1 or len(tf) < 2:
-        raise LoperInputError(f"force_time_s must be 1-D with >= 2 samples, got shape {tf.shape}")
-    if not np.all(np.isfinite(tf)):
-        raise LoperInputError(f"force_time_s is not finite at sample {int(np.argmax(~np.isfinite(tf)))}")
+    tf = _finite_times("force_time_s", force_time_s, 2)
     d = np.diff(tf)
     if np.any(d <= 0):
         i = int(np.argmax(d <= 0))

@@ -39,15 +39,7 @@ def read_model(path: str | os.PathLike):
         The file is missing, is not XML, holds no ``<Model>``, or OpenSim
         cannot read it (OpenSim's message is quoted). The message names the file.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise LoperInputError(f"model file not found: {path}")
-    _require_element(path, "Model", "model")
-    osim = quiet_opensim()
-    try:
-        return osim.Model(str(path))
-    except Exception as exc:  # OpenSim raises its own exception types for unreadable models
-        raise LoperInputError(f"{path}: OpenSim cannot read this model ({exc})") from exc
+    return _read_object(path, "Model", "model file", "model", element="Model")
 
 
 def model_source(model) -> str:
@@ -61,6 +53,24 @@ def model_source(model) -> str:
     if path and path != "Unassigned":
         return f"{path} (model {name})"
     return f"model {name}"
+
+
+def _read_object(path: str | os.PathLike, kind: str, file_name: str, what: str, element: str | None = None):
+    """``opensim.<kind>`` read from ``path``, with every failure a LoperInputError naming the file.
+
+    ``file_name`` names a missing file (``model file not found: <path>``), ``what`` the object in the other
+    messages; with ``element`` the file must be XML holding that element (:func:`_require_element`) first.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LoperInputError(f"{file_name} not found: {path}")
+    if element is not None:
+        _require_element(path, element, what)
+    osim = quiet_opensim()
+    try:
+        return getattr(osim, kind)(str(path))
+    except Exception as exc:  # OpenSim raises its own exception types for unreadable files
+        raise LoperInputError(f"{path}: OpenSim cannot read this {what} ({exc})") from exc
 
 
 def _require_element(path: Path, element: str, what: str) -> None:
@@ -94,15 +104,7 @@ def read_scale_setup(path: str | os.PathLike):
         The file is missing, is not XML, is not a ScaleTool setup, or OpenSim
         cannot read it.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise LoperInputError(f"scale setup file not found: {path}")
-    _require_element(path, "ScaleTool", "ScaleTool setup")
-    osim = quiet_opensim()
-    try:
-        return osim.ScaleTool(str(path))
-    except Exception as exc:  # OpenSim raises its own exception types
-        raise LoperInputError(f"{path}: OpenSim cannot read this ScaleTool setup ({exc})") from exc
+    return _read_object(path, "ScaleTool", "scale setup file", "ScaleTool setup", element="ScaleTool")
 
 
 @timed_io
@@ -114,11 +116,4 @@ def read_marker_set(path: str | os.PathLike):
     LoperInputError
         The file is missing or OpenSim cannot read it.
     """
-    path = Path(path)
-    if not path.is_file():
-        raise LoperInputError(f"marker set file not found: {path}")
-    osim = quiet_opensim()
-    try:
-        return osim.MarkerSet(str(path))
-    except Exception as exc:  # OpenSim raises its own exception types
-        raise LoperInputError(f"{path}: OpenSim cannot read this marker set ({exc})") from exc
+    return _read_object(path, "MarkerSet", "marker set file", "marker set")

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
@@ -12,7 +12,7 @@ import yaml
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.timing import timed_io
 
-__all__ = ["read_bytes", "read_label_map", "read_tsv", "read_yaml"]
+__all__ = ["read_bytes", "read_label_map", "read_label_maps", "read_tsv", "read_yaml"]
 
 
 @timed_io
@@ -114,3 +114,20 @@ def read_label_map(path: str | os.PathLike) -> dict[str, str]:
             raise LoperInputError(f"{path}: label map names label '{label.strip()}' twice")
         out[label.strip()] = marker.strip()
     return out
+
+
+def read_label_maps(label_map) -> dict[str, str] | None:
+    """A label map given inline, read from its file (:func:`read_label_map`), or several such maps merged in order.
+
+    ``label_map`` is a mapping {lab label: model marker}, a path, a sequence of mappings and paths (a later
+    map's entry for a label wins: the map of every trial, then its kind's, then its own) or None (returned as
+    None).
+    """
+    if label_map is None or isinstance(label_map, Mapping):
+        return None if label_map is None else dict(label_map)
+    if isinstance(label_map, (list, tuple)):
+        merged: dict[str, str] = {}
+        for part in label_map:
+            merged.update(read_label_maps(part) or {})
+        return merged
+    return read_label_map(label_map)

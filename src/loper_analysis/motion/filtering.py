@@ -14,10 +14,19 @@ __all__ = ["DC_GAIN_TOLERANCE", "check_cutoff", "lowpass", "lowpass_finite_runs"
 #: below 2e-5 down to a cut-off of 1e-6 of Nyquist, 6e-5 .. 1e-3 at 1e-7 and 0.02 .. 0.1 at 1e-8, and at 1e-9
 #: and below the design divides by zero (``LinAlgError: Singular matrix`` in sosfiltfilt). Order 1 stays sound.
 DC_GAIN_TOLERANCE = 1e-3
+#: Cut-off (Hz) of the markers' and forces' low-pass (config ``filter.cutoff_hz``).
+CUTOFF_HZ: float = 40.0
+#: Designed Butterworth order, run forward and backward (config ``filter.order``).
+ORDER: int = 4
 
 
 def _prefixed(source: str, message: str) -> str:
     return f"{source}: {message}" if source else message
+
+
+def _padlen(sos: np.ndarray) -> int:
+    """Samples ``sosfiltfilt`` pads each end with by default: 3 * (2 * sections + 1)."""
+    return 3 * (2 * len(sos) + 1)
 
 
 def check_cutoff(
@@ -133,8 +142,8 @@ def check_cutoff(
 def lowpass(
     signal,
     sample_rate_hz: float,
-    cutoff_hz: float = 40.0,
-    order: int = 4,
+    cutoff_hz: float = CUTOFF_HZ,
+    order: int = ORDER,
     axis: int = 0,
     *,
     setting: str = "cutoff_hz",
@@ -168,7 +177,7 @@ def lowpass(
             _prefixed(source, f"signal is not finite at sample {idx[axis]} (index {idx}): fill gaps before filtering")
         )
     sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
-    padlen = 3 * (2 * len(sos) + 1)
+    padlen = _padlen(sos)
     if x.shape[axis] <= padlen:
         raise LoperInputError(
             _prefixed(source, f"signal has {x.shape[axis]} samples; the filter needs more than {padlen}")
@@ -180,8 +189,8 @@ def lowpass(
 
 def min_run_samples(
     sample_rate_hz: float,
-    cutoff_hz: float = 40.0,
-    order: int = 4,
+    cutoff_hz: float = CUTOFF_HZ,
+    order: int = ORDER,
     *,
     setting: str = "cutoff_hz",
     rate_name: str = "sample_rate_hz",
@@ -189,7 +198,7 @@ def min_run_samples(
 ) -> int:
     """Fewest samples :func:`lowpass` accepts: one more than the padding of ``sosfiltfilt`` (3 * (2 * sections + 1))."""
     sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
-    return 3 * (2 * len(sos) + 1) + 1
+    return _padlen(sos) + 1
 
 
 def _finite_runs(finite: np.ndarray) -> list[tuple[int, int]]:
@@ -201,8 +210,8 @@ def _finite_runs(finite: np.ndarray) -> list[tuple[int, int]]:
 def lowpass_finite_runs(
     signal,
     sample_rate_hz: float,
-    cutoff_hz: float = 40.0,
-    order: int = 4,
+    cutoff_hz: float = CUTOFF_HZ,
+    order: int = ORDER,
     axis: int = 0,
     *,
     setting: str = "cutoff_hz",
@@ -251,7 +260,7 @@ def lowpass_finite_runs(
         )
     from scipy.signal import sosfiltfilt
 
-    shortest = 3 * (2 * len(sos) + 1) + 1
+    shortest = _padlen(sos) + 1
     moved = np.moveaxis(x, axis, 0)
     flat = moved.reshape(moved.shape[0], -1)
     out = flat.copy()
@@ -272,8 +281,8 @@ def lowpass_finite_runs(
 def lowpass_gain(
     frequency_hz,
     sample_rate_hz: float,
-    cutoff_hz: float = 40.0,
-    order: int = 4,
+    cutoff_hz: float = CUTOFF_HZ,
+    order: int = ORDER,
     *,
     setting: str = "cutoff_hz",
     rate_name: str = "sample_rate_hz",

@@ -36,6 +36,9 @@ __all__ = ["HEADING_MODES", "TrialHeading", "travel_velocity_m_per_s", "trial_he
 
 #: ``auto``: each trial turned to walk along +X when it travels; ``fixed``: the configured rotation for every trial.
 HEADING_MODES: tuple[str, ...] = ("auto", "fixed")
+#: Mean horizontal marker speed (m/s) from which a trial counts as travelling
+#: (config ``markers.min_travel_speed_m_per_s``).
+MIN_TRAVEL_SPEED_M_PER_S: float = 0.25
 #: Decimal places kept of the combined rotation's angles (degrees): exact quarter turns stay exact numbers.
 _ANGLE_DECIMALS = 9
 
@@ -90,7 +93,7 @@ def trial_heading(
     rate_hz: float,
     base_rotation_deg: Sequence[float],
     mode: str = "auto",
-    min_speed_m_per_s: float = 0.25,
+    min_speed_m_per_s: float = MIN_TRAVEL_SPEED_M_PER_S,
     source: str = "",
 ) -> TrialHeading:
     """The lab -> model rotation of one trial (module docstring).

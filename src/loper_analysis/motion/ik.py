@@ -34,6 +34,7 @@ from loper_analysis.motion.ik_determinacy import (
 from loper_analysis.motion.markers import frames_with_markers, require_markers_per_frame
 
 __all__ = [
+    "IK_ACCURACY",
     "IKResult",
     "IK_SUMMARY_COLUMNS",
     "marker_positions",
@@ -46,6 +47,10 @@ __all__ = [
     "ANGLE_COLUMNS",
     "joint_angle_table",
 ]
+
+#: Accuracy of OpenSim's IK solver in the pipeline's IK (config ``opensim.accuracy``; OpenSim's own default is
+#: 1e-5).
+IK_ACCURACY: float = 1e-6
 
 
 #: Columns of the one-row IK summary of a trial (:meth:`IKResult.summary`).

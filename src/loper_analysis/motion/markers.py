@@ -46,6 +46,8 @@ _MAX_LISTED = 10
 
 #: Up direction of the model frame (OpenSim's +Y), model frame.
 MODEL_UP: tuple[float, float, float] = (0.0, 1.0, 0.0)
+#: Interior gaps up to this many frames are filled (config ``markers.max_gap_frames``).
+MAX_GAP_FRAMES: int = 10
 #: Components of :func:`lab_up` smaller than this in magnitude are set to 0 (quarter turns give exact axes).
 _AXIS_ROUND_OFF = 1e-12
 

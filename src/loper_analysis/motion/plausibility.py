@@ -48,6 +48,12 @@ IK_STOP_RMS_M = 0.06
 IK_WARN_RMS_M = 0.02
 #: Share of frames above either level that stops (or warns about) a trial.
 IK_MAX_FRACTION = 0.1
+#: Scale factors outside this range are refused as a unit, label or model mistake
+#: (config ``opensim.scale_factor_range``).
+SCALE_FACTOR_RANGE: tuple[float, float] = (0.5, 2.0)
+#: Range (m) of the largest distance between a trial's markers (config ``markers.extent_range_m``): outside
+#: it the numbers are in another unit than the file declares.
+EXTENT_RANGE_M: tuple[float, float] = (0.1, 5.0)
 
 #: Frames sampled for the marker extent (evenly spaced; the median hardly moves with more).
 _EXTENT_FRAMES = 200
@@ -73,7 +79,7 @@ def marker_extent_m(markers_m) -> float:
 
 
 def require_marker_extent(
-    markers_m, source: str = "", extent_range_m: Sequence[float] = (0.1, 5.0), unit_field: str = "POINT:UNITS"
+    markers_m, source: str = "", extent_range_m: Sequence[float] = EXTENT_RANGE_M, unit_field: str = "POINT:UNITS"
 ) -> float:
     """Refuse markers whose spread (:func:`marker_extent_m`) lies outside ``extent_range_m`` (m); returns it.
 
@@ -136,7 +142,7 @@ def measurement_scale_factors(
 
 
 def require_scale_factors(
-    factors: Mapping[str, float], source: str = "", factor_range: Sequence[float] = (0.5, 2.0)
+    factors: Mapping[str, float], source: str = "", factor_range: Sequence[float] = SCALE_FACTOR_RANGE
 ) -> None:
     """Refuse scale factors outside ``factor_range``: the static trial's distances are not the model's kind.
 

@@ -57,6 +57,7 @@ from loper_analysis.checks import number, where
 from loper_analysis.constants import SEGMENTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.model import BRACE_MARKERS, segment_parameters_from_model
+from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
 
 if TYPE_CHECKING:
     from loper_analysis.swing_leg.dynamics import SegmentParameters
@@ -222,7 +223,7 @@ def segments_from_model(
     model,
     side: str = "l",
     segment_bodies: Mapping[str, Sequence[str]] | None = None,
-    attachment_fraction: float = 0.8,
+    attachment_fraction: float = BRACE_ATTACHMENT_FRACTION,
     brace_markers: Sequence[str] = BRACE_MARKERS,
     source: str = "",
 ) -> SegmentParameters:

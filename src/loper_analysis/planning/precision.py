@@ -13,8 +13,8 @@ planner predicts the SD and the 95 % CI half-width of every K and D for any
 number of perturbed strides, and the number of strides a target half-width
 needs.
 
-* :func:`pulse_force_n` (from :mod:`loper_analysis.planning.inputs`) - the force the rods apply for a rectangular desired
-  pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
+* :func:`pulse_force_n` (from :mod:`loper_analysis.planning.inputs`) - the force the rods apply for a
+  rectangular desired pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
   like the load cell;
 * :func:`pilot_perturbed_pairs` (from :mod:`loper_analysis.planning.inputs`) - the pilot's
   perturbed pairs at an onset, one by one;
@@ -53,13 +53,15 @@ from loper_analysis.checks import integer, number
 from loper_analysis.constants import JOINTS, PARAMETER_UNITS, PARAMETERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
+    FitBounds,
     PreparedWindow,
+    check_interval_scatter,
     nuisance_projection,
     null_pair_errors,
-    parameter_bounds,
     prepare_window,
     response_jacobian,
     t_quantile,
+    window_options,
 )
 from loper_analysis.planning.inputs import pilot_perturbed_pairs, pulse_force_n
 from loper_analysis.swing_leg.dynamics import SegmentParameters
@@ -105,7 +107,7 @@ MIN_PERTURBED_PAIRS = 5
 
 
 @dataclass(frozen=True)
-class PlanSettings:
+class PlanSettings(FitBounds):
     """The planned pulse and the identification settings the prediction follows (config ``identification``).
 
     ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
@@ -136,11 +138,7 @@ class PlanSettings:
 
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)
-        if self.interval_scatter not in ("perturbed_pairs", "null_pairs"):
-            raise LoperInputError(
-                "identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', "
-                f"got {self.interval_scatter!r}"
-            )
+        check_interval_scatter(self.interval_scatter)
         if number("force_rate_hz", self.force_rate_hz) <= 0:
             raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
         d = number("pulse_duration_s", self.pulse_duration_s)
@@ -152,14 +150,6 @@ class PlanSettings:
                 f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
                 f"(identification.window_after_s = {after:g} s): the fit would not see its end"
             )
-
-    @property
-    def lower(self) -> np.ndarray:
-        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
-
-    @property
-    def upper(self) -> np.ndarray:
-        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
 
 
 @dataclass
@@ -274,11 +264,7 @@ def planning_window(
         force_time_s=t_force,
         pelvis_angle_unperturbed_rad=pelvis,
         pelvis_angle_perturbed_rad=pelvis,
-        window_before_s=settings.window_before_s,
-        window_after_s=settings.window_after_s,
-        n_substeps=settings.n_substeps,
-        initial_state_span_s=settings.initial_state_span_s,
-        initial_state_degree=settings.initial_state_degree,
+        **window_options(settings),
     )
 
 

@@ -461,7 +461,7 @@ def front_page_html(
     impedance_status : Mapping[str, int] or None
         Status -> number of rows of the impedance table (shown when nothing was fitted).
     figure_png : bytes or None
-        The main figure (``results/figures/impedance.png``), embedded as a data URI.
+        The main figure (``results/impedance/impedance.png``), embedded as a data URI.
     transparency : pandas.DataFrame or None
         :func:`~loper_analysis.report.headline.transparency_verdict`; None: no subject walked both trials of the
         transparency pair.
@@ -497,7 +497,7 @@ def front_page_html(
         status = ", ".join(f"{n} {html.escape(s)}" for s, n in (impedance_status or {}).items())
         parts.append(
             f'<p id="lf-impedance-summary"><b>Impedance</b>: no joint was fitted '
-            f"({status or 'no rows'}; the reasons are in results/tables/impedance.tsv).</p>"
+            f"({status or 'no rows'}; the reasons are in results/impedance/impedance.tsv).</p>"
         )
     else:
         parts.append(_summary_table(summary))

@@ -70,7 +70,7 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
     Parameters
     ----------
     summary : pandas.DataFrame
-        ``results/tables/impedance_summary.tsv``: ``joint, onset_ms,
+        ``results/impedance/summary.tsv``: ``joint, onset_ms,
         n_subjects, n_not_identifiable``, ``K_mean_nm_per_rad``,
         ``K_sd_nm_per_rad`` (N·m/rad), ``D_mean_nms_per_rad``,
         ``D_sd_nms_per_rad`` (N·m·s/rad) and ``vaf_pct_mean`` (%). No rows:
@@ -150,7 +150,7 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
     Parameters
     ----------
     impedance : pandas.DataFrame
-        ``results/tables/impedance.tsv`` (:data:`loper_analysis.identification.impedance.IMPEDANCE_COLUMNS`):
+        ``results/impedance/impedance.tsv`` (:data:`loper_analysis.identification.impedance.IMPEDANCE_COLUMNS`):
         per subject, onset and joint the estimate, its 95 % CI, the truth and
         the error (estimate - truth; K in N·m/rad, D in N·m·s/rad), and ``status``.
     source : str
@@ -282,28 +282,9 @@ def transparency_verdict(rmsd: pd.DataFrame, source: str = "") -> pd.DataFrame:
         study_isv_ave_rad``, ``n_subjects`` (subjects with a verdict) and
         ``n_subjects_transparent``.
     """
-    needed = [
-        "subject",
-        "phase",
-        "joint",
-        "rmsd_rad",
-        "isv_ave_rad",
-        "transparent",
-        "study_rmsd_rad",
-        "study_isv_ave_rad",
-    ]
-    columns = [
-        "phase",
-        "joint",
-        "rmsd_rad",
-        "isv_ave_rad",
-        "transparent",
-        "study_rmsd_rad",
-        "study_isv_ave_rad",
-        "n_subjects",
-        "n_subjects_transparent",
-    ]
-    table = _rows_or_empty(rmsd, needed, source, "transparency table")
+    carried = ["phase", "joint", "rmsd_rad", "isv_ave_rad", "transparent", "study_rmsd_rad", "study_isv_ave_rad"]
+    columns = [*carried, "n_subjects", "n_subjects_transparent"]
+    table = _rows_or_empty(rmsd, ["subject", *carried], source, "transparency table")
     verdicts = [
         _bool_or_none(v, "transparent", f"{where(source)}row {i}")
         for i, v in enumerate(table["transparent"].to_numpy())

@@ -18,11 +18,17 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.outliers import check_enough_strides
 from loper_analysis.gait.resampling import window_times_s
 from loper_analysis.responses.inputs import trial_angles, trial_name, trial_table
-from loper_analysis.responses.matching import match_unperturbed, stride_table, too_short
+from loper_analysis.responses.matching import match_in_window, stride_table, too_short
 from loper_analysis.responses.native_force import native_force_rate_hz, native_force_windows
 from loper_analysis.responses.sampling import TIME_TOLERANCE_S
-from loper_analysis.responses.windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
-from loper_analysis.swing_leg.dynamics import segment_coordinates
+from loper_analysis.responses.windows import (
+    ResponseSettings,
+    analysis_grid,
+    paired_windows,
+    pooled_windows,
+    window_coordinates,
+    window_outliers,
+)
 
 __all__ = ["COUNT_COLUMNS", "mean_and_sd", "subject_onset_response"]
 
@@ -170,7 +176,8 @@ def subject_onset_response(
         Bad inputs or settings (naming the trial/file, column and value),
         duplicate trial names.
     """
-    onset_s, before, after, initial, start, grid = analysis_grid(trials, onset_ms, settings, side, source)
+    analysis = analysis_grid(trials, onset_ms, settings, side, source)
+    onset_s, before, after, initial, start, grid = analysis
     min_n = int(number("min_strides", settings.min_strides, source, minimum=0.0))
     rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
 
@@ -191,17 +198,8 @@ def subject_onset_response(
         n_short = int(too_short(table, onset_s, after, source=where_s).sum())
         delay = np.fmax(table["onset_s"].to_numpy(float) - table["toe_off_s"].to_numpy(float), onset_s)
         rooms.extend((table["swing_s"].to_numpy(float) - delay)[perturbed].tolist())
-        matches = match_unperturbed(
-            t,
-            columns["joints"],
-            table,
-            before,
-            source=where_s,
-            span_s=(start, after),
-            onset_after_toe_off_s=onset_s,
-            window_after_s=after,
-            candidate_within_swing=candidate_within_swing,
-            missing="drop",
+        matches = match_in_window(
+            t, columns["joints"], table, analysis, where_s, candidate_within_swing=candidate_within_swing
         )
         for s, why in matches.attrs["unmatched"].items():
             log.info("%s: perturbed stride %s has no match: %s", where_s, s, why)
@@ -225,7 +223,7 @@ def subject_onset_response(
             }
         )
 
-    win = {key: tuple(np.concatenate([w[key][i] for w in windows]) for i in range(2)) for key in windows[0]}
+    win = pooled_windows(windows)
     joints_p, joints_u = win["joints"]
     label = f"{source} onset {onset_ms:g} ms" if source else f"onset {onset_ms:g} ms"
     verdict = window_outliers(joints_p - joints_u, grid, before, after, whisker, max_fraction, JOINTS, label)
@@ -314,8 +312,8 @@ def subject_onset_response(
     series: dict = {"time_s": grid.copy(), "onset_s": 0.0}
     pair_series: dict = {"time_s": grid.copy(), "n_pairs": n_pairs}
     for what, i in (("perturbed", 0), ("unperturbed", 1)):
-        j, pel, x = kept["joints"][i], kept["pelvis_angle"][i], kept["pelvis_x"][i]
-        q = segment_coordinates(j.reshape(-1, 3), pel.reshape(-1), x.reshape(-1)).reshape(j.shape[:2] + (4,))
+        pel = kept["pelvis_angle"][i]
+        q = window_coordinates(kept["joints"][i], pel, kept["pelvis_x"][i])
         series[f"q_{what}"] = mean_and_sd(q)[0]
         series[f"pelvis_angle_{what}_rad"] = mean_and_sd(pel)[0]
         series[f"force_{what}_n"] = mean_and_sd(kept["force_vector"][i])[0]

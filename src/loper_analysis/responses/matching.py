@@ -2,7 +2,8 @@
 
 * :func:`too_short` - perturbed strides whose swing cannot hold the window;
 * :func:`match_unperturbed` - the matched unperturbed stride and its anchor
-  (also for null pairs: unperturbed strides matched as if perturbed).
+  (also for null pairs: unperturbed strides matched as if perturbed);
+  :func:`match_in_window` - the same for the windows of a subject's analysis grid.
 
 Alignment: a candidate unperturbed stride ``u`` is aligned to a perturbed
 stride ``p`` at the same time after its own toe-off,
@@ -21,9 +22,16 @@ import pandas as pd
 from loper_analysis.checks import bool_column, number, require_columns, signal, time_vector, where
 from loper_analysis.errors import LoperInputError
 from loper_analysis.responses.sampling import TIME_TOLERANCE_S, SplineSampler, window_span
-from loper_analysis.responses.windows import WINDOW_AFTER_S, WINDOW_BEFORE_S
+from loper_analysis.responses.windows import WINDOW_AFTER_S, WINDOW_BEFORE_S, AnalysisGrid
 
-__all__ = ["MATCH_COLUMNS", "STRIDE_TABLE_COLUMNS", "stride_table", "too_short", "match_unperturbed"]
+__all__ = [
+    "MATCH_COLUMNS",
+    "STRIDE_TABLE_COLUMNS",
+    "stride_table",
+    "too_short",
+    "match_unperturbed",
+    "match_in_window",
+]
 
 #: Columns of the table returned by :func:`match_unperturbed`.
 MATCH_COLUMNS: tuple[str, ...] = (
@@ -305,3 +313,29 @@ def match_unperturbed(
         }
     )
     return out
+
+
+def match_in_window(
+    time_s, signals, strides: pd.DataFrame, grid: AnalysisGrid, source: str = "", **options
+) -> pd.DataFrame:
+    """:func:`match_unperturbed` for the windows of a subject's analysis grid; strides without a match dropped.
+
+    ``grid`` (:func:`loper_analysis.responses.windows.analysis_grid`): the match runs over
+    ``grid.before_s`` before the onset; perturbed and candidate data must cover the windows
+    ``grid.start_s .. grid.after_s`` around onset and anchor; a perturbed stride too short for
+    ``grid.after_s`` after ``grid.onset_s`` is left out (:func:`too_short`). ``time_s``, ``signals``,
+    ``strides`` and ``source`` as for :func:`match_unperturbed`; ``options``: its other keywords
+    (``candidate_within_swing``, ``null_pairs``). Unmatched strides are listed in ``attrs["unmatched"]``.
+    """
+    return match_unperturbed(
+        time_s,
+        signals,
+        strides,
+        grid.before_s,
+        source=source,
+        span_s=(grid.start_s, grid.after_s),
+        onset_after_toe_off_s=grid.onset_s,
+        window_after_s=grid.after_s,
+        missing="drop",
+        **options,
+    )

@@ -16,10 +16,16 @@ from loper_analysis.checks import number, where
 from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.responses.inputs import trial_angles, trial_name, trial_table
-from loper_analysis.responses.matching import match_unperturbed
+from loper_analysis.responses.matching import match_in_window
 from loper_analysis.responses.sampling import TIME_TOLERANCE_S
-from loper_analysis.responses.windows import ResponseSettings, analysis_grid, paired_windows, window_outliers
-from loper_analysis.swing_leg.dynamics import segment_coordinates
+from loper_analysis.responses.windows import (
+    ResponseSettings,
+    analysis_grid,
+    paired_windows,
+    pooled_windows,
+    window_coordinates,
+    window_outliers,
+)
 
 __all__ = ["MAX_TRIAL_DEVIATION_RATIO", "null_pair_windows", "trial_deviation_rad", "deviant_trials"]
 
@@ -111,7 +117,8 @@ def null_pair_windows(
         ``n_outliers``; ``trial_deviation_rad`` (trial name -> :func:`trial_deviation_rad`)
         and ``trials_left_out`` (trial name -> reason).
     """
-    onset_s, before, after, initial, start, grid = analysis_grid(trials, onset_ms, settings, side, source)
+    analysis = analysis_grid(trials, onset_ms, settings, side, source)
+    _, before, after, _, start, grid = analysis
     rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
     parts, deviation = [], {}
     for k, trial in enumerate(trials):
@@ -120,18 +127,7 @@ def null_pair_windows(
             raise LoperInputError(f"{where(source)}trial name {name!r} appears twice; names must be unique")
         t, columns, _ = trial_angles(trial, name, side)
         strides, where_s = trial_table(trial, "strides", name)
-        matches = match_unperturbed(
-            t,
-            columns["joints"],
-            strides,
-            before,
-            source=where_s,
-            span_s=(start, after),
-            onset_after_toe_off_s=onset_s,
-            window_after_s=after,
-            missing="drop",
-            null_pairs=True,
-        )
+        matches = match_in_window(t, columns["joints"], strides, analysis, where_s, null_pairs=True)
         part = paired_windows(t, columns, matches, start, after, rate_hz, source=where_s)
         deviation[name] = trial_deviation_rad(part["joints"][0] - part["joints"][1], grid, before, after)
         parts.append(part)
@@ -140,15 +136,13 @@ def null_pair_windows(
     for why in left_out.values():
         log.warning("%s: %s", label, why)
     parts = [w for w, name in zip(parts, deviation) if name not in left_out]
-    win = {key: tuple(np.concatenate([w[key][i] for w in parts]) for i in range(2)) for key in parts[0]}
+    win = pooled_windows(parts)
     jp, ju = win["joints"]
     keep = ~window_outliers(jp - ju, grid, before, after, whisker, max_fraction, JOINTS, label)["removed"].to_numpy()
     out: dict = {"time_s": grid}
     for what, i in (("perturbed", 0), ("unperturbed", 1)):
         j, pel, x = (win[key][i][keep] for key in ("joints", "pelvis_angle", "pelvis_x"))
-        out[f"q_{what}"] = segment_coordinates(j.reshape(-1, 3), pel.reshape(-1), x.reshape(-1)).reshape(
-            j.shape[:2] + (4,)
-        )
+        out[f"q_{what}"] = window_coordinates(j, pel, x)
         out[f"pelvis_angle_{what}_rad"] = pel
     out["n_pairs"], out["n_outliers"] = int(keep.sum()), int((~keep).sum())
     out["trial_deviation_rad"], out["trials_left_out"] = deviation, left_out

@@ -1,7 +1,8 @@
 """Perturbed and matched unperturbed windows on one relative time grid, and the IQR rule on their differences.
 
 * :func:`analysis_grid` - the checked window settings of a subject and onset and their grid;
-* :func:`paired_windows` - windows of signals around onset and anchor;
+* :func:`paired_windows` - windows of signals around onset and anchor; :func:`pooled_windows` -
+  those of several trials as one; :func:`window_coordinates` - segment coordinates of joint-angle windows;
 * :func:`window_outliers` - the IQR rule on the analysis window of the differences.
 """
 
@@ -9,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -25,6 +27,7 @@ from loper_analysis.gait.outliers import (
 )
 from loper_analysis.gait.resampling import window, window_times_s
 from loper_analysis.responses.sampling import TIME_TOLERANCE_S, SplineSampler, window_span
+from loper_analysis.swing_leg.dynamics import segment_coordinates
 
 __all__ = [
     "INITIAL_STATE_SPAN_S",
@@ -32,8 +35,11 @@ __all__ = [
     "WINDOW_BEFORE_S",
     "MIN_PAIRS_FOR_OUTLIERS",
     "ResponseSettings",
+    "AnalysisGrid",
     "analysis_grid",
     "paired_windows",
+    "pooled_windows",
+    "window_coordinates",
     "window_outliers",
 ]
 
@@ -71,12 +77,28 @@ class ResponseSettings:
     min_strides: int = MIN_VALID_STRIDES
 
 
-def analysis_grid(trials, onset_ms, settings: ResponseSettings, side: str, source: str = ""):
-    """Checked settings of a subject's windows and their grid.
+class AnalysisGrid(NamedTuple):
+    """The checked window settings of a subject and onset and their grid (:func:`analysis_grid`), in s.
 
-    Returns the onset after toe-off (s), ``before``, ``after`` and the
-    initial-state span (s), the window start relative to the onset (s) and
-    the relative time grid (s, :func:`loper_analysis.gait.resampling.window_times_s`).
+    ``onset_s``: the nominal onset after toe-off; ``before_s``, ``after_s``: the analysis window
+    around the onset; ``initial_state_span_s``: the span before it for the fit's initial state;
+    ``start_s``: the windows' start relative to the onset, ``-(initial_state_span_s + before_s)``;
+    ``time_s``: the relative time grid (:func:`loper_analysis.gait.resampling.window_times_s`).
+    """
+
+    onset_s: float
+    before_s: float
+    after_s: float
+    initial_state_span_s: float
+    start_s: float
+    time_s: np.ndarray
+
+
+def analysis_grid(trials, onset_ms, settings: ResponseSettings, side: str, source: str = "") -> AnalysisGrid:
+    """Checked settings of a subject's windows and their grid (:class:`AnalysisGrid`).
+
+    ``onset_ms`` (ms) and the windows of ``settings`` are checked, ``side`` must be a side and
+    ``trials`` a non-empty sequence; ``source`` names the subject in messages.
     """
     if not isinstance(settings, ResponseSettings):
         raise LoperInputError(f"{where(source)}settings must be ResponseSettings, got {type(settings).__name__}")
@@ -90,7 +112,7 @@ def analysis_grid(trials, onset_ms, settings: ResponseSettings, side: str, sourc
         raise LoperInputError(f"{where(source)}trials must be a non-empty sequence of trial mappings")
     start = -(initial + before)
     grid = window_times_s(-start, after, number("rate_hz", settings.rate_hz, source))
-    return onset_s, before, after, initial, start, grid
+    return AnalysisGrid(onset_s, before, after, initial, start, grid)
 
 
 def paired_windows(
@@ -193,6 +215,26 @@ def paired_windows(
             pair.append(sampler(targets, runs).reshape(targets.shape + v.shape[1:]))
         out[name] = (pair[0], pair[1])
     return out
+
+
+def pooled_windows(windows: Sequence[Mapping[str, tuple[np.ndarray, np.ndarray]]]) -> dict:
+    """The windows of several trials (:func:`paired_windows` of each, same columns) as those of one.
+
+    Per column ``(perturbed, unperturbed)``, each the trials' windows concatenated along the pairs
+    (axis 0) in trial order.
+    """
+    return {key: tuple(np.concatenate([w[key][i] for w in windows]) for i in range(2)) for key in windows[0]}
+
+
+def window_coordinates(joints_rad: np.ndarray, pelvis_angle_rad: np.ndarray, pelvis_x_m: np.ndarray) -> np.ndarray:
+    """Segment coordinates (n_pairs, n_grid, 4) of windows: [pelvis_x (m), thigh, shank, foot (rad)].
+
+    From the joint angles (n_pairs, n_grid, 3) in rad, the pelvis angle (n_pairs, n_grid) in rad and
+    the pelvis x (n_pairs, n_grid) in m, sample by sample
+    (:func:`loper_analysis.swing_leg.dynamics.segment_coordinates`).
+    """
+    q = segment_coordinates(joints_rad.reshape(-1, 3), pelvis_angle_rad.reshape(-1), pelvis_x_m.reshape(-1))
+    return q.reshape(joints_rad.shape[:2] + (4,))
 
 
 # --------------------------------------------------------------------------- outliers

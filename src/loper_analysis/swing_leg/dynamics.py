@@ -36,6 +36,7 @@ from loper_analysis.swing_leg.anthropometry import (
 )
 
 __all__ = [
+    "BRACE_ATTACHMENT_FRACTION",
     "SegmentParameters",
     "read_segments",
     "write_segments",
@@ -53,6 +54,10 @@ __all__ = [
     "generalized_joint_forces",
     "simulate",
 ]
+
+#: Where the robot's brace sits along the thigh, as a fraction of its length from the hip (config
+#: ``opensim.brace_attachment_fraction``); a model's brace markers win.
+BRACE_ATTACHMENT_FRACTION: float = 0.8
 
 _SEGMENT_COLUMNS = ("mass_kg", "inertia_kg_m2", "length_m", "com_x_m", "com_y_m")
 
@@ -203,7 +208,7 @@ def read_segments(path: str | os.PathLike) -> SegmentParameters:
 
 
 def segment_parameters_from_anthropometry(
-    height_m: float, body_mass_kg: float, attachment_fraction: float = 0.8
+    height_m: float, body_mass_kg: float, attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
 ) -> SegmentParameters:
     """Segment parameters from height and body mass with Winter's table (:mod:`loper_analysis.swing_leg.anthropometry`).
 

@@ -72,7 +72,6 @@ def trial_inputs(
     """
     from loper_analysis.device.loadcell import robot_log_frames_and_native
     from loper_analysis.gait.strides import stride_tables
-    from loper_analysis.synthetic.sync import pulse_train_at
 
     if walk.robot is None:
         raise LoperInputError(f"{name}: a trial without the device has no robot log")
@@ -97,9 +96,7 @@ def trial_inputs(
         columns = [c for c in angles.columns if c.endswith("_rad")]
         angles[columns] = angles[columns].to_numpy() + rng.normal(0.0, angle_noise_sd_rad, (len(t), len(columns)))
     ratio = int(round(lab.analog_rate_hz / lab.marker_rate_hz))
-    t_analog = np.arange(len(t) * ratio) / lab.analog_rate_hz
-    scale = 1.0 + 1e-6 * lab.clock_drift_ppm
-    sync_v = pulse_train_at((t_analog + lab.clock_offset_s) / scale, walk.sync_starts_s)
+    sync_v = walk.sync_v(np.arange(len(t) * ratio) / lab.analog_rate_hz, lab)
     force, native = robot_log_frames_and_native(
         walk.robot, lab.robot_rate_hz, sync_v, lab.analog_rate_hz, t, source=name
     )

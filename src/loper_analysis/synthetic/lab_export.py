@@ -419,23 +419,13 @@ def qtm_walking_export(
     seed : int or numpy.random.SeedSequence
     settings : QTMExportSettings
     """
-    from loper_analysis.synthetic.sync import pulse_train_at
-    from loper_analysis.synthetic.treadmill import treadmill_grf
-
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     marker_seed, grf_seed, plate_seed = ss.spawn(3)
     coords = gait2392_coordinates(trial.mocap_coordinates(lab.marker_rate_hz))
     X_exact, names, offset = _lab_markers(model, coords, label_map, lab, settings)
     coords["pelvis_ty"] += offset
     X = _noise_and_gaps(X_exact, names, lab, settings, np.random.default_rng(marker_seed), gaps=True)
-    grf = treadmill_grf(
-        trial.mocap_events(),
-        trial.duration_s,
-        lab.analog_rate_hz,
-        body_mass_kg,
-        np.random.default_rng(grf_seed),
-        noise_sd_n=lab.grf_noise_sd_n,
-    )
+    grf = trial.mocap_grf(body_mass_kg, lab, np.random.default_rng(grf_seed))
     n_a = X.shape[0] * round(lab.analog_rate_hz / lab.marker_rate_hz)
     if len(grf) < n_a:
         raise LoperInputError(
@@ -451,8 +441,7 @@ def qtm_walking_export(
         )
         for s in SIDES
     }
-    drift = 1.0 + 1e-6 * lab.clock_drift_ppm
-    sync_v = pulse_train_at((grf["time_s"].to_numpy(float) + lab.clock_offset_s) / drift, trial.sync_starts_s)
+    sync_v = trial.sync_v(grf["time_s"].to_numpy(float), lab)
     t0 = settings.first_frame / lab.marker_rate_hz
     events = []
     if settings.with_events:

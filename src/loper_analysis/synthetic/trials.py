@@ -26,7 +26,7 @@ writing them is the file layer's job.
 from __future__ import annotations
 
 import zlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -68,6 +68,23 @@ class LabSettings:
     lab_to_model_rotation_deg: tuple[float, float, float] = (-90.0, 0.0, 0.0)
     grf_prefix: tuple[str, str] = ("_left", "_right")  # channel suffix per belt: Fz_left, Fz_right
     sync_channel: str = "sync"
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> LabSettings:
+        """The lab of the whole validated config: noise, gaps and robot clock of ``synthetic``, the lab's axes
+        (``markers.lab_to_model_rotation_deg``) and sync channel (``events.sync_channel``); the rates, the robot
+        log's margin and the belts' channel names keep their defaults."""
+        s = config["synthetic"]
+        return cls(
+            marker_noise_sd_m=s["marker_noise_sd_m"],
+            n_gaps=s["marker_gaps_per_trial"],
+            max_gap_frames=s["max_gap_frames"],
+            grf_noise_sd_n=s["grf_noise_sd_n"],
+            clock_offset_s=s["clock_offset_s"],
+            clock_drift_ppm=s["clock_drift_ppm"],
+            lab_to_model_rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
+            sync_channel=config["events"]["sync_channel"],
+        )
 
 
 def _model_to_lab(points_m: np.ndarray, rotation_deg: Sequence[float]) -> np.ndarray:
@@ -155,6 +172,35 @@ class WalkingTrial:
     def mocap_events(self) -> pd.DataFrame:
         e = self.events
         return e[(e["time_s"] >= 0) & (e["time_s"] <= self.duration_s)].reset_index(drop=True)
+
+    def mocap_grf(self, body_mass_kg: float, lab: LabSettings, rng: np.random.Generator) -> pd.DataFrame:
+        """Both belts' ground reactions at the analog rate over the motion capture, with the lab's noise.
+
+        :func:`loper_analysis.synthetic.treadmill.treadmill_grf` of :meth:`mocap_events` for a body of
+        ``body_mass_kg`` kg at ``lab.analog_rate_hz`` (forces in N, moments in N·m, noise SD
+        ``lab.grf_noise_sd_n`` N drawn from ``rng``).
+        """
+        from loper_analysis.synthetic.treadmill import treadmill_grf
+
+        return treadmill_grf(
+            self.mocap_events(),
+            self.duration_s,
+            lab.analog_rate_hz,
+            body_mass_kg,
+            rng,
+            noise_sd_n=lab.grf_noise_sd_n,
+        )
+
+    def sync_v(self, time_s, lab: LabSettings) -> np.ndarray:
+        """The robot's sync output (V) as the motion capture samples it at its times ``time_s`` (s).
+
+        The robot clock starts ``lab.clock_offset_s`` s before the motion capture and runs
+        ``lab.clock_drift_ppm`` ppm fast; the pulses start at ``sync_starts_s`` on it.
+        """
+        from loper_analysis.synthetic.sync import pulse_train_at
+
+        scale = 1.0 + 1e-6 * lab.clock_drift_ppm
+        return pulse_train_at((np.asarray(time_s, dtype=float) + lab.clock_offset_s) / scale, self.sync_starts_s)
 
 
 def simulate_walking_trial(
@@ -313,22 +359,11 @@ def walking_recording(
     model, trial: WalkingTrial, body_mass_kg: float, lab: LabSettings, seed, source: str = "walking trial"
 ) -> C3DRecording:
     """The C3D contents of a walking trial: markers with noise and gaps, GRF per belt and the sync channel."""
-    from loper_analysis.synthetic.sync import pulse_train_at
-    from loper_analysis.synthetic.treadmill import treadmill_grf
-
     ss = seed if isinstance(seed, np.random.SeedSequence) else np.random.SeedSequence(seed)
     marker_seed, grf_seed = ss.spawn(2)
     coords = trial.mocap_coordinates(lab.marker_rate_hz)
     X, labels = lab_markers(model, coords, lab, np.random.default_rng(marker_seed))
-    grf = treadmill_grf(
-        trial.mocap_events(),
-        trial.duration_s,
-        lab.analog_rate_hz,
-        body_mass_kg,
-        np.random.default_rng(grf_seed),
-        noise_sd_n=lab.grf_noise_sd_n,
-    )
-    scale = 1.0 + 1e-6 * lab.clock_drift_ppm
+    grf = trial.mocap_grf(body_mass_kg, lab, np.random.default_rng(grf_seed))
     names, columns, units = [], [], []
     for side, suffix in zip(SIDES, lab.grf_prefix):
         for quantity, unit in (("fx", "N"), ("fz", "N"), ("mx", "N.m"), ("my", "N.m"), ("mz", "N.m")):
@@ -337,7 +372,7 @@ def walking_recording(
             columns.append(grf[key].to_numpy(float))
             units.append(unit)
     names.append(lab.sync_channel)
-    columns.append(pulse_train_at((grf["time_s"].to_numpy(float) + lab.clock_offset_s) / scale, trial.sync_starts_s))
+    columns.append(trial.sync_v(grf["time_s"].to_numpy(float), lab))
     units.append("V")
     return C3DRecording(
         source=source,

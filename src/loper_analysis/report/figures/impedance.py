@@ -130,6 +130,15 @@ def _window_ms(table: pd.DataFrame, time_ms: np.ndarray) -> tuple[float, float]:
     return ANALYSIS_WINDOW_MS
 
 
+def _grey_and_red(ax, time_ms: np.ndarray, grey: pd.Series, red: pd.Series, labels: tuple[str, str], **red_style):
+    """Two angle columns (rad) drawn in deg against ``time_ms``: the reference in grey, the other in red.
+
+    ``labels`` names the two curves in the legend; ``red_style`` adds to the red curve's style (e.g. ``ls``).
+    """
+    ax.plot(time_ms, grey.to_numpy() * _RAD_TO_DEG, color="0.35", lw=1.3, label=labels[0])
+    ax.plot(time_ms, red.to_numpy() * _RAD_TO_DEG, color="tab:red", lw=1.3, label=labels[1], **red_style)
+
+
 def _say(ax, text: str) -> None:
     ax.text(0.5, 0.5, text, transform=ax.transAxes, ha="center", va="center", color="0.4", fontsize=11)
     ax.set_xticks([])
@@ -215,20 +224,8 @@ def responses_figure(
                 for ax in (ax_a, ax_d):
                     ax.axvspan(lo, hi, color="0.92", lw=0, zorder=0)
                     ax.axvline(0.0, color="0.6", lw=0.6, ls=":")
-                ax_a.plot(
-                    t_ms,
-                    table[f"{joint}_unperturbed_rad_mean"].to_numpy() * _RAD_TO_DEG,
-                    color="0.35",
-                    lw=1.3,
-                    label="unperturbed",
-                )
-                ax_a.plot(
-                    t_ms,
-                    table[f"{joint}_perturbed_rad_mean"].to_numpy() * _RAD_TO_DEG,
-                    color="tab:red",
-                    lw=1.3,
-                    label="perturbed",
-                )
+                means = table[f"{joint}_unperturbed_rad_mean"], table[f"{joint}_perturbed_rad_mean"]
+                _grey_and_red(ax_a, t_ms, *means, ("unperturbed", "perturbed"))
                 ax_d.fill_between(
                     t_ms, (diff - sd) * _RAD_TO_DEG, (diff + sd) * _RAD_TO_DEG, color="tab:red", alpha=0.2, lw=0
                 )
@@ -268,21 +265,8 @@ def fit_figure(tables: Mapping[int, pd.DataFrame], title: str | None = None, sou
             t_ms = table["time_s"].to_numpy() * 1000.0
             for r, joint in enumerate(JOINTS):
                 ax = axes[r, c]
-                ax.plot(
-                    t_ms,
-                    table[f"{joint}_measured_rad"].to_numpy() * _RAD_TO_DEG,
-                    color="0.35",
-                    lw=1.3,
-                    label="measured",
-                )
-                ax.plot(
-                    t_ms,
-                    table[f"{joint}_model_rad"].to_numpy() * _RAD_TO_DEG,
-                    color="tab:red",
-                    lw=1.3,
-                    ls="--",
-                    label="model",
-                )
+                curves = table[f"{joint}_measured_rad"], table[f"{joint}_model_rad"]
+                _grey_and_red(ax, t_ms, *curves, ("measured", "model"), ls="--")
                 ax.axhline(0.0, color="0.7", lw=0.6)
                 if c == 0:
                     ax.set_ylabel(f"{joint} (deg)")
@@ -367,7 +351,7 @@ def impedance_figure(table: pd.DataFrame, source: str = "impedance table") -> Fi
     Parameters
     ----------
     table : pandas.DataFrame
-        Impedance table (``results/tables/impedance.tsv``) with at least
+        Impedance table (``results/impedance/impedance.tsv``) with at least
         ``subject``, ``onset_ms`` (ms), ``joint``, ``K_nm_per_rad``,
         ``D_nms_per_rad``, ``K_true_nm_per_rad``, ``D_true_nms_per_rad`` and ``status``.
     source : str
