@@ -22,7 +22,7 @@ trial). Then the workflow's :func:`loper_analysis.identification.impedance.fit_o
 scaling and event detection.
 
 ``--mode chain`` (the cross-check, ~35-70 min for 34 subjects): builds a copy of the workflow with the
-N subjects and runs ``snakemake -jJ results/tables/impedance.tsv`` (from the simulated C3D files to
+N subjects and runs ``snakemake -jJ results/impedance/impedance.tsv`` (from the simulated C3D files to
 the fits). With ``--keep DIR`` the project stays, and the script also prints the IK noise of the chain
 (SD of IK angle minus true coordinate, per column) behind :data:`IK_NOISE_SD`.
 """
@@ -325,7 +325,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
 
 
 def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFrame:
-    """The workflow on a copy of the project: ``results/tables/impedance.tsv``."""
+    """The workflow on a copy of the project: ``results/impedance/impedance.tsv``."""
     for item in ("Snakefile", "workflow", "config"):
         target = work / item
         if not target.exists():
@@ -343,7 +343,7 @@ def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFram
             "snakemake",
             "-j",
             str(jobs),
-            "results/tables/impedance.tsv",
+            "results/impedance/impedance.tsv",
             "--configfile",
             "config/coverage.yaml",
             "-q",
@@ -353,7 +353,7 @@ def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFram
     )
     if res.returncode:
         raise SystemExit(f"snakemake failed in {work} (exit {res.returncode})")
-    return pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+    return pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
 
 
 def main() -> None:

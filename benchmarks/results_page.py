@@ -10,9 +10,9 @@ every ``--configfile`` given to Snakemake on top of it, in the same order. In th
 was. The names (:data:`BLOCKS`):
 
 * ``run`` - the command, the config files (with their SHA-256) and the design the figures come from;
-* ``impedance-summary`` - across-subject K and D per joint and onset (``results/tables/impedance_summary.tsv``);
+* ``impedance-summary`` - across-subject K and D per joint and onset (``results/impedance/summary.tsv``);
 * ``truth-recovery`` - estimates against the synthetic subjects' truth per joint and onset, the fits' status
-  and the ``ok`` rows whose 95 % interval misses the truth (``results/tables/impedance.tsv``);
+  and the ``ok`` rows whose 95 % interval misses the truth (``results/impedance/impedance.tsv``);
 * ``validation`` - the validation study's errors against the study's (``results/validation/summary.tsv``,
   ``fits.tsv``);
 * ``transparency``, ``interaction-force`` - ``results/transparency/rmsd.tsv`` and ``force.tsv``;
@@ -214,7 +214,7 @@ def block_run(run: Run) -> str:
 
 def block_impedance_summary(run: Run) -> str:
     """Across-subject K and D per joint and onset."""
-    name = "tables/impedance_summary.tsv"
+    name = "impedance/summary.tsv"
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
@@ -286,7 +286,7 @@ def block_truth_recovery(run: Run) -> str:
     """The synthetic subjects' K and D recovered, per joint and onset."""
     from loper_analysis.identification.impedance import TRUTH_TOLERANCE
 
-    name = "tables/impedance.tsv"
+    name = "impedance/impedance.tsv"
     t = run.tsv(name)
     if t is None:
         return not_in_run(run, name)

@@ -9,14 +9,10 @@ it checks out revision REV of this repository and the working tree (with
 its uncommitted changes) into temporary folders, runs ``snakemake -j2`` in
 each with that checkout's own library on ``PYTHONPATH``, and compares.
 
-Checks (exit code 1 when one fails):
-* byte-identical: ``validation/errors.tsv``, ``device/summary.tsv`` and
-  every stride table (``strides/**``);
-* ``tables/impedance.tsv`` identical cell by cell after renaming the old
-  columns to the new ones (:data:`RENAMED`) and leaving out the columns
-  only the new table has (the optimiser's start counts);
-* every other TSV under ``results/`` is listed as identical or not (for
-  information).
+Every file of the base run (job logs and timings aside) must be in the new run,
+at its new place where the layout moved it (:data:`MOVED`), with the same bytes;
+files only the new run has are listed. Exit code 1 when a file differs or is
+missing.
 """
 
 from __future__ import annotations
@@ -29,77 +25,51 @@ import sys
 import tempfile
 from pathlib import Path
 
-import pandas as pd
-
-#: Columns of the impedance table renamed to carry their units: old -> new.
-RENAMED = {
-    "K": "K_nm_per_rad",
-    "D": "D_nms_per_rad",
-    "K_ci95_low": "K_ci95_low_nm_per_rad",
-    "K_ci95_high": "K_ci95_high_nm_per_rad",
-    "D_ci95_low": "D_ci95_low_nms_per_rad",
-    "D_ci95_high": "D_ci95_high_nms_per_rad",
-    "K_true": "K_true_nm_per_rad",
-    "D_true": "D_true_nms_per_rad",
-    "K_error": "K_error_nm_per_rad",
-    "D_error": "D_error_nms_per_rad",
-    "cost_rad2": "sum_sq_error_rad2",
+#: Result files the layout moved: old path -> new path (relative to results/).
+MOVED = {
+    "tables/impedance.tsv": "impedance/impedance.tsv",
+    "tables/impedance_summary.tsv": "impedance/summary.tsv",
+    "tables/literature.tsv": "impedance/literature.tsv",
+    "tables/tables.md": "report/tables.md",
+    "figures/impedance.png": "impedance/impedance.png",
 }
-#: Files that must be byte-identical (relative to results/; globs).
-IDENTICAL = ("validation/errors.tsv", "device/summary.tsv", "strides/**/*.tsv", "strides/*.tsv")
+#: Folders of per-job logs and timings, which differ from run to run.
+NOT_COMPARED = ("logs", "benchmarks")
 
 
-def _same_bytes(base: Path, new: Path) -> list[str]:
-    problems, seen = [], set()
-    for pattern in IDENTICAL:
-        for path in sorted(base.glob(pattern)):
-            rel = path.relative_to(base)
-            if rel in seen:
-                continue
-            seen.add(rel)
-            other = new / rel
-            if not other.is_file():
-                problems.append(f"{rel}: missing in the new results")
-            elif not filecmp.cmp(path, other, shallow=False):
-                problems.append(f"{rel}: bytes differ")
-    print(f"byte-identical: {len(seen) - len(problems)} of {len(seen)} files")
-    return problems
+def new_place(rel: str) -> str:
+    """Where a file of an older run stands in this layout (``figures/S01/fit.png`` -> ``impedance/S01/fit.png``)."""
+    if rel in MOVED:
+        return MOVED[rel]
+    if rel.startswith("figures/"):
+        return "impedance/" + rel.removeprefix("figures/")
+    return rel
 
 
-def _same_impedance(base: Path, new: Path) -> list[str]:
-    rel = Path("tables/impedance.tsv")
-    old = pd.read_csv(base / rel, sep="\t", dtype=str, keep_default_na=False).rename(columns=RENAMED)
-    now = pd.read_csv(new / rel, sep="\t", dtype=str, keep_default_na=False)
-    extra = [c for c in now.columns if c not in old.columns]
-    missing = [c for c in old.columns if c not in now.columns]
-    if missing:
-        return [f"{rel}: column(s) {missing} of the old table are gone"]
-    now = now[list(old.columns)]
-    if now.shape != old.shape:
-        return [f"{rel}: {now.shape[0]} rows against {old.shape[0]}"]
-    diff = now != old
-    print(f"{rel}: {int(diff.to_numpy().sum())} differing cells of {diff.size} after renaming; new columns {extra}")
-    rows, cols = diff.to_numpy().nonzero()
-    return [
-        f"{rel}: row {i}, column {old.columns[j]}: {old.iat[i, j]!r} -> {now.iat[i, j]!r}"
-        for i, j in zip(rows[:20], cols[:20])
-    ]
-
-
-def _others(base: Path, new: Path) -> None:
-    for path in sorted(base.rglob("*.tsv")):
-        rel = path.relative_to(base)
-        if "benchmarks" in rel.parts:
-            continue
-        other = new / rel
-        state = "missing" if not other.is_file() else ("same" if filecmp.cmp(path, other, shallow=False) else "differs")
-        print(f"  {state:8s} {rel}")
+def _files(results: Path) -> list[str]:
+    return sorted(
+        p.relative_to(results).as_posix()
+        for p in results.rglob("*")
+        if p.is_file() and p.relative_to(results).parts[0] not in NOT_COMPARED
+    )
 
 
 def compare(base: Path, new: Path) -> int:
-    problems = _same_bytes(base, new) + _same_impedance(base, new)
-    print("all TSV tables under results/:")
-    _others(base, new)
+    """Print the comparison of two results folders; 1 when a base file is missing or differs in the new."""
+    problems, same = [], 0
+    for rel in _files(base):
+        other = new / new_place(rel)
+        if not other.is_file():
+            problems.append(f"{rel}: missing in the new results (looked for {new_place(rel)})")
+        elif not filecmp.cmp(base / rel, other, shallow=False):
+            problems.append(f"{rel}: bytes differ")
+        else:
+            same += 1
+    mapped = {new_place(rel) for rel in _files(base)}
+    extra = [rel for rel in _files(new) if rel not in mapped]
+    print(f"byte-identical: {same} of {same + len(problems)} files of the base run")
+    for rel in extra:
+        print(f"  only in the new run: {rel}")
     for p in problems:
         print("FAIL", p)
     print("same science" if not problems else f"{len(problems)} problem(s)")
@@ -123,7 +93,7 @@ def build(rev: str, jobs: int) -> int:
                 ["git", "ls-files", "-co", "--exclude-standard"], cwd=root, check=True, capture_output=True, text=True
             ).stdout.split()
             for f in files:
-                if (root / f).is_file():
+                if (root / f).is_file() and not f.startswith(("results/", "data/")):
                     (new / f).parent.mkdir(parents=True, exist_ok=True)
                     (new / f).write_bytes((root / f).read_bytes())
             return compare(_run(base, jobs), _run(new, jobs))

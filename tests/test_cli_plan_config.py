@@ -1,14 +1,15 @@
 """``loper-analysis plan`` reads the workflow's configuration: the rule's settings, layered as Snakemake layers them.
 
 :func:`loper_analysis.config_file.load_config` reads ``config/config.yaml``
-and further files over it; the planner's settings come from one function,
-:func:`loper_analysis.steps.planning.planning_settings`, which both the rule
-``planning`` and the command call.
+and further files over it; the planner's settings come from one classmethod,
+:meth:`loper_analysis.steps.planning.PlanningSettings.from_config`, which both
+the rule ``planning`` (in ``workflow/rules/inputs.smk``) and the command call.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 import re
 import shutil
 from pathlib import Path
@@ -17,17 +18,17 @@ import pandas as pd
 import pytest
 import yaml
 
-from loper_analysis.cli import _parser, _plan_settings, _read_config, main
+from loper_analysis.cli import _parser, _plan_pilot, _plan_settings, _read_config, main
 from loper_analysis.config_file import find_schema, load_config, update_config
 from loper_analysis.errors import LoperInputError
 from loper_analysis.planning.precision import PlanSettings
-from loper_analysis.steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
+from loper_analysis.steps.planning import PlanningSettings
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config" / "config.yaml"
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
-#: Values that differ from the library's defaults (PlanSettings, LIBRARY_PLANNING_SETTINGS).
+#: Values that differ from the library's defaults (PlanSettings, PlanningSettings).
 WINDOW_AFTER_S = 0.3
 STRIDES = [7, 14]
 
@@ -122,28 +123,31 @@ def test_schema_of_the_config_files_project_wins(project, tmp_path_factory):
 
 def test_rule_takes_its_params_from_the_shared_builder():
     rules = ROOT / "workflow" / "rules"
-    assert "PLAN_SETTINGS = planning_settings(config)" in (rules / "inputs.smk").read_text()
-    assert "**PLAN_SETTINGS," in (rules / "planning.smk").read_text()
-    # every setting the rule's script reads besides the pilot and its trials comes from the builder
+    assert "PLAN_SETTINGS = PlanningSettings.from_config(config)" in (rules / "inputs.smk").read_text()
+    assert "**settings_params(PLAN_SETTINGS)," in (rules / "planning.smk").read_text()
+    # the rule's script reads the pilot, its files and the one settings object, nothing else
     script = (ROOT / "workflow" / "scripts" / "planning.py").read_text()
-    read = set(re.findall(r"\bp\.(\w+)", script)) - {"subject", "trials"}
-    assert read == set(planning_settings(yaml.safe_load(CONFIG.read_text())))
+    assert set(re.findall(r"\bp\.(\w+)", script)) == {"files", "subject", "settings"}
 
 
 def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
     config, _ = load_config(["config/config.yaml", second])
-    rule = planning_settings(config)
+    rule = PlanningSettings.from_config(config)
     args = _parser().parse_args(["plan", "--configfile", str(second)])
     read, line = _read_config(args)
     assert line == "config: config/config.yaml, config/mine.yaml (later files override earlier ones)"
     command = _plan_settings(args, read)
-    assert {k: command[k] for k in rule} == rule
+    assert command == rule
     # the config's values, not the library's defaults, reach the planner
-    assert PlanSettings().window_after_s != WINDOW_AFTER_S and LIBRARY_PLANNING_SETTINGS["strides"] != STRIDES
-    assert command["identification"]["window_after_s"] == command["response"]["window_after_s"] == WINDOW_AFTER_S
-    assert command["strides"] == STRIDES
-    assert command["onsets"] == config["trials"]["perturbation_onsets_ms"]
-    assert command["exclude_trials"] == [config["trials"]["no_device"]]
+    assert PlanSettings().window_after_s != WINDOW_AFTER_S and PlanningSettings().strides != tuple(STRIDES)
+    assert command.plan.window_after_s == command.response.window_after_s == WINDOW_AFTER_S
+    assert command.strides == tuple(STRIDES)
+    assert command.onsets_ms == tuple(config["trials"]["perturbation_onsets_ms"])
+    assert _plan_pilot(args, read) == (
+        config["planning"]["pilot_subject"],
+        config["subjects"],
+        [config["trials"]["no_device"]],
+    )
 
 
 def test_options_given_override_the_config(project, second):
@@ -165,9 +169,10 @@ def test_options_given_override_the_config(project, second):
         ]
     )
     settings = _plan_settings(args, _read_config(args)[0])
-    assert settings["strides"] == [5] and settings["pulse_force_n"] == 30.0 and settings["onsets"] == [125.0]
-    assert settings["targets"] == [{"joint": "hip", "parameter": "K", "percent": 10.0}]
-    assert settings["identification"]["window_after_s"] == WINDOW_AFTER_S  # no option: the config's
+    assert settings.strides == (5,) and settings.plan.pulse_force_n == 30.0 and settings.onsets_ms == (125.0,)
+    assert settings.targets == ({"joint": "hip", "parameter": "K", "percent": 10.0},)
+    assert settings.plan.window_after_s == WINDOW_AFTER_S  # no option: the config's
+    assert settings.plan.pulse_duration_s == PlanningSettings.from_config(load_config()[0]).plan.pulse_duration_s
 
 
 def test_without_a_config_the_library_defaults_serve_and_the_line_says_so(tmp_path, monkeypatch):
@@ -176,8 +181,8 @@ def test_without_a_config_the_library_defaults_serve_and_the_line_says_so(tmp_pa
     config, line = _read_config(args)
     assert config is None
     assert line.startswith("config: none (no config/config.yaml in ") and "library defaults" in line
-    settings = _plan_settings(args, config)
-    assert {k: settings[k] for k in LIBRARY_PLANNING_SETTINGS} == LIBRARY_PLANNING_SETTINGS
+    assert _plan_settings(args, config) == PlanningSettings()
+    assert _plan_pilot(args, config) == (None, "config/subjects.tsv", ["walk-nodevice"])
 
 
 def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
@@ -241,3 +246,12 @@ def test_validate_command_runs_with_the_configs_settings(project, capsys):
     )
     fits = pd.read_csv(project / "fits.tsv", sep="\t")
     assert fits["combination"].nunique() == 1  # 1 level of K and D per joint: 1 combination, not the default 729
+
+
+def test_planning_defaults_are_the_configs_but_onsets_and_targets():
+    """Without a config the planner takes the onsets of the pilot's impedance rows and has no targets; every
+    other setting of the library equals config/config.yaml's."""
+    config = yaml.safe_load(CONFIG.read_text())
+    built = PlanningSettings.from_config(config)
+    assert dataclasses.replace(built, onsets_ms=None, targets=()) == PlanningSettings()
+    assert built.onsets_ms == tuple(config["trials"]["perturbation_onsets_ms"]) and built.targets

@@ -21,7 +21,7 @@ from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.model import scale_with_setup
+from loper_analysis.steps.model import ScaleFiles, scale_with_setup
 from loper_analysis.swing_leg.dynamics import read_segments
 from tests.gait2392_models import scaled_gait2392
 
@@ -144,13 +144,10 @@ def test_scale_command_on_a_c3d_equals_the_step_on_the_trc(lab, tmp_path, capsys
         ]
     )
     assert code == 0, capsys.readouterr()
-    scale_with_setup(
-        GAIT2392 / "gait2392_simbody.osim",
-        GAIT2392 / "scale_setup.xml",
-        lab / "static.trc",
-        80.0,
-        tmp_path / "step.osim",
+    files = ScaleFiles(
+        GAIT2392 / "gait2392_simbody.osim", lab / "static.trc", tmp_path / "step.osim", GAIT2392 / "scale_setup.xml"
     )
+    scale_with_setup(files, 80.0)
     ours = segments_from_model(read_model(out), "l")
     step = segments_from_model(read_model(tmp_path / "step.osim"), "l")
     generic = segments_from_model(read_model(GAIT2392 / "gait2392_simbody.osim"), "l")
@@ -188,8 +185,8 @@ def test_a_file_without_platforms_or_channels(tmp_path, capsys):
     write_c3d(path, ["LHEE", "RHEE"], np.ones((50, 2, 3)), 100.0)
     assert main(["grf", str(path), "--out", str(tmp_path / "g.mot")]) == 2
     _one_line_error(capsys, "plain.c3d", "FORCE_PLATFORM")
-    assert main(["events", str(path), "--out", str(tmp_path / "e.tsv")]) == 2
-    _one_line_error(capsys, "plain.c3d", "no force platforms", "events.grf_channels")
+    assert main(["events", str(path), "--out", str(tmp_path / "e.tsv")]) == 2  # the config's belt channels
+    _one_line_error(capsys, "plain.c3d", "no analog channel 'Fz_left' (events.grf_channels.left)", "no force platforms")
     assert not any(tmp_path.glob("[ge].*"))
 
 

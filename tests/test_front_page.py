@@ -6,6 +6,7 @@ The headline tables it shows are tested in test_headline.py.
 from __future__ import annotations
 
 import base64
+import copy
 import importlib.util
 import math
 import re
@@ -18,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from loper_analysis.constants import JOINTS
 from loper_analysis.identification.impedance import impedance_summary
@@ -29,6 +31,7 @@ from loper_analysis.report.headline import (
     truth_recovery,
     validation_verdict,
 )
+from loper_analysis.steps.report import FrontPageSettings
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -210,11 +213,11 @@ def _write_results(root: Path) -> None:
             for joint, (k, d) in truth.items():
                 ke, de = k * (1 + 0.1 * rng.standard_normal()), d * (1 + 0.1 * rng.standard_normal())
                 rows.append(impedance_row(s, onset, joint, ke, de, (0.8 * ke, 1.2 * ke), (0.8 * de, 1.2 * de), k, d))
-    tables = root / "results/tables"
-    tables.mkdir(parents=True)
-    pd.DataFrame(rows).to_csv(tables / "impedance.tsv", sep="\t", index=False)
-    summary_step(tables / "impedance.tsv", tables / "impedance_summary.tsv", tables / "literature.tsv")
-    impedance_figure(tables / "impedance.tsv", root / "results/figures/impedance.png")
+    impedance = root / "results/impedance"
+    impedance.mkdir(parents=True)
+    pd.DataFrame(rows).to_csv(impedance / "impedance.tsv", sep="\t", index=False)
+    summary_step(impedance / "impedance.tsv", impedance / "summary.tsv", impedance / "literature.tsv")
+    impedance_figure(impedance / "impedance.tsv", impedance / "impedance.png")
     (root / "results/transparency").mkdir(parents=True)
     pd.DataFrame(
         {
@@ -235,20 +238,23 @@ def _write_results(root: Path) -> None:
 
 
 def _front_page(root: Path, versions=VERSIONS) -> str:
-    from loper_analysis.steps.report import front_page
+    from loper_analysis.steps.report import FrontPageFiles, front_page
 
     r = root / "results"
+    files = FrontPageFiles(
+        validation=r / "validation/summary.tsv",
+        device=r / "device/summary.tsv",
+        impedance=r / "impedance/impedance.tsv",
+        summary=r / "impedance/summary.tsv",
+        figure=r / "impedance/impedance.png",
+        rmsd=r / "transparency/rmsd.tsv",
+    )
     return front_page(
+        files,
         r / "report/front_page.html",
-        r / "device/summary.tsv",
-        r / "validation/summary.tsv",
         {s: "synthetic" for s in ("S01", "S02", "S03")},
         {s: ["walk-nodevice", "walk-device", "pert050-1"] for s in ("S01", "S02", "S03")},
-        SETTINGS,
-        r / "tables/impedance.tsv",
-        r / "tables/impedance_summary.tsv",
-        r / "figures/impedance.png",
-        r / "transparency/rmsd.tsv",
+        FrontPageSettings(RunSettings(**SETTINGS)),
         versions=versions,
     )
 
@@ -258,11 +264,11 @@ def test_the_file_step_writes_the_same_bytes_from_the_same_files(tmp_path):
     first = (_front_page(tmp_path), (tmp_path / "results/report/front_page.html").read_bytes())
     again = _front_page(tmp_path)
     assert first[1] == again.encode() == (tmp_path / "results/report/front_page.html").read_bytes()
-    png = (tmp_path / "results/figures/impedance.png").read_bytes()
+    png = (tmp_path / "results/impedance/impedance.png").read_bytes()
     embedded = re.search(r'src="data:image/png;base64,([^"]+)"', again).group(1)
     assert base64.b64decode(embedded) == png  # the figure, byte for byte
-    assert str(tmp_path) not in again and "results/figures" not in again  # no path on the page
-    summary = pd.read_csv(tmp_path / "results/tables/impedance_summary.tsv", sep="\t")
+    assert str(tmp_path) not in again and "impedance.png" not in again  # no path on the page
+    summary = pd.read_csv(tmp_path / "results/impedance/summary.tsv", sep="\t")
     assert f'data-v="{float(summary.K_mean_nm_per_rad.iloc[0])!r}"' in again  # hip, 50 ms, from the file
     assert list(summary.joint) == ["hip"] * 3 + ["knee"] * 3 + ["ankle"] * 3 and (summary.n_subjects == 3).all()
     assert not list((tmp_path / "results/report").glob(".*partial"))  # written through the atomic writer
@@ -313,3 +319,15 @@ def test_the_report_shows_the_headline_tables_on_its_first_screen(tmp_path):
     assert (tmp_path / "first_screen.png").read_bytes()[:4] == b"\x89PNG"
     # the methods text follows the results
     assert measured["boxes"]["lf-run"]["bottom"] > 900
+
+
+def test_the_rule_s_settings_come_from_the_config():
+    """FrontPageSettings.from_config: the shipped config's run settings, and a changed key reaches the page."""
+    config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    run = FrontPageSettings.from_config(config).run
+    assert run.rows() == RunSettings(**SETTINGS).rows()
+    changed = copy.deepcopy(config)
+    changed["identification"]["n_starts"] = 3
+    changed["trials"]["perturbation_onsets_ms"] = [60, 200]
+    rows = dict(FrontPageSettings.from_config(changed).run.rows())
+    assert "3 random starts" in rows["bounds"] and rows["perturbations"].startswith("onsets 60, 200 ms after left")

@@ -25,8 +25,9 @@ from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT
 from loper_analysis.planning.precision import StrideCovariance
 from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
-from loper_analysis.steps import processing
+from loper_analysis.steps import strides as stride_steps
 from loper_analysis.steps import transparency as transparency_step
+from loper_analysis.steps.strides import StrideSettings
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
 from loper_analysis.swing_leg.dynamics import read_segments, write_segments
 from tests.parameter_sets import ASYMMETRIC
@@ -49,10 +50,10 @@ def test_min_valid_strides_is_the_config_value_and_every_default():
     defaults = {
         "strides.stride_tables": _default(strides.stride_tables, "min_valid"),
         "strides.stride_summary": _default(strides.stride_summary, "min_valid"),
-        "steps.processing.strides": _default(processing.strides, "min_valid"),
-        "steps.processing.strides_summary": _default(processing.strides_summary, "min_valid"),
+        "steps.strides.StrideSettings.min_valid": StrideSettings().min_valid,
+        "steps.stride_steps.strides_summary": _default(stride_steps.strides_summary, "min_valid"),
         "transparency.transparency_results": _default(transparency.transparency_results, "min_strides"),
-        "steps.transparency.transparency": _default(transparency_step.transparency, "min_strides"),
+        "steps.transparency.TransparencySettings.min_strides": transparency_step.TransparencySettings().min_strides,
         "outliers.check_enough_strides": _default(outliers.check_enough_strides, "minimum"),
         "ResponseSettings.min_strides": ResponseSettings().min_strides,
     }
@@ -117,14 +118,13 @@ def test_the_iqr_rule_s_whisker_and_fraction_are_the_config_s_and_every_default(
     from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION
     from loper_analysis.responses import ResponseSettings
     from loper_analysis.responses.windows import window_outliers
-    from loper_analysis.steps import processing
 
     assert (IQR_WHISKER, MAX_OUTLIER_FRACTION) == (
         CONFIG["strides"]["iqr_whisker"],
         CONFIG["strides"]["max_outlier_fraction"],
     )
-    for function in (iqr_outliers, strides.stride_tables, processing.strides, window_outliers):
+    for function in (iqr_outliers, strides.stride_tables, window_outliers):
         defaults = inspect.signature(function).parameters
         assert (defaults["whisker"].default, defaults["max_fraction"].default) == (IQR_WHISKER, MAX_OUTLIER_FRACTION)
-    settings = ResponseSettings()
-    assert (settings.whisker, settings.max_fraction) == (IQR_WHISKER, MAX_OUTLIER_FRACTION)
+    for settings in (ResponseSettings(), StrideSettings()):
+        assert (settings.whisker, settings.max_fraction) == (IQR_WHISKER, MAX_OUTLIER_FRACTION)

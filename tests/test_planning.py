@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import logging
 import math
+import shutil
 import warnings
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 from scipy.stats import t as student_t
 
 from loper_analysis.cli import main
@@ -350,6 +353,24 @@ def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path,
     assert f"hip D at 50 ms: ±15 % (95 % CI) needs {n} perturbed strides" in captured.out
 
 
+def test_plan_command_takes_the_working_directory_s_config_and_an_option_wins(pilot_results, tmp_path, monkeypatch):
+    """config/config.yaml of the working directory sets the stride counts and onsets; --strides replaces them."""
+    root = Path(__file__).resolve().parents[1]
+    (tmp_path / "config").mkdir()
+    (tmp_path / "workflow/schemas").mkdir(parents=True)
+    shutil.copy(root / "workflow/schemas/config.schema.yaml", tmp_path / "workflow/schemas/config.schema.yaml")
+    config = yaml.safe_load((root / "config/config.yaml").read_text())
+    config["trials"]["perturbation_onsets_ms"] = [50]
+    config["planning"].update(strides=[7, 30], targets=[])
+    (tmp_path / "config/config.yaml").write_text(yaml.safe_dump(config))
+    monkeypatch.chdir(tmp_path)
+    common = ["plan", "--results", str(pilot_results), "--subject", "S09", "--trials", "pert050-1"]
+    assert main([*common, "--out", "config.tsv"]) == 0
+    assert set(pd.read_csv(tmp_path / "config.tsv", sep="\t")["n_strides"]) == {7, 30}
+    assert main([*common, "--strides", "9", "--out", "option.tsv"]) == 0
+    assert set(pd.read_csv(tmp_path / "option.tsv", sep="\t")["n_strides"]) == {9}
+
+
 @pytest.mark.parametrize(
     "args, message",
     [
@@ -369,7 +390,7 @@ def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
 
 def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_results, tmp_path):
     """A pilot onset without an estimate: ``raise`` names it; ``note`` (the rule) writes rows without a prediction."""
-    from loper_analysis.steps.planning import plan
+    from loper_analysis.steps.planning import PilotFiles, PilotTrial, PlanningSettings, plan
 
     failed = pd.DataFrame(
         {
@@ -384,23 +405,23 @@ def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_r
     )
     write_tsv(failed, tmp_path / "175.tsv")
     root = pilot_results
-    files = dict(
-        trials=["pert050-1"],
-        angles=[root / "ik/S09/pert050-1.angles.tsv"],
-        strides=[root / "strides/S09/pert050-1.strides.tsv"],
-        segments_tsv=root / "model/S09/segments.tsv",
-        subject="S09",
-        onsets_ms=[50, 175],
-        n_strides=[10],
+    files = PilotFiles(
+        trials={
+            "pert050-1": PilotTrial(
+                angles=root / "ik/S09/pert050-1.angles.tsv", strides=root / "strides/S09/pert050-1.strides.tsv"
+            )
+        },
+        segments=root / "model/S09/segments.tsv",
+        impedance=(root / "impedance/S09/050.tsv", tmp_path / "175.tsv"),
     )
-    impedance = [root / "impedance/S09/050.tsv", tmp_path / "175.tsv"]
+    settings = PlanningSettings(onsets_ms=(50, 175), strides=(10,))
     with pytest.raises(
         LoperInputError,
         match=r"no fitted impedance of subject S09 at onset 175 ms for the hip "
         r"\(failed: 3 valid perturbed stride",
     ):
-        plan(**files, impedance_tsvs=impedance)
-    table, _ = plan(**files, impedance_tsvs=impedance, unplannable="note")
+        plan(files, "S09", settings)
+    table, _ = plan(files, "S09", settings, unplannable="note")
     late = table[table["onset_ms"] == 175]
     assert len(late) == 6 and late["predicted_sd"].isna().all() and late["note"].str.startswith("not planned").all()
     assert table.loc[table["onset_ms"] == 50, "predicted_sd"].notna().all()

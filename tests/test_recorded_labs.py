@@ -23,6 +23,7 @@ import yaml
 
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
+from loper_analysis.steps.markers import MarkerSettings
 from tests.rajagopal_lab import (
     GENERIC_OSIM,
     GRF_MOT,
@@ -230,8 +231,8 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     turned to walk along the model's +X, with no per-trial setting, and the joint angles agree."""
     from loper_analysis.io.c3d import read_c3d
     from loper_analysis.io.c3d_writer import write_c3d
-    from loper_analysis.steps.ik import ik_trial
-    from loper_analysis.steps.processing import markers
+    from loper_analysis.steps.ik import IKSettings, ik_trial
+    from loper_analysis.steps.markers import markers
 
     rec = read_c3d(WALKING5)
     write_c3d(
@@ -247,8 +248,7 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
         markers(
             c3d,
             tmp_path / f"{name}.trc",
-            walking_direction="auto",
-            span_s=(2.0, 2.6),
+            settings=MarkerSettings(walking_direction="auto", span_s=(2.0, 2.6)),
             summary_out=tmp_path / f"{name}.markers.tsv",
         )
         angles[name] = ik_trial(
@@ -256,8 +256,7 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
             tmp_path / f"{name}.trc",
             tmp_path / f"{name}.mot",
             tmp_path / f"{name}.angles.tsv",
-            coordinate_map,
-            tasks_file=tasks,
+            IKSettings(tasks_file=tasks, coordinate_map=coordinate_map),
         )
     turns = [pd.read_csv(tmp_path / f"{n}.markers.tsv", sep="\t")["turn_deg"].iloc[0] for n in ("minus_x", "plus_x")]
     assert turns == [180.0, 0.0]

@@ -24,7 +24,7 @@ from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.synthetic import lab_export_session
+from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
 from loper_analysis.swing_leg.dynamics import read_segments
 from tests.workflow_copy import copy_workflow, snakemake
 
@@ -35,7 +35,7 @@ GENERIC = EXAMPLE / "gait2392_simbody.osim"
 MASS_KG = 75.1646  # gait2392's own mass: the scaled model keeps its masses
 FIRST_TIME_S = 1000 / 128.0
 TRUE_IMPEDANCE = {"hip": (55.0, 3.5), "knee": (3.0, 0.1), "ankle": (8.0, 0.3)}  # K (N·m/rad), D (N·m·s/rad)
-TARGETS = ("results/tables/impedance.tsv", "results/strides/summary.tsv", "results/grf/R01/pert050-1.grf.mot")
+TARGETS = ("results/impedance/impedance.tsv", "results/strides/summary.tsv", "results/grf/R01/pert050-1.grf.mot")
 
 
 def _test_config() -> dict:
@@ -52,21 +52,17 @@ def lab_run(tmp_path_factory):
     """The workflow on one recorded subject: its session (walking with the device, one perturbation trial)."""
     work = tmp_path_factory.mktemp("lab")
     copy_workflow(work)
+    files = LabExportFiles(
+        work / "data/raw/R01", GENERIC, EXAMPLE / "gait2392_Scale_MarkerSet.xml", EXAMPLE / "qtm_label_map.tsv"
+    )
     truth = lab_export_session(
-        work / "data/raw/R01",
+        files,
         "R01",
-        GENERIC,
-        EXAMPLE / "gait2392_Scale_MarkerSet.xml",
-        EXAMPLE / "qtm_label_map.tsv",
-        ["walk-device", "pert050-1"],
-        [None, 50],
-        "walk-nodevice",
+        ["walk-device", "pert050-1"],  # the default design: pulses 50 ms after toe-off in pert050-1
         1.80,
         MASS_KG,
-        40.0,
-        seed=7,
+        LabExportSettings(seed=7, walking_duration_s=40.0, perturb_every_strides=(2, 3)),
         impedance=[v for j in ("hip", "knee", "ankle") for v in TRUE_IMPEDANCE[j]],
-        perturb_every_strides=(2, 3),
     )
     (work / "config/subjects.tsv").write_text(f"subject\tsource\theight_m\tmass_kg\nR01\trecorded\t1.80\t{MASS_KG}\n")
     (work / "config/test.yaml").write_text(yaml.safe_dump(_test_config(), sort_keys=False))
@@ -144,7 +140,7 @@ def test_ground_reaction_mot_holds_the_belt_force_in_the_model_frame(lab_run):
 
 def test_impedance_table_recovers_the_true_impedance(lab_run):
     work, _ = lab_run
-    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t").set_index("joint")
+    table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t").set_index("joint")
     assert (table.loc[["hip", "ankle"], "status"] == "ok").all(), table["reason"]
     # one 40 s trial, 6 strides kept: the knee's D interval (0 ... 0.99) holds both 0 and the study's whole knee
     # range (D up to 0.14): the data cannot tell its size; its K interval (0 ... 3.2) ends below the range's 3.5,

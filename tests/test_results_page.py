@@ -171,8 +171,8 @@ def run(tmp_path, monkeypatch):
     files = {
         "config/config.yaml": CONFIG,
         "config/subjects.tsv": SUBJECTS,
-        "results/tables/impedance.tsv": impedance_tsv(),
-        "results/tables/impedance_summary.tsv": SUMMARY,
+        "results/impedance/impedance.tsv": impedance_tsv(),
+        "results/impedance/summary.tsv": SUMMARY,
         "results/validation/summary.tsv": VALIDATION,
         "results/validation/fits.tsv": FITS_TSV,
         "results/transparency/rmsd.tsv": RMSD,

@@ -20,7 +20,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
 from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.model import segments_from_model_file
+from loper_analysis.steps.model import ModelSettings, segments_from_model_file
 from loper_analysis.swing_leg.dynamics import read_segments, write_segments
 from tests.gait2392_models import scaled_gait2392
 
@@ -222,13 +222,13 @@ def test_generated_model_table_is_unchanged(tmp_path):
     a, b = tmp_path / "legacy.tsv", tmp_path / "new.tsv"
     write_segments(segment_parameters_from_model(model), a)
     path = write_model(model, tmp_path / "generated.osim")
-    segments_from_model_file(path, b, "left")
+    segments_from_model_file(path, b, ModelSettings(side="left"))
     assert a.read_bytes() == b.read_bytes()
 
 
 def test_segment_table_file_of_a_user_model(scaled_model_file, tmp_path):
     out = tmp_path / "segments.tsv"
-    returned = segments_from_model_file(scaled_model_file, out, "right", attachment_fraction=0.7)
+    returned = segments_from_model_file(scaled_model_file, out, ModelSettings(side="right", attachment_fraction=0.7))
     ref = hand_segment_table(scaled_model_file, "r", 0.7)
     np.testing.assert_allclose(read_segments(out).packed, returned.packed, rtol=1e-9)
     np.testing.assert_allclose(returned.attachment_m, ref["attachment_m"], rtol=1e-9)
@@ -241,7 +241,7 @@ def test_missing_body_names_file_setting_and_body(tmp_path):
         match=r"gait2392_simbody\.osim: opensim\.segment_bodies: shank body 'shin_l' "
         r"is not in the model \(its bodies: pelvis, femur_r",
     ):
-        segments_from_model_file(GAIT2392, tmp_path / "never.tsv", "left", bodies)
+        segments_from_model_file(GAIT2392, tmp_path / "never.tsv", ModelSettings(side="left", segment_bodies=bodies))
     assert not (tmp_path / "never.tsv").exists()
     with pytest.raises(LoperInputError, match=r"gait2392_simbody\.osim: opensim\.segment_bodies: thigh body 'thigh_l'"):
         segments_from_model(

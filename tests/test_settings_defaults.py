@@ -99,7 +99,7 @@ IDENTIFICATION_KEYS = {
     for f in dataclasses.fields(IdentificationSettings)
     if f.name not in ("plausible_ranges", "seed")
 }
-#: LabSettings field -> config key (as the workflow's lab_settings() passes them).
+#: LabSettings field -> config key (as LabSettings.from_config reads them for the workflow).
 LAB_KEYS = {
     "marker_noise_sd_m": "synthetic.marker_noise_sd_m",
     "n_gaps": "synthetic.marker_gaps_per_trial",

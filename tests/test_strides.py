@@ -7,6 +7,7 @@ import pytest
 
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
 from loper_analysis.gait.strides import force_phase_metrics, stride_summary, stride_tables
+from loper_analysis.steps.strides import StrideSettings
 
 FS = 1000.0
 
@@ -240,7 +241,7 @@ def test_the_steps_write_and_summarise_trials_with_zero_and_one_stride(tmp_path)
     n_strides 0 and 1 and too_few_strides, next to a trial with enough strides."""
     from loper_analysis.io.atomic import write_tsv
     from loper_analysis.io.readers import read_tsv
-    from loper_analysis.steps.processing import strides, strides_summary
+    from loper_analysis.steps.strides import strides, strides_summary
 
     files = {}
     for n_heel_strikes in (1, 2, 6):
@@ -255,7 +256,7 @@ def test_the_steps_write_and_summarise_trials_with_zero_and_one_stride(tmp_path)
                 out,
                 tmp_path / f"{n_heel_strikes}.cycles.tsv",
                 tmp_path / f"{n_heel_strikes}.force.tsv",
-                min_valid=5 if n_heel_strikes < 6 else 4,
+                StrideSettings(min_valid=5 if n_heel_strikes < 6 else 4),
             )
         files[n_heel_strikes] = out
     assert files[1].read_text() == "\t".join(STRIDE_COLUMNS) + "\n"  # the header only, every column
@@ -295,8 +296,8 @@ def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
     """The transparency step on stride tables of 0 and 1 strides (as the strides step writes them): the subject
     is left out with its counts, nothing crashes; the other subject is compared with itself (RMSD 0)."""
     from loper_analysis.io.atomic import write_tsv
-    from loper_analysis.steps.processing import strides
-    from loper_analysis.steps.transparency import transparency
+    from loper_analysis.steps.strides import strides
+    from loper_analysis.steps.transparency import TransparencyFiles, transparency
 
     paths = {}
     for n_heel_strikes in (1, 2, 6):
@@ -315,11 +316,7 @@ def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
     pairs = {"S01": (6, 6), "S02": (6, 1), "S03": (2, 6)}  # heel strikes without, with the device
     with pytest.warns(TooFewStridesWarning) as caught:
         transparency(
-            list(pairs),
-            [paths[a][0] for a, _ in pairs.values()],
-            [paths[a][1] for a, _ in pairs.values()],
-            [paths[b][0] for _, b in pairs.values()],
-            [paths[b][1] for _, b in pairs.values()],
+            {s: TransparencyFiles(*paths[a], *paths[b]) for s, (a, b) in pairs.items()},
             tmp_path / "rmsd.tsv",
             tmp_path / "force.tsv",
             tmp_path / "t.png",

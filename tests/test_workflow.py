@@ -123,7 +123,7 @@ def test_impedance_table_from_the_default_run(finished_run):
     """One subject, one 25 s trial at the 50 ms onset: too few perturbations to fit, reported as failed."""
     from loper_analysis.identification.impedance import IMPEDANCE_COLUMNS
 
-    table = pd.read_csv(finished_run / "results/tables/impedance.tsv", sep="\t")
+    table = pd.read_csv(finished_run / "results/impedance/impedance.tsv", sep="\t")
     assert list(table.columns) == list(IMPEDANCE_COLUMNS)
     assert list(table.joint) == ["hip", "knee", "ankle"] and (table.onset_ms == 50).all()
     counts = pd.read_csv(finished_run / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
@@ -132,14 +132,14 @@ def test_impedance_table_from_the_default_run(finished_run):
     assert counts.loc["total", "status"] == "too_few_strides"
     assert (table.status == "failed").all() and table.reason.str.contains("3 valid perturbed stride").all()
     assert table.K_nm_per_rad.isna().all()
-    summary = pd.read_csv(finished_run / "results/tables/impedance_summary.tsv", sep="\t")
+    summary = pd.read_csv(finished_run / "results/impedance/summary.tsv", sep="\t")
     assert len(summary) == 0 and list(summary.columns[:2]) == ["joint", "onset_ms"]  # nothing fitted
-    literature = pd.read_csv(finished_run / "results/tables/literature.tsv", sep="\t")
+    literature = pd.read_csv(finished_run / "results/impedance/literature.tsv", sep="\t")
     assert len(literature) == 7 and literature.K_low_nm_per_rad.iloc[0] == 50.0
-    md = (finished_run / "results/tables/tables.md").read_text()
+    md = (finished_run / "results/report/tables.md").read_text()
     assert "## Impedance per subject, onset and joint" in md and "| S01 | 50 | hip |" in md
     assert "## Transparency: RMSD vs ISV_ave" in md and "## Validation study" in md
-    for fig in ("figures/impedance.png", "figures/S01/responses.png", "figures/S01/fit.png"):
+    for fig in ("impedance/impedance.png", "impedance/S01/responses.png", "impedance/S01/fit.png"):
         assert (finished_run / "results" / fig).read_bytes()[:4] == b"\x89PNG", fig
     truth = yaml.safe_load((finished_run / "data/raw/S01/truth.yaml").read_text())
     np.testing.assert_allclose(
@@ -291,9 +291,9 @@ def test_recorded_subject_without_a_trial_reports_that_onset_missing(finished_ru
     raw.mkdir(parents=True)
     for name in ("static.c3d", "walk-nodevice.c3d", "walk-device.c3d", "walk-device.loper.tsv"):
         shutil.copy(finished_run / "data/raw/S01" / name, raw / name)
-    res = _snakemake(work, "results/tables/impedance.tsv")
+    res = _snakemake(work, "results/impedance/impedance.tsv")
     assert res.returncode == 0, res.stderr[-3000:]
-    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+    table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
     assert list(table.joint) == ["hip", "knee", "ankle"] and (table.subject == "R01").all()
     assert (table.status == "missing").all() and (table.reason == "no trial of this onset").all()
     assert table[["K_nm_per_rad", "D_nms_per_rad", "K_true_nm_per_rad", "D_true_nms_per_rad"]].isna().all().all()
@@ -339,7 +339,7 @@ def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_ru
     assert len(rmsd) == 12 and (rmsd.n_strides_device == [2] * 6 + [0] * 6).all()
     assert rmsd[["rmsd_rad", "isv_ave_rad", "transparent"]].isna().all().all()
     assert "subject S01: " in (work / "results/logs/transparency/transparency.log").read_text()
-    table = pd.read_csv(work / "results/tables/impedance.tsv", sep="\t")
+    table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
     assert (table.status == "failed").all() and table.reason.str.startswith("0 valid perturbed stride(s)").all()
     counts = pd.read_csv(work / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
     assert counts.loc["total", ["n_perturbed", "status"]].tolist() == [0, "too_few_strides"]

@@ -21,7 +21,7 @@ error naming the file and the cause when an input cannot serve
 from __future__ import annotations
 
 import argparse
-import copy
+import dataclasses
 import sys
 import tempfile
 from pathlib import Path
@@ -29,27 +29,24 @@ from pathlib import Path
 import numpy as np
 
 from loper_analysis.errors import LoperInputError, one_line
-from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
 __all__ = ["main"]
 
-#: Lab -> model rotation (degrees about X, Y, Z) used for a C3D when --rotate-deg is not given:
-#: Qualisys Z-up -> OpenSim Y-up.
-C3D_ROTATION_DEG = (-90.0, 0.0, 0.0)
 
-
-def _rotation(args: argparse.Namespace, path: str) -> tuple[float, float, float]:
-    """--rotate-deg, else -90 0 0 for a C3D (Z-up lab) and 0 0 0 for anything else."""
-    if args.rotate_deg is not None:
-        return tuple(args.rotate_deg)
-    return C3D_ROTATION_DEG if str(path).lower().endswith(".c3d") else (0.0, 0.0, 0.0)
+def _rotation_option(args: argparse.Namespace, path: str) -> tuple[float, float, float] | None:
+    """--rotate-deg, else None for a C3D (the config's ``markers.lab_to_model_rotation_deg`` serves) and 0 0 0 for
+    anything else."""
+    if args.rotate_deg is not None or str(path).lower().endswith(".c3d"):
+        return None if args.rotate_deg is None else tuple(args.rotate_deg)
+    return (0.0, 0.0, 0.0)
 
 
 def _walking_direction(args: argparse.Namespace) -> str:
-    """--walking-direction, else ``fixed`` when --rotate-deg is given (the rotation as typed) and ``auto`` otherwise."""
+    """--walking-direction, else ``fixed`` when --rotate-deg is given (the rotation as typed), else None (the
+    config's ``markers.walking_direction``)."""
     if args.walking_direction is not None:
         return args.walking_direction
-    return "fixed" if args.rotate_deg is not None else "auto"
+    return "fixed" if args.rotate_deg is not None else None
 
 
 def _label_map(path: str | None) -> dict[str, str] | None:
@@ -58,20 +55,33 @@ def _label_map(path: str | None) -> dict[str, str] | None:
     return None if path is None else read_label_map(path)
 
 
-def _markers(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.processing import markers
+def _stage_settings(args: argparse.Namespace, settings_type, **given):
+    """A stage's settings: the config's (:func:`_read_config`, its line printed), else the library's defaults;
+    then each option in ``given`` that is not None."""
+    config, line = _read_config(args)
+    print(line)
+    settings = settings_type() if config is None else settings_type.from_config(config)
+    if config is not None and "label_map" in given and given["label_map"] is None:
+        given["label_map"] = config["markers"]["label_map"] or None
+    return dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})
 
-    gaps = markers(
-        args.c3d,
-        args.out,
-        args.gaps,
-        _rotation(args, args.c3d),
-        args.max_gap_frames,
-        args.cutoff_hz or None,
-        args.order,
-        label_map=_label_map(args.label_map),
+
+def _markers(args: argparse.Namespace) -> None:
+    from loper_analysis.steps.markers import MarkerSettings, markers
+
+    settings = _stage_settings(
+        args,
+        MarkerSettings,
+        rotation_deg=_rotation_option(args, args.c3d),
         walking_direction=_walking_direction(args),
+        cutoff_hz=args.cutoff_hz,
+        order=args.order,
+        max_gap_frames=args.max_gap_frames,
+        label_map=_label_map(args.label_map),
     )
+    if not settings.cutoff_hz:
+        settings = dataclasses.replace(settings, cutoff_hz=None)
+    gaps = markers(args.c3d, args.out, args.gaps, settings)
     per_marker = gaps.attrs.get("per_marker", [])
     n_frames = per_marker[0]["n_frames"] if per_marker else 0
     missing = sum(row["n_missing_frames"] > 0 for row in per_marker)
@@ -82,9 +92,12 @@ def _markers(args: argparse.Namespace) -> None:
 
 
 def _grf(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.grf import grf
+    from loper_analysis.steps.grf import GRFSettings, grf
 
-    table = grf(args.c3d, args.out, _rotation(args, args.c3d), args.threshold_n)
+    settings = _stage_settings(
+        args, GRFSettings, rotation_deg=_rotation_option(args, args.c3d), threshold_n=args.threshold_n
+    )
+    table = grf(args.c3d, args.out, settings)
     n_plates = (table.shape[1] - 1) // 9
     print(f"{args.out}: {len(table)} samples, {n_plates} force platform(s)")
 
@@ -104,59 +117,68 @@ def _plates(text: str | None) -> dict[str, int] | None:
 
 
 def _events(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.processing import events
+    from loper_analysis.steps.events import EventSettings, events
 
-    table = events(
-        args.c3d,
-        args.out,
-        grf_channels=None,
+    settings = _stage_settings(
+        args,
+        EventSettings,
         threshold_on_n=args.threshold_on_n,
         threshold_off_n=args.threshold_off_n,
-        foot_markers=dict(zip(("left", "right"), args.feet)),
+        foot_markers=None if args.feet is None else dict(zip(("left", "right"), args.feet)),
         plate_sides=_plates(args.plates),
-        rotation_deg=_rotation(args, args.c3d),
+        rotation_deg=_rotation_option(args, args.c3d),
         label_map=_label_map(args.label_map),
     )
+    table = events(args.c3d, args.out, settings)
     flagged = table.attrs.get("n_contacts_flagged", 0)
     print(f"{args.out}: {len(table)} events; {flagged} contact(s) flagged and left out")
 
 
 def _scale(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.model import scale_with_setup
-    from loper_analysis.steps.processing import markers
+    from loper_analysis.io.readers import read_label_maps
+    from loper_analysis.steps.markers import MarkerSettings, markers
+    from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale_with_setup
 
+    config, line = _read_config(args)
+    print(line)
+    settings = ModelSettings() if config is None else ModelSettings.from_config(config)
+    given = {
+        "rotation_deg": _rotation_option(args, args.static),
+        "time_range_s": None if args.start is None else (args.start, args.end),
+        "max_motion_rms_m": args.max_motion_rms_m,
+    }
+    settings = dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})
+    if not settings.max_motion_rms_m:
+        settings = dataclasses.replace(settings, max_motion_rms_m=None)
     static = c3d = Path(args.static)
     lab_labels = None
     with tempfile.TemporaryDirectory() as tmp:
         if static.suffix.lower() == ".c3d":
             trc = Path(tmp) / (static.stem + ".trc")
-            gaps = markers(
-                static,
-                trc,
-                None,
-                _rotation(args, args.static),
-                args.max_gap_frames,
-                args.cutoff_hz or None,
-                label_map=_label_map(args.label_map),
+            label_map = _label_map(args.label_map)
+            if label_map is None and config is not None:
+                label_map = read_label_maps(config["markers"]["label_map"] or None)
+            frame = MarkerSettings(
+                rotation_deg=settings.rotation_deg,
+                walking_direction="fixed",
+                max_gap_frames=args.max_gap_frames,
+                cutoff_hz=args.cutoff_hz or None,
+                label_map=label_map,
             )
+            gaps = markers(static, trc, None, frame)
             lab_labels = {row["marker"]: row["label"] for row in gaps.attrs["per_marker"]}
             static = trc
         elif args.mass_kg is None:
             raise LoperInputError(f"scale: {args.static}: a .trc static trial has no force plates: give --mass-kg")
-        time_range = None if args.start is None else (args.start, args.end)
-        scale_with_setup(
+        files = ScaleFiles(
             args.model,
-            args.setup,
             static,
-            args.mass_kg,
             args.out,
-            time_range_s=time_range,
+            setup_xml=args.setup,
             static_c3d=c3d if c3d.suffix.lower() == ".c3d" else None,
-            lab_labels=lab_labels,
-            rotation_deg=_rotation(args, args.static),
             report_out=args.report,
-            max_motion_rms_m=args.max_motion_rms_m or None,
         )
+        scale_with_setup(files, args.mass_kg, settings, lab_labels=lab_labels)
     mass = f"{args.mass_kg:g} kg" if args.mass_kg is not None else "mass from the static trial's force plates"
     print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({mass})")
     if args.report:
@@ -164,16 +186,18 @@ def _scale(args: argparse.Namespace) -> None:
 
 
 def _segments(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.model import anthropometric_segments, segments_from_model_file
+    from loper_analysis.steps.model import ModelSettings, anthropometric_segments, segments_from_model_file
 
     if args.model is not None:
         if args.height_m is not None or args.mass_kg is not None:
             raise LoperInputError("segments: give either --model or --height-m and --mass-kg, not both")
-        segments_from_model_file(args.model, args.out, args.side, attachment_fraction=args.attachment_fraction)
     elif args.height_m is None or args.mass_kg is None:
         raise LoperInputError("segments: give --model SCALED.osim, or --height-m and --mass-kg")
+    settings = _stage_settings(args, ModelSettings, side=args.side, attachment_fraction=args.attachment_fraction)
+    if args.model is not None:
+        segments_from_model_file(args.model, args.out, settings)
     else:
-        anthropometric_segments(args.out, args.height_m, args.mass_kg, args.attachment_fraction)
+        anthropometric_segments(args.out, args.height_m, args.mass_kg, settings.attachment_fraction)
     print(f"{args.out}: segment table")
 
 
@@ -228,64 +252,64 @@ def _read_config(args: argparse.Namespace) -> tuple[dict | None, str]:
     return config, f"config: {', '.join(used)}{order}"
 
 
-def _plan_settings(args: argparse.Namespace, config: dict | None) -> dict:
-    """The planner's settings: options given on the command line, else the config's, else the library's defaults.
-
-    The config's are those of the rule ``planning``
-    (:func:`loper_analysis.steps.planning.planning_settings`); besides them
-    ``subject`` (``planning.pilot_subject``; None: the first of the sheet),
-    ``subjects`` (the subject sheet, config ``subjects``) and
-    ``exclude_trials`` (``trials.no_device``).
+def _plan_settings(args: argparse.Namespace, config: dict | None):
+    """The planner's settings: those of the rule ``planning`` (the config's,
+    :meth:`loper_analysis.steps.planning.PlanningSettings.from_config`), else the library's defaults; then the
+    options given on the command line (targets given replace the config's).
     """
-    from loper_analysis.steps.planning import LIBRARY_PLANNING_SETTINGS, planning_settings
+    from loper_analysis.steps.planning import PlanningSettings
 
-    if config is None:
-        settings = copy.deepcopy(LIBRARY_PLANNING_SETTINGS)
-        settings.update(subject=None, subjects="config/subjects.tsv", exclude_trials=["walk-nodevice"])
-    else:
-        settings = planning_settings(config)
-        settings.update(
-            subject=config["planning"]["pilot_subject"],
-            subjects=config["subjects"],
-            exclude_trials=[config["trials"]["no_device"]],
-        )
+    settings = PlanningSettings() if config is None else PlanningSettings.from_config(config)
+    pulse = {k: v for k, v in (("pulse_force_n", args.force_n), ("pulse_duration_s", args.duration_s)) if v is not None}
     given = {
-        "onsets": args.onset_ms,
-        "strides": args.strides,
-        "pulse_force_n": args.force_n,
-        "pulse_duration_s": args.duration_s,
-        "subject": args.subject,
-        "subjects": args.subjects,
-        "exclude_trials": args.exclude_trials,
+        "onsets_ms": None if args.onset_ms is None else tuple(args.onset_ms),
+        "strides": None if args.strides is None else tuple(args.strides),
+        "plan": dataclasses.replace(settings.plan, **pulse) if pulse else None,
     }
-    settings.update({k: v for k, v in given.items() if v is not None})
-    if args.target is not None or args.target_half_width is not None:  # the targets given replace the config's
-        settings["targets"] = [{"joint": j, "parameter": p, "percent": float(v)} for j, p, v in args.target or []]
-        settings["targets"] += [
-            {"joint": j, "parameter": p, "half_width": float(v)} for j, p, v in args.target_half_width or []
-        ]
-    return settings
+    if args.target is not None or args.target_half_width is not None:
+        given["targets"] = tuple(
+            [{"joint": j, "parameter": p, "percent": float(v)} for j, p, v in args.target or []]
+            + [{"joint": j, "parameter": p, "half_width": float(v)} for j, p, v in args.target_half_width or []]
+        )
+    return dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})
+
+
+def _plan_pilot(args: argparse.Namespace, config: dict | None) -> tuple[str | None, str, list[str]]:
+    """The pilot subject (``--subject``, else ``planning.pilot_subject``; None: the first of the subject sheet),
+    the subject sheet (``--subjects``, else the config's ``subjects``, else ``config/subjects.tsv``) and the
+    trials without the device (``--exclude-trials``, else ``trials.no_device``, else the library's)."""
+    from loper_analysis.study_design import StudyDesign
+
+    pilot = args.subject or (None if config is None else config["planning"]["pilot_subject"])
+    sheet = args.subjects or ("config/subjects.tsv" if config is None else config["subjects"])
+    exclude = args.exclude_trials
+    if exclude is None:
+        exclude = [StudyDesign().no_device if config is None else config["trials"]["no_device"]]
+    return pilot, sheet, exclude
 
 
 def _plan(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.planning import plan
+    from loper_analysis.planning.precision import PLAN_COLUMNS
+    from loper_analysis.steps.planning import PilotFiles, PilotTrial, plan
 
     config, line = _read_config(args)
     print(line)
-    s = _plan_settings(args, config)
+    settings = _plan_settings(args, config)
+    pilot, sheet, exclude = _plan_pilot(args, config)
     results = Path(args.results)
-    subject = s["subject"] or _first_subject(s["subjects"], results)
+    subject = pilot or _first_subject(sheet, results)
     ik_dir = results / "ik" / subject
     names = args.trials or sorted(p.name.removesuffix(".angles.tsv") for p in ik_dir.glob("*.angles.tsv"))
-    names = [n for n in names if n not in s["exclude_trials"]]
+    names = [n for n in names if n not in exclude]
     if not names:
         raise LoperInputError(
-            f"plan: no joint-angle table of a trial with the device in {ik_dir} "
-            f"(excluded: {', '.join(s['exclude_trials'])})"
+            f"plan: no joint-angle table of a trial with the device in {ik_dir} (excluded: {', '.join(exclude)})"
         )
-    angles = [ik_dir / f"{n}.angles.tsv" for n in names]
-    strides = [results / "strides" / subject / f"{n}.strides.tsv" for n in names]
-    for path in (*angles, *strides):
+    trials = {
+        n: PilotTrial(angles=ik_dir / f"{n}.angles.tsv", strides=results / "strides" / subject / f"{n}.strides.tsv")
+        for n in names
+    }
+    for path in [*(t.angles for t in trials.values()), *(t.strides for t in trials.values())]:
         if not path.is_file():
             raise LoperInputError(f"plan: {path} not found")
     segments = Path(args.segments) if args.segments else results / "model" / subject / "segments.tsv"
@@ -295,8 +319,7 @@ def _plan(args: argparse.Namespace) -> None:
         else sorted((results / "impedance" / subject).glob("[0-9][0-9][0-9].tsv"))
     )
     values = args.impedance_values
-    onsets = s["onsets"]
-    if onsets is None:
+    if settings.onsets_ms is None:
         if values is not None:
             raise LoperInputError("plan: with --impedance-values give --onset-ms")
         onsets = [int(p.stem) for p in impedance_tsvs if p.stem.isdigit()]
@@ -305,42 +328,15 @@ def _plan(args: argparse.Namespace) -> None:
                 f"plan: no impedance rows of {subject} in {results / 'impedance' / subject}; "
                 "give --onset-ms and --impedance or --impedance-values"
             )
-    table, answers = plan(
-        names,
-        angles,
-        strides,
-        segments,
-        subject,
-        onsets,
-        s["strides"],
-        args.out,
-        impedance_tsvs=impedance_tsvs,
-        impedance=values,
-        targets=s["targets"],
-        pulse_force_n=s["pulse_force_n"],
-        pulse_duration_s=s["pulse_duration_s"],
-        response=s["response"],
-        identification=s["identification"],
-        device=s["device"],
-    )
-    shown = table[
-        [
-            "onset_ms",
-            "joint",
-            "parameter",
-            "unit",
-            "n_strides",
-            "planned_value",
-            "predicted_sd",
-            "ci95_half_width",
-            "ci95_half_width_pct",
-        ]
-    ]
+        settings = dataclasses.replace(settings, onsets_ms=tuple(onsets))
+    files = PilotFiles(trials=trials, segments=segments, impedance=tuple(impedance_tsvs))
+    table, answers = plan(files, subject, settings, args.out, impedance=values)
+    shown = table[list(PLAN_COLUMNS[PLAN_COLUMNS.index("onset_ms") : PLAN_COLUMNS.index("ci95_half_width_pct") + 1])]
     print(
         f"pilot {subject} ({len(names)} trials with the device; null pairs: "
         f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}; perturbed pairs: "
         f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_perturbed_pairs'].first())}); "
-        f"pulse {s['pulse_force_n']:g} N for {s['pulse_duration_s']:g} s"
+        f"pulse {settings.plan.pulse_force_n:g} N for {settings.plan.pulse_duration_s:g} s"
     )
     print(shown.to_string(index=False, float_format=lambda v: f"{v:.4g}"))
     for a in answers:
@@ -350,22 +346,35 @@ def _plan(args: argparse.Namespace) -> None:
 
 
 def _ik(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.ik import ik_file
+    from loper_analysis.io.readers import read_label_maps
+    from loper_analysis.steps.ik import IKSettings, ik_file
+    from loper_analysis.steps.markers import MarkerSettings
 
+    config, line = _read_config(args)
+    print(line)
+    settings = IKSettings() if config is None else IKSettings.from_config(config)
+    given = {
+        "tasks_file": args.tasks,
+        "accuracy": args.accuracy,
+        "max_marker_rms_m": args.max_marker_rms_m,
+        "warn_marker_rms_m": args.warn_marker_rms_m,
+        "max_rms_fraction": args.max_rms_fraction,
+    }
+    settings = dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})
+    # a C3D holds the lab's labels in the lab's frame (the config's markers.*); a TRC the model's already
+    lab = MarkerSettings() if config is None else MarkerSettings.from_config(config)
+    label_map = _label_map(args.label_map)
+    if label_map is None and config is not None and str(args.markers).lower().endswith(".c3d"):
+        label_map = read_label_maps(config["markers"]["label_map"] or None)
     result = ik_file(
         args.model,
         args.markers,
         args.out,
-        args.tasks,
-        args.start,
-        args.end,
-        args.rotate_deg,
-        args.accuracy,
-        max_marker_rms_m=args.max_marker_rms_m,
-        max_rms_fraction=args.max_rms_fraction,
-        label_map=_label_map(args.label_map),
-        warn_marker_rms_m=args.warn_marker_rms_m,
-        walking_direction=_walking_direction(args),
+        settings,
+        (args.start, args.end),
+        _rotation_option(args, args.markers) or lab.rotation_deg,
+        label_map,
+        _walking_direction(args) or lab.walking_direction,
     )
     left_out = f", {result.n_left_out} left out (too few markers)" if result.n_left_out else ""
     print(
@@ -396,7 +405,8 @@ def _rotate_option(p: argparse.ArgumentParser, heading: bool = False) -> None:
         nargs=3,
         metavar=("X", "Y", "Z"),
         help="rotate lab coordinates about the fixed X, Y, Z axes (degrees) into the model frame; default "
-        "-90 0 0 for .c3d (Qualisys Z-up -> OpenSim Y-up), 0 0 0 for .trc",
+        "for .c3d: markers.lab_to_model_rotation_deg (without a config -90 0 0, Qualisys Z-up -> OpenSim Y-up); "
+        "0 0 0 for .trc",
     )
     if heading:
         p.add_argument(
@@ -404,7 +414,7 @@ def _rotate_option(p: argparse.ArgumentParser, heading: bool = False) -> None:
             choices=("auto", "fixed"),
             help="auto: a trial that travels (overground) is turned by quarter turns about the vertical to "
             "walk along the model's +X; fixed: the rotation as it is (default: fixed with --rotate-deg, "
-            "else auto)",
+            "else markers.walking_direction, without a config auto)",
         )
 
 
@@ -413,7 +423,7 @@ def _label_map_option(p: argparse.ArgumentParser) -> None:
         "--label-map",
         metavar="MAP",
         help="TSV (columns label, marker) or YAML mapping: lab label -> "
-        "model marker; subject prefixes (Name:) are stripped first",
+        "model marker; subject prefixes (Name:) are stripped first (default for a .c3d: markers.label_map)",
     )
 
 
@@ -439,16 +449,28 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--gaps", help="output TSV: per marker, frames filled and left missing")
     _label_map_option(p)
     _rotate_option(p, heading=True)
-    p.add_argument("--cutoff-hz", type=float, default=40.0, help="zero-phase Butterworth low-pass (Hz); 0: no filter")
-    p.add_argument("--order", type=int, default=4, help="designed filter order (run forward and backward)")
-    p.add_argument("--max-gap-frames", type=int, default=10, help="fill gaps up to this many frames; 0: no filling")
+    p.add_argument(
+        "--cutoff-hz", type=float, help="zero-phase Butterworth low-pass (Hz); 0: no filter (default: filter.cutoff_hz)"
+    )
+    p.add_argument("--order", type=int, help="designed filter order, run forward and backward (default: filter.order)")
+    p.add_argument(
+        "--max-gap-frames",
+        type=int,
+        help="fill gaps up to this many frames; 0: no filling (default: markers.max_gap_frames)",
+    )
+    _configfile_option(p)
     p.set_defaults(func=_markers)
 
     p = sub.add_parser("grf", help="C3D force platforms -> OpenSim external-loads .mot")
     p.add_argument("c3d", help="C3D file with a FORCE_PLATFORM group")
     p.add_argument("--out", required=True, help="output .mot (columns {n}_ground_force_v*, _p*, {n}_ground_torque_*)")
     _rotate_option(p)
-    p.add_argument("--threshold-n", type=float, default=20.0, help="loaded above this vertical force over rest (N)")
+    p.add_argument(
+        "--threshold-n",
+        type=float,
+        help="loaded above this vertical force over rest (N; default: grf.loaded_threshold_n)",
+    )
+    _configfile_option(p)
     p.set_defaults(func=_grf)
 
     p = sub.add_parser("events", help="heel strikes and toe-offs from the force platforms -> TSV")
@@ -458,16 +480,24 @@ def _parser() -> argparse.ArgumentParser:
         "--feet",
         nargs=2,
         metavar=("LEFT_HEEL", "RIGHT_HEEL"),
-        default=("LHEE", "RHEE"),
-        help="heel marker of each foot (model names, after --label-map)",
+        help="heel marker of each foot (model names, after --label-map; default: events.foot_markers)",
     )
     p.add_argument(
         "--plates", metavar="left=N,right=M", help="belt of each side: a contact on the other foot's plate is flagged"
     )
     _label_map_option(p)
     _rotate_option(p)
-    p.add_argument("--threshold-on-n", type=float, default=50.0, help="heel strike: force over rest rises through (N)")
-    p.add_argument("--threshold-off-n", type=float, default=20.0, help="toe-off: force over rest falls through (N)")
+    p.add_argument(
+        "--threshold-on-n",
+        type=float,
+        help="heel strike: force over rest rises through (N; default: events.threshold_on_n)",
+    )
+    p.add_argument(
+        "--threshold-off-n",
+        type=float,
+        help="toe-off: force over rest falls through (N; default: events.threshold_off_n)",
+    )
+    _configfile_option(p)
     p.set_defaults(func=_events)
 
     p = sub.add_parser("scale", help="scale a generic model with a lab's ScaleTool setup and a static trial")
@@ -483,14 +513,19 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--report", metavar="SCALE.tsv", help="output TSV: scale factors per body and marker errors after scaling"
     )
-    p.add_argument("--start", type=float, help="first time of the static trial to use (s)")
+    p.add_argument(
+        "--start",
+        type=float,
+        help="first time of the static trial to use (s; default: the setup's time range, else the first "
+        "markers.static_duration_s)",
+    )
     p.add_argument("--end", type=float, help="last time of the static trial to use (s)")
     p.add_argument(
         "--max-motion-rms-m",
         type=float,
-        default=0.05,
         help="refuse a static trial with a marker moving "
-        "more than this (m, RMS about its mean over the window; 0: not checked; default 0.05)",
+        "more than this (m, RMS about its mean over the window; 0: not checked; default: "
+        "markers.static_max_motion_rms_m)",
     )
     _label_map_option(p)
     _rotate_option(p)
@@ -502,20 +537,24 @@ def _parser() -> argparse.ArgumentParser:
         help="fill gaps of a .c3d static trial up to this "
         "(default 0: each marker is averaged over the frames where it is present)",
     )
+    _configfile_option(p)
     p.set_defaults(func=_scale)
 
     p = sub.add_parser("segments", help="segment table (TSV) from a scaled model, or from height and mass")
     p.add_argument("--model", help="scaled OpenSim model (.osim): gait2392, Rajagopal2016 or the generated model")
-    p.add_argument("--side", default="left", choices=("left", "right"), help="the swing leg (with --model)")
+    p.add_argument(
+        "--side", choices=("left", "right"), help="the swing leg (with --model; default: trials.perturbed_side)"
+    )
     p.add_argument("--height-m", type=float, help="without --model: Winter's table from height ...")
     p.add_argument("--mass-kg", type=float, help="... and body mass")
     p.add_argument(
         "--attachment-fraction",
         type=float,
-        default=0.8,
-        help="brace position along the thigh (fraction of its length; a model's brace markers win)",
+        help="brace position along the thigh (fraction of its length; a model's brace markers win; default: "
+        "opensim.brace_attachment_fraction)",
     )
     p.add_argument("--out", required=True, help="output TSV")
+    _configfile_option(p)
     p.set_defaults(func=_segments)
 
     p = sub.add_parser("ik", help="OpenSim inverse kinematics of a .c3d or .trc marker file to a .mot (degrees)")
@@ -524,32 +563,34 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="output .mot (angles in degrees, OpenSim's convention)")
     p.add_argument(
         "--tasks",
-        help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: every "
-        "model marker found in the file, weight 1",
+        help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: opensim.ik_tasks, else "
+        "every model marker found in the file, weight 1",
     )
     p.add_argument("--start", type=float, help="first time (s) to solve")
     p.add_argument("--end", type=float, help="last time (s) to solve")
     _label_map_option(p)
     _rotate_option(p, heading=True)
-    p.add_argument("--accuracy", type=float, default=1e-6, help="IK solver accuracy (OpenSim's default 1e-5)")
+    p.add_argument(
+        "--accuracy", type=float, help="IK solver accuracy (default: opensim.accuracy; OpenSim's own default 1e-5)"
+    )
     p.add_argument(
         "--max-marker-rms-m",
         type=float,
-        default=IK_STOP_RMS_M,
-        help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model mistake)",
+        help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model mistake; "
+        "default: opensim.max_marker_rms_m)",
     )
     p.add_argument(
         "--warn-marker-rms-m",
         type=float,
-        default=IK_WARN_RMS_M,
-        help="a frame whose marker RMS error exceeds this (m) counts as poorly fitted (a warning)",
+        help="a frame whose marker RMS error exceeds this (m) counts as poorly fitted (a warning; default: "
+        "opensim.warn_marker_rms_m)",
     )
     p.add_argument(
         "--max-rms-fraction",
         type=float,
-        default=IK_MAX_FRACTION,
-        help="fail (warn) when more frames than this share fail (fit poorly)",
+        help="fail (warn) when more frames than this share fail (fit poorly; default: opensim.max_rms_fraction)",
     )
+    _configfile_option(p)
     p.set_defaults(func=_ik)
 
     p = sub.add_parser(

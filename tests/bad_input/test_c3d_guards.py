@@ -23,9 +23,9 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
+from loper_analysis.steps.events import EventSettings, events
 from loper_analysis.steps.grf import grf
-from loper_analysis.steps.processing import events
-from loper_analysis.steps.processing import markers as markers_step
+from loper_analysis.steps.markers import markers as markers_step
 from loper_analysis.synthetic.force_plates import wrench_channels
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -144,7 +144,7 @@ def good(tmp_path_factory):
 
 
 def run_events(path: Path, out: Path):
-    return events(path, out, foot_markers=FEET, threshold_on_n=ON_N)
+    return events(path, out, EventSettings(foot_markers=FEET, threshold_on_n=ON_N))
 
 
 def assert_refused_and_nothing_written(step, path: Path, out: Path, *fragments: str) -> str:

@@ -9,7 +9,7 @@ Two faults pass every other check of the load-cell step:
   stride counts as perturbed and the trial ends as ``too_few_strides``.
 
 Each refusal goes through the file step of rule ``events_loadcell``
-(:func:`loper_analysis.steps.processing.events_loadcell`) with the rule's settings from the config, and
+(:func:`loper_analysis.steps.event_steps.events_loadcell`) with the rule's settings from the config, and
 must name the file, the field and the values, and leave the outputs of an earlier run as they were. The
 good records pass with the numbers they gave before: the clock map of the edges alone, within 1 ms
 of the simulated clocks.
@@ -29,7 +29,8 @@ import yaml
 from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
-from loper_analysis.steps import processing
+from loper_analysis.steps import events as event_steps
+from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -37,26 +38,10 @@ DURATION_S = 12.0
 OUTPUTS = ("events", "contacts", "force", "native")
 
 
-def _settings() -> tuple[dict, dict]:
-    """The keyword settings rule events_loadcell passes to the step (rules/events.smk, settings in inputs.smk)."""
+def _settings() -> tuple[EventSettings, LoadcellSettings]:
+    """The settings rule events_loadcell passes to the step (built in inputs.smk from config/config.yaml)."""
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    ev = cfg["events"]
-    events = dict(
-        grf_channels=ev["grf_channels"],
-        threshold_on_n=ev["threshold_on_n"],
-        threshold_off_n=ev["threshold_off_n"],
-        min_stance_s=ev["min_stance_s"],
-        min_swing_s=ev["min_swing_s"],
-        cutoff_hz=ev["grf_cutoff_hz"],
-        order=cfg["filter"]["order"],
-        foot_markers=ev["foot_markers"],
-        plate_sides=ev["plate_sides"],
-        rotation_deg=cfg["markers"]["lab_to_model_rotation_deg"],
-        band_n=cfg["grf"]["resting_band_n"],
-        max_rest_n=cfg["grf"]["max_resting_n"],
-    )
-    loadcell = dict(sync_channel=ev["sync_channel"], cutoff_hz=cfg["filter"]["cutoff_hz"], order=cfg["filter"]["order"])
-    return events, loadcell
+    return EventSettings.from_config(cfg), LoadcellSettings.from_config(cfg)
 
 
 @pytest.fixture(scope="module")
@@ -113,7 +98,7 @@ def _outputs(tmp_path: Path) -> dict[str, Path]:
 def _step(c3d: Path, log: Path, outputs: dict[str, Path]):
     """The file step of rule events_loadcell, with the rule's settings."""
     events, loadcell = _settings()
-    return processing.events_loadcell(
+    return event_steps.events_loadcell(
         c3d, log, outputs["events"], outputs["contacts"], outputs["force"], outputs["native"], events, loadcell
     )
 

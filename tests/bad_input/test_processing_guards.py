@@ -23,9 +23,9 @@ from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import read_model, write_model
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
-from loper_analysis.steps.ik import ik_chunk, ik_file
-from loper_analysis.steps.model import scale_with_setup, scaled_model
-from loper_analysis.steps.processing import markers as markers_step
+from loper_analysis.steps.ik import IKSettings, ik_chunk, ik_file
+from loper_analysis.steps.markers import markers as markers_step
+from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale_with_setup, scaled_model
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -90,7 +90,8 @@ def test_scaling_the_generated_model_with_a_static_trial_in_the_wrong_unit_is_re
     static = write_trc(tmp_path / "static.trc", trial["t"][:4], 1000.0 * trial["X"][:4], list(MARKERS))
     out = tmp_path / "scaled.osim"
     with pytest.raises(LoperInputError) as err:
-        scaled_model(trial["model"], static, out, 64.9)
+        # the motion check off: the numbers 1000 times too large move 1000 times as far
+        scaled_model(ScaleFiles(trial["model"], static, out), 64.9, ModelSettings(max_motion_rms_m=None))
     msg = str(err.value)
     assert str(static) in msg and "scale factor" in msg and "0.5 .. 2" in msg
     thigh = float(msg.split("thigh_r ")[1].split(",")[0])
@@ -110,7 +111,8 @@ def test_lab_setup_scaling_with_a_static_trial_in_the_wrong_unit_is_refused(tmp_
     )  # every number 10 times too large
     out = tmp_path / "scaled.osim"
     with pytest.raises(LoperInputError) as err:
-        scale_with_setup(GAIT2392 / "gait2392_simbody.osim", tmp_path / "scale_setup.xml", static, 75.0, out)
+        files = ScaleFiles(GAIT2392 / "gait2392_simbody.osim", static, out, setup_xml=tmp_path / "scale_setup.xml")
+        scale_with_setup(files, 75.0)
     msg = str(err.value)
     assert str(static) in msg and "scale factor" in msg
     factors = [float(part.split()[-1]) for part in msg.split("model's): ")[1].split(";")[0].split(", ")]
@@ -180,7 +182,7 @@ def test_thirty_markers_leave_only_the_left_foot_undetermined(trial, tmp_path):
 
 
 def test_full_marker_set_output_is_unchanged(trial, tmp_path):
-    res = ik_file(trial["model"], trial["trc"], tmp_path / "all.mot", accuracy=1e-8)
+    res = ik_file(trial["model"], trial["trc"], tmp_path / "all.mot", IKSettings(accuracy=1e-8))
     assert res.undetermined == {} and np.isfinite(res.coordinates).all()
     np.testing.assert_allclose(res.frame()["knee_flexion_l"], trial["truth"]["knee_flexion_l"], atol=1e-4)
 

@@ -30,8 +30,12 @@ from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.schema import check_yaml_file
-from loper_analysis.steps import processing, report
+from loper_analysis.steps import events as event_steps
+from loper_analysis.steps import markers as marker_steps
+from loper_analysis.steps import report
+from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.logs import rule_log
+from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake
 
 ENOSPC = "[Errno 28] No space left on device"
@@ -356,7 +360,9 @@ def test_grf_cutoff_is_named_by_its_config_key_and_the_event_table_is_kept(belt_
     out.write_text("side\tevent\ttime_s\tsample\nleft\theel_strike\t0.5\t64\n")
     before = _digest(out)
     with pytest.raises(LoperInputError) as info:
-        processing.events(belt_c3d, out, grf_channels={"left": "Fz_left", "right": "Fz_right"}, cutoff_hz=cutoff)
+        event_steps.events(
+            belt_c3d, out, EventSettings(grf_channels={"left": "Fz_left", "right": "Fz_right"}, cutoff_hz=cutoff)
+        )
     assert str(info.value) == f"{belt_c3d} (analog channel Fz_left): {words}"
     assert "LinAlgError" not in str(info.value)
     assert _digest(out) == before and _entries(tmp_path) == ["walk-nodevice.events.tsv"]
@@ -378,7 +384,7 @@ def test_marker_cutoff_is_named_by_its_config_key_and_the_trc_is_kept(belt_c3d, 
     trc.write_text("PathFileType\t4\t(X/Y/Z)\twalk-nodevice.trc\n")
     before = _digest(trc)
     with pytest.raises(LoperInputError) as info:
-        processing.markers(belt_c3d, trc, tmp_path / "gaps.tsv", cutoff_hz=cutoff)
+        marker_steps.markers(belt_c3d, trc, tmp_path / "gaps.tsv", MarkerSettings(cutoff_hz=cutoff))
     assert str(info.value).startswith(f"{belt_c3d}: markers: {words}")
     assert _digest(trc) == before and _entries(tmp_path) == ["walk-nodevice.trc"]
 
@@ -408,7 +414,7 @@ def test_load_cell_cutoff_above_the_robot_logs_nyquist_names_the_log_and_the_con
     out.write_text("time_s\tforce_measured_n\n0\t0\n")
     before = _digest(out)
     with pytest.raises(LoperInputError) as info:
-        processing.loadcell(belt_c3d, log_path, out, sync_channel="Fz_left", cutoff_hz=40.0)
+        event_steps.loadcell(belt_c3d, log_path, out, LoadcellSettings(sync_channel="Fz_left", cutoff_hz=40.0))
     assert str(info.value) == (
         f"{log_path}: filter.cutoff_hz must lie in 0 .. 30 Hz (below the Nyquist frequency of "
         "the log's sample_rate_hz = 60 Hz), got 40 Hz"

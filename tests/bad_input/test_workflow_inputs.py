@@ -11,6 +11,7 @@ before any work starts).
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import re
 import shutil
@@ -27,7 +28,11 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
-from loper_analysis.steps import ik, processing
+from loper_analysis.steps import events as event_steps
+from loper_analysis.steps import ik
+from loper_analysis.steps import markers as marker_steps
+from loper_analysis.steps.events import EventSettings, LoadcellSettings
+from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
@@ -148,67 +153,41 @@ def _markers(cfg: dict, c3d: str, label_map=None):
     """The markers rule's step for the walking trial, with its outputs and the config's settings."""
     out = f"results/markers/{SUBJECT}/{WALK}"
     m = cfg["markers"]
-    return processing.markers(
+    return marker_steps.markers(
         c3d,
         f"{out}.trc",
         f"{out}.gaps.tsv",
-        m["lab_to_model_rotation_deg"],
-        m["max_gap_frames"],
-        cfg["filter"]["cutoff_hz"],
-        cfg["filter"]["order"],
-        None,
-        label_map=label_map or m["label_map"] or None,
+        dataclasses.replace(MarkerSettings.from_config(cfg), label_map=label_map or m["label_map"] or None),
         summary_out=f"{out}.markers.tsv",
     )
 
 
 def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW}/{WALK}.c3d"):
-    return processing.loadcell(
+    return event_steps.loadcell(
         c3d,
         log,
         f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
-        cfg["events"]["sync_channel"],
-        cfg["filter"]["cutoff_hz"],
-        cfg["filter"]["order"],
+        LoadcellSettings.from_config(cfg),
     )
 
 
 def _events(cfg: dict, grf_channels: dict):
-    e = cfg["events"]
     out = f"results/events/{SUBJECT}/{WALK}"
-    return processing.events(
+    return event_steps.events(
         f"{RAW}/{WALK}.c3d",
         f"{out}.events.tsv",
-        grf_channels,
-        e["threshold_on_n"],
-        e["threshold_off_n"],
-        e["min_stance_s"],
-        e["min_swing_s"],
-        e["grf_cutoff_hz"],
-        cfg["filter"]["order"],
-        e["foot_markers"],
-        e["plate_sides"],
-        None,
-        cfg["markers"]["lab_to_model_rotation_deg"],
-        cfg["grf"]["resting_band_n"],
-        cfg["grf"]["max_resting_n"],
-        f"{out}.contacts.tsv",
+        dataclasses.replace(EventSettings.from_config(cfg), grf_channels=grf_channels),
+        contacts_out=f"{out}.contacts.tsv",
     )
 
 
 def _ik(cfg: dict, trc: Path):
-    o = cfg["opensim"]
     return ik.ik_trial(
         f"results/model/{SUBJECT}/generic.osim",
         trc,
         f"results/ik/{SUBJECT}/{WALK}.mot",
         f"results/ik/{SUBJECT}/{WALK}.angles.tsv",
-        o["coordinate_map"],
-        tasks_file=o["ik_tasks"],
-        default_weight=o["default_marker_weight"],
-        marker_weights=o["marker_weights"],
-        coordinate_tasks=o["coordinate_tasks"],
-        accuracy=o["accuracy"],
+        ik.IKSettings.from_config(cfg),
     )
 
 
@@ -274,13 +253,14 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
     _refused(
         lab,
         lambda: model.scale(
-            f"results/model/{SUBJECT}/generic.osim",
-            lab / "moving.trc",
-            f"results/model/{SUBJECT}/scaled.osim",
+            model.ScaleFiles(
+                f"results/model/{SUBJECT}/generic.osim", lab / "moving.trc", f"results/model/{SUBJECT}/scaled.osim"
+            ),
             MASS_KG,
+            model.ModelSettings(
+                static_duration_s=m["static_duration_s"], max_motion_rms_m=m["static_max_motion_rms_m"]
+            ),
             lab_labels=f"results/markers/{SUBJECT}/static.markers.tsv",
-            duration_s=m["static_duration_s"],
-            max_motion_rms_m=m["static_max_motion_rms_m"],
         ),
         [
             "moving.trc: the subject does not stand still in the scaling window 0.0000 .. 0.9922 s of the static "
@@ -301,9 +281,9 @@ def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
     _refused(
         lab,
         lambda: model.scale(
-            f"results/model/{SUBJECT}/generic.osim",
-            lab / "typo.trc",
-            f"results/model/{SUBJECT}/scaled.osim",
+            model.ScaleFiles(
+                f"results/model/{SUBJECT}/generic.osim", lab / "typo.trc", f"results/model/{SUBJECT}/scaled.osim"
+            ),
             MASS_KG,
             lab_labels={"LHEEL": "L_FCC"},
         ),
@@ -342,7 +322,7 @@ def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_a
         tmp_path / "sparse.trc",
         tmp_path / "sparse.mot",
         tmp_path / "sparse.angles.tsv",
-        o["coordinate_map"],
+        ik.IKSettings(coordinate_map=o["coordinate_map"]),
         summary_tsv=tmp_path / "sparse.ik.tsv",
     )
     blank = angles.drop(columns="time_s").isna().all(axis=1).to_numpy()
@@ -371,12 +351,13 @@ def test_long_gap_is_left_missing_and_counted_not_refused(lab, tmp_path):
     X[300:360, j] = np.nan
     write_recording(tmp_path / "gap.c3d", replace(rec, markers_m=X))
     m = _config(lab)["markers"]
-    processing.markers(
+    marker_steps.markers(
         tmp_path / "gap.c3d",
         tmp_path / "gap.trc",
         tmp_path / "gap.gaps.tsv",
-        m["lab_to_model_rotation_deg"],
-        m["max_gap_frames"],
+        MarkerSettings(
+            rotation_deg=m["lab_to_model_rotation_deg"], max_gap_frames=m["max_gap_frames"], walking_direction="fixed"
+        ),
         summary_out=tmp_path / "gap.markers.tsv",
     )
     summary = pd.read_csv(tmp_path / "gap.markers.tsv", sep="\t").set_index("marker")
@@ -433,8 +414,10 @@ def test_belts_feet_that_cannot_be_confirmed_are_warned(lab, tmp_path):
     cfg = _config(lab)
     e = cfg["events"]
     with pytest.warns(UserWarning, match="the belts' feet could not be confirmed: heel marker.s. LHEE, RHEE"):
-        table = processing.events(
-            tmp_path / "no-heels.c3d", tmp_path / "e.tsv", e["grf_channels"], foot_markers=e["foot_markers"]
+        table = event_steps.events(
+            tmp_path / "no-heels.c3d",
+            tmp_path / "e.tsv",
+            EventSettings(grf_channels=e["grf_channels"], foot_markers=e["foot_markers"]),
         )
     good = pd.read_csv(f"results/events/{SUBJECT}/{WALK}.events.tsv", sep="\t")
     assert len(table) == len(good) and np.allclose(table["time_s"], good["time_s"])
@@ -609,7 +592,7 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
     """Not an error: only the trials on disk are processed (the onset without a trial is reported missing;
     the full run is in tests/test_workflow.py)."""
     before = _state(lab)
-    res = _snakemake(lab, "-n", "results/tables/impedance.tsv", "results/strides/summary.tsv")
+    res = _snakemake(lab, "-n", "results/impedance/impedance.tsv", "results/strides/summary.tsv")
     assert res.returncode == 0, res.stderr[-2000:]
     trials = set(re.findall(r"^\s+wildcards: subject=R01, trial=(\S+)$", res.stdout, re.MULTILINE))
     assert trials == {WALK}  # its IK and strides: markers, events and forces are already there

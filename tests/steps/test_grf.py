@@ -8,7 +8,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.grf import external_loads_columns, plate_vertical_loads
 from loper_analysis.io.c3d import read_c3d
-from loper_analysis.steps.grf import grf
+from loper_analysis.steps.grf import GRFSettings, grf
 from tests.io.force_plate_files import (
     channels_for_load,
     plate_corners_mm,
@@ -48,7 +48,7 @@ def _vec(v) -> np.ndarray:
 def test_walking5_mot_applied_by_opensim(tmp_path):
     out = tmp_path / "walking5.grf.mot"
     xml = tmp_path / "setup" / "walking5.grf.xml"
-    table = grf(WALKING5, out, rotation_deg=(0, 0, 0), xml_out=xml, bodies={1: "calcn_r", 2: "calcn_l"})
+    table = grf(WALKING5, out, GRFSettings(rotation_deg=(0, 0, 0)), xml_out=xml, bodies={1: "calcn_r", 2: "calcn_l"})
     assert table.shape == (8824, 19) and out.is_file()
     head = out.read_text().splitlines()
     assert "inDegrees=no" in head and head[head.index("endheader") + 1].split("\t")[:2] == ["time", "1_ground_force_vx"]
@@ -74,7 +74,7 @@ def test_walking5_mot_applied_by_opensim(tmp_path):
 
 def test_default_rotation_puts_vertical_on_y(tmp_path):
     table = grf(WALKING5, tmp_path / "w.grf.mot")
-    lab = grf(WALKING5, tmp_path / "lab.grf.mot", rotation_deg=(0, 0, 0))
+    lab = grf(WALKING5, tmp_path / "lab.grf.mot", GRFSettings(rotation_deg=(0, 0, 0)))
     np.testing.assert_allclose(table["1_ground_force_vy"], lab["1_ground_force_vz"], atol=1e-9)
     np.testing.assert_allclose(table["1_ground_force_pz"], -lab["1_ground_force_py"], atol=1e-9)
     # the peak is the raw channel's (Fz1 in the plate's downward z, so minus) above the -14.21 N resting level
@@ -95,7 +95,7 @@ def test_known_point_load_through_the_step(tmp_path):
     c3d = write_plate_c3d(
         tmp_path / "load.c3d", np.linalg.solve(cal, ch.T).T, plate_type=4, cal=cal, origin_mm=origin, units=["V"] * 6
     )
-    table = grf(c3d, tmp_path / "load.grf.mot", rotation_deg=(0, 0, 0))
+    table = grf(c3d, tmp_path / "load.grf.mot", GRFSettings(rotation_deg=(0, 0, 0)))
     cols = external_loads_columns(1)
     got = table[cols].to_numpy()
     np.testing.assert_allclose(got[60:, 0:3], np.tile(load, (40, 1)), atol=1e-3)

@@ -11,7 +11,7 @@ from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import write_model
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
-from loper_analysis.steps.ik import ik_chunk, ik_join, ik_trial
+from loper_analysis.steps.ik import IKSettings, ik_chunk, ik_join, ik_trial
 
 FS = 128.0
 
@@ -37,11 +37,12 @@ def trial(tmp_path_factory):
 
 def test_chunks_joined_through_files_equal_the_whole_trial(trial, tmp_path):
     model_osim, trc, truth = trial
-    whole = ik_trial(model_osim, trc, tmp_path / "whole.mot", tmp_path / "whole.angles.tsv", accuracy=1e-8)
+    fine = IKSettings(accuracy=1e-8)
+    whole = ik_trial(model_osim, trc, tmp_path / "whole.mot", tmp_path / "whole.angles.tsv", fine)
     np.testing.assert_allclose(whole.knee_left_rad, truth["knee_flexion_l"], atol=np.deg2rad(0.1) / 10)
     mots = [tmp_path / f"chunk{c}.mot" for c in range(3)]
     for c, mot in enumerate(mots):
-        ik_chunk(model_osim, trc, mot, c, 3, accuracy=1e-8)
+        ik_chunk(model_osim, trc, mot, c, 3, fine)
     assert [len(read_mot(m)) for m in mots] == [85, 86, 85]
     joined = ik_join(mots, tmp_path / "joined.mot", tmp_path / "joined.angles.tsv", summary_tsv=tmp_path / "j.ik.tsv")
     assert (tmp_path / "joined.mot").is_file() and (tmp_path / "joined.angles.tsv").is_file()

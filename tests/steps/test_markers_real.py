@@ -1,4 +1,4 @@
-"""The markers step (loper_analysis.steps.processing.markers) on files written by others.
+"""The markers step (loper_analysis.steps.marker_steps.markers) on files written by others.
 
 walking5.c3d (Vicon, from opensim-core) has 5 to 59 % of the frames of each
 marker missing, most of them in long gaps and at the ends of the trial;
@@ -21,7 +21,7 @@ from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers
 from loper_analysis.io.osim import quiet_opensim
 from loper_analysis.motion.markers import GAP_REPORT_COLUMNS, GAP_SUMMARY_COLUMNS
-from loper_analysis.steps.processing import TRIAL_MARKER_COLUMNS, markers
+from loper_analysis.steps.markers import TRIAL_MARKER_COLUMNS, MarkerSettings, markers
 
 DATA = Path(__file__).parents[1] / "data" / "opensim-core"
 WALKING5 = DATA / "walking5.c3d"
@@ -42,7 +42,11 @@ def _opensim_trc(path):
 
 def test_walking5_as_read_equals_opensims_reading(tmp_path):
     """No rotation, no filter, no filling: our TRC holds the numbers OpenSim read from the same file."""
-    gaps = markers(WALKING5, tmp_path / "w5.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, max_gap_frames=0)
+    gaps = markers(
+        WALKING5,
+        tmp_path / "w5.trc",
+        settings=MarkerSettings(rotation_deg=(0, 0, 0), cutoff_hz=None, max_gap_frames=0, walking_direction="fixed"),
+    )
     assert len(gaps) == 0
     t, X_m, labels = read_markers(tmp_path / "w5.trc")
     t_ref, ref_mm, labels_ref = _opensim_trc(DATA / "std_walking5_markers.trc")
@@ -81,8 +85,7 @@ def test_walking5_through_the_default_chain_keeps_long_gaps_missing(tmp_path):
         WALKING5,
         tmp_path / "w5.trc",
         tmp_path / "w5.gaps.tsv",
-        cutoff_hz=6.0,
-        max_gap_frames=10,
+        MarkerSettings(cutoff_hz=6.0, max_gap_frames=10),
         summary_out=tmp_path / "w5.markers.tsv",
     )
     _, X, labels = read_markers(tmp_path / "w5.trc")
@@ -111,8 +114,8 @@ def test_walking5_through_the_default_chain_keeps_long_gaps_missing(tmp_path):
     assert (summary["n_unfiltered_frames"] == 0).all()
     columns = list(GAP_SUMMARY_COLUMNS)
     assert summary[columns].to_dict("records") == [{k: r[k] for k in columns} for r in gaps.attrs["per_marker"]]
-    # walking toward -X, 1.6 m/s; left as it is (the step's default rotation is the one given)
-    assert summary["heading_deg"].iloc[0] == pytest.approx(182.37, abs=0.01) and (summary["turn_deg"] == 0).all()
+    # walking toward -X, 1.6 m/s: the default (markers.walking_direction: auto) turns it half a turn to walk along +X
+    assert summary["heading_deg"].iloc[0] == pytest.approx(182.37, abs=0.01) and (summary["turn_deg"] == 180).all()
     # the rotation by -90 deg about X took Vicon's Z up to Y up: the pelvis markers sit about 1 m high
     assert 0.8 < np.nanmedian(X[:, labels.index("RASI"), 1]) < 1.2
 
@@ -132,10 +135,13 @@ def test_prefixes_and_label_map_name_the_trc_columns_and_gaps(prefixed, tmp_path
     gaps = markers(
         prefixed,
         tmp_path / "p.trc",
-        rotation_deg=(0, 0, 0),
-        cutoff_hz=0,
-        label_map={"LASIS": "LASI", "Anna:RASIS": "RASI"},
-        required_markers=["LASI", "RASI", "LHEE"],
+        settings=MarkerSettings(
+            rotation_deg=(0, 0, 0),
+            cutoff_hz=0,
+            label_map={"LASIS": "LASI", "Anna:RASIS": "RASI"},
+            required_markers=["LASI", "RASI", "LHEE"],
+            walking_direction="fixed",
+        ),
     )
     _, X, labels = read_markers(tmp_path / "p.trc")
     assert labels == ["LASI", "RASI", "LHEE"]
@@ -153,10 +159,14 @@ def test_prefixes_and_label_map_name_the_trc_columns_and_gaps(prefixed, tmp_path
 
 def test_missing_model_markers_stop_the_step_before_writing(prefixed, tmp_path):
     with pytest.raises(LoperInputError) as err:
-        markers(prefixed, tmp_path / "p.trc", label_map={"LASIS": "LASI"}, required_markers=["LASI", "RASI", "RHEE"])
+        markers(
+            prefixed,
+            tmp_path / "p.trc",
+            settings=MarkerSettings(label_map={"LASIS": "LASI"}, required_markers=["LASI", "RASI", "RHEE"]),
+        )
     assert str(err.value).startswith(f"{prefixed}: model marker(s) RASI, RHEE not provided by any label")
     with pytest.raises(LoperInputError, match=r"markers.label_map: label\(s\) L_ASIS not in the file"):
-        markers(prefixed, tmp_path / "p.trc", label_map={"L_ASIS": "LASI"})
+        markers(prefixed, tmp_path / "p.trc", settings=MarkerSettings(label_map={"L_ASIS": "LASI"}))
     assert not (tmp_path / "p.trc").exists()
 
 
@@ -166,10 +176,18 @@ def test_time_base_of_a_file_not_starting_at_frame_one(prefixed, tmp_path):
     data[6:10] = struct.pack("<HH", 101, 160)
     late = tmp_path / "late.c3d"
     late.write_bytes(bytes(data))
-    markers(late, tmp_path / "late.trc", rotation_deg=(0, 0, 0), cutoff_hz=None)
+    markers(
+        late,
+        tmp_path / "late.trc",
+        settings=MarkerSettings(rotation_deg=(0, 0, 0), cutoff_hz=None, walking_direction="fixed"),
+    )
     t, _, _ = read_markers(tmp_path / "late.trc")
     np.testing.assert_allclose(t, 1.0 + np.arange(60) / 100.0, rtol=0, atol=1e-12)
-    markers(late, tmp_path / "cut.trc", rotation_deg=(0, 0, 0), cutoff_hz=None, duration_s=0.1)
+    markers(
+        late,
+        tmp_path / "cut.trc",
+        settings=MarkerSettings(rotation_deg=(0, 0, 0), cutoff_hz=None, duration_s=0.1, walking_direction="fixed"),
+    )
     t, _, _ = read_markers(tmp_path / "cut.trc")
     np.testing.assert_allclose(t, 1.0 + np.arange(10) / 100.0, rtol=0, atol=1e-12)
 
@@ -200,10 +218,13 @@ def test_labels_with_spaces_through_the_markers_step(bts, tmp_path, label_map, n
     markers(
         bts,
         tmp_path / "bts.trc",
-        rotation_deg=(0, 0, 0),
-        cutoff_hz=None,
-        label_map=label_map,
-        required_markers=[n for n in names if " " not in n],
+        settings=MarkerSettings(
+            rotation_deg=(0, 0, 0),
+            cutoff_hz=None,
+            label_map=label_map,
+            required_markers=[n for n in names if " " not in n],
+            walking_direction="fixed",
+        ),
     )
     t, X, labels = read_markers(tmp_path / "bts.trc")
     assert labels == names
@@ -224,7 +245,7 @@ def test_a_label_map_value_with_a_space_is_refused_naming_the_rule(bts, tmp_path
         match=r"bts\.c3d: markers\.label_map: 'r heel' maps to 'R HEE', not a "
         r"marker name \(non-empty, no spaces: OpenSim refuses whitespace",
     ):
-        markers(bts, tmp_path / "bts.trc", label_map={"r heel": "R HEE"})
+        markers(bts, tmp_path / "bts.trc", settings=MarkerSettings(label_map={"r heel": "R HEE"}))
     assert not (tmp_path / "bts.trc").exists()
 
 
@@ -237,29 +258,33 @@ def test_label_maps_merge_in_order_and_a_static_only_label_needs_no_entry_elsewh
     markers(
         static,
         tmp_path / "s.trc",
-        rotation_deg=(0, 0, 0),
-        cutoff_hz=0,
-        label_map=[every, static_only],
+        settings=MarkerSettings(
+            rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every, static_only], walking_direction="fixed"
+        ),
         summary_out=tmp_path / "s.markers.tsv",
     )
     assert read_markers(tmp_path / "s.trc")[2] == ["LASI", "RASI_static", "LHEE", "LKNM"]  # the later map wins
     summary = pd.read_csv(tmp_path / "s.markers.tsv", sep="\t")
     assert summary["label"].tolist() == ["Anna:LASIS", "Anna:RASIS", "Anna:LHEE", "Anna:L_MED_KNEE"]
-    markers(prefixed, tmp_path / "w.trc", rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every])
+    markers(
+        prefixed,
+        tmp_path / "w.trc",
+        settings=MarkerSettings(rotation_deg=(0, 0, 0), cutoff_hz=0, label_map=[every], walking_direction="fixed"),
+    )
     assert read_markers(tmp_path / "w.trc")[2] == ["LASI", "RASI", "LHEE"]
     with pytest.raises(
         LoperInputError, match=r"prefixed\.c3d: markers\.label_map: label\(s\) L_MED_KNEE not in the file"
     ):
-        markers(prefixed, tmp_path / "never.trc", label_map=[every, static_only])  # the static map on a walking trial
+        markers(
+            prefixed, tmp_path / "never.trc", settings=MarkerSettings(label_map=[every, static_only])
+        )  # the static map on a walking trial
 
 
 def test_a_span_crops_the_trial_on_the_files_clock(prefixed, tmp_path):
     markers(
         prefixed,
         tmp_path / "c.trc",
-        rotation_deg=(0, 0, 0),
-        cutoff_hz=0,
-        span_s=(0.1, 0.3),
+        settings=MarkerSettings(rotation_deg=(0, 0, 0), cutoff_hz=0, span_s=(0.1, 0.3), walking_direction="fixed"),
         summary_out=tmp_path / "c.markers.tsv",
     )
     t, X, _ = read_markers(tmp_path / "c.trc")
@@ -271,5 +296,5 @@ def test_a_span_crops_the_trial_on_the_files_clock(prefixed, tmp_path):
         match=r"prefixed\.c3d: the trial's span 5 \.\. 6 s \(markers\.trial_spans_s\) "
         r"holds no frame of the file \(0\.0000 \.\. 0\.5900 s\)",
     ):
-        markers(prefixed, tmp_path / "never.trc", span_s=(5.0, 6.0))
+        markers(prefixed, tmp_path / "never.trc", settings=MarkerSettings(span_s=(5.0, 6.0)))
     assert not (tmp_path / "never.trc").exists()

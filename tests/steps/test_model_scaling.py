@@ -22,7 +22,7 @@ from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.model import scale_with_setup
+from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -33,6 +33,11 @@ SETUP = ROOT / "examples" / "gait2392" / "scale_setup.xml"
 FACTORS = {"pelvis": 1.05, "torso": 1.02, "femur": 1.10, "tibia": 0.95, "talus": 1.08, "calcn": 1.08, "toes": 1.08}
 MASS_KG = 80.0
 GENERIC_MASS_KG = 75.1646
+
+
+def _files(setup, static, out, **optional) -> ScaleFiles:
+    """The files of scaling gait2392 with the setup ``setup`` to the static trial ``static``, into ``out``."""
+    return ScaleFiles(GENERIC, static, out, setup_xml=setup, **optional)
 
 
 @pytest.fixture(scope="module")
@@ -52,7 +57,7 @@ def lab(tmp_path_factory):
 @pytest.fixture(scope="module")
 def scaled(lab):
     out = lab / "out" / "scaled.osim"
-    scale_with_setup(GENERIC, lab / "scale_setup.xml", lab / "static.trc", MASS_KG, out)
+    scale_with_setup(_files(lab / "scale_setup.xml", lab / "static.trc", out), MASS_KG)
     return out
 
 
@@ -135,7 +140,7 @@ def test_not_a_scale_setup_is_refused(lab, tmp_path):
         match=r"gait2392_Scale_MarkerSet\.xml: not an OpenSim ScaleTool setup "
         r"\(its <OpenSimDocument> element holds no <ScaleTool>\)",
     ):
-        scale_with_setup(GENERIC, MARKER_SET, lab / "static.trc", MASS_KG, tmp_path / "never.osim")
+        scale_with_setup(_files(MARKER_SET, lab / "static.trc", tmp_path / "never.osim"), MASS_KG)
     assert not (tmp_path / "never.osim").exists()
 
 
@@ -148,7 +153,7 @@ def test_markers_the_static_trial_lacks_are_listed(lab, tmp_path):
         match=r"scale_setup\.xml: measurement marker\(s\) \['L\.Heel', 'R\.Knee\.Lat'\] "
         r"are not in the static trial .*short\.trc",
     ):
-        scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "short.trc", MASS_KG, tmp_path / "never.osim")
+        scale_with_setup(_files(lab / "scale_setup.xml", tmp_path / "short.trc", tmp_path / "never.osim"), MASS_KG)
     assert not (tmp_path / "never.osim").exists()
 
 
@@ -161,7 +166,7 @@ def test_markers_the_model_lacks_are_listed(lab, tmp_path):
         match=r"setup\.xml: measurement marker\(s\) \['L\.Epicondyle'\] are not on the "
         r"model .*gait2392_simbody\.osim with marker set .*gait2392_Scale_MarkerSet",
     ):
-        scale_with_setup(GENERIC, tmp_path / "setup.xml", lab / "static.trc", MASS_KG, tmp_path / "never.osim")
+        scale_with_setup(_files(tmp_path / "setup.xml", lab / "static.trc", tmp_path / "never.osim"), MASS_KG)
     assert not (tmp_path / "never.osim").exists()
 
 
@@ -172,7 +177,7 @@ def test_markers_missing_in_some_frames_are_averaged_over_the_others(lab, scaled
     X[:4, labels.index("L.Knee.Lat")] = np.nan
     X[6, labels.index("R.Ankle.Lat")] = np.nan
     write_trc(tmp_path / "gappy.trc", t, X, labels)
-    scale_with_setup(GENERIC, lab / "scale_setup.xml", tmp_path / "gappy.trc", MASS_KG, tmp_path / "gappy.osim")
+    scale_with_setup(_files(lab / "scale_setup.xml", tmp_path / "gappy.trc", tmp_path / "gappy.osim"), MASS_KG)
     ours, full = read_model(tmp_path / "gappy.osim"), read_model(scaled)
     # the markers stand still, so their mean over the present frames is their position: the same model
     np.testing.assert_allclose(segments_from_model(ours, "r").packed, segments_from_model(full, "r").packed, rtol=1e-12)
@@ -193,23 +198,17 @@ def test_marker_absent_from_the_whole_window_is_refused_naming_label_file_and_wi
         r"in every frame of the scaling window 0\.0000 \.\. 0\.0500 s \(6 frames\)",
     ):
         scale_with_setup(
-            GENERIC,
-            lab / "scale_setup.xml",
-            tmp_path / "gappy.trc",
+            _files(lab / "scale_setup.xml", tmp_path / "gappy.trc", tmp_path / "never.osim"),
             MASS_KG,
-            tmp_path / "never.osim",
-            time_range_s=(0.0, 0.05),
+            ModelSettings(time_range_s=(0.0, 0.05)),
             lab_labels={"R.Ankle.Lat": "RANK"},
         )
     assert not (tmp_path / "never.osim").exists()
     # a window in which it is present scales: frames 6 .. 9
     scale_with_setup(
-        GENERIC,
-        lab / "scale_setup.xml",
-        tmp_path / "gappy.trc",
+        _files(lab / "scale_setup.xml", tmp_path / "gappy.trc", tmp_path / "late.osim"),
         MASS_KG,
-        tmp_path / "late.osim",
-        time_range_s=(0.06, 0.09),
+        ModelSettings(time_range_s=(0.06, 0.09)),
     )
     p = segments_from_model(read_model(tmp_path / "late.osim"), "r")
     np.testing.assert_allclose(p.length_m[1] / 0.43, 0.95, rtol=1e-9)
@@ -226,7 +225,7 @@ def test_the_setups_time_range_is_honoured(lab, tmp_path):
     t, X, labels = read_markers(lab / "static.trc")
     X[7:, labels.index("R.Ankle.Lat")] += 0.5  # the subject moves after the window: no effect
     write_trc(tmp_path / "moved.trc", t, X, labels)
-    scale_with_setup(GENERIC, tmp_path / "setup.xml", tmp_path / "moved.trc", MASS_KG, tmp_path / "early.osim")
+    scale_with_setup(_files(tmp_path / "setup.xml", tmp_path / "moved.trc", tmp_path / "early.osim"), MASS_KG)
     p = segments_from_model(read_model(tmp_path / "early.osim"), "r")
     np.testing.assert_allclose(p.length_m[1] / 0.43, 0.95, rtol=1e-9)
     # a trial starting later holds no frame of it and is refused with both spans
@@ -236,7 +235,7 @@ def test_the_setups_time_range_is_honoured(lab, tmp_path):
         match=r"late\.trc: time_range of .*setup\.xml 0 \.\. 0\.05 s holds no frame "
         r"of the static trial \(7\.8125 \.\. 7\.9025 s, the file's clock\)",
     ):
-        scale_with_setup(GENERIC, tmp_path / "setup.xml", tmp_path / "late.trc", MASS_KG, tmp_path / "never.osim")
+        scale_with_setup(_files(tmp_path / "setup.xml", tmp_path / "late.trc", tmp_path / "never.osim"), MASS_KG)
     assert not (tmp_path / "never.osim").exists()
 
 
@@ -248,12 +247,9 @@ def test_scaled_model_without_the_configured_bodies_is_refused(lab, tmp_path):
         r"opensim\.segment_bodies: thigh body 'thigh_l' is not in the model",
     ):
         scale_with_setup(
-            GENERIC,
-            lab / "scale_setup.xml",
-            lab / "static.trc",
+            _files(lab / "scale_setup.xml", lab / "static.trc", tmp_path / "never.osim"),
             MASS_KG,
-            tmp_path / "never.osim",
-            segment_bodies=bodies,
+            ModelSettings(segment_bodies=bodies),
         )
     assert not (tmp_path / "never.osim").exists()
     assert not list(tmp_path.iterdir())
@@ -261,12 +257,10 @@ def test_scaled_model_without_the_configured_bodies_is_refused(lab, tmp_path):
 
 def test_scale_report_gives_the_known_factors_and_no_marker_error(lab, tmp_path):
     scale_with_setup(
-        GENERIC,
-        lab / "scale_setup.xml",
-        lab / "static.trc",
+        _files(
+            lab / "scale_setup.xml", lab / "static.trc", tmp_path / "scaled.osim", report_out=tmp_path / "scale.tsv"
+        ),
         MASS_KG,
-        tmp_path / "scaled.osim",
-        report_out=tmp_path / "scale.tsv",
         lab_labels={"R.ASIS": "Subject:RASI"},
     )
     report = pd.read_csv(tmp_path / "scale.tsv", sep="\t")

@@ -28,8 +28,8 @@ from loper_analysis.gait.grf import external_loads_columns, plate_vertical_loads
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.motion.markers import lab_up
-from loper_analysis.steps.grf import grf
-from loper_analysis.steps.processing import events
+from loper_analysis.steps.events import EventSettings, events
+from loper_analysis.steps.grf import GRFSettings, grf
 from loper_analysis.synthetic.force_plates import plate_frame, wrench_channels
 
 RATE, RATIO = 100.0, 10
@@ -140,8 +140,9 @@ def test_the_files_hold_what_the_module_notes_say(files):
 @pytest.mark.parametrize("name", ["z-up reversed", "z-up reversed, ORIGIN negated"])
 def test_reversed_corners_give_the_known_load_and_the_usual_reading(files, tmp_path, name):
     """Force, centre of pressure and free moment of the .mot (lab frame) are the known load, either corner order."""
-    usual = grf(files["z-up"], tmp_path / "usual.grf.mot", rotation_deg=(0, 0, 0))
-    other = grf(files[name], tmp_path / "other.grf.mot", rotation_deg=(0, 0, 0))
+    lab_frame = GRFSettings(rotation_deg=(0, 0, 0))
+    usual = grf(files["z-up"], tmp_path / "usual.grf.mot", lab_frame)
+    other = grf(files[name], tmp_path / "other.grf.mot", lab_frame)
     t = usual["time_s"].to_numpy()
     for k in range(2):
         cols = external_loads_columns(k + 1)
@@ -180,8 +181,8 @@ def test_y_up_lab_without_rotation_gives_the_z_up_labs_mot(files, tmp_path, name
     """A Y-up file with rotation (0, 0, 0) (up = lab_up of it = +Y) gives the .mot of the Z-up file with
     (-90, 0, 0): the same model-frame loads."""
     assert lab_up((0, 0, 0)).tolist() == [0.0, 1.0, 0.0] and lab_up(Z_UP_ROTATION).tolist() == [0.0, 0.0, 1.0]
-    z_up = grf(files["z-up"], tmp_path / "z.grf.mot", rotation_deg=Z_UP_ROTATION)
-    y_up = grf(files[name], tmp_path / "y.grf.mot", rotation_deg=(0, 0, 0), up=lab_up((0, 0, 0)))
+    z_up = grf(files["z-up"], tmp_path / "z.grf.mot", GRFSettings(rotation_deg=Z_UP_ROTATION))
+    y_up = grf(files[name], tmp_path / "y.grf.mot", GRFSettings(rotation_deg=(0, 0, 0)), up=lab_up((0, 0, 0)))
     assert list(y_up.columns) == list(z_up.columns)
     np.testing.assert_allclose(y_up.to_numpy(), z_up.to_numpy(), rtol=0, atol=1e-9)
     # and it is the known load, turned into the model frame: vertical along +Y, the free moment about +Y
@@ -196,7 +197,7 @@ def test_y_up_lab_without_rotation_gives_the_z_up_labs_mot(files, tmp_path, name
 def test_a_y_up_file_read_as_z_up_is_refused_naming_plate_up_and_setting(files, tmp_path):
     out = tmp_path / "refused.grf.mot"
     with pytest.raises(LoperInputError) as caught:
-        grf(files["y-up reversed"], out, rotation_deg=Z_UP_ROTATION)
+        grf(files["y-up reversed"], out, GRFSettings(rotation_deg=Z_UP_ROTATION))
     message = str(caught.value)
     assert message.startswith(f"{files['y-up reversed']} (force platform 1): the plate does not face up")
     assert "surface normal [0.0, 1.0, 0.0] is 90.0 deg from the up direction [0.0, 0.0, 1.0]" in message
@@ -206,8 +207,7 @@ def test_a_y_up_file_read_as_z_up_is_refused_naming_plate_up_and_setting(files, 
         events(
             files["y-up"],
             tmp_path / "refused.events.tsv",
-            foot_markers={"left": "LHEE", "right": "RHEE"},
-            rotation_deg=Z_UP_ROTATION,
+            EventSettings(foot_markers={"left": "LHEE", "right": "RHEE"}, rotation_deg=Z_UP_ROTATION),
         )
 
 
@@ -215,11 +215,13 @@ def _events(path, rotation_deg, tmp_path, name):
     table = events(
         path,
         tmp_path / f"{name}.events.tsv",
-        foot_markers={"left": "LHEE", "right": "RHEE"},
-        plate_sides={"left": 1, "right": 2},
-        threshold_on_n=ON_N,
-        threshold_off_n=OFF_N,
-        rotation_deg=rotation_deg,
+        EventSettings(
+            foot_markers={"left": "LHEE", "right": "RHEE"},
+            plate_sides={"left": 1, "right": 2},
+            threshold_on_n=ON_N,
+            threshold_off_n=OFF_N,
+            rotation_deg=rotation_deg,
+        ),
         contacts_out=tmp_path / f"{name}.contacts.tsv",
     )
     return table, pd.read_csv(tmp_path / f"{name}.contacts.tsv", sep="\t")

@@ -18,7 +18,12 @@ from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.motion.ik import joint_angle_table
 from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
-from loper_analysis.steps import ik, model, processing, transparency
+from loper_analysis.steps import events as event_steps
+from loper_analysis.steps import ik, model, transparency
+from loper_analysis.steps import markers as marker_steps
+from loper_analysis.steps import strides as stride_steps
+from loper_analysis.steps.events import EventSettings, LoadcellSettings
+from loper_analysis.steps.markers import MarkerSettings
 from loper_analysis.synthetic.trials import (
     LabSettings,
     simulate_walking_trial,
@@ -42,16 +47,18 @@ def lab(tmp_path_factory):
     write_robot_log(d / "walk.loper.tsv", walk.robot, LAB.robot_rate_hz, {"clock": "robot"})
     coords, events = walk.mocap_coordinates(LAB.marker_rate_hz), walk.mocap_events()
     # the chain
-    processing.markers(d / "static.c3d", d / "static.trc", duration_s=1.0)
-    gaps = processing.markers(d / "walk.c3d", d / "walk.trc", d / "walk.gaps.tsv")
+    marker_steps.markers(d / "static.c3d", d / "static.trc", settings=MarkerSettings(duration_s=1.0))
+    gaps = marker_steps.markers(d / "walk.c3d", d / "walk.trc", d / "walk.gaps.tsv")
     model.generic_model(d / "generic.osim", HEIGHT, MASS)
-    model.scaled_model(d / "generic.osim", d / "static.trc", d / "scaled.osim", MASS)
+    model.scaled_model(model.ScaleFiles(d / "generic.osim", d / "static.trc", d / "scaled.osim"), MASS)
     for c in range(2):
         ik.ik_chunk(d / "scaled.osim", d / "walk.trc", d / f"walk.{c}.mot", c, 2)
     angles = ik.ik_join([d / "walk.0.mot", d / "walk.1.mot"], d / "walk.mot", d / "walk.angles.tsv")
-    found = processing.events(d / "walk.c3d", d / "walk.events.tsv", {"left": "Fz_left", "right": "Fz_right"})
-    force = processing.loadcell(d / "walk.c3d", d / "walk.loper.tsv", d / "walk.force.tsv")
-    strides = processing.strides(
+    found = event_steps.events(
+        d / "walk.c3d", d / "walk.events.tsv", EventSettings(grf_channels={"left": "Fz_left", "right": "Fz_right"})
+    )
+    force = event_steps.loadcell(d / "walk.c3d", d / "walk.loper.tsv", d / "walk.force.tsv")
+    strides = stride_steps.strides(
         d / "walk.angles.tsv",
         d / "walk.events.tsv",
         d / "walk.strides.tsv",
@@ -151,7 +158,11 @@ def test_model_marker_missing_from_the_trial_is_named(lab, tmp_path):
 
 def test_missing_belt_channel_is_named(lab, tmp_path):
     with pytest.raises(LoperInputError, match="Fz_belt3"):
-        processing.events(lab["dir"] / "walk.c3d", tmp_path / "e.tsv", {"left": "Fz_belt3", "right": "Fz_right"})
+        event_steps.events(
+            lab["dir"] / "walk.c3d",
+            tmp_path / "e.tsv",
+            EventSettings(grf_channels={"left": "Fz_belt3", "right": "Fz_right"}),
+        )
     assert not (tmp_path / "e.tsv").exists()
 
 
@@ -162,7 +173,7 @@ def test_stride_summary_flags_too_few_strides(lab, tmp_path):
     few.loc[3:, "removed"] = True
     few.loc[3:, "reason"] = "knee: 30.0 % of samples outside 1.5·IQR"
     few.to_csv(tmp_path / "few.strides.tsv", sep="\t", index=False)
-    out = processing.strides_summary(
+    out = stride_steps.strides_summary(
         [("S99", "walk"), ("S99", "few")], [walk, tmp_path / "few.strides.tsv"], tmp_path / "summary.tsv", min_valid=5
     )
     ok, flagged = out.iloc[0], out.iloc[1]
@@ -181,7 +192,7 @@ def test_fewer_than_five_valid_strides_warn(lab, tmp_path):
     short = events[events.time_s <= hs[4] + 1e-9]
     short.to_csv(tmp_path / "short.events.tsv", sep="\t", index=False)
     with pytest.warns(TooFewStridesWarning, match="4"):
-        tables = processing.strides(
+        tables = stride_steps.strides(
             d / "walk.angles.tsv", tmp_path / "short.events.tsv", tmp_path / "s.strides.tsv", tmp_path / "s.cycles.tsv"
         )
     assert len(tables.strides) == 4 and tables.too_few_strides
@@ -190,17 +201,9 @@ def test_fewer_than_five_valid_strides_warn(lab, tmp_path):
 def test_transparency_of_a_trial_against_itself(lab, tmp_path):
     """The same trial as both conditions: RMSD 0 everywhere, so transparent; tables and figure written."""
     d = lab["dir"]
-    strides, cycles = [d / "walk.strides.tsv"] * 2, [d / "walk.cycles.tsv"] * 2
-    out = transparency.transparency(
-        ["S98", "S99"],
-        strides,
-        cycles,
-        strides,
-        cycles,
-        tmp_path / "rmsd.tsv",
-        tmp_path / "force.tsv",
-        tmp_path / "t.png",
-    )
+    strides, cycles = d / "walk.strides.tsv", d / "walk.cycles.tsv"
+    files = {s: transparency.TransparencyFiles(strides, cycles, strides, cycles) for s in ("S98", "S99")}
+    out = transparency.transparency(files, tmp_path / "rmsd.tsv", tmp_path / "force.tsv", tmp_path / "t.png")
     rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
     assert len(rmsd) == 3 * 2 * 3  # (2 subjects + all) x 2 phases x 3 joints
     np.testing.assert_allclose(rmsd["rmsd_rad"], 0.0, atol=1e-12)
@@ -220,7 +223,7 @@ def test_fewer_strides_than_the_outlier_rule_needs_are_kept_unjudged_and_flagged
     hs = events[(events.side == "left") & (events.event == "heel_strike")].time_s.to_numpy()
     events[events.time_s <= hs[n_strides] + 1e-9].to_csv(tmp_path / "short.events.tsv", sep="\t", index=False)
     with pytest.warns(TooFewStridesWarning) as caught:
-        tables = processing.strides(
+        tables = stride_steps.strides(
             d / "walk.angles.tsv",
             tmp_path / "short.events.tsv",
             tmp_path / "s.strides.tsv",
@@ -252,11 +255,10 @@ def test_transparency_leaves_out_a_subject_with_too_few_strides(lab, tmp_path):
     walk, cycles = d / "walk.strides.tsv", d / "walk.cycles.tsv"
     with pytest.warns(TooFewStridesWarning, match="subject S98: .* and 3 with the device, fewer than 5"):
         transparency.transparency(
-            ["S98", "S99"],
-            [walk, walk],
-            [cycles, cycles],
-            [tmp_path / "few.strides.tsv", walk],
-            [cycles, cycles],
+            {
+                "S98": transparency.TransparencyFiles(walk, cycles, tmp_path / "few.strides.tsv", cycles),
+                "S99": transparency.TransparencyFiles(walk, cycles, walk, cycles),
+            },
             tmp_path / "rmsd.tsv",
             tmp_path / "force.tsv",
             tmp_path / "t.png",
@@ -284,11 +286,11 @@ def test_transparency_without_any_subject_left_writes_empty_group_rows(lab, tmp_
     strides.iloc[:1].to_csv(tmp_path / "one.strides.tsv", sep="\t", index=False)
     with pytest.warns(TooFewStridesWarning, match="and 1 with the device, fewer than 5"):
         transparency.transparency(
-            ["S98"],
-            [d / "walk.strides.tsv"],
-            [d / "walk.cycles.tsv"],
-            [tmp_path / "one.strides.tsv"],
-            [d / "walk.cycles.tsv"],
+            {
+                "S98": transparency.TransparencyFiles(
+                    d / "walk.strides.tsv", d / "walk.cycles.tsv", tmp_path / "one.strides.tsv", d / "walk.cycles.tsv"
+                )
+            },
             tmp_path / "rmsd.tsv",
             tmp_path / "force.tsv",
             tmp_path / "t.png",
@@ -306,32 +308,28 @@ def test_events_and_loadcell_from_one_reading_write_the_bytes_of_the_two_steps(l
     """The workflow's one-process step for trials with the device against the two steps run on their own."""
     d = lab["dir"]
     grf = {"left": "Fz_left", "right": "Fz_right"}
-    processing.events(d / "walk.c3d", tmp_path / "alone.events.tsv", grf, contacts_out=tmp_path / "alone.contacts.tsv")
-    processing.loadcell(
+    event_steps.events(
+        d / "walk.c3d",
+        tmp_path / "alone.events.tsv",
+        EventSettings(grf_channels=grf),
+        contacts_out=tmp_path / "alone.contacts.tsv",
+    )
+    event_steps.loadcell(
         d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "alone.force.tsv", native_out=tmp_path / "alone.native.tsv"
     )
-    table, force = processing.events_loadcell(
+    table, force = event_steps.events_loadcell(
         d / "walk.c3d",
         d / "walk.loper.tsv",
         tmp_path / "one.events.tsv",
         tmp_path / "one.contacts.tsv",
         tmp_path / "one.force.tsv",
         tmp_path / "one.native.tsv",
-        {"grf_channels": grf},
-        {"cutoff_hz": 40.0},
+        EventSettings(grf_channels=grf),
+        LoadcellSettings(cutoff_hz=40.0),
     )
     for kind in ("events", "contacts", "force", "native"):
         assert (tmp_path / f"one.{kind}.tsv").read_bytes() == (tmp_path / f"alone.{kind}.tsv").read_bytes(), kind
     assert len(table) == len(lab["found"]) and len(force) == len(lab["force"])
-
-
-def test_events_and_loadcell_refuse_an_unknown_setting(lab, tmp_path):
-    d = lab["dir"]
-    with pytest.raises(TypeError, match=r"events: unknown setting\(s\) \['treshold_on_n'\]"):
-        processing.events_loadcell(
-            d / "walk.c3d", d / "walk.loper.tsv", *(tmp_path / f"x.{k}" for k in "abcd"), {"treshold_on_n": 50.0}
-        )
-    assert not list(tmp_path.iterdir())  # nothing written
 
 
 def test_events_and_loadcell_write_nothing_when_the_robot_log_is_bad(lab, tmp_path):
@@ -345,13 +343,13 @@ def test_events_and_loadcell_write_nothing_when_the_robot_log_is_bad(lab, tmp_pa
     bad.write_text("".join(lines))
     out = tmp_path / "out"
     with pytest.raises(LoperInputError, match=r"bad\.loper\.tsv: column 'force_measured_n', sample 20 .*non-finite"):
-        processing.events_loadcell(
+        event_steps.events_loadcell(
             d / "walk.c3d",
             bad,
             out / "e.tsv",
             out / "c.tsv",
             out / "f.tsv",
             out / "n.tsv",
-            {"grf_channels": {"left": "Fz_left", "right": "Fz_right"}},
+            EventSettings(grf_channels={"left": "Fz_left", "right": "Fz_right"}),
         )
     assert not out.exists()  # the events were found, but nothing is written unless both steps succeed

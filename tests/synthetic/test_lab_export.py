@@ -16,7 +16,7 @@ from loper_analysis.io.robot_log_mat import read_robot_log_mat
 from loper_analysis.motion.ik import inverse_kinematics, marker_positions
 from loper_analysis.motion.markers import rotate_markers
 from loper_analysis.motion.model import build_lower_body_model
-from loper_analysis.steps.synthetic import lab_export_session
+from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
 from loper_analysis.synthetic.lab_export import (
     GAIT2392_COORDINATES,
     ROBOT_LOG_MAT_VARIABLES,
@@ -49,19 +49,15 @@ def gait2392_model():
 @pytest.fixture(scope="module")
 def session(tmp_path_factory):
     out = tmp_path_factory.mktemp("qtm")
-    truth = lab_export_session(
+    files = LabExportFiles(
         out,
-        "S01",
         GAIT2392 / "gait2392_simbody.osim",
         GAIT2392 / "gait2392_Scale_MarkerSet.xml",
         GAIT2392 / "qtm_label_map.tsv",
-        ["walk-device", "pert050-1"],
-        [None, 50],
-        "walk-nodevice",
-        1.75,
-        70.0,
-        8.0,
-        seed=11,
+    )
+    # the default design: no pulses in walk-device, pulses 50 ms after toe-off in pert050-1
+    truth = lab_export_session(
+        files, "S01", ["walk-device", "pert050-1"], 1.75, 70.0, LabExportSettings(seed=11, walking_duration_s=8.0)
     )
     return out, truth
 

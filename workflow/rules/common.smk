@@ -15,7 +15,6 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
 from loper_analysis.schema import check_config, check_table, config_origin
-from loper_analysis.steps.planning import planning_settings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
 from loper_analysis.identification.validation import validation_settings
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
@@ -242,13 +241,13 @@ def processing_targets() -> list[str]:
         out.append("results/strides/summary.tsv")
     if any(DESIGN.onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
         out += [
-            "results/tables/impedance.tsv",
-            "results/tables/impedance_summary.tsv",
-            "results/tables/literature.tsv",
-            "results/figures/impedance.png",
-            "results/tables/tables.md",
+            "results/impedance/impedance.tsv",
+            "results/impedance/summary.tsv",
+            "results/impedance/literature.tsv",
+            "results/impedance/impedance.png",
+            "results/report/tables.md",
         ]
-        out += [f"results/figures/{s}/{f}.png" for s in processed_subjects() for f in ("responses", "fit")]
+        out += [f"results/impedance/{s}/{f}.png" for s in processed_subjects() for f in ("responses", "fit")]
         out += ["results/planning/plan.tsv", "results/planning/answers.txt"]
     if transparency_subjects():
         out += [

@@ -20,7 +20,7 @@ rule events:
     group:
         "trial"
     params:
-        settings=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
+        **settings_params(event_settings),
     script:
         "../scripts/events.py"
 
@@ -48,7 +48,7 @@ rule events_loadcell:
     group:
         "trial"
     params:
-        events=lambda wc: {**EVENT_SETTINGS, "label_map": trial_label_maps(wc.trial) or None},
-        loadcell=LOADCELL_SETTINGS,
+        **settings_params(event_settings, "events"),
+        **settings_params(LOADCELL_SETTINGS, "loadcell"),
     script:
         "../scripts/events_loadcell.py"

@@ -14,9 +14,6 @@ rule grf:
     benchmark:
         "results/benchmarks/grf/{subject}/{trial}.tsv"
     params:
-        rotation_deg=config["markers"]["lab_to_model_rotation_deg"],
-        threshold_n=config["grf"]["loaded_threshold_n"],
-        band_n=config["grf"]["resting_band_n"],
-        max_rest_n=config["grf"]["max_resting_n"],
+        **settings_params(GRF_SETTINGS),
     script:
         "../scripts/grf.py"

@@ -19,8 +19,7 @@ if OPENSIM["ik_chunks"] == 1:
         group:
             "trial"
         params:
-            coordinate_map=OPENSIM["coordinate_map"],
-            settings=IK_SETTINGS,
+            **settings_params(IK_SETTINGS),
         script:
             "../scripts/ik.py"
 
@@ -40,8 +39,8 @@ else:
         group:
             "trial"
         params:
+            **settings_params(IK_SETTINGS),
             n_chunks=OPENSIM["ik_chunks"],
-            settings=IK_SETTINGS,
         script:
             "../scripts/ik_chunk.py"
 
@@ -59,6 +58,6 @@ else:
         group:
             "trial"
         params:
-            coordinate_map=OPENSIM["coordinate_map"],
+            **settings_params(IK_SETTINGS),
         script:
             "../scripts/ik_join.py"

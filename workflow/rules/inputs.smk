@@ -1,5 +1,18 @@
 # The rules' settings from the config and their input functions: the stage files only wire them.
 
+import dataclasses
+
+from loper_analysis.steps.events import EventSettings, LoadcellSettings
+from loper_analysis.steps.grf import GRFSettings
+from loper_analysis.steps.ik import IKSettings
+from loper_analysis.steps.markers import MarkerSettings
+from loper_analysis.steps.model import ModelSettings
+from loper_analysis.steps.strides import StrideSettings
+from loper_analysis.steps.impedance import FitFiles, FitOutputs, FitSettings, TrialFiles
+from loper_analysis.steps.planning import PilotFiles, PilotTrial, PlanningSettings
+from loper_analysis.steps.report import FrontPageSettings
+from loper_analysis.steps.transparency import TransparencyFiles, TransparencySettings
+
 # the config's sections
 TRIALS = config["trials"]
 MARKERS = config["markers"]
@@ -17,35 +30,47 @@ IK_CHUNKS = [f"{i:03d}" for i in range(OPENSIM["ik_chunks"])]
 ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
 
 # the settings of the stages' rules
-STATIC_SETTINGS = dict(duration_s=MARKERS["static_duration_s"], rotation_deg=MARKERS["lab_to_model_rotation_deg"])
-IK_SETTINGS = dict(
-    tasks_file=OPENSIM["ik_tasks"],
-    default_weight=OPENSIM["default_marker_weight"],
-    marker_weights=OPENSIM["marker_weights"],
-    coordinate_tasks=OPENSIM["coordinate_tasks"],
-    accuracy=OPENSIM["accuracy"],
-    max_marker_rms_m=OPENSIM["max_marker_rms_m"],
-    warn_marker_rms_m=OPENSIM["warn_marker_rms_m"],
-    max_rms_fraction=OPENSIM["max_rms_fraction"],
-)
-EVENT_SETTINGS = dict(
-    grf_channels=EVENTS["grf_channels"],
-    threshold_on_n=EVENTS["threshold_on_n"],
-    threshold_off_n=EVENTS["threshold_off_n"],
-    min_stance_s=EVENTS["min_stance_s"],
-    min_swing_s=EVENTS["min_swing_s"],
-    cutoff_hz=EVENTS["grf_cutoff_hz"],
-    order=FILTER["order"],
-    foot_markers=EVENTS["foot_markers"],
-    plate_sides=EVENTS["plate_sides"],
-    rotation_deg=MARKERS["lab_to_model_rotation_deg"],
-    band_n=config["grf"]["resting_band_n"],
-    max_rest_n=config["grf"]["max_resting_n"],
-)
-LOADCELL_SETTINGS = dict(sync_channel=EVENTS["sync_channel"], cutoff_hz=FILTER["cutoff_hz"], order=FILTER["order"])
-#: onsets, strides, targets, pulse, response, identification and device settings: the mapping of config keys that
-#: ``loper-analysis plan`` takes too (one function, so that the command and the rule cannot drift apart)
-PLAN_SETTINGS = planning_settings(config)
+MODEL_SETTINGS = ModelSettings.from_config(config)
+IK_SETTINGS = IKSettings.from_config(config)
+GRF_SETTINGS = GRFSettings.from_config(config)
+MARKER_SETTINGS = MarkerSettings.from_config(config)
+EVENT_SETTINGS = EventSettings.from_config(config)
+LOADCELL_SETTINGS = LoadcellSettings.from_config(config)
+STRIDE_SETTINGS = StrideSettings.from_config(config)
+try:
+    FIT_SETTINGS = FitSettings.from_config(config)
+    TRANSPARENCY_SETTINGS = TransparencySettings.from_config(config)
+    FRONT_PAGE_SETTINGS = FrontPageSettings.from_config(config)
+    #: onsets, strides, targets, pulse, response, identification and device settings: what ``loper-analysis
+    #: plan`` builds too (one classmethod, so that the command and the rule cannot drift apart)
+    PLAN_SETTINGS = PlanningSettings.from_config(config)
+except LoperInputError as exc:
+    raise WorkflowError(str(exc)) from None
+
+
+def settings_params(settings, name: str = "settings") -> dict:
+    """A rule's params for a settings object (or a function of the wildcards giving one): ``name`` itself (passed
+    on by the script) and ``{name}_repr``, its repr: Snakemake's params trigger compares only builtin values (a
+    dataclass is left out), so the repr is what makes a changed setting rerun the rule."""
+    if callable(settings):
+        return {name: settings, f"{name}_repr": lambda wildcards: repr(settings(wildcards))}
+    return {name: settings, f"{name}_repr": repr(settings)}
+
+
+def marker_settings(wildcards) -> MarkerSettings:
+    """A trial's marker settings: its label maps and span; the static trial neither filled nor filtered."""
+    span = trial_span_s(wildcards.subject, wildcards.trial)
+    settings = dataclasses.replace(
+        MARKER_SETTINGS,
+        label_map=tuple(trial_label_maps(wildcards.trial)) or None,
+        span_s=None if span is None else tuple(span),
+    )
+    return settings.for_static() if wildcards.trial == TRIALS["static"] else settings
+
+
+def event_settings(wildcards) -> EventSettings:
+    """A trial's event settings: the config's with the trial's label maps."""
+    return dataclasses.replace(EVENT_SETTINGS, label_map=tuple(trial_label_maps(wildcards.trial)) or None)
 
 
 def subject_model(wildcards):
@@ -91,13 +116,26 @@ def stride_force(wildcards):
     return f"results/loadcell/{wildcards.subject}/{wildcards.trial}.force.tsv"
 
 
-def transparency_inputs(wildcards):
-    """Stride and cycle tables of the transparency pair, one list per condition and kind, in subject order."""
+def transparency_files() -> dict[str, TransparencyFiles]:
+    """Stride and cycle tables of the transparency pair of every subject that walked both trials."""
+
+    def table(s, cond, kind):
+        return f"results/strides/{s}/{TRIALS[cond]}.{kind}.tsv"
+
     return {
-        f"{cond}_{kind}": [f"results/strides/{s}/{TRIALS[cond]}.{kind}.tsv" for s in transparency_subjects()]
-        for cond in ("no_device", "device")
-        for kind in ("strides", "cycles")
+        s: TransparencyFiles(
+            no_device_strides=table(s, "no_device", "strides"),
+            no_device_cycles=table(s, "no_device", "cycles"),
+            device_strides=table(s, "device", "strides"),
+            device_cycles=table(s, "device", "cycles"),
+        )
+        for s in transparency_subjects()
     }
+
+
+def transparency_inputs(wildcards) -> list[str]:
+    """Every table of transparency_files."""
+    return [path for files in transparency_files().values() for path in dataclasses.astuple(files)]
 
 
 def device_log(trial):
@@ -121,29 +159,52 @@ def null_pair_trials(subject: str) -> list[str]:
     return [t for t in subject_trials(subject) if t != config["trials"]["no_device"]]
 
 
-def fit_trials(subject: str) -> list[str]:
-    """The subject's trials any of its fits reads, in subject_trials order: the onsets' own trials and the
-    null-pair trials."""
-    used = {t for o in ONSETS for t in onset_trials(subject, o) + fit_null_trials(subject, o)}
-    return [t for t in subject_trials(subject) if t in used]
+#: The files a subject's fit at one onset writes ({subject}; {onset}: the onset's three digits).
+FIT_OUTPUTS = dict(
+    response="results/responses/{subject}/{onset}.response.tsv",
+    counts="results/responses/{subject}/{onset}.counts.tsv",
+    fit="results/impedance/{subject}/{onset}.tsv",
+    curves="results/impedance/{subject}/{onset}.curves.tsv",
+    force="results/responses/{subject}/{onset}.force.tsv",
+)
 
 
-def fit_inputs(wildcards):
-    """Files of a subject's fits: angles and strides of every trial a fit reads (order of fit_trials), the force
-    at 128 Hz and at the robot rate and the markers of the perturbation trials (order of their onsets' trials),
-    the segment table and a synthetic truth."""
-    s = wildcards.subject
-    out = {"segments": f"results/model/{s}/segments.tsv"}
-    if SUBJECT_SOURCE[s] == "synthetic":
-        out["truth"] = f"data/raw/{s}/truth.yaml"
-    used = fit_trials(s)
-    out["angles"] = [f"results/ik/{s}/{t}.angles.tsv" for t in used]
-    out["strides"] = [f"results/strides/{s}/{t}.strides.tsv" for t in used]
-    own = [t for o in ONSETS for t in onset_trials(s, o)]
-    out["force"] = [f"results/loadcell/{s}/{t}.force.tsv" for t in own]
-    out["force_native"] = [f"results/loadcell/{s}/{t}.force_native.tsv" for t in own]
-    out["markers"] = [f"results/markers/{s}/{t}.trc" for t in own]
-    return out
+def fit_files(subject: str) -> dict[int, FitFiles]:
+    """Files of a subject's fit at every onset (ms, in the config's order): the onset's own trials (angles,
+    strides, the force at 128 Hz and at the robot rate, markers), the null-pair trials (angles, strides), the
+    segment table, a synthetic truth and the outputs (FIT_OUTPUTS)."""
+    s = subject
+
+    def trial_files(t: str, own: bool) -> TrialFiles:
+        tables = dict(angles=f"results/ik/{s}/{t}.angles.tsv", strides=f"results/strides/{s}/{t}.strides.tsv")
+        if own:
+            tables.update(
+                force=f"results/loadcell/{s}/{t}.force.tsv",
+                markers=f"results/markers/{s}/{t}.trc",
+                force_native=f"results/loadcell/{s}/{t}.force_native.tsv",
+            )
+        return TrialFiles(**tables)
+
+    return {
+        int(o): FitFiles(
+            trials={t: trial_files(t, True) for t in onset_trials(s, o)},
+            segments=f"results/model/{s}/segments.tsv",
+            outputs=FitOutputs(**{kind: path.format(subject=s, onset=o) for kind, path in FIT_OUTPUTS.items()}),
+            null_trials={t: trial_files(t, False) for t in fit_null_trials(s, o)},
+            truth=f"data/raw/{s}/truth.yaml" if SUBJECT_SOURCE[s] == "synthetic" else None,
+        )
+        for o in ONSETS
+    }
+
+
+def fit_inputs(wildcards) -> list[str]:
+    """Every file a subject's fits read (fit_files), each once."""
+    paths = []
+    for files in fit_files(wildcards.subject).values():
+        paths += [files.segments, *([files.truth] if files.truth else [])]
+        for trial in (*files.trials.values(), *files.null_trials.values()):
+            paths += [path for path in dataclasses.astuple(trial) if path is not None]
+    return list(dict.fromkeys(paths))
 
 
 def fit_null_trials(subject: str, onset: str) -> list[str]:
@@ -156,9 +217,9 @@ def fit_null_trials(subject: str, onset: str) -> list[str]:
 def markdown_sections() -> dict:
     """Every result table of the run, for the Markdown rendering."""
     sections = {
-        "Impedance per subject, onset and joint": "results/tables/impedance.tsv",
-        "Across-subject summary": "results/tables/impedance_summary.tsv",
-        "Literature": "results/tables/literature.tsv",
+        "Impedance per subject, onset and joint": "results/impedance/impedance.tsv",
+        "Across-subject summary": "results/impedance/summary.tsv",
+        "Literature": "results/impedance/literature.tsv",
         "Strides per trial": "results/strides/summary.tsv",
         "Validation study": "results/validation/summary.tsv",
         "Device": "results/device/summary.tsv",
@@ -182,46 +243,47 @@ def planning_pilot() -> str:
     return pilot
 
 
-def planning_inputs(wildcards):
+def planning_files() -> PilotFiles:
     """The pilot's angle and stride tables of its trials with the device, its segment table and fit rows."""
     s = planning_pilot()
-    trials = null_pair_trials(s)
-    return {
-        "angles": [f"results/ik/{s}/{t}.angles.tsv" for t in trials],
-        "strides": [f"results/strides/{s}/{t}.strides.tsv" for t in trials],
-        "segments": f"results/model/{s}/segments.tsv",
-        "impedance": [f"results/impedance/{s}/{o:03d}.tsv" for o in TRIALS["perturbation_onsets_ms"]],
-    }
+    return PilotFiles(
+        trials={
+            t: PilotTrial(angles=f"results/ik/{s}/{t}.angles.tsv", strides=f"results/strides/{s}/{t}.strides.tsv")
+            for t in null_pair_trials(s)
+        },
+        segments=f"results/model/{s}/segments.tsv",
+        impedance=tuple(f"results/impedance/{s}/{o:03d}.tsv" for o in TRIALS["perturbation_onsets_ms"]),
+    )
+
+
+def planning_inputs(wildcards) -> list[str]:
+    """Every file of planning_files."""
+    files = planning_files()
+    tables = [path for trial in files.trials.values() for path in (trial.angles, trial.strides)]
+    return [*tables, files.segments, *files.impedance]
 
 
 def front_page_inputs(wildcards) -> dict:
     """Tables the front page reads: the validation summary always, the device summary with device tests, the
     impedance tables and the main figure when the run has perturbation trials, the transparency table when a
-    subject walked both trials of the pair (the targets of processing_targets)."""
+    subject walked both trials of the pair (the targets of processing_targets); named as the fields of
+    loper_analysis.steps.report.FrontPageFiles."""
     out = {"validation": "results/validation/summary.tsv"}
     if device_targets():
         out["device"] = "results/device/summary.tsv"
     targets = set(processing_targets())
-    if "results/tables/impedance.tsv" in targets:
+    if "results/impedance/impedance.tsv" in targets:
         out.update(
-            impedance="results/tables/impedance.tsv",
-            summary="results/tables/impedance_summary.tsv",
-            figure="results/figures/impedance.png",
+            impedance="results/impedance/impedance.tsv",
+            summary="results/impedance/summary.tsv",
+            figure="results/impedance/impedance.png",
         )
     if "results/transparency/rmsd.tsv" in targets:
         out["rmsd"] = "results/transparency/rmsd.tsv"
     return out
 
 
-def lab_settings() -> dict:
-    """Keyword arguments of loper_analysis.synthetic.trials.LabSettings from the config."""
-    return dict(
-        marker_noise_sd_m=SYNTH["marker_noise_sd_m"],
-        n_gaps=SYNTH["marker_gaps_per_trial"],
-        max_gap_frames=SYNTH["max_gap_frames"],
-        grf_noise_sd_n=SYNTH["grf_noise_sd_n"],
-        clock_offset_s=SYNTH["clock_offset_s"],
-        clock_drift_ppm=SYNTH["clock_drift_ppm"],
-        lab_to_model_rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
-        sync_channel=config["events"]["sync_channel"],
-    )
+# the simulated gait lab's settings (rule synthetic_lab)
+from loper_analysis.steps.synthetic import LabSessionSettings
+
+LAB_SESSION_SETTINGS = LabSessionSettings.from_config(config)

@@ -18,16 +18,6 @@ rule markers:
     group:
         trial_group
     params:
-        rotation_deg=MARKERS["lab_to_model_rotation_deg"],
-        walking_direction=MARKERS["walking_direction"],
-        min_travel_speed_m_per_s=MARKERS["min_travel_speed_m_per_s"],
-        # the static trial is averaged over the scaling window, each marker over the frames it is present in:
-        # neither filled nor filtered (as OpenSim's ScaleTool reads a lab's static trial)
-        max_gap_frames=lambda wc: 0 if wc.trial == TRIALS["static"] else MARKERS["max_gap_frames"],
-        cutoff_hz=lambda wc: None if wc.trial == TRIALS["static"] else FILTER["cutoff_hz"],
-        order=FILTER["order"],
-        span_s=lambda wc: trial_span_s(wc.subject, wc.trial),
-        label_maps=lambda wc: trial_label_maps(wc.trial),
-        extent_range_m=MARKERS["extent_range_m"],
+        **settings_params(marker_settings),
     script:
         "../scripts/markers.py"

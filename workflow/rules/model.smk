@@ -20,9 +20,9 @@ rule model_generic:
     benchmark:
         "results/benchmarks/model_generic/{subject}.tsv"
     params:
+        **settings_params(MODEL_SETTINGS),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
-        static=STATIC_SETTINGS,
     script:
         "../scripts/model_generic.py"
 
@@ -52,12 +52,10 @@ rule model_scaled:
     group:
         "model"
     params:
+        **settings_params(MODEL_SETTINGS),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
         scale_setup=OPENSIM["scale_setup"],
-        segment_bodies=OPENSIM["segment_bodies"],
-        factor_range=OPENSIM["scale_factor_range"],
-        static={**STATIC_SETTINGS, "max_motion_rms_m": MARKERS["static_max_motion_rms_m"]},
     script:
         "../scripts/model_scaled.py"
 
@@ -73,8 +71,6 @@ rule model_segments:
     benchmark:
         "results/benchmarks/model_segments/{subject}.tsv"
     params:
-        side=TRIALS["perturbed_side"],
-        segment_bodies=OPENSIM["segment_bodies"],
-        attachment_fraction=OPENSIM["brace_attachment_fraction"],
+        **settings_params(MODEL_SETTINGS),
     script:
         "../scripts/model_segments.py"

@@ -9,7 +9,7 @@ localrules:
 
 rule planning:
     input:
-        unpack(planning_inputs),
+        planning_inputs,
     output:
         table=report(
             "results/planning/plan.tsv",
@@ -23,8 +23,8 @@ rule planning:
     benchmark:
         "results/benchmarks/planning/plan.tsv"
     params:
-        **PLAN_SETTINGS,
+        **settings_params(PLAN_SETTINGS),
+        files=lambda wc: planning_files(),
         subject=lambda wc: planning_pilot(),
-        trials=lambda wc: null_pair_trials(planning_pilot()),
     script:
         "../scripts/planning.py"

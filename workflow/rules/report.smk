@@ -19,27 +19,9 @@ rule front_page:
     benchmark:
         "results/benchmarks/front_page/front_page.tsv"
     params:
+        **settings_params(FRONT_PAGE_SETTINGS),
         subjects=SUBJECT_SOURCE,
         trials={s: subject_trials(s) for s in processed_subjects()},
-        settings=dict(
-            seed=config["seed"],
-            perturbation_onsets_ms=TRIALS["perturbation_onsets_ms"],
-            perturbation_repeats=TRIALS["perturbation_repeats"],
-            perturbed_side=TRIALS["perturbed_side"],
-            filter_cutoff_hz=FILTER["cutoff_hz"],
-            filter_order=FILTER["order"],
-            window_before_s=IDENT["window_before_s"],
-            window_after_s=IDENT["window_after_s"],
-            stiffness_bounds_nm_per_rad=IDENT["stiffness_bounds_nm_per_rad"],
-            damping_bounds_nms_per_rad=IDENT["damping_bounds_nms_per_rad"],
-            n_starts=IDENT["n_starts"],
-            noise_model=IDENT["noise_model"],
-            null_pair_components=IDENT["null_pair_components"],
-            synthetic_variability=config["synthetic"]["variability"],
-            synthetic_walking_duration_s=config["synthetic"]["walking_duration_s"],
-            pulse_force_n=config["synthetic"]["pulse_force_n"],
-            pulse_duration_s=config["synthetic"]["pulse_duration_s"],
-        ),
     script:
         "../scripts/front_page.py"
 
@@ -48,7 +30,7 @@ rule tables_markdown:
     input:
         list(markdown_sections().values()),
     output:
-        "results/tables/tables.md",
+        "results/report/tables.md",
     log:
         "results/logs/tables_markdown/tables.log",
     benchmark:

@@ -22,11 +22,7 @@ rule strides:
     group:
         "trial"
     params:
-        side=TRIALS["perturbed_side"],
-        n_points=config["strides"]["n_points"],
-        whisker=config["strides"]["iqr_whisker"],
-        max_fraction=config["strides"]["max_outlier_fraction"],
-        min_valid=config["strides"]["min_valid_strides"],
+        **settings_params(STRIDE_SETTINGS),
     script:
         "../scripts/strides.py"
 
@@ -50,6 +46,6 @@ rule strides_summary:
         "results/benchmarks/strides_summary/summary.tsv"
     params:
         subject_trial=[(s, t) for s in processed_subjects() for t in subject_trials(s)],
-        min_valid=config["strides"]["min_valid_strides"],
+        min_valid=STRIDE_SETTINGS.min_valid,
     script:
         "../scripts/strides_summary.py"

@@ -37,7 +37,7 @@ rule synthetic_lab:
     output:
         static=f"data/raw/{{subject}}/{TRIALS['static']}.c3d",
         c3d=[f"data/raw/{{subject}}/{t}.c3d" for t in DESIGN.walking_trials()],
-        logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in DESIGN.walking_trials() if t != TRIALS["no_device"]],
+        logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in DESIGN.walking_trials() if DESIGN.with_robot(t)],
     log:
         "results/logs/synthetic_lab/{subject}.log",
     benchmark:
@@ -45,13 +45,7 @@ rule synthetic_lab:
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
+        **settings_params(LAB_SESSION_SETTINGS),
         row=lambda wc: SUBJECT_ROWS[wc.subject],
-        trials=DESIGN.walking_trials(),
-        no_device=TRIALS["no_device"],
-        onsets_ms=[DESIGN.onset_ms(t) for t in DESIGN.walking_trials()],
-        settings=SYNTH,
-        lab=lab_settings(),
-        device=config["device"]["parameters"],
-        seed=config["seed"],
     script:
         "../scripts/synthetic_lab.py"

@@ -9,7 +9,7 @@ localrules:
 
 rule transparency:
     input:
-        unpack(transparency_inputs),
+        transparency_inputs,
     output:
         rmsd=report(
             "results/transparency/rmsd.tsv",
@@ -34,8 +34,7 @@ rule transparency:
     benchmark:
         "results/benchmarks/transparency/transparency.tsv"
     params:
-        subjects=transparency_subjects(),
-        side=TRIALS["perturbed_side"],
-        min_strides=config["strides"]["min_valid_strides"],
+        **settings_params(TRANSPARENCY_SETTINGS),
+        files=transparency_files(),
     script:
         "../scripts/transparency.py"

@@ -1,11 +1,7 @@
 from loper_analysis.steps import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import processing
+    from loper_analysis.steps import events
 
-    processing.events(
-        snakemake.input.c3d,
-        snakemake.output.events,
-        contacts_out=snakemake.output.contacts,
-        **snakemake.params.settings,
-    )
+    out = snakemake.output
+    events.events(snakemake.input.c3d, out.events, snakemake.params.settings, contacts_out=out.contacts)

@@ -1,7 +1,7 @@
 from loper_analysis.steps import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import processing
+    from loper_analysis.steps import events
 
     inp, out, p = snakemake.input, snakemake.output, snakemake.params
-    processing.events_loadcell(inp.c3d, inp.log, out.events, out.contacts, out.force, out.native, p.events, p.loadcell)
+    events.events_loadcell(inp.c3d, inp.log, out.events, out.contacts, out.force, out.native, p.events, p.loadcell)

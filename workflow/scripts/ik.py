@@ -3,13 +3,12 @@ from loper_analysis.steps import rule_log
 with rule_log(snakemake.log[0]):
     from loper_analysis.steps import ik
 
-    p, out = snakemake.params, snakemake.output
+    out = snakemake.output
     ik.ik_trial(
         snakemake.input.model,
         snakemake.input.trc,
         out.mot,
         out.angles,
-        p.coordinate_map,
+        snakemake.params.settings,
         summary_tsv=out.summary,
-        **p.settings,
     )

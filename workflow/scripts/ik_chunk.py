@@ -10,5 +10,5 @@ with rule_log(snakemake.log[0]):
         snakemake.output[0],
         int(snakemake.wildcards.chunk),
         p.n_chunks,
-        **p.settings,
+        p.settings,
     )

@@ -4,4 +4,4 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import ik
 
     out = snakemake.output
-    ik.ik_join(snakemake.input, out.mot, out.angles, snakemake.params.coordinate_map, summary_tsv=out.summary)
+    ik.ik_join(snakemake.input, out.mot, out.angles, snakemake.params.settings, summary_tsv=out.summary)

@@ -5,5 +5,5 @@ with rule_log(snakemake.log[0]):
 
     p = snakemake.params
     model.generic_model(
-        snakemake.output[0], p.height_m, p.mass_kg, static_c3d=(snakemake.input.static_c3d or [None])[0], **p.static
+        snakemake.output[0], p.height_m, p.mass_kg, (snakemake.input.static_c3d or [None])[0], p.settings
     )

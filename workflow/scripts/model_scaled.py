@@ -3,18 +3,13 @@ from loper_analysis.steps import rule_log
 with rule_log(snakemake.log[0]):
     from loper_analysis.steps import model
 
-    p, i = snakemake.params, snakemake.input
-    model.scale(
+    p, i, out = snakemake.params, snakemake.input, snakemake.output
+    files = model.ScaleFiles(
         i.generic,
         i.static,
-        snakemake.output.model,
-        p.mass_kg,
-        p.scale_setup,
-        p.segment_bodies,
-        tuple(p.factor_range),
-        lab_labels=i.static_summary,
+        out.model,
+        setup_xml=p.scale_setup,
         static_c3d=(i.static_c3d or [None])[0],
-        height_m=p.height_m,
-        report_out=snakemake.output.report,
-        **p.static,
+        report_out=out.report,
     )
+    model.scale(files, p.mass_kg, p.settings, height_m=p.height_m, lab_labels=i.static_summary)

@@ -3,7 +3,4 @@ from loper_analysis.steps import rule_log
 with rule_log(snakemake.log[0]):
     from loper_analysis.steps import model
 
-    p = snakemake.params
-    model.segments_from_model_file(
-        snakemake.input[0], snakemake.output[0], p.side, p.segment_bodies, p.attachment_fraction
-    )
+    model.segments_from_model_file(snakemake.input[0], snakemake.output[0], snakemake.params.settings)

@@ -1,18 +1,7 @@
 from loper_analysis.steps import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import processing
+    from loper_analysis.steps import strides
 
-    p, inp, out = snakemake.params, snakemake.input, snakemake.output
-    processing.strides(
-        inp.angles,
-        inp.events,
-        out.strides,
-        out.cycles,
-        inp.force or None,
-        p.side,
-        p.n_points,
-        p.whisker,
-        p.max_fraction,
-        p.min_valid,
-    )
+    inp, out = snakemake.input, snakemake.output
+    strides.strides(inp.angles, inp.events, out.strides, out.cycles, inp.force or None, snakemake.params.settings)

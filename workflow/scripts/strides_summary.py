@@ -1,9 +1,9 @@
 from loper_analysis.steps import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import processing
+    from loper_analysis.steps import strides
 
     p, i = snakemake.params, snakemake.input
-    processing.strides_summary(
+    strides.strides_summary(
         p.subject_trial, i.strides, snakemake.output[0], p.min_valid, i.contacts, ik_tsvs=i.ik, markers_tsvs=i.markers
     )

@@ -15,34 +15,68 @@ lab-to-model rotation turns into the model's +Y.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 import os
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.grf import LOADED_THRESHOLD_N, MAX_RESTING_N, RESTING_BAND_N
 from loper_analysis.io.atomic import PathLike
 
-__all__ = ["grf", "trial_grf"]
+__all__ = ["GRFSettings", "grf", "trial_grf"]
 
 log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class GRFSettings:
+    """How a C3D's force platforms become ground reactions in the model frame (config ``grf.*``, ``markers.*``).
+
+    Attributes
+    ----------
+    rotation_deg : (float, float, float)
+        Lab -> model rotation about the fixed X, Y, Z axes, degrees (``markers.lab_to_model_rotation_deg``).
+    threshold_n : float
+        A plate is loaded above this vertical force over its resting level, N (``grf.loaded_threshold_n``).
+    band_n, max_rest_n : float
+        The resting-level rule, N (``grf.resting_band_n``, ``grf.max_resting_n``;
+        :func:`loper_analysis.gait.grf.resting_level`).
+    """
+
+    rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
+    threshold_n: float = LOADED_THRESHOLD_N
+    band_n: float = RESTING_BAND_N
+    max_rest_n: float = MAX_RESTING_N
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> GRFSettings:
+        """The ground-reaction settings of a validated config (``grf.*``, ``markers.lab_to_model_rotation_deg``)."""
+        g = config["grf"]
+        return cls(
+            rotation_deg=tuple(float(v) for v in config["markers"]["lab_to_model_rotation_deg"]),
+            threshold_n=g["loaded_threshold_n"],
+            band_n=g["resting_band_n"],
+            max_rest_n=g["max_resting_n"],
+        )
 
 
 def grf(
     c3d_path: PathLike,
     out_mot: PathLike,
-    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
-    threshold_n: float = 20.0,
-    band_n: float = 10.0,
-    max_rest_n: float = 100.0,
+    settings: GRFSettings = GRFSettings(),
     xml_out: PathLike | None = None,
     bodies: Mapping[int, str] | None = None,
     up: Sequence[float] | None = None,
 ) -> pd.DataFrame:
     """C3D force platforms -> ground reaction on the body in the model frame -> external-loads ``.mot``.
 
+    ``settings`` (:class:`GRFSettings`): ``rotation_deg`` turns the lab frame into the model frame;
     ``threshold_n`` is the vertical force above the resting level from which
     a plate counts as loaded (below it force and torque are written as 0 and
     the COP is held, see :mod:`loper_analysis.gait.grf`); ``band_n``
@@ -57,8 +91,9 @@ def grf(
     from loper_analysis.gait.grf import external_loads_table, read_plate_loads
     from loper_analysis.io.external_loads import write_external_loads_mot, write_external_loads_xml
 
-    loads = read_plate_loads(c3d_path, threshold_n, band_n, max_rest_n, up)
-    table = external_loads_table(loads, rotation_deg)
+    s = settings
+    loads = read_plate_loads(c3d_path, s.threshold_n, s.band_n, s.max_rest_n, up)
+    table = external_loads_table(loads, s.rotation_deg)
     write_external_loads_mot(out_mot, table)
     if xml_out is not None and bodies:
         datafile = os.path.relpath(Path(out_mot).resolve(), Path(xml_out).resolve().parent)
@@ -79,16 +114,13 @@ def trial_grf(
     c3d_path: PathLike,
     out_mot: PathLike,
     markers_summary_tsv: PathLike,
-    base_rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
-    threshold_n: float = 20.0,
-    band_n: float = 10.0,
-    max_rest_n: float = 100.0,
+    settings: GRFSettings = GRFSettings(),
 ) -> pd.DataFrame:
     """:func:`grf` of a trial in the frame its markers were turned into: the trial's rotation is read from its
-    markers summary (columns ``rotation_{x,y,z}_deg`` written by :func:`loper_analysis.steps.processing.markers`,
+    markers summary (columns ``rotation_{x,y,z}_deg`` written by the ``markers`` step,
     the configured rotation plus the quarter turn that makes an overground trial walk along +X), so that the
     ground reactions and the inverse kinematics share one frame. The lab's up direction comes from the configured
-    ``base_rotation_deg`` (:func:`loper_analysis.motion.markers.lab_up`)."""
+    ``settings.rotation_deg`` (:func:`loper_analysis.motion.markers.lab_up`)."""
     from loper_analysis.io.readers import read_tsv
     from loper_analysis.motion.markers import lab_up
 
@@ -98,4 +130,5 @@ def trial_grf(
         raise LoperInputError(f"{markers_summary_tsv}: the markers summary holds no row (no marker in the trial)")
     rotation = tuple(float(v) for v in summary[columns].iloc[0])
     log.info("%s: rotation %s deg (from %s)", c3d_path, list(rotation), markers_summary_tsv)
-    return grf(c3d_path, out_mot, rotation, threshold_n, band_n, max_rest_n, up=lab_up(base_rotation_deg))
+    trial = dataclasses.replace(settings, rotation_deg=rotation)
+    return grf(c3d_path, out_mot, trial, up=lab_up(settings.rotation_deg))

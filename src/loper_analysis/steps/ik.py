@@ -1,30 +1,98 @@
-"""File steps of inverse kinematics: OpenSim IK of a trial's TRC to a .mot and the joint-angle table."""
+"""File steps of inverse kinematics: OpenSim IK of a trial's TRC to a .mot and the joint-angle table.
+
+:class:`IKSettings` holds the IK settings of the config (``opensim.*``), built by :meth:`IKSettings.from_config`;
+:func:`ik_trial`, :func:`ik_chunk` and :func:`ik_join` are the rules' steps, :func:`ik_file` the command's.
+"""
 
 from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from loper_analysis.constants import MIN_IK_MARKERS
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, MIN_IK_MARKERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_tsv
+from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
-__all__ = ["ik_chunk", "ik_file", "ik_join", "ik_trial"]
+__all__ = ["DEFAULT_MARKER_WEIGHT", "IKSettings", "ik_chunk", "ik_file", "ik_join", "ik_trial"]
 
 log = logging.getLogger(__name__)
 
+#: Weight of every model marker without a weight of its own (config ``opensim.default_marker_weight``).
+DEFAULT_MARKER_WEIGHT: float = 1.0
 
-def _checked(res, source: str, max_marker_rms_m: float, max_rms_fraction: float, warn_marker_rms_m: float | None):
-    """Refuse a fit that only a mistake explains (:func:`loper_analysis.motion.plausibility.require_ik_fit`);
-    warn about a poor fit, frames left out and coordinates left NaN. Returns the poor-fit warning (or None)."""
+
+@dataclass(frozen=True)
+class IKSettings:
+    """How a trial's markers are solved for the model's coordinates (config ``opensim.*``).
+
+    Attributes
+    ----------
+    tasks_file : str, optional
+        OpenSim IK task-set XML or TSV (``opensim.ik_tasks``); None: the weights below.
+    default_weight : float
+        Weight of a model marker without an entry in ``marker_weights`` (``opensim.default_marker_weight``).
+    marker_weights : mapping, optional
+        Marker -> weight, 0 leaving a marker out (``opensim.marker_weights``).
+    coordinate_tasks : mapping, optional
+        Coordinate -> ``{"weight": w, "value": rad or None}`` (``opensim.coordinate_tasks``).
+    accuracy : float
+        IK solver accuracy (``opensim.accuracy``).
+    min_markers : int
+        Fewest weighted markers present in a frame for IK to solve it (no config key).
+    max_marker_rms_m, warn_marker_rms_m : float
+        A frame whose marker RMS error (m) exceeds the first counts as failed, the second as poorly fitted
+        (``opensim.max_marker_rms_m``, ``opensim.warn_marker_rms_m``; the second None: no warning).
+    max_rms_fraction : float
+        Share of frames above either level that stops the trial, or warns (``opensim.max_rms_fraction``).
+    coordinate_map : mapping, optional
+        Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``opensim.coordinate_map``); None:
+        :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+    """
+
+    tasks_file: PathLike | None = None
+    default_weight: float = DEFAULT_MARKER_WEIGHT
+    marker_weights: Mapping[str, float] | None = None
+    coordinate_tasks: Mapping[str, Mapping] | None = None
+    accuracy: float = IK_ACCURACY
+    min_markers: int = MIN_IK_MARKERS
+    max_marker_rms_m: float = IK_STOP_RMS_M
+    warn_marker_rms_m: float | None = IK_WARN_RMS_M
+    max_rms_fraction: float = IK_MAX_FRACTION
+    coordinate_map: Mapping[str, Mapping] | None = None
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> IKSettings:
+        """The IK settings of a validated config (``opensim.*``)."""
+        o = config["opensim"]
+        return cls(
+            tasks_file=o["ik_tasks"],
+            default_weight=o["default_marker_weight"],
+            marker_weights=o["marker_weights"],
+            coordinate_tasks=o["coordinate_tasks"],
+            accuracy=o["accuracy"],
+            max_marker_rms_m=o["max_marker_rms_m"],
+            warn_marker_rms_m=o["warn_marker_rms_m"],
+            max_rms_fraction=o["max_rms_fraction"],
+            coordinate_map=o["coordinate_map"],
+        )
+
+
+def _checked(res, source: str, settings: IKSettings):
+    """Refuse a fit that only a mistake explains (:func:`loper_analysis.motion.plausibility.require_ik_fit`, with the
+    limits of ``settings``); warn about a poor fit, frames left out and coordinates left NaN. Returns the poor-fit
+    warning (or None)."""
     from loper_analysis.motion.plausibility import require_ik_fit
 
-    poor = require_ik_fit(res.marker_rms_m, source, max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)
+    poor = require_ik_fit(
+        res.marker_rms_m, source, settings.max_marker_rms_m, settings.max_rms_fraction, settings.warn_marker_rms_m
+    )
     if poor:
         log.warning("%s", poor)
     res.warning = poor
@@ -54,24 +122,23 @@ def _solve(
     time_s: np.ndarray,
     markers_m: np.ndarray,
     labels: Sequence[str],
-    tasks_file=None,
-    default_weight: float = 1.0,
-    marker_weights=None,
-    coordinate_tasks=None,
-    accuracy: float = 1e-6,
+    settings: IKSettings,
     source: str = "",
-    min_markers: int = MIN_IK_MARKERS,
 ):
-    """IK of marker arrays with the tasks of a file or of the config; returns the :class:`IKResult`."""
+    """IK of marker arrays with the tasks of ``settings`` (its task file or its weights); returns the
+    :class:`IKResult`."""
     from loper_analysis.io.ik_tasks import read_ik_tasks
     from loper_analysis.io.osim import read_model
     from loper_analysis.motion.ik import ik_task_weights, inverse_kinematics
 
+    s = settings
     model = read_model(model_osim)
-    tasks = read_ik_tasks(tasks_file) if tasks_file else None
-    weights, coords = ik_task_weights(model, labels, tasks, default_weight, marker_weights, coordinate_tasks, source)
+    tasks = read_ik_tasks(s.tasks_file) if s.tasks_file else None
+    weights, coords = ik_task_weights(
+        model, labels, tasks, s.default_weight, s.marker_weights, s.coordinate_tasks, source
+    )
     return inverse_kinematics(
-        model, time_s, markers_m, labels, weights, coords, accuracy=accuracy, min_markers=min_markers, source=source
+        model, time_s, markers_m, labels, weights, coords, accuracy=s.accuracy, min_markers=s.min_markers, source=source
     )
 
 
@@ -81,18 +148,11 @@ def ik_chunk(
     out_mot: PathLike,
     chunk: int,
     n_chunks: int,
-    tasks_file=None,
-    default_weight: float = 1.0,
-    marker_weights: Mapping[str, float] | None = None,
-    coordinate_tasks: Mapping[str, Mapping] | None = None,
-    accuracy: float = 1e-6,
-    min_markers: int = MIN_IK_MARKERS,
-    max_marker_rms_m: float = IK_STOP_RMS_M,
-    max_rms_fraction: float = IK_MAX_FRACTION,
-    warn_marker_rms_m: float | None = IK_WARN_RMS_M,
+    settings: IKSettings = IKSettings(),
 ):
     """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the :class:`IKResult`.
 
+    The tasks, the solver's accuracy and the limits are those of ``settings`` (:class:`IKSettings`).
     Markers missing (NaN) in a frame are left out of its solve; a frame with
     fewer than ``min_markers`` weighted markers (or with markers on the pelvis
     only) is left out of IK: NaN in every coordinate, with a warning giving
@@ -109,20 +169,8 @@ def ik_chunk(
 
     time_s, X, labels = read_markers(trc_path)
     sel = chunk_frames(len(time_s), n_chunks, chunk)
-    res = _solve(
-        model_osim,
-        time_s[sel],
-        X[sel],
-        labels,
-        tasks_file,
-        default_weight,
-        marker_weights,
-        coordinate_tasks,
-        accuracy,
-        source=f"{trc_path} with {model_osim}",
-        min_markers=min_markers,
-    )
-    _checked(res, f"{trc_path} with {model_osim}", max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)
+    res = _solve(model_osim, time_s[sel], X[sel], labels, settings, source=f"{trc_path} with {model_osim}")
+    _checked(res, f"{trc_path} with {model_osim}", settings)
     log.info(
         "%s chunk %d/%d: %d frames (%d solved), marker RMS error mean %.2f mm, max %.2f mm",
         trc_path,
@@ -142,41 +190,19 @@ def ik_trial(
     trc_path: PathLike,
     out_mot: PathLike,
     angles_tsv: PathLike,
-    coordinate_map: Mapping | None = None,
-    tasks_file=None,
-    default_weight: float = 1.0,
-    marker_weights=None,
-    coordinate_tasks=None,
-    accuracy: float = 1e-6,
-    min_markers: int = MIN_IK_MARKERS,
-    max_marker_rms_m: float = IK_STOP_RMS_M,
-    max_rms_fraction: float = IK_MAX_FRACTION,
-    warn_marker_rms_m: float | None = IK_WARN_RMS_M,
+    settings: IKSettings = IKSettings(),
     summary_tsv: PathLike | None = None,
 ) -> pd.DataFrame:
-    """IK of a whole TRC in one go: the .mot (degrees), the tidy angle table that :func:`ik_join` gives, and
-    (``summary_tsv``) the one-row IK summary (:meth:`loper_analysis.motion.ik.IKResult.summary`)."""
+    """IK of a whole TRC in one go (:func:`ik_chunk` with ``settings``): the .mot (degrees), the tidy angle table
+    that :func:`ik_join` gives (``settings.coordinate_map``), and (``summary_tsv``) the one-row IK summary
+    (:meth:`loper_analysis.motion.ik.IKResult.summary`)."""
     from loper_analysis.motion.ik import joint_angle_table
 
-    res = ik_chunk(
-        model_osim,
-        trc_path,
-        out_mot,
-        0,
-        1,
-        tasks_file,
-        default_weight,
-        marker_weights,
-        coordinate_tasks,
-        accuracy,
-        min_markers,
-        max_marker_rms_m,
-        max_rms_fraction,
-        warn_marker_rms_m,
-    )
-    angles = joint_angle_table(res.frame(), coordinate_map, source=f"{out_mot} (model {model_osim})")
+    res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, settings)
+    angles = joint_angle_table(res.frame(), settings.coordinate_map, source=f"{out_mot} (model {model_osim})")
     if summary_tsv is not None:
-        write_tsv(res.summary(IK_WARN_RMS_M if warn_marker_rms_m is None else warn_marker_rms_m), summary_tsv)
+        warn = settings.warn_marker_rms_m
+        write_tsv(res.summary(IK_WARN_RMS_M if warn is None else warn), summary_tsv)
     write_tsv(angles, angles_tsv)
     log.info("%d frames, %s", len(angles), list(angles.columns))
     return angles
@@ -186,10 +212,11 @@ def ik_join(
     chunk_mots: Sequence[PathLike],
     out_mot: PathLike,
     angles_tsv: PathLike,
-    coordinate_map: Mapping | None = None,
+    settings: IKSettings = IKSettings(),
     summary_tsv: PathLike | None = None,
 ) -> pd.DataFrame:
-    """Join IK chunks into one .mot and the tidy angle table (rad, m; :data:`kinematics.ANGLE_COLUMNS`).
+    """Join IK chunks into one .mot and the tidy angle table (rad, m; :data:`kinematics.ANGLE_COLUMNS`; the
+    coordinates of ``settings.coordinate_map``).
 
     ``summary_tsv``: the one-row IK summary of the joined trial (frames left
     out are those without any coordinate; the chunks keep no marker errors,
@@ -200,7 +227,7 @@ def ik_join(
 
     frames = [read_mot(p) for p in chunk_mots]
     coords = join_chunks(frames, [str(p) for p in chunk_mots])
-    angles = joint_angle_table(coords, coordinate_map, source=str(chunk_mots[0]))
+    angles = joint_angle_table(coords, settings.coordinate_map, source=str(chunk_mots[0]))
     write_mot(out_mot, coords, in_degrees=True)
     if summary_tsv is not None:
         values = coords.drop(columns="time_s").to_numpy(float)
@@ -218,16 +245,10 @@ def ik_file(
     model_osim: PathLike,
     markers_path: PathLike,
     out_mot: PathLike,
-    tasks_file=None,
-    start_s: float | None = None,
-    end_s: float | None = None,
+    settings: IKSettings = IKSettings(),
+    span_s: Sequence[float | None] | None = None,
     rotate_deg: Sequence[float] | None = None,
-    accuracy: float = 1e-6,
-    min_markers: int = MIN_IK_MARKERS,
-    max_marker_rms_m: float = IK_STOP_RMS_M,
-    max_rms_fraction: float = IK_MAX_FRACTION,
     label_map: Mapping[str, str] | None = None,
-    warn_marker_rms_m: float | None = IK_WARN_RMS_M,
     walking_direction: str = "fixed",
 ):
     """IK of a .c3d or .trc marker file to a .mot (degrees), for the command line.
@@ -236,8 +257,10 @@ def ik_file(
     renamed by ``label_map`` {lab label: model marker}
     (:func:`loper_analysis.motion.marker_names.model_marker_names`). ``rotate_deg`` turns the markers into the
     model frame
-    (default -90 0 0 for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). Without a
-    task file every model marker found in the file gets weight 1. Frames with
+    (default -90 0 0 for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). ``span_s`` (start, end), s on
+    the file's clock, is the part solved (None, or None for either end: from the first or to the last frame).
+    Of ``settings`` (:class:`IKSettings`) the task file, the accuracy, ``min_markers`` and the limits count:
+    without a task file every model marker found in the file gets weight 1. Frames with
     too few markers are left out (NaN), with a warning. A fit that only a
     mistake explains (marker RMS error above ``max_marker_rms_m`` m in more
     than ``max_rms_fraction`` of the frames) is refused and nothing is
@@ -260,7 +283,7 @@ def ik_file(
     time_s, markers_m, labels = read_markers(markers_path)
     labels = model_marker_names(labels, label_map, str(markers_path))
     if rotate_deg is None:
-        rotate_deg = (-90.0, 0.0, 0.0) if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
+        rotate_deg = LAB_TO_MODEL_ROTATION_DEG if markers_path.suffix.lower() == ".c3d" else (0.0, 0.0, 0.0)
     if walking_direction != "fixed":
         from loper_analysis.motion.heading import trial_heading
 
@@ -269,6 +292,7 @@ def ik_file(
             markers_m, rate, rotate_deg, walking_direction, source=str(markers_path)
         ).rotation_deg
     markers_m = rotate_markers(markers_m, rotate_deg)
+    start_s, end_s = (None, None) if span_s is None else span_s
     start = time_s[0] if start_s is None else start_s
     end = time_s[-1] if end_s is None else end_s
     sel = (time_s >= start - 1e-9) & (time_s <= end + 1e-9)
@@ -277,6 +301,7 @@ def ik_file(
             f"{markers_path}: no frame between --start {start} and --end {end} s "
             f"(the file spans {time_s[0]:.4f} .. {time_s[-1]:.4f} s)"
         )
+    tasks_file = settings.tasks_file
     weights, coordinate_tasks = (None, None) if tasks_file is None else read_ik_tasks(tasks_file)
     if weights is not None and not weights:
         weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
@@ -289,11 +314,11 @@ def ik_file(
             labels,
             weights,
             coordinate_tasks,
-            accuracy=accuracy,
-            min_markers=min_markers,
+            accuracy=settings.accuracy,
+            min_markers=settings.min_markers,
         )
     except LoperInputError as exc:
         raise LoperInputError(f"{markers_path} with {model_osim}: {exc}") from None
-    _checked(result, f"{markers_path} with {model_osim}", max_marker_rms_m, max_rms_fraction, warn_marker_rms_m)
+    _checked(result, f"{markers_path} with {model_osim}", settings)
     write_mot(out_mot, result.frame(), in_degrees=True)
     return result

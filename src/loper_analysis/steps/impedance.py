@@ -1,21 +1,145 @@
-"""File steps of the impedance analysis: the fit per subject and onset, the aggregate tables, the figures."""
+"""File steps of the impedance analysis: the fit per subject and onset, the aggregate tables, the figures.
+
+:func:`fit` and :func:`subject_fits` read the files of a :class:`FitFiles` bundle (per trial a
+:class:`TrialFiles`, the outputs a :class:`FitOutputs`) with the settings :class:`FitSettings`
+(from the config by :meth:`FitSettings.from_config`).
+"""
 
 from __future__ import annotations
 
+import copy
 import logging
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.identification.impedance import IdentificationSettings
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.truth import read_truth
+from loper_analysis.responses import ResponseSettings
 
-__all__ = ["fit", "subject_fits", "impedance_table", "impedance_summary", "subject_figures", "impedance_figure"]
+__all__ = [
+    "FitSettings",
+    "TrialFiles",
+    "FitOutputs",
+    "FitFiles",
+    "fit",
+    "subject_fits",
+    "impedance_table",
+    "impedance_summary",
+    "subject_figures",
+    "impedance_figure",
+]
 
 log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class FitSettings:
+    """How a subject's responses are windowed and averaged and its impedance fitted and judged.
+
+    ``response``: :class:`~loper_analysis.responses.ResponseSettings` (fit window and initial-state span in s,
+    the IQR rule, the fewest kept pairs); ``identification``:
+    :class:`~loper_analysis.identification.impedance.IdentificationSettings` (noise model, starts, bounds in
+    N·m/rad and N·m·s/rad, judgement, seed).
+    """
+
+    response: ResponseSettings = field(default_factory=ResponseSettings)
+    identification: IdentificationSettings = field(default_factory=IdentificationSettings)
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> FitSettings:
+        """The settings of a validated config: ``identification.*``, ``strides.iqr_whisker``,
+        ``strides.max_outlier_fraction``, ``strides.min_valid_strides`` and ``seed``."""
+        ident, strides = config["identification"], config["strides"]
+        return cls(
+            response=ResponseSettings(
+                window_before_s=ident["window_before_s"],
+                window_after_s=ident["window_after_s"],
+                initial_state_span_s=ident["initial_state_span_s"],
+                whisker=strides["iqr_whisker"],
+                max_fraction=strides["max_outlier_fraction"],
+                min_strides=strides["min_valid_strides"],
+            ),
+            identification=IdentificationSettings(
+                noise_model=ident["noise_model"],
+                interval_scatter=ident["interval_scatter"],
+                null_pair_components=ident["null_pair_components"],
+                min_null_pairs=ident["min_null_pairs"],
+                initial_state_degree=ident["initial_state_degree"],
+                n_starts=ident["n_starts"],
+                n_substeps=ident["n_substeps"],
+                tolerance=ident["tolerance"],
+                merge_tolerance=ident["merge_tolerance"],
+                stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
+                damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
+                max_ci_fraction=ident["max_ci_fraction"],
+                plausible_ranges=copy.deepcopy(ident["plausible_ranges"]),
+                min_vaf_pct=ident["min_vaf_pct"],
+                max_null_trial_ratio=ident["max_null_trial_ratio"],
+                seed=config["seed"],
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class TrialFiles:
+    """The files of one trial a fit reads.
+
+    ``angles`` and ``strides``: its joint-angle and stride tables (TSV), for every trial. A trial of the
+    onset itself also gives ``force`` (the load cell on the marker frames, TSV) and ``markers`` (TRC, for
+    the brace markers), and optionally ``force_native`` (the load cell at the robot rate,
+    ``{trial}.force_native.tsv``, from which the fit then takes its force).
+    """
+
+    angles: PathLike
+    strides: PathLike
+    force: PathLike | None = None
+    markers: PathLike | None = None
+    force_native: PathLike | None = None
+
+
+@dataclass(frozen=True)
+class FitOutputs:
+    """The files one fit writes (TSV): the mean ``response``, the stride ``counts``, the ``fit`` rows, the fit
+    ``curves`` and, optionally, the mean ``force`` the model saw."""
+
+    response: PathLike
+    counts: PathLike
+    fit: PathLike
+    curves: PathLike
+    force: PathLike | None = None
+
+
+@dataclass(frozen=True)
+class FitFiles:
+    """The files of one subject's fit at one onset.
+
+    ``trials``: the onset's own trials (name -> :class:`TrialFiles` with ``force`` and ``markers``), in the
+    order the fit takes them; ``null_trials``: the trials whose unperturbed strides are the null pairs
+    (their ``angles`` and ``strides`` are read); ``segments``: the segment table (read when the onset has a
+    trial); ``outputs``: what the fit writes; ``truth``: a synthetic subject's ``truth.yaml`` (None: recorded).
+
+    Raises
+    ------
+    LoperInputError
+        An own trial without its force or markers file (naming the trial).
+    """
+
+    trials: Mapping[str, TrialFiles]
+    segments: PathLike
+    outputs: FitOutputs
+    null_trials: Mapping[str, TrialFiles] = field(default_factory=dict)
+    truth: PathLike | None = None
+
+    def __post_init__(self):
+        for name, files in self.trials.items():
+            if files.force is None or files.markers is None:
+                raise LoperInputError(f"fit files: trial {name} of the onset needs its force and markers files")
 
 
 class _Tables:
@@ -31,199 +155,75 @@ class _Tables:
         return self._frames[key]
 
 
-def fit(
-    trials: Sequence[str],
-    angles: Sequence[PathLike],
-    strides: Sequence[PathLike],
-    force: Sequence[PathLike],
-    markers: Sequence[PathLike],
-    segments_tsv: PathLike,
-    onset_ms: int,
-    subject: str,
-    response_out: PathLike,
-    counts_out: PathLike,
-    fit_out: PathLike,
-    curves_out: PathLike,
-    truth_yaml: PathLike | None = None,
-    null_trials: Sequence[str] = (),
-    null_angles: Sequence[PathLike] = (),
-    null_strides: Sequence[PathLike] = (),
-    response: Mapping | None = None,
-    identification: Mapping | None = None,
-    force_native: Sequence[PathLike] = (),
-    force_out: PathLike | None = None,
-) -> pd.DataFrame:
+def fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings = FitSettings()) -> pd.DataFrame:
     """Responses and the impedance fit of one subject at one onset
     (:func:`loper_analysis.identification.impedance.fit_onset`).
 
-    ``trials`` names the onset's trials; ``angles``, ``strides``, ``force``
-    (TSV tables of the processing steps) and ``markers`` (TRC, for the brace
-    markers) give their files in the same order. ``null_trials`` with
-    ``null_angles`` and ``null_strides``: the trials whose unperturbed strides
-    are the null pairs. ``force_native``: the load cell at the robot rate per
-    trial (``{trial}.force_native.tsv``, same order), from which the fit takes
-    its force; ``force_out`` gets the mean forces the model saw. ``response`` and ``identification`` are the keyword
-    arguments of :class:`~loper_analysis.responses.ResponseSettings` and
-    :class:`~loper_analysis.identification.impedance.IdentificationSettings`. Writes the
-    mean response, the stride counts, the fit rows and the fit curves; returns the rows.
+    ``files`` (:class:`FitFiles`): the onset's trials, the null-pair trials, the segment table, the truth and
+    the outputs; ``settings`` (:class:`FitSettings`): the response and identification settings. Writes the
+    mean response, the stride counts, the fit rows, the fit curves and (when ``files.outputs.force`` is
+    given) the mean forces the model saw; returns the rows.
     """
-    return _fit(
-        trials,
-        angles,
-        strides,
-        force,
-        markers,
-        segments_tsv,
-        onset_ms,
-        subject,
-        response_out,
-        counts_out,
-        fit_out,
-        curves_out,
-        truth_yaml,
-        null_trials,
-        null_angles,
-        null_strides,
-        response,
-        identification,
-        force_native,
-        force_out,
-        _Tables(),
-    )
+    return _fit(subject, onset_ms, files, settings, _Tables())
 
 
-def _fit(
-    trials,
-    angles,
-    strides,
-    force,
-    markers,
-    segments_tsv,
-    onset_ms,
-    subject,
-    response_out,
-    counts_out,
-    fit_out,
-    curves_out,
-    truth_yaml,
-    null_trials,
-    null_angles,
-    null_strides,
-    response,
-    identification,
-    force_native,
-    force_out,
-    tables: _Tables,
-) -> pd.DataFrame:
+def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, tables: _Tables) -> pd.DataFrame:
     """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
-    from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
+    from loper_analysis.identification.impedance import fit_onset
     from loper_analysis.io.opensim_tables import read_markers
-    from loper_analysis.responses import ResponseSettings
     from loper_analysis.swing_leg.dynamics import read_segments
 
-    ident = IdentificationSettings(**(identification or {}))
-    settings = ResponseSettings(**(response or {}))
     truth = None
-    if truth_yaml:
-        truth = read_truth(truth_yaml).get(int(onset_ms))
+    if files.truth:
+        truth = read_truth(files.truth).get(int(onset_ms))
     inputs = []
-    natives = list(force_native) if len(force_native) else [None] * len(trials)
-    for name, a, s, f, m, fn in zip(trials, angles, strides, force, markers, natives, strict=True):
-        angle_table = tables(a, "angle table")
-        t, X, labels = read_markers(m)
+    for name, trial in files.trials.items():
+        angle_table = tables(trial.angles, "angle table")
+        t, X, labels = read_markers(trial.markers)
         if len(t) != len(angle_table) or not np.allclose(t, angle_table["time_s"].to_numpy(), atol=1e-6):
-            raise LoperInputError(f"{m}: frames differ from {a}")
+            raise LoperInputError(f"{trial.markers}: frames differ from {trial.angles}")
         inputs.append(
             {
                 "name": name,
                 "angles": angle_table,
-                "strides": tables(s, "stride table"),
-                "force": tables(f, "force table"),
+                "strides": tables(trial.strides, "stride table"),
+                "force": tables(trial.force, "force table"),
                 "markers": (t, X, labels),
                 "force_native": None
-                if fn is None
-                else read_tsv(fn, "robot-rate force table", ("time_s", "force_measured_n")),
+                if trial.force_native is None
+                else read_tsv(trial.force_native, "robot-rate force table", ("time_s", "force_measured_n")),
             }
         )
     null = [
-        {"name": name, "angles": tables(a, "angle table"), "strides": tables(s, "stride table")}
-        for name, a, s in zip(null_trials, null_angles, null_strides, strict=True)
+        {"name": name, "angles": tables(trial.angles, "angle table"), "strides": tables(trial.strides, "stride table")}
+        for name, trial in files.null_trials.items()
     ]
-    params = read_segments(segments_tsv) if inputs else None
-    result = fit_onset(inputs, params, int(onset_ms), subject, truth, null, settings, ident)
-    write_tsv(result.response, response_out)
-    write_tsv(result.counts, counts_out)
-    write_tsv(result.rows, fit_out)
-    write_tsv(result.curves, curves_out)
-    if force_out is not None:
-        write_tsv(result.force, force_out)
+    params = read_segments(files.segments) if inputs else None
+    result = fit_onset(inputs, params, int(onset_ms), subject, truth, null, settings.response, settings.identification)
+    out = files.outputs
+    write_tsv(result.response, out.response)
+    write_tsv(result.counts, out.counts)
+    write_tsv(result.rows, out.fit)
+    write_tsv(result.curves, out.curves)
+    if out.force is not None:
+        write_tsv(result.force, out.force)
     log.info("impedance:\n%s", result.rows.to_string(index=False))
     return result.rows
 
 
-def subject_fits(
-    onsets_ms: Sequence[int],
-    trials: Mapping[str, Sequence[str]],
-    null_trials: Mapping[str, Sequence[str]],
-    angles: Mapping[str, PathLike],
-    strides: Mapping[str, PathLike],
-    force: Mapping[str, PathLike],
-    force_native: Mapping[str, PathLike],
-    markers: Mapping[str, PathLike],
-    segments_tsv: PathLike,
-    subject: str,
-    response_outs: Sequence[PathLike],
-    counts_outs: Sequence[PathLike],
-    fit_outs: Sequence[PathLike],
-    curves_outs: Sequence[PathLike],
-    force_outs: Sequence[PathLike],
-    truth_yaml: PathLike | None = None,
-    response: Mapping | None = None,
-    identification: Mapping | None = None,
-) -> pd.DataFrame:
+def subject_fits(subject: str, fits: Mapping[int, FitFiles], settings: FitSettings = FitSettings()) -> pd.DataFrame:
     """:func:`fit` of one subject at every onset in one process, each table read once.
 
-    ``trials`` and ``null_trials`` map each onset (``"050"``, in the order of
-    ``onsets_ms``) to its own trials and its null-pair trials; ``angles``,
-    ``strides``, ``force``, ``force_native`` and ``markers`` map trial names
-    to their files. The outputs are per onset, in the order of ``onsets_ms``.
-    Returns every onset's fit rows.
+    ``fits`` maps each onset (ms after toe-off) to its :class:`FitFiles`; the onsets are fitted in its
+    order. Returns every onset's fit rows.
     """
     tables = _Tables()
-    rows = []
-    for i, onset in enumerate(onsets_ms):
-        key = f"{int(onset):03d}"
-        own, null = list(trials[key]), list(null_trials[key])
-        rows.append(
-            _fit(
-                own,
-                [angles[t] for t in own],
-                [strides[t] for t in own],
-                [force[t] for t in own],
-                [markers[t] for t in own],
-                segments_tsv,
-                int(onset),
-                subject,
-                response_outs[i],
-                counts_outs[i],
-                fit_outs[i],
-                curves_outs[i],
-                truth_yaml,
-                null,
-                [angles[t] for t in null],
-                [strides[t] for t in null],
-                response,
-                identification,
-                [force_native[t] for t in own],
-                force_outs[i],
-                tables,
-            )
-        )
+    rows = [_fit(subject, int(onset), files, settings, tables) for onset, files in fits.items()]
     return pd.concat(rows, ignore_index=True)
 
 
 def impedance_table(fit_tsvs: Sequence[PathLike], out_tsv: PathLike) -> pd.DataFrame:
-    """The fit rows of every subject and onset in one table (``results/tables/impedance.tsv``)."""
+    """The fit rows of every subject and onset in one table (``results/impedance/impedance.tsv``)."""
     table = pd.concat([read_tsv(f, "impedance rows") for f in fit_tsvs], ignore_index=True)
     write_tsv(table, out_tsv)
     log.info("%d rows, status counts:\n%s", len(table), table.status.value_counts().to_string())

@@ -1,21 +1,39 @@
-"""File steps of the subject's OpenSim model: the generic model, scaling to the static trial, the segment table."""
+"""File steps of the subject's OpenSim model: the generic model, scaling to the static trial, the segment table.
+
+:class:`ModelSettings` holds the model stage's settings of the config, built by :meth:`ModelSettings.from_config`;
+:class:`ScaleFiles` the files of one scaling.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from loper_analysis.constants import GRAVITY_M_PER_S2
+from loper_analysis.constants import GRAVITY_M_PER_S2, LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, staged, write_tsv
 from loper_analysis.io.readers import read_tsv
-from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_parameters_from_anthropometry, write_segments
+from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
+from loper_analysis.study_design import PERTURBED_SIDE
+from loper_analysis.swing_leg.dynamics import (
+    BRACE_ATTACHMENT_FRACTION,
+    SegmentParameters,
+    segment_parameters_from_anthropometry,
+    write_segments,
+)
 
 __all__ = [
+    "STATIC_DURATION_S",
+    "STATIC_MAX_MOTION_RMS_M",
+    "ModelSettings",
+    "ScaleFiles",
     "SCALE_FLOAT_FORMAT",
     "SCALE_REPORT_COLUMNS",
     "generic_model",
@@ -29,20 +47,110 @@ __all__ = [
 
 log = logging.getLogger(__name__)
 
+#: Scaling averages the first this many seconds of the static trial when the scale setup sets no time range (s;
+#: config ``markers.static_duration_s``).
+STATIC_DURATION_S: float = 1.0
+#: A static-trial marker moving more than this over the scaling window stops scaling (m, RMS about its mean;
+#: config ``markers.static_max_motion_rms_m``).
+STATIC_MAX_MOTION_RMS_M: float = 0.05
+
+
+@dataclass(frozen=True)
+class ModelSettings:
+    """How the subject's model is built, scaled and turned into a segment table (config ``markers.*``,
+    ``opensim.*``, ``trials.perturbed_side``).
+
+    Attributes
+    ----------
+    rotation_deg : (float, float, float)
+        Lab -> model rotation about the fixed X, Y, Z axes, degrees: the lab's vertical, for the mass from the
+        static trial's force plates (``markers.lab_to_model_rotation_deg``).
+    static_duration_s : float or None
+        Without a time range (``time_range_s``, the scale setup's): the first this many seconds of the static
+        trial are averaged, s; None: the whole trial (``markers.static_duration_s``).
+    max_motion_rms_m : float or None
+        Largest RMS motion of a marker over the window, m: a subject who does not stand still is refused; None:
+        not checked (``markers.static_max_motion_rms_m``).
+    time_range_s : (float, float), optional
+        The window, s, overriding the setup's time ranges and ``static_duration_s`` (no config key).
+    factor_range : (float, float)
+        Least and largest plausible factor of a measurement (``opensim.scale_factor_range``).
+    segment_bodies : mapping, optional
+        Segment -> body names with ``{s}`` for the side suffix (``opensim.segment_bodies``); None: the model's
+        own kind.
+    side : {"left", "right"}
+        The leg of the segment table (``trials.perturbed_side``).
+    attachment_fraction : float
+        Rod attachment as a fraction of the thigh length, for a model without brace markers
+        (``opensim.brace_attachment_fraction``).
+    """
+
+    rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
+    static_duration_s: float | None = STATIC_DURATION_S
+    max_motion_rms_m: float | None = STATIC_MAX_MOTION_RMS_M
+    time_range_s: tuple[float, float] | None = None
+    factor_range: tuple[float, float] = SCALE_FACTOR_RANGE
+    segment_bodies: Mapping[str, Sequence[str]] | None = None
+    side: str = PERTURBED_SIDE
+    attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> ModelSettings:
+        """The model settings of a validated config (``markers.*``, ``opensim.*``, ``trials.perturbed_side``)."""
+        m, o = config["markers"], config["opensim"]
+        return cls(
+            rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
+            static_duration_s=m["static_duration_s"],
+            max_motion_rms_m=m["static_max_motion_rms_m"],
+            factor_range=tuple(float(v) for v in o["scale_factor_range"]),
+            segment_bodies=o["segment_bodies"],
+            side=config["trials"]["perturbed_side"],
+            attachment_fraction=o["brace_attachment_fraction"],
+        )
+
+
+@dataclass(frozen=True)
+class ScaleFiles:
+    """The files of scaling a generic model to a static trial.
+
+    Attributes
+    ----------
+    generic_osim : path
+        The generic ``.osim`` model.
+    static_trc : path
+        The static trial (``.trc``, any length unit OpenSim knows).
+    out_osim : path
+        The scaled model (written atomically).
+    setup_xml : path, optional
+        A lab's OpenSim ScaleTool setup (:func:`scale_with_setup`); None: the generated model's marker-pair
+        measurements (:func:`scaled_model`).
+    static_c3d : path, optional
+        The static trial's C3D, whose force plates give the mass when none is given
+        (:func:`loper_analysis.motion.static_trial.standing_mass_kg`).
+    report_out : path, optional
+        The scale report (TSV, :func:`scale_report`).
+    """
+
+    generic_osim: PathLike
+    static_trc: PathLike
+    out_osim: PathLike
+    setup_xml: PathLike | None = None
+    static_c3d: PathLike | None = None
+    report_out: PathLike | None = None
+
 
 def generic_model(
     out_osim: PathLike,
     height_m: float,
     mass_kg: float | None,
     static_c3d: PathLike | None = None,
-    duration_s: float | None = None,
-    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    settings: ModelSettings = ModelSettings(),
 ) -> None:
     """The generic lower-body model (:func:`loper_analysis.motion.model.build_lower_body_model`) for this subject.
 
     Without ``mass_kg`` the mass comes from the force plates the subject
     stands on in the static trial ``static_c3d``, over its first
-    ``duration_s`` seconds (None: all of it; ``rotation_deg`` tells the lab's
+    ``settings.static_duration_s`` seconds (None: all of it; ``settings.rotation_deg`` tells the lab's
     vertical: :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
     """
     from loper_analysis.io.osim import write_model
@@ -52,10 +160,10 @@ def generic_model(
         from loper_analysis.io.c3d import read_c3d
         from loper_analysis.motion.static_trial import scale_window_s
 
-        window = scale_window_s(read_c3d(static_c3d).time_s, (), duration_s, source=str(static_c3d))
-        mass_kg, source = _subject_mass(None, static_c3d, window, rotation_deg)
+        window = scale_window_s(read_c3d(static_c3d).time_s, (), settings.static_duration_s, source=str(static_c3d))
+        mass_kg, source = _subject_mass(None, static_c3d, window, settings.rotation_deg)
         log.info("mass %.2f kg from the %s", mass_kg, source)
-    mass_kg, _ = _subject_mass(mass_kg, None, (0.0, 0.0), rotation_deg)
+    mass_kg, _ = _subject_mass(mass_kg, None, (0.0, 0.0), settings.rotation_deg)
     write_model(build_lower_body_model(height_m, mass_kg), out_osim)
     log.info("generic model for %s m, %s kg: %s", height_m, mass_kg, out_osim)
 
@@ -70,22 +178,20 @@ def _check_factors(model, measurements, pose, static_trc, factor_range) -> None:
 
 
 def scaled_model(
-    generic_osim: PathLike,
-    static_trc: PathLike,
-    out_osim: PathLike,
+    files: ScaleFiles,
     mass_kg: float | None,
-    time_range_s: tuple[float, float] | None = None,
-    factor_range: Sequence[float] = (0.5, 2.0),
-    **static,
+    settings: ModelSettings = ModelSettings(),
+    height_m: float | None = None,
+    lab_labels: Mapping[str, str] | None = None,
 ) -> None:
     """Personalise the generated model with OpenSim's ScaleTool from a static trial (TRC).
 
     Each body is scaled uniformly by the ratio of the marker-pair distances in
     the static trial to those of the model
     (:data:`loper_analysis.motion.model.SCALE_MEASUREMENTS`); the mass distribution
-    is preserved at ``mass_kg``. The window, the static pose and the
-    keywords ``static`` are those of :func:`scale_with_setup`; every factor
-    must lie in ``factor_range`` (a factor near 10 or 1000 means markers in
+    is preserved at ``mass_kg``. The files (but ``files.setup_xml``, which is not read), the window, the static
+    pose, ``height_m`` and ``lab_labels`` are those of :func:`scale_with_setup`; every factor
+    must lie in ``settings.factor_range`` (a factor near 10 or 1000 means markers in
     another unit than the TRC declares); nothing is written otherwise.
     """
     from loper_analysis.io.osim import quiet_opensim, read_model
@@ -115,62 +221,38 @@ def scaled_model(
         m.getBodyScaleSet().cloneAndAppend(scale)
         measurements.cloneAndAppend(m)
     tool.getMarkerPlacer().setApply(False)
-    generic_osim = Path(generic_osim)
+    generic_osim = Path(files.generic_osim)
     if not generic_osim.is_file():
         raise LoperInputError(f"file not found: {generic_osim}")
-    _run_scale_tool(
-        tool,
-        read_model(generic_osim),
-        generic_osim,
-        None,
-        None,
-        static_trc,
-        out_osim,
-        mass_kg,
-        time_range_s,
-        factor_range,
-        **static,
-    )
+    generated = dataclasses.replace(files, setup_xml=None)
+    _run_scale_tool(tool, read_model(generic_osim), generated, None, mass_kg, settings, height_m, lab_labels)
 
 
 def scale(
-    generic_osim: PathLike,
-    static_trc: PathLike,
-    out_osim: PathLike,
+    files: ScaleFiles,
     mass_kg: float | None,
-    setup_xml: PathLike | None = None,
-    segment_bodies: Mapping[str, Sequence[str]] | None = None,
-    factor_range: Sequence[float] = (0.5, 2.0),
-    **static,
+    settings: ModelSettings = ModelSettings(),
+    height_m: float | None = None,
+    lab_labels: Mapping[str, str] | PathLike | None = None,
 ) -> None:
-    """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when ``setup_xml``
-    is given, else with the generated model's marker-pair measurements (:func:`scaled_model`); scale factors
-    outside ``factor_range`` are refused. ``static``: the keywords of the static trial
-    (:func:`scale_with_setup`); its ``lab_labels`` may be the static trial's markers summary (TSV with the
-    columns ``label`` and ``marker``, written by :func:`loper_analysis.steps.processing.markers`)."""
-    if isinstance(static.get("lab_labels"), (str, Path)):
-        static["lab_labels"] = _lab_labels(static["lab_labels"])
-    if setup_xml is None:
-        scaled_model(generic_osim, static_trc, out_osim, mass_kg, factor_range=factor_range, **static)
+    """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when
+    ``files.setup_xml`` is given, else with the generated model's marker-pair measurements (:func:`scaled_model`,
+    which checks no ``settings.segment_bodies``); scale factors outside ``settings.factor_range`` are refused.
+    ``lab_labels`` may be the static trial's markers summary (TSV with the columns ``label`` and ``marker``,
+    written by the ``markers`` step)."""
+    if isinstance(lab_labels, (str, Path)):
+        lab_labels = _lab_labels(lab_labels)
+    if files.setup_xml is None:
+        generated = dataclasses.replace(settings, segment_bodies=None)
+        scaled_model(files, mass_kg, generated, height_m, lab_labels)
     else:
-        scale_with_setup(
-            generic_osim,
-            setup_xml,
-            static_trc,
-            mass_kg,
-            out_osim,
-            segment_bodies=segment_bodies,
-            factor_range=factor_range,
-            **static,
-        )
+        scale_with_setup(files, mass_kg, settings, height_m, lab_labels)
 
 
 def segments_from_model_file(
     model_osim: PathLike,
     out_tsv: PathLike,
-    side: str = "left",
-    segment_bodies: Mapping[str, Sequence[str]] | None = None,
-    attachment_fraction: float = 0.8,
+    settings: ModelSettings = ModelSettings(),
 ) -> SegmentParameters:
     """Segment table (TSV) of one leg of an OpenSim model file
     (:func:`loper_analysis.motion.segments.segments_from_model`).
@@ -179,16 +261,14 @@ def segments_from_model_file(
     ----------
     model_osim : path
         A (scaled) ``.osim`` model: gait2392, Rajagopal2016, our generated
-        model or any model whose bodies ``segment_bodies`` names.
+        model or any model whose bodies ``settings.segment_bodies`` names.
     out_tsv : path
         The table (:func:`loper_analysis.swing_leg.dynamics.write_segments`), written atomically.
-    side : {"left", "right"}
-        The swing leg.
-    segment_bodies : mapping, optional
-        Segment -> body names with ``{s}`` for the side suffix (setting
-        ``opensim.segment_bodies``); ``None``: the model's own kind.
-    attachment_fraction : float
-        Rod attachment as a fraction of the thigh length, for a model without brace markers.
+    settings : ModelSettings
+        ``side`` (the swing leg, ``"left"`` or ``"right"``), ``segment_bodies`` (segment -> body names with
+        ``{s}`` for the side suffix, setting ``opensim.segment_bodies``; ``None``: the model's own kind) and
+        ``attachment_fraction`` (rod attachment as a fraction of the thigh length, for a model without brace
+        markers).
 
     Raises
     ------
@@ -200,9 +280,14 @@ def segments_from_model_file(
     from loper_analysis.io.osim import read_model
     from loper_analysis.motion.segments import segments_from_model
 
+    side = settings.side
     check_side(side, str(model_osim))
     params = segments_from_model(
-        read_model(model_osim), SIDE_SUFFIX[side], segment_bodies, attachment_fraction, source=str(model_osim)
+        read_model(model_osim),
+        SIDE_SUFFIX[side],
+        settings.segment_bodies,
+        settings.attachment_fraction,
+        source=str(model_osim),
     )
     write_segments(params, out_tsv)
     log.info("segment table of %s (%s leg)", model_osim, side)
@@ -210,7 +295,7 @@ def segments_from_model_file(
 
 
 def anthropometric_segments(
-    out_tsv: PathLike, height_m: float, mass_kg: float, attachment_fraction: float = 0.8
+    out_tsv: PathLike, height_m: float, mass_kg: float, attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
 ) -> SegmentParameters:
     """Segment table from height and mass with Winter's table (the validation study's subject, the CLI)."""
     params = segment_parameters_from_anthropometry(height_m, mass_kg, attachment_fraction)
@@ -220,82 +305,74 @@ def anthropometric_segments(
 
 
 def scale_with_setup(
-    generic_osim: PathLike,
-    setup_xml: PathLike,
-    static_trc: PathLike,
+    files: ScaleFiles,
     mass_kg: float | None,
-    out_osim: PathLike,
-    time_range_s: tuple[float, float] | None = None,
-    segment_bodies: Mapping[str, Sequence[str]] | None = None,
-    factor_range: Sequence[float] = (0.5, 2.0),
-    **static,
+    settings: ModelSettings = ModelSettings(),
+    height_m: float | None = None,
+    lab_labels: Mapping[str, str] | None = None,
 ) -> None:
     """Scale a generic OpenSim model with a lab's own ScaleTool setup and a static trial (TRC).
 
-    The setup (``opensim.ScaleTool(setup_xml)``) keeps its measurements,
+    The setup (``opensim.ScaleTool(files.setup_xml)``) keeps its measurements,
     scale set, scaling order, mass-distribution flag, marker-placer tasks,
     time ranges and its marker set file (resolved, like OpenSim does,
     relative to the setup's folder); replaced are the generic model file,
     the marker file of the model scaler and the marker placer, the subject
     mass and the output files: only the final model is written, atomically,
-    to ``out_osim`` (the marker placer's model when it applies, else the
+    to ``files.out_osim`` (the marker placer's model when it applies, else the
     model scaler's).
 
     The static trial is averaged over a window
-    (:func:`loper_analysis.motion.static_trial.scale_window_s`): ``time_range_s``
+    (:func:`loper_analysis.motion.static_trial.scale_window_s`): ``settings.time_range_s``
     when given, else the setup's time ranges where they are set, else the
-    first ``duration_s`` seconds (keyword of ``static``; None: the whole
+    first ``settings.static_duration_s`` seconds (None: the whole
     trial). Within it each marker counts where it is present: ScaleTool gets
     the window with every marker's missing frames holding its mean over the
     present ones (:func:`loper_analysis.motion.static_trial.static_pose`).
 
     Parameters
     ----------
-    generic_osim : path
-        The generic ``.osim`` model.
-    setup_xml : path
-        An OpenSim ScaleTool setup.
-    static_trc : path
-        The static trial (``.trc``, any length unit OpenSim knows).
+    files : ScaleFiles
+        The generic model, the static trial (``.trc``) and the scaled model;
+        the ScaleTool setup (required here); optionally the static trial's C3D
+        (the mass from its force plates) and the scale report
+        (:func:`scale_report`).
     mass_kg : float or None
-        Subject mass, kg (0 .. 300); None: from the force plates of the
-        static trial's C3D (keyword ``static_c3d`` of ``static``:
+        Subject mass, kg (0 .. 300); None: from the force plates of
+        ``files.static_c3d`` (seen along the vertical of ``settings.rotation_deg``:
         :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
-    out_osim : path
-        The scaled model.
-    time_range_s : (float, float), optional
-        The window (s), overriding the setup's time ranges.
-    segment_bodies : mapping, optional
-        The bodies the segment table will need (``opensim.segment_bodies``);
-        the scaled model must have them on both sides.
-    factor_range : (float, float)
-        Least and largest plausible factor of a measurement (static-trial
-        marker distance over the model's at its default pose, averaged over
-        the measurement's pairs; :func:`loper_analysis.motion.plausibility.measurement_scale_factors`).
-    **static
-        ``duration_s`` (window without a set range, s), ``lab_labels``
-        ({model marker: lab label} for messages), ``static_c3d`` and
-        ``rotation_deg`` (the mass from its force plates), ``height_m`` (the
-        subject's, else estimated from the scaled model), ``report_out`` (the
-        scale report, :func:`scale_report`), ``max_motion_rms_m`` (largest RMS
-        motion of a marker over the window, m: a subject who does not stand
-        still is refused; None: not checked).
+    settings : ModelSettings
+        The window (``time_range_s``, ``static_duration_s``); ``max_motion_rms_m``
+        (largest RMS motion of a marker over the window, m: a subject who does
+        not stand still is refused; None: not checked); ``segment_bodies`` (the
+        bodies the segment table will need: the scaled model must have them on
+        both sides); ``factor_range`` (least and largest plausible factor of a
+        measurement: static-trial marker distance over the model's at its
+        default pose, averaged over the measurement's pairs,
+        :func:`loper_analysis.motion.plausibility.measurement_scale_factors`);
+        ``rotation_deg`` (the lab's vertical, for the mass).
+    height_m : float, optional
+        The subject's height (m) in the scale report; None: estimated from the scaled model.
+    lab_labels : mapping, optional
+        {model marker: lab label}, for messages and the report.
 
     Raises
     ------
     LoperInputError
-        A missing file; a file that is not a ScaleTool setup; measurement
+        No setup in ``files``; a missing file; a file that is not a ScaleTool setup; measurement
         markers that the model (with the setup's marker set) or the static
         trial lacks (all listed); a measurement marker absent from every
         frame of the window (naming its lab label, the file and the window);
         a window outside the trial; a scaled model without the configured
-        bodies; a measurement's scale factor outside ``factor_range``
+        bodies; a measurement's scale factor outside ``settings.factor_range``
         (markers in another unit than the TRC declares); no mass; ScaleTool
         failing. Nothing is written then.
     """
     from loper_analysis.io.osim import read_marker_set, read_model, read_scale_setup
 
-    generic_osim, setup_xml, static_trc = Path(generic_osim), Path(setup_xml), Path(static_trc)
+    if files.setup_xml is None:
+        raise LoperInputError(f"{files.static_trc}: scaling with a lab's setup needs a ScaleTool setup, got none")
+    generic_osim, setup_xml, static_trc = Path(files.generic_osim), Path(files.setup_xml), Path(files.static_trc)
     for path in (generic_osim, static_trc):
         if not path.is_file():
             raise LoperInputError(f"file not found: {path}")
@@ -319,20 +396,7 @@ def scale_with_setup(
         raise LoperInputError(
             f"{setup_xml}: measurement marker(s) {lacking} are not on the model {generic_osim}{extra}"
         )
-    _run_scale_tool(
-        tool,
-        generic,
-        generic_osim,
-        setup_xml,
-        marker_set,
-        static_trc,
-        out_osim,
-        mass_kg,
-        time_range_s,
-        factor_range,
-        segment_bodies=segment_bodies,
-        **static,
-    )
+    _run_scale_tool(tool, generic, files, marker_set, mass_kg, settings, height_m, lab_labels)
 
 
 def _unknown_markers_hint(
@@ -361,25 +425,15 @@ def _unknown_markers_hint(
 def _run_scale_tool(
     tool,
     generic,
-    generic_osim: Path,
-    setup_xml: Path | None,
+    files: ScaleFiles,
     marker_set: Path | None,
-    static_trc: PathLike,
-    out_osim: PathLike,
     mass_kg: float | None,
-    time_range_s: tuple[float, float] | None,
-    factor_range: Sequence[float],
-    segment_bodies: Mapping[str, Sequence[str]] | None = None,
-    duration_s: float | None = None,
-    lab_labels: Mapping[str, str] | None = None,
-    static_c3d: PathLike | None = None,
-    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    settings: ModelSettings,
     height_m: float | None = None,
-    report_out: PathLike | None = None,
-    max_motion_rms_m: float | None = None,
+    lab_labels: Mapping[str, str] | None = None,
 ) -> None:
     """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report
-    (:func:`scale_with_setup`)."""
+    (:func:`scale_with_setup`; ``files.setup_xml`` None: the tool as :func:`scaled_model` built it)."""
     import tempfile
 
     from loper_analysis.io.opensim_tables import read_markers, write_trc
@@ -387,7 +441,9 @@ def _run_scale_tool(
     from loper_analysis.motion.segments import check_segment_bodies
     from loper_analysis.motion.static_trial import scale_window_s, static_pose
 
-    static_trc = Path(static_trc)
+    generic_osim, static_trc, out_osim = Path(files.generic_osim), Path(files.static_trc), files.out_osim
+    setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
+    time_range_s, segment_bodies = settings.time_range_s, settings.segment_bodies
     if not static_trc.is_file():
         raise LoperInputError(f"file not found: {static_trc}")
     where = str(setup_xml) if setup_xml is not None else str(static_trc)
@@ -405,7 +461,9 @@ def _run_scale_tool(
         window = scale_window_s(times, [(t0, t1)], source=str(static_trc), setting="the time range given")
         ranges = dict.fromkeys(ranges)
     else:
-        window = scale_window_s(times, list(ranges.values()), duration_s, source=str(static_trc), setting=setting)
+        window = scale_window_s(
+            times, list(ranges.values()), settings.static_duration_s, source=str(static_trc), setting=setting
+        )
     pairs = _measurement_pairs(tool)
     needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     lacking = [m for m in needed if m not in labels]
@@ -423,7 +481,7 @@ def _run_scale_tool(
         lab_labels,
         source=str(static_trc),
         setting=setting,
-        max_motion_rms_m=max_motion_rms_m,
+        max_motion_rms_m=settings.max_motion_rms_m,
     )
     moving = sorted(pose.motion_rms_m, key=pose.motion_rms_m.get, reverse=True)[:3]
     log.info(
@@ -446,9 +504,9 @@ def _run_scale_tool(
             ", ".join(pose.left_out),
             *window,
         )
-    _check_factors(generic, pairs, pose, static_trc, factor_range)
+    _check_factors(generic, pairs, pose, static_trc, settings.factor_range)
     gravity = float(np.linalg.norm(generic.getGravity().to_numpy()))
-    mass_kg, mass_source = _subject_mass(mass_kg, static_c3d, window, rotation_deg, gravity)
+    mass_kg, mass_source = _subject_mass(mass_kg, files.static_c3d, window, settings.rotation_deg, gravity)
     osim = quiet_opensim()
     maker = tool.getGenericModelMaker()
     tool.setPathToSubject("")  # OpenSim prefixes the setup's folder to every file name; ours are absolute
@@ -486,19 +544,18 @@ def _run_scale_tool(
                 )
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
-            if report_out is not None:
+            if files.report_out is not None:
                 report = scale_report(
                     scaled,
                     pose,
                     _scale_factors(scale_file),
                     _placer_tasks(placer),
-                    mass_kg,
-                    mass_source,
+                    (mass_kg, mass_source),
                     height_m,
                     segment_bodies,
                     lab_labels,
                 )
-                write_tsv(report, report_out, SCALE_FLOAT_FORMAT)
+                write_tsv(report, files.report_out, SCALE_FLOAT_FORMAT)
                 log.info("scale report:\n%s", report.to_string(index=False))
     log.info(
         "scaled %s to %s (window %.4f .. %.4f s, %d frames, %g kg)",
@@ -584,8 +641,6 @@ SCALE_REPORT_COLUMNS: tuple[str, ...] = (
     "height_m",
     "source",
 )
-#: IK accuracy of the static pose in the scale report (the pipeline's IK accuracy).
-_REPORT_IK_ACCURACY = 1e-6
 
 
 def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
@@ -619,15 +674,14 @@ def scale_report(
     pose,
     factors: Mapping[str, Sequence[float]],
     tasks,
-    mass_kg: float,
-    mass_source: str,
+    mass: tuple[float, str],
     height_m: float | None = None,
     segment_bodies: Mapping[str, Sequence[str]] | None = None,
     lab_labels: Mapping[str, str] | None = None,
 ) -> pd.DataFrame:
     """How good the scaling is: one row per body (scale factors), per marker (error) and for the subject.
 
-    Rows (``kind``): ``subject`` (``mass_kg`` and where it came from,
+    Rows (``kind``): ``subject`` (``mass``: the mass in kg and where it came from,
     ``height_m`` given or estimated from the scaled model:
     :func:`loper_analysis.motion.static_trial.model_height_m`), ``body`` (the
     factors OpenSim's model scaler applied; 1 where it scaled nothing),
@@ -642,6 +696,7 @@ def scale_report(
     from loper_analysis.motion.segments import segment_body_names
     from loper_analysis.motion.static_trial import model_height_m
 
+    mass_kg, mass_source = mass
     rows = []
     if height_m is None:
         thigh = segment_body_names(scaled, "r", segment_bodies)["thigh"][0]
@@ -666,9 +721,7 @@ def scale_report(
     weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
     weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
     mean_pose = pose.markers_m.mean(axis=0, keepdims=True)  # complete: missing frames hold the mean already
-    result = inverse_kinematics(
-        scaled, pose.time_s[:1], mean_pose, pose.labels, weights, coords, accuracy=_REPORT_IK_ACCURACY
-    )
+    result = inverse_kinematics(scaled, pose.time_s[:1], mean_pose, pose.labels, weights, coords, accuracy=IK_ACCURACY)
     errors = result.marker_errors_m[0]
     for name, error in zip(result.marker_names, errors):
         rows.append(

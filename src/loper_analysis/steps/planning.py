@@ -3,9 +3,12 @@
 :func:`plan` reads the pilot's joint-angle and stride tables (the trials with
 the device, whose unperturbed strides give the null pairs and whose perturbed
 strides at an onset give that onset's perturbed pairs), its segment table
-(or another subject's) and its impedance rows (the planned impedance), and
-writes the table of :func:`loper_analysis.planning.precision.precision_table` for every
-onset and the answers to the targets (method: ``docs/planning.md``).
+(or another subject's) and its impedance rows (the planned impedance): a
+:class:`PilotFiles` bundle. It writes the table of
+:func:`loper_analysis.planning.precision.precision_table` for every onset and
+the answers to the targets (method: ``docs/planning.md``), with the settings
+:class:`PlanningSettings`, which the rule ``planning`` and ``loper-analysis
+plan`` both build with :meth:`PlanningSettings.from_config`.
 """
 
 from __future__ import annotations
@@ -13,20 +16,28 @@ from __future__ import annotations
 import copy
 import logging
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
+from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_text, write_tsv
 from loper_analysis.io.readers import read_tsv
+from loper_analysis.planning.precision import PlanSettings
+from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings
 
-__all__ = ["LIBRARY_PLANNING_SETTINGS", "plan", "planned_impedance", "planning_settings"]
+__all__ = ["STRIDES", "PlanningSettings", "PilotTrial", "PilotFiles", "plan", "planned_impedance"]
 
 log = logging.getLogger(__name__)
 
-#: Identification settings the planner follows (keys of config ``identification``).
+#: Counts of perturbed strides averaged that the planner predicts for (config ``planning.strides``).
+STRIDES: tuple[int, ...] = (10, 20, 40)
+
+#: Identification settings the planner follows (keys of config ``identification``; fields of
+#: :class:`~loper_analysis.planning.precision.PlanSettings`).
 _PLAN_KEYS = (
     "window_before_s",
     "window_after_s",
@@ -41,112 +52,123 @@ _PLAN_KEYS = (
 )
 
 
-#: Identification settings the rule passes to :func:`plan` (keys of config ``identification``): those the planner
-#: follows and the null pairs' trial ratio.
-_RULE_IDENTIFICATION_KEYS = (
-    "window_before_s",
-    "window_after_s",
-    "initial_state_span_s",
-    "initial_state_degree",
-    "n_substeps",
-    "null_pair_components",
-    "min_null_pairs",
-    "max_null_trial_ratio",
-    "interval_scatter",
-    "stiffness_bounds_nm_per_rad",
-    "damping_bounds_nms_per_rad",
-)
+@dataclass(frozen=True)
+class PlanningSettings:
+    """The planner's settings: onsets, stride counts, targets, the planned pulse and what the fit would do.
 
-#: The settings of :func:`planning_settings` without a configuration (``loper-analysis plan`` with no config file):
-#: ``onsets`` None (those of the pilot's impedance rows), no targets, and the library's own response,
-#: identification and device defaults (None: :class:`~loper_analysis.responses.ResponseSettings`,
-#: :class:`~loper_analysis.planning.precision.PlanSettings`,
-#: :class:`~loper_analysis.device.controller.DeviceParameters`).
-LIBRARY_PLANNING_SETTINGS = {
-    "onsets": None,
-    "strides": [10, 20, 40],
-    "targets": [],
-    "pulse_force_n": 40.0,
-    "pulse_duration_s": 0.1,
-    "response": None,
-    "identification": None,
-    "device": None,
-}
-
-
-def planning_settings(config: Mapping) -> dict:
-    """The planner's settings from the workflow's configuration: the one mapping of config keys to :func:`plan`.
-
-    The rule ``planning`` (its params) and ``loper-analysis plan`` both take
-    their settings from here, so that the two cannot drift apart.
-
-    Parameters
+    Attributes
     ----------
-    config : mapping
-        The validated configuration (``config/config.yaml`` and its layers;
-        :func:`loper_analysis.config_file.load_config`).
-
-    Returns
-    -------
-    dict
-        Keyword arguments of :func:`plan` by the rule's params' names (a copy:
-        changing it leaves ``config`` as it is):
-
-        ``onsets``
-            ``trials.perturbation_onsets_ms`` (ms after toe-off).
-        ``strides``
-            ``planning.strides`` (perturbed strides averaged).
-        ``targets``
-            ``planning.targets`` (``joint``, ``parameter``, ``percent`` or
-            ``half_width`` in N·m/rad or N·m·s/rad, optional ``onset_ms``).
-        ``pulse_force_n``, ``pulse_duration_s``
-            ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s).
-        ``response``
-            :class:`~loper_analysis.responses.ResponseSettings` keywords:
-            ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
-            (s) of ``identification``; ``whisker`` and ``max_fraction`` of
-            ``strides.iqr_whisker`` and ``strides.max_outlier_fraction``.
-        ``identification``
-            The keys of ``identification`` the planner follows: fit window and
-            initial state (s), substeps, projected components, null-pair
-            minimum and trial ratio, interval scatter and the K, D bounds
-            (N·m/rad, N·m·s/rad).
-        ``device``
-            ``device.parameters``
-            (:class:`~loper_analysis.device.controller.DeviceParameters` keywords).
-
-    Raises
-    ------
-    LoperInputError
-        A key the planner needs is missing (naming it).
+    onsets_ms : tuple of float, or None
+        Onsets after toe-off (ms) to plan for; None: not set (``loper-analysis plan`` takes those of the
+        pilot's impedance rows; :func:`plan` needs them).
+    strides : tuple of int
+        Counts of perturbed strides averaged to predict for.
+    targets : tuple of mapping
+        Each ``joint``, ``parameter`` (``K``/``D``), ``percent`` or ``half_width`` (N·m/rad, N·m·s/rad) and
+        optionally ``onset_ms`` (else every onset).
+    plan : PlanSettings
+        The planned pulse (N, s) and the identification settings the prediction follows
+        (:class:`~loper_analysis.planning.precision.PlanSettings`).
+    response : ResponseSettings
+        How the pilot's pairs are windowed and judged (:class:`~loper_analysis.responses.ResponseSettings`).
+    device : DeviceParameters
+        The device (:class:`~loper_analysis.device.controller.DeviceParameters`).
+    max_null_trial_ratio : float or None
+        A pilot trial whose null pairs deviate more than this multiple of the other trials' is left out of
+        the null pairs (None: never).
     """
 
-    def get(*keys):
-        node = config
-        for n, key in enumerate(keys):
-            if not isinstance(node, Mapping) or key not in node:
-                raise LoperInputError(
-                    f"config: key '{'.'.join(keys[: n + 1])}' missing: the planner needs '{'.'.join(keys)}'"
-                )
-            node = node[key]
-        return copy.deepcopy(node)
+    onsets_ms: tuple[float, ...] | None = None
+    strides: tuple[int, ...] = STRIDES
+    targets: tuple[Mapping, ...] = ()
+    plan: PlanSettings = field(default_factory=PlanSettings)
+    response: ResponseSettings = field(default_factory=ResponseSettings)
+    device: DeviceParameters = field(default_factory=DeviceParameters)
+    max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
 
-    return {
-        "onsets": get("trials", "perturbation_onsets_ms"),
-        "strides": get("planning", "strides"),
-        "targets": get("planning", "targets"),
-        "pulse_force_n": get("planning", "pulse_force_n"),
-        "pulse_duration_s": get("planning", "pulse_duration_s"),
-        "response": {
-            "window_before_s": get("identification", "window_before_s"),
-            "window_after_s": get("identification", "window_after_s"),
-            "initial_state_span_s": get("identification", "initial_state_span_s"),
-            "whisker": get("strides", "iqr_whisker"),
-            "max_fraction": get("strides", "max_outlier_fraction"),
-        },
-        "identification": {k: get("identification", k) for k in _RULE_IDENTIFICATION_KEYS},
-        "device": get("device", "parameters"),
-    }
+    @classmethod
+    def from_config(cls, config: Mapping) -> PlanningSettings:
+        """The planner's settings from the workflow's configuration: the rule ``planning`` and
+        ``loper-analysis plan`` both take theirs from here, so that the two cannot drift apart.
+
+        Parameters
+        ----------
+        config : mapping
+            The validated configuration (``config/config.yaml`` and its layers;
+            :func:`loper_analysis.config_file.load_config`). ``onsets_ms``: ``trials.perturbation_onsets_ms``;
+            ``strides``, ``targets``: ``planning.strides``, ``planning.targets``; ``plan``: the pulse
+            ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s) with the keys of
+            ``identification`` the planner follows (fit window and initial state in s, substeps, projected
+            components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad);
+            ``response``: ``identification.window_before_s``, ``window_after_s``, ``initial_state_span_s``
+            and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``; ``device``:
+            ``device.parameters``; ``max_null_trial_ratio``: ``identification.max_null_trial_ratio``.
+
+        Raises
+        ------
+        LoperInputError
+            A key the planner needs is missing (naming it), or the settings cannot serve (e.g. a pulse
+            longer than the fit window after the onset).
+        """
+
+        def get(*keys):
+            node = config
+            for n, key in enumerate(keys):
+                if not isinstance(node, Mapping) or key not in node:
+                    raise LoperInputError(
+                        f"config: key '{'.'.join(keys[: n + 1])}' missing: the planner needs '{'.'.join(keys)}'"
+                    )
+                node = node[key]
+            return copy.deepcopy(node)
+
+        ident = {k: get("identification", k) for k in _PLAN_KEYS}
+        for key in ("stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad"):
+            ident[key] = tuple(ident[key])
+        return cls(
+            onsets_ms=tuple(get("trials", "perturbation_onsets_ms")),
+            strides=tuple(get("planning", "strides")),
+            targets=tuple(get("planning", "targets")),
+            plan=PlanSettings(
+                pulse_force_n=get("planning", "pulse_force_n"),
+                pulse_duration_s=get("planning", "pulse_duration_s"),
+                **ident,
+            ),
+            response=ResponseSettings(
+                window_before_s=get("identification", "window_before_s"),
+                window_after_s=get("identification", "window_after_s"),
+                initial_state_span_s=get("identification", "initial_state_span_s"),
+                whisker=get("strides", "iqr_whisker"),
+                max_fraction=get("strides", "max_outlier_fraction"),
+            ),
+            device=DeviceParameters(**get("device", "parameters")),
+            max_null_trial_ratio=get("identification", "max_null_trial_ratio"),
+        )
+
+
+@dataclass(frozen=True)
+class PilotTrial:
+    """A pilot trial walked with the device: its joint-angle and stride tables (TSV)."""
+
+    angles: PathLike
+    strides: PathLike
+
+
+@dataclass(frozen=True)
+class PilotFiles:
+    """The pilot's files the planner reads.
+
+    ``trials``: the pilot's trials walked with the device (name -> :class:`PilotTrial`): their unperturbed
+    strides are the null pairs; the perturbed strides of the trials at an onset are its perturbed pairs
+    (:func:`loper_analysis.planning.precision.pilot_perturbed_pairs`), whose scatter the prediction takes
+    (the null pairs' when there are none, with a note in the rows). ``segments``: the segment table of the
+    subject to plan for (the pilot's, or another subject's). ``impedance``: impedance rows
+    (``results/impedance/{subject}/{onset}.tsv`` or ``results/impedance/impedance.tsv``) whose pilot estimates
+    are the planned impedance (none: the values are given to :func:`plan`).
+    """
+
+    trials: Mapping[str, PilotTrial]
+    segments: PathLike
+    impedance: tuple[PathLike, ...] = ()
 
 
 def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:
@@ -175,35 +197,14 @@ def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: 
     return np.array(values)
 
 
-def _settings(pulse_force_n: float, pulse_duration_s: float, identification: Mapping | None):
-    from loper_analysis.planning.precision import PlanSettings
-
-    ident = {k: v for k, v in (identification or {}).items() if k in _PLAN_KEYS}
-    for key in ("stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad"):
-        if key in ident:
-            ident[key] = tuple(ident[key])
-    return PlanSettings(pulse_force_n=pulse_force_n, pulse_duration_s=pulse_duration_s, **ident)
-
-
 def plan(
-    trials: Sequence[str],
-    angles: Sequence[PathLike],
-    strides: Sequence[PathLike],
-    segments_tsv: PathLike,
+    files: PilotFiles,
     subject: str,
-    onsets_ms: Sequence[int],
-    n_strides: Sequence[int],
+    settings: PlanningSettings,
     out_tsv: PathLike | None = None,
     answers_out: PathLike | None = None,
     *,
-    impedance_tsvs: Sequence[PathLike] = (),
     impedance: Mapping[int, Sequence[float]] | Sequence[float] | None = None,
-    targets: Sequence[Mapping] = (),
-    pulse_force_n: float = 40.0,
-    pulse_duration_s: float = 0.1,
-    response: Mapping | None = None,
-    identification: Mapping | None = None,
-    device: Mapping | None = None,
     unplannable: str = "raise",
     pool_scatter: bool = True,
 ) -> tuple[pd.DataFrame, list[str]]:
@@ -211,37 +212,20 @@ def plan(
 
     Parameters
     ----------
-    trials, angles, strides
-        The pilot's trials walked with the device (names) and their angle and
-        stride tables (TSV, same order): their unperturbed strides are the null
-        pairs; the perturbed strides of the trials at an onset are its
-        perturbed pairs (:func:`loper_analysis.planning.precision.pilot_perturbed_pairs`),
-        whose scatter the prediction takes (the null pairs' when there are
-        none, with a note in the rows).
-    segments_tsv
-        Segment table of the subject to plan for (the pilot's, or another subject's).
+    files
+        The pilot's trials with the device, the segment table of the subject to plan for and the impedance
+        rows of the planned impedance (:class:`PilotFiles`).
     subject
         The pilot's ID (rows of the impedance tables, messages).
-    onsets_ms, n_strides
-        Onsets after toe-off (ms) and counts of perturbed strides to predict for.
+    settings
+        Onsets after toe-off (ms), counts of perturbed strides, targets, the planned pulse (desired force,
+        N; duration, s), the identification, response and device settings (:class:`PlanningSettings`).
     out_tsv, answers_out
         The table (:data:`loper_analysis.planning.precision.PLAN_COLUMNS`) and the text
         answers; None writes nothing.
-    impedance_tsvs
-        Impedance rows (``results/impedance/{subject}/{onset}.tsv`` or
-        ``results/tables/impedance.tsv``): the pilot's estimates are the planned impedance.
     impedance
-        Instead: the planned impedance (6 values, order of ``PARAMETERS``), one
-        set for every onset or ``{onset_ms: values}``.
-    targets
-        Each ``joint``, ``parameter`` (``K``/``D``), ``percent`` or
-        ``half_width`` (N·m/rad, N·m·s/rad) and optionally ``onset_ms`` (else every onset).
-    pulse_force_n, pulse_duration_s
-        The planned pulse (desired force, N; duration, s).
-    response, identification, device
-        Keyword arguments of :class:`~loper_analysis.responses.ResponseSettings`,
-        the identification settings (config ``identification``) and
-        :class:`~loper_analysis.device.controller.DeviceParameters`.
+        Instead of the rows of ``files.impedance``: the planned impedance (6 values, order of
+        ``PARAMETERS``), one set for every onset or ``{onset_ms: values}``.
     unplannable
         An onset whose pilot fit has no estimate (e.g. ``failed``) or whose
         null pairs are too few: ``raise`` stops with the onset and the cause;
@@ -257,7 +241,6 @@ def plan(
     (pandas.DataFrame, list of str)
         The table and the answers.
     """
-    from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.planning.precision import (
         pilot_perturbed_pairs,
         pool_onsets,
@@ -266,31 +249,35 @@ def plan(
         target_answer,
         unplanned_rows,
     )
-    from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
+    from loper_analysis.responses import null_pair_windows
     from loper_analysis.swing_leg.dynamics import read_segments
 
     if unplannable not in ("raise", "note"):
         raise LoperInputError(f"unplannable must be 'raise' or 'note', got {unplannable!r}")
-    settings = _settings(pulse_force_n, pulse_duration_s, identification)
-    counts = list(n_strides)
+    if settings.onsets_ms is None:
+        raise LoperInputError("planning settings: no onsets (onsets_ms) to plan for")
+    plan_settings = settings.plan
+    counts = list(settings.strides)
     for n in counts:  # checked before any work
         if isinstance(n, bool) or not float(n) == int(n) or int(n) < 1:
             raise LoperInputError(f"stride count must be a whole number >= 1 (perturbed strides averaged), got {n!r}")
-    if not trials:
+    if not files.trials:
         raise LoperInputError(f"pilot {subject}: no trial walked with the device: the null pairs need one")
-    response_settings = ResponseSettings(**(response or {}))
-    ratio = (identification or {}).get("max_null_trial_ratio", MAX_TRIAL_DEVIATION_RATIO)
-    dev = DeviceParameters(**(device or {}))
-    params = read_segments(segments_tsv)
+    response_settings = settings.response
+    ratio = settings.max_null_trial_ratio
+    dev = settings.device
+    params = read_segments(files.segments)
     pool = [
-        {"name": name, "angles": read_tsv(a, "angle table"), "strides": read_tsv(s, "stride table")}
-        for name, a, s in zip(trials, angles, strides, strict=True)
+        {"name": name, "angles": read_tsv(t.angles, "angle table"), "strides": read_tsv(t.strides, "stride table")}
+        for name, t in files.trials.items()
     ]
+    impedance_tsvs = files.impedance
     rows_table = None
     if impedance is None:
         if not impedance_tsvs:
             raise LoperInputError("planned impedance: give the pilot's impedance rows or the values")
         rows_table = pd.concat([read_tsv(f, "impedance rows") for f in impedance_tsvs], ignore_index=True)
+    onsets_ms = settings.onsets_ms
     planned, failed = {}, {}
     for onset in onsets_ms:
         where = f"pilot {subject}, onset {onset:g} ms"
@@ -301,12 +288,14 @@ def plan(
                 values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
             null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
             pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
-            planned[onset] = stride_covariance(null, params, values, settings, dev, source=where, perturbed_pairs=pairs)
+            planned[onset] = stride_covariance(
+                null, params, values, plan_settings, dev, source=where, perturbed_pairs=pairs
+            )
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
             log.warning("%s: not planned: %s", where, exc)
-            failed[onset] = unplanned_rows(counts, onset, f"not planned: {exc}", subject, settings)
+            failed[onset] = unplanned_rows(counts, onset, f"not planned: {exc}", subject, plan_settings)
     if pool_scatter:
         planned = pool_onsets(planned)
     tables, answers = [], []
@@ -315,7 +304,7 @@ def plan(
             tables.append(failed[onset])
             continue
         sc = planned[onset]
-        tables.append(precision_table(sc, counts, onset, subject, settings))
+        tables.append(precision_table(sc, counts, onset, subject, plan_settings))
         log.info(
             "pilot %s, onset %g ms: %d null pairs, %d perturbed pairs (scatter: %s); planned %s",
             subject,
@@ -325,7 +314,7 @@ def plan(
             sc.scatter.replace("_", " "),
             ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, sc.impedance)),
         )
-        for target in targets:
+        for target in settings.targets:
             if target.get("onset_ms") is not None and float(target["onset_ms"]) != float(onset):
                 continue
             answers.append(

@@ -1,4 +1,4 @@
-"""File steps of the report: the result tables in Markdown (``results/tables/tables.md``), the front page of
+"""File steps of the report: the result tables in Markdown (``results/report/tables.md``), the front page of
 the Snakemake report (``results/report/front_page.html``) and the report itself (``results/report.html``),
 written beside its target and moved over it whole."""
 
@@ -10,14 +10,18 @@ import subprocess
 import sys
 import threading
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from loper_analysis.io.atomic import PathLike, write_text
 from loper_analysis.io.readers import read_bytes, read_tsv
+from loper_analysis.report.front_page import RunSettings
 
 __all__ = [
     "markdown_tables",
     "software_versions",
+    "FrontPageSettings",
+    "FrontPageFiles",
     "front_page",
     "snakemake_report_command",
     "check_report_complete",
@@ -54,37 +58,80 @@ def software_versions() -> dict[str, str]:
     return versions
 
 
+@dataclass(frozen=True)
+class FrontPageSettings:
+    """The settings the front page lists: ``run``, the run's
+    :class:`~loper_analysis.report.front_page.RunSettings` (the workflow's configuration)."""
+
+    run: RunSettings
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> FrontPageSettings:
+        """The settings of a validated config: ``seed``, ``trials.perturbation_*`` and ``perturbed_side``,
+        ``filter.*``, the fit window, bounds, starts, noise model and components of ``identification`` and the
+        synthetic lab's ``variability``, ``walking_duration_s`` and pulse."""
+        trials, ident, synthetic = config["trials"], config["identification"], config["synthetic"]
+        return cls(
+            RunSettings(
+                seed=config["seed"],
+                perturbation_onsets_ms=tuple(trials["perturbation_onsets_ms"]),
+                perturbation_repeats=trials["perturbation_repeats"],
+                perturbed_side=trials["perturbed_side"],
+                filter_cutoff_hz=config["filter"]["cutoff_hz"],
+                filter_order=config["filter"]["order"],
+                window_before_s=ident["window_before_s"],
+                window_after_s=ident["window_after_s"],
+                stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
+                damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
+                n_starts=ident["n_starts"],
+                noise_model=ident["noise_model"],
+                null_pair_components=ident["null_pair_components"],
+                synthetic_variability=synthetic["variability"],
+                synthetic_walking_duration_s=synthetic["walking_duration_s"],
+                pulse_force_n=synthetic["pulse_force_n"],
+                pulse_duration_s=synthetic["pulse_duration_s"],
+            )
+        )
+
+
+@dataclass(frozen=True)
+class FrontPageFiles:
+    """The result files the front page reads.
+
+    ``validation``: ``results/validation/summary.tsv``; ``device``: ``results/device/summary.tsv`` (None:
+    no device tests); ``impedance``, ``summary`` and ``figure``: the impedance table, its across-subject
+    summary and the main figure (None: the run had no perturbation trials; the table and its summary come
+    together); ``rmsd``: the transparency table (None: no subject walked both trials of the pair).
+    """
+
+    validation: PathLike
+    device: PathLike | None = None
+    impedance: PathLike | None = None
+    summary: PathLike | None = None
+    figure: PathLike | None = None
+    rmsd: PathLike | None = None
+
+
 def front_page(
+    files: FrontPageFiles,
     out_html: PathLike,
-    device_tsv: PathLike | None,
-    validation_tsv: PathLike,
     subjects: Mapping[str, str],
     trials: Mapping[str, Sequence[str]],
-    settings: Mapping,
-    impedance_tsv: PathLike | None = None,
-    summary_tsv: PathLike | None = None,
-    figure_png: PathLike | None = None,
-    rmsd_tsv: PathLike | None = None,
+    settings: FrontPageSettings,
     versions: Mapping[str, str] | None = None,
 ) -> str:
     """The front page of the report (:func:`loper_analysis.report.front_page.front_page_html`) from the result files.
 
-    ``device_tsv``: ``results/device/summary.tsv`` (None: no device tests); ``validation_tsv``:
-    ``results/validation/summary.tsv``; ``impedance_tsv``, ``summary_tsv`` and
-    ``figure_png``: the impedance table, its across-subject summary and the
-    main figure (None: the run had no perturbation trials); ``rmsd_tsv``: the
-    transparency table (None: no subject walked both trials of the pair).
-    ``subjects``: subject -> source; ``trials``: processed subject -> its
-    walking trials; ``settings``: the keyword arguments of
-    :class:`~loper_analysis.report.front_page.RunSettings`; ``versions``: software ->
-    version (default :func:`software_versions`). The headline tables come
-    from :mod:`loper_analysis.report.headline`. Writes ``out_html`` and returns the
-    fragment.
+    ``files``: the result tables and figure (:class:`FrontPageFiles`); ``subjects``: subject -> source;
+    ``trials``: processed subject -> its walking trials; ``settings``: the run's settings
+    (:class:`FrontPageSettings`); ``versions``: software -> version (default :func:`software_versions`).
+    The headline tables come from :mod:`loper_analysis.report.headline`. Writes ``out_html`` and returns
+    the fragment.
     """
     import pandas
 
     from loper_analysis.errors import LoperInputError
-    from loper_analysis.report.front_page import RunSettings, front_page_html
+    from loper_analysis.report.front_page import front_page_html
     from loper_analysis.report.headline import (
         device_comparison,
         impedance_summary_ci,
@@ -93,35 +140,32 @@ def front_page(
         validation_verdict,
     )
 
+    impedance_tsv, summary_tsv, device_tsv = files.impedance, files.summary, files.device
     if (impedance_tsv is None) != (summary_tsv is None):
         raise LoperInputError(
             f"front page: the impedance table ({impedance_tsv}) and its summary ({summary_tsv}) come together"
         )
-    try:
-        run = RunSettings(**settings)
-    except TypeError as exc:
-        raise LoperInputError(f"front page: settings: {exc}") from None
     summary = truth = status = figure = transparency = None
     if impedance_tsv is not None:
         table = read_tsv(impedance_tsv, "impedance table")
         summary = impedance_summary_ci(read_tsv(summary_tsv, "impedance summary"), str(summary_tsv))
         truth = truth_recovery(table, str(impedance_tsv))
         status = table["status"].value_counts(sort=False).to_dict() if "status" in table else {}
-    if figure_png is not None:
-        figure = read_bytes(figure_png, "figure")
-    if rmsd_tsv is not None:
-        transparency = transparency_verdict(read_tsv(rmsd_tsv, "transparency table"), str(rmsd_tsv))
+    if files.figure is not None:
+        figure = read_bytes(files.figure, "figure")
+    if files.rmsd is not None:
+        transparency = transparency_verdict(read_tsv(files.rmsd, "transparency table"), str(files.rmsd))
     text = front_page_html(
         subjects,
         trials,
-        run,
+        settings.run,
         software_versions() if versions is None else versions,
         device=(
             pandas.DataFrame()
             if device_tsv is None
             else device_comparison(read_tsv(device_tsv, "device summary"), str(device_tsv))
         ),
-        validation=validation_verdict(read_tsv(validation_tsv, "validation summary"), str(validation_tsv)),
+        validation=validation_verdict(read_tsv(files.validation, "validation summary"), str(files.validation)),
         summary=summary,
         truth=truth,
         impedance_status=status,

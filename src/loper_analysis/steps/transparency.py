@@ -1,52 +1,78 @@
-"""File step of the transparency analysis: RMSD vs ISV_ave, interaction force, and the study's figure."""
+"""File step of the transparency analysis: RMSD vs ISV_ave, interaction force, and the study's figure.
+
+:func:`transparency` reads each subject's :class:`TransparencyFiles` with the settings
+:class:`TransparencySettings` (from the config by :meth:`TransparencySettings.from_config`).
+"""
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Sequence
+from collections.abc import Mapping
+from dataclasses import dataclass
 
 from loper_analysis.gait.outliers import MIN_VALID_STRIDES
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
+from loper_analysis.study_design import PERTURBED_SIDE
 
-__all__ = ["transparency"]
+__all__ = ["PERTURBED_SIDE", "TransparencySettings", "TransparencyFiles", "transparency"]
 
 log = logging.getLogger(__name__)
 
 
+@dataclass(frozen=True)
+class TransparencySettings:
+    """How the two walking trials are compared (config ``trials.perturbed_side``, ``strides.min_valid_strides``).
+
+    ``side``: the leg whose strides are compared; ``min_strides``: a subject with fewer kept strides in
+    either trial is left out of the comparison (its rows keep the counts, with empty metrics).
+    """
+
+    side: str = PERTURBED_SIDE
+    min_strides: int = MIN_VALID_STRIDES
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> TransparencySettings:
+        """The settings of a validated config."""
+        return cls(side=config["trials"]["perturbed_side"], min_strides=config["strides"]["min_valid_strides"])
+
+
+@dataclass(frozen=True)
+class TransparencyFiles:
+    """One subject's stride and cycle tables (TSV) of walking without and with the device."""
+
+    no_device_strides: PathLike
+    no_device_cycles: PathLike
+    device_strides: PathLike
+    device_cycles: PathLike
+
+
 def transparency(
-    subjects: Sequence[str],
-    no_device_strides: Sequence[PathLike],
-    no_device_cycles: Sequence[PathLike],
-    device_strides: Sequence[PathLike],
-    device_cycles: Sequence[PathLike],
+    files: Mapping[str, TransparencyFiles],
     rmsd_out: PathLike,
     force_out: PathLike,
     figure_out: PathLike,
-    side: str = "left",
-    min_strides: int = MIN_VALID_STRIDES,
+    settings: TransparencySettings = TransparencySettings(),
 ):
     """Transparency of the device from the stride and cycle tables of each subject's two walking trials.
 
-    The four lists hold one file per subject, in the order of ``subjects``:
-    the stride and cycle tables of walking without and with the device.
-    Writes the tables of :func:`loper_analysis.transparency.transparency_results`
-    and the figure (kept strides of all subjects pooled); returns the results.
-    A subject with fewer than ``min_strides`` kept strides in either trial is
-    left out of the comparison (its rows keep the counts, with empty metrics).
+    ``files`` maps each subject to its tables (:class:`TransparencyFiles`; the rows follow its order);
+    ``settings`` (:class:`TransparencySettings`): the leg and the fewest kept strides. Writes the tables of
+    :func:`loper_analysis.transparency.transparency_results` and the figure (kept strides of all subjects
+    pooled); returns the results. A subject with fewer than ``settings.min_strides`` kept strides in either
+    trial is left out of the comparison (its rows keep the counts, with empty metrics).
     """
     from loper_analysis.report.figures.transparency import transparency_figure
     from loper_analysis.transparency import transparency_results
 
-    files = zip(subjects, no_device_strides, no_device_cycles, device_strides, device_cycles, strict=True)
     frames = {
         subject: {
-            "no_device": (read_tsv(ns, "stride table"), read_tsv(nc, "cycle table")),
-            "device": (read_tsv(ds, "stride table"), read_tsv(dc, "cycle table")),
+            "no_device": (read_tsv(f.no_device_strides, "stride table"), read_tsv(f.no_device_cycles, "cycle table")),
+            "device": (read_tsv(f.device_strides, "stride table"), read_tsv(f.device_cycles, "cycle table")),
         }
-        for subject, ns, nc, ds, dc in files
+        for subject, f in files.items()
     }
-    results = transparency_results(frames, side, min_strides)
+    results = transparency_results(frames, settings.side, settings.min_strides)
     write_tsv(results.rmsd, rmsd_out)
     write_tsv(results.force, force_out)
     write_figure(

@@ -1,0 +1,168 @@
+"""The ``strides`` step: a trial's strides of one leg, their outliers and cycles; the summary over trials.
+
+:func:`strides` (one trial, settings :class:`StrideSettings` from the config by
+:meth:`StrideSettings.from_config`) and :func:`strides_summary` (every trial of the study).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import pandas as pd
+
+from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
+from loper_analysis.gait.resampling import N_POINTS
+from loper_analysis.io.atomic import PathLike, write_tsv
+from loper_analysis.io.readers import read_tsv
+from loper_analysis.study_design import PERTURBED_SIDE
+
+__all__ = ["StrideSettings", "strides", "strides_summary"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class StrideSettings:
+    """Strides of one leg (config ``strides.*``, ``trials.perturbed_side``).
+
+    ``side``: the leg; ``n_points``: samples per time-normalised stride, stance or swing; ``whisker``,
+    ``max_fraction``: the IQR rule (:func:`loper_analysis.gait.outliers.iqr_outliers`); ``min_valid``: the
+    fewest kept strides of an ``ok`` trial.
+    """
+
+    side: str = PERTURBED_SIDE
+    n_points: int = N_POINTS
+    whisker: float = IQR_WHISKER
+    max_fraction: float = MAX_OUTLIER_FRACTION
+    min_valid: int = MIN_VALID_STRIDES
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> StrideSettings:
+        """The settings of a validated config."""
+        s = config["strides"]
+        return cls(
+            side=config["trials"]["perturbed_side"],
+            n_points=s["n_points"],
+            whisker=s["iqr_whisker"],
+            max_fraction=s["max_outlier_fraction"],
+            min_valid=s["min_valid_strides"],
+        )
+
+
+def strides(
+    angles_tsv: PathLike,
+    events_tsv: PathLike,
+    strides_out: PathLike,
+    cycles_out: PathLike,
+    force_tsv: PathLike | None = None,
+    settings: StrideSettings = StrideSettings(),
+):
+    """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
+
+    ``settings`` (:class:`StrideSettings`): the leg, the samples per cycle and the IQR rule.
+
+    Writes the stride table and the cycles (:func:`loper_analysis.gait.strides.stride_tables`);
+    returns the :class:`~loper_analysis.gait.strides.StrideTables`. A trial with 0
+    or 1 strides of the leg is written like any other (the stride table with
+    all its columns, without rows for 0 strides) and flagged ``too_few_strides``.
+    """
+    from loper_analysis.gait.strides import stride_tables
+
+    sources = {"angles": str(angles_tsv), "events": str(events_tsv), "force": str(force_tsv)}
+    force = None if force_tsv is None else read_tsv(force_tsv, "force table", ("time_s", "force_measured_n"))
+    tables = stride_tables(
+        read_tsv(angles_tsv, "angle table"),
+        read_tsv(events_tsv, "event table"),
+        force,
+        settings.side,
+        settings.n_points,
+        settings.whisker,
+        settings.max_fraction,
+        settings.min_valid,
+        sources,
+    )
+    write_tsv(tables.cycles, cycles_out)
+    write_tsv(tables.strides, strides_out)
+    s = tables.strides
+    log.info("%d strides, %d kept", len(s), int((~s["removed"]).sum()))
+    return tables
+
+
+def strides_summary(
+    subject_trials: Sequence[tuple[str, str]],
+    strides_tsvs: Sequence[PathLike],
+    out_tsv: PathLike,
+    min_valid: int = MIN_VALID_STRIDES,
+    contacts_tsvs: Sequence[PathLike] | None = None,
+    ik_tsvs: Sequence[PathLike] | None = None,
+    markers_tsvs: Sequence[PathLike] | None = None,
+) -> pd.DataFrame:
+    """One row per subject x trial of the stride tables (:func:`loper_analysis.gait.strides.stride_summary`).
+
+    ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
+    ``subject_trials``, in order; ``contacts_tsvs`` (optional, same order) the
+    force-plate contact tables written by :func:`events`, whose flagged
+    contacts are counted. A stride table of a trial with 0 strides (its
+    header only, as :func:`strides` writes it) gives ``n_strides`` 0 and the
+    status ``too_few_strides``. ``ik_tsvs`` (the IK summaries of
+    :func:`loper_analysis.steps.ik.ik_trial`) add the frames and those left
+    out of IK, ``markers_tsvs`` (the markers summaries of :func:`markers`) the
+    trial's walking direction and the turn that made it walk along +X.
+
+    Raises
+    ------
+    LoperInputError
+        A stride table without the columns
+        :data:`loper_analysis.gait.strides.SUMMARY_COLUMNS` (naming the file).
+    """
+    from loper_analysis.checks import require_columns
+    from loper_analysis.gait.strides import SUMMARY_COLUMNS, stride_summary
+
+    keys = [tuple(key) for key in subject_trials]
+    tables = {
+        key: require_columns(
+            read_tsv(path, "stride table", keep_default_na=False, na_values=[""]),
+            SUMMARY_COLUMNS,
+            str(path),
+            "stride table",
+        )
+        for key, path in zip(keys, strides_tsvs, strict=True)
+    }
+    contacts = None
+    if contacts_tsvs is not None:
+        contacts = {
+            key: read_tsv(path, "contact table", ("flag",), keep_default_na=False)
+            for key, path in zip(keys, contacts_tsvs, strict=True)
+        }
+    table = stride_summary(tables, min_valid, contacts)
+    extra = []
+    if ik_tsvs is not None:
+        ik = [read_tsv(path, "IK summary", ("n_frames", "n_frames_left_out")).iloc[0] for path in ik_tsvs]
+        extra.append(
+            pd.DataFrame(
+                {"n_frames": [int(r.n_frames) for r in ik], "n_frames_left_out": [int(r.n_frames_left_out) for r in ik]}
+            )
+        )
+    if markers_tsvs is not None:
+        marks = [
+            read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0]
+            for path in markers_tsvs
+        ]
+        extra.append(
+            pd.DataFrame(
+                {
+                    "heading_deg": [float(r.heading_deg) for r in marks],
+                    "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
+                    "turn_deg": [float(r.turn_deg) for r in marks],
+                }
+            )
+        )
+    if extra:
+        table = pd.concat([table, *extra], axis=1)
+    write_tsv(table, out_tsv)
+    for row in table[table.status != "ok"].itertuples():
+        log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
+    log.info("strides:\n%s", table.to_string(index=False))
+    return table

@@ -1,0 +1,109 @@
+"""The stages' settings objects: built from the config as the rules build them, and defaulting to its values.
+
+Each stage's settings (:class:`~loper_analysis.steps.markers.MarkerSettings`, ``EventSettings``,
+``LoadcellSettings``, ``StrideSettings``) has one ``from_config``, which the rules (``inputs.smk``) and the
+``loper-analysis`` command call; their defaults are the library's named constants, which must equal
+``config/config.yaml``, so that the library alone and the workflow agree.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+from pathlib import Path
+
+import pytest
+import yaml
+
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
+from loper_analysis.device import analysis
+from loper_analysis.gait import events, grf, resampling
+from loper_analysis.motion import filtering, heading, markers, plausibility
+from loper_analysis.steps.events import EventSettings, LoadcellSettings
+from loper_analysis.steps.markers import MarkerSettings
+from loper_analysis.steps.strides import StrideSettings
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+#: library constant -> config key of the same value
+CONSTANTS = {
+    "filtering.CUTOFF_HZ": (filtering.CUTOFF_HZ, "filter.cutoff_hz"),
+    "filtering.ORDER": (filtering.ORDER, "filter.order"),
+    "markers.MAX_GAP_FRAMES": (markers.MAX_GAP_FRAMES, "markers.max_gap_frames"),
+    "heading.MIN_TRAVEL_SPEED_M_PER_S": (heading.MIN_TRAVEL_SPEED_M_PER_S, "markers.min_travel_speed_m_per_s"),
+    "plausibility.EXTENT_RANGE_M": (plausibility.EXTENT_RANGE_M, "markers.extent_range_m"),
+    "constants.LAB_TO_MODEL_ROTATION_DEG": (LAB_TO_MODEL_ROTATION_DEG, "markers.lab_to_model_rotation_deg"),
+    "events.THRESHOLD_ON_N": (events.THRESHOLD_ON_N, "events.threshold_on_n"),
+    "events.THRESHOLD_OFF_N": (events.THRESHOLD_OFF_N, "events.threshold_off_n"),
+    "events.MIN_STANCE_S": (events.MIN_STANCE_S, "events.min_stance_s"),
+    "events.MIN_SWING_S": (events.MIN_SWING_S, "events.min_swing_s"),
+    "grf.RESTING_BAND_N": (grf.RESTING_BAND_N, "grf.resting_band_n"),
+    "grf.MAX_RESTING_N": (grf.MAX_RESTING_N, "grf.max_resting_n"),
+    "resampling.N_POINTS": (resampling.N_POINTS, "strides.n_points"),
+    "analysis.WELCH_WINDOW_SAMPLES": (analysis.WELCH_WINDOW_SAMPLES, "device.analysis.welch_window_samples"),
+    "analysis.WELCH_OVERLAP_SAMPLES": (analysis.WELCH_OVERLAP_SAMPLES, "device.analysis.welch_overlap_samples"),
+    "analysis.BANDWIDTH_REFERENCE_BAND_HZ": (
+        analysis.BANDWIDTH_REFERENCE_BAND_HZ,
+        "device.analysis.bandwidth_reference_band_hz",
+    ),
+    "analysis.STEP_BEFORE_S": (analysis.STEP_BEFORE_S, "device.analysis.step_before_s"),
+    "analysis.STEP_AFTER_S": (analysis.STEP_AFTER_S, "device.analysis.step_after_s"),
+    "analysis.STEADY_WINDOW_S": (analysis.STEADY_WINDOW_S, "device.analysis.steady_window_s"),
+}
+
+SETTINGS = (MarkerSettings, EventSettings, LoadcellSettings, StrideSettings)
+
+
+def _get(config: dict, path: str):
+    node = config
+    for key in path.split("."):
+        node = node[key]
+    return node
+
+
+def _plain(value):
+    """Lists and tuples alike (YAML has no tuples)."""
+    return tuple(_plain(v) for v in value) if isinstance(value, list | tuple) else value
+
+
+@pytest.mark.parametrize("name", CONSTANTS)
+def test_library_constant_equals_the_config(name):
+    value, key = CONSTANTS[name]
+    assert _plain(value) == _plain(_get(CONFIG, key)), f"{name} = {value!r}, but {key} = {_get(CONFIG, key)!r}"
+
+
+@pytest.mark.parametrize("settings_type", SETTINGS, ids=lambda t: t.__name__)
+def test_defaults_are_what_the_config_builds(settings_type):
+    built, default = settings_type.from_config(CONFIG), settings_type()
+    for f in dataclasses.fields(settings_type):
+        assert _plain(getattr(default, f.name)) == _plain(getattr(built, f.name)), f.name
+
+
+@pytest.mark.parametrize(
+    ("settings_type", "path", "field", "value"),
+    [
+        (MarkerSettings, "markers.max_gap_frames", "max_gap_frames", 3),
+        (MarkerSettings, "filter.cutoff_hz", "cutoff_hz", 12.0),
+        (MarkerSettings, "markers.walking_direction", "walking_direction", "fixed"),
+        (EventSettings, "events.threshold_on_n", "threshold_on_n", 80.0),
+        (EventSettings, "grf.max_resting_n", "max_rest_n", 50.0),
+        (EventSettings, "events.grf_channels", "grf_channels", {"left": "belt_l", "right": "belt_r"}),
+        (LoadcellSettings, "events.sync_channel", "sync_channel", "trigger"),
+        (LoadcellSettings, "filter.order", "order", 2),
+        (StrideSettings, "strides.min_valid_strides", "min_valid", 7),
+        (StrideSettings, "trials.perturbed_side", "side", "right"),
+    ],
+)
+def test_a_changed_config_key_reaches_its_field(settings_type, path, field, value):
+    config = copy.deepcopy(CONFIG)
+    *parents, key = path.split(".")
+    _get(config, ".".join(parents))[key] = value
+    assert getattr(settings_type.from_config(config), field) == value
+    assert getattr(settings_type(), field) != value
+
+
+def test_the_static_trial_is_neither_filled_nor_filtered():
+    static = MarkerSettings.from_config(CONFIG).for_static()
+    assert (static.max_gap_frames, static.cutoff_hz) == (0, None)
+    assert static.rotation_deg == tuple(CONFIG["markers"]["lab_to_model_rotation_deg"])
