@@ -214,7 +214,7 @@ def problems(measured: dict) -> list[str]:
                 f"#{table} lies at top {box['top']:.0f} … bottom {box['bottom']:.0f} px, left "
                 f"{box['left']:.0f} … right {box['right']:.0f} px: not within {width}×{height}"
             )
-    for words in ("Truth recovered", "Impedance: across-subject mean", "Truth recovery"):
+    for words in ("the truth</b>", "Impedance: across-subject mean", "Truth recovery"):
         if words not in measured["text"]:
             out.append(f"the first screen does not show {words!r}")
     return out

@@ -212,46 +212,37 @@ def block_run(run: Run) -> str:
     )
 
 
+#: The summary's random-effects columns of a parameter, between its letter and its unit.
+GROUP_COLUMNS = ("group_mean", "group_ci95_low", "group_ci95_high", "between_sd")
+
+
 def block_impedance_summary(run: Run) -> str:
-    """Across-subject K and D per joint and onset."""
+    """Across-subject K and D per joint and onset: the random-effects mean, its 95 % interval and the SD between
+    subjects."""
     name = "impedance/summary.tsv"
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
-    cols = [
-        "joint",
-        "onset_ms",
-        "n_subjects",
-        "n_not_identifiable",
-        "K_mean_nm_per_rad",
-        "K_sd_nm_per_rad",
-        "D_mean_nms_per_rad",
-        "D_sd_nms_per_rad",
-        "vaf_pct_mean",
-    ]
-    s = run.need(s, name, cols)
+    per_p = [f"{p}_{w}_{u}" for p, u in zip("KD", ("nm_per_rad", "nms_per_rad")) for w in GROUP_COLUMNS]
+    s = run.need(s, name, ["joint", "onset_ms", "n_subjects", "n_not_identifiable", *per_p, "vaf_pct_mean"])
     rows = []
     for joint in ordered(s["joint"], JOINT_ORDER):
         for _, r in s[s["joint"] == joint].sort_values("onset_ms").iterrows():
-            rows.append(
-                [
-                    joint,
-                    int(r["onset_ms"]),
-                    int(r["n_subjects"]),
-                    int(r["n_not_identifiable"]),
-                    f"{num(r['K_mean_nm_per_rad'])} ± {num(r['K_sd_nm_per_rad'])}",
-                    f"{num(r['D_mean_nms_per_rad'])} ± {num(r['D_sd_nms_per_rad'])}",
-                    fixed(r["vaf_pct_mean"], 1),
-                ]
-            )
+            cells = [joint, int(r["onset_ms"]), int(r["n_subjects"]), int(r["n_not_identifiable"])]
+            for p, u in zip("KD", ("nm_per_rad", "nms_per_rad")):
+                mean, low, high, between = (r[f"{p}_{w}_{u}"] for w in GROUP_COLUMNS)
+                cells += [f"{num(mean)} [{num(low)}, {num(high)}]", num(between)]
+            rows.append([*cells, fixed(r["vaf_pct_mean"], 1)])
     return table(
         [
             "joint",
             "onset (ms)",
             "subjects",
             "not identifiable",
-            "K mean ± SD (N·m/rad)",
-            "D mean ± SD (N·m·s/rad)",
+            "K mean [95 % CI] (N·m/rad)",
+            "K SD between subjects",
+            "D mean [95 % CI] (N·m·s/rad)",
+            "D SD between subjects",
             "mean VAF (%)",
         ],
         rows,

@@ -6,8 +6,12 @@ import math
 
 import pandas as pd
 
+from loper_analysis.identification import t_quantile
 from loper_analysis.identification.impedance import IMPEDANCE_COLUMNS
 from loper_analysis.reference import STUDY_DEVICE
+
+#: Degrees of freedom of the intervals of these rows (those of a fit with 31 null pairs).
+CI_DOF = 30
 
 
 def impedance_row(subject, onset, joint, k, d, k_ci, d_ci, k_true=None, d_true=None, status="ok") -> dict:
@@ -23,6 +27,9 @@ def impedance_row(subject, onset, joint, k, d, k_ci, d_ci, k_true=None, d_true=N
         K_ci95_high_nm_per_rad=k_ci[1],
         D_ci95_low_nms_per_rad=d_ci[0],
         D_ci95_high_nms_per_rad=d_ci[1],
+        K_se_nm_per_rad=(k_ci[1] - k_ci[0]) / (2 * t_quantile(CI_DOF)),
+        D_se_nms_per_rad=(d_ci[1] - d_ci[0]) / (2 * t_quantile(CI_DOF)),
+        ci_dof=CI_DOF,
         vaf_pct=90.0,
         n_strides=10,
         status=status,

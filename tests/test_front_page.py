@@ -22,6 +22,7 @@ import pytest
 import yaml
 
 from loper_analysis.constants import JOINTS
+from loper_analysis.identification.group_mean import random_effects_mean
 from loper_analysis.identification.impedance import impedance_summary
 from loper_analysis.report.front_page import RunSettings, front_page_html
 from loper_analysis.report.headline import (
@@ -158,7 +159,9 @@ def test_fragment_numbers_are_the_tables_numbers():
         assert shown_value == value, key  # the full-precision value is the table's
         assert abs(_shown(text) - value) <= 0.5 * 10 ** -_decimals_shown(text) + 1e-12, (key, text, value)
     # the means of the library's summary: hip at 50 ms over S1, S2 and R1
-    assert found["impedance-summary|hip|50|K_mean_nm_per_rad"] == (55.0, "55.0")  # (50 + 70 + 45) / 3
+    hip = table[(table.joint == "hip") & (table.onset_ms == 50) & (table.status == "ok")]
+    group = random_effects_mean(hip.K_nm_per_rad.to_numpy(float), hip.K_se_nm_per_rad.to_numpy(float))
+    assert found["impedance-summary|hip|50|K_mean_nm_per_rad"][0] == group.mean  # 50, 70, 45 weighted
     assert found["impedance-summary|hip|50|n_subjects"][0] == 3
     assert found["truth-recovery|K_hip|K_error_mean_nm_per_rad"] == (6.5, "6.50")
     assert found["truth-recovery|K_hip|K_n_within_tolerance"] == (1, "1")
@@ -166,7 +169,8 @@ def test_fragment_numbers_are_the_tables_numbers():
     assert found["device|bandwidth_hz|value"] == (38.79, "38.8")
     # the verdicts: 4 of 6 intervals hold the truth, too few for 95 % (p = 0.033)
     assert found["verdict|truth|n_truth_in_ci95"] == (4, "4")
-    assert "Truth missed" in page and "binomial p = 0.03" in page
+    assert "Intervals miss the truth" in page and "</span>/6 (67 %; target 90–98 %; binomial p = 0.03" in page
+    assert "Estimates outside tolerance</b>: K" in page
     assert found["verdict|transparency|n_transparent"] == (1, "1") and "Transparent</b>" in page
     assert found["verdict|device|max_abs_difference_pct"][1] == "3.3"  # overshoot 31.5 against 30.5
     assert found["verdict|validation|K_max_abs_error"] == (0.02, "0.020")
@@ -269,7 +273,7 @@ def test_the_file_step_writes_the_same_bytes_from_the_same_files(tmp_path):
     assert base64.b64decode(embedded) == png  # the figure, byte for byte
     assert str(tmp_path) not in again and "impedance.png" not in again  # no path on the page
     summary = pd.read_csv(tmp_path / "results/impedance/summary.tsv", sep="\t")
-    assert f'data-v="{float(summary.K_mean_nm_per_rad.iloc[0])!r}"' in again  # hip, 50 ms, from the file
+    assert f'data-v="{float(summary.K_group_mean_nm_per_rad.iloc[0])!r}"' in again  # hip, 50 ms, from the file
     assert list(summary.joint) == ["hip"] * 3 + ["knee"] * 3 + ["ankle"] * 3 and (summary.n_subjects == 3).all()
     assert not list((tmp_path / "results/report").glob(".*partial"))  # written through the atomic writer
 

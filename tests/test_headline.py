@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.identification.impedance import impedance_summary
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.report.headline import (
     ci_coverage_p,
@@ -18,33 +19,29 @@ from loper_analysis.report.headline import (
     truth_recovery,
     validation_verdict,
 )
-from tests.headline_tables import impedance_table, validation_summary
+from tests.headline_tables import impedance_row, impedance_table, validation_summary
 
 #: t(0.975, 2): the 95 % quantile factor of a mean over 3 subjects
 T_975_2 = 4.302652729749464
 
 
-def test_ci_of_the_across_subject_mean_is_students_t():
-    summary = pd.DataFrame(
-        {
-            "joint": ["hip", "knee"],
-            "onset_ms": [50, 50],
-            "n_subjects": [3, 1],
-            "n_not_identifiable": [1, 0],
-            "K_mean_nm_per_rad": [10.0, 5.0],
-            "K_sd_nm_per_rad": [2.0, np.nan],
-            "D_mean_nms_per_rad": [0.3, 0.1],
-            "D_sd_nms_per_rad": [0.06, np.nan],
-            "vaf_pct_mean": [95.0, 80.0],
-        }
-    )
-    ci = impedance_summary_ci(summary, "s.tsv")
+def test_the_across_subject_ci_is_students_t_when_subjects_differ_more_than_their_fits():
+    """Three hip fits K 8, 10, 12 N·m/rad (SD 2 between subjects) with equal standard errors of 0.49 (D 0.30,
+    0.33, 0.36 with 0.005): the random-effects interval is the t interval of the three estimates; one knee fit
+    has no interval."""
+    rows = [
+        impedance_row(s, 50, "hip", k, 0.3 + 0.03 * i, (k - 1.0, k + 1.0), (0.29 + 0.03 * i, 0.31 + 0.03 * i))
+        for i, (s, k) in enumerate((("S1", 8.0), ("S2", 10.0), ("S3", 12.0)))
+    ]
+    rows.append(impedance_row("S1", 50, "knee", 5.0, 0.1, (4.0, 6.0), (0.05, 0.15)))
+    ci = impedance_summary_ci(impedance_summary(pd.DataFrame(rows)), "s.tsv")
     half_k = T_975_2 * 2.0 / math.sqrt(3)  # 4.968 N·m/rad
+    assert ci.loc[0, "K_mean_nm_per_rad"] == pytest.approx(10.0, rel=1e-12)
     assert ci.loc[0, "K_ci95_low_nm_per_rad"] == pytest.approx(10.0 - half_k, rel=1e-12)
     assert ci.loc[0, "K_ci95_high_nm_per_rad"] == pytest.approx(14.968275, abs=1e-6)
-    assert ci.loc[0, "D_ci95_high_nms_per_rad"] == pytest.approx(0.3 + T_975_2 * 0.06 / math.sqrt(3), rel=1e-12)
+    assert ci.loc[0, "D_ci95_high_nms_per_rad"] == pytest.approx(0.33 + T_975_2 * 0.03 / math.sqrt(3), rel=1e-9)
     assert math.isnan(ci.loc[1, "K_ci95_low_nm_per_rad"])  # one subject: no interval
-    assert ci.loc[1, "K_mean_nm_per_rad"] == 5.0 and ci.loc[0, "n_not_identifiable"] == 1
+    assert ci.loc[1, "K_mean_nm_per_rad"] == 5.0 and ci.loc[0, "n_subjects"] == 3
 
 
 def test_truth_recovery_counts_the_known_errors():
@@ -111,10 +108,12 @@ def test_transparency_device_and_validation_verdicts():
                         "onset_ms": [50],
                         "n_subjects": [0],
                         "n_not_identifiable": [0],
-                        "K_mean_nm_per_rad": [1.0],
-                        "K_sd_nm_per_rad": [1.0],
-                        "D_mean_nms_per_rad": [1.0],
-                        "D_sd_nms_per_rad": [1.0],
+                        "K_group_mean_nm_per_rad": [1.0],
+                        "K_group_ci95_low_nm_per_rad": [0.5],
+                        "K_group_ci95_high_nm_per_rad": [1.5],
+                        "D_group_mean_nms_per_rad": [1.0],
+                        "D_group_ci95_low_nms_per_rad": [0.5],
+                        "D_group_ci95_high_nms_per_rad": [1.5],
                         "vaf_pct_mean": [90.0],
                     }
                 ),

@@ -100,7 +100,13 @@ def test_summary_and_literature_rows():
     for subject, k, d in (("S01", 50.0, 3.0), ("S02", 60.0, 5.0)):
         rows.append(
             status_rows(subject, 50, "ok", "").assign(
-                K_nm_per_rad=k, D_nms_per_rad=d, vaf_pct=99.0, K_true_nm_per_rad=55.0, D_true_nms_per_rad=3.0
+                K_nm_per_rad=k,
+                D_nms_per_rad=d,
+                K_se_nm_per_rad=2.0,
+                D_se_nms_per_rad=0.5,
+                vaf_pct=99.0,
+                K_true_nm_per_rad=55.0,
+                D_true_nms_per_rad=3.0,
             )
         )
     rows.append(status_rows("S03", 50, "missing", "no trial"))
@@ -113,6 +119,12 @@ def test_summary_and_literature_rows():
     assert hip.K_sd_nm_per_rad == pytest.approx(np.sqrt(50.0))
     assert hip.K_fraction_within_tolerance == 1.0  # |5| <= 0.1 * 55
     assert hip.D_fraction_within_tolerance == 0.5  # 0 ok, 2 > 0.15 * 3
+    # random effects, equal standard errors below the spread: the t interval of 50 and 60 (t(0.975, 1) = 12.71)
+    half = 12.706204736174707 * np.sqrt(50.0) / np.sqrt(2.0)
+    assert hip.K_group_mean_nm_per_rad == pytest.approx(55.0, rel=1e-12)
+    assert hip.K_group_ci95_high_nm_per_rad == pytest.approx(55.0 + half, rel=1e-9)
+    assert hip.K_between_sd_nm_per_rad == pytest.approx(np.sqrt(50.0 - 4.0), rel=1e-12)
+    assert hip.K_true_mean_nm_per_rad == 55.0 and hip.K_group_truth_in_ci95
     lit = literature_table(summary)
     ours = lit[lit.source.str.startswith("this pipeline") & (lit.joint == "hip")].iloc[0]
     assert (ours.K_low_nm_per_rad, ours.K_high_nm_per_rad, ours.D_low_nms_per_rad, ours.D_high_nms_per_rad) == (
@@ -127,7 +139,9 @@ def test_summary_and_literature_rows():
 def test_summary_leaves_out_estimates_on_an_upper_bound():
     """The campaign's case: a bad trial's knee K at the 200 N·m/rad bound would pull the knee mean from 3 to 68."""
     rows = [
-        status_rows(s, 50, "ok", "").assign(K_nm_per_rad=k, D_nms_per_rad=0.1, vaf_pct=99.0)
+        status_rows(s, 50, "ok", "").assign(
+            K_nm_per_rad=k, D_nms_per_rad=0.1, K_se_nm_per_rad=1.0, D_se_nms_per_rad=0.05, vaf_pct=99.0
+        )
         for s, k in (("S01", 3.0), ("S02", 3.0), ("S03", 200.0))
     ]
     table = pd.concat(rows, ignore_index=True)
@@ -144,11 +158,21 @@ def test_summary_keeps_uninformative_rows_and_counts_them():
     the mean stays (0.10 + 0.12 + 0.01) / 3 = 0.0767, not the 0.11 of the informative rows alone, and the count
     says 1."""
     rows = [
-        status_rows(s, 175, st, "").assign(K_nm_per_rad=1.0, D_nms_per_rad=d, vaf_pct=99.0)
-        for s, d, st in (("S01", 0.10, "ok"), ("S02", 0.12, "ok"), ("S03", 0.01, "not_identifiable"))
+        status_rows(s, 175, st, "").assign(
+            K_nm_per_rad=1.0, D_nms_per_rad=d, K_se_nm_per_rad=0.5, D_se_nms_per_rad=se, vaf_pct=99.0
+        )
+        for s, d, se, st in (
+            ("S01", 0.10, 0.01, "ok"),
+            ("S02", 0.12, 0.01, "ok"),
+            ("S03", 0.01, 0.15, "not_identifiable"),
+        )
     ]
     knee = (
         impedance_summary(pd.concat(rows, ignore_index=True), upper_bounds=(200.0, 10.0)).set_index("joint").loc["knee"]
     )
     assert knee.n_subjects == 3 and knee.n_not_identifiable == 1
     assert knee.D_mean_nms_per_rad == pytest.approx(0.23 / 3)
+    # the random-effects mean weighs the uninformative fit by its standard error, not by leaving it out:
+    # DerSimonian-Laird Q = 2.444 on 2 df, tau^2 = 0.444 / 10066.5 = 4.41e-5, weights 6940, 6940, 44.4
+    assert knee.D_group_mean_nms_per_rad == pytest.approx(0.10968, abs=1e-5)
+    assert knee.D_group_ci95_low_nms_per_rad < 0.10 and knee.D_group_ci95_high_nms_per_rad > 0.12

@@ -67,16 +67,20 @@ SUMMARY = (
             "onset_ms",
             "n_subjects",
             "n_not_identifiable",
-            "K_mean_nm_per_rad",
-            "K_sd_nm_per_rad",
-            "D_mean_nms_per_rad",
-            "D_sd_nms_per_rad",
+            "K_group_mean_nm_per_rad",
+            "K_group_ci95_low_nm_per_rad",
+            "K_group_ci95_high_nm_per_rad",
+            "K_between_sd_nm_per_rad",
+            "D_group_mean_nms_per_rad",
+            "D_group_ci95_low_nms_per_rad",
+            "D_group_ci95_high_nms_per_rad",
+            "D_between_sd_nms_per_rad",
             "vaf_pct_mean",
         ]
     )
     + """
-hip\t50\t2\t0\t70.5\t13.4350288\t2.5\t0.707106781\t98.9
-hip\t175\t1\t1\t30\t\t3.5\t\t97.3
+hip\t50\t2\t0\t70.5\t-50.2\t191.2\t13.4350288\t2.5\t-3.85\t8.85\t0.707106781\t98.9
+hip\t175\t1\t1\t30\t\t\t\t3.5\t\t\t\t97.3
 """
 )
 VALIDATION = """\
@@ -215,8 +219,9 @@ def test_the_parts_hold_the_run_and_the_rest_is_kept_byte_for_byte(run, capsys):
     assert "2 subjects (2 synthetic); seed 7; `synthetic.variability: study`" in stamp
     assert "walking trials of 30 s; onsets 50, 175 ms; 1 trial per onset" in stamp
 
-    assert "| hip | 50 | 2 | 0 | 70.5 ± 13.4 | 2.50 ± 0.707 | 98.9 |" in part(text, "impedance-summary")
-    assert "| hip | 175 | 1 | 1 | 30.0 ± — | 3.50 ± — | 97.3 |" in part(text, "impedance-summary")
+    summary_part = part(text, "impedance-summary")
+    assert "| hip | 50 | 2 | 0 | 70.5 [−50.2, 191] | 13.4 | 2.50 [−3.85, 8.85] | 0.707 | 98.9 |" in summary_part
+    assert "| hip | 175 | 1 | 1 | 30.0 [—, —] | — | 3.50 [—, —] | — | 97.3 |" in summary_part
 
     truth = part(text, "truth-recovery")
     # onset 50: A1 within (K 1 of 60, D 0.1 of 3.1), B2 off (K 20, D 1.0); both CIs of B2 miss its truth

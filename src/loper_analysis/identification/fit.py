@@ -84,7 +84,8 @@ class ImpedanceFit:
 
     ``cost`` and ``start_costs`` are costs as defined in the module docstring
     (rad^2); ``sum_sq_error_rad2`` is the unweighted sum of squared prediction
-    errors at the estimate; ``n_starts_at_best`` counts the starts whose final
+    errors at the estimate; ``sd`` the parameters' standard deviations (linearised; inf: no information) and
+    ``ci_dof`` the degrees of freedom of the intervals' t quantile; ``n_starts_at_best`` counts the starts whose final
     cost lies within :data:`AT_BEST_RELATIVE` above the lowest start cost.
     """
 
@@ -93,6 +94,8 @@ class ImpedanceFit:
     sum_sq_error_rad2: float
     ci95_low: np.ndarray
     ci95_high: np.ndarray
+    sd: np.ndarray
+    ci_dof: int
     correlation: np.ndarray
     vaf_pct: np.ndarray
     success: bool
@@ -478,6 +481,8 @@ def identify_impedance(
         sum_sq_error_rad2=float(np.sum(pe**2)),
         ci95_low=ci_low,
         ci95_high=ci_high,
+        sd=sd,
+        ci_dof=int(dof if ci_dof is None else ci_dof),
         correlation=corr,
         vaf_pct=vaf,
         success=success,

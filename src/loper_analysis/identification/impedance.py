@@ -53,6 +53,7 @@ from loper_analysis.identification import (
     prepare_window,
     refit_with_null_pairs,
 )
+from loper_analysis.identification.group_mean import random_effects_mean
 from loper_analysis.reference import LITERATURE
 from loper_analysis.responses import (
     MAX_TRIAL_DEVIATION_RATIO,
@@ -92,6 +93,9 @@ IMPEDANCE_COLUMNS: tuple[str, ...] = (
     parameter_column("K", "ci95_high"),
     parameter_column("D", "ci95_low"),
     parameter_column("D", "ci95_high"),
+    parameter_column("K", "se"),
+    parameter_column("D", "se"),
+    "ci_dof",
     "vaf_pct",
     "n_strides",
     parameter_column("K", "true"),
@@ -303,6 +307,9 @@ def impedance_rows(
             parameter_column("K", "ci95_high"): fit.ci95_high[k],
             parameter_column("D", "ci95_low"): fit.ci95_low[d],
             parameter_column("D", "ci95_high"): fit.ci95_high[d],
+            parameter_column("K", "se"): fit.sd[k],
+            parameter_column("D", "se"): fit.sd[d],
+            "ci_dof": int(fit.ci_dof),
             "vaf_pct": fit.vaf_pct[j],
             "n_strides": int(n_strides),
             "sum_sq_error_rad2": fit.sum_sq_error_rad2,
@@ -543,10 +550,14 @@ def impedance_summary(
     made mostly of uninformative fits shows as such.
 
     Columns ``joint, onset_ms, n_subjects, n_not_identifiable``, then per parameter its mean, SD,
-    min and max over subjects (``K_mean_nm_per_rad`` ...), ``vaf_pct_mean``;
-    where the truth is known also the mean error, the largest absolute error
-    and the fraction of subjects within tolerance (``K_fraction_within_tolerance``:
-    ``|error| <= max(rel * |truth|, abs)``) for K and D.
+    min and max over subjects (``K_mean_nm_per_rad`` ...); the random-effects mean with its 95 % interval,
+    which carries each fit's own standard error and the between-subject spread
+    (:func:`loper_analysis.identification.group_mean.random_effects_mean`: ``K_group_mean_nm_per_rad``,
+    ``K_group_ci95_low_nm_per_rad``, ``K_group_ci95_high_nm_per_rad``, ``K_between_sd_nm_per_rad``);
+    ``vaf_pct_mean``; where the truth is known also the mean error, the largest absolute error, the
+    fraction of subjects within tolerance (``K_fraction_within_tolerance``:
+    ``|error| <= max(rel * |truth|, abs)``), the mean of the subjects' truths (``K_true_mean_nm_per_rad``)
+    and whether the random-effects interval holds it (``K_group_truth_in_ci95``) for K and D.
     """
     fitted = table[table["status"].isin(["ok", "not_identifiable"])]
     if upper_bounds is not None:
@@ -574,17 +585,32 @@ def impedance_summary(
                     parameter_column(p, "max"): v.max(),
                 }
             )
+        for p in ("K", "D"):
+            estimates, errors = (g[parameter_column(p, w)].to_numpy(float) for w in ("", "se"))
+            group = random_effects_mean(estimates, errors)
+            row.update(
+                {
+                    parameter_column(p, "group_mean"): group.mean,
+                    parameter_column(p, "group_ci95_low"): group.ci95_low,
+                    parameter_column(p, "group_ci95_high"): group.ci95_high,
+                    parameter_column(p, "between_sd"): group.between_sd,
+                }
+            )
         row["vaf_pct_mean"] = g["vaf_pct"].mean()
         known = g[g[parameter_column("K", "true")].notna()]
         if len(known):
             for p, (rel, ab) in (("K", k_tolerance), ("D", d_tolerance)):
                 err = known[parameter_column(p, "error")]
                 tol = np.maximum(rel * known[parameter_column(p, "true")].abs(), ab)
+                true_mean = known[parameter_column(p, "true")].mean()
+                low, high = row[parameter_column(p, "group_ci95_low")], row[parameter_column(p, "group_ci95_high")]
                 row.update(
                     {
                         parameter_column(p, "error_mean"): err.mean(),
                         parameter_column(p, "max_abs_error"): err.abs().max(),
                         f"{p}_fraction_within_tolerance": float((err.abs() <= tol).mean()),
+                        parameter_column(p, "true_mean"): true_mean,
+                        f"{p}_group_truth_in_ci95": bool(low <= true_mean <= high) if len(known) == len(g) else None,
                     }
                 )
         rows.append(row)

@@ -253,5 +253,5 @@ def refit_with_null_pairs(
             fit.estimate, sd, dof, fit_options.get("lower", DEFAULT_LOWER), fit_options.get("upper", DEFAULT_UPPER)
         )
         with np.errstate(divide="ignore", invalid="ignore"):
-            fit = replace(fit, ci95_low=low, ci95_high=high, correlation=cv / np.outer(sd, sd))
+            fit = replace(fit, ci95_low=low, ci95_high=high, sd=sd, correlation=cv / np.outer(sd, sd))
     return NullPairFit(fit, "null_pairs", n_null)

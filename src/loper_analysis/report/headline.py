@@ -29,12 +29,13 @@ from loper_analysis.checks import integer, number, require_columns, where
 from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification.impedance import TRUTH_TOLERANCE
-from loper_analysis.identification.intervals import t_quantile
 from loper_analysis.reference import STUDY_DEVICE
 
 __all__ = [
     "FITTED_STATUSES",
     "PARAMETER_KINDS",
+    "COVERAGE_TARGET",
+    "WITHIN_TOLERANCE_TARGET",
     "impedance_summary_ci",
     "truth_recovery",
     "ci_coverage_p",
@@ -47,6 +48,12 @@ __all__ = [
 FITTED_STATUSES: tuple[str, ...] = ("ok", "not_identifiable")
 #: Parameter kinds of the headline tables, in their column order: stiffness K (N·m/rad), damping D (N·m·s/rad).
 PARAMETER_KINDS: tuple[str, ...] = ("K", "D")
+#: Share of the fits' 95 % intervals that should hold the truth: calibrated intervals hold it in about 95 %; fewer
+#: than 90 % is too narrow, more than 98 % too wide to be informative.
+COVERAGE_TARGET: tuple[float, float] = (0.90, 0.98)
+#: Share of the fits whose K (and D) should lie within tolerance of the truth
+#: (:data:`loper_analysis.identification.impedance.TRUTH_TOLERANCE`).
+WITHIN_TOLERANCE_TARGET: float = 0.90
 
 
 def _rows_or_empty(table, columns: Sequence[str], source: str, what: str) -> pd.DataFrame:
@@ -65,34 +72,31 @@ def _numbers(table: pd.DataFrame, column: str, source: str) -> np.ndarray:
 
 
 def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFrame:
-    """The across-subject summary with the 95 % confidence interval of each mean.
+    """The across-subject summary's random-effects means with their 95 % intervals, per joint and onset.
 
     Parameters
     ----------
     summary : pandas.DataFrame
-        ``results/impedance/summary.tsv``: ``joint, onset_ms,
-        n_subjects, n_not_identifiable``, ``K_mean_nm_per_rad``,
-        ``K_sd_nm_per_rad`` (N·m/rad), ``D_mean_nms_per_rad``,
-        ``D_sd_nms_per_rad`` (N·m·s/rad) and ``vaf_pct_mean`` (%). No rows:
-        nothing was fitted.
+        ``results/impedance/summary.tsv``: ``joint, onset_ms, n_subjects, n_not_identifiable``,
+        ``K_group_mean_nm_per_rad``, ``K_group_ci95_low_nm_per_rad``, ``K_group_ci95_high_nm_per_rad``
+        (N·m/rad), the same for D (N·m·s/rad; :func:`loper_analysis.identification.group_mean.random_effects_mean`:
+        each fit weighted by its own standard error and the between-subject spread) and ``vaf_pct_mean`` (%).
+        No rows: nothing was fitted.
     source : str
         Where the table came from, for error messages.
 
     Returns
     -------
     pandas.DataFrame
-        One row per summary row: ``joint, onset_ms, n_subjects,
-        n_not_identifiable``, per parameter its mean and the bounds of the
-        95 % CI of the mean, ``mean ± t(0.975, n - 1) · sd / sqrt(n)``
-        (``K_ci95_low_nm_per_rad`` ...; NaN for one subject), and
-        ``vaf_pct_mean``.
+        One row per summary row: ``joint, onset_ms, n_subjects, n_not_identifiable``, per parameter the mean
+        and the bounds of its 95 % interval (``K_mean_nm_per_rad``, ``K_ci95_low_nm_per_rad`` ...; NaN bounds
+        for fewer than two subjects with information), and ``vaf_pct_mean``.
 
     Raises
     ------
     LoperInputError
-        A column missing, a count that is not an integer >= 1 (or a
-        not-identifiable count above it), a mean that is no finite number,
-        or no SD where two or more subjects were averaged.
+        A column missing, a count that is not an integer >= 1 (or a not-identifiable count above it), a mean
+        that is no finite number, or an interval that does not hold its mean.
     """
     needed = [
         "joint",
@@ -100,7 +104,7 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
         "n_subjects",
         "n_not_identifiable",
         "vaf_pct_mean",
-        *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("mean", "sd")),
+        *(parameter_column(p, w) for p in PARAMETER_KINDS for w in ("group_mean", "group_ci95_low", "group_ci95_high")),
     ]
     out_columns = [
         "joint",
@@ -125,13 +129,12 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
             "n_not_identifiable": n_ni,
         }
         for p in PARAMETER_KINDS:
-            mean = number(parameter_column(p, "mean"), r[parameter_column(p, "mean")], at)
-            if n >= 2:
-                sd = number(parameter_column(p, "sd"), r[parameter_column(p, "sd")], at, minimum=0.0)
-                half = t_quantile(n - 1, 0.95) * sd / math.sqrt(n)
-                low, high = mean - half, mean + half
-            else:
-                low = high = math.nan
+            mean = number(parameter_column(p, "group_mean"), r[parameter_column(p, "group_mean")], at)
+            low, high = (float(r[parameter_column(p, w)]) for w in ("group_ci95_low", "group_ci95_high"))
+            if not (math.isnan(low) and math.isnan(high)) and not low <= mean <= high:
+                raise LoperInputError(
+                    f"{at}: the interval [{low}, {high}] of {parameter_column(p, 'group_mean')} = {mean} must hold it"
+                )
             row.update(
                 {
                     parameter_column(p, "mean"): mean,
