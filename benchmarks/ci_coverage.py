@@ -191,8 +191,17 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     }
 
 
-def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.DataFrame:
-    """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table)."""
+#: Parts of the study-level lab that ``coordinate_subject`` can leave out (``benchmarks/bias_sources.py``).
+LAB_PARTS = ("adaptation", "minimal_impedance", "variability")
+
+
+def coordinate_subject(subject: str, config: dict, noise_scale: float, without: tuple[str, ...] = ()) -> pd.DataFrame:
+    """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table).
+
+    ``without``: parts of the study-level lab left out (:data:`LAB_PARTS`): the device adaptation, the leg's
+    answer to the minimal-impedance force (only the pulses act), the stride-to-stride variability (that of the
+    gentle lab instead).
+    """
     from loper_analysis.constants import JOINTS
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.identification.impedance import fit_onset
@@ -219,6 +228,12 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     design = StudyDesign.from_config(trials)
     onsets = list(design.perturbation_onsets_ms)
     variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
+    unknown = set(without) - set(LAB_PARTS)
+    if unknown:
+        raise SystemExit(f"unknown lab part(s) {sorted(unknown)}; choose from {LAB_PARTS}")
+    adaptation = None if "adaptation" in without else adaptation
+    minimal_impedance = None if "minimal_impedance" in without else minimal_impedance
+    variability = None if "variability" in without else variability
     names = [(t, design.onset_ms(t)) for t in (design.device, *design.perturbation_trials())]
     inputs = {}
     for trial, onset in names:
@@ -263,12 +278,15 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float) -> pd.Dat
     return pd.concat(rows, ignore_index=True)
 
 
-def run_coordinates(names: list[str], config: dict, noise_scale: float, jobs: int) -> pd.DataFrame:
-    """Every subject's rows, ``jobs`` subjects at a time."""
+def run_coordinates(
+    names: list[str], config: dict, noise_scale: float, jobs: int, without: tuple[str, ...] = ()
+) -> pd.DataFrame:
+    """Every subject's rows, ``jobs`` subjects at a time (``without``: as :func:`coordinate_subject`)."""
     if jobs <= 1:
-        return pd.concat([coordinate_subject(s, config, noise_scale) for s in names], ignore_index=True)
+        return pd.concat([coordinate_subject(s, config, noise_scale, without) for s in names], ignore_index=True)
+    n = len(names)
     with ProcessPoolExecutor(jobs) as pool:
-        frames = list(pool.map(coordinate_subject, names, [config] * len(names), [noise_scale] * len(names)))
+        frames = list(pool.map(coordinate_subject, names, [config] * n, [noise_scale] * n, [without] * n))
     return pd.concat(frames, ignore_index=True)
 
 
