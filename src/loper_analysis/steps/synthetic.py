@@ -26,16 +26,15 @@ from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
 from loper_analysis.synthetic.lab_export import QTMExportSettings
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 from loper_analysis.synthetic.variability import GaitVariability
+from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = [
     "ADAPTATION_AMPLITUDE_CHANGE",
     "ADAPTATION_OFFSET_RAD",
     "ADAPTATION_SWING_GAIN",
-    "AMPLITUDE_CV",
     "LAB_EXPORT_IMPEDANCE",
     "STATIC_TRIAL_DURATION_S",
     "STUDY_VARIABILITY",
-    "TIMING_CV",
     "VARIABILITY",
     "WALKING_TRIAL_DURATION_S",
     "LabExportFiles",
@@ -54,10 +53,6 @@ log = logging.getLogger(__name__)
 STATIC_TRIAL_DURATION_S: float = 2.0
 #: Duration of a synthetic walking trial (s; config ``synthetic.walking_duration_s``).
 WALKING_TRIAL_DURATION_S: float = 45.0
-#: Stride-to-stride CV of the stride duration (config ``synthetic.timing_cv``).
-TIMING_CV: float = 0.03
-#: Gentle lab: CV of the joint-angle amplitudes per stride, leg and joint (config ``synthetic.amplitude_cv``).
-AMPLITUDE_CV: float = 0.05
 #: Variability model of the synthetic subjects, ``"study"`` or ``"gentle"`` (config ``synthetic.variability``;
 #: :mod:`loper_analysis.synthetic.variability`).
 VARIABILITY: str = "study"

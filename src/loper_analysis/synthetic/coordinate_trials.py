@@ -32,6 +32,7 @@ import pandas as pd
 from loper_analysis.constants import JOINTS, SIDES, angle_column
 from loper_analysis.errors import LoperInputError
 from loper_analysis.swing_leg.dynamics import segment_coordinates
+from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = ["BRACE_LABELS", "trial_inputs", "perturbation_experiment"]
 
@@ -132,8 +133,8 @@ def perturbation_experiment(
     *,
     lab=None,
     device=None,
-    timing_cv: float = 0.03,
-    amplitude_cv: float = 0.05,
+    timing_cv: float = TIMING_CV,
+    amplitude_cv: float = AMPLITUDE_CV,
     force_n: float = 40.0,
     duration_s: float = 0.1,
     every_strides: tuple[int, int] = (3, 5),

@@ -36,6 +36,7 @@ from scipy.spatial.transform import Rotation
 from loper_analysis.constants import SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
+from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = [
     "LabSettings",
@@ -209,8 +210,8 @@ def simulate_walking_trial(
     seed,
     height_m: float,
     params,
-    timing_cv: float = 0.03,
-    amplitude_cv: float = 0.05,
+    timing_cv: float = TIMING_CV,
+    amplitude_cv: float = AMPLITUDE_CV,
     device=None,
     perturbation: PerturbationSettings | None = None,
     gait=None,

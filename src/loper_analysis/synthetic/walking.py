@@ -37,11 +37,18 @@ from loper_analysis.synthetic.gait_curves import CURVE_JOINTS, NominalGait
 from loper_analysis.synthetic.variability import DeviceAdaptation, GaitVariability, smooth_noise, swing_envelope
 
 __all__ = [
+    "AMPLITUDE_CV",
+    "TIMING_CV",
     "TRUE_EVENT_COLUMNS",
     "leg_length_from_height",
     "pelvis_height_m",
     "walking_kinematics",
 ]
+
+#: Stride-to-stride CV of the stride duration (config ``synthetic.timing_cv``).
+TIMING_CV: float = 0.03
+#: Gentle lab: CV of the joint-angle amplitudes per stride, leg and joint (config ``synthetic.amplitude_cv``).
+AMPLITUDE_CV: float = 0.05
 
 #: Columns of the true events of a simulated trial.
 TRUE_EVENT_COLUMNS: tuple[str, ...] = ("side", "event", "time_s")
@@ -160,8 +167,8 @@ def walking_kinematics(
     sample_rate_hz: float,
     gait: NominalGait,
     rng: np.random.Generator,
-    timing_cv: float = 0.03,
-    amplitude_cv: float = 0.05,
+    timing_cv: float = TIMING_CV,
+    amplitude_cv: float = AMPLITUDE_CV,
     leg_length_m: float | None = None,
     start_phase: float | None = None,
     variability: GaitVariability | None = None,
