@@ -106,36 +106,10 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def _settings(config: dict):
     """ResponseSettings and IdentificationSettings as the workflow's rule impedance_fit builds them."""
-    from loper_analysis.identification.impedance import IdentificationSettings
-    from loper_analysis.responses import ResponseSettings
+    from loper_analysis.steps.impedance import FitSettings
 
-    ident, strides = config["identification"], config["strides"]
-    response = ResponseSettings(
-        window_before_s=ident["window_before_s"],
-        window_after_s=ident["window_after_s"],
-        initial_state_span_s=ident["initial_state_span_s"],
-        whisker=strides["iqr_whisker"],
-        max_fraction=strides["max_outlier_fraction"],
-        min_strides=strides["min_valid_strides"],
-    )
-    keys = (
-        "noise_model",
-        "interval_scatter",
-        "null_pair_components",
-        "min_null_pairs",
-        "initial_state_degree",
-        "n_starts",
-        "n_substeps",
-        "tolerance",
-        "merge_tolerance",
-        "stiffness_bounds_nm_per_rad",
-        "damping_bounds_nms_per_rad",
-        "max_ci_fraction",
-        "plausible_ranges",
-        "min_vaf_pct",
-        "max_null_trial_ratio",
-    )
-    return response, IdentificationSettings(**{k: ident[k] for k in keys if k in ident}, seed=config["seed"])
+    settings = FitSettings.from_config(config)
+    return settings.response, settings.identification
 
 
 def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.random.Generator) -> dict:

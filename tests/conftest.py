@@ -1,4 +1,5 @@
-"""What every test module may use: the repository's root, a fresh copy of the workflow, and the `slow` lane.
+"""What every test module may use: the repository's root, a fresh copy of the workflow, a project folder as the
+working directory, and the `slow` lane.
 
 Tests marked ``slow`` run Snakemake or OpenSim on whole trials (end-to-end runs, recorded labs, the
 guards that need a processed project). ``pytest -m "not slow"`` leaves them out for day-to-day work;
@@ -7,6 +8,7 @@ CI runs them all.
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -24,3 +26,15 @@ def repo_root() -> Path:
 def workflow_dir(tmp_path: Path) -> Path:
     """A fresh copy of the workflow files (Snakefile, rules, config, examples) in the test's own folder."""
     return copy_workflow(tmp_path)
+
+
+@pytest.fixture
+def project(tmp_path: Path, monkeypatch) -> Path:
+    """A project folder as the working directory: ``config/config.yaml`` and the config schema, as in the
+    repository (what ``loper-analysis`` reads when run where the workflow lives)."""
+    (tmp_path / "config").mkdir()
+    shutil.copy(ROOT / "config" / "config.yaml", tmp_path / "config" / "config.yaml")
+    (tmp_path / "workflow" / "schemas").mkdir(parents=True)
+    shutil.copy(ROOT / "workflow/schemas/config.schema.yaml", tmp_path / "workflow/schemas/config.schema.yaml")
+    monkeypatch.chdir(tmp_path)
+    return tmp_path

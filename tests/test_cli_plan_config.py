@@ -11,7 +11,6 @@ from __future__ import annotations
 import copy
 import dataclasses
 import re
-import shutil
 from pathlib import Path
 
 import pandas as pd
@@ -31,17 +30,6 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 #: Values that differ from the library's defaults (PlanSettings, PlanningSettings).
 WINDOW_AFTER_S = 0.3
 STRIDES = [7, 14]
-
-
-@pytest.fixture
-def project(tmp_path, monkeypatch):
-    """A project folder (the working directory): config/config.yaml and the schema, as in the repository."""
-    (tmp_path / "config").mkdir()
-    shutil.copy(CONFIG, tmp_path / "config" / "config.yaml")
-    (tmp_path / "workflow" / "schemas").mkdir(parents=True)
-    shutil.copy(SCHEMA, tmp_path / "workflow" / "schemas" / "config.schema.yaml")
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
 
 
 def _write(path: Path, data: dict) -> Path:

@@ -8,7 +8,6 @@ Run in a project folder, each command builds its stage's settings as the rule do
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -26,17 +25,6 @@ GAP_FRAMES = 5  # one interior gap of marker RASI
 ANALOG_HZ = 1000.0
 RAMP_N_PER_S = 6000.0  # the belt force rises from 0 to 600 N in 0.1 s at each heel strike
 STRIKES_S = (0.5, 1.5, 2.5)
-
-
-@pytest.fixture
-def project(tmp_path, monkeypatch):
-    """A project folder (the working directory) with the repository's config and schema."""
-    (tmp_path / "config").mkdir()
-    shutil.copy(ROOT / "config" / "config.yaml", tmp_path / "config" / "config.yaml")
-    (tmp_path / "workflow" / "schemas").mkdir(parents=True)
-    shutil.copy(ROOT / "workflow/schemas/config.schema.yaml", tmp_path / "workflow/schemas/config.schema.yaml")
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
 
 
 def _layer(project: Path, name: str, data: dict) -> str:

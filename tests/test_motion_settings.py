@@ -8,7 +8,6 @@
 from __future__ import annotations
 
 import dataclasses
-import shutil
 from pathlib import Path
 
 import numpy as np
@@ -34,17 +33,6 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 SCALE_SETUP = ROOT / "examples" / "gait2392" / "scale_setup.xml"
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"
 SHIPPED = yaml.safe_load(CONFIG.read_text())
-
-
-@pytest.fixture
-def project(tmp_path, monkeypatch):
-    """A project folder as the working directory: config/config.yaml and the schema, as in the repository."""
-    (tmp_path / "config").mkdir()
-    shutil.copy(CONFIG, tmp_path / "config" / "config.yaml")
-    (tmp_path / "workflow" / "schemas").mkdir(parents=True)
-    shutil.copy(SCHEMA, tmp_path / "workflow" / "schemas" / "config.schema.yaml")
-    monkeypatch.chdir(tmp_path)
-    return tmp_path
 
 
 def _configure(project: Path, **sections: dict) -> None:

@@ -15,7 +15,7 @@ from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.io.robot_log_mat import read_robot_log_mat
 from loper_analysis.motion.ik import inverse_kinematics, marker_positions
 from loper_analysis.motion.markers import rotate_markers
-from loper_analysis.motion.model import build_lower_body_model
+from loper_analysis.motion.model import COORDINATES, build_lower_body_model
 from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
 from loper_analysis.synthetic.lab_export import (
     GAIT2392_COORDINATES,
@@ -203,24 +203,7 @@ def test_gait2392_coordinate_signs_match_our_model():
         cosine = delta[0] @ delta[1] / np.linalg.norm(delta[0]) / np.linalg.norm(delta[1])
         assert cosine > 0.95, (g_name, delta)
     frame = gait2392_coordinates(
-        pd.DataFrame(
-            {
-                c: [0.1 * k]
-                for k, c in enumerate(
-                    (
-                        "pelvis_tilt",
-                        "pelvis_tx",
-                        "pelvis_ty",
-                        "hip_flexion_r",
-                        "knee_flexion_r",
-                        "ankle_dorsiflexion_r",
-                        "hip_flexion_l",
-                        "knee_flexion_l",
-                        "ankle_dorsiflexion_l",
-                    )
-                )
-            }
-        ),
+        pd.DataFrame({c: [0.1 * k] for k, c in enumerate(COORDINATES)}),
         pelvis_ty_offset_m=0.5,
     )
     assert frame["knee_angle_l"][0] == pytest.approx(-0.7) and frame["pelvis_ty"][0] == pytest.approx(0.7)
