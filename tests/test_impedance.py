@@ -123,6 +123,7 @@ def test_summary_and_literature_rows():
     half = 12.706204736174707 * np.sqrt(50.0) / np.sqrt(2.0)
     assert hip.K_group_mean_nm_per_rad == pytest.approx(55.0, rel=1e-12)
     assert hip.K_group_ci95_high_nm_per_rad == pytest.approx(55.0 + half, rel=1e-9)
+    assert hip.K_group_ci95_low_nm_per_rad == 0.0  # 55 - 63.5, cut at 0 as the fits' own intervals
     assert hip.K_between_sd_nm_per_rad == pytest.approx(np.sqrt(50.0 - 4.0), rel=1e-12)
     assert hip.K_true_mean_nm_per_rad == 55.0 and hip.K_group_truth_in_ci95
     lit = literature_table(summary)

@@ -551,7 +551,8 @@ def impedance_summary(
 
     Columns ``joint, onset_ms, n_subjects, n_not_identifiable``, then per parameter its mean, SD,
     min and max over subjects (``K_mean_nm_per_rad`` ...); the random-effects mean with its 95 % interval,
-    which carries each fit's own standard error and the between-subject spread
+    (cut at 0, as the fits' intervals are), which carries each fit's own standard error and the between-subject
+    spread
     (:func:`loper_analysis.identification.group_mean.random_effects_mean`: ``K_group_mean_nm_per_rad``,
     ``K_group_ci95_low_nm_per_rad``, ``K_group_ci95_high_nm_per_rad``, ``K_between_sd_nm_per_rad``);
     ``vaf_pct_mean``; where the truth is known also the mean error, the largest absolute error, the
@@ -591,7 +592,10 @@ def impedance_summary(
             row.update(
                 {
                     parameter_column(p, "group_mean"): group.mean,
-                    parameter_column(p, "group_ci95_low"): group.ci95_low,
+                    # cut at 0, the parameters' physical limit, as the fits' own intervals are
+                    parameter_column(p, "group_ci95_low"): max(group.ci95_low, 0.0)
+                    if not np.isnan(group.ci95_low)
+                    else group.ci95_low,
                     parameter_column(p, "group_ci95_high"): group.ci95_high,
                     parameter_column(p, "between_sd"): group.between_sd,
                 }
