@@ -1,9 +1,10 @@
 """Where does the bias of the impedance fits come from? The synthetic lab with one part at a time left out.
 
 Usage: python benchmarks/bias_sources.py [--subjects N] [--jobs J] [--seed S] [--variants NAME ...]
-                                         [--ik-noise-scale X] [--keep DIR]
+                                         [--ik-noise-scale X] [--keep DIR] [--configfile FILE ...]
 
-N synthetic subjects of the default design (``config/config.yaml``: 2 trials of 45 s per onset), fitted at
+N synthetic subjects of the default design (``config/config.yaml``: 2 trials of 45 s per onset; the study's
+design with ``--configfile config/paper.yaml``: 4-minute trials), fitted at
 the coordinate level as ``benchmarks/ci_coverage.py --mode coordinates`` fits them (the workflow's
 ``fit_onset`` on the simulated coordinates with IK-like noise), once with the study-level lab as it is
 and once with each candidate departure from what the identification model assumes left out:
@@ -35,6 +36,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from ci_coverage import ROOT, run_coordinates  # noqa: E402
 
+from loper_analysis.config_file import update_config  # noqa: E402
 from loper_analysis.identification.impedance import TRUTH_TOLERANCE  # noqa: E402
 from loper_analysis.report.markdown import markdown_table  # noqa: E402
 
@@ -86,8 +88,11 @@ def main() -> None:
     ap.add_argument("--variants", nargs="+", choices=sorted(VARIANTS), default=list(VARIANTS))
     ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
     ap.add_argument("--keep", type=Path, help="write every variant's impedance rows here (TSV, one per variant)")
+    ap.add_argument("--configfile", nargs="+", default=[], help="config files layered over config/config.yaml")
     args = ap.parse_args()
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    for extra in args.configfile:
+        update_config(config, yaml.safe_load(Path(extra).read_text()) or {})
     config["seed"] = args.seed
     config["synthetic"]["variability"] = "study"
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
@@ -100,9 +105,11 @@ def main() -> None:
             rows.to_csv(args.keep / f"{variant}.tsv", sep="\t", index=False)
         tables.append(bias_table(rows, variant))
         print(f"{variant}: {args.subjects} subjects, {time.perf_counter() - t0:.0f} s", file=sys.stderr)
+    layered = f" --configfile {' '.join(args.configfile)}" if args.configfile else ""
     print(
         f"python benchmarks/bias_sources.py --subjects {args.subjects} --seed {args.seed} "
-        f"--ik-noise-scale {args.ik_noise_scale:g} (default design, coordinate level)\n"
+        f"--ik-noise-scale {args.ik_noise_scale:g}{layered} (coordinate level; trials of "
+        f"{config['synthetic']['walking_duration_s']:g} s, {config['trials']['perturbation_repeats']} per onset)\n"
     )
     print(markdown_table(pd.concat(tables, ignore_index=True).round(3)))
 
