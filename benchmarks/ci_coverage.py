@@ -169,6 +169,22 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
 LAB_PARTS = ("adaptation", "minimal_impedance", "variability")
 
 
+def _truth(subject: str, config: dict) -> dict:
+    """The synthetic subject's true K and D per onset and joint, as the workflow draws them."""
+    from loper_analysis.synthetic.subjects import true_impedance
+
+    syn, ident = config["synthetic"], config["identification"]
+    return true_impedance(
+        subject,
+        int(config["seed"]),
+        syn["stiffness_nm_per_rad"],
+        syn["damping_nms_per_rad"],
+        syn["between_subject_cv"],
+        ident["stiffness_bounds_nm_per_rad"],
+        ident["damping_bounds_nms_per_rad"],
+    )
+
+
 def coordinate_subject(subject: str, config: dict, noise_scale: float, without: tuple[str, ...] = ()) -> pd.DataFrame:
     """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table).
 
@@ -180,21 +196,13 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float, without: 
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.identification.impedance import fit_onset
     from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
-    from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
+    from loper_analysis.synthetic.subjects import subject_anthropometry
     from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial
     from loper_analysis.synthetic.variability import lab_variability
 
     syn, trials, seed = config["synthetic"], config["trials"], int(config["seed"])
     row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
-    truth = true_impedance(
-        subject,
-        seed,
-        syn["stiffness_nm_per_rad"],
-        syn["damping_nms_per_rad"],
-        syn["between_subject_cv"],
-        config["identification"]["stiffness_bounds_nm_per_rad"],
-        config["identification"]["damping_bounds_nms_per_rad"],
-    )
+    truth = _truth(subject, config)
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
     device = DeviceParameters(**config["device"]["parameters"])
     model = build_lower_body_model(row["height_m"], row["mass_kg"])
@@ -270,7 +278,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
     from loper_analysis.device.controller import DeviceParameters
     from loper_analysis.io.readers import read_tsv
     from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
-    from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
+    from loper_analysis.synthetic.subjects import subject_anthropometry
     from loper_analysis.synthetic.trials import LabSettings, simulate_walking_trial
     from loper_analysis.synthetic.variability import lab_variability
 
@@ -283,15 +291,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
         row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
         params = segment_parameters_from_model(build_lower_body_model(row["height_m"], row["mass_kg"]))
         sim_seed, _ = np.random.SeedSequence([seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]).spawn(2)
-        truth = true_impedance(
-            subject,
-            seed,
-            syn["stiffness_nm_per_rad"],
-            syn["damping_nms_per_rad"],
-            syn["between_subject_cv"],
-            config["identification"]["stiffness_bounds_nm_per_rad"],
-            config["identification"]["damping_bounds_nms_per_rad"],
-        )
+        truth = _truth(subject, config)
         variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
         walk = simulate_walking_trial(
             syn["walking_duration_s"],
