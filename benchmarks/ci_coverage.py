@@ -38,6 +38,7 @@ import time
 import warnings
 import zlib
 from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -185,12 +186,20 @@ def _truth(subject: str, config: dict) -> dict:
     )
 
 
-def coordinate_subject(subject: str, config: dict, noise_scale: float, without: tuple[str, ...] = ()) -> pd.DataFrame:
+def coordinate_subject(
+    subject: str,
+    config: dict,
+    noise_scale: float,
+    without: tuple[str, ...] = (),
+    estimators: tuple[tuple[str, str, str], ...] = (),
+) -> pd.DataFrame:
     """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table).
 
     ``without``: parts of the study-level lab left out (:data:`LAB_PARTS`): the device adaptation, the leg's
     answer to the minimal-impedance force (only the pulses act), the stride-to-stride variability (that of the
-    gentle lab instead).
+    gentle lab instead). ``estimators``: fit the same simulated trials with each ``(name, counterfactual,
+    interval_scatter)`` (``identification.counterfactual`` and ``identification.interval_scatter``), the rows
+    tagged with the name in a column ``estimator``; empty: the config's.
     """
     from loper_analysis.constants import JOINTS
     from loper_analysis.device.controller import DeviceParameters
@@ -254,21 +263,32 @@ def coordinate_subject(subject: str, config: dict, noise_scale: float, without: 
     response, ident = _settings(config)
     null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
     rows = []
-    for onset in onsets:
-        own = [inputs[name] for name in design.perturbation_trials(onset)]
-        rows.append(fit_onset(own, params, onset, subject, truth[onset], null, response, ident).rows)
+    for label, counterfactual, scatter in estimators or (("", response.counterfactual, ident.interval_scatter),):
+        settings = replace(response, counterfactual=counterfactual)
+        fitting = replace(ident, interval_scatter=scatter)
+        for onset in onsets:
+            own = [inputs[name] for name in design.perturbation_trials(onset)]
+            fitted = fit_onset(own, params, onset, subject, truth[onset], null, settings, fitting).rows
+            rows.append(fitted.assign(estimator=label) if estimators else fitted)
     return pd.concat(rows, ignore_index=True)
 
 
 def run_coordinates(
-    names: list[str], config: dict, noise_scale: float, jobs: int, without: tuple[str, ...] = ()
+    names: list[str],
+    config: dict,
+    noise_scale: float,
+    jobs: int,
+    without: tuple[str, ...] = (),
+    estimators: tuple[tuple[str, str, str], ...] = (),
 ) -> pd.DataFrame:
-    """Every subject's rows, ``jobs`` subjects at a time (``without``: as :func:`coordinate_subject`)."""
-    if jobs <= 1:
-        return pd.concat([coordinate_subject(s, config, noise_scale, without) for s in names], ignore_index=True)
+    """Every subject's rows, ``jobs`` subjects at a time (``without``, ``estimators``: as
+    :func:`coordinate_subject`)."""
     n = len(names)
+    args = (names, [config] * n, [noise_scale] * n, [without] * n, [estimators] * n)
+    if jobs <= 1:
+        return pd.concat(list(map(coordinate_subject, *args)), ignore_index=True)
     with ProcessPoolExecutor(jobs) as pool:
-        frames = list(pool.map(coordinate_subject, names, [config] * n, [noise_scale] * n, [without] * n))
+        frames = list(pool.map(coordinate_subject, *args))
     return pd.concat(frames, ignore_index=True)
 
 

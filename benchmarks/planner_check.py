@@ -32,6 +32,7 @@ from scipy.stats import t as student_t
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
+from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL
 from loper_analysis.planning.precision import PlanSettings, pilot_perturbed_pairs, stride_covariance
 from loper_analysis.report.markdown import markdown_table
 from loper_analysis.responses import ResponseSettings, null_pair_windows
@@ -88,8 +89,9 @@ def run_check(
     """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D)."""
     truth = TRUTH[onset_ms] if truth is None else truth
     params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
-    ident = IdentificationSettings(n_starts=n_starts, seed=seed)
-    response = ResponseSettings()
+    # the planner's method: matched strides, intervals from the perturbed pairs' scatter
+    ident = IdentificationSettings(n_starts=n_starts, seed=seed, interval_scatter="perturbed_pairs")
+    response = ResponseSettings(counterfactual=PLANNED_COUNTERFACTUAL)
     lab_kwargs = lab(variability, seed, onset_ms, truth)
 
     def experiment(k: int):
@@ -103,8 +105,9 @@ def run_check(
     planned = np.clip(estimates(pilot_fit.rows), ident.lower, ident.upper)
     null = null_pair_windows([full], onset_ms, response, source="pilot")
     pairs = pilot_perturbed_pairs([full], onset_ms, response)
-    sc = stride_covariance(null, params, planned, PlanSettings(), perturbed_pairs=pairs)
-    sc_null = stride_covariance(null, params, planned, PlanSettings())
+    plan = PlanSettings(interval_scatter="perturbed_pairs")
+    sc = stride_covariance(null, params, planned, plan, perturbed_pairs=pairs)
+    sc_null = stride_covariance(null, params, planned, plan)
     found = {n: [] for n in counts}
     kept = {n: [] for n in counts}
     reported = {n: [] for n in counts}

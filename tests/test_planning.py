@@ -54,6 +54,10 @@ from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropome
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.response import thigh_normal
 
+#: The planner predicts for the study's matched strides, whose perturbed pairs' scatter the fit's intervals take.
+MATCHED = ResponseSettings(counterfactual="matched_stride")
+PLAN = PlanSettings(interval_scatter="perturbed_pairs")
+
 HEIGHT_M, MASS_KG = 1.73, 64.9
 ONSET_MS = 50
 TRUTH = np.array([55.0, 3.5, 3.0, 0.10, 8.0, 0.3])
@@ -71,15 +75,15 @@ def pilot(params):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         full, cut = perturbation_experiment([11, 0], params, HEIGHT_M, ONSET_MS, TRUTH, [40], angle_noise_sd_rad=0.001)
-        null = null_pair_windows([full], ONSET_MS, ResponseSettings(), source="pilot")
-        pairs = pilot_perturbed_pairs([full], ONSET_MS, ResponseSettings())
+        null = null_pair_windows([full], ONSET_MS, MATCHED, source="pilot")
+        pairs = pilot_perturbed_pairs([full], ONSET_MS, MATCHED)
     return full, cut[40], null, pairs
 
 
 @pytest.fixture(scope="module")
 def stride_cov(params, pilot):
     _, _, null, pairs = pilot
-    return stride_covariance(null, params, TRUTH, perturbed_pairs=pairs)
+    return stride_covariance(null, params, TRUTH, PLAN, perturbed_pairs=pairs)
 
 
 def test_pulse_is_the_device_step(params):
@@ -114,7 +118,7 @@ def test_prediction_is_the_fits_own_sandwich(params, pilot, stride_cov):
     """A noise-free fit given the null pairs' projection and the perturbed pairs' covariance / N (t at N - 1, as
     the fit's refit takes them) reports the predicted half-width."""
     _, _, null, pairs = pilot
-    settings = PlanSettings()
+    settings = PLAN
     sc = stride_cov
     window = planning_window(null, params, settings)
     # the pulse reaches the fit at 1 kHz: every RK4 step carries the exact impulse of the pulse's spline
@@ -164,11 +168,11 @@ def test_strides_needed_is_the_smallest_count(params, pilot, stride_cov):
 def test_pilot_without_perturbed_pairs_falls_back_to_the_null_pairs(params, pilot, stride_cov):
     """No perturbed pairs at the onset: C = cov(null-pair errors), the sandwich computed here; the rows say so."""
     full, _, null, pairs = pilot
-    assert pilot_perturbed_pairs([full], 175, ResponseSettings()) is None  # the pilot's strides are perturbed at 50 ms
-    sc = stride_covariance(null, params, TRUTH)
+    assert pilot_perturbed_pairs([full], 175, MATCHED) is None  # the pilot's strides are perturbed at 50 ms
+    sc = stride_covariance(null, params, TRUTH, PLAN)
     window = planning_window(null, params)
     E = null_pair_errors(window, TRUTH, null)
-    J = response_jacobian(window, TRUTH, PlanSettings().lower, PlanSettings().upper)
+    J = response_jacobian(window, TRUTH, PLAN.lower, PLAN.upper)
     WJ = nuisance_projection(E, 6) @ J
     M = np.linalg.pinv(WJ.T @ WJ) @ WJ.T @ nuisance_projection(E, 6)
     np.testing.assert_allclose(sc.covariance, M @ np.cov(E, rowvar=False) @ M.T, rtol=1e-6, atol=1e-12)
@@ -185,7 +189,7 @@ def test_pilot_without_perturbed_pairs_falls_back_to_the_null_pairs(params, pilo
         k: (v[: MIN_PERTURBED_PAIRS - 1] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in pairs.items()
     }
     few["n_pairs"] = MIN_PERTURBED_PAIRS - 1
-    assert stride_covariance(null, params, TRUTH, perturbed_pairs=few).scatter == "null_pairs"
+    assert stride_covariance(null, params, TRUTH, PLAN, perturbed_pairs=few).scatter == "null_pairs"
 
 
 def test_pooled_scatter_is_the_weighted_mean_variance_ratio(stride_cov):
@@ -219,21 +223,21 @@ def test_repeated_experiments_report_the_predicted_sd(params, pilot):
     benchmarks/planner_check.py compares with the scatter of the estimates themselves over 60 repeats.
     """
     full, cut, null, pairs = pilot
-    ident = IdentificationSettings(n_starts=3)
+    ident = IdentificationSettings(n_starts=3, interval_scatter="perturbed_pairs")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         logging.disable(logging.WARNING)
         try:
-            pilot_fit = fit_onset([cut], params, ONSET_MS, "pilot", None, [full], ResponseSettings(), ident)
+            pilot_fit = fit_onset([cut], params, ONSET_MS, "pilot", None, [full], MATCHED, ident)
             rows = pilot_fit.rows.set_index("joint")
             planned = np.array([rows.loc[j, parameter_column(p)] for j in JOINTS for p in ("K", "D")])
-            sc = stride_covariance(null, params, np.clip(planned, 0, None), perturbed_pairs=pairs)
+            sc = stride_covariance(null, params, np.clip(planned, 0, None), PLAN, perturbed_pairs=pairs)
             reported, kept = [], []
             for k in range(1, 9):
                 f, c = perturbation_experiment(
                     [11, k], params, HEIGHT_M, ONSET_MS, TRUTH, [10], angle_noise_sd_rad=0.001
                 )
-                r = fit_onset([c[10]], params, ONSET_MS, f"R{k}", None, [f], ResponseSettings(), ident).rows
+                r = fit_onset([c[10]], params, ONSET_MS, f"R{k}", None, [f], MATCHED, ident).rows
                 assert (r["noise_model"] == "null_pairs").all()
                 r = r.set_index("joint")
                 n_kept = int(r["n_strides"].iloc[0])
@@ -344,12 +348,13 @@ def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path,
     table = pd.read_csv(out, sep="\t")
     assert len(table) == 12 and set(table["n_strides"]) == {10, 40} and set(table["onset_ms"]) == {50}
     _, _, null, pairs = pilot
-    sc = stride_covariance(null, params, TRUTH, perturbed_pairs=pairs)
+    sc = stride_covariance(null, params, TRUTH, PLAN, perturbed_pairs=pairs)
     expected = precision_table(sc, [10, 40], ONSET_MS, "S09")
     assert (table["scatter"] == "perturbed_pairs").all() and (table["n_perturbed_pairs"] == pairs["n_pairs"]).all()
     # the pilot's tables went through TSV files (9 significant digits) on the way in
     np.testing.assert_allclose(table["predicted_sd"], expected["predicted_sd"], rtol=2e-4)
-    n = strides_needed(sc, "hip", "D", percent=15)
+    # the command's intervals are the library default's (identification.interval_scatter): its t quantile
+    n = strides_needed(stride_covariance(null, params, TRUTH, perturbed_pairs=pairs), "hip", "D", percent=15)
     assert f"hip D at 50 ms: ±15 % (95 % CI) needs {n} perturbed strides" in captured.out
 
 

@@ -91,6 +91,7 @@ RESPONSE_KEYS = {
     "whisker": "strides.iqr_whisker",
     "max_fraction": "strides.max_outlier_fraction",
     "min_strides": "strides.min_valid_strides",
+    "counterfactual": "identification.counterfactual",
 }
 #: IdentificationSettings field -> config key: the same name under ``identification`` (as the impedance_fit rule
 #: passes them), except ``plausible_ranges`` (default None stands for DEFAULT_PLAUSIBLE_RANGES) and ``seed``.

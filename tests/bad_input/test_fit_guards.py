@@ -75,7 +75,7 @@ def onset_trials():
     return [walking_trial("pert100-1", 1), walking_trial("pert100-2", 2)]
 
 
-def _fit(trials, after, null=(), min_strides=4, **ident):
+def _fit(trials, after, null=(), min_strides=4, counterfactual="conditional", **ident):
     settings = IdentificationSettings(**{"n_starts": 3, "min_null_pairs": 20, **ident})
     return fit_onset(
         [fit_inputs(t) for t in trials],
@@ -83,7 +83,7 @@ def _fit(trials, after, null=(), min_strides=4, **ident):
         ONSET_MS,
         "S01",
         null_trials=[fit_inputs(t) for t in null],
-        response=ResponseSettings(window_after_s=after, min_strides=min_strides),
+        response=ResponseSettings(window_after_s=after, min_strides=min_strides, counterfactual=counterfactual),
         identification=settings,
     )
 
@@ -161,18 +161,20 @@ def test_the_true_impedance_stays_ok(truth_window):
 
 def test_a_grossly_deviant_trial_is_left_out_of_the_null_pairs(onset_trials, caplog):
     """Strides 20x as varied as the others' (offsets +-1 rad): the trial is left out, the fit equals the fit
-    without it; without the screen the trial's pairs change the fit."""
+    without it; without the screen the trial's pairs change the fit. (The null pairs of the matched strides,
+    which come from every trial with the device; the conditional counterfactual's come from the onset's own
+    trials.)"""
     device = walking_trial("walk-device", 3, perturbed=())
     bad = walking_trial("pert300-1", 4, spread=1.0)
     good = [*onset_trials, device]
     with caplog.at_level(logging.WARNING, logger="loper_analysis.responses.null_pairs"):
-        with_bad = _fit(onset_trials, 0.25, null=[*good, bad])
+        with_bad = _fit(onset_trials, 0.25, null=[*good, bad], counterfactual="matched_stride")
     assert "trial pert300-1 left out of the null pairs" in caplog.text
-    without = _fit(onset_trials, 0.25, null=good)
+    without = _fit(onset_trials, 0.25, null=good, counterfactual="matched_stride")
     numbers = [c for c in with_bad.rows.columns if c not in ("reason",)]
     pd.testing.assert_frame_equal(with_bad.rows[numbers], without.rows[numbers], check_exact=True)
     assert with_bad.rows.n_null_pairs.iloc[0] == without.rows.n_null_pairs.iloc[0] == 69
     assert with_bad.rows.reason.str.contains(r"trial pert300-1 left out of the null pairs: .* 18\.9 times").all()
-    unscreened = _fit(onset_trials, 0.25, null=[*good, bad], max_null_trial_ratio=None)
+    unscreened = _fit(onset_trials, 0.25, null=[*good, bad], counterfactual="matched_stride", max_null_trial_ratio=None)
     assert unscreened.rows.n_null_pairs.iloc[0] > 69
     assert not np.allclose(unscreened.rows.K_nm_per_rad, without.rows.K_nm_per_rad)

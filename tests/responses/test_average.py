@@ -28,6 +28,9 @@ from tests.responses.twin_strides import (
     twin_trial,
 )
 
+#: The study's matching, whose matched strides these tests check.
+MATCHED = ResponseSettings(min_strides=4, counterfactual="matched_stride")
+
 
 @pytest.fixture
 def rng():
@@ -37,7 +40,7 @@ def rng():
 def test_subject_response_returns_the_planted_bump(rng):
     amplitudes = {4: 1.0, 8: 1.1, 12: 1.3, 16: 0.8}
     trial, _ = twin_trial(rng, amplitudes={p: BUMP_AMP * a for p, a in amplitudes.items()})
-    response, counts, series = subject_onset_response([trial.inputs()], 100, ResponseSettings(min_strides=4))
+    response, counts, series = subject_onset_response([trial.inputs()], 100, MATCHED)
     grid = window_times_s(0.125, 0.25, RATE)
     np.testing.assert_array_equal(response["time_s"], grid)
     a = np.array(list(amplitudes.values()))
@@ -126,7 +129,7 @@ def test_subject_counts_too_short_no_match_outlier(rng):
         np.mean(list(good.values())) * BUMP_AMP[0] * bump(response["time_s"].to_numpy()),
         atol=1e-9,
     )
-    _, counts, _ = subject_onset_response([trial_a.inputs(), trial_b.inputs()], 100, ResponseSettings(min_strides=4))
+    _, counts, _ = subject_onset_response([trial_a.inputs(), trial_b.inputs()], 100, MATCHED)
     assert counts["status"].tolist() == ["ok", "too_few_strides", "ok"]
 
 
@@ -166,9 +169,9 @@ def test_counts_carry_the_longest_swing_after_an_onset(rng):
     """Perturbed swings of 60, 62, 59 and 61 frames, onsets 13 frames after toe-off: 49 frames are left at most;
     a nominal onset later than the planted one counts instead (240 ms: 62 / 128 - 0.24 s, all too short)."""
     trial, _ = twin_trial(rng)
-    _, counts, _ = subject_onset_response([trial.inputs()], 100, ResponseSettings(min_strides=4))
+    _, counts, _ = subject_onset_response([trial.inputs()], 100, MATCHED)
     assert counts.attrs["longest_swing_after_onset_s"] == pytest.approx(49 / RATE, abs=1e-12)
     with pytest.warns(TooFewStridesWarning):
-        _, late, _ = subject_onset_response([trial.inputs()], 240, ResponseSettings(min_strides=4))
+        _, late, _ = subject_onset_response([trial.inputs()], 240, MATCHED)
     assert late.attrs["longest_swing_after_onset_s"] == pytest.approx(62 / RATE - 0.24, abs=1e-12)
     assert late.set_index("trial").loc["total", "n_too_short"] == 4

@@ -12,6 +12,9 @@ from tests.responses.twin_strides import twin_trial
 ROBOT_HZ = 1000.0
 ANGLE = np.deg2rad(-20.0)  # a fixed rod direction: the known answer needs no interpolation of it
 
+#: The study's matching, whose matched strides these tests check.
+MATCHED = ResponseSettings(min_strides=4, counterfactual="matched_stride")
+
 
 def linear_force(t):
     """Force (N) linear in time: its straight-line interpolation between robot samples is exact."""
@@ -36,7 +39,7 @@ def test_response_force_at_the_robot_rate_is_the_mean_of_the_pairs():
     F(mean anchor + grid) x direction, to rounding."""
     rng = np.random.default_rng(20240612)
     trial, inputs = native_inputs(rng)
-    _, counts, series = subject_onset_response([inputs], 100, ResponseSettings(min_strides=4))
+    _, counts, series = subject_onset_response([inputs], 100, MATCHED)
     grid = window_times_s(0.125, 0.25, ROBOT_HZ)
     np.testing.assert_allclose(series["force_time_s"], grid, rtol=0, atol=1e-15)
     assert series["force_perturbed_n"].shape == (grid.size, 2) == series["force_unperturbed_n"].shape
@@ -55,7 +58,7 @@ def test_force_at_the_robot_rate_must_cover_every_window():
     onset_s = float(trial.angles["time_s"].iloc[trial.onset[first]])
     _, inputs = native_inputs(np.random.default_rng(20240612), start_s=onset_s)
     with pytest.raises(LoperInputError, match=rf"perturbed force window of stride {first} .* leaves the finite force"):
-        subject_onset_response([inputs], 100, ResponseSettings(min_strides=4))
+        subject_onset_response([inputs], 100, MATCHED)
 
 
 def test_force_at_the_robot_rate_for_every_trial_or_none():
@@ -65,4 +68,4 @@ def test_force_at_the_robot_rate_for_every_trial_or_none():
     with pytest.raises(
         LoperInputError, match="walk-2: the force at the robot rate .* every trial of the onset or for none"
     ):
-        subject_onset_response([with_native, other.inputs()], 100, ResponseSettings(min_strides=4))
+        subject_onset_response([with_native, other.inputs()], 100, MATCHED)

@@ -129,11 +129,13 @@ class IdentificationSettings(FitBounds):
     multiple of the other trials' is left out of the null pairs (None: never);
     ``interval_scatter``: with the ``null_pairs`` noise model, whose scatter
     gives the 95 % intervals: ``perturbed_pairs`` (the averaged pairs
-    themselves) or ``null_pairs`` (:func:`loper_analysis.identification.refit_with_null_pairs`).
+    themselves), ``null_pairs`` or ``cross_validated_null_pairs`` (each null
+    pair judged by a projection made without it;
+    :func:`loper_analysis.identification.refit_with_null_pairs`).
     """
 
     noise_model: str = "null_pairs"
-    interval_scatter: str = "perturbed_pairs"
+    interval_scatter: str = "cross_validated_null_pairs"
     null_pair_components: int = NULL_PAIR_COMPONENTS
     min_null_pairs: int = MIN_NULL_PAIRS
     initial_state_degree: int = INITIAL_STATE_DEGREE
@@ -423,7 +425,10 @@ def fit_onset(
         trial whose null pairs deviate more than
         ``identification.max_null_trial_ratio`` times the other trials' is
         left out of them (:func:`loper_analysis.responses.deviant_trials`);
-        the rows' reason names it.
+        the rows' reason names it. With ``response.counterfactual``
+        ``conditional`` the null pairs are instead the onset's own unperturbed
+        strides, each predicted from the others
+        (:func:`loper_analysis.responses.conditional.conditional_null_pairs`).
     response, identification : settings
 
     Returns
@@ -491,7 +496,10 @@ def fit_onset(
     if ident.noise_model == "null_pairs":
         loaded = {i["name"]: i for i in inputs}
         pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
-        null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
+        if r.counterfactual == "conditional":  # the candidates' leave-one-out predictions
+            null = series["null_pairs"]
+        else:
+            null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
         pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
         refit = refit_with_null_pairs(
             window,
@@ -500,6 +508,7 @@ def fit_onset(
             n_kept,
             ident.null_pair_components,
             ident.min_null_pairs,
+            cross_validated=ident.interval_scatter == "cross_validated_null_pairs",
             perturbed_pairs=pairs,
             **ident.fit_options(),
         )

@@ -50,15 +50,16 @@ NULL_PAIR_COMPONENTS: int = 6
 #: Fewer null pairs: the white fit stands (``identification.min_null_pairs``).
 MIN_NULL_PAIRS: int = 30
 #: Whose scatter gives the refit's 95 % intervals (``identification.interval_scatter``): the perturbed pairs
-#: averaged in the window, or the null pairs (:func:`refit_with_null_pairs`).
-INTERVAL_SCATTERS: tuple[str, ...] = ("perturbed_pairs", "null_pairs")
+#: averaged in the window, the null pairs, or the null pairs each judged by a projection made without it
+#: (:func:`refit_with_null_pairs`, :func:`cross_validated_covariance`).
+INTERVAL_SCATTERS: tuple[str, ...] = ("perturbed_pairs", "null_pairs", "cross_validated_null_pairs")
 
 
 def check_interval_scatter(value: str) -> str:
     """``value`` when it is one of :data:`INTERVAL_SCATTERS`, else a LoperInputError naming the config key."""
     if value not in INTERVAL_SCATTERS:
         raise LoperInputError(
-            f"identification.interval_scatter must be 'perturbed_pairs' or 'null_pairs', got {value!r}"
+            f"identification.interval_scatter must be one of {', '.join(INTERVAL_SCATTERS)}, got {value!r}"
         )
     return value
 
@@ -214,7 +215,10 @@ def refit_with_null_pairs(
     ``n_averaged - 1`` degrees of freedom. It holds what the null pairs
     cannot show - each stride answers the pulse about its own course - and
     is the t interval of the mean of the per-stride estimates (to first
-    order). The null pairs still shape the fit (the projection). With fewer
+    order). The null pairs still shape the fit (the projection). Either
+    covariance is multiplied by the pairs' ``covariance_scale`` when they hold one
+    (the conditional counterfactual's shared prediction error,
+    :func:`loper_analysis.responses.conditional.covariance_scale`). With fewer
     than ``max(min_null_pairs, n_components + 2)`` null pairs the first fit
     stands and ``note`` says so.
     """
@@ -229,7 +233,7 @@ def refit_with_null_pairs(
         raise LoperInputError(f"n_averaged must be >= 1 (strides in the mean response), got {n_averaged}")
     errors = null_pair_errors(window, first.estimate, null_pairs)
     weight = nuisance_projection(errors, n_components)
-    cov, dof = np.cov(errors, rowvar=False) / n_averaged, n_null - 1
+    cov, dof = np.cov(errors, rowvar=False) / n_averaged * float(null_pairs.get("covariance_scale", 1.0)), n_null - 1
     if perturbed_pairs is not None:
         n_pairs = int(perturbed_pairs["n_pairs"])
         if n_pairs != int(n_averaged) or n_pairs < 3:
@@ -238,6 +242,7 @@ def refit_with_null_pairs(
                 "the intervals from their scatter need them all, at least 3"
             )
         cov = np.cov(null_pair_errors(window, first.estimate, perturbed_pairs), rowvar=False) / n_averaged
+        cov *= float(perturbed_pairs.get("covariance_scale", 1.0))
         dof = n_pairs - 1
     fit = identify_impedance(
         replace(window, noise_cov=cov, residual_weight=weight), extra_starts=first.estimate, ci_dof=dof, **fit_options
@@ -247,6 +252,7 @@ def refit_with_null_pairs(
             window, fit.estimate, fit_options.get("lower", DEFAULT_LOWER), fit_options.get("upper", DEFAULT_UPPER)
         )
         cv = cross_validated_covariance(errors, n_components, G, n_averaged)
+        cv *= float(null_pairs.get("covariance_scale", 1.0))
         sd = np.sqrt(np.clip(np.diag(cv), 0, None))
         sd = np.where(np.diag(G.T @ G) > 0, sd, np.inf)
         low, high = bounded_interval(

@@ -22,7 +22,11 @@ import pandas as pd
 from loper_analysis.checks import number
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["pulse_force_n", "pilot_perturbed_pairs"]
+__all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_perturbed_pairs"]
+
+#: The counterfactual the planner predicts for: the study's matched stride, whose pairs' scatter the prediction
+#: scales (``docs/planning.md``); a fit with the conditional counterfactual scatters less.
+PLANNED_COUNTERFACTUAL: str = "matched_stride"
 
 
 def pulse_force_n(
@@ -112,7 +116,11 @@ def pilot_perturbed_pairs(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TooFewStridesWarning)
         _, _, series = subject_onset_response(
-            own, onset_ms, response or ResponseSettings(), side=side, source=f"{source}, perturbed pairs"
+            own,
+            onset_ms,
+            response or ResponseSettings(counterfactual=PLANNED_COUNTERFACTUAL),
+            side=side,
+            source=f"{source}, perturbed pairs",
         )
     pairs = series["pairs"]
     return pairs if int(pairs["n_pairs"]) > 0 else None

@@ -129,7 +129,7 @@ class PlanSettings(FitBounds):
     n_substeps: int = 2
     null_pair_components: int = 6
     min_null_pairs: int = 30
-    interval_scatter: str = "perturbed_pairs"
+    interval_scatter: str = "cross_validated_null_pairs"
     stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
     damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
     force_cutoff_hz: float = 40.0

@@ -17,6 +17,13 @@ from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.outliers import check_enough_strides
 from loper_analysis.gait.resampling import window_times_s
+from loper_analysis.responses.conditional import (
+    CandidatePool,
+    conditional_null_pair_windows,
+    conditional_null_pairs,
+    conditional_windows,
+    covariance_scale,
+)
 from loper_analysis.responses.inputs import trial_angles, trial_name, trial_table
 from loper_analysis.responses.matching import match_in_window, stride_table, too_short
 from loper_analysis.responses.native_force import native_force_rate_hz, native_force_windows
@@ -84,6 +91,60 @@ def _trial_inputs(trial: Mapping, k: int, side: str, source: str):
         native, where_n = trial_table(trial, "force_native", name, ("time_s", "force_measured_n"))
         native = (native, where_n, direction)
     return name, where_s, t, columns, strides, native
+
+
+def _conditional(pool, win, force_pairs, pair_table, delays_s, analysis, settings, native_rate, label) -> dict:
+    """The perturbed pairs with the conditional counterfactual as their unperturbed side.
+
+    Pairs without a prediction (too few candidates) are dropped and counted per trial (``unpredicted``);
+    the pair table's ``matched_stride`` is -1, ``matched_anchor_s`` NaN and ``rmsd_rad`` the RMS of the
+    perturbed minus predicted joint angles over the matching span. Also the candidates' null pairs at the
+    nominal onset (``null``, :func:`conditional_null_pairs`, whose penalty the predictions use) and each
+    pair's weights over the candidates (``weights``).
+    """
+    onset_s, before, after, _, start, grid = analysis
+    candidates = CandidatePool(pool, start, after, settings.rate_hz)
+    native_grid = None if native_rate is None else window_times_s(-start, after, native_rate)
+    labels = [f"{tr}: perturbed stride {s}" for tr, s in zip(pair_table["trial"], pair_table["stride"])]
+    try:
+        null = conditional_null_pairs(candidates, onset_s, source=label)
+    except LoperInputError as err:  # too few unperturbed strides: no pair has a counterfactual
+        log.warning("%s", err)
+        null, missing = None, [str(err)] * len(pair_table)
+        predicted = {k: np.full_like(p, np.nan) for k, (p, _) in win.items()}
+        native = None if force_pairs is None else np.full_like(force_pairs[0], np.nan)
+        weights = np.zeros((len(pair_table), candidates.size))
+    else:
+        predicted, native, weights, missing = conditional_windows(
+            candidates,
+            delays_s,
+            {k: win[k][0] for k in ("joints", "pelvis_angle")},
+            null["alpha"],
+            native_grid,
+            label,
+            labels,
+        )
+    ok = np.array([not m for m in missing], dtype=bool)
+    for why in filter(None, missing):
+        log.info("%s", why)
+    unpredicted = pair_table.loc[~ok, "trial"].value_counts().to_dict()
+    win = {k: (p[ok], predicted[k][ok]) for k, (p, _) in win.items()}
+    if force_pairs is not None:
+        force_pairs = (force_pairs[0][ok], native[ok])
+    span = (grid >= -before - TIME_TOLERANCE_S) & (grid <= TIME_TOLERANCE_S)
+    diff = win["joints"][0][:, span] - win["joints"][1][:, span]
+    pair_table = pair_table[ok].reset_index(drop=True)
+    pair_table = pair_table.assign(
+        matched_stride=-1, matched_anchor_s=np.nan, rmsd_rad=np.sqrt(np.mean(diff**2, axis=(1, 2)))
+    )
+    return {
+        "win": win,
+        "force_pairs": force_pairs,
+        "pair_table": pair_table,
+        "unpredicted": unpredicted,
+        "null": null,
+        "weights": weights[ok],
+    }
 
 
 def subject_onset_response(
@@ -181,7 +242,7 @@ def subject_onset_response(
     min_n = int(number("min_strides", settings.min_strides, source, minimum=0.0))
     rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
 
-    per_trial, pairs, windows, rooms, force_windows = [], [], [], [], []
+    per_trial, pairs, windows, rooms, force_windows, pool = [], [], [], [], [], []
     native_rate = None
     for k, trial in enumerate(trials):
         name, where_s, t, columns, strides, native = _trial_inputs(trial, k, side, source)
@@ -204,6 +265,7 @@ def subject_onset_response(
         for s, why in matches.attrs["unmatched"].items():
             log.info("%s: perturbed stride %s has no match: %s", where_s, s, why)
         windows.append(paired_windows(t, columns, matches, start, after, rate_hz, method=method, source=where_s))
+        pool.append((name, t, columns, table, None if native is None else (native[0], native[2])))
         if native is not None:
             table, where_n, direction = native
             rate_n = native_force_rate_hz(table, where_n)
@@ -224,13 +286,23 @@ def subject_onset_response(
         )
 
     win = pooled_windows(windows)
-    joints_p, joints_u = win["joints"]
     label = f"{source} onset {onset_ms:g} ms" if source else f"onset {onset_ms:g} ms"
-    verdict = window_outliers(joints_p - joints_u, grid, before, after, whisker, max_fraction, JOINTS, label)
     pair_columns = ["trial", "stride", "matched_stride", "onset_s", "matched_anchor_s", "rmsd_rad"]
     filled = [m[pair_columns] for m in pairs if len(m)]
     pair_table = (pd.concat(filled, ignore_index=True) if filled else pairs[0][pair_columns]).reset_index(drop=True)
     pair_table.attrs = {}
+    force_pairs = None
+    if native_rate is not None:
+        force_pairs = tuple(np.concatenate([w[i] for w in force_windows]) for i in range(2))
+    conditional = None
+    if settings.counterfactual == "conditional":
+        delays = pair_table["onset_s"].to_numpy(float) - np.concatenate([m["toe_off_s"].to_numpy(float) for m in pairs])
+        conditional = _conditional(pool, win, force_pairs, pair_table, delays, analysis, settings, native_rate, label)
+        win, force_pairs, pair_table = conditional["win"], conditional["force_pairs"], conditional["pair_table"]
+        for rec in per_trial:
+            rec["n_no_match"] += conditional["unpredicted"].get(rec["trial"], 0)
+    joints_p, joints_u = win["joints"]
+    verdict = window_outliers(joints_p - joints_u, grid, before, after, whisker, max_fraction, JOINTS, label)
     pair_table = pair_table.assign(removed=verdict["removed"].to_numpy(), reason=verdict["reason"].to_numpy())
     keep = ~pair_table["removed"].to_numpy(bool)
     n_pairs = int(keep.sum())
@@ -319,11 +391,22 @@ def subject_onset_response(
         series[f"force_{what}_n"] = mean_and_sd(kept["force_vector"][i])[0]
         pair_series[f"q_{what}"], pair_series[f"pelvis_angle_{what}_rad"] = q, pel
     series["pairs"] = pair_series
-    if native_rate is not None:
+    if force_pairs is not None:
         # the force at the robot rate replaces the frames' for the identification
         series["force_time_s"] = window_times_s(-start, after, native_rate)
         for i, what in enumerate(("perturbed", "unperturbed")):
-            series[f"force_{what}_n"] = mean_and_sd(np.concatenate([w[i] for w in force_windows])[keep])[0]
+            series[f"force_{what}_n"] = mean_and_sd(force_pairs[i][keep])[0]
+    if conditional is not None and conditional["null"] is not None:
+        null = conditional["null"]
+        d = null["own"]["joints"] - null["predicted"]["joints"]
+        null_keep = ~window_outliers(d, grid, before, after, whisker, max_fraction, JOINTS, f"{label} null pairs")[
+            "removed"
+        ].to_numpy(bool)
+        series["null_pairs"] = conditional_null_pair_windows(null, grid, before, after, null_keep)
+        if n_pairs:
+            kept_weights = conditional["weights"][keep]
+            pair_series["covariance_scale"] = covariance_scale(kept_weights)
+            series["null_pairs"]["covariance_scale"] = covariance_scale(kept_weights, null["weights"], null_keep)
     series.update(
         {"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial, "n_pairs": n_pairs}
     )

@@ -30,6 +30,7 @@ from loper_analysis.responses.sampling import TIME_TOLERANCE_S, SplineSampler, w
 from loper_analysis.swing_leg.dynamics import segment_coordinates
 
 __all__ = [
+    "COUNTERFACTUALS",
     "INITIAL_STATE_SPAN_S",
     "WINDOW_AFTER_S",
     "WINDOW_BEFORE_S",
@@ -52,6 +53,10 @@ WINDOW_AFTER_S: float = 0.25
 #: Pre-onset span of the fit's initial-state polynomial (s; ``identification.initial_state_span_s``).
 INITIAL_STATE_SPAN_S: float = 0.1
 
+#: The unperturbed reference of a perturbed stride (``identification.counterfactual``): the study's one
+#: matched stride, or the conditional mean over all unperturbed strides (:mod:`loper_analysis.responses.conditional`).
+COUNTERFACTUALS: tuple[str, ...] = ("matched_stride", "conditional")
+
 #: Fewest pairs the IQR rule judges (:func:`loper_analysis.gait.outliers.iqr_outliers`); fewer are all kept.
 MIN_PAIRS_FOR_OUTLIERS: int = MIN_STRIDES_FOR_OUTLIERS
 
@@ -65,7 +70,11 @@ class ResponseSettings:
     preceded by ``initial_state_span_s`` for the fit's initial state;
     ``whisker`` and ``max_fraction`` are the IQR rule's
     (:func:`window_outliers`); ``min_strides`` the fewest kept pairs for an
-    ``ok`` average.
+    ``ok`` average; ``counterfactual`` the unperturbed reference of a perturbed
+    stride: ``conditional`` (its own continuation predicted from all
+    unperturbed strides, :mod:`loper_analysis.responses.conditional`) or
+    ``matched_stride`` (the study's: the most similar unperturbed stride of
+    its trial).
     """
 
     rate_hz: float = 128.0
@@ -75,6 +84,14 @@ class ResponseSettings:
     whisker: float = IQR_WHISKER
     max_fraction: float = MAX_OUTLIER_FRACTION
     min_strides: int = MIN_VALID_STRIDES
+    counterfactual: str = "conditional"
+
+    def __post_init__(self):
+        if self.counterfactual not in COUNTERFACTUALS:
+            raise LoperInputError(
+                f"identification.counterfactual must be one of {', '.join(COUNTERFACTUALS)}, "
+                f"got {self.counterfactual!r}"
+            )
 
 
 class AnalysisGrid(NamedTuple):

@@ -64,6 +64,7 @@ class FitSettings:
                 whisker=strides["iqr_whisker"],
                 max_fraction=strides["max_outlier_fraction"],
                 min_strides=strides["min_valid_strides"],
+                counterfactual=ident["counterfactual"],
             ),
             identification=IdentificationSettings(
                 noise_model=ident["noise_model"],

@@ -26,6 +26,7 @@ from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_text, write_tsv
 from loper_analysis.io.readers import read_tsv
+from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL
 from loper_analysis.planning.precision import PlanSettings
 from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings
 
@@ -82,7 +83,7 @@ class PlanningSettings:
     strides: tuple[int, ...] = STRIDES
     targets: tuple[Mapping, ...] = ()
     plan: PlanSettings = field(default_factory=PlanSettings)
-    response: ResponseSettings = field(default_factory=ResponseSettings)
+    response: ResponseSettings = field(default_factory=lambda: ResponseSettings(counterfactual=PLANNED_COUNTERFACTUAL))
     device: DeviceParameters = field(default_factory=DeviceParameters)
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
 
@@ -139,6 +140,7 @@ class PlanningSettings:
                 initial_state_span_s=get("identification", "initial_state_span_s"),
                 whisker=get("strides", "iqr_whisker"),
                 max_fraction=get("strides", "max_outlier_fraction"),
+                counterfactual=PLANNED_COUNTERFACTUAL,
             ),
             device=DeviceParameters(**get("device", "parameters")),
             max_null_trial_ratio=get("identification", "max_null_trial_ratio"),
