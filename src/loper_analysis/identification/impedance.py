@@ -22,9 +22,10 @@ The rules of a fitted row are :func:`loper_analysis.identification.joint_status`
 
 from __future__ import annotations
 
+import logging
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -79,6 +80,8 @@ __all__ = [
     "impedance_summary",
     "literature_table",
 ]
+
+log = logging.getLogger(__name__)
 
 _K, _D = parameter_column("K"), parameter_column("D")
 
@@ -455,10 +458,20 @@ def fit_onset(
                 "force_native": tr.get("force_native"),
             }
         )
-    r = response
+    r, fallback = response, ""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TooFewStridesWarning)  # the counts table carries the verdict
         mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
+        n_candidates = int(series.get("null_pairs", {}).get("n_pairs", 0))
+        if r.counterfactual == "conditional" and n_candidates < identification.min_null_pairs:
+            # too few unperturbed strides in the onset's trials to judge the prediction: the study's matched stride
+            fallback = (
+                f"matched stride instead of the conditional counterfactual: {n_candidates} unperturbed stride(s) of "
+                f"the onset's trials, fewer than identification.min_null_pairs = {identification.min_null_pairs}"
+            )
+            log.warning("%s, onset %s ms: %s", subject, onset_ms, fallback)
+            r = replace(r, counterfactual="matched_stride")
+            mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
     total = counts[counts["trial"] == "total"].iloc[0]
     n_kept = int(total["n_kept"])
     if n_kept < r.min_strides:
@@ -514,6 +527,7 @@ def fit_onset(
         )
         fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
         note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
+    note = "; ".join(filter(None, [fallback, note]))
     rows = impedance_rows(
         fit,
         subject,
