@@ -30,13 +30,11 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from ci_coverage import ROOT, run_coordinates  # noqa: E402
+from ci_coverage import run_coordinates, study_lab_config  # noqa: E402
 
-from loper_analysis.config_file import update_config  # noqa: E402
 from loper_analysis.identification.impedance import TRUTH_TOLERANCE  # noqa: E402
 from loper_analysis.report.markdown import markdown_table  # noqa: E402
 
@@ -90,11 +88,7 @@ def main() -> None:
     ap.add_argument("--keep", type=Path, help="write every variant's impedance rows here (TSV, one per variant)")
     ap.add_argument("--configfile", nargs="+", default=[], help="config files layered over config/config.yaml")
     args = ap.parse_args()
-    config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    for extra in args.configfile:
-        update_config(config, yaml.safe_load(Path(extra).read_text()) or {})
-    config["seed"] = args.seed
-    config["synthetic"]["variability"] = "study"
+    config = study_lab_config(args.configfile, args.seed)
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     tables = []
     for variant in args.variants:

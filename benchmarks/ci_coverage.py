@@ -68,6 +68,18 @@ IK_NOISE_CORR = np.array(
 _ANGLES = ("pelvis_x", "pelvis_angle", "hip_left", "knee_left", "ankle_left")
 
 
+def study_lab_config(configfiles=(), seed: int = 2024) -> dict:
+    """``config/config.yaml`` with ``configfiles`` layered over it, the seed ``seed`` and the study-level lab."""
+    from loper_analysis.config_file import update_config
+
+    config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    for extra in configfiles:
+        update_config(config, yaml.safe_load(Path(extra).read_text()) or {})
+    config["seed"] = seed
+    config["synthetic"]["variability"] = "study"
+    return config
+
+
 def binomial_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
     """Clopper-Pearson interval of a share k / n (0..1)."""
     a = (1 - level) / 2
