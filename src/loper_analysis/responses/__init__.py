@@ -1,9 +1,10 @@
 """Perturbation responses: matched unperturbed strides, paired windows, outliers, subject averages.
 
-For each perturbed stride the unperturbed stride of the same trial that is most similar just before the
-onset is its reference; the response is perturbed minus matched
-unperturbed; pairs are judged by the IQR outlier rule on the analysis window
-only and averaged per subject and onset. The averaged pair is also what the
+For each perturbed stride an unperturbed counterfactual is its reference: its own continuation predicted
+from its pre-onset course by all unperturbed strides of the onset's trials (``conditional``, the default),
+or the unperturbed stride of the same trial that is most similar just before the onset (the study's
+``matched_stride``); the response is perturbed minus counterfactual; pairs are judged by the IQR outlier
+rule on the analysis window only and averaged per subject and onset. The averaged pair is also what the
 identification (:func:`loper_analysis.identification.prepare_window`) fits.
 
 * :mod:`.matching` - :func:`too_short` (perturbed strides whose swing cannot
@@ -16,6 +17,8 @@ identification (:func:`loper_analysis.identification.prepare_window`) fits.
 * :mod:`.average` - :func:`subject_onset_response`: all of it for one
   subject and onset, over the subject's trials: the mean response table,
   the stride counts and the averaged series for the identification;
+* :mod:`.conditional` - the conditional counterfactual: the ridge prediction of a
+  stride's window from its pre-onset samples, its candidates and null pairs;
 * :mod:`.null_pairs` - :func:`null_pair_windows`: unperturbed strides paired
   the same way, the stride-to-stride noise the identification weights its
   errors by (a trial whose null pairs deviate far more than the other
