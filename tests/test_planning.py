@@ -34,6 +34,7 @@ from loper_analysis.identification import (
     simulate_response,
 )
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
+from loper_analysis.identification.intervals import t_quantile
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.planning.precision import (
     MIN_PERTURBED_PAIRS,
@@ -430,3 +431,20 @@ def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_r
     late = table[table["onset_ms"] == 175]
     assert len(late) == 6 and late["predicted_sd"].isna().all() and late["note"].str.startswith("not planned").all()
     assert table.loc[table["onset_ms"] == 50, "predicted_sd"].notna().all()
+
+
+def test_a_planned_value_near_zero_gets_an_answer_not_a_hang():
+    """A relative target on a planned K of 1e-30 (a fit at its bound): bisection, not stepping, to the smallest
+    N (about 7e62 here), and the answer says it is out of reach."""
+    cov = np.diag([100.0, 1.0, 4.0, 0.01, 1.0, 0.01])
+    for dof in (None, 120):
+        sc = StrideCovariance(cov, np.array([55, 3.5, 1e-30, 0.1, 8, 0.3]), dof, 121)
+        n = strides_needed(sc, "knee", "K", percent=15)
+        t = 1.959964 if dof is None else t_quantile(dof)  # the fit's t: N - 1 (here ~1e62) or the null pairs' dof
+        assert n == pytest.approx((t * 2.0 / 1.5e-31) ** 2, rel=1e-5)
+        answer = target_answer(sc, "knee", "K", 50, percent=15)
+        assert "needs more than 1,000,000 perturbed strides" in answer and "give a half_width" in answer
+        # an ordinary target: the smallest N whose half-width t(N - 1 or dof) * sd / sqrt(N) meets 15 % of 3.5
+        n = strides_needed(sc, "hip", "D", percent=15)
+        meets = [sc.t95(m) * 1.0 / np.sqrt(m) <= 0.15 * 3.5 for m in (n - 1, n)]
+        assert meets == [False, True]

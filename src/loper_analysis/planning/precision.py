@@ -102,6 +102,8 @@ PLAN_COLUMNS: tuple[str, ...] = (
     "note",
 )
 
+#: A target that needs more perturbed strides than this is answered as "more than" it.
+MAX_ANSWERED_STRIDES: int = 1_000_000
 #: Fewest pilot perturbed pairs whose scatter the prediction takes (fewer: the null pairs' scatter, noted).
 MIN_PERTURBED_PAIRS = 5
 
@@ -543,14 +545,18 @@ def strides_needed(
     def meets(n: int) -> bool:
         return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
 
-    # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96
-    n = max(1, int(math.ceil((t_quantile(10**6) * sd1 / target) ** 2 * (1 - 1e-12))))
+    # the half-width falls with N; t at N - 1 dof is at most t(1) = 12.7 and at least 1.96: below `low` no N
+    # meets the target; from there up to the first N found to meet it, the smallest by bisection (a planned value
+    # near 0 asks for astronomically many strides, too many to step through)
+    low = max(1, int(math.ceil((t_quantile(10**6) * sd1 / target) ** 2 * (1 - 1e-12))) - 1)
+    n = low
     while not meets(n):
         t = stride_cov.t95(n)
         n = n + 1 if not math.isfinite(t) else max(n + 1, int(math.ceil((t * sd1 / target) ** 2 * (1 - 1e-12))))
-    while n > 1 and meets(n - 1):
-        n -= 1
-    return n
+    while n - low > 1:
+        mid = (low + n) // 2
+        low, n = (low, mid) if meets(mid) else (mid, n)
+    return n if n > 1 or not meets(1) else 1
 
 
 def target_answer(
@@ -566,8 +572,14 @@ def target_answer(
     n = strides_needed(stride_cov, joint, parameter, percent=percent, half_width=half_width)
     i = PARAMETERS.index(f"{parameter}_{joint}")
     unit, planned = PARAMETER_UNITS[PARAMETERS[i]], float(stride_cov.impedance[i])
-    reached = stride_cov.t95(n) * stride_cov.sd[i] / math.sqrt(n)
     wanted = f"±{percent:g} %" if percent is not None else f"±{half_width:g} {unit}"
+    if n > MAX_ANSWERED_STRIDES:
+        return (
+            f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs more than {MAX_ANSWERED_STRIDES:,} "
+            f"perturbed strides (planned {parameter} {planned:.3g} {unit}"
+            + ("; a relative target on a value this close to 0: give a half_width instead)" if percent else ")")
+        )
+    reached = stride_cov.t95(n) * stride_cov.sd[i] / math.sqrt(n)
     return (
         f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
         f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "
