@@ -31,7 +31,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-import pandas as pd
 
 from loper_analysis.checks import bool_column, where
 from loper_analysis.errors import LoperInputError
@@ -376,11 +375,6 @@ def conditional_null_pairs(pool: CandidatePool, delay_s: float, alpha: float | N
     W = loo_weights(X, alpha)
     predicted = {k: np.tensordot(W, v, axes=1) for k, v in cols.items()}
     return {"own": cols, "predicted": predicted, "alpha": float(alpha), "weights": W, "ids": ids}
-
-
-def pool_trial(name: str, time_s, columns: Mapping, strides: pd.DataFrame, native=None) -> tuple:
-    """One entry of :class:`CandidatePool`'s ``trials``."""
-    return (name, time_s, columns, strides, native)
 
 
 def conditional_null_pair_windows(null: dict, time_s, before_s: float, after_s: float, keep) -> dict:
