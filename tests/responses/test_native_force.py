@@ -7,6 +7,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.resampling import window_times_s
 from loper_analysis.responses import ResponseSettings, subject_onset_response
+from loper_analysis.responses.native_force import finite_spans
 from tests.responses.twin_strides import twin_trial
 
 ROBOT_HZ = 1000.0
@@ -69,3 +70,17 @@ def test_force_at_the_robot_rate_for_every_trial_or_none():
         LoperInputError, match="walk-2: the force at the robot rate .* every trial of the onset or for none"
     ):
         subject_onset_response([with_native, other.inputs()], 100, MATCHED)
+
+
+def test_finite_spans_equals_a_mask_per_span():
+    rng = np.random.default_rng(3)
+    t = np.sort(rng.uniform(0.0, 10.0, 2000))
+    v = rng.normal(size=t.size)
+    v[rng.choice(t.size, 25, replace=False)] = np.nan
+    lo = rng.uniform(-1.0, 10.0, 500)
+    hi = lo + rng.uniform(0.0, 0.5, 500)
+    lo[:3], hi[:3] = t[:3], t[:3]  # ends on samples: included
+    expected = [bool(np.all(np.isfinite(v[(t >= a) & (t <= b)]))) for a, b in zip(lo, hi)]
+    got = finite_spans(t, v, lo, hi)
+    assert got.tolist() == expected
+    assert 0 < int(got.sum()) < got.size

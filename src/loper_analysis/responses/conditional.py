@@ -35,6 +35,7 @@ import numpy as np
 from loper_analysis.checks import bool_column, where
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.resampling import window_times_s
+from loper_analysis.responses.native_force import finite_spans, force_vectors
 from loper_analysis.responses.sampling import SplineSampler
 from loper_analysis.responses.windows import window_coordinates
 
@@ -166,6 +167,7 @@ class _PoolTrial:
     end_s: np.ndarray
     stride: np.ndarray
     native: tuple | None  # (robot times s, magnitude N, frame times s, direction (n, 2))
+    native_step_s: float = 0.0  # the robot's sample interval (s)
 
 
 class CandidatePool:
@@ -222,6 +224,7 @@ class CandidatePool:
                     strides["end_s"].to_numpy(float)[keep],
                     strides["stride"].to_numpy()[keep],
                     nat,
+                    float(np.median(np.diff(nat[0]))) if nat is not None else 0.0,
                 )
             )
 
@@ -249,11 +252,9 @@ class CandidatePool:
                 ok &= hi <= tr.end_s + tr.sampler.tol
             if native_grid is not None:
                 tn, fm, tf, _ = tr.native
-                step = float(np.median(np.diff(tn)))
+                step = tr.native_step_s
                 ok &= (lo >= max(tn[0], tf[0]) - 1e-9) & (hi <= min(tn[-1], tf[-1]) + 1e-9)
-                for i in np.flatnonzero(ok):
-                    inside = (tn >= lo[i] - step) & (tn <= hi[i] + step)
-                    ok[i] = bool(np.all(np.isfinite(fm[inside])))
+                ok &= finite_spans(tn, fm, lo - step, hi + step)
             if not ok.any():
                 continue
             targets = anchors[ok, None] + self.grid
@@ -282,15 +283,6 @@ class CandidatePool:
 
 def _width(shape: tuple[int, ...]) -> int:
     return int(np.prod(shape)) if shape else 1
-
-
-def force_vectors(targets, robot_time_s, magnitude_n, frame_time_s, direction) -> np.ndarray:
-    """Rod-force vectors (N) at ``targets`` (any shape, s): the robot-rate magnitude and the frames' rod
-    direction, both linearly interpolated, the direction normalised. Shape ``targets.shape + (2,)``."""
-    m = np.interp(targets, robot_time_s, magnitude_n)
-    d = np.stack([np.interp(targets, frame_time_s, direction[:, j]) for j in range(2)], axis=-1)
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
-    return m[..., None] * d
 
 
 def conditional_windows(

@@ -18,7 +18,7 @@ from loper_analysis.checks import require_columns, where
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.resampling import window_times_s
 
-__all__ = ["native_force_rate_hz", "native_force_windows"]
+__all__ = ["native_force_rate_hz", "native_force_windows", "force_vectors", "finite_spans"]
 
 
 def native_force_rate_hz(native: pd.DataFrame, source: str = "") -> float:
@@ -28,6 +28,25 @@ def native_force_rate_hz(native: pd.DataFrame, source: str = "") -> float:
     if t.size < 2 or not np.all(np.isfinite(t)) or np.any(d <= 0):
         raise LoperInputError(f"{where(source)}column 'time_s' must hold >= 2 finite, strictly increasing times")
     return float(round(1.0 / float(np.median(d))))
+
+
+def force_vectors(targets, robot_time_s, magnitude_n, frame_time_s, direction) -> np.ndarray:
+    """Rod-force vectors (N) at ``targets`` (s, any shape): the robot-rate magnitude ``magnitude_n`` (N) at
+    ``robot_time_s`` and the frames' rod ``direction`` (n_frames, 2) at ``frame_time_s``, both linearly
+    interpolated, the direction normalised. Shape ``targets.shape + (2,)``."""
+    m = np.interp(targets, robot_time_s, magnitude_n)
+    d = np.stack([np.interp(targets, frame_time_s, direction[:, j]) for j in range(2)], axis=-1)
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    return m[..., None] * d
+
+
+def finite_spans(time_s, values, lo_s, hi_s) -> np.ndarray:
+    """Whether every sample of ``values`` at ``time_s`` (sorted, s) within ``lo_s[i] .. hi_s[i]`` (s, ends
+    included) is finite: (n,) bool, one count of non-finite samples per span instead of a mask per span."""
+    bad = np.concatenate([[0], np.cumsum(~np.isfinite(np.asarray(values, dtype=float)))])
+    a = np.searchsorted(time_s, np.asarray(lo_s, dtype=float), side="left")
+    b = np.searchsorted(time_s, np.asarray(hi_s, dtype=float), side="right")
+    return bad[b] == bad[a]
 
 
 def native_force_windows(
@@ -72,23 +91,14 @@ def native_force_windows(
     for what, col in (("perturbed", "onset_s"), ("unperturbed", "matched_anchor_s")):
         anchors = matches[col].to_numpy(float)
         targets = anchors[:, None] + grid
-        for i in range(len(anchors)):
-            lo, hi = targets[i, 0], targets[i, -1]
-            inside = (tn >= lo - 1.0 / rate_hz) & (tn <= hi + 1.0 / rate_hz)
-            if (
-                lo < tn[0] - 1e-9
-                or hi > tn[-1] + 1e-9
-                or lo < tf[0] - 1e-9
-                or hi > tf[-1] + 1e-9
-                or not np.all(np.isfinite(fm[inside]))
-            ):
-                raise LoperInputError(
-                    f"{where(source)}the {what} force window of stride {matches['stride'].iloc[i]} "
-                    f"({lo:.4f} .. {hi:.4f} s) leaves the finite force at the robot rate "
-                    f"({tn[0]:.4f} .. {tn[-1]:.4f} s) or the marker frames ({tf[0]:.4f} .. {tf[-1]:.4f} s)"
-                )
-        magnitude = np.interp(targets, tn, fm)
-        d = np.stack([np.interp(targets, tf, u[:, j]) for j in range(2)], axis=-1)
-        d /= np.linalg.norm(d, axis=-1, keepdims=True)
-        out.append(magnitude[..., None] * d)
+        lo, hi = targets[:, 0], targets[:, -1]
+        ok = (lo >= max(tn[0], tf[0]) - 1e-9) & (hi <= min(tn[-1], tf[-1]) + 1e-9)
+        ok &= finite_spans(tn, fm, lo - 1.0 / rate_hz, hi + 1.0 / rate_hz)
+        for i in np.flatnonzero(~ok)[:1]:
+            raise LoperInputError(
+                f"{where(source)}the {what} force window of stride {matches['stride'].iloc[i]} "
+                f"({lo[i]:.4f} .. {hi[i]:.4f} s) leaves the finite force at the robot rate "
+                f"({tn[0]:.4f} .. {tn[-1]:.4f} s) or the marker frames ({tf[0]:.4f} .. {tf[-1]:.4f} s)"
+            )
+        out.append(force_vectors(targets, tn, fm, tf, u))
     return out[0], out[1]
