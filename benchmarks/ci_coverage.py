@@ -205,15 +205,15 @@ def coordinate_subject(
     config: dict,
     noise_scale: float,
     without: tuple[str, ...] = (),
-    estimators: tuple[tuple[str, str, str], ...] = (),
+    estimators: tuple[tuple[str, str, str, bool], ...] = (),
 ) -> pd.DataFrame:
     """The three fits of one synthetic subject from its simulated coordinates (rows of the impedance table).
 
     ``without``: parts of the study-level lab left out (:data:`LAB_PARTS`): the device adaptation, the leg's
     answer to the minimal-impedance force (only the pulses act), the stride-to-stride variability (that of the
     gentle lab instead). ``estimators``: fit the same simulated trials with each ``(name, counterfactual,
-    interval_scatter)`` (``identification.counterfactual`` and ``identification.interval_scatter``), the rows
-    tagged with the name in a column ``estimator``; empty: the config's.
+    interval_scatter, averaging_correction)`` (those keys of ``identification``), the rows tagged with the name in a
+    column ``estimator``; empty: the config's.
     """
     from loper_analysis.constants import JOINTS
     from loper_analysis.device.controller import DeviceParameters
@@ -277,9 +277,10 @@ def coordinate_subject(
     response, ident = _settings(config)
     null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
     rows = []
-    for label, counterfactual, scatter in estimators or (("", response.counterfactual, ident.interval_scatter),):
+    chosen = estimators or (("", response.counterfactual, ident.interval_scatter, ident.averaging_correction),)
+    for label, counterfactual, scatter, averaging in chosen:
         settings = replace(response, counterfactual=counterfactual)
-        fitting = replace(ident, interval_scatter=scatter)
+        fitting = replace(ident, interval_scatter=scatter, averaging_correction=averaging)
         for onset in onsets:
             own = [inputs[name] for name in design.perturbation_trials(onset)]
             fitted = fit_onset(own, params, onset, subject, truth[onset], null, settings, fitting).rows
@@ -293,7 +294,7 @@ def run_coordinates(
     noise_scale: float,
     jobs: int,
     without: tuple[str, ...] = (),
-    estimators: tuple[tuple[str, str, str], ...] = (),
+    estimators: tuple[tuple[str, str, str, bool], ...] = (),
 ) -> pd.DataFrame:
     """Every subject's rows, ``jobs`` subjects at a time (``without``, ``estimators``: as
     :func:`coordinate_subject`)."""

@@ -2,13 +2,16 @@
 
 Usage: python benchmarks/estimators.py [--subjects N] [--first K] [--jobs J] [--seed S] [--ik-noise-scale X]
                                        [--keep FILE] [--configfile FILE ...] [--tables FILE ...]
+                                       [--estimators NAME ...]
 
 N synthetic subjects with the study-level lab, at the default design (``config/config.yaml``: 2 trials of 45 s
 per onset) or, with ``--configfile config/paper.yaml``, the study's (4-minute trials), simulated once and fitted
 at the coordinate level (as ``benchmarks/ci_coverage.py --mode coordinates``) with each
-``identification.counterfactual``: ``matched_stride`` (the study's one most similar unperturbed stride; intervals
-from the perturbed pairs' scatter) and ``conditional`` (the stride's own continuation predicted from its
-pre-onset course by all unperturbed strides; intervals from its cross-validated null pairs).
+estimator of :data:`ESTIMATORS`: ``matched_stride``, the study's method (the one most similar unperturbed stride, the
+fit of the mean response, intervals from the perturbed pairs' scatter), and ``conditional``, the default (the
+stride's own continuation predicted from its pre-onset course by all unperturbed strides, the fit allowing for
+what averaging the pairs does to the model's response, intervals from its cross-validated null pairs).
+``--estimators`` fits with some only (their rows can be joined with ``--tables`` later).
 
 Prints, per estimator and parameter (hip/knee K and D) over all fitted rows of the three onsets (``ok`` or
 ``not_identifiable``): fits, RMSE, mean error and its ratio to the error's SD (a bias beyond a quarter of the
@@ -33,12 +36,12 @@ from ci_coverage import binomial_interval, run_coordinates, study_lab_config  # 
 from loper_analysis.identification.impedance import TRUTH_TOLERANCE  # noqa: E402
 from loper_analysis.report.markdown import markdown_table  # noqa: E402
 
-#: name -> (identification.counterfactual, identification.interval_scatter): the study's matched stride with the
-#: intervals from the perturbed pairs' scatter, the conditional counterfactual with those of its cross-validated
-#: null pairs.
+#: (name, identification.counterfactual, identification.interval_scatter, identification.averaging_correction):
+#: the study's method (its matched stride, the fit of the mean, intervals from the perturbed pairs' scatter) and the
+#: default (the conditional counterfactual, the averaging term, intervals from its cross-validated null pairs).
 ESTIMATORS = (
-    ("matched_stride", "matched_stride", "perturbed_pairs"),
-    ("conditional", "conditional", "cross_validated_null_pairs"),
+    ("matched_stride", "matched_stride", "perturbed_pairs", False),
+    ("conditional", "conditional", "cross_validated_null_pairs", True),
 )
 UNITS = {"K": "nm_per_rad", "D": "nms_per_rad"}
 
@@ -75,8 +78,11 @@ def estimator_table(rows: pd.DataFrame, by_onset: bool = False) -> pd.DataFrame:
 
 
 def rmse_ratio(table: pd.DataFrame) -> pd.DataFrame:
-    """RMSE of the conditional counterfactual over that of the matched stride, per parameter."""
+    """RMSE of the conditional counterfactual over that of the matched stride, per parameter (empty unless both
+    were fitted)."""
     wide = table.pivot(index="parameter", columns="estimator", values="rmse")
+    if not {"conditional", "matched_stride"} <= set(wide.columns):
+        return pd.DataFrame(columns=["parameter", "rmse_ratio"])
     return (wide["conditional"] / wide["matched_stride"]).rename("rmse_ratio").reset_index()
 
 
@@ -90,6 +96,9 @@ def main() -> None:
     ap.add_argument("--keep", type=Path, help="write every fit's row here (TSV)")
     ap.add_argument("--tables", type=Path, nargs="+", help="no fits: the tables of rows kept by earlier runs")
     ap.add_argument("--configfile", nargs="+", default=[], help="config files layered over config/config.yaml")
+    ap.add_argument(
+        "--estimators", nargs="+", choices=[e[0] for e in ESTIMATORS], help="fit with these only (default: all)"
+    )
     args = ap.parse_args()
     config = study_lab_config(args.configfile, args.seed)
     names = [f"C{k:03d}" for k in range(args.first, args.first + args.subjects)]
@@ -99,7 +108,8 @@ def main() -> None:
         names = sorted(set(rows["subject"]))
         print(f"python benchmarks/estimators.py --tables {' '.join(map(str, args.tables))}: {len(names)} subjects\n")
     else:
-        rows = run_coordinates(names, config, args.ik_noise_scale, args.jobs, estimators=ESTIMATORS)
+        chosen = tuple(e for e in ESTIMATORS if not args.estimators or e[0] in args.estimators)
+        rows = run_coordinates(names, config, args.ik_noise_scale, args.jobs, estimators=chosen)
         print(f"{args.subjects} subjects, {time.perf_counter() - t0:.0f} s", file=sys.stderr)
     if args.keep:
         args.keep.parent.mkdir(parents=True, exist_ok=True)

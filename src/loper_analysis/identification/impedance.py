@@ -55,6 +55,7 @@ from loper_analysis.identification import (
     refit_with_null_pairs,
 )
 from loper_analysis.identification.group_mean import random_effects_mean
+from loper_analysis.identification.pair_averaging import averaging_corrected_fit, pair_windows
 from loper_analysis.reference import LITERATURE
 from loper_analysis.responses import (
     MAX_TRIAL_DEVIATION_RATIO,
@@ -135,6 +136,8 @@ class IdentificationSettings(FitBounds):
     themselves), ``null_pairs`` or ``cross_validated_null_pairs`` (each null
     pair judged by a projection made without it;
     :func:`loper_analysis.identification.refit_with_null_pairs`).
+    ``averaging_correction``: fit the mean response less what averaging the pairs does to the model's
+    response (:mod:`loper_analysis.identification.pair_averaging`).
     """
 
     noise_model: str = "null_pairs"
@@ -153,6 +156,7 @@ class IdentificationSettings(FitBounds):
     min_vaf_pct: float = MIN_VAF_PCT
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
     seed: int = 0
+    averaging_correction: bool = True
 
     def __post_init__(self):
         if self.noise_model not in NOISE_MODELS:
@@ -487,6 +491,13 @@ def fit_onset(
         rows = status_rows(subject, onset_ms, "failed", reason, n_kept, truth)
         return OnsetFit(mean, counts, rows, _no_curves())
     ident = identification
+    options = dict(
+        window_before_s=r.window_before_s,
+        window_after_s=r.window_after_s,
+        n_substeps=ident.n_substeps,
+        initial_state_span_s=r.initial_state_span_s,
+        initial_state_degree=ident.initial_state_degree,
+    )
     window = prepare_window(
         series["time_s"],
         series["q_unperturbed"],
@@ -498,13 +509,13 @@ def fit_onset(
         force_time_s=series.get("force_time_s"),
         pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
         pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
-        window_before_s=r.window_before_s,
-        window_after_s=r.window_after_s,
-        n_substeps=ident.n_substeps,
-        initial_state_span_s=r.initial_state_span_s,
-        initial_state_degree=ident.initial_state_degree,
+        **options,
     )
     fit = identify_impedance(window, **ident.fit_options())
+    averaging = np.zeros_like(window.measured)
+    if ident.averaging_correction:
+        windows = pair_windows(series["pairs"], params, **options)
+        window, fit, averaging = averaging_corrected_fit(window, windows, fit, **ident.fit_options())
     used, n_null, note = "white", 0, ""
     if ident.noise_model == "null_pairs":
         loaded = {i["name"]: i for i in inputs}
@@ -546,8 +557,8 @@ def fit_onset(
     curves = pd.DataFrame(
         {
             "time_s": fit.time_s,
-            **{f"{j}_measured_rad": fit.measured[:, i] for i, j in enumerate(JOINTS)},
-            **{f"{j}_model_rad": fit.model[:, i] for i, j in enumerate(JOINTS)},
+            **{f"{j}_measured_rad": fit.measured[:, i] + averaging[:, i] for i, j in enumerate(JOINTS)},
+            **{f"{j}_model_rad": fit.model[:, i] + averaging[:, i] for i, j in enumerate(JOINTS)},
         }
     )
     return OnsetFit(mean, counts, rows, curves, force_table(series))

@@ -390,12 +390,14 @@ def subject_onset_response(
         series[f"pelvis_angle_{what}_rad"] = mean_and_sd(pel)[0]
         series[f"force_{what}_n"] = mean_and_sd(kept["force_vector"][i])[0]
         pair_series[f"q_{what}"], pair_series[f"pelvis_angle_{what}_rad"] = q, pel
+        pair_series[f"force_{what}_n"] = kept["force_vector"][i]
     series["pairs"] = pair_series
     if force_pairs is not None:
         # the force at the robot rate replaces the frames' for the identification
-        series["force_time_s"] = window_times_s(-start, after, native_rate)
+        series["force_time_s"] = pair_series["force_time_s"] = window_times_s(-start, after, native_rate)
         for i, what in enumerate(("perturbed", "unperturbed")):
             series[f"force_{what}_n"] = mean_and_sd(force_pairs[i][keep])[0]
+            pair_series[f"force_{what}_n"] = force_pairs[i][keep]
     if conditional is not None and conditional["null"] is not None:
         null = conditional["null"]
         d = null["own"]["joints"] - null["predicted"]["joints"]

@@ -82,6 +82,7 @@ class FitSettings:
                 plausible_ranges=copy.deepcopy(ident["plausible_ranges"]),
                 min_vaf_pct=ident["min_vaf_pct"],
                 max_null_trial_ratio=ident["max_null_trial_ratio"],
+                averaging_correction=ident["averaging_correction"],
                 seed=config["seed"],
             ),
         )
