@@ -1,7 +1,7 @@
 """Where does the bias of the impedance fits come from? The synthetic lab with one part at a time left out.
 
 Usage: python benchmarks/bias_sources.py [--subjects N] [--jobs J] [--seed S] [--variants NAME ...]
-                                         [--ik-noise-scale X] [--keep DIR] [--configfile FILE ...]
+                                         [--ik-noise-scale X] [--keep DIR] [--configfile FILE ...] [--study-fit]
 
 N synthetic subjects of the default design (``config/config.yaml``: 2 trials of 45 s per onset; the study's
 design with ``--configfile config/paper.yaml``: 4-minute trials), fitted at
@@ -13,7 +13,14 @@ and once with each candidate departure from what the identification model assume
 * ``no_minimal_impedance``: the leg's answer to the minimal-impedance force on every swing (only the
   pulses act, as the gentle lab has it);
 * ``no_variability``: the study-level stride-to-stride variability (the gentle lab's instead);
-* ``gentle``: all three left out.
+* ``gentle``: all three left out;
+* ``exact_counterfactual``: the counterfactual's error left out: every perturbation trial is simulated a
+  second time without its pulses (same walking, same noise), and each perturbed stride is fitted against its
+  own twin (the study's matching finds it at distance 0), so what remains is the model's;
+* ``exact_counterfactual_no_variability``: that, with the gentle lab's variability.
+
+``--study-fit``: the study's fit of the mean response (``identification.averaging_correction: false``) instead of
+the default with the averaging term.
 
 Prints, per variant, onset, joint and parameter, over the fitted rows (``ok`` or ``not_identifiable``):
 the mean error (estimate - truth) with its standard error over subjects, the error SD, their ratio
@@ -45,6 +52,8 @@ VARIANTS: dict[str, tuple[str, ...]] = {
     "no_minimal_impedance": ("minimal_impedance",),
     "no_variability": ("variability",),
     "gentle": ("adaptation", "minimal_impedance", "variability"),
+    "exact_counterfactual": ("counterfactual",),
+    "exact_counterfactual_no_variability": ("counterfactual", "variability"),
 }
 UNITS = {"K": "nm_per_rad", "D": "nms_per_rad"}
 
@@ -87,8 +96,11 @@ def main() -> None:
     ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
     ap.add_argument("--keep", type=Path, help="write every variant's impedance rows here (TSV, one per variant)")
     ap.add_argument("--configfile", nargs="+", default=[], help="config files layered over config/config.yaml")
+    ap.add_argument("--study-fit", action="store_true", help="identification.averaging_correction: false")
     args = ap.parse_args()
     config = study_lab_config(args.configfile, args.seed)
+    if args.study_fit:
+        config["identification"]["averaging_correction"] = False
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     tables = []
     for variant in args.variants:
@@ -102,7 +114,9 @@ def main() -> None:
     layered = f" --configfile {' '.join(args.configfile)}" if args.configfile else ""
     print(
         f"python benchmarks/bias_sources.py --subjects {args.subjects} --seed {args.seed} "
-        f"--ik-noise-scale {args.ik_noise_scale:g}{layered} (coordinate level; trials of "
+        f"--ik-noise-scale {args.ik_noise_scale:g}{layered}{' --study-fit' if args.study_fit else ''} "
+        f"--variants {' '.join(args.variants)} "
+        f"(coordinate level; trials of "
         f"{config['synthetic']['walking_duration_s']:g} s, {config['trials']['perturbation_repeats']} per onset)\n"
     )
     print(markdown_table(pd.concat(tables, ignore_index=True).round(3)))

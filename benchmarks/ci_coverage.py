@@ -180,8 +180,53 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     }
 
 
-#: Parts of the study-level lab that ``coordinate_subject`` can leave out (``benchmarks/bias_sources.py``).
-LAB_PARTS = ("adaptation", "minimal_impedance", "variability")
+#: Parts of the study-level lab that ``coordinate_subject`` can leave out (``benchmarks/bias_sources.py``);
+#: ``counterfactual``: the counterfactual's error (each perturbed stride gets its exact twin, :func:`with_twin`).
+LAB_PARTS = ("adaptation", "minimal_impedance", "variability", "counterfactual")
+#: Stride numbers of the twin trial's strides start here (:func:`with_twin`).
+TWIN_STRIDE_OFFSET = 100_000
+
+
+def with_twin(real: dict, twin: dict) -> dict:
+    """One trial's inputs followed by those of its twin, the same walking simulated without the pulses.
+
+    The twin's frames continue the trial's clock after a gap of NaN frames (the brace markers held) long enough
+    that the two robot logs do not overlap (a uniform clock), its strides are numbered from
+    :data:`TWIN_STRIDE_OFFSET` and none is perturbed. Its IK-like noise is the trial's own (the same seed),
+    so the study's matching finds every perturbed stride's twin at a distance of 0 before the onset: its exact
+    counterfactual, noise and all.
+    """
+    t = real["angles"]["time_s"].to_numpy(float)
+    dt = t[1] - t[0]
+    reach = real["force_native"]["time_s"].max() - twin["force_native"]["time_s"].min()
+    k = int(np.ceil((reach + 0.5) / dt))
+    shift = k * dt
+    gap = t[0] + dt * np.arange(t.size, k)
+
+    def joined(key: str) -> pd.DataFrame:
+        blank = pd.DataFrame({c: np.nan for c in real[key].columns}, index=range(gap.size)).assign(time_s=gap)
+        return pd.concat([real[key], blank, twin[key].assign(time_s=twin[key]["time_s"] + shift)], ignore_index=True)
+
+    times = ("heel_strike_s", "toe_off_s", "end_s", "onset_s")
+    strides = twin["strides"].assign(
+        stride=twin["strides"]["stride"] + TWIN_STRIDE_OFFSET,
+        **{c: twin["strides"][c] + shift for c in times if c in twin["strides"]},
+    )
+    tm, markers, labels = real["markers"]
+    return {
+        "angles": joined("angles"),
+        "strides": pd.concat([real["strides"], strides], ignore_index=True),
+        "force": joined("force"),
+        "force_native": pd.concat(
+            [real["force_native"], twin["force_native"].assign(time_s=twin["force_native"]["time_s"] + shift)],
+            ignore_index=True,
+        ),
+        "markers": (
+            np.concatenate([tm, gap, twin["markers"][0] + shift]),
+            np.concatenate([markers, np.repeat(markers[-1:], gap.size, axis=0), twin["markers"][1]]),
+            labels,
+        ),
+    }
 
 
 def _truth(subject: str, config: dict) -> dict:
@@ -211,7 +256,9 @@ def coordinate_subject(
 
     ``without``: parts of the study-level lab left out (:data:`LAB_PARTS`): the device adaptation, the leg's
     answer to the minimal-impedance force (only the pulses act), the stride-to-stride variability (that of the
-    gentle lab instead). ``estimators``: fit the same simulated trials with each ``(name, counterfactual,
+    gentle lab instead), the counterfactual's error (each perturbation trial followed by its twin without pulses,
+    :func:`with_twin`, fitted with the matched stride, which finds the twin). ``estimators``: fit the same
+    simulated trials with each ``(name, counterfactual,
     interval_scatter, averaging_correction)`` (those keys of ``identification``), the rows tagged with the name in a
     column ``estimator``; empty: the config's.
     """
@@ -240,7 +287,7 @@ def coordinate_subject(
     minimal_impedance = None if "minimal_impedance" in without else minimal_impedance
     variability = None if "variability" in without else variability
     names = [(t, design.onset_ms(t)) for t in (design.device, *design.perturbation_trials())]
-    inputs = {}
+    inputs, twins = {}, {}
     for trial, onset in names:
         perturbation = None
         if onset is not None:
@@ -274,8 +321,31 @@ def coordinate_subject(
             "name": trial,
             **_trial_inputs(walk, model, lab, config, noise_scale, np.random.default_rng(file_seed)),
         }
+        if onset is not None and "counterfactual" in without:
+            twin = simulate_walking_trial(
+                syn["walking_duration_s"],
+                lab,
+                # a fresh copy: spawning children advances a SeedSequence, and the twin must walk the same
+                np.random.SeedSequence(sim_seed.entropy, spawn_key=sim_seed.spawn_key),
+                row["height_m"],
+                params,
+                syn["timing_cv"],
+                syn["amplitude_cv"],
+                device,
+                replace(perturbation, force_n=0.0),
+                variability=variability,
+                adaptation=adaptation,
+                minimal_impedance=minimal_impedance,
+            )
+            own = _trial_inputs(twin, model, lab, config, noise_scale, np.random.default_rng(file_seed))
+            twins[trial] = {"name": trial, **with_twin(inputs[trial], own)}
     response, ident = _settings(config)
+    if "counterfactual" in without:  # the study's matching finds the twin; the conditional would predict it
+        estimators = tuple((label, "matched_stride", *rest) for label, _, *rest in estimators) or (
+            ("", "matched_stride", ident.interval_scatter, ident.averaging_correction),
+        )
     null = [{k: v for k, v in tr.items() if k in ("name", "angles", "strides")} for tr in inputs.values()]
+    inputs.update(twins)  # the null pairs stay those of the trials as they are: a twin is no unperturbed stride
     rows = []
     chosen = estimators or (("", response.counterfactual, ident.interval_scatter, ident.averaging_correction),)
     for label, counterfactual, scatter, averaging in chosen:
@@ -300,9 +370,7 @@ def run_coordinates(
     :func:`coordinate_subject`)."""
     n = len(names)
     args = (names, [config] * n, [noise_scale] * n, [without] * n, [estimators] * n)
-    if jobs <= 1:
-        return pd.concat(list(map(coordinate_subject, *args)), ignore_index=True)
-    with single_threaded_pool(jobs) as pool:
+    with single_threaded_pool(max(jobs, 1)) as pool:
         frames = list(pool.map(coordinate_subject, *args))
     return pd.concat(frames, ignore_index=True)
 
