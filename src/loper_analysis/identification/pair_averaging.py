@@ -6,8 +6,8 @@ about its own course with its own force, and the swing leg's dynamics are not li
 (the inertia, gravity and the rod's lever change with the joint angles). The mean of the strides'
 responses therefore differs from the response about their mean, by a term of second order in the
 strides' spread: a bias of the estimate that no number of strides removes (with the stride-to-stride
-variability of the study and the exact counterfactual, hip K +1 N·m/rad and knee D +0.035 N·m·s/rad,
-as large as the knee's truth, at 175 ms; none without that variability).
+variability of the study and the exact counterfactual, hip K +0.56 N·m/rad and knee D +0.055 N·m·s/rad,
+more than the knee's truth, at 175 ms; none without that variability).
 
 * :func:`pair_windows` - every kept pair prepared as a window of its own;
 * :func:`averaging_bias` - at an impedance, the mean of the pairs' model responses minus the response of
