@@ -2,6 +2,7 @@
 
 Usage: nice -n 10 python benchmarks/planner_check.py [--repeats 60] [--onset-ms 50] [--strides 10 40] [--seed 2024]
                                                      [--variability study|gentle]
+                                                     [--counterfactual conditional|matched_stride]
 
 A pilot experiment (one synthetic trial with the device, perturbed at the onset every 3-5 strides, built at
 the coordinate level by :func:`loper_analysis.synthetic.coordinate_trials.perturbation_experiment`: no markers, no IK;
@@ -15,6 +16,15 @@ scatter) with their first N perturbed strides, for each N of ``--strides``; thei
 whole trial. The measured SD is the SD of the estimates over the repeats; the prediction for the same repeats
 is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the table predicted vs measured
 (ratio, and the measured SD's own 95 % range).
+
+``--counterfactual conditional`` (the workflow's default; without the option the study's matched stride) plans
+and fits with the conditional counterfactual instead: the prediction is
+:func:`loper_analysis.planning.precision.conditional_stride_covariance` of the pilot (its cross-validated null
+pairs and its perturbed strides' prediction weights), the fits are the pipeline's defaults (averaging term,
+intervals from the cross-validated null pairs), and each repeat keeps its first N perturbed strides while all
+its unperturbed strides stay candidates (the later perturbed strides are left out of its stride table), so
+that it has as many candidates as the pilot; the prediction for the repeats is the mean of
+``sd_of(n_i)^2`` over them.
 """
 
 from __future__ import annotations
@@ -32,8 +42,13 @@ from scipy.stats import t as student_t
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
-from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL
-from loper_analysis.planning.precision import PlanSettings, pilot_perturbed_pairs, stride_covariance
+from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL, pilot_onset_series
+from loper_analysis.planning.precision import (
+    PlanSettings,
+    conditional_stride_covariance,
+    pilot_perturbed_pairs,
+    stride_covariance,
+)
 from loper_analysis.report.markdown import markdown_table
 from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
@@ -60,10 +75,10 @@ def estimates(rows: pd.DataFrame) -> np.ndarray:
 
 def reported_sd(rows: pd.DataFrame) -> np.ndarray:
     """The SD (6,) the fit itself reports: the upper half of its 95 % CI (the lower end may be cut at 0) over
-    Student's t (n_kept - 1 degrees of freedom, the perturbed pairs' scatter)."""
+    Student's t with the fit's degrees of freedom (``ci_dof``)."""
     by_joint = rows.set_index("joint")
     high = by_joint[[parameter_column(p, "ci95_high") for p in ("K", "D")]].loc[list(JOINTS)].to_numpy(float).ravel()
-    return (high - estimates(rows)) / student_t.ppf(0.975, int(rows["n_strides"].iloc[0]) - 1)
+    return (high - estimates(rows)) / student_t.ppf(0.975, int(rows["ci_dof"].iloc[0]))
 
 
 def lab(variability: str, seed: int, onset_ms: int, truth) -> dict:
@@ -85,29 +100,45 @@ def run_check(
     verbose: bool = True,
     angle_noise_sd_rad: float = ANGLE_NOISE_SD_RAD,
     variability: str | None = None,
+    counterfactual: str = PLANNED_COUNTERFACTUAL,
 ) -> pd.DataFrame:
     """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D)."""
     truth = TRUTH[onset_ms] if truth is None else truth
     params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
-    # the planner's method: matched strides, intervals from the perturbed pairs' scatter
-    ident = IdentificationSettings(n_starts=n_starts, seed=seed, interval_scatter="perturbed_pairs")
-    response = ResponseSettings(counterfactual=PLANNED_COUNTERFACTUAL)
+    conditional = counterfactual == "conditional"
+    if conditional:  # the pipeline's defaults: averaging term, intervals from the cross-validated null pairs
+        ident = IdentificationSettings(n_starts=n_starts, seed=seed)
+    else:  # the study's matched strides, intervals from the perturbed pairs' scatter
+        ident = IdentificationSettings(n_starts=n_starts, seed=seed, interval_scatter="perturbed_pairs")
+    response = ResponseSettings(counterfactual=counterfactual)
     lab_kwargs = lab(variability, seed, onset_ms, truth)
 
     def experiment(k: int):
-        return perturbation_experiment(
+        full, cut = perturbation_experiment(
             [seed, k], params, HEIGHT_M, onset_ms, truth, counts, angle_noise_sd_rad=angle_noise_sd_rad, **lab_kwargs
         )
+        if conditional:  # the first n perturbed strides, every unperturbed stride a candidate
+            table = full["strides"]
+            rank = table["perturbed"].astype(bool).cumsum()
+            cut = {
+                n: {**full, "name": f"first{n}", "strides": table[~table["perturbed"].astype(bool) | (rank <= n)]}
+                for n in counts
+            }
+        return full, cut
 
     # the pilot: its null pairs, and its fit of all its perturbed strides as the planned impedance
     full, cut = experiment(0)
     pilot_fit = fit_onset([cut[max(counts)]], params, onset_ms, "pilot", None, [full], response, ident)
     planned = np.clip(estimates(pilot_fit.rows), ident.lower, ident.upper)
-    null = null_pair_windows([full], onset_ms, response, source="pilot")
-    pairs = pilot_perturbed_pairs([full], onset_ms, response)
-    plan = PlanSettings(interval_scatter="perturbed_pairs")
-    sc = stride_covariance(null, params, planned, plan, perturbed_pairs=pairs)
-    sc_null = stride_covariance(null, params, planned, plan)
+    if conditional:
+        sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned)
+        sc_null = sc
+    else:
+        null = null_pair_windows([full], onset_ms, response, source="pilot")
+        pairs = pilot_perturbed_pairs([full], onset_ms, response)
+        plan = PlanSettings(interval_scatter="perturbed_pairs")
+        sc = stride_covariance(null, params, planned, plan, perturbed_pairs=pairs)
+        sc_null = stride_covariance(null, params, planned, plan)
     found = {n: [] for n in counts}
     kept = {n: [] for n in counts}
     reported = {n: [] for n in counts}
@@ -120,9 +151,17 @@ def run_check(
         except np.linalg.LinAlgError as exc:  # a fit that raises: the repeat is left out and counted
             skipped.append(f"repeat {k}: {exc}")
             continue
+        unlike = [
+            f"repeat {k}, {n} strides: {fit.rows['status'].iloc[0]}: {fit.rows['reason'].iloc[0]}"
+            for n, fit in fits.items()
+            if fit.rows["status"].iloc[0] == "failed"
+            or fit.rows["noise_model"].iloc[0] != "null_pairs"
+            or "instead of the conditional" in str(fit.rows["reason"].iloc[0])
+        ]
+        if unlike:  # not fitted, or fitted another way than planned: the repeat is left out and counted
+            skipped += unlike
+            continue
         for n, fit in fits.items():
-            if fit.rows["noise_model"].iloc[0] != "null_pairs":
-                raise RuntimeError(f"repeat {k}, {n} strides: {fit.rows['reason'].iloc[0]}")
             found[n].append(estimates(fit.rows))
             kept[n].append(int(fit.rows["n_strides"].iloc[0]))
             reported[n].append(reported_sd(fit.rows))
@@ -135,8 +174,8 @@ def run_check(
         measured = est.std(axis=0, ddof=1)
         # robust: 1.4826 x the median absolute deviation (the SD for normal estimates; deaf to a few wild fits)
         robust = 1.4826 * np.median(np.abs(est - np.median(est, axis=0)), axis=0)
-        predicted = sc.sd * np.sqrt(np.mean(1.0 / n_kept))
-        predicted_null = sc_null.sd * np.sqrt(np.mean(1.0 / n_kept))
+        predicted = np.sqrt(np.mean([sc.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
+        predicted_null = np.sqrt(np.mean([sc_null.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         fits_say = np.sqrt(np.mean(np.array(reported[n]) ** 2, axis=0))
         # 95 % range of a sample SD over `repeats` normal draws, relative
         rel = 1.96 / np.sqrt(2.0 * (len(est) - 1))
@@ -163,7 +202,12 @@ def run_check(
                 }
             )
     out = pd.DataFrame(rows)
-    out.attrs = {"n_null_pairs": sc.n_null_pairs, "n_perturbed_pairs": sc.n_perturbed_pairs, "skipped": skipped}
+    out.attrs = {
+        "n_null_pairs": sc.n_null_pairs,
+        "n_perturbed_pairs": sc.n_perturbed_pairs,
+        "skipped": skipped,
+        "counterfactual": counterfactual,
+    }
     return out
 
 
@@ -180,6 +224,12 @@ def main() -> None:
         default=None,
         help="the lab's variability (default: config/config.yaml synthetic.variability)",
     )
+    ap.add_argument(
+        "--counterfactual",
+        choices=("matched_stride", "conditional"),
+        default=PLANNED_COUNTERFACTUAL,
+        help="plan and fit with this counterfactual (default: the study's matched stride)",
+    )
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     logging.disable(logging.WARNING)
@@ -191,9 +241,11 @@ def main() -> None:
         args.seed,
         angle_noise_sd_rad=args.angle_noise_sd_rad,
         variability=args.variability,
+        counterfactual=args.counterfactual,
     )
     print(
-        f"onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, {args.repeats} repeats, "
+        f"{args.counterfactual}, onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, "
+        f"{args.repeats} repeats, "
         f"pilot null pairs {table.attrs['n_null_pairs']}, perturbed pairs {table.attrs['n_perturbed_pairs']}, "
         f"{time.perf_counter() - t0:.0f} s"
     )

@@ -4,7 +4,9 @@ Known answers: the device loop's step (steady state = the desired force with a s
 ~10 ms rise), Student's t with N - 1 degrees of freedom and the 1/N law of the prediction, the
 identification's own sandwich covariance (a noise-free fit with the pilot's perturbed pairs' covariance
 reports the predicted half-width), the null pairs' covariance when the pilot has no perturbed pairs, and
-repeated synthetic experiments whose fits report the SD the planner predicted.
+repeated synthetic experiments whose fits report the SD the planner predicted. For the conditional
+counterfactual (the default): white noise through the leave-one-out weights (simulated), the mean weight of
+n pairs (simulated), and at the pilot's own strides the fit's interval formula exactly.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.device.analysis import step_metrics
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
+    cross_validated_covariance,
     identify_impedance,
     nuisance_projection,
     null_pair_errors,
@@ -36,10 +39,13 @@ from loper_analysis.identification import (
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
 from loper_analysis.identification.intervals import t_quantile
 from loper_analysis.io.atomic import write_tsv
+from loper_analysis.planning.inputs import pilot_onset_series
 from loper_analysis.planning.precision import (
+    MAX_ANSWERED_STRIDES,
     MIN_PERTURBED_PAIRS,
     PlanSettings,
     StrideCovariance,
+    conditional_stride_covariance,
     pilot_perturbed_pairs,
     planning_window,
     pool_onsets,
@@ -51,6 +57,7 @@ from loper_analysis.planning.precision import (
 )
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.responses import ResponseSettings, null_pair_windows
+from loper_analysis.responses.conditional import shared_weight_terms, unit_scatter_variance
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry, write_segments
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.response import thigh_normal
@@ -79,6 +86,15 @@ def pilot(params):
         null = null_pair_windows([full], ONSET_MS, MATCHED, source="pilot")
         pairs = pilot_perturbed_pairs([full], ONSET_MS, MATCHED)
     return full, cut[40], null, pairs
+
+
+@pytest.fixture(scope="module")
+def conditional_series(pilot):
+    """The pilot's onset series with the conditional counterfactual (the default): null pairs and perturbed pairs."""
+    full, _, _, _ = pilot
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return pilot_onset_series([full], ONSET_MS, ResponseSettings())
 
 
 @pytest.fixture(scope="module")
@@ -321,7 +337,7 @@ def pilot_results(tmp_path_factory, params, pilot):
     return root
 
 
-def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path, capsys, monkeypatch):
+def test_plan_command_answers_the_target(pilot_results, params, conditional_series, tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)  # no config/config.yaml here: the library's defaults (onsets of the impedance rows)
     out = tmp_path / "plan.tsv"
     code = main(
@@ -348,14 +364,14 @@ def test_plan_command_answers_the_target(pilot_results, params, pilot, tmp_path,
     assert code == 0, captured.err
     table = pd.read_csv(out, sep="\t")
     assert len(table) == 12 and set(table["n_strides"]) == {10, 40} and set(table["onset_ms"]) == {50}
-    _, _, null, pairs = pilot
-    sc = stride_covariance(null, params, TRUTH, PLAN, perturbed_pairs=pairs)
+    # the library's default: the conditional counterfactual, planned from the onset's own strides
+    sc = conditional_stride_covariance(conditional_series, params, TRUTH)
     expected = precision_table(sc, [10, 40], ONSET_MS, "S09")
-    assert (table["scatter"] == "perturbed_pairs").all() and (table["n_perturbed_pairs"] == pairs["n_pairs"]).all()
+    assert (table["scatter"] == "cross_validated_null_pairs").all()
+    assert (table["n_perturbed_pairs"] == conditional_series["pairs"]["n_pairs"]).all()
     # the pilot's tables went through TSV files (9 significant digits) on the way in
     np.testing.assert_allclose(table["predicted_sd"], expected["predicted_sd"], rtol=2e-4)
-    # the command's intervals are the library default's (identification.interval_scatter): its t quantile
-    n = strides_needed(stride_covariance(null, params, TRUTH, perturbed_pairs=pairs), "hip", "D", percent=15)
+    n = strides_needed(sc, "hip", "D", percent=15)
     assert f"hip D at 50 ms: ±15 % (95 % CI) needs {n} perturbed strides" in captured.out
 
 
@@ -382,7 +398,11 @@ def test_plan_command_takes_the_working_directory_s_config_and_an_option_wins(pi
     [
         (["--strides", "0"], "stride count must be a whole number >= 1 (perturbed strides averaged), got 0"),
         (["--duration-s", "0.5"], "pulse_duration_s = 0.5 s is longer than the fit window"),
-        (["--trials", "pert050-2"], "S09, onset 50 ms: 0 null pair(s), fewer than identification.null_pair_components"),
+        (
+            ["--trials", "pert050-2"],
+            "S09, onset 50 ms: 0 unperturbed stride(s) predicted from the others at this onset, fewer than "
+            "identification.null_pair_components + 3",
+        ),
     ],
 )
 def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
@@ -448,3 +468,60 @@ def test_a_planned_value_near_zero_gets_an_answer_not_a_hang():
         n = strides_needed(sc, "hip", "D", percent=15)
         meets = [sc.t95(m) * 1.0 / np.sqrt(m) <= 0.15 * 3.5 for m in (n - 1, n)]
         assert meets == [False, True]
+
+
+def test_unit_scatter_variance_is_that_of_white_noise_through_the_leave_one_out_weights():
+    """Known answer by simulation: the scatter (ddof 1) of the kept rows of (I - S) e for white e of unit variance."""
+    rng = np.random.default_rng(3)
+    n = 40
+    S = rng.random((n, n))
+    np.fill_diagonal(S, 0.0)
+    S /= S.sum(axis=1, keepdims=True)
+    keep = rng.random(n) > 0.2
+    M = (np.eye(n) - S)[keep]
+    draws = [np.var(M @ rng.standard_normal(n), ddof=1) for _ in range(20000)]
+    assert abs(np.mean(draws) / unit_scatter_variance(S, keep) - 1) < 0.01
+
+
+def test_shared_weight_terms_predict_the_mean_weight_of_n_pairs():
+    """E |w_mean|^2 over n pairs drawn like the given ones = |mu|^2 + tr Sigma / n (simulated, 1 %)."""
+    rng = np.random.default_rng(5)
+    mu = rng.random(60) / 60
+    draw = lambda k: mu + 0.02 * rng.standard_normal((k, 60))  # noqa: E731
+    mu2, spread = shared_weight_terms(draw(4000))
+    assert abs(mu2 / float(mu @ mu) - 1) < 0.05 and abs(spread / (60 * 0.02**2) - 1) < 0.05
+    for n in (5, 30):
+        simulated = np.mean([float(np.sum(draw(n).mean(axis=0) ** 2)) for _ in range(4000)])
+        assert abs(simulated / (mu2 + spread / n) - 1) < 0.02
+
+
+def test_conditional_plan_at_the_pilot_s_own_strides_is_the_fit_s_interval_formula(params, conditional_series):
+    """For as many strides as the pilot kept, the planned SD is the fit's own: the cross-validated covariance
+    of the null pairs' errors times their covariance scale (refit_with_null_pairs), at the same window."""
+    from loper_analysis.planning.precision import planning_window
+
+    sc = conditional_stride_covariance(conditional_series, params, TRUTH)
+    null, n = conditional_series["null_pairs"], int(conditional_series["pairs"]["n_pairs"])
+    assert n >= MIN_PERTURBED_PAIRS and sc.scatter == "cross_validated_null_pairs" and sc.dof == null["n_pairs"] - 1
+    window = planning_window(null, params, PlanSettings())
+    J = response_jacobian(window, TRUTH, PlanSettings().lower, PlanSettings().upper)
+    E = null_pair_errors(window, TRUTH, null)
+    fit_cov = cross_validated_covariance(E, PlanSettings().null_pair_components, J, n) * null["covariance_scale"]
+    np.testing.assert_allclose(sc.sd_of(n), np.sqrt(np.diag(fit_cov)), rtol=1e-9)
+    # the candidates' share stays: the SD falls more slowly than 1/sqrt(N) and levels off
+    per_stride, shared = sc.variance_terms()
+    assert np.all(shared > 0) and np.all(sc.sd_of(10_000) > np.sqrt(shared))
+    assert np.all(sc.sd_of(40) / sc.sd_of(10) > 0.5)
+
+
+def test_conditional_strides_needed_meets_the_target_and_says_when_none_can(params, conditional_series):
+    """The smallest N whose half-width meets the target (checked at N and N - 1); a target below t sqrt(shared)
+    is out of reach."""
+    sc = conditional_stride_covariance(conditional_series, params, TRUTH)
+    i = 1  # hip D
+    target = 0.15 * TRUTH[i]
+    n = strides_needed(sc, "hip", "D", percent=15)
+    assert sc.half_width(n)[i] <= target * (1 + 1e-9) and (n == 1 or sc.half_width(n - 1)[i] > target)
+    floor = sc.t95(2) * math.sqrt(sc.variance_terms()[1][i])
+    assert strides_needed(sc, "hip", "D", half_width=0.99 * floor) == MAX_ANSWERED_STRIDES + 1
+    assert "more than" in target_answer(sc, "hip", "D", ONSET_MS, half_width=0.99 * floor)

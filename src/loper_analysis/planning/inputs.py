@@ -3,6 +3,9 @@
 * :func:`pulse_force_n` - the force the rods apply for a rectangular desired
   pulse: the device's closed loop (about 10 ms rise, 30 % overshoot), low-passed
   like the load cell;
+* :func:`pilot_onset_series` - the pilot's response series at an onset: its
+  perturbed pairs one by one and, with the conditional counterfactual, its
+  unperturbed strides each predicted from the others;
 * :func:`pilot_perturbed_pairs` - the pilot's kept perturbed pairs at an onset,
   one by one, whose scatter the prediction takes.
 
@@ -22,10 +25,10 @@ import pandas as pd
 from loper_analysis.checks import number
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_perturbed_pairs"]
+__all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs"]
 
-#: The counterfactual the planner predicts for: the study's matched stride, whose pairs' scatter the prediction
-#: scales (``docs/planning.md``); a fit with the conditional counterfactual scatters less.
+#: The counterfactual the planner predicts for when none is given: the study's matched stride, whose pairs' scatter
+#: the prediction scales (``docs/planning.md``); the workflow plans for ``identification.counterfactual``.
 PLANNED_COUNTERFACTUAL: str = "matched_stride"
 
 
@@ -66,7 +69,7 @@ def pulse_force_n(
     return np.interp(t, t_dev, force, left=0.0, right=float(force[-1]))
 
 
-def pilot_perturbed_pairs(
+def pilot_onset_series(
     trials: Sequence[Mapping],
     onset_ms: float,
     response=None,
@@ -75,17 +78,18 @@ def pilot_perturbed_pairs(
     onset_tolerance_ms: float = 12.5,
     source: str = "pilot",
 ) -> dict | None:
-    """The pilot's kept perturbed pairs at ``onset_ms`` one by one (format of ``null_pairs``), or None.
+    """The pilot's response series at ``onset_ms`` (of :func:`~loper_analysis.responses.subject_onset_response`).
 
     ``trials``: ``name``, ``angles`` and ``strides`` tables of the pilot's
     trials with the device (:mod:`loper_analysis.responses.inputs`). Those
     whose perturbed strides' median onset (``onset_s - toe_off_s``) lies
     within ``onset_tolerance_ms`` of ``onset_ms`` are the onset's; their
-    pairs are matched, windowed and judged for outliers as the fit's
-    (``series["pairs"]`` of :func:`loper_analysis.responses.subject_onset_response`
-    with ``response`` settings). The pairs' angles do not depend on the
-    force, so none is needed (the response gets a zero force). None when no
-    trial is the onset's or no pair is kept.
+    pairs are matched (or predicted), windowed and judged for outliers as the
+    fit's with ``response`` settings (``pairs``: the kept perturbed pairs one
+    by one; with the conditional counterfactual also ``null_pairs``, the
+    onset's unperturbed strides each predicted from the others). The pairs'
+    angles do not depend on the force, so none is needed (the response gets a
+    zero force). None when no trial is the onset's.
     """
     from loper_analysis.errors import TooFewStridesWarning
     from loper_analysis.responses import ResponseSettings, subject_onset_response
@@ -122,5 +126,27 @@ def pilot_perturbed_pairs(
             side=side,
             source=f"{source}, perturbed pairs",
         )
+    return series
+
+
+def pilot_perturbed_pairs(
+    trials: Sequence[Mapping],
+    onset_ms: float,
+    response=None,
+    *,
+    side: str = "left",
+    onset_tolerance_ms: float = 12.5,
+    source: str = "pilot",
+) -> dict | None:
+    """The pilot's kept perturbed pairs at ``onset_ms`` one by one (format of ``null_pairs``), or None.
+
+    ``series["pairs"]`` of :func:`pilot_onset_series` (same arguments); None
+    when no trial is the onset's or no pair is kept.
+    """
+    series = pilot_onset_series(
+        trials, onset_ms, response, side=side, onset_tolerance_ms=onset_tolerance_ms, source=source
+    )
+    if series is None:
+        return None
     pairs = series["pairs"]
     return pairs if int(pairs["n_pairs"]) > 0 else None

@@ -23,7 +23,10 @@ needs.
   along the thigh normal;
 * :func:`stride_covariance` - the covariance of (K, D) per joint for one
   perturbed stride (divide by ``N``), from the pilot's perturbed pairs (or
-  its null pairs when it has none at the onset);
+  its null pairs when it has none at the onset), for the study's matched stride;
+* :func:`conditional_stride_covariance` - the same for the conditional
+  counterfactual, from the pilot's cross-validated null pairs as the fit's
+  intervals take them, with the candidates' share that does not average out;
 * :func:`pool_onsets` - the perturbed pairs' excess scatter pooled over the
   pilot's onsets (steadier than one onset's dozen pairs);
 * :func:`precision_table` - predicted SD and 95 % half-width per joint,
@@ -56,6 +59,7 @@ from loper_analysis.identification import (
     FitBounds,
     PreparedWindow,
     check_interval_scatter,
+    cross_validated_covariance,
     nuisance_projection,
     null_pair_errors,
     prepare_window,
@@ -71,6 +75,7 @@ __all__ = [
     "MIN_PERTURBED_PAIRS",
     "PlanSettings",
     "StrideCovariance",
+    "conditional_stride_covariance",
     "pulse_force_n",
     "planning_window",
     "pilot_perturbed_pairs",
@@ -163,8 +168,12 @@ class StrideCovariance:
     ``N - 1`` (the fit's intervals from the scatter of its ``N`` perturbed
     pairs), else a fixed count (the null pairs' ``M - 1``); ``n_null_pairs``
     and ``n_perturbed_pairs`` the pilot's pairs; ``scatter`` whose errors
-    gave the covariance (``perturbed_pairs`` or ``null_pairs``); ``note`` a
-    caveat for the rows (empty when none).
+    gave the covariance (``perturbed_pairs``, ``null_pairs`` or
+    ``cross_validated_null_pairs``); ``note`` a caveat for the rows (empty
+    when none). ``shared_covariance`` (6, 6): the part that does not shrink
+    with the strides averaged (the conditional counterfactual's candidates,
+    shared by every prediction); for ``N`` strides the covariance is
+    ``covariance / N + shared_covariance``.
     """
 
     covariance: np.ndarray
@@ -175,11 +184,22 @@ class StrideCovariance:
     n_perturbed_pairs: int = 0
     scatter: str = "null_pairs"
     null_covariance: np.ndarray | None = None
+    shared_covariance: np.ndarray | None = None
 
     @property
     def sd(self) -> np.ndarray:
-        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad)."""
+        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad), without the shared part."""
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    def variance_terms(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(per_stride, shared)`` variances (6,): for ``N`` strides ``per_stride / N + shared``."""
+        shared = np.zeros(6) if self.shared_covariance is None else np.diag(self.shared_covariance)
+        return np.clip(np.diag(self.covariance), 0.0, None), np.clip(shared, 0.0, None)
+
+    def sd_of(self, n_strides: int) -> np.ndarray:
+        """Predicted SD (6,) of K and D for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
+        per_stride, shared = self.variance_terms()
+        return np.sqrt(per_stride / int(n_strides) + shared)
 
     def t95(self, n_strides: int) -> float:
         """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof;
@@ -189,7 +209,7 @@ class StrideCovariance:
 
     def half_width(self, n_strides: int) -> np.ndarray:
         """Predicted 95 % CI half-width (6,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
-        return self.t95(n_strides) * self.sd / math.sqrt(int(n_strides))
+        return self.t95(n_strides) * self.sd_of(n_strides)
 
 
 def _null_arrays(null_pairs: Mapping, source: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
@@ -372,6 +392,84 @@ def stride_covariance(
     return StrideCovariance(sandwich(E), p, dof, n_pairs, "; ".join(notes), n_pert, scatter, sandwich(E0))
 
 
+def conditional_stride_covariance(
+    series: Mapping,
+    params: SegmentParameters,
+    impedance,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    source: str = "pilot",
+) -> StrideCovariance:
+    """Covariance of (K, D) per joint for the conditional counterfactual, as the fit's intervals take it.
+
+    ``series``: the pilot's onset series with the conditional counterfactual
+    (:func:`loper_analysis.planning.inputs.pilot_onset_series`): ``null_pairs``,
+    each unperturbed candidate against its prediction from the others (with
+    ``unit_scatter_variance``), and ``pairs``, its perturbed pairs (with their
+    ``prediction_weights`` over the candidates). With the window of
+    :func:`planning_window`, the errors ``E0`` of the null pairs, ``J`` at
+    ``impedance`` and ``V`` = :func:`~loper_analysis.identification.cross_validated_covariance`
+    of ``E0`` for one stride, white stride noise of variance ``s^2`` gives
+    ``V = s^2 v`` (``v`` the unit scatter variance), and the mean of ``N``
+    predicted pairs has ``s^2 ((1 + tr Sigma) / N + |mu|^2)``
+    (:func:`loper_analysis.responses.conditional.shared_weight_terms` of the
+    pilot's perturbed pairs' weights): ``covariance = V (1 + tr Sigma) / v``
+    per stride and ``shared_covariance = V |mu|^2 / v``, the fit's own
+    interval (``cross_validated_null_pairs``, t with ``M - 1`` degrees of
+    freedom) for a planned experiment with as many candidates as the pilot's
+    trials at the onset.
+
+    Raises
+    ------
+    LoperInputError
+        Fewer than ``null_pair_components + 3`` null pairs, no perturbed pair
+        (their weights say how much of the candidates' noise the mean keeps),
+        a planned value outside the bounds.
+    """
+    from loper_analysis.responses.conditional import shared_weight_terms
+
+    p = _impedance(impedance, settings, source)
+    null = series.get("null_pairs") or {}
+    n_null = int(null.get("n_pairs", 0))
+    r = integer("null_pair_components", settings.null_pair_components, source, minimum=0)
+    if n_null < r + 3 or "unit_scatter_variance" not in null:
+        raise LoperInputError(
+            f"{source}: {n_null} unperturbed stride(s) predicted from the others at this onset, fewer than "
+            f"identification.null_pair_components + 3 = {r + 3}: the conditional counterfactual's intervals "
+            "need the onset's own unperturbed strides"
+        )
+    pairs = series.get("pairs") or {}
+    n_pert = int(pairs.get("n_pairs", 0))
+    if n_pert < 1 or "prediction_weights" not in pairs:
+        raise LoperInputError(
+            f"{source}: no perturbed stride of the pilot at this onset: the conditional counterfactual's plan "
+            "needs the pilot's perturbed strides (their prediction weights); plan with "
+            "identification.counterfactual: matched_stride instead"
+        )
+    notes = []
+    if n_null < settings.min_null_pairs:
+        notes.append(
+            f"{n_null} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+            "the pilot's own fits fell back to the matched stride"
+        )
+    window = planning_window(null, params, settings, device, source)
+    J = response_jacobian(window, p, settings.lower, settings.upper)
+    V = cross_validated_covariance(null_pair_errors(window, p, null), r, J, 1)
+    unit = float(null["unit_scatter_variance"])
+    mu2, spread = shared_weight_terms(pairs["prediction_weights"])
+    return StrideCovariance(
+        V * (1.0 + spread) / unit,
+        p,
+        n_null - 1,
+        n_null,
+        "; ".join(notes),
+        n_pert,
+        "cross_validated_null_pairs",
+        None,
+        V * mu2 / unit,
+    )
+
+
 def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, StrideCovariance]:
     """The perturbed pairs' excess scatter pooled over the pilot's onsets (``{onset_ms: StrideCovariance}``).
 
@@ -440,21 +538,21 @@ def precision_table(
 ) -> pd.DataFrame:
     """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
 
-    ``predicted_sd = sd_1 / sqrt(N)`` and ``ci95_half_width = t * predicted_sd``
+    ``predicted_sd = sqrt(sd_1^2 / N + shared)`` (:meth:`StrideCovariance.sd_of`) and
+    ``ci95_half_width = t * predicted_sd``
     (Student's t at 97.5 % with the fit's degrees of freedom,
     :meth:`StrideCovariance.t95`: ``N - 1`` by default), both in ``unit``;
     ``ci95_half_width_pct`` relative to the planned value (%; NaN for a
     planned value of 0). Rows: hip, knee, ankle x K, D x ``n_strides``.
     """
     counts = _counts(n_strides, subject or "plan")
-    sd1 = stride_cov.sd
     rows = []
     for j, joint in enumerate(JOINTS):
         for k, kind in enumerate(("K", "D")):
             i = 2 * j + k
             planned = float(stride_cov.impedance[i])
             for n in counts:
-                sd = sd1[i] / math.sqrt(n)
+                sd = float(stride_cov.sd_of(n)[i])
                 half = stride_cov.t95(n) * sd
                 rows.append(
                     {
@@ -516,7 +614,11 @@ def strides_needed(
     Give either ``percent`` (of the planned value, e.g. 15 for +-15 %) or
     ``half_width`` (absolute, N·m/rad or N·m·s/rad): the smallest ``N`` with
     ``t_N sd_1 / sqrt(N) <= target`` (``t_N`` :meth:`StrideCovariance.t95`;
-    with a fixed t, ``N = ceil((t sd_1 / target)^2)``).
+    with a fixed t, ``N = ceil((t sd_1 / target)^2)``). With a shared part
+    (the conditional counterfactual) the fixed t gives
+    ``N = ceil(sd_1^2 / ((target / t)^2 - shared))``; a target at or below
+    ``t sqrt(shared)`` no number of strides reaches (more than
+    :data:`MAX_ANSWERED_STRIDES`).
     """
     if joint not in JOINTS:
         raise LoperInputError(f"target joint must be one of {JOINTS}, got {joint!r}")
@@ -541,6 +643,12 @@ def strides_needed(
         if target <= 0:
             raise LoperInputError(f"target half_width must be > 0, got {target:g}")
     sd1 = float(stride_cov.sd[i])
+    if stride_cov.shared_covariance is not None and stride_cov.dof is not None:
+        per_stride, shared = (float(v[i]) for v in stride_cov.variance_terms())
+        room = (target / stride_cov.t95(2)) ** 2 - shared
+        if room <= 0:
+            return MAX_ANSWERED_STRIDES + 1
+        return max(1, int(math.ceil(per_stride / room * (1 - 1e-12))))
 
     def meets(n: int) -> bool:
         return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
@@ -579,7 +687,7 @@ def target_answer(
             f"perturbed strides (planned {parameter} {planned:.3g} {unit}"
             + ("; a relative target on a value this close to 0: give a half_width instead)" if percent else ")")
         )
-    reached = stride_cov.t95(n) * stride_cov.sd[i] / math.sqrt(n)
+    reached = float(stride_cov.half_width(n)[i])
     return (
         f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
         f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "

@@ -23,6 +23,7 @@ from loper_analysis.responses.conditional import (
     conditional_null_pairs,
     conditional_windows,
     covariance_scale,
+    unit_scatter_variance,
 )
 from loper_analysis.responses.inputs import trial_angles, trial_name, trial_table
 from loper_analysis.responses.matching import match_in_window, stride_table, too_short
@@ -405,7 +406,9 @@ def subject_onset_response(
             "removed"
         ].to_numpy(bool)
         series["null_pairs"] = conditional_null_pair_windows(null, grid, before, after, null_keep)
+        series["null_pairs"]["unit_scatter_variance"] = unit_scatter_variance(null["weights"], null_keep)
         if n_pairs:
+            pair_series["prediction_weights"] = conditional["weights"][keep]
             kept_weights = conditional["weights"][keep]
             pair_series["covariance_scale"] = covariance_scale(kept_weights)
             series["null_pairs"]["covariance_scale"] = covariance_scale(kept_weights, null["weights"], null_keep)

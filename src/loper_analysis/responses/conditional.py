@@ -49,6 +49,8 @@ __all__ = [
     "conditional_windows",
     "conditional_null_pairs",
     "covariance_scale",
+    "unit_scatter_variance",
+    "shared_weight_terms",
 ]
 
 #: Penalties tried by :func:`loo_penalty`, as fractions of the mean eigenvalue of ``Xc^T Xc``.
@@ -128,6 +130,36 @@ def _scatter_variance(M: np.ndarray) -> float:
     return float(np.sum(Mc**2)) / (M.shape[0] - 1)
 
 
+def unit_scatter_variance(null_weights, null_keep=None) -> float:
+    """Expected scatter (ddof 1) of the candidates' leave-one-out errors for white noise of unit variance.
+
+    ``null_weights`` (N, N): :func:`loo_weights`; ``null_keep`` (N,) bool: the rows kept. A leave-one-out
+    error is ``e_i - S_i @ e``, so its variance exceeds the noise's by ``|S_i|^2``; the scatter of the kept
+    errors about their mean is this factor times the noise's variance.
+    """
+    S = np.asarray(null_weights, dtype=float)
+    M = np.eye(S.shape[0]) - S
+    if null_keep is not None:
+        M = M[np.asarray(null_keep, dtype=bool)]
+    return _scatter_variance(M)
+
+
+def shared_weight_terms(weights) -> tuple[float, float]:
+    """``(|mu|^2, tr Sigma)`` of the prediction weights (n_pairs, N) over the N candidates.
+
+    ``mu`` is their mean and ``Sigma`` their covariance over the pairs (ddof 1); for ``n`` pairs drawn
+    like these the mean weight vector has ``E |w_mean|^2 = |mu|^2 + tr Sigma / n``, so white noise of
+    variance ``s^2`` on every stride gives the mean of ``n`` pairs' counterfactual errors the variance
+    ``s^2 ((1 + tr Sigma) / n + |mu|^2)``: the candidates' share does not average out
+    (:func:`covariance_scale`).
+    """
+    W = np.atleast_2d(np.asarray(weights, dtype=float))
+    n = W.shape[0]
+    w_mean = W.mean(axis=0)
+    spread = float(np.sum((W - w_mean) ** 2)) / (n - 1) if n > 1 else 0.0
+    return max(float(w_mean @ w_mean) - spread / n, 0.0), spread
+
+
 def covariance_scale(weights, null_weights=None, null_keep=None) -> float:
     """Factor by which the covariance from the pairs' scatter / n_pairs understates that of their mean.
 
@@ -147,13 +179,8 @@ def covariance_scale(weights, null_weights=None, null_keep=None) -> float:
     w_mean = W.mean(axis=0)
     target = (1.0 + n * float(w_mean @ w_mean)) / n
     if null_weights is None:
-        M = np.hstack([np.eye(n), -W])
-    else:
-        S = np.asarray(null_weights, dtype=float)
-        M = np.eye(S.shape[0]) - S
-        if null_keep is not None:
-            M = M[np.asarray(null_keep, dtype=bool)]
-    return target / (_scatter_variance(M) / n)
+        return target / (_scatter_variance(np.hstack([np.eye(n), -W])) / n)
+    return target / (unit_scatter_variance(null_weights, null_keep) / n)
 
 
 # --------------------------------------------------------------------------- the candidates

@@ -26,7 +26,6 @@ from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_text, write_tsv
 from loper_analysis.io.readers import read_tsv
-from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL
 from loper_analysis.planning.precision import PlanSettings
 from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings
 
@@ -71,7 +70,10 @@ class PlanningSettings:
         The planned pulse (N, s) and the identification settings the prediction follows
         (:class:`~loper_analysis.planning.precision.PlanSettings`).
     response : ResponseSettings
-        How the pilot's pairs are windowed and judged (:class:`~loper_analysis.responses.ResponseSettings`).
+        How the pilot's pairs are windowed and judged (:class:`~loper_analysis.responses.ResponseSettings`),
+        and the counterfactual planned for: ``conditional`` (the default) takes the fit's cross-validated null
+        pairs, ``matched_stride`` the scatter of the pilot's perturbed pairs
+        (:func:`~loper_analysis.planning.precision.conditional_stride_covariance`).
     device : DeviceParameters
         The device (:class:`~loper_analysis.device.controller.DeviceParameters`).
     max_null_trial_ratio : float or None
@@ -83,7 +85,7 @@ class PlanningSettings:
     strides: tuple[int, ...] = STRIDES
     targets: tuple[Mapping, ...] = ()
     plan: PlanSettings = field(default_factory=PlanSettings)
-    response: ResponseSettings = field(default_factory=lambda: ResponseSettings(counterfactual=PLANNED_COUNTERFACTUAL))
+    response: ResponseSettings = field(default_factory=ResponseSettings)
     device: DeviceParameters = field(default_factory=DeviceParameters)
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
 
@@ -102,7 +104,8 @@ class PlanningSettings:
             ``identification`` the planner follows (fit window and initial state in s, substeps, projected
             components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad);
             ``response``: ``identification.window_before_s``, ``window_after_s``, ``initial_state_span_s``
-            and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``; ``device``:
+            and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``, the counterfactual planned for
+            ``identification.counterfactual``; ``device``:
             ``device.parameters``; ``max_null_trial_ratio``: ``identification.max_null_trial_ratio``.
 
         Raises
@@ -140,7 +143,7 @@ class PlanningSettings:
                 initial_state_span_s=get("identification", "initial_state_span_s"),
                 whisker=get("strides", "iqr_whisker"),
                 max_fraction=get("strides", "max_outlier_fraction"),
-                counterfactual=PLANNED_COUNTERFACTUAL,
+                counterfactual=get("identification", "counterfactual"),
             ),
             device=DeviceParameters(**get("device", "parameters")),
             max_null_trial_ratio=get("identification", "max_null_trial_ratio"),
@@ -243,7 +246,9 @@ def plan(
     (pandas.DataFrame, list of str)
         The table and the answers.
     """
+    from loper_analysis.planning.inputs import pilot_onset_series
     from loper_analysis.planning.precision import (
+        conditional_stride_covariance,
         pilot_perturbed_pairs,
         pool_onsets,
         precision_table,
@@ -288,11 +293,21 @@ def plan(
                 values = planned_impedance(rows_table, subject, onset, ", ".join(map(str, impedance_tsvs)))
             else:
                 values = np.asarray(impedance[onset] if isinstance(impedance, Mapping) else impedance, float)
-            null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
-            pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
-            planned[onset] = stride_covariance(
-                null, params, values, plan_settings, dev, source=where, perturbed_pairs=pairs
-            )
+            if response_settings.counterfactual == "conditional":
+                series = pilot_onset_series(pool, onset, response_settings, source=subject)
+                if series is None:
+                    raise LoperInputError(
+                        f"{where}: no trial of the pilot is perturbed at this onset: the conditional "
+                        "counterfactual's plan takes the onset's own strides (or plan with "
+                        "identification.counterfactual: matched_stride)"
+                    )
+                planned[onset] = conditional_stride_covariance(series, params, values, plan_settings, dev, source=where)
+            else:
+                null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
+                pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
+                planned[onset] = stride_covariance(
+                    null, params, values, plan_settings, dev, source=where, perturbed_pairs=pairs
+                )
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
