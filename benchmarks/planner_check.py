@@ -21,10 +21,11 @@ is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the tab
 and fits with the conditional counterfactual instead: the prediction is
 :func:`loper_analysis.planning.precision.conditional_stride_covariance` of the pilot (its cross-validated null
 pairs and its perturbed strides' prediction weights), the fits are the pipeline's defaults (averaging term,
-intervals from the cross-validated null pairs), and each repeat keeps its first N perturbed strides while all
-its unperturbed strides stay candidates (the later perturbed strides are left out of its stride table), so
-that it has as many candidates as the pilot; the prediction for the repeats is the mean of
-``sd_of(n_i)^2`` over them.
+intervals from the cross-validated null pairs); as for the matched stride each repeat is its trial cut after
+its N-th perturbed stride, so its candidates (the unperturbed strides of the cut trial) grow with N, as the
+planner assumes; the prediction for the repeats is the mean of ``sd_of(n_i)^2`` over them. Repeats whose fit
+fails or falls back to the matched stride (fewer than ``identification.min_null_pairs`` candidates) are left
+out and listed.
 """
 
 from __future__ import annotations
@@ -117,13 +118,6 @@ def run_check(
         full, cut = perturbation_experiment(
             [seed, k], params, HEIGHT_M, onset_ms, truth, counts, angle_noise_sd_rad=angle_noise_sd_rad, **lab_kwargs
         )
-        if conditional:  # the first n perturbed strides, every unperturbed stride a candidate
-            table = full["strides"]
-            rank = table["perturbed"].astype(bool).cumsum()
-            cut = {
-                n: {**full, "name": f"first{n}", "strides": table[~table["perturbed"].astype(bool) | (rank <= n)]}
-                for n in counts
-            }
         return full, cut
 
     # the pilot: its null pairs, and its fit of all its perturbed strides as the planned impedance

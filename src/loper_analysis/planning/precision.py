@@ -170,10 +170,10 @@ class StrideCovariance:
     and ``n_perturbed_pairs`` the pilot's pairs; ``scatter`` whose errors
     gave the covariance (``perturbed_pairs``, ``null_pairs`` or
     ``cross_validated_null_pairs``); ``note`` a caveat for the rows (empty
-    when none). ``shared_covariance`` (6, 6): the part that does not shrink
-    with the strides averaged (the conditional counterfactual's candidates,
-    shared by every prediction); for ``N`` strides the covariance is
-    ``covariance / N + shared_covariance``.
+    when none). ``spread_covariance`` (6, 6): a part that falls as ``1/N^2``
+    (the conditional counterfactual: the spread of the perturbed strides'
+    prediction weights over candidates whose number grows with ``N``); for
+    ``N`` strides the covariance is ``covariance / N + spread_covariance / N^2``.
     """
 
     covariance: np.ndarray
@@ -184,22 +184,23 @@ class StrideCovariance:
     n_perturbed_pairs: int = 0
     scatter: str = "null_pairs"
     null_covariance: np.ndarray | None = None
-    shared_covariance: np.ndarray | None = None
+    spread_covariance: np.ndarray | None = None
 
     @property
     def sd(self) -> np.ndarray:
-        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad), without the shared part."""
+        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad), the ``1/N`` part."""
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def variance_terms(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(per_stride, shared)`` variances (6,): for ``N`` strides ``per_stride / N + shared``."""
-        shared = np.zeros(6) if self.shared_covariance is None else np.diag(self.shared_covariance)
-        return np.clip(np.diag(self.covariance), 0.0, None), np.clip(shared, 0.0, None)
+        """``(a, b)`` variances (6,): for ``N`` strides the variance is ``a / N + b / N^2``."""
+        spread = np.zeros(6) if self.spread_covariance is None else np.diag(self.spread_covariance)
+        return np.clip(np.diag(self.covariance), 0.0, None), np.clip(spread, 0.0, None)
 
     def sd_of(self, n_strides: int) -> np.ndarray:
         """Predicted SD (6,) of K and D for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
-        per_stride, shared = self.variance_terms()
-        return np.sqrt(per_stride / int(n_strides) + shared)
+        a, b = self.variance_terms()
+        n = int(n_strides)
+        return np.sqrt(a / n + b / n**2)
 
     def t95(self, n_strides: int) -> float:
         """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof;
@@ -411,13 +412,15 @@ def conditional_stride_covariance(
     ``impedance`` and ``V`` = :func:`~loper_analysis.identification.cross_validated_covariance`
     of ``E0`` for one stride, white stride noise of variance ``s^2`` gives
     ``V = s^2 v`` (``v`` the unit scatter variance), and the mean of ``N``
-    predicted pairs has ``s^2 ((1 + tr Sigma) / N + |mu|^2)``
+    predicted pairs has ``s^2 (1 / N + |mu|^2 + tr Sigma / N)``
     (:func:`loper_analysis.responses.conditional.shared_weight_terms` of the
-    pilot's perturbed pairs' weights): ``covariance = V (1 + tr Sigma) / v``
-    per stride and ``shared_covariance = V |mu|^2 / v``, the fit's own
-    interval (``cross_validated_null_pairs``, t with ``M - 1`` degrees of
-    freedom) for a planned experiment with as many candidates as the pilot's
-    trials at the onset.
+    pilot's ``P`` perturbed pairs' weights over its candidates). The planned
+    experiment perturbs at the pilot's rate, so its candidates grow with
+    ``N`` and both weight terms, about inversely proportional to the
+    candidates, scale by ``P / N``: ``covariance = V (1 + P |mu|^2) / v``
+    per stride and ``spread_covariance = V P tr Sigma / v``. At ``N = P``
+    this is the pilot fit's own interval (``cross_validated_null_pairs``, t
+    with ``M - 1`` degrees of freedom).
 
     Raises
     ------
@@ -458,7 +461,7 @@ def conditional_stride_covariance(
     unit = float(null["unit_scatter_variance"])
     mu2, spread = shared_weight_terms(pairs["prediction_weights"])
     return StrideCovariance(
-        V * (1.0 + spread) / unit,
+        V * (1.0 + n_pert * mu2) / unit,
         p,
         n_null - 1,
         n_null,
@@ -466,7 +469,7 @@ def conditional_stride_covariance(
         n_pert,
         "cross_validated_null_pairs",
         None,
-        V * mu2 / unit,
+        V * n_pert * spread / unit,
     )
 
 
@@ -538,7 +541,7 @@ def precision_table(
 ) -> pd.DataFrame:
     """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
 
-    ``predicted_sd = sqrt(sd_1^2 / N + shared)`` (:meth:`StrideCovariance.sd_of`) and
+    ``predicted_sd = sqrt(sd_1^2 / N + b / N^2)`` (:meth:`StrideCovariance.sd_of`) and
     ``ci95_half_width = t * predicted_sd``
     (Student's t at 97.5 % with the fit's degrees of freedom,
     :meth:`StrideCovariance.t95`: ``N - 1`` by default), both in ``unit``;
@@ -614,11 +617,9 @@ def strides_needed(
     Give either ``percent`` (of the planned value, e.g. 15 for +-15 %) or
     ``half_width`` (absolute, N·m/rad or N·m·s/rad): the smallest ``N`` with
     ``t_N sd_1 / sqrt(N) <= target`` (``t_N`` :meth:`StrideCovariance.t95`;
-    with a fixed t, ``N = ceil((t sd_1 / target)^2)``). With a shared part
-    (the conditional counterfactual) the fixed t gives
-    ``N = ceil(sd_1^2 / ((target / t)^2 - shared))``; a target at or below
-    ``t sqrt(shared)`` no number of strides reaches (more than
-    :data:`MAX_ANSWERED_STRIDES`).
+    with a fixed t, ``N = ceil((t sd_1 / target)^2)``). With a ``1/N^2``
+    part ``b`` (the conditional counterfactual) and a fixed t, the smallest
+    ``N`` with ``t^2 (sd_1^2 / N + b / N^2) <= target^2``.
     """
     if joint not in JOINTS:
         raise LoperInputError(f"target joint must be one of {JOINTS}, got {joint!r}")
@@ -643,12 +644,11 @@ def strides_needed(
         if target <= 0:
             raise LoperInputError(f"target half_width must be > 0, got {target:g}")
     sd1 = float(stride_cov.sd[i])
-    if stride_cov.shared_covariance is not None and stride_cov.dof is not None:
-        per_stride, shared = (float(v[i]) for v in stride_cov.variance_terms())
-        room = (target / stride_cov.t95(2)) ** 2 - shared
-        if room <= 0:
-            return MAX_ANSWERED_STRIDES + 1
-        return max(1, int(math.ceil(per_stride / room * (1 - 1e-12))))
+    if stride_cov.spread_covariance is not None and stride_cov.dof is not None:
+        a, b = (float(v[i]) for v in stride_cov.variance_terms())
+        c = (target / stride_cov.t95(2)) ** 2
+        n = int(math.ceil((a + math.sqrt(a * a + 4.0 * b * c)) / (2.0 * c) * (1 - 1e-12)))
+        return max(1, n)
 
     def meets(n: int) -> bool:
         return stride_cov.t95(n) * sd1 / math.sqrt(n) <= target * (1 + 1e-12)
