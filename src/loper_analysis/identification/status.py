@@ -5,11 +5,12 @@ Rules (``docs/identification.md``, section "Fit status"), judged in this order:
 1. the optimiser did not converge: ``failed``;
 2. the joint's VAF is below ``min_vaf_pct`` (or undefined, a response of
    zero): ``failed`` - the model does not describe the measured response;
-3. K or D lies on its upper bound, or on a lower bound above zero (within
+3. K or D lies on its upper bound, or on a lower bound other than zero (within
    ``at_bound_fraction`` of the bound range): ``not_identifiable`` - the
    data ask for a value the bounds exclude, and the estimate is the bound;
-4. the 95 % interval of K or D reaches its lower bound (0: the data cannot
-   tell the estimate from no stiffness or damping at all) *and* its upper
+4. the 95 % interval of K or D reaches 0, or its lower bound when that is
+   above 0 (the data cannot tell the estimate from no stiffness or damping
+   at all) *and* its upper
    end reaches the upper end of the joint's plausible range
    (``plausible_range``; by default the study's range of across-subject
    means, :data:`DEFAULT_PLAUSIBLE_RANGES`): the interval holds "none" and
@@ -154,11 +155,12 @@ def joint_status(
         if plausible is None or np.isnan(low[i]) or np.isnan(high[i]):
             continue
         r_low, r_high = plausible[i]
-        if low[i] <= lb[i] + at_bound_fraction * span[i] and high[i] >= r_high:
+        floor = max(lb[i], 0.0)  # none at all, or the least the bounds allow
+        if low[i] <= floor + at_bound_fraction * span[i] and high[i] >= r_high:
             unidentifiable.append(
                 f"{p}_{joint} = {est[i]:.3g} {unit}, 95 % CI {low[i]:.3g} … {high[i]:.3g} {unit}: holds both "
-                f"{lb[i]:g} and the plausible range {r_low:g}–{r_high:g} {unit} (identification.plausible_ranges), "
-                f"the data cannot tell the {what} from {lb[i]:g}"
+                f"{floor:g} and the plausible range {r_low:g}–{r_high:g} {unit} (identification.plausible_ranges), "
+                f"the data cannot tell the {what} from {floor:g}"
             )
     if not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
         unidentifiable.append(
