@@ -154,6 +154,23 @@ def test_summary_leaves_out_estimates_on_an_upper_bound():
     assert impedance_summary(table, upper_bounds=(200.0, 0.1)).empty  # every D on its bound: nothing left
 
 
+def test_summary_cuts_the_group_interval_at_the_lower_bound():
+    """Knee K -0.6, 0.2, 0.1 N·m/rad (SE 0.5 each; signed bounds): the random-effects mean -0.1 and its interval
+    stay below 0 with a lower bound of -20, and are cut at 0 with the default bound (the fits' own rule)."""
+    rows = [
+        status_rows(s, 175, "ok", "").assign(
+            K_nm_per_rad=k, D_nms_per_rad=0.1, K_se_nm_per_rad=0.5, D_se_nms_per_rad=0.05, vaf_pct=99.0
+        )
+        for s, k in (("S01", -0.6), ("S02", 0.2), ("S03", 0.1))
+    ]
+    table = pd.concat(rows, ignore_index=True)
+    signed = impedance_summary(table, lower_bounds=(-20.0, -1.0)).set_index("joint").loc["knee"]
+    assert signed.K_group_mean_nm_per_rad == pytest.approx(-0.1)
+    assert signed.K_group_ci95_low_nm_per_rad < -0.1 < signed.K_group_ci95_high_nm_per_rad
+    clipped = impedance_summary(table).set_index("joint").loc["knee"]
+    assert clipped.K_group_ci95_low_nm_per_rad == 0.0 and clipped.K_group_mean_nm_per_rad == pytest.approx(-0.1)
+
+
 def test_summary_keeps_uninformative_rows_and_counts_them():
     """Knee D 0.10, 0.12 (ok) and 0.01 whose interval 0 ... 0.3 holds 0 and the study's range (not_identifiable):
     the mean stays (0.10 + 0.12 + 0.01) / 3 = 0.0767, not the 0.11 of the informative rows alone, and the count

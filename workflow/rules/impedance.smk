@@ -72,6 +72,7 @@ rule impedance_summary:
         "results/benchmarks/impedance_summary/summary.tsv"
     params:
         upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
+        lower_bounds=(IDENT["stiffness_bounds_nm_per_rad"][0], IDENT["damping_bounds_nms_per_rad"][0]),
     script:
         "../scripts/impedance_summary.py"
 

@@ -569,6 +569,7 @@ def impedance_summary(
     k_tolerance=TRUTH_TOLERANCE["K"],
     d_tolerance=TRUTH_TOLERANCE["D"],
     upper_bounds: tuple[float, float] | None = None,
+    lower_bounds: tuple[float, float] = (0.0, 0.0),
 ) -> pd.DataFrame:
     """Across-subject summary per joint and onset of the fitted rows (``ok`` and ``not_identifiable``).
 
@@ -576,6 +577,10 @@ def impedance_summary(
     upper bounds): rows whose K or D sits on its upper bound (within
     :data:`~loper_analysis.identification.AT_BOUND_FRACTION` of the bound)
     carry no estimate and are left out; None keeps every fitted row.
+    ``lower_bounds`` (K, D; the identification's lower bounds): the
+    random-effects intervals are cut there, as the fits' own intervals are
+    (at 0 by default, the physical limit; a negative bound leaves negative
+    means and intervals, ``docs/identification.md``).
 
     Rows that are ``not_identifiable`` because an interval holds 0 and the
     whole plausible range stay in: their estimate is still the fit's best
@@ -584,9 +589,9 @@ def impedance_summary(
     made mostly of uninformative fits shows as such.
 
     Columns ``joint, onset_ms, n_subjects, n_not_identifiable``, then per parameter its mean, SD,
-    min and max over subjects (``K_mean_nm_per_rad`` ...); the random-effects mean with its 95 % interval,
-    (cut at 0, as the fits' intervals are), which carries each fit's own standard error and the between-subject
-    spread
+    min and max over subjects (``K_mean_nm_per_rad`` ...); the random-effects mean with its 95 % interval
+    (cut at the lower bound, as the fits' intervals are), which carries each fit's own standard error and the
+    between-subject spread
     (:func:`loper_analysis.identification.group_mean.random_effects_mean`: ``K_group_mean_nm_per_rad``,
     ``K_group_ci95_low_nm_per_rad``, ``K_group_ci95_high_nm_per_rad``, ``K_between_sd_nm_per_rad``);
     ``vaf_pct_mean``; where the truth is known also the mean error, the largest absolute error, the
@@ -620,14 +625,14 @@ def impedance_summary(
                     parameter_column(p, "max"): v.max(),
                 }
             )
-        for p in ("K", "D"):
+        for p, floor in zip(("K", "D"), lower_bounds, strict=True):
             estimates, errors = (g[parameter_column(p, w)].to_numpy(float) for w in ("", "se"))
             group = random_effects_mean(estimates, errors)
             row.update(
                 {
                     parameter_column(p, "group_mean"): group.mean,
-                    # cut at 0, the parameters' physical limit, as the fits' own intervals are
-                    parameter_column(p, "group_ci95_low"): max(group.ci95_low, 0.0)
+                    # cut at the lower bound (0: the parameters' physical limit), as the fits' own intervals are
+                    parameter_column(p, "group_ci95_low"): max(group.ci95_low, float(floor))
                     if not np.isnan(group.ci95_low)
                     else group.ci95_low,
                     parameter_column(p, "group_ci95_high"): group.ci95_high,

@@ -237,15 +237,19 @@ def impedance_summary(
     summary_out: PathLike,
     literature_out: PathLike,
     upper_bounds: tuple[float, float] | None = None,
+    lower_bounds: tuple[float, float] = (0.0, 0.0),
 ) -> pd.DataFrame:
     """Across-subject summary per joint and onset and the literature table with our row.
 
-    ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary.
+    ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary;
+    ``lower_bounds`` (K, D): where the across-subject intervals are cut (N·m/rad, N·m·s/rad).
     """
     from loper_analysis.identification.impedance import impedance_summary as summarise
     from loper_analysis.identification.impedance import literature_table
 
-    summary = summarise(read_tsv(impedance_tsv, "impedance table"), upper_bounds=upper_bounds)
+    summary = summarise(
+        read_tsv(impedance_tsv, "impedance table"), upper_bounds=upper_bounds, lower_bounds=lower_bounds
+    )
     write_tsv(summary, summary_out)
     write_tsv(literature_table(summary), literature_out)
     log.info("summary:\n%s", summary.to_string(index=False))
