@@ -333,7 +333,8 @@ def _plan(args: argparse.Namespace) -> None:
     table, answers = plan(files, subject, settings, args.out, impedance=values)
     shown = table[list(PLAN_COLUMNS[PLAN_COLUMNS.index("onset_ms") : PLAN_COLUMNS.index("ci95_half_width_pct") + 1])]
     print(
-        f"pilot {subject} ({len(names)} trials with the device; null pairs: "
+        f"pilot {subject} ({len(names)} trials with the device; {settings.response.counterfactual.replace('_', ' ')} "
+        "counterfactual; null pairs: "
         f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_null_pairs'].first())}; perturbed pairs: "
         f"{', '.join(str(n) for n in table.groupby('onset_ms')['n_perturbed_pairs'].first())}); "
         f"pulse {settings.plan.pulse_force_n:g} N for {settings.plan.pulse_duration_s:g} s"
@@ -619,7 +620,8 @@ def _parser() -> argparse.ArgumentParser:
         "highest priority first: (1) options given here; (2) the config: config/config.yaml of the "
         "working directory with each --configfile over it, as Snakemake layers them (onsets: "
         "trials.perturbation_onsets_ms; strides, targets, pulse and pilot: planning.*; fit window, "
-        "initial state, bounds and null pairs: identification.*; outliers: strides.iqr_whisker, "
+        "initial state, bounds, null pairs and the counterfactual planned for: identification.*; outliers: "
+        "strides.iqr_whisker, "
         "strides.max_outlier_fraction; device: device.parameters; excluded trial: trials.no_device; "
         "subject sheet: subjects); (3) without any config file, the library's defaults (said in the "
         "first line printed, which names the config file(s) used).",
