@@ -408,8 +408,7 @@ def subject_onset_response(
         series["null_pairs"] = conditional_null_pair_windows(null, grid, before, after, null_keep)
         series["null_pairs"]["unit_scatter_variance"] = unit_scatter_variance(null["weights"], null_keep)
         if n_pairs:
-            pair_series["prediction_weights"] = conditional["weights"][keep]
-            kept_weights = conditional["weights"][keep]
+            kept_weights = pair_series["prediction_weights"] = conditional["weights"][keep]
             pair_series["covariance_scale"] = covariance_scale(kept_weights)
             series["null_pairs"]["covariance_scale"] = covariance_scale(kept_weights, null["weights"], null_keep)
     series.update(
