@@ -3,6 +3,7 @@
 Usage: nice -n 10 python benchmarks/planner_check.py [--repeats 60] [--onset-ms 50] [--strides 10 40] [--seed 2024]
                                                      [--variability study|gentle]
                                                      [--counterfactual conditional|matched_stride]
+                                                     [--pilots-from-repeats]
 
 A pilot experiment (one synthetic trial with the device, perturbed at the onset every 3-5 strides, built at
 the coordinate level by :func:`loper_analysis.synthetic.coordinate_trials.perturbation_experiment`: no markers, no IK;
@@ -26,6 +27,11 @@ its N-th perturbed stride, so its candidates (the unperturbed strides of the cut
 planner assumes; the prediction for the repeats is the mean of ``sd_of(n_i)^2`` over them. Repeats whose fit
 fails or falls back to the matched stride (fewer than ``identification.min_null_pairs`` candidates) are left
 out and listed.
+
+``--pilots-from-repeats``: one pilot is one draw. Every kept repeat also plans exactly as the pilot does (from
+its whole trial and its fit of all its perturbed strides, one more prediction per repeat); the table gains
+``pilots``, the 5th, 50th and 95th percentiles of their predictions over the measured SD and the share of
+them within ±25 % of it (each pilot is also one of the repeats whose SD is measured).
 """
 
 from __future__ import annotations
@@ -42,6 +48,7 @@ import yaml
 from scipy.stats import t as student_t
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
+from loper_analysis.errors import LoperInputError
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
 from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL, pilot_onset_series
 from loper_analysis.planning.precision import (
@@ -82,6 +89,27 @@ def reported_sd(rows: pd.DataFrame) -> np.ndarray:
     return (high - estimates(rows)) / student_t.ppf(0.975, int(rows["ci_dof"].iloc[0]))
 
 
+def pilot_spread(ratios: np.ndarray) -> dict:
+    """Columns for the predictions of many pilots over the measured SD (``ratios`` (n,)): their count, 5th,
+    50th and 95th percentiles and the share within ±25 % (NaN without pilots)."""
+    if ratios.size == 0:
+        return {
+            "pilots": 0,
+            **{
+                c: np.nan
+                for c in ("pilots_ratio_p05", "pilots_ratio_median", "pilots_ratio_p95", "pilots_within_25pct")
+            },
+        }
+    p05, p50, p95 = np.percentile(ratios, [5, 50, 95])
+    return {
+        "pilots": int(ratios.size),
+        "pilots_ratio_p05": p05,
+        "pilots_ratio_median": p50,
+        "pilots_ratio_p95": p95,
+        "pilots_within_25pct": float(np.mean(np.abs(ratios - 1.0) <= 0.25)),
+    }
+
+
 def lab(variability: str, seed: int, onset_ms: int, truth) -> dict:
     """Keyword arguments of perturbation_experiment for the lab's variability (config ``synthetic``)."""
     syn = yaml.safe_load((ROOT / "config/config.yaml").read_text())["synthetic"]
@@ -102,8 +130,13 @@ def run_check(
     angle_noise_sd_rad: float = ANGLE_NOISE_SD_RAD,
     variability: str | None = None,
     counterfactual: str = PLANNED_COUNTERFACTUAL,
+    pilots_from_repeats: bool = False,
 ) -> pd.DataFrame:
-    """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D)."""
+    """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D).
+
+    With ``pilots_from_repeats`` every kept repeat also plans as the pilot does (from its whole trial and its
+    fit of all its perturbed strides), and the rows gain the spread of those predictions over the measured SD
+    (:func:`pilot_spread`)."""
     truth = TRUTH[onset_ms] if truth is None else truth
     params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
     conditional = counterfactual == "conditional"
@@ -120,19 +153,26 @@ def run_check(
         )
         return full, cut
 
+    def plan_from(full, fit_rows):
+        """The planner's (prediction, null pairs' prediction) from one experiment and its fit of all strides."""
+        planned = np.clip(estimates(fit_rows), ident.lower, ident.upper)
+        if conditional:
+            sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned)
+            return sc, sc
+        null = null_pair_windows([full], onset_ms, response, source="pilot")
+        pairs = pilot_perturbed_pairs([full], onset_ms, response)
+        plan = PlanSettings(interval_scatter="perturbed_pairs")
+        return (
+            stride_covariance(null, params, planned, plan, perturbed_pairs=pairs),
+            stride_covariance(null, params, planned, plan),
+        )
+
     # the pilot: its null pairs, and its fit of all its perturbed strides as the planned impedance
     full, cut = experiment(0)
     pilot_fit = fit_onset([cut[max(counts)]], params, onset_ms, "pilot", None, [full], response, ident)
     planned = np.clip(estimates(pilot_fit.rows), ident.lower, ident.upper)
-    if conditional:
-        sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned)
-        sc_null = sc
-    else:
-        null = null_pair_windows([full], onset_ms, response, source="pilot")
-        pairs = pilot_perturbed_pairs([full], onset_ms, response)
-        plan = PlanSettings(interval_scatter="perturbed_pairs")
-        sc = stride_covariance(null, params, planned, plan, perturbed_pairs=pairs)
-        sc_null = stride_covariance(null, params, planned, plan)
+    sc, sc_null = plan_from(full, pilot_fit.rows)
+    repeat_plans = []  # with pilots_from_repeats: each kept repeat's own plan, as if it had been the pilot
     found = {n: [] for n in counts}
     kept = {n: [] for n in counts}
     reported = {n: [] for n in counts}
@@ -155,6 +195,11 @@ def run_check(
         if unlike:  # not fitted, or fitted another way than planned: the repeat is left out and counted
             skipped += unlike
             continue
+        if pilots_from_repeats:
+            try:
+                repeat_plans.append(plan_from(full, fits[max(counts)].rows)[0])
+            except LoperInputError as exc:  # a repeat that cannot be planned from: counted, its fits kept
+                skipped.append(f"repeat {k} as a pilot: {exc}")
         for n, fit in fits.items():
             found[n].append(estimates(fit.rows))
             kept[n].append(int(fit.rows["n_strides"].iloc[0]))
@@ -171,6 +216,10 @@ def run_check(
         predicted = np.sqrt(np.mean([sc.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         predicted_null = np.sqrt(np.mean([sc_null.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         fits_say = np.sqrt(np.mean(np.array(reported[n]) ** 2, axis=0))
+        # every repeat as the pilot: its prediction for the same repeats over the measured SD
+        pilot_ratios = np.array(
+            [np.sqrt(np.mean([r.sd_of(int(m)) ** 2 for m in n_kept], axis=0)) / measured for r in repeat_plans]
+        ).reshape(-1, 6)
         # 95 % range of a sample SD over `repeats` normal draws, relative
         rel = 1.96 / np.sqrt(2.0 * (len(est) - 1))
         for i, name in enumerate(PARAMETERS):
@@ -193,6 +242,7 @@ def run_check(
                     "measured_sd_95_high": measured[i] * (1 + rel),
                     "ratio_predicted_to_measured": predicted[i] / measured[i],
                     "repeats": len(est),
+                    **pilot_spread(pilot_ratios[:, i]),
                 }
             )
     out = pd.DataFrame(rows)
@@ -224,6 +274,11 @@ def main() -> None:
         default=PLANNED_COUNTERFACTUAL,
         help="plan and fit with this counterfactual (default: the study's matched stride)",
     )
+    ap.add_argument(
+        "--pilots-from-repeats",
+        action="store_true",
+        help="every repeat also plans as the pilot: the spread of the predictions over pilots",
+    )
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     logging.disable(logging.WARNING)
@@ -236,6 +291,7 @@ def main() -> None:
         angle_noise_sd_rad=args.angle_noise_sd_rad,
         variability=args.variability,
         counterfactual=args.counterfactual,
+        pilots_from_repeats=args.pilots_from_repeats,
     )
     print(
         f"{args.counterfactual}, onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, "
@@ -254,6 +310,13 @@ def main() -> None:
         f"{worst['n_strides']} strides); "
         f"within ±25 %: {bool(((hk['ratio_predicted_to_measured'] - 1).abs() <= 0.25).all())}"
     )
+    if args.pilots_from_repeats:
+        cells = hk[["joint", "parameter", "n_strides", "pilots_ratio_p05", "pilots_ratio_median", "pilots_ratio_p95"]]
+        print(
+            f"every repeat as the pilot ({int(hk['pilots'].min())} pilots): hip and knee predictions within ±25 % "
+            f"of the measured SD in {hk['pilots_within_25pct'].mean():.0%} of pilot x cell; per cell:"
+        )
+        print(markdown_table(cells.round(2)))
 
 
 if __name__ == "__main__":
