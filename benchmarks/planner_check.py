@@ -24,7 +24,10 @@ and fits with the conditional counterfactual instead: the prediction is
 pairs and its perturbed strides' prediction weights), the fits are the pipeline's defaults (averaging term,
 intervals from the cross-validated null pairs); as for the matched stride each repeat is its trial cut after
 its N-th perturbed stride, so its candidates (the unperturbed strides of the cut trial) grow with N, as the
-planner assumes; the prediction for the repeats is the mean of ``sd_of(n_i)^2`` over them. Repeats whose fit
+planner assumes; the prediction for the repeats is the mean of ``sd_of(n_i)^2`` over them. For a count N the
+pilot holds at least twice, the workflow's plan and this prediction come from the pilot's stretches of N perturbed
+strides (:func:`loper_analysis.planning.precision.stretch_covariances`; ``predicted_from`` says which, and
+``whole_pilot_predicted_sd`` gives the whole pilot's extrapolation beside it). Repeats whose fit
 fails or falls back to the matched stride (fewer than ``identification.min_null_pairs`` candidates) are left
 out and listed.
 
@@ -55,6 +58,7 @@ from loper_analysis.planning.precision import (
     PlanSettings,
     conditional_stride_covariance,
     pilot_perturbed_pairs,
+    stretch_covariances,
     stride_covariance,
 )
 from loper_analysis.report.markdown import markdown_table
@@ -154,24 +158,27 @@ def run_check(
         return full, cut
 
     def plan_from(full, fit_rows):
-        """The planner's (prediction, null pairs' prediction) from one experiment and its fit of all strides."""
+        """The planner's (prediction, null pairs' prediction, {count: prediction from the pilot's stretches})
+        from one experiment and its fit of all strides."""
         planned = np.clip(estimates(fit_rows), ident.lower, ident.upper)
         if conditional:
             sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned)
-            return sc, sc
+            by_count = stretch_covariances([full], onset_ms, counts, params, planned, response=response)
+            return sc, sc, by_count
         null = null_pair_windows([full], onset_ms, response, source="pilot")
         pairs = pilot_perturbed_pairs([full], onset_ms, response)
         plan = PlanSettings(interval_scatter="perturbed_pairs")
         return (
             stride_covariance(null, params, planned, plan, perturbed_pairs=pairs),
             stride_covariance(null, params, planned, plan),
+            {},
         )
 
     # the pilot: its null pairs, and its fit of all its perturbed strides as the planned impedance
     full, cut = experiment(0)
     pilot_fit = fit_onset([cut[max(counts)]], params, onset_ms, "pilot", None, [full], response, ident)
     planned = np.clip(estimates(pilot_fit.rows), ident.lower, ident.upper)
-    sc, sc_null = plan_from(full, pilot_fit.rows)
+    sc, sc_null, by_count = plan_from(full, pilot_fit.rows)
     repeat_plans = []  # with pilots_from_repeats: each kept repeat's own plan, as if it had been the pilot
     found = {n: [] for n in counts}
     kept = {n: [] for n in counts}
@@ -197,7 +204,8 @@ def run_check(
             continue
         if pilots_from_repeats:
             try:
-                repeat_plans.append(plan_from(full, fits[max(counts)].rows)[0])
+                plan_k = plan_from(full, fits[max(counts)].rows)
+                repeat_plans.append((plan_k[0], plan_k[2]))
             except LoperInputError as exc:  # a repeat that cannot be planned from: counted, its fits kept
                 skipped.append(f"repeat {k} as a pilot: {exc}")
         for n, fit in fits.items():
@@ -213,12 +221,16 @@ def run_check(
         measured = est.std(axis=0, ddof=1)
         # robust: 1.4826 x the median absolute deviation (the SD for normal estimates; deaf to a few wild fits)
         robust = 1.4826 * np.median(np.abs(est - np.median(est, axis=0)), axis=0)
-        predicted = np.sqrt(np.mean([sc.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
+        whole = np.sqrt(np.mean([sc.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
+        predicted = np.sqrt(np.mean([by_count.get(n, sc).sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         predicted_null = np.sqrt(np.mean([sc_null.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         fits_say = np.sqrt(np.mean(np.array(reported[n]) ** 2, axis=0))
         # every repeat as the pilot: its prediction for the same repeats over the measured SD
         pilot_ratios = np.array(
-            [np.sqrt(np.mean([r.sd_of(int(m)) ** 2 for m in n_kept], axis=0)) / measured for r in repeat_plans]
+            [
+                np.sqrt(np.mean([by.get(n, r).sd_of(int(m)) ** 2 for m in n_kept], axis=0)) / measured
+                for r, by in repeat_plans
+            ]
         ).reshape(-1, 6)
         # 95 % range of a sample SD over `repeats` normal draws, relative
         rel = 1.96 / np.sqrt(2.0 * (len(est) - 1))
@@ -234,6 +246,8 @@ def run_check(
                     "planned": planned[i],
                     "mean_estimate": est[:, i].mean(),
                     "predicted_sd": predicted[i],
+                    "predicted_from": "stretches" if n in by_count else "whole_pilot",
+                    "whole_pilot_predicted_sd": whole[i],
                     "null_pairs_predicted_sd": predicted_null[i],
                     "fits_reported_sd": fits_say[i],
                     "measured_sd": measured[i],

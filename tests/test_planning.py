@@ -39,7 +39,7 @@ from loper_analysis.identification import (
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
 from loper_analysis.identification.intervals import t_quantile
 from loper_analysis.io.atomic import write_tsv
-from loper_analysis.planning.inputs import pilot_onset_series
+from loper_analysis.planning.inputs import pilot_onset_series, trial_stretches
 from loper_analysis.planning.precision import (
     MIN_PERTURBED_PAIRS,
     PlanSettings,
@@ -50,6 +50,7 @@ from loper_analysis.planning.precision import (
     pool_onsets,
     precision_table,
     pulse_force_n,
+    stretch_covariances,
     stride_covariance,
     strides_needed,
     target_answer,
@@ -336,7 +337,9 @@ def pilot_results(tmp_path_factory, params, pilot):
     return root
 
 
-def test_plan_command_answers_the_target(pilot_results, params, conditional_series, tmp_path, capsys, monkeypatch):
+def test_plan_command_answers_the_target(
+    pilot_results, pilot, params, conditional_series, tmp_path, capsys, monkeypatch
+):
     monkeypatch.chdir(tmp_path)  # no config/config.yaml here: the library's defaults (onsets of the impedance rows)
     out = tmp_path / "plan.tsv"
     code = main(
@@ -365,9 +368,15 @@ def test_plan_command_answers_the_target(pilot_results, params, conditional_seri
     assert len(table) == 12 and set(table["n_strides"]) == {10, 40} and set(table["onset_ms"]) == {50}
     # the library's default: the conditional counterfactual, planned from the onset's own strides
     sc = conditional_stride_covariance(conditional_series, params, TRUTH)
-    expected = precision_table(sc, [10, 40], ONSET_MS, "S09")
+    # 10 strides: the pilot holds them four times over; its stretches of 10 plan for them
+    full = {"name": "pert050-1", "angles": pilot[0]["angles"], "strides": pilot[0]["strides"]}
+    by_count = stretch_covariances([full], ONSET_MS, [10, 40], params, TRUTH)
+    assert set(by_count) == {10}
+    expected = precision_table(sc, [10, 40], ONSET_MS, "S09", by_count=by_count)
     assert (table["scatter"] == "cross_validated_null_pairs").all()
-    assert (table["n_perturbed_pairs"] == conditional_series["pairs"]["n_pairs"]).all()
+    at_40 = table["n_strides"] == 40
+    assert (table.loc[at_40, "n_perturbed_pairs"] == conditional_series["pairs"]["n_pairs"]).all()
+    assert table.loc[~at_40, "note"].str.startswith("mean over 4 stretches of the pilot holding 10").all()
     # the pilot's tables went through TSV files (9 significant digits) on the way in
     np.testing.assert_allclose(table["predicted_sd"], expected["predicted_sd"], rtol=2e-4)
     n = strides_needed(sc, "hip", "D", percent=15)
@@ -523,3 +532,52 @@ def test_conditional_strides_needed_is_the_smallest_count_that_meets_the_target(
         n = strides_needed(sc, joint, parameter, percent=15)
         assert sc.half_width(n)[i] <= target * (1 + 1e-9) and (n == 1 or sc.half_width(n - 1)[i] > target)
         assert f"needs {n} perturbed strides" in target_answer(sc, joint, parameter, ONSET_MS, percent=15)
+
+
+def test_trial_stretches_hold_the_planned_perturbed_strides():
+    """Strides of 1 s, perturbed 1, 3, 5, 7 and 9: stretches of 2 end before the heel strikes of strides 5 and 9;
+    5 in one stretch is the whole trial; 6 none."""
+    strides = pd.DataFrame(
+        {
+            "heel_strike_s": np.arange(12.0),
+            "end_s": np.arange(12.0) + 1.0,
+            "perturbed": np.isin(np.arange(12), [1, 3, 5, 7, 9]),
+        }
+    )
+    trial = {"name": "T", "angles": pd.DataFrame({"time_s": np.arange(0, 1201) / 100.0}), "strides": strides}
+    two = trial_stretches(trial, 2)
+    assert [s["name"] for s in two] == ["T [1/2]", "T [2/2]"]
+    assert two[0]["strides"]["heel_strike_s"].tolist() == [0, 1, 2, 3, 4]
+    assert two[1]["strides"]["heel_strike_s"].tolist() == [5, 6, 7, 8]
+    assert [int(s["strides"]["perturbed"].sum()) for s in two] == [2, 2]
+    assert two[0]["angles"]["time_s"].iloc[[0, -1]].tolist() == [0.0, 5.0]
+    assert two[1]["angles"]["time_s"].iloc[[0, -1]].tolist() == [5.0, 9.0]
+    (whole,) = trial_stretches(trial, 5)
+    assert len(whole["strides"]) == 12 and len(whole["angles"]) == 1201
+    assert trial_stretches(trial, 6) == []
+    with pytest.raises(LoperInputError, match="n_perturbed must be >= 1"):
+        trial_stretches(trial, 0)
+
+
+def test_a_stretch_holding_every_perturbed_stride_plans_as_the_whole_pilot(params, pilot, conditional_series):
+    """One stretch with all the pilot's perturbed strides is the pilot: the same covariance to 1e-9."""
+    full = pilot[0]
+    every = int(full["strides"]["perturbed"].sum())
+    whole = conditional_stride_covariance(conditional_series, params, TRUTH)
+    alone = stretch_covariances([full], ONSET_MS, [every], params, TRUTH, response=ResponseSettings(), min_stretches=1)
+    np.testing.assert_allclose(alone[every].sd_of(every), whole.sd_of(every), rtol=1e-9)
+    assert stretch_covariances([full], ONSET_MS, [every], params, TRUTH) == {}  # held once: planned from the whole
+
+
+def test_stretch_plan_is_the_mean_of_its_stretches_plans(params, pilot):
+    """The plan for 10 strides: the mean over the pilot's stretches of 10 of each stretch's own variance terms."""
+    full = pilot[0]
+    own = [
+        conditional_stride_covariance(pilot_onset_series([s], ONSET_MS, ResponseSettings()), params, TRUTH)
+        for s in trial_stretches(full, 10)
+    ]
+    planned = stretch_covariances([full], ONSET_MS, [10], params, TRUTH)[10]
+    for n in (10, 15):
+        expected = np.mean([c.sd_of(n) ** 2 for c in own], axis=0)
+        np.testing.assert_allclose(planned.sd_of(n) ** 2, expected, rtol=1e-12)
+    assert planned.n_null_pairs == round(np.mean([c.n_null_pairs for c in own]))

@@ -7,7 +7,10 @@
   perturbed pairs one by one and, with the conditional counterfactual, its
   unperturbed strides each predicted from the others;
 * :func:`pilot_perturbed_pairs` - the pilot's kept perturbed pairs at an onset,
-  one by one, whose scatter the prediction takes.
+  one by one, whose scatter the prediction takes;
+* :func:`trial_stretches` - a pilot trial cut into consecutive stretches that
+  each hold a planned number of perturbed strides: shorter experiments of
+  the planned size.
 
 Used by :mod:`loper_analysis.planning.precision` (method: ``docs/planning.md``).
 """
@@ -25,7 +28,7 @@ import pandas as pd
 from loper_analysis.checks import number
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs"]
+__all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs", "trial_stretches"]
 
 #: The counterfactual the planner predicts for when none is given: the study's matched stride, whose pairs' scatter
 #: the prediction scales (``docs/planning.md``); the workflow plans for ``identification.counterfactual``.
@@ -150,3 +153,49 @@ def pilot_perturbed_pairs(
         return None
     pairs = series["pairs"]
     return pairs if int(pairs["n_pairs"]) > 0 else None
+
+
+def trial_stretches(trial: Mapping, n_perturbed: int, *, side: str = "left") -> list[dict]:
+    """``trial`` cut into consecutive stretches that each hold ``n_perturbed`` perturbed strides.
+
+    ``trial``: ``name``, ``angles`` (with ``time_s``) and ``strides`` (the
+    stride table of ``side``: ``heel_strike_s``, ``end_s``, ``perturbed``).
+    Stretch ``j`` starts at the heel strike of perturbed stride ``j * n``
+    (the first at the trial's first stride) and ends before that of stride
+    ``(j + 1) * n`` (the last at the trial's end when no stride follows); it
+    keeps the strides that lie wholly inside it, their stride-table rows
+    unchanged (outlier flags included), and the angle frames from its first
+    heel strike to its last stride's end. Perturbed strides
+    after the last whole stretch are left out. Each stretch is a trial with
+    ``name`` (``"{name} [j/k]"``), ``angles`` and ``strides`` (what
+    :func:`pilot_onset_series` reads); an empty list when the trial holds
+    fewer than ``n_perturbed`` perturbed strides.
+    """
+    n = int(n_perturbed)
+    if n < 1:
+        raise LoperInputError(f"{trial.get('name', 'trial')}: n_perturbed must be >= 1, got {n_perturbed!r}")
+    table = trial["strides"]
+    if "side" in table.columns:
+        table = table[table["side"] == side]
+    table = table.sort_values("heel_strike_s").reset_index(drop=True)
+    starts = table["heel_strike_s"].to_numpy(float)
+    pert = np.flatnonzero(table["perturbed"].to_numpy(bool))
+    k = pert.size // n
+    if k == 0:
+        return []
+    bounds = [-np.inf] + [starts[pert[j * n]] if j * n < pert.size else np.inf for j in range(1, k + 1)]
+    time_s = trial["angles"]["time_s"].to_numpy(float)
+    out = []
+    for j in range(k):
+        keep = (starts >= bounds[j]) & (table["end_s"].to_numpy(float) <= bounds[j + 1])
+        rows = table[keep].reset_index(drop=True)
+        first, last = float(rows["heel_strike_s"].min()), float(rows["end_s"].max())
+        frames = (time_s >= first - 1e-9) & (time_s <= last + 1e-9)
+        out.append(
+            {
+                "name": f"{trial['name']} [{j + 1}/{k}]",
+                "angles": trial["angles"][frames].reset_index(drop=True),
+                "strides": rows,
+            }
+        )
+    return out

@@ -27,6 +27,9 @@ needs.
 * :func:`conditional_stride_covariance` - the same for the conditional
   counterfactual, from the pilot's cross-validated null pairs as the fit's
   intervals take them, with the candidates' share that does not average out;
+* :func:`stretch_covariances` - for stride counts the pilot holds several
+  times over: the mean of that covariance over the pilot's stretches of the
+  planned size, each with only its own candidates;
 * :func:`pool_onsets` - the perturbed pairs' excess scatter pooled over the
   pilot's onsets (steadier than one onset's dozen pairs);
 * :func:`precision_table` - predicted SD and 95 % half-width per joint,
@@ -67,7 +70,7 @@ from loper_analysis.identification import (
     t_quantile,
     window_options,
 )
-from loper_analysis.planning.inputs import pilot_perturbed_pairs, pulse_force_n
+from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs, pulse_force_n, trial_stretches
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = [
@@ -76,6 +79,7 @@ __all__ = [
     "PlanSettings",
     "StrideCovariance",
     "conditional_stride_covariance",
+    "stretch_covariances",
     "pulse_force_n",
     "planning_window",
     "pilot_perturbed_pairs",
@@ -473,6 +477,83 @@ def conditional_stride_covariance(
     )
 
 
+def stretch_covariances(
+    trials: Sequence[Mapping],
+    onset_ms: float,
+    n_strides: Sequence[int],
+    params: SegmentParameters,
+    impedance,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    response=None,
+    source: str = "pilot",
+    min_stretches: int = 2,
+) -> dict[int, StrideCovariance]:
+    """``{N: covariance}`` for the conditional counterfactual from stretches of the pilot holding ``N`` strides.
+
+    A planned experiment of ``N`` perturbed strides is shorter than the
+    pilot, so it has fewer unperturbed candidates, and the fit's interval
+    depends on them not only through their number (the nuisance projection
+    and the ridge's penalty are estimated from them too). For every ``N``
+    the pilot's trials at ``onset_ms`` hold at least ``min_stretches`` times
+    (:func:`~loper_analysis.planning.inputs.trial_stretches`), each stretch
+    is planned alone (:func:`conditional_stride_covariance` of its own series
+    at ``impedance``) and the covariance is the mean over the stretches of
+    both its parts (``covariance`` and ``spread_covariance``): what the fit
+    of an ``N``-stride experiment reports, averaged over the pilot's
+    experiments of that size. Counts held fewer times are left out (plan them
+    with the whole pilot); a stretch that cannot be planned (too few
+    candidates or no perturbed stride kept) is skipped. ``response``: the
+    response settings (default :class:`~loper_analysis.responses.ResponseSettings`,
+    whose counterfactual must be ``conditional``).
+    """
+    from loper_analysis.responses import ResponseSettings
+
+    response = ResponseSettings() if response is None else response
+    if response.counterfactual != "conditional":
+        raise LoperInputError(
+            f"{source}: stretches of the pilot are planned for the conditional counterfactual, "
+            f"not {response.counterfactual!r}"
+        )
+    out = {}
+    for n in _counts(n_strides, source):
+        covs = []
+        for trial in trials:
+            for stretch in trial_stretches(trial, n):
+                series = pilot_onset_series([stretch], onset_ms, response, source=stretch["name"])
+                if series is None:
+                    continue
+                try:
+                    covs.append(conditional_stride_covariance(series, params, impedance, settings, device, source))
+                except LoperInputError:
+                    continue
+        if len(covs) >= max(int(min_stretches), 1):
+            out[n] = _mean_covariance(covs, n, settings.min_null_pairs)
+    return out
+
+
+def _mean_covariance(covs: Sequence[StrideCovariance], n: int, min_null_pairs: int) -> StrideCovariance:
+    spread = [c.spread_covariance if c.spread_covariance is not None else np.zeros((6, 6)) for c in covs]
+    notes = [f"mean over {len(covs)} stretches of the pilot holding {n} perturbed strides each"]
+    few = sum(c.n_null_pairs < min_null_pairs for c in covs)
+    if few:
+        notes.append(
+            f"{few} of them with fewer than identification.min_null_pairs = {min_null_pairs} null pairs: "
+            "a fit of that size would fall back to the matched stride"
+        )
+    return StrideCovariance(
+        np.mean([c.covariance for c in covs], axis=0),
+        covs[0].impedance,
+        min(c.dof for c in covs) if all(c.dof is not None for c in covs) else None,
+        int(round(np.mean([c.n_null_pairs for c in covs]))),
+        "; ".join(notes),
+        int(round(np.mean([c.n_perturbed_pairs for c in covs]))),
+        covs[0].scatter,
+        None,
+        np.mean(spread, axis=0),
+    )
+
+
 def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, StrideCovariance]:
     """The perturbed pairs' excess scatter pooled over the pilot's onsets (``{onset_ms: StrideCovariance}``).
 
@@ -538,8 +619,12 @@ def precision_table(
     onset_ms: float,
     subject: str = "",
     settings: PlanSettings = PlanSettings(),
+    by_count: Mapping[int, StrideCovariance] | None = None,
 ) -> pd.DataFrame:
     """Predicted SD and 95 % CI half-width per joint, parameter and stride count (columns :data:`PLAN_COLUMNS`).
+
+    ``by_count``: covariances for some stride counts (:func:`stretch_covariances`) that replace
+    ``stride_cov`` in those counts' rows.
 
     ``predicted_sd = sqrt(sd_1^2 / N + b / N^2)`` (:meth:`StrideCovariance.sd_of`) and
     ``ci95_half_width = t * predicted_sd``
@@ -555,8 +640,9 @@ def precision_table(
             i = 2 * j + k
             planned = float(stride_cov.impedance[i])
             for n in counts:
-                sd = float(stride_cov.sd_of(n)[i])
-                half = stride_cov.t95(n) * sd
+                sc = (by_count or {}).get(n, stride_cov)
+                sd = float(sc.sd_of(n)[i])
+                half = sc.t95(n) * sd
                 rows.append(
                     {
                         "subject": subject,
@@ -571,10 +657,10 @@ def precision_table(
                         "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
                         "pulse_force_n": float(settings.pulse_force_n),
                         "pulse_duration_s": float(settings.pulse_duration_s),
-                        "n_null_pairs": stride_cov.n_null_pairs,
-                        "n_perturbed_pairs": stride_cov.n_perturbed_pairs,
-                        "scatter": stride_cov.scatter,
-                        "note": stride_cov.note,
+                        "n_null_pairs": sc.n_null_pairs,
+                        "n_perturbed_pairs": sc.n_perturbed_pairs,
+                        "scatter": sc.scatter,
+                        "note": sc.note,
                     }
                 )
     return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))

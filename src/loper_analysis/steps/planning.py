@@ -6,7 +6,10 @@ strides at an onset give that onset's perturbed pairs), its segment table
 (or another subject's) and its impedance rows (the planned impedance): a
 :class:`PilotFiles` bundle. It writes the table of
 :func:`loper_analysis.planning.precision.precision_table` for every onset and
-the answers to the targets (method: ``docs/planning.md``), with the settings
+the answers to the targets (method: ``docs/planning.md``; with the conditional
+counterfactual, counts the pilot holds at least twice at an onset are planned
+from its stretches of that size,
+:func:`loper_analysis.planning.precision.stretch_covariances`), with the settings
 :class:`PlanningSettings`, which the rule ``planning`` and ``loper-analysis
 plan`` both build with :meth:`PlanningSettings.from_config`.
 """
@@ -252,6 +255,7 @@ def plan(
         pilot_perturbed_pairs,
         pool_onsets,
         precision_table,
+        stretch_covariances,
         stride_covariance,
         target_answer,
         unplanned_rows,
@@ -285,7 +289,7 @@ def plan(
             raise LoperInputError("planned impedance: give the pilot's impedance rows or the values")
         rows_table = pd.concat([read_tsv(f, "impedance rows") for f in impedance_tsvs], ignore_index=True)
     onsets_ms = settings.onsets_ms
-    planned, failed = {}, {}
+    planned, failed, by_count = {}, {}, {}
     for onset in onsets_ms:
         where = f"pilot {subject}, onset {onset:g} ms"
         try:
@@ -302,6 +306,9 @@ def plan(
                         "identification.counterfactual: matched_stride)"
                     )
                 planned[onset] = conditional_stride_covariance(series, params, values, plan_settings, dev, source=where)
+                by_count[onset] = stretch_covariances(
+                    pool, onset, counts, params, values, plan_settings, dev, response_settings, source=where
+                )
             else:
                 null = null_pair_windows(pool, onset, response_settings, source=subject, max_trial_ratio=ratio)
                 pairs = pilot_perturbed_pairs(pool, onset, response_settings, source=subject)
@@ -321,7 +328,7 @@ def plan(
             tables.append(failed[onset])
             continue
         sc = planned[onset]
-        tables.append(precision_table(sc, counts, onset, subject, plan_settings))
+        tables.append(precision_table(sc, counts, onset, subject, plan_settings, by_count.get(onset)))
         log.info(
             "pilot %s, onset %g ms: %d null pairs, %d perturbed pairs (scatter: %s); planned %s",
             subject,
