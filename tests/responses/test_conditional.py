@@ -113,6 +113,23 @@ def test_conditional_counterfactual_returns_the_planted_response_without_twins(r
     assert series["pairs"]["covariance_scale"] > 1.0
 
 
+def test_candidates_whose_swing_cannot_hold_the_window_are_left_out(rng):
+    # unperturbed strides with 40-frame swings: the window (onset 13 frames after toe-off + 0.25 s = 45 frames)
+    # runs into their next stance, as it would for a perturbed stride too short to keep. Left in the pool they
+    # would predict a kept stride's continuation from swings unlike it; left out, the planted response returns.
+    short = (1, 2, 3, 5, 9, 13, 20)
+    scale = {4: 1.0, 8: 1.1, 12: 1.3, 16: 0.8}
+    trial, _ = twin_trial(rng, twins={}, amplitudes={p: BUMP_AMP * a for p, a in scale.items()}, short=short)
+    grid = window_times_s(0.125, 0.25, RATE)
+    planted = bump(grid)[:, None] * BUMP_AMP * np.mean(list(scale.values()))
+    settings = ResponseSettings(min_strides=3, counterfactual="conditional")
+    response, counts, series = subject_onset_response([trial.inputs()], 100, settings)
+    measured = response[[f"{j}_rad_mean" for j in JOINTS]].to_numpy()
+    assert int(counts.iloc[-1]["n_kept"]) == 4
+    assert np.abs(measured - planted).max() < 1e-5
+    assert series["null_pairs"]["n_pairs"] == 26 - 4 - len(short)
+
+
 def test_unknown_counterfactual_is_refused():
     with pytest.raises(LoperInputError, match="identification.counterfactual.*'nearest'"):
         ResponseSettings(counterfactual="nearest")

@@ -213,13 +213,18 @@ class CandidatePool:
     rate_hz : float
         Grid rate (Hz).
     within_swing : bool
-        A candidate's window must end before its own heel strike.
+        A candidate's window must end before its own heel strike (default), as a perturbed stride's must
+        (:func:`loper_analysis.responses.matching.too_short`): the pool then holds the strides whose swing
+        could have held the window, as the kept perturbed strides' did. Without it, at a late onset the pool
+        mixes in shorter swings, whose windows run into the next stance, and the predictions of the kept
+        (longer) swings are biased.
 
     Candidates are the strides neither perturbed nor removed; at a given delay a candidate counts when its
-    window lies in one run of finite frames of every column (and inside the robot log).
+    window lies in one run of finite frames of every column (and inside the robot log) and, with
+    ``within_swing``, ends before its own heel strike.
     """
 
-    def __init__(self, trials, start_s: float, end_s: float, rate_hz: float, within_swing: bool = False):
+    def __init__(self, trials, start_s: float, end_s: float, rate_hz: float, within_swing: bool = True):
         self.grid = window_times_s(-start_s, end_s, rate_hz)
         self.pre = self.grid <= 1e-9
         self.within_swing = within_swing
