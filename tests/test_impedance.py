@@ -194,3 +194,16 @@ def test_summary_keeps_uninformative_rows_and_counts_them():
     # DerSimonian-Laird Q = 2.444 on 2 df, tau^2 = 0.444 / 10066.5 = 4.41e-5, weights 6940, 6940, 44.4
     assert knee.D_group_mean_nms_per_rad == pytest.approx(0.10968, abs=1e-5)
     assert knee.D_group_ci95_low_nms_per_rad < 0.10 and knee.D_group_ci95_high_nms_per_rad > 0.12
+
+
+def test_rows_carry_each_parameter_s_strongest_coupling_with_another_joint(fit):
+    """Per K and D, the other joint's parameter with the largest |correlation| in the fit's matrix, and its value."""
+    rows = impedance_rows(fit, "S01", 50, 12, TRUTH_BY_JOINT).set_index("joint")
+    names = ("K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", "D_ankle")
+    for i, name in enumerate(names):
+        joint, p = name.split("_")[1], name.split("_")[0]
+        others = [k for k in range(6) if k // 2 != i // 2]
+        k = others[int(np.argmax(np.abs(fit.correlation[i, others])))]
+        assert rows.loc[joint, f"{p}_coupled_with"] == names[k]
+        assert rows.loc[joint, f"{p}_coupling_correlation"] == fit.correlation[i, k]
+    assert -1.0 <= rows.K_coupling_correlation.min() and rows.K_coupling_correlation.max() <= 1.0

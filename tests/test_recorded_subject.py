@@ -141,7 +141,13 @@ def test_ground_reaction_mot_holds_the_belt_force_in_the_model_frame(lab_run):
 def test_impedance_table_recovers_the_true_impedance(lab_run):
     work, _ = lab_run
     table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t").set_index("joint")
-    assert (table.loc[["hip", "ankle"], "status"] == "ok").all(), table["reason"]
+    assert table.loc["ankle", "status"] == "ok", table["reason"]
+    # six strides: the hip's K interval is informative, its D interval (1.83 ... 4.84) wider than the study's
+    # whole hip D range (1.9-4.6): the data cannot place the hip's damping within it
+    hip = table.loc["hip"]
+    assert hip.status == "not_identifiable" and "D_hip" in hip.reason and "K_hip" not in hip.reason
+    assert "wider than the plausible range 1.9–4.6 N·m·s/rad" in hip.reason
+    assert hip.D_ci95_high_nms_per_rad - hip.D_ci95_low_nms_per_rad >= 4.6 - 1.9
     # one 40 s trial, 12 unperturbed strides: too few for the conditional counterfactual, the fit says it took the
     # matched stride; 6 strides kept: the knee's K and D intervals (0 ... 5.4, 0 ... 0.65) hold both 0 and the
     # study's whole knee range (K up to 3.5, D up to 0.14): the data cannot tell their size

@@ -52,7 +52,7 @@ def test_negative_values_are_recovered_within_signed_bounds_and_clipped_at_zero(
 
 @pytest.mark.parametrize(
     "low, high, identifiable",
-    [(-0.3, 4.0, False), (0.5, 4.0, True), (-0.3, 2.0, True)],
+    [(-0.3, 4.0, False), (0.5, 3.9, True), (-0.3, 2.0, True)],  # (0.5, 3.9): clear of 0, narrower than 0-3.5
 )
 def test_rule_4_asks_whether_the_interval_holds_zero_not_the_lower_bound(low, high, identifiable):
     status, reason = joint_status("knee", [1.8, 0.08], [low, 0.05], [high, 0.11], 95.0, [-20.0, -1.0], [200.0, 10.0])

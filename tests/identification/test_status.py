@@ -6,7 +6,14 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import AT_BOUND_FRACTION, DEFAULT_PLAUSIBLE_RANGES, MIN_VAF_PCT, joint_status
+from loper_analysis.identification import (
+    AT_BOUND_FRACTION,
+    COUPLING_CORRELATION,
+    DEFAULT_PLAUSIBLE_RANGES,
+    MIN_VAF_PCT,
+    joint_status,
+    strongest_coupling,
+)
 
 LOWER, UPPER = (0.0, 0.0), (200.0, 10.0)
 NARROW = (1.0, 0.1)
@@ -112,10 +119,11 @@ def test_an_interval_clear_of_zero_is_ok():
 @pytest.mark.parametrize(
     "low, high, expected",
     [
-        (0.0, 0.139, "ok"),  # holds 0 but excludes the top of the study's range: says D < 0.14
-        (0.0, 0.14, "not_identifiable"),  # reaches it exactly
+        (0.0, 0.119, "ok"),  # holds 0, excludes the top of the study's range and is narrower than it: D < 0.12
+        (0.0, 0.14, "not_identifiable"),  # reaches the top exactly
         (9e-6, 0.5, "not_identifiable"),  # within 1e-6 of the bound range (1e-5 N·m·s/rad) of 0
-        (2e-5, 0.5, "ok"),  # clear of 0: the damping is told from none
+        (2e-5, 0.1, "ok"),  # clear of 0 and narrower than the range: the damping is told from none
+        (2e-5, 0.5, "not_identifiable"),  # clear of 0, but wider than the whole range 0.02-0.14
     ],
 )
 def test_the_edges_of_the_information_rule(low, high, expected):
@@ -123,9 +131,9 @@ def test_the_edges_of_the_information_rule(low, high, expected):
 
 
 def test_the_plausible_range_can_be_given():
-    """Hip K 0 ... 70: holds 0 and the study's 34-66; with a range up to 100 it would not reach the top."""
+    """Hip K 0 ... 70: holds 0 and the study's 34-66; a range of 34-110 it neither reaches the top of nor spans."""
     assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip")[0] == "not_identifiable"
-    assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip", plausible_range=((34.0, 100.0), (1.9, 4.6))) == (
+    assert status((30.0, 3.0), widths=(80.0, 1.0), joint="hip", plausible_range=((34.0, 110.0), (1.9, 4.6))) == (
         "ok",
         "",
     )
@@ -139,3 +147,49 @@ def test_the_default_ranges_are_the_study_s():
         "knee": ((0.0, 3.5), (0.02, 0.14)),
         "ankle": ((0.0, 20.0), (0.0, 0.75)),
     }
+
+
+def test_an_interval_wider_than_the_plausible_range_is_not_identifiable():
+    """Knee D 0.2, 95 % CI 0.03 ... 0.37: clear of 0, but 0.34 wide against the study's 0.02-0.14 (0.12)."""
+    s, reason = joint_status("knee", (2.0, 0.2), (1.5, 0.03), (2.5, 0.37), 99.0, LOWER, UPPER)
+    assert s == "not_identifiable"
+    assert reason == (
+        "D_knee = 0.2 N·m·s/rad, 95 % CI 0.03 … 0.37 N·m·s/rad: wider than the plausible range 0.02–0.14 N·m·s/rad "
+        "(identification.plausible_ranges), the data cannot place the damping within it"
+    )
+    # a little narrower than the range (0.115): informative; a little wider (0.125): not; wholly above the range:
+    # says D is above it
+    assert joint_status("knee", (2.0, 0.1), (1.5, 0.045), (2.5, 0.16), 99.0, LOWER, UPPER) == ("ok", "")
+    assert joint_status("knee", (2.0, 0.1), (1.5, 0.035), (2.5, 0.16), 99.0, LOWER, UPPER)[0] == "not_identifiable"
+    assert joint_status("knee", (2.0, 0.5), (1.5, 0.3), (2.5, 0.7), 99.0, LOWER, UPPER) == ("ok", "")
+
+
+def test_a_too_wide_interval_names_the_joint_it_trades_off_against():
+    """The pulse on the thigh moves hip and knee alike: a knee D correlated -0.93 with the hip's D is named so."""
+    args = ("knee", (2.0, 0.2), (1.5, 0.03), (2.5, 0.37), 99.0, LOWER, UPPER)
+    s, reason = joint_status(*args, coupling=(("K_hip", -0.95), ("D_hip", -0.93)))
+    assert s == "not_identifiable"
+    assert reason.endswith(
+        "the data cannot place the damping within it; it trades off against D_hip (correlation -0.93): "
+        "the data cannot separate the knee's damping from the hip's"
+    )
+    assert "K_hip" not in reason  # K's interval (1 N·m/rad of 3.5) is informative: nothing to say about it
+    weak = -(COUPLING_CORRELATION - 0.01)
+    assert "trades off" not in joint_status(*args, coupling=(None, ("D_hip", weak)))[1]
+    with pytest.raises(LoperInputError, match="knee: coupling must hold K and D"):
+        joint_status(*args, coupling=(("D_hip", -0.9),))
+
+
+def test_strongest_coupling_is_the_largest_correlation_with_another_joint():
+    c = np.eye(6)
+    c[2, 3] = c[3, 2] = 0.99  # K_knee with D_knee: the same joint, never named
+    c[2, 0] = c[0, 2] = -0.92  # K_knee with K_hip
+    c[2, 4] = c[4, 2] = 0.5
+    c[3, 1] = c[1, 3] = -0.6  # D_knee with D_hip
+    c[3, 5] = c[5, 3] = 0.7  # D_knee with D_ankle: the stronger
+    assert strongest_coupling(c, "knee") == (("K_hip", -0.92), ("D_ankle", 0.7))
+    assert strongest_coupling(c, "hip") == (("K_knee", -0.92), ("D_knee", -0.6))
+    c[3, [0, 1, 4, 5]] = np.nan  # no finite standard error elsewhere: nothing to name
+    assert strongest_coupling(c, "knee")[1] is None
+    with pytest.raises(LoperInputError, match="correlation must be 6 x 6"):
+        strongest_coupling(np.eye(4), "knee")

@@ -57,11 +57,13 @@ from loper_analysis.identification.null_pairs import (
 )
 from loper_analysis.identification.status import (
     AT_BOUND_FRACTION,
+    COUPLING_CORRELATION,
     DEFAULT_PLAUSIBLE_RANGES,
     MAX_CI_FRACTION,
     MIN_VAF_PCT,
     check_plausible_range,
     joint_status,
+    strongest_coupling,
 )
 from loper_analysis.identification.window import (
     INITIAL_STATE_DEGREE,
@@ -125,6 +127,8 @@ __all__ = [
     "MAX_CI_FRACTION",
     "AT_BOUND_FRACTION",
     "joint_status",
+    "strongest_coupling",
+    "COUPLING_CORRELATION",
     "DEFAULT_PLAUSIBLE_RANGES",
     "check_plausible_range",
     "CI_LEVEL",

@@ -11,7 +11,9 @@ and a status (``docs/identification.md``):
 * ``not_identifiable``: K or D on its upper bound (or on a lower bound
   above zero), or its 95 % CI holds both 0 and the upper end of the joint's
   plausible range (``plausible_ranges``: the data cannot tell its size), or
-  spans more than ``max_ci_fraction`` of its bound range;
+  is at least as wide as that range (the reason names the parameter of
+  another joint it trades off against), or spans more than
+  ``max_ci_fraction`` of its bound range;
 * ``missing``: no trial of that onset;
 * ``failed``: too few strides (the reason names ``identification.window_after_s``
   when strides were too short for the window), the optimiser did not
@@ -53,6 +55,7 @@ from loper_analysis.identification import (
     joint_status,
     prepare_window,
     refit_with_null_pairs,
+    strongest_coupling,
 )
 from loper_analysis.identification.group_mean import random_effects_mean
 from loper_analysis.identification.pair_averaging import averaging_corrected_fit, pair_windows
@@ -111,6 +114,10 @@ IMPEDANCE_COLUMNS: tuple[str, ...] = (
     "n_starts_at_best",
     "noise_model",
     "n_null_pairs",
+    "K_coupled_with",
+    "K_coupling_correlation",
+    "D_coupled_with",
+    "D_coupling_correlation",
     "status",
     "reason",
 )
@@ -331,6 +338,9 @@ def impedance_rows(
         if truth is not None:
             row[parameter_column("K", "error")] = row[_K] - truth[joint]["K"]
             row[parameter_column("D", "error")] = row[_D] - truth[joint]["D"]
+        coupling = strongest_coupling(fit.correlation, joint)
+        for p, c in zip(("K", "D"), coupling):
+            row[f"{p}_coupled_with"], row[f"{p}_coupling_correlation"] = c if c is not None else ("", np.nan)
         status, reason = joint_status(
             joint,
             fit.estimate[[k, d]],
@@ -345,6 +355,7 @@ def impedance_rows(
             max_ci_fraction=max_ci_fraction,
             min_vaf_pct=min_vaf_pct,
             at_bound_fraction=at_bound_fraction,
+            coupling=coupling,
         )
         row.update(status=status, reason=reason)
         if note:
@@ -583,7 +594,7 @@ def impedance_summary(
     means and intervals, ``docs/identification.md``).
 
     Rows that are ``not_identifiable`` because an interval holds 0 and the
-    whole plausible range stay in: their estimate is still the fit's best
+    whole plausible range, or is wider than it, stay in: their estimate is still the fit's best
     value, and leaving out exactly the estimates near 0 would push the
     across-subject mean up. ``n_not_identifiable`` counts them, so a mean
     made mostly of uninformative fits shows as such.

@@ -16,10 +16,19 @@ Rules (``docs/identification.md``, section "Fit status"), judged in this order:
    means, :data:`DEFAULT_PLAUSIBLE_RANGES`): the interval holds "none" and
    every plausible size alike, so the data say nothing about the size:
    ``not_identifiable``;
-5. the 95 % interval of K or D spans more than ``max_ci_fraction`` of the
+5. the 95 % interval of K or D overlaps the joint's plausible range and is
+   at least as wide as it (and rule 4 did not already judge it): it cannot
+   place the parameter within the range of sizes the joint plausibly has,
+   wherever its centre (an interval wholly outside the range still says the
+   parameter lies outside it). When the parameter is strongly correlated with one of
+   another joint (``|r| >= COUPLING_CORRELATION``, e.g. the knee's D with
+   the hip's: the pulse on the thigh moves both), the reason names that
+   parameter: the data cannot separate the two joints' shares:
+   ``not_identifiable``;
+6. the 95 % interval of K or D spans more than ``max_ci_fraction`` of the
    bound range, or is infinite: ``not_identifiable``.
 
-Every finding of 2-5 is named in the reason (parameter or key, value and
+Every finding of 2-6 is named in the reason (parameter or key, value and
 limit); the status is the most severe. An estimate on a lower bound of zero
 is a valid estimate (no measurable stiffness or damping, e.g. the knee's K
 early in swing): by itself it adds nothing to the reason; rule 4 judges
@@ -30,6 +39,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from loper_analysis.constants import PARAMETERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANCE
 
@@ -37,9 +47,11 @@ __all__ = [
     "MIN_VAF_PCT",
     "MAX_CI_FRACTION",
     "AT_BOUND_FRACTION",
+    "COUPLING_CORRELATION",
     "DEFAULT_PLAUSIBLE_RANGES",
     "check_plausible_range",
     "joint_status",
+    "strongest_coupling",
 ]
 
 #: VAF (%) below which a joint's fit is ``failed``: below 0 the model explains less than no response at all.
@@ -49,6 +61,10 @@ AT_BOUND_FRACTION: float = 1e-6
 #: A K or D whose 95 % CI spans more than this share of its bound range is not identifiable (1: only an unbounded
 #: one; ``identification.max_ci_fraction``).
 MAX_CI_FRACTION: float = 1.0
+
+#: A parameter whose estimate correlates at least this strongly (absolute) with one of another joint trades off
+#: against it; a too-wide interval's reason names that parameter (rule 5).
+COUPLING_CORRELATION: float = 0.8
 
 #: Plausible range per joint, ((K low, K high) N·m/rad, (D low, D high) N·m·s/rad): the study's across-subject
 #: means for hip and knee, a stated choice for the ankle (:data:`loper_analysis.reference.ANKLE_SWING_IMPEDANCE`).
@@ -75,6 +91,36 @@ def check_plausible_range(joint: str, plausible_range) -> np.ndarray:
     return r
 
 
+def strongest_coupling(correlation, joint: str) -> tuple[tuple[str, float] | None, tuple[str, float] | None]:
+    """Per K and D of ``joint``, the parameter of another joint it correlates with most strongly.
+
+    Parameters
+    ----------
+    correlation : (6, 6) array_like
+        Correlation of the fit's parameters, order :data:`loper_analysis.constants.PARAMETERS`; NaN
+        where a parameter has no finite standard error.
+    joint : str
+        ``hip``, ``knee`` or ``ankle``.
+
+    Returns
+    -------
+    (K, D) : each ``(name, r)`` (``("D_hip", -0.93)``), or None when no correlation with another joint is finite.
+    """
+    c = np.asarray(correlation, dtype=float)
+    if c.shape != (len(PARAMETERS),) * 2:
+        raise LoperInputError(f"correlation must be {len(PARAMETERS)} x {len(PARAMETERS)}, got shape {c.shape}")
+    out = []
+    for p in ("K", "D"):
+        i = PARAMETERS.index(f"{p}_{joint}")
+        others = [k for k, name in enumerate(PARAMETERS) if not name.endswith(f"_{joint}") and np.isfinite(c[i, k])]
+        if not others:
+            out.append(None)
+            continue
+        k = max(others, key=lambda k: abs(c[i, k]))
+        out.append((PARAMETERS[k], float(c[i, k])))
+    return out[0], out[1]
+
+
 def joint_status(
     joint: str,
     estimate,
@@ -90,6 +136,7 @@ def joint_status(
     max_ci_fraction: float = MAX_CI_FRACTION,
     min_vaf_pct: float = MIN_VAF_PCT,
     at_bound_fraction: float = AT_BOUND_FRACTION,
+    coupling=None,
 ) -> tuple[str, str]:
     """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
 
@@ -109,6 +156,10 @@ def joint_status(
         entry of :data:`DEFAULT_PLAUSIBLE_RANGES` (none for another joint name:
         rule 4 is skipped).
     max_ci_fraction, min_vaf_pct, at_bound_fraction : the thresholds (see the module docstring).
+    coupling : (2,) sequence of (str, float) or None, optional
+        Per K and D the parameter of another joint it correlates with most strongly and that correlation
+        (``("D_hip", -0.93)``), or None; named in the reason of a too-wide interval when
+        ``|r| >= COUPLING_CORRELATION`` (rule 5).
 
     Returns
     -------
@@ -151,17 +202,32 @@ def joint_status(
                 f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
                 f"less {what} than the bounds allow"
             )
+    coupling = (None, None) if coupling is None else tuple(coupling)
+    if len(coupling) != 2:
+        raise LoperInputError(f"{joint}: coupling must hold K and D (2 entries), got {len(coupling)}")
     for i, (p, unit, _, what) in enumerate(_PARAMETERS):
         if plausible is None or np.isnan(low[i]) or np.isnan(high[i]):
             continue
         r_low, r_high = plausible[i]
         floor = max(lb[i], 0.0)  # none at all, or the least the bounds allow
+        interval = f"{p}_{joint} = {est[i]:.3g} {unit}, 95 % CI {low[i]:.3g} … {high[i]:.3g} {unit}"
         if low[i] <= floor + at_bound_fraction * span[i] and high[i] >= r_high:
             unidentifiable.append(
-                f"{p}_{joint} = {est[i]:.3g} {unit}, 95 % CI {low[i]:.3g} … {high[i]:.3g} {unit}: holds both "
-                f"{floor:g} and the plausible range {r_low:g}–{r_high:g} {unit} (identification.plausible_ranges), "
-                f"the data cannot tell the {what} from {floor:g}"
+                f"{interval}: holds both {floor:g} and the plausible range {r_low:g}–{r_high:g} {unit} "
+                f"(identification.plausible_ranges), the data cannot tell the {what} from {floor:g}"
             )
+        elif widths[i] >= r_high - r_low and low[i] <= r_high and high[i] >= r_low:
+            text = (
+                f"{interval}: wider than the plausible range {r_low:g}–{r_high:g} {unit} "
+                f"(identification.plausible_ranges), the data cannot place the {what} within it"
+            )
+            if coupling[i] is not None and abs(float(coupling[i][1])) >= COUPLING_CORRELATION:
+                other, r = coupling[i][0], float(coupling[i][1])
+                text += (
+                    f"; it trades off against {other} (correlation {r:+.2f}): the data cannot separate "
+                    f"the {joint}'s {what} from the {other.split('_', 1)[-1]}'s"
+                )
+            unidentifiable.append(text)
     if not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
         unidentifiable.append(
             f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "

@@ -259,7 +259,8 @@ def _summary_table(ci: pd.DataFrame) -> str:
         f"<tbody>{''.join(body)}</tbody></table>"
         '<p class="lf-note">Onset after toe-off. Mean and CI: random effects, each subject weighted by its fit’s '
         "standard error and the spread between subjects (Hartung–Knapp, t on n − 1 df). “Not ident.”: fits whose "
-        "CI holds 0 and the plausible range (in the mean). Study: the range of its across-subject means over "
+        "CI holds 0 and the plausible range, or is wider than that range (in the mean). Study: the range of its "
+        "across-subject means over "
         "onsets.</p>"
     )
 
