@@ -16,7 +16,8 @@ what averaging the pairs does to the model's response, intervals from its cross-
 Prints, per estimator and parameter (hip/knee K and D) over all fitted rows of the three onsets (``ok`` or
 ``not_identifiable``): fits, RMSE, mean error and its ratio to the error's SD (a bias beyond a quarter of the
 scatter shows here), the fits within tolerance and the intervals that hold the truth (with its binomial 95 %
-interval); then the same per onset; then the RMSE ratio conditional / matched stride.
+interval), the rows ``ok`` (their joint's K and D judged informative) and how many of their intervals miss the
+truth; then the same per onset; then the RMSE ratio conditional / matched stride.
 """
 
 from __future__ import annotations
@@ -57,6 +58,7 @@ def estimator_table(rows: pd.DataFrame, by_onset: bool = False) -> pd.DataFrame:
             true = g[f"{p}_true_{unit}"].to_numpy(float)
             low, high = g[f"{p}_ci95_low_{unit}"].to_numpy(float), g[f"{p}_ci95_high_{unit}"].to_numpy(float)
             rel, ab = TRUTH_TOLERANCE[p]
+            ok = (g["status"] == "ok").to_numpy()
             held = int(np.sum((true >= low) & (true <= high)))
             lo, hi = binomial_interval(held, err.size)
             sd = float(np.std(err, ddof=1)) if err.size > 1 else np.nan
@@ -72,6 +74,8 @@ def estimator_table(rows: pd.DataFrame, by_onset: bool = False) -> pd.DataFrame:
                     "within_tolerance": int(np.sum(np.abs(err) <= np.maximum(rel * np.abs(true), ab))),
                     "truth_in_ci95": held,
                     "coverage": f"{held / err.size:.2f} [{lo:.2f}, {hi:.2f}]",
+                    "ok": int(ok.sum()),
+                    "ok_ci95_misses_truth": int(np.sum(ok & ~((true >= low) & (true <= high)))),
                 }
             )
     return pd.DataFrame(out)
