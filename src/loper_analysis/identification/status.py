@@ -225,7 +225,7 @@ def joint_status(
                 other, r = coupling[i][0], float(coupling[i][1])
                 text += (
                     f"; it trades off against {other} (correlation {r:+.2f}): the data cannot separate "
-                    f"the {joint}'s {what} from the {other.split('_', 1)[-1]}'s"
+                    f"{p}_{joint} from {other}"
                 )
             unidentifiable.append(text)
     if not np.all(np.isfinite(widths)) or np.any(widths > max_ci_fraction * span):
