@@ -59,7 +59,8 @@ def estimator_table(rows: pd.DataFrame, by_onset: bool = False) -> pd.DataFrame:
             low, high = g[f"{p}_ci95_low_{unit}"].to_numpy(float), g[f"{p}_ci95_high_{unit}"].to_numpy(float)
             rel, ab = TRUTH_TOLERANCE[p]
             ok = (g["status"] == "ok").to_numpy()
-            held = int(np.sum((true >= low) & (true <= high)))
+            inside = (true >= low) & (true <= high)
+            held = int(np.sum(inside))
             lo, hi = binomial_interval(held, err.size)
             sd = float(np.std(err, ddof=1)) if err.size > 1 else np.nan
             row = dict(zip(keys, key))
@@ -75,7 +76,7 @@ def estimator_table(rows: pd.DataFrame, by_onset: bool = False) -> pd.DataFrame:
                     "truth_in_ci95": held,
                     "coverage": f"{held / err.size:.2f} [{lo:.2f}, {hi:.2f}]",
                     "ok": int(ok.sum()),
-                    "ok_ci95_misses_truth": int(np.sum(ok & ~((true >= low) & (true <= high)))),
+                    "ok_ci95_misses_truth": int(np.sum(ok & ~inside)),
                 }
             )
     return pd.DataFrame(out)
