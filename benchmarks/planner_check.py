@@ -34,9 +34,7 @@ out and listed.
 ``--pilots-from-repeats``: one pilot is one draw. Every kept repeat also plans exactly as the pilot does (from
 its whole trial and its fit of all its perturbed strides, one more prediction per repeat); the table gains
 ``pilots``, the 5th, 50th and 95th percentiles of their predictions over the measured SD and the share of
-them within ±25 % of it (each pilot is also one of the repeats whose SD is measured), and
-``pilots_range_holds``, the share of pilots whose 95 % range of the predicted SD
-(:func:`loper_analysis.planning.precision.sd_range_factors`) holds the measured SD.
+them within ±25 % of it (each pilot is also one of the repeats whose SD is measured).
 """
 
 from __future__ import annotations
@@ -114,18 +112,6 @@ def pilot_spread(ratios: np.ndarray) -> dict:
         "pilots_ratio_p95": p95,
         "pilots_within_25pct": float(np.mean(np.abs(ratios - 1.0) <= 0.25)),
     }
-
-
-def range_factors(sd_factors) -> np.ndarray:
-    """The plan's factors (2, 6) of the predicted SD's 95 % range (NaN for a plan without a range)."""
-    return np.full((2, 6), np.nan) if sd_factors is None else np.asarray(sd_factors, float)
-
-
-def range_holds(ratios: np.ndarray, sd_factors) -> np.ndarray:
-    """Whether the 95 % range of each predicted SD holds the measured SD (6,): ``ratios`` are predicted over
-    measured, so the range holds it when ``low <= 1 / ratio <= high``."""
-    factors = range_factors(sd_factors)
-    return (factors[0] <= 1.0 / ratios) & (1.0 / ratios <= factors[1])
 
 
 def lab(variability: str, seed: int, onset_ms: int, truth) -> dict:
@@ -246,11 +232,6 @@ def run_check(
                 for r, by in repeat_plans
             ]
         ).reshape(-1, 6)
-        # and whether its 95 % range of the predicted SD holds the measured SD (NaN without a range)
-        pilot_holds = np.array(
-            [range_holds(ratio, by.get(n, r).sd_factors) for ratio, (r, by) in zip(pilot_ratios, repeat_plans)]
-        ).reshape(-1, 6)
-        factors = range_factors(by_count.get(n, sc).sd_factors)
         # 95 % range of a sample SD over `repeats` normal draws, relative
         rel = 1.96 / np.sqrt(2.0 * (len(est) - 1))
         for i, name in enumerate(PARAMETERS):
@@ -265,9 +246,6 @@ def run_check(
                     "planned": planned[i],
                     "mean_estimate": est[:, i].mean(),
                     "predicted_sd": predicted[i],
-                    "predicted_sd_95_low": predicted[i] * factors[0, i],
-                    "predicted_sd_95_high": predicted[i] * factors[1, i],
-                    "range_holds_measured": bool(factors[0, i] <= measured[i] / predicted[i] <= factors[1, i]),
                     "predicted_from": "stretches" if n in by_count else "whole_pilot",
                     "whole_pilot_predicted_sd": whole[i],
                     "null_pairs_predicted_sd": predicted_null[i],
@@ -279,7 +257,6 @@ def run_check(
                     "ratio_predicted_to_measured": predicted[i] / measured[i],
                     "repeats": len(est),
                     **pilot_spread(pilot_ratios[:, i]),
-                    "pilots_range_holds": float(np.mean(pilot_holds[:, i])) if len(pilot_holds) else np.nan,
                 }
             )
     out = pd.DataFrame(rows)
@@ -354,11 +331,6 @@ def main() -> None:
             f"of the measured SD in {hk['pilots_within_25pct'].mean():.0%} of pilot x cell; per cell:"
         )
         print(markdown_table(cells.round(2)))
-        print(
-            f"the 95 % range of one pilot's predicted SD holds the measured SD in "
-            f"{hk['pilots_range_holds'].mean():.0%} of pilot x cell (hip and knee; per cell "
-            f"{hk['pilots_range_holds'].min():.0%} .. {hk['pilots_range_holds'].max():.0%})"
-        )
 
 
 if __name__ == "__main__":

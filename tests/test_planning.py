@@ -50,7 +50,6 @@ from loper_analysis.planning.precision import (
     pool_onsets,
     precision_table,
     pulse_force_n,
-    sd_range_factors,
     stretch_covariances,
     stride_covariance,
     strides_needed,
@@ -582,69 +581,3 @@ def test_stretch_plan_is_the_mean_of_its_stretches_plans(params, pilot):
         expected = np.mean([c.sd_of(n) ** 2 for c in own], axis=0)
         np.testing.assert_allclose(planned.sd_of(n) ** 2, expected, rtol=1e-12)
     assert planned.n_null_pairs == round(np.mean([c.n_null_pairs for c in own]))
-
-
-def test_sd_range_of_white_errors_is_that_of_a_sample_variance():
-    """White normal errors, M pairs, no projection: the log of a sample SD has SD 1/sqrt(2 M), so the 95 % range
-    of the predicted SD is exp(-+1.96 / sqrt(2 M)); the bootstrap's 400 draws find it to within 10 %."""
-    rng = np.random.default_rng(7)
-    m_pairs = 400
-    errors = rng.standard_normal((m_pairs, 30))
-    jacobian = rng.standard_normal((30, 3))
-    factors = sd_range_factors(errors, jacobian, 0, seed=11, replicates=400)
-    expected = 1.959963984540054 / np.sqrt(2 * m_pairs)
-    np.testing.assert_allclose(np.log(factors[1]), expected, rtol=0.10)
-    np.testing.assert_allclose(np.log(factors[0]), -np.log(factors[1]), rtol=1e-12)  # centred on the prediction
-    # pairs of unequal size scatter a sample variance more: rows scaled by exp(0.5 z) have kurtosis
-    # 3 exp(4 x 0.25) = 8.15, the log-SD's SD sqrt((8.15 - 1) / (4 M)) instead of sqrt(2 / (4 M)): 1.89 times
-    scaled = np.exp(0.5 * rng.standard_normal((m_pairs, 1))) * rng.standard_normal((m_pairs, 30))
-    heavy = sd_range_factors(scaled, jacobian, 0, seed=11, replicates=400)
-    assert 1.4 < np.log(heavy[1]).mean() / np.log(factors[1]).mean() < 2.5
-
-
-def test_sd_range_is_the_seed_s_and_refuses_too_few_pairs_or_draws():
-    rng = np.random.default_rng(3)
-    errors, jacobian = rng.standard_normal((60, 20)), rng.standard_normal((20, 6))
-    one = sd_range_factors(errors, jacobian, 2, seed=5, replicates=50)
-    assert one.shape == (2, 6)
-    np.testing.assert_array_equal(one, sd_range_factors(errors, jacobian, 2, seed=5, replicates=50))
-    assert not np.array_equal(one, sd_range_factors(errors, jacobian, 2, seed=6, replicates=50))
-    with pytest.raises(LoperInputError, match="M >= n_components \\+ 3 = 9"):
-        sd_range_factors(errors[:8], jacobian, 6, seed=5)
-    with pytest.raises(LoperInputError, match="replicates must be an integer >= 20"):
-        sd_range_factors(errors, jacobian, 2, seed=5, replicates=10)
-
-
-def test_plan_rows_carry_the_predicted_sd_s_range_and_the_answer_its_stride_counts(params, conditional_series):
-    """The conditional plan's rows: low and high are the factors times the predicted SD; the answer gives the
-    counts a target needs at both ends, which bracket the count at the prediction."""
-    sc = conditional_stride_covariance(conditional_series, params, TRUTH, PlanSettings(seed=2024))
-    assert sc.sd_factors.shape == (2, 6) and np.all(sc.sd_factors[0] < 1) and np.all(sc.sd_factors[1] > 1)
-    table = precision_table(sc, [10, 40], ONSET_MS)
-    for n in (10, 40):
-        rows = table[table["n_strides"] == n]
-        np.testing.assert_allclose(rows["predicted_sd_95_low"], sc.sd_factors[0] * sc.sd_of(n), rtol=1e-12)
-        np.testing.assert_allclose(rows["predicted_sd_95_high"], sc.sd_factors[1] * sc.sd_of(n), rtol=1e-12)
-    answer = target_answer(sc, "hip", "D", ONSET_MS, percent=5)
-    n = strides_needed(sc, "hip", "D", percent=5)
-    low, high = (int(v) for v in answer.split("; ")[-1].split(" over")[0].split("-"))
-    assert low < n < high
-    f = sc.sd_factors[:, 1] ** 2  # hip D: the count scales as the variance (less the 1/N^2 part, ceilings)
-    np.testing.assert_allclose([low, high], n * f, rtol=0.05)
-
-
-def test_matched_stride_plan_has_no_range(stride_cov):
-    table = precision_table(stride_cov, [10], ONSET_MS)
-    assert table["predicted_sd_95_low"].isna().all() and table["predicted_sd_95_high"].isna().all()
-    assert "range" not in target_answer(stride_cov, "hip", "D", ONSET_MS, percent=15)
-
-
-def test_stretch_plan_s_range_narrows_with_the_root_of_its_stretches(params, pilot):
-    full = pilot[0]
-    own = [
-        conditional_stride_covariance(pilot_onset_series([s], ONSET_MS, ResponseSettings()), params, TRUTH)
-        for s in trial_stretches(full, 10)
-    ]
-    planned = stretch_covariances([full], ONSET_MS, [10], params, TRUTH)[10]
-    s = np.sqrt(np.mean([np.log(c.sd_factors[1]) ** 2 for c in own], axis=0) / len(own))
-    np.testing.assert_allclose(planned.sd_factors, np.vstack([np.exp(-s), np.exp(s)]), rtol=1e-12)

@@ -27,8 +27,6 @@ needs.
 * :func:`conditional_stride_covariance` - the same for the conditional
   counterfactual, from the pilot's cross-validated null pairs as the fit's
   intervals take them, with the candidates' share that does not average out;
-* :func:`sd_range_factors` - the 95 % range of a predicted SD from the
-  pilot's own null pairs (a bootstrap that finds the projection anew);
 * :func:`stretch_covariances` - for stride counts the pilot holds several
   times over: the mean of that covariance over the pilot's stretches of the
   planned size, each with only its own candidates;
@@ -52,7 +50,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -81,7 +79,6 @@ __all__ = [
     "PlanSettings",
     "StrideCovariance",
     "conditional_stride_covariance",
-    "sd_range_factors",
     "stretch_covariances",
     "pulse_force_n",
     "planning_window",
@@ -104,8 +101,6 @@ PLAN_COLUMNS: tuple[str, ...] = (
     "n_strides",
     "planned_value",
     "predicted_sd",
-    "predicted_sd_95_low",
-    "predicted_sd_95_high",
     "ci95_half_width",
     "ci95_half_width_pct",
     "pulse_force_n",
@@ -120,8 +115,6 @@ PLAN_COLUMNS: tuple[str, ...] = (
 MAX_ANSWERED_STRIDES: int = 1_000_000
 #: Fewest pilot perturbed pairs whose scatter the prediction takes (fewer: the null pairs' scatter, noted).
 MIN_PERTURBED_PAIRS = 5
-#: Bootstrap draws of the pilot's null pairs behind the 95 % range of a predicted SD (:func:`sd_range_factors`).
-SD_RANGE_REPLICATES = 200
 
 
 @dataclass(frozen=True)
@@ -153,7 +146,6 @@ class PlanSettings(FitBounds):
     force_cutoff_hz: float = 40.0
     force_order: int = 4
     force_rate_hz: float = 1000.0
-    seed: int = 0
 
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)
@@ -197,7 +189,6 @@ class StrideCovariance:
     scatter: str = "null_pairs"
     null_covariance: np.ndarray | None = None
     spread_covariance: np.ndarray | None = None
-    sd_factors: np.ndarray | None = None
 
     @property
     def sd(self) -> np.ndarray:
@@ -214,11 +205,6 @@ class StrideCovariance:
         a, b = self.variance_terms()
         n = int(n_strides)
         return np.sqrt(a / n + b / n**2)
-
-    def sd_range_of(self, n_strides: int) -> np.ndarray:
-        """95 % range (2, 6) of the predicted SD for ``n_strides`` strides (low, high; NaN without factors)."""
-        factors = np.full((2, 6), np.nan) if self.sd_factors is None else np.asarray(self.sd_factors, float)
-        return factors * self.sd_of(n_strides)
 
     def t95(self, n_strides: int) -> float:
         """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof;
@@ -411,53 +397,6 @@ def stride_covariance(
     return StrideCovariance(sandwich(E), p, dof, n_pairs, "; ".join(notes), n_pert, scatter, sandwich(E0))
 
 
-def sd_range_factors(
-    errors, jacobian, n_components: int, seed: int, replicates: int = SD_RANGE_REPLICATES
-) -> np.ndarray:
-    """Factors (2, p) on a predicted SD: the low and high ends of its 95 % range, from the pilot's null pairs.
-
-    The prediction scales the null pairs' errors ``errors`` (M, m) through the
-    projection found from those same pairs
-    (:func:`~loper_analysis.identification.nuisance_projection`, ``n_components``
-    shapes), so another pilot of the same size would give another SD: the
-    shapes the projection removes change from trial to trial, and with them
-    the scatter left along the sensitivities ``jacobian`` (m, p). Each of
-    ``replicates`` bootstrap draws (``seed``) takes M pairs with replacement,
-    finds the projection anew and takes the SD of every parameter from the
-    sandwich ``M C M^T`` of the draw. ``s`` is the SD over the draws of the
-    log of these SDs; the range is ``exp(-1.96 s) .. exp(1.96 s)`` times the
-    prediction, centred on it (the draws' own centre is low: a draw repeats
-    pairs, which its projection then fits better).
-
-    Raises
-    ------
-    LoperInputError
-        ``errors`` and ``jacobian`` of mismatched shapes, too few pairs for the projection, fewer than 20
-        replicates.
-    """
-    E = np.asarray(errors, dtype=float)
-    J = np.asarray(jacobian, dtype=float)
-    r = int(n_components)
-    if E.ndim != 2 or J.ndim != 2 or J.shape[0] != E.shape[1] or E.shape[0] < r + 3:
-        raise LoperInputError(
-            f"range of a predicted SD: errors (M, m) with M >= n_components + 3 = {r + 3} and jacobian (m, p) "
-            f"expected, got {E.shape} and {J.shape}"
-        )
-    n_draws = integer("replicates", replicates, "range of a predicted SD", minimum=20)
-    rng = np.random.default_rng(int(seed))
-
-    def log_sd(rows: np.ndarray) -> np.ndarray:
-        W = nuisance_projection(rows, r)
-        WJ = W @ J
-        effect = (rows - rows.mean(axis=0)) @ (np.linalg.pinv(WJ.T @ WJ, rcond=1e-13) @ WJ.T @ W).T
-        return 0.5 * np.log(np.clip(np.mean(effect**2, axis=0), np.finfo(float).tiny, None))
-
-    draws = np.array([log_sd(E[rng.integers(0, E.shape[0], E.shape[0])]) for _ in range(n_draws)])
-    s = draws.std(axis=0, ddof=1)
-    z = 1.959963984540054
-    return np.vstack([np.exp(-z * s), np.exp(z * s)])
-
-
 def conditional_stride_covariance(
     series: Mapping,
     params: SegmentParameters,
@@ -522,8 +461,7 @@ def conditional_stride_covariance(
         )
     window = planning_window(null, params, settings, device, source)
     J = response_jacobian(window, p, settings.lower, settings.upper)
-    E0 = null_pair_errors(window, p, null)
-    V = cross_validated_covariance(E0, r, J, 1)
+    V = cross_validated_covariance(null_pair_errors(window, p, null), r, J, 1)
     unit = float(null["unit_scatter_variance"])
     mu2, spread = shared_weight_terms(pairs["prediction_weights"])
     return StrideCovariance(
@@ -536,7 +474,6 @@ def conditional_stride_covariance(
         "cross_validated_null_pairs",
         None,
         V * n_pert * spread / unit,
-        sd_range_factors(E0, J, r, settings.seed),
     )
 
 
@@ -564,9 +501,7 @@ def stretch_covariances(
     at ``impedance``) and the covariance is the mean over the stretches of
     both its parts (``covariance`` and ``spread_covariance``): what the fit
     of an ``N``-stride experiment reports, averaged over the pilot's
-    experiments of that size. The range of its SD (``sd_factors``) narrows
-    by the root of the stretches' count: each stretch's null pairs are its
-    own. Counts held fewer times are left out (plan them
+    experiments of that size. Counts held fewer times are left out (plan them
     with the whole pilot); a stretch that cannot be planned (too few
     candidates or no perturbed stride kept) is skipped. ``response``: the
     response settings (default :class:`~loper_analysis.responses.ResponseSettings`,
@@ -606,10 +541,6 @@ def _mean_covariance(covs: Sequence[StrideCovariance], n: int, min_null_pairs: i
             f"{few} of them with fewer than identification.min_null_pairs = {min_null_pairs} null pairs: "
             "a fit of that size would fall back to the matched stride"
         )
-    factors = None
-    if all(c.sd_factors is not None for c in covs):  # the mean of K independent log-SDs: their SD over sqrt(K)
-        s = np.sqrt(np.mean([np.log(np.asarray(c.sd_factors, float)[1]) ** 2 for c in covs], axis=0) / len(covs))
-        factors = np.vstack([np.exp(-s), np.exp(s)])
     return StrideCovariance(
         np.mean([c.covariance for c in covs], axis=0),
         covs[0].impedance,
@@ -620,7 +551,6 @@ def _mean_covariance(covs: Sequence[StrideCovariance], n: int, min_null_pairs: i
         covs[0].scatter,
         None,
         np.mean(spread, axis=0),
-        factors,
     )
 
 
@@ -696,9 +626,7 @@ def precision_table(
     ``by_count``: covariances for some stride counts (:func:`stretch_covariances`) that replace
     ``stride_cov`` in those counts' rows.
 
-    ``predicted_sd = sqrt(sd_1^2 / N + b / N^2)`` (:meth:`StrideCovariance.sd_of`), its 95 % range
-    ``predicted_sd_95_low`` .. ``predicted_sd_95_high`` (:meth:`StrideCovariance.sd_range_of`; empty for a
-    plan without one, the matched stride's) and
+    ``predicted_sd = sqrt(sd_1^2 / N + b / N^2)`` (:meth:`StrideCovariance.sd_of`) and
     ``ci95_half_width = t * predicted_sd``
     (Student's t at 97.5 % with the fit's degrees of freedom,
     :meth:`StrideCovariance.t95`: ``N - 1`` by default), both in ``unit``;
@@ -714,7 +642,6 @@ def precision_table(
             for n in counts:
                 sc = (by_count or {}).get(n, stride_cov)
                 sd = float(sc.sd_of(n)[i])
-                low, high = (float(v) for v in sc.sd_range_of(n)[:, i])
                 half = sc.t95(n) * sd
                 rows.append(
                     {
@@ -726,8 +653,6 @@ def precision_table(
                         "n_strides": n,
                         "planned_value": planned,
                         "predicted_sd": sd,
-                        "predicted_sd_95_low": low,
-                        "predicted_sd_95_high": high,
                         "ci95_half_width": half,
                         "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
                         "pulse_force_n": float(settings.pulse_force_n),
@@ -849,21 +774,8 @@ def target_answer(
             + ("; a relative target on a value this close to 0: give a half_width instead)" if percent else ")")
         )
     reached = float(stride_cov.half_width(n)[i])
-    between = ""
-    if stride_cov.sd_factors is not None:  # the counts the ends of the predicted SD's 95 % range would need
-        ends = [
-            strides_needed(_scaled(stride_cov, float(f) ** 2), joint, parameter, percent=percent, half_width=half_width)
-            for f in np.asarray(stride_cov.sd_factors, float)[:, i]
-        ]
-        between = f"; {ends[0]}-{ends[1]} over the 95 % range of the predicted SD"
     return (
         f"{joint} {parameter} at {onset_ms:g} ms: {wanted} (95 % CI) needs {n} perturbed strides kept in the "
         f"average (planned {parameter} {planned:.3g} {unit}; predicted half-width at {n}: ±{reached:.3g} {unit}, "
-        f"±{100 * reached / abs(planned) if planned else float('nan'):.3g} %{between})"
+        f"±{100 * reached / abs(planned) if planned else float('nan'):.3g} %)"
     )
-
-
-def _scaled(stride_cov: StrideCovariance, factor: float) -> StrideCovariance:
-    """``stride_cov`` with both variance parts times ``factor``."""
-    spread = None if stride_cov.spread_covariance is None else factor * stride_cov.spread_covariance
-    return replace(stride_cov, covariance=factor * stride_cov.covariance, spread_covariance=spread)

@@ -105,8 +105,7 @@ class PlanningSettings:
             ``strides``, ``targets``: ``planning.strides``, ``planning.targets``; ``plan``: the pulse
             ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s) with the keys of
             ``identification`` the planner follows (fit window and initial state in s, substeps, projected
-            components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad; the
-            bootstrap behind the range of a predicted SD seeded by ``seed``);
+            components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad);
             ``response``: ``identification.window_before_s``, ``window_after_s``, ``initial_state_span_s``
             and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``, the counterfactual planned for
             ``identification.counterfactual``; ``device``:
@@ -139,7 +138,6 @@ class PlanningSettings:
             plan=PlanSettings(
                 pulse_force_n=get("planning", "pulse_force_n"),
                 pulse_duration_s=get("planning", "pulse_duration_s"),
-                seed=get("seed"),
                 **ident,
             ),
             response=ResponseSettings(
