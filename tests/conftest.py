@@ -16,6 +16,14 @@ import pytest
 from tests.workflow_copy import ROOT, copy_workflow
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Test files holding a ``slow`` test first, each file's own order kept: run one file to a process
+    (``--dist loadfile``), the long end-to-end files start at once and the short ones fill in behind them,
+    instead of the long ones starting last and running on alone."""
+    slow_files = {item.path for item in items if item.get_closest_marker("slow")}
+    items.sort(key=lambda item: item.path not in slow_files)
+
+
 @pytest.fixture(scope="session")
 def repo_root() -> Path:
     """The repository's root folder."""
