@@ -8,7 +8,7 @@ experiments as ``benchmarks/planner_check.py``: one trial with the device, pertu
 onset, 60 perturbed strides; :func:`loper_analysis.synthetic.coordinate_trials.perturbation_experiment`) are
 each planned as a pilot with the conditional counterfactual. For every trial the script takes the
 per-stride SD of every K and D from the sandwich ``M C M^T`` of its null pairs' errors (linearised at the
-truth), four ways:
+truth), three ways (a fourth with ``--fit``):
 
 * ``own``: with the projection found from the trial's own null pairs (what the planner does);
 * ``fixed``: with the projection found from the first trial's null pairs, the same for all;
@@ -90,6 +90,7 @@ def main() -> None:
     r = plan.null_pair_components
     lab_kwargs = lab(None, args.seed, args.onset_ms, truth)
     rng = np.random.default_rng(args.seed)
+    ident = IdentificationSettings(n_starts=10, seed=args.seed)  # the pipeline's fit, for --fit
     own, fixed, boot, weight, at_fit, at_truth = [], [], [], [], [], []
     first_projection = None
     for k in range(1, args.trials + 1):
@@ -116,7 +117,6 @@ def main() -> None:
         mu2, _ = shared_weight_terms(pairs["prediction_weights"])
         weight.append((1.0 + pairs["n_pairs"] * mu2) / float(null["unit_scatter_variance"]))
         if args.fit:
-            ident = IdentificationSettings(n_starts=10, seed=args.seed)
             fit = fit_onset([cut[N_STRIDES]], params, args.onset_ms, f"T{k}", None, [full], response, ident)
             planned = np.clip(estimates(fit.rows), ident.lower, ident.upper)
             at_fit.append(conditional_stride_covariance(series, params, planned).sd)
