@@ -315,7 +315,12 @@ def _cut_c3d(path: Path, seconds: float) -> None:
 
     rec = read_c3d(path)
     n = round(seconds * rec.point_rate_hz)
-    write_recording(path, replace(rec, markers_m=rec.markers_m[:n], analogs=rec.analogs[: n * rec.samples_per_frame]))
+    cut = {
+        "markers_m": rec.markers_m[:n],
+        "outputs": rec.outputs[:n],
+        "analogs": rec.analogs[: n * rec.samples_per_frame],
+    }
+    write_recording(path, replace(rec, **cut))
 
 
 def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_run, tmp_path):

@@ -8,10 +8,12 @@ if OPENSIM["ik_chunks"] == 1:
         input:
             model=subject_model,
             trc="results/markers/{subject}/{trial}.trc",
+            lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
         output:
             mot="results/ik/{subject}/{trial}.mot",
             angles="results/ik/{subject}/{trial}.angles.tsv",
             summary="results/ik/{subject}/{trial}.ik.tsv",
+            agreement="results/ik/{subject}/{trial}.lab_agreement.tsv",
         log:
             "results/logs/ik/{subject}/{trial}.log",
         benchmark:
@@ -46,11 +48,13 @@ else:
 
     rule ik_join:
         input:
-            expand("results/ik/{{subject}}/{{trial}}.chunk{chunk}.mot", chunk=IK_CHUNKS),
+            chunks=expand("results/ik/{{subject}}/{{trial}}.chunk{chunk}.mot", chunk=IK_CHUNKS),
+            lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
         output:
             mot="results/ik/{subject}/{trial}.mot",
             angles="results/ik/{subject}/{trial}.angles.tsv",
             summary="results/ik/{subject}/{trial}.ik.tsv",
+            agreement="results/ik/{subject}/{trial}.lab_agreement.tsv",
         log:
             "results/logs/ik_join/{subject}/{trial}.log",
         benchmark:

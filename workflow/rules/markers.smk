@@ -11,6 +11,7 @@ rule markers:
         trc="results/markers/{subject}/{trial}.trc",
         gaps="results/markers/{subject}/{trial}.gaps.tsv",
         summary="results/markers/{subject}/{trial}.markers.tsv",
+        lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
     log:
         "results/logs/markers/{subject}/{trial}.log",
     benchmark:

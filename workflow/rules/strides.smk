@@ -33,6 +33,7 @@ rule strides_summary:
         contacts=[f"results/events/{s}/{t}.contacts.tsv" for s in processed_subjects() for t in subject_trials(s)],
         ik=[f"results/ik/{s}/{t}.ik.tsv" for s in processed_subjects() for t in subject_trials(s)],
         markers=[f"results/markers/{s}/{t}.markers.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        agreement=[f"results/ik/{s}/{t}.lab_agreement.tsv" for s in processed_subjects() for t in subject_trials(s)],
     output:
         report(
             "results/strides/summary.tsv",

@@ -4,4 +4,12 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import ik
 
     out = snakemake.output
-    ik.ik_join(snakemake.input, out.mot, out.angles, snakemake.params.settings, summary_tsv=out.summary)
+    ik.ik_join(
+        snakemake.input.chunks,
+        out.mot,
+        out.angles,
+        snakemake.params.settings,
+        summary_tsv=out.summary,
+        lab_angles_tsv=snakemake.input.lab_angles,
+        agreement_tsv=out.agreement,
+    )

@@ -5,5 +5,12 @@ with rule_log(snakemake.log[0]):
 
     p, i = snakemake.params, snakemake.input
     strides.strides_summary(
-        p.subject_trial, i.strides, snakemake.output[0], p.min_valid, i.contacts, ik_tsvs=i.ik, markers_tsvs=i.markers
+        p.subject_trial,
+        i.strides,
+        snakemake.output[0],
+        p.min_valid,
+        i.contacts,
+        ik_tsvs=i.ik,
+        markers_tsvs=i.markers,
+        agreement_tsvs=i.agreement,
     )

@@ -16,6 +16,13 @@ Reading (:func:`read_c3d`)
       read as missing.
     * ``LABELS``, ``LABELS2``, ... are joined (ezc3d splits more than 255
       labels over several parameters).
+    * Only markers are markers: the outputs of a lab's models stored as
+      points (Plug-in Gait's angles, forces, moments, powers, segment points,
+      modelled markers) and unlabelled points are kept apart, as they are in
+      the file (:mod:`loper_analysis.io.c3d_points`); a point of theirs is
+      missing where it is not finite or its residual is negative.
+    * The numeric parameters of the ``PROCESSING`` group (Nexus writes
+      ``Bodymass`` in kg and ``Height`` in mm there) are kept as read.
     * Labels and units are decoded as UTF-8, or as Latin-1 when they are not
       valid UTF-8 (:func:`~loper_analysis.io.c3d_parameters.decode_text`).
     * Events come from ``EVENT:CONTEXTS/LABELS/TIMES``
@@ -64,6 +71,7 @@ from loper_analysis.io.c3d_parameters import (
     param_value,
     read_events,
 )
+from loper_analysis.io.c3d_points import MARKER, point_kinds, point_units
 from loper_analysis.io.timing import library_import, timed_io
 
 __all__ = [
@@ -112,6 +120,18 @@ class C3DRecording:
     n_force_platforms : int
         ``FORCE_PLATFORM:USED`` (0 without platforms); the platforms
         themselves are read by :mod:`loper_analysis.io.force_platforms`.
+    output_labels, output_kinds : list of str
+        The points that are not markers (a lab's model outputs, segment and
+        unlabelled points) and the kind of each
+        (:func:`loper_analysis.io.c3d_points.point_kinds`: ``ANGLES``, ...).
+    outputs : numpy.ndarray
+        Shape (n_frames, n_outputs, 3), as stored (each kind in its unit:
+        ``output_units``), NaN where missing.
+    output_units : dict
+        Kind -> unit as the file declares it (``{"ANGLES": "deg"}``).
+    processing : dict
+        Numeric parameters of the ``PROCESSING`` group, first value of each,
+        as stored (Nexus: ``Bodymass`` kg, ``Height`` mm); empty without the group.
     """
 
     source: str
@@ -125,6 +145,11 @@ class C3DRecording:
     analog_rate_hz: float | None = None
     events: pd.DataFrame = field(default_factory=lambda: _no_events())
     n_force_platforms: int = 0
+    output_labels: list[str] = field(default_factory=list)
+    output_kinds: list[str] = field(default_factory=list)
+    outputs: np.ndarray | None = None
+    output_units: dict[str, str] = field(default_factory=dict)
+    processing: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.markers_m = np.asarray(self.markers_m, dtype=float)
@@ -133,6 +158,15 @@ class C3DRecording:
             raise LoperInputError(
                 f"{self.source}: markers_m must have shape (n_frames, n_markers={len(self.marker_labels)}, 3), "
                 f"got {X.shape}"
+            )
+        if self.outputs is None:
+            self.outputs = np.zeros((X.shape[0], 0, 3))
+        self.outputs = np.asarray(self.outputs, dtype=float)
+        n_out = len(self.output_labels)
+        if self.outputs.shape != (X.shape[0], n_out, 3) or len(self.output_kinds) != n_out:
+            raise LoperInputError(
+                f"{self.source}: outputs must have shape (n_frames, n_outputs={n_out}, 3) with one kind per "
+                f"output, got {self.outputs.shape} and {len(self.output_kinds)} kind(s)"
             )
         if not isinstance(self.events, pd.DataFrame) or list(self.events.columns) != list(EVENT_COLUMNS):
             raise LoperInputError(f"{self.source}: events must be a DataFrame with columns {list(EVENT_COLUMNS)}")
@@ -412,16 +446,35 @@ def _open_c3d(path: Path):
         ) from exc
 
 
-def _markers_from(c3d, units_per_m: float) -> np.ndarray:
-    """(n_frames, n_markers, 3) in m, NaN where ezc3d gives NaN, the residual is negative or the point is (0,0,0)."""
-    points = np.asarray(c3d["data"]["points"], dtype=float)[:3]  # (3, n_markers, n_frames)
-    X = np.transpose(points, (2, 1, 0)) / units_per_m
-    missing = ~np.all(np.isfinite(X), axis=2) | np.all(X == 0.0, axis=2)
+def _points_from(c3d) -> tuple[np.ndarray, np.ndarray]:
+    """Every point (n_frames, n_points, 3) as stored, and where ezc3d gives NaN or the residual is negative."""
+    points = np.asarray(c3d["data"]["points"], dtype=float)[:3]  # (3, n_points, n_frames)
+    X = np.transpose(points, (2, 1, 0))
+    missing = ~np.all(np.isfinite(X), axis=2)
     residuals = np.asarray(c3d["data"]["meta_points"]["residuals"], dtype=float)
     if residuals.shape == (1, X.shape[1], X.shape[0]):
         missing |= residuals[0].T < 0
-    X[missing] = np.nan
+    return X, missing
+
+
+def _markers_from(points: np.ndarray, missing: np.ndarray, units_per_m: float) -> np.ndarray:
+    """(n_frames, n_markers, 3) in m, NaN where missing or at exactly (0, 0, 0)."""
+    X = points / units_per_m
+    X[missing | np.all(points == 0.0, axis=2)] = np.nan
     return X
+
+
+def _processing(params) -> dict[str, float]:
+    """First value of each numeric ``PROCESSING`` parameter."""
+    out = {}
+    for name, entry in (params.get("PROCESSING") or {}).items():
+        try:
+            value = np.asarray(entry["value"], dtype=float).ravel()
+        except (TypeError, ValueError, KeyError):
+            continue
+        if value.size and np.isfinite(value[0]):
+            out[str(name)] = float(value[0])
+    return out
 
 
 def _analogs_from(c3d, point_rate_hz: float, source: str) -> tuple[float, int, list[str], list[str], np.ndarray]:
@@ -490,22 +543,31 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
     c3d = _open_c3d(path)
     params = c3d["parameters"]
     point_rate = param_float(params, "POINT", "RATE", source)
-    n_markers = int(np.shape(c3d["data"]["points"])[1])
-    labels = _labels_for(params, "POINT", n_markers, source)
+    n_points = int(np.shape(c3d["data"]["points"])[1])
+    labels = _labels_for(params, "POINT", n_points, source)
+    kinds = point_kinds(params, labels)
+    is_marker = np.array([k == MARKER for k in kinds], dtype=bool)
+    n_markers = int(is_marker.sum())
     units_per_m = _point_units_per_m(params, source) if n_markers else 1.0
     analog_rate, ratio, analog_labels, analog_units, samples = _analogs_from(c3d, point_rate, source)
     n_channels = samples.shape[1]
     _check_rates(path, point_rate, analog_rate, ratio, n_channels)
-    n_frames = int(np.shape(c3d["data"]["points"])[2]) if n_markers else samples.shape[0] // ratio
+    n_frames = int(np.shape(c3d["data"]["points"])[2]) if n_points else samples.shape[0] // ratio
     if n_channels and samples.shape[0] != n_frames * ratio:
         raise LoperInputError(
             f"{source}: {samples.shape[0]} analog samples for {n_frames} frames at {ratio} samples per frame"
         )
-    _check_complete(c3d, path, n_frames, 4 * n_markers + n_channels * ratio)
-    markers = _markers_from(c3d, units_per_m) if n_markers else np.zeros((n_frames, 0, 3))
+    _check_complete(c3d, path, n_frames, 4 * n_points + n_channels * ratio)
+    if n_points:
+        points, missing = _points_from(c3d)
+    else:
+        points, missing = np.zeros((n_frames, 0, 3)), np.zeros((n_frames, 0), dtype=bool)
+    markers = _markers_from(points[:, is_marker], missing[:, is_marker], units_per_m)
+    outputs = points[:, ~is_marker].copy()
+    outputs[missing[:, ~is_marker]] = np.nan
     return C3DRecording(
         source=source,
-        marker_labels=labels,
+        marker_labels=[lab for lab, m in zip(labels, is_marker) if m],
         markers_m=markers,
         point_rate_hz=point_rate,
         first_frame=int(c3d["header"]["points"]["first_frame"]),
@@ -515,4 +577,9 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         analog_rate_hz=analog_rate,
         events=read_events(params, source),
         n_force_platforms=_force_platforms_used(params),
+        output_labels=[lab for lab, m in zip(labels, is_marker) if not m],
+        output_kinds=[k for k in kinds if k != MARKER],
+        outputs=outputs,
+        output_units=point_units(params),
+        processing=_processing(params),
     )

@@ -10,7 +10,15 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import staged
 from loper_analysis.io.timing import library_import, timed_io
 
-__all__ = ["quiet_opensim", "read_model", "model_source", "write_model", "read_scale_setup", "read_marker_set"]
+__all__ = [
+    "quiet_opensim",
+    "read_model",
+    "model_source",
+    "write_model",
+    "write_osim_object",
+    "read_scale_setup",
+    "read_marker_set",
+]
 
 
 def quiet_opensim():
@@ -85,8 +93,14 @@ def _require_element(path: Path, element: str, what: str) -> None:
 
 def write_model(model, path: str | os.PathLike) -> Path:
     """Print an ``opensim.Model`` to a .osim file atomically; returns the path."""
-    with staged(path, "OpenSim model") as tmp:
-        model.printToXML(str(tmp))
+    return write_osim_object(model, path, "OpenSim model")
+
+
+def write_osim_object(obj, path: str | os.PathLike, what: str) -> Path:
+    """Print an OpenSim object (a model, a marker set, a ScaleTool setup) to its XML file atomically; returns
+    the path."""
+    with staged(path, what) as tmp:
+        obj.printToXML(str(tmp))
     return Path(path)
 
 

@@ -63,6 +63,9 @@ IK_SUMMARY_COLUMNS: tuple[str, ...] = (
     "marker_rms_mean_m",
     "marker_rms_max_m",
     "n_frames_over_warn",
+    "worst_marker",
+    "worst_marker_rms_m",
+    "warnings",
 )
 
 
@@ -78,7 +81,8 @@ class IKResult:
     few markers): every coordinate and error is NaN there.
     ``marker_errors_m`` (n_frames, n_markers_in_use) holds each weighted
     marker's distance error (m, NaN where missing), in the order of
-    ``marker_names``. ``warning``: a poor fit's warning, set by the file step.
+    ``marker_names``. ``warning``: a poor fit's warning, set by the file step; ``warnings``: other warnings
+    of the file step (a joint angle that looks inverted).
     """
 
     time_s: np.ndarray
@@ -91,6 +95,7 @@ class IKResult:
     marker_errors_m: np.ndarray | None = None
     marker_names: list[str] = field(default_factory=list)
     warning: str | None = None
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def n_left_out(self) -> int:
@@ -101,11 +106,15 @@ class IKResult:
         """One row: frames solved and left out, the solved span (s) and the marker RMS error (m).
 
         Columns :data:`IK_SUMMARY_COLUMNS`; ``n_frames_over_warn`` counts the
-        frames whose marker RMS error exceeds ``warn_rms_m`` (m).
+        frames whose marker RMS error exceeds ``warn_rms_m`` (m); ``worst_marker`` is the marker with the
+        largest RMS error over the trial (``worst_marker_rms_m``; '' and NaN without marker errors);
+        ``warnings`` joins :attr:`warning` and :attr:`warnings` ('' when none).
         """
         solved = np.ones(self.time_s.size, bool) if self.solved is None else self.solved
         rms = self.marker_rms_m[np.isfinite(self.marker_rms_m)]
         t = self.time_s[solved]
+        per_marker = self.marker_error_rms_m()
+        worst = max(per_marker, key=per_marker.get) if per_marker else ""
         return pd.DataFrame(
             [
                 {
@@ -117,10 +126,25 @@ class IKResult:
                     "marker_rms_mean_m": float(rms.mean()) if rms.size else np.nan,
                     "marker_rms_max_m": float(rms.max()) if rms.size else np.nan,
                     "n_frames_over_warn": int((rms > warn_rms_m).sum()),
+                    "worst_marker": worst,
+                    "worst_marker_rms_m": per_marker[worst] if worst else np.nan,
+                    "warnings": " | ".join(w for w in [self.warning, *self.warnings] if w),
                 }
             ],
             columns=list(IK_SUMMARY_COLUMNS),
         )
+
+    def marker_error_rms_m(self) -> dict[str, float]:
+        """Each weighted marker's RMS distance error over the frames it is present in (m), largest first."""
+        if self.marker_errors_m is None or not len(self.marker_names):
+            return {}
+        E = np.asarray(self.marker_errors_m, float)
+        out = {}
+        for j, name in enumerate(self.marker_names):
+            e = E[:, j][np.isfinite(E[:, j])]
+            if e.size:
+                out[name] = float(np.sqrt(np.mean(e**2)))
+        return dict(sorted(out.items(), key=lambda kv: -kv[1]))
 
     def frame(self) -> pd.DataFrame:
         """Tidy-wide table: time_s plus one column per coordinate (rad or m)."""

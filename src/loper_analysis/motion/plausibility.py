@@ -32,6 +32,9 @@ from loper_analysis.checks import where
 from loper_analysis.errors import LoperInputError
 
 __all__ = [
+    "KNEE_SIGN_MAX_RAD",
+    "KNEE_SIGN_MIN_RAD",
+    "inverted_knee_warnings",
     "marker_extent_m",
     "require_marker_extent",
     "measurement_scale_factors",
@@ -156,6 +159,44 @@ def require_scale_factors(
             f"{where(source)}scale factor(s) outside {lo:g} .. {hi:g} (static-trial marker distance over the "
             f"model's): {listed}; are the markers in the unit the file declares?"
         )
+
+
+#: A knee whose angle stays below this (rad; -20 degrees) at its most negative while its most positive stays under
+#: :data:`KNEE_SIGN_MAX_RAD` flexes "negative": a sign.
+KNEE_SIGN_MIN_RAD: float = float(np.radians(-20.0))
+#: See :data:`KNEE_SIGN_MIN_RAD` (rad; 10 degrees).
+KNEE_SIGN_MAX_RAD: float = float(np.radians(10.0))
+
+
+def inverted_knee_warnings(angles, setting: str = "opensim.coordinate_map") -> list[str]:
+    """Warnings for knees that flex negative: a walking knee flexes to 60 degrees in swing and barely
+    hyperextends, so a knee angle that reaches below -20 degrees and never above 10 degrees has the wrong sign.
+
+    Parameters
+    ----------
+    angles : pandas.DataFrame
+        Our angle table (``knee_left_rad``, ``knee_right_rad``; others ignored).
+    setting : str
+        The config key named in the warning.
+
+    Returns
+    -------
+    list of str
+        One warning per inverted knee (empty when none).
+    """
+    out = []
+    for side in ("left", "right"):
+        column = f"knee_{side}_rad"
+        if column not in angles:
+            continue
+        q = np.asarray(angles[column], float)
+        q = q[np.isfinite(q)]
+        if q.size and q.min() < KNEE_SIGN_MIN_RAD and q.max() < KNEE_SIGN_MAX_RAD:
+            out.append(
+                f"knee_{side} flexes negative (from {np.degrees(q.min()):.0f} to {np.degrees(q.max()):.0f} deg): "
+                f"its sign is likely wrong ({setting}.knee_{side}.sign)"
+            )
+    return out
 
 
 def require_ik_fit(

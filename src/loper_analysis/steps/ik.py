@@ -17,6 +17,7 @@ import pandas as pd
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, MIN_IK_MARKERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_tsv
+from loper_analysis.io.readers import read_tsv
 from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
@@ -129,10 +130,13 @@ def _solve(
     :class:`IKResult`."""
     from loper_analysis.io.ik_tasks import read_ik_tasks
     from loper_analysis.io.osim import read_model
-    from loper_analysis.motion.ik import ik_task_weights, inverse_kinematics
+    from loper_analysis.motion.coordinate_signs import require_map_signs
+    from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP, ik_task_weights, inverse_kinematics
 
     s = settings
     model = read_model(model_osim)
+    cmap = DEFAULT_COORDINATE_MAP if s.coordinate_map is None else s.coordinate_map
+    require_map_signs(model, cmap, str(model_osim), "opensim.coordinate_map")
     tasks = read_ik_tasks(s.tasks_file) if s.tasks_file else None
     weights, coords = ik_task_weights(
         model, labels, tasks, s.default_weight, s.marker_weights, s.coordinate_tasks, source
@@ -185,6 +189,38 @@ def ik_chunk(
     return res
 
 
+def _angle_checks(res, angles: pd.DataFrame, source: str) -> None:
+    """Warn about joint angles that look inverted (:func:`loper_analysis.motion.plausibility.inverted_knee_warnings`);
+    the warnings go to the log and to ``res.warnings`` (the trial's IK summary)."""
+    from loper_analysis.motion.plausibility import inverted_knee_warnings
+
+    for warning in inverted_knee_warnings(angles):
+        log.warning("%s: %s", source, warning)
+        res.warnings.append(warning)
+
+
+def _lab_agreement(angles: pd.DataFrame, lab_angles_tsv: PathLike, res, agreement_tsv: PathLike | None, source: str):
+    """Our angles against the lab's own (:func:`loper_analysis.motion.lab_angles.lab_agreement`): the table written
+    to ``agreement_tsv``, each joint beyond the limits warned about (log and ``res.warnings``)."""
+    from loper_analysis.motion.lab_angles import lab_agreement
+
+    table = lab_agreement(angles, read_tsv(lab_angles_tsv, "lab angles", ("time_s",)))
+    for row in table[table["warning"] != ""].itertuples():
+        text = f"{row.angle} against the lab's own angle: {row.warning}"
+        log.warning("%s: %s", source, text)
+        res.warnings.append(text)
+    if len(table):
+        log.info(
+            "agreement with the lab's own angles (deg):\n%s",
+            table.assign(
+                rms_diff_deg=np.degrees(table["rms_diff_rad"]), mean_offset_deg=np.degrees(table["mean_offset_rad"])
+            )[["angle", "n_frames", "r", "rms_diff_deg", "mean_offset_deg"]].to_string(index=False),
+        )
+    if agreement_tsv is not None:
+        write_tsv(table, agreement_tsv)
+    return table
+
+
 def ik_trial(
     model_osim: PathLike,
     trc_path: PathLike,
@@ -192,14 +228,27 @@ def ik_trial(
     angles_tsv: PathLike,
     settings: IKSettings = IKSettings(),
     summary_tsv: PathLike | None = None,
+    lab_angles_tsv: PathLike | None = None,
+    agreement_tsv: PathLike | None = None,
 ) -> pd.DataFrame:
     """IK of a whole TRC in one go (:func:`ik_chunk` with ``settings``): the .mot (degrees), the tidy angle table
     that :func:`ik_join` gives (``settings.coordinate_map``), and (``summary_tsv``) the one-row IK summary
-    (:meth:`loper_analysis.motion.ik.IKResult.summary`)."""
+    (:meth:`loper_analysis.motion.ik.IKResult.summary`, with the worst marker and the warnings).
+
+    ``lab_angles_tsv``: the lab's own joint angles of the trial (written by the markers step,
+    :func:`loper_analysis.motion.lab_angles.lab_joint_angles`); our angles are compared with them and the
+    agreement per angle written to ``agreement_tsv``
+    (:func:`loper_analysis.motion.lab_angles.lab_agreement`), each joint beyond the limits warned about.
+    A knee that flexes negative is warned about
+    (:func:`loper_analysis.motion.plausibility.inverted_knee_warnings`).
+    """
     from loper_analysis.motion.ik import joint_angle_table
 
     res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, settings)
     angles = joint_angle_table(res.frame(), settings.coordinate_map, source=f"{out_mot} (model {model_osim})")
+    _angle_checks(res, angles, str(trc_path))
+    if lab_angles_tsv is not None:
+        _lab_agreement(angles, lab_angles_tsv, res, agreement_tsv, str(trc_path))
     if summary_tsv is not None:
         warn = settings.warn_marker_rms_m
         write_tsv(res.summary(IK_WARN_RMS_M if warn is None else warn), summary_tsv)
@@ -214,13 +263,15 @@ def ik_join(
     angles_tsv: PathLike,
     settings: IKSettings = IKSettings(),
     summary_tsv: PathLike | None = None,
+    lab_angles_tsv: PathLike | None = None,
+    agreement_tsv: PathLike | None = None,
 ) -> pd.DataFrame:
     """Join IK chunks into one .mot and the tidy angle table (rad, m; :data:`kinematics.ANGLE_COLUMNS`; the
     coordinates of ``settings.coordinate_map``).
 
     ``summary_tsv``: the one-row IK summary of the joined trial (frames left
     out are those without any coordinate; the chunks keep no marker errors,
-    so those columns are NaN).
+    so those columns are NaN). ``lab_angles_tsv`` and ``agreement_tsv`` as in :func:`ik_trial`.
     """
     from loper_analysis.io.opensim_tables import read_mot, write_mot
     from loper_analysis.motion.ik import IKResult, join_chunks, joint_angle_table
@@ -228,13 +279,14 @@ def ik_join(
     frames = [read_mot(p) for p in chunk_mots]
     coords = join_chunks(frames, [str(p) for p in chunk_mots])
     angles = joint_angle_table(coords, settings.coordinate_map, source=str(chunk_mots[0]))
+    values = coords.drop(columns="time_s").to_numpy(float)
+    none = np.full(len(coords), np.nan)
+    joined = IKResult(coords["time_s"].to_numpy(float), values, [], none, none, solved=np.isfinite(values).any(axis=1))
+    _angle_checks(joined, angles, str(out_mot))
+    if lab_angles_tsv is not None:
+        _lab_agreement(angles, lab_angles_tsv, joined, agreement_tsv, str(out_mot))
     write_mot(out_mot, coords, in_degrees=True)
     if summary_tsv is not None:
-        values = coords.drop(columns="time_s").to_numpy(float)
-        none = np.full(len(coords), np.nan)
-        joined = IKResult(
-            coords["time_s"].to_numpy(float), values, [], none, none, solved=np.isfinite(values).any(axis=1)
-        )
         write_tsv(joined.summary(IK_WARN_RMS_M), summary_tsv)
     write_tsv(angles, angles_tsv)
     log.info("%d frames, %s", len(angles), list(angles.columns))

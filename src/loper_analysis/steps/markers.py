@@ -80,6 +80,7 @@ def markers(
     gaps_out: PathLike | None = None,
     settings: MarkerSettings = MarkerSettings(),
     summary_out: PathLike | None = None,
+    lab_angles_out: PathLike | None = None,
 ) -> pd.DataFrame:
     """C3D markers -> model names -> gap fill -> lab-to-model rotation -> zero-phase low-pass -> TRC (mm).
 
@@ -105,6 +106,13 @@ def markers(
     (:func:`loper_analysis.motion.heading.trial_heading`); ``"fixed"`` keeps
     ``rotation_deg``.
 
+    A knee alignment device (``LKAX``, ``LKD1``, ``LKD2`` after the label map) in a trial without the knee
+    marker (``LKNE``) yields that marker (:func:`loper_analysis.motion.knee_alignment.kad_knee_markers`).
+    Points that are not markers (a lab's model outputs: :mod:`loper_analysis.io.c3d_points`) are left out;
+    the lab's own sagittal joint angles among them are written to ``lab_angles_out`` when given (``time_s``
+    on the file's clock and ``{angle}_rad``; only ``time_s`` when the file holds none:
+    :func:`loper_analysis.motion.lab_angles.lab_joint_angles`).
+
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
     row per gap, :data:`loper_analysis.motion.markers.GAP_REPORT_COLUMNS`). The
     per-marker summary (:func:`loper_analysis.motion.markers.gap_summary`, with the
@@ -119,6 +127,7 @@ def markers(
     from loper_analysis.io.opensim_tables import write_trc
     from loper_analysis.motion.filtering import lowpass_finite_runs
     from loper_analysis.motion.heading import trial_heading
+    from loper_analysis.motion.knee_alignment import kad_knee_markers
     from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
     from loper_analysis.motion.markers import fill_gaps, gap_summary, rotate_markers
     from loper_analysis.motion.plausibility import require_marker_extent
@@ -126,10 +135,22 @@ def markers(
     s = settings
     source = str(c3d_path)
     rec = read_c3d(c3d_path)
+    if rec.output_labels:
+        kinds = pd.Series(rec.output_kinds).value_counts()
+        log.info(
+            "%s: %d point(s) that are not markers left out (%s)",
+            source,
+            len(rec.output_labels),
+            ", ".join(f"{k} {n}" for k, n in kinds.items()),
+        )
     names = model_marker_names(rec.marker_labels, read_label_maps(s.label_map), source)
+    names, raw, added = kad_knee_markers(names, rec.markers_m, source=source)
+    labels = list(rec.marker_labels) + [f"{knee} (knee alignment device)" for knee in added]
+    for knee in added:
+        log.info("%s: %s from the knee alignment device (its origin on the lateral epicondyle)", source, knee)
     if s.required_markers is not None:
-        require_model_markers(names, s.required_markers, source, rec.marker_labels)
-    time_s, raw = rec.time_s, rec.markers_m
+        require_model_markers(names, s.required_markers, source, labels)
+    time_s = rec.time_s
     if s.duration_s is not None:
         keep = time_s < time_s[0] + s.duration_s - 1e-9
         time_s, raw = time_s[keep], raw[keep]
@@ -158,7 +179,7 @@ def markers(
             )
         except LoperInputError as exc:
             raise LoperInputError(f"{c3d_path}: markers: {exc}") from None
-    summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), rec.marker_labels, time_s, X, heading)
+    summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), labels, time_s, X, heading)
     log.info(
         "%s: %d frames at %g Hz, %d markers, %d gap(s) filled",
         c3d_path,
@@ -168,6 +189,8 @@ def markers(
         len(gaps),
     )
     write_trc(trc_out, time_s, X, names)
+    if lab_angles_out is not None:
+        _write_lab_angles(rec, lab_angles_out)
     if gaps_out is not None:
         write_tsv(gaps, gaps_out)
     if summary_out is not None:
@@ -224,6 +247,18 @@ def _trial_marker_summary(per_marker: pd.DataFrame, labels: Sequence[str], time_
     for axis, angle in zip("xyz", heading.rotation_deg):
         out[f"rotation_{axis}_deg"] = angle
     return out
+
+
+def _write_lab_angles(rec, out: PathLike) -> None:
+    """The lab's own joint angles of a recording (:func:`loper_analysis.motion.lab_angles.lab_joint_angles`)."""
+    from loper_analysis.motion.lab_angles import lab_joint_angles
+
+    table, used = lab_joint_angles(
+        rec.time_s, rec.output_labels, rec.output_kinds, rec.outputs, rec.output_units.get("ANGLES"), rec.source
+    )
+    write_tsv(table, out)
+    if used:
+        log.info("%s: the lab's own joint angles: %s", rec.source, ", ".join(f"{k} <- {v}" for k, v in used.items()))
 
 
 def _cropped(time_s, markers_m, span_s: Sequence[float], source: str):

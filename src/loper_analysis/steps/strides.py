@@ -10,6 +10,7 @@ import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
+import numpy as np
 import pandas as pd
 
 from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
@@ -90,6 +91,17 @@ def strides(
     return tables
 
 
+#: Columns of the IK summaries the strides summary reads.
+IK_COLUMNS: tuple[str, ...] = (
+    "n_frames",
+    "n_frames_left_out",
+    "marker_rms_mean_m",
+    "worst_marker",
+    "worst_marker_rms_m",
+    "warnings",
+)
+
+
 def strides_summary(
     subject_trials: Sequence[tuple[str, str]],
     strides_tsvs: Sequence[PathLike],
@@ -98,6 +110,7 @@ def strides_summary(
     contacts_tsvs: Sequence[PathLike] | None = None,
     ik_tsvs: Sequence[PathLike] | None = None,
     markers_tsvs: Sequence[PathLike] | None = None,
+    agreement_tsvs: Sequence[PathLike] | None = None,
 ) -> pd.DataFrame:
     """One row per subject x trial of the stride tables (:func:`loper_analysis.gait.strides.stride_summary`).
 
@@ -108,8 +121,10 @@ def strides_summary(
     header only, as :func:`strides` writes it) gives ``n_strides`` 0 and the
     status ``too_few_strides``. ``ik_tsvs`` (the IK summaries of
     :func:`loper_analysis.steps.ik.ik_trial`) add the frames and those left
-    out of IK, ``markers_tsvs`` (the markers summaries of :func:`markers`) the
-    trial's walking direction and the turn that made it walk along +X.
+    out of IK, the mean marker RMS error, the worst marker and the IK warnings, ``markers_tsvs`` (the markers
+    summaries of :func:`markers`) the trial's walking direction and the turn that made it walk along +X,
+    ``agreement_tsvs`` (our angles against the lab's own, :func:`loper_analysis.steps.ik.ik_trial`) the least
+    correlation and the largest RMS difference over the angles compared (NaN where the file holds none).
 
     Raises
     ------
@@ -139,10 +154,18 @@ def strides_summary(
     table = stride_summary(tables, min_valid, contacts)
     extra = []
     if ik_tsvs is not None:
-        ik = [read_tsv(path, "IK summary", ("n_frames", "n_frames_left_out")).iloc[0] for path in ik_tsvs]
+        ik = [
+            read_tsv(path, "IK summary", IK_COLUMNS, keep_default_na=False, na_values=[""]).iloc[0] for path in ik_tsvs
+        ]
         extra.append(
             pd.DataFrame(
-                {"n_frames": [int(r.n_frames) for r in ik], "n_frames_left_out": [int(r.n_frames_left_out) for r in ik]}
+                {
+                    "n_frames": [int(r.n_frames) for r in ik],
+                    "n_frames_left_out": [int(r.n_frames_left_out) for r in ik],
+                    "marker_rms_mean_m": [float(r.marker_rms_mean_m) for r in ik],
+                    "worst_marker": ["" if pd.isna(r.worst_marker) else str(r.worst_marker) for r in ik],
+                    "worst_marker_rms_m": [float(r.worst_marker_rms_m) for r in ik],
+                }
             )
         )
     if markers_tsvs is not None:
@@ -159,10 +182,27 @@ def strides_summary(
                 }
             )
         )
+    if agreement_tsvs is not None:
+        agree = [read_tsv(path, "lab agreement", ("angle", "r", "rms_diff_rad")) for path in agreement_tsvs]
+        extra.append(
+            pd.DataFrame(
+                {
+                    "lab_angles_min_r": [float(a["r"].min()) if len(a) else np.nan for a in agree],
+                    "lab_angles_max_rms_diff_rad": [
+                        float(a["rms_diff_rad"].max()) if len(a) else np.nan for a in agree
+                    ],
+                }
+            )
+        )
+    if ik_tsvs is not None:
+        extra.append(pd.DataFrame({"warnings": ["" if pd.isna(r.warnings) else str(r.warnings) for r in ik]}))
     if extra:
         table = pd.concat([table, *extra], axis=1)
     write_tsv(table, out_tsv)
     for row in table[table.status != "ok"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
+    if "warnings" in table:
+        for row in table[table["warnings"] != ""].itertuples():
+            log.warning("%s %s: %s", row.subject, row.trial, row.warnings)
     log.info("strides:\n%s", table.to_string(index=False))
     return table
