@@ -34,7 +34,16 @@ WIDTH_PX, HEIGHT_PX = 1400, 900
 #: Tables of the front page that must lie within the first screen.
 FIRST_SCREEN_TABLES = ("lf-impedance-summary", "lf-truth-recovery")
 #: Every table of the front page whose box is measured.
-TABLES = ("lf-impedance-summary", "lf-truth-recovery", "lf-figure", "lf-transparency", "lf-device", "lf-run")
+TABLES = (
+    "lf-impedance-summary",
+    "lf-truth-recovery",
+    "lf-figure",
+    "lf-recorded",
+    "lf-trials",
+    "lf-transparency",
+    "lf-device",
+    "lf-run",
+)
 CHROMIUM_FLAGS = (
     "--headless",
     "--no-sandbox",
@@ -165,12 +174,18 @@ class DevTools:
 
 
 def first_screen(
-    report_html: Path, screenshot_png: Path | None = None, chromium: str | None = None, wait_s: float = 30.0
+    report_html: Path,
+    screenshot_png: Path | None = None,
+    chromium: str | None = None,
+    wait_s: float = 30.0,
+    ready_id: str = "lf-impedance-summary",
 ) -> dict:
-    """Open the report at 1400×900, wait for the front page, measure it and (optionally) save a screenshot.
+    """Open the report at 1400×900, wait for the front page (its element ``ready_id``), measure it and
+    (optionally) save a screenshot.
 
     Returns ``{"viewport": [w, h], "boxes": {id: {top, bottom, left, right}}, "text": first screen's text,
-    "load_s": seconds until the front page was drawn}`` (CSS pixels, relative to the viewport).
+    "images": [[alt, natural width, natural height], ...] of the front page's figures, "load_s": seconds until
+    the front page was drawn}`` (CSS pixels, relative to the viewport).
     """
     chromium = chromium or chromium_path()
     if chromium is None:
@@ -181,9 +196,7 @@ def first_screen(
         )
         start = time.monotonic()
         browser.call("Page.navigate", url=Path(report_html).resolve().as_uri())
-        while not browser.evaluate(
-            "!!document.getElementById('lf-impedance-summary') && document.readyState === 'complete'"
-        ):
+        while not browser.evaluate(f"!!document.getElementById('{ready_id}') && document.readyState === 'complete'"):
             if time.monotonic() - start > wait_s:
                 raise TimeoutError(f"{report_html}: the front page did not appear within {wait_s} s")
             time.sleep(0.1)
@@ -191,6 +204,9 @@ def first_screen(
         browser.evaluate("new Promise(r => requestAnimationFrame(() => requestAnimationFrame(r)))")
         time.sleep(0.3)  # the rule graph (vega) draws after the first frames
         measured = json.loads(browser.evaluate(_MEASURE % json.dumps(list(TABLES))))
+        measured["images"] = browser.evaluate(
+            "Array.from(document.querySelectorAll('.lf img')).map(i => [i.alt, i.naturalWidth, i.naturalHeight])"
+        )
         if screenshot_png is not None:
             data = base64.b64decode(browser.call("Page.captureScreenshot", format="png")["data"])
             sys.path.insert(0, str(ROOT / "src"))
@@ -214,7 +230,7 @@ def problems(measured: dict) -> list[str]:
                 f"#{table} lies at top {box['top']:.0f} … bottom {box['bottom']:.0f} px, left "
                 f"{box['left']:.0f} … right {box['right']:.0f} px: not within {width}×{height}"
             )
-    for words in ("the truth</b>", "Impedance: across-subject mean", "Truth recovery"):
+    for words in ("the truth (", "Impedance: across-subject mean", "Truth recovery"):
         if words not in measured["text"]:
             out.append(f"the first screen does not show {words!r}")
     return out

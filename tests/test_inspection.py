@@ -13,6 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
 
@@ -432,14 +433,22 @@ def test_inspect_command_on_walking5(tmp_path, capsys, walking5):
 
 
 def test_inspect_command_on_the_yup_file_without_a_model(yup_file, tmp_path, capsys):
-    snippet = tmp_path / "snippet.yaml"
-    assert main(["inspect", str(yup_file), "--config-out", str(snippet)]) == 0
-    out = capsys.readouterr().out
-    assert "corners listed counter-clockwise seen from above" in out and "vertical axis: +Y" in out
-    assert yaml.safe_load(snippet.read_text()) == {
-        "markers": {"lab_to_model_rotation_deg": [0, 0, 0]},
-        "events": {"foot_markers": {"left": "LHEE", "right": "RHEE"}},
-    }
+    """Without a model the files choose a marker-set template; this file's eight markers fit none: the summary is
+    printed, one line says what was and was not mapped, a starter map holds every label, and no config is written."""
+    config = tmp_path / "lab" / "config.yaml"
+    assert main(["inspect", str(yup_file), "--config-out", str(config)]) == 2
+    captured = capsys.readouterr()
+    assert "corners listed counter-clockwise seen from above" in captured.out and "vertical axis: +Y" in captured.out
+    err = captured.err.strip()
+    assert len(err.splitlines()) == 1
+    assert "fit no marker-set template; closest: plugin_gait" in err and "8 of 12 required" in err
+    assert "missing: LPSI or SACR, RPSI or SACR, LANK, RANK" in err and "left without a marker: HEAD" in err
+    starter = pd.read_csv(tmp_path / "lab" / "label_map_starter.tsv", sep="\t", keep_default_na=False)
+    assert starter.set_index("label")["marker"].to_dict() == {
+        "LASI": "LASI", "RASI": "RASI", "LKNE": "LKNE", "RKNE": "RKNE", "LHEE": "LHEE", "RHEE": "RHEE",
+        "LTOE": "LTOE", "RTOE": "RTOE", "HEAD": "",
+    }  # fmt: skip
+    assert not config.exists() and sorted(p.name for p in (tmp_path / "lab").iterdir()) == ["label_map_starter.tsv"]
 
 
 def test_inspect_command_refuses_a_missing_file_and_a_map_without_model(tmp_path, capsys):

@@ -21,8 +21,9 @@ import pandas as pd
 import pytest
 import yaml
 
-from loper_analysis.io.opensim_tables import read_mot
+from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
+from loper_analysis.motion.markers import rotate_markers
 from loper_analysis.steps.markers import MarkerSettings
 from tests.rajagopal_lab import (
     GENERIC_OSIM,
@@ -98,12 +99,19 @@ def rajagopal(tmp_path_factory):
 
 def test_scaled_model_is_opensims_scale_tool(rajagopal, tmp_path):
     ours = read_model(rajagopal / "results/model/R11/scaled.osim")
+    # the workflow turned the static trial about the vertical to face +X (its pelvis markers): the same turn of
+    # OpenSim's own static trial
+    turn = pd.read_csv(rajagopal / "results/markers/R11/static.markers.tsv", sep="\t").turn_deg.iloc[0]
+    assert turn == 90.0
+    t, X, labels = read_markers(STATIC_TRC)
+    write_trc(tmp_path / "static.trc", t, rotate_markers(X, (0.0, turn, 0.0)), labels)
     # OpenSim's ScaleTool with the setup as distributed, its pipeline's marker set and the mass the plates carry
     peer = read_model(
         opensim_scale_reference(
-            GENERIC_OSIM, SCALE_SETUP, STATIC_TRC, SUBJECT_MASS_KG, tmp_path / "peer.osim", marker_set_xml=MARKER_SET
+            GENERIC_OSIM, SCALE_SETUP, tmp_path / "static.trc", SUBJECT_MASS_KG, tmp_path / "peer.osim",
+            marker_set_xml=MARKER_SET,
         )
-    )
+    )  # fmt: skip
     s1, s2 = ours.initSystem(), peer.initSystem()
     # the mass comes from the plates' float32 channels: 85.0668003 kg (3e-9 relative)
     assert ours.getTotalMass(s1) == pytest.approx(peer.getTotalMass(s2), rel=1e-8)

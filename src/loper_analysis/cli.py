@@ -10,7 +10,7 @@ segments     swing-leg segment table from a scaled model, or from height and mas
 ik           OpenSim inverse kinematics of a marker file (.c3d or .trc) to a .mot
 validate     run (part of) the validation study and write its tables
 plan         predict the 95 % CI half-width of K and D of a planned experiment from a pilot subject
-inspect      what a lab's C3D file holds; labels matched to a model; starter label map and config snippet
+inspect      what a lab's C3D files hold; a subject's config from a marker-set template (or labels matched to a model)
 report       the Snakemake report (``snakemake --report``) written beside its target and moved over it when whole
 
 Every command exits with 0 on success and with 2 and one line on standard
@@ -387,9 +387,25 @@ def _ik(args: argparse.Namespace) -> None:
 
 
 def _inspect(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.inspect import inspect_c3d
+    from loper_analysis.steps.inspect import inspect_c3d, inspect_subject
+    from loper_analysis.subject_setup import NoTemplateFits
 
-    print(inspect_c3d(args.c3d, args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
+    if args.model is not None or args.marker_set is not None or args.label_map_out is not None:
+        if len(args.c3d) != 1:
+            raise LoperInputError(
+                f"inspect: --model, --marker-set and --label-map-out take one file, got {len(args.c3d)}; without "
+                "them several files of one subject choose a marker-set template"
+            )
+        print(inspect_c3d(args.c3d[0], args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
+        return
+    config, _ = _read_config(args)
+    static_name = "static" if config is None else config["trials"]["static"]
+    try:
+        result = inspect_subject(args.c3d, args.config_out, static_name)
+    except NoTemplateFits as exc:
+        print(exc.text, end="")
+        raise
+    print(result.text, end="")
 
 
 def _report(args: argparse.Namespace) -> None:
@@ -685,8 +701,15 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output TSV (one row per onset x joint x parameter x stride count)")
     p.set_defaults(func=_plan)
 
-    p = sub.add_parser("inspect", help="what a lab's C3D file holds; starter label map and config snippet")
-    p.add_argument("c3d", help="the lab's C3D file")
+    p = sub.add_parser(
+        "inspect",
+        help="what a lab's C3D files hold; a subject's config from a marker-set template, or labels matched to a model",
+        description="Without --model: a subject's files (static and walking trials, their kinds from their names) "
+        "are matched to the marker-set templates, and --config-out writes the subject's config with the model, "
+        "marker set, ScaleTool setup, IK tasks and label map beside it. With --model: one file's labels matched "
+        "to that model's markers, a starter label map and a config snippet.",
+    )
+    p.add_argument("c3d", nargs="+", help="the lab's C3D file(s) of one subject (static.c3d, walk-nodevice.c3d, ...)")
     p.add_argument("--model", metavar="M.osim", help="OpenSim model whose markers the file's labels are matched to")
     p.add_argument("--marker-set", metavar="SET.xml", help="OpenSim MarkerSet whose markers are added to the model's")
     p.add_argument(
@@ -694,9 +717,11 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--config-out",
-        metavar="SNIPPET.yaml",
-        help="write a config snippet (rotation, label map, heel markers, model) to merge over the configuration",
+        metavar="CONFIG.yaml",
+        help="without --model: the subject's config (files it names beside it); with --model: a config snippet "
+        "(rotation, label map, heel markers, model) to merge over the configuration",
     )
+    _configfile_option(p)
     p.set_defaults(func=_inspect)
 
     p = sub.add_parser(

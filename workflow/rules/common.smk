@@ -236,7 +236,9 @@ def processing_targets() -> list[str]:
             out.append(f"data/raw/{s}/truth.yaml")
         out += [f"results/strides/{s}/{t}.strides.tsv" for t in subject_trials(s)]
         if SUBJECT_SOURCE[s] == "recorded":  # lab files: their force platforms as OpenSim external loads
-            out += [f"results/grf/{s}/{t}.grf.mot" for t in subject_trials(s) if has_force_platforms(s, t)]
+            plated = [t for t in subject_trials(s) if has_force_platforms(s, t)]
+            out += [f"results/grf/{s}/{t}.grf.mot" for t in plated]
+            out += recorded_figures(s)
     if out:
         out.append("results/strides/summary.tsv")
     if any(DESIGN.onset_ms(t) is not None for s in processed_subjects() for t in subject_trials(s)):
@@ -258,16 +260,35 @@ def processing_targets() -> list[str]:
     return out
 
 
+def recorded_figures(subject: str) -> list[str]:
+    """A recorded subject's quality figures: joint angles over the gait cycle of every walking trial, force plates
+    and events of every trial with plates."""
+    trials = subject_trials(subject)
+    out = [f"results/strides/{subject}/{t}.angles.png" for t in trials]
+    return out + [f"results/grf/{subject}/{t}.grf.png" for t in trials if has_force_platforms(subject, t)]
+
+
 def all_targets() -> list[str]:
-    """Everything `snakemake` builds by default."""
+    """Everything `snakemake` builds by default: the validation study only for a study that identifies impedance
+    (its perturbation trials) or has no subject, so a gait study's report needs none of it."""
     return [
         *processing_targets(),
+        *validation_targets(),
+        *device_targets(),
+        "results/report/front_page.html",
+    ]
+
+
+def validation_targets() -> list[str]:
+    """The validation study's tables and figure: for a study with perturbation trials, or without subjects."""
+    targets = processing_targets()
+    if targets and "results/impedance/impedance.tsv" not in targets:
+        return []
+    return [
         "results/validation/summary.tsv",
         "results/validation/errors.tsv",
         "results/validation/fits.tsv",
         "results/validation/errors.png",
-        *device_targets(),
-        "results/report/front_page.html",
     ]
 
 

@@ -91,8 +91,10 @@ def generic_model(wildcards):
 
 
 def static_c3d_for_mass(wildcards) -> list[str]:
-    """The static trial's C3D when the subject sheet gives no mass (the mass comes from its force plates)."""
-    if "mass_kg" in SUBJECT_ROWS[wildcards.subject]:
+    """The static trial's C3D when the subject sheet gives no mass or no height (the mass comes from its force
+    plates or its PROCESSING:Bodymass, the height from its PROCESSING:Height)."""
+    row = SUBJECT_ROWS[wildcards.subject]
+    if "mass_kg" in row and "height_m" in row:
         return []
     return [f"data/raw/{wildcards.subject}/{TRIALS['static']}.c3d"]
 
@@ -264,11 +266,12 @@ def planning_inputs(wildcards) -> list[str]:
 
 
 def front_page_inputs(wildcards) -> dict:
-    """Tables the front page reads: the validation summary always, the device summary with device tests, the
+    """Tables the front page reads: the validation summary with the validation study, the device summary with
+    device tests, the
     impedance tables and the main figure when the run has perturbation trials, the transparency table when a
     subject walked both trials of the pair (the targets of processing_targets); named as the fields of
     loper_analysis.steps.report.FrontPageFiles."""
-    out = {"validation": "results/validation/summary.tsv"}
+    out = {"validation": "results/validation/summary.tsv"} if validation_targets() else {}
     if device_targets():
         out["device"] = "results/device/summary.tsv"
     targets = set(processing_targets())
@@ -280,6 +283,36 @@ def front_page_inputs(wildcards) -> dict:
         )
     if "results/transparency/rmsd.tsv" in targets:
         out["rmsd"] = "results/transparency/rmsd.tsv"
+    recorded = recorded_quality_files()
+    if recorded:
+        out["strides"] = "results/strides/summary.tsv"
+        out["quality"] = [
+            path
+            for entry in recorded.values()
+            for path in [entry["scale"], *(p for files in entry["trials"].values() for p in files.values())]
+            if path is not None
+        ]
+    return out
+
+
+def recorded_quality_files() -> dict:
+    """The files of the front page's section on recorded subjects: per recorded subject its scale report (None with
+    a scaled model from the sheet) and per walking trial its IK summary, agreement with the lab's own angles and
+    figures (the force plates' None without plates); loper_analysis.steps.report.front_page's ``recorded``."""
+    out = {}
+    for s in processed_subjects():
+        if SUBJECT_SOURCE[s] != "recorded":
+            continue
+        trials = {
+            t: {
+                "ik": f"results/ik/{s}/{t}.ik.tsv",
+                "agreement": f"results/ik/{s}/{t}.lab_agreement.tsv",
+                "angles_png": f"results/strides/{s}/{t}.angles.png",
+                "grf_png": f"results/grf/{s}/{t}.grf.png" if has_force_platforms(s, t) else None,
+            }
+            for t in subject_trials(s)
+        }
+        out[s] = {"scale": f"results/model/{s}/scale.tsv" if s in scaled_subjects() else None, "trials": trials}
     return out
 
 

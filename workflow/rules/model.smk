@@ -34,6 +34,7 @@ rule model_scaled:
         generic=generic_model,
         static=f"results/markers/{{subject}}/{TRIALS['static']}.trc",
         static_summary=f"results/markers/{{subject}}/{TRIALS['static']}.markers.tsv",
+        static_lab_angles=f"results/markers/{{subject}}/{TRIALS['static']}.lab_angles.tsv",
         static_c3d=static_c3d_for_mass,
         setup=[OPENSIM["scale_setup"]] if OPENSIM["scale_setup"] else [],
     output:

@@ -22,6 +22,7 @@ rule front_page:
         **settings_params(FRONT_PAGE_SETTINGS),
         subjects=SUBJECT_SOURCE,
         trials={s: subject_trials(s) for s in processed_subjects()},
+        recorded=recorded_quality_files(),
     script:
         "../scripts/front_page.py"
 

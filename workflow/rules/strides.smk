@@ -50,3 +50,28 @@ rule strides_summary:
         min_valid=STRIDE_SETTINGS.min_valid,
     script:
         "../scripts/strides_summary.py"
+
+
+rule strides_figure:
+    """Both sides' joint angles over the gait cycle, with the lab's own where its file holds them (recorded
+    subjects)."""
+    input:
+        angles="results/ik/{subject}/{trial}.angles.tsv",
+        events="results/events/{subject}/{trial}.events.tsv",
+        lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
+    output:
+        report(
+            "results/strides/{subject}/{trial}.angles.png",
+            caption="../report/strides_figure.rst",
+            category="Processing",
+            subcategory="{subject}",
+            labels={"subject": "{subject}", "trial": "{trial}", "figure": "joint angles"},
+        ),
+    log:
+        "results/logs/strides_figure/{subject}/{trial}.log",
+    benchmark:
+        "results/benchmarks/strides_figure/{subject}/{trial}.tsv"
+    params:
+        title=lambda wc: f"{wc.subject} {wc.trial}: joint angles over the gait cycle (mean ± SD; dashed: the lab's)",
+    script:
+        "../scripts/strides_figure.py"

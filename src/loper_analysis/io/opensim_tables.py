@@ -41,6 +41,7 @@ the atomic writer (:func:`loper_analysis.io.atomic.staged`). Every problem raise
 
 from __future__ import annotations
 
+import logging
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -54,6 +55,8 @@ from loper_analysis.io.atomic import staged
 from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, read_c3d
 from loper_analysis.io.osim import quiet_opensim
 from loper_analysis.io.timing import timed_io
+
+log = logging.getLogger(__name__)
 
 __all__ = [
     "TRANSLATION_SUFFIXES",
@@ -183,7 +186,38 @@ def _read_trc_text(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]] | Non
     if data.shape != (n_frames, 2 + 3 * n_markers):
         return None
     X = data[:, 2:].reshape(n_frames, n_markers, 3) / LENGTH_UNITS_PER_M[unit]
-    return data[:, 1].copy(), X, labels
+    return _nominal_times(data[:, 1].copy(), meta.get("DataRate"), path), X, labels
+
+
+#: Printed times within this share of a frame step of the header rate's grid are read on that grid.
+_TIME_JITTER_FRACTION = 0.25
+
+
+def _nominal_times(t: np.ndarray, rate, path: Path) -> np.ndarray:
+    """A TRC's times on the grid of its header's ``DataRate`` when the printed times only round it.
+
+    OpenSim's own files print times to a few digits (the gait2392 tutorial's 60 Hz static trial: 0.000,
+    0.017, 0.033, ...), so their steps jitter by up to half the last digit. Where every printed time lies
+    within :data:`_TIME_JITTER_FRACTION` of a step from ``t[0] + k / DataRate``, the grid's times are
+    returned and the jitter is logged; otherwise (no rate, frames missing, another rate) the printed times.
+    """
+    try:
+        rate_hz = float(rate)
+    except (TypeError, ValueError):
+        return t
+    if not np.isfinite(rate_hz) or rate_hz <= 0 or t.size < 2 or not np.all(np.isfinite(t)):
+        return t
+    grid = t[0] + np.arange(t.size) / rate_hz
+    jitter = float(np.max(np.abs(t - grid)))
+    if jitter == 0.0 or jitter > _TIME_JITTER_FRACTION / rate_hz:
+        return t
+    log.info(
+        "%s: times printed to a few digits (up to %.3g ms off the %g Hz grid of DataRate): read on that grid",
+        path,
+        1e3 * jitter,
+        rate_hz,
+    )
+    return grid
 
 
 def _read_trc(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
@@ -199,7 +233,8 @@ def _read_trc(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:
     if unit.lower() not in LENGTH_UNITS_PER_M:
         raise LoperInputError(f"{path}: unknown TRC Units '{unit}'; expected one of {', '.join(LENGTH_UNITS_PER_M)}")
     labels = list(table.getColumnLabels())
-    t = np.array(table.getIndependentColumn(), dtype=float)
+    rate = table.getTableMetaDataAsString("DataRate") if table.hasTableMetaDataKey("DataRate") else None
+    t = _nominal_times(np.array(table.getIndependentColumn(), dtype=float), rate, path)
     if not labels:
         return t, np.zeros((t.size, 0, 3)), labels
     flat_table = table.flatten(["_x", "_y", "_z"])  # keep temporaries alive

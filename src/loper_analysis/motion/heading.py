@@ -11,8 +11,14 @@ each trial's direction of travel is estimated from the markers themselves:
    consecutive frames in which it is present) gives the direction of travel;
 3. if the subject travels (mean speed at least ``min_speed_m_per_s``), a
    quarter turn about the vertical (0, 90, 180 or 270 degrees) is added so
-   that the travel points along the model's +X (forward); otherwise
-   (treadmill, standing) the configured rotation stands.
+   that the travel points along the model's +X (forward);
+4. otherwise, when the trial's pelvis markers tell which way the subject
+   faces (the anterior superior iliac spines in front of the posterior ones
+   or the sacrum: :func:`facing_m`), the quarter turn that makes the subject
+   face +X: a static trial faces the model's forward, as OpenSim's pelvis
+   angles assume (its tilt, list and rotation mix for a subject facing the
+   side); otherwise (a treadmill trial without pelvis markers) the
+   configured rotation stands.
 
 Quarter turns keep the lab's axes (force plates and walkway stay aligned
 with the model's axes); the estimated direction is reported besides, so a
@@ -32,7 +38,7 @@ import numpy as np
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.markers import rotate_markers
 
-__all__ = ["HEADING_MODES", "TrialHeading", "travel_velocity_m_per_s", "trial_heading"]
+__all__ = ["HEADING_MODES", "TrialHeading", "facing_m", "travel_velocity_m_per_s", "trial_heading"]
 
 #: ``auto``: each trial turned to walk along +X when it travels; ``fixed``: the configured rotation for every trial.
 HEADING_MODES: tuple[str, ...] = ("auto", "fixed")
@@ -60,7 +66,8 @@ class TrialHeading:
     turn_deg : float
         Quarter turn about the vertical added to the configured rotation (0, 90, 180 or 270).
     source : str
-        ``travel`` (turned by the travel) or ``config`` (the configured rotation stands).
+        ``travel`` (turned by the travel), ``pelvis`` (turned to face +X by the pelvis markers) or ``config``
+        (the configured rotation stands).
     """
 
     rotation_deg: tuple[float, float, float]
@@ -88,6 +95,18 @@ def travel_velocity_m_per_s(markers_m, rate_hz: float) -> np.ndarray:
     return step.mean(axis=0) * float(rate_hz)
 
 
+def facing_m(markers_m, front: Sequence[int], back: Sequence[int]) -> np.ndarray:
+    """Mean vector (3,) from the back pelvis markers' centre to the front ones' (m): the way the subject faces;
+    NaN where the markers are missing throughout."""
+    X = np.asarray(markers_m, dtype=float)
+    if not len(front) or not len(back):
+        return np.full(3, np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN frames
+        d = np.nanmean(X[:, list(front)], axis=1) - np.nanmean(X[:, list(back)], axis=1)
+        return np.nanmean(d, axis=0)
+
+
 def trial_heading(
     markers_lab_m,
     rate_hz: float,
@@ -95,6 +114,7 @@ def trial_heading(
     mode: str = "auto",
     min_speed_m_per_s: float = MIN_TRAVEL_SPEED_M_PER_S,
     source: str = "",
+    pelvis: tuple[Sequence[int], Sequence[int]] | None = None,
 ) -> TrialHeading:
     """The lab -> model rotation of one trial (module docstring).
 
@@ -112,12 +132,14 @@ def trial_heading(
         Least mean horizontal speed (m/s) that counts as travel (``markers.min_travel_speed_m_per_s``).
     source : str
         The file, for messages.
+    pelvis : (sequence of int, sequence of int), optional
+        Indices of the front (ASIS) and back (PSIS, sacrum) pelvis markers: a trial that does not travel is
+        turned to face +X by them.
 
     Returns
     -------
     TrialHeading
     """
-    from scipy.spatial.transform import Rotation
 
     if mode not in HEADING_MODES:
         raise LoperInputError(
@@ -127,14 +149,27 @@ def trial_heading(
     v = travel_velocity_m_per_s(rotate_markers(markers_lab_m, base), rate_hz)
     speed = float(np.hypot(v[0], v[2]))
     heading = float(np.degrees(np.arctan2(-v[2], v[0]))) % 360.0 if np.isfinite(speed) and speed > 0 else np.nan
-    if mode == "fixed" or not np.isfinite(speed) or speed < min_speed_m_per_s:
+    if mode == "fixed":
         return TrialHeading(base, heading, speed, 0.0, "config")
-    turn = float((-90.0 * round(heading / 90.0)) % 360.0)
+    if not np.isfinite(speed) or speed < min_speed_m_per_s:
+        face = facing_m(rotate_markers(markers_lab_m, base), *pelvis) if pelvis is not None else np.full(3, np.nan)
+        if not np.all(np.isfinite(face)) or np.hypot(face[0], face[2]) < 0.05:
+            return TrialHeading(base, heading, speed, 0.0, "config")
+        facing = float(np.degrees(np.arctan2(-face[2], face[0]))) % 360.0
+        return _turned(base, facing, heading, speed, "pelvis")
+    return _turned(base, heading, heading, speed, "travel")
+
+
+def _turned(base: tuple[float, float, float], direction_deg: float, heading: float, speed: float, source: str):
+    """The heading with the quarter turn that brings ``direction_deg`` (about +Y) nearest to +X."""
+    from scipy.spatial.transform import Rotation
+
+    turn = float((-90.0 * round(direction_deg / 90.0)) % 360.0)
     if turn == 0.0:
-        return TrialHeading(base, heading, speed, 0.0, "travel")
+        return TrialHeading(base, heading, speed, 0.0, source)
     combined = Rotation.from_euler("y", turn, degrees=True) * Rotation.from_euler("xyz", base, degrees=True)
     with warnings.catch_warnings():  # a quarter turn of a Z-up lab puts the middle angle at 90 deg ("gimbal lock"):
         warnings.simplefilter("ignore", UserWarning)  # the angles still give the rotation, only not uniquely
         euler = combined.as_euler("xyz", degrees=True)
     angles = np.round(euler, _ANGLE_DECIMALS) + 0.0  # + 0.0: no -0.0
-    return TrialHeading((float(angles[0]), float(angles[1]), float(angles[2])), heading, speed, turn, "travel")
+    return TrialHeading((float(angles[0]), float(angles[1]), float(angles[2])), heading, speed, turn, source)

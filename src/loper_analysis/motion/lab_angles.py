@@ -28,6 +28,7 @@ __all__ = [
     "LAB_AGREEMENT_COLUMNS",
     "LAB_ANGLE_STEMS",
     "MAX_LAB_RMS_RAD",
+    "MIN_LAB_EXCURSION_RAD",
     "MIN_LAB_R",
     "lab_agreement",
     "lab_agreement_warnings",
@@ -48,10 +49,14 @@ LAB_ANGLE_STEMS: dict[str, str] = {
 MIN_LAB_R: float = 0.9
 #: Above this RMS difference from the lab's angle (rad; 10 degrees) a joint is warned about.
 MAX_LAB_RMS_RAD: float = float(np.radians(10.0))
+#: The correlation is judged only where the lab's angle moves at least this much (rad; 10 degrees, max - min):
+#: the pelvis tilts by 2-4 degrees in walking, where r says more about noise than about agreement.
+MIN_LAB_EXCURSION_RAD: float = float(np.radians(10.0))
 #: Columns of :func:`lab_agreement`.
 LAB_AGREEMENT_COLUMNS: tuple[str, ...] = (
     "angle",
     "n_frames",
+    "lab_excursion_rad",
     "r",
     "rms_diff_rad",
     "mean_offset_rad",
@@ -157,7 +162,7 @@ def lab_agreement(ours: pd.DataFrame, lab: pd.DataFrame, min_frames: int = 10) -
         b = lab[column].to_numpy(float)[i_lab]
         ok = np.isfinite(a) & np.isfinite(b)
         n = int(ok.sum())
-        row = {"angle": angle, "n_frames": n}
+        row = {"angle": angle, "n_frames": n, "lab_excursion_rad": float(np.ptp(b[ok])) if n else np.nan}
         if n >= min_frames and np.std(a[ok]) > 0 and np.std(b[ok]) > 0:
             d = a[ok] - b[ok]
             row |= {
@@ -180,14 +185,15 @@ def lab_agreement_warnings(
     out = []
     for row in table.itertuples():
         problems = []
-        if np.isfinite(row.r) and row.r < min_r:
+        moves = np.isfinite(row.lab_excursion_rad) and row.lab_excursion_rad >= MIN_LAB_EXCURSION_RAD
+        if moves and np.isfinite(row.r) and row.r < min_r:
             problems.append(f"r {row.r:.2f} < {min_r:g}")
         if np.isfinite(row.rms_diff_rad) and row.rms_diff_rad > max_rms_rad:
             problems.append(
                 f"RMS difference {np.degrees(row.rms_diff_rad):.1f} deg > {np.degrees(max_rms_rad):.0f} deg "
                 f"(mean offset {np.degrees(row.mean_offset_rad):+.1f} deg)"
             )
-        if row.r < 0:
+        if moves and row.r < 0:
             problems.append("anticorrelated: a sign (opensim.coordinate_map) or swapped sides (markers.label_map)?")
         out.append("; ".join(problems))
     return out

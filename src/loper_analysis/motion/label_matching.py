@@ -38,6 +38,7 @@ __all__ = [
     "LANDMARK_SYNONYMS",
     "LabelMatch",
     "heel_markers",
+    "landmark_indices",
     "match_labels",
     "starter_label_map",
 ]
@@ -195,6 +196,12 @@ def starter_label_map(match: LabelMatch) -> pd.DataFrame:
         if strip_subject_prefix(label) != marker
     ]
     return pd.DataFrame(rows, columns=["label", "marker"], dtype=object)
+
+
+def landmark_indices(names: Sequence[str], landmarks: Sequence[str]) -> list[int]:
+    """Indices of the names that spell one of ``landmarks`` (keys of :data:`LANDMARK_SYNONYMS`), either side."""
+    wanted = set(landmarks)
+    return [i for i, name in enumerate(names) if any(lm in wanted for _, lm in _landmarks(str(name)))]
 
 
 def heel_markers(names: Sequence[str]) -> dict[str, str] | None:

@@ -210,6 +210,10 @@ _STYLE = """<style>
 .lf .lf-note{font-size:11px;margin:0 0 6px}
 .lf tr.lf-sep td{border-top:1px solid #9ca3af}
 .lf img{max-width:100%;height:auto;margin:4px 0 2px}
+.lf h3{font-size:13px;font-weight:700;margin:8px 0 2px}
+.lf img.lf-wide{max-width:760px}
+.lf td.lf-wrap{white-space:normal;max-width:360px}
+.lf ul.lf-warnings{color:#b91c1c;margin:2px 0 6px;padding-left:18px}
 </style>"""
 
 
@@ -446,12 +450,13 @@ def front_page_html(
     settings: RunSettings,
     versions: Mapping[str, str],
     device: pd.DataFrame,
-    validation: pd.DataFrame,
+    validation: pd.DataFrame | None,
     summary: pd.DataFrame | None = None,
     truth: pd.DataFrame | None = None,
     impedance_status: Mapping[str, int] | None = None,
     figure_png: bytes | None = None,
     transparency: pd.DataFrame | None = None,
+    recorded_html: str = "",
 ) -> str:
     """The front page as one HTML fragment (a ``<style>`` and a ``<div class="lf">``).
 
@@ -467,8 +472,9 @@ def front_page_html(
         Software -> version, in the order to show (Python and :data:`SOFTWARE`).
     device : pandas.DataFrame
         :func:`~loper_analysis.report.headline.device_comparison`.
-    validation : pandas.DataFrame
-        :func:`~loper_analysis.report.headline.validation_verdict`.
+    validation : pandas.DataFrame or None
+        :func:`~loper_analysis.report.headline.validation_verdict`; None: no validation study (a study without
+        perturbation trials).
     summary : pandas.DataFrame or None
         :func:`~loper_analysis.report.headline.impedance_summary_ci`; None: the run had no perturbation trials.
     truth : pandas.DataFrame or None
@@ -480,6 +486,9 @@ def front_page_html(
     transparency : pandas.DataFrame or None
         :func:`~loper_analysis.report.headline.transparency_verdict`; None: no subject walked both trials of the
         transparency pair.
+    recorded_html : str
+        The section on recorded subjects (:func:`loper_analysis.report.subject_quality.recorded_subjects_html`),
+        placed after the impedance results.
 
     Returns
     -------
@@ -490,9 +499,13 @@ def front_page_html(
         raise LoperInputError(f"settings must be a RunSettings, got {type(settings).__name__}")
     parts = [_STYLE, '<div class="lf">']
     onsets = ", ".join(str(int(o)) for o in settings.perturbation_onsets_ms)
+    design = (
+        f" (onsets {onsets} ms × {settings.perturbation_repeats} + the transparency pair)"
+        if summary is not None
+        else ""
+    )
     parts.append(
-        f"<p><b>Run</b>: {_subject_line(subjects, trials)} (onsets {onsets} ms × "
-        f"{settings.perturbation_repeats} + the transparency pair); seed {settings.seed}; settings and "
+        f"<p><b>Run</b>: {_subject_line(subjects, trials)}{design}; seed {settings.seed}; settings and "
         "versions at the end.</p>"
     )
     verdicts = []
@@ -503,11 +516,12 @@ def front_page_html(
         verdicts.append(_transparency_verdict_line(transparency))
     if len(device):
         verdicts.append(_device_verdict_line(device))
-    if len(validation):
+    if validation is not None and len(validation):
         verdicts.append(_validation_verdict_line(validation))
     parts.append(f'<ul class="lf-verdicts">{"".join(verdicts)}</ul>')
     if summary is None:
         parts.append("<p>No perturbation trials in this run: no impedance was identified.</p>")
+
     elif not len(summary):
         status = ", ".join(f"{n} {html.escape(s)}" for s, n in (impedance_status or {}).items())
         parts.append(
@@ -527,6 +541,8 @@ def front_page_html(
             '<p class="lf-note">Grey: each subject; black: the across-subject mean; open circles: the '
             "truth of synthetic subjects.</p>"
         )
+    if recorded_html:
+        parts.append(recorded_html)
     if transparency is not None and len(transparency):
         parts.append(_transparency_table(transparency))
     if len(device):

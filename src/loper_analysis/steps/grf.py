@@ -132,3 +132,15 @@ def trial_grf(
     log.info("%s: rotation %s deg (from %s)", c3d_path, list(rotation), markers_summary_tsv)
     trial = dataclasses.replace(settings, rotation_deg=rotation)
     return grf(c3d_path, out_mot, trial, up=lab_up(settings.rotation_deg))
+
+
+def grf_figure(grf_mot: PathLike, events_tsv: PathLike, out_png: PathLike, title: str | None = None) -> None:
+    """The trial's force plates over time with its heel strikes and toe-offs
+    (:func:`loper_analysis.report.figures.gait.ground_reaction_figure`), as a PNG."""
+    from loper_analysis.io.atomic import write_figure
+    from loper_analysis.io.opensim_tables import read_mot
+    from loper_analysis.io.readers import read_tsv
+    from loper_analysis.report.figures.gait import ground_reaction_figure
+
+    events = read_tsv(events_tsv, "event table", ("side", "event", "time_s"))
+    write_figure(ground_reaction_figure(read_mot(grf_mot), events, title), out_png)

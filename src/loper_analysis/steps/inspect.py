@@ -12,8 +12,11 @@ snippet are written through the atomic writer (:mod:`loper_analysis.io.atomic`).
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+
+import pandas as pd
 
 from loper_analysis.errors import LoperInputError, one_line
 from loper_analysis.inspection import (
@@ -23,14 +26,15 @@ from loper_analysis.inspection import (
     format_summary,
     recording_summary,
 )
-from loper_analysis.io.atomic import PathLike, write_text, write_tsv
+from loper_analysis.io.atomic import PathLike, write_bytes, write_text, write_tsv
 from loper_analysis.io.c3d_parameters import param_strings
 from loper_analysis.io.timing import library_import, timed_io
 from loper_analysis.motion.lab_frame import axis_name
 from loper_analysis.motion.label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
 from loper_analysis.motion.marker_names import strip_subject_prefix
+from loper_analysis.subject_setup import SubjectSetup
 
-__all__ = ["Inspection", "inspect_c3d", "model_marker_names_of"]
+__all__ = ["Inspection", "SubjectInspection", "inspect_c3d", "inspect_subject", "model_marker_names_of"]
 
 
 @dataclass(frozen=True)
@@ -229,3 +233,249 @@ def inspect_c3d(
         None if label_map_out is None else Path(label_map_out),
         None if config_out is None else Path(config_out),
     )
+
+
+# ---------------------------------------------------------------- a subject's files -> its config
+
+
+@dataclass(frozen=True)
+class SubjectInspection:
+    """What :func:`inspect_subject` found and wrote.
+
+    Attributes
+    ----------
+    summaries : list of RecordingSummary
+        One per file, in the order given.
+    setup : SubjectSetup or None
+        The template and what follows (None when no config was asked for and no template fits).
+    text : str
+        The report to print.
+    written : tuple of Path
+        The files written (the config last).
+    """
+
+    summaries: list[RecordingSummary]
+    setup: SubjectSetup | None
+    text: str
+    written: tuple[Path, ...] = ()
+
+
+def _trial_kind(path: Path, static_name: str) -> str:
+    return "static" if path.stem == static_name else "walking"
+
+
+def _subject_config_text(
+    paths: Sequence[Path],
+    kinds: Sequence[str],
+    setup: SubjectSetup,
+    summary: RecordingSummary,
+    files: Mapping[str, str],
+    coordinate_map: Mapping[str, Mapping],
+    mass_height: str,
+) -> str:
+    """The subject's config: every key with a comment (YAML)."""
+    t = setup.template
+    rotation = [float(a) for a in summary.rotation_deg]
+    up = axis_name(summary.vertical.axis, summary.vertical.sign)
+    lines = [
+        f"# Settings of the subject recorded in {', '.join(str(p) for p in paths)}, written by loper-analysis inspect.",
+        f"# Marker-set template: {t.name} ({t.title}) on {t.model}.",
+        "# Add the subject to a sheet (subject, source: recorded, ...) named by `subjects:` below, then run",
+        f"#   snakemake -j2 --configfile {files['config']}",
+        f"# {mass_height}",
+        "# subjects: lab/subjects.tsv          # the subject sheet (add this key)",
+        "markers:",
+        f"  lab_to_model_rotation_deg: {_flow(rotation)}   # up {up} -> model +Y (each walking trial is turned "
+        "to walk along model +X)",
+    ]
+    if "label_map" in files:
+        lines.append(f"  label_map: {_flow(files['label_map'])}   # lab label -> template marker")
+    else:
+        lines.append("  label_map: {}   # the labels are the template's marker names")
+    lines += [
+        "opensim:",
+        f"  generic_model: {_flow(files['model'])}   # {t.model} as OpenSim distributes it",
+        f"  scale_setup: {_flow(files['scale_setup'])}   # ScaleTool setup; names marker_set.xml beside it",
+        f"  ik_tasks: {_flow(files['ik_tasks'])}   # markers of the walking trials and their weights"
+        + (f"; not tracked (static trial only): {', '.join(setup.static_only)}" if setup.static_only else ""),
+        "  coordinate_map:   # our angle -> model coordinate; each sign read from the model's kinematics",
+    ]
+    lines += [f"    {k}: {_flow(dict(v))}" for k, v in coordinate_map.items()]
+    feet = t.foot_markers
+    lines += ["events:", f"  foot_markers: {_flow(dict(feet))}   # heel markers: assign plate contacts to feet"]
+    kinds_text = ", ".join(f"{p.stem} ({k})" for p, k in zip(paths, kinds))
+    lines.append(f"# trials: {kinds_text}")
+    return "\n".join(lines) + "\n"
+
+
+def _flow(value) -> str:
+    """A YAML flow value (JSON is YAML)."""
+    import json
+
+    if isinstance(value, Mapping):
+        return "{" + ", ".join(f"{k}: {_flow(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_flow(v) for v in value) + "]"
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return json.dumps(value)
+
+
+def _mass_height_line(static_rec) -> str:
+    """Where the subject's mass and height will come from when the sheet leaves them empty."""
+    parts = []
+    if static_rec is not None and static_rec.n_force_platforms:
+        parts.append("mass: the static trial's force plates")
+    elif static_rec is not None and "Bodymass" in static_rec.processing:
+        parts.append(f"mass: {static_rec.processing['Bodymass']:.2f} kg (the file's PROCESSING:Bodymass)")
+    if static_rec is not None and "Height" in static_rec.processing:
+        parts.append(f"height: {static_rec.processing['Height'] / 1000:.3f} m (PROCESSING:Height)")
+    return "Without mass or height in the sheet: " + ("; ".join(parts) or "give them in the sheet") + "."
+
+
+def inspect_subject(
+    c3d_paths: Sequence[PathLike],
+    config_out: PathLike | None = None,
+    static_name: str = "static",
+) -> SubjectInspection:
+    """Inspect a subject's C3D files, choose the marker-set template that fits their labels, and (``config_out``)
+    write the subject's config with the files it names beside it.
+
+    Each file's kind comes from its name: ``static_name`` (``trials.static``) is the static trial, every other
+    file a walking trial. The template (:func:`loper_analysis.subject_setup.subject_setup`) gives the label
+    map, the marker set of the static trial's markers, a ScaleTool setup naming it, the walking trials' IK
+    tasks (a marker of the static trial only is not tracked) and the heel markers; the coordinate map's signs
+    are read from the template's model
+    (:func:`loper_analysis.motion.marker_templates.template_coordinate_map`).
+
+    Written beside ``config_out`` (paths in the config as given, so relative ones count from where snakemake
+    runs): the model (a copy), ``marker_set.xml``, ``scale_setup.xml``, ``ik_tasks.tsv``, ``label_map.tsv``
+    (when a label differs from its marker), then the config. Everything is built before anything is written.
+
+    Raises
+    ------
+    LoperInputError
+        A missing or unreadable file; an output path equal to an input.
+    loper_analysis.subject_setup.NoTemplateFits
+        The labels fit no template: the message lists what was and was not mapped; with ``config_out`` a
+        starter map (``label_map_starter.tsv``: every label, the template's marker where one was found) is
+        written beside it and nothing else.
+    """
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.force_platforms import read_force_platforms
+    from loper_analysis.io.marker_templates import read_templates, template_file
+    from loper_analysis.io.osim import read_model, write_osim_object
+    from loper_analysis.io.readers import read_bytes
+    from loper_analysis.motion.marker_templates import (
+        template_coordinate_map,
+        template_marker_set,
+        template_scale_tool,
+    )
+    from loper_analysis.subject_setup import NoTemplateFits, format_fits, subject_setup
+
+    paths = [Path(p) for p in c3d_paths]
+    if config_out is not None and any(Path(config_out).resolve() == p.resolve() for p in paths):
+        raise LoperInputError(f"{config_out}: the config would overwrite an input file")
+    kinds = [_trial_kind(p, static_name) for p in paths]
+    recs, summaries, text = [], [], ""
+    for path in paths:
+        rec = read_c3d(path)
+        plates, problem = [], ""
+        if rec.n_force_platforms:
+            try:
+                plates = read_force_platforms(path)
+            except LoperInputError as exc:
+                problem = one_line(exc)
+        summary = recording_summary(rec, plates, point_unit=_point_unit(path), plate_problem=problem)
+        recs.append(rec)
+        summaries.append(summary)
+        text += format_summary(summary) + "\n"
+        if rec.output_labels:
+            text += (
+                f"  {len(rec.output_labels)} point(s) that are not markers left out (the lab's model outputs, segment "
+                f"and unlabelled points); {len(rec.marker_labels)} markers\n"
+            )
+    static = next((r for r, k in zip(recs, kinds) if k == "static"), None)
+    walking = [r.marker_labels for r, k in zip(recs, kinds) if k == "walking"]
+    source = ", ".join(str(p) for p in paths)
+    templates = read_templates()
+    try:
+        setup = subject_setup(None if static is None else static.marker_labels, walking, templates, source)
+    except NoTemplateFits as exc:
+        exc.text = (
+            text + f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(exc.fits)}\n"
+        )
+        if config_out is not None:
+            best = exc.fits[0].match
+            marker_of = {strip_subject_prefix(lab): m for lab, m, _ in best.pairs}
+            labels = list(dict.fromkeys(strip_subject_prefix(lab) for r in recs for lab in r.marker_labels))
+            starter = Path(config_out).parent / "label_map_starter.tsv"
+            write_tsv(pd.DataFrame({"label": labels, "marker": [marker_of.get(lab, "") for lab in labels]}), starter)
+            error = NoTemplateFits(
+                f"{exc}; a starter label map to complete: {starter} (then give the lab's model, marker set and "
+                "setups in the config by hand: docs/first_recorded_subject.md)",
+                exc.fits,
+            )
+            error.text = exc.text
+            raise error from None
+        raise
+    t = setup.template
+    text += (
+        f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(setup.fits)}\n"
+        f"chosen: {t.name} ({t.title}) on {t.model}\n"
+        f"  static trial markers: {len(setup.static_markers)}; walking trials: {len(setup.walking_markers)}"
+        + (f"; static trial only (not tracked in walking): {', '.join(setup.static_only)}" if setup.static_only else "")
+        + (
+            f"\n  labels without a template marker (kept, not used): {', '.join(setup.unmapped)}"
+            if setup.unmapped
+            else ""
+        )
+        + (f"\n  label map: {len(setup.label_map)} row(s)" if len(setup.label_map) else "\n  label map: none needed")
+        + "\n"
+    )
+    if static is None:
+        text += "  no static trial among the files: its markers were taken from the first walking trial\n"
+    mass_height = _mass_height_line(static)
+    text += f"  {mass_height}\n"
+    if config_out is None:
+        return SubjectInspection(summaries, setup, text)
+
+    folder = Path(config_out).parent
+    model_path = template_file(t.model)
+    model = read_model(model_path)
+    coordinate_map = template_coordinate_map(t, model)
+    marker_set = template_marker_set(t, setup.static_markers)
+    tool = template_scale_tool(t, setup.static_markers, "marker_set.xml")
+    files = {
+        "model": str(folder / t.model),
+        "marker_set": str(folder / "marker_set.xml"),
+        "scale_setup": str(folder / "scale_setup.xml"),
+        "ik_tasks": str(folder / "ik_tasks.tsv"),
+        "config": str(config_out),
+    }
+    if len(setup.label_map):
+        files["label_map"] = str(folder / "label_map.tsv")
+    inputs = {p.resolve() for p in paths}
+    clash = [f for f in files.values() if Path(f).resolve() in inputs]
+    if clash:
+        raise LoperInputError(f"{clash[0]}: would overwrite an input file; write the config to another folder")
+    config_text = _subject_config_text(paths, kinds, setup, summaries[0], files, coordinate_map, mass_height)
+    model_bytes = read_bytes(model_path, "OpenSim model")
+    write_bytes(files["model"], model_bytes, "OpenSim model")
+    write_osim_object(marker_set, files["marker_set"], "marker set")
+    write_osim_object(tool, files["scale_setup"], "ScaleTool setup")
+    write_tsv(setup.ik_tasks, files["ik_tasks"])
+    if "label_map" in files:
+        write_tsv(setup.label_map, files["label_map"])
+    write_text(config_out, config_text, "subject config")
+    written = tuple(
+        Path(files[k]) for k in ("model", "marker_set", "scale_setup", "ik_tasks", "label_map", "config") if k in files
+    )
+    text += "\n" + "\n".join(f"wrote {w}" for w in written) + "\n"
+    device = any(k == "walking" and p.stem != "walk-nodevice" and "device" in p.stem for p, k in zip(paths, kinds))
+    text += (
+        "next: add `subjects:` (a sheet with the row `SUBJECT recorded`) to the config"
+        + ("" if device else ", and `device.subject: null` (no device trials)")
+        + f", then: snakemake -j2 --configfile {config_out}\n"
+    )
+    return SubjectInspection(summaries, setup, text, written)

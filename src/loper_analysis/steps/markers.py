@@ -128,6 +128,7 @@ def markers(
     from loper_analysis.motion.filtering import lowpass_finite_runs
     from loper_analysis.motion.heading import trial_heading
     from loper_analysis.motion.knee_alignment import kad_knee_markers
+    from loper_analysis.motion.label_matching import landmark_indices
     from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
     from loper_analysis.motion.markers import fill_gaps, gap_summary, rotate_markers
     from loper_analysis.motion.plausibility import require_marker_extent
@@ -157,10 +158,15 @@ def markers(
     if s.span_s is not None:
         time_s, raw = _cropped(time_s, raw, s.span_s, source)
     require_marker_extent(raw, source, s.extent_range_m)
+    pelvis = (landmark_indices(names, ["asis"]), landmark_indices(names, ["psis", "sacrum"]))
     heading = trial_heading(
-        raw, rec.point_rate_hz, s.rotation_deg, s.walking_direction, s.min_travel_speed_m_per_s, source
+        raw, rec.point_rate_hz, s.rotation_deg, s.walking_direction, s.min_travel_speed_m_per_s, source, pelvis
     )
-    if heading.turn_deg:
+    if heading.turn_deg and heading.source == "pelvis":
+        log.info(
+            "%s: turned %g deg about the vertical to face the model's +X (pelvis markers)", source, heading.turn_deg
+        )
+    elif heading.turn_deg:
         log.info(
             "%s: walks %.1f deg from the model's +X at %.2f m/s: turned %g deg about the vertical (rotation %s deg)",
             source,

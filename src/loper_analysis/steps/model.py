@@ -13,7 +13,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from loper_analysis.constants import GRAVITY_M_PER_S2, LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
@@ -21,6 +20,7 @@ from loper_analysis.io.atomic import PathLike, staged, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
+from loper_analysis.motion.scale_report import SCALE_FLOAT_FORMAT
 from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.dynamics import (
     BRACE_ATTACHMENT_FRACTION,
@@ -34,13 +34,10 @@ __all__ = [
     "STATIC_MAX_MOTION_RMS_M",
     "ModelSettings",
     "ScaleFiles",
-    "SCALE_FLOAT_FORMAT",
-    "SCALE_REPORT_COLUMNS",
     "generic_model",
     "scaled_model",
     "scale_with_setup",
     "scale",
-    "scale_report",
     "segments_from_model_file",
     "anthropometric_segments",
 ]
@@ -83,6 +80,11 @@ class ModelSettings:
     attachment_fraction : float
         Rod attachment as a fraction of the thigh length, for a model without brace markers
         (``opensim.brace_attachment_fraction``).
+    coordinate_map : mapping, optional
+        Our angle -> model coordinate and sign, for the static pose of the scale report
+        (``opensim.coordinate_map``); None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+    accuracy : float
+        IK solver accuracy of the scale report's static pose (``opensim.accuracy``).
     """
 
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
@@ -93,6 +95,8 @@ class ModelSettings:
     segment_bodies: Mapping[str, Sequence[str]] | None = None
     side: str = PERTURBED_SIDE
     attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
+    coordinate_map: Mapping[str, Mapping] | None = None
+    accuracy: float = IK_ACCURACY
 
     @classmethod
     def from_config(cls, config: Mapping) -> ModelSettings:
@@ -106,6 +110,8 @@ class ModelSettings:
             segment_bodies=o["segment_bodies"],
             side=config["trials"]["perturbed_side"],
             attachment_fraction=o["brace_attachment_fraction"],
+            coordinate_map=o["coordinate_map"],
+            accuracy=o["accuracy"],
         )
 
 
@@ -128,7 +134,9 @@ class ScaleFiles:
         The static trial's C3D, whose force plates give the mass when none is given
         (:func:`loper_analysis.motion.static_trial.standing_mass_kg`).
     report_out : path, optional
-        The scale report (TSV, :func:`scale_report`).
+        The scale report (TSV, :func:`loper_analysis.motion.scale_report.scale_report`).
+    static_lab_angles : path, optional
+        The lab's own joint angles of the static trial (TSV written by the markers step), for the report.
     """
 
     generic_osim: PathLike
@@ -137,6 +145,7 @@ class ScaleFiles:
     setup_xml: PathLike | None = None
     static_c3d: PathLike | None = None
     report_out: PathLike | None = None
+    static_lab_angles: PathLike | None = None
 
 
 def generic_model(
@@ -438,6 +447,7 @@ def _run_scale_tool(
 
     from loper_analysis.io.opensim_tables import read_markers, write_trc
     from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.motion.scale_report import scaled_model_report
     from loper_analysis.motion.segments import check_segment_bodies
     from loper_analysis.motion.static_trial import scale_window_s, static_pose
 
@@ -527,10 +537,14 @@ def _run_scale_tool(
         scaler.setOutputScaleFileName(str(scale_file) if scaler.getApply() else "Unassigned")
         placer.setOutputMotionFileName("Unassigned")
         placer.setOutputMarkerFileName("Unassigned")
+        unplaced_file = Path(tmp_dir) / "scaled_unplaced.osim"
         with staged(out_osim, "OpenSim model") as tmp:
-            final, other = (placer, scaler) if placer.getApply() else (scaler, placer)
-            final.setOutputModelFileName(str(tmp))
-            other.setOutputModelFileName("Unassigned")
+            if placer.getApply():  # the model scaler's model too: the static pose before marker placement
+                placer.setOutputModelFileName(str(tmp))
+                scaler.setOutputModelFileName(str(unplaced_file) if scaler.getApply() else "Unassigned")
+            else:
+                scaler.setOutputModelFileName(str(tmp))
+                placer.setOutputModelFileName("Unassigned")
             try:
                 tool.run()  # False when the marker placer is off, even after a good scaling: the file tells
             except Exception as exc:  # OpenSim raises its own exception types
@@ -545,16 +559,25 @@ def _run_scale_tool(
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
             if files.report_out is not None:
-                report = scale_report(
+                unplaced = read_model(unplaced_file) if unplaced_file.is_file() else None
+                if unplaced is None and placer.getApply():
+                    unplaced = generic  # placement without scaling: the generic markers are the ones placed
+                height = _subject_height(height_m, files.static_c3d, scaled, segment_bodies)
+                subject = (mass_kg, height[0], f"mass: {mass_source}; height: {height[1]}")
+                lab_static = None if files.static_lab_angles is None else _lab_static(files.static_lab_angles, window)
+                report = scaled_model_report(
                     scaled,
+                    unplaced,
                     pose,
-                    _scale_factors(scale_file),
-                    _placer_tasks(placer),
-                    (mass_kg, mass_source),
-                    height_m,
-                    segment_bodies,
-                    lab_labels,
+                    (_scale_factors(scale_file), _placer_tasks(placer)),
+                    subject,
+                    coordinate_map=settings.coordinate_map,
+                    accuracy=settings.accuracy,
+                    lab_labels=lab_labels,
+                    lab_static=lab_static,
                 )
+                for text in report.loc[report["kind"] == "warning", "source"]:
+                    log.warning("%s: %s", static_trc, text)
                 write_tsv(report, files.report_out, SCALE_FLOAT_FORMAT)
                 log.info("scale report:\n%s", report.to_string(index=False))
     log.info(
@@ -612,9 +635,12 @@ def _subject_mass(
         )
     plates = read_force_platforms(static_c3d)
     if not plates:
+        bodymass = _processing(static_c3d).get("Bodymass")
+        if bodymass is not None and 0 < bodymass <= 300:
+            return float(bodymass), f"PROCESSING:Bodymass of {Path(static_c3d).name} (no force plates)"
         raise LoperInputError(
             f"{static_c3d}: no body mass: the static trial has no force platforms "
-            "(FORCE_PLATFORM:USED 0); give mass_kg in the subject sheet"
+            "(FORCE_PLATFORM:USED 0) and no PROCESSING:Bodymass; give mass_kg in the subject sheet"
         )
     up = lab_up(rotation_deg)
     vertical = np.column_stack([p.force_n @ up for p in plates])
@@ -622,25 +648,42 @@ def _subject_mass(
     return mass, f"force plates {', '.join(str(p.number) for p in plates)} of {Path(static_c3d).name}"
 
 
-#: Significant digits of the scale report.
-SCALE_FLOAT_FORMAT = "%.8g"
-#: Columns of the scale report (:func:`scale_report`).
-SCALE_REPORT_COLUMNS: tuple[str, ...] = (
-    "kind",
-    "name",
-    "label",
-    "scale_factor_x",
-    "scale_factor_y",
-    "scale_factor_z",
-    "marker_weight",
-    "marker_error_m",
-    "marker_error_rms_m",
-    "marker_error_max_m",
-    "n_frames",
-    "mass_kg",
-    "height_m",
-    "source",
-)
+def _processing(static_c3d: PathLike) -> dict[str, float]:
+    """The ``PROCESSING`` parameters of a C3D file (Nexus: ``Bodymass`` kg, ``Height`` mm)."""
+    from loper_analysis.io.c3d import read_c3d
+
+    return read_c3d(static_c3d).processing
+
+
+def _subject_height(height_m: float | None, static_c3d: PathLike | None, scaled, segment_bodies) -> tuple[float, str]:
+    """The subject's height (m) and where it came from: given, the static trial's ``PROCESSING:Height`` (mm, as
+    Nexus writes it), or estimated from the scaled model
+    (:func:`loper_analysis.motion.static_trial.model_height_m`)."""
+    from loper_analysis.motion.segments import segment_body_names
+    from loper_analysis.motion.static_trial import model_height_m
+
+    if height_m is not None:
+        return float(height_m), "given"
+    if static_c3d is not None:
+        height_mm = _processing(static_c3d).get("Height")
+        if height_mm is not None and 500 <= height_mm <= 2500:
+            return height_mm / 1000.0, f"PROCESSING:Height of {Path(static_c3d).name}"
+    thigh = segment_body_names(scaled, "r", segment_bodies)["thigh"][0]
+    return model_height_m(scaled, thigh), "estimated from the scaled model"
+
+
+def _lab_static(lab_angles_tsv: PathLike, window: tuple[float, float]) -> dict[str, float]:
+    """The lab's own joint angles of the static trial (rad), averaged over the scaling window."""
+    table = read_tsv(lab_angles_tsv, "lab angles", ("time_s",))
+    if not len(table):
+        return {}
+    t = table["time_s"].to_numpy(float)
+    inside = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
+    return (
+        {c.removesuffix("_rad"): float(np.nanmean(table.loc[inside, c])) for c in table.columns if c.endswith("_rad")}
+        if inside.any()
+        else {}
+    )
 
 
 def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
@@ -667,82 +710,6 @@ def _placer_tasks(placer) -> tuple[dict[str, float], dict] | None:
     if not placer.getApply():
         return None
     return task_set_tasks(placer.getIKTaskSet(), "MarkerPlacer/IKTaskSet")
-
-
-def scale_report(
-    scaled,
-    pose,
-    factors: Mapping[str, Sequence[float]],
-    tasks,
-    mass: tuple[float, str],
-    height_m: float | None = None,
-    segment_bodies: Mapping[str, Sequence[str]] | None = None,
-    lab_labels: Mapping[str, str] | None = None,
-) -> pd.DataFrame:
-    """How good the scaling is: one row per body (scale factors), per marker (error) and for the subject.
-
-    Rows (``kind``): ``subject`` (``mass``: the mass in kg and where it came from,
-    ``height_m`` given or estimated from the scaled model:
-    :func:`loper_analysis.motion.static_trial.model_height_m`), ``body`` (the
-    factors OpenSim's model scaler applied; 1 where it scaled nothing),
-    ``marker`` (each weighted marker's distance to the model's marker after
-    scaling, ``marker_error_m``: IK of the static pose, the window's mean as
-    OpenSim's marker placer takes it, on the scaled model with the marker
-    placer's weights, or weight 1 for every marker) and ``markers`` (their
-    RMS and the largest, over the ``n_frames`` frames averaged). Columns
-    :data:`SCALE_REPORT_COLUMNS`.
-    """
-    from loper_analysis.motion.ik import inverse_kinematics
-    from loper_analysis.motion.segments import segment_body_names
-    from loper_analysis.motion.static_trial import model_height_m
-
-    mass_kg, mass_source = mass
-    rows = []
-    if height_m is None:
-        thigh = segment_body_names(scaled, "r", segment_bodies)["thigh"][0]
-        height, height_source = model_height_m(scaled, thigh), "estimated from the scaled model"
-    else:
-        height, height_source = float(height_m), "given"
-    rows.append(
-        {
-            "kind": "subject",
-            "name": "subject",
-            "mass_kg": mass_kg,
-            "height_m": height,
-            "source": f"mass: {mass_source}; height: {height_source}",
-        }
-    )
-    bodies = scaled.getBodySet()
-    for i in range(bodies.getSize()):
-        name = bodies.get(i).getName()
-        fx, fy, fz = factors.get(name, (1.0, 1.0, 1.0))
-        rows.append({"kind": "body", "name": name, "scale_factor_x": fx, "scale_factor_y": fy, "scale_factor_z": fz})
-    model_markers = set(_names(scaled.getMarkerSet()))
-    weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
-    weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
-    mean_pose = pose.markers_m.mean(axis=0, keepdims=True)  # complete: missing frames hold the mean already
-    result = inverse_kinematics(scaled, pose.time_s[:1], mean_pose, pose.labels, weights, coords, accuracy=IK_ACCURACY)
-    errors = result.marker_errors_m[0]
-    for name, error in zip(result.marker_names, errors):
-        rows.append(
-            {
-                "kind": "marker",
-                "name": name,
-                "label": (lab_labels or {}).get(name, name),
-                "marker_weight": weights[name],
-                "marker_error_m": float(error),
-            }
-        )
-    rows.append(
-        {
-            "kind": "markers",
-            "name": "all weighted",
-            "marker_error_rms_m": float(np.sqrt(np.mean(errors**2))),
-            "marker_error_max_m": float(errors.max()),
-            "n_frames": len(pose.time_s),
-        }
-    )
-    return pd.DataFrame(rows, columns=list(SCALE_REPORT_COLUMNS))
 
 
 def _names(object_set) -> list[str]:

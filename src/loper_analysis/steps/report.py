@@ -98,18 +98,23 @@ class FrontPageSettings:
 class FrontPageFiles:
     """The result files the front page reads.
 
-    ``validation``: ``results/validation/summary.tsv``; ``device``: ``results/device/summary.tsv`` (None:
+    ``validation``: ``results/validation/summary.tsv`` (None: no validation study, a study without
+    perturbation trials); ``device``: ``results/device/summary.tsv`` (None:
     no device tests); ``impedance``, ``summary`` and ``figure``: the impedance table, its across-subject
     summary and the main figure (None: the run had no perturbation trials; the table and its summary come
-    together); ``rmsd``: the transparency table (None: no subject walked both trials of the pair).
+    together); ``rmsd``: the transparency table (None: no subject walked both trials of the pair);
+    ``strides``: the strides summary and ``quality`` the recorded subjects' scale reports, IK summaries,
+    agreement tables and figures (named in :func:`front_page`'s ``recorded``).
     """
 
-    validation: PathLike
+    validation: PathLike | None = None
     device: PathLike | None = None
     impedance: PathLike | None = None
     summary: PathLike | None = None
     figure: PathLike | None = None
     rmsd: PathLike | None = None
+    strides: PathLike | None = None
+    quality: Sequence[PathLike] = ()
 
 
 def front_page(
@@ -119,12 +124,16 @@ def front_page(
     trials: Mapping[str, Sequence[str]],
     settings: FrontPageSettings,
     versions: Mapping[str, str] | None = None,
+    recorded: Mapping[str, Mapping] | None = None,
 ) -> str:
     """The front page of the report (:func:`loper_analysis.report.front_page.front_page_html`) from the result files.
 
     ``files``: the result tables and figure (:class:`FrontPageFiles`); ``subjects``: subject -> source;
     ``trials``: processed subject -> its walking trials; ``settings``: the run's settings
-    (:class:`FrontPageSettings`); ``versions``: software -> version (default :func:`software_versions`).
+    (:class:`FrontPageSettings`); ``versions``: software -> version (default :func:`software_versions`);
+    ``recorded``: recorded subject -> ``{"scale": path or None, "trials": {trial: {"ik", "agreement",
+    "angles_png", "grf_png": path or None}}}``, the files of the section on recorded subjects
+    (:func:`loper_analysis.report.subject_quality.recorded_subjects_html`).
     The headline tables come from :mod:`loper_analysis.report.headline`. Writes ``out_html`` and returns
     the fragment.
     """
@@ -165,16 +174,53 @@ def front_page(
             if device_tsv is None
             else device_comparison(read_tsv(device_tsv, "device summary"), str(device_tsv))
         ),
-        validation=validation_verdict(read_tsv(files.validation, "validation summary"), str(files.validation)),
+        validation=(
+            None
+            if files.validation is None
+            else validation_verdict(read_tsv(files.validation, "validation summary"), str(files.validation))
+        ),
         summary=summary,
         truth=truth,
         impedance_status=status,
         figure_png=figure,
         transparency=transparency,
+        recorded_html=_recorded_html(recorded or {}, files.strides),
     )
     write_text(out_html, text, "front page")
     log.info("front page: %d bytes (%d kB of figure)", len(text.encode()), len(figure or b"") // 1024)
     return text
+
+
+def _recorded_html(recorded: Mapping[str, Mapping], strides_tsv: PathLike | None) -> str:
+    """The section on recorded subjects from their files (:func:`front_page`'s ``recorded``)."""
+    from loper_analysis.report.subject_quality import SubjectQuality, TrialQuality, recorded_subjects_html
+
+    if not recorded:
+        return ""
+    strides = None
+    if strides_tsv is not None:
+        strides = read_tsv(strides_tsv, "strides summary", ("subject", "trial"), keep_default_na=False, na_values=[""])
+        strides = strides.set_index(["subject", "trial"])
+    subjects = []
+    for subject, entry in recorded.items():
+        trials = []
+        for trial, paths in entry["trials"].items():
+            ik = read_tsv(paths["ik"], "IK summary", keep_default_na=False, na_values=[""]).iloc[0]
+            row = None if strides is None or (subject, trial) not in strides.index else strides.loc[(subject, trial)]
+            trials.append(
+                TrialQuality(
+                    trial,
+                    ik,
+                    read_tsv(paths["agreement"], "lab agreement"),
+                    row,
+                    None if paths.get("angles_png") is None else read_bytes(paths["angles_png"], "figure"),
+                    None if paths.get("grf_png") is None else read_bytes(paths["grf_png"], "figure"),
+                )
+            )
+        scale = entry.get("scale")
+        table = None if scale is None else read_tsv(scale, "scale report", keep_default_na=False, na_values=[""])
+        subjects.append(SubjectQuality(subject, table, trials))
+    return recorded_subjects_html(subjects)
 
 
 #: Bytes read from the end of a finished HTML report to find its closing tag.

@@ -206,3 +206,22 @@ def strides_summary(
             log.warning("%s %s: %s", row.subject, row.trial, row.warnings)
     log.info("strides:\n%s", table.to_string(index=False))
     return table
+
+
+def angles_figure(
+    angles_tsv: PathLike,
+    events_tsv: PathLike,
+    out_png: PathLike,
+    lab_angles_tsv: PathLike | None = None,
+    title: str | None = None,
+) -> None:
+    """Both sides' joint angles over the gait cycle, mean ± SD over the strides found from the events, with the
+    lab's own angles where the file holds them (:func:`loper_analysis.report.figures.gait.stride_angles_figure`),
+    as a PNG."""
+    from loper_analysis.io.atomic import write_figure
+    from loper_analysis.report.figures.gait import stride_angles_figure
+
+    angles = read_tsv(angles_tsv, "angle table", ("time_s",))
+    events = read_tsv(events_tsv, "event table", ("side", "event", "time_s"))
+    lab = None if lab_angles_tsv is None else read_tsv(lab_angles_tsv, "lab angles", ("time_s",))
+    write_figure(stride_angles_figure(angles, events, lab, title), out_png)

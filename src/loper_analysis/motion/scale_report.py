@@ -1,0 +1,345 @@
+"""How good a scaling is: the scale report, with the checks that tell a model built wrong from one built right.
+
+Marker placement moves markers onto the static trial, so the marker errors after it are small by
+construction and say nothing about the static pose the markers were placed in. A model whose generic
+markers fit the subject badly is solved into a wrong static pose (a hip at -22 degrees, a
+hyperextended knee), and placing the markers there builds that error into every joint angle of the
+walking trials as an offset, while their IK marker error may even drop. The report therefore gives:
+
+* the marker errors *before* placement (the static pose the marker placer solved, with the scaled
+  generic markers) beside those after it;
+* the static pose's joint angles in our convention (and the lab's own static angles where the file
+  holds them);
+* the scale factors of every body.
+
+And it warns (rows of kind ``warning``) about a static pose whose hip, knee or ankle flexion lies beyond
+:data:`MAX_STATIC_FLEXION_RAD`, a static pose more than :data:`MAX_STATIC_LAB_DIFF_RAD` from the lab's
+own, and a body whose scale factor differs from a neighbour's (the body it is jointed to) by more than
+:data:`MAX_NEIGHBOUR_FACTOR_RATIO`, each warning naming the setting to check.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.constants import JOINTS, SIDES
+
+__all__ = [
+    "MAX_NEIGHBOUR_FACTOR_RATIO",
+    "MAX_STATIC_FLEXION_RAD",
+    "MAX_STATIC_LAB_DIFF_RAD",
+    "SCALE_FLOAT_FORMAT",
+    "SCALE_REPORT_COLUMNS",
+    "StaticFit",
+    "neighbour_factor_warnings",
+    "jointed_bodies",
+    "scale_report",
+    "scaled_model_report",
+    "static_fit",
+    "static_pose_warnings",
+]
+
+#: Significant digits of the scale report.
+SCALE_FLOAT_FORMAT = "%.8g"
+#: A static pose's hip, knee or ankle flexion beyond +- this (rad; 15 degrees) is warned about.
+MAX_STATIC_FLEXION_RAD: float = float(np.radians(15.0))
+#: A static pose's joint angle further than this from the lab's own static angle (rad; 10 degrees) is warned about.
+MAX_STATIC_LAB_DIFF_RAD: float = float(np.radians(10.0))
+#: Neighbouring bodies whose scale factors differ by more than this ratio are warned about (20 %).
+MAX_NEIGHBOUR_FACTOR_RATIO: float = 1.2
+#: Columns of the scale report (:func:`scale_report`).
+SCALE_REPORT_COLUMNS: tuple[str, ...] = (
+    "kind",
+    "name",
+    "label",
+    "scale_factor_x",
+    "scale_factor_y",
+    "scale_factor_z",
+    "marker_weight",
+    "marker_error_before_m",
+    "marker_error_m",
+    "marker_error_rms_m",
+    "marker_error_max_m",
+    "worst_marker",
+    "angle_rad",
+    "lab_angle_rad",
+    "n_frames",
+    "mass_kg",
+    "height_m",
+    "source",
+)
+
+
+@dataclass(frozen=True)
+class StaticFit:
+    """Marker errors of the static trial's mean pose on one model (m) and the pose's joint angles (rad).
+
+    ``errors_m``: marker -> distance to the model's marker; ``angles_rad``: our angle (``hip_left``, ...)
+    -> value, from the coordinate map.
+    """
+
+    errors_m: dict[str, float]
+    angles_rad: dict[str, float]
+
+
+def static_pose_warnings(
+    angles_rad: Mapping[str, float],
+    lab_angles_rad: Mapping[str, float] | None = None,
+    setting: str = "opensim.scale_setup",
+) -> list[tuple[str, str]]:
+    """(name, warning) for each joint of a static pose beyond :data:`MAX_STATIC_FLEXION_RAD`, or further than
+    :data:`MAX_STATIC_LAB_DIFF_RAD` from the lab's own static angle."""
+    out = []
+    for side in SIDES:
+        for joint in JOINTS:
+            key = f"{joint}_{side}"
+            value = angles_rad.get(key)
+            if value is None or not np.isfinite(value):
+                continue
+            if abs(value) > MAX_STATIC_FLEXION_RAD:
+                out.append(
+                    (
+                        f"static_pose_{key}",
+                        f"static pose: {key} {np.degrees(value):+.1f} deg, beyond +-"
+                        f"{np.degrees(MAX_STATIC_FLEXION_RAD):.0f} deg: the model's markers do not fit the subject "
+                        f"(check the marker set and label map of {setting} and markers.label_map) or the subject "
+                        "did not stand upright; the offset goes into every joint angle of the walking trials",
+                    )
+                )
+            lab = (lab_angles_rad or {}).get(key)
+            if lab is not None and np.isfinite(lab) and abs(value - lab) > MAX_STATIC_LAB_DIFF_RAD:
+                out.append(
+                    (
+                        f"static_pose_{key}_lab",
+                        f"static pose: {key} {np.degrees(value):+.1f} deg where the lab's own model gives "
+                        f"{np.degrees(lab):+.1f} deg: an offset of {np.degrees(value - lab):+.1f} deg goes into every "
+                        f"joint angle (check the marker set of {setting} and markers.label_map)",
+                    )
+                )
+    return out
+
+
+def neighbour_factor_warnings(
+    factors: Mapping[str, Sequence[float]], neighbours: Sequence[tuple[str, str]]
+) -> list[tuple[str, str]]:
+    """(name, warning) for each pair of jointed bodies whose (mean) scale factors differ by more than
+    :data:`MAX_NEIGHBOUR_FACTOR_RATIO`; bodies a measurement did not scale are skipped."""
+    out = []
+    for parent, child in neighbours:
+        if parent not in factors or child not in factors:
+            continue
+        a, b = float(np.mean(factors[parent])), float(np.mean(factors[child]))
+        if a > 0 and b > 0 and max(a, b) / min(a, b) > MAX_NEIGHBOUR_FACTOR_RATIO:
+            out.append(
+                (
+                    f"scale_{parent}_{child}",
+                    f"scale factors of neighbouring bodies differ by {100 * (max(a, b) / min(a, b) - 1):.0f} %: "
+                    f"{parent} {a:.3f}, {child} {b:.3f} (more than {100 * (MAX_NEIGHBOUR_FACTOR_RATIO - 1):.0f} %): "
+                    "a marker of the measurement placed elsewhere on the subject than on the model? (the "
+                    "measurements and marker set of opensim.scale_setup)",
+                )
+            )
+    return out
+
+
+def scale_report(
+    bodies: Sequence[str],
+    factors: Mapping[str, Sequence[float]],
+    weights: Mapping[str, float],
+    after: StaticFit,
+    before: StaticFit | None,
+    n_frames: int,
+    subject: tuple[float, float, str],
+    lab_labels: Mapping[str, str] | None = None,
+    lab_angles_rad: Mapping[str, float] | None = None,
+    warnings: Sequence[tuple[str, str]] = (),
+) -> pd.DataFrame:
+    """The scale report: one row per body, marker, angle of the static pose and warning, and for the subject.
+
+    Parameters
+    ----------
+    bodies : sequence of str
+        The scaled model's bodies.
+    factors : mapping
+        Body -> (x, y, z) factors OpenSim's model scaler applied (1 where it scaled nothing).
+    weights : mapping
+        Weighted marker -> weight.
+    after : StaticFit
+        The static mean pose on the final model (after marker placement).
+    before : StaticFit or None
+        The same on the scaled model before placement (the pose the marker placer solved); None without
+        placement.
+    n_frames : int
+        Frames averaged into the static pose.
+    subject : (float, float, str)
+        Mass (kg), height (m) and where they came from.
+    lab_labels : mapping, optional
+        Model marker -> the lab's label.
+    lab_angles_rad : mapping, optional
+        Our angle -> the lab's own static angle (rad).
+    warnings : sequence of (str, str)
+        (name, text) rows of kind ``warning``.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`SCALE_REPORT_COLUMNS`. Rows (``kind``): ``subject``; ``body``; ``marker``
+        (``marker_error_before_m`` and ``marker_error_m``); ``markers`` (``before placement`` and ``after
+        placement``: RMS, largest, worst marker); ``pose`` (``angle_rad`` of the static pose the markers were
+        placed in, ``lab_angle_rad``); ``warning`` (``source`` holds the text).
+    """
+    mass_kg, height_m, source = subject
+    rows = [{"kind": "subject", "name": "subject", "mass_kg": mass_kg, "height_m": height_m, "source": source}]
+    for name in bodies:
+        fx, fy, fz = factors.get(name, (1.0, 1.0, 1.0))
+        rows.append({"kind": "body", "name": name, "scale_factor_x": fx, "scale_factor_y": fy, "scale_factor_z": fz})
+    for name, error in after.errors_m.items():
+        rows.append(
+            {
+                "kind": "marker",
+                "name": name,
+                "label": (lab_labels or {}).get(name, name),
+                "marker_weight": weights.get(name, np.nan),
+                "marker_error_before_m": np.nan if before is None else before.errors_m.get(name, np.nan),
+                "marker_error_m": error,
+            }
+        )
+    for stage, fit in (("before placement", before), ("after placement", after)):
+        if fit is None or not fit.errors_m:
+            continue
+        e = np.array(list(fit.errors_m.values()))
+        rows.append(
+            {
+                "kind": "markers",
+                "name": stage,
+                "marker_error_rms_m": float(np.sqrt(np.mean(e**2))),
+                "marker_error_max_m": float(e.max()),
+                "worst_marker": max(fit.errors_m, key=fit.errors_m.get),
+                "n_frames": n_frames,
+            }
+        )
+    pose = (before or after).angles_rad
+    for key, value in pose.items():
+        lab = (lab_angles_rad or {}).get(key, np.nan)
+        rows.append({"kind": "pose", "name": key, "angle_rad": value, "lab_angle_rad": lab})
+    rows += [{"kind": "warning", "name": name, "source": text} for name, text in warnings]
+    return pd.DataFrame(rows, columns=list(SCALE_REPORT_COLUMNS))
+
+
+def _names(object_set) -> list[str]:
+    return [object_set.get(i).getName() for i in range(object_set.getSize())]
+
+
+def _map_coordinate(entry) -> str:
+    return entry["coordinate"] if isinstance(entry, Mapping) else entry[0]
+
+
+def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float) -> StaticFit:
+    """Marker errors of the static trial's mean pose on ``model`` and the pose's joint angles: IK with the
+    marker placer's weights and tasks of the window's mean, as OpenSim's marker placer takes it.
+
+    Parameters
+    ----------
+    model : opensim.Model
+    pose : loper_analysis.motion.static_trial.StaticPose
+        The scaling window (its markers complete: missing frames hold the marker's mean).
+    weights, coords : dict
+        Marker -> weight; coordinate -> (weight, value or None).
+    coordinate_map : mapping
+        Our angle -> model coordinate and sign; angles whose coordinate the model lacks are left out.
+    accuracy : float
+        IK solver accuracy.
+    """
+    from loper_analysis.motion.ik import inverse_kinematics, joint_angle_table
+
+    mean_pose = pose.markers_m.mean(axis=0, keepdims=True)
+    result = inverse_kinematics(model, pose.time_s[:1], mean_pose, pose.labels, weights, coords, accuracy=accuracy)
+    errors = dict(zip(result.marker_names, (float(e) for e in result.marker_errors_m[0])))
+    frame = result.frame()
+    known = {k: v for k, v in coordinate_map.items() if _map_coordinate(v) in frame.columns}
+    angles = joint_angle_table(frame, known).drop(columns="time_s").iloc[0] if known else pd.Series(dtype=float)
+    return StaticFit(errors, {k.removesuffix("_rad"): float(v) for k, v in angles.items() if k.endswith("_rad")})
+
+
+def jointed_bodies(model) -> list[tuple[str, str]]:
+    """(parent body, child body) of every joint between two bodies of an ``opensim.Model``."""
+    joints = model.getJointSet()
+    bodies = set(_names(model.getBodySet()))
+    out = []
+    for i in range(joints.getSize()):
+        j = joints.get(i)
+        parent = j.getParentFrame().findBaseFrame().getName()
+        child = j.getChildFrame().findBaseFrame().getName()
+        if parent in bodies and child in bodies:
+            out.append((parent, child))
+    return out
+
+
+def scaled_model_report(
+    scaled,
+    unplaced,
+    pose,
+    scaling: tuple[Mapping[str, Sequence[float]], tuple | None],
+    subject: tuple[float, float, str],
+    *,
+    coordinate_map: Mapping | None = None,
+    accuracy: float = 1e-6,
+    lab_labels: Mapping[str, str] | None = None,
+    lab_static: Mapping[str, float] | None = None,
+) -> pd.DataFrame:
+    """The scale report (:func:`scale_report`) of a scaled model, with its checks.
+
+    Parameters
+    ----------
+    scaled : opensim.Model
+        The final model (after marker placement).
+    unplaced : opensim.Model or None
+        The scaled model before marker placement (None: no placement).
+    pose : loper_analysis.motion.static_trial.StaticPose
+        The scaling window.
+    scaling : (dict, tuple or None)
+        Body -> factors OpenSim applied; the marker placer's (marker weights, coordinate tasks), None when it
+        does not apply (every marker of the window then weighs 1).
+    subject : (float, float, str)
+        Mass (kg), height (m), where they came from.
+    coordinate_map : mapping, optional
+        ``opensim.coordinate_map``; None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+    accuracy : float
+        IK accuracy of the static pose (``opensim.accuracy``).
+    lab_labels, lab_static : mapping, optional
+        Model marker -> the lab's label; our angle -> the lab's own static angle (rad).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`scale_report`'s table, with the warnings of :func:`static_pose_warnings` and
+        :func:`neighbour_factor_warnings` as rows (and logged by the caller).
+    """
+    from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP
+
+    factors, tasks = scaling
+    model_markers = set(_names(scaled.getMarkerSet()))
+    weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
+    weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
+    cmap = DEFAULT_COORDINATE_MAP if coordinate_map is None else coordinate_map
+    after = static_fit(scaled, pose, weights, coords, cmap, accuracy)
+    before = None if unplaced is None else static_fit(unplaced, pose, weights, coords, cmap, accuracy)
+    scaled_factors = {b: f for b, f in factors.items() if not np.allclose(f, 1.0)}
+    warnings = static_pose_warnings((before or after).angles_rad, lab_static)
+    warnings += neighbour_factor_warnings(scaled_factors, jointed_bodies(scaled))
+    return scale_report(
+        _names(scaled.getBodySet()),
+        factors,
+        weights,
+        after,
+        before,
+        len(pose.time_s),
+        subject,
+        lab_labels,
+        lab_static,
+        warnings,
+    )
