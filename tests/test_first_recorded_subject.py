@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
+import importlib.util
 import re
 import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from tests.workflow_copy import copy_workflow
 
@@ -50,63 +53,136 @@ def test_the_doc_holds_the_commands_of_each_step():
     commands = doc_commands()
     assert [c.split()[0] for c in commands] == [
         "mkdir",
-        "loper-analysis",
-        "loper-analysis",
-        "mkdir",
         "cp",
         "loper-analysis",
+        "printf",
+        "printf",
+        "loper-analysis",
+        "snakemake",
         "snakemake",
         "loper-analysis",
     ]
 
 
-def test_inspect_reports_what_the_doc_says(walkthrough):
+def test_inspect_chooses_plug_in_gait_and_writes_what_the_doc_says(walkthrough):
     work, outputs = walkthrough
-    static, walk = outputs[1][1], outputs[2][1]
-    assert re.search(r"Subject11:R\.Knee\s+93\.5\s+10\s+152", static)
-    assert re.search(r"Subject11:R\.Toe\s+98\.0\s+3\s+152", static)
-    assert "peak vertical force 433.8 N" in static and "peak vertical force 400.4 N" in static
-    assert "vertical axis: +Z" in static and "matched: 41 label(s)" in static
-    assert (work / "lab/label_map.tsv").read_text() == "label\tmarker\n"  # no row needed
-    assert walk.count("resting (unloaded) vertical level -6.0 N") == 3
-    assert re.search(r"walking direction: \+X .* at 1\.2[45] m/s", walk)
+    printed = outputs[2][1]
+    assert "plugin_gait  12 of 12 required, 24 of 25 markers" in printed
+    assert "isb          10 of 12 required" in printed and "chosen: plugin_gait" in printed
+    assert "static trial only (not tracked in walking): LMKNE, RMKNE, LMMAL, RMMAL" in printed
+    assert "labels without a template marker (kept, not used): RBAK" in printed and "label map: none needed" in printed
+    lab = work / "lab/QCMAS"
+    assert sorted(p.name for p in lab.iterdir()) == [
+        "config.yaml", "gait2392_simbody.osim", "ik_tasks.tsv", "marker_set.xml", "scale_setup.xml",
+    ]  # fmt: skip
+    config = yaml.safe_load((lab / "config.yaml").read_text())
+    assert config["opensim"]["coordinate_map"]["knee_left"] == {"coordinate": "knee_angle_l", "sign": -1}
+    assert config["opensim"]["coordinate_map"]["pelvis_angle"] == {"coordinate": "pelvis_tilt", "sign": -1}
+    assert config["events"]["foot_markers"] == {"left": "LHEE", "right": "RHEE"}
+    assert config["markers"] == {"lab_to_model_rotation_deg": [-90, 0, 0], "label_map": {}}
+    tasks = pd.read_csv(lab / "ik_tasks.tsv", sep="\t")
+    assert "LMKNE" not in set(tasks["name"]) and {"LKNE", "LTHI", "LTOE"} <= set(tasks["name"])
+    # the generic model is OpenSim's gait2392 as distributed
+    assert (lab / "gait2392_simbody.osim").read_bytes() == (
+        ROOT / "src/loper_analysis/templates/gait2392_simbody.osim"
+    ).read_bytes()
 
 
-def test_the_scale_report_and_the_hand_run_agree(walkthrough):
+def test_the_scale_report_and_the_hand_run_agree_with_the_doc(walkthrough):
     work, _ = walkthrough
-    report = pd.read_csv(work / "results/model/R11/scale.tsv", sep="\t")
-    by_hand = pd.read_csv(work / "lab/R11_scale.tsv", sep="\t")
+    report = pd.read_csv(work / "results/model/QCMAS/scale.tsv", sep="\t")
+    by_hand = pd.read_csv(work / "lab/QCMAS_scale.tsv", sep="\t")
     pd.testing.assert_frame_equal(report, by_hand)
     subject = report[report.kind == "subject"].iloc[0]
-    assert round(subject.mass_kg, 3) == 85.067 and round(subject.height_m, 2) == 1.60
-    assert "force plates 1, 2" in subject.source
-    assert (report[report.kind == "body"][["scale_factor_x", "scale_factor_y", "scale_factor_z"]] == 1).all().all()
-    assert (report.kind == "marker").sum() == 23
-    assert round(1000 * report[report.kind == "markers"].marker_error_rms_m.iloc[0]) == 48
-    log = (work / "results/logs/model_scaled/R11.log").read_text()
-    assert "marker R.Knee missing in 10 of 11 frames of the window: averaged over the others" in log
+    assert round(subject.mass_kg, 1) == 72.2 and subject.height_m == 1.86
+    assert "force plates" in subject.source and "PROCESSING:Height" in subject.source
+    bodies = report[report.kind == "body"].set_index("name").scale_factor_x.round(3).to_dict()
+    assert [bodies[b] for b in ("pelvis", "femur_r", "tibia_r", "calcn_r", "torso")] == [
+        1.058,
+        1.071,
+        1.108,
+        0.995,
+        0.993,
+    ]
+    fits = report[report.kind == "markers"].set_index("name")
+    assert round(1000 * fits.loc["before placement", "marker_error_rms_m"], 1) == 37.0
+    assert round(1000 * fits.loc["before placement", "marker_error_max_m"], 1) == 97.9
+    assert fits.loc["before placement", "worst_marker"] == "LTHI"
+    assert round(1000 * fits.loc["after placement", "marker_error_rms_m"], 1) == 13.1
+    pose = report[report.kind == "pose"].set_index("name")
+    ours = {k: round(float(np.degrees(v)), 1) for k, v in pose.angle_rad.items()}
+    lab = {k: round(float(np.degrees(v)), 1) for k, v in pose.lab_angle_rad.items()}
+    assert [ours[k] for k in ("hip_left", "hip_right", "knee_left", "knee_right", "ankle_left", "ankle_right")] == [
+        4.7,
+        4.8,
+        -4.0,
+        -8.1,
+        1.4,
+        -2.4,
+    ]
+    assert [lab[k] for k in ("hip_left", "hip_right", "knee_left", "knee_right", "ankle_left", "ankle_right")] == [
+        0.1,
+        1.1,
+        -8.1,
+        -10.8,
+        0.3,
+        -4.1,
+    ]
+    assert (report.kind == "warning").sum() == 0
 
 
-def test_markers_ik_and_the_summary_say_what_the_doc_says(walkthrough):
+def test_ik_events_and_the_summary_say_what_the_doc_says(walkthrough):
     work, _ = walkthrough
-    markers = pd.read_csv(work / "results/markers/R11/static.markers.tsv", sep="\t").set_index("marker")
-    assert markers.loc["R.Knee", "label"] == "Subject11:R.Knee" and markers.loc["R.Knee", "n_missing_frames"] == 10
-    ik = pd.read_csv(work / "results/ik/R11/walk-nodevice.ik.tsv", sep="\t").iloc[0]
-    assert (ik.n_frames, ik.n_frames_solved, ik.n_frames_left_out) == (238, 238, 0)
-    assert round(1000 * ik.marker_rms_mean_m, 1) == 34.8
-    assert "exceeds 20 mm" in (work / "results/logs/ik/R11/walk-nodevice.log").read_text()
+    static = pd.read_csv(work / "results/markers/QCMAS/static.markers.tsv", sep="\t").iloc[0]
+    assert static.turn_deg == 90.0
+    ik = pd.read_csv(work / "results/ik/QCMAS/walk-nodevice.ik.tsv", sep="\t").iloc[0]
+    assert (ik.n_frames, ik.n_frames_solved, ik.n_frames_left_out) == (216, 216, 0)
+    assert round(1000 * ik.marker_rms_mean_m, 1) == 15.8 and ik.worst_marker == "LTHI"
+    agree = pd.read_csv(work / "results/ik/QCMAS/walk-nodevice.lab_agreement.tsv", sep="\t").set_index("angle")
+    figures = {
+        a: (round(agree.loc[a, "r"], 3), round(float(np.degrees(agree.loc[a, "rms_diff_rad"])), 1))
+        for a in ("hip_left", "hip_right", "knee_left", "knee_right", "ankle_left", "ankle_right")
+    }
+    assert figures == {
+        "hip_left": (0.991, 2.5), "hip_right": (0.994, 3.1), "knee_left": (0.998, 4.1),
+        "knee_right": (0.997, 4.5), "ankle_left": (0.98, 1.8), "ankle_right": (0.985, 1.3),
+    }  # fmt: skip
+    events = pd.read_csv(work / "results/events/QCMAS/walk-nodevice.events.tsv", sep="\t")
+    hs = events[events.event == "heel_strike"].time_s.round(3).tolist()
+    to = events[events.event == "toe_off"].time_s.round(3).tolist()
+    assert hs == [2.461, 3.024, 3.543] and to == [3.183, 3.71, 4.246]
     summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t").iloc[0]
-    assert (summary.subject, summary.status, summary.n_frames, summary.n_frames_left_out, summary.turn_deg) == (
-        "R11",
-        "too_few_strides",
-        238,
-        0,
-        0.0,
+    assert (summary.subject, summary.status, summary.n_strides, summary.turn_deg) == (
+        "QCMAS", "too_few_strides", 1, 270.0,
+    )  # fmt: skip
+    assert round(summary.speed_m_per_s, 2) == 1.27
+    assert (
+        round(summary.lab_joints_min_r, 3) == 0.98 and round(np.degrees(summary.lab_joints_max_rms_diff_rad), 1) == 4.5
     )
-    assert (work / "results/grf/R11/walk-nodevice.grf.mot").is_file()
+    assert not (work / "results/validation").exists() and not (work / "results/impedance").exists()
 
 
-def test_the_report_is_written(walkthrough):
+def test_the_report_shows_the_subject_in_a_browser(walkthrough, tmp_path):
+    """The report's front page, opened in headless Chromium: the recorded subject's section and the table of its
+    trials are drawn, both figures decode, and the numbers are the tables'."""
     work, _ = walkthrough
     html = (work / "results/report.html").read_text(errors="replace")
-    assert len(html) > 100_000 and "R11" in html
+    assert len(html) > 100_000 and "QCMAS" in html
+    screen = _devtools()
+    if screen.chromium_path() is None:
+        pytest.skip("no Chromium at /usr/bin/chromium (or $CHROMIUM): the report cannot be rendered")
+    measured = screen.first_screen(work / "results/report.html", tmp_path / "screen.png", ready_id="lf-trials")
+    boxes = measured["boxes"]
+    assert boxes["lf-recorded"]["top"] < 900 and boxes["lf-trials"]["bottom"] > boxes["lf-trials"]["top"]
+    assert sorted(alt for alt, width, height in measured["images"] if width > 0 and height > 0) == [
+        "QCMAS walk-nodevice: force plates and events",
+        "QCMAS walk-nodevice: joint angles over the gait cycle",
+    ]
+    assert "mass 72.2 kg, height 1.86 m" in measured["text"] and "before placement 37.0 97.9 LTHI" in measured["text"]
+
+
+def _devtools():
+    spec = importlib.util.spec_from_file_location("report_screenshot", ROOT / "benchmarks/report_screenshot.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module

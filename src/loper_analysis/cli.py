@@ -151,7 +151,7 @@ def _scale(args: argparse.Namespace) -> None:
     if not settings.max_motion_rms_m:
         settings = dataclasses.replace(settings, max_motion_rms_m=None)
     static = c3d = Path(args.static)
-    lab_labels = None
+    lab_labels = lab_angles = None
     with tempfile.TemporaryDirectory() as tmp:
         if static.suffix.lower() == ".c3d":
             trc = Path(tmp) / (static.stem + ".trc")
@@ -160,12 +160,13 @@ def _scale(args: argparse.Namespace) -> None:
                 label_map = read_label_maps(config["markers"]["label_map"] or None)
             frame = MarkerSettings(
                 rotation_deg=settings.rotation_deg,
-                walking_direction="fixed",
+                walking_direction="auto" if config is None else config["markers"]["walking_direction"],
                 max_gap_frames=args.max_gap_frames,
                 cutoff_hz=args.cutoff_hz or None,
                 label_map=label_map,
             )
-            gaps = markers(static, trc, None, frame)
+            lab_angles = Path(tmp) / "lab_angles.tsv"
+            gaps = markers(static, trc, None, frame, lab_angles_out=lab_angles)
             lab_labels = {row["marker"]: row["label"] for row in gaps.attrs["per_marker"]}
             static = trc
         elif args.mass_kg is None:
@@ -177,12 +178,16 @@ def _scale(args: argparse.Namespace) -> None:
             setup_xml=args.setup,
             static_c3d=c3d if c3d.suffix.lower() == ".c3d" else None,
             report_out=args.report,
+            static_lab_angles=lab_angles,
         )
         scale_with_setup(files, args.mass_kg, settings, lab_labels=lab_labels)
     mass = f"{args.mass_kg:g} kg" if args.mass_kg is not None else "mass from the static trial's force plates"
     print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({mass})")
     if args.report:
-        print(f"{args.report}: scale factors and marker errors after scaling")
+        print(
+            f"{args.report}: scale factors, marker errors before and after marker placement, the static pose"
+            " and the checks' warnings"
+        )
 
 
 def _segments(args: argparse.Namespace) -> None:

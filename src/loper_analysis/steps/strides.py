@@ -124,7 +124,8 @@ def strides_summary(
     out of IK, the mean marker RMS error, the worst marker and the IK warnings, ``markers_tsvs`` (the markers
     summaries of :func:`markers`) the trial's walking direction and the turn that made it walk along +X,
     ``agreement_tsvs`` (our angles against the lab's own, :func:`loper_analysis.steps.ik.ik_trial`) the least
-    correlation and the largest RMS difference over the angles compared (NaN where the file holds none).
+    correlation and the largest RMS difference over the hip, knee and ankle angles compared (NaN where the file
+    holds none).
 
     Raises
     ------
@@ -184,12 +185,13 @@ def strides_summary(
         )
     if agreement_tsvs is not None:
         agree = [read_tsv(path, "lab agreement", ("angle", "r", "rms_diff_rad")) for path in agreement_tsvs]
+        joints = [a[a["angle"] != "pelvis_angle"] if len(a) else a for a in agree]
         extra.append(
             pd.DataFrame(
                 {
-                    "lab_angles_min_r": [float(a["r"].min()) if len(a) else np.nan for a in agree],
-                    "lab_angles_max_rms_diff_rad": [
-                        float(a["rms_diff_rad"].max()) if len(a) else np.nan for a in agree
+                    "lab_joints_min_r": [float(a["r"].min()) if len(a) else np.nan for a in joints],
+                    "lab_joints_max_rms_diff_rad": [
+                        float(a["rms_diff_rad"].max()) if len(a) else np.nan for a in joints
                     ],
                 }
             )
