@@ -73,3 +73,26 @@ def test_a_treadmill_or_fixed_mode_keeps_the_configured_rotation(walking5):
     assert slow.rotation_deg == Z_UP
     with pytest.raises(LoperInputError, match=r"t\.c3d: markers\.walking_direction must be one of .*got 'north'"):
         trial_heading(X, rate, Z_UP, mode="north", source="t.c3d")
+
+
+QCMAS = Path(__file__).resolve().parent / "data" / "c3d-parser" / "QCMAS"
+
+
+def test_a_static_trial_is_turned_to_face_plus_x_by_its_pelvis_markers():
+    """The clinical lab's static trial: the subject stands facing the lab's +Y, which the Z-up rotation turns to
+    the model's -Z; a quarter turn faces it to +X, after which its ASIS lie in front of its PSIS."""
+    from loper_analysis.motion.heading import facing_m
+    from loper_analysis.motion.label_matching import landmark_indices
+
+    rec = read_c3d(QCMAS / "static.c3d")
+    names = rec.marker_labels
+    front, back = landmark_indices(names, ["asis"]), landmark_indices(names, ["psis", "sacrum"])
+    assert [names[i] for i in front] == ["LASI", "RASI"] and [names[i] for i in back] == ["LPSI", "RPSI"]
+    h = trial_heading(rec.markers_m, rec.point_rate_hz, Z_UP, pelvis=(front, back))
+    assert h.source == "pelvis" and h.turn_deg == 90.0 and h.speed_m_per_s < 0.01
+    face = facing_m(rotate_markers(rec.markers_m, h.rotation_deg), front, back)
+    # forward along +X (ASIS to PSIS 0.17 m), the subject standing 7 degrees off the lab's axis
+    assert face[0] > 0.15 and np.degrees(np.arctan2(abs(face[2]), face[0])) == pytest.approx(7.3, abs=0.1)
+    # without pelvis markers, or in fixed mode, the configured rotation stands
+    assert trial_heading(rec.markers_m, rec.point_rate_hz, Z_UP).source == "config"
+    assert trial_heading(rec.markers_m, rec.point_rate_hz, Z_UP, "fixed", pelvis=(front, back)).turn_deg == 0.0

@@ -79,7 +79,8 @@ def _markers_of(labels: Sequence[str], to_marker: Mapping[str, str], template: M
     """Template markers a file's labels provide (derived ones included)."""
     names = [to_marker[strip_subject_prefix(lab)] for lab in labels if strip_subject_prefix(lab) in to_marker]
     names += list(derived_markers(names, template.side_prefix))
-    return list(dict.fromkeys(names))
+    known = set(template.marker_names)
+    return list(dict.fromkeys(n for n in names if n in known))
 
 
 def subject_setup(
@@ -132,7 +133,10 @@ def subject_setup(
     static = _markers_of(static_labels or (walking_labels[0] if walking_labels else []), to_marker, template)
     walking = [_markers_of(labels, to_marker, template) for labels in walking_labels]
     in_walking = [m for m in template.marker_names if all(m in w for w in walking)] if walking else static
-    unmapped = tuple(strip_subject_prefix(lab) for lab in every if strip_subject_prefix(lab) not in to_marker)
+    known = set(template.marker_names)
+    unmapped = tuple(
+        strip_subject_prefix(lab) for lab in every if to_marker.get(strip_subject_prefix(lab)) not in known
+    )
     return SubjectSetup(
         template=template,
         fits=fits,
