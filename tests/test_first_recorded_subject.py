@@ -186,3 +186,26 @@ def _devtools():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def test_every_clean_plate_contact_has_its_events_within_15_ms_of_the_plate_s_own_contact(walkthrough):
+    """Against the plates themselves: each contact the events step calls clean (flag ``ok``) starts and ends where
+    its plate's vertical force crosses 20 N above the plate's resting level, within 15 ms."""
+    from loper_analysis.io.force_platforms import read_force_platforms
+
+    work, _ = walkthrough
+    contacts = pd.read_csv(work / "results/events/QCMAS/walk-nodevice.contacts.tsv", sep="\t")
+    events = pd.read_csv(work / "results/events/QCMAS/walk-nodevice.events.tsv", sep="\t")
+    plates = {p.number: p for p in read_force_platforms(ROOT / "tests/data/c3d-parser/QCMAS/walk-nodevice.c3d")}
+    clean = contacts[contacts.flag == "ok"]
+    assert len(clean) == 3
+    for row in clean.itertuples():
+        plate = plates[row.plate]
+        fz, t = plate.force_n[:, 2], plate.time_s
+        rest = np.median(fz[fz < fz.min() + 10.0])
+        loaded = np.flatnonzero(fz - rest > 20.0)
+        on, off = t[loaded[0]], t[loaded[-1]]
+        mine = events[events.side == row.side]
+        hs = mine[mine.event == "heel_strike"].time_s.to_numpy()
+        to = mine[mine.event == "toe_off"].time_s.to_numpy()
+        assert np.min(np.abs(hs - on)) <= 0.015 and np.min(np.abs(to - off)) <= 0.015, (row.plate, on, off)

@@ -50,3 +50,16 @@ def test_type_groups_segment_points_and_unlabelled_points_are_not_markers():
     kinds = point_kinds(params, labels)
     assert kinds == [MARKER, "ANGLES", "REACTIONS_X", SEGMENT_POINT, SEGMENT_POINT, UNLABELLED, UNLABELLED, MARKER,
                      MARKER]  # fmt: skip
+
+
+def test_the_walk_s_speed_comes_from_its_markers_as_its_pelvis_gives_it():
+    """Read with the model outputs as markers, the walk's mean marker speed was 0.71 m/s; its markers alone travel
+    at the speed of its pelvis markers (1.275 m/s)."""
+    from loper_analysis.motion.heading import travel_velocity_m_per_s
+
+    rec = read_c3d(QCMAS / "walk-nodevice.c3d")
+    pelvis = [rec.marker_labels.index(m) for m in ("LASI", "RASI", "LPSI", "RPSI")]
+    v_pelvis = travel_velocity_m_per_s(rec.markers_m[:, pelvis], rec.point_rate_hz)
+    v_all = travel_velocity_m_per_s(rec.markers_m, rec.point_rate_hz)
+    assert np.hypot(*v_pelvis[:2]) == pytest.approx(1.275, abs=0.001)
+    assert np.hypot(*v_all[:2]) == pytest.approx(np.hypot(*v_pelvis[:2]), rel=0.01)

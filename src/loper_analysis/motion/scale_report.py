@@ -189,8 +189,9 @@ def scale_report(
     pandas.DataFrame
         Columns :data:`SCALE_REPORT_COLUMNS`. Rows (``kind``): ``subject``; ``body``; ``marker``
         (``marker_error_before_m`` and ``marker_error_m``); ``markers`` (``before placement`` and ``after
-        placement``: RMS, largest, worst marker); ``pose`` (``angle_rad`` of the static pose the markers were
-        placed in, ``lab_angle_rad``); ``warning`` (``source`` holds the text).
+        placement``, or ``after scaling`` alone without placement: RMS, largest, worst marker); ``pose``
+        (``angle_rad`` of the static pose the markers were placed in, ``lab_angle_rad``); ``warning``
+        (``source`` holds the text).
     """
     mass_kg, height_m, source = subject
     rows = [{"kind": "subject", "name": "subject", "mass_kg": mass_kg, "height_m": height_m, "source": source}]
@@ -208,7 +209,8 @@ def scale_report(
                 "marker_error_m": error,
             }
         )
-    for stage, fit in (("before placement", before), ("after placement", after)):
+    final = "after scaling" if before is None else "after placement"  # no marker placement: only scaled
+    for stage, fit in (("before placement", before), (final, after)):
         if fit is None or not fit.errors_m:
             continue
         e = np.array(list(fit.errors_m.values()))
