@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import re
 import subprocess
 import sys
@@ -13,6 +12,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from tests.browser import report_screen
 from tests.workflow_copy import copy_workflow
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
@@ -168,7 +168,7 @@ def test_the_report_shows_the_subject_in_a_browser(walkthrough, tmp_path):
     work, _ = walkthrough
     html = (work / "results/report.html").read_text(errors="replace")
     assert len(html) > 100_000 and "QCMAS" in html
-    screen = _devtools()
+    screen = report_screen()
     if screen.chromium_path() is None:
         pytest.skip("no Chromium at /usr/bin/chromium (or $CHROMIUM): the report cannot be rendered")
     measured = screen.first_screen(work / "results/report.html", tmp_path / "screen.png", ready_id="lf-trials")
@@ -179,13 +179,6 @@ def test_the_report_shows_the_subject_in_a_browser(walkthrough, tmp_path):
         "QCMAS walk-nodevice: joint angles over the gait cycle",
     ]
     assert "mass 72.2 kg, height 1.86 m" in measured["text"] and "before placement 37.0 97.9 LTHI" in measured["text"]
-
-
-def _devtools():
-    spec = importlib.util.spec_from_file_location("report_screenshot", ROOT / "benchmarks/report_screenshot.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def test_every_clean_plate_contact_has_its_events_within_15_ms_of_the_plate_s_own_contact(walkthrough):

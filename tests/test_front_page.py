@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import base64
 import copy
-import importlib.util
 import math
 import re
 import shutil
@@ -33,6 +32,7 @@ from loper_analysis.report.headline import (
     validation_verdict,
 )
 from loper_analysis.steps.report import FrontPageSettings
+from tests.browser import report_screen
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -278,17 +278,10 @@ def test_the_file_step_writes_the_same_bytes_from_the_same_files(tmp_path):
     assert not list((tmp_path / "results/report").glob(".*partial"))  # written through the atomic writer
 
 
-def _devtools():
-    spec = importlib.util.spec_from_file_location("report_screenshot", ROOT / "benchmarks/report_screenshot.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_the_report_shows_the_headline_tables_on_its_first_screen(tmp_path):
     """The workflow's own report text (workflow/report/workflow.rst) in a Snakemake report of a small results set,
     opened in headless Chromium at 1400×900: both headline tables lie wholly within the first screen."""
-    screen = _devtools()
+    screen = report_screen()
     if screen.chromium_path() is None:
         pytest.skip("no Chromium at /usr/bin/chromium (or $CHROMIUM): the first screen cannot be rendered")
     _write_results(tmp_path)

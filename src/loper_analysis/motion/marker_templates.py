@@ -42,6 +42,8 @@ __all__ = [
     "TemplateFit",
     "TemplateMarker",
     "derived_markers",
+    "measured_scale_tool",
+    "scale_measurement",
     "template_coordinate_map",
     "template_fit",
     "template_from_spec",
@@ -294,6 +296,47 @@ def _present_pairs(template: MarkerTemplate, present: set[str]) -> dict[str, tup
     return pairs
 
 
+def scale_measurement(name: str, pairs: Sequence[tuple[str, str]], bodies: Sequence[str]):
+    """An ``opensim.Measurement``: the mean ratio of the marker ``pairs``' distances scales ``bodies`` uniformly
+    (X, Y and Z)."""
+    from loper_analysis.io.osim import quiet_opensim
+
+    osim = quiet_opensim()
+    m = osim.Measurement()
+    m.setName(name)
+    m.setApply(True)
+    for a, b in pairs:
+        m.getMarkerPairSet().cloneAndAppend(osim.MarkerPair(a, b))
+    for body in bodies:
+        scale = osim.BodyScale()
+        scale.setName(body)
+        axes = osim.ArrayStr()
+        for axis in "XYZ":
+            axes.append(axis)
+        scale.setAxisNames(axes)
+        m.getBodyScaleSet().cloneAndAppend(scale)
+    return m
+
+
+def measured_scale_tool(measurements: Mapping[str, tuple[Sequence[tuple[str, str]], Sequence[str]]]):
+    """An ``opensim.ScaleTool`` whose model scaler applies ``measurements`` (name -> (marker pairs, bodies),
+    :func:`scale_measurement`) with the mass distribution preserved; the marker placer is left as OpenSim
+    makes it (off)."""
+    from loper_analysis.io.osim import quiet_opensim
+
+    osim = quiet_opensim()
+    tool = osim.ScaleTool()
+    scaler = tool.getModelScaler()
+    scaler.setApply(True)
+    order = osim.ArrayStr()
+    order.append("measurements")
+    scaler.setScalingOrder(order)
+    scaler.setPreserveMassDist(True)
+    for name, (pairs, bodies) in measurements.items():
+        scaler.getMeasurementSet().cloneAndAppend(scale_measurement(name, pairs, bodies))
+    return tool
+
+
 def template_scale_tool(template: MarkerTemplate, static_markers: Sequence[str], marker_set_file: str):
     """An ``opensim.ScaleTool`` for a static trial holding ``static_markers`` (model names, derived ones
     included).
@@ -307,32 +350,14 @@ def template_scale_tool(template: MarkerTemplate, static_markers: Sequence[str],
 
     osim = quiet_opensim()
     present = set(static_markers) & set(template.marker_names)
-    tool = osim.ScaleTool()
+    measurements = {
+        name: (pairs, template.measurements[name][1])
+        for name, pairs in _present_pairs(template, present).items()
+        if pairs
+    }
+    tool = measured_scale_tool(measurements)
     tool.setName(template.name)
     tool.getGenericModelMaker().setMarkerSetFileName(marker_set_file)
-    scaler = tool.getModelScaler()
-    scaler.setApply(True)
-    order = osim.ArrayStr()
-    order.append("measurements")
-    scaler.setScalingOrder(order)
-    scaler.setPreserveMassDist(True)
-    for name, pairs in _present_pairs(template, present).items():
-        if not pairs:
-            continue
-        m = osim.Measurement()
-        m.setName(name)
-        m.setApply(True)
-        for a, b in pairs:
-            m.getMarkerPairSet().cloneAndAppend(osim.MarkerPair(a, b))
-        for body in template.measurements[name][1]:
-            scale = osim.BodyScale()
-            scale.setName(body)
-            axes = osim.ArrayStr()
-            for axis in "XYZ":
-                axes.append(axis)
-            scale.setAxisNames(axes)
-            m.getBodyScaleSet().cloneAndAppend(scale)
-        scaler.getMeasurementSet().cloneAndAppend(m)
     placer = tool.getMarkerPlacer()
     placer.setApply(True)
     tasks = placer.getIKTaskSet()

@@ -77,6 +77,22 @@ def _point_unit(path: Path) -> str:
     return units[0] if units else ""
 
 
+def _recording(path: Path) -> tuple:
+    """A C3D file read with its force platforms, and its summary
+    (:func:`loper_analysis.inspection.recording_summary`); plates that cannot be read are reported in it."""
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.force_platforms import read_force_platforms
+
+    rec = read_c3d(path)
+    plates, problem = [], ""
+    if rec.n_force_platforms:
+        try:
+            plates = read_force_platforms(path)
+        except LoperInputError as exc:
+            problem = one_line(exc)
+    return rec, recording_summary(rec, plates, point_unit=_point_unit(path), plate_problem=problem)
+
+
 def model_marker_names_of(model_osim: PathLike, marker_set_xml: PathLike | None = None) -> list[str]:
     """Names of a model's markers, followed by those of a marker set the model lacks (as ScaleTool adds them).
 
@@ -167,22 +183,13 @@ def inspect_c3d(
         ``label_map_out`` without ``model_osim``. Force platforms that cannot be read are
         reported in the text instead.
     """
-    from loper_analysis.io.c3d import read_c3d
-    from loper_analysis.io.force_platforms import read_force_platforms
 
     if model_osim is None and marker_set_xml is not None:
         raise LoperInputError(f"{marker_set_xml}: a marker set is added to a model: give --model as well")
     if model_osim is None and label_map_out is not None:
         raise LoperInputError(f"{label_map_out}: a label map needs a model to match the labels to: give --model")
     path = Path(c3d_path)
-    rec = read_c3d(path)
-    plates, problem = [], ""
-    if rec.n_force_platforms:
-        try:
-            plates = read_force_platforms(path)
-        except LoperInputError as exc:
-            problem = one_line(exc)
-    summary = recording_summary(rec, plates, point_unit=_point_unit(path), plate_problem=problem)
+    rec, summary = _recording(path)
     text = format_summary(summary)
 
     match, model_markers = None, ()
@@ -361,8 +368,6 @@ def inspect_subject(
         starter map (``label_map_starter.tsv``: every label, the template's marker where one was found) is
         written beside it and nothing else.
     """
-    from loper_analysis.io.c3d import read_c3d
-    from loper_analysis.io.force_platforms import read_force_platforms
     from loper_analysis.io.marker_templates import read_templates, template_file
     from loper_analysis.io.osim import read_model, write_osim_object
     from loper_analysis.io.readers import read_bytes
@@ -379,14 +384,7 @@ def inspect_subject(
     kinds = [_trial_kind(p, static_name) for p in paths]
     recs, summaries, text = [], [], ""
     for path in paths:
-        rec = read_c3d(path)
-        plates, problem = [], ""
-        if rec.n_force_platforms:
-            try:
-                plates = read_force_platforms(path)
-            except LoperInputError as exc:
-                problem = one_line(exc)
-        summary = recording_summary(rec, plates, point_unit=_point_unit(path), plate_problem=problem)
+        rec, summary = _recording(path)
         recs.append(rec)
         summaries.append(summary)
         text += format_summary(summary) + "\n"

@@ -203,32 +203,11 @@ def scaled_model(
     must lie in ``settings.factor_range`` (a factor near 10 or 1000 means markers in
     another unit than the TRC declares); nothing is written otherwise.
     """
-    from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.io.osim import read_model
+    from loper_analysis.motion.marker_templates import measured_scale_tool
     from loper_analysis.motion.model import SCALE_MEASUREMENTS
 
-    osim = quiet_opensim()
-    tool = osim.ScaleTool()
-    scaler = tool.getModelScaler()
-    scaler.setApply(True)
-    order = osim.ArrayStr()
-    order.append("measurements")
-    scaler.setScalingOrder(order)
-    scaler.setPreserveMassDist(True)
-    measurements = scaler.getMeasurementSet()
-    for body, pairs in SCALE_MEASUREMENTS.items():
-        m = osim.Measurement()
-        m.setName(body)
-        m.setApply(True)
-        for a, b in pairs:
-            m.getMarkerPairSet().cloneAndAppend(osim.MarkerPair(a, b))
-        scale = osim.BodyScale()
-        scale.setName(body)
-        axes = osim.ArrayStr()
-        for axis in "XYZ":
-            axes.append(axis)
-        scale.setAxisNames(axes)
-        m.getBodyScaleSet().cloneAndAppend(scale)
-        measurements.cloneAndAppend(m)
+    tool = measured_scale_tool({body: (pairs, [body]) for body, pairs in SCALE_MEASUREMENTS.items()})
     tool.getMarkerPlacer().setApply(False)
     generic_osim = Path(files.generic_osim)
     if not generic_osim.is_file():
