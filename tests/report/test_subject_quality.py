@@ -24,7 +24,7 @@ SCALE = pd.DataFrame(
 )  # fmt: skip
 IK = pd.Series(
     {"n_frames_solved": 216, "n_frames_left_out": 0, "marker_rms_mean_m": 0.0158, "worst_marker": "LTHI",
-     "worst_marker_rms_m": 0.028, "warnings": ""}
+     "worst_marker_rms_m": 0.028, "worst_markers_mm": "LTHI 28.0, RTHI 25.1, C7 20.2", "warnings": ""}
 )  # fmt: skip
 AGREEMENT = pd.DataFrame(
     {
@@ -54,6 +54,7 @@ def test_the_numbers_are_the_tables_in_the_page_s_units():
     assert shown["trial|QCMAS|walk|speed_m_per_s"] == (1.2724, "1.27")
     assert shown["trial|QCMAS|walk|marker_rms_mean_m"] == (0.0158, "15.8")
     assert "static pose: knee &lt;beyond&gt;" in page and "too_few_strides" in page
+    assert '<td class="lf-l">LTHI 28.0, RTHI 25.1, C7 20.2</td>' in page
     assert page.index('id="lf-subject-QCMAS"') < page.index('id="lf-trials"')
 
 

@@ -65,6 +65,7 @@ IK_SUMMARY_COLUMNS: tuple[str, ...] = (
     "n_frames_over_warn",
     "worst_marker",
     "worst_marker_rms_m",
+    "worst_markers_mm",
     "warnings",
 )
 
@@ -107,7 +108,8 @@ class IKResult:
 
         Columns :data:`IK_SUMMARY_COLUMNS`; ``n_frames_over_warn`` counts the
         frames whose marker RMS error exceeds ``warn_rms_m`` (m); ``worst_marker`` is the marker with the
-        largest RMS error over the trial (``worst_marker_rms_m``; '' and NaN without marker errors);
+        largest RMS error over the trial (``worst_marker_rms_m``; '' and NaN without marker errors),
+        ``worst_markers_mm`` the three worst with their RMS error in mm, as text (``LTHI 28.0, RTHI 25.1, ...``);
         ``warnings`` joins :attr:`warning` and :attr:`warnings` ('' when none).
         """
         solved = np.ones(self.time_s.size, bool) if self.solved is None else self.solved
@@ -128,6 +130,7 @@ class IKResult:
                     "n_frames_over_warn": int((rms > warn_rms_m).sum()),
                     "worst_marker": worst,
                     "worst_marker_rms_m": per_marker[worst] if worst else np.nan,
+                    "worst_markers_mm": ", ".join(f"{m} {1e3 * e:.1f}" for m, e in list(per_marker.items())[:3]),
                     "warnings": " | ".join(w for w in [self.warning, *self.warnings] if w),
                 }
             ],

@@ -4,7 +4,7 @@ Per subject (:class:`SubjectQuality`): the mass and height used and where they c
 the marker errors before and after marker placement, the static pose the markers were placed in (beside the
 lab's own static angles), the scaling's warnings, and per trial the joint angles over the gait cycle and the
 force plates with the events found. Then one table with a row per trial (:class:`TrialQuality`): frames solved
-and left out of inverse kinematics, the marker RMS error and the worst marker, strides found and kept, speed,
+and left out of inverse kinematics, the marker RMS error and the three worst markers, strides found and kept, speed,
 the agreement with the lab's own angles and the trial's warnings. Angles are shown in degrees, marker errors
 in mm; each number's ``data-v`` holds the table's value in SI units.
 """
@@ -162,13 +162,13 @@ def _trial_row(subject: str, t: TrialQuality) -> str:
     warnings = str(ik.get("warnings", "") or "")
     if strides is not None and str(strides.get("status", "ok")) != "ok":
         warnings = "; ".join(w for w in [str(strides.status), warnings] if w)
-    worst = str(ik.get("worst_marker", "") or "")
+    worst = str(ik.get("worst_markers_mm", "") or "")
     return (
         f'<tr><td class="lf-l">{html.escape(subject)}</td><td class="lf-l">{html.escape(t.trial)}</td>'
         f"<td>{_v(int(ik.n_frames_solved), str(int(ik.n_frames_solved)), key + '|n_frames_solved')}</td>"
         f"<td>{_v(int(ik.n_frames_left_out), str(int(ik.n_frames_left_out)), key + '|n_frames_left_out')}</td>"
         f"<td>{_mm(ik.marker_rms_mean_m, key + '|marker_rms_mean_m')}</td>"
-        f'<td class="lf-l">{html.escape(worst)} ({_mm(ik.get("worst_marker_rms_m"), key + "|worst_marker_rms_m")})</td>'
+        f'<td class="lf-l">{html.escape(worst)}</td>'
         f"<td>{found}</td><td>{kept}</td><td>{speed}</td><td>{agree}</td>"
         f'<td class="lf-l lf-wrap">{html.escape(warnings)}</td></tr>'
     )
@@ -193,7 +193,7 @@ def recorded_subjects_html(subjects: Sequence[SubjectQuality]) -> str:
     parts.append(
         '<table id="lf-trials"><caption>Per trial: inverse kinematics, strides and agreement with the lab\'s own '
         "angles (hip, knee, ankle)</caption><thead><tr><th>subject</th><th>trial</th><th>frames solved</th>"
-        "<th>left out</th><th>marker RMS (mm)</th><th>worst marker (mm)</th><th>strides</th><th>kept</th>"
+        "<th>left out</th><th>marker RMS (mm)</th><th>worst markers (RMS, mm)</th><th>strides</th><th>kept</th>"
         "<th>speed (m/s)</th><th>lab's own angles</th><th>warnings</th></tr></thead>"
         f"<tbody>{rows}</tbody></table>"
     )
