@@ -77,3 +77,63 @@ def test_hip_knee_and_ankle_agree_with_opensim_s_own_inverse_kinematics(r11, pee
             b = np.degrees(peer[f"{coordinate}_{s}"].to_numpy())  # Rajagopal2016: flexion positive
             r, rms = np.corrcoef(a, b)[0, 1], np.sqrt(np.mean((a - b) ** 2))
             assert r >= r_min and rms <= rms_max, (joint, side, r, rms)
+
+
+QCMAS = ROOT / "tests" / "data" / "c3d-parser" / "QCMAS"
+
+
+def _clinical_run(work: Path, kad: bool) -> Path:
+    """The clinical pair, its static trial written again with markers only (no plates: the sheet gives mass and
+    height), the knee markers replaced by a knee alignment device when ``kad``; inspect and the workflow."""
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.c3d_writer import write_c3d
+    from tests.knee_device import device_markers
+
+    work.mkdir()
+    copy_workflow(work)
+    raw = work / "data/raw/QCMAS"
+    raw.mkdir(parents=True)
+    rec = read_c3d(QCMAS / "static.c3d")
+    labels, X = list(rec.marker_labels), rec.markers_m
+    if kad:
+        keep = [i for i, n in enumerate(labels) if n not in ("LKNE", "RKNE")]
+        extra_labels, extra = [], []
+        for side, seed in (("L", 1), ("R", 2)):
+            knee, medial = X[:, labels.index(f"{side}KNE")], X[:, labels.index(f"{side}MKNE")]
+            for code, marker in zip(("KAX", "KD1", "KD2"), device_markers(knee, medial, seed)):
+                extra_labels.append(f"{side}{code}")
+                extra.append(marker)
+        labels, X = [labels[i] for i in keep] + extra_labels, np.concatenate([X[:, keep], np.stack(extra, 1)], 1)
+    write_c3d(raw / "static.c3d", labels, X, rec.point_rate_hz, first_frame=rec.first_frame)
+    (raw / "walk-nodevice.c3d").write_bytes((QCMAS / "walk-nodevice.c3d").read_bytes())
+    res = subprocess.run(
+        [str(Path(sys.executable).parent / "loper-analysis"), "inspect", "data/raw/QCMAS/static.c3d",
+         "data/raw/QCMAS/walk-nodevice.c3d", "--config-out", "lab/QCMAS/config.yaml"],
+        cwd=work, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    assert "chosen: plugin_gait" in res.stdout
+    (work / "lab/subjects.tsv").write_text("subject\tsource\theight_m\tmass_kg\nQCMAS\trecorded\t1.86\t70.23\n")
+    with (work / "lab/QCMAS/config.yaml").open("a") as fh:
+        fh.write("subjects: lab/subjects.tsv\ndevice: {subject: null}\n")
+    run = snakemake(work, "--configfile", "lab/QCMAS/config.yaml")
+    assert run.returncode == 0, run.stderr[-3000:]
+    return work
+
+
+def test_a_knee_alignment_device_gives_the_model_and_angles_of_the_knee_marker(tmp_path):
+    """The same static trial with its knee markers, and with a knee alignment device built around them instead:
+    the same scale factors, static pose and walking angles."""
+    plain = _clinical_run(tmp_path / "plain", kad=False)
+    device = _clinical_run(tmp_path / "kad", kad=True)
+    a = pd.read_csv(plain / "results/model/QCMAS/scale.tsv", sep="\t")
+    b = pd.read_csv(device / "results/model/QCMAS/scale.tsv", sep="\t")
+    factors = [t[t.kind == "body"].set_index("name").scale_factor_x for t in (a, b)]
+    np.testing.assert_allclose(factors[1], factors[0], rtol=1e-4)
+    poses = [t[t.kind == "pose"].set_index("name").angle_rad for t in (a, b)]
+    np.testing.assert_allclose(poses[1], poses[0], atol=np.radians(0.05))
+    angles = [pd.read_csv(w / "results/ik/QCMAS/walk-nodevice.angles.tsv", sep="\t") for w in (plain, device)]
+    for column in ("hip_left_rad", "knee_left_rad", "ankle_left_rad", "knee_right_rad"):
+        np.testing.assert_allclose(angles[1][column], angles[0][column], atol=np.radians(0.05))
+    markers = pd.read_csv(device / "results/markers/QCMAS/static.markers.tsv", sep="\t").set_index("marker")
+    assert markers.loc["LKNE", "label"] == "LKNE (knee alignment device)"

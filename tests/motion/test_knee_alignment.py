@@ -11,25 +11,9 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.motion.knee_alignment import kad_knee_markers
+from tests.knee_device import device_markers
 
 QCMAS = Path(__file__).resolve().parents[1] / "data" / "c3d-parser" / "QCMAS"
-ARM_M = 0.10  # arm length of the device
-
-
-def _device_at(knee: np.ndarray, lateral: np.ndarray, axis_hint: np.ndarray, seed: int) -> list[np.ndarray]:
-    """Markers of a device whose origin is ``knee`` and whose arms point away from the body (a cube corner with
-    its diagonal along ``lateral``), turned about that diagonal by a seeded angle."""
-    rng = np.random.default_rng(seed)
-    d = lateral / np.linalg.norm(lateral)
-    u = np.cross(d, axis_hint)
-    u /= np.linalg.norm(u)
-    w = np.cross(d, u)
-    turn = rng.uniform(0, 2 * np.pi)
-    arms = []
-    for k in range(3):  # three unit vectors at 54.7 deg from the diagonal, 120 deg apart about it
-        phi = turn + 2 * np.pi * k / 3
-        arms.append(d / np.sqrt(3) + np.sqrt(2 / 3) * (np.cos(phi) * u + np.sin(phi) * w))
-    return [knee + ARM_M * a for a in arms]
 
 
 def test_a_device_around_the_lab_knee_markers_gives_them_back_to_a_tenth_of_a_millimetre():
@@ -42,10 +26,9 @@ def test_a_device_around_the_lab_knee_markers_gives_them_back_to_a_tenth_of_a_mi
     for side, seed in (("L", 1), ("R", 2)):
         knee, medial = X[:, names.index(f"{side}KNE")], X[:, names.index(f"{side}MKNE")]
         truth[f"{side}KNE"] = knee
-        devices = [_device_at(k, k - m, np.array([0.0, 0.0, 1.0]), seed) for k, m in zip(knee, medial)]
-        for j, code in enumerate(("KAX", "KD1", "KD2")):
+        for code, marker in zip(("KAX", "KD1", "KD2"), device_markers(knee, medial, seed)):
             out_names.append(f"{side}{code}")
-            out_X = np.concatenate([out_X, np.stack([dev[j] for dev in devices])[:, None, :]], axis=1)
+            out_X = np.concatenate([out_X, marker[:, None, :]], axis=1)
     names2, X2, added = kad_knee_markers(out_names, out_X, source="static.c3d")
     assert added == ["LKNE", "RKNE"] and names2[-2:] == added
     for knee in added:
