@@ -59,6 +59,7 @@ if TYPE_CHECKING:  # records only; nothing is read here
     from loper_analysis.io.force_platforms import ForcePlatform
 
 __all__ = [
+    "yaml_flow",
     "MIN_MARKERS_PER_FRAME",
     "PlateSummary",
     "RecordingSummary",
@@ -429,14 +430,14 @@ def recording_summary(
 # ---------------------------------------------------------------- config snippet
 
 
-def _yaml_scalar(value) -> str:
+def yaml_flow(value) -> str:
     """A YAML flow value: JSON for strings and lists (valid YAML), whole numbers without a point."""
     if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_yaml_scalar(v) for v in value) + "]"
+        return "[" + ", ".join(yaml_flow(v) for v in value) + "]"
     if isinstance(value, float) and value.is_integer():
         return str(int(value))
     if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{k}: {_yaml_scalar(v)}" for k, v in value.items()) + "}"
+        return "{" + ", ".join(f"{k}: {yaml_flow(v)}" for k, v in value.items()) + "}"
     return json.dumps(value)
 
 
@@ -473,7 +474,7 @@ def config_snippet(
     notes = dict(notes or {})
 
     def line(key: str, value, note: str) -> str:
-        text = f"  {key}: {_yaml_scalar(value)}"
+        text = f"  {key}: {yaml_flow(value)}"
         return text + (f"   # {note}" if note else "")
 
     out = [f"# {h}" for h in header]
@@ -481,7 +482,7 @@ def config_snippet(
     if isinstance(label_map, Mapping):
         if label_map:
             out.append("  label_map:" + (f"   # {notes['label_map']}" if notes.get("label_map") else ""))
-            out += [f"    {_yaml_scalar(str(k))}: {_yaml_scalar(str(v))}" for k, v in label_map.items()]
+            out += [f"    {yaml_flow(str(k))}: {yaml_flow(str(v))}" for k, v in label_map.items()]
         else:
             out.append("  label_map: {}" + (f"   # {notes['label_map']}" if notes.get("label_map") else ""))
     elif label_map is not None:

@@ -25,6 +25,7 @@ from loper_analysis.inspection import (
     format_label_match,
     format_summary,
     recording_summary,
+    yaml_flow,
 )
 from loper_analysis.io.atomic import PathLike, write_bytes, write_text, write_tsv
 from loper_analysis.io.c3d_parameters import param_strings
@@ -292,40 +293,27 @@ def _subject_config_text(
         f"# {mass_height}",
         "# subjects: lab/subjects.tsv          # the subject sheet (add this key)",
         "markers:",
-        f"  lab_to_model_rotation_deg: {_flow(rotation)}   # up {up} -> model +Y (each walking trial is turned "
+        f"  lab_to_model_rotation_deg: {yaml_flow(rotation)}   # up {up} -> model +Y (each walking trial is turned "
         "to walk along model +X)",
     ]
     if "label_map" in files:
-        lines.append(f"  label_map: {_flow(files['label_map'])}   # lab label -> template marker")
+        lines.append(f"  label_map: {yaml_flow(files['label_map'])}   # lab label -> template marker")
     else:
         lines.append("  label_map: {}   # the labels are the template's marker names")
     lines += [
         "opensim:",
-        f"  generic_model: {_flow(files['model'])}   # {t.model} as OpenSim distributes it",
-        f"  scale_setup: {_flow(files['scale_setup'])}   # ScaleTool setup; names marker_set.xml beside it",
-        f"  ik_tasks: {_flow(files['ik_tasks'])}   # markers of the walking trials and their weights"
+        f"  generic_model: {yaml_flow(files['model'])}   # {t.model} as OpenSim distributes it",
+        f"  scale_setup: {yaml_flow(files['scale_setup'])}   # ScaleTool setup; names marker_set.xml beside it",
+        f"  ik_tasks: {yaml_flow(files['ik_tasks'])}   # markers of the walking trials and their weights"
         + (f"; not tracked (static trial only): {', '.join(setup.static_only)}" if setup.static_only else ""),
         "  coordinate_map:   # our angle -> model coordinate; each sign read from the model's kinematics",
     ]
-    lines += [f"    {k}: {_flow(dict(v))}" for k, v in coordinate_map.items()]
+    lines += [f"    {k}: {yaml_flow(dict(v))}" for k, v in coordinate_map.items()]
     feet = t.foot_markers
-    lines += ["events:", f"  foot_markers: {_flow(dict(feet))}   # heel markers: assign plate contacts to feet"]
+    lines += ["events:", f"  foot_markers: {yaml_flow(dict(feet))}   # heel markers: assign plate contacts to feet"]
     kinds_text = ", ".join(f"{p.stem} ({k})" for p, k in zip(paths, kinds))
     lines.append(f"# trials: {kinds_text}")
     return "\n".join(lines) + "\n"
-
-
-def _flow(value) -> str:
-    """A YAML flow value (JSON is YAML)."""
-    import json
-
-    if isinstance(value, Mapping):
-        return "{" + ", ".join(f"{k}: {_flow(v)}" for k, v in value.items()) + "}"
-    if isinstance(value, (list, tuple)):
-        return "[" + ", ".join(_flow(v) for v in value) + "]"
-    if isinstance(value, float) and value.is_integer():
-        return str(int(value))
-    return json.dumps(value)
 
 
 def _mass_height_line(static_rec) -> str:
