@@ -64,6 +64,11 @@ def _mm(value_m, key: str) -> str:
     return _v(float(value_m), f"{1000 * value_m:.1f}", key)
 
 
+def _text(value) -> str:
+    """A text cell of a table ('' for an empty cell, which a TSV reader may give as NaN)."""
+    return "" if value is None or (isinstance(value, float) and math.isnan(value)) else str(value)
+
+
 def _img(png: bytes | None, alt: str) -> str:
     if not png:
         return ""
@@ -159,10 +164,10 @@ def _trial_row(subject: str, t: TrialQuality) -> str:
                 f"r ≥ {_v(float(r_min), f'{r_min:.2f}', key + '|lab_r_min')}, RMS ≤ "
                 f"{_v(float(rms_max), f'{math.degrees(rms_max):.1f}', key + '|lab_rms_max_rad')}°"
             )
-    warnings = str(ik.get("warnings", "") or "")
+    warnings = _text(ik.get("warnings"))
     if strides is not None and str(strides.get("status", "ok")) != "ok":
         warnings = "; ".join(w for w in [str(strides.status), warnings] if w)
-    worst = str(ik.get("worst_markers_mm", "") or "")
+    worst = _text(ik.get("worst_markers_mm"))
     return (
         f'<tr><td class="lf-l">{html.escape(subject)}</td><td class="lf-l">{html.escape(t.trial)}</td>'
         f"<td>{_v(int(ik.n_frames_solved), str(int(ik.n_frames_solved)), key + '|n_frames_solved')}</td>"
