@@ -69,3 +69,9 @@ def test_a_study_without_perturbations_says_so_and_shows_the_section_without_a_v
     assert "No perturbation trials in this run" in page and "onsets" not in page.split("</p>")[0]
     assert "Scaled model given in the subject sheet" in page and 'id="lf-trials"' in page
     assert "validation" not in page.lower().split('id="lf-run"')[0]
+    run = page.split('id="lf-run"')[1]
+    assert (
+        "filter" in run
+        and "seed" in run
+        and not {"fit window", "bounds", "synthetic lab"} & set(re.findall(r'<td class="lf-l">([a-z ]+)</td>', run))
+    )

@@ -547,9 +547,16 @@ def front_page_html(
         parts.append(_transparency_table(transparency))
     if len(device):
         parts.append(_device_table(device))
+    shown = settings.rows()
+    if (
+        summary is None
+    ):  # a study without perturbation trials: no fit settings, and a synthetic lab only with its subjects
+        skip = {"perturbations", "fit window", "bounds", "noise model"}
+        if "synthetic" not in subjects.values():
+            skip.add("synthetic lab")
+        shown = [(k, v) for k, v in shown if k not in skip]
     rows = "".join(
-        f'<tr><td class="lf-l">{html.escape(k)}</td><td class="lf-l">{html.escape(v)}</td></tr>'
-        for k, v in settings.rows()
+        f'<tr><td class="lf-l">{html.escape(k)}</td><td class="lf-l">{html.escape(v)}</td></tr>' for k, v in shown
     )
     software = " · ".join(f"{html.escape(k)} {html.escape(v)}" for k, v in versions.items())
     parts.append(
