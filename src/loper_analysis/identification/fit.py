@@ -198,8 +198,8 @@ class ResidualBatch:
         return r if self.weight is None else r @ self.weight.T
 
     def cost(self, impedance_sets: np.ndarray) -> np.ndarray:
-        """Costs (B,) at the rows of ``impedance_sets``."""
-        return np.sum(self.residuals(impedance_sets) ** 2, axis=1)
+        """Costs (B,) at the rows of ``impedance_sets``; ``inf`` where the simulation diverged (:func:`costs_of`)."""
+        return costs_of(self.residuals(impedance_sets))
 
     def residuals_and_jacobians(self, impedance_sets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """r (B, m) and J (B, m, 6) of the residuals at the rows of ``impedance_sets``."""
@@ -211,7 +211,8 @@ class ResidualBatch:
         idx = np.arange(6)
         batch[:, idx + 1, idx] += step
         R = self.residuals(batch.reshape(-1, 6)).reshape(B, 7, -1)
-        J = (R[:, 1:, :] - R[:, :1, :]) / step[:, :, None]
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged simulation: inf - inf
+            J = (R[:, 1:, :] - R[:, :1, :]) / step[:, :, None]
         return R[:, 0, :], np.transpose(J, (0, 2, 1))
 
 
@@ -227,6 +228,20 @@ def initial_state_jacobian(window: PreparedWindow, impedance) -> np.ndarray:
         shifted = replace(window, initial_deviation=e0, initial_rate=ed0)
         G[:, k] = (simulate_response(shifted, impedance).ravel() - base) / h
     return G
+
+
+def costs_of(residuals: np.ndarray) -> np.ndarray:
+    """Sums of squares (B,) of residual rows (B, m); ``inf`` for a row that is not finite or whose square
+    overflows.
+
+    A start whose simulation diverges (a negative stiffness within signed bounds makes the response grow
+    exponentially) is a normal event of a multistart fit: its cost is infinite, so every comparison rejects it,
+    with no floating-point warning on any CPU.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        c = np.sum(np.square(residuals), axis=1)
+    c[~np.isfinite(c)] = np.inf
+    return c
 
 
 def _merge_close(
@@ -276,9 +291,9 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
     N = len(starts)
     points = starts.copy()
     r, J = batch.residuals_and_jacobians(points)
-    cost = np.sum(r**2, axis=1)
+    cost = costs_of(r)
     mu = np.full(N, _MU_START)
-    active = np.ones(N, bool)
+    active = np.isfinite(cost)  # a start whose simulation diverged at once takes no step
     converged = np.zeros(N, bool)
     merged_into = np.arange(N)
     scale = ub - lb
@@ -289,8 +304,12 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
             break
         trial = np.empty((ids.size, 6))
         for k, i in enumerate(ids):
-            g = J[i].T @ r[i]
-            A = J[i].T @ J[i]
+            with np.errstate(over="ignore", invalid="ignore"):  # huge sensitivities of a nearly diverging start
+                g = J[i].T @ r[i]
+                A = J[i].T @ J[i]
+            if not (np.all(np.isfinite(g)) and np.all(np.isfinite(A))):
+                trial[k] = points[i]  # no step: the trial equals the point and is rejected, its damping grows
+                continue
             at_bound = ((points[i] <= lb) & (g > 0)) | ((points[i] >= ub) & (g < 0))
             free = ~at_bound
             step = np.zeros(6)
@@ -306,11 +325,11 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
                 step = np.zeros(6)
             trial[k] = np.clip(points[i] + step, lb, ub)
         rt, Jt = batch.residuals_and_jacobians(trial)
-        ct = np.sum(rt**2, axis=1)
+        ct = costs_of(rt)
         for k, i in enumerate(ids):
             dx = np.abs(trial[k] - points[i])
             small_step = np.all(dx <= tol * (np.abs(points[i]) + batch.typical))
-            if ct[k] <= cost[i]:
+            if ct[k] <= cost[i] and np.isfinite(ct[k]) and not np.array_equal(trial[k], points[i]):
                 gain = cost[i] - ct[k]
                 points[i], r[i], J[i] = trial[k], rt[k], Jt[k]
                 small_gain = gain <= tol * cost[i] or ct[k] < _COST_ZERO
