@@ -22,8 +22,10 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import sys
 import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -747,10 +749,53 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Options naming a file a subcommand reads, and those naming a file it writes.
+_INPUT_OPTIONS: tuple[str, ...] = ("c3d", "model", "setup", "static", "markers", "segments", "tasks", "label_map",
+                                   "marker_set", "configfile")  # fmt: skip
+_OUTPUT_OPTIONS: tuple[str, ...] = ("out", "gaps", "report", "errors", "fits", "label_map_out", "config_out", "target")
+
+
+def _files(args: argparse.Namespace, names: Sequence[str]) -> list[tuple[str, Path]]:
+    """(option, path) of every file the options name (lists flattened)."""
+    out = []
+    for name in names:
+        value = getattr(args, name, None)
+        for item in value if isinstance(value, (list, tuple)) else [value]:
+            if isinstance(item, (str, Path)) and str(item):
+                out.append(("--" + name.replace("_", "-") if name not in ("c3d", "target") else name, Path(item)))
+    return out
+
+
+def _same_file(a: Path, b: Path) -> bool:
+    """Whether two paths name one file (the same path, a link to it, or a hard link)."""
+    if a.exists() and b.exists():
+        return os.path.samefile(a, b)
+    return a.resolve() == b.resolve()
+
+
+def refuse_overwriting(args: argparse.Namespace) -> None:
+    """Stop before any work when a subcommand would write over one of its inputs, or write two outputs to one file.
+
+    Raises
+    ------
+    LoperInputError
+        Naming the output option and the input (or other output) option and their paths.
+    """
+    inputs, outputs = _files(args, _INPUT_OPTIONS), _files(args, _OUTPUT_OPTIONS)
+    for k, (out_name, out_path) in enumerate(outputs):
+        for in_name, in_path in inputs + outputs[:k]:
+            if _same_file(out_path, in_path):
+                raise LoperInputError(
+                    f"{out_path}: {out_name} would write over {in_name} {in_path}: nothing was done; give another "
+                    "output path"
+                )
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one subcommand; 0 on success, 2 with one line on standard error when an input cannot serve."""
     args = _parser().parse_args(argv)
     try:
+        refuse_overwriting(args)
         args.func(args)
     except Exception as exc:
         if args.traceback:
