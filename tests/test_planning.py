@@ -404,7 +404,7 @@ def test_plan_command_takes_the_working_directory_s_config_and_an_option_wins(pi
 @pytest.mark.parametrize(
     "args, message",
     [
-        (["--strides", "0"], "stride count must be a whole number >= 1 (perturbed strides averaged), got 0"),
+        (["--strides", "0"], "--strides [0]: 0 is less than the minimum of 1 (the limits of planning.strides"),
         (["--duration-s", "0.5"], "pulse_duration_s = 0.5 s is longer than the fit window"),
         (
             ["--trials", "pert050-2"],

@@ -791,11 +791,80 @@ def refuse_overwriting(args: argparse.Namespace) -> None:
                 )
 
 
+#: Each command's options with a config counterpart: option -> (schema file, key path); a value is held to the key's
+#: limits (:func:`check_option_limits`). ``subjects`` is the subject sheet's schema.
+_OPTION_KEYS: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
+    "markers": {
+        "cutoff_hz": ("config", ("filter", "cutoff_hz")),
+        "order": ("config", ("filter", "order")),
+        "max_gap_frames": ("config", ("markers", "max_gap_frames")),
+    },
+    "grf": {"threshold_n": ("config", ("grf", "loaded_threshold_n"))},
+    "events": {
+        "threshold_on_n": ("config", ("events", "threshold_on_n")),
+        "threshold_off_n": ("config", ("events", "threshold_off_n")),
+    },
+    "scale": {
+        "mass_kg": ("subjects", ("mass_kg",)),
+        "max_motion_rms_m": ("config", ("markers", "static_max_motion_rms_m")),
+        "cutoff_hz": ("config", ("filter", "cutoff_hz")),
+        "max_gap_frames": ("config", ("markers", "max_gap_frames")),
+    },
+    "segments": {
+        "mass_kg": ("subjects", ("mass_kg",)),
+        "height_m": ("subjects", ("height_m",)),
+        "attachment_fraction": ("config", ("opensim", "brace_attachment_fraction")),
+    },
+    "ik": {
+        "accuracy": ("config", ("opensim", "accuracy")),
+        "max_marker_rms_m": ("config", ("opensim", "max_marker_rms_m")),
+        "warn_marker_rms_m": ("config", ("opensim", "warn_marker_rms_m")),
+        "max_rms_fraction": ("config", ("opensim", "max_rms_fraction")),
+    },
+    "validate": {
+        "n_starts": ("config", ("identification", "n_starts")),
+        "n_chunks": ("config", ("validation", "n_chunks")),
+        "seed": ("config", ("seed",)),
+    },
+    "plan": {
+        "force_n": ("config", ("planning", "pulse_force_n")),
+        "duration_s": ("config", ("planning", "pulse_duration_s")),
+        "strides": ("config", ("planning", "strides")),
+    },
+}
+#: Options whose 0 switches their step off (their help says so), beside the key's limits.
+_OFF_WITH_ZERO: set[tuple[str, str]] = {("markers", "cutoff_hz"), ("scale", "cutoff_hz"), ("scale", "max_motion_rms_m")}
+
+
+def check_option_limits(args: argparse.Namespace) -> None:
+    """Hold every option given to the limits of its config key (one schema for the workflow and the command).
+
+    Raises
+    ------
+    LoperInputError
+        Naming the option, its value, the problem and the key.
+    """
+    from loper_analysis.config_file import find_schema
+    from loper_analysis.schema import check_value
+
+    keys = _OPTION_KEYS.get(args.command, {})
+    given = {a: getattr(args, a) for a in keys if getattr(args, a, None) is not None}
+    given = {a: v for a, v in given.items() if not ((args.command, a) in _OFF_WITH_ZERO and v == 0)}
+    if not given:
+        return
+    schemas = {"config": find_schema(getattr(args, "configfile", None) or [])}
+    schemas["subjects"] = schemas["config"].parent / "subjects.schema.yaml"
+    for attr, value in given.items():
+        schema, key_path = keys[attr]
+        check_value(value, schemas[schema], key_path, "--" + attr.replace("_", "-"))
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one subcommand; 0 on success, 2 with one line on standard error when an input cannot serve."""
     args = _parser().parse_args(argv)
     try:
         refuse_overwriting(args)
+        check_option_limits(args)
         args.func(args)
     except Exception as exc:
         if args.traceback:

@@ -19,7 +19,7 @@ import yaml
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["ConfigLayers", "check_config", "check_table", "check_yaml_file", "config_origin"]
+__all__ = ["ConfigLayers", "check_config", "check_table", "check_value", "check_yaml_file", "config_origin"]
 
 #: The configuration's layers, highest priority first: ``(name, mapping)``, e.g.
 #: ``[("--config", {...}), ("my.yaml", {...}), ("config/config.yaml", {...})]``.
@@ -91,6 +91,39 @@ def check_config(
         key = ".".join(map(str, path)) or "(top level)"
         more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
         raise LoperInputError(f"{config_origin(path, layers, source)}: key '{key}': {e.message}{more}")
+
+
+def check_value(value, schema_path: str | Path, key_path: Sequence[str], name: str) -> None:
+    """Refuse a value outside the limits the schema sets for one key: a command's option is held to its config
+    key's range, type and enumeration (one schema for both).
+
+    Parameters
+    ----------
+    value
+        The option's value (a number, a string, a list).
+    schema_path : path
+        The JSON schema (``config.schema.yaml`` or ``subjects.schema.yaml``).
+    key_path : sequence of str
+        The key's path through the schema's ``properties`` (``["planning", "pulse_force_n"]``).
+    name : str
+        The option, for the message (``--force-n``).
+
+    Raises
+    ------
+    LoperInputError
+        Naming the option, its value, the problem and the config key whose limits hold (a key the schema lacks is
+        a programming error: KeyError).
+    """
+    import jsonschema
+
+    node = yaml.safe_load(Path(schema_path).read_text())
+    for key in key_path:
+        node = node["properties"][key]
+    errors = list(jsonschema.Draft202012Validator(node).iter_errors(value))
+    if errors:
+        raise LoperInputError(
+            f"{name} {value!r}: {errors[0].message} (the limits of {'.'.join(key_path)} in {Path(schema_path).name})"
+        )
 
 
 def check_table(table: pd.DataFrame, schema_path: str | Path, source: str) -> None:
