@@ -29,6 +29,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from loper_analysis.errors import LoperInputError, one_line
 
@@ -224,9 +225,9 @@ def _first_subject(subjects_tsv: str, results: Path) -> str:
     """The first subject of the subject sheet, else the first subject with joint angles under ``results/ik``."""
     sheet = Path(subjects_tsv)
     if sheet.is_file():
-        from loper_analysis.io.readers import read_tsv
+        from loper_analysis.io.readers import read_subject_sheet
 
-        names = read_tsv(sheet, "subject sheet", ["subject"], dtype={"subject": str}, comment="#")["subject"]
+        names = read_subject_sheet(sheet).get("subject", pd.Series(dtype=str))
         if len(names):
             return str(names.iloc[0])
     found = sorted(p.name for p in (results / "ik").glob("*") if p.is_dir())

@@ -14,6 +14,7 @@ from loper_analysis.cluster import check_slurm_submission
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
+from loper_analysis.io.readers import read_subject_sheet
 from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
 from loper_analysis.identification.validation import validation_settings
@@ -49,7 +50,7 @@ try:
     _subjects_path = Path(config["subjects"])
     if not _subjects_path.is_file():
         raise LoperInputError(f"{config_source('subjects')}: key 'subjects': file '{_subjects_path}' not found")
-    subjects = pd.read_csv(_subjects_path, sep="\t", dtype={"subject": str}, comment="#")
+    subjects = read_subject_sheet(_subjects_path)
     check_table(subjects, _SCHEMAS / "subjects.schema.yaml", str(_subjects_path))
     validate(subjects, "../schemas/subjects.schema.yaml")
 except LoperInputError as exc:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -12,7 +13,7 @@ import yaml
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.timing import timed_io
 
-__all__ = ["read_bytes", "read_label_map", "read_label_maps", "read_tsv", "read_yaml"]
+__all__ = ["read_bytes", "read_label_map", "read_label_maps", "read_subject_sheet", "read_tsv", "read_yaml"]
 
 
 @timed_io
@@ -131,3 +132,76 @@ def read_label_maps(label_map) -> dict[str, str] | None:
             merged.update(read_label_maps(part) or {})
         return merged
     return read_label_map(label_map)
+
+
+#: Columns of a subject sheet read as numbers (a decimal comma in them is named).
+SHEET_NUMBER_COLUMNS: tuple[str, ...] = ("age_yr", "height_m", "mass_kg")
+
+
+def _sheet_text(path: Path) -> str:
+    """A sheet's text as spreadsheets save it: UTF-16 with its byte-order mark ("Unicode text"), UTF-8 with or
+    without one, else Latin-1; line ends of any system."""
+    raw = read_bytes(path, "subject sheet")
+    if raw.startswith((b"\xff\xfe", b"\xfe\xff")):
+        text = raw.decode("utf-16")
+    else:
+        try:
+            text = raw.decode("utf-8-sig")
+        except UnicodeDecodeError:
+            text = raw.decode("latin-1")
+    return text.replace("\r\n", "\n").replace("\r", "\n")
+
+
+def read_subject_sheet(path: str | os.PathLike) -> pd.DataFrame:
+    """The subject sheet (TSV, one row per subject), read as a spreadsheet saves it.
+
+    Encodings: UTF-16 with a byte-order mark (a spreadsheet's "Unicode text"), UTF-8 with or without one, else
+    Latin-1; Windows or old Mac line ends; lines starting with ``#`` and blank lines are skipped; empty cells at
+    a row's end beyond the header's columns (trailing tabs) are dropped. ``subject`` is text; ``age_yr``,
+    ``height_m`` and ``mass_kg`` numbers (empty: NaN).
+
+    Raises
+    ------
+    LoperInputError
+        A missing or unreadable file, no header, a row with more filled cells than the header has columns, or a
+        number that is none (a decimal comma ``1,75`` is named as such), each naming the sheet, the row (its
+        line in the file) and the column.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LoperInputError(f"{path}: subject sheet not found")
+    lines = [(n, line) for n, line in enumerate(_sheet_text(path).split("\n"), start=1)]
+    lines = [(n, line) for n, line in lines if line.strip() and not line.lstrip().startswith("#")]
+    if not lines:
+        raise LoperInputError(f"{path}: the subject sheet is empty (no header line)")
+    header = [c.strip() for c in lines[0][1].split("\t")]
+    while header and header[-1] == "":
+        header.pop()
+    kept = ["\t".join(header)]
+    for n, line in lines[1:]:
+        cells = [c.strip() for c in line.split("\t")]
+        extra = cells[len(header) :]
+        if any(extra):
+            raise LoperInputError(
+                f"{path}: line {n}: {len(cells)} cells for the header's {len(header)} columns "
+                f"({', '.join(header)}); the extra ones hold {[c for c in extra if c]}"
+            )
+        cells = (cells + [""] * len(header))[: len(header)]
+        for column, value in zip(header, cells):
+            if column in SHEET_NUMBER_COLUMNS:
+                _sheet_number(value, path, n, column)
+        kept.append("\t".join(cells))
+    return pd.read_csv(io.StringIO("\n".join(kept) + "\n"), sep="\t", dtype={"subject": str})
+
+
+def _sheet_number(text: str, path: Path, line: int, column: str) -> float:
+    if text == "":
+        return float("nan")
+    try:
+        return float(text)
+    except ValueError:
+        if "," in text and text.replace(",", ".", 1).replace(".", "", 1).isdigit():
+            raise LoperInputError(
+                f"{path}: line {line}, column '{column}': '{text}' has a decimal comma; write {text.replace(',', '.')}"
+            ) from None
+        raise LoperInputError(f"{path}: line {line}, column '{column}': '{text}' is not a number") from None
