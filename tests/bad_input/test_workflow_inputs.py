@@ -557,6 +557,18 @@ def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab)
     assert _state(lab) == before
 
 
+@pytest.mark.parametrize("name", [f"{WALK}.C3D", f"{WALK}.Loper.tsv"])
+def test_a_raw_file_named_in_another_case_stops_the_run_naming_it(lab, name):
+    """An export's upper-case suffix: on a case-sensitive file system the trial would be left out without a word."""
+    right = name.split(".", 1)[0] + "." + name.split(".", 1)[1].lower()
+    (lab / RAW / right).rename(lab / RAW / name)
+    _refused(
+        lab,
+        lambda: _snakemake(lab, "-n"),
+        [f"{RAW}/{name}: the raw file of trial '{WALK}' is named '{name}'", f"rename it '{right}'"],
+    )
+
+
 def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(lab):
     """Not an error: onsets without a synthetic truth (no synthetic subject), and C3D files with one force channel
     per belt instead of force platforms: events from the channels, no external loads, said in a note."""

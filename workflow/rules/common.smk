@@ -13,7 +13,12 @@ from snakemake.common.configfile import load_configfile
 from loper_analysis.cluster import check_slurm_submission
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
-from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, unmatched_raw_files
+from loper_analysis.io.raw_files import (
+    RAW_SUFFIXES,
+    raw_file_present,
+    refuse_miscased_raw_files,
+    unmatched_raw_files,
+)
 from loper_analysis.io.readers import read_subject_sheet
 from loper_analysis.schema import check_config, check_table, config_origin
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
@@ -149,6 +154,7 @@ try:
         for _t in DESIGN.trials():
             for _suffix in RAW_SUFFIXES:
                 raw_file_present(_raw / f"{_t}{_suffix}", f"raw file of trial '{_t}' of subject '{_s}'")
+        refuse_miscased_raw_files(_raw, DESIGN.trials())
         _unmatched = unmatched_raw_files(_raw, DESIGN.trials())
         if _unmatched:
             _t = config["trials"]

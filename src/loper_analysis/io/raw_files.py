@@ -15,7 +15,7 @@ from pathlib import Path
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["RAW_SUFFIXES", "raw_file_present", "unmatched_raw_files"]
+__all__ = ["RAW_SUFFIXES", "raw_file_present", "refuse_miscased_raw_files", "unmatched_raw_files"]
 
 #: Suffixes of raw files: motion capture, robot log, the robot's MATLAB export.
 RAW_SUFFIXES: tuple[str, ...] = (".c3d", ".loper.tsv", ".mat")
@@ -58,4 +58,29 @@ def unmatched_raw_files(folder: str | os.PathLike, trials: Iterable[str]) -> lis
     if not folder.is_dir():
         return []
     names = {f"{t}{suffix}" for t in trials for suffix in RAW_SUFFIXES}
-    return sorted(p.name for p in folder.iterdir() if p.name.endswith(RAW_SUFFIXES) and p.name not in names)
+    raw = [p.name for p in folder.iterdir() if p.name.lower().endswith(RAW_SUFFIXES)]
+    lower = {n.lower() for n in names}
+    return sorted(n for n in raw if n not in names and n.lower() not in lower)
+
+
+def refuse_miscased_raw_files(folder: str | os.PathLike, trials: Iterable[str]) -> None:
+    """Refuse a trial's raw file whose name differs from the expected one only in case (``pert175-2.C3D``,
+    ``walk-device.Loper.tsv``, as some exports write them): the workflow, on a case-sensitive file system,
+    would not find it and would leave the trial out without a word.
+
+    Raises
+    ------
+    LoperInputError
+        Naming the file and the name it must have.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return
+    expected = {f"{t}{suffix}".lower(): f"{t}{suffix}" for t in trials for suffix in RAW_SUFFIXES}
+    for p in sorted(folder.iterdir()):
+        want = expected.get(p.name.lower())
+        if want is not None and p.name != want:
+            raise LoperInputError(
+                f"{p}: the raw file of trial '{want.split('.')[0]}' is named '{p.name}'; raw files are named "
+                f"{{trial}}.c3d, .loper.tsv or .mat in lower case: rename it '{want}' (it would be left out)"
+            )
