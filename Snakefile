@@ -6,8 +6,10 @@ from snakemake.utils import min_version
 min_version("9.0")
 
 
-# A syntax error in the config file as one line naming the file, line and column (Snakemake's own message names
-# neither). Files given with --configfile are read by Snakemake while it parses its command line, before this runs.
+# A syntax error or a key given twice in a config file as one line naming the file, line and column (Snakemake's
+# own message names neither, and YAML keeps a repeated key's second value silently). Files given with --configfile
+# are read by Snakemake while it parses its command line, before this runs: their syntax is Snakemake's to judge,
+# their repeated keys are checked here.
 if os.path.exists("config/config.yaml"):  # a missing file: Snakemake's own message
     from snakemake.exceptions import WorkflowError
 
@@ -15,7 +17,9 @@ if os.path.exists("config/config.yaml"):  # a missing file: Snakemake's own mess
     from loper_analysis.schema import check_yaml_file
 
     try:
-        check_yaml_file("config/config.yaml")
+        for _file in ["config/config.yaml", *map(str, workflow.config_settings.configfiles)]:
+            _relative = os.path.relpath(_file)
+            check_yaml_file(_file if _relative.startswith("..") else _relative)
     except LoperInputError as exc:
         raise WorkflowError(str(exc)) from None
 

@@ -192,3 +192,25 @@ def check_yaml_file(path: str | Path, what: str = "config file") -> None:
     if not documents or not isinstance(documents[0], yaml.MappingNode):
         found = "nothing" if not documents else f"a {documents[0].id} at {_mark(documents[0].start_mark)}"
         raise LoperInputError(f"{path}: the {what} must hold keys at its top level (key: value), found {found}")
+    _refuse_duplicate_keys(documents[0], path, what)
+
+
+def _refuse_duplicate_keys(node, path, what: str, parents: tuple[str, ...] = ()) -> None:
+    """Refuse a mapping that gives a key twice: YAML keeps the later value, which replaces the earlier one whole
+    (a second, partial ``filter:`` block silently drops the keys of the first)."""
+    if isinstance(node, yaml.MappingNode):
+        seen: dict[str, yaml.Node] = {}
+        for key, value in node.value:
+            name = str(key.value) if isinstance(key, yaml.ScalarNode) else None
+            if name is not None and name in seen:
+                dotted = ".".join((*parents, name))
+                raise LoperInputError(
+                    f"{path}: key '{dotted}' is given twice in the {what}, at {_mark(seen[name].start_mark)} and "
+                    f"{_mark(key.start_mark)}: YAML keeps the second, which replaces the first whole; merge them"
+                )
+            if name is not None:
+                seen[name] = key
+            _refuse_duplicate_keys(value, path, what, (*parents, name or "?"))
+    elif isinstance(node, yaml.SequenceNode):
+        for k, item in enumerate(node.value):
+            _refuse_duplicate_keys(item, path, what, (*parents, str(k)))
