@@ -328,6 +328,15 @@ onstart:
             raise WorkflowError(str(exc)) from None
 
 
+onsuccess:
+    # what the run found wrong, on the console (each also in its job's log and in its table)
+    from loper_analysis.steps.report import run_warnings
+
+    _said = run_warnings("results/strides/summary.tsv", [f"results/model/{s}/scale.tsv" for s in scaled_subjects()])
+    if _said:
+        print("warnings of this run's results:", *(f"  {line}" for line in _said), sep="\n", file=sys.stderr)
+
+
 onerror:
     # a SLURM run: say which failed jobs SLURM itself ended, and why (memory, time limit, cancel)
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":

@@ -356,3 +356,23 @@ def write_report(
             signal.signal(signal.SIGTERM, previous)
     log.info("%s: report written (%d bytes)", target, target.stat().st_size)
     return target
+
+
+def run_warnings(strides_summary: PathLike, scale_reports: Sequence[PathLike] = ()) -> list[str]:
+    """The warnings a finished run leaves in its tables, one line each, for the console: each trial's warnings
+    and a status other than ``ok`` (``results/strides/summary.tsv``), each scaling's warnings (the scale
+    reports). Tables not (yet) there are skipped."""
+    lines = []
+    for path in scale_reports:
+        if Path(path).is_file():
+            report = read_tsv(path, "scale report", keep_default_na=False)
+            if "kind" in report:
+                lines += [f"{path}: {text}" for text in report.loc[report["kind"] == "warning", "source"]]
+    if Path(strides_summary).is_file():
+        table = read_tsv(strides_summary, "strides summary", keep_default_na=False)
+        for row in table.to_dict("records"):
+            said = [str(row.get("status", "ok"))] if str(row.get("status", "ok")) != "ok" else []
+            said += [str(row["warnings"])] if str(row.get("warnings", "")) else []
+            if said:
+                lines.append(f"{row['subject']} {row['trial']}: {'; '.join(said)}")
+    return lines
