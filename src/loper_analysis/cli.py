@@ -853,8 +853,8 @@ def check_option_limits(args: argparse.Namespace) -> None:
     given = {a: v for a, v in given.items() if not ((args.command, a) in _OFF_WITH_ZERO and v == 0)}
     if not given:
         return
-    schemas = {"config": find_schema(getattr(args, "configfile", None) or [])}
-    schemas["subjects"] = schemas["config"].parent / "subjects.schema.yaml"
+    files = getattr(args, "configfile", None) or []
+    schemas = {"config": find_schema(files), "subjects": find_schema(files, "subjects.schema.yaml")}
     for attr, value in given.items():
         schema, key_path = keys[attr]
         check_value(value, schemas[schema], key_path, "--" + attr.replace("_", "-"))

@@ -122,8 +122,9 @@ def read_config_file(path: str | os.PathLike) -> dict:
     return data
 
 
-def find_schema(paths: Sequence[str | os.PathLike] = ()) -> Path:
-    """The workflow's config schema for configuration files ``paths``.
+def find_schema(paths: Sequence[str | os.PathLike] = (), name: str = SCHEMA.name) -> Path:
+    """The workflow's config schema for configuration files ``paths`` (or another schema of its folder, ``name``:
+    ``subjects.schema.yaml``).
 
     Looked for, in this order, in the project folder of each file (the parent
     of the folder holding it: ``PROJECT/config/config.yaml`` ->
@@ -135,15 +136,16 @@ def find_schema(paths: Sequence[str | os.PathLike] = ()) -> Path:
     LoperInputError
         Found in none of those places (the message lists them).
     """
-    candidates = [Path(p).resolve().parent.parent / SCHEMA for p in paths]
-    candidates += [Path.cwd() / SCHEMA, Path(__file__).resolve().parents[2] / SCHEMA]
+    schema = SCHEMA.parent / name
+    candidates = [Path(p).resolve().parent.parent / schema for p in paths]
+    candidates += [Path.cwd() / schema, Path(__file__).resolve().parents[2] / schema]
     tried = list(dict.fromkeys(candidates))
     for candidate in tried:
         if candidate.is_file():
             return candidate
     files = ", ".join(shown_path(p) for p in paths) or "the configuration"
     raise LoperInputError(
-        f"{files}: cannot validate: no {SCHEMA.as_posix()} found (looked in: {', '.join(str(c) for c in tried)})"
+        f"{files}: cannot validate: no {schema.as_posix()} found (looked in: {', '.join(str(c) for c in tried)})"
     )
 
 

@@ -64,7 +64,7 @@ def test_a_config_over_an_input_is_refused_and_nothing_is_written(tmp_path, caps
     static.write_bytes((QCMAS / "static.c3d").read_bytes())
     before = static.read_bytes()
     assert main(["inspect", str(static), "--config-out", str(static)]) == 2
-    assert "would overwrite an input file" in capsys.readouterr().err
+    assert f"--config-out would write over c3d {static}" in capsys.readouterr().err
     assert static.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["static.c3d"]
     with pytest.raises(LoperInputError, match="would overwrite an input file"):
         inspect_subject([static], tmp_path / "static.c3d")
