@@ -183,7 +183,10 @@ def _scale(args: argparse.Namespace) -> None:
             report_out=args.report,
             static_lab_angles=lab_angles,
         )
-        scale_with_setup(files, args.mass_kg, settings, lab_labels=lab_labels)
+        try:
+            scale_with_setup(files, args.mass_kg, settings, lab_labels=lab_labels)
+        except LoperInputError as exc:  # name the file given, not the TRC made from it in a temporary folder
+            raise LoperInputError(str(exc).replace(str(static), f"{args.static} (its markers)")) from None
     mass = f"{args.mass_kg:g} kg" if args.mass_kg is not None else "mass from the static trial's force plates"
     print(f"{args.out}: {args.model} scaled with {args.setup} to {args.static} ({mass})")
     if args.report:

@@ -35,17 +35,20 @@ def static(tmp_path_factory):
     gaps = markers(
         QCMAS / "static.c3d", d / "static.trc", None, MarkerSettings().for_static(), lab_angles_out=d / "lab.tsv"
     )
-    return d, [row["marker"] for row in gaps.attrs["per_marker"]]
+    return d / "static.trc", [row["marker"] for row in gaps.attrs["per_marker"]], d / "lab.tsv"
 
 
 def _scale(static, tmp_path, template) -> pd.DataFrame:
-    d, names = static
+    """Scale gait2392 with ``template`` to ``static`` = (the static trial's TRC, its markers, its lab angles or
+    None); the scale report."""
+    trc, names, lab = static
+    tmp_path.mkdir(exist_ok=True)
     write_osim_object(template_marker_set(template, names), tmp_path / "marker_set.xml", "marker set")
     write_osim_object(template_scale_tool(template, names, "marker_set.xml"), tmp_path / "setup.xml", "setup")
     cmap = template_coordinate_map(template, read_model(GAIT2392))
     files = ScaleFiles(
-        GAIT2392, d / "static.trc", tmp_path / "scaled.osim", setup_xml=tmp_path / "setup.xml",
-        report_out=tmp_path / "scale.tsv", static_lab_angles=d / "lab.tsv",
+        GAIT2392, trc, tmp_path / "scaled.osim", setup_xml=tmp_path / "setup.xml",
+        report_out=tmp_path / "scale.tsv", static_lab_angles=lab,
     )  # fmt: skip
     scale_with_setup(files, 70.0, ModelSettings(coordinate_map=cmap))
     return pd.read_csv(tmp_path / "scale.tsv", sep="\t")
@@ -147,3 +150,24 @@ def test_the_gait2392_tutorial_static_trial_scales_as_opensim_scales_it(tmp_path
     for i in range(m2.getSize()):  # placed on the same static pose
         theirs = m2.get(i).get_location().to_numpy()
         assert np.linalg.norm(m1.get(m2.get(i).getName()).get_location().to_numpy() - theirs) < 1e-4
+
+
+def test_a_one_frame_static_trial_scales_like_the_whole_second(static, tmp_path):
+    """A snapshot static trial (one frame): written as a one-frame TRC and scaled (OpenSim averages over a span,
+    so the frame is given twice); its factors are those of the first second within 0.1 %."""
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.io.c3d_writer import write_c3d
+
+    rec = read_c3d(QCMAS / "static.c3d")
+    write_c3d(tmp_path / "one.c3d", rec.marker_labels, rec.markers_m[:1], rec.point_rate_hz)
+    gaps = markers(tmp_path / "one.c3d", tmp_path / "one.trc", None, MarkerSettings().for_static())
+    t, _, _ = read_markers(tmp_path / "one.trc")
+    assert t.size == 1
+    template = read_templates()["plugin_gait"]
+    one = _scale(
+        (tmp_path / "one.trc", [r["marker"] for r in gaps.attrs["per_marker"]], None), tmp_path / "o", template
+    )
+    whole = _scale(static, tmp_path / "w", template)
+    factors = [r[r.kind == "body"].set_index("name").scale_factor_x for r in (one, whole)]
+    np.testing.assert_allclose(factors[0], factors[1], rtol=1e-3)
+    assert one[one.kind == "markers"].n_frames.tolist() == [1, 1]

@@ -59,6 +59,7 @@ from loper_analysis.io.timing import timed_io
 log = logging.getLogger(__name__)
 
 __all__ = [
+    "trc_data_rate_hz",
     "TRANSLATION_SUFFIXES",
     "read_markers",
     "read_mot",
@@ -88,7 +89,9 @@ def _open_table(osim, path: Path, kind: str, what: str):
 
 
 @timed_io
-def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str], unit: str = "mm") -> Path:
+def write_trc(
+    path: str | os.PathLike, time_s, markers_m, labels: Sequence[str], unit: str = "mm", rate_hz: float | None = None
+) -> Path:
     """Write marker trajectories to a TRC file as OpenSim's ``TRCFileAdapter`` does, atomically; returns ``path``.
 
     Parameters
@@ -96,8 +99,8 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
     path : str or path-like
         Target ``.trc`` file (a missing directory is created).
     time_s : array_like
-        Shape (n_frames,), n_frames >= 2, s, strictly increasing and equally
-        spaced (relative tolerance 1e-6); ``DataRate`` = 1 / mean step.
+        Shape (n_frames,), s, strictly increasing and equally spaced (relative tolerance 1e-6); ``DataRate`` =
+        1 / mean step. One frame (a snapshot static trial, which OpenSim's ScaleTool takes) needs ``rate_hz``.
     markers_m : array_like
         Shape (n_frames, n_markers, 3), metres; NaN (missing) is written as ``nan``.
     labels : sequence of str
@@ -105,6 +108,8 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
         no tabs, line breaks or blanks at either end.
     unit : {"mm", "cm", "m"}
         Unit of the file (``Units`` metadata); values are converted from m.
+    rate_hz : float, optional
+        The frame rate (Hz) of a one-frame file's ``DataRate``; with more frames their step gives it.
 
     Raises
     ------
@@ -116,7 +121,7 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
     source = str(path)
     if unit not in LENGTH_UNITS_PER_M:
         raise LoperInputError(f"{source}: unit must be one of {', '.join(LENGTH_UNITS_PER_M)}, got {unit!r}")
-    t = time_vector(time_s, source, min_count=2, item="row")
+    t = time_vector(time_s, source, min_count=1 if rate_hz else 2, item="row")
     X = np.asarray(markers_m, dtype=float)
     labels = list(labels)
     if X.ndim != 3 or X.shape != (t.size, len(labels), 3) or not labels:
@@ -129,7 +134,7 @@ def write_trc(path: str | os.PathLike, time_s, markers_m, labels: Sequence[str],
         raise LoperInputError(
             f"{source}: markers_m holds infinite values (first at {tuple(np.argwhere(np.isinf(X))[0])})"
         )
-    rate = f"{1.0 / uniform_step_s(t, source):.12g}"
+    rate = f"{(1.0 / uniform_step_s(t, source) if t.size > 1 else float(rate_hz)):.12g}"
     values = (X * LENGTH_UNITS_PER_M[unit]).reshape(t.size, -1)
     n, m = t.size, len(labels)
     head = [
@@ -218,6 +223,17 @@ def _nominal_times(t: np.ndarray, rate, path: Path) -> np.ndarray:
         rate_hz,
     )
     return grid
+
+
+def trc_data_rate_hz(path: str | os.PathLike) -> float | None:
+    """The ``DataRate`` of a TRC file's header (Hz); None when the header does not give one."""
+    try:
+        with Path(path).open("r", encoding="utf-8") as fh:
+            head = [fh.readline().rstrip("\r\n") for _ in range(3)]
+        rate = float(dict(zip(head[1].split("\t"), head[2].split("\t")))["DataRate"])
+    except (OSError, UnicodeDecodeError, KeyError, ValueError, IndexError):
+        return None
+    return rate if np.isfinite(rate) and rate > 0 else None
 
 
 def _read_trc(path: Path) -> tuple[np.ndarray, np.ndarray, list[str]]:

@@ -194,7 +194,7 @@ def markers(
         len(names),
         len(gaps),
     )
-    write_trc(trc_out, time_s, X, names)
+    write_trc(trc_out, time_s, X, names, rate_hz=rec.point_rate_hz)
     if lab_angles_out is not None:
         _write_lab_angles(rec, lab_angles_out)
     if gaps_out is not None:

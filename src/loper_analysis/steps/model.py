@@ -424,7 +424,7 @@ def _run_scale_tool(
     (:func:`scale_with_setup`; ``files.setup_xml`` None: the tool as :func:`scaled_model` built it)."""
     import tempfile
 
-    from loper_analysis.io.opensim_tables import read_markers, write_trc
+    from loper_analysis.io.opensim_tables import read_markers, trc_data_rate_hz, write_trc
     from loper_analysis.io.osim import quiet_opensim, read_model
     from loper_analysis.motion.scale_report import scaled_model_report
     from loper_analysis.motion.segments import check_segment_bodies
@@ -507,7 +507,12 @@ def _run_scale_tool(
         placer.setCoordinateFileName(str(coordinates) if coordinates is not None else "Unassigned")
     with tempfile.TemporaryDirectory(prefix="loper-scale-") as tmp_dir:
         trc = Path(tmp_dir) / "static_window.trc"
-        write_trc(trc, pose.time_s, pose.markers_m, pose.labels)
+        t, X = pose.time_s, pose.markers_m
+        if t.size == 1:  # a snapshot static trial: OpenSim averages over a span of frames, so the frame twice
+            rate_hz = trc_data_rate_hz(static_trc) or 100.0
+            t, X = np.array([t[0], t[0] + 1.0 / rate_hz]), np.repeat(X, 2, axis=0)
+            window = (float(t[0]), float(t[1]))
+        write_trc(trc, t, X, pose.labels)
         scale_file = Path(tmp_dir) / "scale_set.xml"
         for part in (scaler, placer):
             part.setMarkerFileName(str(trc))
@@ -527,8 +532,9 @@ def _run_scale_tool(
             try:
                 tool.run()  # False when the marker placer is off, even after a good scaling: the file tells
             except Exception as exc:  # OpenSim raises its own exception types
+                said = str(exc).replace(str(trc), f"{static_trc} (the scaling window)")
                 raise LoperInputError(
-                    f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} ({exc})"
+                    f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} ({said})"
                 ) from exc
             if not tmp.is_file():
                 raise LoperInputError(
