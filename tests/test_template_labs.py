@@ -22,6 +22,24 @@ pytestmark = pytest.mark.slow  # Snakemake and OpenSim on whole trials
 WALK_TRC = DATA / "Rajagopal_motion_capture_walk.trc"
 
 
+def inspect_and_run(work: Path, subject: str, sheet_row: str, columns: str = "subject\tsource") -> str:
+    """A subject's raw files in ``work`` through ``loper-analysis inspect`` (no model: a template) and the workflow,
+    with nothing added but the sheet (``columns`` and ``sheet_row``) and the keys ``subjects`` and
+    ``device.subject: null``; returns what inspect printed."""
+    res = subprocess.run(
+        [str(Path(sys.executable).parent / "loper-analysis"), "inspect", f"data/raw/{subject}/static.c3d",
+         f"data/raw/{subject}/walk-nodevice.c3d", "--config-out", f"lab/{subject}/config.yaml"],
+        cwd=work, capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    (work / "lab/subjects.tsv").write_text(f"{columns}\n{sheet_row}\n")
+    with (work / f"lab/{subject}/config.yaml").open("a") as fh:
+        fh.write("subjects: lab/subjects.tsv\ndevice: {subject: null}\n")
+    run = snakemake(work, "--configfile", f"lab/{subject}/config.yaml")
+    assert run.returncode == 0, run.stderr[-3000:]
+    return res.stdout
+
+
 @pytest.fixture(scope="module")
 def r11(tmp_path_factory):
     """R11's lab files through inspect (no model given) and the workflow, with only the sheet's row and two keys."""
@@ -31,18 +49,7 @@ def r11(tmp_path_factory):
     raw.mkdir(parents=True)
     for trial in ("static", "walk-nodevice"):
         (raw / f"{trial}.c3d").write_bytes((ROOT / f"examples/rajagopal2016/raw/R11/{trial}.c3d").read_bytes())
-    res = subprocess.run(
-        [str(Path(sys.executable).parent / "loper-analysis"), "inspect", "data/raw/R11/static.c3d",
-         "data/raw/R11/walk-nodevice.c3d", "--config-out", "lab/R11/config.yaml"],
-        cwd=work, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert res.returncode == 0, res.stderr
-    (work / "lab/subjects.tsv").write_text("subject\tsource\nR11\trecorded\n")
-    with (work / "lab/R11/config.yaml").open("a") as fh:
-        fh.write("subjects: lab/subjects.tsv\ndevice: {subject: null}\n")
-    run = snakemake(work, "--configfile", "lab/R11/config.yaml")
-    assert run.returncode == 0, run.stderr[-3000:]
-    return work, res.stdout
+    return work, inspect_and_run(work, "R11", "R11\trecorded")
 
 
 @pytest.fixture(scope="module")
@@ -106,18 +113,8 @@ def _clinical_run(work: Path, kad: bool) -> Path:
         labels, X = [labels[i] for i in keep] + extra_labels, np.concatenate([X[:, keep], np.stack(extra, 1)], 1)
     write_c3d(raw / "static.c3d", labels, X, rec.point_rate_hz, first_frame=rec.first_frame)
     (raw / "walk-nodevice.c3d").write_bytes((QCMAS / "walk-nodevice.c3d").read_bytes())
-    res = subprocess.run(
-        [str(Path(sys.executable).parent / "loper-analysis"), "inspect", "data/raw/QCMAS/static.c3d",
-         "data/raw/QCMAS/walk-nodevice.c3d", "--config-out", "lab/QCMAS/config.yaml"],
-        cwd=work, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert res.returncode == 0, res.stderr
-    assert "chosen: plugin_gait" in res.stdout
-    (work / "lab/subjects.tsv").write_text("subject\tsource\theight_m\tmass_kg\nQCMAS\trecorded\t1.86\t70.23\n")
-    with (work / "lab/QCMAS/config.yaml").open("a") as fh:
-        fh.write("subjects: lab/subjects.tsv\ndevice: {subject: null}\n")
-    run = snakemake(work, "--configfile", "lab/QCMAS/config.yaml")
-    assert run.returncode == 0, run.stderr[-3000:]
+    printed = inspect_and_run(work, "QCMAS", "QCMAS\trecorded\t1.86\t70.23", "subject\tsource\theight_m\tmass_kg")
+    assert "chosen: plugin_gait" in printed
     return work
 
 
@@ -155,18 +152,8 @@ def test_a_qtm_lab_with_its_own_labels_gets_its_known_angles_back(tmp_path):
     )  # fmt: skip
     settings = LabExportSettings(seed=3, walking_duration_s=15.0)
     truth = lab_export_session(files, "Q01", ["walk-nodevice"], 1.80, 75.1646, settings)
-    res = subprocess.run(
-        [str(Path(sys.executable).parent / "loper-analysis"), "inspect", "data/raw/Q01/static.c3d",
-         "data/raw/Q01/walk-nodevice.c3d", "--config-out", "lab/Q01/config.yaml"],
-        cwd=work, capture_output=True, text=True, timeout=300,
-    )  # fmt: skip
-    assert res.returncode == 0, res.stderr
-    assert "chosen: isb" in res.stdout and "label map: none needed" in res.stdout  # the labels are the template's
-    (work / "lab/subjects.tsv").write_text("subject\tsource\tmass_kg\nQ01\trecorded\t75.1646\n")
-    with (work / "lab/Q01/config.yaml").open("a") as fh:
-        fh.write("subjects: lab/subjects.tsv\ndevice: {subject: null}\n")
-    run = snakemake(work, "--configfile", "lab/Q01/config.yaml")
-    assert run.returncode == 0, run.stderr[-3000:]
+    printed = inspect_and_run(work, "Q01", "Q01\trecorded\t75.1646", "subject\tsource\tmass_kg")
+    assert "chosen: isb" in printed and "label map: none needed" in printed  # the labels are the template's
     ours = pd.read_csv(work / "results/ik/Q01/walk-nodevice.angles.tsv", sep="\t")
     known = truth["walk-nodevice"][1].coordinates
     np.testing.assert_allclose(ours["time_s"], known["time_s"], atol=1e-9)

@@ -22,15 +22,14 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import os
 import sys
 import tempfile
-from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from loper_analysis.cli_checks import check_option_limits, refuse_overwriting
 from loper_analysis.errors import LoperInputError, one_line
 
 __all__ = ["main"]
@@ -751,116 +750,6 @@ def _parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=_report)
     return parser
-
-
-#: Options naming a file a subcommand reads, and those naming a file it writes.
-_INPUT_OPTIONS: tuple[str, ...] = ("c3d", "model", "setup", "static", "markers", "segments", "tasks", "label_map",
-                                   "marker_set", "configfile")  # fmt: skip
-_OUTPUT_OPTIONS: tuple[str, ...] = ("out", "gaps", "report", "errors", "fits", "label_map_out", "config_out", "target")
-
-
-def _files(args: argparse.Namespace, names: Sequence[str]) -> list[tuple[str, Path]]:
-    """(option, path) of every file the options name (lists flattened)."""
-    out = []
-    for name in names:
-        value = getattr(args, name, None)
-        for item in value if isinstance(value, (list, tuple)) else [value]:
-            if isinstance(item, (str, Path)) and str(item):
-                out.append(("--" + name.replace("_", "-") if name not in ("c3d", "target") else name, Path(item)))
-    return out
-
-
-def _same_file(a: Path, b: Path) -> bool:
-    """Whether two paths name one file (the same path, a link to it, or a hard link)."""
-    if a.exists() and b.exists():
-        return os.path.samefile(a, b)
-    return a.resolve() == b.resolve()
-
-
-def refuse_overwriting(args: argparse.Namespace) -> None:
-    """Stop before any work when a subcommand would write over one of its inputs, or write two outputs to one file.
-
-    Raises
-    ------
-    LoperInputError
-        Naming the output option and the input (or other output) option and their paths.
-    """
-    inputs, outputs = _files(args, _INPUT_OPTIONS), _files(args, _OUTPUT_OPTIONS)
-    for k, (out_name, out_path) in enumerate(outputs):
-        for in_name, in_path in inputs + outputs[:k]:
-            if _same_file(out_path, in_path):
-                raise LoperInputError(
-                    f"{out_path}: {out_name} would write over {in_name} {in_path}: nothing was done; give another "
-                    "output path"
-                )
-
-
-#: Each command's options with a config counterpart: option -> (schema file, key path); a value is held to the key's
-#: limits (:func:`check_option_limits`). ``subjects`` is the subject sheet's schema.
-_OPTION_KEYS: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
-    "markers": {
-        "cutoff_hz": ("config", ("filter", "cutoff_hz")),
-        "order": ("config", ("filter", "order")),
-        "max_gap_frames": ("config", ("markers", "max_gap_frames")),
-    },
-    "grf": {"threshold_n": ("config", ("grf", "loaded_threshold_n"))},
-    "events": {
-        "threshold_on_n": ("config", ("events", "threshold_on_n")),
-        "threshold_off_n": ("config", ("events", "threshold_off_n")),
-    },
-    "scale": {
-        "mass_kg": ("subjects", ("mass_kg",)),
-        "max_motion_rms_m": ("config", ("markers", "static_max_motion_rms_m")),
-        "cutoff_hz": ("config", ("filter", "cutoff_hz")),
-        "max_gap_frames": ("config", ("markers", "max_gap_frames")),
-    },
-    "segments": {
-        "mass_kg": ("subjects", ("mass_kg",)),
-        "height_m": ("subjects", ("height_m",)),
-        "attachment_fraction": ("config", ("opensim", "brace_attachment_fraction")),
-    },
-    "ik": {
-        "accuracy": ("config", ("opensim", "accuracy")),
-        "max_marker_rms_m": ("config", ("opensim", "max_marker_rms_m")),
-        "warn_marker_rms_m": ("config", ("opensim", "warn_marker_rms_m")),
-        "max_rms_fraction": ("config", ("opensim", "max_rms_fraction")),
-    },
-    "validate": {
-        "n_starts": ("config", ("identification", "n_starts")),
-        "n_chunks": ("config", ("validation", "n_chunks")),
-        "seed": ("config", ("seed",)),
-    },
-    "plan": {
-        "force_n": ("config", ("planning", "pulse_force_n")),
-        "duration_s": ("config", ("planning", "pulse_duration_s")),
-        "strides": ("config", ("planning", "strides")),
-    },
-}
-#: Options whose 0 switches their step off (their help says so), beside the key's limits.
-_OFF_WITH_ZERO: set[tuple[str, str]] = {("markers", "cutoff_hz"), ("scale", "cutoff_hz"), ("scale", "max_motion_rms_m")}
-
-
-def check_option_limits(args: argparse.Namespace) -> None:
-    """Hold every option given to the limits of its config key (one schema for the workflow and the command).
-
-    Raises
-    ------
-    LoperInputError
-        Naming the option, its value, the problem and the key.
-    """
-    from loper_analysis.config_file import find_schema
-    from loper_analysis.schema import check_value
-
-    keys = _OPTION_KEYS.get(args.command, {})
-    given = {a: getattr(args, a) for a in keys if getattr(args, a, None) is not None}
-    given = {a: v for a, v in given.items() if not ((args.command, a) in _OFF_WITH_ZERO and v == 0)}
-    if not given:
-        return
-    files = getattr(args, "configfile", None) or []
-    schemas = {"config": find_schema(files), "subjects": find_schema(files, "subjects.schema.yaml")}
-    for attr, value in given.items():
-        schema, key_path = keys[attr]
-        check_value(value, schemas[schema], key_path, "--" + attr.replace("_", "-"))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from loper_analysis.cli import _OPTION_KEYS, main
+from loper_analysis.cli import main
+from loper_analysis.cli_checks import OPTION_KEYS
 
 CASES = {
     "a planned pulse of 0 N": (["plan", "--force-n", "0"], "--force-n 0.0", "planning.pulse_force_n"),
@@ -55,7 +56,7 @@ def test_zero_switches_a_filter_off_and_every_mapped_key_exists(tmp_path, capsys
     from loper_analysis.schema import check_value
 
     schema = find_schema()
-    for command, options in _OPTION_KEYS.items():
+    for command, options in OPTION_KEYS.items():
         for option, (which, key_path) in options.items():
             path = schema if which == "config" else schema.parent / "subjects.schema.yaml"
             with pytest.raises(Exception, match=r"the limits of"):
