@@ -110,7 +110,7 @@ def markers(
     marker (``LKNE``) yields that marker (:func:`loper_analysis.motion.knee_alignment.kad_knee_markers`).
     Points that are not markers (a lab's model outputs: :mod:`loper_analysis.io.c3d_points`) are left out;
     the lab's own sagittal joint angles among them are written to ``lab_angles_out`` when given (``time_s``
-    on the file's clock and ``{angle}_rad``; only ``time_s`` when the file holds none:
+    on the file's clock and ``{angle}_rad``; the header ``time_s`` alone when the file holds none:
     :func:`loper_analysis.motion.lab_angles.lab_joint_angles`).
 
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
@@ -262,7 +262,7 @@ def _write_lab_angles(rec, out: PathLike) -> None:
     table, used = lab_joint_angles(
         rec.time_s, rec.output_labels, rec.output_kinds, rec.outputs, rec.output_units.get("ANGLES"), rec.source
     )
-    write_tsv(table, out)
+    write_tsv(table if used else table.iloc[:0], out)  # no lab angles: the header alone, not a column of times
     if used:
         log.info("%s: the lab's own joint angles: %s", rec.source, ", ".join(f"{k} <- {v}" for k, v in used.items()))
 
