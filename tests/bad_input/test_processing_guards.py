@@ -123,8 +123,14 @@ def test_lab_setup_scaling_with_a_static_trial_in_the_wrong_unit_is_refused(tmp_
 def test_ik_with_markers_1000_times_too_far_apart_fails_naming_the_rms_and_the_limit(trial, tmp_path):
     trc = write_trc(tmp_path / "huge.trc", trial["t"], 1000.0 * trial["X"], list(MARKERS))
     out = tmp_path / "huge.mot"
-    with pytest.raises(LoperInputError) as err:
+    with pytest.raises(LoperInputError) as err:  # the marker geometry says it first
         ik_chunk(trial["model"], trc, out, 0, 1)
+    msg = str(err.value)
+    assert str(trc) in msg and "opensim.geometry_stop_change" in msg and "ratio 1000.000" in msg
+    assert "1000 times the model's: markers in another length unit (the file's POINT:UNITS)" in msg
+    assert not out.exists()
+    with pytest.raises(LoperInputError) as err:  # and IK's marker error, without the geometry check
+        ik_chunk(trial["model"], trc, out, 0, 1, IKSettings(geometry_stop_change=np.inf))
     msg = str(err.value)
     assert str(trc) in msg and "IK marker RMS error exceeds 60 mm" in msg and f"in {N} of {N} frames" in msg
     assert "opensim.max_marker_rms_m" in msg

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import pytest
 
 from loper_analysis.motion.scale_report import (
     StaticFit,
@@ -52,3 +53,14 @@ def test_the_report_holds_the_errors_before_and_after_placement_and_the_pose():
     assert (pose["name"], pose.angle_rad, pose.lab_angle_rad) == ("knee_left", -0.07, -0.14)  # before placement
     assert table[table.kind == "warning"].source.tolist() == ["text"]
     assert pd.isna(table[table.kind == "subject"].iloc[0].scale_factor_x)
+
+
+def test_a_model_far_from_the_given_height_is_warned_about():
+    from loper_analysis.motion.scale_report import MAX_STATURE_CHANGE, stature_change, stature_warnings
+
+    assert stature_change(1.80, 1.62) == pytest.approx(-0.1)
+    assert stature_warnings(1.80, 1.80 * (1 + 0.99 * MAX_STATURE_CHANGE), "given") == []
+    [(name, text)] = stature_warnings(1.80, 1.50, "given")
+    assert name == "stature"
+    assert "1.50 m tall where the subject's height is 1.80 m (given; -17 %" in text and "height_m" in text
+    assert stature_warnings(1.80, float("nan"), "given") == []

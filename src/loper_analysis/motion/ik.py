@@ -66,6 +66,7 @@ IK_SUMMARY_COLUMNS: tuple[str, ...] = (
     "worst_marker",
     "worst_marker_rms_m",
     "worst_markers_mm",
+    "marker_geometry_change",
     "warnings",
 )
 
@@ -83,7 +84,9 @@ class IKResult:
     ``marker_errors_m`` (n_frames, n_markers_in_use) holds each weighted
     marker's distance error (m, NaN where missing), in the order of
     ``marker_names``. ``warning``: a poor fit's warning, set by the file step; ``warnings``: other warnings
-    of the file step (a joint angle that looks inverted).
+    of the file step (a joint angle that looks inverted). ``geometry_change``: the median relative change of the
+    distances between markers on one body against the model's (:mod:`loper_analysis.motion.marker_geometry`;
+    NaN when not compared).
     """
 
     time_s: np.ndarray
@@ -97,6 +100,7 @@ class IKResult:
     marker_names: list[str] = field(default_factory=list)
     warning: str | None = None
     warnings: list[str] = field(default_factory=list)
+    geometry_change: float = float("nan")
 
     @property
     def n_left_out(self) -> int:
@@ -131,6 +135,7 @@ class IKResult:
                     "worst_marker": worst,
                     "worst_marker_rms_m": per_marker[worst] if worst else np.nan,
                     "worst_markers_mm": ", ".join(f"{m} {1e3 * e:.1f}" for m, e in list(per_marker.items())[:3]),
+                    "marker_geometry_change": self.geometry_change,
                     "warnings": " | ".join(w for w in [self.warning, *self.warnings] if w),
                 }
             ],

@@ -30,6 +30,8 @@ from loper_analysis.constants import JOINTS, SIDES
 
 __all__ = [
     "MAX_NEIGHBOUR_FACTOR_RATIO",
+    "MAX_STATURE_CHANGE",
+    "STOP_STATURE_CHANGE",
     "MAX_STATIC_FLEXION_RAD",
     "MAX_STATIC_LAB_DIFF_RAD",
     "SCALE_FLOAT_FORMAT",
@@ -41,6 +43,8 @@ __all__ = [
     "scaled_model_report",
     "static_fit",
     "static_pose_warnings",
+    "stature_change",
+    "stature_warnings",
 ]
 
 #: Significant digits of the scale report.
@@ -51,6 +55,11 @@ MAX_STATIC_FLEXION_RAD: float = float(np.radians(15.0))
 MAX_STATIC_LAB_DIFF_RAD: float = float(np.radians(10.0))
 #: Neighbouring bodies whose scale factors differ by more than this ratio are warned about (20 %).
 MAX_NEIGHBOUR_FACTOR_RATIO: float = 1.2
+#: A scaled model whose stature (estimated from its hip height) differs from the subject's given height by more
+#: than this share is warned about (12 %: the estimate alone is off by up to 9 % on correct subjects) ...
+MAX_STATURE_CHANGE: float = 0.12
+#: ... and by more than this share refused (25 %: another subject's static trial, or a wrong height).
+STOP_STATURE_CHANGE: float = 0.25
 #: Columns of the scale report (:func:`scale_report`).
 SCALE_REPORT_COLUMNS: tuple[str, ...] = (
     "kind",
@@ -144,6 +153,30 @@ def neighbour_factor_warnings(
                 )
             )
     return out
+
+
+def stature_change(height_m: float, model_height_m: float) -> float:
+    """The scaled model's stature (m) relative to the subject's given height (m), minus 1 (NaN when either is
+    not finite)."""
+    if not (np.isfinite(height_m) and np.isfinite(model_height_m)) or height_m <= 0:
+        return float("nan")
+    return float(model_height_m / height_m - 1.0)
+
+
+def stature_warnings(height_m: float, model_height_m: float, height_source: str) -> list[tuple[str, str]]:
+    """(name, warning) when the scaled model's stature differs from the given height by more than
+    :data:`MAX_STATURE_CHANGE`."""
+    change = stature_change(height_m, model_height_m)
+    if not np.isfinite(change) or abs(change) <= MAX_STATURE_CHANGE:
+        return []
+    return [
+        (
+            "stature",
+            f"the scaled model stands {model_height_m:.2f} m tall where the subject's height is {height_m:.2f} m "
+            f"({height_source}; {100 * change:+.0f} %, more than {100 * MAX_STATURE_CHANGE:.0f} %): is the static "
+            "trial this subject's, and the height in the subject sheet (height_m) right?",
+        )
+    ]
 
 
 def scale_report(
@@ -292,6 +325,7 @@ def scaled_model_report(
     accuracy: float = 1e-6,
     lab_labels: Mapping[str, str] | None = None,
     lab_static: Mapping[str, float] | None = None,
+    model_height_m: float = float("nan"),
 ) -> pd.DataFrame:
     """The scale report (:func:`scale_report`) of a scaled model, with its checks.
 
@@ -314,12 +348,15 @@ def scaled_model_report(
         IK accuracy of the static pose (``opensim.accuracy``).
     lab_labels, lab_static : mapping, optional
         Model marker -> the lab's label; our angle -> the lab's own static angle (rad).
+    model_height_m : float
+        The scaled model's stature (m; :func:`loper_analysis.motion.static_trial.model_height_m`), compared with
+        the subject's height (:func:`stature_warnings`); NaN: not compared.
 
     Returns
     -------
     pandas.DataFrame
-        :func:`scale_report`'s table, with the warnings of :func:`static_pose_warnings` and
-        :func:`neighbour_factor_warnings` as rows (and logged by the caller).
+        :func:`scale_report`'s table, with the warnings of :func:`static_pose_warnings`,
+        :func:`neighbour_factor_warnings` and :func:`stature_warnings` as rows (and logged by the caller).
     """
     from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP
 
@@ -333,6 +370,7 @@ def scaled_model_report(
     scaled_factors = {b: f for b, f in factors.items() if not np.allclose(f, 1.0)}
     warnings = static_pose_warnings((before or after).angles_rad, lab_static)
     warnings += neighbour_factor_warnings(scaled_factors, jointed_bodies(scaled))
+    warnings += stature_warnings(subject[1], model_height_m, subject[2])
     return scale_report(
         _names(scaled.getBodySet()),
         factors,

@@ -19,6 +19,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.marker_geometry import GEOMETRY_STOP_CHANGE, GEOMETRY_WARN_CHANGE
 from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
 __all__ = ["DEFAULT_MARKER_WEIGHT", "IKSettings", "ik_chunk", "ik_file", "ik_join", "ik_trial"]
@@ -55,6 +56,10 @@ class IKSettings:
     coordinate_map : mapping, optional
         Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``opensim.coordinate_map``); None:
         :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+    geometry_warn_change, geometry_stop_change : float
+        Median relative change of the distances between markers on one body, trial against model, above which
+        the trial is warned about or refused as another subject's (``opensim.geometry_warn_change``,
+        ``opensim.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
     """
 
     tasks_file: PathLike | None = None
@@ -67,6 +72,8 @@ class IKSettings:
     warn_marker_rms_m: float | None = IK_WARN_RMS_M
     max_rms_fraction: float = IK_MAX_FRACTION
     coordinate_map: Mapping[str, Mapping] | None = None
+    geometry_warn_change: float = GEOMETRY_WARN_CHANGE
+    geometry_stop_change: float = GEOMETRY_STOP_CHANGE
 
     @classmethod
     def from_config(cls, config: Mapping) -> IKSettings:
@@ -82,6 +89,8 @@ class IKSettings:
             warn_marker_rms_m=o["warn_marker_rms_m"],
             max_rms_fraction=o["max_rms_fraction"],
             coordinate_map=o["coordinate_map"],
+            geometry_warn_change=o["geometry_warn_change"],
+            geometry_stop_change=o["geometry_stop_change"],
         )
 
 
@@ -118,6 +127,32 @@ def _checked(res, source: str, settings: IKSettings):
     return poor
 
 
+def _geometry_checked(model, markers_m: np.ndarray, labels: Sequence[str], settings: IKSettings, source: str):
+    """Compare the trial's distances between markers on one body with the model's
+    (:func:`loper_analysis.motion.marker_geometry.marker_geometry`): beyond ``settings.geometry_stop_change`` the
+    trial is refused as another subject's, beyond ``settings.geometry_warn_change`` warned about. Returns the
+    median change and the warning (or None)."""
+    from loper_analysis.motion.marker_geometry import (
+        geometry_change,
+        geometry_message,
+        marker_geometry,
+        same_body_marker_pairs,
+    )
+
+    table = marker_geometry(same_body_marker_pairs(model, labels), markers_m, labels)
+    change = geometry_change(table)
+    log.info("marker geometry against the model: median change %.2f %% over %d pairs", 100 * change, len(table))
+    if change > settings.geometry_stop_change:
+        raise LoperInputError(
+            f"{source}: {geometry_message(table, settings.geometry_stop_change, 'opensim.geometry_stop_change')}"
+        )
+    if change > settings.geometry_warn_change:
+        warning = geometry_message(table, settings.geometry_warn_change, "opensim.geometry_warn_change")
+        log.warning("%s: %s", source, warning)
+        return change, warning
+    return change, None
+
+
 def _solve(
     model_osim: PathLike,
     time_s: np.ndarray,
@@ -141,9 +176,14 @@ def _solve(
     weights, coords = ik_task_weights(
         model, labels, tasks, s.default_weight, s.marker_weights, s.coordinate_tasks, source
     )
-    return inverse_kinematics(
+    change, warning = _geometry_checked(model, markers_m, labels, s, source)
+    res = inverse_kinematics(
         model, time_s, markers_m, labels, weights, coords, accuracy=s.accuracy, min_markers=s.min_markers, source=source
     )
+    res.geometry_change = change
+    if warning:
+        res.warnings.append(warning)
+    return res
 
 
 def ik_chunk(
@@ -358,6 +398,7 @@ def ik_file(
     if weights is not None and not weights:
         weights = None  # a task file with coordinate tasks only: every model marker in the file, weight 1
     model = read_model(model_osim)
+    change, warning = _geometry_checked(model, markers_m[sel], labels, settings, f"{markers_path} with {model_osim}")
     try:
         result = inverse_kinematics(
             model,
@@ -371,6 +412,9 @@ def ik_file(
         )
     except LoperInputError as exc:
         raise LoperInputError(f"{markers_path} with {model_osim}: {exc}") from None
+    result.geometry_change = change
+    if warning:
+        result.warnings.append(warning)
     _checked(result, f"{markers_path} with {model_osim}", settings)
     write_mot(out_mot, result.frame(), in_degrees=True)
     return result
