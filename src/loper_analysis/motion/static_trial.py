@@ -18,6 +18,8 @@ take a missing marker (NaN) in a TRC. Here:
   did not stand still, and the averaged pose would place markers wrongly;
 * :func:`standing_mass_kg` - body mass from the force plates the subject
   stands on: mean total vertical force over the window divided by gravity;
+* :func:`markers_off_plates` - the foot markers (those near the floor) not over a loaded plate: a subject with
+  a foot beside the plates weighs less on them than their mass;
 * :func:`model_height_m` - stature estimated from a scaled model: the hip
   joint centre's height above the lowest marker in the default pose, over
   Winter's ratio of that height to stature (0.530).
@@ -46,13 +48,21 @@ __all__ = [
     "scale_window_s",
     "static_pose",
     "standing_mass_kg",
+    "markers_off_plates",
     "model_height_m",
+    "FOOT_MARKER_HEIGHT_M",
+    "PLATE_EDGE_MARGIN_M",
 ]
 
 #: Hip joint centre height over stature (Winter's table: thigh + shank + ankle height).
 HIP_HEIGHT_FRACTION: float = WINTER_SEGMENTS["thigh"].length + WINTER_SEGMENTS["shank"].length + ANKLE_HEIGHT_FRACTION
 #: Body masses a standing subject may have (kg): outside, the plates or their units are wrong.
 MASS_RANGE_KG: tuple[float, float] = (20.0, 300.0)
+#: Markers lower than this over the plates' surface (m) are taken for foot markers (heel, toe, malleoli).
+FOOT_MARKER_HEIGHT_M: float = 0.15
+#: A foot marker this far (m) beyond a plate's edge still counts as over the plate (a heel marker sits behind
+#: the heel).
+PLATE_EDGE_MARGIN_M: float = 0.03
 #: Relative SD of the total vertical force above which a "standing" subject is not standing still.
 _MAX_FORCE_CV = 0.1
 
@@ -317,3 +327,69 @@ def model_height_m(model, thigh_body: str) -> float:
     if not heights:
         return float("nan")
     return float((hip[1] - min(heights)) / HIP_HEIGHT_FRACTION)
+
+
+def markers_off_plates(
+    markers_m,
+    labels: Sequence[str],
+    corners_m: Sequence,
+    up,
+    floor_m: float,
+    max_height_m: float = FOOT_MARKER_HEIGHT_M,
+    margin_m: float = PLATE_EDGE_MARGIN_M,
+) -> tuple[list[str], list[str]]:
+    """The foot markers of a standing pose and those of them that are over none of the given plates.
+
+    Parameters
+    ----------
+    markers_m : array_like
+        Shape (n_markers, 3), m, lab frame: the pose (NaN: marker missing).
+    labels : sequence of str
+        The markers' names.
+    corners_m : sequence of array_like
+        Each loaded plate's four corners, shape (4, 3), m, lab frame, around its outline.
+    up : array_like
+        Shape (3,): the lab's up direction.
+    floor_m : float
+        Height of the plates' surface along ``up`` (m).
+    max_height_m, margin_m : float
+        Height over the plates' surface below which a marker is a foot marker (m); distance beyond a plate's
+        edge still counted as over it (m).
+
+    Returns
+    -------
+    (list of str, list of str)
+        The foot markers; those over no plate (empty: the subject stands on the plates with both feet).
+    """
+    X = np.asarray(markers_m, float)
+    u = np.asarray(up, float) / np.linalg.norm(up)
+    plates = [np.asarray(c, float) for c in corners_m]
+    e1 = np.cross(u, [1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.cross(u, [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(u, e1)
+
+    def flat(p):
+        return np.stack([p @ e1, p @ e2], axis=-1)
+
+    feet, off = [], []
+    for name, x in zip(labels, X, strict=True):
+        if not np.all(np.isfinite(x)) or x @ u - floor_m > max_height_m:
+            continue
+        feet.append(name)
+        if not any(_inside(flat(x), flat(c), margin_m) for c in plates):
+            off.append(name)
+    return feet, off
+
+
+def _inside(point, polygon, margin: float) -> bool:
+    """Whether a 2-D point lies inside a convex polygon (either winding) or within ``margin`` of its edges."""
+    n = len(polygon)
+    edges = [(polygon[i], polygon[(i + 1) % n]) for i in range(n)]
+    sides = []
+    for a, b in edges:
+        d = b - a
+        sides.append((d[0] * (point[1] - a[1]) - d[1] * (point[0] - a[0])) / np.linalg.norm(d))
+    sides = np.asarray(sides)
+    centre = polygon.mean(axis=0)
+    inward = np.sign([(b - a)[0] * (centre[1] - a[1]) - (b - a)[1] * (centre[0] - a[0]) for a, b in edges])
+    return bool(np.all(sides * inward >= -margin))

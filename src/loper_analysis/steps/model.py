@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -543,11 +544,13 @@ def _run_scale_tool(
                 )
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
+            height = _subject_height(height_m, files.static_c3d, scaled, segment_bodies)
+            stature = _model_stature(scaled, segment_bodies)
+            _require_stature(height, stature, static_trc)
             if files.report_out is not None:
                 unplaced = read_model(unplaced_file) if unplaced_file.is_file() else None
                 if unplaced is None and placer.getApply():
                     unplaced = generic  # placement without scaling: the generic markers are the ones placed
-                height = _subject_height(height_m, files.static_c3d, scaled, segment_bodies)
                 subject = (mass_kg, height[0], f"mass: {mass_source}; height: {height[1]}")
                 lab_static = None if files.static_lab_angles is None else _lab_static(files.static_lab_angles, window)
                 report = scaled_model_report(
@@ -560,6 +563,7 @@ def _run_scale_tool(
                     accuracy=settings.accuracy,
                     lab_labels=lab_labels,
                     lab_static=lab_static,
+                    model_height_m=stature,
                 )
                 for text in report.loc[report["kind"] == "warning", "source"]:
                     log.warning("%s: %s", static_trc, text)
@@ -629,8 +633,45 @@ def _subject_mass(
         )
     up = lab_up(rotation_deg)
     vertical = np.column_stack([p.force_n @ up for p in plates])
+    off = _feet_off_plates(static_c3d, plates, vertical, window, up)
+    if off:
+        bodymass = _processing(static_c3d).get("Bodymass")
+        if bodymass is not None and 0 < bodymass <= 300:
+            return float(bodymass), f"PROCESSING:Bodymass of {Path(static_c3d).name} ({off})"
+        raise LoperInputError(
+            f"{static_c3d}: no body mass: {off}, and the file has no PROCESSING:Bodymass; give mass_kg in the "
+            "subject sheet"
+        )
     mass = standing_mass_kg(plates[0].time_s, vertical, window, gravity_m_per_s2, source=str(static_c3d))
     return mass, f"force plates {', '.join(str(p.number) for p in plates)} of {Path(static_c3d).name}"
+
+
+def _feet_off_plates(static_c3d: PathLike, plates, vertical_n: np.ndarray, window, up) -> str:
+    """Why the plates do not weigh the whole subject ('' when they do): foot markers of the static trial's mean
+    pose over no loaded plate (:func:`loper_analysis.motion.static_trial.markers_off_plates`)."""
+    from loper_analysis.gait.grf import LOADED_THRESHOLD_N
+    from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.motion.static_trial import FOOT_MARKER_HEIGHT_M, markers_off_plates
+
+    rec = read_c3d(static_c3d)
+    t = plates[0].time_s
+    in_window = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
+    loaded = [p for j, p in enumerate(plates) if np.nanmean(vertical_n[in_window, j]) > LOADED_THRESHOLD_N]
+    floor = float(np.mean([p.corners_m @ up for p in plates]))
+    frames = (rec.time_s >= window[0] - 1e-9) & (rec.time_s <= window[1] + 1e-9)
+    if not frames.any() or not len(rec.marker_labels):
+        return ""
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a marker missing throughout: NaN, skipped
+        pose = np.nanmean(rec.markers_m[frames], axis=0)
+    _, off = markers_off_plates(pose, rec.marker_labels, [p.corners_m for p in loaded], up, floor)
+    if not off:
+        return ""
+    numbers = ", ".join(str(p.number) for p in loaded) or "none"
+    return (
+        f"the plates do not carry the whole subject: foot markers {', '.join(off)} (lower than "
+        f"{FOOT_MARKER_HEIGHT_M} m) stand beside the loaded plates ({numbers}) in the scaling window"
+    )
 
 
 def _processing(static_c3d: PathLike) -> dict[str, float]:
@@ -655,6 +696,31 @@ def _subject_height(height_m: float | None, static_c3d: PathLike | None, scaled,
             return height_mm / 1000.0, f"PROCESSING:Height of {Path(static_c3d).name}"
     thigh = segment_body_names(scaled, "r", segment_bodies)["thigh"][0]
     return model_height_m(scaled, thigh), "estimated from the scaled model"
+
+
+def _model_stature(scaled, segment_bodies) -> float:
+    """The scaled model's stature (m; :func:`loper_analysis.motion.static_trial.model_height_m`)."""
+    from loper_analysis.motion.segments import segment_body_names
+    from loper_analysis.motion.static_trial import model_height_m
+
+    return model_height_m(scaled, segment_body_names(scaled, "r", segment_bodies)["thigh"][0])
+
+
+def _require_stature(height: tuple[float, str], stature_m: float, static_trc: PathLike) -> None:
+    """Refuse a scaled model whose stature differs from a height given (sheet or file) by more than
+    :data:`loper_analysis.motion.scale_report.STOP_STATURE_CHANGE`: another subject's static trial."""
+    from loper_analysis.motion.scale_report import STOP_STATURE_CHANGE, stature_change
+
+    if height[1] == "estimated from the scaled model":
+        return
+    change = stature_change(height[0], stature_m)
+    if np.isfinite(change) and abs(change) > STOP_STATURE_CHANGE:
+        raise LoperInputError(
+            f"{static_trc}: the model scaled to this static trial stands {stature_m:.2f} m tall where the "
+            f"subject's height is {height[0]:.2f} m ({height[1]}; {100 * change:+.0f} %, more than "
+            f"{100 * STOP_STATURE_CHANGE:.0f} %): is the static trial this subject's, and the height in the "
+            "subject sheet (height_m) right?"
+        )
 
 
 def _lab_static(lab_angles_tsv: PathLike, window: tuple[float, float]) -> dict[str, float]:
