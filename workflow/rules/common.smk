@@ -14,6 +14,7 @@ from loper_analysis.cluster import check_slurm_submission
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.raw_files import (
+    content_checksum,
     RAW_SUFFIXES,
     raw_file_present,
     refuse_miscased_raw_files,

@@ -39,6 +39,7 @@ rule device_log_from_mat:
     benchmark:
         "results/benchmarks/device_log_from_mat/{subject}/{trial}.tsv"
     params:
+        **raw_checksums("data/raw/{subject}/{trial}.mat"),
         column_map=DEVICE["mat_column_map"],
         sample_rate_hz=DEVICE_RATE_HZ,
     script:
@@ -57,6 +58,7 @@ rule device_frf:
     group:
         "device"
     params:
+        **raw_checksums(lambda wildcards: device_log("device-frf")),
         sample_rate_hz=DEVICE_RATE_HZ,
         window_samples=DEVICE["analysis"]["welch_window_samples"],
         overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
@@ -77,6 +79,7 @@ rule device_steps:
     group:
         "device"
     params:
+        **raw_checksums(lambda wildcards: device_log("device-steps")),
         sample_rate_hz=DEVICE_RATE_HZ,
         amplitudes_n=DEVICE["tests"]["step_amplitudes_n"],
         before_s=DEVICE["analysis"]["step_before_s"],

@@ -21,6 +21,7 @@ rule events:
         "trial"
     params:
         **settings_params(event_settings),
+        **raw_checksums("data/raw/{subject}/{trial}.c3d"),
     script:
         "../scripts/events.py"
 
@@ -50,5 +51,6 @@ rule events_loadcell:
     params:
         **settings_params(event_settings, "events"),
         **settings_params(LOADCELL_SETTINGS, "loadcell"),
+        **raw_checksums("data/raw/{subject}/{trial}.c3d", robot_log),
     script:
         "../scripts/events_loadcell.py"

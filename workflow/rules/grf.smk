@@ -15,6 +15,7 @@ rule grf:
         "results/benchmarks/grf/{subject}/{trial}.tsv"
     params:
         **settings_params(GRF_SETTINGS),
+        **raw_checksums("data/raw/{subject}/{trial}.c3d"),
     script:
         "../scripts/grf.py"
 

@@ -99,6 +99,27 @@ def static_c3d_for_mass(wildcards) -> list[str]:
     return [f"data/raw/{wildcards.subject}/{TRIALS['static']}.c3d"]
 
 
+def raw_checksums(*files) -> dict:
+    """The param that reruns a job reading raw files when their content changed, even when a copy kept an older
+    time (``cp -p``): the content checksums of ``files`` (path patterns or functions of the wildcards) of
+    recorded subjects; generated raw files are the workflow's own outputs, rerun by it."""
+
+    def checksums(wildcards) -> dict[str, str]:
+        paths = []
+        for item in files:
+            value = item(wildcards) if callable(item) else item.format(**wildcards)
+            paths += [value] if isinstance(value, str) else list(value)
+        return {
+            path: content_checksum(path)
+            for path in paths
+            if Path(path).parts[:2] == ("data", "raw")
+            and SUBJECT_SOURCE.get(Path(path).parts[2]) == "recorded"
+            and Path(path).is_file()
+        }
+
+    return {"raw_sha256": checksums}
+
+
 def robot_log(wildcards):
     """A trial's robot log: data/raw/{subject}/{trial}.loper.tsv, or converted from the MATLAB export {trial}.mat."""
     raw = Path("data/raw") / wildcards.subject

@@ -20,5 +20,6 @@ rule markers:
         trial_group
     params:
         **settings_params(marker_settings),
+        **raw_checksums("data/raw/{subject}/{trial}.c3d"),
     script:
         "../scripts/markers.py"

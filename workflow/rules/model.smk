@@ -21,6 +21,7 @@ rule model_generic:
         "results/benchmarks/model_generic/{subject}.tsv"
     params:
         **settings_params(MODEL_SETTINGS),
+        **raw_checksums(static_c3d_for_mass),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
     script:
@@ -54,6 +55,7 @@ rule model_scaled:
         "model"
     params:
         **settings_params(MODEL_SETTINGS),
+        **raw_checksums(static_c3d_for_mass),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
         scale_setup=OPENSIM["scale_setup"],

@@ -15,6 +15,7 @@ rule strides:
     output:
         strides="results/strides/{subject}/{trial}.strides.tsv",
         cycles="results/strides/{subject}/{trial}.cycles.tsv",
+        dropped="results/strides/{subject}/{trial}.dropped.tsv",
     log:
         "results/logs/strides/{subject}/{trial}.log",
     benchmark:
@@ -34,6 +35,7 @@ rule strides_summary:
         ik=[f"results/ik/{s}/{t}.ik.tsv" for s in processed_subjects() for t in subject_trials(s)],
         markers=[f"results/markers/{s}/{t}.markers.tsv" for s in processed_subjects() for t in subject_trials(s)],
         agreement=[f"results/ik/{s}/{t}.lab_agreement.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        dropped=[f"results/strides/{s}/{t}.dropped.tsv" for s in processed_subjects() for t in subject_trials(s)],
     output:
         report(
             "results/strides/summary.tsv",

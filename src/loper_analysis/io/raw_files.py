@@ -9,13 +9,20 @@ it would have entered.
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections.abc import Iterable
 from pathlib import Path
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["RAW_SUFFIXES", "raw_file_present", "refuse_miscased_raw_files", "unmatched_raw_files"]
+__all__ = [
+    "RAW_SUFFIXES",
+    "content_checksum",
+    "raw_file_present",
+    "refuse_miscased_raw_files",
+    "unmatched_raw_files",
+]
 
 #: Suffixes of raw files: motion capture, robot log, the robot's MATLAB export.
 RAW_SUFFIXES: tuple[str, ...] = (".c3d", ".loper.tsv", ".mat")
@@ -84,3 +91,24 @@ def refuse_miscased_raw_files(folder: str | os.PathLike, trials: Iterable[str]) 
                 f"{p}: the raw file of trial '{want.split('.')[0]}' is named '{p.name}'; raw files are named "
                 f"{{trial}}.c3d, .loper.tsv or .mat in lower case: rename it '{want}' (it would be left out)"
             )
+
+
+_CHECKSUMS: dict[tuple, str] = {}
+
+
+def content_checksum(path: str | os.PathLike) -> str:
+    """SHA-256 of a file's content (hex).
+
+    A raw file copied over with its old time kept (``cp -p``, ``rsync -a``) looks older than the results made
+    from it; its checksum tells that it changed. Computed once per process for a file whose size, modification
+    time and status-change time (which no copy keeps) are unchanged.
+    """
+    st = os.stat(path)
+    key = (os.fspath(path), st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino)
+    if key not in _CHECKSUMS:
+        digest = hashlib.sha256()
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                digest.update(block)
+        _CHECKSUMS[key] = digest.hexdigest()
+    return _CHECKSUMS[key]
