@@ -312,6 +312,119 @@ def test_model_marker_missing_from_the_trial_stops_ik(lab):
     )
 
 
+def _other_subject(folder: Path, height_m: float, mass_kg: float, seed: int = 5) -> None:
+    """A static trial and a walking trial of another subject (``height_m`` tall), written as the simulated lab
+    writes R01's, into ``folder``."""
+    from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
+    from loper_analysis.synthetic.trials import (
+        LabSettings,
+        simulate_walking_trial,
+        subject_static_recording,
+        walking_recording,
+    )
+
+    lab, model = LabSettings(), build_lower_body_model(height_m, mass_kg)
+    folder.mkdir(parents=True, exist_ok=True)
+    write_recording(folder / "static.c3d", subject_static_recording("R02", height_m, mass_kg, 2.0, lab, seed))
+    walk = simulate_walking_trial(
+        8.0, lab, seed, height_m, segment_parameters_from_model(model), 0.03, 0.05, DeviceParameters()
+    )
+    write_recording(folder / f"{WALK}.c3d", walking_recording(model, walk, mass_kg, lab, seed + 10))
+
+
+@pytest.mark.parametrize(
+    ("height_m", "refused"), [(1.55, True), (1.62, False)], ids=["11-percent-smaller", "7-percent-smaller"]
+)
+def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_geometry(
+    lab, tmp_path, height_m, refused, caplog
+):
+    _other_subject(tmp_path / "R02", height_m, 50.0)
+    cfg = _config(lab)
+    out = tmp_path / "R02.trc"
+    marker_steps.markers(
+        tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", MarkerSettings.from_config(cfg)
+    )
+    if refused:
+        message = _refused(lab, lambda: _ik(cfg, out), [f"{out} with ", "opensim.geometry_stop_change 0.08"])
+        change = float(
+            re.search(r"differ from the subject's model \(scaled to its static trial\) by ([\d.]+) %", message)[1]
+        )
+        assert 9.0 < change < 13.0
+        assert re.search(r"ratio 0\.8[6-9]\d", message) and re.search(r"\w+-\w+ \(\w+\) \d+ mm against \d+", message)
+        return
+    summary = tmp_path / "ik.tsv"
+    ik.ik_trial(
+        f"results/model/{SUBJECT}/generic.osim",
+        out,
+        tmp_path / "R02.mot",
+        tmp_path / "R02.angles.tsv",
+        ik.IKSettings.from_config(cfg),
+        summary_tsv=summary,
+    )
+    row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
+    assert 0.05 < row["marker_geometry_change"] < 0.08
+    assert "opensim.geometry_warn_change 0.05" in row["warnings"]
+    assert any("opensim.geometry_warn_change" in r.getMessage() for r in caplog.records if r.levelname == "WARNING")
+
+
+def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
+    summary = tmp_path / "ik.tsv"
+    ik.ik_trial(
+        f"results/model/{SUBJECT}/generic.osim",
+        f"results/markers/{SUBJECT}/{WALK}.trc",
+        tmp_path / "own.mot",
+        tmp_path / "own.angles.tsv",
+        ik.IKSettings.from_config(_config(lab)),
+        summary_tsv=summary,
+    )
+    row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
+    assert row["marker_geometry_change"] < 0.005 and "geometry" not in row["warnings"]
+
+
+def test_a_static_trial_of_another_subject_stops_the_walking_trials_ik(lab, tmp_path):
+    """Another subject's static trial scales the model to that subject; the subject's own walking trial then
+    differs from it and IK stops, naming the trial and the setting; the earlier results stay as they were."""
+    _other_subject(tmp_path / "R02", 1.55, 50.0)
+    shutil.copy(tmp_path / "R02" / "static.c3d", lab / RAW / "static.c3d")
+    before = {k: v for k, v in _state(lab).items() if k in GOOD_TARGETS and "static" not in k}
+    res = _snakemake(lab, f"results/ik/{SUBJECT}/{WALK}.mot")
+    assert res.returncode != 0
+    message = res.stdout + res.stderr
+    assert f"results/markers/{SUBJECT}/{WALK}.trc with results/model/{SUBJECT}/scaled.osim" in message
+    assert "opensim.geometry_stop_change 0.08" in message
+    after = _state(lab)
+    assert {k: after[k] for k in before} == before
+    assert not (lab / f"results/ik/{SUBJECT}/{WALK}.mot").exists()
+
+
+def test_a_static_trial_far_from_the_subjects_height_stops_scaling(lab, tmp_path):
+    from loper_analysis.steps import model
+
+    _other_subject(tmp_path / "R02", 1.25, 30.0)
+    static = tmp_path / "static.trc"
+    marker_steps.markers(
+        tmp_path / "R02" / "static.c3d",
+        static,
+        tmp_path / "static.gaps.tsv",
+        MarkerSettings.from_config(_config(lab)).for_static(),
+    )
+    message = _refused(
+        lab,
+        lambda: model.scale(
+            model.ScaleFiles(f"results/model/{SUBJECT}/generic.osim", static, f"results/model/{SUBJECT}/scaled.osim"),
+            MASS_KG,
+            height_m=HEIGHT_M,
+        ),
+        [
+            f"{static}: the model scaled to this static trial stands ",
+            f"where the subject's height is {HEIGHT_M:.2f} m (given;",
+            "height_m",
+        ],
+    )
+    assert float(re.search(r"stands ([\d.]+) m tall", message)[1]) == pytest.approx(1.25, abs=0.06)
+
+
 def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_any_stops(lab, tmp_path):
     t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
     X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only: left out, the rest solved
@@ -567,6 +680,58 @@ def test_a_raw_file_named_in_another_case_stops_the_run_naming_it(lab, name):
         lambda: _snakemake(lab, "-n"),
         [f"{RAW}/{name}: the raw file of trial '{WALK}' is named '{name}'", f"rename it '{right}'"],
     )
+
+
+def test_a_raw_file_replaced_with_its_old_time_kept_is_processed_again(lab):
+    """``cp -p`` of another recording over a raw file keeps a time older than the results: the content
+    checksum (a param of every rule that reads raw files) reruns what was made from it, and only that."""
+    import os
+
+    trc = lab / f"results/markers/{SUBJECT}/{WALK}.trc"
+    static_trc = lab / f"results/markers/{SUBJECT}/static.trc"
+    old_trc, old_static = trc.read_bytes(), static_trc.read_bytes()
+    assert "Nothing to be done" in _snakemake(lab, "-n", *GOOD_TARGETS).stdout
+    raw = lab / RAW / f"{WALK}.c3d"
+    for name in (f"{WALK}.c3d", f"{WALK}.loper.tsv"):  # the trial recorded again, both files copied as cp -p does
+        then = (lab / RAW / name).stat().st_mtime_ns
+        shutil.copyfile(lab / "elsewhere" / name, lab / RAW / name)
+        os.utime(lab / RAW / name, ns=(then, then))
+    assert raw.stat().st_mtime_ns < trc.stat().st_mtime_ns
+    dry = _snakemake(lab, "-n", *GOOD_TARGETS)
+    assert dry.returncode == 0, dry.stderr[-2000:]
+    assert "Rules with provenance triggered jobs: events_loadcell markers\n" in dry.stdout, dry.stdout[-3000:]
+    assert re.search(r"^total\s+2$", dry.stdout, re.M), dry.stdout[-3000:]
+    res = _snakemake(lab, *GOOD_TARGETS)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert trc.read_bytes() != old_trc and static_trc.read_bytes() == old_static
+    assert "Nothing to be done" in _snakemake(lab, "-n", *GOOD_TARGETS).stdout
+
+
+def test_a_robot_log_that_ends_half_way_sets_the_trials_status_and_says_so_on_the_console(lab):
+    cfg = _config(lab)
+    cfg["strides"]["min_valid_strides"] = 3  # an 8-s trial
+    (lab / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
+    summary = lab / "results/strides/summary.tsv"
+    res = _snakemake(lab, "results/strides/summary.tsv")
+    assert res.returncode == 0, res.stderr[-3000:]
+    whole = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
+    assert whole["status"] == "ok" and whole["n_outside_robot_log"] == 0
+    log = lab / RAW / f"{WALK}.loper.tsv"
+    lines = log.read_text().splitlines(keepends=True)
+    header = [line for line in lines if line.startswith("#")]
+    body = [line for line in lines if not line.startswith("#")]
+    log.write_text("".join(header + body[: len(body) // 2 + 1]))  # the header line and the first half
+    res = _snakemake(lab, "results/strides/summary.tsv")
+    assert res.returncode == 0, res.stderr[-3000:]
+    cut = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
+    n_with_events = cut["n_strides"] + cut["n_outside_robot_log"]
+    assert cut["status"] == "log_truncated"
+    assert n_with_events == whole["n_strides"] and cut["outside_robot_log_fraction"] > 0.3
+    said = f"robot log truncated? {cut['n_outside_robot_log']} of the strides with events"
+    assert said in cut["warnings"]
+    assert f"{SUBJECT} {WALK}: log_truncated; {said}" in res.stderr  # the run's warnings on the console
+    dropped = pd.read_csv(lab / f"results/strides/{SUBJECT}/{WALK}.dropped.tsv", sep="\t")
+    assert (dropped["reason"] == "outside_robot_log").sum() == cut["n_outside_robot_log"]
 
 
 def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(lab):

@@ -4,4 +4,6 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import strides
 
     inp, out = snakemake.input, snakemake.output
-    strides.strides(inp.angles, inp.events, out.strides, out.cycles, inp.force or None, snakemake.params.settings)
+    strides.strides(
+        inp.angles, inp.events, out.strides, out.cycles, inp.force or None, snakemake.params.settings, out.dropped
+    )

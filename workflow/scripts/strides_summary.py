@@ -9,8 +9,7 @@ with rule_log(snakemake.log[0]):
         i.strides,
         snakemake.output[0],
         p.min_valid,
-        i.contacts,
-        ik_tsvs=i.ik,
-        markers_tsvs=i.markers,
-        agreement_tsvs=i.agreement,
+        strides.TrialTables(
+            contacts=i.contacts, ik=i.ik, markers=i.markers, agreement=i.agreement, dropped=i.dropped
+        ),
     )

@@ -17,7 +17,7 @@ from __future__ import annotations
 import logging
 import warnings
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -41,6 +41,8 @@ __all__ = [
     "STRIDE_COLUMNS",
     "FORCE_PHASES",
     "SUMMARY_COLUMNS",
+    "DROPPED_COLUMNS",
+    "MAX_OUTSIDE_LOG_FRACTION",
     "StrideTables",
     "strides_from_events",
     "force_phase_metrics",
@@ -66,6 +68,10 @@ STRIDE_COLUMNS: tuple[str, ...] = (
 FORCE_PHASES: tuple[str, ...] = ("stance", "swing")
 #: Columns of a stride table that :func:`stride_summary` reads.
 SUMMARY_COLUMNS: tuple[str, ...] = ("removed", "reason", "duration_s")
+#: Columns of the table of strides with events that could not be cut (:attr:`StrideTables.dropped`).
+DROPPED_COLUMNS: tuple[str, ...] = ("heel_strike_s", "end_s", "reason")
+#: Share of a trial's strides outside its robot log's span above which the trial's status is ``log_truncated``.
+MAX_OUTSIDE_LOG_FRACTION: float = 0.1
 
 
 def strides_from_events(events: pd.DataFrame, side: str) -> pd.DataFrame:
@@ -171,12 +177,15 @@ def _flagged_spans(mine: pd.DataFrame, t: np.ndarray, side: str, source: str) ->
 class StrideTables:
     """The stride table and the normalised cycles of one trial (:func:`stride_tables`).
 
-    ``too_few_strides``: fewer unperturbed strides kept than required.
+    ``too_few_strides``: fewer unperturbed strides kept than required. ``dropped``: the strides with events that
+    could not be cut (columns :data:`DROPPED_COLUMNS`; ``reason`` ``ik_frames_left_out`` or
+    ``outside_robot_log``).
     """
 
     strides: pd.DataFrame
     cycles: pd.DataFrame
     too_few_strides: bool
+    dropped: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=list(DROPPED_COLUMNS)))
 
 
 def force_phase_metrics(time_s, force_n, stride_table: pd.DataFrame, source: str = "") -> pd.DataFrame:
@@ -338,6 +347,8 @@ def stride_tables(
     # frames left out of IK (too few markers) and angles no marker determined are NaN: such strides cannot be cut
     complete = np.isfinite(values).all(axis=1)
     whole = [bool(complete[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
+    n_with_events = len(table)
+    dropped = [table.loc[[not w for w in whole], ["heel_strike_s", "end_s"]].assign(reason="ik_frames_left_out")]
     if not all(whole):
         log.info(
             "%s: %d stride(s) with frames left out of IK (NaN angles) dropped", names["angles"], len(whole) - sum(whole)
@@ -352,7 +363,19 @@ def stride_tables(
         covered = np.isfinite(force_n)
         ok = [bool(covered[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
         if not all(ok):
-            log.info("%s: %d stride(s) outside the robot log's span dropped", names["force"], len(ok) - sum(ok))
+            lost = table.loc[[not k for k in ok], ["heel_strike_s", "end_s"]]
+            dropped.append(lost.assign(reason="outside_robot_log"))
+            span = t[covered]
+            log.warning(
+                "%s: %d of %d strides with events lie outside the robot log's span (%s of the trial's %.2f .. %.2f s) "
+                "and are dropped: is the robot log truncated?",
+                names["force"],
+                len(lost),
+                n_with_events,
+                f"{span[0]:.2f} .. {span[-1]:.2f} s" if span.size else "no frame",
+                t[0],
+                t[-1],
+            )
             table = table[ok].reset_index(drop=True)
             table["stride"] = np.arange(len(table))
     table["perturbed"] = False
@@ -433,7 +456,8 @@ def stride_tables(
         if force_n is not None:
             block["force_n"] = normalise(t, force_n, table, phase, n_points, source=names["force"]).ravel()
         cycles.append(pd.DataFrame(block))
-    return StrideTables(out, pd.concat(cycles, ignore_index=True), too_few)
+    lost = pd.concat(dropped, ignore_index=True)[list(DROPPED_COLUMNS)]
+    return StrideTables(out, pd.concat(cycles, ignore_index=True), too_few, lost)
 
 
 def _mean_duration_s(table: pd.DataFrame, source: str) -> float:
@@ -449,8 +473,14 @@ def stride_summary(
     tables: Mapping[tuple[str, str], pd.DataFrame],
     min_valid: int = MIN_VALID_STRIDES,
     contacts: Mapping[tuple[str, str], pd.DataFrame] | None = None,
+    dropped: Mapping[tuple[str, str], pd.DataFrame] | None = None,
 ) -> pd.DataFrame:
     """One row per subject x trial: strides found, removed as outliers (and why), kept, and a status.
+
+    ``dropped``: the strides each trial could not cut (:attr:`StrideTables.dropped`); with them, the columns
+    ``n_outside_robot_log`` and ``outside_robot_log_fraction`` (of the strides with events), and the status
+    ``log_truncated`` where that share exceeds :data:`MAX_OUTSIDE_LOG_FRACTION` (the robot log ends, or starts,
+    within the trial).
 
     ``tables``: ``{(subject, trial): stride table}`` of :func:`stride_tables`.
     ``status`` is ``ok`` or ``too_few_strides`` (fewer than ``min_valid``
@@ -506,6 +536,14 @@ def stride_summary(
                 "status": "ok" if n_kept >= min_valid else "too_few_strides",
             }
         )
+        if dropped is not None:
+            lost = dropped[(subject, trial)]
+            n_out = int((lost["reason"] == "outside_robot_log").sum()) if len(lost) else 0
+            share = n_out / (len(table) + len(lost)) if len(table) + len(lost) else 0.0
+            rows[-1]["n_outside_robot_log"] = n_out
+            rows[-1]["outside_robot_log_fraction"] = share
+            if share > MAX_OUTSIDE_LOG_FRACTION:
+                rows[-1]["status"] = "log_truncated"
         if with_contacts:
             from loper_analysis.gait.contacts import count_flagged
 

@@ -15,11 +15,12 @@ import pandas as pd
 
 from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
 from loper_analysis.gait.resampling import N_POINTS
+from loper_analysis.gait.strides import DROPPED_COLUMNS, MAX_OUTSIDE_LOG_FRACTION
 from loper_analysis.io.atomic import PathLike, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.study_design import PERTURBED_SIDE
 
-__all__ = ["StrideSettings", "strides", "strides_summary"]
+__all__ = ["StrideSettings", "TrialTables", "strides", "strides_summary"]
 
 log = logging.getLogger(__name__)
 
@@ -59,12 +60,15 @@ def strides(
     cycles_out: PathLike,
     force_tsv: PathLike | None = None,
     settings: StrideSettings = StrideSettings(),
+    dropped_out: PathLike | None = None,
 ):
     """Strides of one leg, their outlier verdicts and the time-normalised cycles of one trial.
 
     ``settings`` (:class:`StrideSettings`): the leg, the samples per cycle and the IQR rule.
 
-    Writes the stride table and the cycles (:func:`loper_analysis.gait.strides.stride_tables`);
+    Writes the stride table and the cycles (:func:`loper_analysis.gait.strides.stride_tables`), and
+    (``dropped_out``) the strides with events that could not be cut: frames left out of IK, or outside the robot
+    log's span (a truncated log, warned about);
     returns the :class:`~loper_analysis.gait.strides.StrideTables`. A trial with 0
     or 1 strides of the leg is written like any other (the stride table with
     all its columns, without rows for 0 strides) and flagged ``too_few_strides``.
@@ -85,6 +89,8 @@ def strides(
         sources,
     )
     write_tsv(tables.cycles, cycles_out)
+    if dropped_out is not None:
+        write_tsv(tables.dropped, dropped_out)
     write_tsv(tables.strides, strides_out)
     s = tables.strides
     log.info("%d strides, %d kept", len(s), int((~s["removed"]).sum()))
@@ -98,8 +104,30 @@ IK_COLUMNS: tuple[str, ...] = (
     "marker_rms_mean_m",
     "worst_marker",
     "worst_marker_rms_m",
+    "marker_geometry_change",
     "warnings",
 )
+
+
+@dataclass(frozen=True)
+class TrialTables:
+    """The per-trial tables the strides summary adds (each a sequence of paths in the order of the trials, or
+    None).
+
+    Attributes
+    ----------
+    contacts : force-plate contact tables (:func:`loper_analysis.steps.events.events`).
+    ik : IK summaries (:func:`loper_analysis.steps.ik.ik_trial`).
+    markers : markers summaries (:func:`loper_analysis.steps.markers.markers`).
+    agreement : our angles against the lab's own (:func:`loper_analysis.steps.ik.ik_trial`).
+    dropped : strides that could not be cut (:func:`strides`).
+    """
+
+    contacts: Sequence[PathLike] | None = None
+    ik: Sequence[PathLike] | None = None
+    markers: Sequence[PathLike] | None = None
+    agreement: Sequence[PathLike] | None = None
+    dropped: Sequence[PathLike] | None = None
 
 
 def strides_summary(
@@ -107,25 +135,25 @@ def strides_summary(
     strides_tsvs: Sequence[PathLike],
     out_tsv: PathLike,
     min_valid: int = MIN_VALID_STRIDES,
-    contacts_tsvs: Sequence[PathLike] | None = None,
-    ik_tsvs: Sequence[PathLike] | None = None,
-    markers_tsvs: Sequence[PathLike] | None = None,
-    agreement_tsvs: Sequence[PathLike] | None = None,
+    files: TrialTables = TrialTables(),
 ) -> pd.DataFrame:
     """One row per subject x trial of the stride tables (:func:`loper_analysis.gait.strides.stride_summary`).
 
     ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
-    ``subject_trials``, in order; ``contacts_tsvs`` (optional, same order) the
+    ``subject_trials``, in order; of ``files`` (:class:`TrialTables`, same order), ``contacts`` the
     force-plate contact tables written by :func:`events`, whose flagged
     contacts are counted. A stride table of a trial with 0 strides (its
     header only, as :func:`strides` writes it) gives ``n_strides`` 0 and the
-    status ``too_few_strides``. ``ik_tsvs`` (the IK summaries of
+    status ``too_few_strides``. ``ik`` (the IK summaries of
     :func:`loper_analysis.steps.ik.ik_trial`) add the frames and those left
-    out of IK, the mean marker RMS error, the worst marker and the IK warnings, ``markers_tsvs`` (the markers
+    out of IK, the mean marker RMS error, the worst marker, the change of the marker geometry against the
+    model and the IK warnings, ``markers`` (the markers
     summaries of :func:`markers`) the trial's walking direction and the turn that made it walk along +X,
-    ``agreement_tsvs`` (our angles against the lab's own, :func:`loper_analysis.steps.ik.ik_trial`) the least
+    ``agreement`` (our angles against the lab's own, :func:`loper_analysis.steps.ik.ik_trial`) the least
     correlation and the largest RMS difference over the hip, knee and ankle angles compared (NaN where the file
-    holds none).
+    holds none), ``dropped`` (the strides :func:`strides` could not cut) the strides outside the robot log's span:
+    beyond :data:`loper_analysis.gait.strides.MAX_OUTSIDE_LOG_FRACTION` of a trial's strides, its status is
+    ``log_truncated`` and its warnings say so.
 
     Raises
     ------
@@ -147,16 +175,22 @@ def strides_summary(
         for key, path in zip(keys, strides_tsvs, strict=True)
     }
     contacts = None
-    if contacts_tsvs is not None:
+    if files.contacts is not None:
         contacts = {
             key: read_tsv(path, "contact table", ("flag",), keep_default_na=False)
-            for key, path in zip(keys, contacts_tsvs, strict=True)
+            for key, path in zip(keys, files.contacts, strict=True)
         }
-    table = stride_summary(tables, min_valid, contacts)
+    dropped = None
+    if files.dropped is not None:
+        dropped = {
+            key: read_tsv(path, "dropped strides", DROPPED_COLUMNS, keep_default_na=False)
+            for key, path in zip(keys, files.dropped, strict=True)
+        }
+    table = stride_summary(tables, min_valid, contacts, dropped)
     extra = []
-    if ik_tsvs is not None:
+    if files.ik is not None:
         ik = [
-            read_tsv(path, "IK summary", IK_COLUMNS, keep_default_na=False, na_values=[""]).iloc[0] for path in ik_tsvs
+            read_tsv(path, "IK summary", IK_COLUMNS, keep_default_na=False, na_values=[""]).iloc[0] for path in files.ik
         ]
         extra.append(
             pd.DataFrame(
@@ -166,13 +200,14 @@ def strides_summary(
                     "marker_rms_mean_m": [float(r.marker_rms_mean_m) for r in ik],
                     "worst_marker": ["" if pd.isna(r.worst_marker) else str(r.worst_marker) for r in ik],
                     "worst_marker_rms_m": [float(r.worst_marker_rms_m) for r in ik],
+                    "marker_geometry_change": [float(r.marker_geometry_change) for r in ik],
                 }
             )
         )
-    if markers_tsvs is not None:
+    if files.markers is not None:
         marks = [
             read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0]
-            for path in markers_tsvs
+            for path in files.markers
         ]
         extra.append(
             pd.DataFrame(
@@ -183,8 +218,8 @@ def strides_summary(
                 }
             )
         )
-    if agreement_tsvs is not None:
-        agree = [read_tsv(path, "lab agreement", ("angle", "r", "rms_diff_rad")) for path in agreement_tsvs]
+    if files.agreement is not None:
+        agree = [read_tsv(path, "lab agreement", ("angle", "r", "rms_diff_rad")) for path in files.agreement]
         joints = [a[a["angle"] != "pelvis_angle"] if len(a) else a for a in agree]
         extra.append(
             pd.DataFrame(
@@ -196,12 +231,21 @@ def strides_summary(
                 }
             )
         )
-    if ik_tsvs is not None:
+    if files.ik is not None:
         extra.append(pd.DataFrame({"warnings": ["" if pd.isna(r.warnings) else str(r.warnings) for r in ik]}))
     if extra:
         table = pd.concat([table, *extra], axis=1)
+    if "outside_robot_log_fraction" in table:
+        said = [
+            f"robot log truncated? {n} of the strides with events ({100 * f:.0f} %) lie outside its span"
+            if f > MAX_OUTSIDE_LOG_FRACTION
+            else ""
+            for n, f in zip(table["n_outside_robot_log"], table["outside_robot_log_fraction"])
+        ]
+        before = table["warnings"] if "warnings" in table else pd.Series([""] * len(table))
+        table["warnings"] = [" | ".join(w for w in pair if w) for pair in zip(said, before.fillna(""))]
     write_tsv(table, out_tsv)
-    for row in table[table.status != "ok"].itertuples():
+    for row in table[table.status == "too_few_strides"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
     if "warnings" in table:
         for row in table[table["warnings"] != ""].itertuples():
