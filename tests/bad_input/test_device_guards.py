@@ -386,3 +386,40 @@ def test_force_pulses_of_the_simulated_robot():
     assert np.all((t[found[:, 0].astype(int)] - onsets >= 0) & (t[found[:, 0].astype(int)] - onsets < 0.03))
     assert np.all((found[:, 2] > 35.0) & (found[:, 2] < 60.0))
     assert find_force_pulses(free.to_numpy(), fs).shape == (0, 3)
+
+
+# --------------------------------------------------------------------------- the load cell's unit
+
+
+@pytest.mark.parametrize(
+    ("factor", "words"),
+    [
+        (1e-3, ["is 0.000", "is the load cell logged in kN (ratio about 0.001)?"]),
+        (20.0, ["is 1", "is the load cell logged uncalibrated (a voltage, in mV or V), or in another unit?"]),
+    ],
+    ids=["kN", "mV"],
+)
+def test_a_load_cell_logged_in_another_unit_is_refused_from_the_pulses(trial, tmp_path, factor, words):
+    """During the flagged pulses the measured force follows the desired one (ratio 0.9-1 in the simulated robot);
+    a load cell in kN or uncalibrated (mV, about 20 times the newtons here) is named with its ratio."""
+    from loper_analysis.device.loadcell import require_force_unit
+
+    robot = trial["walk"].robot
+    on = robot["perturbation"].to_numpy() == 1
+    assert 0.85 < require_force_unit(robot["force_desired_n"], robot["force_measured_n"], on) < 1.1
+    log = _log_with(trial, tmp_path, "units.loper.tsv", force_measured_n=factor * robot["force_measured_n"])
+    message = _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [
+            f"{log} / ",
+            ": column 'force_measured_n' is ",
+            "times column 'force_desired_n' during the ",
+            "accepted 0.5 .. 2",
+        ],
+    )
+    for word in words:
+        assert word in message
+    ratio = float(message.split("column 'force_measured_n' is ")[1].split(" times")[0])
+    assert ratio == pytest.approx(factor * 0.95, rel=0.1)

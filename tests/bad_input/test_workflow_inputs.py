@@ -517,6 +517,33 @@ def test_belt_channels_swapped_are_refused_from_the_heel_markers(lab):
     )
 
 
+def _belts_in(lab: Path, path: Path, unit: str, factor: float) -> Path:
+    """The trial with its vertical belt channels written in ``unit`` (values times ``factor``)."""
+    rec = read_c3d(lab / RAW / f"{WALK}.c3d")
+    belts = [rec.analog_labels.index(name) for name in ("Fz_left", "Fz_right")]
+    analogs, units = rec.analogs.copy(), list(rec.analog_units)
+    for i in belts:
+        analogs[:, i] *= factor
+        units[i] = unit
+    write_recording(path, replace(rec, analogs=analogs, analog_units=units))
+    return path
+
+
+def test_belt_channels_in_kn_give_the_same_events_and_in_mv_are_refused(lab, tmp_path):
+    cfg = _config(lab)
+    e = cfg["events"]
+    settings = dataclasses.replace(EventSettings.from_config(cfg), grf_channels=e["grf_channels"])
+    kn = _belts_in(lab, tmp_path / "kn.c3d", "kN", 1e-3)
+    table = event_steps.events(kn, tmp_path / "e.tsv", settings)
+    good = pd.read_csv(f"results/events/{SUBJECT}/{WALK}.events.tsv", sep="\t")
+    assert len(table) == len(good) and np.allclose(table["time_s"], good["time_s"])
+    mv = _belts_in(lab, tmp_path / "mv.c3d", "mV", 20.0)
+    with pytest.raises(LoperInputError) as err:
+        event_steps.events(mv, tmp_path / "m.tsv", settings)
+    assert f"{mv}: analog channel 'Fz_left' (events.grf_channels.left) is in 'mV' (ANALOG:UNITS)" in str(err.value)
+    assert not (tmp_path / "m.tsv").exists()
+
+
 def test_belts_feet_that_cannot_be_confirmed_are_warned(lab, tmp_path):
     rec = read_c3d(lab / RAW / f"{WALK}.c3d")
     keep = [i for i, name in enumerate(rec.marker_labels) if name not in ("LHEE", "RHEE")]

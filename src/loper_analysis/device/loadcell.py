@@ -9,8 +9,9 @@ the mocap clock -> linear interpolation of the forces, nearest-sample pick of
 the perturbation flag, at the mocap frame times (128 Hz); the same filtered
 forces at every robot sample, on the mocap clock, for the identification.
 
-Two checks guard against records that would give wrong numbers without an
-error (``docs/device.md``, "Checks on the robot's records"): the sync pulses
+Three checks guard against records that would give wrong numbers without an
+error (``docs/device.md``, "Checks on the robot's records"): the measured force must be in the unit of the
+desired one, N (:func:`require_force_unit`), the sync pulses
 must have the same high time in both records (an inverted sync, e.g. an
 active-low robot output, shifts the clock map by the pulse width;
 :func:`loper_analysis.device.clock_sync.clock_map`), and force pulses in the load
@@ -33,6 +34,8 @@ from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
 __all__ = [
     "OUTPUT_COLUMNS",
     "MIN_UNFLAGGED_PULSES",
+    "FORCE_RATIO_RANGE",
+    "require_force_unit",
     "robot_log_on_mocap_frames",
     "robot_log_frames_and_native",
     "check_perturbation_flags",
@@ -49,6 +52,8 @@ _FORCE_COLUMNS = ("force_measured_n", "force_desired_n")
 
 #: A log is refused when at least this many force pulses are found and more than half of them carry no flag.
 MIN_UNFLAGGED_PULSES = 3
+#: Accepted range of the measured over the desired force during the flagged pulses: outside, a unit (kN, mV).
+FORCE_RATIO_RANGE: tuple[float, float] = (0.5, 2.0)
 #: A force pulse counts as flagged if the flag is 1 anywhere from this long before its start to this long after
 #: its end, s (the load cell follows the flag by the robot's delays, ~15 ms).
 _FLAG_MARGIN_S = 0.1
@@ -220,6 +225,7 @@ def robot_log_frames_and_native(
     if not np.all(np.isin(flag, (0.0, 1.0))):
         k = int(np.flatnonzero(~np.isin(flag, (0.0, 1.0)))[0])
         raise LoperInputError(f"{src}: column 'perturbation', sample {k}: value {flag[k]!r} is not 0 or 1")
+    require_force_unit(native["force_desired_n"], native["force_measured_n"], flag, src)
     check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
     pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
     nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
@@ -228,6 +234,56 @@ def robot_log_frames_and_native(
     result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
     result.attrs["clock_map"] = cm
     return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
+
+
+def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:
+    """Refuse a robot log whose measured force is not in the desired force's unit (N).
+
+    During the flagged perturbation pulses the load cell measures about the force the controller asks for: the
+    median ratio of ``measured_n`` to ``desired_n`` over the flagged samples where the desired force exceeds half
+    its largest magnitude lies within :data:`FORCE_RATIO_RANGE`. A load cell logged in kN gives about 0.001, an
+    uncalibrated one in mV a ratio far from 1. Logs without flagged pulses (minimal-impedance trials) cannot be
+    judged and pass.
+
+    Parameters
+    ----------
+    desired_n, measured_n : array_like, shape (n,)
+        The log's ``force_desired_n`` and ``force_measured_n`` (low-passed).
+    flag : array_like, shape (n,)
+        The log's ``perturbation`` column, 0/1.
+    source : str
+        Names the robot log in messages.
+
+    Returns
+    -------
+    float
+        The median ratio (NaN when not judged).
+
+    Raises
+    ------
+    LoperInputError
+        A ratio outside :data:`FORCE_RATIO_RANGE`, naming the file, the columns, the ratio and the likely unit.
+    """
+    fd = np.asarray(desired_n, float)
+    fm = np.asarray(measured_n, float)
+    on = (np.asarray(flag, float) == 1) & np.isfinite(fd) & np.isfinite(fm)
+    if not on.any() or not np.nanmax(np.abs(fd[on])) > 0:
+        return float("nan")
+    strong = on & (np.abs(fd) > 0.5 * np.nanmax(np.abs(fd[on])))
+    ratio = float(np.median(fm[strong] / fd[strong]))
+    lo, hi = FORCE_RATIO_RANGE
+    if lo <= ratio <= hi:
+        return ratio
+    unit = (
+        "in kN (ratio about 0.001)"
+        if 0.0003 < abs(ratio) < 0.003
+        else "uncalibrated (a voltage, in mV or V), or in another unit"
+    )
+    raise LoperInputError(
+        f"{source or 'robot log'}: column 'force_measured_n' is {ratio:.4g} times column 'force_desired_n' during "
+        f"the {int(strong.sum())} samples of the flagged perturbation pulses (median; accepted {lo:g} .. {hi:g}): "
+        f"is the load cell logged {unit}? Both columns must hold newtons"
+    )
 
 
 def check_perturbation_flags(force_n, flag, sample_rate_hz: float, time_s, source: str = "") -> np.ndarray:

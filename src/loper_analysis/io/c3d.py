@@ -76,6 +76,7 @@ from loper_analysis.io.timing import library_import, timed_io
 
 __all__ = [
     "LENGTH_UNITS_PER_M",
+    "NEWTONS_PER_FORCE_UNIT",
     "C3DRecording",
     "rate_ratio",
     "read_c3d",
@@ -83,6 +84,8 @@ __all__ = [
 
 #: Length units accepted in files, as the number of units per metre.
 LENGTH_UNITS_PER_M: dict[str, float] = {"mm": 1000.0, "cm": 100.0, "m": 1.0}
+#: Newtons per unit of a force channel's ``ANALOG:UNITS`` (an empty unit is taken for N).
+NEWTONS_PER_FORCE_UNIT: dict[str, float] = {"": 1.0, "N": 1.0, "n": 1.0, "kN": 1000.0, "KN": 1000.0, "kn": 1000.0}
 
 #: Relative tolerance of the integer analog/point rate ratio.
 _RATIO_TOLERANCE = 1e-6
@@ -216,6 +219,26 @@ class C3DRecording:
                 f"{self.source}: {problem} '{label}'; channels present: {', '.join(self.analog_labels) or 'none'}"
             )
         return self.analogs[:, hits[0]].copy()
+
+    def force_channel_n(self, label: str, setting: str) -> np.ndarray:
+        """One analog channel that holds a force (n_samples,), in N: its ``ANALOG:UNITS`` converted
+        (:data:`NEWTONS_PER_FORCE_UNIT`).
+
+        Raises
+        ------
+        LoperInputError
+            A unit that is not a force's (``mV``, ``V``: an uncalibrated channel), naming the file, the channel,
+            the unit and ``setting`` (the config key that chose the channel).
+        """
+        values = self.analog(label)
+        unit = self.analog_units[self.analog_labels.index(label)].strip() if self.analog_units else ""
+        if unit not in NEWTONS_PER_FORCE_UNIT:
+            raise LoperInputError(
+                f"{self.source}: analog channel '{label}' ({setting}) is in '{unit}' (ANALOG:UNITS), not a force "
+                f"unit ({', '.join(u for u in NEWTONS_PER_FORCE_UNIT if u)}): an uncalibrated channel? Export "
+                "it in N"
+            )
+        return values * NEWTONS_PER_FORCE_UNIT[unit]
 
 
 # ---------------------------------------------------------------- helpers

@@ -174,7 +174,7 @@ def _channel_events(rec, s: EventSettings) -> pd.DataFrame:
         )
     tables = []
     for side in SIDES:
-        fz = rec.analog(grf_channels[side])
+        fz = rec.force_channel_n(grf_channels[side], f"events.grf_channels.{side}")
         if s.cutoff_hz is not None:
             fz = lowpass(
                 fz,
