@@ -91,6 +91,65 @@ def check_config(
         key = ".".join(map(str, path)) or "(top level)"
         more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
         raise LoperInputError(f"{config_origin(path, layers, source)}: key '{key}': {e.message}{more}")
+    _check_relations(data, lambda path: config_origin(path, layers, source))
+
+
+#: Parts of a key's name that make a two-number list an interval [low, high].
+_INTERVAL_WORDS = ("range", "bounds", "span", "window")
+#: (lower, upper) keys of one setting: the first must not exceed the second.
+_ORDERED_KEYS = (
+    (("opensim", "warn_marker_rms_m"), ("opensim", "max_marker_rms_m")),
+    (("opensim", "geometry_warn_change"), ("opensim", "geometry_stop_change")),
+)
+
+
+def _intervals(node, path: tuple = ()):
+    """(key path, [low, high]) of every two-number list whose key names an interval (:data:`_INTERVAL_WORDS`)."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from _intervals(v, (*path, str(k)))
+    elif (
+        isinstance(node, list)
+        and len(node) == 2
+        and all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in node)
+        and any(word in part for part in path for word in _INTERVAL_WORDS)
+    ):
+        yield path, node
+
+
+def _check_relations(config: dict, origin) -> None:
+    """Refuse settings that pass the schema one by one but not together: an interval whose low end is not below
+    its high end, a warning level above its stop level, a static trial named like a walking trial."""
+    for path, (low, high) in _intervals(config):
+        if not low < high:
+            raise LoperInputError(
+                f"{origin(path)}: key '{'.'.join(path)}': [{low}, {high}] is reversed or empty: give [low, high] "
+                "with low below high"
+            )
+    for lower, upper in _ORDERED_KEYS:
+        a, b = _get(config, lower), _get(config, upper)
+        if isinstance(a, (int, float)) and isinstance(b, (int, float)) and a > b:
+            raise LoperInputError(
+                f"{origin(lower)}: key '{'.'.join(lower)}' {a} exceeds '{'.'.join(upper)}' {b} (from "
+                f"{origin(upper)}): the warning level must not be above the level that stops"
+            )
+    trials = config.get("trials")
+    if isinstance(trials, dict) and isinstance(trials.get("static"), str):
+        for other in ("no_device", "device"):
+            if trials.get(other) == trials["static"]:
+                raise LoperInputError(
+                    f"{origin(('trials', 'static'))}: key 'trials.static': '{trials['static']}' is also the walking "
+                    f"trial trials.{other}: the static trial is a standing trial of its own (e.g. 'static')"
+                )
+
+
+def _get(config: dict, path: Sequence[str]):
+    node = config
+    for key in path:
+        if not isinstance(node, dict) or key not in node:
+            return None
+        node = node[key]
+    return node
 
 
 def check_value(value, schema_path: str | Path, key_path: Sequence[str], name: str) -> None:

@@ -101,11 +101,14 @@ def load_shape(plate: int, t: np.ndarray) -> np.ndarray:
     return shape
 
 
-def write_trial(path: Path, kind: int = 2, order=(0, 1, 2, 3), channels_order=(0, 1, 2, 3), sign: float = 1.0) -> Path:
+def write_trial(
+    path: Path, kind: int = 2, order=(0, 1, 2, 3), channels_order=(0, 1, 2, 3), sign: float = 1.0, offset_n=0.0
+) -> Path:
     """Two plates of TYPE ``kind`` under the walking load and the heels over them.
 
     The channels are those of plates whose corners are listed in ``channels_order``; the file lists them in
-    ``order``. ``sign`` -1 writes the force on the plate instead of on the body.
+    ``order``. ``sign`` -1 writes the force on the plate instead of on the body; ``offset_n`` adds a constant
+    vertical force (N, lab up) to the first plate's every sample (a plate not zeroed).
     """
     t = np.arange(N_FRAMES * RATIO) / (RATE * RATIO)
     tm = np.arange(N_FRAMES) / RATE
@@ -122,6 +125,8 @@ def write_trial(path: Path, kind: int = 2, order=(0, 1, 2, 3), channels_order=(0
         for a, b in CONTACTS[k]:
             heels[(tm >= a - 0.1) & (tm <= b + 0.1), k, 2] = 0.05
         force = sign * (np.column_stack([20.0 * shape, -10.0 * shape, PEAK_N * shape]) + REST_N)
+        if k == 0:
+            force[:, 2] += offset_n
         columns.append(wrench_channels(physical, force, np.zeros_like(force)))
     labels = [f"{q}{k}" for k in (1, 2) for q in ("Fx", "Fy", "Fz", "Mx", "My", "Mz")]
     units = (["N"] * 3 + ["Nmm"] * 3) * 2 if kind == 2 else ["V"] * 12
@@ -344,6 +349,19 @@ def test_force_on_the_plate_with_the_usual_corners_names_both_causes(tmp_path):
         "force on the plate instead of on the body",
         f"at most {-REST_N[2]:.1f} N at the 99th",
     )
+
+
+def test_a_plate_not_zeroed_is_named_as_an_offset_not_as_its_corners(tmp_path):
+    bad = write_trial(tmp_path / "offset.c3d", offset_n=-3000.0)
+    message = assert_refused_and_nothing_written(
+        run_events,
+        bad,
+        tmp_path / "events.tsv",
+        "platform 1: its vertical force (along up [0.0, 0.0, 1.0]) never comes near zero",
+        "an offset of about 30",
+        "the plate not zeroed before the trial, or the ANALOG:OFFSET of its channels [1, 2, 3, 4, 5, 6]",
+    )
+    assert "FORCE_PLATFORM:CORNERS" not in message  # walking: the load comes and goes on top of the offset
 
 
 @pytest.mark.parametrize("order", [(3, 2, 1, 0), (1, 0, 3, 2)], ids=["reversed", "pairs swapped"])

@@ -825,12 +825,39 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
             ["--configfile", "config/lab.yaml", "--config", "seed=7"],
             ["config/lab.yaml: key 'filter.cutoff_hz': -40.0"],
         ),
+        (
+            {"config/lab.yaml": {"identification": {"stiffness_bounds_nm_per_rad": [200.0, 0.0]}}},
+            ["--configfile", "config/lab.yaml"],
+            [
+                "config/lab.yaml: key 'identification.stiffness_bounds_nm_per_rad': [200.0, 0.0] is reversed or "
+                "empty: give [low, high] with low below high"
+            ],
+        ),
+        (
+            {"config/lab.yaml": {"trials": {"static": "walk-nodevice"}}},
+            ["--configfile", "config/lab.yaml"],
+            [
+                "config/lab.yaml: key 'trials.static': 'walk-nodevice' is also the walking trial trials.no_device: "
+                "the static trial is a standing trial of its own"
+            ],
+        ),
+        (
+            {"config/lab.yaml": {"opensim": {"geometry_warn_change": 0.2}}},
+            ["--configfile", "config/lab.yaml"],
+            [
+                "config/lab.yaml: key 'opensim.geometry_warn_change' 0.2 exceeds 'opensim.geometry_stop_change' 0.08 "
+                "(from config/config.yaml)"
+            ],
+        ),
     ],
     ids=[
         "type-in-configfile",
         "range-in-config-option",
         "unknown-key-in-last-configfile",
         "configfile-under-config-option",
+        "reversed-bounds",
+        "static-named-as-a-walking-trial",
+        "warning-above-stop",
     ],
 )
 def test_bad_config_names_the_file_or_option_key_and_value(lab, files, args, words):

@@ -347,7 +347,13 @@ def _plate_frame(corners: np.ndarray) -> np.ndarray:
 
 
 def _check_force_direction(
-    force_n: np.ndarray, z_axis: np.ndarray, up: np.ndarray, corners: np.ndarray, unit: str, plate: int, source: str
+    force_n: np.ndarray,
+    z_axis: np.ndarray,
+    up: np.ndarray,
+    corners: np.ndarray,
+    unit: str,
+    plate: tuple[int, Sequence[int]],
+    source: str,
 ) -> None:
     """Refuse a level plate whose vertical force points down while loaded, naming its corners and their z axis.
 
@@ -373,11 +379,15 @@ def _check_force_direction(
         Shape (4, 3): ``FORCE_PLATFORM:CORNERS`` as stored, in ``unit``.
     unit : str
         ``POINT:UNITS`` (the corners' unit).
-    plate : int
-        Plate number, 1-based.
+    plate : (int, sequence of int)
+        Plate number, 1-based, and its analog channels (1-based).
     source : str
         The file (for messages).
+
+    A vertical force that never comes near zero (its 99th percentile below ``-DOWNWARD_LOAD_N``) is an offset
+    under every sample, not a flipped load: refused as such, naming the plate's channels.
     """
+    plate, channels = plate
     facing = float(z_axis @ up)
     if force_n.shape[0] == 0 or abs(facing) < np.cos(np.radians(_LEVEL_DEG)):
         return
@@ -385,6 +395,20 @@ def _check_force_direction(
     low, high = (float(v) for v in np.percentile(vertical, [1.0, 99.0]))
     if not (low <= -DOWNWARD_LOAD_N and high < MAX_UPWARD_REST_N):
         return
+    if high < -DOWNWARD_LOAD_N:  # never near zero: an offset under every sample rather than a flipped load
+        steady = high - low < DOWNWARD_LOAD_N
+        also = (
+            f"; or someone stood on it throughout while FORCE_PLATFORM:CORNERS lists its corners the other way "
+            f"round the frame of its channels (z axis {np.round(z_axis, 3).tolist()})"
+            if steady
+            else ""
+        )
+        raise LoperInputError(
+            f"{source}: platform {plate}: its vertical force (along up {np.round(up, 3).tolist()}) never comes near "
+            f"zero: {high:.1f} N or less throughout (99th percentile), {low:.1f} N at the 1st: an offset of about "
+            f"{-low:.0f} N under every sample (the plate not zeroed before the trial, or the ANALOG:OFFSET of its "
+            f"channels {list(channels)}){also}; zero the plate, or export the trial again"
+        )
     listed = [[float(f"{v:.6g}") for v in corner] for corner in corners]
     reading = (
         f"its vertical force (along up {np.round(up, 3).tolist()}) points down while loaded: {low:.1f} N at "
@@ -497,7 +521,7 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
             raise LoperInputError(f"{source}: platform {k + 1} holds non-finite forces, moments or corners")
         frame = _plate_frame(corners)
         _check_force_direction(
-            force, frame[:, 2], lab_up, np.asarray(pf["corners"], dtype=float).T, unit_pos, k + 1, source
+            force, frame[:, 2], lab_up, np.asarray(pf["corners"], dtype=float).T, unit_pos, (k + 1, chans), source
         )
         if frame[:, 2] @ lab_up > 0:  # corners the other way round: the surface lies at positive plate z
             origin = np.asarray(pf["origin"], dtype=float).ravel() / per_m  # ezc3d's, z <= 0, plate frame, m
