@@ -14,6 +14,8 @@ from __future__ import annotations
 import math
 import re
 import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -390,3 +392,36 @@ def test_repository_files_pass_with_their_known_forces():
         np.testing.assert_allclose([p.force_n[:, 2].max() for p in plates], peaks, atol=1e-4)
     assert read_force_platforms(WALKING5)[0].force_n[4100, 2] == pytest.approx(480.3877, abs=1e-3)
     assert read_c3d(WALKING5).markers_m.shape == (1103, 40, 3)
+
+
+#: An analog-only C3D (force plates exported without the trajectories), written by ezc3d in a child process.
+ANALOG_ONLY = """
+import sys
+import ezc3d
+import numpy as np
+
+c = ezc3d.c3d()
+c["parameters"]["POINT"]["RATE"]["value"] = [100.0]
+c["parameters"]["POINT"]["LABELS"]["value"] = []
+c["parameters"]["ANALOG"]["RATE"]["value"] = [1000.0]
+c["parameters"]["ANALOG"]["LABELS"]["value"] = ["Fx1", "Fy1", "Fz1"]
+c["data"]["points"] = np.zeros((4, 0, 100))
+c["data"]["analogs"] = np.zeros((1, 3, 1000))
+c.write(sys.argv[1])
+"""
+
+
+def test_an_analog_only_c3d_is_named_as_holding_no_markers(tmp_path):
+    path = tmp_path / "plates-only.c3d"
+    subprocess.run([sys.executable, "-c", ANALOG_ONLY, str(path)], check=True)
+    rec = read_c3d(path)
+    assert rec.marker_labels == [] and rec.analog_labels == ["Fx1", "Fy1", "Fz1"]
+    message = assert_refused_and_nothing_written(
+        lambda c3d, out: markers_step(c3d, out, tmp_path / "gaps.tsv"),
+        path,
+        tmp_path / "out.trc",
+        "no markers (POINT:LABELS holds no marker trajectory)",
+        "3 analog channel(s) (Fx1, Fy1, Fz1)",
+        "export the trial with its marker trajectories",
+    )
+    assert "shape" not in message

@@ -139,6 +139,18 @@ def test_ik_with_markers_1000_times_too_far_apart_fails_naming_the_rms_and_the_l
     assert not out.exists()
 
 
+def test_ik_on_a_model_without_markers_says_it_has_none_and_where_they_come_from(trial, tmp_path):
+    """OpenSim's gait2392 as distributed keeps its markers in a file of its own."""
+    generic = ROOT / "src/loper_analysis/templates/gait2392_simbody.osim"
+    out = tmp_path / "x.mot"
+    with pytest.raises(LoperInputError) as err:
+        ik_file(generic, trial["trc"], out)
+    msg = str(err.value)
+    assert f"{generic} (model 3DGaitModel2392) has no markers (its MarkerSet is empty)" in msg
+    assert "gait2392_Scale_MarkerSet.xml" in msg and "opensim.scale_setup" in msg and "--config-out" in msg
+    assert not out.exists()
+
+
 # ---------------------------------------------------------------- 2. ANALOG:RATE against the data layout
 
 

@@ -40,6 +40,7 @@ __all__ = [
     "marker_positions",
     "markers_table",
     "inverse_kinematics",
+    "require_model_markers",
     "ik_task_weights",
     "chunk_frames",
     "join_chunks",
@@ -220,6 +221,21 @@ def markers_table(time_s, markers_m, labels):
     return v3
 
 
+def require_model_markers(model, source: str = "") -> None:
+    """Refuse a model without markers (an empty MarkerSet: the marker set kept in a file of its own), naming the
+    model and where its markers come from."""
+    if model.getMarkerSet().getSize():
+        return
+    where = f"{source}: " if source else ""
+    raise LoperInputError(
+        f"{where}{model_source(model)} has no markers (its MarkerSet is empty): IK and scaling fit the model's "
+        "markers. Give the model with its marker set: the marker set file that came with it (OpenSim's "
+        "gait2392_Scale_MarkerSet.xml beside gait2392_simbody.osim) is attached by the ScaleTool setup's "
+        "<MarkerSet> (opensim.scale_setup), or `loper-analysis inspect STATIC WALK --config-out ...` writes a "
+        "model with its markers"
+    )
+
+
 def inverse_kinematics(
     model,
     time_s,
@@ -275,6 +291,7 @@ def inverse_kinematics(
         raise LoperInputError("time_s must be finite and strictly increasing")
     ms = model.getMarkerSet()
     model_markers = [ms.get(i).getName() for i in range(ms.getSize())]
+    require_model_markers(model, source)
     if marker_weights is None:
         marker_weights = {mk: 1.0 for mk in labels if mk in model_markers}
         if not marker_weights:
@@ -402,6 +419,7 @@ def ik_task_weights(
     (dict, dict)
         ``{marker: weight}`` and ``{coordinate: (weight, value or None)}``.
     """
+    require_model_markers(model, source)
     if tasks is not None:
         weights, coords = tasks
     else:

@@ -136,6 +136,16 @@ def markers(
     s = settings
     source = str(c3d_path)
     rec = read_c3d(c3d_path)
+    if not rec.marker_labels:
+        others = f" and {len(rec.output_labels)} computed point(s) ({', '.join(rec.output_labels[:4])}, ...)" * bool(
+            rec.output_labels
+        )
+        channels = ", ".join(rec.analog_labels[:6]) + (", ..." if len(rec.analog_labels) > 6 else "")
+        raise LoperInputError(
+            f"{source}: no markers (POINT:LABELS holds no marker trajectory): the file holds "
+            f"{len(rec.analog_labels)} analog channel(s) ({channels or 'none'}){others}; export the trial with "
+            "its marker trajectories"
+        )
     if rec.output_labels:
         kinds = pd.Series(rec.output_kinds).value_counts()
         log.info(
