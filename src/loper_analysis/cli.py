@@ -371,7 +371,7 @@ def _ik(args: argparse.Namespace) -> None:
         "warn_marker_rms_m": args.warn_marker_rms_m,
         "max_rms_fraction": args.max_rms_fraction,
     }
-    settings = dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})
+    settings = dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None}, subjects_model=False)
     # a C3D holds the lab's labels in the lab's frame (the config's markers.*); a TRC the model's already
     lab = MarkerSettings() if config is None else MarkerSettings.from_config(config)
     label_map = _label_map(args.label_map)

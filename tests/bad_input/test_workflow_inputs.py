@@ -368,6 +368,29 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
     assert any("opensim.geometry_warn_change" in r.getMessage() for r in caplog.records if r.levelname == "WARNING")
 
 
+def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_on_a_unit(lab, tmp_path):
+    """A model_osim of the subject sheet may carry its markers elsewhere than on the subject: a warning; a
+    factor of 1000 between the distances is a unit, a stop whatever the model."""
+    _other_subject(tmp_path / "R02", 1.55, 50.0)
+    cfg = _config(lab)
+    out = tmp_path / "R02.trc"
+    marker_steps.markers(
+        tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", MarkerSettings.from_config(cfg)
+    )
+    given = dataclasses.replace(ik.IKSettings.from_config(cfg), subjects_model=False)
+    summary = tmp_path / "ik.tsv"
+    model = f"results/model/{SUBJECT}/generic.osim"
+    ik.ik_trial(model, out, tmp_path / "a.mot", tmp_path / "a.angles.tsv", given, summary_tsv=summary)
+    row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
+    assert row["marker_geometry_change"] > 0.08 and "opensim.geometry_warn_change 0.05" in row["warnings"]
+    t, X, labels = read_markers(out)
+    write_trc(tmp_path / "km.trc", t, 1000.0 * X, labels)
+    message = _refused(
+        lab, lambda: ik.ik_trial(model, tmp_path / "km.trc", tmp_path / "b.mot", tmp_path / "b.angles.tsv", given), []
+    )
+    assert "times the model's: markers in another length unit" in message
+
+
 def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
     summary = tmp_path / "ik.tsv"
     ik.ik_trial(

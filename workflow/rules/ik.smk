@@ -21,7 +21,7 @@ if OPENSIM["ik_chunks"] == 1:
         group:
             "trial"
         params:
-            **settings_params(IK_SETTINGS),
+            **settings_params(ik_settings),
         script:
             "../scripts/ik.py"
 
@@ -41,7 +41,7 @@ else:
         group:
             "trial"
         params:
-            **settings_params(IK_SETTINGS),
+            **settings_params(ik_settings),
             n_chunks=OPENSIM["ik_chunks"],
         script:
             "../scripts/ik_chunk.py"
@@ -62,6 +62,6 @@ else:
         group:
             "trial"
         params:
-            **settings_params(IK_SETTINGS),
+            **settings_params(ik_settings),
         script:
             "../scripts/ik_join.py"

@@ -73,6 +73,12 @@ def event_settings(wildcards) -> EventSettings:
     return dataclasses.replace(EVENT_SETTINGS, label_map=tuple(trial_label_maps(wildcards.trial)) or None)
 
 
+def ik_settings(wildcards) -> IKSettings:
+    """A subject's IK settings: the config's, the marker geometry judged against a model scaled here (a stop) or
+    given in the subject sheet (a warning)."""
+    return dataclasses.replace(IK_SETTINGS, subjects_model="model_osim" not in SUBJECT_ROWS[wildcards.subject])
+
+
 def subject_model(wildcards):
     """The subject's OpenSim model: user-supplied (subjects.tsv column model_osim) or scaled from the static trial."""
     user = SUBJECT_ROWS[wildcards.subject].get("model_osim")

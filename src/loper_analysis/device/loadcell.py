@@ -54,6 +54,9 @@ _FORCE_COLUMNS = ("force_measured_n", "force_desired_n")
 MIN_UNFLAGGED_PULSES = 3
 #: Accepted range of the measured over the desired force during the flagged pulses: outside, a unit (kN, mV).
 FORCE_RATIO_RANGE: tuple[float, float] = (0.5, 2.0)
+#: Smallest peak desired force during the flagged samples (N) for that ratio to be judged (a log without the
+#: desired pulses cannot be).
+MIN_DESIRED_PULSE_N: float = 1.0
 #: A force pulse counts as flagged if the flag is 1 anywhere from this long before its start to this long after
 #: its end, s (the load cell follows the flag by the robot's delays, ~15 ms).
 _FLAG_MARGIN_S = 0.1
@@ -242,8 +245,8 @@ def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:
     During the flagged perturbation pulses the load cell measures about the force the controller asks for: the
     median ratio of ``measured_n`` to ``desired_n`` over the flagged samples where the desired force exceeds half
     its largest magnitude lies within :data:`FORCE_RATIO_RANGE`. A load cell logged in kN gives about 0.001, an
-    uncalibrated one in mV a ratio far from 1. Logs without flagged pulses (minimal-impedance trials) cannot be
-    judged and pass.
+    uncalibrated one in mV a ratio far from 1. Logs without flagged pulses (minimal-impedance trials), or whose
+    desired force stays below :data:`MIN_DESIRED_PULSE_N` during them, cannot be judged and pass.
 
     Parameters
     ----------
@@ -267,7 +270,7 @@ def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:
     fd = np.asarray(desired_n, float)
     fm = np.asarray(measured_n, float)
     on = (np.asarray(flag, float) == 1) & np.isfinite(fd) & np.isfinite(fm)
-    if not on.any() or not np.nanmax(np.abs(fd[on])) > 0:
+    if not on.any() or not np.nanmax(np.abs(fd[on])) >= MIN_DESIRED_PULSE_N:
         return float("nan")
     strong = on & (np.abs(fd) > 0.5 * np.nanmax(np.abs(fd[on])))
     ratio = float(np.median(fm[strong] / fd[strong]))

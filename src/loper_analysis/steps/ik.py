@@ -60,6 +60,11 @@ class IKSettings:
         Median relative change of the distances between markers on one body, trial against model, above which
         the trial is warned about or refused as another subject's (``opensim.geometry_warn_change``,
         ``opensim.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
+    subjects_model : bool
+        Whether the model was scaled to this subject's static trial (True) or given as it is (a ``model_osim``
+        of the subject sheet, the command line's ``--model``): its markers may then sit elsewhere than on the
+        subject, and a change beyond ``geometry_stop_change`` is a warning, unless the distances differ by a
+        factor beyond 1.5 (a unit).
     """
 
     tasks_file: PathLike | None = None
@@ -74,6 +79,7 @@ class IKSettings:
     coordinate_map: Mapping[str, Mapping] | None = None
     geometry_warn_change: float = GEOMETRY_WARN_CHANGE
     geometry_stop_change: float = GEOMETRY_STOP_CHANGE
+    subjects_model: bool = True
 
     @classmethod
     def from_config(cls, config: Mapping) -> IKSettings:
@@ -142,7 +148,9 @@ def _geometry_checked(model, markers_m: np.ndarray, labels: Sequence[str], setti
     table = marker_geometry(same_body_marker_pairs(model, labels), markers_m, labels)
     change = geometry_change(table)
     log.info("marker geometry against the model: median change %.2f %% over %d pairs", 100 * change, len(table))
-    if change > settings.geometry_stop_change:
+    ratio = float(np.median(table["trial_distance_m"] / table["model_distance_m"])) if len(table) else 1.0
+    stops = settings.subjects_model or not 2 / 3 < ratio < 3 / 2
+    if change > settings.geometry_stop_change and stops:
         raise LoperInputError(
             f"{source}: {geometry_message(table, settings.geometry_stop_change, 'opensim.geometry_stop_change')}"
         )

@@ -624,26 +624,25 @@ def _subject_mass(
         )
     plates = read_force_platforms(static_c3d)
     if not plates:
-        bodymass = _processing(static_c3d).get("Bodymass")
-        if bodymass is not None and 0 < bodymass <= 300:
-            return float(bodymass), f"PROCESSING:Bodymass of {Path(static_c3d).name} (no force plates)"
-        raise LoperInputError(
-            f"{static_c3d}: no body mass: the static trial has no force platforms "
-            "(FORCE_PLATFORM:USED 0) and no PROCESSING:Bodymass; give mass_kg in the subject sheet"
-        )
+        return _file_bodymass(static_c3d, "the static trial has no force platforms (FORCE_PLATFORM:USED 0)")
     up = lab_up(rotation_deg)
     vertical = np.column_stack([p.force_n @ up for p in plates])
     off = _feet_off_plates(static_c3d, plates, vertical, window, up)
     if off:
-        bodymass = _processing(static_c3d).get("Bodymass")
-        if bodymass is not None and 0 < bodymass <= 300:
-            return float(bodymass), f"PROCESSING:Bodymass of {Path(static_c3d).name} ({off})"
-        raise LoperInputError(
-            f"{static_c3d}: no body mass: {off}, and the file has no PROCESSING:Bodymass; give mass_kg in the "
-            "subject sheet"
-        )
+        return _file_bodymass(static_c3d, off)
     mass = standing_mass_kg(plates[0].time_s, vertical, window, gravity_m_per_s2, source=str(static_c3d))
     return mass, f"force plates {', '.join(str(p.number) for p in plates)} of {Path(static_c3d).name}"
+
+
+def _file_bodymass(static_c3d: PathLike, why: str) -> tuple[float, str]:
+    """The file's ``PROCESSING:Bodymass`` (kg) when its plates cannot weigh the subject (``why``), with where it
+    came from; a stop asking for ``mass_kg`` without it."""
+    bodymass = _processing(static_c3d).get("Bodymass")
+    if bodymass is not None and 0 < bodymass <= 300:
+        return float(bodymass), f"PROCESSING:Bodymass of {Path(static_c3d).name} ({why})"
+    raise LoperInputError(
+        f"{static_c3d}: no body mass: {why}, and the file has no PROCESSING:Bodymass; give mass_kg in the subject sheet"
+    )
 
 
 def _feet_off_plates(static_c3d: PathLike, plates, vertical_n: np.ndarray, window, up) -> str:
