@@ -11,6 +11,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tests.workflow_copy import ROOT, copy_workflow
@@ -22,6 +23,16 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     instead of the long ones starting last and running on alone."""
     slow_files = {item.path for item in items if item.get_closest_marker("slow")}
     items.sort(key=lambda item: item.path not in slow_files)
+
+
+#: Seed of the ``rng`` fixture where the test module sets no ``RNG_SEED`` of its own.
+DEFAULT_RNG_SEED = 20240611
+
+
+@pytest.fixture
+def rng(request) -> np.random.Generator:
+    """A fresh seeded generator for each test: the module's ``RNG_SEED``, else :data:`DEFAULT_RNG_SEED`."""
+    return np.random.default_rng(getattr(request.module, "RNG_SEED", DEFAULT_RNG_SEED))
 
 
 @pytest.fixture(scope="session")

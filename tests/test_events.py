@@ -19,11 +19,6 @@ N_HUMPS = 9
 N_SAMPLES = 12_000
 
 
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240611)
-
-
 def _crossings():
     """Offsets (samples from hump start) of the first sample >= 50 N and the first <= 20 N after the peak."""
     rise = STANCE_SAMPLES / math.pi * math.asin(50.0 / PEAK_N)  # 16.38

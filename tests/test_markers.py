@@ -18,9 +18,8 @@ N = 256
 SOURCE = "data/raw/S01/walk01.c3d"
 
 
-@pytest.fixture
-def rng():
-    return np.random.default_rng(7)
+#: Seed of the ``rng`` fixture (tests/conftest.py) in this module.
+RNG_SEED = 7
 
 
 def cubic_marker(t):

@@ -13,11 +13,6 @@ from loper_analysis.gait.outliers import (
 )
 
 
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240611)
-
-
 def test_iqr_outliers_against_a_by_hand_percentile(rng):
     n_strides, n_samples = 20, 100
     x = rng.normal(0.0, 1.0, (n_strides, n_samples, 2))

@@ -21,11 +21,6 @@ ANALOG_HZ = 1024.0
 RATIO = 8
 
 
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240611)
-
-
 #: Raw ezc3d writer, run in a child process like write_c3d does: an in-process
 #: ezc3d write would break OpenSim's std::vector arguments for later tests.
 RAW_WRITER = """

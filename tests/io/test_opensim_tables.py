@@ -22,12 +22,6 @@ from loper_analysis.io.opensim_tables import (
 from loper_analysis.io.osim import quiet_opensim
 from tests.io.marker_arrays import LABELS, N_FRAMES, POINT_HZ, as_stored, lab_markers
 
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240611)
-
-
 # ---------------------------------------------------------------- TRC (OpenSim TRCFileAdapter)
 
 

@@ -32,9 +32,8 @@ from tests.responses.twin_strides import (
 MATCHED = ResponseSettings(min_strides=4, counterfactual="matched_stride")
 
 
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240612)
+#: Seed of the ``rng`` fixture (tests/conftest.py) in this module.
+RNG_SEED = 20240612
 
 
 def test_subject_response_returns_the_planted_bump(rng):

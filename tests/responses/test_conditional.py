@@ -21,9 +21,8 @@ from tests.responses.twin_strides import BUMP_AMP, RATE, bump, twin_trial
 TINY = 1e-12  # a penalty this small is least squares
 
 
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20261126)
+#: Seed of the ``rng`` fixture (tests/conftest.py) in this module.
+RNG_SEED = 20261126
 
 
 def test_ridge_weights_give_the_least_squares_prediction_and_sum_to_one(rng):

@@ -17,10 +17,8 @@ from tests.responses.twin_strides import (
     twin_trial,
 )
 
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240612)
+#: Seed of the ``rng`` fixture (tests/conftest.py) in this module.
+RNG_SEED = 20240612
 
 
 def test_match_picks_exact_twin_at_toe_off_aligned_anchor(rng):

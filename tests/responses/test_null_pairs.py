@@ -15,10 +15,8 @@ from loper_analysis.responses import (
 from loper_analysis.swing_leg.dynamics import joint_angles
 from tests.responses.twin_strides import DELAY, RATE, null_trial, twin_trial
 
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240612)
+#: Seed of the ``rng`` fixture (tests/conftest.py) in this module.
+RNG_SEED = 20240612
 
 
 def test_null_pair_windows_of_twins_are_identical_and_pool_trials(rng):

@@ -16,10 +16,8 @@ from tests.responses.twin_strides import (
     twin_trial,
 )
 
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(20240612)
+#: Seed of the ``rng`` fixture (tests/conftest.py) in this module.
+RNG_SEED = 20240612
 
 
 def test_paired_windows_grid_shapes_and_frame_values(rng):
