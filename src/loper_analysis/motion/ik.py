@@ -473,7 +473,7 @@ def chunk_frames(n_frames: int, n_chunks: int, chunk: int) -> slice:
     The chunks tile the trial without overlap. IK solves every frame on its
     own (the previous frame is only the starting guess), so chunks solved
     separately join seamlessly (:func:`join_chunks`; checked against one run
-    in ``tests/test_kinematics.py``).
+    in ``tests/motion/test_ik.py``).
     """
     if n_chunks < 1 or not 0 <= chunk < n_chunks:
         raise LoperInputError(f"chunk must lie in 0 .. {n_chunks - 1} (n_chunks = {n_chunks}), got {chunk}")

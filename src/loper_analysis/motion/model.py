@@ -14,7 +14,7 @@ Python in older OpenSim versions):
 * Onto the swing-leg model (:mod:`loper_analysis.swing_leg.dynamics`): cart x =
   ``pelvis_tx``, the pelvis angle there is ``-pelvis_tilt``, and the joint
   angles are the coordinates themselves (checked against OpenSim's body
-  positions in ``tests/test_model.py``).
+  positions in ``tests/motion/test_model.py``).
 
 Segment masses, lengths, COM and radii of gyration follow Winter's table
 (:mod:`loper_analysis.swing_leg.anthropometry`), as do

@@ -26,7 +26,7 @@ from loper_analysis.motion.ik import (
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
 
 FS = 128.0
-GENERIC_RAJAGOPAL = Path(__file__).resolve().parent / "data" / "rajagopal2016" / "Rajagopal2016.osim"
+GENERIC_RAJAGOPAL = Path(__file__).resolve().parents[1] / "data" / "rajagopal2016" / "Rajagopal2016.osim"
 
 
 @pytest.fixture(scope="module")

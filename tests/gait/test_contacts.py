@@ -320,7 +320,7 @@ def test_a_single_crossover_step_alone_on_the_other_belt_is_assigned_by_the_mark
     assert (ev["side"] == "left").all()
 
 
-WALKING5 = __import__("pathlib").Path(__file__).parent / "data" / "opensim-core" / "walking5.c3d"
+WALKING5 = __import__("pathlib").Path(__file__).parents[1] / "data" / "opensim-core" / "walking5.c3d"
 
 
 @pytest.fixture(scope="module")

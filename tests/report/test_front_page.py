@@ -35,7 +35,7 @@ from loper_analysis.steps.report import FrontPageSettings
 from tests.browser import report_screen
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 SETTINGS = dict(
     seed=2024,

@@ -12,7 +12,7 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.motion.heading import travel_velocity_m_per_s, trial_heading
 from loper_analysis.motion.markers import rotate_markers
 
-WALKING5 = Path(__file__).resolve().parent / "data" / "opensim-core" / "walking5.c3d"
+WALKING5 = Path(__file__).resolve().parents[1] / "data" / "opensim-core" / "walking5.c3d"
 Z_UP = (-90.0, 0.0, 0.0)
 
 
@@ -75,7 +75,7 @@ def test_a_treadmill_or_fixed_mode_keeps_the_configured_rotation(walking5):
         trial_heading(X, rate, Z_UP, mode="north", source="t.c3d")
 
 
-QCMAS = Path(__file__).resolve().parent / "data" / "c3d-parser" / "QCMAS"
+QCMAS = Path(__file__).resolve().parents[1] / "data" / "c3d-parser" / "QCMAS"
 
 
 def test_a_static_trial_is_turned_to_face_plus_x_by_its_pelvis_markers():

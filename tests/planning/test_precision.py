@@ -385,7 +385,7 @@ def test_plan_command_answers_the_target(
 
 def test_plan_command_takes_the_working_directory_s_config_and_an_option_wins(pilot_results, tmp_path, monkeypatch):
     """config/config.yaml of the working directory sets the stride counts and onsets; --strides replaces them."""
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     (tmp_path / "config").mkdir()
     (tmp_path / "workflow/schemas").mkdir(parents=True)
     shutil.copy(root / "workflow/schemas/config.schema.yaml", tmp_path / "workflow/schemas/config.schema.yaml")

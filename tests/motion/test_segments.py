@@ -24,7 +24,7 @@ from loper_analysis.steps.model import ModelSettings, segments_from_model_file
 from loper_analysis.swing_leg.dynamics import read_segments, write_segments
 from tests.gait2392_models import scaled_gait2392
 
-DATA = Path(__file__).parents[1] / "examples" / "gait2392"
+DATA = Path(__file__).parents[2] / "examples" / "gait2392"
 GAIT2392 = DATA / "gait2392_simbody.osim"
 #: Known scale factors (uniform per body) of the scaled gait2392.
 FACTORS = {"pelvis": 1.05, "torso": 1.02, "femur": 1.10, "tibia": 0.95, "talus": 1.08, "calcn": 1.08, "toes": 1.08}
