@@ -17,7 +17,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from loper_analysis.cli import _parser, _plan_pilot, _plan_settings, _read_config, main
+from loper_analysis.cli import _plan_pilot, _plan_settings, _read_config, command_parser, main
 from loper_analysis.config_file import find_schema, load_config, update_config
 from loper_analysis.errors import LoperInputError
 from loper_analysis.planning.precision import PlanSettings
@@ -121,7 +121,7 @@ def test_rule_takes_its_params_from_the_shared_builder():
 def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
     config, _ = load_config(["config/config.yaml", second])
     rule = PlanningSettings.from_config(config)
-    args = _parser().parse_args(["plan", "--configfile", str(second)])
+    args = command_parser().parse_args(["plan", "--configfile", str(second)])
     read, line = _read_config(args)
     assert line == "config: config/config.yaml, config/mine.yaml (later files override earlier ones)"
     command = _plan_settings(args, read)
@@ -139,7 +139,7 @@ def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
 
 
 def test_options_given_override_the_config(project, second):
-    args = _parser().parse_args(
+    args = command_parser().parse_args(
         [
             "plan",
             "--configfile",
@@ -165,7 +165,7 @@ def test_options_given_override_the_config(project, second):
 
 def test_without_a_config_the_library_defaults_serve_and_the_line_says_so(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    args = _parser().parse_args(["plan"])
+    args = command_parser().parse_args(["plan"])
     config, line = _read_config(args)
     assert config is None
     assert line.startswith("config: none (no config/config.yaml in ") and "library defaults" in line
