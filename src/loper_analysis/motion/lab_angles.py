@@ -33,6 +33,7 @@ __all__ = [
     "lab_agreement",
     "lab_agreement_warnings",
     "lab_joint_angles",
+    "window_means",
 ]
 
 #: Our angle -> the stem of the lab's label holding it (x component), Plug-in Gait's names.
@@ -197,3 +198,17 @@ def lab_agreement_warnings(
             problems.append("anticorrelated: a sign (opensim.coordinate_map) or swapped sides (markers.label_map)?")
         out.append("; ".join(problems))
     return out
+
+
+def window_means(table: pd.DataFrame, window: tuple[float, float]) -> dict[str, float]:
+    """Each angle of a lab-angle table (columns ``time_s`` and ``*_rad``) averaged over the frames within
+    ``window`` (s): ``{angle: rad}``, the ``_rad`` suffix dropped; empty without rows or frames there."""
+    if not len(table):
+        return {}
+    t = table["time_s"].to_numpy(float)
+    inside = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
+    if not inside.any():
+        return {}
+    return {
+        c.removesuffix("_rad"): float(np.nanmean(table.loc[inside, c])) for c in table.columns if c.endswith("_rad")
+    }

@@ -27,6 +27,7 @@ __all__ = [
     "model_marker_names",
     "require_model_markers",
     "strip_subject_prefix",
+    "unknown_markers_hint",
 ]
 
 #: Configuration field of the label map (named in messages).
@@ -140,3 +141,26 @@ def require_model_markers(
             f"{source or 'markers'}: model marker(s) {_listed(missing)} not provided by any label of the file "
             f"(map lab labels to them in {LABEL_MAP_FIELD}); the file's labels: {_listed(shown)}"
         )
+
+
+def unknown_markers_hint(
+    labels: Sequence[str], model_markers: Sequence[str], lab_labels: Mapping[str, str] | None
+) -> str:
+    """The trial's markers the model does not have, as a hint at a label-map typo ('' when there are none)."""
+    import difflib
+
+    unknown = [m for m in labels if m not in set(model_markers)]
+    if not unknown:
+        return ""
+    shown = []
+    for m in unknown:
+        label = (lab_labels or {}).get(m)
+        close = difflib.get_close_matches(m, model_markers, n=1)
+        shown.append(
+            (f"'{label}' mapped to {m}" if label and label != m else f"'{m}'")
+            + (f" (the model has {close[0]})" if close else "")
+        )
+    return (
+        f"; the trial's marker(s) {', '.join(shown)} are not on the model: a typo in the label map "
+        "(markers.label_map, markers.trial_label_maps)?"
+    )

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,9 +16,12 @@ import numpy as np
 
 from loper_analysis.constants import GRAVITY_M_PER_S2, LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
+from loper_analysis.io import scale_tool
 from loper_analysis.io.atomic import PathLike, staged, write_tsv
 from loper_analysis.io.readers import read_tsv
+from loper_analysis.motion.body_size import require_stature
 from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.marker_names import unknown_markers_hint
 from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
 from loper_analysis.motion.scale_report import SCALE_FLOAT_FORMAT
 from loper_analysis.study_design import PERTURBED_SIDE
@@ -369,7 +371,7 @@ def scale_with_setup(
         raise LoperInputError(f"{static_trc}: ScaleTool reads a static trial as .trc, got '{static_trc.suffix}'")
     tool = read_scale_setup(setup_xml)
     maker = tool.getGenericModelMaker()
-    marker_set = _setup_file(maker.getMarkerSetFileName(), setup_xml)
+    marker_set = scale_tool.setup_file(maker.getMarkerSetFileName(), setup_xml)
     if marker_set is not None and not marker_set.is_file():
         raise LoperInputError(
             f"{setup_xml}: GenericModelMaker/marker_set_file {maker.getMarkerSetFileName()} "
@@ -378,8 +380,8 @@ def scale_with_setup(
     generic = read_model(generic_osim)
     if marker_set is not None:
         generic.updateMarkerSet(read_marker_set(marker_set))  # as ScaleTool does: the set's markers replace or add
-    model_markers = set(_names(generic.getMarkerSet()))
-    lacking = sorted(_measurement_markers(tool) - model_markers)
+    model_markers = set(scale_tool.object_names(generic.getMarkerSet()))
+    lacking = sorted(scale_tool.measurement_markers(tool) - model_markers)
     if lacking:
         extra = f" with marker set {marker_set}" if marker_set is not None else ""
         raise LoperInputError(
@@ -388,58 +390,22 @@ def scale_with_setup(
     _run_scale_tool(tool, generic, files, marker_set, mass_kg, settings, height_m, lab_labels)
 
 
-def _unknown_markers_hint(
-    labels: Sequence[str], model_markers: Sequence[str], lab_labels: Mapping[str, str] | None
-) -> str:
-    """The trial's markers the model does not have, as a hint at a label-map typo ('' when there are none)."""
-    import difflib
-
-    unknown = [m for m in labels if m not in set(model_markers)]
-    if not unknown:
-        return ""
-    shown = []
-    for m in unknown:
-        label = (lab_labels or {}).get(m)
-        close = difflib.get_close_matches(m, model_markers, n=1)
-        shown.append(
-            (f"'{label}' mapped to {m}" if label and label != m else f"'{m}'")
-            + (f" (the model has {close[0]})" if close else "")
-        )
-    return (
-        f"; the trial's marker(s) {', '.join(shown)} are not on the model: a typo in the label map "
-        "(markers.label_map, markers.trial_label_maps)?"
-    )
-
-
-def _run_scale_tool(
-    tool,
-    generic,
-    files: ScaleFiles,
-    marker_set: Path | None,
-    mass_kg: float | None,
-    settings: ModelSettings,
-    height_m: float | None = None,
-    lab_labels: Mapping[str, str] | None = None,
-) -> None:
-    """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report
-    (:func:`scale_with_setup`; ``files.setup_xml`` None: the tool as :func:`scaled_model` built it)."""
-    import tempfile
-
-    from loper_analysis.io.opensim_tables import read_markers, trc_data_rate_hz, write_trc
-    from loper_analysis.io.osim import quiet_opensim, read_model
-    from loper_analysis.motion.scale_report import scaled_model_report
-    from loper_analysis.motion.segments import check_segment_bodies
+def _scaling_pose(tool, generic, files: ScaleFiles, settings: ModelSettings, lab_labels: Mapping[str, str] | None):
+    """The static trial's scaling window (s), the tool's own time ranges (None where unset, or all when
+    ``settings.time_range_s`` overrides them), its measurements' marker pairs and the averaged pose
+    (:func:`loper_analysis.motion.static_trial.static_pose`), each checked."""
+    from loper_analysis.io.opensim_tables import read_markers
     from loper_analysis.motion.static_trial import scale_window_s, static_pose
 
-    generic_osim, static_trc, out_osim = Path(files.generic_osim), Path(files.static_trc), files.out_osim
+    static_trc = Path(files.static_trc)
     setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
-    time_range_s, segment_bodies = settings.time_range_s, settings.segment_bodies
+    time_range_s = settings.time_range_s
     if not static_trc.is_file():
         raise LoperInputError(f"file not found: {static_trc}")
     where = str(setup_xml) if setup_xml is not None else str(static_trc)
     times, X, labels = read_markers(static_trc)
     scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
-    ranges = {part: _range(part) for part in (scaler, placer) if part.getApply()}  # None where unset
+    ranges = {part: scale_tool.time_range(part) for part in (scaler, placer) if part.getApply()}  # None where unset
     setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
     if time_range_s is not None:
         t0, t1 = map(float, time_range_s)
@@ -454,13 +420,13 @@ def _run_scale_tool(
         window = scale_window_s(
             times, list(ranges.values()), settings.static_duration_s, source=str(static_trc), setting=setting
         )
-    pairs = _measurement_pairs(tool)
+    pairs = scale_tool.measurement_pairs(tool)
     needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     lacking = [m for m in needed if m not in labels]
     if lacking:
         raise LoperInputError(
             f"{where}: measurement marker(s) {lacking} are not in the static trial {static_trc}"
-            f"{_unknown_markers_hint(labels, _names(generic.getMarkerSet()), lab_labels)}"
+            f"{unknown_markers_hint(labels, scale_tool.object_names(generic.getMarkerSet()), lab_labels)}"
         )
     pose = static_pose(
         times,
@@ -473,6 +439,12 @@ def _run_scale_tool(
         setting=setting,
         max_motion_rms_m=settings.max_motion_rms_m,
     )
+    _log_pose(pose, static_trc, window)
+    return window, ranges, pairs, pose
+
+
+def _log_pose(pose, static_trc: Path, window: tuple[float, float]) -> None:
+    """The static pose's largest marker motion, the markers filled and those left out, in the log."""
     moving = sorted(pose.motion_rms_m, key=pose.motion_rms_m.get, reverse=True)[:3]
     log.info(
         "%s: largest marker motion over the window (RMS about the mean): %s",
@@ -494,6 +466,32 @@ def _run_scale_tool(
             ", ".join(pose.left_out),
             *window,
         )
+
+
+def _run_scale_tool(
+    tool,
+    generic,
+    files: ScaleFiles,
+    marker_set: Path | None,
+    mass_kg: float | None,
+    settings: ModelSettings,
+    height_m: float | None = None,
+    lab_labels: Mapping[str, str] | None = None,
+) -> None:
+    """Window, static pose, checks and mass, then OpenSim's ScaleTool and the scale report
+    (:func:`scale_with_setup`; ``files.setup_xml`` None: the tool as :func:`scaled_model` built it)."""
+    import tempfile
+
+    from loper_analysis.io.opensim_tables import trc_data_rate_hz, write_trc
+    from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.motion.segments import check_segment_bodies
+
+    generic_osim, static_trc, out_osim = Path(files.generic_osim), Path(files.static_trc), files.out_osim
+    setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
+    segment_bodies = settings.segment_bodies
+    where = str(setup_xml) if setup_xml is not None else str(static_trc)
+    scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
+    window, ranges, pairs, pose = _scaling_pose(tool, generic, files, settings, lab_labels)
     _check_factors(generic, pairs, pose, static_trc, settings.factor_range)
     gravity = float(np.linalg.norm(generic.getGravity().to_numpy()))
     mass_kg, mass_source = _subject_mass(mass_kg, files.static_c3d, window, settings.rotation_deg, gravity)
@@ -504,7 +502,7 @@ def _run_scale_tool(
     maker.setModelFileName(str(generic_osim.resolve()))
     maker.setMarkerSetFileName(str(marker_set) if marker_set is not None else "Unassigned")
     if setup_xml is not None:
-        coordinates = _setup_file(placer.getCoordinateFileName(), setup_xml)
+        coordinates = scale_tool.setup_file(placer.getCoordinateFileName(), setup_xml)
         placer.setCoordinateFileName(str(coordinates) if coordinates is not None else "Unassigned")
     with tempfile.TemporaryDirectory(prefix="loper-scale-") as tmp_dir:
         trc = Path(tmp_dir) / "static_window.trc"
@@ -518,7 +516,7 @@ def _run_scale_tool(
         for part in (scaler, placer):
             part.setMarkerFileName(str(trc))
             own = ranges.get(part)
-            part.setTimeRange(_array(osim, own if own is not None else window))
+            part.setTimeRange(scale_tool.array_double(osim, own if own is not None else window))
         scaler.setOutputScaleFileName(str(scale_file) if scaler.getApply() else "Unassigned")
         placer.setOutputMotionFileName("Unassigned")
         placer.setOutputMarkerFileName("Unassigned")
@@ -544,31 +542,16 @@ def _run_scale_tool(
                 )
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
-            height = _subject_height(height_m, files.static_c3d, scaled, segment_bodies)
             stature = _model_stature(scaled, segment_bodies)
-            _require_stature(height, stature, static_trc)
+            height = _subject_height(height_m, files.static_c3d, stature)
+            require_stature(height, stature, str(static_trc))
             if files.report_out is not None:
                 unplaced = read_model(unplaced_file) if unplaced_file.is_file() else None
                 if unplaced is None and placer.getApply():
                     unplaced = generic  # placement without scaling: the generic markers are the ones placed
-                subject = (mass_kg, height[0], f"mass: {mass_source}; height: {height[1]}")
-                lab_static = None if files.static_lab_angles is None else _lab_static(files.static_lab_angles, window)
-                report = scaled_model_report(
-                    scaled,
-                    unplaced,
-                    pose,
-                    (_scale_factors(scale_file), _placer_tasks(placer)),
-                    subject,
-                    coordinate_map=settings.coordinate_map,
-                    accuracy=settings.accuracy,
-                    lab_labels=lab_labels,
-                    lab_static=lab_static,
-                    model_height_m=stature,
-                )
-                for text in report.loc[report["kind"] == "warning", "source"]:
-                    log.warning("%s: %s", static_trc, text)
-                write_tsv(report, files.report_out, SCALE_FLOAT_FORMAT)
-                log.info("scale report:\n%s", report.to_string(index=False))
+                subject = (mass_kg, height[0], f"mass: {mass_source}; height: {height[1]}", stature)
+                scaling = (scale_tool.read_scale_factors(scale_file), scale_tool.placer_tasks(placer))
+                _write_scale_report((scaled, unplaced), pose, scaling, subject, files, window, settings, lab_labels)
     log.info(
         "scaled %s to %s (window %.4f .. %.4f s, %d frames, %g kg)",
         generic_osim,
@@ -579,26 +562,33 @@ def _run_scale_tool(
     )
 
 
+def _write_scale_report(models, pose, scaling, subject, files: ScaleFiles, window, settings, lab_labels) -> None:
+    """The scale report (:func:`loper_analysis.motion.scale_report.scaled_model_report`) of the scaled and the
+    unplaced model, ``subject`` (mass kg, height m, their sources, the model's stature m), its warnings logged."""
+    from loper_analysis.motion.scale_report import scaled_model_report
+
+    lab_static = None if files.static_lab_angles is None else _lab_static(files.static_lab_angles, window)
+    report = scaled_model_report(
+        *models,
+        pose,
+        scaling,
+        subject[:3],
+        coordinate_map=settings.coordinate_map,
+        accuracy=settings.accuracy,
+        lab_labels=lab_labels,
+        lab_static=lab_static,
+        model_height_m=subject[3],
+    )
+    for text in report.loc[report["kind"] == "warning", "source"]:
+        log.warning("%s: %s", files.static_trc, text)
+    write_tsv(report, files.report_out, SCALE_FLOAT_FORMAT)
+    log.info("scale report:\n%s", report.to_string(index=False))
+
+
 def _lab_labels(summary_tsv: PathLike) -> dict[str, str]:
     """Model marker -> the lab's label, from the static trial's markers summary (columns ``label`` and ``marker``)."""
     table = read_tsv(summary_tsv, "markers summary", ("label", "marker"), dtype=str, keep_default_na=False)
     return dict(zip(table["marker"], table["label"]))
-
-
-def _range(part) -> tuple[float, float] | None:
-    """A model scaler's or marker placer's time range, None when unset (``-1 -1`` or reversed)."""
-    from loper_analysis.motion.static_trial import time_range_is_set
-
-    r = part.getTimeRange()
-    pair = (r.get(0), r.get(1)) if r.getSize() >= 2 else None
-    return pair if time_range_is_set(pair) else None
-
-
-def _array(osim, pair) -> object:
-    out = osim.ArrayDouble()
-    for value in pair:
-        out.append(float(value))
-    return out
 
 
 def _subject_mass(
@@ -608,93 +598,28 @@ def _subject_mass(
     rotation_deg: Sequence[float],
     gravity_m_per_s2: float = GRAVITY_M_PER_S2,
 ) -> tuple[float, str]:
-    """The subject's mass (kg) and where it came from: given, or from the static trial's force plates (weight over
-    the model's gravity)."""
-    from loper_analysis.io.force_platforms import read_force_platforms
+    """The subject's mass (kg) and where it came from (:func:`loper_analysis.motion.body_size.body_mass_kg`),
+    the static trial read when no mass is given."""
+    from loper_analysis.motion.body_size import body_mass_kg
     from loper_analysis.motion.markers import lab_up
-    from loper_analysis.motion.static_trial import standing_mass_kg
 
-    if mass_kg is not None:
-        if not 0 < mass_kg <= 300:
-            raise LoperInputError(f"mass_kg must lie in 0 .. 300 kg, got {mass_kg}")
-        return float(mass_kg), "given"
-    if static_c3d is None:
-        raise LoperInputError(
-            "no body mass: give mass_kg (subject sheet), or a static trial that stands on force plates"
-        )
-    plates = read_force_platforms(static_c3d)
-    if not plates:
-        return _file_bodymass(static_c3d, "the static trial has no force platforms (FORCE_PLATFORM:USED 0)")
-    up = lab_up(rotation_deg)
-    vertical = np.column_stack([p.force_n @ up for p in plates])
-    off = _feet_off_plates(static_c3d, plates, vertical, window, up)
-    if off:
-        return _file_bodymass(static_c3d, off)
-    mass = standing_mass_kg(plates[0].time_s, vertical, window, gravity_m_per_s2, source=str(static_c3d))
-    return mass, f"force plates {', '.join(str(p.number) for p in plates)} of {Path(static_c3d).name}"
-
-
-def _file_bodymass(static_c3d: PathLike, why: str) -> tuple[float, str]:
-    """The file's ``PROCESSING:Bodymass`` (kg) when its plates cannot weigh the subject (``why``), with where it
-    came from; a stop asking for ``mass_kg`` without it."""
-    bodymass = _processing(static_c3d).get("Bodymass")
-    if bodymass is not None and 0 < bodymass <= 300:
-        return float(bodymass), f"PROCESSING:Bodymass of {Path(static_c3d).name} ({why})"
-    raise LoperInputError(
-        f"{static_c3d}: no body mass: {why}, and the file has no PROCESSING:Bodymass; give mass_kg in the subject sheet"
-    )
-
-
-def _feet_off_plates(static_c3d: PathLike, plates, vertical_n: np.ndarray, window, up) -> str:
-    """Why the plates do not weigh the whole subject ('' when they do): foot markers of the static trial's mean
-    pose over no loaded plate (:func:`loper_analysis.motion.static_trial.markers_off_plates`)."""
-    from loper_analysis.gait.grf import LOADED_THRESHOLD_N
+    if mass_kg is not None or static_c3d is None:
+        return body_mass_kg(mass_kg)
     from loper_analysis.io.c3d import read_c3d
-    from loper_analysis.motion.static_trial import FOOT_MARKER_HEIGHT_M, markers_off_plates
+    from loper_analysis.io.force_platforms import read_force_platforms
 
-    rec = read_c3d(static_c3d)
-    t = plates[0].time_s
-    in_window = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
-    loaded = [p for j, p in enumerate(plates) if np.nanmean(vertical_n[in_window, j]) > LOADED_THRESHOLD_N]
-    floor = float(np.mean([p.corners_m @ up for p in plates]))
-    frames = (rec.time_s >= window[0] - 1e-9) & (rec.time_s <= window[1] + 1e-9)
-    if not frames.any() or not len(rec.marker_labels):
-        return ""
-    with np.errstate(invalid="ignore"), warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # a marker missing throughout: NaN, skipped
-        pose = np.nanmean(rec.markers_m[frames], axis=0)
-    _, off = markers_off_plates(pose, rec.marker_labels, [p.corners_m for p in loaded], up, floor)
-    if not off:
-        return ""
-    numbers = ", ".join(str(p.number) for p in loaded) or "none"
-    return (
-        f"the plates do not carry the whole subject: foot markers {', '.join(off)} (lower than "
-        f"{FOOT_MARKER_HEIGHT_M} m) stand beside the loaded plates ({numbers}) in the scaling window"
-    )
+    rec, plates = read_c3d(static_c3d), read_force_platforms(static_c3d)
+    return body_mass_kg(None, rec, plates, window, lab_up(rotation_deg), gravity_m_per_s2)
 
 
-def _processing(static_c3d: PathLike) -> dict[str, float]:
-    """The ``PROCESSING`` parameters of a C3D file (Nexus: ``Bodymass`` kg, ``Height`` mm)."""
+def _subject_height(height_m: float | None, static_c3d: PathLike | None, stature_m: float) -> tuple[float, str]:
+    """The subject's height (m) and where it came from (:func:`loper_analysis.motion.body_size.body_height_m`)."""
     from loper_analysis.io.c3d import read_c3d
+    from loper_analysis.motion.body_size import body_height_m
 
-    return read_c3d(static_c3d).processing
-
-
-def _subject_height(height_m: float | None, static_c3d: PathLike | None, scaled, segment_bodies) -> tuple[float, str]:
-    """The subject's height (m) and where it came from: given, the static trial's ``PROCESSING:Height`` (mm, as
-    Nexus writes it), or estimated from the scaled model
-    (:func:`loper_analysis.motion.static_trial.model_height_m`)."""
-    from loper_analysis.motion.segments import segment_body_names
-    from loper_analysis.motion.static_trial import model_height_m
-
-    if height_m is not None:
-        return float(height_m), "given"
-    if static_c3d is not None:
-        height_mm = _processing(static_c3d).get("Height")
-        if height_mm is not None and 500 <= height_mm <= 2500:
-            return height_mm / 1000.0, f"PROCESSING:Height of {Path(static_c3d).name}"
-    thigh = segment_body_names(scaled, "r", segment_bodies)["thigh"][0]
-    return model_height_m(scaled, thigh), "estimated from the scaled model"
+    if height_m is not None or static_c3d is None:
+        return body_height_m(height_m, {}, stature_m, "")
+    return body_height_m(None, read_c3d(static_c3d).processing, stature_m, Path(static_c3d).name)
 
 
 def _model_stature(scaled, segment_bodies) -> float:
@@ -705,92 +630,9 @@ def _model_stature(scaled, segment_bodies) -> float:
     return model_height_m(scaled, segment_body_names(scaled, "r", segment_bodies)["thigh"][0])
 
 
-def _require_stature(height: tuple[float, str], stature_m: float, static_trc: PathLike) -> None:
-    """Refuse a scaled model whose stature differs from a height given (sheet or file) by more than
-    :data:`loper_analysis.motion.scale_report.STOP_STATURE_CHANGE`: another subject's static trial."""
-    from loper_analysis.motion.scale_report import STOP_STATURE_CHANGE, stature_change
-
-    if height[1] == "estimated from the scaled model":
-        return
-    change = stature_change(height[0], stature_m)
-    if np.isfinite(change) and abs(change) > STOP_STATURE_CHANGE:
-        raise LoperInputError(
-            f"{static_trc}: the model scaled to this static trial stands {stature_m:.2f} m tall where the "
-            f"subject's height is {height[0]:.2f} m ({height[1]}; {100 * change:+.0f} %, more than "
-            f"{100 * STOP_STATURE_CHANGE:.0f} %): is the static trial this subject's, and the height in the "
-            "subject sheet (height_m) right?"
-        )
-
-
 def _lab_static(lab_angles_tsv: PathLike, window: tuple[float, float]) -> dict[str, float]:
-    """The lab's own joint angles of the static trial (rad), averaged over the scaling window."""
-    table = read_tsv(lab_angles_tsv, "lab angles", ("time_s",))
-    if not len(table):
-        return {}
-    t = table["time_s"].to_numpy(float)
-    inside = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
-    return (
-        {c.removesuffix("_rad"): float(np.nanmean(table.loc[inside, c])) for c in table.columns if c.endswith("_rad")}
-        if inside.any()
-        else {}
-    )
+    """The lab's own joint angles of the static trial (rad), averaged over the scaling window
+    (:func:`loper_analysis.motion.lab_angles.window_means`)."""
+    from loper_analysis.motion.lab_angles import window_means
 
-
-def _scale_factors(scale_file: Path) -> dict[str, tuple[float, float, float]]:
-    """Body -> scale factors (x, y, z) of the ScaleSet OpenSim wrote (empty when it wrote none)."""
-    from loper_analysis.io.osim import quiet_opensim
-
-    if not scale_file.is_file():
-        return {}
-    osim = quiet_opensim()
-    scales = osim.ScaleSet(str(scale_file))
-    out = {}
-    for i in range(scales.getSize()):
-        sc = scales.get(i)
-        if sc.getApply():
-            f = sc.getScaleFactors()
-            out[sc.getSegmentName()] = (f.get(0), f.get(1), f.get(2))
-    return out
-
-
-def _placer_tasks(placer) -> tuple[dict[str, float], dict] | None:
-    """Marker weights and coordinate tasks of the marker placer (None when it does not apply)."""
-    from loper_analysis.io.ik_tasks import task_set_tasks
-
-    if not placer.getApply():
-        return None
-    return task_set_tasks(placer.getIKTaskSet(), "MarkerPlacer/IKTaskSet")
-
-
-def _names(object_set) -> list[str]:
-    return [object_set.get(i).getName() for i in range(object_set.getSize())]
-
-
-def _setup_file(name: str, setup_xml: Path) -> Path | None:
-    """A file named in a setup, relative to the setup's folder (as OpenSim reads it); None when unset."""
-    name = (name or "").strip()
-    if name in ("", "Unassigned"):
-        return None
-    path = Path(name)
-    return (path if path.is_absolute() else setup_xml.parent / path).resolve()
-
-
-def _measurement_pairs(tool) -> dict[str, list[tuple[str, str]]]:
-    """Marker pairs of each applied measurement of a ScaleTool (empty when its model scaler does not measure)."""
-    scaler = tool.getModelScaler()
-    order = scaler.getScalingOrder()
-    if not scaler.getApply() or "measurements" not in [order.get(i) for i in range(order.getSize())]:
-        return {}
-    out: dict[str, list[tuple[str, str]]] = {}
-    measurements = scaler.getMeasurementSet()
-    for i in range(measurements.getSize()):
-        m = measurements.get(i)
-        if m.getApply():
-            pairs = [m.getMarkerPair(j) for j in range(m.getNumMarkerPairs())]
-            out[m.getName()] = [(p.getMarkerName(0), p.getMarkerName(1)) for p in pairs]
-    return out
-
-
-def _measurement_markers(tool) -> set[str]:
-    """Markers of the applied measurements of a ScaleTool (empty when its model scaler does not measure)."""
-    return {m for pairs in _measurement_pairs(tool).values() for pair in pairs for m in pair}
+    return window_means(read_tsv(lab_angles_tsv, "lab angles", ("time_s",)), window)
