@@ -10,9 +10,10 @@ from loper_analysis.cli import main
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import quiet_opensim, write_model
+from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
-from loper_analysis.swing_leg.dynamics import read_segments, segment_parameters_from_anthropometry
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 
 def test_segments_command_writes_winter_table(tmp_path):

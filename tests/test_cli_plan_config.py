@@ -197,7 +197,7 @@ def test_validation_defaults_of_the_library_are_the_configs():
 
 def test_validate_command_runs_with_the_configs_settings(project, capsys):
     """One K/D level (one combination): the config's levels reach the chunk, the option --n-starts wins."""
-    from loper_analysis.swing_leg.dynamics import write_segments
+    from loper_analysis.io.segment_table import write_segments
     from tests.parameter_sets import WINTER
 
     write_segments(WINTER, project / "segments.tsv")

@@ -19,10 +19,10 @@ from loper_analysis.cli import main
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
+from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.steps.model import ScaleFiles, scale_with_setup
-from loper_analysis.swing_leg.dynamics import read_segments
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[1]

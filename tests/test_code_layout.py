@@ -91,3 +91,37 @@ def test_no_file_step_imports_another():
                     and m.split(".")[2] != p.stem
                 ]
     assert found == []
+
+
+#: Calls that read or write a file (or ask the file system), which only the file layer makes.
+FILE_CALLS = re.compile(
+    r"\b(open|read_text|write_text|read_bytes|write_bytes|to_csv|read_csv|is_file|exists|read_c3d|"
+    r"read_\w+|write_\w+)\("
+)
+#: The file layer: formats, the file steps, the command line and the config's readers.
+FILE_LAYER = ("io/", "steps/", "cli.py", "cli_parser.py", "cli_checks.py", "config_file.py", "schema.py")
+
+
+def test_no_library_module_outside_the_file_layer_opens_a_file():
+    """Below the file layer functions take arrays, tables, recordings and models, never paths."""
+    src = ROOT / "src" / "loper_analysis"
+    found = []
+    for path in sorted(src.rglob("*.py")):
+        rel = path.relative_to(src).as_posix()
+        if rel.startswith(FILE_LAYER):
+            continue
+        tree = ast.parse(path.read_text())
+        code = "\n".join(
+            ast.get_source_segment(path.read_text(), node) or ""
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Call)
+        )
+        found += [f"{rel}: {m}" for m in sorted(set(FILE_CALLS.findall(code)))]
+    assert found == []
+
+
+def test_the_file_layer_check_sees_a_file_read():
+    assert FILE_CALLS.findall("x = read_force_platforms(path, up); Path(p).read_text()") == [
+        "read_force_platforms",
+        "read_text",
+    ]

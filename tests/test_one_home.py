@@ -22,14 +22,13 @@ from loper_analysis.gait import events, outliers, strides
 from loper_analysis.gait.outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, iqr_outliers
 from loper_analysis.identification import t_quantile
 from loper_analysis.io.atomic import write_tsv
-from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT
+from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments, write_segments
 from loper_analysis.planning.precision import StrideCovariance
 from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.steps import strides as stride_steps
 from loper_analysis.steps import transparency as transparency_step
 from loper_analysis.steps.strides import StrideSettings
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
-from loper_analysis.swing_leg.dynamics import read_segments, write_segments
 from tests.parameter_sets import ASYMMETRIC
 
 ROOT = Path(__file__).resolve().parents[1]

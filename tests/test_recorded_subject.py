@@ -23,9 +23,9 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
+from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
-from loper_analysis.swing_leg.dynamics import read_segments
 from tests.workflow_copy import copy_workflow, snakemake
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)

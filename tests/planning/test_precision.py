@@ -39,6 +39,7 @@ from loper_analysis.identification import (
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
 from loper_analysis.identification.intervals import t_quantile
 from loper_analysis.io.atomic import write_tsv
+from loper_analysis.io.segment_table import write_segments
 from loper_analysis.planning.inputs import pilot_onset_series, trial_stretches
 from loper_analysis.planning.precision import (
     MIN_PERTURBED_PAIRS,
@@ -58,7 +59,7 @@ from loper_analysis.planning.precision import (
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.responses.conditional import shared_weight_terms, unit_scatter_variance
-from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry, write_segments
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.response import thigh_normal
 

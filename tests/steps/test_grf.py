@@ -8,6 +8,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.grf import external_loads_columns, plate_vertical_loads
 from loper_analysis.io.c3d import read_c3d
+from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.steps.grf import GRFSettings, grf
 from tests.io.force_plate_files import (
     channels_for_load,
@@ -104,7 +105,7 @@ def test_known_point_load_through_the_step(tmp_path):
     np.testing.assert_array_equal(got[:60, [0, 1, 2, 6, 7, 8]], 0.0)
     np.testing.assert_allclose(got[:60, 3:6], np.tile(point / 1000.0, (60, 1)), atol=1e-7)  # held at the contact
     np.testing.assert_allclose(table["time_s"].to_numpy()[[0, -1]], [0.0, 99 / 1000.0], atol=1e-12)
-    vl = plate_vertical_loads(c3d, rotation_deg=(0, 0, 0))
+    vl = plate_vertical_loads(read_force_platforms(c3d), rotation_deg=(0, 0, 0))
     assert vl.rest_vertical_n[0] == pytest.approx(-40.0, abs=1e-4)
     np.testing.assert_allclose(vl.vertical_n[[0, 99], 0], [0.0, 700.0], atol=1e-3)
     np.testing.assert_allclose(vl.corners_m[0], plate_corners_mm() / 1000.0, atol=1e-9)

@@ -7,6 +7,7 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
+from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.ik import marker_positions, markers_table
 from loper_analysis.motion.model import (
     MARKERS,
@@ -19,7 +20,7 @@ from loper_analysis.steps.model import (
     scaled_model,
     segments_from_model_file,
 )
-from loper_analysis.swing_leg.dynamics import read_segments, segment_parameters_from_anthropometry
+from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 
 @pytest.fixture(scope="module")

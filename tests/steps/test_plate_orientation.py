@@ -156,7 +156,10 @@ def test_reversed_corners_give_the_known_load_and_the_usual_reading(files, tmp_p
             got[:, 6:9], np.column_stack([0 * free, 0 * free, free])[loaded], rtol=0, atol=2e-3
         )  # N·m, about +z
         np.testing.assert_array_equal(other[cols].to_numpy()[~loaded][:, [0, 1, 2, 6, 7, 8]], 0.0)
-    vl_usual, vl_other = plate_vertical_loads(files["z-up"], (0, 0, 0)), plate_vertical_loads(files[name], (0, 0, 0))
+    vl_usual, vl_other = (
+        plate_vertical_loads(read_force_platforms(files["z-up"]), (0, 0, 0)),
+        plate_vertical_loads(read_force_platforms(files[name]), (0, 0, 0)),
+    )
     np.testing.assert_allclose(vl_other.vertical_n, vl_usual.vertical_n, rtol=0, atol=1e-9)
     np.testing.assert_allclose(vl_other.rest_vertical_n, REST_FORCE_N[2], atol=1e-4)
 

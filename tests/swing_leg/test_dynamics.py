@@ -22,6 +22,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import prepare_window, simulate_response
 from loper_analysis.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
+from loper_analysis.io.segment_table import read_segments, write_segments
 from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     attachment_jacobian,
@@ -33,11 +34,9 @@ from loper_analysis.swing_leg.dynamics import (
     inverse_dynamics,
     joint_angles,
     mass_matrix,
-    read_segments,
     segment_com_positions,
     segment_coordinates,
     simulate,
-    write_segments,
 )
 from tests.parameter_sets import ASYMMETRIC, WINTER
 

@@ -48,14 +48,13 @@ Rotation to the model frame (:func:`external_loads_table`)
     :func:`loper_analysis.motion.markers.rotate_markers` (``(-90, 0, 0)`` takes a
     Z-up lab into OpenSim's Y-up frame).
 
-From a C3D file (:func:`read_plate_loads`, :func:`plate_vertical_loads`)
+From a recording's force platforms (:func:`plates_loads`, :func:`plate_vertical_loads`)
     Every plate of a file read (:func:`loper_analysis.io.force_platforms.read_force_platforms`)
     and analysed as above; shared by the ``grf`` and ``events`` steps.
 """
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -78,7 +77,7 @@ __all__ = [
     "external_loads_table",
     "plate_loads",
     "plate_vertical_loads",
-    "read_plate_loads",
+    "plates_loads",
     "resting_level",
     "surface_normal",
     "up_vector",
@@ -544,23 +543,21 @@ def vertical_loads(loads: Sequence[PlateLoads], rotation_deg: Sequence[float] = 
     )
 
 
-def read_plate_loads(
-    c3d_path: str | os.PathLike,
+def plates_loads(
+    plates: Sequence,
     threshold_n: float,
     band_n: float,
     max_rest_n: float,
     up: Sequence[float] | None = None,
+    source: str = "",
 ) -> list[PlateLoads]:
-    """Every plate of a C3D file read and analysed (:func:`plate_loads`), lab frame.
+    """Every plate of a recording analysed (:func:`plate_loads`), lab frame.
 
-    ``up``: the lab's up direction, lab frame (None: lab +Z); a plate more than
-    :data:`MAX_TILT_DEG` from level is refused, naming the file, the plate, its
-    normal and ``up``.
+    ``plates``: the recording's force platforms (:func:`loper_analysis.io.force_platforms.read_force_platforms`,
+    read with the same ``up``). ``up``: the lab's up direction, lab frame (None: lab +Z); a plate more than
+    :data:`MAX_TILT_DEG` from level is refused, naming ``source`` (the file), the plate, its normal and ``up``.
     """
-    from loper_analysis.io.force_platforms import read_force_platforms
-
-    lab_up = up_vector(LAB_Z_UP if up is None else up, str(c3d_path))
-    plates = read_force_platforms(c3d_path, lab_up)
+    lab_up = up_vector(LAB_Z_UP if up is None else up, source)
     return [
         plate_loads(
             p.number,
@@ -571,7 +568,7 @@ def read_plate_loads(
             threshold_n,
             band_n,
             max_rest_n,
-            source=f"{c3d_path} (force platform {p.number})",
+            source=f"{source} (force platform {p.number})",
             up=lab_up,
         )
         for p in plates
@@ -579,16 +576,16 @@ def read_plate_loads(
 
 
 def plate_vertical_loads(
-    c3d_path: str | os.PathLike,
+    plates: Sequence,
     rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
     band_n: float = RESTING_BAND_N,
     max_rest_n: float = MAX_RESTING_N,
     up: Sequence[float] | None = None,
+    source: str = "",
 ) -> VerticalLoads:
-    """Each plate of a C3D file: its lab-vertical force above its resting level at the analog rate, corners in the
-    model frame (:func:`vertical_loads` of :func:`read_plate_loads`).
+    """Each plate of a recording: its lab-vertical force above its resting level at the analog rate, corners in
+    the model frame (:func:`vertical_loads` of :func:`plates_loads`).
 
-    ``up``: the lab's up direction, lab frame (None: lab +Z), as in
-    :func:`read_plate_loads`. Reads only (writes nothing).
+    ``plates`` and ``up`` (the lab's up direction, lab frame; None: lab +Z) as in :func:`plates_loads`.
     """
-    return vertical_loads(read_plate_loads(c3d_path, 20.0, band_n, max_rest_n, up), rotation_deg)
+    return vertical_loads(plates_loads(plates, 20.0, band_n, max_rest_n, up, source), rotation_deg)

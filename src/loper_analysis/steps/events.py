@@ -285,6 +285,7 @@ def _plate_events(rec, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
     """
     from loper_analysis.gait.contacts import PlateForce, contact_events, foot_contacts
     from loper_analysis.gait.grf import plate_vertical_loads
+    from loper_analysis.io.force_platforms import read_force_platforms
     from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
     from loper_analysis.motion.markers import MODEL_UP, lab_up, rotate_markers
 
@@ -294,7 +295,10 @@ def _plate_events(rec, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
         raise LoperInputError(f"{source}: force platforms need the heel marker of each foot (events.foot_markers)")
     names = model_marker_names(rec.marker_labels, read_label_maps(s.label_map), source)
     require_model_markers(names, [foot_markers[side] for side in SIDES], source, rec.marker_labels)
-    loads = plate_vertical_loads(c3d_path, rotation_deg, s.band_n, s.max_rest_n, up=lab_up(rotation_deg))
+    up = lab_up(rotation_deg)
+    loads = plate_vertical_loads(
+        read_force_platforms(c3d_path, up), rotation_deg, s.band_n, s.max_rest_n, up=up, source=str(c3d_path)
+    )
     plates = [
         PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i]) for i, n in enumerate(loads.numbers)
     ]

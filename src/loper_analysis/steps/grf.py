@@ -88,11 +88,14 @@ def grf(
     more than 45 deg from level is refused, naming the file, the plate, its normal and ``up``.
     Returns the table written (``time_s`` plus nine columns per plate).
     """
-    from loper_analysis.gait.grf import external_loads_table, read_plate_loads
+    from loper_analysis.gait.grf import external_loads_table, plates_loads, up_vector
     from loper_analysis.io.external_loads import write_external_loads_mot, write_external_loads_xml
+    from loper_analysis.io.force_platforms import read_force_platforms
 
     s = settings
-    loads = read_plate_loads(c3d_path, s.threshold_n, s.band_n, s.max_rest_n, up)
+    lab_up = None if up is None else up_vector(up, str(c3d_path))
+    plates = read_force_platforms(c3d_path, lab_up)
+    loads = plates_loads(plates, s.threshold_n, s.band_n, s.max_rest_n, up, str(c3d_path))
     table = external_loads_table(loads, s.rotation_deg)
     write_external_loads_mot(out_mot, table)
     if xml_out is not None and bodies:

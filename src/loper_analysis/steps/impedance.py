@@ -173,7 +173,7 @@ def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, ta
     """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
     from loper_analysis.identification.impedance import fit_onset
     from loper_analysis.io.opensim_tables import read_markers
-    from loper_analysis.swing_leg.dynamics import read_segments
+    from loper_analysis.io.segment_table import read_segments
 
     truth = None
     if files.truth:

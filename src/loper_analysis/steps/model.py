@@ -19,6 +19,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io import scale_tool
 from loper_analysis.io.atomic import PathLike, staged, write_tsv
 from loper_analysis.io.readers import read_tsv
+from loper_analysis.io.segment_table import write_segments
 from loper_analysis.motion.body_size import require_stature
 from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.marker_names import unknown_markers_hint
@@ -29,7 +30,6 @@ from loper_analysis.swing_leg.dynamics import (
     BRACE_ATTACHMENT_FRACTION,
     SegmentParameters,
     segment_parameters_from_anthropometry,
-    write_segments,
 )
 
 __all__ = [
@@ -254,7 +254,7 @@ def segments_from_model_file(
         A (scaled) ``.osim`` model: gait2392, Rajagopal2016, our generated
         model or any model whose bodies ``settings.segment_bodies`` names.
     out_tsv : path
-        The table (:func:`loper_analysis.swing_leg.dynamics.write_segments`), written atomically.
+        The table (:func:`loper_analysis.io.segment_table.write_segments`), written atomically.
     settings : ModelSettings
         ``side`` (the swing leg, ``"left"`` or ``"right"``), ``segment_bodies`` (segment -> body names with
         ``{s}`` for the side suffix, setting ``opensim.segment_bodies``; ``None``: the model's own kind) and

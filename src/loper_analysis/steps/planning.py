@@ -249,6 +249,7 @@ def plan(
     (pandas.DataFrame, list of str)
         The table and the answers.
     """
+    from loper_analysis.io.segment_table import read_segments
     from loper_analysis.planning.inputs import pilot_onset_series
     from loper_analysis.planning.precision import (
         conditional_stride_covariance,
@@ -261,7 +262,6 @@ def plan(
         unplanned_rows,
     )
     from loper_analysis.responses import null_pair_windows
-    from loper_analysis.swing_leg.dynamics import read_segments
 
     if unplannable not in ("raise", "note"):
         raise LoperInputError(f"unplannable must be 'raise' or 'note', got {unplannable!r}")

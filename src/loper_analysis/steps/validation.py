@@ -31,7 +31,7 @@ def validation_chunk(
         impedance_grid,
         run_validation_chunk,
     )
-    from loper_analysis.swing_leg.dynamics import read_segments
+    from loper_analysis.io.segment_table import read_segments
 
     study = ValidationSettings(**settings)
     log.info("chunk %d of %d with %s", chunk, n_chunks, study)

@@ -19,7 +19,6 @@ checked, vectorised NumPy API and a reference forward simulation on SciPy's
 
 from __future__ import annotations
 
-import os
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -38,8 +37,6 @@ from loper_analysis.swing_leg.anthropometry import (
 __all__ = [
     "BRACE_ATTACHMENT_FRACTION",
     "SegmentParameters",
-    "read_segments",
-    "write_segments",
     "segment_parameters_from_anthropometry",
     "mass_matrix",
     "coriolis_forces",
@@ -190,21 +187,6 @@ class SegmentParameters:
             )
         except LoperInputError as exc:
             raise LoperInputError(f"{source}: {exc}") from exc
-
-
-def write_segments(params: SegmentParameters, path: str | os.PathLike) -> None:
-    """Write the segment table (:meth:`SegmentParameters.to_frame`) as TSV
-    (:func:`loper_analysis.io.segment_table.write_segment_table`)."""
-    from loper_analysis.io.segment_table import write_segment_table
-
-    write_segment_table(params.to_frame(), path)
-
-
-def read_segments(path: str | os.PathLike) -> SegmentParameters:
-    """The segment table written by :func:`write_segments`."""
-    from loper_analysis.io.segment_table import read_segment_table
-
-    return SegmentParameters.from_frame(read_segment_table(path), source=str(path))
 
 
 def segment_parameters_from_anthropometry(
