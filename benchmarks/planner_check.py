@@ -20,13 +20,13 @@ is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the tab
 
 ``--counterfactual conditional`` (the workflow's default; without the option the study's matched stride) plans
 and fits with the conditional counterfactual instead: the prediction is
-:func:`loper_analysis.planning.precision.conditional_stride_covariance` of the pilot (its cross-validated null
+:func:`loper_analysis.planning.covariance.conditional_stride_covariance` of the pilot (its cross-validated null
 pairs and its perturbed strides' prediction weights), the fits are the pipeline's defaults (averaging term,
 intervals from the cross-validated null pairs); as for the matched stride each repeat is its trial cut after
 its N-th perturbed stride, so its candidates (the unperturbed strides of the cut trial) grow with N, as the
 planner assumes; the prediction for the repeats is the mean of ``sd_of(n_i)^2`` over them. For a count N the
 pilot holds at least twice, the workflow's plan and this prediction come from the pilot's stretches of N perturbed
-strides (:func:`loper_analysis.planning.precision.stretch_covariances`; ``predicted_from`` says which, and
+strides (:func:`loper_analysis.planning.covariance.stretch_covariances`; ``predicted_from`` says which, and
 ``whole_pilot_predicted_sd`` gives the whole pilot's extrapolation beside it). Repeats whose fit
 fails or falls back to the matched stride (fewer than ``identification.min_null_pairs`` candidates) are left
 out and listed.
@@ -53,14 +53,9 @@ from scipy.stats import t as student_t
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
-from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL, pilot_onset_series
-from loper_analysis.planning.precision import (
-    PlanSettings,
-    conditional_stride_covariance,
-    pilot_perturbed_pairs,
-    stretch_covariances,
-    stride_covariance,
-)
+from loper_analysis.planning.covariance import conditional_stride_covariance, stretch_covariances, stride_covariance
+from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL, pilot_onset_series, pilot_perturbed_pairs
+from loper_analysis.planning.window import PlanSettings
 from loper_analysis.report.markdown import markdown_table
 from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry

@@ -20,7 +20,7 @@ import yaml
 from loper_analysis.cli import _plan_pilot, _plan_settings, _read_config, command_parser, main
 from loper_analysis.config_file import find_schema, load_config, update_config
 from loper_analysis.errors import LoperInputError
-from loper_analysis.planning.precision import PlanSettings
+from loper_analysis.planning.window import PlanSettings
 from loper_analysis.steps.planning import PlanningSettings
 
 ROOT = Path(__file__).resolve().parents[1]

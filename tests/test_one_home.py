@@ -23,7 +23,7 @@ from loper_analysis.gait.outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STR
 from loper_analysis.identification import t_quantile
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments, write_segments
-from loper_analysis.planning.precision import StrideCovariance
+from loper_analysis.planning.covariance import StrideCovariance
 from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.steps import strides as stride_steps
 from loper_analysis.steps import transparency as transparency_step

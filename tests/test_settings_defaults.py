@@ -31,7 +31,7 @@ from loper_analysis.identification import (
 )
 from loper_analysis.identification.impedance import IdentificationSettings, impedance_rows
 from loper_analysis.identification.validation import ValidationSettings, validation_settings
-from loper_analysis.planning.precision import PlanSettings
+from loper_analysis.planning.window import PlanSettings
 from loper_analysis.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 

@@ -40,22 +40,17 @@ from loper_analysis.identification.impedance import IdentificationSettings, fit_
 from loper_analysis.identification.intervals import t_quantile
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import write_segments
-from loper_analysis.planning.inputs import pilot_onset_series, trial_stretches
-from loper_analysis.planning.precision import (
+from loper_analysis.planning.covariance import (
     MIN_PERTURBED_PAIRS,
-    PlanSettings,
     StrideCovariance,
     conditional_stride_covariance,
-    pilot_perturbed_pairs,
-    planning_window,
     pool_onsets,
-    precision_table,
-    pulse_force_n,
     stretch_covariances,
     stride_covariance,
-    strides_needed,
-    target_answer,
 )
+from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs, pulse_force_n, trial_stretches
+from loper_analysis.planning.precision import precision_table, strides_needed, target_answer
+from loper_analysis.planning.window import PlanSettings, planning_window
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.responses.conditional import shared_weight_terms, unit_scatter_variance
@@ -507,7 +502,7 @@ def test_shared_weight_terms_predict_the_mean_weight_of_n_pairs():
 def test_conditional_plan_at_the_pilot_s_own_strides_is_the_fit_s_interval_formula(params, conditional_series):
     """For as many strides as the pilot kept, the planned SD is the fit's own: the cross-validated covariance
     of the null pairs' errors times their covariance scale (refit_with_null_pairs), at the same window."""
-    from loper_analysis.planning.precision import planning_window
+    from loper_analysis.planning.window import planning_window
 
     sc = conditional_stride_covariance(conditional_series, params, TRUTH)
     null, n = conditional_series["null_pairs"], int(conditional_series["pairs"]["n_pairs"])

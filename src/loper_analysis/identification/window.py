@@ -119,7 +119,7 @@ def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.nd
 
 
 #: Fields of a settings object (:class:`~loper_analysis.identification.validation.ValidationSettings`,
-#: :class:`~loper_analysis.planning.precision.PlanSettings`) that :func:`prepare_window` takes by name.
+#: :class:`~loper_analysis.planning.window.PlanSettings`) that :func:`prepare_window` takes by name.
 WINDOW_FIELDS: tuple[str, ...] = (
     "window_before_s",
     "window_after_s",

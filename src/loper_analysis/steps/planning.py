@@ -9,7 +9,7 @@ strides at an onset give that onset's perturbed pairs), its segment table
 the answers to the targets (method: ``docs/planning.md``; with the conditional
 counterfactual, counts the pilot holds at least twice at an onset are planned
 from its stretches of that size,
-:func:`loper_analysis.planning.precision.stretch_covariances`), with the settings
+:func:`loper_analysis.planning.covariance.stretch_covariances`), with the settings
 :class:`PlanningSettings`, which the rule ``planning`` and ``loper-analysis
 plan`` both build with :meth:`PlanningSettings.from_config`.
 """
@@ -29,7 +29,7 @@ from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_text, write_tsv
 from loper_analysis.io.readers import read_tsv
-from loper_analysis.planning.precision import PlanSettings
+from loper_analysis.planning.window import PlanSettings
 from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings
 
 __all__ = ["STRIDES", "PlanningSettings", "PilotTrial", "PilotFiles", "plan", "planned_impedance"]
@@ -40,7 +40,7 @@ log = logging.getLogger(__name__)
 STRIDES: tuple[int, ...] = (10, 20, 40)
 
 #: Identification settings the planner follows (keys of config ``identification``; fields of
-#: :class:`~loper_analysis.planning.precision.PlanSettings`).
+#: :class:`~loper_analysis.planning.window.PlanSettings`).
 _PLAN_KEYS = (
     "window_before_s",
     "window_after_s",
@@ -71,12 +71,12 @@ class PlanningSettings:
         optionally ``onset_ms`` (else every onset).
     plan : PlanSettings
         The planned pulse (N, s) and the identification settings the prediction follows
-        (:class:`~loper_analysis.planning.precision.PlanSettings`).
+        (:class:`~loper_analysis.planning.window.PlanSettings`).
     response : ResponseSettings
         How the pilot's pairs are windowed and judged (:class:`~loper_analysis.responses.ResponseSettings`),
         and the counterfactual planned for: ``conditional`` (the default) takes the fit's cross-validated null
         pairs, ``matched_stride`` the scatter of the pilot's perturbed pairs
-        (:func:`~loper_analysis.planning.precision.conditional_stride_covariance`).
+        (:func:`~loper_analysis.planning.covariance.conditional_stride_covariance`).
     device : DeviceParameters
         The device (:class:`~loper_analysis.device.controller.DeviceParameters`).
     max_null_trial_ratio : float or None
@@ -167,7 +167,7 @@ class PilotFiles:
 
     ``trials``: the pilot's trials walked with the device (name -> :class:`PilotTrial`): their unperturbed
     strides are the null pairs; the perturbed strides of the trials at an onset are its perturbed pairs
-    (:func:`loper_analysis.planning.precision.pilot_perturbed_pairs`), whose scatter the prediction takes
+    (:func:`loper_analysis.planning.inputs.pilot_perturbed_pairs`), whose scatter the prediction takes
     (the null pairs' when there are none, with a note in the rows). ``segments``: the segment table of the
     subject to plan for (the pilot's, or another subject's). ``impedance``: impedance rows
     (``results/impedance/{subject}/{onset}.tsv`` or ``results/impedance/impedance.tsv``) whose pilot estimates
@@ -242,7 +242,7 @@ def plan(
     pool_scatter
         With perturbed pairs at two or more onsets, their excess scatter over
         the null pairs is pooled over the onsets
-        (:func:`loper_analysis.planning.precision.pool_onsets`); False: each onset its own.
+        (:func:`loper_analysis.planning.covariance.pool_onsets`); False: each onset its own.
 
     Returns
     -------
@@ -250,17 +250,14 @@ def plan(
         The table and the answers.
     """
     from loper_analysis.io.segment_table import read_segments
-    from loper_analysis.planning.inputs import pilot_onset_series
-    from loper_analysis.planning.precision import (
+    from loper_analysis.planning.covariance import (
         conditional_stride_covariance,
-        pilot_perturbed_pairs,
         pool_onsets,
-        precision_table,
         stretch_covariances,
         stride_covariance,
-        target_answer,
-        unplanned_rows,
     )
+    from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs
+    from loper_analysis.planning.precision import precision_table, target_answer, unplanned_rows
     from loper_analysis.responses import null_pair_windows
 
     if unplannable not in ("raise", "note"):

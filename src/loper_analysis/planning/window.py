@@ -1,0 +1,171 @@
+"""The planned experiment as the fit would see it: the planner's settings and its identification window
+(method: ``docs/planning.md``).
+
+* :class:`PlanSettings` - the planned pulse, impedance and the fit's window and bounds;
+* :func:`planning_window` - the identification window of the planned experiment: the pilot's mean
+  unperturbed swing as the reference, the pulse along the thigh normal.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from loper_analysis.checks import number
+from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.identification import (
+    FitBounds,
+    PreparedWindow,
+    check_interval_scatter,
+    prepare_window,
+    window_options,
+)
+from loper_analysis.planning.inputs import pulse_force_n
+from loper_analysis.swing_leg.dynamics import SegmentParameters
+
+__all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
+
+
+@dataclass(frozen=True)
+class PlanSettings(FitBounds):
+    """The planned pulse and the identification settings the prediction follows (config ``identification``).
+
+    ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
+    onset; ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
+    (s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
+    ``min_null_pairs``, ``interval_scatter`` (whose scatter the fit's
+    intervals take, hence their t quantile) and the bounds (N·m/rad,
+    N·m·s/rad) as the fit uses them; ``force_cutoff_hz`` and ``force_order``
+    the load cell's low-pass; ``force_rate_hz`` the rate of the pulse given
+    to the fit (the robot log's).
+    """
+
+    pulse_force_n: float = 40.0
+    pulse_duration_s: float = 0.1
+    window_before_s: float = 0.025
+    window_after_s: float = 0.25
+    initial_state_span_s: float = 0.1
+    initial_state_degree: int = 1
+    n_substeps: int = 2
+    null_pair_components: int = 6
+    min_null_pairs: int = 30
+    interval_scatter: str = "cross_validated_null_pairs"
+    stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
+    damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
+    force_cutoff_hz: float = 40.0
+    force_order: int = 4
+    force_rate_hz: float = 1000.0
+
+    def __post_init__(self):
+        number("pulse_force_n", self.pulse_force_n)
+        check_interval_scatter(self.interval_scatter)
+        if number("force_rate_hz", self.force_rate_hz) <= 0:
+            raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
+        d = number("pulse_duration_s", self.pulse_duration_s)
+        after = number("window_after_s", self.window_after_s, minimum=0.0)
+        if d <= 0:
+            raise LoperInputError(f"pulse_duration_s must be > 0 s, got {d:g} s")
+        if d > after:
+            raise LoperInputError(
+                f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
+                f"(identification.window_after_s = {after:g} s): the fit would not see its end"
+            )
+
+
+def planning_window(
+    null_pairs: Mapping,
+    params: SegmentParameters,
+    settings: PlanSettings = PlanSettings(),
+    device=None,
+    source: str = "pilot",
+) -> PreparedWindow:
+    """The identification window of the planned experiment (onset at t = 0).
+
+    Reference: the mean of the pilot's unperturbed null-pair strides
+    (``null_pairs["q_unperturbed"]`` (M, n, 4) and
+    ``pelvis_angle_unperturbed_rad`` (M, n), on the grid ``time_s`` (n,)
+    relative to the onset; :func:`loper_analysis.responses.null_pair_windows`),
+    the mean swing a perturbed stride starts from. The perturbed force is
+    :func:`pulse_force_n` along the thigh's forward normal of that swing,
+    given to the fit at ``settings.force_rate_hz`` (``force_time_s`` of
+    :func:`~loper_analysis.identification.prepare_window`, as the fit takes
+    the robot log's samples); the minimal-impedance force and the initial
+    deviation are zero (they average out over the perturbed strides).
+    ``measured`` is zero: only the model's sensitivities are used.
+    """
+    from loper_analysis.synthetic.response import thigh_normal
+
+    t, arrays, n_pairs = null_pair_arrays(null_pairs, source)
+    if n_pairs < 1:
+        raise LoperInputError(f"{source}: no null pairs: the pilot needs unperturbed strides walked with the device")
+    q_ref = arrays["q_unperturbed"].mean(axis=0)
+    pelvis = arrays["pelvis_angle_unperturbed_rad"].mean(axis=0)
+    rate = float(settings.force_rate_hz)
+    t_force = np.arange(math.ceil(t[0] * rate - 1e-6), math.floor(t[-1] * rate + 1e-6) + 1) / rate
+    force = pulse_force_n(
+        t_force,
+        settings.pulse_force_n,
+        settings.pulse_duration_s,
+        device,
+        settings.force_cutoff_hz,
+        settings.force_order,
+    )
+    force_vector = force[:, None] * thigh_normal(np.interp(t_force, t, q_ref[:, 1]))
+    return prepare_window(
+        t,
+        q_ref,
+        q_ref,
+        params,
+        0.0,
+        force_perturbed_n=force_vector,
+        force_unperturbed_n=np.zeros_like(force_vector),
+        force_time_s=t_force,
+        pelvis_angle_unperturbed_rad=pelvis,
+        pelvis_angle_perturbed_rad=pelvis,
+        **window_options(settings),
+    )
+
+
+def planned_impedance(impedance, settings: PlanSettings, source: str) -> np.ndarray:
+    p = np.asarray(impedance, dtype=float)
+    if p.shape != (6,) or not np.all(np.isfinite(p)):
+        raise LoperInputError(
+            f"{source}: the planned impedance must be 6 finite values ({', '.join(PARAMETERS)}), "
+            f"got {np.asarray(impedance).tolist()}"
+        )
+    out = np.flatnonzero((p < settings.lower) | (p > settings.upper))
+    if out.size:
+        i = int(out[0])
+        raise LoperInputError(
+            f"{source}: planned {PARAMETERS[i]} = {p[i]:g} {PARAMETER_UNITS[PARAMETERS[i]]} lies "
+            f"outside the identification bounds {settings.lower[i]:g} .. {settings.upper[i]:g}"
+        )
+    return p
+
+
+def null_pair_arrays(null_pairs: Mapping, source: str) -> tuple[np.ndarray, dict[str, np.ndarray], int]:
+    """Checked grid and arrays of the pilot's null pairs, and how many there are."""
+    missing = [
+        k
+        for k in (
+            "time_s",
+            "q_perturbed",
+            "q_unperturbed",
+            "pelvis_angle_perturbed_rad",
+            "pelvis_angle_unperturbed_rad",
+        )
+        if k not in null_pairs
+    ]
+    if missing:
+        raise LoperInputError(f"{source}: null pairs lack {missing}")
+    t = np.asarray(null_pairs["time_s"], dtype=float)
+    arrays = {
+        k: np.asarray(null_pairs[k], dtype=float)
+        for k in ("q_perturbed", "q_unperturbed", "pelvis_angle_perturbed_rad", "pelvis_angle_unperturbed_rad")
+    }
+    n = int(arrays["q_unperturbed"].shape[0]) if arrays["q_unperturbed"].ndim == 3 else 0
+    return t, arrays, n
