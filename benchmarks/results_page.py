@@ -275,7 +275,7 @@ def _recovery_row(rows: pd.DataFrame, tolerance: dict) -> list[str]:
 
 def block_truth_recovery(run: Run) -> str:
     """The synthetic subjects' K and D recovered, per joint and onset."""
-    from loper_analysis.identification.impedance import TRUTH_TOLERANCE
+    from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE
 
     name = "impedance/impedance.tsv"
     t = run.tsv(name)

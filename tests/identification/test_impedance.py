@@ -11,13 +11,12 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import identify_impedance
+from loper_analysis.identification.across_subjects import impedance_summary, literature_table
 from loper_analysis.identification.impedance import (
     IMPEDANCE_COLUMNS,
     brace_force_direction,
     fit_onset,
     impedance_rows,
-    impedance_summary,
-    literature_table,
     status_rows,
 )
 from loper_analysis.identification.validation import (

@@ -21,8 +21,8 @@ import pytest
 import yaml
 
 from loper_analysis.constants import JOINTS
+from loper_analysis.identification.across_subjects import impedance_summary
 from loper_analysis.identification.group_mean import random_effects_mean
-from loper_analysis.identification.impedance import impedance_summary
 from loper_analysis.report.front_page import RunSettings, front_page_html
 from loper_analysis.report.headline import (
     device_comparison,

@@ -22,7 +22,7 @@ Beyond the study, :mod:`.null_pairs` weights the prediction error by the
 stride-to-stride deviation that null pairs show, and :mod:`.status` judges
 each joint's fit (convergence, VAF floor, bounds, the information in the
 intervals), whose ends :mod:`.intervals` forms. :mod:`.impedance` fits each subject's
-mean response per onset and aggregates the fits; :mod:`.validation` is the
+mean response per onset, :mod:`.across_subjects` aggregates the fits; :mod:`.validation` is the
 synthetic validation study of the whole identification.
 """
 

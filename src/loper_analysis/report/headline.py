@@ -28,7 +28,7 @@ import pandas as pd
 from loper_analysis.checks import integer, number, require_columns, where
 from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.impedance import TRUTH_TOLERANCE
+from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE
 from loper_analysis.reference import STUDY_DEVICE
 
 __all__ = [
@@ -52,7 +52,7 @@ PARAMETER_KINDS: tuple[str, ...] = ("K", "D")
 #: than 90 % is too narrow, more than 98 % too wide to be informative.
 COVERAGE_TARGET: tuple[float, float] = (0.90, 0.98)
 #: Share of the fits whose K (and D) should lie within tolerance of the truth
-#: (:data:`loper_analysis.identification.impedance.TRUTH_TOLERANCE`).
+#: (:data:`loper_analysis.identification.across_subjects.TRUTH_TOLERANCE`).
 WITHIN_TOLERANCE_TARGET: float = 0.90
 
 
@@ -168,7 +168,7 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
         per parameter over the fits: ``K_error_mean_nm_per_rad`` (bias),
         ``K_error_median_abs_nm_per_rad``, ``K_error_median_abs_pct`` (median
         of ``|error| / |truth|``, %; truths of 0 left out),
-        ``K_n_within_tolerance`` (:data:`loper_analysis.identification.impedance.TRUTH_TOLERANCE`, the rule of the
+        ``K_n_within_tolerance`` (:data:`loper_analysis.identification.across_subjects.TRUTH_TOLERANCE`, the rule of the
         across-subject summary) and
         ``K_n_truth_in_ci95`` (the truth inside the fit's 95 % CI, bounds
         included); the same for D. No truth known: no rows.

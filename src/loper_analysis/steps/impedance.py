@@ -244,8 +244,8 @@ def impedance_summary(
     ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary;
     ``lower_bounds`` (K, D): where the across-subject intervals are cut (N·m/rad, N·m·s/rad).
     """
-    from loper_analysis.identification.impedance import impedance_summary as summarise
-    from loper_analysis.identification.impedance import literature_table
+    from loper_analysis.identification.across_subjects import impedance_summary as summarise
+    from loper_analysis.identification.across_subjects import literature_table
 
     summary = summarise(
         read_tsv(impedance_tsv, "impedance table"), upper_bounds=upper_bounds, lower_bounds=lower_bounds
