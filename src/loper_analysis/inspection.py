@@ -4,8 +4,9 @@ The library side of ``loper-analysis inspect`` (the file side is
 :mod:`loper_analysis.steps.inspect`). Every function takes arrays or
 records already read (:class:`~loper_analysis.io.c3d.C3DRecording`,
 :class:`~loper_analysis.io.force_platforms.ForcePlatform`) and returns new
-objects; :func:`format_summary` and :func:`format_label_match` turn them
-into plain text and :func:`config_snippet` into YAML. The lab's axes and
+objects; :func:`loper_analysis.inspection_text.format_summary` and
+:func:`~loper_analysis.inspection_text.format_label_match` turn them into plain text and :func:`config_snippet`
+into YAML. The lab's axes and
 the suggested rotation come from :mod:`loper_analysis.motion.lab_frame`, the
 matching of labels to model markers from :mod:`loper_analysis.motion.label_matching`.
 
@@ -31,7 +32,6 @@ Force platforms (:func:`plate_summary`)
 from __future__ import annotations
 
 import json
-import textwrap
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -42,17 +42,13 @@ import pandas as pd
 from loper_analysis.checks import marker_array
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.lab_frame import (
-    AXIS_NAMES,
     VerticalAxis,
     WalkingDirection,
-    axis_name,
     corner_normal,
     lab_to_model_rotation_deg,
     vertical_axis,
     walking_direction,
 )
-from loper_analysis.motion.label_matching import LabelMatch
-from loper_analysis.motion.markers import rotate_markers
 
 if TYPE_CHECKING:  # records only; nothing is read here
     from loper_analysis.io.c3d import C3DRecording
@@ -64,8 +60,6 @@ __all__ = [
     "PlateSummary",
     "RecordingSummary",
     "config_snippet",
-    "format_label_match",
-    "format_summary",
     "marker_presence",
     "plate_summary",
     "recording_summary",
@@ -502,201 +496,3 @@ def config_snippet(
 
 
 # ---------------------------------------------------------------- text
-
-
-def _xyz(v, digits: int = 3) -> str:
-    return (
-        "("
-        + ", ".join(f"{float(x) + 0.0:.{digits}f}".replace("-0." + "0" * digits, "0." + "0" * digits) for x in v)
-        + ")"
-    )
-
-
-def _ranges(frames: np.ndarray, limit: int = 6) -> str:
-    """'0-56, 1050-1102' for sorted frame numbers (at most ``limit`` ranges, then '...')."""
-    if frames.size == 0:
-        return ""
-    breaks = np.flatnonzero(np.diff(frames) != 1)
-    starts = np.concatenate([[frames[0]], frames[breaks + 1]])
-    ends = np.concatenate([frames[breaks], [frames[-1]]])
-    parts = [f"{a}" if a == b else f"{a}-{b}" for a, b in zip(starts, ends)]
-    more = len(parts) - limit
-    return ", ".join(parts[:limit]) + (f", ... ({more} more ranges)" if more > 0 else "")
-
-
-def _rotation_text(angles: Sequence[float]) -> str:
-    return "[" + ", ".join(f"{a:g}" for a in angles) + "]"
-
-
-def _model_axis(rotation_deg: Sequence[float], axis: int, sign: int) -> str:
-    """Where the lab direction ``sign`` x axis ``axis`` points after the rotation (``"-X"`` ...)."""
-    v = np.zeros(3)
-    v[axis] = sign
-    r = np.round(rotate_markers(v, rotation_deg))
-    k = int(np.argmax(np.abs(r)))
-    return axis_name(k, int(r[k]))
-
-
-def format_summary(s: RecordingSummary) -> str:
-    """The inspection of one recording as plain text (units stated on every line that has numbers)."""
-    rate = s.point_rate_hz
-    last = s.first_frame + s.n_frames - 1
-    lines = [
-        f"File {s.source}",
-        f"  markers   {rate:g} Hz, POINT:UNITS {s.point_unit or '(none)'} (shown below in m)",
-        f"  analogs   {s.analog_rate_hz:g} Hz ({round(s.analog_rate_hz / rate)} samples per frame), "
-        f"{len(s.analog_labels)} channel(s)",
-        f"  frames    {s.n_frames}, first frame {s.first_frame} (0-based) at {s.first_time_s:.3f} s, last frame "
-        f"{last} at {last / rate:.3f} s; duration {s.duration_s:.3f} s ({s.n_frames} frames / {rate:g} Hz)",
-        "",
-    ]
-    m = s.markers
-    width = max([len(lab) for lab in m["label"]] + [5])
-    if len(m):
-        lines.append(
-            f"Markers: {len(m)} label(s); present = % of the {s.n_frames} frames; first and last present "
-            "frame; longest gap = missing frames between them"
-        )
-        lines.append(f"  {'label':<{width}}  present %  first  last   longest gap")
-    else:
-        lines.append("Markers: none")
-    for row in m.itertuples(index=False):
-        if row.n_present == 0:
-            lines.append(f"  {row.label:<{width}}  {0.0:9.1f}  never present")
-            continue
-        gap = "none" if row.longest_gap_frames == 0 else f"{row.longest_gap_frames} frames ({row.longest_gap_s:.3f} s)"
-        lines.append(
-            f"  {row.label:<{width}}  {row.present_pct:9.1f}  {int(row.first_present_frame):5d}  "
-            f"{int(row.last_present_frame):5d}  {gap}"
-        )
-    n_sparse = s.sparse_frames.size
-    lines.append(
-        f"  frames with fewer than {MIN_MARKERS_PER_FRAME} markers: {n_sparse} of {s.n_frames}"
-        + (
-            f" (frames {_ranges(s.sparse_frames)}; {s.n_empty_frames} of them without any marker; "
-            "inverse kinematics cannot use them)"
-            if n_sparse
-            else ""
-        )
-    )
-    lines.append("")
-
-    if s.plates:
-        lines.append(
-            f"Force platforms: {len(s.plates)} (forces on the body, lab frame; vertical = "
-            f"{axis_name(s.vertical.axis, s.vertical.sign)})"
-        )
-    elif s.n_plates_declared:
-        lines.append(f"Force platforms: {s.n_plates_declared} declared, not readable: {s.plate_problem}")
-    else:
-        lines.append("Force platforms: none (no FORCE_PLATFORM group; events then need events.grf_channels)")
-    for p in s.plates:
-        lines.append(f"  plate {p.number}: TYPE {p.type}, analog channels {', '.join(map(str, p.channels))}")
-        lines.append("    corners (lab, m): " + " ".join(_xyz(c) for c in p.corners_m))
-        lines.append(f"    size {p.side_lengths_m[0]:.3f} x {p.side_lengths_m[1]:.3f} m, centre {_xyz(p.centre_m)} m")
-        order = (
-            f"corners listed {p.corner_order} seen from above"
-            if p.corner_order
-            else "the plate does not face up or down"
-        )
-        lines.append(f"    normal from the corners (right-hand rule of their order): {_xyz(p.normal)}: {order}")
-        if p.rest_vertical_n is None:
-            lines.append("    resting vertical level: none (the plate is loaded throughout)")
-            lines.append(f"    peak vertical force {p.peak_vertical_n:.1f} N at {p.peak_time_s:.3f} s (as read)")
-        else:
-            lines.append(
-                f"    resting (unloaded) vertical level {p.rest_vertical_n:.1f} N; loaded (> 20 N above it) "
-                f"{p.loaded_pct:.1f} % of the time"
-            )
-            lines.append(
-                f"    peak vertical force {p.peak_vertical_n:.1f} N above rest at {p.peak_time_s:.3f} s "
-                f"({p.peak_vertical_n + p.rest_vertical_n:.1f} N as read)"
-            )
-    lines.append("")
-
-    lines.append(f"Analog channels: {len(s.analog_labels)}, all at {s.analog_rate_hz:g} Hz")
-    if s.analog_labels:
-        width = max(len(lab) for lab in s.analog_labels)
-        for i, (lab, unit) in enumerate(zip(s.analog_labels, s.analog_units)):
-            owner = s.channel_owner.get(i, "")
-            lines.append(f"  {i + 1:3d}  {lab:<{width}}  {unit or '(no unit)':<8}" + (f"  {owner}" if owner else ""))
-    lines.append("")
-
-    if len(s.events):
-        lines.append(f"Events: {len(s.events)} (EVENT group; time on the file's clock, s)")
-        for ev in s.events.itertuples(index=False):
-            lines.append(f"  {ev.context:<8} {ev.label:<16} {ev.time_s:8.3f} s  (frame {round(ev.time_s * rate)})")
-    else:
-        lines.append("Events: none")
-    lines.append("")
-
-    v, w = s.vertical, s.walking
-    lines.append("Lab frame")
-    text = f"  vertical axis: {axis_name(v.axis, v.sign)} " + (
-        "(assumed: neither plates nor markers tell)" if v.basis == "assumed" else f"(from the {v.basis})"
-    )
-    if v.marker_axis is not None:
-        spread = ", ".join(f"{AXIS_NAMES[a]} {v.marker_spread_m[a]:.2f}" for a in range(3))
-        agree = (
-            "agree"
-            if (v.marker_axis, v.marker_sign) == (v.axis, v.sign)
-            else f"say {axis_name(v.marker_axis, v.marker_sign)}: check"
-        )
-        text += f"; the markers {agree} (median spread of a frame's markers, m: {spread})"
-    lines.append(text)
-    if w.axis is None and not np.all(np.isfinite(w.travel_m)):
-        lines.append("  walking direction: unknown (no marker is present in two frames)")
-    elif w.axis is None:
-        travel = ", ".join(f"{AXIS_NAMES[a]} {w.travel_m[a]:+.2f}" for a in range(3))
-        lines.append(f"  walking direction: treadmill/standing (the markers do not travel; median travel, m: {travel})")
-    else:
-        lines.append(
-            f"  walking direction: {axis_name(w.axis, w.sign)} (the markers travel "
-            f"{w.travel_m[w.axis]:+.2f} m along {AXIS_NAMES[w.axis]} at {w.speed_m_per_s:.2f} m/s)"
-        )
-    lines.append(
-        f"  suggested markers.lab_to_model_rotation_deg: {_rotation_text(s.rotation_deg)} (degrees about the "
-        "fixed X, Y, Z: up -> model +Y)"
-    )
-    if w.axis is None:
-        lines.append(
-            "  (the facing direction is not known: check that the subject faces model +X, OpenSim's forward, "
-            "after the rotation)"
-        )
-    elif tuple(s.rotation_forward_deg) == tuple(s.rotation_deg):
-        lines.append("  (this trial then walks toward model +X, OpenSim's forward)")
-    else:
-        lines.append(
-            f"  (this trial then walks toward model {_model_axis(s.rotation_deg, w.axis, w.sign)}; "
-            f"{_rotation_text(s.rotation_forward_deg)} also turns its walking direction to model +X, "
-            "OpenSim's forward)"
-        )
-    return "\n".join(line.rstrip() for line in lines) + "\n"
-
-
-def format_label_match(match: LabelMatch, model_name: str, n_model_markers: int) -> str:
-    """The matching of a file's labels to a model's markers as plain text."""
-    lines = [f"Labels and model markers ({model_name}: {n_model_markers} markers)"]
-    lines.append(f"  matched: {len(match.pairs)} label(s)")
-    if match.pairs:
-        width = max(len(lab) for lab, _, _ in match.pairs)
-        for label, marker, rule in match.pairs:
-            lines.append(f"    {label:<{width}} -> {marker:<20} ({rule})")
-    if match.ambiguous:
-        lines.append(f"  ambiguous (left unmatched): {len(match.ambiguous)}")
-        for label, candidates in match.ambiguous.items():
-            lines.append(
-                f"    {label}: {' or '.join(candidates)}"
-                if len(candidates) > 1
-                else f"    {label}: {candidates[0]} (wanted by more than one label)"
-            )
-    for title, names in (
-        ("labels without a model marker", match.unmatched_labels),
-        ("model markers no label provides", match.unprovided_markers),
-    ):
-        lines.append(f"  {title}: {len(names)}")
-        if names:
-            lines += textwrap.wrap(
-                ", ".join(names), width=100, initial_indent="    ", subsequent_indent="    ", break_on_hyphens=False
-            )
-    return "\n".join(lines) + "\n"

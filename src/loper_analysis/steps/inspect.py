@@ -19,14 +19,8 @@ from pathlib import Path
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError, one_line
-from loper_analysis.inspection import (
-    RecordingSummary,
-    config_snippet,
-    format_label_match,
-    format_summary,
-    recording_summary,
-    yaml_flow,
-)
+from loper_analysis.inspection import RecordingSummary, config_snippet, recording_summary, yaml_flow
+from loper_analysis.inspection_text import format_label_match, format_summary
 from loper_analysis.io.atomic import PathLike, write_bytes, write_text, write_tsv
 from loper_analysis.io.c3d_parameters import param_strings
 from loper_analysis.io.timing import library_import, timed_io
