@@ -125,3 +125,13 @@ def test_the_file_layer_check_sees_a_file_read():
         "read_force_platforms",
         "read_text",
     ]
+
+
+#: Most lines of a library module: a longer one does several jobs.
+MAX_MODULE_LINES = 600
+
+
+def test_no_library_module_is_longer_than_600_lines():
+    src = ROOT / "src" / "loper_analysis"
+    long = {p.relative_to(src).as_posix(): n for p in src.rglob("*.py") if (n := len(p.read_text().splitlines())) > 600}
+    assert long == {}

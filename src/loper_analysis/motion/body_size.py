@@ -22,7 +22,7 @@ import numpy as np
 from loper_analysis.constants import GRAVITY_M_PER_S2
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["MASS_LIMIT_KG", "body_height_m", "body_mass_kg", "require_stature"]
+__all__ = ["MASS_LIMIT_KG", "body_height_m", "body_mass_kg", "model_stature_m", "require_stature"]
 
 #: A given or stored body mass must lie in (0, this] kg.
 MASS_LIMIT_KG: float = 300.0
@@ -104,6 +104,16 @@ def require_stature(height: tuple[float, str], stature_m: float, source: str) ->
             f"{100 * STOP_STATURE_CHANGE:.0f} %): is the static trial this subject's, and the height in the "
             "subject sheet (height_m) right?"
         )
+
+
+def model_stature_m(scaled, segment_bodies=None) -> float:
+    """A scaled model's stature (m; :func:`loper_analysis.motion.static_trial.model_height_m` of its right thigh,
+    the bodies named by ``segment_bodies`` as :func:`loper_analysis.motion.segments.segment_body_names` takes
+    them)."""
+    from loper_analysis.motion.segments import segment_body_names
+    from loper_analysis.motion.static_trial import model_height_m
+
+    return model_height_m(scaled, segment_body_names(scaled, "r", segment_bodies)["thigh"][0])
 
 
 def _name(recording) -> str:

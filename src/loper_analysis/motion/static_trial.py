@@ -30,6 +30,7 @@ where missing), forces in N.
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -47,12 +48,15 @@ __all__ = [
     "time_range_is_set",
     "scale_window_s",
     "static_pose",
+    "log_static_pose",
     "standing_mass_kg",
     "markers_off_plates",
     "model_height_m",
     "FOOT_MARKER_HEIGHT_M",
     "PLATE_EDGE_MARGIN_M",
 ]
+
+log = logging.getLogger(__name__)
 
 #: Hip joint centre height over stature (Winter's table: thigh + shank + ankle height).
 HIP_HEIGHT_FRACTION: float = WINTER_SEGMENTS["thigh"].length + WINTER_SEGMENTS["shank"].length + ANKLE_HEIGHT_FRACTION
@@ -393,3 +397,28 @@ def _inside(point, polygon, margin: float) -> bool:
     centre = polygon.mean(axis=0)
     inward = np.sign([(b - a)[0] * (centre[1] - a[1]) - (b - a)[1] * (centre[0] - a[0]) for a, b in edges])
     return bool(np.all(sides * inward >= -margin))
+
+
+def log_static_pose(pose: StaticPose, static_trc: str, window: tuple[float, float]) -> None:
+    """The static pose's largest marker motion, the markers filled and those left out, in the log."""
+    moving = sorted(pose.motion_rms_m, key=pose.motion_rms_m.get, reverse=True)[:3]
+    log.info(
+        "%s: largest marker motion over the window (RMS about the mean): %s",
+        static_trc,
+        ", ".join(f"{m} {pose.motion_rms_m[m] * 1000:.1f} mm" for m in moving),
+    )
+    for marker, n in pose.n_filled.items():
+        log.info(
+            "%s: marker %s missing in %d of %d frames of the window: averaged over the others",
+            static_trc,
+            marker,
+            n,
+            len(pose.time_s),
+        )
+    if pose.left_out:
+        log.warning(
+            "%s: marker(s) %s missing throughout the window %.4f .. %.4f s: left out of scaling",
+            static_trc,
+            ", ".join(pose.left_out),
+            *window,
+        )

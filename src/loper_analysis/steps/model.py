@@ -14,16 +14,17 @@ from pathlib import Path
 
 import numpy as np
 
-from loper_analysis.constants import GRAVITY_M_PER_S2, LAB_TO_MODEL_ROTATION_DEG
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io import scale_tool
 from loper_analysis.io.atomic import PathLike, staged, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.segment_table import write_segments
-from loper_analysis.motion.body_size import require_stature
+from loper_analysis.motion.body_size import body_height_m, body_mass_kg, model_stature_m, require_stature
 from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.marker_names import unknown_markers_hint
-from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
+from loper_analysis.motion.markers import lab_up
+from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE, measurement_scale_factors, require_scale_factors
 from loper_analysis.motion.scale_report import SCALE_FLOAT_FORMAT
 from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.dynamics import (
@@ -169,24 +170,15 @@ def generic_model(
     from loper_analysis.motion.model import build_lower_body_model
 
     if mass_kg is None and static_c3d is not None:
-        from loper_analysis.io.c3d import read_c3d
         from loper_analysis.motion.static_trial import scale_window_s
 
-        window = scale_window_s(read_c3d(static_c3d).time_s, (), settings.static_duration_s, source=str(static_c3d))
-        mass_kg, source = _subject_mass(None, static_c3d, window, settings.rotation_deg)
+        rec, plates = _static_record(static_c3d)
+        window = scale_window_s(rec.time_s, (), settings.static_duration_s, source=str(static_c3d))
+        mass_kg, source = body_mass_kg(None, rec, plates, window, lab_up(settings.rotation_deg))
         log.info("mass %.2f kg from the %s", mass_kg, source)
-    mass_kg, _ = _subject_mass(mass_kg, None, (0.0, 0.0), settings.rotation_deg)
+    mass_kg, _ = body_mass_kg(mass_kg)
     write_model(build_lower_body_model(height_m, mass_kg), out_osim)
     log.info("generic model for %s m, %s kg: %s", height_m, mass_kg, out_osim)
-
-
-def _check_factors(model, measurements, pose, static_trc, factor_range) -> None:
-    """Refuse scale factors outside ``factor_range``
-    (:func:`loper_analysis.motion.plausibility.require_scale_factors`)."""
-    from loper_analysis.motion.plausibility import measurement_scale_factors, require_scale_factors
-
-    factors = measurement_scale_factors(model, measurements, pose.markers_m, pose.labels)
-    require_scale_factors(factors, str(static_trc), factor_range)
 
 
 def scaled_model(
@@ -395,7 +387,7 @@ def _scaling_pose(tool, generic, files: ScaleFiles, settings: ModelSettings, lab
     ``settings.time_range_s`` overrides them), its measurements' marker pairs and the averaged pose
     (:func:`loper_analysis.motion.static_trial.static_pose`), each checked."""
     from loper_analysis.io.opensim_tables import read_markers
-    from loper_analysis.motion.static_trial import scale_window_s, static_pose
+    from loper_analysis.motion.static_trial import log_static_pose, scale_window_s, static_pose
 
     static_trc = Path(files.static_trc)
     setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
@@ -439,33 +431,8 @@ def _scaling_pose(tool, generic, files: ScaleFiles, settings: ModelSettings, lab
         setting=setting,
         max_motion_rms_m=settings.max_motion_rms_m,
     )
-    _log_pose(pose, static_trc, window)
+    log_static_pose(pose, str(static_trc), window)
     return window, ranges, pairs, pose
-
-
-def _log_pose(pose, static_trc: Path, window: tuple[float, float]) -> None:
-    """The static pose's largest marker motion, the markers filled and those left out, in the log."""
-    moving = sorted(pose.motion_rms_m, key=pose.motion_rms_m.get, reverse=True)[:3]
-    log.info(
-        "%s: largest marker motion over the window (RMS about the mean): %s",
-        static_trc,
-        ", ".join(f"{m} {pose.motion_rms_m[m] * 1000:.1f} mm" for m in moving),
-    )
-    for marker, n in pose.n_filled.items():
-        log.info(
-            "%s: marker %s missing in %d of %d frames of the window: averaged over the others",
-            static_trc,
-            marker,
-            n,
-            len(pose.time_s),
-        )
-    if pose.left_out:
-        log.warning(
-            "%s: marker(s) %s missing throughout the window %.4f .. %.4f s: left out of scaling",
-            static_trc,
-            ", ".join(pose.left_out),
-            *window,
-        )
 
 
 def _run_scale_tool(
@@ -492,9 +459,11 @@ def _run_scale_tool(
     where = str(setup_xml) if setup_xml is not None else str(static_trc)
     scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
     window, ranges, pairs, pose = _scaling_pose(tool, generic, files, settings, lab_labels)
-    _check_factors(generic, pairs, pose, static_trc, settings.factor_range)
+    factors = measurement_scale_factors(generic, pairs, pose.markers_m, pose.labels)
+    require_scale_factors(factors, str(static_trc), settings.factor_range)
     gravity = float(np.linalg.norm(generic.getGravity().to_numpy()))
-    mass_kg, mass_source = _subject_mass(mass_kg, files.static_c3d, window, settings.rotation_deg, gravity)
+    rec, plates = _static_record(files.static_c3d) if mass_kg is None and files.static_c3d else (None, [])
+    mass_kg, mass_source = body_mass_kg(mass_kg, rec, plates, window, lab_up(settings.rotation_deg), gravity)
     osim = quiet_opensim()
     maker = tool.getGenericModelMaker()
     tool.setPathToSubject("")  # OpenSim prefixes the setup's folder to every file name; ours are absolute
@@ -542,8 +511,9 @@ def _run_scale_tool(
                 )
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
-            stature = _model_stature(scaled, segment_bodies)
-            height = _subject_height(height_m, files.static_c3d, stature)
+            stature = model_stature_m(scaled, segment_bodies)
+            stored = _stored_values(files.static_c3d)
+            height = body_height_m(height_m, stored[0], stature, stored[1])
             require_stature(height, stature, str(static_trc))
             if files.report_out is not None:
                 unplaced = read_model(unplaced_file) if unplaced_file.is_file() else None
@@ -591,43 +561,20 @@ def _lab_labels(summary_tsv: PathLike) -> dict[str, str]:
     return dict(zip(table["marker"], table["label"]))
 
 
-def _subject_mass(
-    mass_kg: float | None,
-    static_c3d: PathLike | None,
-    window: tuple[float, float],
-    rotation_deg: Sequence[float],
-    gravity_m_per_s2: float = GRAVITY_M_PER_S2,
-) -> tuple[float, str]:
-    """The subject's mass (kg) and where it came from (:func:`loper_analysis.motion.body_size.body_mass_kg`),
-    the static trial read when no mass is given."""
-    from loper_analysis.motion.body_size import body_mass_kg
-    from loper_analysis.motion.markers import lab_up
+def _stored_values(static_c3d: PathLike | None) -> tuple[dict[str, float], str]:
+    """The static trial's ``PROCESSING`` values (Nexus: ``Height`` mm) and its file name; empty without one."""
+    from loper_analysis.io.c3d import read_c3d
 
-    if mass_kg is not None or static_c3d is None:
-        return body_mass_kg(mass_kg)
+    return ({}, "") if static_c3d is None else (read_c3d(static_c3d).processing, Path(static_c3d).name)
+
+
+def _static_record(static_c3d: PathLike):
+    """The static trial's recording and its force platforms (none when the file has none)."""
     from loper_analysis.io.c3d import read_c3d
     from loper_analysis.io.force_platforms import read_force_platforms
 
-    rec, plates = read_c3d(static_c3d), read_force_platforms(static_c3d)
-    return body_mass_kg(None, rec, plates, window, lab_up(rotation_deg), gravity_m_per_s2)
-
-
-def _subject_height(height_m: float | None, static_c3d: PathLike | None, stature_m: float) -> tuple[float, str]:
-    """The subject's height (m) and where it came from (:func:`loper_analysis.motion.body_size.body_height_m`)."""
-    from loper_analysis.io.c3d import read_c3d
-    from loper_analysis.motion.body_size import body_height_m
-
-    if height_m is not None or static_c3d is None:
-        return body_height_m(height_m, {}, stature_m, "")
-    return body_height_m(None, read_c3d(static_c3d).processing, stature_m, Path(static_c3d).name)
-
-
-def _model_stature(scaled, segment_bodies) -> float:
-    """The scaled model's stature (m; :func:`loper_analysis.motion.static_trial.model_height_m`)."""
-    from loper_analysis.motion.segments import segment_body_names
-    from loper_analysis.motion.static_trial import model_height_m
-
-    return model_height_m(scaled, segment_body_names(scaled, "r", segment_bodies)["thigh"][0])
+    rec = read_c3d(static_c3d)
+    return rec, read_force_platforms(static_c3d) if rec.n_force_platforms else []
 
 
 def _lab_static(lab_angles_tsv: PathLike, window: tuple[float, float]) -> dict[str, float]:
