@@ -26,6 +26,7 @@ explains it with figures in words):
 from __future__ import annotations
 
 __all__ = [
+    "LOADED_THRESHOLD_N",
     "SIDES",
     "SIDE_SUFFIX",
     "JOINTS",
@@ -82,6 +83,11 @@ LAB_TO_MODEL_ROTATION_DEG: tuple[float, float, float] = (-90.0, 0.0, 0.0)
 MIN_IK_MARKERS: int = 3
 #: Kinds of trial, as label maps and spans are keyed (besides the trial's own name).
 TRIAL_KINDS: tuple[str, ...] = ("static", "walking")
+
+
+#: A force plate is loaded above this vertical force over its resting level (N; config
+#: ``grf.loaded_threshold_n``).
+LOADED_THRESHOLD_N: float = 20.0
 
 
 def angle_column(joint: str, side: str) -> str:

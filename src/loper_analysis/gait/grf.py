@@ -62,7 +62,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.checks import number, where
-from loper_analysis.constants import LAB_Z_UP
+from loper_analysis.constants import LAB_Z_UP, LOADED_THRESHOLD_N
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.markers import rotate_markers
 
@@ -84,8 +84,6 @@ __all__ = [
     "vertical_loads",
 ]
 
-#: A plate is loaded above this vertical force over its resting level (N; config ``grf.loaded_threshold_n``).
-LOADED_THRESHOLD_N: float = 20.0
 #: Samples within this of a plate's lowest vertical force are unloaded (N; config ``grf.resting_band_n``) ...
 RESTING_BAND_N: float = 10.0
 #: ... and their median, the resting level, must lie within +- this (N; ``grf.max_resting_n``).

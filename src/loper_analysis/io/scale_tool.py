@@ -22,12 +22,10 @@ __all__ = [
 
 
 def time_range(part) -> tuple[float, float] | None:
-    """A model scaler's or marker placer's time range, None when unset (``-1 -1`` or reversed)."""
-    from loper_analysis.motion.static_trial import time_range_is_set
-
+    """A model scaler's or marker placer's time range as the setup holds it (None without two numbers; OpenSim's
+    unset ``-1 -1`` is judged by :func:`loper_analysis.motion.static_trial.time_range_is_set`)."""
     r = part.getTimeRange()
-    pair = (r.get(0), r.get(1)) if r.getSize() >= 2 else None
-    return pair if time_range_is_set(pair) else None
+    return (r.get(0), r.get(1)) if r.getSize() >= 2 else None
 
 
 def array_double(osim, pair) -> object:

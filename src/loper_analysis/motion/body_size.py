@@ -19,7 +19,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from loper_analysis.constants import GRAVITY_M_PER_S2
+from loper_analysis.constants import GRAVITY_M_PER_S2, LOADED_THRESHOLD_N
 from loper_analysis.errors import LoperInputError
 
 __all__ = ["MASS_LIMIT_KG", "body_height_m", "body_mass_kg", "model_stature_m", "require_stature"]
@@ -135,7 +135,6 @@ def _file_bodymass(recording, why: str) -> tuple[float, str]:
 def _feet_off_plates(recording, plates, vertical_n: np.ndarray, window, up: np.ndarray) -> str:
     """Why the plates do not weigh the whole subject ('' when they do): foot markers of the static trial's mean
     pose over no loaded plate (:func:`loper_analysis.motion.static_trial.markers_off_plates`)."""
-    from loper_analysis.gait.grf import LOADED_THRESHOLD_N
     from loper_analysis.motion.static_trial import FOOT_MARKER_HEIGHT_M, markers_off_plates
 
     t = plates[0].time_s

@@ -387,7 +387,7 @@ def _scaling_pose(tool, generic, files: ScaleFiles, settings: ModelSettings, lab
     ``settings.time_range_s`` overrides them), its measurements' marker pairs and the averaged pose
     (:func:`loper_analysis.motion.static_trial.static_pose`), each checked."""
     from loper_analysis.io.opensim_tables import read_markers
-    from loper_analysis.motion.static_trial import log_static_pose, scale_window_s, static_pose
+    from loper_analysis.motion.static_trial import log_static_pose, scale_window_s, static_pose, time_range_is_set
 
     static_trc = Path(files.static_trc)
     setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
@@ -397,7 +397,8 @@ def _scaling_pose(tool, generic, files: ScaleFiles, settings: ModelSettings, lab
     where = str(setup_xml) if setup_xml is not None else str(static_trc)
     times, X, labels = read_markers(static_trc)
     scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
-    ranges = {part: scale_tool.time_range(part) for part in (scaler, placer) if part.getApply()}  # None where unset
+    ranges = {part: scale_tool.time_range(part) for part in (scaler, placer) if part.getApply()}
+    ranges = {part: r if time_range_is_set(r) else None for part, r in ranges.items()}  # None where unset
     setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
     if time_range_s is not None:
         t0, t1 = map(float, time_range_s)
