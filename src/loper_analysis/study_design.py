@@ -22,6 +22,8 @@ from loper_analysis.errors import LoperInputError
 __all__ = [
     "DEVICE_TESTS",
     "PERTURBED_SIDE",
+    "PULSE_DURATION_S",
+    "PULSE_FORCE_N",
     "SEED",
     "TRANSPARENCY_CONDITIONS",
     "TRIAL_CONDITIONS",
@@ -31,6 +33,11 @@ __all__ = [
 
 #: The leg the robot perturbs, whose swing is identified (config ``trials.perturbed_side``).
 PERTURBED_SIDE: str = "left"
+#: The study's perturbation: a rectangular desired force along the thigh (N) ... (config
+#: ``synthetic.pulse_force_n``, ``planning.pulse_force_n``, ``validation.pulse_force_n``)
+PULSE_FORCE_N: float = 40.0
+#: ... for this long (s; ``*.pulse_duration_s``).
+PULSE_DURATION_S: float = 0.1
 #: The study's random seed, from which every random number of the pipeline derives (config ``seed``).
 SEED: int = 2024
 

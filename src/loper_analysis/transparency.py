@@ -30,7 +30,7 @@ from loper_analysis.errors import LoperInputError, TooFewStridesWarning
 from loper_analysis.gait.outliers import MIN_VALID_STRIDES
 from loper_analysis.gait.strides import phase_cycles
 from loper_analysis.reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
-from loper_analysis.study_design import TRANSPARENCY_CONDITIONS
+from loper_analysis.study_design import PERTURBED_SIDE, TRANSPARENCY_CONDITIONS
 
 __all__ = [
     "TRANSPARENCY_PHASES",
@@ -330,7 +330,7 @@ def _flagged_rows(subject: str, counts: Mapping[str, int], joints: Sequence[str]
 
 def transparency_results(
     trials: Mapping[str, Mapping[str, tuple[pd.DataFrame, pd.DataFrame]]],
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     min_strides: int = MIN_VALID_STRIDES,
 ) -> TransparencyResults:
     """Transparency of the device from each subject's stride and cycle tables with and without it.

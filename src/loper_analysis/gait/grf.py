@@ -62,7 +62,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.checks import number, where
-from loper_analysis.constants import LAB_Z_UP, LOADED_THRESHOLD_N
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, LAB_Z_UP, LOADED_THRESHOLD_N
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.markers import rotate_markers
 
@@ -575,7 +575,7 @@ def plates_loads(
 
 def plate_vertical_loads(
     plates: Sequence,
-    rotation_deg: Sequence[float] = (-90.0, 0.0, 0.0),
+    rotation_deg: Sequence[float] = LAB_TO_MODEL_ROTATION_DEG,
     band_n: float = RESTING_BAND_N,
     max_rest_n: float = MAX_RESTING_N,
     up: Sequence[float] | None = None,

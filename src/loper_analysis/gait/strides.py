@@ -36,6 +36,7 @@ from loper_analysis.gait.outliers import (
     iqr_outliers,
 )
 from loper_analysis.gait.resampling import N_POINTS, PHASE_BOUNDS, normalise
+from loper_analysis.study_design import PERTURBED_SIDE
 
 __all__ = [
     "STRIDE_COLUMNS",
@@ -279,7 +280,7 @@ def stride_tables(
     angles: pd.DataFrame,
     events: pd.DataFrame,
     force: pd.DataFrame | None = None,
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     n_points: int = N_POINTS,
     whisker: float = IQR_WHISKER,
     max_fraction: float = MAX_OUTLIER_FRACTION,

@@ -44,7 +44,7 @@ from loper_analysis.identification import (
     window_options,
 )
 from loper_analysis.reference import STUDY_DEVICE, STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
-from loper_analysis.study_design import SEED
+from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N, SEED
 from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
 
 __all__ = [
@@ -77,8 +77,8 @@ class ValidationSettings:
     sample_rate_hz: float = 128.0
     swing_duration_s: float = 0.6
     onset_s: float = 0.05
-    pulse_force_n: float = 40.0
-    pulse_duration_s: float = 0.1
+    pulse_force_n: float = PULSE_FORCE_N
+    pulse_duration_s: float = PULSE_DURATION_S
     pulse_rise_time_s: float = STUDY_DEVICE["rise_time_ms"][0] / 1e3
     pulse_overshoot_pct: float = STUDY_DEVICE["overshoot_pct"][0]
     force_rate_hz: float = 1000.0

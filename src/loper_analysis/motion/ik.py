@@ -243,7 +243,7 @@ def inverse_kinematics(
     labels,
     marker_weights: dict[str, float] | None = None,
     coordinate_tasks: dict[str, tuple[float, float | None]] | None = None,
-    accuracy: float = 1e-8,
+    accuracy: float = IK_ACCURACY,
     min_markers: int = 3,
     source: str = "",
     undetermined: str = "nan",

@@ -27,6 +27,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import JOINTS, SIDES
+from loper_analysis.motion.ik import IK_ACCURACY
 
 __all__ = [
     "MAX_NEIGHBOUR_FACTOR_RATIO",
@@ -322,7 +323,7 @@ def scaled_model_report(
     subject: tuple[float, float, str],
     *,
     coordinate_map: Mapping | None = None,
-    accuracy: float = 1e-6,
+    accuracy: float = IK_ACCURACY,
     lab_labels: Mapping[str, str] | None = None,
     lab_static: Mapping[str, float] | None = None,
     model_height_m: float = float("nan"),

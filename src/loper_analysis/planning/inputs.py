@@ -27,6 +27,7 @@ import pandas as pd
 
 from loper_analysis.checks import number
 from loper_analysis.errors import LoperInputError
+from loper_analysis.study_design import PERTURBED_SIDE
 
 __all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs", "trial_stretches"]
 
@@ -77,7 +78,7 @@ def pilot_onset_series(
     onset_ms: float,
     response=None,
     *,
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     onset_tolerance_ms: float = 12.5,
     source: str = "pilot",
 ) -> dict | None:
@@ -137,7 +138,7 @@ def pilot_perturbed_pairs(
     onset_ms: float,
     response=None,
     *,
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     onset_tolerance_ms: float = 12.5,
     source: str = "pilot",
 ) -> dict | None:
@@ -155,7 +156,7 @@ def pilot_perturbed_pairs(
     return pairs if int(pairs["n_pairs"]) > 0 else None
 
 
-def trial_stretches(trial: Mapping, n_perturbed: int, *, side: str = "left") -> list[dict]:
+def trial_stretches(trial: Mapping, n_perturbed: int, *, side: str = PERTURBED_SIDE) -> list[dict]:
     """``trial`` cut into consecutive stretches that each hold ``n_perturbed`` perturbed strides.
 
     ``trial``: ``name``, ``angles`` (with ``time_s``) and ``strides`` (the

@@ -25,6 +25,7 @@ from loper_analysis.identification import (
     window_options,
 )
 from loper_analysis.planning.inputs import pulse_force_n
+from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
@@ -44,8 +45,8 @@ class PlanSettings(FitBounds):
     to the fit (the robot log's).
     """
 
-    pulse_force_n: float = 40.0
-    pulse_duration_s: float = 0.1
+    pulse_force_n: float = PULSE_FORCE_N
+    pulse_duration_s: float = PULSE_DURATION_S
     window_before_s: float = 0.025
     window_after_s: float = 0.25
     initial_state_span_s: float = 0.1

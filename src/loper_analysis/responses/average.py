@@ -37,6 +37,7 @@ from loper_analysis.responses.windows import (
     window_coordinates,
     window_outliers,
 )
+from loper_analysis.study_design import PERTURBED_SIDE
 
 __all__ = ["COUNT_COLUMNS", "mean_and_sd", "subject_onset_response"]
 
@@ -153,7 +154,7 @@ def subject_onset_response(
     onset_ms: float,
     settings: ResponseSettings = ResponseSettings(),
     *,
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     method: str = "cubic",
     candidate_within_swing: bool = False,
     source: str = "",

@@ -26,6 +26,7 @@ from loper_analysis.responses.windows import (
     window_coordinates,
     window_outliers,
 )
+from loper_analysis.study_design import PERTURBED_SIDE
 
 __all__ = ["MAX_TRIAL_DEVIATION_RATIO", "null_pair_windows", "trial_deviation_rad", "deviant_trials"]
 
@@ -84,7 +85,7 @@ def null_pair_windows(
     onset_ms: float,
     settings: ResponseSettings = ResponseSettings(),
     *,
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     source: str = "",
     max_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO,
 ) -> dict:

@@ -31,6 +31,7 @@ import pandas as pd
 
 from loper_analysis.constants import JOINTS, SIDES, angle_column
 from loper_analysis.errors import LoperInputError
+from loper_analysis.study_design import PERTURBED_SIDE, PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import segment_coordinates
 from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
@@ -42,7 +43,14 @@ _COORDINATE = {"hip": "hip_flexion", "knee": "knee_flexion", "ankle": "ankle_dor
 
 
 def trial_inputs(
-    walk, lab, name: str, *, angle_noise_sd_rad: float = 0.0, seed=None, end_s: float | None = None, side: str = "left"
+    walk,
+    lab,
+    name: str,
+    *,
+    angle_noise_sd_rad: float = 0.0,
+    seed=None,
+    end_s: float | None = None,
+    side: str = PERTURBED_SIDE,
 ) -> dict:
     """The inputs of the response analysis for one simulated trial with the device.
 
@@ -135,8 +143,8 @@ def perturbation_experiment(
     device=None,
     timing_cv: float = TIMING_CV,
     amplitude_cv: float = AMPLITUDE_CV,
-    force_n: float = 40.0,
-    duration_s: float = 0.1,
+    force_n: float = PULSE_FORCE_N,
+    duration_s: float = PULSE_DURATION_S,
     every_strides: tuple[int, int] = (3, 5),
     angle_noise_sd_rad: float = 0.0,
     variability=None,

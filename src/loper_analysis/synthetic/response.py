@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.study_design import PERTURBED_SIDE, PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
 
 __all__ = ["perturbation_schedule", "pulse_train", "thigh_normal", "swing_response", "swing_responses", "swing_spans"]
@@ -40,7 +41,7 @@ def perturbation_schedule(
     rng: np.random.Generator,
     start_s: float,
     end_s: float,
-    side: str = "left",
+    side: str = PERTURBED_SIDE,
     every_strides: tuple[int, int] = (3, 5),
 ) -> pd.DataFrame:
     """Perturbed strides: every 3-5 strides at random (uniform), ``onset_s`` after toe-off.
@@ -66,7 +67,7 @@ def perturbation_schedule(
     return pd.DataFrame(rows, columns=["toe_off_s", "onset_s", "heel_strike_s"])
 
 
-def pulse_train(time_s, onsets_s, force_n: float = 40.0, duration_s: float = 0.1) -> np.ndarray:
+def pulse_train(time_s, onsets_s, force_n: float = PULSE_FORCE_N, duration_s: float = PULSE_DURATION_S) -> np.ndarray:
     """Desired force (N): ``force_n`` for ``onset <= t < onset + duration_s``, else 0."""
     t = np.asarray(time_s, float)
     out = np.zeros_like(t)
@@ -197,7 +198,7 @@ def swing_responses(
     return delta
 
 
-def swing_spans(events: pd.DataFrame, side: str = "left") -> pd.DataFrame:
+def swing_spans(events: pd.DataFrame, side: str = PERTURBED_SIDE) -> pd.DataFrame:
     """Every swing of ``side``: ``toe_off_s`` and the next ``heel_strike_s`` (true events, sorted)."""
     ev = events[events["side"] == side]
     to = np.sort(ev.loc[ev["event"] == "toe_off", "time_s"].to_numpy(float))

@@ -33,9 +33,10 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from loper_analysis.constants import SIDES
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
+from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = [
@@ -66,7 +67,7 @@ class LabSettings:
     clock_offset_s: float = 1.3  # robot log starts this long before the motion capture
     clock_drift_ppm: float = 80.0  # robot clock runs this much fast
     robot_margin_s: float = 2.0  # robot log runs this long past the motion capture
-    lab_to_model_rotation_deg: tuple[float, float, float] = (-90.0, 0.0, 0.0)
+    lab_to_model_rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
     grf_prefix: tuple[str, str] = ("_left", "_right")  # channel suffix per belt: Fz_left, Fz_right
     sync_channel: str = "sync"
 
@@ -139,8 +140,8 @@ class PerturbationSettings:
 
     onset_s: float  # after toe-off of the perturbed (left) leg
     impedance: tuple[float, ...]  # K_hip, D_hip, K_knee, D_knee, K_ankle, D_ankle (N·m/rad, N·m·s/rad)
-    force_n: float = 40.0
-    duration_s: float = 0.1
+    force_n: float = PULSE_FORCE_N
+    duration_s: float = PULSE_DURATION_S
     every_strides: tuple[int, int] = (3, 5)
 
 
