@@ -45,7 +45,7 @@ GOOD_TARGETS = (
     f"results/markers/{SUBJECT}/static.trc",
     f"results/markers/{SUBJECT}/{WALK}.trc",
     f"results/events/{SUBJECT}/{WALK}.events.tsv",
-    f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
+    f"results/events/{SUBJECT}/{WALK}.force.tsv",
     f"results/model/{SUBJECT}/generic.osim",
 )
 
@@ -166,7 +166,7 @@ def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW
     return event_steps.loadcell(
         c3d,
         log,
-        f"results/loadcell/{SUBJECT}/{WALK}.force.tsv",
+        f"results/events/{SUBJECT}/{WALK}.force.tsv",
         LoadcellSettings.from_config(cfg),
     )
 
@@ -658,7 +658,7 @@ def test_bad_robot_log_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab)
     (lab / RAW / "pert050-1.loper.tsv").write_text("".join(_nan_at(_log_lines(lab), 20, 2)))
     _refused(
         lab,
-        lambda: _snakemake(lab, f"results/loadcell/{SUBJECT}/pert050-1.force.tsv"),
+        lambda: _snakemake(lab, f"results/events/{SUBJECT}/pert050-1.force.tsv"),
         [
             (
                 f"{RAW}/pert050-1.loper.tsv: column 'force_measured_n', sample 16 (t = 0.016 s, line 21): "

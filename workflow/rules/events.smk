@@ -37,8 +37,8 @@ rule events_loadcell:
     output:
         events="results/events/{subject}/{trial}.events.tsv",
         contacts="results/events/{subject}/{trial}.contacts.tsv",
-        force="results/loadcell/{subject}/{trial}.force.tsv",
-        native="results/loadcell/{subject}/{trial}.force_native.tsv",
+        force="results/events/{subject}/{trial}.force.tsv",
+        native="results/events/{subject}/{trial}.force_native.tsv",
     log:
         "results/logs/events_loadcell/{subject}/{trial}.log",
     benchmark:

@@ -142,7 +142,7 @@ def stride_force(wildcards):
     """The interaction force of a trial walked with the device (none without it)."""
     if wildcards.trial == TRIALS["no_device"]:
         return []
-    return f"results/loadcell/{wildcards.subject}/{wildcards.trial}.force.tsv"
+    return f"results/events/{wildcards.subject}/{wildcards.trial}.force.tsv"
 
 
 def transparency_files() -> dict[str, TransparencyFiles]:
@@ -208,9 +208,9 @@ def fit_files(subject: str) -> dict[int, FitFiles]:
         tables = dict(angles=f"results/ik/{s}/{t}.angles.tsv", strides=f"results/strides/{s}/{t}.strides.tsv")
         if own:
             tables.update(
-                force=f"results/loadcell/{s}/{t}.force.tsv",
+                force=f"results/events/{s}/{t}.force.tsv",
                 markers=f"results/markers/{s}/{t}.trc",
-                force_native=f"results/loadcell/{s}/{t}.force_native.tsv",
+                force_native=f"results/events/{s}/{t}.force_native.tsv",
             )
         return TrialFiles(**tables)
 

@@ -3,7 +3,7 @@
 The 128 Hz frames cut a pulse's 10 ms edges short; the identification takes
 the force from the robot's samples instead (``docs/identification.md``). The
 load cell's force (low-passed, on the mocap clock:
-``results/loadcell/{subject}/{trial}.force_native.tsv``) is linearly
+``results/events/{subject}/{trial}.force_native.tsv``) is linearly
 interpolated on a relative grid at the robot rate around each onset and
 anchor, and multiplied by the rod direction from the brace markers, whose
 frames are linearly interpolated to the same times and normalised.
