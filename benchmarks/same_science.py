@@ -43,6 +43,8 @@ def new_place(rel: str) -> str:
         return MOVED[rel]
     if rel.startswith("figures/"):
         return "impedance/" + rel.removeprefix("figures/")
+    if rel.startswith("responses/"):  # an onset's mean response beside its fit
+        return "impedance/" + rel.removeprefix("responses/")
     if rel.startswith("loadcell/"):  # the load cell's forces beside the events of the trial they were read with
         return "events/" + rel.removeprefix("loadcell/")
     return rel

@@ -15,7 +15,7 @@ STEPS = ROOT / "src" / "loper_analysis" / "steps"
 #: Rule files without a stage: config checks and targets, settings and input functions.
 SHARED_RULE_FILES = {"common", "inputs"}
 #: Results folders a stage writes besides its own (``docs/code_layout.md``).
-OTHER_FOLDERS = {"impedance": {"responses"}}
+OTHER_FOLDERS: dict[str, set[str]] = {}
 #: Most parameters a file step takes (a settings object and a bundle of files instead of long lists).
 MAX_STEP_PARAMETERS = 8
 

@@ -126,7 +126,7 @@ def test_impedance_table_from_the_default_run(finished_run):
     table = pd.read_csv(finished_run / "results/impedance/impedance.tsv", sep="\t")
     assert list(table.columns) == list(IMPEDANCE_COLUMNS)
     assert list(table.joint) == ["hip", "knee", "ankle"] and (table.onset_ms == 50).all()
-    counts = pd.read_csv(finished_run / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
+    counts = pd.read_csv(finished_run / "results/impedance/S01/050.counts.tsv", sep="\t").set_index("trial")
     # a pulse every 3-5 of ~14 strides: 3 perturbed, all matched and kept (too few for the IQR rule to judge)
     assert counts.loc["total", ["n_perturbed", "n_kept"]].tolist() == [3, 3]
     assert counts.loc["total", "status"] == "too_few_strides"
@@ -346,7 +346,7 @@ def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_ru
     assert "subject S01: " in (work / "results/logs/transparency/transparency.log").read_text()
     table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
     assert (table.status == "failed").all() and table.reason.str.startswith("0 valid perturbed stride(s)").all()
-    counts = pd.read_csv(work / "results/responses/S01/050.counts.tsv", sep="\t").set_index("trial")
+    counts = pd.read_csv(work / "results/impedance/S01/050.counts.tsv", sep="\t").set_index("trial")
     assert counts.loc["total", ["n_perturbed", "status"]].tolist() == [0, "too_few_strides"]
 
 

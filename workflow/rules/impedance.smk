@@ -80,7 +80,7 @@ rule impedance_summary:
 rule impedance_figures:
     input:
         responses=lambda wc: [
-            f"results/responses/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]
+            f"results/impedance/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]
         ],
         curves=lambda wc: [
             f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]

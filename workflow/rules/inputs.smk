@@ -190,11 +190,11 @@ def null_pair_trials(subject: str) -> list[str]:
 
 #: The files a subject's fit at one onset writes ({subject}; {onset}: the onset's three digits).
 FIT_OUTPUTS = dict(
-    response="results/responses/{subject}/{onset}.response.tsv",
-    counts="results/responses/{subject}/{onset}.counts.tsv",
+    response="results/impedance/{subject}/{onset}.response.tsv",
+    counts="results/impedance/{subject}/{onset}.counts.tsv",
     fit="results/impedance/{subject}/{onset}.tsv",
     curves="results/impedance/{subject}/{onset}.curves.tsv",
-    force="results/responses/{subject}/{onset}.force.tsv",
+    force="results/impedance/{subject}/{onset}.force.tsv",
 )
 
 
