@@ -135,3 +135,15 @@ def test_no_library_module_is_longer_than_600_lines():
     src = ROOT / "src" / "loper_analysis"
     long = {p.relative_to(src).as_posix(): n for p in src.rglob("*.py") if (n := len(p.read_text().splitlines())) > 600}
     assert long == {}
+
+
+def test_each_rule_calls_its_own_stages_step():
+    """A rule's script calls the file step of the stage whose rule file holds the rule, never another stage's."""
+    wrong = []
+    for smk in RULES.glob("*.smk"):
+        for script in re.findall(r'"\.\./scripts/(\w+)\.py"', smk.read_text()):
+            text = (ROOT / "workflow" / "scripts" / f"{script}.py").read_text()
+            steps = set(re.findall(r"from loper_analysis\.steps import (\w+)", text)) - {"rule_log"}
+            if steps != {smk.stem}:
+                wrong.append(f"{smk.name}: {script}.py calls {sorted(steps)}")
+    assert wrong == []

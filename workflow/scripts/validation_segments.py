@@ -1,7 +1,7 @@
 from loper_analysis.steps import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import model
+    from loper_analysis.steps import validation
 
     p = snakemake.params
-    model.anthropometric_segments(snakemake.output[0], p.height_m, p.mass_kg, p.attachment_fraction)
+    validation.validation_segments(snakemake.output[0], p.height_m, p.mass_kg, p.attachment_fraction)

@@ -280,7 +280,7 @@ def segments_from_model_file(
 def anthropometric_segments(
     out_tsv: PathLike, height_m: float, mass_kg: float, attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
 ) -> SegmentParameters:
-    """Segment table from height and mass with Winter's table (the validation study's subject, the CLI)."""
+    """Segment table from height and mass with Winter's table (the command line's ``segments --height-m``)."""
     params = segment_parameters_from_anthropometry(height_m, mass_kg, attachment_fraction)
     write_segments(params, out_tsv)
     log.info("segment table for %s m, %s kg: %s", height_m, mass_kg, params)

@@ -10,12 +10,29 @@ import pandas as pd
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 
-__all__ = ["VALIDATION_FLOAT_FORMAT", "validation_chunk", "validation_tables", "validation_figure"]
+__all__ = [
+    "VALIDATION_FLOAT_FORMAT",
+    "validation_chunk",
+    "validation_figure",
+    "validation_segments",
+    "validation_tables",
+]
 
 log = logging.getLogger(__name__)
 
 #: Significant digits of the validation tables: errors of 1e-5 N·m/rad on values up to 150 need them.
 VALIDATION_FLOAT_FORMAT = "%.15g"
+
+
+def validation_segments(out_tsv: PathLike, height_m: float, mass_kg: float, attachment_fraction: float) -> None:
+    """The validation study's subject: the segment table from height (m) and mass (kg) with Winter's table
+    (:func:`loper_analysis.swing_leg.dynamics.segment_parameters_from_anthropometry`)."""
+    from loper_analysis.io.segment_table import write_segments
+    from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
+
+    params = segment_parameters_from_anthropometry(height_m, mass_kg, attachment_fraction)
+    write_segments(params, out_tsv)
+    log.info("segment table for %s m, %s kg: %s", height_m, mass_kg, params)
 
 
 def validation_chunk(
