@@ -325,15 +325,10 @@ def scale_with_setup(
         ``files.static_c3d`` (seen along the vertical of ``settings.rotation_deg``:
         :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
     settings : ModelSettings
-        The window (``time_range_s``, ``static_duration_s``); ``max_motion_rms_m``
-        (largest RMS motion of a marker over the window, m: a subject who does
-        not stand still is refused; None: not checked); ``segment_bodies`` (the
-        bodies the segment table will need: the scaled model must have them on
-        both sides); ``factor_range`` (least and largest plausible factor of a
-        measurement: static-trial marker distance over the model's at its
-        default pose, averaged over the measurement's pairs,
-        :func:`loper_analysis.motion.plausibility.measurement_scale_factors`);
-        ``rotation_deg`` (the lab's vertical, for the mass).
+        The window (``time_range_s``, ``static_duration_s``), the static trial's largest marker motion
+        (``max_motion_rms_m``), the bodies the scaled model must have (``segment_bodies``), the plausible
+        measurement factors (``factor_range``,
+        :func:`loper_analysis.motion.plausibility.measurement_scale_factors`) and the lab's vertical.
     height_m : float, optional
         The subject's height (m) in the scale report; None: estimated from the scaled model.
     lab_labels : mapping, optional
@@ -450,22 +445,20 @@ def _run_scale_tool(
     (:func:`scale_with_setup`; ``files.setup_xml`` None: the tool as :func:`scaled_model` built it)."""
     import tempfile
 
-    from loper_analysis.io.opensim_tables import trc_data_rate_hz, write_trc
-    from loper_analysis.io.osim import quiet_opensim, read_model
+    from loper_analysis.io.osim import read_model
     from loper_analysis.motion.segments import check_segment_bodies
 
     generic_osim, static_trc, out_osim = Path(files.generic_osim), Path(files.static_trc), files.out_osim
     setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
     segment_bodies = settings.segment_bodies
     where = str(setup_xml) if setup_xml is not None else str(static_trc)
-    scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
+    placer = tool.getMarkerPlacer()
     window, ranges, pairs, pose = _scaling_pose(tool, generic, files, settings, lab_labels)
     factors = measurement_scale_factors(generic, pairs, pose.markers_m, pose.labels)
     require_scale_factors(factors, str(static_trc), settings.factor_range)
     gravity = float(np.linalg.norm(generic.getGravity().to_numpy()))
     rec, plates = _static_record(files.static_c3d) if mass_kg is None and files.static_c3d else (None, [])
     mass_kg, mass_source = body_mass_kg(mass_kg, rec, plates, window, lab_up(settings.rotation_deg), gravity)
-    osim = quiet_opensim()
     maker = tool.getGenericModelMaker()
     tool.setPathToSubject("")  # OpenSim prefixes the setup's folder to every file name; ours are absolute
     tool.setSubjectMass(mass_kg)
@@ -475,41 +468,10 @@ def _run_scale_tool(
         coordinates = scale_tool.setup_file(placer.getCoordinateFileName(), setup_xml)
         placer.setCoordinateFileName(str(coordinates) if coordinates is not None else "Unassigned")
     with tempfile.TemporaryDirectory(prefix="loper-scale-") as tmp_dir:
-        trc = Path(tmp_dir) / "static_window.trc"
-        t, X = pose.time_s, pose.markers_m
-        if t.size == 1:  # a snapshot static trial: OpenSim averages over a span of frames, so the frame twice
-            rate_hz = trc_data_rate_hz(static_trc) or 100.0
-            t, X = np.array([t[0], t[0] + 1.0 / rate_hz]), np.repeat(X, 2, axis=0)
-            window = (float(t[0]), float(t[1]))
-        write_trc(trc, t, X, pose.labels)
-        scale_file = Path(tmp_dir) / "scale_set.xml"
-        for part in (scaler, placer):
-            part.setMarkerFileName(str(trc))
-            own = ranges.get(part)
-            part.setTimeRange(scale_tool.array_double(osim, own if own is not None else window))
-        scaler.setOutputScaleFileName(str(scale_file) if scaler.getApply() else "Unassigned")
-        placer.setOutputMotionFileName("Unassigned")
-        placer.setOutputMarkerFileName("Unassigned")
-        unplaced_file = Path(tmp_dir) / "scaled_unplaced.osim"
+        trc, window = _window_file(tool, pose, ranges, window, Path(tmp_dir), static_trc)
+        scale_file, unplaced_file = Path(tmp_dir) / "scale_set.xml", Path(tmp_dir) / "scaled_unplaced.osim"
         with staged(out_osim, "OpenSim model") as tmp:
-            if placer.getApply():  # the model scaler's model too: the static pose before marker placement
-                placer.setOutputModelFileName(str(tmp))
-                scaler.setOutputModelFileName(str(unplaced_file) if scaler.getApply() else "Unassigned")
-            else:
-                scaler.setOutputModelFileName(str(tmp))
-                placer.setOutputModelFileName("Unassigned")
-            try:
-                tool.run()  # False when the marker placer is off, even after a good scaling: the file tells
-            except Exception as exc:  # OpenSim raises its own exception types
-                said = str(exc).replace(str(trc), f"{static_trc} (the scaling window)")
-                raise LoperInputError(
-                    f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} ({said})"
-                ) from exc
-            if not tmp.is_file():
-                raise LoperInputError(
-                    f"{where}: OpenSim's ScaleTool wrote no model for {static_trc} with "
-                    f"{generic_osim} (are the model scaler and the marker placer both off?)"
-                )
+            _run_tool(tool, (tmp, scale_file, unplaced_file), (trc, static_trc, generic_osim), where)
             scaled = read_model(tmp)
             check_segment_bodies(scaled, segment_bodies, source=f"{out_osim} (scaled from {generic_osim})")
             stature = model_stature_m(scaled, segment_bodies)
@@ -531,6 +493,56 @@ def _run_scale_tool(
         len(pose.time_s),
         mass_kg,
     )
+
+
+def _window_file(tool, pose, ranges, window, tmp_dir: Path, static_trc: Path):
+    """Write the scaling window's pose as the TRC the tool reads and point the model scaler and the marker placer
+    at it, each over its own time range or the window; returns the TRC and the window (a snapshot static trial:
+    its frame twice, a frame apart, as OpenSim averages over a span)."""
+    from loper_analysis.io.opensim_tables import trc_data_rate_hz, write_trc
+    from loper_analysis.io.osim import quiet_opensim
+
+    osim = quiet_opensim()
+    trc = tmp_dir / "static_window.trc"
+    t, X = pose.time_s, pose.markers_m
+    if t.size == 1:
+        rate_hz = trc_data_rate_hz(static_trc) or 100.0
+        t, X = np.array([t[0], t[0] + 1.0 / rate_hz]), np.repeat(X, 2, axis=0)
+        window = (float(t[0]), float(t[1]))
+    write_trc(trc, t, X, pose.labels)
+    for part in (tool.getModelScaler(), tool.getMarkerPlacer()):
+        part.setMarkerFileName(str(trc))
+        own = ranges.get(part)
+        part.setTimeRange(scale_tool.array_double(osim, own if own is not None else window))
+    return trc, window
+
+
+def _run_tool(tool, outputs: tuple[Path, Path, Path], inputs: tuple[Path, Path, Path], where: str) -> None:
+    """Run OpenSim's ScaleTool writing the model, the scale set and the model before marker placement
+    (``outputs``) from the window's TRC, the static trial and the generic model (``inputs``, named in messages)."""
+    (model, scale_file, unplaced_file), (trc, static_trc, generic_osim) = outputs, inputs
+    scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
+    scaler.setOutputScaleFileName(str(scale_file) if scaler.getApply() else "Unassigned")
+    placer.setOutputMotionFileName("Unassigned")
+    placer.setOutputMarkerFileName("Unassigned")
+    if placer.getApply():  # the model scaler's model too: the static pose before marker placement
+        placer.setOutputModelFileName(str(model))
+        scaler.setOutputModelFileName(str(unplaced_file) if scaler.getApply() else "Unassigned")
+    else:
+        scaler.setOutputModelFileName(str(model))
+        placer.setOutputModelFileName("Unassigned")
+    try:
+        tool.run()  # False when the marker placer is off, even after a good scaling: the file tells
+    except Exception as exc:  # OpenSim raises its own exception types
+        said = str(exc).replace(str(trc), f"{static_trc} (the scaling window)")
+        raise LoperInputError(
+            f"{where}: OpenSim's ScaleTool failed for {static_trc} with {generic_osim} ({said})"
+        ) from exc
+    if not model.is_file():
+        raise LoperInputError(
+            f"{where}: OpenSim's ScaleTool wrote no model for {static_trc} with {generic_osim} (are the model "
+            "scaler and the marker placer both off?)"
+        )
 
 
 def _write_scale_report(models, pose, scaling, subject, files: ScaleFiles, window, settings, lab_labels) -> None:

@@ -187,63 +187,20 @@ def strides_summary(
             for key, path in zip(keys, files.dropped, strict=True)
         }
     table = stride_summary(tables, min_valid, contacts, dropped)
-    extra = []
+    extra, ik_warnings = [], None
     if files.ik is not None:
-        ik = [
-            read_tsv(path, "IK summary", IK_COLUMNS, keep_default_na=False, na_values=[""]).iloc[0] for path in files.ik
-        ]
-        extra.append(
-            pd.DataFrame(
-                {
-                    "n_frames": [int(r.n_frames) for r in ik],
-                    "n_frames_left_out": [int(r.n_frames_left_out) for r in ik],
-                    "marker_rms_mean_m": [float(r.marker_rms_mean_m) for r in ik],
-                    "worst_marker": ["" if pd.isna(r.worst_marker) else str(r.worst_marker) for r in ik],
-                    "worst_marker_rms_m": [float(r.worst_marker_rms_m) for r in ik],
-                    "marker_geometry_change": [float(r.marker_geometry_change) for r in ik],
-                }
-            )
-        )
+        columns, ik_warnings = _ik_columns(files.ik)
+        extra.append(columns)
     if files.markers is not None:
-        marks = [
-            read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0]
-            for path in files.markers
-        ]
-        extra.append(
-            pd.DataFrame(
-                {
-                    "heading_deg": [float(r.heading_deg) for r in marks],
-                    "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
-                    "turn_deg": [float(r.turn_deg) for r in marks],
-                }
-            )
-        )
+        extra.append(_marker_columns(files.markers))
     if files.agreement is not None:
-        agree = [read_tsv(path, "lab agreement", ("angle", "r", "rms_diff_rad")) for path in files.agreement]
-        joints = [a[a["angle"] != "pelvis_angle"] if len(a) else a for a in agree]
-        extra.append(
-            pd.DataFrame(
-                {
-                    "lab_joints_min_r": [float(a["r"].min()) if len(a) else np.nan for a in joints],
-                    "lab_joints_max_rms_diff_rad": [
-                        float(a["rms_diff_rad"].max()) if len(a) else np.nan for a in joints
-                    ],
-                }
-            )
-        )
-    if files.ik is not None:
-        extra.append(pd.DataFrame({"warnings": ["" if pd.isna(r.warnings) else str(r.warnings) for r in ik]}))
+        extra.append(_agreement_columns(files.agreement))
+    if ik_warnings is not None:
+        extra.append(pd.DataFrame({"warnings": ik_warnings}))
     if extra:
         table = pd.concat([table, *extra], axis=1)
     if "outside_robot_log_fraction" in table:
-        said = [
-            f"robot log truncated? {n} of the strides with events ({100 * f:.0f} %) lie outside its span"
-            if f > MAX_OUTSIDE_LOG_FRACTION
-            else ""
-            for n, f in zip(table["n_outside_robot_log"], table["outside_robot_log_fraction"])
-        ]
-        before = table["warnings"] if "warnings" in table else pd.Series([""] * len(table))
-        table["warnings"] = [" | ".join(w for w in pair if w) for pair in zip(said, before.fillna(""))]
+        table["warnings"] = _with_truncation_warnings(table)
     write_tsv(table, out_tsv)
     for row in table[table.status == "too_few_strides"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
@@ -252,6 +209,59 @@ def strides_summary(
             log.warning("%s %s: %s", row.subject, row.trial, row.warnings)
     log.info("strides:\n%s", table.to_string(index=False))
     return table
+
+
+def _ik_columns(paths: Sequence[PathLike]) -> tuple[pd.DataFrame, list[str]]:
+    """The strides summary's columns from the trials' IK summaries, and their warnings."""
+    ik = [read_tsv(path, "IK summary", IK_COLUMNS, keep_default_na=False, na_values=[""]).iloc[0] for path in paths]
+    columns = pd.DataFrame(
+        {
+            "n_frames": [int(r.n_frames) for r in ik],
+            "n_frames_left_out": [int(r.n_frames_left_out) for r in ik],
+            "marker_rms_mean_m": [float(r.marker_rms_mean_m) for r in ik],
+            "worst_marker": ["" if pd.isna(r.worst_marker) else str(r.worst_marker) for r in ik],
+            "worst_marker_rms_m": [float(r.worst_marker_rms_m) for r in ik],
+            "marker_geometry_change": [float(r.marker_geometry_change) for r in ik],
+        }
+    )
+    return columns, ["" if pd.isna(r.warnings) else str(r.warnings) for r in ik]
+
+
+def _marker_columns(paths: Sequence[PathLike]) -> pd.DataFrame:
+    """The trials' walking direction, speed and turn, from their markers summaries."""
+    marks = [read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0] for path in paths]
+    return pd.DataFrame(
+        {
+            "heading_deg": [float(r.heading_deg) for r in marks],
+            "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
+            "turn_deg": [float(r.turn_deg) for r in marks],
+        }
+    )
+
+
+def _agreement_columns(paths: Sequence[PathLike]) -> pd.DataFrame:
+    """The least r and the largest RMS difference over the hip, knee and ankle angles against the lab's own."""
+    agree = [read_tsv(path, "lab agreement", ("angle", "r", "rms_diff_rad")) for path in paths]
+    joints = [a[a["angle"] != "pelvis_angle"] if len(a) else a for a in agree]
+    return pd.DataFrame(
+        {
+            "lab_joints_min_r": [float(a["r"].min()) if len(a) else np.nan for a in joints],
+            "lab_joints_max_rms_diff_rad": [float(a["rms_diff_rad"].max()) if len(a) else np.nan for a in joints],
+        }
+    )
+
+
+def _with_truncation_warnings(table: pd.DataFrame) -> list[str]:
+    """The summary's warnings, each trial whose strides lie outside its robot log beyond
+    :data:`loper_analysis.gait.strides.MAX_OUTSIDE_LOG_FRACTION` warned about first."""
+    said = [
+        f"robot log truncated? {n} of the strides with events ({100 * f:.0f} %) lie outside its span"
+        if f > MAX_OUTSIDE_LOG_FRACTION
+        else ""
+        for n, f in zip(table["n_outside_robot_log"], table["outside_robot_log_fraction"])
+    ]
+    before = table["warnings"] if "warnings" in table else pd.Series([""] * len(table))
+    return [" | ".join(w for w in pair if w) for pair in zip(said, before.fillna(""))]
 
 
 def angles_figure(
