@@ -9,7 +9,5 @@ with rule_log(snakemake.log[0]):
         i.strides,
         snakemake.output[0],
         p.min_valid,
-        strides.TrialTables(
-            contacts=i.contacts, ik=i.ik, markers=i.markers, agreement=i.agreement, dropped=i.dropped
-        ),
+        strides.TrialTables(contacts=i.contacts, ik=i.ik, markers=i.markers, agreement=i.agreement, dropped=i.dropped),
     )
