@@ -48,10 +48,12 @@ import pandas as pd
 import yaml
 from scipy.stats import beta
 
+from loper_analysis.layout import Paths, fill
 from loper_analysis.report.markdown import markdown_table
 from loper_analysis.study_design import StudyDesign
 
 ROOT = Path(__file__).resolve().parents[1]
+PATHS = Paths()
 #: Columns of the angle table that get IK-like noise, and the noise measured in the whole chain (``--mode chain
 #: --keep``: IK angle minus true coordinate, minimal-impedance trials of C014 and C030, 0.5 mm marker noise,
 #: 40 Hz marker filter, generated model): SD (m, rad) and correlations. The noise is close to white noise
@@ -402,7 +404,8 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
     diffs: dict[str, list] = {a: [] for a in _ANGLES}
     trial = config["trials"]["device"]
-    subjects = sorted(p.parent.name for p in (work / "results/ik").glob(f"*/{trial}.angles.tsv"))[:max_subjects]
+    angles = fill(PATHS.ik.angles, subject="*", trial=trial)
+    subjects = sorted(p.parent.name for p in work.glob(angles))[:max_subjects]
     for subject in subjects:
         row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
         params = segment_parameters_from_model(build_lower_body_model(row["height_m"], row["mass_kg"]))
@@ -423,7 +426,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
             minimal_impedance=minimal_impedance,
         )
         coords = walk.mocap_coordinates(lab.marker_rate_hz)
-        ik = read_tsv(work / f"results/ik/{subject}/{trial}.angles.tsv", "angle table")
+        ik = read_tsv(work / fill(PATHS.ik.angles, subject=subject, trial=trial), "angle table")
         for a in _ANGLES:
             entry = config["opensim"]["coordinate_map"][a]
             column = f"{a}_m" if a == "pelvis_x" else f"{a}_rad"
@@ -451,7 +454,7 @@ def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFram
             "snakemake",
             "-j",
             str(jobs),
-            "results/impedance/impedance.tsv",
+            PATHS.impedance.table,
             "--configfile",
             "config/coverage.yaml",
             "-q",
@@ -461,7 +464,7 @@ def run_chain(names: list[str], seed: int, jobs: int, work: Path) -> pd.DataFram
     )
     if res.returncode:
         raise SystemExit(f"snakemake failed in {work} (exit {res.returncode})")
-    return pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
+    return pd.read_csv(work / PATHS.impedance.table, sep="\t")
 
 
 def main() -> None:

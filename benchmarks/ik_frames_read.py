@@ -25,6 +25,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from loper_analysis.layout import RESULTS_DIR
+
 
 def covered(time_s: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:
     """Frames inside any span (s)."""
@@ -52,7 +54,7 @@ def trial_shares(
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("results", nargs="?", default="results")
+    parser.add_argument("results", nargs="?", default=RESULTS_DIR)
     parser.add_argument("--configfile", nargs="*", default=["config/config.yaml"])
     parser.add_argument("--margin-s", type=float, default=0.1, help="spline margin on each side of a window (s)")
     args = parser.parse_args()

@@ -22,9 +22,11 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
+from loper_analysis.layout import Paths, fill
 from loper_analysis.study_design import StudyDesign
 
 ROOT = Path(__file__).resolve().parents[1]
+PATHS = Paths()
 
 
 def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
@@ -42,7 +44,7 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
             "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
         )
         trials = StudyDesign.from_config(cfg["trials"]).walking_trials()
-        raw = [f"data/raw/S01/{cfg['trials']['static']}.c3d"] + [f"data/raw/S01/{t}.c3d" for t in trials]
+        raw = [fill(PATHS.raw.c3d, subject="S01", trial=t) for t in [cfg["trials"]["static"], *trials]]
 
         def run(*targets: str) -> None:
             res = subprocess.run(
@@ -57,12 +59,13 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None) -> None:
         t0 = time.perf_counter()
         run(*raw)
         t1 = time.perf_counter()
-        targets = [f"results/strides/S01/{t}.strides.tsv" for t in trials] + ["results/transparency/rmsd.tsv"]
+        targets = [fill(PATHS.strides.strides, subject="S01", trial=t) for t in trials] + [PATHS.transparency.rmsd]
         run(*targets)
         t2 = time.perf_counter()
         rows = []
-        for tsv in (work / "results/benchmarks").rglob("*.tsv"):
-            rule = tsv.relative_to(work / "results/benchmarks").parts[0]
+        benchmarks = (work / PATHS.benchmark("rule", "job")).parents[1]
+        for tsv in benchmarks.rglob("*.tsv"):
+            rule = tsv.relative_to(benchmarks).parts[0]
             if rule.startswith("synthetic"):
                 continue
             rows.append({"rule": rule, "cpu_s": pd.read_csv(tsv, sep="\t")["cpu_time"].iloc[0]})

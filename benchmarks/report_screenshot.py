@@ -28,6 +28,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from loper_analysis.layout import RESULTS_DIR
+
 ROOT = Path(__file__).resolve().parents[1]
 #: The screen the requirement is written for (CSS pixels).
 WIDTH_PX, HEIGHT_PX = 1400, 900
@@ -255,7 +257,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--out",
         type=Path,
-        default=Path("results/benchmarks/report_first_screen.png"),
+        default=Path(RESULTS_DIR, "benchmarks", "report_first_screen.png"),
         help="screenshot (PNG, 1400×900)",
     )
     args = parser.parse_args(argv)

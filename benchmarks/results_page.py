@@ -38,6 +38,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
+from loper_analysis.layout import RESULTS_DIR, Paths
+
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_PAGE = ROOT / "docs" / "results.md"
 DEFAULT_CONFIG = "config/config.yaml"
@@ -128,6 +130,7 @@ class Run:
 
     def __init__(self, results: Path, configfiles: list[str]):
         self.results = results
+        self.paths = Paths(results_dir=str(results))
         self.configfiles = [DEFAULT_CONFIG, *configfiles]
         self.config: dict = {}
         for name in self.configfiles:
@@ -137,13 +140,13 @@ class Run:
             self.config = deep_merge(self.config, yaml.safe_load(path.read_text()) or {})
         self.read: list[Path] = []
 
-    def path(self, relative: str) -> Path:
-        """A file under the results folder (``relative`` to it)."""
-        return self.results / relative
+    def path(self, name: str) -> Path:
+        """A result file (``name``: its path, from ``self.paths``)."""
+        return Path(name)
 
-    def tsv(self, relative: str) -> pd.DataFrame | None:
+    def tsv(self, name: str) -> pd.DataFrame | None:
         """A result table, or None when the run did not write it."""
-        path = self.path(relative)
+        path = self.path(name)
         if not path.is_file():
             return None
         self.read.append(path)
@@ -152,17 +155,17 @@ class Run:
         except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
             raise PageError(f"{path}: not a readable TSV table ({exc})") from None
 
-    def need(self, frame: pd.DataFrame, relative: str, columns: list[str]) -> pd.DataFrame:
+    def need(self, frame: pd.DataFrame, name: str, columns: list[str]) -> pd.DataFrame:
         """``frame`` when it holds ``columns``, else a PageError naming the table and the missing columns."""
         missing = [c for c in columns if c not in frame.columns]
         if missing:
-            raise PageError(f"{self.path(relative)}: columns {missing} missing (has {list(frame.columns)})")
+            raise PageError(f"{self.path(name)}: columns {missing} missing (has {list(frame.columns)})")
         return frame
 
 
-def not_in_run(run: Run, *relatives: str) -> str:
+def not_in_run(run: Run, *names: str) -> str:
     """The text of a part whose tables the run did not write."""
-    names = ", ".join(f"`{run.path(r).as_posix()}`" for r in relatives)
+    names = ", ".join(f"`{run.path(r).as_posix()}`" for r in names)
     return f"*Not in this run: no {names}.*"
 
 
@@ -173,7 +176,7 @@ def block_run(run: Run) -> str:
     """The command, the config files and the design the generated figures come from."""
     cfg = run.config
     extra = "".join(f" --configfile {f}" for f in run.configfiles[1:])
-    results = "" if run.results == Path("results") else f" --results {run.results.as_posix()}"
+    results = "" if run.results == Path(RESULTS_DIR) else f" --results {run.results.as_posix()}"
     files = [f"`{f}` (SHA-256 {sha256(Path(f))}…)" for f in run.configfiles]
     sheet = cfg.get("subjects")
     design = []
@@ -219,7 +222,7 @@ GROUP_COLUMNS = ("group_mean", "group_ci95_low", "group_ci95_high", "between_sd"
 def block_impedance_summary(run: Run) -> str:
     """Across-subject K and D per joint and onset: the random-effects mean, its 95 % interval and the SD between
     subjects."""
-    name = "impedance/summary.tsv"
+    name = run.paths.impedance.summary
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
@@ -277,7 +280,7 @@ def block_truth_recovery(run: Run) -> str:
     """The synthetic subjects' K and D recovered, per joint and onset."""
     from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE
 
-    name = "impedance/impedance.tsv"
+    name = run.paths.impedance.table
     t = run.tsv(name)
     if t is None:
         return not_in_run(run, name)
@@ -352,7 +355,7 @@ def block_truth_recovery(run: Run) -> str:
 
 def block_validation(run: Run) -> str:
     """The validation study's errors against the study's."""
-    name = "validation/summary.tsv"
+    name = run.paths.validation.summary
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
@@ -404,11 +407,11 @@ def block_validation(run: Run) -> str:
             f"Without noise every estimate of the {int(clean['n'].min())} combinations is within "
             f"|ΔK| ≤ {num(k, 2)} N·m/rad and |ΔD| ≤ {num(d, 2)} N·m·s/rad."
         )
-    fits = run.tsv("validation/fits.tsv")
+    fits = run.tsv(run.paths.validation.fits)
     if fits is not None:
         from loper_analysis.identification.fit import AT_BEST_RELATIVE
 
-        fits = run.need(fits, "validation/fits.tsv", ["condition", "n_starts", "n_starts_at_best"])
+        fits = run.need(fits, run.paths.validation.fits, ["condition", "n_starts", "n_starts_at_best"])
         parts = []
         for cond, label in (("no_noise", "noise-free"), ("noise", "noisy")):
             g = fits[fits["condition"] == cond]
@@ -425,7 +428,7 @@ def block_validation(run: Run) -> str:
 
 def block_transparency(run: Run) -> str:
     """RMSD with vs without the device against ISV_ave, the group rows."""
-    name = "transparency/rmsd.tsv"
+    name = run.paths.transparency.rmsd
     r = run.tsv(name)
     if r is None:
         return not_in_run(run, name)
@@ -484,7 +487,7 @@ def block_transparency(run: Run) -> str:
 
 def block_interaction_force(run: Run) -> str:
     """Interaction force in minimal-impedance walking, the group rows."""
-    name = "transparency/force.tsv"
+    name = run.paths.transparency.force
     f = run.tsv(name)
     if f is None:
         return not_in_run(run, name)
@@ -518,7 +521,7 @@ def block_interaction_force(run: Run) -> str:
 
 def block_device(run: Run) -> str:
     """The device figures beside the study's."""
-    name = "device/summary.tsv"
+    name = run.paths.device.summary
     d = run.tsv(name)
     if d is None:
         return not_in_run(run, name)
@@ -538,7 +541,7 @@ def block_device(run: Run) -> str:
 
 def block_strides(run: Run) -> str:
     """Strides per subject: recorded, perturbed, removed as outliers, kept; flagged trials."""
-    name = "strides/summary.tsv"
+    name = run.paths.strides.summary
     s = run.tsv(name)
     if s is None:
         return not_in_run(run, name)
@@ -569,7 +572,7 @@ def block_strides(run: Run) -> str:
 
 def block_planning(run: Run) -> str:
     """The workflow's planning answers."""
-    name = "planning/answers.txt"
+    name = run.paths.planning.answers
     path = run.path(name)
     if not path.is_file():
         return not_in_run(run, name)
@@ -621,7 +624,7 @@ def rewrite(page: str, run: Run, source: str = "page") -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--results", default="results", help="the run's results folder (default: results)")
+    ap.add_argument("--results", default=RESULTS_DIR, help="the run's results folder (default: results)")
     ap.add_argument(
         "--configfile",
         action="append",

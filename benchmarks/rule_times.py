@@ -27,6 +27,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from loper_analysis.layout import RESULTS_DIR
+
 TIMING = re.compile(r"job time: after_first_io_s=([0-9.]+) io_s=(-?[0-9.]+) library_import_s=([0-9.]+)")
 
 
@@ -73,7 +75,7 @@ def rule_times(results: Path) -> pd.DataFrame:
     return table.sort_values("wall_s", ascending=False, ignore_index=True)
 
 
-def main(results: str = "results") -> None:
+def main(results: str = RESULTS_DIR) -> None:
     root = Path(results)
     if root.name == "benchmarks":  # the former argument: results/benchmarks
         root = root.parent

@@ -25,6 +25,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from loper_analysis.layout import RAW_DIR, RESULTS_DIR
+
 #: Result files the layout moved: old path -> new path (relative to results/).
 MOVED = {
     "tables/impedance.tsv": "impedance/impedance.tsv",
@@ -84,7 +86,7 @@ def _run(checkout: Path, jobs: int) -> Path:
     env = dict(os.environ, PYTHONPATH=str(checkout / "src"))
     subprocess.run([sys.executable, "-m", "compileall", "-q", "src"], cwd=checkout, env=env, check=True)
     subprocess.run(["snakemake", f"-j{jobs}", "--quiet", "rules"], cwd=checkout, env=env, check=True)
-    return checkout / "results"
+    return checkout / RESULTS_DIR
 
 
 def build(rev: str, jobs: int) -> int:
@@ -97,7 +99,7 @@ def build(rev: str, jobs: int) -> int:
                 ["git", "ls-files", "-co", "--exclude-standard"], cwd=root, check=True, capture_output=True, text=True
             ).stdout.split()
             for f in files:
-                if (root / f).is_file() and not f.startswith(("results/", "data/")):
+                if (root / f).is_file() and not f.startswith((f"{RESULTS_DIR}/", f"{RAW_DIR.split('/')[0]}/")):
                     (new / f).parent.mkdir(parents=True, exist_ok=True)
                     (new / f).write_bytes((root / f).read_bytes())
             return compare(_run(base, jobs), _run(new, jobs))

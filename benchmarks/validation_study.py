@@ -17,7 +17,10 @@ from pathlib import Path
 
 import pandas as pd
 
+from loper_analysis.layout import Paths
+
 ROOT = Path(__file__).resolve().parents[1]
+PATHS = Paths()
 
 
 def main() -> None:
@@ -28,7 +31,7 @@ def main() -> None:
             (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
         t0 = time.perf_counter()
         res = subprocess.run(
-            [sys.executable, "-m", "snakemake", "-j2", "results/validation/summary.tsv"],
+            [sys.executable, "-m", "snakemake", "-j2", PATHS.validation.summary],
             cwd=work,
             capture_output=True,
             text=True,
@@ -36,9 +39,9 @@ def main() -> None:
         wall = time.perf_counter() - t0
         if res.returncode:
             sys.exit(res.stderr[-3000:])
-        summary = pd.read_csv(work / "results/validation/summary.tsv", sep="\t")
+        summary = pd.read_csv(work / PATHS.validation.summary, sep="\t")
         bench = pd.concat(
-            pd.read_csv(p, sep="\t") for p in (work / "results/benchmarks/validation_chunk").glob("*.tsv")
+            pd.read_csv(p, sep="\t") for p in (work / PATHS.benchmark("validation_chunk", "*")).parent.glob("*.tsv")
         )
     print(
         f"validation study (729 combinations x 2 conditions x 10 starts), snakemake -j2: {wall:.1f} s wall "

@@ -26,9 +26,9 @@ STAGES = sorted(p.stem for p in RULES.glob("*.smk") if p.stem not in SHARED_RULE
 def test_each_rule_file_has_its_file_step_and_writes_to_its_folder(stage):
     assert (STEPS / f"{stage}.py").is_file()
     outputs = "\n".join(_output_blocks((RULES / f"{stage}.smk").read_text()))
-    folders = set(re.findall(r'"results/([a-z_]+)/', outputs))
+    folders = set(re.findall(r"PATHS\.([a-z_]+)\.", outputs)) - {"raw"}
     if stage == "synthetic":
-        assert folders == set() and "data/raw/" in outputs  # the synthetic lab writes the raw files
+        assert folders == set() and "PATHS.raw." in outputs  # the synthetic lab writes the raw files
     else:
         assert folders and folders <= {stage} | OTHER_FOLDERS.get(stage, set()), folders
 
@@ -98,8 +98,18 @@ FILE_CALLS = re.compile(
     r"\b(open|read_text|write_text|read_bytes|write_bytes|to_csv|read_csv|is_file|exists|read_c3d|"
     r"read_\w+|write_\w+)\("
 )
-#: The file layer: formats, the file steps, the command line and the config's readers.
-FILE_LAYER = ("io/", "steps/", "cli.py", "cli_parser.py", "cli_checks.py", "config_file.py", "schema.py")
+#: The file layer: formats, the file steps, the command line, the config's readers and the study's files (layout).
+FILE_LAYER = (
+    "io/",
+    "steps/",
+    "cli.py",
+    "cli_parser.py",
+    "cli_checks.py",
+    "config_file.py",
+    "schema.py",
+    "layout.py",
+    "study_checks.py",
+)
 
 
 def test_no_library_module_outside_the_file_layer_opens_a_file():
@@ -147,3 +157,95 @@ def test_each_rule_calls_its_own_stages_step():
             if steps != {smk.stem}:
                 wrong.append(f"{smk.name}: {script}.py calls {sorted(steps)}")
     assert wrong == []
+
+
+#: A string that is a path under the results or the raw folder (prose naming a file has spaces).
+PATH_LITERAL = re.compile(r"^(results|data/raw)/[^\s`]*$")
+
+
+def _path_literals(text: str) -> list[str]:
+    """String constants of Python source that are results or raw paths, docstrings aside."""
+    tree = ast.parse(text)
+    docs = {
+        id(n.body[0].value)
+        for n in ast.walk(tree)
+        if isinstance(n, (ast.Module, ast.FunctionDef, ast.ClassDef))
+        and n.body
+        and isinstance(n.body[0], ast.Expr)
+        and isinstance(n.body[0].value, ast.Constant)
+    }
+    return [
+        n.value
+        for n in ast.walk(tree)
+        if isinstance(n, ast.Constant)
+        and isinstance(n.value, str)
+        and id(n) not in docs
+        and PATH_LITERAL.match(n.value)
+    ]
+
+
+def test_only_the_layout_module_spells_a_results_or_raw_path():
+    """Rules, scripts, the library, the command line and the benchmarks ask ``loper_analysis.layout``."""
+    found = []
+    for smk in [ROOT / "Snakefile", *RULES.glob("*.smk")]:
+        found += [f"{smk.name}: {m}" for m in re.findall(r"f?\"(?:results|data/raw)/[^\"]*\"", smk.read_text())]
+    python = [
+        *(ROOT / "src").rglob("*.py"),
+        *(ROOT / "workflow" / "scripts").glob("*.py"),
+        *(ROOT / "benchmarks").glob("*.py"),
+    ]
+    for path in python:
+        if path.name != "layout.py":
+            found += [f"{path.relative_to(ROOT)}: {m}" for m in _path_literals(path.read_text())]
+    assert found == []
+
+
+def test_the_path_check_sees_a_spelled_path():
+    assert _path_literals('x = "results/ik/S01/a.tsv"\ny = f"data/raw/{s}/t.c3d"\nz = "see results/x.tsv"') == [
+        "results/ik/S01/a.tsv",
+        "data/raw/",  # the f-string's first part
+    ]
+
+
+#: Most lines of the workflow's shared rule files (config checks, targets, settings, input functions).
+MAX_SHARED_RULE_LINES = 250
+
+
+def test_the_shared_rule_files_are_short():
+    n = sum(len((RULES / f"{name}.smk").read_text().splitlines()) for name in SHARED_RULE_FILES)
+    assert n <= MAX_SHARED_RULE_LINES
+
+
+#: Most lines of code of a function (docstring, comments and blank lines aside).
+MAX_FUNCTION_LINES = 80
+
+
+def _code_lines(f: ast.FunctionDef, lines: list[str]) -> int:
+    body = f.body
+    doc = (
+        range(body[0].lineno, body[0].end_lineno + 1)
+        if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant)
+        else range(0)
+    )
+    return sum(
+        1
+        for i in range(f.lineno, f.end_lineno + 1)
+        if i not in doc and lines[i - 1].strip() and not lines[i - 1].strip().startswith("#")
+    )
+
+
+def test_no_library_function_is_longer_than_80_lines_of_code():
+    src = ROOT / "src" / "loper_analysis"
+    long = {}
+    for path in src.rglob("*.py"):
+        text = path.read_text()
+        for f in _functions(path):
+            if (n := _code_lines(f, text.splitlines())) > MAX_FUNCTION_LINES:
+                long[f"{path.relative_to(src).as_posix()}:{f.name}"] = n
+    assert long == {}
+
+
+def test_the_function_length_counts_code_only():
+    source = 'def f():\n    """Doc.\n\n    More."""\n    # comment\n\n    x = 1\n    return x\n'
+    (f,) = _functions_of(source)
+    assert _code_lines(f, source.splitlines()) == 3

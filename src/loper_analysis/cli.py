@@ -32,6 +32,7 @@ import pandas as pd
 from loper_analysis.cli_checks import check_option_limits, refuse_overwriting
 from loper_analysis.cli_parser import build_parser
 from loper_analysis.errors import LoperInputError, one_line
+from loper_analysis.layout import Paths, fill
 
 __all__ = ["command_parser", "main"]
 
@@ -224,7 +225,7 @@ def _validate(args: argparse.Namespace) -> None:
     validation_chunk(args.segments, settings, args.chunk, n_chunks, args.errors, args.fits)
 
 
-def _first_subject(subjects_tsv: str, results: Path) -> str:
+def _first_subject(subjects_tsv: str, paths: Paths) -> str:
     """The first subject of the subject sheet, else the first subject with joint angles under ``results/ik``."""
     sheet = Path(subjects_tsv)
     if sheet.is_file():
@@ -233,9 +234,10 @@ def _first_subject(subjects_tsv: str, results: Path) -> str:
         names = read_subject_sheet(sheet).get("subject", pd.Series(dtype=str))
         if len(names):
             return str(names.iloc[0])
-    found = sorted(p.name for p in (results / "ik").glob("*") if p.is_dir())
+    ik = Path(paths.ik.root)
+    found = sorted(p.name for p in ik.glob("*") if p.is_dir())
     if not found:
-        raise LoperInputError(f"plan: no subject given, {sheet} not found and no subject under {results / 'ik'}")
+        raise LoperInputError(f"plan: no subject given, {sheet} not found and no subject under {ik}")
     return found[0]
 
 
@@ -307,27 +309,32 @@ def _plan(args: argparse.Namespace) -> None:
     print(line)
     settings = _plan_settings(args, config)
     pilot, sheet, exclude = _plan_pilot(args, config)
-    results = Path(args.results)
-    subject = pilot or _first_subject(sheet, results)
-    ik_dir = results / "ik" / subject
-    names = args.trials or sorted(p.name.removesuffix(".angles.tsv") for p in ik_dir.glob("*.angles.tsv"))
+    paths = Paths(results_dir=args.results)
+    subject = pilot or _first_subject(sheet, paths)
+    angles = Path(fill(paths.ik.angles, subject=subject))
+    suffix = angles.name.format(trial="")  # ".angles.tsv"
+    names = args.trials or sorted(p.name.removesuffix(suffix) for p in angles.parent.glob(f"*{suffix}"))
     names = [n for n in names if n not in exclude]
     if not names:
         raise LoperInputError(
-            f"plan: no joint-angle table of a trial with the device in {ik_dir} (excluded: {', '.join(exclude)})"
+            f"plan: no joint-angle table of a trial with the device in {angles.parent} (excluded: {', '.join(exclude)})"
         )
     trials = {
-        n: PilotTrial(angles=ik_dir / f"{n}.angles.tsv", strides=results / "strides" / subject / f"{n}.strides.tsv")
+        n: PilotTrial(
+            angles=Path(fill(paths.ik.angles, subject=subject, trial=n)),
+            strides=Path(fill(paths.strides.strides, subject=subject, trial=n)),
+        )
         for n in names
     }
     for path in [*(t.angles for t in trials.values()), *(t.strides for t in trials.values())]:
         if not path.is_file():
             raise LoperInputError(f"plan: {path} not found")
-    segments = Path(args.segments) if args.segments else results / "model" / subject / "segments.tsv"
+    segments = Path(args.segments) if args.segments else Path(fill(paths.model.segments, subject=subject))
+    fits = Path(fill(paths.impedance.fit, subject=subject))
     impedance_tsvs = (
         [Path(f) for f in args.impedance]
         if args.impedance
-        else sorted((results / "impedance" / subject).glob("[0-9][0-9][0-9].tsv"))
+        else sorted(fits.parent.glob(fits.name.format(onset="[0-9][0-9][0-9]")))
     )
     values = args.impedance_values
     if settings.onsets_ms is None:
@@ -336,7 +343,7 @@ def _plan(args: argparse.Namespace) -> None:
         onsets = [int(p.stem) for p in impedance_tsvs if p.stem.isdigit()]
         if not onsets:
             raise LoperInputError(
-                f"plan: no impedance rows of {subject} in {results / 'impedance' / subject}; "
+                f"plan: no impedance rows of {subject} in {fits.parent}; "
                 "give --onset-ms and --impedance or --impedance-values"
             )
         settings = dataclasses.replace(settings, onsets_ms=tuple(onsets))

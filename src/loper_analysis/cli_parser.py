@@ -8,6 +8,8 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable, Mapping
 
+from loper_analysis.layout import RESULTS_DIR
+
 __all__ = ["SUBCOMMANDS", "build_parser"]
 
 
@@ -257,7 +259,7 @@ def _add_plan(sub, handlers: Mapping[str, Callable]) -> None:
         "first line printed, which names the config file(s) used).",
     )
     _configfile_option(p)
-    p.add_argument("--results", default="results", help="results folder of the pilot's processed trials")
+    p.add_argument("--results", default=RESULTS_DIR, help="results folder of the pilot's processed trials")
     p.add_argument("--subject", help="pilot subject (default: planning.pilot_subject, else the first of --subjects)")
     p.add_argument(
         "--subjects",

@@ -49,6 +49,14 @@ def shown_path(path: str | os.PathLike) -> str:
         return str(path)
 
 
+def config_layers(command_line: Mapping, files: Sequence, load) -> list[tuple[str, dict]]:
+    """Where each config value came from, highest priority first: ``("--config", values)``, then each config file
+    given, last to first, as ``(its name as typed, its values)`` (:func:`loper_analysis.schema.config_origin`).
+
+    ``load(path) -> dict`` reads one file (Snakemake's ``load_configfile`` in the workflow)."""
+    return [("--config", dict(command_line))] + [(shown_path(f), load(str(f)) or {}) for f in reversed(list(files))]
+
+
 def update_config(config: dict, overwrite_config: Mapping) -> None:
     """Recursively update ``config`` with ``overwrite_config`` in place, exactly as ``snakemake.utils.update_config``.
 

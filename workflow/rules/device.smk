@@ -10,11 +10,11 @@ localrules:
 
 rule device_trial:
     output:
-        "data/raw/{subject}/{trial}.loper.tsv",
+        PATHS.raw.robot_log,
     log:
-        "results/logs/device_trial/{subject}/{trial}.log",
+        PATHS.log("device_trial", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/device_trial/{subject}/{trial}.tsv"
+        PATHS.benchmark("device_trial", "{subject}/{trial}")
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
         trial="|".join(DEVICE_TESTS),
@@ -31,35 +31,35 @@ rule device_trial:
 
 rule device_log_from_mat:
     input:
-        "data/raw/{subject}/{trial}.mat",
+        PATHS.raw.mat,
     output:
-        "results/device/{subject}/{trial}.loper.tsv",
+        PATHS.device.robot_log,
     log:
-        "results/logs/device_log_from_mat/{subject}/{trial}.log",
+        PATHS.log("device_log_from_mat", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/device_log_from_mat/{subject}/{trial}.tsv"
+        PATHS.benchmark("device_log_from_mat", "{subject}/{trial}")
     params:
-        **raw_checksums("data/raw/{subject}/{trial}.mat"),
+        **raw_checksums(PATHS.raw.mat),
         column_map=DEVICE["mat_column_map"],
-        sample_rate_hz=DEVICE_RATE_HZ,
+        sample_rate_hz=DEVICE["parameters"]["sample_rate_hz"],
     script:
         "../scripts/device_log_from_mat.py"
 
 
 rule device_frf:
     input:
-        device_log("device-frf"),
+        STUDY.device_log("device-frf"),
     output:
-        "results/device/frf.tsv",
+        PATHS.device.frf,
     log:
-        "results/logs/device_frf/frf.log",
+        PATHS.log("device_frf", "frf"),
     benchmark:
-        "results/benchmarks/device_frf/frf.tsv"
+        PATHS.benchmark("device_frf", "frf")
     group:
         "device"
     params:
-        **raw_checksums(lambda wildcards: device_log("device-frf")),
-        sample_rate_hz=DEVICE_RATE_HZ,
+        **raw_checksums(lambda wildcards: STUDY.device_log("device-frf")),
+        sample_rate_hz=DEVICE["parameters"]["sample_rate_hz"],
         window_samples=DEVICE["analysis"]["welch_window_samples"],
         overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
     script:
@@ -68,19 +68,19 @@ rule device_frf:
 
 rule device_steps:
     input:
-        device_log("device-steps"),
+        STUDY.device_log("device-steps"),
     output:
-        metrics="results/device/step_metrics.tsv",
-        average="results/device/step_average.tsv",
+        metrics=PATHS.device.step_metrics,
+        average=PATHS.device.step_average,
     log:
-        "results/logs/device_steps/steps.log",
+        PATHS.log("device_steps", "steps"),
     benchmark:
-        "results/benchmarks/device_steps/steps.tsv"
+        PATHS.benchmark("device_steps", "steps")
     group:
         "device"
     params:
-        **raw_checksums(lambda wildcards: device_log("device-steps")),
-        sample_rate_hz=DEVICE_RATE_HZ,
+        **raw_checksums(lambda wildcards: STUDY.device_log("device-steps")),
+        sample_rate_hz=DEVICE["parameters"]["sample_rate_hz"],
         amplitudes_n=DEVICE["tests"]["step_amplitudes_n"],
         before_s=DEVICE["analysis"]["step_before_s"],
         after_s=DEVICE["analysis"]["step_after_s"],
@@ -91,19 +91,19 @@ rule device_steps:
 
 rule device_summary:
     input:
-        frf="results/device/frf.tsv",
-        metrics="results/device/step_metrics.tsv",
+        frf=PATHS.device.frf,
+        metrics=PATHS.device.step_metrics,
     output:
         report(
-            "results/device/summary.tsv",
+            PATHS.device.summary,
             caption="../report/device_summary.rst",
             category="Device",
             labels={"table": "device figures vs study"},
         ),
     log:
-        "results/logs/device_summary/summary.log",
+        PATHS.log("device_summary", "summary"),
     benchmark:
-        "results/benchmarks/device_summary/summary.tsv"
+        PATHS.benchmark("device_summary", "summary")
     params:
         reference_band_hz=DEVICE["analysis"]["bandwidth_reference_band_hz"],
     script:
@@ -112,25 +112,25 @@ rule device_summary:
 
 rule device_figures:
     input:
-        frf="results/device/frf.tsv",
-        summary="results/device/summary.tsv",
-        average="results/device/step_average.tsv",
+        frf=PATHS.device.frf,
+        summary=PATHS.device.summary,
+        average=PATHS.device.step_average,
     output:
         bode=report(
-            "results/device/bode.png",
+            PATHS.device.bode,
             caption="../report/device_bode.rst",
             category="Device",
             labels={"figure": "Bode plot"},
         ),
         steps=report(
-            "results/device/steps.png",
+            PATHS.device.steps,
             caption="../report/device_steps.rst",
             category="Device",
             labels={"figure": "step responses"},
         ),
     log:
-        "results/logs/device_figures/figures.log",
+        PATHS.log("device_figures", "figures"),
     benchmark:
-        "results/benchmarks/device_figures/figures.tsv"
+        PATHS.benchmark("device_figures", "figures")
     script:
         "../scripts/device_figures.py"

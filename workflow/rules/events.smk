@@ -6,22 +6,22 @@ rule events:
     """Heel strikes and toe-offs of the trial without the device: force platforms with the heel markers, or the
     named GRF channels of each belt."""
     input:
-        c3d="data/raw/{subject}/{trial}.c3d",
+        c3d=PATHS.raw.c3d,
         label_map=label_map_files,
     output:
-        events="results/events/{subject}/{trial}.events.tsv",
-        contacts="results/events/{subject}/{trial}.contacts.tsv",
+        events=PATHS.events.events,
+        contacts=PATHS.events.contacts,
     log:
-        "results/logs/events/{subject}/{trial}.log",
+        PATHS.log("events", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/events/{subject}/{trial}.tsv"
+        PATHS.benchmark("events", "{subject}/{trial}")
     wildcard_constraints:
         trial=TRIALS["no_device"],
     group:
         "trial"
     params:
         **settings_params(event_settings),
-        **raw_checksums("data/raw/{subject}/{trial}.c3d"),
+        **raw_checksums(PATHS.raw.c3d),
     script:
         "../scripts/events.py"
 
@@ -31,18 +31,18 @@ rule events_loadcell:
     heel strikes and toe-offs (as rule events), and the robot log's force on the mocap frames and at its own
     rate. Both feed only the stride table, so a change of either's settings reruns a cheap sibling at most."""
     input:
-        c3d="data/raw/{subject}/{trial}.c3d",
+        c3d=PATHS.raw.c3d,
         label_map=label_map_files,
-        log=robot_log,
+        log=by_trial(STUDY.robot_log),
     output:
-        events="results/events/{subject}/{trial}.events.tsv",
-        contacts="results/events/{subject}/{trial}.contacts.tsv",
-        force="results/events/{subject}/{trial}.force.tsv",
-        native="results/events/{subject}/{trial}.force_native.tsv",
+        events=PATHS.events.events,
+        contacts=PATHS.events.contacts,
+        force=PATHS.events.force,
+        native=PATHS.events.force_native,
     log:
-        "results/logs/events_loadcell/{subject}/{trial}.log",
+        PATHS.log("events_loadcell", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/events_loadcell/{subject}/{trial}.tsv"
+        PATHS.benchmark("events_loadcell", "{subject}/{trial}")
     wildcard_constraints:
         # any trial but the one without the device (the lookahead ends at the wildcard's end, not the path's)
         trial=f"(?!{re.escape(TRIALS['no_device'])}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
@@ -51,6 +51,6 @@ rule events_loadcell:
     params:
         **settings_params(event_settings, "events"),
         **settings_params(LOADCELL_SETTINGS, "loadcell"),
-        **raw_checksums("data/raw/{subject}/{trial}.c3d", robot_log),
+        **raw_checksums(PATHS.raw.c3d, by_trial(STUDY.robot_log)),
     script:
         "../scripts/events_loadcell.py"

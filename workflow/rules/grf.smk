@@ -5,17 +5,17 @@ rule grf:
     """Ground reaction forces of the C3D's force platforms as an OpenSim external-loads .mot, in the frame the
     trial's markers were turned into (its markers summary)."""
     input:
-        c3d="data/raw/{subject}/{trial}.c3d",
-        markers="results/markers/{subject}/{trial}.markers.tsv",
+        c3d=PATHS.raw.c3d,
+        markers=PATHS.markers.summary,
     output:
-        "results/grf/{subject}/{trial}.grf.mot",
+        PATHS.grf.mot,
     log:
-        "results/logs/grf/{subject}/{trial}.log",
+        PATHS.log("grf", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/grf/{subject}/{trial}.tsv"
+        PATHS.benchmark("grf", "{subject}/{trial}")
     params:
         **settings_params(GRF_SETTINGS),
-        **raw_checksums("data/raw/{subject}/{trial}.c3d"),
+        **raw_checksums(PATHS.raw.c3d),
     script:
         "../scripts/grf.py"
 
@@ -23,20 +23,20 @@ rule grf:
 rule grf_figure:
     """The trial's force plates over time with the heel strikes and toe-offs found (recorded subjects)."""
     input:
-        grf="results/grf/{subject}/{trial}.grf.mot",
-        events="results/events/{subject}/{trial}.events.tsv",
+        grf=PATHS.grf.mot,
+        events=PATHS.events.events,
     output:
         report(
-            "results/grf/{subject}/{trial}.grf.png",
+            PATHS.grf.figure,
             caption="../report/grf_figure.rst",
             category="Processing",
             subcategory="{subject}",
             labels={"subject": "{subject}", "trial": "{trial}", "figure": "force plates and events"},
         ),
     log:
-        "results/logs/grf_figure/{subject}/{trial}.log",
+        PATHS.log("grf_figure", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/grf_figure/{subject}/{trial}.tsv"
+        PATHS.benchmark("grf_figure", "{subject}/{trial}")
     params:
         title=lambda wc: f"{wc.subject} {wc.trial}: force plates; heel strikes solid, toe-offs dotted",
     script:

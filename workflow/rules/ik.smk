@@ -6,18 +6,18 @@ if OPENSIM["ik_chunks"] == 1:
     rule ik:
         """The whole trial in one job (the default): IK, .mot and angle table."""
         input:
-            model=subject_model,
-            trc="results/markers/{subject}/{trial}.trc",
-            lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
+            model=by_subject(STUDY.subject_model),
+            trc=PATHS.markers.trc,
+            lab_angles=PATHS.markers.lab_angles,
         output:
-            mot="results/ik/{subject}/{trial}.mot",
-            angles="results/ik/{subject}/{trial}.angles.tsv",
-            summary="results/ik/{subject}/{trial}.ik.tsv",
-            agreement="results/ik/{subject}/{trial}.lab_agreement.tsv",
+            mot=PATHS.ik.mot,
+            angles=PATHS.ik.angles,
+            summary=PATHS.ik.summary,
+            agreement=PATHS.ik.agreement,
         log:
-            "results/logs/ik/{subject}/{trial}.log",
+            PATHS.log("ik", "{subject}/{trial}"),
         benchmark:
-            "results/benchmarks/ik/{subject}/{trial}.tsv"
+            PATHS.benchmark("ik", "{subject}/{trial}")
         group:
             "trial"
         params:
@@ -30,14 +30,14 @@ else:
     rule ik_chunk:
         """One of opensim.ik_chunks time chunks of a trial (long trials, many cores)."""
         input:
-            model=subject_model,
-            trc="results/markers/{subject}/{trial}.trc",
+            model=by_subject(STUDY.subject_model),
+            trc=PATHS.markers.trc,
         output:
-            temp("results/ik/{subject}/{trial}.chunk{chunk}.mot"),
+            temp(PATHS.ik.chunk),
         log:
-            "results/logs/ik_chunk/{subject}/{trial}.{chunk}.log",
+            PATHS.log("ik_chunk", "{subject}/{trial}.{chunk}"),
         benchmark:
-            "results/benchmarks/ik_chunk/{subject}/{trial}.{chunk}.tsv"
+            PATHS.benchmark("ik_chunk", "{subject}/{trial}.{chunk}")
         group:
             "trial"
         params:
@@ -48,17 +48,17 @@ else:
 
     rule ik_join:
         input:
-            chunks=expand("results/ik/{{subject}}/{{trial}}.chunk{chunk}.mot", chunk=IK_CHUNKS),
-            lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
+            chunks=expand(PATHS.ik.chunk, chunk=IK_CHUNKS, allow_missing=True),
+            lab_angles=PATHS.markers.lab_angles,
         output:
-            mot="results/ik/{subject}/{trial}.mot",
-            angles="results/ik/{subject}/{trial}.angles.tsv",
-            summary="results/ik/{subject}/{trial}.ik.tsv",
-            agreement="results/ik/{subject}/{trial}.lab_agreement.tsv",
+            mot=PATHS.ik.mot,
+            angles=PATHS.ik.angles,
+            summary=PATHS.ik.summary,
+            agreement=PATHS.ik.agreement,
         log:
-            "results/logs/ik_join/{subject}/{trial}.log",
+            PATHS.log("ik_join", "{subject}/{trial}"),
         benchmark:
-            "results/benchmarks/ik_join/{subject}/{trial}.tsv"
+            PATHS.benchmark("ik_join", "{subject}/{trial}")
         group:
             "trial"
         params:

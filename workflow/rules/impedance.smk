@@ -14,62 +14,62 @@ rule impedance_fit:
     """Responses and impedance fits of one subject at every onset, in one job: the onsets share the null-pair
     trials, so a change to any of the subject's trials reruns every onset's fit anyway."""
     input:
-        fit_inputs,
+        by_subject(STUDY.fit_inputs),
     output:
-        response=expand(FIT_OUTPUTS["response"], onset=ONSETS, allow_missing=True),
-        counts=expand(FIT_OUTPUTS["counts"], onset=ONSETS, allow_missing=True),
-        fit=expand(FIT_OUTPUTS["fit"], onset=ONSETS, allow_missing=True),
-        curves=expand(FIT_OUTPUTS["curves"], onset=ONSETS, allow_missing=True),
-        force=expand(FIT_OUTPUTS["force"], onset=ONSETS, allow_missing=True),
+        response=expand(PATHS.impedance.response, onset=ONSETS, allow_missing=True),
+        counts=expand(PATHS.impedance.counts, onset=ONSETS, allow_missing=True),
+        fit=expand(PATHS.impedance.fit, onset=ONSETS, allow_missing=True),
+        curves=expand(PATHS.impedance.curves, onset=ONSETS, allow_missing=True),
+        force=expand(PATHS.impedance.force, onset=ONSETS, allow_missing=True),
     log:
-        "results/logs/impedance_fit/{subject}.log",
+        PATHS.log("impedance_fit", "{subject}"),
     benchmark:
-        "results/benchmarks/impedance_fit/{subject}.tsv"
+        PATHS.benchmark("impedance_fit", "{subject}")
     params:
         **settings_params(FIT_SETTINGS),
-        fits=lambda wc: fit_files(wc.subject),
+        fits=by_subject(STUDY.fit_files),
     script:
         "../scripts/impedance_fit.py"
 
 
 rule impedance_table:
     input:
-        [f"results/impedance/{s}/{o:03d}.tsv" for s in processed_subjects() for o in TRIALS["perturbation_onsets_ms"]],
+        STUDY.onset_files("impedance", "fit"),
     output:
         report(
-            "results/impedance/impedance.tsv",
+            PATHS.impedance.table,
             caption="../report/impedance_table.rst",
             category="Impedance",
             labels={"table": "impedance per subject, onset and joint"},
         ),
     log:
-        "results/logs/impedance_table/impedance.log",
+        PATHS.log("impedance_table", "impedance"),
     benchmark:
-        "results/benchmarks/impedance_table/impedance.tsv"
+        PATHS.benchmark("impedance_table", "impedance")
     script:
         "../scripts/impedance_table.py"
 
 
 rule impedance_summary:
     input:
-        "results/impedance/impedance.tsv",
+        PATHS.impedance.table,
     output:
         summary=report(
-            "results/impedance/summary.tsv",
+            PATHS.impedance.summary,
             caption="../report/impedance_summary.rst",
             category="Impedance",
             labels={"table": "across-subject summary per onset"},
         ),
         literature=report(
-            "results/impedance/literature.tsv",
+            PATHS.impedance.literature,
             caption="../report/literature.rst",
             category="Impedance",
             labels={"table": "literature comparison"},
         ),
     log:
-        "results/logs/impedance_summary/summary.log",
+        PATHS.log("impedance_summary", "summary"),
     benchmark:
-        "results/benchmarks/impedance_summary/summary.tsv"
+        PATHS.benchmark("impedance_summary", "summary")
     params:
         upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
         lower_bounds=(IDENT["stiffness_bounds_nm_per_rad"][0], IDENT["damping_bounds_nms_per_rad"][0]),
@@ -79,31 +79,27 @@ rule impedance_summary:
 
 rule impedance_figures:
     input:
-        responses=lambda wc: [
-            f"results/impedance/{wc.subject}/{o:03d}.response.tsv" for o in TRIALS["perturbation_onsets_ms"]
-        ],
-        curves=lambda wc: [
-            f"results/impedance/{wc.subject}/{o:03d}.curves.tsv" for o in TRIALS["perturbation_onsets_ms"]
-        ],
+        responses=lambda wc: STUDY.onset_files("impedance", "response", wc.subject),
+        curves=lambda wc: STUDY.onset_files("impedance", "curves", wc.subject),
     output:
         responses=report(
-            "results/impedance/{subject}/responses.png",
+            PATHS.impedance.responses_figure,
             caption="../report/responses_figure.rst",
             category="Impedance",
             subcategory="{subject}",
             labels={"subject": "{subject}", "figure": "responses"},
         ),
         fit=report(
-            "results/impedance/{subject}/fit.png",
+            PATHS.impedance.fit_figure,
             caption="../report/fit_figure.rst",
             category="Impedance",
             subcategory="{subject}",
             labels={"subject": "{subject}", "figure": "fit vs data"},
         ),
     log:
-        "results/logs/impedance_figures/{subject}.log",
+        PATHS.log("impedance_figures", "{subject}"),
     benchmark:
-        "results/benchmarks/impedance_figures/{subject}.tsv"
+        PATHS.benchmark("impedance_figures", "{subject}")
     params:
         onsets=TRIALS["perturbation_onsets_ms"],
     script:
@@ -112,17 +108,17 @@ rule impedance_figures:
 
 rule impedance_figure:
     input:
-        "results/impedance/impedance.tsv",
+        PATHS.impedance.table,
     output:
         report(
-            "results/impedance/impedance.png",
+            PATHS.impedance.figure,
             caption="../report/impedance_figure.rst",
             category="Impedance",
             labels={"figure": "K and D per onset"},
         ),
     log:
-        "results/logs/impedance_figure/impedance.log",
+        PATHS.log("impedance_figure", "impedance"),
     benchmark:
-        "results/benchmarks/impedance_figure/impedance.tsv"
+        PATHS.benchmark("impedance_figure", "impedance")
     script:
         "../scripts/impedance_figure.py"

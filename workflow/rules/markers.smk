@@ -5,21 +5,21 @@ rule markers:
     """Markers of a C3D in the model's names and frame (each trial turned to walk along +X), gaps filled or left
     missing, low-passed: a TRC (mm), and per marker its lab label, gaps and the trial's frames, span and rotation."""
     input:
-        c3d="data/raw/{subject}/{trial}.c3d",
+        c3d=PATHS.raw.c3d,
         label_map=label_map_files,
     output:
-        trc="results/markers/{subject}/{trial}.trc",
-        gaps="results/markers/{subject}/{trial}.gaps.tsv",
-        summary="results/markers/{subject}/{trial}.markers.tsv",
-        lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
+        trc=PATHS.markers.trc,
+        gaps=PATHS.markers.gaps,
+        summary=PATHS.markers.summary,
+        lab_angles=PATHS.markers.lab_angles,
     log:
-        "results/logs/markers/{subject}/{trial}.log",
+        PATHS.log("markers", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/markers/{subject}/{trial}.tsv"
+        PATHS.benchmark("markers", "{subject}/{trial}")
     group:
         trial_group
     params:
         **settings_params(marker_settings),
-        **raw_checksums("data/raw/{subject}/{trial}.c3d"),
+        **raw_checksums(PATHS.raw.c3d),
     script:
         "../scripts/markers.py"

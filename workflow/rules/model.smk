@@ -12,16 +12,16 @@ localrules:
 rule model_generic:
     """The generated sagittal model (used when opensim.generic_model is null)."""
     input:
-        static_c3d=static_c3d_for_mass,
+        static_c3d=by_subject(STUDY.static_c3d_for_mass),
     output:
-        "results/model/{subject}/generic.osim",
+        PATHS.model.generic,
     log:
-        "results/logs/model_generic/{subject}.log",
+        PATHS.log("model_generic", "{subject}"),
     benchmark:
-        "results/benchmarks/model_generic/{subject}.tsv"
+        PATHS.benchmark("model_generic", "{subject}")
     params:
         **settings_params(MODEL_SETTINGS),
-        **raw_checksums(static_c3d_for_mass),
+        **raw_checksums(by_subject(STUDY.static_c3d_for_mass)),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
     script:
@@ -32,30 +32,30 @@ rule model_scaled:
     """The generic model scaled to the static trial (OpenSim's ScaleTool, with opensim.scale_setup when given), and
     the scale report: scale factors per body, marker errors after scaling, the mass and height used."""
     input:
-        generic=generic_model,
-        static=f"results/markers/{{subject}}/{TRIALS['static']}.trc",
-        static_summary=f"results/markers/{{subject}}/{TRIALS['static']}.markers.tsv",
-        static_lab_angles=f"results/markers/{{subject}}/{TRIALS['static']}.lab_angles.tsv",
-        static_c3d=static_c3d_for_mass,
+        generic=by_subject(STUDY.generic_model),
+        static=fill(PATHS.markers.trc, trial=DESIGN.static),
+        static_summary=fill(PATHS.markers.summary, trial=DESIGN.static),
+        static_lab_angles=fill(PATHS.markers.lab_angles, trial=DESIGN.static),
+        static_c3d=by_subject(STUDY.static_c3d_for_mass),
         setup=[OPENSIM["scale_setup"]] if OPENSIM["scale_setup"] else [],
     output:
-        model="results/model/{subject}/scaled.osim",
+        model=PATHS.model.scaled,
         report=report(
-            "results/model/{subject}/scale.tsv",
+            PATHS.model.scale,
             caption="../report/scale_report.rst",
             category="Model",
             subcategory="{subject}",
             labels={"subject": "{subject}", "table": "scaling"},
         ),
     log:
-        "results/logs/model_scaled/{subject}.log",
+        PATHS.log("model_scaled", "{subject}"),
     benchmark:
-        "results/benchmarks/model_scaled/{subject}.tsv"
+        PATHS.benchmark("model_scaled", "{subject}")
     group:
         "model"
     params:
         **settings_params(MODEL_SETTINGS),
-        **raw_checksums(static_c3d_for_mass),
+        **raw_checksums(by_subject(STUDY.static_c3d_for_mass)),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
         scale_setup=OPENSIM["scale_setup"],
@@ -66,13 +66,13 @@ rule model_scaled:
 rule model_segments:
     """The swing leg's segment table, exported from the subject's model (opensim.segment_bodies)."""
     input:
-        subject_model,
+        by_subject(STUDY.subject_model),
     output:
-        "results/model/{subject}/segments.tsv",
+        PATHS.model.segments,
     log:
-        "results/logs/model_segments/{subject}.log",
+        PATHS.log("model_segments", "{subject}"),
     benchmark:
-        "results/benchmarks/model_segments/{subject}.tsv"
+        PATHS.benchmark("model_segments", "{subject}")
     params:
         **settings_params(MODEL_SETTINGS),
     script:

@@ -12,19 +12,19 @@ rule planning:
         planning_inputs,
     output:
         table=report(
-            "results/planning/plan.tsv",
+            PATHS.planning.plan,
             caption="../report/planning_table.rst",
             category="Planning",
             labels={"table": "predicted 95 % CI half-width of K and D"},
         ),
-        answers="results/planning/answers.txt",
+        answers=PATHS.planning.answers,
     log:
-        "results/logs/planning/plan.log",
+        PATHS.log("planning", "plan"),
     benchmark:
-        "results/benchmarks/planning/plan.tsv"
+        PATHS.benchmark("planning", "plan")
     params:
         **settings_params(PLAN_SETTINGS),
-        files=lambda wc: planning_files(),
+        files=lambda wc: STUDY.planning_files(planning_pilot()),
         subject=lambda wc: planning_pilot(),
     script:
         "../scripts/planning.py"

@@ -11,32 +11,32 @@ localrules:
 
 rule front_page:
     input:
-        unpack(front_page_inputs),
+        unpack(lambda wc: STUDY.front_page_inputs()),
     output:
-        "results/report/front_page.html",
+        PATHS.report.front_page,
     log:
-        "results/logs/front_page/front_page.log",
+        PATHS.log("front_page", "front_page"),
     benchmark:
-        "results/benchmarks/front_page/front_page.tsv"
+        PATHS.benchmark("front_page", "front_page")
     params:
         **settings_params(FRONT_PAGE_SETTINGS),
         subjects=SUBJECT_SOURCE,
-        trials={s: subject_trials(s) for s in processed_subjects()},
-        recorded=recorded_quality_files(),
+        trials={s: STUDY.subject_trials(s) for s in STUDY.processed_subjects()},
+        recorded=STUDY.recorded_quality_files(),
     script:
         "../scripts/front_page.py"
 
 
 rule tables_markdown:
     input:
-        list(markdown_sections().values()),
+        list(STUDY.markdown_sections().values()),
     output:
-        "results/report/tables.md",
+        PATHS.report.tables,
     log:
-        "results/logs/tables_markdown/tables.log",
+        PATHS.log("tables_markdown", "tables"),
     benchmark:
-        "results/benchmarks/tables_markdown/tables.tsv"
+        PATHS.benchmark("tables_markdown", "tables")
     params:
-        headings=list(markdown_sections()),
+        headings=list(STUDY.markdown_sections()),
     script:
         "../scripts/tables_markdown.py"

@@ -9,17 +9,17 @@ localrules:
 
 rule strides:
     input:
-        angles="results/ik/{subject}/{trial}.angles.tsv",
-        events="results/events/{subject}/{trial}.events.tsv",
-        force=stride_force,
+        angles=PATHS.ik.angles,
+        events=PATHS.events.events,
+        force=by_trial(STUDY.stride_force),
     output:
-        strides="results/strides/{subject}/{trial}.strides.tsv",
-        cycles="results/strides/{subject}/{trial}.cycles.tsv",
-        dropped="results/strides/{subject}/{trial}.dropped.tsv",
+        strides=PATHS.strides.strides,
+        cycles=PATHS.strides.cycles,
+        dropped=PATHS.strides.dropped,
     log:
-        "results/logs/strides/{subject}/{trial}.log",
+        PATHS.log("strides", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/strides/{subject}/{trial}.tsv"
+        PATHS.benchmark("strides", "{subject}/{trial}")
     group:
         "trial"
     params:
@@ -30,25 +30,25 @@ rule strides:
 
 rule strides_summary:
     input:
-        strides=[f"results/strides/{s}/{t}.strides.tsv" for s in processed_subjects() for t in subject_trials(s)],
-        contacts=[f"results/events/{s}/{t}.contacts.tsv" for s in processed_subjects() for t in subject_trials(s)],
-        ik=[f"results/ik/{s}/{t}.ik.tsv" for s in processed_subjects() for t in subject_trials(s)],
-        markers=[f"results/markers/{s}/{t}.markers.tsv" for s in processed_subjects() for t in subject_trials(s)],
-        agreement=[f"results/ik/{s}/{t}.lab_agreement.tsv" for s in processed_subjects() for t in subject_trials(s)],
-        dropped=[f"results/strides/{s}/{t}.dropped.tsv" for s in processed_subjects() for t in subject_trials(s)],
+        strides=STUDY.trial_files("strides", "strides"),
+        contacts=STUDY.trial_files("events", "contacts"),
+        ik=STUDY.trial_files("ik", "summary"),
+        markers=STUDY.trial_files("markers", "summary"),
+        agreement=STUDY.trial_files("ik", "agreement"),
+        dropped=STUDY.trial_files("strides", "dropped"),
     output:
         report(
-            "results/strides/summary.tsv",
+            PATHS.strides.summary,
             caption="../report/strides_summary.rst",
             category="Processing",
             labels={"table": "strides per trial"},
         ),
     log:
-        "results/logs/strides_summary/summary.log",
+        PATHS.log("strides_summary", "summary"),
     benchmark:
-        "results/benchmarks/strides_summary/summary.tsv"
+        PATHS.benchmark("strides_summary", "summary")
     params:
-        subject_trial=[(s, t) for s in processed_subjects() for t in subject_trials(s)],
+        subject_trial=[(s, t) for s in STUDY.processed_subjects() for t in STUDY.subject_trials(s)],
         min_valid=STRIDE_SETTINGS.min_valid,
     script:
         "../scripts/strides_summary.py"
@@ -58,21 +58,21 @@ rule strides_figure:
     """Both sides' joint angles over the gait cycle, with the lab's own where its file holds them (recorded
     subjects)."""
     input:
-        angles="results/ik/{subject}/{trial}.angles.tsv",
-        events="results/events/{subject}/{trial}.events.tsv",
-        lab_angles="results/markers/{subject}/{trial}.lab_angles.tsv",
+        angles=PATHS.ik.angles,
+        events=PATHS.events.events,
+        lab_angles=PATHS.markers.lab_angles,
     output:
         report(
-            "results/strides/{subject}/{trial}.angles.png",
+            PATHS.strides.figure,
             caption="../report/strides_figure.rst",
             category="Processing",
             subcategory="{subject}",
             labels={"subject": "{subject}", "trial": "{trial}", "figure": "joint angles"},
         ),
     log:
-        "results/logs/strides_figure/{subject}/{trial}.log",
+        PATHS.log("strides_figure", "{subject}/{trial}"),
     benchmark:
-        "results/benchmarks/strides_figure/{subject}/{trial}.tsv"
+        PATHS.benchmark("strides_figure", "{subject}/{trial}")
     params:
         title=lambda wc: f"{wc.subject} {wc.trial}: joint angles over the gait cycle (mean ± SD; dashed: the lab's)",
     script:

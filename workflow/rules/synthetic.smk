@@ -9,11 +9,11 @@ localrules:
 
 rule synthetic_truth:
     output:
-        "data/raw/{subject}/truth.yaml",
+        PATHS.raw.truth,
     log:
-        "results/logs/synthetic_truth/{subject}.log",
+        PATHS.log("synthetic_truth", "{subject}"),
     benchmark:
-        "results/benchmarks/synthetic_truth/{subject}.tsv"
+        PATHS.benchmark("synthetic_truth", "{subject}")
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
@@ -33,15 +33,15 @@ rule synthetic_lab:
     (C3D, and the robot log of trials with the device). One job per subject: a trial's own work is a second,
     the start of a job (Python, SciPy, OpenSim, numba) almost three."""
     input:
-        truth="data/raw/{subject}/truth.yaml",
+        truth=PATHS.raw.truth,
     output:
-        static=f"data/raw/{{subject}}/{TRIALS['static']}.c3d",
-        c3d=[f"data/raw/{{subject}}/{t}.c3d" for t in DESIGN.walking_trials()],
-        logs=[f"data/raw/{{subject}}/{t}.loper.tsv" for t in DESIGN.walking_trials() if DESIGN.with_robot(t)],
+        static=fill(PATHS.raw.c3d, trial=DESIGN.static),
+        c3d=[fill(PATHS.raw.c3d, trial=t) for t in DESIGN.walking_trials()],
+        logs=[fill(PATHS.raw.robot_log, trial=t) for t in DESIGN.walking_trials() if DESIGN.with_robot(t)],
     log:
-        "results/logs/synthetic_lab/{subject}.log",
+        PATHS.log("synthetic_lab", "{subject}"),
     benchmark:
-        "results/benchmarks/synthetic_lab/{subject}.tsv"
+        PATHS.benchmark("synthetic_lab", "{subject}")
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:

@@ -12,29 +12,29 @@ rule transparency:
         transparency_inputs,
     output:
         rmsd=report(
-            "results/transparency/rmsd.tsv",
+            PATHS.transparency.rmsd,
             caption="../report/transparency_rmsd.rst",
             category="Transparency",
             labels={"table": "RMSD vs ISV_ave"},
         ),
         force=report(
-            "results/transparency/force.tsv",
+            PATHS.transparency.force,
             caption="../report/transparency_force.rst",
             category="Transparency",
             labels={"table": "interaction force"},
         ),
         figure=report(
-            "results/transparency/transparency.png",
+            PATHS.transparency.figure,
             caption="../report/transparency_figure.rst",
             category="Transparency",
             labels={"figure": "gait cycle with and without LOPER"},
         ),
     log:
-        "results/logs/transparency/transparency.log",
+        PATHS.log("transparency", "transparency"),
     benchmark:
-        "results/benchmarks/transparency/transparency.tsv"
+        PATHS.benchmark("transparency", "transparency")
     params:
         **settings_params(TRANSPARENCY_SETTINGS),
-        files=transparency_files(),
+        files=STUDY.transparency_files(),
     script:
         "../scripts/transparency.py"

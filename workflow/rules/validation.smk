@@ -11,11 +11,11 @@ localrules:
 
 rule validation_segments:
     output:
-        "results/validation/segments.tsv",
+        PATHS.validation.segments,
     log:
-        "results/logs/validation_segments/segments.log",
+        PATHS.log("validation_segments", "segments"),
     benchmark:
-        "results/benchmarks/validation_segments/segments.tsv"
+        PATHS.benchmark("validation_segments", "segments")
     params:
         height_m=config["validation"]["subject_height_m"],
         mass_kg=config["validation"]["subject_mass_kg"],
@@ -26,14 +26,14 @@ rule validation_segments:
 
 rule validation_chunk:
     input:
-        segments="results/validation/segments.tsv",
+        segments=PATHS.validation.segments,
     output:
-        errors=temp("results/validation/chunks/{chunk}.errors.tsv"),
-        fits=temp("results/validation/chunks/{chunk}.fits.tsv"),
+        errors=temp(PATHS.validation.chunk_errors),
+        fits=temp(PATHS.validation.chunk_fits),
     log:
-        "results/logs/validation_chunk/{chunk}.log",
+        PATHS.log("validation_chunk", "{chunk}"),
     benchmark:
-        "results/benchmarks/validation_chunk/{chunk}.tsv"
+        PATHS.benchmark("validation_chunk", "{chunk}")
     params:
         settings=validation_settings(config),
         n_chunks=config["validation"]["n_chunks"],
@@ -43,38 +43,38 @@ rule validation_chunk:
 
 rule validation_gather:
     input:
-        errors=expand("results/validation/chunks/{chunk}.errors.tsv", chunk=VALIDATION_CHUNKS),
-        fits=expand("results/validation/chunks/{chunk}.fits.tsv", chunk=VALIDATION_CHUNKS),
+        errors=expand(PATHS.validation.chunk_errors, chunk=VALIDATION_CHUNKS),
+        fits=expand(PATHS.validation.chunk_fits, chunk=VALIDATION_CHUNKS),
     output:
-        errors="results/validation/errors.tsv",
-        fits="results/validation/fits.tsv",
+        errors=PATHS.validation.errors,
+        fits=PATHS.validation.fits,
         summary=report(
-            "results/validation/summary.tsv",
+            PATHS.validation.summary,
             caption="../report/validation_summary.rst",
             category="Validation",
             labels={"table": "error summary"},
         ),
     log:
-        "results/logs/validation_gather/gather.log",
+        PATHS.log("validation_gather", "gather"),
     benchmark:
-        "results/benchmarks/validation_gather/gather.tsv"
+        PATHS.benchmark("validation_gather", "gather")
     script:
         "../scripts/validation_gather.py"
 
 
 rule validation_figure:
     input:
-        errors="results/validation/errors.tsv",
+        errors=PATHS.validation.errors,
     output:
         report(
-            "results/validation/errors.png",
+            PATHS.validation.figure,
             caption="../report/validation_errors.rst",
             category="Validation",
             labels={"figure": "estimation errors"},
         ),
     log:
-        "results/logs/validation_figure/figure.log",
+        PATHS.log("validation_figure", "figure"),
     benchmark:
-        "results/benchmarks/validation_figure/figure.tsv"
+        PATHS.benchmark("validation_figure", "figure")
     script:
         "../scripts/validation_figure.py"

@@ -7,7 +7,7 @@ from pathlib import Path
 from loper_analysis.cluster import failed_slurm_logs, slurm_end_reason
 from loper_analysis.io.atomic import PathLike
 
-__all__ = ["slurm_failure_lines"]
+__all__ = ["requested_partitions", "slurm_failure_lines"]
 
 
 def slurm_failure_lines(snakemake_log: PathLike) -> list[str]:
@@ -30,3 +30,21 @@ def slurm_failure_lines(snakemake_log: PathLike) -> list[str]:
             )
             lines.append(f"SLURM job {path.stem} ({job}): {reason} (SLURM's output: {path})")
     return lines
+
+
+def requested_partitions(resource_settings) -> dict[str, str]:
+    """The SLURM partitions a run asks for as plain text, by where they were given (``default-resources``,
+    ``set-resources {rule}``), from Snakemake's resource settings; a partition given as a function is left out."""
+
+    def plain(resource) -> str | None:
+        raw = getattr(resource, "raw", None)
+        return raw.strip("'\"") if isinstance(raw, str) else None
+
+    requested = {}
+    defaults = resource_settings.default_resources
+    if defaults is not None and "slurm_partition" in defaults.keys():
+        requested["default-resources"] = plain(defaults.get("slurm_partition"))
+    for rule, resources in resource_settings.overwrite_resources.items():
+        if "slurm_partition" in resources.keys():
+            requested[f"set-resources {rule}"] = plain(resources.get("slurm_partition"))
+    return {k: v for k, v in requested.items() if v is not None}

@@ -1,0 +1,566 @@
+"""Where every file of a study lives: the raw files, the results, the rules' logs and benchmarks, the files each
+job reads and the targets of a run.
+
+This module is the only place that spells a path. :class:`Paths` holds the
+file patterns (Snakemake wildcards in braces: ``{subject}``, ``{trial}``,
+``{onset}``, ``{chunk}``), one attribute per stage folder::
+
+    paths = Paths(raw_dir="data/raw")
+    paths.ik.angles            # 'results/ik/{subject}/{trial}.angles.tsv'
+    paths.raw.c3d              # 'data/raw/{subject}/{trial}.c3d'
+    fill(paths.ik.angles, subject="S01", trial="pert050-1")
+
+:class:`Study` adds the subjects and the trial design: which trials of which
+subject exist, the bundles of files a job reads and the targets of a run.
+The workflow's rules, the command line and the benchmarks ask these two.
+"""
+
+from __future__ import annotations
+
+import string
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.study_design import StudyDesign
+
+__all__ = ["RAW_DIR", "RESULTS_DIR", "RAW_FILES", "RESULT_FILES", "Paths", "Study", "fill", "subject_rows"]
+
+#: The raw files' folder unless the config's ``raw_dir`` says otherwise.
+RAW_DIR = "data/raw"
+#: The results' folder.
+RESULTS_DIR = "results"
+
+#: The raw files of a subject: name -> pattern under the raw folder.
+RAW_FILES: dict[str, str] = {
+    "c3d": "{subject}/{trial}.c3d",
+    "robot_log": "{subject}/{trial}.loper.tsv",
+    "mat": "{subject}/{trial}.mat",
+    "truth": "{subject}/truth.yaml",
+}
+
+#: Every result file: stage folder -> name -> pattern under ``results/{stage}/``.
+RESULT_FILES: dict[str, dict[str, str]] = {
+    "markers": {
+        "trc": "{subject}/{trial}.trc",
+        "gaps": "{subject}/{trial}.gaps.tsv",
+        "summary": "{subject}/{trial}.markers.tsv",
+        "lab_angles": "{subject}/{trial}.lab_angles.tsv",
+    },
+    "model": {
+        "generic": "{subject}/generic.osim",
+        "scaled": "{subject}/scaled.osim",
+        "scale": "{subject}/scale.tsv",
+        "segments": "{subject}/segments.tsv",
+    },
+    "ik": {
+        "mot": "{subject}/{trial}.mot",
+        "chunk": "{subject}/{trial}.chunk{chunk}.mot",
+        "angles": "{subject}/{trial}.angles.tsv",
+        "summary": "{subject}/{trial}.ik.tsv",
+        "agreement": "{subject}/{trial}.lab_agreement.tsv",
+    },
+    "grf": {"mot": "{subject}/{trial}.grf.mot", "figure": "{subject}/{trial}.grf.png"},
+    "events": {
+        "events": "{subject}/{trial}.events.tsv",
+        "contacts": "{subject}/{trial}.contacts.tsv",
+        "force": "{subject}/{trial}.force.tsv",
+        "force_native": "{subject}/{trial}.force_native.tsv",
+    },
+    "strides": {
+        "strides": "{subject}/{trial}.strides.tsv",
+        "cycles": "{subject}/{trial}.cycles.tsv",
+        "dropped": "{subject}/{trial}.dropped.tsv",
+        "figure": "{subject}/{trial}.angles.png",
+        "summary": "summary.tsv",
+    },
+    "transparency": {"rmsd": "rmsd.tsv", "force": "force.tsv", "figure": "transparency.png"},
+    "device": {
+        "robot_log": "{subject}/{trial}.loper.tsv",
+        "frf": "frf.tsv",
+        "step_metrics": "step_metrics.tsv",
+        "step_average": "step_average.tsv",
+        "summary": "summary.tsv",
+        "bode": "bode.png",
+        "steps": "steps.png",
+    },
+    "impedance": {
+        "response": "{subject}/{onset}.response.tsv",
+        "counts": "{subject}/{onset}.counts.tsv",
+        "fit": "{subject}/{onset}.tsv",
+        "curves": "{subject}/{onset}.curves.tsv",
+        "force": "{subject}/{onset}.force.tsv",
+        "responses_figure": "{subject}/responses.png",
+        "fit_figure": "{subject}/fit.png",
+        "table": "impedance.tsv",
+        "summary": "summary.tsv",
+        "literature": "literature.tsv",
+        "figure": "impedance.png",
+    },
+    "planning": {"plan": "plan.tsv", "answers": "answers.txt"},
+    "validation": {
+        "segments": "segments.tsv",
+        "chunk_errors": "chunks/{chunk}.errors.tsv",
+        "chunk_fits": "chunks/{chunk}.fits.tsv",
+        "errors": "errors.tsv",
+        "fits": "fits.tsv",
+        "summary": "summary.tsv",
+        "figure": "errors.png",
+    },
+    "report": {"tables": "tables.md", "front_page": "front_page.html"},
+}
+
+
+def subject_rows(sheet: pd.DataFrame, seed: int) -> dict[str, dict]:
+    """Subject -> its row of the subject sheet, empty cells left out; a synthetic subject's missing
+    anthropometrics drawn from the study's subjects (``synthetic.subjects.subject_anthropometry``)."""
+    from loper_analysis.synthetic.subjects import subject_anthropometry
+
+    rows = {
+        r["subject"]: {k: v for k, v in r.items() if not (isinstance(v, float) and pd.isna(v))}
+        for r in sheet.to_dict("records")
+    }
+    for row in rows.values():
+        if row["source"] == "synthetic":
+            row.update(subject_anthropometry(row, seed))
+    return rows
+
+
+class _Keep(dict):
+    """Format fields: the given ones filled, the others kept as wildcards."""
+
+    def __missing__(self, key: str) -> str:
+        return "{" + key + "}"
+
+
+def fill(pattern: str, **fields) -> str:
+    """``pattern`` with the given wildcards filled and the others left as they are (``{onset}`` of an int is
+    written with three digits)."""
+    values = {k: f"{v:03d}" if k == "onset" and isinstance(v, int) else str(v) for k, v in fields.items()}
+    return string.Formatter().vformat(pattern, (), _Keep(values))
+
+
+class Folder:
+    """The file patterns of one folder, as attributes (``Folder.angles``)."""
+
+    def __init__(self, root: str, files: Mapping[str, str]):
+        self.root = root
+        self._files = {name: f"{root}/{pattern}" for name, pattern in files.items()}
+
+    def __getattr__(self, name: str) -> str:
+        try:
+            return self.__dict__["_files"][name]
+        except KeyError:
+            raise AttributeError(f"{self.root}: no file '{name}' (files: {', '.join(self._files)})") from None
+
+    def __dir__(self):
+        return [*super().__dir__(), *self._files]
+
+
+class Paths:
+    """Every file pattern of a study: ``raw`` (the raw folder, the config's ``raw_dir``) and one attribute per
+    results folder (:data:`RESULT_FILES`), plus the rules' logs and benchmarks."""
+
+    def __init__(self, raw_dir: str = RAW_DIR, results_dir: str = RESULTS_DIR):
+        self.raw_dir, self.results_dir = str(raw_dir).rstrip("/"), str(results_dir).rstrip("/")
+        self.raw = Folder(self.raw_dir, RAW_FILES)
+        for stage, files in RESULT_FILES.items():
+            setattr(self, stage, Folder(f"{self.results_dir}/{stage}", files))
+
+    def log(self, rule: str, key: str) -> str:
+        """A rule's log: ``results/logs/{rule}/{key}.log`` (``key``: its wildcards, e.g. ``{subject}/{trial}``)."""
+        return f"{self.results_dir}/logs/{rule}/{key}.log"
+
+    def benchmark(self, rule: str, key: str) -> str:
+        """A rule's benchmark table: ``results/benchmarks/{rule}/{key}.tsv``."""
+        return f"{self.results_dir}/benchmarks/{rule}/{key}.tsv"
+
+    def raw_folder(self, subject: str) -> Path:
+        """A subject's raw folder."""
+        return Path(self.raw_dir) / subject
+
+    def __getattr__(self, name: str) -> Folder:  # for type checkers: the stage folders are set in __init__
+        raise AttributeError(f"no results folder '{name}' (folders: {', '.join(RESULT_FILES)})")
+
+
+@dataclass
+class Study:
+    """The study's subjects and trials on disk, the files each job reads and the run's targets.
+
+    Parameters
+    ----------
+    rows : mapping
+        Subject -> its subject-sheet row (``source``, optional ``model_osim``, ``mass_kg``, ``height_m``).
+    design : StudyDesign
+        The trial design.
+    paths : Paths
+        The file patterns.
+    config : mapping
+        The workflow's config (the keys read: ``trials``, ``events``, ``identification.noise_model``,
+        ``device.subject``, ``validation``, ``planning.pilot_subject``).
+    has_plates : callable
+        ``has_plates(path) -> bool``: whether a C3D has force platforms (read once per file).
+    note : callable
+        Where notes for the user go (one line each).
+    """
+
+    rows: Mapping[str, Mapping]
+    design: StudyDesign
+    paths: Paths
+    config: Mapping
+    has_plates: Callable[[Path], bool]
+    note: Callable[[str], None] = print
+    _plates: dict = field(default_factory=dict, repr=False)
+
+    # --- subjects and trials -------------------------------------------------------------------------------
+    def source(self, subject: str) -> str:
+        """``synthetic`` or ``recorded``."""
+        return self.rows[subject]["source"]
+
+    def subject_trials(self, subject: str) -> list[str]:
+        """Walking trials of a subject: all for a synthetic one, those with a raw C3D on disk for a recorded one."""
+        if self.source(subject) == "synthetic":
+            return self.design.walking_trials()
+        raw = self.paths.raw_folder(subject)
+        return [t for t in self.design.walking_trials() if (raw / f"{t}.c3d").is_file()]
+
+    def processed_subjects(self) -> list[str]:
+        """Synthetic subjects, and recorded subjects with a static trial on disk or a scaled model."""
+        static = self.design.static
+        return [
+            s
+            for s, row in self.rows.items()
+            if row["source"] == "synthetic"
+            or "model_osim" in row
+            or (self.paths.raw_folder(s) / f"{static}.c3d").is_file()
+        ]
+
+    def scaled_subjects(self) -> list[str]:
+        """Processed subjects whose model is scaled here from their static trial (no model_osim)."""
+        return [s for s in self.processed_subjects() if "model_osim" not in self.rows[s]]
+
+    def transparency_subjects(self) -> list[str]:
+        """Processed subjects with both walking trials of the transparency experiment."""
+        pair = {self.design.no_device, self.design.device}
+        return [s for s in self.processed_subjects() if pair <= set(self.subject_trials(s))]
+
+    def onset_trials(self, subject: str, onset: int | str) -> list[str]:
+        """The subject's trials of one onset (ms) that are on disk (or generated)."""
+        return [t for t in self.subject_trials(subject) if self.design.onset_ms(t) == int(onset)]
+
+    def null_pair_trials(self, subject: str) -> list[str]:
+        """The subject's trials with the device: their unperturbed strides are the null pairs of every fit."""
+        return [t for t in self.subject_trials(subject) if t != self.design.no_device]
+
+    def has_force_platforms(self, subject: str, trial: str) -> bool:
+        """Whether a recorded trial's C3D has force platforms; a file without them gets one note."""
+        key = (subject, trial)
+        if key not in self._plates:
+            path = Path(fill(self.paths.raw.c3d, subject=subject, trial=trial))
+            self._plates[key] = self.has_plates(path)
+            if not self._plates[key]:
+                self.note(
+                    f"note: {path}: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the belt "
+                    f"channels (events.grf_channels: {self.config['events']['grf_channels']}), no OpenSim "
+                    f"external loads ({fill(self.paths.grf.mot, subject=subject, trial=trial)}) for this trial"
+                )
+        return self._plates[key]
+
+    # --- files of one job ------------------------------------------------------------------------------------
+    def subject_model(self, subject: str) -> str:
+        """The subject's OpenSim model: the sheet's model_osim or the one scaled from the static trial."""
+        return self.rows[subject].get("model_osim") or fill(self.paths.model.scaled, subject=subject)
+
+    def generic_model(self, subject: str) -> str:
+        """The model scaled per subject: opensim.generic_model, or the generated model for the subject."""
+        return self.config["opensim"]["generic_model"] or fill(self.paths.model.generic, subject=subject)
+
+    def static_c3d_for_mass(self, subject: str) -> list[str]:
+        """The static trial's C3D when the sheet gives no mass or no height (read for them), else nothing."""
+        row = self.rows[subject]
+        if "mass_kg" in row and "height_m" in row:
+            return []
+        return [fill(self.paths.raw.c3d, subject=subject, trial=self.design.static)]
+
+    def robot_log(self, subject: str, trial: str) -> str:
+        """A trial's robot log: the raw ``{trial}.loper.tsv``, or converted from a recorded ``{trial}.mat``."""
+        raw = fill(self.paths.raw.robot_log, subject=subject, trial=trial)
+        mat = fill(self.paths.raw.mat, subject=subject, trial=trial)
+        if self.source(subject) == "recorded" and not Path(raw).exists() and Path(mat).exists():
+            return fill(self.paths.device.robot_log, subject=subject, trial=trial)
+        return raw
+
+    def device_log(self, trial: str) -> str | list:
+        """The robot log of a device test (none without a device subject)."""
+        subject = self.config["device"]["subject"]
+        if subject is None:
+            return []
+        mat = fill(self.paths.raw.mat, subject=subject, trial=trial)
+        if self.source(subject) == "recorded" and Path(mat).exists():
+            return fill(self.paths.device.robot_log, subject=subject, trial=trial)
+        return fill(self.paths.raw.robot_log, subject=subject, trial=trial)
+
+    def label_maps(self, trial: str) -> list:
+        """The label maps of a trial, merged in this order: markers.label_map, then its kind's and its own from
+        markers.trial_label_maps (each inline, a mapping, or a file, a path)."""
+        markers = self.config["markers"]
+        per_trial = markers["trial_label_maps"]
+        maps = [markers["label_map"], per_trial.get(self.design.kind(trial)), per_trial.get(trial)]
+        return [m for m in maps if m]
+
+    def recorded_checksums(self, paths: list[str]) -> dict[str, str]:
+        """Path -> content checksum of the raw files among ``paths`` of recorded subjects (generated raw files
+        are the workflow's own outputs, rerun by it)."""
+        from loper_analysis.io.raw_files import content_checksum
+
+        out = {}
+        for path in paths:
+            try:
+                subject = Path(path).relative_to(self.paths.raw_dir).parts[0]
+            except (ValueError, IndexError):
+                continue
+            if self.rows.get(subject, {}).get("source") == "recorded" and Path(path).is_file():
+                out[path] = content_checksum(path)
+        return out
+
+    def stride_force(self, subject: str, trial: str) -> str | list:
+        """The interaction force of a trial walked with the device (none without it)."""
+        if trial == self.design.no_device:
+            return []
+        return fill(self.paths.events.force, subject=subject, trial=trial)
+
+    def trial_files(self, stage: str, name: str) -> list[str]:
+        """One file of every processed subject's walking trials (e.g. ``("strides", "strides")``)."""
+        pattern = getattr(getattr(self.paths, stage), name)
+        return [fill(pattern, subject=s, trial=t) for s in self.processed_subjects() for t in self.subject_trials(s)]
+
+    def onset_files(self, stage: str, name: str, subject: str | None = None) -> list[str]:
+        """One file per onset of one subject (or of every processed subject)."""
+        pattern = getattr(getattr(self.paths, stage), name)
+        subjects = self.processed_subjects() if subject is None else [subject]
+        return [fill(pattern, subject=s, onset=o) for s in subjects for o in self.design.perturbation_onsets_ms]
+
+    def planning_pilot(self, source: str = "planning.pilot_subject") -> str:
+        """The pilot subject: planning.pilot_subject, else the first processed subject."""
+        pilot = self.config["planning"]["pilot_subject"]
+        if pilot is None:
+            return self.processed_subjects()[0]
+        if pilot not in self.processed_subjects():
+            raise LoperInputError(
+                f"{source}: key 'planning.pilot_subject': subject '{pilot}' is not a processed subject of "
+                f"{self.config['subjects']}"
+            )
+        return pilot
+
+    # --- targets ---------------------------------------------------------------------------------------------
+    def identifies_impedance(self) -> bool:
+        """Whether a processed subject has a perturbation trial (impedance, planning and validation are built)."""
+        s_t = [(s, t) for s in self.processed_subjects() for t in self.subject_trials(s)]
+        return any(self.design.onset_ms(t) is not None for _, t in s_t)
+
+    def processing_targets(self) -> list[str]:
+        """Stride tables of every processed trial, the models, impedance and planning, transparency."""
+        p, out = self.paths, []
+        for s in self.processed_subjects():
+            out.append(fill(p.model.segments, subject=s))
+            if s in self.scaled_subjects():
+                out.append(fill(p.model.scale, subject=s))
+            if self.source(s) == "synthetic":
+                out.append(fill(p.raw.truth, subject=s))
+            out += [fill(p.strides.strides, subject=s, trial=t) for t in self.subject_trials(s)]
+            if self.source(s) == "recorded":  # lab files: their force platforms as OpenSim external loads
+                plated = [t for t in self.subject_trials(s) if self.has_force_platforms(s, t)]
+                out += [fill(p.grf.mot, subject=s, trial=t) for t in plated]
+                out += self.recorded_figures(s)
+        if out:
+            out.append(p.strides.summary)
+        if self.identifies_impedance():
+            out += [p.impedance.table, p.impedance.summary, p.impedance.literature, p.impedance.figure]
+            out.append(p.report.tables)
+            out += [
+                fill(getattr(p.impedance, f), subject=s)
+                for s in self.processed_subjects()
+                for f in ("responses_figure", "fit_figure")
+            ]
+            out += [p.planning.plan, p.planning.answers]
+        if self.transparency_subjects():
+            out += [p.transparency.rmsd, p.transparency.force, p.transparency.figure]
+        return out
+
+    def recorded_figures(self, subject: str) -> list[str]:
+        """A recorded subject's joint-angle figure of every walking trial and force-plate figure of those with
+        plates."""
+        trials, p = self.subject_trials(subject), self.paths
+        out = [fill(p.strides.figure, subject=subject, trial=t) for t in trials]
+        return out + [
+            fill(p.grf.figure, subject=subject, trial=t) for t in trials if self.has_force_platforms(subject, t)
+        ]
+
+    def validation_targets(self) -> list[str]:
+        """The validation study's tables and figure: for a study with perturbation trials, or without subjects."""
+        targets = self.processing_targets()
+        if targets and self.paths.impedance.table not in targets:
+            return []
+        v = self.paths.validation
+        return [v.summary, v.errors, v.fits, v.figure]
+
+    def device_targets(self) -> list[str]:
+        """The device tests' results: none without a device subject (device.subject null)."""
+        if self.config["device"]["subject"] is None:
+            return []
+        return [self.paths.device.summary, self.paths.device.bode, self.paths.device.steps]
+
+    def all_targets(self) -> list[str]:
+        """Everything a run builds by default."""
+        return [
+            *self.processing_targets(),
+            *self.validation_targets(),
+            *self.device_targets(),
+            self.paths.report.front_page,
+        ]
+
+    def markdown_sections(self) -> dict[str, str]:
+        """Heading -> result table, for the Markdown rendering of the run's tables."""
+        p = self.paths
+        sections = {
+            "Impedance per subject, onset and joint": p.impedance.table,
+            "Across-subject summary": p.impedance.summary,
+            "Literature": p.impedance.literature,
+            "Strides per trial": p.strides.summary,
+            "Validation study": p.validation.summary,
+            "Device": p.device.summary,
+        }
+        if self.transparency_subjects():
+            sections["Transparency: RMSD vs ISV_ave"] = p.transparency.rmsd
+            sections["Transparency: interaction force"] = p.transparency.force
+        return sections
+
+    # --- bundles of files ------------------------------------------------------------------------------------
+    def fit_files(self, subject: str) -> dict:
+        """Files of a subject's fit at every onset (ms -> ``FitFiles``, the config's order): the onset's own
+        trials (angles, strides, force at 128 Hz and at the robot rate, markers), the null-pair trials (angles,
+        strides), the segment table, a synthetic truth and the outputs."""
+        from loper_analysis.steps.impedance import FitFiles, FitOutputs, TrialFiles
+
+        s, p = subject, self.paths
+
+        def trial_files(t: str, own: bool) -> TrialFiles:
+            tables = dict(
+                angles=fill(p.ik.angles, subject=s, trial=t), strides=fill(p.strides.strides, subject=s, trial=t)
+            )
+            if own:
+                tables.update(
+                    force=fill(p.events.force, subject=s, trial=t),
+                    markers=fill(p.markers.trc, subject=s, trial=t),
+                    force_native=fill(p.events.force_native, subject=s, trial=t),
+                )
+            return TrialFiles(**tables)
+
+        def null_trials(onset: int) -> list[str]:
+            # none for a white-noise fit or a missing onset (reported without any input)
+            if self.config["identification"]["noise_model"] != "null_pairs" or not self.onset_trials(s, onset):
+                return []
+            return self.null_pair_trials(s)
+
+        outputs = ("response", "counts", "fit", "curves", "force")
+        return {
+            o: FitFiles(
+                trials={t: trial_files(t, True) for t in self.onset_trials(s, o)},
+                segments=fill(p.model.segments, subject=s),
+                outputs=FitOutputs(**{k: fill(getattr(p.impedance, k), subject=s, onset=o) for k in outputs}),
+                null_trials={t: trial_files(t, False) for t in null_trials(o)},
+                truth=fill(p.raw.truth, subject=s) if self.source(s) == "synthetic" else None,
+            )
+            for o in self.design.perturbation_onsets_ms
+        }
+
+    def fit_inputs(self, subject: str) -> list[str]:
+        """Every file a subject's fits read (:meth:`fit_files`), each once."""
+        paths = []
+        for files in self.fit_files(subject).values():
+            paths += [files.segments, *([files.truth] if files.truth else [])]
+            for trial in (*files.trials.values(), *files.null_trials.values()):
+                paths += [path for path in vars(trial).values() if path is not None]
+        return list(dict.fromkeys(paths))
+
+    def planning_files(self, pilot: str):
+        """The pilot's angle and stride tables of its trials with the device, its segment table and fit rows
+        (``PilotFiles``)."""
+        from loper_analysis.steps.planning import PilotFiles, PilotTrial
+
+        p = self.paths
+        return PilotFiles(
+            trials={
+                t: PilotTrial(
+                    angles=fill(p.ik.angles, subject=pilot, trial=t),
+                    strides=fill(p.strides.strides, subject=pilot, trial=t),
+                )
+                for t in self.null_pair_trials(pilot)
+            },
+            segments=fill(p.model.segments, subject=pilot),
+            impedance=tuple(self.onset_files("impedance", "fit", pilot)),
+        )
+
+    def transparency_files(self) -> dict:
+        """Stride and cycle tables of the transparency pair of every subject that walked both trials (subject ->
+        ``TransparencyFiles``)."""
+        from loper_analysis.steps.transparency import TransparencyFiles
+
+        st, d = self.paths.strides, self.design
+        return {
+            s: TransparencyFiles(
+                no_device_strides=fill(st.strides, subject=s, trial=d.no_device),
+                no_device_cycles=fill(st.cycles, subject=s, trial=d.no_device),
+                device_strides=fill(st.strides, subject=s, trial=d.device),
+                device_cycles=fill(st.cycles, subject=s, trial=d.device),
+            )
+            for s in self.transparency_subjects()
+        }
+
+    def recorded_quality_files(self) -> dict:
+        """The files of the front page's section on recorded subjects: per recorded subject its scale report
+        (None with a model from the sheet) and per walking trial its IK summary, agreement with the lab's own
+        angles and figures (the force plates' None without plates)."""
+        p, out = self.paths, {}
+        for s in self.processed_subjects():
+            if self.source(s) != "recorded":
+                continue
+            trials = {
+                t: {
+                    "ik": fill(p.ik.summary, subject=s, trial=t),
+                    "agreement": fill(p.ik.agreement, subject=s, trial=t),
+                    "angles_png": fill(p.strides.figure, subject=s, trial=t),
+                    "grf_png": fill(p.grf.figure, subject=s, trial=t) if self.has_force_platforms(s, t) else None,
+                }
+                for t in self.subject_trials(s)
+            }
+            scale = fill(p.model.scale, subject=s) if s in self.scaled_subjects() else None
+            out[s] = {"scale": scale, "trials": trials}
+        return out
+
+    def front_page_inputs(self) -> dict:
+        """The tables the front page reads, named as the fields of ``FrontPageFiles``: the validation and device
+        summaries when built, the impedance tables and main figure with perturbation trials, the transparency
+        table with a subject who walked both trials, the recorded subjects' quality files."""
+        p = self.paths
+        out = {"validation": p.validation.summary} if self.validation_targets() else {}
+        if self.device_targets():
+            out["device"] = p.device.summary
+        targets = set(self.processing_targets())
+        if p.impedance.table in targets:
+            out.update(impedance=p.impedance.table, summary=p.impedance.summary, figure=p.impedance.figure)
+        if p.transparency.rmsd in targets:
+            out["rmsd"] = p.transparency.rmsd
+        recorded = self.recorded_quality_files()
+        if recorded:
+            out["strides"] = p.strides.summary
+            out["quality"] = [
+                path
+                for entry in recorded.values()
+                for path in [entry["scale"], *(f for files in entry["trials"].values() for f in files.values())]
+                if path is not None
+            ]
+        return out

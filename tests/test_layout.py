@@ -1,0 +1,133 @@
+"""The study's files (``loper_analysis.layout``): patterns, wildcards, trials on disk, bundles, targets."""
+
+from __future__ import annotations
+
+import hashlib
+from pathlib import Path
+
+import pytest
+import yaml
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.layout import RESULT_FILES, Paths, Study, fill
+from loper_analysis.study_checks import check_subjects, raw_file_warnings
+from loper_analysis.study_design import StudyDesign
+from tests.workflow_copy import copy_workflow, snakemake
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+
+def test_patterns_are_the_folders_and_names_of_the_docs():
+    paths = Paths("lab/raw")
+    assert paths.ik.angles == "results/ik/{subject}/{trial}.angles.tsv"
+    assert paths.impedance.fit == "results/impedance/{subject}/{onset}.tsv"
+    assert paths.raw.c3d == "lab/raw/{subject}/{trial}.c3d"
+    assert paths.log("ik", "{subject}/{trial}") == "results/logs/ik/{subject}/{trial}.log"
+    assert paths.benchmark("planning", "plan") == "results/benchmarks/planning/plan.tsv"
+    # every stage folder holds its own files only
+    assert all(getattr(paths, stage).root == f"results/{stage}" for stage in RESULT_FILES)
+
+
+def test_an_unknown_file_or_folder_is_named():
+    with pytest.raises(AttributeError, match=r"results/ik: no file 'angle' \(files: mot, chunk, angles"):
+        _ = Paths().ik.angle
+    with pytest.raises(AttributeError, match="no results folder 'kinematics'"):
+        _ = Paths().kinematics
+
+
+def test_fill_leaves_the_wildcards_not_given():
+    assert fill(Paths().ik.angles, trial="static") == "results/ik/{subject}/static.angles.tsv"
+    assert fill(Paths().impedance.fit, subject="S01", onset=50) == "results/impedance/S01/050.tsv"
+    assert fill(Paths().impedance.fit, subject="S01", onset="175") == "results/impedance/S01/175.tsv"
+
+
+def _study(tmp_path: Path, rows: dict, **config) -> Study:
+    cfg = {**CONFIG, **config}
+    said: list[str] = []
+    study = Study(
+        rows,
+        StudyDesign.from_config(cfg["trials"]),
+        Paths(str(tmp_path / "raw")),
+        cfg,
+        has_plates=lambda path: path.name != "walk-nodevice.c3d",
+        note=said.append,
+    )
+    study.said = said
+    return study
+
+
+def _touch(path: Path, data: bytes = b"x") -> Path:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(data)
+    return path
+
+
+def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
+    raw = tmp_path / "raw" / "R01"
+    for t in ("static", "walk-nodevice", "pert050-1"):
+        _touch(raw / f"{t}.c3d")
+    study = _study(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}}, device={"subject": None})
+    assert study.subject_trials("R01") == ["walk-nodevice", "pert050-1"]
+    assert len(study.subject_trials("S01")) == 8  # every walking trial of the design
+    assert study.processed_subjects() == ["R01", "S01"]
+    assert study.transparency_subjects() == ["S01"]
+    targets = study.all_targets()
+    # plates in pert050-1 only: its external loads and force-plate figure, one note for the other trial
+    assert "results/grf/R01/pert050-1.grf.mot" in targets and "results/grf/R01/walk-nodevice.grf.mot" not in targets
+    assert study.said == [
+        f"note: {raw / 'walk-nodevice.c3d'}: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from "
+        f"the belt channels (events.grf_channels: {CONFIG['events']['grf_channels']}), no OpenSim external "
+        "loads (results/grf/R01/walk-nodevice.grf.mot) for this trial"
+    ]
+    assert "results/validation/summary.tsv" in targets and "results/device/summary.tsv" not in targets
+
+
+def test_a_fits_files_are_its_onsets_own_trials_and_the_null_pairs(tmp_path):
+    raw = tmp_path / "raw" / "R01"
+    for t in ("static", "walk-device", "pert050-1", "pert175-1"):
+        _touch(raw / f"{t}.c3d")
+    study = _study(tmp_path, {"R01": {"source": "recorded"}})
+    fits = study.fit_files("R01")
+    assert list(fits) == [50, 175, 300]
+    assert list(fits[50].trials) == ["pert050-1"] and fits[50].trials["pert050-1"].force == (
+        "results/events/R01/pert050-1.force.tsv"
+    )
+    assert list(fits[50].null_trials) == ["walk-device", "pert050-1", "pert175-1"]
+    assert fits[300].trials == {} and fits[300].null_trials == {}  # a missing onset reads nothing
+    assert fits[175].outputs.curves == "results/impedance/R01/175.curves.tsv" and fits[175].truth is None
+    inputs = study.fit_inputs("R01")
+    assert len(inputs) == len(set(inputs)) and "results/markers/R01/pert175-1.trc" in inputs
+    assert study.planning_files("R01").impedance == tuple(
+        f"results/impedance/R01/{o}.tsv" for o in ("050", "175", "300")
+    )
+
+
+def test_checksums_only_of_a_recorded_subjects_raw_files(tmp_path):
+    c3d = _touch(tmp_path / "raw" / "R01" / "static.c3d", b"abc")
+    _touch(tmp_path / "raw" / "S01" / "static.c3d", b"abc")
+    study = _study(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}})
+    paths = [str(c3d), str(tmp_path / "raw" / "S01" / "static.c3d"), "results/markers/R01/static.trc"]
+    assert study.recorded_checksums(paths) == {str(c3d): hashlib.sha256(b"abc").hexdigest()}
+
+
+def test_the_checks_name_the_sheet_subject_and_file(tmp_path):
+    study = _study(tmp_path, {"R01": {"source": "recorded", "height_m": 1.7}}, device={"subject": "R01"})
+    with pytest.raises(
+        LoperInputError, match=r"subjects.tsv: recorded subject 'R01' has no static trial .*raw/R01/static.c3d"
+    ):
+        check_subjects(study, "subjects.tsv", lambda *keys: "config/config.yaml")
+    _touch(tmp_path / "raw" / "R01" / "static.c3d")
+    _touch(tmp_path / "raw" / "R01" / "walk-fast.c3d")
+    check_subjects(study, "subjects.tsv", lambda *keys: "config/config.yaml")
+    (warning,) = raw_file_warnings(study)
+    assert warning.startswith(f"warning: {tmp_path / 'raw' / 'R01'}: walk-fast.c3d: no trial of the design")
+
+
+def test_the_workflow_reads_and_writes_raw_files_in_the_configs_raw_dir(tmp_path):
+    work = copy_workflow(tmp_path)
+    run = snakemake(work, "-n", "--config", "raw_dir=lab/raw")
+    assert run.returncode == 0, run.stderr[-2000:]
+    written = {line.split(": ", 1)[1] for line in run.stdout.splitlines() if line.startswith("    output: ")}
+    assert "lab/raw/S01/truth.yaml" in written
+    assert not [p for line in written for p in line.split(", ") if p.startswith("data/raw")]
