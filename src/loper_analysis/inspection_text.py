@@ -55,9 +55,17 @@ def _model_axis(rotation_deg: Sequence[float], axis: int, sign: int) -> str:
 
 def format_summary(s: RecordingSummary) -> str:
     """The inspection of one recording as plain text (units stated on every line that has numbers)."""
+    lines = (
+        _header_lines(s) + _marker_lines(s) + _plate_lines(s) + _analog_lines(s) + _event_lines(s) + _lab_frame_lines(s)
+    )
+    return "\n".join(line.rstrip() for line in lines) + "\n"
+
+
+def _header_lines(s: RecordingSummary) -> list[str]:
+    """The file's rates (Hz), channel count and frame span (frames, s), then a blank line."""
     rate = s.point_rate_hz
     last = s.first_frame + s.n_frames - 1
-    lines = [
+    return [
         f"File {s.source}",
         f"  markers   {rate:g} Hz, POINT:UNITS {s.point_unit or '(none)'} (shown below in m)",
         f"  analogs   {s.analog_rate_hz:g} Hz ({round(s.analog_rate_hz / rate)} samples per frame), "
@@ -66,6 +74,12 @@ def format_summary(s: RecordingSummary) -> str:
         f"{last} at {last / rate:.3f} s; duration {s.duration_s:.3f} s ({s.n_frames} frames / {rate:g} Hz)",
         "",
     ]
+
+
+def _marker_lines(s: RecordingSummary) -> list[str]:
+    """The markers' table (presence in %, frames, longest gap in frames and s) and the sparse frames, then a
+    blank line."""
+    lines: list[str] = []
     m = s.markers
     width = max([len(lab) for lab in m["label"]] + [5])
     if len(m):
@@ -96,7 +110,13 @@ def format_summary(s: RecordingSummary) -> str:
         )
     )
     lines.append("")
+    return lines
 
+
+def _plate_lines(s: RecordingSummary) -> list[str]:
+    """The force platforms: channels, corners, size and centre (m), normal, resting and peak vertical force (N),
+    then a blank line."""
+    lines: list[str] = []
     if s.plates:
         lines.append(
             f"Force platforms: {len(s.plates)} (forces on the body, lab frame; vertical = "
@@ -129,25 +149,40 @@ def format_summary(s: RecordingSummary) -> str:
                 f"({p.peak_vertical_n + p.rest_vertical_n:.1f} N as read)"
             )
     lines.append("")
+    return lines
 
-    lines.append(f"Analog channels: {len(s.analog_labels)}, all at {s.analog_rate_hz:g} Hz")
+
+def _analog_lines(s: RecordingSummary) -> list[str]:
+    """The analog channels (rate in Hz; number, label, unit and owner of each), then a blank line."""
+    lines = [f"Analog channels: {len(s.analog_labels)}, all at {s.analog_rate_hz:g} Hz"]
     if s.analog_labels:
         width = max(len(lab) for lab in s.analog_labels)
         for i, (lab, unit) in enumerate(zip(s.analog_labels, s.analog_units)):
             owner = s.channel_owner.get(i, "")
             lines.append(f"  {i + 1:3d}  {lab:<{width}}  {unit or '(no unit)':<8}" + (f"  {owner}" if owner else ""))
     lines.append("")
+    return lines
 
+
+def _event_lines(s: RecordingSummary) -> list[str]:
+    """The file's events (context, label, time in s and frame), then a blank line."""
+    lines: list[str] = []
     if len(s.events):
         lines.append(f"Events: {len(s.events)} (EVENT group; time on the file's clock, s)")
         for ev in s.events.itertuples(index=False):
-            lines.append(f"  {ev.context:<8} {ev.label:<16} {ev.time_s:8.3f} s  (frame {round(ev.time_s * rate)})")
+            lines.append(
+                f"  {ev.context:<8} {ev.label:<16} {ev.time_s:8.3f} s  (frame {round(ev.time_s * s.point_rate_hz)})"
+            )
     else:
         lines.append("Events: none")
     lines.append("")
+    return lines
 
+
+def _lab_frame_lines(s: RecordingSummary) -> list[str]:
+    """The lab frame: vertical axis, walking direction (m, m/s) and the suggested rotation (degrees)."""
     v, w = s.vertical, s.walking
-    lines.append("Lab frame")
+    lines = ["Lab frame"]
     text = f"  vertical axis: {axis_name(v.axis, v.sign)} " + (
         "(assumed: neither plates nor markers tell)" if v.basis == "assumed" else f"(from the {v.basis})"
     )
@@ -160,16 +195,7 @@ def format_summary(s: RecordingSummary) -> str:
         )
         text += f"; the markers {agree} (median spread of a frame's markers, m: {spread})"
     lines.append(text)
-    if w.axis is None and not np.all(np.isfinite(w.travel_m)):
-        lines.append("  walking direction: unknown (no marker is present in two frames)")
-    elif w.axis is None:
-        travel = ", ".join(f"{AXIS_NAMES[a]} {w.travel_m[a]:+.2f}" for a in range(3))
-        lines.append(f"  walking direction: treadmill/standing (the markers do not travel; median travel, m: {travel})")
-    else:
-        lines.append(
-            f"  walking direction: {axis_name(w.axis, w.sign)} (the markers travel "
-            f"{w.travel_m[w.axis]:+.2f} m along {AXIS_NAMES[w.axis]} at {w.speed_m_per_s:.2f} m/s)"
-        )
+    lines.append(_walking_line(s))
     lines.append(
         f"  suggested markers.lab_to_model_rotation_deg: {_rotation_text(s.rotation_deg)} (degrees about the "
         "fixed X, Y, Z: up -> model +Y)"
@@ -187,7 +213,21 @@ def format_summary(s: RecordingSummary) -> str:
             f"{_rotation_text(s.rotation_forward_deg)} also turns its walking direction to model +X, "
             "OpenSim's forward)"
         )
-    return "\n".join(line.rstrip() for line in lines) + "\n"
+    return lines
+
+
+def _walking_line(s: RecordingSummary) -> str:
+    """The walking direction's line: its axis, travel (m) and speed (m/s), or why it is not known."""
+    w = s.walking
+    if w.axis is None and not np.all(np.isfinite(w.travel_m)):
+        return "  walking direction: unknown (no marker is present in two frames)"
+    if w.axis is None:
+        travel = ", ".join(f"{AXIS_NAMES[a]} {w.travel_m[a]:+.2f}" for a in range(3))
+        return f"  walking direction: treadmill/standing (the markers do not travel; median travel, m: {travel})"
+    return (
+        f"  walking direction: {axis_name(w.axis, w.sign)} (the markers travel "
+        f"{w.travel_m[w.axis]:+.2f} m along {AXIS_NAMES[w.axis]} at {w.speed_m_per_s:.2f} m/s)"
+    )
 
 
 def format_label_match(match: LabelMatch, model_name: str, n_model_markers: int) -> str:

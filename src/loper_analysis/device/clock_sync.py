@@ -282,9 +282,63 @@ def _pair(r: np.ndarray, m: np.ndarray, a: float, b: float, gate: float) -> tupl
     return i[first], j[first]
 
 
+def _matching_windows(
+    r: np.ndarray, m: np.ndarray, tol: float, drift: float, src: str
+) -> tuple[np.ndarray, np.ndarray]:
+    """First robot and mocap edge (indices, each shape (n_matches,)) of every pair of windows of
+    ``MIN_MATCHED_EDGES - 1`` consecutive intervals that agree within ``2 * tol + drift * interval`` (s); edges
+    ``r``, ``m`` in s. None matching raises LoperInputError."""
+    w = MIN_MATCHED_EDGES - 1  # intervals per window
+    dr, dm = np.diff(r), np.diff(m)
+    ok = np.abs(dr[:, None] - dm[None, :]) <= 2 * tol + drift * np.maximum(dr[:, None], dm[None, :])
+    nr, nm = dr.size - w + 1, dm.size - w + 1
+    win = ok[:nr, :nm].copy()
+    for k in range(1, w):
+        win &= ok[k : k + nr, k : k + nm]
+    ai, aj = np.nonzero(win)
+    if ai.size == 0:
+        raise LoperInputError(
+            f"{src}: no {MIN_MATCHED_EDGES} consecutive sync edges of the robot log ({r.size} edges) match the "
+            f"interval pattern of the mocap record ({m.size} edges) within {2 * tol * 1e3:.3g} ms + "
+            f"{drift * 1e6:.4g} ppm: different trains, or too little overlap"
+        )
+    return ai, aj
+
+
+def _check_unambiguous(
+    r: np.ndarray,
+    m: np.ndarray,
+    windows: tuple[np.ndarray, np.ndarray],
+    line: tuple[float, float],
+    gate: float,
+    src: str,
+) -> None:
+    """Refuse a match that another mapping fits nearly as well: the matching ``windows`` (first robot and mocap
+    edge of each) off the chosen ``line`` (offset in s, scale) by more than ``gate`` (s) voting for one other
+    shift at least half as often as those on it."""
+    (ai, aj), (a, b) = windows, line
+    shift = ai - aj
+    consistent = np.abs(m[aj] - (a + b * r[ai])) <= gate
+    n_ok = int(consistent.sum())
+    if (~consistent).any():
+        alt = shift[~consistent]
+        alt_votes = np.bincount(alt - alt.min())
+        k_alt = int(np.argmax(alt_votes))
+        v_alt = int(alt_votes[k_alt])
+        if 2 * v_alt >= n_ok:
+            pick = np.flatnonzero(~consistent & (shift == k_alt + alt.min()))[0]
+            delta = m[aj[pick]] - (a + b * r[ai[pick]])
+            raise LoperInputError(
+                f"{src}: ambiguous sync match: {n_ok} edge window(s) support the chosen clock map, {v_alt} support "
+                f"another whose offset differs by {delta:+.4f} s (a periodic pulse train cannot resolve whole "
+                "periods; use pseudo-random intervals, loper_analysis.synthetic.sync.sync_pulse_starts)"
+            )
+
+
 def clock_map(
     robot_edges_s,
     mocap_edges_s,
+    *,
     max_drift: float = 1e-3,
     source: str = "",
     tolerance_s: float = 3e-3,
@@ -368,20 +422,7 @@ def clock_map(
                 f"{src}: high times of shapes {hr.shape} and {hm.shape} do not match the edges' {r.shape} and {m.shape}"
             )
     w = MIN_MATCHED_EDGES - 1  # intervals per window
-
-    dr, dm = np.diff(r), np.diff(m)
-    ok = np.abs(dr[:, None] - dm[None, :]) <= 2 * tol + drift * np.maximum(dr[:, None], dm[None, :])
-    nr, nm = dr.size - w + 1, dm.size - w + 1
-    win = ok[:nr, :nm].copy()
-    for k in range(1, w):
-        win &= ok[k : k + nr, k : k + nm]
-    ai, aj = np.nonzero(win)
-    if ai.size == 0:
-        raise LoperInputError(
-            f"{src}: no {MIN_MATCHED_EDGES} consecutive sync edges of the robot log ({r.size} edges) match the "
-            f"interval pattern of the mocap record ({m.size} edges) within {2 * tol * 1e3:.3g} ms + "
-            f"{drift * 1e6:.4g} ppm: different trains, or too little overlap"
-        )
+    ai, aj = _matching_windows(r, m, tol, drift, src)
     shift = ai - aj
     votes = np.bincount(shift - shift.min())
     best = int(np.argmax(votes)) + int(shift.min())
@@ -401,22 +442,7 @@ def clock_map(
         )
     a, b = _fit(r[i], m[j])
 
-    # ambiguity: windows voting for a mapping other than the chosen line
-    consistent = np.abs(m[aj] - (a + b * r[ai])) <= gate
-    n_ok = int(consistent.sum())
-    if (~consistent).any():
-        alt = shift[~consistent]
-        alt_votes = np.bincount(alt - alt.min())
-        k_alt = int(np.argmax(alt_votes))
-        v_alt = int(alt_votes[k_alt])
-        if 2 * v_alt >= n_ok:
-            pick = np.flatnonzero(~consistent & (shift == k_alt + alt.min()))[0]
-            delta = m[aj[pick]] - (a + b * r[ai[pick]])
-            raise LoperInputError(
-                f"{src}: ambiguous sync match: {n_ok} edge window(s) support the chosen clock map, {v_alt} support "
-                f"another whose offset differs by {delta:+.4f} s (a periodic pulse train cannot resolve whole "
-                "periods; use pseudo-random intervals, loper_analysis.synthetic.sync.sync_pulse_starts)"
-            )
+    _check_unambiguous(r, m, (ai, aj), (a, b), gate, src)
 
     if robot_high_s is not None:
         _check_polarity(m, i, j, b, hr, hm, tol, src, robot_name, mocap_name)

@@ -238,6 +238,51 @@ def _filter_coefficients(dev: DeviceParameters):
 
 
 @njit(cache=True)
+def _limited_velocity(vd, vd_prev, th, vmax, dv_max, amax, pbound):
+    """The velocity command (rad/s) after the PVA limiter and whether it limited it.
+
+    ``vd`` is the admittance's command and ``vd_prev`` the previous limited command (rad/s), ``th`` the motor
+    angle (rad); limits: speed ``vmax`` (rad/s), change per sample ``dv_max`` (rad/s), and near the position
+    bound ``pbound`` (rad) the constant deceleration ``amax`` (rad/s^2) towards it, no outward motion beyond it.
+    """
+    limited = False
+    if vd > vmax:
+        vd, limited = vmax, True
+    elif vd < -vmax:
+        vd, limited = -vmax, True
+    dv = vd - vd_prev
+    if dv > dv_max:
+        vd, limited = vd_prev + dv_max, True
+    elif dv < -dv_max:
+        vd, limited = vd_prev - dv_max, True
+    # the position bound has the last word: constant deceleration towards it,
+    # no outward motion beyond it
+    room = pbound - abs(th)
+    vtoward = np.sqrt(2.0 * amax * room) if room > 0 else 0.0
+    if th >= 0 and vd > vtoward:
+        vd, limited = vtoward, True
+    elif th < 0 and vd < -vtoward:
+        vd, limited = -vtoward, True
+    return vd, limited
+
+
+@njit(cache=True)
+def _cutoff_state(th, omega, torque, spos, mpos, mvel, mtorque):
+    """The safety state a cut-off latches (servo off 5, motor off at the position 2, velocity 3 or torque 4),
+    0 when none trips: motor angle ``th`` (rad), velocity ``omega`` (rad/s) and torque (N m) against their
+    cut-offs."""
+    if abs(th) > spos:
+        return 5
+    if abs(th) > mpos:
+        return 2
+    if abs(omega) > mvel:
+        return 3
+    if abs(torque) > mtorque:
+        return 4
+    return 0
+
+
+@njit(cache=True)
 def _run(coef, Aon, Bon, Aoff, Boff, consts, fd, noise, xp, vp, ap, free_leg, x0):
     """The 1 kHz loop; returns the log columns and the safety state per sample."""
     n = fd.shape[0]
@@ -277,26 +322,8 @@ def _run(coef, Aon, Bon, Aoff, Boff, consts, fd, noise, xp, vp, ap, free_leg, x0
         vb2 = (coef[4, 0] * w + coef[4, 1] * w1 - coef[5, 1] * v2a) / coef[5, 0]
         e1, v1a, w1, v2a = e, va, w, vb2
         vd = va + vb2
-        # PVA limiter
-        limited = False
-        if vd > vmax:
-            vd, limited = vmax, True
-        elif vd < -vmax:
-            vd, limited = -vmax, True
-        dv = vd - vd_prev
-        if dv > amax * T:
-            vd, limited = vd_prev + amax * T, True
-        elif dv < -amax * T:
-            vd, limited = vd_prev - amax * T, True
-        # the position bound has the last word: constant deceleration towards it,
-        # no outward motion beyond it
         th = x[0]
-        room = pbound - abs(th)
-        vtoward = np.sqrt(2.0 * amax * room) if room > 0 else 0.0
-        if th >= 0 and vd > vtoward:
-            vd, limited = vtoward, True
-        elif th < 0 and vd < -vtoward:
-            vd, limited = -vtoward, True
+        vd, limited = _limited_velocity(vd, vd_prev, th, vmax, amax * T, amax, pbound)
         vd_prev = vd
         # servo delay
         for i in range(delay):
@@ -306,14 +333,7 @@ def _run(coef, Aon, Bon, Aoff, Boff, consts, fd, noise, xp, vp, ap, free_leg, x0
         # cut-offs (latching)
         torque = Jm * x[2] + r * f_true
         if latched == 0:
-            if abs(th) > spos:
-                latched = 5
-            elif abs(th) > mpos:
-                latched = 2
-            elif abs(x[1]) > mvel:
-                latched = 3
-            elif abs(torque) > mtorque:
-                latched = 4
+            latched = _cutoff_state(th, x[1], torque, spos, mpos, mvel, mtorque)
         fm_out[k] = fm
         th_out[k] = th
         om_out[k] = x[1]

@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.checks import positive
-from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
+from loper_analysis.device.clock_sync import ClockMap, clock_map, high_times, rising_edges
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
@@ -147,6 +147,7 @@ def robot_log_frames_and_native(
     mocap_sync_v,
     analog_rate_hz: float,
     frame_time_s,
+    *,
     cutoff_hz: float = CUTOFF_HZ,
     order: int = ORDER,
     source: str = "",
@@ -173,6 +174,41 @@ def robot_log_frames_and_native(
         raise LoperInputError(f"{src}: robot log lacks column(s) {', '.join(missing)}")
     rate = positive("log_rate_hz", log_rate_hz, src)
     arate = positive("analog_rate_hz", analog_rate_hz, src)
+    t_log = _log_times(log, rate, src)
+    frames = np.asarray(frame_time_s, dtype=float)
+    if frames.ndim != 1 or frames.size == 0 or not np.all(np.isfinite(frames)) or np.any(np.diff(frames) <= 0):
+        raise LoperInputError(f"{src}: frame_time_s must be a non-empty, finite, strictly increasing 1-D array")
+    start = frames[0] if analog_start_s is None else float(analog_start_s)
+
+    cm = _sync_clock_map(
+        log, t_log, rate, (mocap_sync_v, arate, start), src, sync_channel, max_drift=max_drift, tolerance_s=tolerance_s
+    )
+    t_mapped = cm.to_mocap(t_log)
+    inside = (frames >= t_mapped[0]) & (frames <= t_mapped[-1])
+    if not inside.any():
+        raise LoperInputError(
+            f"{src}: no mocap frame ({frames[0]:.6g} .. {frames[-1]:.6g} s) lies within the robot log's span on "
+            f"the mocap clock ({t_mapped[0]:.6g} .. {t_mapped[-1]:.6g} s)"
+        )
+    native = {"time_s": t_mapped, **_filtered_forces(log, rate, cutoff_hz, order, src)}
+    out = {"time_s": frames}
+    for col in _FORCE_COLUMNS:
+        out[col] = np.interp(frames, t_mapped, native[col], left=np.nan, right=np.nan)
+    flag = _perturbation_flag(log, src)
+    require_force_unit(native["force_desired_n"], native["force_measured_n"], flag, src)
+    check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
+    pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
+    nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
+    out["perturbation"] = np.where(inside, flag[nearest], np.nan)
+    native["perturbation"] = flag
+    result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
+    result.attrs["clock_map"] = cm
+    return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
+
+
+def _log_times(log: pd.DataFrame, rate: float, src: str) -> np.ndarray:
+    """The log's ``time_s`` (s, robot clock, shape (n_samples,)), checked: at least 2 finite samples, each step
+    ``1 / rate`` within 1 %."""
     t_log = log["time_s"].to_numpy(dtype=float)
     if t_log.size < 2 or not np.all(np.isfinite(t_log)):
         raise LoperInputError(f"{src}: column 'time_s' must hold >= 2 finite samples")
@@ -184,18 +220,31 @@ def robot_log_frames_and_native(
             f"{src}: column 'time_s', sample {k} (t = {t_log[k]:.9g} s): step {step[k - 1]:.6g} s is not "
             f"1 / log_rate_hz = {1 / rate:.6g} s within 1 %"
         )
-    frames = np.asarray(frame_time_s, dtype=float)
-    if frames.ndim != 1 or frames.size == 0 or not np.all(np.isfinite(frames)) or np.any(np.diff(frames) <= 0):
-        raise LoperInputError(f"{src}: frame_time_s must be a non-empty, finite, strictly increasing 1-D array")
-    start = frames[0] if analog_start_s is None else float(analog_start_s)
+    return t_log
 
+
+def _sync_clock_map(
+    log: pd.DataFrame,
+    t_log: np.ndarray,
+    rate: float,
+    mocap_sync: tuple,
+    src: str,
+    sync_channel: str,
+    *,
+    max_drift: float,
+    tolerance_s: float,
+) -> ClockMap:
+    """The robot -> mocap clock map (:func:`loper_analysis.device.clock_sync.clock_map`) from the rising edges
+    and high times of the log's ``sync_v`` (at ``t_log``, s; ``rate`` Hz) and of the mocap sync channel
+    (``mocap_sync``: the channel in V, its rate in Hz and the mocap time of its sample 0 in s)."""
+    mocap_sync_v, arate, start = mocap_sync
     robot_name = "robot log column 'sync_v'"
     mocap_name = f"mocap sync channel '{sync_channel}'" if sync_channel else "mocap sync channel"
     robot_sync = log["sync_v"].to_numpy(dtype=float, na_value=np.nan)
     robot_rel = rising_edges(robot_sync, rate, source=f"{src}: {robot_name}")
     mocap_rel = rising_edges(mocap_sync_v, arate, source=f"{src}: {mocap_name}")
     robot_edges = np.interp(robot_rel * rate, np.arange(t_log.size), t_log)
-    cm = clock_map(
+    return clock_map(
         robot_edges,
         start + mocap_rel,
         max_drift=max_drift,
@@ -207,36 +256,28 @@ def robot_log_frames_and_native(
         mocap_name=mocap_name,
     )
 
-    t_mapped = cm.to_mocap(t_log)
-    inside = (frames >= t_mapped[0]) & (frames <= t_mapped[-1])
-    if not inside.any():
-        raise LoperInputError(
-            f"{src}: no mocap frame ({frames[0]:.6g} .. {frames[-1]:.6g} s) lies within the robot log's span on "
-            f"the mocap clock ({t_mapped[0]:.6g} .. {t_mapped[-1]:.6g} s)"
-        )
-    out = {"time_s": frames}
-    native = {"time_s": t_mapped}
+
+def _filtered_forces(log: pd.DataFrame, rate: float, cutoff_hz: float, order: int, src: str) -> dict[str, np.ndarray]:
+    """The log's measured and desired forces (N, shape (n_samples,)) low-passed at the robot rate ``rate``
+    (Hz; :func:`loper_analysis.motion.filtering.lowpass`), by column."""
+    forces = {}
     for col in _FORCE_COLUMNS:
         f = log[col].to_numpy(dtype=float, na_value=np.nan)
         try:
             f = lowpass(f, rate, cutoff_hz, order)
         except LoperInputError as exc:
             raise LoperInputError(f"{src}: column '{col}': {exc}") from None
-        native[col] = f
-        out[col] = np.interp(frames, t_mapped, f, left=np.nan, right=np.nan)
+        forces[col] = f
+    return forces
+
+
+def _perturbation_flag(log: pd.DataFrame, src: str) -> np.ndarray:
+    """The log's ``perturbation`` column as float (shape (n_samples,)), checked to hold 0 and 1 only."""
     flag = log["perturbation"].to_numpy(dtype=float, na_value=np.nan)
     if not np.all(np.isin(flag, (0.0, 1.0))):
         k = int(np.flatnonzero(~np.isin(flag, (0.0, 1.0)))[0])
         raise LoperInputError(f"{src}: column 'perturbation', sample {k}: value {flag[k]!r} is not 0 or 1")
-    require_force_unit(native["force_desired_n"], native["force_measured_n"], flag, src)
-    check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
-    pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
-    nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
-    out["perturbation"] = np.where(inside, flag[nearest], np.nan)
-    native["perturbation"] = flag
-    result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
-    result.attrs["clock_map"] = cm
-    return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
+    return flag
 
 
 def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:

@@ -27,6 +27,7 @@ import pandas as pd
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import model_source, quiet_opensim
 from loper_analysis.motion.ik_determinacy import (
+    ModelTree,
     model_tree,
     require_markers_beyond_root,
     undetermined_coordinates,
@@ -284,49 +285,16 @@ def inverse_kinematics(
         the state (naming the .osim file and the coordinate).
     """
     osim = quiet_opensim()
-    where = f"{source}: " if source else ""
     labels = list(labels)
     t = np.asarray(time_s, float)
     if t.ndim != 1 or t.size < 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise LoperInputError("time_s must be finite and strictly increasing")
-    ms = model.getMarkerSet()
-    model_markers = [ms.get(i).getName() for i in range(ms.getSize())]
-    require_model_markers(model, source)
-    if marker_weights is None:
-        marker_weights = {mk: 1.0 for mk in labels if mk in model_markers}
-        if not marker_weights:
-            raise LoperInputError(f"{where}none of the data's markers {labels[:8]}... is in {model_source(model)}")
-    not_in_model = [mk for mk in marker_weights if mk not in model_markers]
-    if not_in_model:
-        raise LoperInputError(f"{where}marker(s) {not_in_model} of the IK tasks are not in {model_source(model)}")
-    not_in_data = [mk for mk, w in marker_weights.items() if w > 0 and mk not in labels]
-    if not_in_data:
-        raise LoperInputError(f"marker(s) {not_in_data} of the IK tasks are not in the marker data")
-    keep = [i for i, lab in enumerate(labels) if lab in marker_weights and marker_weights[lab] > 0]
-    X = np.asarray(markers_m, float)[:, keep, :]
-    kept_labels = [labels[i] for i in keep]
+    X, kept_labels, marker_weights = _weighted_markers(model, labels, markers_m, marker_weights, source)
     if undetermined not in ("nan", "error"):
         raise LoperInputError(f"undetermined must be 'nan' or 'error', got {undetermined!r}")
     if sparse_frames not in ("leave_out", "error"):
         raise LoperInputError(f"sparse_frames must be 'leave_out' or 'error', got {sparse_frames!r}")
-    if sparse_frames == "error":
-        require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
-    tree = model_tree(model)
-    solved = frames_with_markers(
-        X,
-        kept_labels,
-        min_markers,
-        root_markers=[lab for lab in kept_labels if tree.marker_bodies.get(lab) in tree.root_bodies],
-    )
-    if not solved.any():
-        require_markers_per_frame(X, kept_labels, min_markers, None, t, source)  # names the frames and markers
-    require_markers_beyond_root(tree, X, kept_labels, source)
-    if not solved.any():
-        raise LoperInputError(
-            f"{where}no frame holds {min_markers} weighted markers with one beyond the pelvis: "
-            "nothing to solve (are the pelvis markers mapped in markers.label_map and weighted in "
-            "the IK tasks?)"
-        )
+    tree, solved = _frames_to_solve(model, X, kept_labels, t, min_markers, source, sparse_frames)
     free = undetermined_coordinates(tree, X, kept_labels, coordinate_tasks)  # (n_frames, n_coordinates)
     free[~solved] = False  # frames left out are NaN throughout, not counted as undetermined
     lacking = {c: int(n) for c, n in zip(tree.coordinates, free.sum(axis=0)) if n}
@@ -342,16 +310,7 @@ def inverse_kinematics(
     mref = osim.MarkersReference(table, weights)
     cs = model.getCoordinateSet()
     names = [cs.get(i).getName() for i in range(cs.getSize())]
-    cref = osim.SimTKArrayCoordinateReference()
-    for cname, (w, value) in (coordinate_tasks or {}).items():
-        if cname not in names:
-            raise LoperInputError(
-                f"{where}coordinate task on '{cname}': not a coordinate of {model_source(model)}; has {names}"
-            )
-        v = cs.get(cname).getDefaultValue() if value is None else float(value)
-        ref = osim.CoordinateReference(cname, osim.Constant(v))
-        ref.setWeight(float(w))
-        cref.push_back(ref)
+    cref = _coordinate_references(osim, model, names, coordinate_tasks, source)
     state = model.initSystem()
     perm = _q_order(model, state, cs)
     solver = osim.InverseKinematicsSolver(model, mref, cref, float("inf"))
@@ -359,18 +318,8 @@ def inverse_kinematics(
     frames = np.flatnonzero(solved)
     state.setTime(float(t[frames[0]]))
     solver.assemble(state)
-    Q = np.full((t.size, state.getNQ()), np.nan)
-    n_m = solver.getNumMarkersInUse()
-    E = np.full((t.size, n_m), np.nan)  # marker distance errors (m)
-    errs = osim.SimTKArrayDouble()
-    get_elt, track, set_time, get_q = errs.getElt, solver.track, state.setTime, state.getQ
-    compute_errors, markers_in_use = solver.computeCurrentMarkerErrors, range(n_m)
-    for k in frames:  # the hot loop: one SWIG call per quantity
-        set_time(float(t[k]))
-        track(state)
-        Q[k] = get_q().to_numpy()
-        compute_errors(errs)
-        E[k] = [get_elt(j) for j in markers_in_use]
+    Q, E = _tracked(osim, solver, state, t, frames)
+    markers_in_use = range(E.shape[1])
     # OpenSim reports 0 (not NaN) for a marker missing in a frame: leave those out of RMS and max
     in_use_names = [solver.getMarkerNameForIndex(j) for j in markers_in_use]
     in_use = [kept_labels.index(name) for name in in_use_names]
@@ -391,6 +340,102 @@ def inverse_kinematics(
         marker_errors_m=E,
         marker_names=in_use_names,
     )
+
+
+def _weighted_markers(
+    model, labels: list[str], markers_m, marker_weights: dict[str, float] | None, source: str
+) -> tuple[np.ndarray, list[str], dict[str, float]]:
+    """The trajectories (n_frames, n_weighted, 3) in m of the markers with a positive weight, their labels and
+    the marker weights (None: every model marker in the data weighted 1).
+
+    Raises LoperInputError for a model without markers, a weighted marker missing from the model or the data,
+    or no model marker in the data."""
+    where = f"{source}: " if source else ""
+    ms = model.getMarkerSet()
+    model_markers = [ms.get(i).getName() for i in range(ms.getSize())]
+    require_model_markers(model, source)
+    if marker_weights is None:
+        marker_weights = {mk: 1.0 for mk in labels if mk in model_markers}
+        if not marker_weights:
+            raise LoperInputError(f"{where}none of the data's markers {labels[:8]}... is in {model_source(model)}")
+    not_in_model = [mk for mk in marker_weights if mk not in model_markers]
+    if not_in_model:
+        raise LoperInputError(f"{where}marker(s) {not_in_model} of the IK tasks are not in {model_source(model)}")
+    not_in_data = [mk for mk, w in marker_weights.items() if w > 0 and mk not in labels]
+    if not_in_data:
+        raise LoperInputError(f"marker(s) {not_in_data} of the IK tasks are not in the marker data")
+    keep = [i for i, lab in enumerate(labels) if lab in marker_weights and marker_weights[lab] > 0]
+    X = np.asarray(markers_m, float)[:, keep, :]
+    kept_labels = [labels[i] for i in keep]
+    return X, kept_labels, marker_weights
+
+
+def _frames_to_solve(
+    model, X: np.ndarray, kept_labels: list[str], t: np.ndarray, min_markers: int, source: str, sparse_frames: str
+) -> tuple[ModelTree, np.ndarray]:
+    """The model's tree (:func:`loper_analysis.motion.ik_determinacy.model_tree`) and which frames (n_frames,
+    bool) hold enough weighted markers (``X``: n_frames, n_weighted, 3 in m) to solve.
+
+    Raises LoperInputError for a sparse frame with ``sparse_frames="error"``, no frame to solve, or weighted
+    markers on the body jointed to the ground only."""
+    where = f"{source}: " if source else ""
+    if sparse_frames == "error":
+        require_markers_per_frame(X, kept_labels, min_markers, None, t, source)
+    tree = model_tree(model)
+    solved = frames_with_markers(
+        X,
+        kept_labels,
+        min_markers,
+        root_markers=[lab for lab in kept_labels if tree.marker_bodies.get(lab) in tree.root_bodies],
+    )
+    if not solved.any():
+        require_markers_per_frame(X, kept_labels, min_markers, None, t, source)  # names the frames and markers
+    require_markers_beyond_root(tree, X, kept_labels, source)
+    if not solved.any():
+        raise LoperInputError(
+            f"{where}no frame holds {min_markers} weighted markers with one beyond the pelvis: "
+            "nothing to solve (are the pelvis markers mapped in markers.label_map and weighted in "
+            "the IK tasks?)"
+        )
+    return tree, solved
+
+
+def _coordinate_references(osim, model, names: list[str], coordinate_tasks, source: str):
+    """OpenSim's coordinate references of the coordinate tasks ({coordinate: (weight, value in rad or m, or
+    None for the default)}); ``names`` are the model's coordinates, ``osim`` the opensim module. An unknown
+    coordinate raises LoperInputError."""
+    where = f"{source}: " if source else ""
+    cs = model.getCoordinateSet()
+    cref = osim.SimTKArrayCoordinateReference()
+    for cname, (w, value) in (coordinate_tasks or {}).items():
+        if cname not in names:
+            raise LoperInputError(
+                f"{where}coordinate task on '{cname}': not a coordinate of {model_source(model)}; has {names}"
+            )
+        v = cs.get(cname).getDefaultValue() if value is None else float(value)
+        ref = osim.CoordinateReference(cname, osim.Constant(v))
+        ref.setWeight(float(w))
+        cref.push_back(ref)
+    return cref
+
+
+def _tracked(osim, solver, state, t: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The generalised coordinates Q (n_frames, n_q) in state order and each marker in use's distance error
+    (n_frames, n_markers_in_use) in m, tracked by the assembled ``solver`` at the frames ``frames`` of ``t`` (s);
+    NaN in the other frames (``osim``: the opensim module)."""
+    Q = np.full((t.size, state.getNQ()), np.nan)
+    n_m = solver.getNumMarkersInUse()
+    E = np.full((t.size, n_m), np.nan)  # marker distance errors (m)
+    errs = osim.SimTKArrayDouble()
+    get_elt, track, set_time, get_q = errs.getElt, solver.track, state.setTime, state.getQ
+    compute_errors, markers_in_use = solver.computeCurrentMarkerErrors, range(n_m)
+    for k in frames:  # the hot loop: one SWIG call per quantity
+        set_time(float(t[k]))
+        track(state)
+        Q[k] = get_q().to_numpy()
+        compute_errors(errs)
+        E[k] = [get_elt(j) for j in markers_in_use]
+    return Q, E
 
 
 def ik_task_weights(

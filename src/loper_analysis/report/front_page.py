@@ -451,6 +451,7 @@ def front_page_html(
     versions: Mapping[str, str],
     device: pd.DataFrame,
     validation: pd.DataFrame | None,
+    *,
     summary: pd.DataFrame | None = None,
     truth: pd.DataFrame | None = None,
     impedance_status: Mapping[str, int] | None = None,
@@ -508,17 +509,8 @@ def front_page_html(
         f"<p><b>Run</b>: {_subject_line(subjects, trials)}{design}; seed {settings.seed}; settings and "
         "versions at the end.</p>"
     )
-    verdicts = []
     has_truth = truth is not None and len(truth) > 0
-    if has_truth:
-        verdicts.append(_truth_verdicts(truth))
-    if transparency is not None and len(transparency):
-        verdicts.append(_transparency_verdict_line(transparency))
-    if len(device):
-        verdicts.append(_device_verdict_line(device))
-    if validation is not None and len(validation):
-        verdicts.append(_validation_verdict_line(validation))
-    parts.append(f'<ul class="lf-verdicts">{"".join(verdicts)}</ul>')
+    parts.append(_verdict_list(truth if has_truth else None, transparency, device, validation))
     if summary is None:
         parts.append("<p>No perturbation trials in this run: no impedance was identified.</p>")
 
@@ -547,10 +539,42 @@ def front_page_html(
         parts.append(_transparency_table(transparency))
     if len(device):
         parts.append(_device_table(device))
+    parts.append(_run_table(subjects, trials, settings, versions, summary is None))
+    parts.append("</div>")
+    return "\n".join(parts) + "\n"
+
+
+def _verdict_list(
+    truth: pd.DataFrame | None,
+    transparency: pd.DataFrame | None,
+    device: pd.DataFrame,
+    validation: pd.DataFrame | None,
+) -> str:
+    """The verdicts (``<ul class="lf-verdicts">``): truth recovery, transparency, device and validation, each
+    when there is something to judge."""
+    verdicts = []
+    if truth is not None:
+        verdicts.append(_truth_verdicts(truth))
+    if transparency is not None and len(transparency):
+        verdicts.append(_transparency_verdict_line(transparency))
+    if len(device):
+        verdicts.append(_device_verdict_line(device))
+    if validation is not None and len(validation):
+        verdicts.append(_validation_verdict_line(validation))
+    return f'<ul class="lf-verdicts">{"".join(verdicts)}</ul>'
+
+
+def _run_table(
+    subjects: Mapping[str, str],
+    trials: Mapping[str, Sequence[str]],
+    settings: RunSettings,
+    versions: Mapping[str, str],
+    no_perturbations: bool,
+) -> str:
+    """The table of what was run: subjects, settings and software versions (a study without perturbation
+    trials: without the fit's settings)."""
     shown = settings.rows()
-    if (
-        summary is None
-    ):  # a study without perturbation trials: no fit settings, and a synthetic lab only with its subjects
+    if no_perturbations:  # no fit settings, and a synthetic lab only with its subjects
         skip = {"perturbations", "fit window", "bounds", "noise model"}
         if "synthetic" not in subjects.values():
             skip.add("synthetic lab")
@@ -559,11 +583,9 @@ def front_page_html(
         f'<tr><td class="lf-l">{html.escape(k)}</td><td class="lf-l">{html.escape(v)}</td></tr>' for k, v in shown
     )
     software = " · ".join(f"{html.escape(k)} {html.escape(v)}" for k, v in versions.items())
-    parts.append(
+    return (
         '<table id="lf-run"><caption>What was run</caption><tbody>'
         f'<tr><td class="lf-l">subjects</td><td class="lf-l">{_subject_line(subjects, trials)}</td></tr>'
         f'{rows}<tr><td class="lf-l">software</td><td class="lf-l" style="white-space:normal">'
         f"{software}</td></tr></tbody></table>"
     )
-    parts.append("</div>")
-    return "\n".join(parts) + "\n"

@@ -15,6 +15,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
@@ -27,7 +28,10 @@ from loper_analysis.io.timing import library_import, timed_io
 from loper_analysis.motion.lab_frame import axis_name
 from loper_analysis.motion.label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
 from loper_analysis.motion.marker_names import strip_subject_prefix
-from loper_analysis.subject_setup import SubjectSetup
+from loper_analysis.subject_setup import NoTemplateFits, SubjectSetup, format_fits
+
+if TYPE_CHECKING:
+    from loper_analysis.io.c3d import C3DRecording
 
 __all__ = ["Inspection", "SubjectInspection", "inspect_c3d", "inspect_subject", "model_marker_names_of"]
 
@@ -350,31 +354,14 @@ def inspect_subject(
         starter map (``label_map_starter.tsv``: every label, the template's marker where one was found) is
         written beside it and nothing else.
     """
-    from loper_analysis.io.marker_templates import read_templates, template_file
-    from loper_analysis.io.osim import read_model, write_osim_object
-    from loper_analysis.io.readers import read_bytes
-    from loper_analysis.motion.marker_templates import (
-        template_coordinate_map,
-        template_marker_set,
-        template_scale_tool,
-    )
-    from loper_analysis.subject_setup import NoTemplateFits, format_fits, subject_setup
+    from loper_analysis.io.marker_templates import read_templates
+    from loper_analysis.subject_setup import subject_setup
 
     paths = [Path(p) for p in c3d_paths]
     if config_out is not None and any(Path(config_out).resolve() == p.resolve() for p in paths):
         raise LoperInputError(f"{config_out}: the config would overwrite an input file")
     kinds = [_trial_kind(p, static_name) for p in paths]
-    recs, summaries, text = [], [], ""
-    for path in paths:
-        rec, summary = _recording(path)
-        recs.append(rec)
-        summaries.append(summary)
-        text += format_summary(summary) + "\n"
-        if rec.output_labels:
-            text += (
-                f"  {len(rec.output_labels)} point(s) that are not markers left out (the lab's model outputs, segment "
-                f"and unlabelled points); {len(rec.marker_labels)} markers\n"
-            )
+    recs, summaries, text = _recordings_text(paths)
     static = next((r for r, k in zip(recs, kinds) if k == "static"), None)
     walking = [r.marker_labels for r, k in zip(recs, kinds) if k == "walking"]
     source = ", ".join(str(p) for p in paths)
@@ -386,21 +373,64 @@ def inspect_subject(
             text + f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(exc.fits)}\n"
         )
         if config_out is not None:
-            best = exc.fits[0].match
-            marker_of = {strip_subject_prefix(lab): m for lab, m, _ in best.pairs}
-            labels = list(dict.fromkeys(strip_subject_prefix(lab) for r in recs for lab in r.marker_labels))
-            starter = Path(config_out).parent / "label_map_starter.tsv"
-            write_tsv(pd.DataFrame({"label": labels, "marker": [marker_of.get(lab, "") for lab in labels]}), starter)
-            error = NoTemplateFits(
-                f"{exc}; a starter label map to complete: {starter} (then give the lab's model, marker set and "
-                "setups in the config by hand: docs/first_recorded_subject.md)",
-                exc.fits,
-            )
-            error.text = exc.text
-            raise error from None
+            raise _starter_map_error(exc, recs, config_out) from None
         raise
-    t = setup.template
+    text += _template_text(setup)
+    if static is None:
+        text += "  no static trial among the files: its markers were taken from the first walking trial\n"
+    mass_height = _mass_height_line(static)
+    text += f"  {mass_height}\n"
+    if config_out is None:
+        return SubjectInspection(summaries, setup, text)
+
+    written = _written_subject_files(paths, kinds, setup, summaries[0], config_out, mass_height)
+    text += "\n" + "\n".join(f"wrote {w}" for w in written) + "\n"
+    device = any(k == "walking" and p.stem != "walk-nodevice" and "device" in p.stem for p, k in zip(paths, kinds))
     text += (
+        "next: add `subjects:` (a sheet with the row `SUBJECT recorded`) to the config"
+        + ("" if device else ", and `device.subject: null` (no device trials)")
+        + f", then: snakemake -j2 --configfile {config_out}\n"
+    )
+    return SubjectInspection(summaries, setup, text, written)
+
+
+def _recordings_text(paths: Sequence[Path]) -> tuple[list[C3DRecording], list[RecordingSummary], str]:
+    """The C3D files read (:func:`_recording`), their summaries and the summaries' text, in the order given."""
+    recs, summaries, text = [], [], ""
+    for path in paths:
+        rec, summary = _recording(path)
+        recs.append(rec)
+        summaries.append(summary)
+        text += format_summary(summary) + "\n"
+        if rec.output_labels:
+            text += (
+                f"  {len(rec.output_labels)} point(s) that are not markers left out (the lab's model outputs, segment "
+                f"and unlabelled points); {len(rec.marker_labels)} markers\n"
+            )
+    return recs, summaries, text
+
+
+def _starter_map_error(exc: NoTemplateFits, recs: Sequence[C3DRecording], config_out: PathLike) -> NoTemplateFits:
+    """Write the starter label map (``label_map_starter.tsv`` beside ``config_out``: every label of ``recs``,
+    the best template's marker where one was found) and return the error naming it (``exc``'s fits and text)."""
+    best = exc.fits[0].match
+    marker_of = {strip_subject_prefix(lab): m for lab, m, _ in best.pairs}
+    labels = list(dict.fromkeys(strip_subject_prefix(lab) for r in recs for lab in r.marker_labels))
+    starter = Path(config_out).parent / "label_map_starter.tsv"
+    write_tsv(pd.DataFrame({"label": labels, "marker": [marker_of.get(lab, "") for lab in labels]}), starter)
+    error = NoTemplateFits(
+        f"{exc}; a starter label map to complete: {starter} (then give the lab's model, marker set and "
+        "setups in the config by hand: docs/first_recorded_subject.md)",
+        exc.fits,
+    )
+    error.text = exc.text
+    return error
+
+
+def _template_text(setup: SubjectSetup) -> str:
+    """The templates' fits, the one chosen and its markers and label map, as text."""
+    t = setup.template
+    return (
         f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(setup.fits)}\n"
         f"chosen: {t.name} ({t.title}) on {t.model}\n"
         f"  static trial markers: {len(setup.static_markers)}; walking trials: {len(setup.walking_markers)}"
@@ -413,13 +443,31 @@ def inspect_subject(
         + (f"\n  label map: {len(setup.label_map)} row(s)" if len(setup.label_map) else "\n  label map: none needed")
         + "\n"
     )
-    if static is None:
-        text += "  no static trial among the files: its markers were taken from the first walking trial\n"
-    mass_height = _mass_height_line(static)
-    text += f"  {mass_height}\n"
-    if config_out is None:
-        return SubjectInspection(summaries, setup, text)
 
+
+def _written_subject_files(
+    paths: Sequence[Path],
+    kinds: Sequence[str],
+    setup: SubjectSetup,
+    summary: RecordingSummary,
+    config_out: PathLike,
+    mass_height: str,
+) -> tuple[Path, ...]:
+    """Write the template's model (a copy), marker set, ScaleTool setup, IK tasks, label map (when needed) and
+    then the subject's config (``config_out``) beside it; returns the files written, the config last.
+
+    Everything is built before anything is written; a file that would overwrite an input raises
+    LoperInputError."""
+    from loper_analysis.io.marker_templates import template_file
+    from loper_analysis.io.osim import read_model, write_osim_object
+    from loper_analysis.io.readers import read_bytes
+    from loper_analysis.motion.marker_templates import (
+        template_coordinate_map,
+        template_marker_set,
+        template_scale_tool,
+    )
+
+    t = setup.template
     folder = Path(config_out).parent
     model_path = template_file(t.model)
     model = read_model(model_path)
@@ -439,7 +487,7 @@ def inspect_subject(
     clash = [f for f in files.values() if Path(f).resolve() in inputs]
     if clash:
         raise LoperInputError(f"{clash[0]}: would overwrite an input file; write the config to another folder")
-    config_text = _subject_config_text(paths, kinds, setup, summaries[0], files, coordinate_map, mass_height)
+    config_text = _subject_config_text(paths, kinds, setup, summary, files, coordinate_map, mass_height)
     model_bytes = read_bytes(model_path, "OpenSim model")
     write_bytes(files["model"], model_bytes, "OpenSim model")
     write_osim_object(marker_set, files["marker_set"], "marker set")
@@ -448,14 +496,6 @@ def inspect_subject(
     if "label_map" in files:
         write_tsv(setup.label_map, files["label_map"])
     write_text(config_out, config_text, "subject config")
-    written = tuple(
+    return tuple(
         Path(files[k]) for k in ("model", "marker_set", "scale_setup", "ik_tasks", "label_map", "config") if k in files
     )
-    text += "\n" + "\n".join(f"wrote {w}" for w in written) + "\n"
-    device = any(k == "walking" and p.stem != "walk-nodevice" and "device" in p.stem for p, k in zip(paths, kinds))
-    text += (
-        "next: add `subjects:` (a sheet with the row `SUBJECT recorded`) to the config"
-        + ("" if device else ", and `device.subject: null` (no device trials)")
-        + f", then: snakemake -j2 --configfile {config_out}\n"
-    )
-    return SubjectInspection(summaries, setup, text, written)

@@ -242,13 +242,7 @@ def simulate_walking_trial(
     without them).
     """
     from loper_analysis.device.controller import simulate_device
-    from loper_analysis.synthetic.response import (
-        perturbation_schedule,
-        pulse_train,
-        swing_response,
-        swing_responses,
-        swing_spans,
-    )
+    from loper_analysis.synthetic.response import perturbation_schedule, pulse_train
     from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
     from loper_analysis.synthetic.walking import leg_length_from_height
 
@@ -296,65 +290,115 @@ def simulate_walking_trial(
         else 0 * t_robot
     )
     sim = simulate_device(fd, device, None, brace_position_m=brace, seed=device_seed)
-    robot = pd.DataFrame(
+    robot = _robot_frame(t_robot, sim, fd, pulse_train_at(t_robot, starts))
+    if minimal_impedance is not None:
+        impedance = perturbation.impedance if perturbation is not None else tuple(minimal_impedance)
+        fine = _fine_answering_every_swing(fine, events, t_robot, robot, lab, params, impedance)
+    elif perturbation is not None and len(schedule):
+        free = simulate_device(0 * t_robot, device, None, brace_position_m=brace, seed=device_seed)
+        fine = _fine_answering_pulses(fine, schedule, t_robot, (robot, free), lab, params, perturbation.impedance)
+    return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
+
+
+def _robot_frame(t_robot: np.ndarray, sim: pd.DataFrame, fd: np.ndarray, sync_v: np.ndarray) -> pd.DataFrame:
+    """The robot-log frame: time (s) on the robot clock, desired and measured force (N), motor angle (rad) and
+    velocity (rad/s), sync output (V), perturbation flag and safety state (n_samples rows).
+
+    ``sim`` is the device simulation (:func:`loper_analysis.device.controller.simulate_device`) of the desired
+    force ``fd`` (N) at ``t_robot``."""
+    return pd.DataFrame(
         {
             "time_s": t_robot,
             "force_desired_n": sim["force_desired_n"].to_numpy(),
             "force_measured_n": sim["force_measured_n"].to_numpy(),
             "motor_angle_rad": sim["motor_angle_rad"].to_numpy(),
             "motor_velocity_rad_s": sim["motor_velocity_rad_s"].to_numpy(),
-            "sync_v": pulse_train_at(t_robot, starts),
+            "sync_v": sync_v,
             "perturbation": (np.abs(fd) > 0).astype(np.int64),
             "safety_state": sim["safety_state"].to_numpy().astype(np.int64),
         }
     )
-    if minimal_impedance is not None:
-        fm = np.interp((t_fine + lab.clock_offset_s) / scale, t_robot, robot["force_measured_n"].to_numpy())
-        impedance = perturbation.impedance if perturbation is not None else tuple(minimal_impedance)
-        angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
-        t_span = -lab.clock_offset_s + scale * t_robot[[0, -1]]
-        inside = (t_fine >= t_span[0]) & (t_fine <= t_span[1])
-        delta = swing_responses(
-            t_fine[inside],
-            angles[inside],
-            -fine["pelvis_tilt"].to_numpy()[inside],
-            fine["pelvis_tx"].to_numpy()[inside],
+
+
+def _fine_answering_every_swing(
+    fine: pd.DataFrame,
+    events: pd.DataFrame,
+    t_robot: np.ndarray,
+    robot: pd.DataFrame,
+    lab: LabSettings,
+    params,
+    impedance: Sequence[float],
+) -> pd.DataFrame:
+    """The fine coordinates (rad) with every left swing within the robot log answering the measured force (N)
+    with ``impedance`` (:func:`loper_analysis.synthetic.response.swing_responses`); ``t_robot`` (s) on the robot
+    clock."""
+    from loper_analysis.synthetic.response import swing_responses, swing_spans
+
+    scale = 1.0 + 1e-6 * lab.clock_drift_ppm
+    t_fine = fine["time_s"].to_numpy()
+    fm = np.interp((t_fine + lab.clock_offset_s) / scale, t_robot, robot["force_measured_n"].to_numpy())
+    angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
+    t_span = -lab.clock_offset_s + scale * t_robot[[0, -1]]
+    inside = (t_fine >= t_span[0]) & (t_fine <= t_span[1])
+    delta = swing_responses(
+        t_fine[inside],
+        angles[inside],
+        -fine["pelvis_tilt"].to_numpy()[inside],
+        fine["pelvis_tx"].to_numpy()[inside],
+        params,
+        impedance,
+        fm[inside],
+        swing_spans(events, "left"),
+    )
+    fine = fine.copy()
+    for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
+        fine.loc[inside, c] = angles[inside, i] + delta[:, i]
+    return fine
+
+
+def _fine_answering_pulses(
+    fine: pd.DataFrame,
+    schedule: pd.DataFrame,
+    t_robot: np.ndarray,
+    runs: tuple[pd.DataFrame, pd.DataFrame],
+    lab: LabSettings,
+    params,
+    impedance: Sequence[float],
+) -> pd.DataFrame:
+    """The fine coordinates (rad) with the left leg answering each scheduled pulse with ``impedance``: the
+    difference of the measured force (N) of the device runs with and without the pulses (``runs``, on the robot
+    clock ``t_robot`` in s) around each pulse (:func:`loper_analysis.synthetic.response.swing_response`)."""
+    from loper_analysis.synthetic.response import swing_response
+
+    robot, free = runs
+    scale = 1.0 + 1e-6 * lab.clock_drift_ppm
+    t_fine = fine["time_s"].to_numpy()
+    to_robot_fine = (t_fine + lab.clock_offset_s) / scale
+    fp = np.interp(to_robot_fine, t_robot, robot["force_measured_n"].to_numpy())
+    fu = np.interp(to_robot_fine, t_robot, free["force_measured_n"].to_numpy())
+    angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
+    pelvis_angle = -fine["pelvis_tilt"].to_numpy()
+    delta = np.zeros_like(angles)
+    for row in schedule.itertuples():
+        sl = slice(
+            int(np.searchsorted(t_fine, row.onset_s - 0.3)), int(np.searchsorted(t_fine, row.heel_strike_s + 0.35))
+        )
+        delta[sl] += swing_response(
+            t_fine[sl],
+            angles[sl],
+            pelvis_angle[sl],
+            fine["pelvis_tx"].to_numpy()[sl],
             params,
             impedance,
-            fm[inside],
-            swing_spans(events, "left"),
+            fp[sl],
+            fu[sl],
+            row.onset_s,
+            row.heel_strike_s,
         )
-        fine = fine.copy()
-        for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
-            fine.loc[inside, c] = angles[inside, i] + delta[:, i]
-    elif perturbation is not None and len(schedule):
-        free = simulate_device(0 * t_robot, device, None, brace_position_m=brace, seed=device_seed)
-        to_robot_fine = (t_fine + lab.clock_offset_s) / scale
-        fp = np.interp(to_robot_fine, t_robot, robot["force_measured_n"].to_numpy())
-        fu = np.interp(to_robot_fine, t_robot, free["force_measured_n"].to_numpy())
-        angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
-        pelvis_angle = -fine["pelvis_tilt"].to_numpy()
-        delta = np.zeros_like(angles)
-        for row in schedule.itertuples():
-            sl = slice(
-                int(np.searchsorted(t_fine, row.onset_s - 0.3)), int(np.searchsorted(t_fine, row.heel_strike_s + 0.35))
-            )
-            delta[sl] += swing_response(
-                t_fine[sl],
-                angles[sl],
-                pelvis_angle[sl],
-                fine["pelvis_tx"].to_numpy()[sl],
-                params,
-                perturbation.impedance,
-                fp[sl],
-                fu[sl],
-                row.onset_s,
-                row.heel_strike_s,
-            )
-        fine = fine.copy()
-        for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
-            fine[c] = angles[:, i] + delta[:, i]
-    return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
+    fine = fine.copy()
+    for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
+        fine[c] = angles[:, i] + delta[:, i]
+    return fine
 
 
 def walking_recording(

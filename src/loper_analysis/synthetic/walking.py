@@ -162,6 +162,76 @@ def _solve_phase(
     return 0.5 * (lo + hi)
 
 
+def _checked_arguments(
+    duration_s: float,
+    sample_rate_hz: float,
+    gait: NominalGait,
+    rng,
+    timing_cv: float,
+    amplitude_cv: float,
+    leg_length_m: float | None,
+    start_phase: float | None,
+    variability: GaitVariability | None,
+    adaptation: DeviceAdaptation | None,
+) -> tuple[np.random.Generator, int, float]:
+    """The random generator, the number of samples and the standing hip height (m) of
+    :func:`walking_kinematics`'s arguments, each checked (LoperInputError naming a bad one)."""
+    if not isinstance(gait, NominalGait):
+        raise LoperInputError(f"gait must be a NominalGait, got {type(gait).__name__}")
+    rng = generator(rng)
+    if not (np.isfinite(duration_s) and duration_s > 0):
+        raise LoperInputError(f"duration_s must be > 0, got {duration_s}")
+    if not (np.isfinite(sample_rate_hz) and sample_rate_hz > 0):
+        raise LoperInputError(f"sample_rate_hz must be > 0, got {sample_rate_hz}")
+    n = int(round(duration_s * sample_rate_hz))
+    if n < 2:
+        raise LoperInputError(f"duration_s * sample_rate_hz must give >= 2 samples, got {n}")
+    if not 0 <= timing_cv <= 0.2:
+        raise LoperInputError(f"timing_cv must lie in 0 .. 0.2, got {timing_cv}")
+    if not 0 <= amplitude_cv <= 0.3:
+        raise LoperInputError(f"amplitude_cv must lie in 0 .. 0.3, got {amplitude_cv}")
+    leg = _check_leg_length(leg_length_m)
+    if start_phase is not None and not 0 <= start_phase < 1:
+        raise LoperInputError(f"start_phase must lie in [0, 1), got {start_phase}")
+    if variability is not None and not isinstance(variability, GaitVariability):
+        raise LoperInputError(f"variability must be a GaitVariability or None, got {type(variability).__name__}")
+    if adaptation is not None and not isinstance(adaptation, DeviceAdaptation):
+        raise LoperInputError(f"adaptation must be a DeviceAdaptation or None, got {type(adaptation).__name__}")
+    return rng, n, leg
+
+
+def _true_events(
+    gait: NominalGait,
+    duration_s: float,
+    first_phase: float,
+    phase_of_t: PchipInterpolator,
+    knot_t: np.ndarray,
+    knot_phase0: int,
+) -> pd.DataFrame:
+    """The true gait events (``side``, ``event``, ``time_s`` in s) with 0 <= time_s <= ``duration_s``, sorted by
+    time: where each leg's phase passes a whole stride (heel strike) or the stance fraction (toe-off).
+
+    ``first_phase`` is the right leg's phase at t = 0; the stride knots (right heel strikes) lie at ``knot_t``
+    (s) with phases ``knot_phase0``, ``knot_phase0 + 1``, ...
+    """
+    knot_phase = np.arange(knot_t.size, dtype=float) + knot_phase0
+    s = gait.stance_fraction
+    first, last = int(np.floor(first_phase)) - 1, int(np.ceil(phase_of_t(duration_s))) + 1
+    ints = np.arange(first, last + 1, dtype=float)
+    rows = []
+    for side, offset in (("right", 0.0), ("left", 0.5)):
+        for event, shift in (("heel_strike", 0.0), ("toe_off", s)):
+            targets = ints + offset + shift
+            targets = targets[(targets >= knot_phase[0]) & (targets < knot_phase[-1])]
+            times = _solve_phase(phase_of_t, knot_t, knot_phase0, targets)
+            if side == "right" and event == "heel_strike":  # exact at the knots
+                times = knot_t[targets.astype(int) - knot_phase0]
+            rows += [(side, event, float(tt)) for tt in times if 0.0 <= tt <= duration_s]
+    return (
+        pd.DataFrame(rows, columns=list(TRUE_EVENT_COLUMNS)).sort_values("time_s", kind="stable").reset_index(drop=True)
+    )
+
+
 def walking_kinematics(
     duration_s: float,
     sample_rate_hz: float,
@@ -225,27 +295,18 @@ def walking_kinematics(
         Non-positive duration or rate, fewer than 2 samples, a CV out of range,
         a bad ``gait``, ``rng``, ``leg_length_m`` or ``start_phase``.
     """
-    if not isinstance(gait, NominalGait):
-        raise LoperInputError(f"gait must be a NominalGait, got {type(gait).__name__}")
-    rng = generator(rng)
-    if not (np.isfinite(duration_s) and duration_s > 0):
-        raise LoperInputError(f"duration_s must be > 0, got {duration_s}")
-    if not (np.isfinite(sample_rate_hz) and sample_rate_hz > 0):
-        raise LoperInputError(f"sample_rate_hz must be > 0, got {sample_rate_hz}")
-    n = int(round(duration_s * sample_rate_hz))
-    if n < 2:
-        raise LoperInputError(f"duration_s * sample_rate_hz must give >= 2 samples, got {n}")
-    if not 0 <= timing_cv <= 0.2:
-        raise LoperInputError(f"timing_cv must lie in 0 .. 0.2, got {timing_cv}")
-    if not 0 <= amplitude_cv <= 0.3:
-        raise LoperInputError(f"amplitude_cv must lie in 0 .. 0.3, got {amplitude_cv}")
-    leg = _check_leg_length(leg_length_m)
-    if start_phase is not None and not 0 <= start_phase < 1:
-        raise LoperInputError(f"start_phase must lie in [0, 1), got {start_phase}")
-    if variability is not None and not isinstance(variability, GaitVariability):
-        raise LoperInputError(f"variability must be a GaitVariability or None, got {type(variability).__name__}")
-    if adaptation is not None and not isinstance(adaptation, DeviceAdaptation):
-        raise LoperInputError(f"adaptation must be a DeviceAdaptation or None, got {type(adaptation).__name__}")
+    rng, n, leg = _checked_arguments(
+        duration_s,
+        sample_rate_hz,
+        gait,
+        rng,
+        timing_cv,
+        amplitude_cv,
+        leg_length_m,
+        start_phase,
+        variability,
+        adaptation,
+    )
 
     T0 = gait.stride_s
     phi0 = float(rng.uniform()) if start_phase is None else float(start_phase)
@@ -290,19 +351,4 @@ def walking_kinematics(
             out[f"{joint}_{side}"] = series.mean + a * excursion + o
     coordinates = pd.DataFrame({c: out[c] for c in ("time_s", *COORDINATES)})
 
-    s = gait.stance_fraction
-    first, last = int(np.floor(Phi[0])) - 1, int(np.ceil(phase_of_t(duration_s))) + 1
-    ints = np.arange(first, last + 1, dtype=float)
-    rows = []
-    for side, offset in (("right", 0.0), ("left", 0.5)):
-        for event, shift in (("heel_strike", 0.0), ("toe_off", s)):
-            targets = ints + offset + shift
-            targets = targets[(targets >= knot_phase[0]) & (targets < knot_phase[-1])]
-            times = _solve_phase(phase_of_t, knot_t, knot_phase0, targets)
-            if side == "right" and event == "heel_strike":  # exact at the knots
-                times = knot_t[targets.astype(int) - knot_phase0]
-            rows += [(side, event, float(tt)) for tt in times if 0.0 <= tt <= duration_s]
-    events = (
-        pd.DataFrame(rows, columns=list(TRUE_EVENT_COLUMNS)).sort_values("time_s", kind="stable").reset_index(drop=True)
-    )
-    return coordinates, events
+    return coordinates, _true_events(gait, duration_s, Phi[0], phase_of_t, knot_t, knot_phase0)
