@@ -1,0 +1,225 @@
+"""A trial's markers prepared for OpenSim: named as the model's, cropped, gaps filled, turned into the model's
+frame and low-passed (:func:`prepared_markers`), with a per-marker summary; :class:`MarkerSettings` says how.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, MIN_IK_MARKERS
+from loper_analysis.errors import LoperInputError
+from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass_finite_runs
+from loper_analysis.motion.heading import MIN_TRAVEL_SPEED_M_PER_S, trial_heading
+from loper_analysis.motion.knee_alignment import kad_knee_markers
+from loper_analysis.motion.label_matching import landmark_indices
+from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
+from loper_analysis.motion.markers import MAX_GAP_FRAMES, fill_gaps, gap_summary, rotate_markers
+from loper_analysis.motion.plausibility import EXTENT_RANGE_M, require_marker_extent
+
+__all__ = ["MarkerSettings", "PreparedMarkers", "TRIAL_MARKER_COLUMNS", "prepared_markers"]
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class MarkerSettings:
+    """How a trial's markers are named, cropped, filled, turned and filtered (config ``markers.*``, ``filter.*``).
+
+    ``rotation_deg``: lab -> model rotation about the fixed X, Y, Z axes (degrees); ``walking_direction``:
+    ``"auto"`` turns a travelling trial to walk along the model's +X, ``"fixed"`` keeps ``rotation_deg``;
+    ``min_travel_speed_m_per_s``: the speed from which a trial travels (m/s); ``max_gap_frames``: interior gaps
+    up to this many frames are filled (0: none); ``cutoff_hz``, ``order``: the zero-phase Butterworth low-pass
+    (Hz; None or 0: none); ``extent_range_m``: the markers' largest distance (m) a file in the declared unit
+    can have; ``label_map``: {lab label: model marker}, a file, or a sequence of them merged in order;
+    ``span_s``: (start, end) on the file's clock (s) or None; ``duration_s``: keep the first seconds or None;
+    ``required_markers``: model markers that must be found, or None.
+    """
+
+    rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
+    walking_direction: str = "auto"
+    min_travel_speed_m_per_s: float = MIN_TRAVEL_SPEED_M_PER_S
+    max_gap_frames: int = MAX_GAP_FRAMES
+    cutoff_hz: float | None = CUTOFF_HZ
+    order: int = ORDER
+    extent_range_m: tuple[float, float] = EXTENT_RANGE_M
+    label_map: Mapping[str, str] | str | os.PathLike | Sequence | None = None
+    span_s: tuple[float, float] | None = None
+    duration_s: float | None = None
+    required_markers: tuple[str, ...] | None = None
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> MarkerSettings:
+        """The walking trials' settings from a validated config (``markers.*``, ``filter.*``)."""
+        m, f = config["markers"], config["filter"]
+        return cls(
+            rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
+            walking_direction=m["walking_direction"],
+            min_travel_speed_m_per_s=float(m["min_travel_speed_m_per_s"]),
+            max_gap_frames=int(m["max_gap_frames"]),
+            cutoff_hz=f["cutoff_hz"],
+            order=int(f["order"]),
+            extent_range_m=tuple(float(v) for v in m["extent_range_m"]),
+        )
+
+    def for_static(self) -> MarkerSettings:
+        """The static trial's settings: neither filled nor filtered (scaling averages each marker over the frames
+        it is present in, as OpenSim's ScaleTool reads a lab's static trial)."""
+        return dataclasses.replace(self, max_gap_frames=0, cutoff_hz=None)
+
+
+@dataclass(frozen=True)
+class PreparedMarkers:
+    """A trial's markers ready for a TRC: ``time_s`` (n,) on the file's clock, ``markers_m`` (n, m, 3) in the
+    model's frame (m; NaN where missing), the model's marker ``names`` (m), the filled ``gaps`` (one row per
+    gap) and the per-marker ``summary`` (:data:`TRIAL_MARKER_COLUMNS`)."""
+
+    time_s: np.ndarray
+    markers_m: np.ndarray
+    names: list[str]
+    gaps: pd.DataFrame
+    summary: pd.DataFrame
+
+
+def prepared_markers(rec, label_map, settings: MarkerSettings, source: str) -> PreparedMarkers:
+    """The markers of a recording (:class:`loper_analysis.io.c3d.C3DRecording`) named by ``label_map`` (one
+    mapping {lab label: model marker}, or several merged in order), cropped, filled, turned and low-passed as
+    ``settings`` says (:func:`loper_analysis.steps.markers.markers` tells each step).
+
+    Raises
+    ------
+    LoperInputError
+        No markers, a required marker missing, an empty span, markers in another unit, a filter the rate
+        cannot hold: naming ``source``.
+    """
+    s = settings
+    _require_markers(rec, source)
+    names = model_marker_names(rec.marker_labels, label_map, source)
+    names, raw, added = kad_knee_markers(names, rec.markers_m, source=source)
+    labels = list(rec.marker_labels) + [f"{knee} (knee alignment device)" for knee in added]
+    for knee in added:
+        log.info("%s: %s from the knee alignment device (its origin on the lateral epicondyle)", source, knee)
+    if s.required_markers is not None:
+        require_model_markers(names, s.required_markers, source, labels)
+    time_s = rec.time_s
+    if s.duration_s is not None:
+        keep = time_s < time_s[0] + s.duration_s - 1e-9
+        time_s, raw = time_s[keep], raw[keep]
+    if s.span_s is not None:
+        time_s, raw = _cropped(time_s, raw, s.span_s, source)
+    require_marker_extent(raw, source, s.extent_range_m)
+    heading = _heading(raw, names, rec.point_rate_hz, s, source)
+    filled, gaps = fill_gaps(raw, s.max_gap_frames, names, source=source, unfillable="keep")
+    X = rotate_markers(filled, heading.rotation_deg)
+    unfiltered = None
+    if s.cutoff_hz:
+        try:
+            X, unfiltered = lowpass_finite_runs(
+                X, rec.point_rate_hz, s.cutoff_hz, s.order, axis=0, setting="filter.cutoff_hz", rate_name="POINT:RATE"
+            )
+        except LoperInputError as exc:
+            raise LoperInputError(f"{source}: markers: {exc}") from None
+    summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), labels, time_s, X, heading)
+    log.info(
+        "%s: %d frames at %g Hz, %d markers, %d gap(s) filled",
+        source,
+        len(time_s),
+        rec.point_rate_hz,
+        len(names),
+        len(gaps),
+    )
+    return PreparedMarkers(time_s, X, names, gaps, summary)
+
+
+def _require_markers(rec, source: str) -> None:
+    """Refuse a recording without marker trajectories; note the points that are not markers, left out."""
+    if not rec.marker_labels:
+        others = f" and {len(rec.output_labels)} computed point(s) ({', '.join(rec.output_labels[:4])}, ...)" * bool(
+            rec.output_labels
+        )
+        channels = ", ".join(rec.analog_labels[:6]) + (", ..." if len(rec.analog_labels) > 6 else "")
+        raise LoperInputError(
+            f"{source}: no markers (POINT:LABELS holds no marker trajectory): the file holds "
+            f"{len(rec.analog_labels)} analog channel(s) ({channels or 'none'}){others}; export the trial with "
+            "its marker trajectories"
+        )
+    if rec.output_labels:
+        kinds = pd.Series(rec.output_kinds).value_counts()
+        log.info(
+            "%s: %d point(s) that are not markers left out (%s)",
+            source,
+            len(rec.output_labels),
+            ", ".join(f"{k} {n}" for k, n in kinds.items()),
+        )
+
+
+def _heading(raw: np.ndarray, names: list[str], rate_hz: float, s: MarkerSettings, source: str):
+    """The trial's heading and the lab-to-model rotation (:func:`loper_analysis.motion.heading.trial_heading`)."""
+    pelvis = (landmark_indices(names, ["asis"]), landmark_indices(names, ["psis", "sacrum"]))
+    heading = trial_heading(
+        raw, rate_hz, s.rotation_deg, s.walking_direction, s.min_travel_speed_m_per_s, source, pelvis
+    )
+    if heading.turn_deg and heading.source == "pelvis":
+        log.info(
+            "%s: turned %g deg about the vertical to face the model's +X (pelvis markers)", source, heading.turn_deg
+        )
+    elif heading.turn_deg:
+        log.info(
+            "%s: walks %.1f deg from the model's +X at %.2f m/s: turned %g deg about the vertical (rotation %s deg)",
+            source,
+            heading.heading_deg,
+            heading.speed_m_per_s,
+            heading.turn_deg,
+            list(heading.rotation_deg),
+        )
+    return heading
+
+
+#: Columns the markers summary adds to :data:`loper_analysis.motion.markers.GAP_SUMMARY_COLUMNS`: the marker's lab
+#: label, then facts of the whole trial repeated on each row (like ``n_frames``).
+TRIAL_MARKER_COLUMNS: tuple[str, ...] = (
+    "label",
+    "n_frames_too_few_markers",
+    "first_time_s",
+    "last_time_s",
+    "heading_deg",
+    "speed_m_per_s",
+    "turn_deg",
+    "rotation_x_deg",
+    "rotation_y_deg",
+    "rotation_z_deg",
+)
+
+
+def _trial_marker_summary(per_marker: pd.DataFrame, labels: Sequence[str], time_s, markers_m, heading) -> pd.DataFrame:
+    """The per-marker gap summary with the lab labels and the trial's facts (:data:`TRIAL_MARKER_COLUMNS`)."""
+    present = np.all(np.isfinite(np.asarray(markers_m, float)), axis=2)
+    out = per_marker.copy()
+    out.insert(0, "label", [str(lab) for lab in labels])
+    out["n_frames_too_few_markers"] = int((present.sum(axis=1) < MIN_IK_MARKERS).sum())
+    out["first_time_s"] = float(time_s[0]) if len(time_s) else np.nan
+    out["last_time_s"] = float(time_s[-1]) if len(time_s) else np.nan
+    out["heading_deg"] = heading.heading_deg
+    out["speed_m_per_s"] = heading.speed_m_per_s
+    out["turn_deg"] = heading.turn_deg
+    for axis, angle in zip("xyz", heading.rotation_deg):
+        out[f"rotation_{axis}_deg"] = angle
+    return out
+
+
+def _cropped(time_s, markers_m, span_s: Sequence[float], source: str):
+    """Frames of a trial between ``span_s`` = (start, end) in s on the file's clock; an empty crop is refused."""
+    start, end = (float(v) for v in span_s)
+    keep = (time_s >= start - 1e-9) & (time_s <= end + 1e-9)
+    if end <= start or not keep.any():
+        raise LoperInputError(
+            f"{source}: the trial's span {start:g} .. {end:g} s (markers.trial_spans_s) holds no frame of the file "
+            f"({time_s[0]:.4f} .. {time_s[-1]:.4f} s)"
+        )
+    return time_s[keep], markers_m[keep]
