@@ -253,3 +253,32 @@ def test_events_from_reversed_and_y_up_plates_equal_the_usual_ones(files, tmp_pa
         off = b - (b - a) / math.pi * math.asin(OFF_N / PEAK_N)
         mine = other[other["side"] == side].set_index("event")["time_s"]
         assert 0.0 <= mine["heel_strike"] - on < dt + 1e-9 and 0.0 <= mine["toe_off"] - off < dt + 1e-9
+
+
+def test_the_events_step_reads_its_c3d_once_and_gets_the_same_plates(files, tmp_path, monkeypatch):
+    """One reading of the file gives the markers and the force platforms: ezc3d opens it once, and the platforms
+    equal those read on their own."""
+    from loper_analysis.io import c3d as c3d_module
+    from loper_analysis.io import force_platforms as platforms_module
+
+    alone = read_force_platforms(files["z-up"], lab_up(Z_UP_ROTATION))
+    opened = []
+
+    def counting(real):
+        def open_file(path, *args, **kwargs):
+            opened.append(str(path))
+            return real(path, *args, **kwargs)
+
+        return open_file
+
+    # every opening of a C3D by the library goes through one of these two
+    monkeypatch.setattr(c3d_module, "_open_c3d", counting(c3d_module._open_c3d))
+    monkeypatch.setattr(platforms_module, "_open", counting(platforms_module._open))
+    rec, plates = platforms_module.read_c3d_with_platforms(files["z-up"], lab_up(Z_UP_ROTATION))
+    assert opened == [str(files["z-up"])] and rec.n_force_platforms == len(plates) == 2
+    for a, b in zip(plates, alone):
+        np.testing.assert_array_equal(a.force_n, b.force_n)
+        np.testing.assert_array_equal(a.moment_nm, b.moment_nm)
+    opened.clear()
+    _events(files["z-up"], Z_UP_ROTATION, tmp_path, "once")
+    assert opened == [str(files["z-up"])]

@@ -391,8 +391,14 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         message names the file.
     """
     path = Path(path)
+    return recording_from_ezc3d(_open_c3d(path), path)
+
+
+def recording_from_ezc3d(c3d, path: str | os.PathLike) -> C3DRecording:
+    """The :class:`C3DRecording` of a file ezc3d has read (``ezc3d.c3d(path)``), checked as :func:`read_c3d`
+    says."""
+    path = Path(path)
     source = str(path)
-    c3d = _open_c3d(path)
     params = c3d["parameters"]
     point_rate = param_float(params, "POINT", "RATE", source)
     n_points = int(np.shape(c3d["data"]["points"])[1])

@@ -72,8 +72,8 @@ import numpy as np
 
 from loper_analysis.constants import LAB_Z_UP
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.c3d import LENGTH_UNITS_PER_M
-from loper_analysis.io.timing import library_import
+from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, C3DRecording, read_c3d, recording_from_ezc3d
+from loper_analysis.io.timing import library_import, timed_io
 
 __all__ = [
     "CALIBRATED_TYPES",
@@ -83,6 +83,8 @@ __all__ = [
     "SUPPORTED_TYPES",
     "ForcePlatform",
     "count_force_platforms",
+    "platforms_from_ezc3d",
+    "read_c3d_with_platforms",
     "read_force_platforms",
 ]
 
@@ -484,6 +486,29 @@ def read_force_platforms(path: str | os.PathLike, up: Sequence[float] | None = N
         c3d = _open(path, extract=False)  # diagnose the parameters ezc3d's extraction refused
         if isinstance(c3d, Exception):
             raise LoperInputError(f"{source}: not a readable C3D file: {type(c3d).__name__}: {c3d}") from c3d
+    return platforms_from_ezc3d(c3d, path, lab_up, failure)
+
+
+@timed_io
+def read_c3d_with_platforms(
+    path: str | os.PathLike, up: Sequence[float] | None = None
+) -> tuple[C3DRecording, list[ForcePlatform]]:
+    """A C3D file's recording (:func:`loper_analysis.io.c3d.read_c3d`) and its force platforms
+    (:func:`read_force_platforms`; none when ``FORCE_PLATFORM:USED`` is 0 or absent), from one reading of the
+    file. A file whose platforms ezc3d cannot extract is read again to name the cause, as those two say."""
+    path = Path(path)
+    c3d = _open(path, extract=True)
+    if isinstance(c3d, Exception):
+        rec = read_c3d(path)  # its own refusals first, then the platforms'
+        return rec, (read_force_platforms(path, up) if rec.n_force_platforms else [])
+    rec = recording_from_ezc3d(c3d, path)
+    return rec, (platforms_from_ezc3d(c3d, path, _lab_up(up, str(path))) if rec.n_force_platforms else [])
+
+
+def platforms_from_ezc3d(c3d, path: str | os.PathLike, lab_up: np.ndarray, failure: Exception | None = None):
+    """The force platforms of a file ezc3d has read with ``extract_forceplat_data=True`` (``failure``: the
+    exception of that extraction, ``c3d`` then read without it to diagnose), as :func:`read_force_platforms`."""
+    source = str(path)
     params = c3d["parameters"]
     n_analogs = int(np.shape(c3d["data"]["analogs"])[1])
     used, types, plate_channels = _check_parameters(params, n_analogs, source)

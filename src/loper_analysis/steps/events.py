@@ -122,18 +122,26 @@ def events(
     low-passes it first (zero-phase Butterworth; None thresholds the raw
     force: a 40 Hz filter moves a 20 N toe-off threshold by about 4.5 ms).
     """
-    from loper_analysis.io.c3d import read_c3d
-
-    table, contacts = _events_of(read_c3d(c3d_path), settings)
+    table, contacts = _events_of(*_read_trial(c3d_path, settings), settings)
     return _write_events(table, contacts, out_tsv, contacts_out)
 
 
-def _events_of(rec, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """The event table and the contact table (empty without force platforms) of a C3D already read."""
+def _read_trial(c3d_path: PathLike, s: EventSettings):
+    """The recording and its force platforms, from one reading of the C3D; the vertical is the lab's up
+    direction that ``rotation_deg`` turns into the model's +Y (:func:`loper_analysis.motion.markers.lab_up`)."""
+    from loper_analysis.io.force_platforms import read_c3d_with_platforms
+    from loper_analysis.motion.markers import lab_up
+
+    return read_c3d_with_platforms(c3d_path, lab_up(s.rotation_deg))
+
+
+def _events_of(rec, platforms: list, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The event table and the contact table (empty without force platforms) of a C3D already read, with its
+    force platforms."""
     from loper_analysis.gait.contacts import count_flagged
 
     if rec.n_force_platforms:
-        table, contacts = _plate_events(rec, s)
+        table, contacts = _plate_events(rec, platforms, s)
         log.info("contacts:\n%s", contacts.to_string(index=False))
         table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"])
         return table, contacts
@@ -275,7 +283,7 @@ def _check_belt_feet(rec, table: pd.DataFrame, s: EventSettings) -> None:
     )
 
 
-def _plate_events(rec, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
+def _plate_events(rec, platforms: list, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Events and the contact table from the force platforms and the heel markers of a read C3D.
 
     The vertical is the lab's up direction that ``rotation_deg`` turns into the model's +Y
@@ -285,20 +293,17 @@ def _plate_events(rec, s: EventSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
     """
     from loper_analysis.gait.contacts import PlateForce, contact_events, foot_contacts
     from loper_analysis.gait.grf import plate_vertical_loads
-    from loper_analysis.io.force_platforms import read_force_platforms
     from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
     from loper_analysis.motion.markers import MODEL_UP, lab_up, rotate_markers
 
-    source = c3d_path = rec.source
+    source = rec.source
     foot_markers, rotation_deg = s.foot_markers, s.rotation_deg
     if not foot_markers:
         raise LoperInputError(f"{source}: force platforms need the heel marker of each foot (events.foot_markers)")
     names = model_marker_names(rec.marker_labels, read_label_maps(s.label_map), source)
     require_model_markers(names, [foot_markers[side] for side in SIDES], source, rec.marker_labels)
     up = lab_up(rotation_deg)
-    loads = plate_vertical_loads(
-        read_force_platforms(c3d_path, up), rotation_deg, s.band_n, s.max_rest_n, up=up, source=str(c3d_path)
-    )
+    loads = plate_vertical_loads(platforms, rotation_deg, s.band_n, s.max_rest_n, up=up, source=source)
     plates = [
         PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i]) for i, n in enumerate(loads.numbers)
     ]
@@ -406,10 +411,8 @@ def events_loadcell(
 
     Nothing is written unless both succeed. Returns the event table and the force table on the mocap frames.
     """
-    from loper_analysis.io.c3d import read_c3d
-
-    rec = read_c3d(c3d_path)
-    table, contacts = _events_of(rec, event_settings)
+    rec, platforms = _read_trial(c3d_path, event_settings)
+    table, contacts = _events_of(rec, platforms, event_settings)
     forces = _loadcell_of(rec, log_path, loadcell_settings)  # both computed before anything is written
     _write_events(table, contacts, events_out, contacts_out)
     return table, _write_loadcell(*forces, force_out, native_out)
