@@ -3,7 +3,7 @@ platforms, the lab's own marker names, gaps, a late first frame, MATLAB robot lo
 scaled with a lab's ScaleTool setup (the settings of ``examples/gait2392/config.yaml``), through the
 workflow to the impedance table.
 
-The raw files come from :func:`loper_analysis.steps.synthetic.lab_export_session` (a simulated subject
+The raw files come from ``tests/lab_export_session.lab_export_session`` (a simulated subject
 whose markers are gait2392's, whose perturbation responses follow a known impedance with gait2392's
 own segment table); the pipeline meets them as a lab's export: labels ``Subject:L_FCC``, plates not
 zeroed with decoy voltage channels named like force channels, 40-frame gaps, first frame 1000 (the file
@@ -25,7 +25,7 @@ from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
 from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
+from tests.lab_export_session import LabExportFiles, LabExportSettings, lab_export_session
 from tests.workflow_copy import copy_workflow, snakemake
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)

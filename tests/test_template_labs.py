@@ -140,7 +140,7 @@ def test_a_qtm_lab_with_its_own_labels_gets_its_known_angles_back(tmp_path):
     """A simulated Qualisys lab (gait2392 driven by known coordinates, markers under QTM-style labels with a subject
     prefix, gaps, belt plates): inspect chooses the ISB template, and the workflow gives the hip, knee and ankle
     angles the files were made from."""
-    from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
+    from tests.lab_export_session import LabExportFiles, LabExportSettings, lab_export_session
 
     work = tmp_path / "qtm"
     work.mkdir()

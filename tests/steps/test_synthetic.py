@@ -16,7 +16,6 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.robot_log import read_robot_log
 from loper_analysis.steps.synthetic import (
-    LabExportSettings,
     LabSessionFiles,
     LabSessionSettings,
     SyntheticLabSettings,
@@ -27,6 +26,7 @@ from loper_analysis.study_design import StudyDesign
 from loper_analysis.synthetic.subjects import subject_anthropometry
 from loper_analysis.synthetic.trials import LabSettings
 from loper_analysis.synthetic.variability import lab_variability
+from tests.lab_export_session import LabExportSettings
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

@@ -1,4 +1,4 @@
-"""The QTM-style lab export (synthetic/lab_export.py, steps/synthetic.lab_export_session): a session written to
+"""The QTM-style lab export (synthetic/lab_export.py, tests/lab_export_session.py): a session written to
 disk and read back by our readers, by ezc3d's force-platform extraction (child process) and through OpenSim IK."""
 
 import subprocess
@@ -16,7 +16,6 @@ from loper_analysis.io.robot_log_mat import read_robot_log_mat
 from loper_analysis.motion.ik import inverse_kinematics, marker_positions
 from loper_analysis.motion.markers import rotate_markers
 from loper_analysis.motion.model import COORDINATES, build_lower_body_model
-from loper_analysis.steps.synthetic import LabExportFiles, LabExportSettings, lab_export_session
 from loper_analysis.synthetic.lab_export import (
     GAIT2392_COORDINATES,
     ROBOT_LOG_MAT_VARIABLES,
@@ -25,6 +24,7 @@ from loper_analysis.synthetic.lab_export import (
     qtm_walking_export,
 )
 from loper_analysis.synthetic.trials import LabSettings
+from tests.lab_export_session import LabExportFiles, LabExportSettings, lab_export_session
 
 GAIT2392 = Path(__file__).resolve().parents[2] / "examples" / "gait2392"
 FIRST_FRAME = 1000

@@ -7,7 +7,7 @@
 * :mod:`.response` - the swing leg's answer to a LOPER pulse (and the minimal-impedance force) with the true impedance;
 * :mod:`.sync` - the robot's sync pulse trains;
 * :mod:`.trials` - whole trials: C3D contents and robot logs;
-* :mod:`.coordinate_trials` - trials at the coordinate level (no markers, no IK) for the validation study.
+* :mod:`.coordinate_trials` - trials at the coordinate level (no markers, no IK), for the planner's checks.
 
 Importing the package has no side effects.
 """
