@@ -44,6 +44,7 @@ exponential, zero-order hold on the velocity command).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -119,6 +120,11 @@ class DeviceParameters:
     motor_cutoff_velocity_rad_s: float = 6.28
     motor_cutoff_torque_nm: float = 120.0
     servo_cutoff_position_rad: float = 1.34
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> DeviceParameters:
+        """The device of a validated config (``device.parameters``)."""
+        return cls(**config["device"]["parameters"])
 
     def __post_init__(self) -> None:
         for name, value in asdict(self).items():

@@ -38,20 +38,25 @@ log = logging.getLogger(__name__)
 #: Counts of perturbed strides averaged that the planner predicts for (config ``planning.strides``).
 STRIDES: tuple[int, ...] = (10, 20, 40)
 
-#: Identification settings the planner follows (keys of config ``identification``; fields of
-#: :class:`~loper_analysis.planning.window.PlanSettings`).
-_PLAN_KEYS = (
-    "window_before_s",
-    "window_after_s",
-    "initial_state_span_s",
-    "initial_state_degree",
-    "n_substeps",
-    "null_pair_components",
-    "min_null_pairs",
-    "interval_scatter",
-    "stiffness_bounds_nm_per_rad",
-    "damping_bounds_nms_per_rad",
-)
+#: The config keys the planner reads beside its own section, by section.
+_PLANNER_KEYS = {
+    "planning": ("pulse_force_n", "pulse_duration_s"),
+    "identification": (
+        "window_before_s",
+        "window_after_s",
+        "initial_state_span_s",
+        "initial_state_degree",
+        "n_substeps",
+        "null_pair_components",
+        "min_null_pairs",
+        "interval_scatter",
+        "stiffness_bounds_nm_per_rad",
+        "damping_bounds_nms_per_rad",
+        "counterfactual",
+    ),
+    "strides": ("iqr_whisker", "max_outlier_fraction", "min_valid_strides"),
+    "device": ("parameters",),
+}
 
 
 @dataclass(frozen=True)
@@ -127,27 +132,16 @@ class PlanningSettings:
                 node = node[key]
             return copy.deepcopy(node)
 
-        ident = {k: get("identification", k) for k in _PLAN_KEYS}
-        for key in ("stiffness_bounds_nm_per_rad", "damping_bounds_nms_per_rad"):
-            ident[key] = tuple(ident[key])
+        for section, keys in _PLANNER_KEYS.items():  # a config made by hand for the command: one message
+            for key in keys:
+                get(section, key)
         return cls(
             onsets_ms=tuple(get("trials", "perturbation_onsets_ms")),
             strides=tuple(get("planning", "strides")),
             targets=tuple(get("planning", "targets")),
-            plan=PlanSettings(
-                pulse_force_n=get("planning", "pulse_force_n"),
-                pulse_duration_s=get("planning", "pulse_duration_s"),
-                **ident,
-            ),
-            response=ResponseSettings(
-                window_before_s=get("identification", "window_before_s"),
-                window_after_s=get("identification", "window_after_s"),
-                initial_state_span_s=get("identification", "initial_state_span_s"),
-                whisker=get("strides", "iqr_whisker"),
-                max_fraction=get("strides", "max_outlier_fraction"),
-                counterfactual=get("identification", "counterfactual"),
-            ),
-            device=DeviceParameters(**get("device", "parameters")),
+            plan=PlanSettings.from_config(config),
+            response=ResponseSettings.from_config(config),
+            device=DeviceParameters.from_config(config),
             max_null_trial_ratio=get("identification", "max_null_trial_ratio"),
         )
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from loper_analysis.checks import number
 from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
+from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
     FitBounds,
@@ -24,11 +25,29 @@ from loper_analysis.identification import (
     prepare_window,
     window_options,
 )
+from loper_analysis.identification.fit import DAMPING_BOUNDS_NMS_PER_RAD, STIFFNESS_BOUNDS_NM_PER_RAD
+from loper_analysis.identification.null_pairs import MIN_NULL_PAIRS, NULL_PAIR_COMPONENTS
+from loper_analysis.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS
+from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.planning.inputs import pulse_force_n
+from loper_analysis.responses.windows import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
+
+
+#: Keys of config ``identification`` the planner follows as they are (the bounds become tuples).
+_IDENTIFICATION_KEYS = (
+    "window_before_s",
+    "window_after_s",
+    "initial_state_span_s",
+    "initial_state_degree",
+    "n_substeps",
+    "null_pair_components",
+    "min_null_pairs",
+    "interval_scatter",
+)
 
 
 @dataclass(frozen=True)
@@ -47,19 +66,32 @@ class PlanSettings(FitBounds):
 
     pulse_force_n: float = PULSE_FORCE_N
     pulse_duration_s: float = PULSE_DURATION_S
-    window_before_s: float = 0.025
-    window_after_s: float = 0.25
-    initial_state_span_s: float = 0.1
-    initial_state_degree: int = 1
-    n_substeps: int = 2
-    null_pair_components: int = 6
-    min_null_pairs: int = 30
+    window_before_s: float = WINDOW_BEFORE_S
+    window_after_s: float = WINDOW_AFTER_S
+    initial_state_span_s: float = INITIAL_STATE_SPAN_S
+    initial_state_degree: int = INITIAL_STATE_DEGREE
+    n_substeps: int = N_SUBSTEPS
+    null_pair_components: int = NULL_PAIR_COMPONENTS
+    min_null_pairs: int = MIN_NULL_PAIRS
     interval_scatter: str = "cross_validated_null_pairs"
-    stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
-    damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
-    force_cutoff_hz: float = 40.0
-    force_order: int = 4
-    force_rate_hz: float = 1000.0
+    stiffness_bounds_nm_per_rad: tuple[float, float] = STIFFNESS_BOUNDS_NM_PER_RAD
+    damping_bounds_nms_per_rad: tuple[float, float] = DAMPING_BOUNDS_NMS_PER_RAD
+    force_cutoff_hz: float = CUTOFF_HZ
+    force_order: int = ORDER
+    force_rate_hz: float = DeviceParameters.sample_rate_hz
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> PlanSettings:
+        """The settings of a validated config: the pulse of ``planning`` (N, s) and the keys of
+        ``identification`` the prediction follows."""
+        ident = config["identification"]
+        return cls(
+            pulse_force_n=config["planning"]["pulse_force_n"],
+            pulse_duration_s=config["planning"]["pulse_duration_s"],
+            **{key: ident[key] for key in _IDENTIFICATION_KEYS},
+            stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
+            damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
+        )
 
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)

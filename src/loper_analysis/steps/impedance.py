@@ -7,7 +7,6 @@
 
 from __future__ import annotations
 
-import copy
 import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -55,36 +54,9 @@ class FitSettings:
     def from_config(cls, config: Mapping) -> FitSettings:
         """The settings of a validated config: ``identification.*``, ``strides.iqr_whisker``,
         ``strides.max_outlier_fraction``, ``strides.min_valid_strides`` and ``seed``."""
-        ident, strides = config["identification"], config["strides"]
         return cls(
-            response=ResponseSettings(
-                window_before_s=ident["window_before_s"],
-                window_after_s=ident["window_after_s"],
-                initial_state_span_s=ident["initial_state_span_s"],
-                whisker=strides["iqr_whisker"],
-                max_fraction=strides["max_outlier_fraction"],
-                min_strides=strides["min_valid_strides"],
-                counterfactual=ident["counterfactual"],
-            ),
-            identification=IdentificationSettings(
-                noise_model=ident["noise_model"],
-                interval_scatter=ident["interval_scatter"],
-                null_pair_components=ident["null_pair_components"],
-                min_null_pairs=ident["min_null_pairs"],
-                initial_state_degree=ident["initial_state_degree"],
-                n_starts=ident["n_starts"],
-                n_substeps=ident["n_substeps"],
-                tolerance=ident["tolerance"],
-                merge_tolerance=ident["merge_tolerance"],
-                stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
-                damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
-                max_ci_fraction=ident["max_ci_fraction"],
-                plausible_ranges=copy.deepcopy(ident["plausible_ranges"]),
-                min_vaf_pct=ident["min_vaf_pct"],
-                max_null_trial_ratio=ident["max_null_trial_ratio"],
-                averaging_correction=ident["averaging_correction"],
-                seed=config["seed"],
-            ),
+            response=ResponseSettings.from_config(config),
+            identification=IdentificationSettings.from_config(config),
         )
 
 

@@ -114,7 +114,7 @@ class SyntheticLabSettings:
             seed=config["seed"],
             design=StudyDesign.from_config(config["trials"]),
             lab=LabSettings.from_config(config),
-            device=DeviceParameters(**config["device"]["parameters"]),
+            device=DeviceParameters.from_config(config),
             static_duration_s=s["static_duration_s"],
             walking_duration_s=s["walking_duration_s"],
             timing_cv=s["timing_cv"],
