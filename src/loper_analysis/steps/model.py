@@ -8,25 +8,23 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io import scale_tool
 from loper_analysis.io.atomic import PathLike, staged, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.segment_table import write_segments
 from loper_analysis.motion.body_size import body_height_m, body_mass_kg, model_stature_m, require_stature
-from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.marker_names import unknown_markers_hint
 from loper_analysis.motion.markers import lab_up
-from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE, measurement_scale_factors, require_scale_factors
+from loper_analysis.motion.model_settings import STATIC_DURATION_S, STATIC_MAX_MOTION_RMS_M, ModelSettings
+from loper_analysis.motion.plausibility import measurement_scale_factors, require_scale_factors
 from loper_analysis.motion.scale_report import SCALE_FLOAT_FORMAT
-from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.dynamics import (
     BRACE_ATTACHMENT_FRACTION,
     SegmentParameters,
@@ -47,76 +45,6 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
-
-#: Scaling averages the first this many seconds of the static trial when the scale setup sets no time range (s;
-#: config ``markers.static_duration_s``).
-STATIC_DURATION_S: float = 1.0
-#: A static-trial marker moving more than this over the scaling window stops scaling (m, RMS about its mean;
-#: config ``markers.static_max_motion_rms_m``).
-STATIC_MAX_MOTION_RMS_M: float = 0.05
-
-
-@dataclass(frozen=True)
-class ModelSettings:
-    """How the subject's model is built, scaled and turned into a segment table (config ``markers.*``,
-    ``opensim.*``, ``trials.perturbed_side``).
-
-    Attributes
-    ----------
-    rotation_deg : (float, float, float)
-        Lab -> model rotation about the fixed X, Y, Z axes, degrees: the lab's vertical, for the mass from the
-        static trial's force plates (``markers.lab_to_model_rotation_deg``).
-    static_duration_s : float or None
-        Without a time range (``time_range_s``, the scale setup's): the first this many seconds of the static
-        trial are averaged, s; None: the whole trial (``markers.static_duration_s``).
-    max_motion_rms_m : float or None
-        Largest RMS motion of a marker over the window, m: a subject who does not stand still is refused; None:
-        not checked (``markers.static_max_motion_rms_m``).
-    time_range_s : (float, float), optional
-        The window, s, overriding the setup's time ranges and ``static_duration_s`` (no config key).
-    factor_range : (float, float)
-        Least and largest plausible factor of a measurement (``opensim.scale_factor_range``).
-    segment_bodies : mapping, optional
-        Segment -> body names with ``{s}`` for the side suffix (``opensim.segment_bodies``); None: the model's
-        own kind.
-    side : {"left", "right"}
-        The leg of the segment table (``trials.perturbed_side``).
-    attachment_fraction : float
-        Rod attachment as a fraction of the thigh length, for a model without brace markers
-        (``opensim.brace_attachment_fraction``).
-    coordinate_map : mapping, optional
-        Our angle -> model coordinate and sign, for the static pose of the scale report
-        (``opensim.coordinate_map``); None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
-    accuracy : float
-        IK solver accuracy of the scale report's static pose (``opensim.accuracy``).
-    """
-
-    rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
-    static_duration_s: float | None = STATIC_DURATION_S
-    max_motion_rms_m: float | None = STATIC_MAX_MOTION_RMS_M
-    time_range_s: tuple[float, float] | None = None
-    factor_range: tuple[float, float] = SCALE_FACTOR_RANGE
-    segment_bodies: Mapping[str, Sequence[str]] | None = None
-    side: str = PERTURBED_SIDE
-    attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
-    coordinate_map: Mapping[str, Mapping] | None = None
-    accuracy: float = IK_ACCURACY
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> ModelSettings:
-        """The model settings of a validated config (``markers.*``, ``opensim.*``, ``trials.perturbed_side``)."""
-        m, o = config["markers"], config["opensim"]
-        return cls(
-            rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
-            static_duration_s=m["static_duration_s"],
-            max_motion_rms_m=m["static_max_motion_rms_m"],
-            factor_range=tuple(float(v) for v in o["scale_factor_range"]),
-            segment_bodies=o["segment_bodies"],
-            side=config["trials"]["perturbed_side"],
-            attachment_fraction=o["brace_attachment_fraction"],
-            coordinate_map=o["coordinate_map"],
-            accuracy=o["accuracy"],
-        )
 
 
 @dataclass(frozen=True)
