@@ -17,6 +17,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -311,9 +312,7 @@ def foot_contacts(
     corners = [np.asarray(p.corners_m, dtype=float) for p in plates]
     for name, c in zip(names, corners):
         plate_axes(c, vertical_axis, name, up)
-
-    def on(outside: np.ndarray, above: np.ndarray) -> np.ndarray:
-        return (outside <= margin) & (above <= height)  # NaN: False
+    scene = _Scene(tm, heels, corners, vertical_axis, up, delay, dwell, margin, reach, height)
 
     rows = []
     for k, (plate, name) in enumerate(zip(plates, names)):
@@ -327,67 +326,133 @@ def foot_contacts(
             source=name,
         )
         for c in found.itertuples():
-            mid = 0.5 * (c.start_s + c.end_s)
-            ps, pe = min(c.start_s + delay, mid), max(c.end_s - delay, mid)
-            times = np.concatenate([[ps], tm[(tm > ps) & (tm < pe)], [pe] if pe > ps else []])
-            need = min(dwell, pe - ps)
-            start_on, on_all, missing, window = {}, {}, {}, {}
-            for s in SIDES:
-                xyz = _at(tm, heels[s], times)
-                out, above = plate_offsets(xyz, corners[k], vertical_axis, up=up)
-                window[s] = (out, above)
-                start_on[s] = on(out[:1], above[:1])[0]
-                missing[s] = np.isnan(out)
-                # on every plate at the start probe: (n_plates,) outside, height
-                on_all[s] = np.array([on(*plate_offsets(xyz[:1], cc, vertical_axis, up=up))[0] for cc in corners])
-            at_start = [s for s in SIDES if start_on[s]]
-            side = at_start[0] if len(at_start) == 1 else ""
-            others = [s for s in SIDES if s != side]
-            dwells = {s for s in others if _longest_run_s(times, on(*window[s])) >= need}
-            undecided = any(
-                missing[s].any() and _longest_run_s(times, on(*window[s]) | missing[s]) >= need
-                for s in others
-                if s not in dwells
-            )
-            present = set(at_start) | dwells
-            if c.incomplete:
-                flag = "incomplete"
-            elif any(missing[s][0] for s in SIDES) or undecided:
-                flag = "heel_missing"
-            elif len(present) == 2:
-                flag = "two_feet"
-            elif not at_start:
-                # low heels near this plate that stand on no other plate
-                near = {
-                    s: window[s][0][0]
-                    for s in SIDES
-                    if window[s][0][0] <= reach and window[s][1][0] <= height and not np.delete(on_all[s], k).any()
-                }
-                side = min(near, key=near.get) if near else ""
-                flag = "no_foot" if not near else ("two_feet" if present - {side} else "off_plate")
-                side = "" if flag == "two_feet" else side
-            elif belt.get(numbers[k], side) != side:
-                flag = "wrong_belt"
-            else:
-                flag = "ok"
-            rows.append(
-                {
-                    "plate": numbers[k],
-                    "contact": c.contact,
-                    "side": side,
-                    "flag": flag,
-                    "start_sample": c.start_sample,
-                    "end_sample": c.end_sample,
-                    "start_s": c.start_s,
-                    "end_s": c.end_s,
-                    "belt_side": belt.get(numbers[k], ""),
-                    **{
-                        f"{s}_heel_{q}_m": float(window[s][i][0])
-                        for s in SIDES
-                        for i, q in enumerate(("outside", "height"))
-                    },
-                }
-            )
+            rows.append(_contact_row(c, k, numbers[k], belt, scene))
+    return _contact_table(rows, source)
+
+
+class _Scene(NamedTuple):
+    """What the contacts of a trial are judged against (:func:`foot_contacts`).
+
+    ``marker_time_s`` (n_frames,) in s; ``heels_m``: ``{side: (n_frames, 3)}`` in m; ``corners_m``: per plate
+    its corners (4, 3) in m; ``vertical_axis`` and ``up``: the vertical; the checked probe delay and dwell
+    time (s), margin, reach and highest heel (m).
+    """
+
+    marker_time_s: np.ndarray
+    heels_m: dict[str, np.ndarray]
+    corners_m: list[np.ndarray]
+    vertical_axis: int | None
+    up: Sequence[float] | None
+    delay_s: float
+    dwell_s: float
+    margin_m: float
+    reach_m: float
+    max_height_m: float
+
+
+def _on(scene: _Scene, outside: np.ndarray, above: np.ndarray) -> np.ndarray:
+    """Whether heels at ``outside`` (m outside the outline) and ``above`` (m above the surface) are on the plate."""
+    return (outside <= scene.margin_m) & (above <= scene.max_height_m)  # NaN: False
+
+
+def _heel_offsets(scene: _Scene, k: int, times: np.ndarray) -> dict[str, dict]:
+    """Per side the heel over plate ``k`` at the window's ``times`` (s).
+
+    ``window``: ``(outside, above)`` (m, each (n_times,)); ``start_on``: on the plate at the start probe;
+    ``missing`` (n_times,): NaN heel; ``on_all`` (n_plates,): on each plate at the start probe.
+    """
+    start_on, on_all, missing, window = {}, {}, {}, {}
+    for s in SIDES:
+        xyz = _at(scene.marker_time_s, scene.heels_m[s], times)
+        out, above = plate_offsets(xyz, scene.corners_m[k], scene.vertical_axis, up=scene.up)
+        window[s] = (out, above)
+        start_on[s] = _on(scene, out[:1], above[:1])[0]
+        missing[s] = np.isnan(out)
+        # on every plate at the start probe: (n_plates,) outside, height
+        on_all[s] = np.array(
+            [_on(scene, *plate_offsets(xyz[:1], cc, scene.vertical_axis, up=scene.up))[0] for cc in scene.corners_m]
+        )
+    return {"window": window, "start_on": start_on, "missing": missing, "on_all": on_all}
+
+
+def _side_and_flag(
+    incomplete: bool,
+    k: int,
+    times: np.ndarray,
+    need: float,
+    heels: Mapping[str, dict],
+    belt_side: str | None,
+    scene: _Scene,
+) -> tuple[str, str]:
+    """The foot (``""`` if unknown or ambiguous) and the flag (:data:`CONTACT_FLAGS`) of a contact of plate ``k``.
+
+    ``times`` (s): the window's probes and frames; ``need`` (s): the unbroken time on the plate that makes a
+    heel dwell; ``heels``: :func:`_heel_offsets`; ``belt_side``: the side ``plate_sides`` gives the plate (None).
+    """
+    window, start_on, missing, on_all = heels["window"], heels["start_on"], heels["missing"], heels["on_all"]
+    at_start = [s for s in SIDES if start_on[s]]
+    side = at_start[0] if len(at_start) == 1 else ""
+    others = [s for s in SIDES if s != side]
+    dwells = {s for s in others if _longest_run_s(times, _on(scene, *window[s])) >= need}
+    undecided = any(
+        missing[s].any() and _longest_run_s(times, _on(scene, *window[s]) | missing[s]) >= need
+        for s in others
+        if s not in dwells
+    )
+    present = set(at_start) | dwells
+    if incomplete:
+        flag = "incomplete"
+    elif any(missing[s][0] for s in SIDES) or undecided:
+        flag = "heel_missing"
+    elif len(present) == 2:
+        flag = "two_feet"
+    elif not at_start:
+        # low heels near this plate that stand on no other plate
+        near = {
+            s: window[s][0][0]
+            for s in SIDES
+            if window[s][0][0] <= scene.reach_m
+            and window[s][1][0] <= scene.max_height_m
+            and not np.delete(on_all[s], k).any()
+        }
+        side = min(near, key=near.get) if near else ""
+        flag = "no_foot" if not near else ("two_feet" if present - {side} else "off_plate")
+        side = "" if flag == "two_feet" else side
+    elif (side if belt_side is None else belt_side) != side:
+        flag = "wrong_belt"
+    else:
+        flag = "ok"
+    return side, flag
+
+
+def _contact_row(c, k: int, number: int, belt: Mapping[int, str], scene: _Scene) -> dict:
+    """The row (:data:`CONTACT_COLUMNS`) of contact ``c`` (a row of :func:`plate_contacts`) of plate ``k``,
+    numbered ``number``; ``belt``: ``{plate number: side}``."""
+    mid = 0.5 * (c.start_s + c.end_s)
+    ps, pe = min(c.start_s + scene.delay_s, mid), max(c.end_s - scene.delay_s, mid)
+    tm = scene.marker_time_s
+    times = np.concatenate([[ps], tm[(tm > ps) & (tm < pe)], [pe] if pe > ps else []])
+    need = min(scene.dwell_s, pe - ps)
+    heels = _heel_offsets(scene, k, times)
+    side, flag = _side_and_flag(c.incomplete, k, times, need, heels, belt.get(number), scene)
+    window = heels["window"]
+    return {
+        "plate": number,
+        "contact": c.contact,
+        "side": side,
+        "flag": flag,
+        "start_sample": c.start_sample,
+        "end_sample": c.end_sample,
+        "start_s": c.start_s,
+        "end_s": c.end_s,
+        "belt_side": belt.get(number, ""),
+        **{f"{s}_heel_{q}_m": float(window[s][i][0]) for s in SIDES for i, q in enumerate(("outside", "height"))},
+    }
+
+
+def _contact_table(rows: Sequence[dict], source: str) -> pd.DataFrame:
+    """The contact table of :func:`foot_contacts` from its rows, ordered by start time then plate; every flagged
+    contact logged."""
     table = pd.DataFrame(rows, columns=list(CONTACT_COLUMNS))
     table = table.astype(
         {

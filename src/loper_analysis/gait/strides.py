@@ -24,9 +24,10 @@ import pandas as pd
 
 from loper_analysis.checks import bool_column, require_columns, where
 from loper_analysis.checks import side as check_side
-from loper_analysis.constants import FLAGGED_EVENTS, JOINTS, PHASES, angle_column
+from loper_analysis.constants import FLAGGED_EVENTS, JOINTS, angle_column
 from loper_analysis.device.loadcell import perturbation_onsets
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
+from loper_analysis.gait.cycles import cycles_table
 from loper_analysis.gait.outliers import (
     IQR_WHISKER,
     MAX_OUTLIER_FRACTION,
@@ -345,48 +346,19 @@ def stride_tables(
     inside = (table["heel_strike_s"] >= t[0]) & (table["end_s"] <= t[-1])
     table = table[inside].reset_index(drop=True)
     values = angles[cols].to_numpy(float)
-    # frames left out of IK (too few markers) and angles no marker determined are NaN: such strides cannot be cut
-    complete = np.isfinite(values).all(axis=1)
-    whole = [bool(complete[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
     n_with_events = len(table)
-    dropped = [table.loc[[not w for w in whole], ["heel_strike_s", "end_s"]].assign(reason="ik_frames_left_out")]
-    if not all(whole):
-        log.info(
-            "%s: %d stride(s) with frames left out of IK (NaN angles) dropped", names["angles"], len(whole) - sum(whole)
-        )
-        table = table[whole].reset_index(drop=True)
-    table["stride"] = np.arange(len(table))
+    table, lost = _strides_without_ik_gaps(table, t, values, names["angles"])
+    dropped = [lost]
     force_n = None
     if force is not None:
         if len(force) != len(angles) or not np.allclose(force["time_s"].to_numpy(float), t, atol=1e-6):
             raise LoperInputError(f"{names['force']}: frames differ from the kinematics in {names['angles']}")
         force_n = force["force_measured_n"].to_numpy(float)
-        covered = np.isfinite(force_n)
-        ok = [bool(covered[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
-        if not all(ok):
-            lost = table.loc[[not k for k in ok], ["heel_strike_s", "end_s"]]
-            dropped.append(lost.assign(reason="outside_robot_log"))
-            span = t[covered]
-            log.warning(
-                "%s: %d of %d strides with events lie outside the robot log's span (%s of the trial's %.2f .. %.2f s) "
-                "and are dropped: is the robot log truncated?",
-                names["force"],
-                len(lost),
-                n_with_events,
-                f"{span[0]:.2f} .. {span[-1]:.2f} s" if span.size else "no frame",
-                t[0],
-                t[-1],
-            )
-            table = table[ok].reset_index(drop=True)
-            table["stride"] = np.arange(len(table))
-    table["perturbed"] = False
-    table["onset_s"] = np.nan
-    if force_n is not None and "perturbation" in force.columns:
-        onsets = perturbation_onsets(t, force["perturbation"].to_numpy(float))
-        for i, (a, b) in enumerate(zip(table.heel_strike_s, table.end_s)):
-            within = onsets[(onsets >= a) & (onsets < b)]
-            if within.size:
-                table.loc[i, ["perturbed", "onset_s"]] = (True, within[0])
+        table, lost = _strides_inside_robot_log(table, t, force_n, n_with_events, names["force"])
+        if lost is not None:
+            dropped.append(lost)
+    perturbation = None if force_n is None or "perturbation" not in force.columns else force["perturbation"]
+    table = _with_perturbations(table, t, perturbation)
     by_stride = normalise(t, values, table, "stride", n_points, source=names["angles"])
     joint_names = [c.split("_")[0] for c in cols]
     plain = ~table["perturbed"].to_numpy(bool)  # perturbed strides are the responses, judged in their window later
@@ -413,24 +385,7 @@ def stride_tables(
     out.loc[out["perturbed"], "reason"] = "perturbed"
     out["reason"] = out["reason"].fillna("")
     if force_n is not None:
-        # samples outside the robot log (NaN) belong to no stride kept above: the metrics need only the others
-        logged = np.isfinite(force_n)
-        if logged.sum() >= 2 or len(table):
-            metrics = force_phase_metrics(t[logged], force_n[logged], table, source=names["force"])
-        else:  # no stride and (almost) no robot log: the columns without rows
-            metrics = pd.DataFrame(
-                {
-                    "stride": np.empty(0, np.int64),
-                    "phase": np.empty(0, object),
-                    "rms_force_n": np.empty(0),
-                    "max_abs_force_n": np.empty(0),
-                }
-            )
-        wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
-        wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
-        # the same columns without any stride
-        wide = wide.reindex(columns=[f"{m}_{ph}_n" for m in ("rms_force", "max_abs_force") for ph in FORCE_PHASES])
-        out = out.merge(wide.reset_index(), on="stride")
+        out = out.merge(_force_metric_columns(t, force_n, table, names["force"]).reset_index(), on="stride")
     n_kept = int((~out["removed"] & ~out["perturbed"]).sum())
     log.info(
         "%s: %d strides, %d perturbed, %d removed as outliers, %d unperturbed kept",
@@ -443,22 +398,88 @@ def stride_tables(
     for r in out[out["removed"]].itertuples():
         log.info("stride %d removed: %s", r.stride, r.reason)
     too_few = not check_enough_strides(n_kept, names["angles"], min_valid)
-    cycles = []
-    for phase in PHASES:
-        arr = normalise(t, values, table, phase, n_points, source=names["angles"])
-        block = {
-            "stride": np.repeat(table["stride"].to_numpy(), n_points),
-            "phase": phase,
-            "point": np.tile(np.arange(n_points), len(table)),
-            "percent": np.tile(np.linspace(0.0, 100.0, n_points), len(table)),
-        }
-        for i, c in enumerate(cols):
-            block[c] = arr[:, :, i].ravel()
-        if force_n is not None:
-            block["force_n"] = normalise(t, force_n, table, phase, n_points, source=names["force"]).ravel()
-        cycles.append(pd.DataFrame(block))
+    cycles = cycles_table(t, values, cols, table, n_points, force_n, names)
     lost = pd.concat(dropped, ignore_index=True)[list(DROPPED_COLUMNS)]
-    return StrideTables(out, pd.concat(cycles, ignore_index=True), too_few, lost)
+    return StrideTables(out, cycles, too_few, lost)
+
+
+def _strides_without_ik_gaps(
+    table: pd.DataFrame, t: np.ndarray, values: np.ndarray, source: str
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The strides whose joint angles ``values`` (n_frames, 3; rad at ``t`` s) are finite from heel strike to
+    end, renumbered, and the others (``heel_strike_s``, ``end_s`` in s, ``reason`` ``ik_frames_left_out``)."""
+    # frames left out of IK (too few markers) and angles no marker determined are NaN: such strides cannot be cut
+    complete = np.isfinite(values).all(axis=1)
+    whole = [bool(complete[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
+    lost = table.loc[[not w for w in whole], ["heel_strike_s", "end_s"]].assign(reason="ik_frames_left_out")
+    if not all(whole):
+        log.info("%s: %d stride(s) with frames left out of IK (NaN angles) dropped", source, len(whole) - sum(whole))
+        table = table[whole].reset_index(drop=True)
+    table["stride"] = np.arange(len(table))
+    return table, lost
+
+
+def _strides_inside_robot_log(
+    table: pd.DataFrame, t: np.ndarray, force_n: np.ndarray, n_with_events: int, source: str
+) -> tuple[pd.DataFrame, pd.DataFrame | None]:
+    """The strides whose force ``force_n`` (n_frames,; N at ``t`` s, NaN outside the robot log) is finite from
+    heel strike to end, and the others (``heel_strike_s``, ``end_s``, ``reason`` ``outside_robot_log``; None
+    when every stride is inside), with a warning naming the share of the ``n_with_events`` strides lost."""
+    covered = np.isfinite(force_n)
+    ok = [bool(covered[(t >= a) & (t <= b)].all()) for a, b in zip(table.heel_strike_s, table.end_s)]
+    if all(ok):
+        return table, None
+    lost = table.loc[[not k for k in ok], ["heel_strike_s", "end_s"]]
+    span = t[covered]
+    log.warning(
+        "%s: %d of %d strides with events lie outside the robot log's span (%s of the trial's %.2f .. %.2f s) "
+        "and are dropped: is the robot log truncated?",
+        source,
+        len(lost),
+        n_with_events,
+        f"{span[0]:.2f} .. {span[-1]:.2f} s" if span.size else "no frame",
+        t[0],
+        t[-1],
+    )
+    table = table[ok].reset_index(drop=True)
+    table["stride"] = np.arange(len(table))
+    return table, lost.assign(reason="outside_robot_log")
+
+
+def _with_perturbations(table: pd.DataFrame, t: np.ndarray, perturbation: pd.Series | None) -> pd.DataFrame:
+    """The stride table with the columns ``perturbed`` and ``onset_s`` (the first perturbation onset in the
+    stride, s; NaN if none), from the 0/1 ``perturbation`` flag (n_frames,) at ``t`` (s; None: none perturbed)."""
+    table["perturbed"] = False
+    table["onset_s"] = np.nan
+    if perturbation is not None:
+        onsets = perturbation_onsets(t, perturbation.to_numpy(float))
+        for i, (a, b) in enumerate(zip(table.heel_strike_s, table.end_s)):
+            within = onsets[(onsets >= a) & (onsets < b)]
+            if within.size:
+                table.loc[i, ["perturbed", "onset_s"]] = (True, within[0])
+    return table
+
+
+def _force_metric_columns(t: np.ndarray, force_n: np.ndarray, table: pd.DataFrame, source: str) -> pd.DataFrame:
+    """RMS and largest absolute force (N) per stride (index) and phase (columns ``rms_force_{phase}_n``,
+    ``max_abs_force_{phase}_n``) from the force ``force_n`` (n_frames,; NaN outside the robot log) at ``t`` (s)."""
+    # samples outside the robot log (NaN) belong to no stride kept above: the metrics need only the others
+    logged = np.isfinite(force_n)
+    if logged.sum() >= 2 or len(table):
+        metrics = force_phase_metrics(t[logged], force_n[logged], table, source=source)
+    else:  # no stride and (almost) no robot log: the columns without rows
+        metrics = pd.DataFrame(
+            {
+                "stride": np.empty(0, np.int64),
+                "phase": np.empty(0, object),
+                "rms_force_n": np.empty(0),
+                "max_abs_force_n": np.empty(0),
+            }
+        )
+    wide = metrics.pivot(index="stride", columns="phase", values=["rms_force_n", "max_abs_force_n"])
+    wide.columns = [f"{m.removesuffix('_n')}_{ph}_n" for m, ph in wide.columns]
+    # the same columns without any stride
+    return wide.reindex(columns=[f"{m}_{ph}_n" for m in ("rms_force", "max_abs_force") for ph in FORCE_PHASES])
 
 
 def _mean_duration_s(table: pd.DataFrame, source: str) -> float:

@@ -420,13 +420,7 @@ def identify_impedance(
         raise LoperInputError(f"n_starts must be an integer >= 1, got {n_starts}")
     if ci_dof is not None and (int(ci_dof) != ci_dof or ci_dof < 1):
         raise LoperInputError(f"ci_dof must be an integer >= 1, got {ci_dof}")
-    rng = np.random.default_rng(seed)
-    starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
-    if extra_starts is not None:
-        extra = np.atleast_2d(np.asarray(extra_starts, dtype=float))
-        if extra.shape[1:] != (6,) or not np.all(np.isfinite(extra)):
-            raise LoperInputError(f"extra_starts must be finite with 6 values per row, got shape {extra.shape}")
-        starts = np.vstack([np.clip(extra, lb, ub), starts])
+    starts = _starts(lb, ub, n_starts, seed, extra_starts)
     batch = ResidualBatch(window, lb, ub)
     if not 0 <= merge_tolerance < 1:
         raise LoperInputError(f"merge_tolerance must lie in [0, 1), got {merge_tolerance}")
@@ -435,25 +429,7 @@ def identify_impedance(
     if not np.any(np.isfinite(costs)):
         raise LoperInputError("identify_impedance: the simulation diverged from every start")
     best = int(np.argmin(costs))
-
-    def fun(p):
-        return batch.residuals(p[None])[0]
-
-    def jac(p):
-        return batch.residuals_and_jacobians(p[None])[1][0]
-
-    polish = least_squares(
-        fun,
-        points[best],
-        jac=jac,
-        bounds=(lb, ub),
-        method="trf",
-        x_scale=batch.typical * 100,
-        ftol=1e-14,
-        xtol=1e-14,
-        gtol=1e-14,
-        max_nfev=int(polish_max_evaluations),
-    )
+    polish = _polish(batch, points[best], polish_max_evaluations)
     estimate = np.clip(polish.x, lb, ub)
     if float(np.sum(polish.fun**2)) > costs[best]:  # keep the better of the two (trf steps inside bounds)
         estimate = points[best]
@@ -469,28 +445,7 @@ def identify_impedance(
             f"polish status {polish.status} ({polish.message})"
         )
     )
-    # confidence intervals and correlations from the Jacobian. Without
-    # noise_cov: white residual noise plus the uncertainty of the initial
-    # state, propagated (sandwich). With noise_cov: the sandwich of the
-    # linearised estimator M = (W J)^+ W; noise_cov holds the initial
-    # state's share already.
-    m = r.size
-    dof = max(m - 6, 1)
-    s2 = float(np.sum(r**2)) / dof
-    JTJ = J.T @ J
-    A = np.linalg.pinv(JTJ, rcond=1e-13)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        if window.noise_cov is None:
-            JG = J.T @ initial_state_jacobian(window, estimate)
-            cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
-        else:
-            cov = sandwich_covariance(J, window.noise_cov, batch.weight)
-        sd = np.sqrt(np.clip(np.diag(cov), 0, None))
-        corr = cov / np.outer(sd, sd)
-    rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
-    if rank < 6:
-        sd = np.where(np.diag(JTJ) > 0, sd, np.inf)
-    sd = np.where(np.isnan(sd), np.inf, sd)
+    sd, corr, dof = _parameter_sd_and_correlation(window, batch, estimate, r, J)
     ci_low, ci_high = bounded_interval(estimate, sd, dof if ci_dof is None else int(ci_dof), lb, ub)
     model = window.measured - pe
     vaf = variance_accounted_for(window.measured, model)
@@ -516,3 +471,72 @@ def identify_impedance(
         measured=window.measured,
         model=model,
     )
+
+
+def _starts(
+    lb: np.ndarray, ub: np.ndarray, n_starts: int, seed: int | np.random.SeedSequence | None, extra_starts
+) -> np.ndarray:
+    """The starts (k + n_starts, 6) of the fit: ``extra_starts`` (k, 6) clipped to the bounds ``lb``, ``ub``
+    (6,), then ``n_starts`` drawn uniformly inside them (NumPy ``default_rng(seed)``)."""
+    rng = np.random.default_rng(seed)
+    starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
+    if extra_starts is not None:
+        extra = np.atleast_2d(np.asarray(extra_starts, dtype=float))
+        if extra.shape[1:] != (6,) or not np.all(np.isfinite(extra)):
+            raise LoperInputError(f"extra_starts must be finite with 6 values per row, got shape {extra.shape}")
+        starts = np.vstack([np.clip(extra, lb, ub), starts])
+    return starts
+
+
+def _polish(batch: ResidualBatch, start: np.ndarray, max_evaluations: int):
+    """SciPy's ``least_squares`` (trust-region reflective, inside the batch's bounds) from ``start`` (6,),
+    with the batch's residuals and Jacobians, to machine precision or ``max_evaluations`` residual evaluations."""
+
+    def fun(p):
+        return batch.residuals(p[None])[0]
+
+    def jac(p):
+        return batch.residuals_and_jacobians(p[None])[1][0]
+
+    return least_squares(
+        fun,
+        start,
+        jac=jac,
+        bounds=(batch.lb, batch.ub),
+        method="trf",
+        x_scale=batch.typical * 100,
+        ftol=1e-14,
+        xtol=1e-14,
+        gtol=1e-14,
+        max_nfev=int(max_evaluations),
+    )
+
+
+def _parameter_sd_and_correlation(
+    window: PreparedWindow, batch: ResidualBatch, estimate: np.ndarray, r: np.ndarray, J: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Standard deviations (6,; inf: no information) and correlation (6, 6) of the parameters at ``estimate``
+    from the residuals ``r`` (m,) and their Jacobian ``J`` (m, 6), and the residuals' degrees of freedom.
+
+    Without ``noise_cov``: white residual noise plus the uncertainty of the initial state, propagated
+    (sandwich). With ``noise_cov``: the sandwich of the linearised estimator M = (W J)^+ W; ``noise_cov``
+    holds the initial state's share already.
+    """
+    m = r.size
+    dof = max(m - 6, 1)
+    s2 = float(np.sum(r**2)) / dof
+    JTJ = J.T @ J
+    A = np.linalg.pinv(JTJ, rcond=1e-13)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if window.noise_cov is None:
+            JG = J.T @ initial_state_jacobian(window, estimate)
+            cov = s2 * A + A @ JG @ window.initial_state_cov @ JG.T @ A
+        else:
+            cov = sandwich_covariance(J, window.noise_cov, batch.weight)
+        sd = np.sqrt(np.clip(np.diag(cov), 0, None))
+        corr = cov / np.outer(sd, sd)
+    rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
+    if rank < 6:
+        sd = np.where(np.diag(JTJ) > 0, sd, np.inf)
+    sd = np.where(np.isnan(sd), np.inf, sd)
+    return sd, corr, dof

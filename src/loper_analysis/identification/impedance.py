@@ -55,15 +55,14 @@ from loper_analysis.identification import (
     check_interval_scatter,
     identify_impedance,
     joint_status,
-    prepare_window,
     refit_with_null_pairs,
     strongest_coupling,
 )
+from loper_analysis.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
 from loper_analysis.identification.pair_averaging import averaging_corrected_fit, pair_windows
 from loper_analysis.responses import (
     MAX_TRIAL_DEVIATION_RATIO,
     ResponseSettings,
-    null_pair_windows,
     subject_onset_response,
 )
 from loper_analysis.swing_leg.dynamics import SegmentParameters
@@ -476,49 +475,12 @@ def fit_onset(
         counts = pd.DataFrame([{"trial": "total", "status": "missing", "reason": "no trial of this onset"}])
         rows = status_rows(subject, onset_ms, "missing", "no trial of this onset", truth=truth)
         return OnsetFit(pd.DataFrame(), counts, rows, _no_curves())
-    inputs = []
-    for tr in trials:
-        t, X, labels = tr["markers"]
-        angles = tr["angles"]
-        if len(t) != len(angles) or not np.allclose(t, angles["time_s"].to_numpy(), atol=1e-6):
-            raise LoperInputError(f"{tr['name']}: marker frames differ from the joint angles' frames")
-        inputs.append(
-            {
-                "name": tr["name"],
-                "angles": angles,
-                "strides": tr["strides"],
-                "force": tr["force"],
-                "force_direction": brace_force_direction(X, labels, source=str(tr["name"])),
-                "force_native": tr.get("force_native"),
-            }
-        )
-    r, fallback = response, ""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", TooFewStridesWarning)  # the counts table carries the verdict
-        mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
-        n_candidates = int(series.get("null_pairs", {}).get("n_pairs", 0))
-        if r.counterfactual == "conditional" and n_candidates < identification.min_null_pairs:
-            # too few unperturbed strides in the onset's trials to judge the prediction: the study's matched stride
-            fallback = (
-                f"matched stride instead of the conditional counterfactual: {n_candidates} unperturbed stride(s) of "
-                f"the onset's trials, fewer than identification.min_null_pairs = {identification.min_null_pairs}"
-            )
-            log.warning("%s, onset %s ms: %s", subject, onset_ms, fallback)
-            r = replace(r, counterfactual="matched_stride")
-            mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
+    inputs = [_response_input(tr) for tr in trials]
+    mean, counts, series, r, fallback = _onset_response(inputs, onset_ms, subject, response, identification)
     total = counts[counts["trial"] == "total"].iloc[0]
     n_kept = int(total["n_kept"])
     if n_kept < r.min_strides:
-        reason = f"{n_kept} valid perturbed stride(s), fewer than {r.min_strides}: not fitted"
-        if int(total["n_too_short"]):
-            reason += "; " + too_short_reason(
-                int(total["n_too_short"]),
-                int(total["n_perturbed"]),
-                onset_ms,
-                r.window_after_s,
-                counts.attrs["longest_swing_after_onset_s"],
-            )
-        rows = status_rows(subject, onset_ms, "failed", reason, n_kept, truth)
+        rows = status_rows(subject, onset_ms, "failed", _not_fitted_reason(counts, onset_ms, r), n_kept, truth)
         return OnsetFit(mean, counts, rows, _no_curves())
     ident = identification
     options = dict(
@@ -528,19 +490,7 @@ def fit_onset(
         initial_state_span_s=r.initial_state_span_s,
         initial_state_degree=ident.initial_state_degree,
     )
-    window = prepare_window(
-        series["time_s"],
-        series["q_unperturbed"],
-        series["q_perturbed"],
-        params,
-        0.0,
-        force_unperturbed_n=series["force_unperturbed_n"],
-        force_perturbed_n=series["force_perturbed_n"],
-        force_time_s=series.get("force_time_s"),
-        pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
-        pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
-        **options,
-    )
+    window = mean_response_window(series, params, options)
     fit = identify_impedance(window, **ident.fit_options())
     averaging = np.zeros_like(window.measured)
     if ident.averaging_correction:
@@ -548,12 +498,7 @@ def fit_onset(
         window, fit, averaging = averaging_corrected_fit(window, windows, fit, **ident.fit_options())
     used, n_null, note = "white", 0, ""
     if ident.noise_model == "null_pairs":
-        loaded = {i["name"]: i for i in inputs}
-        pool = [loaded.get(str(t.get("name")), t) for t in null_trials] or inputs
-        if r.counterfactual == "conditional":  # the candidates' leave-one-out predictions
-            null = series["null_pairs"]
-        else:
-            null = null_pair_windows(pool, onset_ms, r, source=subject, max_trial_ratio=ident.max_null_trial_ratio)
+        null = fit_null_pairs(inputs, null_trials, series, onset_ms, r, ident.max_null_trial_ratio, subject)
         pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
         refit = refit_with_null_pairs(
             window,
@@ -584,11 +529,68 @@ def fit_onset(
         min_vaf_pct=ident.min_vaf_pct,
         plausible_ranges=ident.plausible_ranges,
     )
-    curves = pd.DataFrame(
-        {
-            "time_s": fit.time_s,
-            **{f"{j}_measured_rad": fit.measured[:, i] + averaging[:, i] for i, j in enumerate(JOINTS)},
-            **{f"{j}_model_rad": fit.model[:, i] + averaging[:, i] for i, j in enumerate(JOINTS)},
-        }
-    )
-    return OnsetFit(mean, counts, rows, curves, force_table(series))
+    return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series))
+
+
+def _response_input(trial: Mapping) -> dict:
+    """One trial as :func:`loper_analysis.responses.subject_onset_response` takes it: its frames, with the rods'
+    force direction (n, 2) from the brace markers of ``trial["markers"]`` (:func:`brace_force_direction`)."""
+    t, X, labels = trial["markers"]
+    angles = trial["angles"]
+    if len(t) != len(angles) or not np.allclose(t, angles["time_s"].to_numpy(), atol=1e-6):
+        raise LoperInputError(f"{trial['name']}: marker frames differ from the joint angles' frames")
+    return {
+        "name": trial["name"],
+        "angles": angles,
+        "strides": trial["strides"],
+        "force": trial["force"],
+        "force_direction": brace_force_direction(X, labels, source=str(trial["name"])),
+        "force_native": trial.get("force_native"),
+    }
+
+
+def _onset_response(
+    inputs: Sequence[Mapping],
+    onset_ms: int,
+    subject: str,
+    response: ResponseSettings,
+    identification: IdentificationSettings,
+) -> tuple[pd.DataFrame, pd.DataFrame, dict, ResponseSettings, str]:
+    """The mean response, counts and series of the onset (:func:`loper_analysis.responses.subject_onset_response`),
+    the response settings they were made with and why those differ from ``response`` ("" when they do not).
+
+    With the conditional counterfactual and fewer unperturbed strides than ``identification.min_null_pairs``,
+    the matched stride instead (a warning in the log).
+    """
+    r, fallback = response, ""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TooFewStridesWarning)  # the counts table carries the verdict
+        mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
+        n_candidates = int(series.get("null_pairs", {}).get("n_pairs", 0))
+        if r.counterfactual == "conditional" and n_candidates < identification.min_null_pairs:
+            # too few unperturbed strides in the onset's trials to judge the prediction: the study's matched stride
+            fallback = (
+                f"matched stride instead of the conditional counterfactual: {n_candidates} unperturbed stride(s) of "
+                f"the onset's trials, fewer than identification.min_null_pairs = {identification.min_null_pairs}"
+            )
+            log.warning("%s, onset %s ms: %s", subject, onset_ms, fallback)
+            r = replace(r, counterfactual="matched_stride")
+            mean, counts, series = subject_onset_response(inputs, onset_ms, r, source=f"{subject}, onset {onset_ms} ms")
+    return mean, counts, series, r, fallback
+
+
+def _not_fitted_reason(counts: pd.DataFrame, onset_ms: int, response: ResponseSettings) -> str:
+    """Why an onset with fewer kept pairs than ``response.min_strides`` (the counts' ``total`` row) is not fitted,
+    naming the strides too short for the window."""
+    total = counts[counts["trial"] == "total"].iloc[0]
+    n_kept = int(total["n_kept"])
+    reason = f"{n_kept} valid perturbed stride(s), fewer than {response.min_strides}: not fitted"
+    if int(total["n_too_short"]):
+        reason += "; " + too_short_reason(
+            int(total["n_too_short"]),
+            int(total["n_perturbed"]),
+            onset_ms,
+            response.window_after_s,
+            counts.attrs["longest_swing_after_onset_s"],
+        )
+    return reason

@@ -180,28 +180,9 @@ def joint_status(
     widths = high - low
     if not success:
         return "failed", f"optimiser did not converge: {message}"
-    failed, unidentifiable = [], []
-    if not np.isfinite(vaf_pct):
-        failed.append(f"VAF of the {joint} undefined: its measured response is zero over the fit window")
-    elif vaf_pct < min_vaf_pct:
-        failed.append(
-            f"VAF {vaf_pct:.3g} % below identification.min_vaf_pct = {min_vaf_pct:g} %: "
-            f"the model does not describe the {joint} response"
-        )
+    failed = _vaf_findings(joint, vaf_pct, min_vaf_pct)
     span = ub - lb
-    for i, (p, unit, key, what) in enumerate(_PARAMETERS):
-        tol = at_bound_fraction * span[i]
-        name = f"{p}_{joint} = {est[i]:.6g} {unit}"
-        if est[i] >= ub[i] - tol:
-            unidentifiable.append(
-                f"{name} at its upper bound {ub[i]:g} {unit} ({key}): the data ask for more "
-                f"{what} than the bounds allow"
-            )
-        elif est[i] <= lb[i] + tol and lb[i] != 0:
-            unidentifiable.append(
-                f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
-                f"less {what} than the bounds allow"
-            )
+    unidentifiable = _bound_findings(joint, est, lb, ub, at_bound_fraction)
     coupling = (None, None) if coupling is None else tuple(coupling)
     if len(coupling) != 2:
         raise LoperInputError(f"{joint}: coupling must hold K and D (2 entries), got {len(coupling)}")
@@ -235,3 +216,37 @@ def joint_status(
         )
     status = "failed" if failed else ("not_identifiable" if unidentifiable else "ok")
     return status, "; ".join(failed + unidentifiable)
+
+
+def _vaf_findings(joint: str, vaf_pct: float, min_vaf_pct: float) -> list[str]:
+    """Why the joint's fit failed by its VAF (%): undefined, or below ``min_vaf_pct``; empty when neither."""
+    failed = []
+    if not np.isfinite(vaf_pct):
+        failed.append(f"VAF of the {joint} undefined: its measured response is zero over the fit window")
+    elif vaf_pct < min_vaf_pct:
+        failed.append(
+            f"VAF {vaf_pct:.3g} % below identification.min_vaf_pct = {min_vaf_pct:g} %: "
+            f"the model does not describe the {joint} response"
+        )
+    return failed
+
+
+def _bound_findings(joint: str, est: np.ndarray, lb: np.ndarray, ub: np.ndarray, at_bound_fraction: float) -> list[str]:
+    """Per K and D (``est``, bounds ``lb``, ``ub``, each (2,)) on its upper bound, or on a lower bound other
+    than zero (within ``at_bound_fraction`` of the bound range): why it is not identifiable (rule 3)."""
+    found = []
+    span = ub - lb
+    for i, (p, unit, key, what) in enumerate(_PARAMETERS):
+        tol = at_bound_fraction * span[i]
+        name = f"{p}_{joint} = {est[i]:.6g} {unit}"
+        if est[i] >= ub[i] - tol:
+            found.append(
+                f"{name} at its upper bound {ub[i]:g} {unit} ({key}): the data ask for more "
+                f"{what} than the bounds allow"
+            )
+        elif est[i] <= lb[i] + tol and lb[i] != 0:
+            found.append(
+                f"{name} at its lower bound {lb[i]:g} {unit} ({key}): the data ask for "
+                f"less {what} than the bounds allow"
+            )
+    return found

@@ -198,14 +198,11 @@ def prepare_window(
         outside the data, forces at their own rate that do not cover the window.
     """
     t = _finite_times("time_s", time_s, 4)
-    dts = np.diff(t)
-    dt = float(np.mean(dts))
-    if dt <= 0 or np.max(np.abs(dts - dt)) > 1e-6 * dt:
-        i = int(np.argmax(np.abs(dts - dt)))
-        raise LoperInputError(f"time_s must be uniformly increasing; step at sample {i} is {dts[i]} s, mean {dt} s")
+    dt = _uniform_step_s(t)
     n = len(t)
     qu = _column("q_unperturbed", q_unperturbed, n, 4)
     qp = _column("q_perturbed", q_perturbed, n, 4)
+    tf = None
     if force_time_s is None:
         fu = _column("force_unperturbed_n", force_unperturbed_n, n, 2)
         fpm = _column("force_perturbed_n", force_perturbed_n, n, 2)
@@ -215,88 +212,21 @@ def prepare_window(
         fpm = _column("force_perturbed_n", force_perturbed_n, len(tf), 2, "force_time_s")
     pu = _column("pelvis_angle_unperturbed_rad", pelvis_angle_unperturbed_rad, n, 1)[:, 0]
     pp = _column("pelvis_angle_perturbed_rad", pelvis_angle_perturbed_rad, n, 1)[:, 0]
-    for name, v in (("onset_s", onset_s), ("window_before_s", window_before_s), ("window_after_s", window_after_s)):
-        if not np.isfinite(v):
-            raise LoperInputError(f"{name} must be finite, got {v}")
-    if window_before_s < 0 or window_after_s <= 0:
-        raise LoperInputError(
-            f"window must have window_before_s >= 0 and window_after_s > 0, got {window_before_s}, {window_after_s}"
-        )
-    if int(n_substeps) != n_substeps or n_substeps < 1:
-        raise LoperInputError(f"n_substeps must be an integer >= 1, got {n_substeps}")
-    n_substeps = int(n_substeps)
+    i0, i1, n_substeps = _window_samples(t, dt, onset_s, window_before_s, window_after_s, n_substeps)
     tol = 1e-9 * dt
-    i0 = int(np.ceil((onset_s - window_before_s - t[0]) / dt - 1e-9))
-    i1 = int(np.floor((onset_s + window_after_s - t[0]) / dt + 1e-9))
-    if onset_s - window_before_s < t[0] - tol or i1 > n - 1 or i0 < 0:
-        raise LoperInputError(
-            f"window {onset_s - window_before_s:.4f} .. {onset_s + window_after_s:.4f} s "
-            f"is longer than the data ({t[0]:.4f} .. {t[-1]:.4f} s)"
-        )
-    if i1 - i0 < 3:
-        raise LoperInputError(f"window holds only {i1 - i0 + 1} samples; need >= 4")
 
     # reference: cubic spline of the unperturbed coordinates, at RK4 stage times
     step = dt / n_substeps
     n_steps = (i1 - i0) * n_substeps
     ts = t[i0] + 0.5 * step * np.arange(2 * n_steps + 1)
     q_ref = qu if q_reference is None else _column("q_reference", q_reference, n, 4)
-    if reference_cutoff_hz is not None:
-        nyq = 0.5 / dt
-        if not 0 < reference_cutoff_hz < nyq:
-            raise LoperInputError(f"reference_cutoff_hz must lie in 0 .. {nyq} Hz, got {reference_cutoff_hz}")
-        from scipy.signal import (  # only here: scipy.signal costs ~1 s to import
-            butter,
-            filtfilt,
-        )
-
-        b, a = butter(2, reference_cutoff_hz / nyq)
-        q_ref = filtfilt(b, a, q_ref, axis=0)
-    spline = CubicSpline(t, q_ref, axis=0)
-    ref_q = spline(ts)
-    ref_qd = spline(ts, 1)
-    ref_qdd = spline(ts, 2)
-    if force_time_s is None:
-        force_u = np.stack([np.interp(ts, t, fu[:, j]) for j in range(2)], axis=-1)
-        force_p = per_step(np.stack([np.interp(ts, t, fpm[:, j]) for j in range(2)], axis=-1))
-    else:
-        tol_f = 1e-6 * step
-        if tf[0] > ts[0] + tol_f or tf[-1] < ts[-1] - tol_f:
-            raise LoperInputError(
-                f"the force at its own rate ({tf[0]:.4f} .. {tf[-1]:.4f} s) does not cover the fit window "
-                f"{ts[0]:.4f} .. {ts[-1]:.4f} s"
-            )
-        force_u = stage_force_means(tf, fu, ts)
-        force_p = per_step(force_u) + step_stage_forces(tf, fpm - fu, ts[0], step, n_steps)
+    ref_q, ref_qd, ref_qdd = _reference_coordinates(t, dt, q_ref, ts, reference_cutoff_hz)
+    force_u, force_p = _stage_forces(t, fu, fpm, tf, ts, step, n_steps)
     # u_ff - Ja(q_u)^T F_u = inverse dynamics with the unperturbed force
     feedforward = inverse_dynamics(ref_q, ref_qd, ref_qdd, params, force_u)
     dpel_spline = CubicSpline(t, pp - pu)
     dpel = np.stack([dpel_spline(ts), dpel_spline(ts, 1)], axis=-1)
-    # initial deviation: polynomial through the pre-onset differences, taken
-    # relative to the reference actually simulated
-    sel = (t >= onset_s - initial_state_span_s - tol) & (t <= onset_s + tol)
-    if int(initial_state_degree) != initial_state_degree or initial_state_degree < 0:
-        raise LoperInputError(f"initial_state_degree must be an integer >= 0, got {initial_state_degree}")
-    if sel.sum() < initial_state_degree + 1 or onset_s - initial_state_span_s < t[0] - tol:
-        raise LoperInputError(
-            f"initial state needs data from {onset_s - initial_state_span_s:.4f} s "
-            f"(initial_state_span_s = {initial_state_span_s}) with >= {initial_state_degree + 1} samples; "
-            f"data start at {t[0]:.4f} s"
-        )
-    V = initial_state_basis(t[sel] - t[i0], initial_state_degree)
-    coef, *_ = np.linalg.lstsq(V, (qp - qu)[sel], rcond=None)
-    e0 = coef[0]
-    ed0 = coef[1] if initial_state_degree >= 1 else np.zeros(4)
-    n_sel, n_coef = V.shape
-    state_cov = np.zeros((8, 8))
-    if n_sel > n_coef:
-        resid = (qp - qu)[sel] - V @ coef
-        var = np.sum(resid**2, axis=0) / (n_sel - n_coef)  # per coordinate
-        C = np.linalg.pinv(V.T @ V)
-        k = min(n_coef, 2)
-        for a in range(4):
-            idx = [a, 4 + a][:k]
-            state_cov[np.ix_(idx, idx)] = var[a] * C[:k, :k]
+    e0, ed0, state_cov = _initial_state(t, qp - qu, i0, onset_s, initial_state_span_s, initial_state_degree, tol)
     measured = joint_angles(qp[i0 : i1 + 1], pp[i0 : i1 + 1]) - joint_angles(qu[i0 : i1 + 1], pu[i0 : i1 + 1])
     return PreparedWindow(
         params=params,
@@ -317,6 +247,141 @@ def prepare_window(
         initial_state_span_s=float(initial_state_span_s),
         initial_state_degree=int(initial_state_degree),
     )
+
+
+def _uniform_step_s(t: np.ndarray) -> float:
+    """The mean step (s) of the sample times ``t`` (n,), checked to increase uniformly (to 1e-6 of the step)."""
+    dts = np.diff(t)
+    dt = float(np.mean(dts))
+    if dt <= 0 or np.max(np.abs(dts - dt)) > 1e-6 * dt:
+        i = int(np.argmax(np.abs(dts - dt)))
+        raise LoperInputError(f"time_s must be uniformly increasing; step at sample {i} is {dts[i]} s, mean {dt} s")
+    return dt
+
+
+def _window_samples(
+    t: np.ndarray, dt: float, onset_s: float, window_before_s: float, window_after_s: float, n_substeps: int
+) -> tuple[int, int, int]:
+    """First and last sample (indices into ``t``, step ``dt`` s) of the window ``onset_s - window_before_s ..
+    onset_s + window_after_s`` (s), checked to lie inside the data and hold >= 4 samples, and ``n_substeps``
+    checked to be an integer >= 1."""
+    for name, v in (("onset_s", onset_s), ("window_before_s", window_before_s), ("window_after_s", window_after_s)):
+        if not np.isfinite(v):
+            raise LoperInputError(f"{name} must be finite, got {v}")
+    if window_before_s < 0 or window_after_s <= 0:
+        raise LoperInputError(
+            f"window must have window_before_s >= 0 and window_after_s > 0, got {window_before_s}, {window_after_s}"
+        )
+    if int(n_substeps) != n_substeps or n_substeps < 1:
+        raise LoperInputError(f"n_substeps must be an integer >= 1, got {n_substeps}")
+    n_substeps = int(n_substeps)
+    n = len(t)
+    tol = 1e-9 * dt
+    i0 = int(np.ceil((onset_s - window_before_s - t[0]) / dt - 1e-9))
+    i1 = int(np.floor((onset_s + window_after_s - t[0]) / dt + 1e-9))
+    if onset_s - window_before_s < t[0] - tol or i1 > n - 1 or i0 < 0:
+        raise LoperInputError(
+            f"window {onset_s - window_before_s:.4f} .. {onset_s + window_after_s:.4f} s "
+            f"is longer than the data ({t[0]:.4f} .. {t[-1]:.4f} s)"
+        )
+    if i1 - i0 < 3:
+        raise LoperInputError(f"window holds only {i1 - i0 + 1} samples; need >= 4")
+    return i0, i1, n_substeps
+
+
+def _reference_coordinates(
+    t: np.ndarray, dt: float, q_ref: np.ndarray, stage_time_s: np.ndarray, reference_cutoff_hz: float | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The reference coordinates (m, rad) and their first and second derivatives, each (n_stage, 4) at the
+    stage times: the cubic spline through ``q_ref`` (n, 4) at ``t`` (n,; step ``dt`` s), low-pass filtered
+    first (2nd-order zero-phase Butterworth) when ``reference_cutoff_hz`` is given."""
+    if reference_cutoff_hz is not None:
+        nyq = 0.5 / dt
+        if not 0 < reference_cutoff_hz < nyq:
+            raise LoperInputError(f"reference_cutoff_hz must lie in 0 .. {nyq} Hz, got {reference_cutoff_hz}")
+        from scipy.signal import (  # only here: scipy.signal costs ~1 s to import
+            butter,
+            filtfilt,
+        )
+
+        b, a = butter(2, reference_cutoff_hz / nyq)
+        q_ref = filtfilt(b, a, q_ref, axis=0)
+    spline = CubicSpline(t, q_ref, axis=0)
+    return spline(stage_time_s), spline(stage_time_s, 1), spline(stage_time_s, 2)
+
+
+def _stage_forces(
+    t: np.ndarray,
+    force_u: np.ndarray,
+    force_p: np.ndarray,
+    force_time_s: np.ndarray | None,
+    stage_time_s: np.ndarray,
+    step_s: float,
+    n_steps: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The unperturbed force at the stage times (n_stage, 2) and the perturbed force at the four stages of every
+    RK4 step (n_steps, 4, 2) of ``step_s`` s, N, world x/y.
+
+    ``force_u``, ``force_p``: the forces at ``t`` (n, 2), interpolated linearly; with ``force_time_s`` (k,) the
+    forces (k, 2) at their own rate, which must cover the stage times (:func:`stage_force_means`,
+    :func:`step_stage_forces`).
+    """
+    ts = stage_time_s
+    if force_time_s is None:
+        stage_u = np.stack([np.interp(ts, t, force_u[:, j]) for j in range(2)], axis=-1)
+        return stage_u, per_step(np.stack([np.interp(ts, t, force_p[:, j]) for j in range(2)], axis=-1))
+    tf, step = force_time_s, step_s
+    tol_f = 1e-6 * step
+    if tf[0] > ts[0] + tol_f or tf[-1] < ts[-1] - tol_f:
+        raise LoperInputError(
+            f"the force at its own rate ({tf[0]:.4f} .. {tf[-1]:.4f} s) does not cover the fit window "
+            f"{ts[0]:.4f} .. {ts[-1]:.4f} s"
+        )
+    stage_u = stage_force_means(tf, force_u, ts)
+    return stage_u, per_step(stage_u) + step_stage_forces(tf, force_p - force_u, ts[0], step, n_steps)
+
+
+def _initial_state(
+    t: np.ndarray,
+    deviation: np.ndarray,
+    i0: int,
+    onset_s: float,
+    initial_state_span_s: float,
+    initial_state_degree: int,
+    tol: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The coordinate deviation (4,) and its rate (4,) at window start (sample ``i0``) and their covariance (8, 8).
+
+    From a least-squares polynomial of ``initial_state_degree`` through the perturbed-minus-unperturbed
+    coordinates ``deviation`` (n, 4; m, rad) at ``t`` (n,) over the last ``initial_state_span_s`` (s) up to
+    the onset (``tol`` s of slack); the covariance from the scatter about it (zero without spare samples).
+    """
+    # initial deviation: polynomial through the pre-onset differences, taken
+    # relative to the reference actually simulated
+    sel = (t >= onset_s - initial_state_span_s - tol) & (t <= onset_s + tol)
+    if int(initial_state_degree) != initial_state_degree or initial_state_degree < 0:
+        raise LoperInputError(f"initial_state_degree must be an integer >= 0, got {initial_state_degree}")
+    if sel.sum() < initial_state_degree + 1 or onset_s - initial_state_span_s < t[0] - tol:
+        raise LoperInputError(
+            f"initial state needs data from {onset_s - initial_state_span_s:.4f} s "
+            f"(initial_state_span_s = {initial_state_span_s}) with >= {initial_state_degree + 1} samples; "
+            f"data start at {t[0]:.4f} s"
+        )
+    V = initial_state_basis(t[sel] - t[i0], initial_state_degree)
+    coef, *_ = np.linalg.lstsq(V, deviation[sel], rcond=None)
+    e0 = coef[0]
+    ed0 = coef[1] if initial_state_degree >= 1 else np.zeros(4)
+    n_sel, n_coef = V.shape
+    state_cov = np.zeros((8, 8))
+    if n_sel > n_coef:
+        resid = deviation[sel] - V @ coef
+        var = np.sum(resid**2, axis=0) / (n_sel - n_coef)  # per coordinate
+        C = np.linalg.pinv(V.T @ V)
+        k = min(n_coef, 2)
+        for a in range(4):
+            idx = [a, 4 + a][:k]
+            state_cov[np.ix_(idx, idx)] = var[a] * C[:k, :k]
+    return e0, ed0, state_cov
 
 
 def stage_times_s(window: PreparedWindow) -> np.ndarray:

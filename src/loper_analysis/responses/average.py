@@ -30,6 +30,7 @@ from loper_analysis.responses.matching import match_in_window, stride_table, too
 from loper_analysis.responses.native_force import native_force_rate_hz, native_force_windows
 from loper_analysis.responses.sampling import TIME_TOLERANCE_S
 from loper_analysis.responses.windows import (
+    AnalysisGrid,
     ResponseSettings,
     analysis_grid,
     paired_windows,
@@ -240,10 +241,82 @@ def subject_onset_response(
         duplicate trial names.
     """
     analysis = analysis_grid(trials, onset_ms, settings, side, source)
-    onset_s, before, after, initial, start, grid = analysis
+    _, before, after, initial, _, grid = analysis
     min_n = int(number("min_strides", settings.min_strides, source, minimum=0.0))
-    rate_hz, whisker, max_fraction = settings.rate_hz, settings.whisker, settings.max_fraction
+    whisker, max_fraction = settings.whisker, settings.max_fraction
 
+    found = _trial_windows(trials, analysis, settings, side, method, candidate_within_swing, source)
+    per_trial, pairs, native_rate = found["per_trial"], found["pairs"], found["native_rate"]
+    win = pooled_windows(found["windows"])
+    label = f"{source} onset {onset_ms:g} ms" if source else f"onset {onset_ms:g} ms"
+    pair_table = _pair_table(pairs)
+    force_pairs = None
+    if native_rate is not None:
+        force_pairs = tuple(np.concatenate([w[i] for w in found["force_windows"]]) for i in range(2))
+    conditional = None
+    if settings.counterfactual == "conditional":
+        delays = pair_table["onset_s"].to_numpy(float) - np.concatenate([m["toe_off_s"].to_numpy(float) for m in pairs])
+        conditional = _conditional(
+            found["pool"], win, force_pairs, pair_table, delays, analysis, settings, native_rate, label
+        )
+        win, force_pairs, pair_table = conditional["win"], conditional["force_pairs"], conditional["pair_table"]
+        for rec in per_trial:
+            rec["n_no_match"] += conditional["unpredicted"].get(rec["trial"], 0)
+    joints_p, joints_u = win["joints"]
+    verdict = window_outliers(joints_p - joints_u, grid, before, after, whisker, max_fraction, JOINTS, label)
+    pair_table = pair_table.assign(removed=verdict["removed"].to_numpy(), reason=verdict["reason"].to_numpy())
+    keep = ~pair_table["removed"].to_numpy(bool)
+    n_pairs = int(keep.sum())
+
+    rows = _count_rows(per_trial, pair_table, verdict, min_n, before, after)
+    counts = _counts_table(rows, pair_table, verdict, found["rooms"], onset_ms, source)
+    check_enough_strides(n_pairs, label or "perturbation response", min_n)
+    total = rows[-1]
+    log.info(
+        "%s: %d perturbed, %d too short, %d without match, %d outliers, %d kept",
+        label,
+        total["n_perturbed"],
+        total["n_too_short"],
+        total["n_no_match"],
+        total["n_outliers"],
+        total["n_kept"],
+    )
+
+    kept = {key: (p[keep], u[keep]) for key, (p, u) in win.items()}
+    response = _response_table(kept, n_pairs, analysis, onset_ms, source)
+    series = _mean_series(kept, n_pairs, force_pairs, keep, analysis, native_rate)
+    if conditional is not None and conditional["null"] is not None:
+        series["null_pairs"], weights = _null_pair_series(conditional, keep, analysis, settings, label)
+        series["pairs"].update(weights)
+    series.update(
+        {"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial, "n_pairs": n_pairs}
+    )
+    return response, counts, series
+
+
+def _trial_windows(
+    trials: Sequence[Mapping],
+    analysis: AnalysisGrid,
+    settings: ResponseSettings,
+    side: str,
+    method: str,
+    candidate_within_swing: bool,
+    source: str,
+) -> dict:
+    """The perturbed strides of every trial matched and cut into windows (:func:`subject_onset_response`).
+
+    Returns
+    -------
+    dict
+        ``per_trial``: per trial its name and counts of perturbed, too short and unmatched strides;
+        ``pairs``: per trial its match table (:func:`match_in_window`) with a ``trial`` column;
+        ``windows``: per trial its :func:`paired_windows`; ``rooms``: per perturbed stride the swing time
+        (s) left after its onset; ``force_windows``: per trial the forces at the robot rate
+        (:func:`native_force_windows`, empty without ``force_native``); ``pool``: per trial ``(name, time,
+        columns, stride table, (native force table, force direction (n, 2)) or None)``; ``native_rate``:
+        the robot rate (Hz), None without ``force_native``.
+    """
+    onset_s, _, after, _, start, _ = analysis
     per_trial, pairs, windows, rooms, force_windows, pool = [], [], [], [], [], []
     native_rate = None
     for k, trial in enumerate(trials):
@@ -266,7 +339,9 @@ def subject_onset_response(
         )
         for s, why in matches.attrs["unmatched"].items():
             log.info("%s: perturbed stride %s has no match: %s", where_s, s, why)
-        windows.append(paired_windows(t, columns, matches, start, after, rate_hz, method=method, source=where_s))
+        windows.append(
+            paired_windows(t, columns, matches, start, after, settings.rate_hz, method=method, source=where_s)
+        )
         pool.append((name, t, columns, table, None if native is None else (native[0], native[2])))
         if native is not None:
             table, where_n, direction = native
@@ -286,30 +361,36 @@ def subject_onset_response(
                 "n_no_match": len(matches.attrs["unmatched"]),
             }
         )
+    return {
+        "per_trial": per_trial,
+        "pairs": pairs,
+        "windows": windows,
+        "rooms": rooms,
+        "force_windows": force_windows,
+        "pool": pool,
+        "native_rate": native_rate,
+    }
 
-    win = pooled_windows(windows)
-    label = f"{source} onset {onset_ms:g} ms" if source else f"onset {onset_ms:g} ms"
+
+def _pair_table(pairs: Sequence[pd.DataFrame]) -> pd.DataFrame:
+    """One row per matched pair of all trials (``trial``, ``stride``, ``matched_stride``, ``onset_s``,
+    ``matched_anchor_s`` in s, ``rmsd_rad``), without attrs; the first trial's empty columns when none matched."""
     pair_columns = ["trial", "stride", "matched_stride", "onset_s", "matched_anchor_s", "rmsd_rad"]
     filled = [m[pair_columns] for m in pairs if len(m)]
     pair_table = (pd.concat(filled, ignore_index=True) if filled else pairs[0][pair_columns]).reset_index(drop=True)
     pair_table.attrs = {}
-    force_pairs = None
-    if native_rate is not None:
-        force_pairs = tuple(np.concatenate([w[i] for w in force_windows]) for i in range(2))
-    conditional = None
-    if settings.counterfactual == "conditional":
-        delays = pair_table["onset_s"].to_numpy(float) - np.concatenate([m["toe_off_s"].to_numpy(float) for m in pairs])
-        conditional = _conditional(pool, win, force_pairs, pair_table, delays, analysis, settings, native_rate, label)
-        win, force_pairs, pair_table = conditional["win"], conditional["force_pairs"], conditional["pair_table"]
-        for rec in per_trial:
-            rec["n_no_match"] += conditional["unpredicted"].get(rec["trial"], 0)
-    joints_p, joints_u = win["joints"]
-    verdict = window_outliers(joints_p - joints_u, grid, before, after, whisker, max_fraction, JOINTS, label)
-    pair_table = pair_table.assign(removed=verdict["removed"].to_numpy(), reason=verdict["reason"].to_numpy())
-    keep = ~pair_table["removed"].to_numpy(bool)
-    n_pairs = int(keep.sum())
+    return pair_table
 
-    # counts
+
+def _count_rows(
+    per_trial: Sequence[dict], pair_table: pd.DataFrame, verdict: pd.DataFrame, min_n: int, before: float, after: float
+) -> list[dict]:
+    """The rows of the counts table (:data:`COUNT_COLUMNS`): one per trial, then ``total``.
+
+    ``pair_table`` holds the pairs' ``trial`` and ``removed``; ``verdict`` is :func:`window_outliers`'
+    (its ``attrs["judged"]``); ``before`` and ``after`` (s) are the analysis window, quoted in reasons.
+    """
+    keep = ~pair_table["removed"].to_numpy(bool)
     judged = bool(verdict.attrs["judged"])
     rows = []
     for rec in per_trial:
@@ -336,28 +417,38 @@ def subject_onset_response(
             parts.append(verdict["reason"].iloc[0] if len(verdict) else "outliers not judged: no pair")
         r["status"] = "ok" if r["n_kept"] >= min_n else "too_few_strides"
         r["reason"] = "; ".join(parts)
+    return rows
+
+
+def _counts_table(
+    rows: Sequence[dict],
+    pair_table: pd.DataFrame,
+    verdict: pd.DataFrame,
+    rooms: Sequence[float],
+    onset_ms: float,
+    source: str,
+) -> pd.DataFrame:
+    """The counts table of :func:`subject_onset_response` from its rows (:func:`_count_rows`), with its attrs;
+    ``rooms``: per perturbed stride the swing time (s) left after its onset."""
     counts = pd.DataFrame(rows, columns=list(COUNT_COLUMNS))
-    check_enough_strides(n_pairs, label or "perturbation response", min_n)
     finite_rooms = [r for r in rooms if np.isfinite(r)]
     counts.attrs = {
         "pairs": pair_table,
-        "outliers_judged": judged,
+        "outliers_judged": bool(verdict.attrs["judged"]),
         "onset_ms": float(onset_ms),
         "source": source,
         "longest_swing_after_onset_s": max(finite_rooms) if finite_rooms else float("nan"),
     }
-    log.info(
-        "%s: %d perturbed, %d too short, %d without match, %d outliers, %d kept",
-        label,
-        total["n_perturbed"],
-        total["n_too_short"],
-        total["n_no_match"],
-        total["n_outliers"],
-        total["n_kept"],
-    )
+    return counts
 
-    # averages over the kept pairs
-    kept = {key: (p[keep], u[keep]) for key, (p, u) in win.items()}
+
+def _response_table(kept: Mapping, n_pairs: int, analysis: AnalysisGrid, onset_ms: float, source: str) -> pd.DataFrame:
+    """The response table of :func:`subject_onset_response`: means and SDs over the kept pairs on the grid.
+
+    ``kept``: per window key the kept pairs' perturbed and unperturbed windows (n_pairs, n_grid, ...);
+    joint angles in rad, forces in N.
+    """
+    _, before, after, initial, _, grid = analysis
     jp, ju = kept["joints"]
     d_mean, d_sd = mean_and_sd(jp - ju)
     fp, fu = kept["force"]
@@ -382,7 +473,21 @@ def subject_onset_response(
         "after_s": after,
         "initial_span_s": initial,
     }
+    return response
 
+
+def _mean_series(
+    kept: Mapping,
+    n_pairs: int,
+    force_pairs: tuple[np.ndarray, np.ndarray] | None,
+    keep: np.ndarray,
+    analysis: AnalysisGrid,
+    native_rate: float | None,
+) -> dict:
+    """The series of :func:`subject_onset_response` (means over the kept pairs) with the kept pairs one by one
+    under ``pairs``; the forces at the robot rate (``native_rate``, Hz) when ``force_pairs`` (all pairs'
+    perturbed and unperturbed forces, (n, k, 2) in N) are given, ``keep`` (n,) selecting the kept pairs."""
+    _, _, after, _, start, grid = analysis
     series: dict = {"time_s": grid.copy(), "onset_s": 0.0}
     pair_series: dict = {"time_s": grid.copy(), "n_pairs": n_pairs}
     for what, i in (("perturbed", 0), ("unperturbed", 1)):
@@ -400,19 +505,26 @@ def subject_onset_response(
         for i, what in enumerate(("perturbed", "unperturbed")):
             series[f"force_{what}_n"] = mean_and_sd(force_pairs[i][keep])[0]
             pair_series[f"force_{what}_n"] = force_pairs[i][keep]
-    if conditional is not None and conditional["null"] is not None:
-        null = conditional["null"]
-        d = null["own"]["joints"] - null["predicted"]["joints"]
-        null_keep = ~window_outliers(d, grid, before, after, whisker, max_fraction, JOINTS, f"{label} null pairs")[
-            "removed"
-        ].to_numpy(bool)
-        series["null_pairs"] = conditional_null_pair_windows(null, grid, before, after, null_keep)
-        series["null_pairs"]["unit_scatter_variance"] = unit_scatter_variance(null["weights"], null_keep)
-        if n_pairs:
-            kept_weights = pair_series["prediction_weights"] = conditional["weights"][keep]
-            pair_series["covariance_scale"] = covariance_scale(kept_weights)
-            series["null_pairs"]["covariance_scale"] = covariance_scale(kept_weights, null["weights"], null_keep)
-    series.update(
-        {"window_before_s": before, "window_after_s": after, "initial_state_span_s": initial, "n_pairs": n_pairs}
-    )
-    return response, counts, series
+    return series
+
+
+def _null_pair_series(
+    conditional: Mapping, keep: np.ndarray, analysis: AnalysisGrid, settings: ResponseSettings, label: str
+) -> tuple[dict, dict]:
+    """The conditional counterfactual's null pairs (:func:`conditional_null_pair_windows`, those kept by
+    :func:`window_outliers`, with their unit scatter variance and, with kept pairs, covariance scale) and the
+    kept pairs' prediction weights (n_pairs, N) and covariance scale (empty without kept pairs)."""
+    _, before, after, _, _, grid = analysis
+    null = conditional["null"]
+    d = null["own"]["joints"] - null["predicted"]["joints"]
+    null_keep = ~window_outliers(
+        d, grid, before, after, settings.whisker, settings.max_fraction, JOINTS, f"{label} null pairs"
+    )["removed"].to_numpy(bool)
+    null_pairs = conditional_null_pair_windows(null, grid, before, after, null_keep)
+    null_pairs["unit_scatter_variance"] = unit_scatter_variance(null["weights"], null_keep)
+    weights: dict = {}
+    if int(keep.sum()):
+        kept_weights = weights["prediction_weights"] = conditional["weights"][keep]
+        weights["covariance_scale"] = covariance_scale(kept_weights)
+        null_pairs["covariance_scale"] = covariance_scale(kept_weights, null["weights"], null_keep)
+    return null_pairs, weights

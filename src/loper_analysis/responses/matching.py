@@ -15,6 +15,7 @@ clock; angles in rad.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -222,16 +223,7 @@ def match_unperturbed(
     perturbed, onset = _perturbed_onsets(table, source)
     removed = bool_column(table, "removed", source, what="strides")
     if null_pairs:
-        if onset_after_toe_off_s is None:
-            raise LoperInputError(f"{where(source)}null_pairs needs onset_after_toe_off_s")
-        delay = number("onset_after_toe_off_s", onset_after_toe_off_s, source, minimum=0.0)
-        table = table.assign(
-            onset_s=np.where(perturbed, np.nan, table["toe_off_s"].to_numpy(float) + delay),
-            perturbed=~perturbed & ~removed,
-            removed=removed | perturbed,
-        )
-        perturbed, onset = _perturbed_onsets(table, source)
-        removed = bool_column(table, "removed", source, what="strides")
+        table, perturbed, onset, removed = _as_null_pairs(table, perturbed, removed, onset_after_toe_off_s, source)
     short = (
         too_short(table, onset_after_toe_off_s, window_after_s, source)
         if window_after_s is not None
@@ -246,17 +238,10 @@ def match_unperturbed(
     tol = sampler.tol
     unmatched: dict[int, str] = {}
 
-    # matching frames of each perturbed stride, padded to the longest
     onset_p, toe_p = onset[p], toe_off[p]
-    first = np.searchsorted(t, onset_p - before - tol, side="left")
-    count = np.searchsorted(t, onset_p + tol, side="right") - first
-    m = max(int(count.max()) if p.size else 0, 1)
-    valid = np.arange(m) < count[:, None]  # (np, m)
-    idx = np.minimum(first[:, None] + np.arange(m), t.size - 1)
-    rel = np.where(valid, t[idx] - onset_p[:, None], 0.0)
-    vp = v2[idx]  # (np, m, k)
+    frames = _matching_frames(t, v2, onset_p, before, tol)
     own = sampler.run(onset_p + lo_span, onset_p + hi_span) >= 0
-    own &= (count > 0) & np.where(valid[..., None], np.isfinite(vp), True).all(axis=(1, 2))
+    own &= (frames.count > 0) & np.where(frames.valid[..., None], np.isfinite(frames.values), True).all(axis=(1, 2))
     for i in np.flatnonzero(~own):
         unmatched[int(stride_no[p[i]])] = (
             f"its window {onset_p[i] + lo_span:.4f} .. {onset_p[i] + hi_span:.4f} s leaves the finite data "
@@ -270,16 +255,7 @@ def match_unperturbed(
         ok &= anchors + hi_span <= end[c][None, :] + tol
     if null_pairs:
         ok &= p[:, None] != c[None, :]
-    targets = anchors[:, :, None] + rel[:, None, :]  # (np, nc, m)
-    sq = np.zeros(targets.shape)
-    if ok.any():
-        runs = sampler.run(anchors[ok] + lo_span, anchors[ok] + hi_span)
-        vc = sampler(targets[ok], runs)  # (n_ok, m, k)
-        diff = vc - np.broadcast_to(vp[:, None], ok.shape + vp.shape[1:])[ok]
-        sq[ok] = np.sum(diff**2, axis=-1)
-    n_values = np.maximum(count, 1)[:, None] * v2.shape[1]
-    rmsd = np.where(ok, np.sqrt(np.sum(np.where(valid[:, None, :], sq, 0.0), axis=-1) / n_values), np.inf)
-    best = np.argmin(rmsd, axis=1) if c.size else np.zeros(p.size, dtype=int)
+    rmsd = _candidate_rmsd(sampler, anchors, ok, (lo_span, hi_span), frames)
     n_cand = ok.sum(axis=1)
     for i in np.flatnonzero(own & (n_cand == 0)):
         unmatched[int(stride_no[p[i]])] = (
@@ -290,19 +266,7 @@ def match_unperturbed(
     if unmatched and missing == "raise":
         s, why = next(iter(unmatched.items()))
         raise LoperInputError(f"{where(source)}perturbed stride {s} has no unperturbed match: {why}")
-    rows = np.flatnonzero(hit)
-    out = pd.DataFrame(
-        {
-            "stride": stride_no[p[rows]],
-            "onset_s": onset_p[rows],
-            "toe_off_s": toe_p[rows],
-            "matched_stride": stride_no[c][best[rows]] if c.size else np.empty(0, dtype=stride_no.dtype),
-            "matched_anchor_s": anchors[rows, best[rows]] if c.size else np.empty(0),
-            "rmsd_rad": rmsd[rows, best[rows]] if c.size else np.empty(0),
-            "n_candidates": n_cand[rows].astype(np.int64),
-        },
-        columns=list(MATCH_COLUMNS),
-    )
+    out = _match_table(stride_no[p], stride_no[c], hit, onset_p, toe_p, anchors, rmsd, n_cand)
     out.attrs.update(
         {
             "source": source,
@@ -313,6 +277,105 @@ def match_unperturbed(
         }
     )
     return out
+
+
+def _as_null_pairs(
+    table: pd.DataFrame,
+    perturbed: np.ndarray,
+    removed: np.ndarray,
+    onset_after_toe_off_s: float | None,
+    source: str,
+) -> tuple[pd.DataFrame, np.ndarray, np.ndarray, np.ndarray]:
+    """The stride table with the unperturbed strides as if perturbed ``onset_after_toe_off_s`` (s) after their
+    toe-off and the perturbed ones removed, and its perturbed mask, onsets (s) and removed mask (each (n,))."""
+    if onset_after_toe_off_s is None:
+        raise LoperInputError(f"{where(source)}null_pairs needs onset_after_toe_off_s")
+    delay = number("onset_after_toe_off_s", onset_after_toe_off_s, source, minimum=0.0)
+    table = table.assign(
+        onset_s=np.where(perturbed, np.nan, table["toe_off_s"].to_numpy(float) + delay),
+        perturbed=~perturbed & ~removed,
+        removed=removed | perturbed,
+    )
+    perturbed, onset = _perturbed_onsets(table, source)
+    removed = bool_column(table, "removed", source, what="strides")
+    return table, perturbed, onset, removed
+
+
+class _Frames(NamedTuple):
+    """The matching frames of each perturbed stride, padded to the longest (m frames).
+
+    ``count`` (np,): frames of each; ``valid`` (np, m): the real ones; ``rel`` (np, m): their times relative to
+    the onset (s; 0 for padding); ``values`` (np, m, k): the signals at them.
+    """
+
+    count: np.ndarray
+    valid: np.ndarray
+    rel: np.ndarray
+    values: np.ndarray
+
+
+def _matching_frames(t: np.ndarray, v2: np.ndarray, onset_p: np.ndarray, before: float, tol: float) -> _Frames:
+    """The frames of ``t`` (s) from ``before`` (s) before each onset ``onset_p`` (np,) to it (``tol`` s of slack),
+    with the signals ``v2`` (n_frames, k) there."""
+    first = np.searchsorted(t, onset_p - before - tol, side="left")
+    count = np.searchsorted(t, onset_p + tol, side="right") - first
+    m = max(int(count.max()) if onset_p.size else 0, 1)
+    valid = np.arange(m) < count[:, None]  # (np, m)
+    idx = np.minimum(first[:, None] + np.arange(m), t.size - 1)
+    rel = np.where(valid, t[idx] - onset_p[:, None], 0.0)
+    return _Frames(count, valid, rel, v2[idx])
+
+
+def _candidate_rmsd(
+    sampler: SplineSampler, anchors: np.ndarray, ok: np.ndarray, span: tuple[float, float], frames: _Frames
+) -> np.ndarray:
+    """RMSD (np, nc) over the matching frames and signals between each perturbed stride and each candidate
+    aligned at ``anchors`` (np, nc; s), sampled by cubic spline; inf where ``ok`` (np, nc) is False (the
+    candidate's ``span`` (s) around its anchor leaves the data or it is not a candidate)."""
+    lo_span, hi_span = span
+    vp = frames.values  # (np, m, k)
+    targets = anchors[:, :, None] + frames.rel[:, None, :]  # (np, nc, m)
+    sq = np.zeros(targets.shape)
+    if ok.any():
+        runs = sampler.run(anchors[ok] + lo_span, anchors[ok] + hi_span)
+        vc = sampler(targets[ok], runs)  # (n_ok, m, k)
+        diff = vc - np.broadcast_to(vp[:, None], ok.shape + vp.shape[1:])[ok]
+        sq[ok] = np.sum(diff**2, axis=-1)
+    n_values = np.maximum(frames.count, 1)[:, None] * vp.shape[2]
+    return np.where(ok, np.sqrt(np.sum(np.where(frames.valid[:, None, :], sq, 0.0), axis=-1) / n_values), np.inf)
+
+
+def _match_table(
+    perturbed_strides: np.ndarray,
+    candidate_strides: np.ndarray,
+    hit: np.ndarray,
+    onset_p: np.ndarray,
+    toe_p: np.ndarray,
+    anchors: np.ndarray,
+    rmsd: np.ndarray,
+    n_cand: np.ndarray,
+) -> pd.DataFrame:
+    """The table of :func:`match_unperturbed` (:data:`MATCH_COLUMNS`): per perturbed stride with a match
+    (``hit`` (np,)) the candidate of least ``rmsd`` (np, nc) and its anchor (``anchors`` (np, nc), s).
+
+    ``perturbed_strides`` (np,), ``candidate_strides`` (nc,): the stride numbers; ``onset_p``, ``toe_p`` (np,):
+    the perturbed strides' onsets and toe-offs (s); ``n_cand`` (np,): the candidates that covered the span.
+    """
+    best = np.argmin(rmsd, axis=1) if candidate_strides.size else np.zeros(perturbed_strides.size, dtype=int)
+    rows = np.flatnonzero(hit)
+    c_size = candidate_strides.size
+    return pd.DataFrame(
+        {
+            "stride": perturbed_strides[rows],
+            "onset_s": onset_p[rows],
+            "toe_off_s": toe_p[rows],
+            "matched_stride": candidate_strides[best[rows]] if c_size else np.empty(0, dtype=candidate_strides.dtype),
+            "matched_anchor_s": anchors[rows, best[rows]] if c_size else np.empty(0),
+            "rmsd_rad": rmsd[rows, best[rows]] if c_size else np.empty(0),
+            "n_candidates": n_cand[rows].astype(np.int64),
+        },
+        columns=list(MATCH_COLUMNS),
+    )
 
 
 def match_in_window(
