@@ -423,6 +423,8 @@ def _dry_run_rules(work: Path, *args: str) -> dict[str, set[str]]:
         ),
         # a setting of the subjects' fits only (the validation study does not use it)
         ("identification", "min_vaf_pct", 1.0, {"impedance_fit"}),
+        # a setting of the segment table only: never the generic or scaled model, nor IK after them
+        ("opensim", "brace_attachment_fraction", 0.75, {"model_segments", "impedance_fit"}),
     ],
 )
 def test_a_changed_setting_reruns_only_what_depends_on_it(finished_run, tmp_path, section, key, value, expected):

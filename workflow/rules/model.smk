@@ -54,7 +54,7 @@ rule model_scaled:
     group:
         "model"
     params:
-        **settings_params(MODEL_SETTINGS),
+        **settings_params(MODEL_SETTINGS.for_scaling()),
         **raw_checksums(by_subject(STUDY.static_c3d_for_mass)),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),

@@ -4,7 +4,7 @@ segment table, from the config (:meth:`ModelSettings.from_config`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.motion.ik import IK_ACCURACY
@@ -88,6 +88,10 @@ class ModelSettings:
         """What the generated model reads (the static trial's window and vertical, for a mass from its plates),
         the other fields at their defaults: a setting it does not read leaves its rule's params unchanged."""
         return ModelSettings(rotation_deg=self.rotation_deg, static_duration_s=self.static_duration_s)
+
+    def for_scaling(self) -> ModelSettings:
+        """What scaling reads: all but the segment table's leg and rod attachment (at their defaults)."""
+        return replace(self, side=PERTURBED_SIDE, attachment_fraction=BRACE_ATTACHMENT_FRACTION)
 
     def for_segments(self) -> ModelSettings:
         """What the segment table reads (bodies, side, rod attachment), the other fields at their defaults."""
