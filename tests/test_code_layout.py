@@ -249,3 +249,23 @@ def test_the_function_length_counts_code_only():
     source = 'def f():\n    """Doc.\n\n    More."""\n    # comment\n\n    x = 1\n    return x\n'
     (f,) = _functions_of(source)
     assert _code_lines(f, source.splitlines()) == 3
+
+
+def test_each_stages_library_column_names_modules_that_exist():
+    """The library column of ``docs/code_layout.md``'s stage table: every module and package it names exists (a
+    bare ``name.py`` lies in the package named before it on the row)."""
+    src = ROOT / "src" / "loper_analysis"
+    missing, rows = [], 0
+    for line in (ROOT / "docs" / "code_layout.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) != 6 or not cells[1].endswith(".smk`"):
+            continue
+        rows += 1
+        package = ""
+        for name in re.findall(r"`([a-z_/]+(?:\.py|/))`", cells[3]):
+            found = next((p for p in (src / name, src / package / name) if p.exists()), None)
+            if found is None:
+                missing.append(f"{cells[0]}: {name}")
+            elif "/" in name and (src / name).exists():
+                package = name.rstrip("/") if name.endswith("/") else name.rsplit("/", 1)[0]
+    assert rows == len(STAGES) and missing == []

@@ -6,6 +6,8 @@ it); one that reran none would be a setting nothing reads."""
 from __future__ import annotations
 
 import copy
+import fnmatch
+import re
 from pathlib import Path
 
 import pytest
@@ -273,3 +275,34 @@ def test_a_changed_setting_changes_exactly_the_rules_that_read_it(base, name):
     changed = rule_signatures(ROOT, _nested(key, copy.deepcopy(_changed(key, value))))
     rerun = {rule for rule in set(base) | set(changed) if base.get(rule) != changed.get(rule)}
     assert rerun - {"all"} == set(READERS[name].split()) - {"all"}
+
+
+#: Keys that shape the whole study (which subjects, trials and files there are), not one stage's settings.
+STUDY_KEYS = {"raw_dir", "seed", "trials.static", "trials.no_device", "trials.device", "trials.perturbation_onsets_ms"}
+STUDY_KEYS |= {"trials.perturbation_repeats"}
+
+
+def _stage_rows() -> dict[str, list[str]]:
+    """Stage (its rule file) -> the config patterns of its row in ``docs/code_layout.md``'s stage table."""
+    rows = {}
+    for line in (ROOT / "docs" / "code_layout.md").read_text().splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if len(cells) == 6 and cells[1].startswith("`") and cells[1].endswith(".smk`"):
+            rows[cells[1].strip("`").removesuffix(".smk")] = re.findall(r"`([^`]+)`", cells[5])
+    return rows
+
+
+def test_each_stages_row_lists_the_settings_its_rules_read():
+    """The config column of the stage table: every setting a stage's rules read matches one of its patterns."""
+    rows = _stage_rows()
+    stages = sorted(p.stem for p in (ROOT / "workflow" / "rules").glob("*.smk") if p.stem not in ("common", "inputs"))
+    assert sorted(rows) == stages
+    missing = {}
+    for stage, patterns in rows.items():
+        rules = set(re.findall(r"^\s*rule (\w+):", (ROOT / "workflow" / "rules" / f"{stage}.smk").read_text(), re.M))
+        read = {k for k, readers in READERS.items() if rules & set(readers.split())} - STUDY_KEYS
+        unlisted = sorted(k for k in read if not any(fnmatch.fnmatch(k, p) for p in patterns))
+        unread = sorted(p for p in patterns if not any(fnmatch.fnmatch(k, p) for k in read))
+        if unlisted or unread:
+            missing[stage] = unlisted + [f"{p} (read by none)" for p in unread]
+    assert missing == {}

@@ -27,7 +27,7 @@ from loper_analysis.planning.covariance import (
 )
 from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs
 from loper_analysis.planning.precision import precision_table, target_answer, unplanned_rows
-from loper_analysis.planning.window import PlanSettings
+from loper_analysis.planning.window import PLAN_IDENTIFICATION_KEYS, PlanSettings
 from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
@@ -42,14 +42,7 @@ STRIDES: tuple[int, ...] = (10, 20, 40)
 _PLANNER_KEYS = {
     "planning": ("pulse_force_n", "pulse_duration_s"),
     "identification": (
-        "window_before_s",
-        "window_after_s",
-        "initial_state_span_s",
-        "initial_state_degree",
-        "n_substeps",
-        "null_pair_components",
-        "min_null_pairs",
-        "interval_scatter",
+        *PLAN_IDENTIFICATION_KEYS,
         "stiffness_bounds_nm_per_rad",
         "damping_bounds_nms_per_rad",
         "counterfactual",

@@ -34,11 +34,11 @@ from loper_analysis.responses.windows import INITIAL_STATE_SPAN_S, WINDOW_AFTER_
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
+__all__ = ["PLAN_IDENTIFICATION_KEYS", "null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
 
 
 #: Keys of config ``identification`` the planner follows as they are (the bounds become tuples).
-_IDENTIFICATION_KEYS = (
+PLAN_IDENTIFICATION_KEYS: tuple[str, ...] = (
     "window_before_s",
     "window_after_s",
     "initial_state_span_s",
@@ -88,7 +88,7 @@ class PlanSettings(FitBounds):
         return cls(
             pulse_force_n=config["planning"]["pulse_force_n"],
             pulse_duration_s=config["planning"]["pulse_duration_s"],
-            **{key: ident[key] for key in _IDENTIFICATION_KEYS},
+            **{key: ident[key] for key in PLAN_IDENTIFICATION_KEYS},
             stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
             damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
         )
