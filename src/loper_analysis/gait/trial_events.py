@@ -1,0 +1,265 @@
+"""A trial's gait events: heel strikes and toe-offs from the force platforms with the heel markers, or from one
+vertical-force channel per belt whose feet the heel markers confirm (:func:`trial_events`); how, in
+:class:`EventSettings`."""
+
+from __future__ import annotations
+
+import logging
+import os
+import warnings
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDES
+from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.events import MIN_STANCE_S, MIN_SWING_S, THRESHOLD_OFF_N, THRESHOLD_ON_N
+from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
+from loper_analysis.motion.filtering import ORDER
+
+__all__ = [
+    "FOOT_MARKERS",
+    "GRF_CHANNELS",
+    "MIN_JUDGED_STANCES",
+    "SWAPPED_BELT_FRACTION",
+    "EventSettings",
+    "trial_events",
+]
+
+log = logging.getLogger(__name__)
+
+#: Vertical-GRF analog channel of each belt in a file without force platforms (config ``events.grf_channels``).
+GRF_CHANNELS: Mapping[str, str] = {"left": "Fz_left", "right": "Fz_right"}
+#: Heel marker of each foot, model names (config ``events.foot_markers``).
+FOOT_MARKERS: Mapping[str, str] = {"left": "LHEE", "right": "RHEE"}
+
+
+@dataclass(frozen=True)
+class EventSettings:
+    """How heel strikes and toe-offs are found (config ``events.*``, ``grf.*``, ``filter.order``).
+
+    ``grf_channels``: {side: analog channel} of each belt (files without force platforms);
+    ``threshold_on_n`` / ``threshold_off_n``: the vertical force (N) rises / falls through these at heel strike /
+    toe-off; ``min_stance_s``, ``min_swing_s``: shorter phases are noise (s); ``cutoff_hz``, ``order``: low-pass
+    of a belt's force before thresholding (Hz; None: raw); ``foot_markers``: {side: heel marker}; ``plate_sides``:
+    {side: plate number} as a check, or None; ``label_map``: as :class:`~loper_analysis.steps.markers.MarkerSettings`;
+    ``rotation_deg``: lab -> model rotation (degrees), which fixes the lab's vertical; ``band_n``, ``max_rest_n``:
+    a plate's resting level (N, :func:`loper_analysis.gait.grf.resting_level`).
+    """
+
+    grf_channels: Mapping[str, str] | None = field(default_factory=lambda: dict(GRF_CHANNELS))
+    threshold_on_n: float = THRESHOLD_ON_N
+    threshold_off_n: float = THRESHOLD_OFF_N
+    min_stance_s: float = MIN_STANCE_S
+    min_swing_s: float = MIN_SWING_S
+    cutoff_hz: float | None = None
+    order: int = ORDER
+    foot_markers: Mapping[str, str] | None = field(default_factory=lambda: dict(FOOT_MARKERS))
+    plate_sides: Mapping[str, int] | None = None
+    label_map: Mapping[str, str] | str | os.PathLike | Sequence | None = None
+    rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
+    band_n: float = RESTING_BAND_N
+    max_rest_n: float = MAX_RESTING_N
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> EventSettings:
+        """The settings of a validated config (``events.*``, ``grf.resting_band_n``, ``grf.max_resting_n``,
+        ``filter.order``, ``markers.lab_to_model_rotation_deg``)."""
+        e = config["events"]
+        return cls(
+            grf_channels=e["grf_channels"],
+            threshold_on_n=e["threshold_on_n"],
+            threshold_off_n=e["threshold_off_n"],
+            min_stance_s=e["min_stance_s"],
+            min_swing_s=e["min_swing_s"],
+            cutoff_hz=e["grf_cutoff_hz"],
+            order=config["filter"]["order"],
+            foot_markers=e["foot_markers"],
+            plate_sides=e["plate_sides"],
+            rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
+            band_n=config["grf"]["resting_band_n"],
+            max_rest_n=config["grf"]["max_resting_n"],
+        )
+
+
+def trial_events(
+    rec, platforms: list, s: EventSettings, label_map: Mapping[str, str] | Sequence | None = None
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The event table and the contact table (empty without force platforms) of a recording and its force
+    platforms: the plates with the heel markers (named by ``label_map``), or one analog channel per belt whose
+    feet the heel markers confirm (as :func:`loper_analysis.steps.events.events` describes)."""
+    from loper_analysis.gait.contacts import count_flagged
+
+    if rec.n_force_platforms:
+        table, contacts = _plate_events(rec, platforms, s, label_map)
+        log.info("contacts:\n%s", contacts.to_string(index=False))
+        table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"])
+        return table, contacts
+    if not s.grf_channels:
+        raise LoperInputError(
+            f"{rec.source}: no force platforms (FORCE_PLATFORM:USED is 0 or absent) and no GRF channel configured "
+            "(events.grf_channels); cannot detect gait events"
+        )
+    table = _channel_events(rec, s)
+    _check_belt_feet(rec, table, s, label_map)
+    table.attrs["n_contacts_flagged"] = 0
+    return table, pd.DataFrame(columns=["plate", "contact", "side", "flag"])
+
+
+def _channel_events(rec, s: EventSettings) -> pd.DataFrame:
+    """Events from one named vertical-GRF analog channel per belt of a read C3D."""
+    from loper_analysis.gait.events import gait_events
+    from loper_analysis.motion.filtering import lowpass
+
+    c3d_path, grf_channels = rec.source, s.grf_channels
+    missing = [side for side in SIDES if grf_channels[side] not in rec.analog_labels]
+    if missing:
+        named = ", ".join(f"{grf_channels[side]!r} (events.grf_channels.{side})" for side in missing)
+        raise LoperInputError(
+            f"{c3d_path}: no analog channel {named}, and no force platforms (FORCE_PLATFORM:USED is 0 or absent); "
+            f"channels present: {', '.join(rec.analog_labels) or 'none'}"
+        )
+    tables = []
+    for side in SIDES:
+        fz = rec.force_channel_n(grf_channels[side], f"events.grf_channels.{side}")
+        if s.cutoff_hz is not None:
+            fz = lowpass(
+                fz,
+                rec.analog_rate_hz,
+                s.cutoff_hz,
+                s.order,
+                setting="events.grf_cutoff_hz",
+                rate_name="ANALOG:RATE",
+                source=f"{c3d_path} (analog channel {grf_channels[side]})",
+            )
+        tables.append(
+            gait_events(
+                rec.analog_time_s,
+                fz,
+                side,
+                s.threshold_on_n,
+                s.threshold_off_n,
+                s.min_stance_s,
+                s.min_swing_s,
+                source=f"{c3d_path} ({grf_channels[side]})",
+            )
+        )
+    return pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
+
+
+#: Fewest stances of a belt, with both heels seen at mid-stance, that can confirm the belt's foot.
+MIN_JUDGED_STANCES = 3
+#: A belt is taken for the other foot's when its own heel was the lower in at most this fraction of its
+#: stances; between it and 1 - it the belt's foot is unclear (a warning).
+SWAPPED_BELT_FRACTION = 0.25
+
+
+def _check_belt_feet(rec, table: pd.DataFrame, s: EventSettings, label_map) -> None:
+    """Confirm from the heel markers that each belt channel carries the foot it is named for.
+
+    Stops when a belt's stances are the other foot's (channels swapped, or both naming one belt); warns when
+    the heel markers cannot tell (missing markers, too few stances, a mixed verdict).
+    """
+    from loper_analysis.gait.events import stance_heels
+    from loper_analysis.motion.marker_names import model_marker_names
+    from loper_analysis.motion.markers import lab_up
+
+    source, grf_channels, foot_markers = rec.source, s.grf_channels, s.foot_markers
+    keys = {side: f"events.grf_channels.{side}" for side in SIDES}
+    if not foot_markers or not rec.marker_labels:
+        warnings.warn(
+            f"{source}: the belts' feet ({', '.join(f'{keys[side]} {grf_channels[side]}' for side in SIDES)}) "
+            "could not be confirmed: no heel markers (events.foot_markers) in the file",
+            stacklevel=2,
+        )
+        return
+    names = model_marker_names(rec.marker_labels, label_map, source)
+    missing = [foot_markers[side] for side in SIDES if foot_markers[side] not in names]
+    if missing:
+        warnings.warn(
+            f"{source}: the belts' feet could not be confirmed: heel marker(s) {', '.join(missing)} "
+            "(events.foot_markers) not in the file",
+            stacklevel=2,
+        )
+        return
+    up = lab_up(s.rotation_deg)
+    heights = {side: rec.markers_m[:, names.index(foot_markers[side]), :] @ up for side in SIDES}
+    table.attrs["source"] = source
+    stances = stance_heels(table, rec.time_s, heights)
+    judged = stances[np.isfinite(stances["own_heel_lower_m"])]
+    for side in SIDES:
+        other = "right" if side == "left" else "left"
+        mine = judged[judged["side"] == side]
+        n, own = len(mine), int(mine["own_heel_lower"].sum())
+        if n < MIN_JUDGED_STANCES:
+            warnings.warn(
+                f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) could not be "
+                f"confirmed: {n} stance(s) with both heels seen at mid-stance (at least "
+                f"{MIN_JUDGED_STANCES} needed)",
+                stacklevel=2,
+            )
+        elif own <= SWAPPED_BELT_FRACTION * n:
+            raise LoperInputError(
+                f"{source}: {keys[side]}: channel {grf_channels[side]} does not carry the {side} foot: in "
+                f"{n - own} of its {n} stances the {other} heel ({foot_markers[other]}) was the lower at "
+                f"mid-stance (by {mine['own_heel_lower_m'].median() * -1000:.0f} mm, median); are the belts' "
+                f"channels swapped (events.grf_channels: {{left: {grf_channels['left']}, "
+                f"right: {grf_channels['right']}}})?"
+            )
+        elif own < (1 - SWAPPED_BELT_FRACTION) * n:
+            warnings.warn(
+                f"{source}: the {side} belt's foot ({keys[side]} {grf_channels[side]}) is unclear: its "
+                f"own heel ({foot_markers[side]}) was the lower at mid-stance in {own} of {n} stances",
+                stacklevel=2,
+            )
+    log.info(
+        "belts' feet: own heel the lower at mid-stance in %s",
+        ", ".join(
+            f"{int(judged.loc[judged['side'] == side, 'own_heel_lower'].sum())} of "
+            f"{int((judged['side'] == side).sum())} {side} stances"
+            for side in SIDES
+        ),
+    )
+
+
+def _plate_events(rec, platforms: list, s: EventSettings, label_map) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Events and the contact table from the force platforms and the heel markers of a read C3D.
+
+    The vertical is the lab's up direction that ``rotation_deg`` turns into the model's +Y
+    (:func:`loper_analysis.motion.markers.lab_up`: lab +Z for the default -90 deg about X, +Y for a Y-up lab
+    with no rotation); plates whose corners run either way round are accepted, a plate more than 45 deg
+    from level is refused naming the file, the plate and ``markers.lab_to_model_rotation_deg``.
+    """
+    from loper_analysis.gait.contacts import PlateForce, contact_events, foot_contacts
+    from loper_analysis.gait.grf import plate_vertical_loads
+    from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
+    from loper_analysis.motion.markers import MODEL_UP, lab_up, rotate_markers
+
+    source = rec.source
+    foot_markers, rotation_deg = s.foot_markers, s.rotation_deg
+    if not foot_markers:
+        raise LoperInputError(f"{source}: force platforms need the heel marker of each foot (events.foot_markers)")
+    names = model_marker_names(rec.marker_labels, label_map, source)
+    require_model_markers(names, [foot_markers[side] for side in SIDES], source, rec.marker_labels)
+    up = lab_up(rotation_deg)
+    loads = plate_vertical_loads(platforms, rotation_deg, s.band_n, s.max_rest_n, up=up, source=source)
+    plates = [
+        PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i]) for i, n in enumerate(loads.numbers)
+    ]
+    heels = {side: rotate_markers(rec.markers_m[:, names.index(foot_markers[side]), :], rotation_deg) for side in SIDES}
+    # corners and heels are in the model frame, whose up is +Y
+    contacts = foot_contacts(
+        plates,
+        rec.time_s,
+        heels,
+        s.plate_sides,
+        s.threshold_on_n,
+        s.threshold_off_n,
+        s.min_stance_s,
+        s.min_swing_s,
+        source=source,
+        up=MODEL_UP,
+    )
+    return contact_events(contacts), contacts
