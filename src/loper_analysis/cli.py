@@ -214,13 +214,14 @@ def _segments(args: argparse.Namespace) -> None:
 
 
 def _validate(args: argparse.Namespace) -> None:
-    from loper_analysis.identification.validation import validation_settings
+    from loper_analysis.identification.validation import ValidationSettings
     from loper_analysis.steps.validation import validation_chunk
 
     config, line = _read_config(args)
     print(line)
-    settings = {} if config is None else validation_settings(config)
-    settings.update({k: v for k, v in (("n_starts", args.n_starts), ("seed", args.seed)) if v is not None})
+    settings = ValidationSettings() if config is None else ValidationSettings.from_config(config)
+    given = {k: v for k, v in (("n_starts", args.n_starts), ("seed", args.seed)) if v is not None}
+    settings = dataclasses.replace(settings, **given)
     n_chunks = args.n_chunks if args.n_chunks is not None else (config or {}).get("validation", {}).get("n_chunks", 1)
     validation_chunk(args.segments, settings, args.chunk, n_chunks, args.errors, args.fits)
 

@@ -63,7 +63,7 @@ def test_validation_accepts_the_window_up_to_the_heel_strike():
 def test_validation_chunk_step_refuses_before_writing(tmp_path):
     out = [tmp_path / "errors.tsv", tmp_path / "fits.tsv"]
     with pytest.raises(LoperInputError, match=r"identification\.window_after_s = 1 s"):
-        validation_chunk(tmp_path / "segments.tsv", {"window_after_s": 1.0}, 0, 2, *out)
+        validation_chunk(tmp_path / "segments.tsv", ValidationSettings(window_after_s=1.0), 0, 2, *out)
     assert not any(p.exists() for p in out)
 
 

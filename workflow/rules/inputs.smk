@@ -13,7 +13,7 @@ from loper_analysis.steps.planning import PlanningSettings
 from loper_analysis.steps.report import FrontPageSettings
 from loper_analysis.steps.synthetic import LabSessionSettings
 from loper_analysis.steps.transparency import TransparencySettings
-from loper_analysis.identification.validation import validation_settings
+from loper_analysis.identification.validation import ValidationSettings
 
 # the config's sections
 TRIALS = config["trials"]
@@ -38,6 +38,7 @@ try:
     TRANSPARENCY_SETTINGS = TransparencySettings.from_config(config)
     FRONT_PAGE_SETTINGS = FrontPageSettings.from_config(config)
     PLAN_SETTINGS = PlanningSettings.from_config(config)  # as ``loper-analysis plan`` builds them
+    VALIDATION_SETTINGS = ValidationSettings.from_config(config)
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
 

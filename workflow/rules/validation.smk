@@ -35,7 +35,7 @@ rule validation_chunk:
     benchmark:
         PATHS.benchmark("validation_chunk", "{chunk}")
     params:
-        settings=validation_settings(config),
+        **settings_params(VALIDATION_SETTINGS),
         n_chunks=config["validation"]["n_chunks"],
     script:
         "../scripts/validation_chunk.py"

@@ -101,6 +101,11 @@ class ValidationSettings:
     def __post_init__(self):
         check_window_in_swing(self.onset_s, self.window_before_s, self.window_after_s, self.swing_duration_s)
 
+    @classmethod
+    def from_config(cls, config: Mapping) -> ValidationSettings:
+        """The settings of a validated config (:func:`validation_settings`)."""
+        return cls(**validation_settings(config))
+
 
 def validation_settings(config: Mapping) -> dict:
     """Keyword arguments of :class:`ValidationSettings` from a validated config (sections ``validation``,

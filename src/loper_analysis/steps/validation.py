@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
+
+if TYPE_CHECKING:  # the identification package is imported by the chunk step only
+    from loper_analysis.identification.validation import ValidationSettings
 
 __all__ = [
     "VALIDATION_FLOAT_FORMAT",
@@ -36,21 +40,19 @@ def validation_segments(out_tsv: PathLike, height_m: float, mass_kg: float, atta
 
 
 def validation_chunk(
-    segments_tsv: PathLike, settings: Mapping, chunk: int, n_chunks: int, errors_out: PathLike, fits_out: PathLike
+    segments_tsv: PathLike,
+    settings: ValidationSettings,
+    chunk: int,
+    n_chunks: int,
+    errors_out: PathLike,
+    fits_out: PathLike,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Simulate and identify chunk ``chunk`` of ``n_chunks`` of the combinations; write its two tables.
-
-    ``settings``: keyword arguments of :class:`~loper_analysis.identification.validation.ValidationSettings`.
-    """
-    from loper_analysis.identification.validation import (
-        ValidationSettings,
-        chunk_combinations,
-        impedance_grid,
-        run_validation_chunk,
-    )
+    """Simulate and identify chunk ``chunk`` of ``n_chunks`` of the combinations (``settings``: the study's
+    :class:`~loper_analysis.identification.validation.ValidationSettings`); write its two tables."""
+    from loper_analysis.identification.validation import chunk_combinations, impedance_grid, run_validation_chunk
     from loper_analysis.io.segment_table import read_segments
 
-    study = ValidationSettings(**settings)
+    study = settings
     log.info("chunk %d of %d with %s", chunk, n_chunks, study)
     grid = impedance_grid(study.stiffness_levels_nm_per_rad, study.damping_levels_nms_per_rad)
     errors, fits = run_validation_chunk(
