@@ -8,9 +8,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from loper_analysis.errors import LoperInputError
 from loper_analysis.layout import RESULT_FILES, Paths, Study, fill
-from loper_analysis.study_checks import check_subjects, raw_file_warnings
 from loper_analysis.study_design import StudyDesign
 from tests.workflow_copy import copy_workflow, snakemake
 
@@ -109,19 +107,6 @@ def test_checksums_only_of_a_recorded_subjects_raw_files(tmp_path):
     study = _study(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}})
     paths = [str(c3d), str(tmp_path / "raw" / "S01" / "static.c3d"), "results/markers/R01/static.trc"]
     assert study.recorded_checksums(paths) == {str(c3d): hashlib.sha256(b"abc").hexdigest()}
-
-
-def test_the_checks_name_the_sheet_subject_and_file(tmp_path):
-    study = _study(tmp_path, {"R01": {"source": "recorded", "height_m": 1.7}}, device={"subject": "R01"})
-    with pytest.raises(
-        LoperInputError, match=r"subjects.tsv: recorded subject 'R01' has no static trial .*raw/R01/static.c3d"
-    ):
-        check_subjects(study, "subjects.tsv", lambda *keys: "config/config.yaml")
-    _touch(tmp_path / "raw" / "R01" / "static.c3d")
-    _touch(tmp_path / "raw" / "R01" / "walk-fast.c3d")
-    check_subjects(study, "subjects.tsv", lambda *keys: "config/config.yaml")
-    (warning,) = raw_file_warnings(study)
-    assert warning.startswith(f"warning: {tmp_path / 'raw' / 'R01'}: walk-fast.c3d: no trial of the design")
 
 
 def test_the_workflow_reads_and_writes_raw_files_in_the_configs_raw_dir(tmp_path):

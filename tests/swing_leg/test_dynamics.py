@@ -8,7 +8,7 @@ Known answers used here:
   forces from the Christoffel symbols of ``M`` (all by central differences);
 * a physical pendulum (thigh alone, cart pinned by a huge mass);
 * virtual work of the joint torques;
-* the segment table: frame and TSV round trips, and its input checks;
+* the segment table: the frame round trip and its input checks;
 * the compiled RK4 of :mod:`loper_analysis.identification` against SciPy's
   DOP853 in :func:`loper_analysis.swing_leg.dynamics.simulate`.
 """
@@ -22,7 +22,6 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import prepare_window, simulate_response
 from loper_analysis.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
-from loper_analysis.io.segment_table import read_segments, write_segments
 from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     attachment_jacobian,
@@ -232,32 +231,6 @@ def test_segment_parameters_frame_round_trip(params):
     np.testing.assert_array_equal(_fields(back), _fields(params))
 
 
-def test_segment_parameters_tsv_round_trip(tmp_path, params):
-    path = tmp_path / "segments.tsv"
-    write_segments(params, path)
-    back = read_segments(path)
-    # %.10g in write_segments: measured 6.3e-11 relative for the Winter set, 0 for the asymmetric set
-    np.testing.assert_allclose(_fields(back), _fields(params), rtol=1e-10, atol=0)
-
-
-def test_segment_parameters_tsv_round_trip_many_digits(tmp_path):
-    """Values with 16 significant digits survive to the 10 digits that write_segments writes (<= 5e-10)."""
-    rng = np.random.default_rng(9)
-    p = SegmentParameters(
-        cart_mass_kg=rng.uniform(40, 60),
-        mass_kg=tuple(rng.uniform(1, 8, 3)),
-        inertia_kg_m2=tuple(rng.uniform(0.005, 0.15, 3)),
-        length_m=tuple(rng.uniform(0.25, 0.45, 3)),
-        com_x_m=tuple(rng.uniform(-0.05, 0.05, 3)),
-        com_y_m=tuple(rng.uniform(-0.2, -0.02, 3)),
-        attachment_m=0.27123456789012345,
-        gravity_m_per_s2=9.80665,
-    )
-    write_segments(p, tmp_path / "s.tsv")
-    back = read_segments(tmp_path / "s.tsv")
-    np.testing.assert_allclose(_fields(back), _fields(p), rtol=5e-10, atol=0)
-
-
 @pytest.mark.parametrize(
     "changes, words",
     [
@@ -286,16 +259,6 @@ def _edited_frame(row: str, column: str, value: str) -> pd.DataFrame:
     return df.reset_index()
 
 
-def test_read_segments_names_the_file_and_the_missing_column(tmp_path):
-    good = tmp_path / "good.tsv"
-    write_segments(PARAMETER_SETS["asymmetric"], good)
-    bad = tmp_path / "no_com_x.tsv"
-    pd.read_csv(good, sep="\t").drop(columns="com_x_m").to_csv(bad, sep="\t", index=False)
-    with pytest.raises(LoperInputError) as info:
-        read_segments(bad)
-    assert str(bad) in str(info.value) and "com_x_m" in str(info.value)
-
-
 def test_from_frame_missing_column():
     frame = PARAMETER_SETS["asymmetric"].to_frame().drop(columns="com_x_m")
     with pytest.raises(LoperInputError) as info:
@@ -316,15 +279,6 @@ def test_from_frame_non_numeric_scalar_cell(row, column):
     with pytest.raises(LoperInputError) as info:
         SegmentParameters.from_frame(_edited_frame(row, column, "abc"), source="segments.tsv")
     assert "segments.tsv" in str(info.value) and column in str(info.value)
-
-
-def test_read_segments_names_the_file_of_a_non_numeric_cell(tmp_path):
-    bad = tmp_path / "bad.tsv"
-    _edited_frame("shank", "mass_kg", "abc").to_csv(bad, sep="\t", index=False)
-    with pytest.raises(LoperInputError) as info:
-        read_segments(bad)
-    msg = str(info.value)
-    assert str(bad) in msg and "mass_kg" in msg and "abc" in msg, msg
 
 
 # ---------------------------------------------------------------- compiled RK4 vs DOP853

@@ -1,4 +1,4 @@
-"""Synthetic subjects: anthropometrics drawn per subject, the true impedance, and the truth file round trip."""
+"""Synthetic subjects: anthropometrics drawn per subject, the true impedance, and the truth step's file."""
 
 from __future__ import annotations
 
@@ -7,8 +7,7 @@ import pytest
 
 from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.atomic import write_yaml
-from loper_analysis.io.truth import TRUTH_HEADER, read_truth, truth_document, truth_from_document, write_truth
+from loper_analysis.io.truth import read_truth
 from loper_analysis.steps.synthetic import truth as truth_step
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
@@ -47,20 +46,6 @@ def test_implausible_anthropometrics_are_refused_naming_subject_and_value():
 def test_true_impedance_scatters_about_the_group_values(truth):
     ratios = [truth[o][j]["K"] / K[o][i] for o in K for i, j in enumerate(JOINTS)]
     assert 0.6 < min(ratios) and max(ratios) < 1.6 and np.std(ratios) > 0.01
-
-
-def test_truth_document_round_trip(anthropometry, truth):
-    assert truth_from_document(truth_document(anthropometry, truth)) == truth
-
-
-def test_truth_file_round_trip(tmp_path, anthropometry, truth):
-    path = tmp_path / "truth.yaml"
-    write_truth(path, anthropometry, truth)
-    assert read_truth(path) == truth
-    # the header line, then the document: the bytes the step wrote before the writer moved to io.truth
-    write_yaml(tmp_path / "by_hand.yaml", truth_document(anthropometry, truth), TRUTH_HEADER)
-    assert path.read_bytes() == (tmp_path / "by_hand.yaml").read_bytes()
-    assert path.read_text().startswith(f"# {TRUTH_HEADER}\n")
 
 
 def test_truth_step_writes_the_true_impedance(tmp_path, anthropometry, truth):
