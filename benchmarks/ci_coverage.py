@@ -165,11 +165,11 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
             angles,
             walk.mocap_events(),
             force,
-            "left",
-            s["n_points"],
-            s["iqr_whisker"],
-            s["max_outlier_fraction"],
-            s["min_valid_strides"],
+            side="left",
+            n_points=s["n_points"],
+            whisker=s["iqr_whisker"],
+            max_fraction=s["max_outlier_fraction"],
+            min_valid=s["min_valid_strides"],
         ).strides
     values = {c: coords[c].to_numpy(float) for c in coords.columns if c != "time_s"}
     markers = marker_positions(model, values, list(BRACE_MARKERS))
