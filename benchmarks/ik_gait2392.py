@@ -50,7 +50,13 @@ def _run(name: str, model, coordinates, angles: dict[str, tuple[str, float]], rn
 def main(duration_s: float = 240.0) -> None:
     rng = np.random.default_rng(2024)
     coordinates, _ = walking_kinematics(
-        duration_s, RATE_HZ, NominalGait(), rng, 0.03, 0.05, leg_length_from_height(HEIGHT_M)
+        duration_s,
+        RATE_HZ,
+        NominalGait(),
+        rng,
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        leg_length_m=leg_length_from_height(HEIGHT_M),
     )
     generated = build_lower_body_model(HEIGHT_M, MASS_KG)
     _run(

@@ -142,7 +142,7 @@ def lab_export_session(
         settings.static_duration_s,
         lab_settings,
         seeded("qtm", static_name),
-        export,
+        settings=export,
         source=f"{subject} {static_name}",
     )
     write_recording(out / f"{static_name}.c3d", static.recording, **static.writer_extras())
@@ -157,10 +157,10 @@ def lab_export_session(
             sim_seed,
             height_m,
             params,
-            settings.timing_cv,
-            settings.amplitude_cv,
-            device_parameters,
-            perturbation,
+            timing_cv=settings.timing_cv,
+            amplitude_cv=settings.amplitude_cv,
+            device=device_parameters,
+            perturbation=perturbation,
         )
         exported = qtm_walking_export(
             model, walk, label_map, mass_kg, lab_settings, file_seed, export, f"{subject} {trial}"

@@ -225,7 +225,7 @@ def _write_walk(path: Path, prefix: str, margin_m: float, unloaded_force_n: floa
         np.hstack(columns),
         units,
         WALK_ANALOG_RATE_HZ,
-        "mm",
+        point_unit="mm",
         first_frame=_first_frame(float(time_s[0]), rate, WALK_TRC),
         force_platforms=plates,
     )
@@ -273,7 +273,7 @@ def _write_static(path: Path, prefix: str, margin_m: float, mass_kg: float, stat
         np.hstack(columns),
         units,
         STATIC_ANALOG_RATE_HZ,
-        "mm",
+        point_unit="mm",
         first_frame=_first_frame(float(time_s[0]), rate, static_trc),
         force_platforms=plates,
     )

@@ -63,8 +63,20 @@ def trial(tmp_path_factory):
     model = build_lower_body_model(1.75, 70.0)
     params = segment_parameters_from_model(model)
     pert = PerturbationSettings(onset_s=0.05, impedance=(40.0, 2.0, 1.0, 0.05, 8.0, 0.3), every_strides=(1, 1))
-    walk = simulate_walking_trial(DURATION_S, lab, 5, 1.75, params, 0.03, 0.05, DeviceParameters(), pert)
-    still = simulate_walking_trial(DURATION_S, lab, 5, 1.75, params, 0.03, 0.05, DeviceParameters())
+    walk = simulate_walking_trial(
+        DURATION_S,
+        lab,
+        5,
+        1.75,
+        params,
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        device=DeviceParameters(),
+        perturbation=pert,
+    )
+    still = simulate_walking_trial(
+        DURATION_S, lab, 5, 1.75, params, timing_cv=0.03, amplitude_cv=0.05, device=DeviceParameters()
+    )
     assert len(walk.schedule) >= 4
     np.testing.assert_array_equal(still.sync_starts_s, walk.sync_starts_s)  # one sync train: one C3D for both
     rec = walking_recording(model, walk, 70.0, lab, 15, source=str(raw / "pert050-1.c3d"))

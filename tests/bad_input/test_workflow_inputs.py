@@ -87,7 +87,14 @@ def project(tmp_path_factory) -> Path:
     model = build_lower_body_model(HEIGHT_M, MASS_KG)
     for folder, seed in ((raw, 3), (work / "elsewhere", 4)):  # the trial, and one recorded at another time
         walk = simulate_walking_trial(
-            8.0, lab, seed, HEIGHT_M, segment_parameters_from_model(model), 0.03, 0.05, DeviceParameters()
+            8.0,
+            lab,
+            seed,
+            HEIGHT_M,
+            segment_parameters_from_model(model),
+            timing_cv=0.03,
+            amplitude_cv=0.05,
+            device=DeviceParameters(),
         )
         folder.mkdir(exist_ok=True)
         write_recording(folder / f"{WALK}.c3d", walking_recording(model, walk, MASS_KG, lab, seed + 10))
@@ -328,7 +335,14 @@ def _other_subject(folder: Path, height_m: float, mass_kg: float, seed: int = 5)
     folder.mkdir(parents=True, exist_ok=True)
     write_recording(folder / "static.c3d", subject_static_recording("R02", height_m, mass_kg, 2.0, lab, seed))
     walk = simulate_walking_trial(
-        8.0, lab, seed, height_m, segment_parameters_from_model(model), 0.03, 0.05, DeviceParameters()
+        8.0,
+        lab,
+        seed,
+        height_m,
+        segment_parameters_from_model(model),
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        device=DeviceParameters(),
     )
     write_recording(folder / f"{WALK}.c3d", walking_recording(model, walk, mass_kg, lab, seed + 10))
 

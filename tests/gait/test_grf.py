@@ -24,7 +24,7 @@ THRESHOLD_N = 20.0
 @pytest.fixture(scope="module")
 def walking5_loads():
     return [
-        plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, THRESHOLD_N)
+        plate_loads(p.number, p.time_s, p.force_n, p.moment_nm, p.corners_m, threshold_n=THRESHOLD_N)
         for p in read_force_platforms(WALKING5)
     ]
 
@@ -221,7 +221,9 @@ def test_plate_loads_of_a_y_up_lab_are_the_z_up_ones_turned(walking5_loads):
     for p in walking5_loads:
         raw_f, raw_m = p.force_n + p.rest_force_n, p.moment_nm + p.rest_moment_nm
         for corners in (p.corners_m @ Q.T, (p.corners_m @ Q.T)[::-1]):
-            q = plate_loads(p.number, p.time_s, raw_f @ Q.T, raw_m @ Q.T, corners, THRESHOLD_N, up=(0.0, 1.0, 0.0))
+            q = plate_loads(
+                p.number, p.time_s, raw_f @ Q.T, raw_m @ Q.T, corners, threshold_n=THRESHOLD_N, up=(0.0, 1.0, 0.0)
+            )
             np.testing.assert_array_equal(q.loaded, p.loaded)
             np.testing.assert_array_equal(q.up, [0.0, 1.0, 0.0])
             np.testing.assert_allclose(q.normal, [0.0, 1.0, 0.0], atol=1e-12)
@@ -234,7 +236,7 @@ def test_plate_loads_of_a_y_up_lab_are_the_z_up_ones_turned(walking5_loads):
     # read as if Z were up, the Y-up plate is a wall
     p = walking5_loads[0]
     with pytest.raises(LoperInputError, match="does not face up"):
-        plate_loads(1, p.time_s, p.force_n @ Q.T, p.moment_nm @ Q.T, p.corners_m @ Q.T, THRESHOLD_N)
+        plate_loads(1, p.time_s, p.force_n @ Q.T, p.moment_nm @ Q.T, p.corners_m @ Q.T, threshold_n=THRESHOLD_N)
 
 
 def test_resting_level_along_up():

@@ -116,7 +116,9 @@ def test_marker_errors_equal_the_distances_of_the_solved_pose(model, synthetic):
 def test_coordinate_task_locks_the_ankle(model, synthetic):
     t, _, X = synthetic
     weights = {m: (0.0 if m in ("RHEE", "RMT1", "RMT5") else 1.0) for m in MARKERS}
-    res = inverse_kinematics(model, t, X, list(MARKERS), weights, {"ankle_dorsiflexion_r": (1e3, 0.25)})
+    res = inverse_kinematics(
+        model, t, X, list(MARKERS), marker_weights=weights, coordinate_tasks={"ankle_dorsiflexion_r": (1e3, 0.25)}
+    )
     k = res.coordinate_names.index("ankle_dorsiflexion_r")
     np.testing.assert_allclose(res.coordinates[:, k], 0.25, atol=1e-3)
 
@@ -166,7 +168,7 @@ def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, 
     in_degrees = ref.getTableMetaDataAsString("inDegrees") == "yes"
     ours_w, ours_c = read_ik_tasks(tasks_xml)
     assert ours_w == weights and ours_c == {"ankle_dorsiflexion_r": (10.0, 0.05)}
-    res = inverse_kinematics(model, t, Xn, list(MARKERS), ours_w, ours_c, accuracy=1e-8)
+    res = inverse_kinematics(model, t, Xn, list(MARKERS), marker_weights=ours_w, coordinate_tasks=ours_c, accuracy=1e-8)
     labels = list(ref.getColumnLabels())
     for i, name in enumerate(res.coordinate_names):
         col = ref.getDependentColumn(name).to_numpy()
@@ -192,11 +194,13 @@ def test_tsv_tasks_and_bad_input(model, synthetic, tmp_path):
     with pytest.raises(
         LoperInputError, match=r"\['XYZ'\] of the IK tasks are not in .*model\.osim \(model loper_lower_body\)"
     ):
-        inverse_kinematics(model, t, X, list(MARKERS), {"XYZ": 1.0})
+        inverse_kinematics(model, t, X, list(MARKERS), marker_weights={"XYZ": 1.0})
     with pytest.raises(LoperInputError, match=r"\['RASI'\] of the IK tasks are not in the marker data"):
-        inverse_kinematics(model, t, X[:, 1:], list(MARKERS)[1:], {"LASI": 1.0, "RASI": 1.0})
+        inverse_kinematics(model, t, X[:, 1:], list(MARKERS)[1:], marker_weights={"LASI": 1.0, "RASI": 1.0})
     with pytest.raises(LoperInputError, match="coordinate task on 'knee_angle_r'"):
-        inverse_kinematics(model, t, X, list(MARKERS), None, {"knee_angle_r": (1.0, None)})
+        inverse_kinematics(
+            model, t, X, list(MARKERS), marker_weights=None, coordinate_tasks={"knee_angle_r": (1.0, None)}
+        )
 
 
 def test_chunks_join_seamlessly(model, synthetic):
@@ -270,7 +274,14 @@ def test_frames_with_too_few_markers_stop_ik_when_asked(model, synthetic):
     assert message.endswith(", LTHI_AS, and 14 more")  # 34 markers missing in those frames: 20 named
     with pytest.raises(LoperInputError) as err:
         inverse_kinematics(
-            model, t, X, list(MARKERS), {m: 1.0 for m in keep}, min_markers=3, source="walk.trc", sparse_frames="error"
+            model,
+            t,
+            X,
+            list(MARKERS),
+            marker_weights={m: 1.0 for m in keep},
+            min_markers=3,
+            source="walk.trc",
+            sparse_frames="error",
         )
     assert str(err.value) == (
         "walk.trc: 3 frame(s) hold fewer than 3 of the 4 weighted markers, too few to solve IK: "
@@ -321,7 +332,7 @@ def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
     t, X, labels = read_markers(WALK_TRC)
     weights, coordinates = read_ik_tasks(IK_SETUP)  # the task set of OpenSim's own IK setup
     assert len(weights) == 39 and weights["R.ASIS"] == 50.0 and coordinates == {}
-    res = inverse_kinematics(model, t[:20], X[:20], labels, weights, coordinates)
+    res = inverse_kinematics(model, t[:20], X[:20], labels, marker_weights=weights, coordinate_tasks=coordinates)
     names = res.coordinate_names
     assert len(names) == 39 and res.solved.all()
     for locked in ("subtalar_angle_r", "mtp_angle_l", "wrist_flex_r", "wrist_dev_l"):
@@ -334,4 +345,6 @@ def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
         match=r"coordinate task on 'subtalar': not a coordinate of .*Rajagopal2016\.osim "
         r"\(model Rajagopal2016\)",
     ):
-        inverse_kinematics(model, t[:2], X[:2], labels, weights, {"subtalar": (1.0, None)})
+        inverse_kinematics(
+            model, t[:2], X[:2], labels, marker_weights=weights, coordinate_tasks={"subtalar": (1.0, None)}
+        )

@@ -47,7 +47,7 @@ def test_each_marker_is_averaged_over_the_frames_where_it_is_present():
     t, X = _markers()
     X[:4, 1] = np.nan  # knee hidden in the first 4 frames
     X[7, 2] = np.nan
-    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), needed=["ASIS", "KNEE"])
+    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], window_s=(0.0, 0.09), needed=["ASIS", "KNEE"])
     assert pose.n_filled == {"KNEE": 4, "TOE": 1} and pose.left_out == [] and not np.isnan(pose.markers_m).any()
     np.testing.assert_allclose(pose.markers_m.mean(axis=0)[1], np.nanmean(X[:, 1], axis=0), rtol=1e-15)
     np.testing.assert_allclose(pose.markers_m[:4, 1], np.tile(np.nanmean(X[4:, 1], axis=0), (4, 1)), rtol=1e-15)
@@ -68,13 +68,13 @@ def test_a_marker_absent_from_the_window_stops_if_needed_and_is_left_out_otherwi
             t,
             X,
             ["ASIS", "KNEE", "TOE"],
-            (0.0, 0.05),
+            window_s=(0.0, 0.05),
             needed=["KNEE"],
             lab_labels={"KNEE": "Subject:RKNE"},
             source="static.trc",
             setting="time_range of scale_setup.xml",
         )
-    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.06, 0.09), needed=["KNEE"])
+    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], window_s=(0.06, 0.09), needed=["KNEE"])
     assert pose.labels == ["ASIS", "KNEE"] and pose.left_out == ["TOE"] and pose.markers_m.shape == (4, 2, 3)
 
 
@@ -84,12 +84,14 @@ def test_marker_motion_is_the_rms_distance_from_the_mean_and_a_moving_subject_st
     angle = 2 * np.pi * np.arange(10) / 10  # the toe marker circles a radius of 30 mm: RMS motion 30 mm exactly
     X[:, 2] += 0.03 * np.column_stack([np.cos(angle), np.sin(angle), 0 * angle])
     X[3, 2] = np.nan  # an absent frame does not count: the RMS is over the 9 present points
-    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09))
+    pose = static_pose(t, X, ["ASIS", "KNEE", "TOE"], window_s=(0.0, 0.09))
     present = np.delete(X[:, 2], 3, axis=0)
     expected = np.sqrt(np.mean(np.sum((present - present.mean(axis=0)) ** 2, axis=1)))
     assert pose.motion_rms_m["TOE"] == pytest.approx(expected, rel=1e-12) and 0.029 < expected < 0.031
     assert pose.motion_rms_m["ASIS"] == pytest.approx(0.0, abs=1e-15)  # a still marker
-    assert static_pose(t, X, ["ASIS", "KNEE", "TOE"], (0.0, 0.09), max_motion_rms_m=0.031).labels  # under the limit
+    assert static_pose(
+        t, X, ["ASIS", "KNEE", "TOE"], window_s=(0.0, 0.09), max_motion_rms_m=0.031
+    ).labels  # under the limit
     with pytest.raises(
         LoperInputError,
         match=r"static\.trc: the subject does not stand still in the scaling window "
@@ -101,7 +103,7 @@ def test_marker_motion_is_the_rms_distance_from_the_mean_and_a_moving_subject_st
             t,
             X,
             ["ASIS", "KNEE", "TOE"],
-            (0.0, 0.09),
+            window_s=(0.0, 0.09),
             lab_labels={"TOE": "Subject:RTOE"},
             source="static.trc",
             max_motion_rms_m=0.02,

@@ -41,7 +41,14 @@ def lab(tmp_path_factory):
     write_recording(d / "static.c3d", subject_static_recording("S99", HEIGHT, MASS, 2.0, LAB, 7))
     osim_model = build_lower_body_model(HEIGHT, MASS)
     walk = simulate_walking_trial(
-        20.0, LAB, 3, HEIGHT, segment_parameters_from_model(osim_model), 0.03, 0.05, DeviceParameters()
+        20.0,
+        LAB,
+        3,
+        HEIGHT,
+        segment_parameters_from_model(osim_model),
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        device=DeviceParameters(),
     )
     write_recording(d / "walk.c3d", walking_recording(osim_model, walk, MASS, LAB, 11))
     write_robot_log(d / "walk.loper.tsv", walk.robot, LAB.robot_rate_hz, {"clock": "robot"})

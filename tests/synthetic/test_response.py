@@ -39,10 +39,10 @@ def trial(params):
         5,
         1.73,
         params,
-        0.03,
-        0.05,
-        DeviceParameters(),
-        PerturbationSettings(onset_s=0.05, impedance=IMPEDANCE),
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        device=DeviceParameters(),
+        perturbation=PerturbationSettings(onset_s=0.05, impedance=IMPEDANCE),
     )
 
 
@@ -84,7 +84,15 @@ def test_responses_look_like_the_study(trial):
     assert len(trial.schedule) >= 5
     assert trial.robot.perturbation.sum() / LAB.robot_rate_hz == pytest.approx(0.1 * len(trial.schedule), rel=0.02)
     free = simulate_walking_trial(
-        40.0, LAB, 5, 1.73, segment_parameters_from_model(build_lower_body_model(1.73, 64.9)), 0.03, 0.05, None, None
+        40.0,
+        LAB,
+        5,
+        1.73,
+        segment_parameters_from_model(build_lower_body_model(1.73, 64.9)),
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        device=None,
+        perturbation=None,
     ).fine
     peaks = []
     for row in trial.schedule.itertuples():
@@ -111,7 +119,9 @@ def test_identification_recovers_the_truth_from_the_simulated_swing(trial, param
     from loper_analysis.identification import identify_impedance, prepare_window
     from loper_analysis.swing_leg.dynamics import segment_coordinates
 
-    free = simulate_walking_trial(40.0, LAB, 5, 1.73, params, 0.03, 0.05, DeviceParameters(), None)
+    free = simulate_walking_trial(
+        40.0, LAB, 5, 1.73, params, timing_cv=0.03, amplitude_cv=0.05, device=DeviceParameters(), perturbation=None
+    )
     row = trial.schedule.iloc[2]
     t = trial.fine.time_s.to_numpy()
     sel = (t >= row.onset_s - 0.2) & (t <= row.onset_s + 0.3)

@@ -23,8 +23,8 @@ GAIT = NominalGait()
 def grf_trial():
     """A 4-min study trial with its treadmill forces at 1024 Hz (noise 2 N) and without noise."""
     _coords, events = walking_kinematics(240.0, FS, GAIT, np.random.default_rng(7))
-    noisy = treadmill_grf(events, 240.0, FS_ANALOG, MASS, np.random.default_rng(8), noise_sd_n=2.0)
-    clean = treadmill_grf(events, 240.0, FS_ANALOG, MASS, np.random.default_rng(8), noise_sd_n=0.0)
+    noisy = treadmill_grf(events, 240.0, FS_ANALOG, MASS, rng=np.random.default_rng(8), noise_sd_n=2.0)
+    clean = treadmill_grf(events, 240.0, FS_ANALOG, MASS, rng=np.random.default_rng(8), noise_sd_n=0.0)
     return events, noisy, clean
 
 
@@ -119,9 +119,9 @@ def test_grf_partial_stance_at_start():
 
 def test_same_seed_same_forces_other_seed_other_noise():
     _, events = walking_kinematics(10.0, FS, GAIT, np.random.default_rng(5))
-    ga = treadmill_grf(events, 10.0, FS_ANALOG, MASS, np.random.default_rng(1))
-    gb = treadmill_grf(events.copy(), 10.0, FS_ANALOG, MASS, np.random.default_rng(1))
-    gc = treadmill_grf(events, 10.0, FS_ANALOG, MASS, np.random.default_rng(2))
+    ga = treadmill_grf(events, 10.0, FS_ANALOG, MASS, rng=np.random.default_rng(1))
+    gb = treadmill_grf(events.copy(), 10.0, FS_ANALOG, MASS, rng=np.random.default_rng(1))
+    gc = treadmill_grf(events, 10.0, FS_ANALOG, MASS, rng=np.random.default_rng(2))
     pd.testing.assert_frame_equal(ga, gb, check_exact=True)
     assert not np.allclose(ga["fz_left_n"], gc["fz_left_n"])
 

@@ -124,7 +124,7 @@ def test_study_variability_reaches_the_studys_isv():
     sigmas = []
     for seed in range(4):
         coords, events = walking_kinematics(
-            150.0, FS, GAIT, np.random.default_rng(seed), SYNTH["timing_cv"], variability=_study_variability()
+            150.0, FS, GAIT, np.random.default_rng(seed), timing_cv=SYNTH["timing_cv"], variability=_study_variability()
         )
         stance, swing = _phases(coords, events)
         sigmas.append([x.std(axis=0, ddof=1).mean(axis=0) for x in (stance, swing)])
@@ -160,9 +160,9 @@ def test_walking_with_the_device_differs_as_in_the_study():
                 [i, k],
                 1.73,
                 params,
-                SYNTH["timing_cv"],
-                0.05,
-                device,
+                timing_cv=SYNTH["timing_cv"],
+                amplitude_cv=0.05,
+                device=device,
                 variability=_study_variability(),
                 adaptation=adaptation,
                 minimal_impedance=impedance,
@@ -189,7 +189,15 @@ def test_pulse_response_rides_on_top_of_the_minimal_impedance_response():
     params = segment_parameters_from_model(build_lower_body_model(1.73, 65.0))
     impedance = (55.0, 3.5, 3.0, 0.1, 8.0, 0.3)
     walk = simulate_walking_trial(
-        12.0, LabSettings(), 11, 1.73, params, 0.03, 0.05, DeviceParameters(), variability=_study_variability()
+        12.0,
+        LabSettings(),
+        11,
+        1.73,
+        params,
+        timing_cv=0.03,
+        amplitude_cv=0.05,
+        device=DeviceParameters(),
+        variability=_study_variability(),
     )
     fine = walk.fine
     t = fine["time_s"].to_numpy()

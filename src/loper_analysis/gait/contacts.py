@@ -200,6 +200,7 @@ def foot_contacts(
     plates: Sequence[PlateForce],
     marker_time_s,
     heels_m: Mapping[str, np.ndarray],
+    *,
     plate_sides: Mapping[str, int] | None = None,
     threshold_on_n: float = THRESHOLD_ON_N,
     threshold_off_n: float = THRESHOLD_OFF_N,

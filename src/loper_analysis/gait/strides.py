@@ -281,6 +281,7 @@ def stride_tables(
     angles: pd.DataFrame,
     events: pd.DataFrame,
     force: pd.DataFrame | None = None,
+    *,
     side: str = PERTURBED_SIDE,
     n_points: int = N_POINTS,
     whisker: float = IQR_WHISKER,

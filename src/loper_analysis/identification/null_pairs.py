@@ -190,6 +190,7 @@ def refit_with_null_pairs(
     first: ImpedanceFit,
     null_pairs: dict,
     n_averaged: int,
+    *,
     n_components: int = NULL_PAIR_COMPONENTS,
     min_null_pairs: int = MIN_NULL_PAIRS,
     cross_validated: bool = False,

@@ -271,8 +271,8 @@ def write_c3d(
     analogs=None,
     analog_units: Sequence[str] = (),
     analog_rate_hz: float | None = None,
-    point_unit: str = "mm",
     *,
+    point_unit: str = "mm",
     first_frame: int = 0,
     force_platforms: Sequence[ForcePlatform | Mapping] = (),
     analog_scales: Sequence[float] | None = None,
@@ -426,7 +426,7 @@ def write_recording(path: str | os.PathLike, recording: C3DRecording, point_unit
         recording.analogs if recording.analog_labels else None,
         recording.analog_units,
         recording.analog_rate_hz,
-        point_unit,
+        point_unit=point_unit,
         first_frame=recording.first_frame,
         **extras,
     )

@@ -242,6 +242,7 @@ def inverse_kinematics(
     time_s,
     markers_m,
     labels,
+    *,
     marker_weights: dict[str, float] | None = None,
     coordinate_tasks: dict[str, tuple[float, float | None]] | None = None,
     accuracy: float = IK_ACCURACY,

@@ -188,6 +188,7 @@ def scale_report(
     before: StaticFit | None,
     n_frames: int,
     subject: tuple[float, float, str],
+    *,
     lab_labels: Mapping[str, str] | None = None,
     lab_angles_rad: Mapping[str, float] | None = None,
     warnings: Sequence[tuple[str, str]] = (),
@@ -293,7 +294,15 @@ def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float) ->
     from loper_analysis.motion.ik import inverse_kinematics, joint_angle_table
 
     mean_pose = pose.markers_m.mean(axis=0, keepdims=True)
-    result = inverse_kinematics(model, pose.time_s[:1], mean_pose, pose.labels, weights, coords, accuracy=accuracy)
+    result = inverse_kinematics(
+        model,
+        pose.time_s[:1],
+        mean_pose,
+        pose.labels,
+        marker_weights=weights,
+        coordinate_tasks=coords,
+        accuracy=accuracy,
+    )
     errors = dict(zip(result.marker_names, (float(e) for e in result.marker_errors_m[0])))
     frame = result.frame()
     known = {k: v for k, v in coordinate_map.items() if _map_coordinate(v) in frame.columns}
@@ -380,7 +389,7 @@ def scaled_model_report(
         before,
         len(pose.time_s),
         subject,
-        lab_labels,
-        lab_static,
-        warnings,
+        lab_labels=lab_labels,
+        lab_angles_rad=lab_static,
+        warnings=warnings,
     )

@@ -170,6 +170,7 @@ def static_pose(
     time_s,
     markers_m,
     labels: Sequence[str],
+    *,
     window_s: tuple[float, float],
     needed: Sequence[str] = (),
     lab_labels: Mapping[str, str] | None = None,

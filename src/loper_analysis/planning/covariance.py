@@ -271,6 +271,7 @@ def stretch_covariances(
     n_strides: Sequence[int],
     params: SegmentParameters,
     impedance,
+    *,
     settings: PlanSettings = PlanSettings(),
     device=None,
     response=None,

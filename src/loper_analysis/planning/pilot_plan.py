@@ -275,7 +275,9 @@ def _onset_covariance(pool, onset, counts, params, values, settings: PlanningSet
                 "identification.counterfactual: matched_stride)"
             )
         planned = conditional_stride_covariance(series, params, values, plan, dev, source=where)
-        return planned, stretch_covariances(pool, onset, counts, params, values, plan, dev, response, source=where)
+        return planned, stretch_covariances(
+            pool, onset, counts, params, values, settings=plan, device=dev, response=response, source=where
+        )
     null = null_pair_windows(pool, onset, response, source=subject, max_trial_ratio=settings.max_null_trial_ratio)
     pairs = pilot_perturbed_pairs(pool, onset, response, source=subject)
     return stride_covariance(null, params, values, plan, dev, source=where, perturbed_pairs=pairs), None

@@ -186,7 +186,15 @@ def _solve(
     )
     change, warning = _geometry_checked(model, markers_m, labels, s, source)
     res = inverse_kinematics(
-        model, time_s, markers_m, labels, weights, coords, accuracy=s.accuracy, min_markers=s.min_markers, source=source
+        model,
+        time_s,
+        markers_m,
+        labels,
+        marker_weights=weights,
+        coordinate_tasks=coords,
+        accuracy=s.accuracy,
+        min_markers=s.min_markers,
+        source=source,
     )
     res.geometry_change = change
     if warning:
@@ -413,8 +421,8 @@ def ik_file(
             time_s[sel],
             markers_m[sel],
             labels,
-            weights,
-            coordinate_tasks,
+            marker_weights=weights,
+            coordinate_tasks=coordinate_tasks,
             accuracy=settings.accuracy,
             min_markers=settings.min_markers,
         )

@@ -81,12 +81,12 @@ def strides(
         read_tsv(angles_tsv, "angle table"),
         read_tsv(events_tsv, "event table"),
         force,
-        settings.side,
-        settings.n_points,
-        settings.whisker,
-        settings.max_fraction,
-        settings.min_valid,
-        sources,
+        side=settings.side,
+        n_points=settings.n_points,
+        whisker=settings.whisker,
+        max_fraction=settings.max_fraction,
+        min_valid=settings.min_valid,
+        sources=sources,
     )
     write_tsv(tables.cycles, cycles_out)
     if dropped_out is not None:

@@ -471,6 +471,7 @@ def qtm_static_export(
     duration_s: float,
     lab: LabSettings,
     seed,
+    *,
     settings: QTMExportSettings = QTMExportSettings(),
     pelvis_ty_m: float = 0.95,
     source: str = "static trial",

@@ -93,6 +93,7 @@ def swing_response(
     force_unperturbed_n,
     onset_s: float,
     heel_strike_s: float,
+    *,
     before_s: float = 0.05,
     fade_s: float = 0.2,
     n_substeps: int = 2,
@@ -159,6 +160,7 @@ def swing_responses(
     impedance,
     force_n,
     swings,
+    *,
     n_substeps: int = 2,
 ) -> np.ndarray:
     """Joint-angle deviations (n, 3) rad of every swing driven by the measured force, against walking without it.

@@ -112,6 +112,7 @@ def treadmill_grf(
     duration_s: float,
     analog_rate_hz: float,
     body_mass_kg: float,
+    *,
     rng: np.random.Generator | None = None,
     noise_sd_n: float = 2.0,
     edge_n: float = 100.0,

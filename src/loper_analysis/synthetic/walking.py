@@ -237,6 +237,7 @@ def walking_kinematics(
     sample_rate_hz: float,
     gait: NominalGait,
     rng: np.random.Generator,
+    *,
     timing_cv: float = TIMING_CV,
     amplitude_cv: float = AMPLITUDE_CV,
     leg_length_m: float | None = None,
