@@ -269,3 +269,26 @@ def test_each_stages_library_column_names_modules_that_exist():
             elif "/" in name and (src / name).exists():
                 package = name.rstrip("/") if name.endswith("/") else name.rsplit("/", 1)[0]
     assert rows == len(STAGES) and missing == []
+
+
+#: Library functions that keep more than eight positional parameters, and why: compiled kernels (numba takes no
+#: keyword-only parameters) and a response simulator whose ten arguments are all data.
+MANY_POSITIONAL = {"swing_leg/kernels.py:simulate_deviation_batch", "synthetic/response.py:swing_response"}
+
+
+def test_library_functions_take_their_options_by_name():
+    """A library function of more than eight parameters takes its data positionally and its options keyword-only
+    (``*``); private helpers called only in their module aside."""
+    src = ROOT / "src" / "loper_analysis"
+    found = []
+    for path in src.rglob("*.py"):
+        rel = path.relative_to(src).as_posix()
+        if rel.startswith("steps/"):
+            continue
+        for f in _functions(path):
+            a = f.args
+            positional = [p.arg for p in (*a.posonlyargs, *a.args) if p.arg not in ("self", "cls")]
+            name = f"{rel}:{f.name}"
+            if len(positional) > MAX_STEP_PARAMETERS and name not in MANY_POSITIONAL and not f.name.startswith("_"):
+                found.append(f"{name}: {len(positional)}")
+    assert found == []
