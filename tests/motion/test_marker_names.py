@@ -84,23 +84,6 @@ def test_label_map_files_tsv_and_yaml(tmp_path):
     assert model_marker_names(VICON, read_label_map(tsv))[:3] == ["LASI", "RASIS", "LKNE"]
 
 
-@pytest.mark.parametrize(
-    "name, text, match",
-    [
-        ("twice.tsv", "label\tmarker\nLASIS\tLASI\nLASIS\tRASI\n", "names label 'LASIS' twice"),
-        ("blank.tsv", "label\tmarker\nLASIS\t\n", "entry 1: 'LASIS' -> '' is not a pair of names"),
-        ("cols.tsv", "lab\tmarker\nLASIS\tLASI\n", r"column\(s\) \['label'\] missing"),
-        ("list.yaml", "- LASIS\n- LASI\n", "must be a YAML mapping"),
-    ],
-)
-def test_bad_label_map_files_are_named(tmp_path, name, text, match):
-    path = tmp_path / name
-    path.write_text(text)
-    with pytest.raises(LoperInputError, match=match) as err:
-        read_label_map(path)
-    assert str(path) in str(err.value)
-
-
 def test_labels_with_inner_spaces_are_kept_and_mapped_by_a_key_with_spaces(tmp_path):
     """BTS labels: a key with spaces renames them (inline, YAML or TSV map); unmapped ones keep their spaces."""
     bts = ["Anna:r heel", "l heel", "r toe tip"]
