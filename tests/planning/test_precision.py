@@ -1,7 +1,6 @@
 """The experiment planner (loper_analysis.planning.precision, steps.planning, ``loper-analysis plan``).
 
-Known answers: the device loop's step (steady state = the desired force with a still brace, the study's
-~10 ms rise), Student's t with N - 1 degrees of freedom and the 1/N law of the prediction, the
+Known answers: Student's t with N - 1 degrees of freedom and the 1/N law of the prediction, the
 identification's own sandwich covariance (a noise-free fit with the pilot's perturbed pairs' covariance
 reports the predicted half-width), the null pairs' covariance when the pilot has no perturbed pairs, and
 repeated synthetic experiments whose fits report the SD the planner predicted. For the conditional
@@ -26,7 +25,6 @@ from scipy.stats import t as student_t
 
 from loper_analysis.cli import main
 from loper_analysis.constants import JOINTS, parameter_column
-from loper_analysis.device.analysis import step_metrics
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import (
     cross_validated_covariance,
@@ -51,7 +49,6 @@ from loper_analysis.planning.covariance import (
 from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs, pulse_force_n, trial_stretches
 from loper_analysis.planning.precision import precision_table, strides_needed, target_answer
 from loper_analysis.planning.window import PlanSettings, planning_window
-from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.responses.conditional import shared_weight_terms, unit_scatter_variance
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
@@ -97,17 +94,6 @@ def conditional_series(pilot):
 def stride_cov(params, pilot):
     _, _, null, pairs = pilot
     return stride_covariance(null, params, TRUTH, PLAN, perturbed_pairs=pairs)
-
-
-def test_pulse_is_the_device_step(params):
-    """A long pulse through the device loop with a still brace: settles at the desired force, rises in ~10 ms."""
-    t = np.arange(-0.1, 0.6, 0.001)
-    f = pulse_force_n(t, 40.0, 0.4)
-    m = step_metrics(t, f, 40.0, (0.15, 0.3))
-    np.testing.assert_allclose(m["steady_state_n"], 40.0, rtol=0.01)
-    assert abs(m["rise_time_ms"] - STUDY_DEVICE["rise_time_ms"][0]) < 3.0  # study 10 ms; 12 ms after the 40 Hz low-pass
-    assert 5.0 < m["overshoot_pct"] < STUDY_DEVICE["overshoot_pct"][0]  # the load cell's low-pass trims the overshoot
-    assert np.max(np.abs(f[t < -0.02])) < 0.01 * 40.0  # the zero-phase low-pass rings ahead by < 1 %
 
 
 def test_prediction_follows_one_over_n_and_student_t(stride_cov, pilot):
@@ -528,31 +514,6 @@ def test_conditional_strides_needed_is_the_smallest_count_that_meets_the_target(
         n = strides_needed(sc, joint, parameter, percent=15)
         assert sc.half_width(n)[i] <= target * (1 + 1e-9) and (n == 1 or sc.half_width(n - 1)[i] > target)
         assert f"needs {n} perturbed strides" in target_answer(sc, joint, parameter, ONSET_MS, percent=15)
-
-
-def test_trial_stretches_hold_the_planned_perturbed_strides():
-    """Strides of 1 s, perturbed 1, 3, 5, 7 and 9: stretches of 2 end before the heel strikes of strides 5 and 9;
-    5 in one stretch is the whole trial; 6 none."""
-    strides = pd.DataFrame(
-        {
-            "heel_strike_s": np.arange(12.0),
-            "end_s": np.arange(12.0) + 1.0,
-            "perturbed": np.isin(np.arange(12), [1, 3, 5, 7, 9]),
-        }
-    )
-    trial = {"name": "T", "angles": pd.DataFrame({"time_s": np.arange(0, 1201) / 100.0}), "strides": strides}
-    two = trial_stretches(trial, 2)
-    assert [s["name"] for s in two] == ["T [1/2]", "T [2/2]"]
-    assert two[0]["strides"]["heel_strike_s"].tolist() == [0, 1, 2, 3, 4]
-    assert two[1]["strides"]["heel_strike_s"].tolist() == [5, 6, 7, 8]
-    assert [int(s["strides"]["perturbed"].sum()) for s in two] == [2, 2]
-    assert two[0]["angles"]["time_s"].iloc[[0, -1]].tolist() == [0.0, 5.0]
-    assert two[1]["angles"]["time_s"].iloc[[0, -1]].tolist() == [5.0, 9.0]
-    (whole,) = trial_stretches(trial, 5)
-    assert len(whole["strides"]) == 12 and len(whole["angles"]) == 1201
-    assert trial_stretches(trial, 6) == []
-    with pytest.raises(LoperInputError, match="n_perturbed must be >= 1"):
-        trial_stretches(trial, 0)
 
 
 def test_a_stretch_holding_every_perturbed_stride_plans_as_the_whole_pilot(params, pilot, conditional_series):
