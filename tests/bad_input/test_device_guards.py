@@ -27,7 +27,6 @@ import pytest
 import yaml
 
 from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
-from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
 from loper_analysis.steps import events as event_steps
 from loper_analysis.steps.events import EventSettings, LoadcellSettings
@@ -378,26 +377,6 @@ def test_mat_export_without_its_flag_variable_is_refused(trial, tmp_path):
         log,
         [str(log), "column 'perturbation' flags 0 pulse(s)", "device.mat_column_map.perturbation"],
     )
-
-
-def test_force_pulses_of_the_simulated_robot():
-    """find_force_pulses: every 40 N pulse of the perturbation trial, none in minimal-impedance mode (the
-    robot's start-up transient rings shorter than a pulse)."""
-    from loper_analysis.device.controller import DeviceParameters, simulate_device
-    from loper_analysis.synthetic.response import pulse_train
-
-    fs = 1000.0
-    t = np.arange(int(20 * fs)) / fs
-    brace = 0.03 * np.sin(2 * np.pi * 0.9 * t)  # a thigh swinging at a stride frequency
-    onsets = np.array([3.2, 7.55, 11.0, 15.31])
-    fd = pulse_train(t, onsets, 40.0, 0.1)
-    pulsed = simulate_device(fd, DeviceParameters(), None, brace_position_m=brace, seed=3)["force_measured_n"]
-    free = simulate_device(0 * t, DeviceParameters(), None, brace_position_m=brace, seed=3)["force_measured_n"]
-    found = find_force_pulses(pulsed.to_numpy(), fs)
-    assert found.shape == (4, 3)
-    assert np.all((t[found[:, 0].astype(int)] - onsets >= 0) & (t[found[:, 0].astype(int)] - onsets < 0.03))
-    assert np.all((found[:, 2] > 35.0) & (found[:, 2] < 60.0))
-    assert find_force_pulses(free.to_numpy(), fs).shape == (0, 3)
 
 
 # --------------------------------------------------------------------------- the load cell's unit

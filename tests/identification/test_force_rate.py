@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from loper_analysis.device.pulse import pulse_force, second_order_parameters, step_response
+from loper_analysis.device.pulse import pulse_force
 from loper_analysis.identification import (
     identify_impedance,
     per_step,
@@ -22,22 +22,6 @@ def _impulse(window) -> np.ndarray:
     """The impulse (N·s, x/y) RK4 gives the perturbed leg: sum over steps of h/6 (F1 + 2 F2 + 2 F3 + F4)."""
     f = window.force_perturbed_n
     return window.step_s / 6 * (f[:, 0] + 2 * f[:, 1] + 2 * f[:, 2] + f[:, 3]).sum(axis=0)
-
-
-def test_pulse_has_the_study_rise_time_overshoot_and_impulse():
-    """Second-order step response: 10 ms (10-90 %), 30.5 % overshoot; a 40 N, 100 ms pulse carries 4 N·s."""
-    zeta, wn = second_order_parameters(0.010, 30.5)
-    assert zeta == pytest.approx(-np.log(0.305) / np.sqrt(np.pi**2 + np.log(0.305) ** 2), rel=1e-12)
-    t = np.arange(0.0, 0.1, 1e-6)
-    y = step_response(t, 0.010, 30.5)
-    rising = t < np.pi / (wn * np.sqrt(1 - zeta**2))  # up to the peak
-    rise = np.interp(0.9, y[rising], t[rising]) - np.interp(0.1, y[rising], t[rising])
-    assert rise == pytest.approx(0.010, abs=2e-6)
-    assert y.max() == pytest.approx(1.305, abs=1e-6)
-    tt = np.arange(-0.05, 0.6, 1e-6)
-    f = pulse_force(tt, 0.0, 0.1, 40.0, 0.010, 30.5)
-    assert np.all(f[tt <= 0] == 0.0)
-    assert np.trapezoid(f, tt) == pytest.approx(4.0, abs=1e-6)
 
 
 def test_rectangle_impulse_4_00_at_1_khz_against_3_75_at_128_hz():
