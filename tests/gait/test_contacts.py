@@ -181,23 +181,6 @@ def test_bad_input_is_named(trial):
         )
 
 
-def test_plate_offsets_inside_outside_and_height():
-    c = CORNERS[2]
-    out, up = plate_offsets([[0.2, 0.5, 0.07], [0.6, 0.5, 0.0], [0.7, 1.9, 0.1], [np.nan, 0, 0]], c)
-    np.testing.assert_allclose(out[:3], [0.0, 0.1, math.hypot(0.2, 0.3)], atol=1e-12)
-    np.testing.assert_allclose(up[:3], [0.07, 0.0, 0.1], atol=1e-12)
-    assert np.isnan(out[3]) and np.isnan(up[3])
-    # a plate tilted into a Y-up frame (X forward, Z right) gives the same answers
-    rot = np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], dtype=float)  # lab Z up -> model Y up
-    out2, up2 = plate_offsets(np.array([[0.2, 0.5, 0.07], [0.6, 0.5, 0.0]]) @ rot.T, c @ rot.T)
-    np.testing.assert_allclose(out2, [0.0, 0.1], atol=1e-12)
-    np.testing.assert_allclose(up2, [0.07, 0.0], atol=1e-12)
-    out3, up3 = plate_offsets(np.array([[0.6, 0.5, 0.0]]) @ rot.T, c @ rot.T, vertical_axis=1)
-    np.testing.assert_allclose([out3[0], up3[0]], [0.1, 0.0], atol=1e-12)
-    with pytest.raises(LoperInputError, match="enclose no area"):
-        plate_offsets([[0, 0, 0]], np.zeros((4, 3)))
-
-
 def test_every_contact_gets_its_known_foot_and_flag(judged):
     assert list(judged.columns) == list(CONTACT_COLUMNS)
     assert set(judged["flag"]) <= set(CONTACT_FLAGS)
