@@ -268,7 +268,7 @@ def _read_config(args: argparse.Namespace) -> tuple[dict | None, str]:
 
 def _plan_settings(args: argparse.Namespace, config: dict | None):
     """The planner's settings: those of the rule ``planning`` (the config's,
-    :meth:`loper_analysis.steps.planning.PlanningSettings.from_config`), else the library's defaults; then the
+    :meth:`loper_analysis.planning.pilot_plan.PlanningSettings.from_config`), else the library's defaults; then the
     options given on the command line (targets given replace the config's).
     """
     from loper_analysis.steps.planning import PlanningSettings
