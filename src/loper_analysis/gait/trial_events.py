@@ -44,8 +44,8 @@ class EventSettings:
     ``threshold_on_n`` / ``threshold_off_n``: the vertical force (N) rises / falls through these at heel strike /
     toe-off; ``min_stance_s``, ``min_swing_s``: shorter phases are noise (s); ``cutoff_hz``, ``order``: low-pass
     of a belt's force before thresholding (Hz; None: raw); ``foot_markers``: {side: heel marker}; ``plate_sides``:
-    {side: plate number} as a check, or None; ``label_map``: as :class:`~loper_analysis.motion.trial_markers.MarkerSettings`;
-    ``rotation_deg``: lab -> model rotation (degrees), which fixes the lab's vertical; ``band_n``, ``max_rest_n``:
+    {side: plate number} as a check, or None; ``label_map``: as
+    :class:`~loper_analysis.motion.trial_markers.MarkerSettings`; ``rotation_deg``: lab -> model rotation (degrees), which fixes the lab's vertical; ``band_n``, ``max_rest_n``:
     a plate's resting level (N, :func:`loper_analysis.gait.grf.resting_level`).
     """
 
