@@ -45,8 +45,9 @@ class EventSettings:
     toe-off; ``min_stance_s``, ``min_swing_s``: shorter phases are noise (s); ``cutoff_hz``, ``order``: low-pass
     of a belt's force before thresholding (Hz; None: raw); ``foot_markers``: {side: heel marker}; ``plate_sides``:
     {side: plate number} as a check, or None; ``label_map``: as
-    :class:`~loper_analysis.motion.trial_markers.MarkerSettings`; ``rotation_deg``: lab -> model rotation (degrees), which fixes the lab's vertical; ``band_n``, ``max_rest_n``:
-    a plate's resting level (N, :func:`loper_analysis.gait.grf.resting_level`).
+    :class:`~loper_analysis.motion.trial_markers.MarkerSettings`; ``rotation_deg``: lab -> model rotation
+    (degrees), which fixes the lab's vertical; ``band_n``, ``max_rest_n``: a plate's resting level (N,
+    :func:`loper_analysis.gait.grf.resting_level`).
     """
 
     grf_channels: Mapping[str, str] | None = field(default_factory=lambda: dict(GRF_CHANNELS))
