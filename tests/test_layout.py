@@ -6,14 +6,12 @@ import hashlib
 from pathlib import Path
 
 import pytest
-import yaml
 
-from loper_analysis.layout import RESULT_FILES, Paths, Study, fill
-from loper_analysis.study_design import StudyDesign
+from loper_analysis.layout import RESULT_FILES, Paths, fill
+from tests.study_files import CONFIG, study_on, touch
 from tests.workflow_copy import copy_workflow, snakemake
 
 ROOT = Path(__file__).resolve().parents[1]
-CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 
 def test_patterns_are_the_folders_and_names_of_the_docs():
@@ -40,32 +38,13 @@ def test_fill_leaves_the_wildcards_not_given():
     assert fill(Paths().impedance.fit, subject="S01", onset="175") == "results/impedance/S01/175.tsv"
 
 
-def _study(tmp_path: Path, rows: dict, **config) -> Study:
-    cfg = {**CONFIG, **config}
-    said: list[str] = []
-    study = Study(
-        rows,
-        StudyDesign.from_config(cfg["trials"]),
-        Paths(str(tmp_path / "raw")),
-        cfg,
-        has_plates=lambda path: path.name != "walk-nodevice.c3d",
-        note=said.append,
-    )
-    study.said = said
-    return study
-
-
-def _touch(path: Path, data: bytes = b"x") -> Path:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_bytes(data)
-    return path
-
-
 def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
     raw = tmp_path / "raw" / "R01"
     for t in ("static", "walk-nodevice", "pert050-1"):
-        _touch(raw / f"{t}.c3d")
-    study = _study(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}}, device={"subject": None})
+        touch(raw / f"{t}.c3d")
+    study = study_on(
+        tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}}, device={"subject": None}
+    )
     assert study.subject_trials("R01") == ["walk-nodevice", "pert050-1"]
     assert len(study.subject_trials("S01")) == 8  # every walking trial of the design
     assert study.processed_subjects() == ["R01", "S01"]
@@ -84,8 +63,8 @@ def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
 def test_a_fits_files_are_its_onsets_own_trials_and_the_null_pairs(tmp_path):
     raw = tmp_path / "raw" / "R01"
     for t in ("static", "walk-device", "pert050-1", "pert175-1"):
-        _touch(raw / f"{t}.c3d")
-    study = _study(tmp_path, {"R01": {"source": "recorded"}})
+        touch(raw / f"{t}.c3d")
+    study = study_on(tmp_path, {"R01": {"source": "recorded"}})
     fits = study.fit_files("R01")
     assert list(fits) == [50, 175, 300]
     assert list(fits[50].trials) == ["pert050-1"] and fits[50].trials["pert050-1"].force == (
@@ -102,9 +81,9 @@ def test_a_fits_files_are_its_onsets_own_trials_and_the_null_pairs(tmp_path):
 
 
 def test_checksums_only_of_a_recorded_subjects_raw_files(tmp_path):
-    c3d = _touch(tmp_path / "raw" / "R01" / "static.c3d", b"abc")
-    _touch(tmp_path / "raw" / "S01" / "static.c3d", b"abc")
-    study = _study(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}})
+    c3d = touch(tmp_path / "raw" / "R01" / "static.c3d", b"abc")
+    touch(tmp_path / "raw" / "S01" / "static.c3d", b"abc")
+    study = study_on(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}})
     paths = [str(c3d), str(tmp_path / "raw" / "S01" / "static.c3d"), "results/markers/R01/static.trc"]
     assert study.recorded_checksums(paths) == {str(c3d): hashlib.sha256(b"abc").hexdigest()}
 

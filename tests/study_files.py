@@ -1,0 +1,38 @@
+"""A study on a temporary raw folder, for the tests of the layout and of the study's checks."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import yaml
+
+from loper_analysis.layout import Paths, Study
+from loper_analysis.study_design import StudyDesign
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+
+def study_on(tmp_path: Path, rows: dict, **config) -> Study:
+    """The study of ``rows`` (subject -> sheet row) with the raw folder ``tmp_path/raw`` and the default config
+    with ``config``'s sections replaced; a C3D has plates unless it is ``walk-nodevice.c3d``; the notes said are
+    kept in ``study.said``."""
+    cfg = {**CONFIG, **config}
+    said: list[str] = []
+    study = Study(
+        rows,
+        StudyDesign.from_config(cfg["trials"]),
+        Paths(str(tmp_path / "raw")),
+        cfg,
+        has_plates=lambda path: path.name != "walk-nodevice.c3d",
+        note=said.append,
+    )
+    study.said = said
+    return study
+
+
+def touch(path: Path, data: bytes = b"x") -> Path:
+    """Write ``data`` to ``path`` (its folders made); returns the path."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_bytes(data)
+    return path
