@@ -363,10 +363,10 @@ class Study:
 
     def processing_targets(self) -> list[str]:
         """Stride tables of every processed trial, the models, impedance and planning, transparency."""
-        p, out = self.paths, []
+        p, out, scaled = self.paths, [], set(self.scaled_subjects())
         for s in self.processed_subjects():
             out.append(fill(p.model.segments, subject=s))
-            if s in self.scaled_subjects():
+            if s in scaled:
                 out.append(fill(p.model.scale, subject=s))
             if self.source(s) == "synthetic":
                 out.append(fill(p.raw.truth, subject=s))
@@ -524,7 +524,7 @@ class Study:
         """The files of the front page's section on recorded subjects: per recorded subject its scale report
         (None with a model from the sheet) and per walking trial its IK summary, agreement with the lab's own
         angles and figures (the force plates' None without plates)."""
-        p, out = self.paths, {}
+        p, out, scaled = self.paths, {}, set(self.scaled_subjects())
         for s in self.processed_subjects():
             if self.source(s) != "recorded":
                 continue
@@ -537,7 +537,7 @@ class Study:
                 }
                 for t in self.subject_trials(s)
             }
-            scale = fill(p.model.scale, subject=s) if s in self.scaled_subjects() else None
+            scale = fill(p.model.scale, subject=s) if s in scaled else None
             out[s] = {"scale": scale, "trials": trials}
         return out
 
