@@ -26,6 +26,7 @@ import pandas as pd
 import yaml
 
 from loper_analysis.layout import RESULTS_DIR
+from loper_analysis.responses.response_window import ResponseWindow
 
 
 def covered(time_s: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:
@@ -62,8 +63,8 @@ def main() -> None:
     for f in args.configfile:
         for key, value in (yaml.safe_load(Path(f).read_text()) or {}).items():
             cfg[key] = {**cfg.get(key, {}), **value} if isinstance(value, dict) else value
-    ident, trials = cfg["identification"], cfg["trials"]
-    before = ident["initial_state_span_s"] + ident["window_before_s"]
+    window, trials = ResponseWindow.from_config(cfg), cfg["trials"]
+    before = window.initial_state_span_s + window.before_s
     onsets_s = [o / 1e3 for o in trials["perturbation_onsets_ms"]]
     rows = []
     for table in sorted(Path(args.results, "strides").glob("*/pert*.strides.tsv")):
@@ -74,7 +75,7 @@ def main() -> None:
             pd.read_csv(table, sep="\t"),
             onsets_s,
             before,
-            ident["window_after_s"],
+            window.after_s,
             args.margin_s,
         )
         rows.append(

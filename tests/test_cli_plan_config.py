@@ -127,8 +127,8 @@ def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
     command = _plan_settings(args, read)
     assert command == rule
     # the config's values, not the library's defaults, reach the planner
-    assert PlanSettings().window_after_s != WINDOW_AFTER_S and PlanningSettings().strides != tuple(STRIDES)
-    assert command.plan.window_after_s == command.response.window_after_s == WINDOW_AFTER_S
+    assert PlanSettings().window.after_s != WINDOW_AFTER_S and PlanningSettings().strides != tuple(STRIDES)
+    assert command.plan.window.after_s == command.response.window.after_s == WINDOW_AFTER_S
     assert command.strides == tuple(STRIDES)
     assert command.onsets_ms == tuple(config["trials"]["perturbation_onsets_ms"])
     assert _plan_pilot(args, read) == (
@@ -159,7 +159,7 @@ def test_options_given_override_the_config(project, second):
     settings = _plan_settings(args, _read_config(args)[0])
     assert settings.strides == (5,) and settings.plan.pulse_force_n == 30.0 and settings.onsets_ms == (125.0,)
     assert settings.targets == ({"joint": "hip", "parameter": "K", "percent": 10.0},)
-    assert settings.plan.window_after_s == WINDOW_AFTER_S  # no option: the config's
+    assert settings.plan.window.after_s == WINDOW_AFTER_S  # no option: the config's
     assert settings.plan.pulse_duration_s == PlanningSettings.from_config(load_config()[0]).plan.pulse_duration_s
 
 

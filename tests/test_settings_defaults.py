@@ -33,6 +33,7 @@ from loper_analysis.identification.impedance import IdentificationSettings, impe
 from loper_analysis.identification.validation import ValidationSettings, validation_settings
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
+from loper_analysis.responses.response_window import WINDOW_KEYS, ResponseWindow
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -83,11 +84,9 @@ def _signature_defaults(function) -> dict:
     }
 
 
-#: ResponseSettings field -> config key (as the workflow's impedance_fit rule passes them).
+#: ResponseSettings field -> config key (as the workflow's impedance_fit rule passes them; the window aside:
+#: a ResponseWindow, whose fields map to their keys by WINDOW_KEYS).
 RESPONSE_KEYS = {
-    "window_before_s": "identification.window_before_s",
-    "window_after_s": "identification.window_after_s",
-    "initial_state_span_s": "identification.initial_state_span_s",
     "whisker": "strides.iqr_whisker",
     "max_fraction": "strides.max_outlier_fraction",
     "min_strides": "strides.min_valid_strides",
@@ -146,12 +145,23 @@ def test_free_leg_and_device_test_defaults_equal_config():
 # --------------------------------------------------------------------------- responses and identification
 
 
+def test_response_window_defaults_equal_config_identification():
+    assert WINDOW_KEYS == {
+        "before_s": "identification.window_before_s",
+        "after_s": "identification.window_after_s",
+        "initial_state_span_s": "identification.initial_state_span_s",
+    }
+    assert _mismatches(_defaults(ResponseWindow), CONFIG, WINDOW_KEYS) == []
+    assert ResponseWindow.from_config(CONFIG) == ResponseWindow()
+
+
 def test_response_settings_defaults_equal_config_identification_and_strides():
     defaults = _defaults(ResponseSettings)
     assert _mismatches(defaults, CONFIG, RESPONSE_KEYS) == []
+    assert defaults["window"] == ResponseWindow()
     # rate_hz has no config key (the workflow leaves it at its default): the response grid runs at the study's
     # motion-capture rate, the rate of the validation's simulated measurements and of the synthetic lab's markers
-    assert set(defaults) - set(RESPONSE_KEYS) == {"rate_hz"}
+    assert set(defaults) - set(RESPONSE_KEYS) == {"rate_hz", "window"}
     assert defaults["rate_hz"] == CONFIG["validation"]["sample_rate_hz"] == LabSettings().marker_rate_hz
 
 
@@ -173,6 +183,7 @@ def test_identification_settings_defaults_equal_config_identification():
 
 def test_every_identification_key_has_a_checked_default():
     checked = set(IDENTIFICATION_KEYS.values()) | {v for v in RESPONSE_KEYS.values() if v.startswith("identification.")}
+    checked |= set(WINDOW_KEYS.values())
     checked |= {"identification.plausible_ranges"}
     assert {f"identification.{k}" for k in CONFIG["identification"]} == checked
 
@@ -209,10 +220,7 @@ KEYWORD_DEFAULTS = [
     (
         prepare_window,
         {
-            "window_before_s": "identification.window_before_s",
-            "window_after_s": "identification.window_after_s",
             "n_substeps": "identification.n_substeps",
-            "initial_state_span_s": "identification.initial_state_span_s",
             "initial_state_degree": "identification.initial_state_degree",
         },
     ),
@@ -258,6 +266,10 @@ def test_keyword_defaults_equal_config(function, keys):
     assert _mismatches(_signature_defaults(function), CONFIG, keys) == []
 
 
+def test_prepare_window_default_window_is_the_configs():
+    assert _signature_defaults(prepare_window)["window"] == ResponseWindow.from_config(CONFIG)
+
+
 def test_prepared_window_and_identify_defaults_agree_with_config():
     fields = {f.name: f.default for f in dataclasses.fields(PreparedWindow)}
     keys = {
@@ -297,9 +309,6 @@ def test_plan_settings_defaults_equal_config():
         **{
             name: f"identification.{name}"
             for name in (
-                "window_before_s",
-                "window_after_s",
-                "initial_state_span_s",
                 "initial_state_degree",
                 "n_substeps",
                 "null_pair_components",
@@ -316,8 +325,9 @@ def test_plan_settings_defaults_equal_config():
         "force_rate_hz": "device.parameters.sample_rate_hz",
     }
     defaults = _defaults(PlanSettings)
-    assert set(defaults) == set(keys)
+    assert set(defaults) == set(keys) | {"window"}
     assert _mismatches(defaults, CONFIG, keys) == []
+    assert defaults["window"] == ResponseWindow.from_config(CONFIG)
 
 
 # --------------------------------------------------------------------------- synthetic lab
@@ -361,8 +371,16 @@ def test_a_changed_config_value_is_a_mismatch(path, value):
     config = copy.deepcopy(CONFIG)
     *parents, key = path.split(".")
     _get(config, ".".join(parents))[key] = value
-    keys = {**RESPONSE_KEYS, **{f"device.{n}": f"device.parameters.{n}" for n in CONFIG["device"]["parameters"]}}
-    defaults = {**_defaults(ResponseSettings), **{f"device.{k}": v for k, v in _defaults(DeviceParameters).items()}}
+    keys = {
+        **RESPONSE_KEYS,
+        **{f"window.{n}": key for n, key in WINDOW_KEYS.items()},
+        **{f"device.{n}": f"device.parameters.{n}" for n in CONFIG["device"]["parameters"]},
+    }
+    defaults = {
+        **_defaults(ResponseSettings),
+        **{f"window.{k}": v for k, v in _defaults(ResponseWindow).items()},
+        **{f"device.{k}": v for k, v in _defaults(DeviceParameters).items()},
+    }
     assert _mismatches(defaults, CONFIG, keys) == []
     (line,) = _mismatches(defaults, config, keys)
     assert path in line and repr(value) in line

@@ -25,6 +25,7 @@ from loper_analysis.identification.validation import (
     validation_window,
 )
 from loper_analysis.responses import ResponseSettings
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.steps.validation import validation_chunk
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.bad_input.fit_trials import ONSET_MS, fit_inputs, walking_trial
@@ -42,7 +43,7 @@ LONGEST_AFTER_ONSET_S = (62 - 13) / 128
 @pytest.mark.parametrize("after, limit", [(1.0, "0.55 s"), (0.56, "0.55 s")])
 def test_validation_refuses_a_window_after_the_heel_strike(after, limit):
     with pytest.raises(LoperInputError) as info:
-        ValidationSettings(window_after_s=after)
+        ValidationSettings(window=ResponseWindow(after_s=after))
     message = str(info.value)
     assert f"identification.window_after_s = {after:g} s" in message
     assert f"at most {limit}" in message and "validation.swing_duration_s = 0.6 s" in message
@@ -51,19 +52,19 @@ def test_validation_refuses_a_window_after_the_heel_strike(after, limit):
 
 def test_validation_refuses_a_window_before_toe_off():
     with pytest.raises(LoperInputError) as info:
-        ValidationSettings(window_before_s=0.1)
+        ValidationSettings(window=ResponseWindow(before_s=0.1))
     assert "identification.window_before_s = 0.1 s" in str(info.value) and "at most 0.05 s" in str(info.value)
 
 
 def test_validation_accepts_the_window_up_to_the_heel_strike():
-    settings = ValidationSettings(window_after_s=0.55, window_before_s=0.05)
-    assert settings.onset_s + settings.window_after_s == pytest.approx(settings.swing_duration_s)
+    settings = ValidationSettings(window=ResponseWindow(after_s=0.55, before_s=0.05))
+    assert settings.onset_s + settings.window.after_s == pytest.approx(settings.swing_duration_s)
 
 
 def test_validation_chunk_step_refuses_before_writing(tmp_path):
     out = [tmp_path / "errors.tsv", tmp_path / "fits.tsv"]
     with pytest.raises(LoperInputError, match=r"identification\.window_after_s = 1 s"):
-        validation_chunk(tmp_path / "segments.tsv", ValidationSettings(window_after_s=1.0), 0, 2, *out)
+        validation_chunk(tmp_path / "segments.tsv", ValidationSettings(window=ResponseWindow(after_s=1.0)), 0, 2, *out)
     assert not any(p.exists() for p in out)
 
 
@@ -83,7 +84,9 @@ def _fit(trials, after, null=(), min_strides=4, counterfactual="conditional", **
         ONSET_MS,
         "S01",
         null_trials=[fit_inputs(t) for t in null],
-        response=ResponseSettings(window_after_s=after, min_strides=min_strides, counterfactual=counterfactual),
+        response=ResponseSettings(
+            window=ResponseWindow(after_s=after), min_strides=min_strides, counterfactual=counterfactual
+        ),
         identification=settings,
     )
 

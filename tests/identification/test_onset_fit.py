@@ -8,6 +8,7 @@ from loper_analysis.identification.fit import ImpedanceFit
 from loper_analysis.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
 from loper_analysis.identification.window import N_SUBSTEPS
 from loper_analysis.responses import ResponseSettings, null_pair_windows
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.responses.twin_strides import DELAY, RATE, null_trial
 
@@ -41,7 +42,7 @@ def _series(force_time_s=None):
 def test_mean_response_window_holds_the_analytic_deviation():
     """Window -0.1 .. 0.3 s about the onset at 0 s; measured hip, knee, ankle = (-0.08, -0.3, -0.25) tau^2,
     the pelvis deviation 0.02 tau^2 at the data samples, the perturbed force (3, -1) N throughout."""
-    window = mean_response_window(_series(), PARAMS, {"window_before_s": 0.1, "window_after_s": 0.3})
+    window = mean_response_window(_series(), PARAMS, {"window": ResponseWindow(before_s=0.1, after_s=0.3)})
     assert window.onset_s == 0.0
     np.testing.assert_allclose(window.time_s, np.arange(-10, 31) * 0.01, rtol=0, atol=1e-12)
     tau2 = np.clip(window.time_s, 0.0, None) ** 2
@@ -54,9 +55,9 @@ def test_mean_response_window_holds_the_analytic_deviation():
 def test_mean_response_window_takes_forces_at_their_own_clock():
     """Forces sampled at 1000 Hz (``force_time_s`` in the series) give the same constant perturbed force."""
     own = mean_response_window(
-        _series(np.arange(-300, 501) * 0.001), PARAMS, {"window_before_s": 0.1, "window_after_s": 0.3}
+        _series(np.arange(-300, 501) * 0.001), PARAMS, {"window": ResponseWindow(before_s=0.1, after_s=0.3)}
     )
-    shared = mean_response_window(_series(), PARAMS, {"window_before_s": 0.1, "window_after_s": 0.3})
+    shared = mean_response_window(_series(), PARAMS, {"window": ResponseWindow(before_s=0.1, after_s=0.3)})
     np.testing.assert_allclose(own.force_perturbed_n, shared.force_perturbed_n, rtol=0, atol=1e-12)
     np.testing.assert_allclose(own.feedforward, shared.feedforward, rtol=0, atol=1e-9)
     np.testing.assert_array_equal(own.measured, shared.measured)

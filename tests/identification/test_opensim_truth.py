@@ -26,6 +26,7 @@ import pytest
 
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.identification import identify_impedance, prepare_window
+from loper_analysis.responses.response_window import ResponseWindow
 from tests.opensim_swing_leg import (
     A_INV,
     COORDINATES,
@@ -82,7 +83,7 @@ def _fit(rec: dict, onset_s: float, native: bool):
             for key, src in (("force_unperturbed_n", "force_u_n"), ("force_perturbed_n", "force_p_n"))
         }
     window = prepare_window(
-        rec["time_s"], rec["q_u"], rec["q_p"], WINTER, onset_s, window_before_s=0.025, window_after_s=0.25, **kw
+        rec["time_s"], rec["q_u"], rec["q_p"], WINTER, onset_s, window=ResponseWindow(0.025, 0.25), **kw
     )
     return identify_impedance(window)
 

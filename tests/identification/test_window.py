@@ -11,6 +11,7 @@ from loper_analysis.identification import (
     simulate_deviation,
     simulate_response,
 )
+from loper_analysis.responses.response_window import ResponseWindow
 from tests.identification.validation_windows import (
     MID_TRUTH,
     PARAMS,
@@ -86,10 +87,14 @@ def test_prepare_window_rejects_bad_input(trial_mid):
     t_bad[10] += 0.002
     expect_error(lambda: prepare_window(t_bad, qu, qp, PARAMS, onset, **kw), "time_s", "uniform", "sample 9")
     expect_error(
-        lambda: prepare_window(t, qu, qp, PARAMS, onset, window_after_s=1.0, **kw), "window", "longer than the data"
+        lambda: prepare_window(t, qu, qp, PARAMS, onset, window=ResponseWindow(after_s=1.0), **kw),
+        "window",
+        "longer than the data",
     )
     expect_error(
-        lambda: prepare_window(t, qu, qp, PARAMS, onset, window_before_s=1.0, **kw), "window", "longer than the data"
+        lambda: prepare_window(t, qu, qp, PARAMS, onset, window=ResponseWindow(before_s=1.0), **kw),
+        "window",
+        "longer than the data",
     )
     expect_error(lambda: prepare_window(t, qu, qp, PARAMS, onset, n_substeps=2.5, **kw), "n_substeps", "2.5")
     expect_error(lambda: prepare_window(t, qu, qp, PARAMS, onset, n_substeps=0, **kw), "n_substeps", "0")

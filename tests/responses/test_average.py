@@ -13,6 +13,7 @@ from loper_analysis.responses import (
     ResponseSettings,
     subject_onset_response,
 )
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.swing_leg.dynamics import (
     segment_coordinates,
     segment_parameters_from_anthropometry,
@@ -83,9 +84,7 @@ def test_subject_response_returns_the_planted_bump(rng):
         force_perturbed_n=series["force_perturbed_n"],
         pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
         pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],
-        window_before_s=series["window_before_s"],
-        window_after_s=series["window_after_s"],
-        initial_state_span_s=series["initial_state_span_s"],
+        window=ResponseWindow(series["window_before_s"], series["window_after_s"], series["initial_state_span_s"]),
     )
     inside = response[response["analysis_window"]]
     np.testing.assert_allclose(window.time_s, inside["time_s"], atol=1e-12)

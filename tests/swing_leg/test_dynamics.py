@@ -22,6 +22,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.identification import prepare_window, simulate_response
 from loper_analysis.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     attachment_jacobian,
@@ -312,10 +313,8 @@ def test_compiled_rk4_matches_dop853_for_a_perturbed_swing_with_feedback():
         force_perturbed_n=fp,
         pelvis_angle_unperturbed_rad=pelvis,
         pelvis_angle_perturbed_rad=pelvis,
-        window_before_s=0.025,
-        window_after_s=0.25,
+        window=ResponseWindow(before_s=0.025, after_s=0.25, initial_state_span_s=0.05),
         n_substeps=n_sub,
-        initial_state_span_s=0.05,
         initial_state_degree=1,
     )
     np.testing.assert_array_equal(window.initial_deviation, 0.0)  # q_perturbed = q_unperturbed before the onset

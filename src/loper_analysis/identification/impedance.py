@@ -483,13 +483,7 @@ def fit_onset(
         rows = status_rows(subject, onset_ms, "failed", _not_fitted_reason(counts, onset_ms, r), n_kept, truth)
         return OnsetFit(mean, counts, rows, _no_curves())
     ident = identification
-    options = dict(
-        window_before_s=r.window_before_s,
-        window_after_s=r.window_after_s,
-        n_substeps=ident.n_substeps,
-        initial_state_span_s=r.initial_state_span_s,
-        initial_state_degree=ident.initial_state_degree,
-    )
+    options = dict(window=r.window, n_substeps=ident.n_substeps, initial_state_degree=ident.initial_state_degree)
     window = mean_response_window(series, params, options)
     fit = identify_impedance(window, **ident.fit_options())
     averaging = np.zeros_like(window.measured)
@@ -590,7 +584,7 @@ def _not_fitted_reason(counts: pd.DataFrame, onset_ms: int, response: ResponseSe
             int(total["n_too_short"]),
             int(total["n_perturbed"]),
             onset_ms,
-            response.window_after_s,
+            response.window.after_s,
             counts.attrs["longest_swing_after_onset_s"],
         )
     return reason

@@ -16,12 +16,11 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
 
-from loper_analysis.checks import number
 from loper_analysis.constants import JOINTS, PARAMETERS
 from loper_analysis.device.pulse import pulse_force
 from loper_analysis.errors import LoperInputError
@@ -30,12 +29,9 @@ from loper_analysis.identification import (
     DEFAULT_UPPER,
     FIT_TOLERANCE,
     INITIAL_STATE_DEGREE,
-    INITIAL_STATE_SPAN_S,
     MERGE_TOLERANCE,
     N_STARTS,
     N_SUBSTEPS,
-    WINDOW_AFTER_S,
-    WINDOW_BEFORE_S,
     identify_impedance,
     per_step,
     prepare_window,
@@ -44,13 +40,13 @@ from loper_analysis.identification import (
     window_options,
 )
 from loper_analysis.reference import STUDY_DEVICE, STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N, SEED
 from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
 
 __all__ = [
     "ValidationSettings",
     "validation_settings",
-    "check_window_in_swing",
     "impedance_grid",
     "chunk_combinations",
     "nominal_swing",
@@ -70,7 +66,12 @@ CONDITIONS: tuple[str, ...] = ("no_noise", "noise")
 
 @dataclass(frozen=True)
 class ValidationSettings:
-    """Settings of the validation study (SI units); the defaults are the study's design."""
+    """Settings of the validation study (SI units); the defaults are the study's design.
+
+    ``window``: the fit window and initial-state span
+    (:class:`~loper_analysis.responses.response_window.ResponseWindow`, s), checked to lie inside the
+    simulated swing ``0 .. swing_duration_s`` around ``onset_s`` (:meth:`ResponseWindow.check_in_swing`).
+    """
 
     stiffness_levels_nm_per_rad: tuple[float, ...] = (0.0, 75.0, 150.0)
     damping_levels_nms_per_rad: tuple[float, ...] = (0.0, 2.0, 4.0)
@@ -83,8 +84,7 @@ class ValidationSettings:
     pulse_overshoot_pct: float = STUDY_DEVICE["overshoot_pct"][0]
     force_rate_hz: float = 1000.0
     force_direction_deg: float = 0.0
-    window_before_s: float = WINDOW_BEFORE_S
-    window_after_s: float = WINDOW_AFTER_S
+    window: ResponseWindow = field(default_factory=ResponseWindow)
     noise_peak_to_peak: float = 0.01
     n_starts: int = N_STARTS
     n_substeps: int = N_SUBSTEPS
@@ -92,14 +92,13 @@ class ValidationSettings:
     tolerance: float = FIT_TOLERANCE
     merge_tolerance: float = MERGE_TOLERANCE
     reference_cutoff_hz: float | None = None
-    initial_state_span_s: float = INITIAL_STATE_SPAN_S
     initial_state_degree: int = INITIAL_STATE_DEGREE
     seed: int = SEED
     lower: tuple[float, ...] = tuple(DEFAULT_LOWER)
     upper: tuple[float, ...] = tuple(DEFAULT_UPPER)
 
     def __post_init__(self):
-        check_window_in_swing(self.onset_s, self.window_before_s, self.window_after_s, self.swing_duration_s)
+        self.window.check_in_swing(self.onset_s, self.swing_duration_s)
 
     @classmethod
     def from_config(cls, config: Mapping) -> ValidationSettings:
@@ -133,64 +132,14 @@ def validation_settings(config: Mapping) -> dict:
             )
         },
         seed=config["seed"],
+        window=ResponseWindow.from_config(config),
         **{
             key: ident[key]
-            for key in (
-                "window_before_s",
-                "window_after_s",
-                "n_starts",
-                "n_substeps",
-                "tolerance",
-                "merge_tolerance",
-                "initial_state_span_s",
-                "initial_state_degree",
-            )
+            for key in ("n_starts", "n_substeps", "tolerance", "merge_tolerance", "initial_state_degree")
         },
         lower=(k_lo, d_lo) * 3,
         upper=(k_hi, d_hi) * 3,
     )
-
-
-def check_window_in_swing(
-    onset_s: float, window_before_s: float, window_after_s: float, swing_duration_s: float
-) -> None:
-    """Refuse a fit window that does not lie inside the simulated swing ``0 .. swing_duration_s`` (s after toe-off).
-
-    The window runs from ``onset_s - window_before_s`` to ``onset_s + window_after_s``. Outside the
-    swing :func:`nominal_swing` holds the toe-off or heel-strike posture, which is no swing at all, so a
-    fit there says nothing about the identification. The message names the config keys
-    (``identification.window_*``, ``validation.*``), the value and the limit.
-
-    Raises
-    ------
-    LoperInputError
-        A non-finite or non-positive swing, an onset outside ``0 .. swing_duration_s``, a window
-        starting before toe-off or ending after the heel strike.
-    """
-    swing_duration_s = number("validation.swing_duration_s", swing_duration_s)
-    onset_s = number("validation.onset_s", onset_s)
-    window_before_s = number("identification.window_before_s", window_before_s, minimum=0.0)
-    window_after_s = number("identification.window_after_s", window_after_s, minimum=0.0)
-    if swing_duration_s <= 0:
-        raise LoperInputError(f"validation.swing_duration_s must be positive, got {swing_duration_s:g} s")
-    if not 0 <= onset_s < swing_duration_s:
-        raise LoperInputError(
-            f"validation.onset_s = {onset_s:g} s lies outside the simulated swing "
-            f"0 .. {swing_duration_s:g} s (validation.swing_duration_s)"
-        )
-    room_after = swing_duration_s - onset_s
-    if window_after_s > room_after + 1e-12:
-        raise LoperInputError(
-            f"identification.window_after_s = {window_after_s:g} s does not fit in the simulated swing of the "
-            f"validation study: the window must end by the heel strike, so it may be at most {room_after:g} s "
-            f"(validation.swing_duration_s = {swing_duration_s:g} s - validation.onset_s = {onset_s:g} s)"
-        )
-    if window_before_s > onset_s + 1e-12:
-        raise LoperInputError(
-            f"identification.window_before_s = {window_before_s:g} s does not fit in the simulated swing of the "
-            f"validation study: the window must start after toe-off, so it may be at most {onset_s:g} s "
-            f"(validation.onset_s)"
-        )
 
 
 def impedance_grid(stiffness_levels, damping_levels) -> np.ndarray:
@@ -276,8 +225,8 @@ def _truth_window(params: SegmentParameters, settings: ValidationSettings):
     key = (params.packed.tobytes(), settings)
     if key not in _TRUTH_WINDOWS:
         fs = settings.sample_rate_hz
-        t_start = settings.onset_s - settings.window_before_s - 0.1
-        t_end = settings.onset_s + settings.window_after_s + 0.05
+        t_start = settings.onset_s - settings.window.before_s - 0.1
+        t_end = settings.onset_s + settings.window.after_s + 0.05
         n = int(np.floor((t_end - t_start) * fs)) + 1
         t = t_start + np.arange(n) / fs
         qu, pelvis = nominal_swing(t, settings.swing_duration_s)
@@ -290,8 +239,7 @@ def _truth_window(params: SegmentParameters, settings: ValidationSettings):
             settings.onset_s,
             pelvis_angle_unperturbed_rad=pelvis,
             pelvis_angle_perturbed_rad=pelvis,
-            window_before_s=settings.window_before_s,
-            window_after_s=t[-1] - settings.onset_s,
+            window=ResponseWindow(before_s=settings.window.before_s, after_s=t[-1] - settings.onset_s),
             n_substeps=settings.truth_substeps,
         )
         window = with_pulse_at_stages(window, settings)

@@ -19,7 +19,12 @@ from scipy.interpolate import CubicSpline
 
 from loper_analysis.checks import finite_rows
 from loper_analysis.errors import LoperInputError
-from loper_analysis.responses.windows import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
+from loper_analysis.responses.response_window import (
+    INITIAL_STATE_SPAN_S,
+    WINDOW_AFTER_S,
+    WINDOW_BEFORE_S,
+    ResponseWindow,
+)
 from loper_analysis.swing_leg import kernels
 from loper_analysis.swing_leg.dynamics import SegmentParameters, inverse_dynamics, joint_angles
 
@@ -46,7 +51,8 @@ __all__ = [
 
 # Defaults of the fit's initial state and integration (config ``identification.*``, the same values); the
 # window's span (WINDOW_BEFORE_S, WINDOW_AFTER_S, INITIAL_STATE_SPAN_S) is the responses' own
-# (:mod:`loper_analysis.responses.windows`): the fit covers the window the responses were cut to.
+# (:class:`loper_analysis.responses.response_window.ResponseWindow`): the fit covers the window the responses
+# were cut to.
 #: Degree of that polynomial (1: position and rate; ``identification.initial_state_degree``).
 INITIAL_STATE_DEGREE: int = 1
 #: RK4 steps per sample of the data (``identification.n_substeps``).
@@ -120,13 +126,7 @@ def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.nd
 
 #: Fields of a settings object (:class:`~loper_analysis.identification.validation.ValidationSettings`,
 #: :class:`~loper_analysis.planning.window.PlanSettings`) that :func:`prepare_window` takes by name.
-WINDOW_FIELDS: tuple[str, ...] = (
-    "window_before_s",
-    "window_after_s",
-    "n_substeps",
-    "initial_state_span_s",
-    "initial_state_degree",
-)
+WINDOW_FIELDS: tuple[str, ...] = ("window", "n_substeps", "initial_state_degree")
 
 
 def window_options(settings) -> dict:
@@ -146,12 +146,10 @@ def prepare_window(
     force_time_s=None,
     pelvis_angle_unperturbed_rad=None,
     pelvis_angle_perturbed_rad=None,
-    window_before_s: float = WINDOW_BEFORE_S,
-    window_after_s: float = WINDOW_AFTER_S,
+    window: ResponseWindow = ResponseWindow(),
     n_substeps: int = N_SUBSTEPS,
     reference_cutoff_hz: float | None = None,
     q_reference=None,
-    initial_state_span_s: float = INITIAL_STATE_SPAN_S,
     initial_state_degree: int = INITIAL_STATE_DEGREE,
 ) -> PreparedWindow:
     """Check the inputs of one fit and precompute reference, inputs and initial state.
@@ -176,7 +174,8 @@ def prepare_window(
         must cover the fit window. Without it the forces are (n, 2) at
         ``time_s`` and are interpolated linearly at the stage times.
     pelvis_angle_*_rad : (n,) pelvis angle (rad); zero when omitted.
-    window_before_s, window_after_s : window around the onset (s).
+    window : the window around the onset (``before_s``, ``after_s``, s) and the span before it for the initial
+        state (``initial_state_span_s``, s; :class:`~loper_analysis.responses.response_window.ResponseWindow`).
     n_substeps : RK4 steps per sample (integer >= 1).
     reference_cutoff_hz : if given, the unperturbed coordinates are low-pass
         filtered (2nd-order zero-phase Butterworth) before they serve as the
@@ -185,10 +184,10 @@ def prepare_window(
     q_reference : (n, 4) optional smooth reference coordinates for ``u_ff``
         and the feedback operating point (e.g. the mean of many unperturbed
         strides); ``q_unperturbed`` when omitted.
-    initial_state_span_s, initial_state_degree : the initial deviation and
+    initial_state_degree : the initial deviation and
         its rate at window start come from a least-squares polynomial of this
         degree through the perturbed-minus-unperturbed coordinates over the
-        last ``initial_state_span_s`` before the onset, when the perturbation
+        last ``window.initial_state_span_s`` before the onset, when the perturbation
         has not yet acted (robust to measurement noise; exact for smooth data).
 
     Raises
@@ -212,7 +211,10 @@ def prepare_window(
         fpm = _column("force_perturbed_n", force_perturbed_n, len(tf), 2, "force_time_s")
     pu = _column("pelvis_angle_unperturbed_rad", pelvis_angle_unperturbed_rad, n, 1)[:, 0]
     pp = _column("pelvis_angle_perturbed_rad", pelvis_angle_perturbed_rad, n, 1)[:, 0]
-    i0, i1, n_substeps = _window_samples(t, dt, onset_s, window_before_s, window_after_s, n_substeps)
+    if not isinstance(window, ResponseWindow):
+        raise LoperInputError(f"window must be a ResponseWindow, got {type(window).__name__}")
+    initial_state_span_s = window.initial_state_span_s
+    i0, i1, n_substeps = _window_samples(t, dt, onset_s, window.before_s, window.after_s, n_substeps)
     tol = 1e-9 * dt
 
     # reference: cubic spline of the unperturbed coordinates, at RK4 stage times

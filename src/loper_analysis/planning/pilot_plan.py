@@ -29,6 +29,7 @@ from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_p
 from loper_analysis.planning.precision import precision_table, target_answer, unplanned_rows
 from loper_analysis.planning.window import PLAN_IDENTIFICATION_KEYS, PlanSettings
 from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
+from loper_analysis.responses.response_window import WINDOW_KEYS
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = ["STRIDES", "PlanningSettings", "check_plan_request", "pilot_plan", "planned_impedance"]
@@ -42,6 +43,7 @@ STRIDES: tuple[int, ...] = (10, 20, 40)
 _PLANNER_KEYS = {
     "planning": ("pulse_force_n", "pulse_duration_s"),
     "identification": (
+        *(key.removeprefix("identification.") for key in WINDOW_KEYS.values()),
         *PLAN_IDENTIFICATION_KEYS,
         "stiffness_bounds_nm_per_rad",
         "damping_bounds_nms_per_rad",
@@ -101,12 +103,12 @@ class PlanningSettings:
             :func:`loper_analysis.config_file.load_config`). ``onsets_ms``: ``trials.perturbation_onsets_ms``;
             ``strides``, ``targets``: ``planning.strides``, ``planning.targets``; ``plan``: the pulse
             ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s) with the keys of
-            ``identification`` the planner follows (fit window and initial state in s, substeps, projected
+            ``identification`` the planner follows (the fit window and initial-state span as a
+            :class:`~loper_analysis.responses.ResponseWindow` in s, substeps, projected
             components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad);
-            ``response``: ``identification.window_before_s``, ``window_after_s``, ``initial_state_span_s``
-            and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``, the counterfactual planned for
-            ``identification.counterfactual``; ``device``:
-            ``device.parameters``; ``max_null_trial_ratio``: ``identification.max_null_trial_ratio``.
+            ``response``: the same window and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``, the
+            counterfactual planned for ``identification.counterfactual``; ``device``: ``device.parameters``;
+            ``max_null_trial_ratio``: ``identification.max_null_trial_ratio``.
 
         Raises
         ------

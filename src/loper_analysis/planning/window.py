@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -30,18 +30,16 @@ from loper_analysis.identification.null_pairs import MIN_NULL_PAIRS, NULL_PAIR_C
 from loper_analysis.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS
 from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.planning.inputs import pulse_force_n
-from loper_analysis.responses.windows import INITIAL_STATE_SPAN_S, WINDOW_AFTER_S, WINDOW_BEFORE_S
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = ["PLAN_IDENTIFICATION_KEYS", "null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
 
 
-#: Keys of config ``identification`` the planner follows as they are (the bounds become tuples).
+#: Keys of config ``identification`` the planner follows as they are (beside the window's, which
+#: :meth:`ResponseWindow.from_config` reads; the bounds become tuples).
 PLAN_IDENTIFICATION_KEYS: tuple[str, ...] = (
-    "window_before_s",
-    "window_after_s",
-    "initial_state_span_s",
     "initial_state_degree",
     "n_substeps",
     "null_pair_components",
@@ -55,8 +53,8 @@ class PlanSettings(FitBounds):
     """The planned pulse and the identification settings the prediction follows (config ``identification``).
 
     ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
-    onset; ``window_before_s``, ``window_after_s``, ``initial_state_span_s``
-    (s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
+    onset; ``window`` (:class:`~loper_analysis.responses.response_window.ResponseWindow`: the fit's
+    window and initial-state span, s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
     ``min_null_pairs``, ``interval_scatter`` (whose scatter the fit's
     intervals take, hence their t quantile) and the bounds (N·m/rad,
     N·m·s/rad) as the fit uses them; ``force_cutoff_hz`` and ``force_order``
@@ -66,9 +64,7 @@ class PlanSettings(FitBounds):
 
     pulse_force_n: float = PULSE_FORCE_N
     pulse_duration_s: float = PULSE_DURATION_S
-    window_before_s: float = WINDOW_BEFORE_S
-    window_after_s: float = WINDOW_AFTER_S
-    initial_state_span_s: float = INITIAL_STATE_SPAN_S
+    window: ResponseWindow = field(default_factory=ResponseWindow)
     initial_state_degree: int = INITIAL_STATE_DEGREE
     n_substeps: int = N_SUBSTEPS
     null_pair_components: int = NULL_PAIR_COMPONENTS
@@ -88,6 +84,7 @@ class PlanSettings(FitBounds):
         return cls(
             pulse_force_n=config["planning"]["pulse_force_n"],
             pulse_duration_s=config["planning"]["pulse_duration_s"],
+            window=ResponseWindow.from_config(config),
             **{key: ident[key] for key in PLAN_IDENTIFICATION_KEYS},
             stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
             damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
@@ -98,15 +95,7 @@ class PlanSettings(FitBounds):
         check_interval_scatter(self.interval_scatter)
         if number("force_rate_hz", self.force_rate_hz) <= 0:
             raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
-        d = number("pulse_duration_s", self.pulse_duration_s)
-        after = number("window_after_s", self.window_after_s, minimum=0.0)
-        if d <= 0:
-            raise LoperInputError(f"pulse_duration_s must be > 0 s, got {d:g} s")
-        if d > after:
-            raise LoperInputError(
-                f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
-                f"(identification.window_after_s = {after:g} s): the fit would not see its end"
-            )
+        self.window.check_pulse(self.pulse_duration_s)
 
 
 def planning_window(

@@ -23,6 +23,8 @@ identification (:func:`loper_analysis.identification.prepare_window`) fits.
   the same way, the stride-to-stride noise the identification weights its
   errors by (a trial whose null pairs deviate far more than the other
   trials' is left out: :func:`deviant_trials`);
+* :mod:`.response_window` - :class:`ResponseWindow`: the analysis window around the onset and the span
+  before it for the fit's initial state, which the fit, the planner and the validation study share;
 * :mod:`.inputs` and :mod:`.sampling` - the trial inputs (frames) and the
   spline sampling the others share.
 
@@ -49,6 +51,7 @@ from loper_analysis.responses.null_pairs import (
     null_pair_windows,
     trial_deviation_rad,
 )
+from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.responses.windows import (
     MIN_PAIRS_FOR_OUTLIERS,
     ResponseSettings,
@@ -62,6 +65,7 @@ __all__ = [
     "COUNT_COLUMNS",
     "MIN_PAIRS_FOR_OUTLIERS",
     "ResponseSettings",
+    "ResponseWindow",
     "analysis_grid",
     "too_short",
     "match_unperturbed",

@@ -9,7 +9,7 @@
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numpy as np
@@ -26,6 +26,12 @@ from loper_analysis.gait.outliers import (
     iqr_outliers,
 )
 from loper_analysis.gait.resampling import window, window_times_s
+from loper_analysis.responses.response_window import (
+    INITIAL_STATE_SPAN_S,
+    WINDOW_AFTER_S,
+    WINDOW_BEFORE_S,
+    ResponseWindow,
+)
 from loper_analysis.responses.sampling import TIME_TOLERANCE_S, SplineSampler, window_span
 from loper_analysis.swing_leg.dynamics import segment_coordinates
 
@@ -36,6 +42,7 @@ __all__ = [
     "WINDOW_BEFORE_S",
     "MIN_PAIRS_FOR_OUTLIERS",
     "ResponseSettings",
+    "ResponseWindow",
     "AnalysisGrid",
     "analysis_grid",
     "paired_windows",
@@ -43,15 +50,6 @@ __all__ = [
     "window_coordinates",
     "window_outliers",
 ]
-
-# The analysis window around each onset (config ``identification.*``, the same values): every default of these
-# settings in the library (responses, identification, validation, impedance) refers to these.
-#: The window starts this long before the perturbation onset (s; ``identification.window_before_s``) ...
-WINDOW_BEFORE_S: float = 0.025
-#: ... and ends this long after it (s; ``identification.window_after_s``).
-WINDOW_AFTER_S: float = 0.25
-#: Pre-onset span of the fit's initial-state polynomial (s; ``identification.initial_state_span_s``).
-INITIAL_STATE_SPAN_S: float = 0.1
 
 #: The unperturbed reference of a perturbed stride (``identification.counterfactual``): the study's one
 #: matched stride, or the conditional mean over all unperturbed strides (:mod:`loper_analysis.responses.conditional`).
@@ -65,9 +63,8 @@ MIN_PAIRS_FOR_OUTLIERS: int = MIN_STRIDES_FOR_OUTLIERS
 class ResponseSettings:
     """How the responses of a subject and onset are windowed, judged and averaged.
 
-    ``rate_hz``: frame and grid rate (Hz); the analysis window runs from
-    ``window_before_s`` before to ``window_after_s`` after the onset (s),
-    preceded by ``initial_state_span_s`` for the fit's initial state;
+    ``rate_hz``: frame and grid rate (Hz); ``window``: the analysis window around the onset, preceded by
+    the span for the fit's initial state (:class:`~loper_analysis.responses.response_window.ResponseWindow`);
     ``whisker`` and ``max_fraction`` are the IQR rule's
     (:func:`window_outliers`); ``min_strides`` the fewest kept pairs for an
     ``ok`` average; ``counterfactual`` the unperturbed reference of a perturbed
@@ -78,9 +75,7 @@ class ResponseSettings:
     """
 
     rate_hz: float = 128.0
-    window_before_s: float = WINDOW_BEFORE_S
-    window_after_s: float = WINDOW_AFTER_S
-    initial_state_span_s: float = INITIAL_STATE_SPAN_S
+    window: ResponseWindow = field(default_factory=ResponseWindow)
     whisker: float = IQR_WHISKER
     max_fraction: float = MAX_OUTLIER_FRACTION
     min_strides: int = MIN_VALID_STRIDES
@@ -93,9 +88,7 @@ class ResponseSettings:
         alike)."""
         ident, strides = config["identification"], config["strides"]
         return cls(
-            window_before_s=ident["window_before_s"],
-            window_after_s=ident["window_after_s"],
-            initial_state_span_s=ident["initial_state_span_s"],
+            window=ResponseWindow.from_config(config),
             whisker=strides["iqr_whisker"],
             max_fraction=strides["max_outlier_fraction"],
             min_strides=strides["min_valid_strides"],
@@ -136,9 +129,9 @@ def analysis_grid(trials, onset_ms, settings: ResponseSettings, side: str, sourc
     if not isinstance(settings, ResponseSettings):
         raise LoperInputError(f"{where(source)}settings must be ResponseSettings, got {type(settings).__name__}")
     onset_s = number("onset_ms", onset_ms, source, minimum=0.0) / 1e3
-    before = number("window_before_s", settings.window_before_s, source, minimum=0.0)
-    after = number("window_after_s", settings.window_after_s, source, minimum=0.0)
-    initial = number("initial_state_span_s", settings.initial_state_span_s, source, minimum=0.0)
+    before = number("window_before_s", settings.window.before_s, source, minimum=0.0)
+    after = number("window_after_s", settings.window.after_s, source, minimum=0.0)
+    initial = number("initial_state_span_s", settings.window.initial_state_span_s, source, minimum=0.0)
     if side not in SIDES:
         raise LoperInputError(f"{where(source)}side must be 'left' or 'right', got {side!r}")
     if isinstance(trials, Mapping) or not len(trials):

@@ -16,6 +16,7 @@ from pathlib import Path
 from loper_analysis.io.atomic import PathLike, write_text
 from loper_analysis.io.readers import read_bytes, read_tsv
 from loper_analysis.report.front_page import RunSettings
+from loper_analysis.responses.response_window import ResponseWindow
 
 __all__ = [
     "markdown_tables",
@@ -71,6 +72,7 @@ class FrontPageSettings:
         ``filter.*``, the fit window, bounds, starts, noise model and components of ``identification`` and the
         synthetic lab's ``variability``, ``walking_duration_s`` and pulse."""
         trials, ident, synthetic = config["trials"], config["identification"], config["synthetic"]
+        window = ResponseWindow.from_config(config)
         return cls(
             RunSettings(
                 seed=config["seed"],
@@ -79,8 +81,8 @@ class FrontPageSettings:
                 perturbed_side=trials["perturbed_side"],
                 filter_cutoff_hz=config["filter"]["cutoff_hz"],
                 filter_order=config["filter"]["order"],
-                window_before_s=ident["window_before_s"],
-                window_after_s=ident["window_after_s"],
+                window_before_s=window.before_s,
+                window_after_s=window.after_s,
                 stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
                 damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
                 n_starts=ident["n_starts"],

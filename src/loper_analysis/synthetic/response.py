@@ -108,6 +108,7 @@ def swing_response(
     ``onset_s - before_s``; simulated to ``heel_strike_s``; faded out after.
     """
     from loper_analysis.identification import prepare_window, simulate_response
+    from loper_analysis.responses.response_window import ResponseWindow
 
     t = np.asarray(time_s, float)
     th = np.asarray(joint_angles_rad, float)
@@ -131,10 +132,8 @@ def swing_response(
             force_perturbed_n=fp,
             pelvis_angle_unperturbed_rad=pel,
             pelvis_angle_perturbed_rad=pel,
-            window_before_s=before_s,
-            window_after_s=heel_strike_s - onset_s,
+            window=ResponseWindow(before_s=before_s, after_s=heel_strike_s - onset_s, initial_state_span_s=0.04),
             n_substeps=n_substeps,
-            initial_state_span_s=0.04,
         )
         response = simulate_response(window, np.asarray(impedance, float))
         i0 = int(np.searchsorted(t, window.time_s[0] - 1e-9))
