@@ -8,22 +8,22 @@ analyses them and prints wall time and the device figures beside the study's.
 
 from __future__ import annotations
 
+import dataclasses
 import tempfile
 import time
 from pathlib import Path
 
 import yaml
 
-from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.steps import device
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())["device"]
-    rate = DeviceParameters(**cfg["parameters"]).sample_rate_hz
-    a = cfg["analysis"]
+    settings = device.DeviceSettings.from_config(yaml.safe_load((ROOT / "config/config.yaml").read_text()))
+    rate = settings.parameters.sample_rate_hz
+    analysis = settings.analysis
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         # compile once outside the timing (numba caches it for later runs anyway)
@@ -31,33 +31,27 @@ def main() -> None:
             tmp / "warm.loper.tsv",
             "warm",
             "device-steps",
-            cfg["parameters"],
-            cfg["leg"],
-            {**cfg["tests"], "step_repetitions": 1},
+            settings.parameters,
+            settings.leg,
+            dataclasses.replace(settings.tests, step_repetitions=1),
             0,
         )
         t0 = time.perf_counter()
         for trial in ("device-frf", "device-steps"):
             device.device_trial(
-                tmp / f"{trial}.loper.tsv", "S01", trial, cfg["parameters"], cfg["leg"], cfg["tests"], 2024
+                tmp / f"{trial}.loper.tsv", "S01", trial, settings.parameters, settings.leg, settings.tests, 2024
             )
         t1 = time.perf_counter()
-        device.frf(
-            tmp / "device-frf.loper.tsv", tmp / "frf.tsv", rate, a["welch_window_samples"], a["welch_overlap_samples"]
-        )
+        device.frf(tmp / "device-frf.loper.tsv", tmp / "frf.tsv", rate, analysis.frf)
         device.steps(
             tmp / "device-steps.loper.tsv",
             tmp / "steps.tsv",
             tmp / "avg.tsv",
             rate,
-            cfg["tests"]["step_amplitudes_n"],
-            a["step_before_s"],
-            a["step_after_s"],
-            a["steady_window_s"],
+            settings.tests.step_amplitudes_n,
+            analysis.steps,
         )
-        summary = device.summary(
-            tmp / "frf.tsv", tmp / "steps.tsv", tmp / "summary.tsv", a["bandwidth_reference_band_hz"]
-        )
+        summary = device.summary(tmp / "frf.tsv", tmp / "steps.tsv", tmp / "summary.tsv", analysis.reference_band_hz)
         t2 = time.perf_counter()
     print(
         f"simulate + write 2 device trials: {t1 - t0:.2f} s; read + analyse: {t2 - t1:.2f} s; "

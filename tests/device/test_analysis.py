@@ -9,6 +9,9 @@ import pytest
 from scipy.signal import cont2discrete, dlsim, freqz
 
 from loper_analysis.device.analysis import (
+    DeviceAnalysisSettings,
+    FRFSettings,
+    StepSettings,
     average_step,
     bandwidth_hz,
     device_summary,
@@ -161,3 +164,51 @@ def test_simulated_device_reproduces_the_study_within_15_percent():
     rms, peak = np.sqrt(np.mean(f**2)), np.abs(f).max()
     assert abs(rms - 2.05) / 2.05 <= 0.15, rms  # study 1.97 (stance) / 2.13 (swing)
     assert abs(peak - 4.55) / 4.55 <= 0.15, peak  # study 4.46 / 4.63
+
+
+# --------------------------------------------------------------------------- settings from the config
+
+#: A ``device.analysis`` section unlike the shipped one in every key.
+ANALYSIS = {
+    "welch_window_samples": 4000,
+    "welch_overlap_samples": 100,
+    "bandwidth_reference_band_hz": [0.4, 1.5],
+    "step_before_s": 0.04,
+    "step_after_s": 0.5,
+    "steady_window_s": [0.2, 0.35],
+}
+
+
+def test_analysis_settings_from_config_hold_every_key():
+    settings = DeviceAnalysisSettings.from_config({"device": {"analysis": ANALYSIS}})
+    assert settings.frf == FRFSettings(window_samples=4000, overlap_samples=100)
+    assert settings.steps == StepSettings(before_s=0.04, after_s=0.5, steady_window_s=(0.2, 0.35))
+    assert settings.reference_band_hz == (0.4, 1.5)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("welch_window_samples", 8, "device.analysis.welch_window_samples must be an integer >= 16, got 8"),
+        (
+            "welch_overlap_samples",
+            4000,
+            "device.analysis.welch_overlap_samples must be below device.analysis.welch_window_samples (4000), got 4000",
+        ),
+        ("step_after_s", 0.0, "device.analysis.step_after_s must be a positive number, got 0.0"),
+        (
+            "steady_window_s",
+            [0.3, 0.2],
+            "device.analysis.steady_window_s must be [low, high] with low < high, got [0.3, 0.2]",
+        ),
+        (
+            "bandwidth_reference_band_hz",
+            [0.5],
+            "device.analysis.bandwidth_reference_band_hz must be two numbers [low, high], got (0.5,)",
+        ),
+    ],
+)
+def test_a_bad_analysis_value_is_refused_naming_its_key(key, value, message):
+    with pytest.raises(LoperInputError) as info:
+        DeviceAnalysisSettings.from_config({"device": {"analysis": {**ANALYSIS, key: value}}})
+    assert str(info.value) == message

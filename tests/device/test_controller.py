@@ -138,3 +138,28 @@ def test_bad_inputs_are_refused():
         DeviceParameters(rod_stiffness_n_per_m=-1.0)
     with pytest.raises(LoperInputError, match="brace_position_m"):
         simulate_device(np.zeros(10), DEV, None)
+
+
+# --------------------------------------------------------------------------- the leg from the config
+
+
+def test_free_leg_from_config_holds_every_key():
+    leg = FreeLeg.from_config(
+        {"device": {"leg": {"mass_kg": 9.5, "damping_ns_per_m": 4.0, "stiffness_n_per_m": 120.0}}}
+    )
+    assert (leg.mass_kg, leg.damping_ns_per_m, leg.stiffness_n_per_m) == (9.5, 4.0, 120.0)
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("mass_kg", 0.0, "device.leg.mass_kg must be positive, got 0.0"),
+        ("damping_ns_per_m", -1.0, "device.leg.damping_ns_per_m must be finite and >= 0, got -1.0"),
+        ("stiffness_n_per_m", float("nan"), "device.leg.stiffness_n_per_m must be finite and >= 0, got nan"),
+    ],
+)
+def test_a_bad_leg_value_is_refused_naming_its_key(key, value, message):
+    leg = {"mass_kg": 14.0, "damping_ns_per_m": 10.0, "stiffness_n_per_m": 250.0, key: value}
+    with pytest.raises(LoperInputError) as info:
+        FreeLeg.from_config({"device": {"leg": leg}})
+    assert str(info.value) == message

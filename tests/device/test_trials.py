@@ -1,5 +1,7 @@
 """Device-test trials: desired-force profiles, sync pulses and simulated robot-log frames."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.signal import butter, sosfreqz, welch
@@ -80,3 +82,40 @@ def test_unknown_trial_is_refused_by_name():
     s = DeviceTestSettings(step_repetitions=1, broadband_duration_s=5.0)
     with pytest.raises(LoperInputError, match="device-walk"):
         simulate_device_trial("device-walk", DeviceParameters(), FreeLeg(), s, 7)
+
+
+# --------------------------------------------------------------------------- settings from the config
+
+#: A ``device.tests`` section unlike the shipped one in every key.
+TESTS = {
+    "broadband_duration_s": 60.0,
+    "broadband_bandwidth_hz": 80.0,
+    "broadband_sd_n": 12.0,
+    "step_amplitudes_n": [10.0, 30.0],
+    "step_repetitions": 4,
+    "step_on_s": 0.4,
+    "step_off_s": 0.6,
+    "sync_period_s": 2.0,
+    "sync_pulse_s": 0.02,
+    "sync_level_v": 3.3,
+}
+
+
+def test_device_test_settings_from_config_hold_every_key():
+    settings = DeviceTestSettings.from_config({"device": {"tests": TESTS}})
+    assert dataclasses.asdict(settings) == {**TESTS, "step_amplitudes_n": (10.0, 30.0)}
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "message"),
+    [
+        ("step_repetitions", 0, "device.tests.step_repetitions must be an integer >= 1, got 0"),
+        ("broadband_sd_n", -1.0, "device.tests.broadband_sd_n must be a positive number, got -1.0"),
+        ("step_amplitudes_n", [], "device.tests.step_amplitudes_n must be a non-empty tuple of heights (N), got ()"),
+        ("step_amplitudes_n", [20.0, 0.0], "device.tests.step_amplitudes_n must be a positive number, got 0.0"),
+    ],
+)
+def test_a_bad_device_test_value_is_refused_naming_its_key(key, value, message):
+    with pytest.raises(LoperInputError) as info:
+        DeviceTestSettings.from_config({"device": {"tests": {**TESTS, key: value}}})
+    assert str(info.value) == message

@@ -3,26 +3,34 @@ written."""
 
 from __future__ import annotations
 
-import dataclasses
+import copy
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
+from loper_analysis.device.analysis import FRFSettings, StepSettings
+from loper_analysis.device.controller import DeviceParameters, FreeLeg
 from loper_analysis.device.trials import DeviceTestSettings
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.robot_log import read_robot_log, write_robot_log
 from loper_analysis.steps import device
+from loper_analysis.steps.device import DeviceSettings
 
-SHORT = dataclasses.asdict(DeviceTestSettings(broadband_duration_s=30.0, step_repetitions=3))
-STEP_ARGS = (1000.0, (20.0, 40.0, 60.0), 0.05, 0.45, (0.15, 0.3))
+ROOT = Path(__file__).resolve().parents[2]
+
+SHORT = DeviceTestSettings(broadband_duration_s=30.0, step_repetitions=3)
+STEP_ARGS = (1000.0, (20.0, 40.0, 60.0), StepSettings(before_s=0.05, after_s=0.45, steady_window_s=(0.15, 0.3)))
+FRF = FRFSettings(window_samples=5000, overlap_samples=50)
 
 
 @pytest.fixture(scope="module")
 def logs(tmp_path_factory):
     d = tmp_path_factory.mktemp("raw")
     for trial in ("device-frf", "device-steps"):
-        device.device_trial(d / f"{trial}.loper.tsv", "S01", trial, {}, {}, SHORT, 3)
+        device.device_trial(d / f"{trial}.loper.tsv", "S01", trial, DeviceParameters(), FreeLeg(), SHORT, 3)
     return d
 
 
@@ -30,7 +38,7 @@ def logs(tmp_path_factory):
 def tables(logs, tmp_path_factory):
     """FRF, step metrics, averages and summary of the logs on disk; returns (directory, frf, metrics, summary)."""
     d = tmp_path_factory.mktemp("device")
-    frf = device.frf(logs / "device-frf.loper.tsv", d / "frf.tsv", 1000.0, 5000, 50)
+    frf = device.frf(logs / "device-frf.loper.tsv", d / "frf.tsv", 1000.0, FRF)
     metrics = device.steps(logs / "device-steps.loper.tsv", d / "m.tsv", d / "a.tsv", *STEP_ARGS)
     summary = device.summary(d / "frf.tsv", d / "m.tsv", d / "s.tsv", (0.5, 2.0))
     return d, frf, metrics, summary
@@ -86,7 +94,7 @@ def test_a_log_with_nan_force_is_refused_naming_file_column_sample(logs, tmp_pat
     bad = tmp_path / "nan.loper.tsv"
     bad.write_text("\n".join(text) + "\n")
     with pytest.raises(LoperInputError) as info:
-        device.frf(bad, tmp_path / "frf.tsv", 1000.0, 5000, 50)
+        device.frf(bad, tmp_path / "frf.tsv", 1000.0, FRF)
     msg = str(info.value)
     assert "nan.loper.tsv" in msg and "force_measured_n" in msg and "sample 100" in msg, msg
     assert not (tmp_path / "frf.tsv").exists()
@@ -94,5 +102,26 @@ def test_a_log_with_nan_force_is_refused_naming_file_column_sample(logs, tmp_pat
 
 def test_declared_rate_must_match(logs, tmp_path):
     with pytest.raises(LoperInputError, match="sample_rate_hz"):
-        device.frf(logs / "device-frf.loper.tsv", tmp_path / "frf.tsv", 500.0, 5000, 50)
+        device.frf(logs / "device-frf.loper.tsv", tmp_path / "frf.tsv", 500.0, FRF)
     assert not (tmp_path / "frf.tsv").exists()
+
+
+# ---------------------------------------------------------------- the stage's settings from the config
+
+
+def test_device_settings_of_the_shipped_config_are_the_library_defaults():
+    config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    assert DeviceSettings.from_config(config) == DeviceSettings()
+
+
+def test_device_settings_from_config_take_each_section_to_its_part():
+    config = copy.deepcopy(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
+    config["device"]["leg"]["mass_kg"] = 9.0
+    config["device"]["tests"]["step_amplitudes_n"] = [30.0]
+    config["device"]["analysis"]["welch_window_samples"] = 2000
+    config["device"]["parameters"]["lever_arm_m"] = 0.6
+    settings = DeviceSettings.from_config(config)
+    assert settings.leg.mass_kg == 9.0 and settings.tests.step_amplitudes_n == (30.0,)
+    assert settings.analysis.frf == FRFSettings(window_samples=2000, overlap_samples=50)
+    assert settings.parameters.lever_arm_m == 0.6
+    assert settings.analysis.steps == StepSettings() and settings.tests.step_repetitions == 10

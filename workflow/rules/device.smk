@@ -21,9 +21,9 @@ rule device_trial:
     group:
         "device"
     params:
-        device=DEVICE["parameters"],
-        leg=DEVICE["leg"],
-        tests=DEVICE["tests"],
+        **settings_params(DEVICE_SETTINGS.parameters, "device"),
+        **settings_params(DEVICE_SETTINGS.leg, "leg"),
+        **settings_params(DEVICE_SETTINGS.tests, "tests"),
         seed=config["seed"],
     script:
         "../scripts/device_trial.py"
@@ -41,7 +41,7 @@ rule device_log_from_mat:
     params:
         **raw_checksums(PATHS.raw.mat),
         column_map=DEVICE["mat_column_map"],
-        sample_rate_hz=DEVICE["parameters"]["sample_rate_hz"],
+        sample_rate_hz=DEVICE_SETTINGS.parameters.sample_rate_hz,
     script:
         "../scripts/device_log_from_mat.py"
 
@@ -59,9 +59,8 @@ rule device_frf:
         "device"
     params:
         **raw_checksums(lambda wildcards: STUDY.device_log("device-frf")),
-        sample_rate_hz=DEVICE["parameters"]["sample_rate_hz"],
-        window_samples=DEVICE["analysis"]["welch_window_samples"],
-        overlap_samples=DEVICE["analysis"]["welch_overlap_samples"],
+        **settings_params(DEVICE_SETTINGS.analysis.frf),
+        sample_rate_hz=DEVICE_SETTINGS.parameters.sample_rate_hz,
     script:
         "../scripts/device_frf.py"
 
@@ -80,11 +79,9 @@ rule device_steps:
         "device"
     params:
         **raw_checksums(lambda wildcards: STUDY.device_log("device-steps")),
-        sample_rate_hz=DEVICE["parameters"]["sample_rate_hz"],
-        amplitudes_n=DEVICE["tests"]["step_amplitudes_n"],
-        before_s=DEVICE["analysis"]["step_before_s"],
-        after_s=DEVICE["analysis"]["step_after_s"],
-        steady_window_s=DEVICE["analysis"]["steady_window_s"],
+        **settings_params(DEVICE_SETTINGS.analysis.steps),
+        sample_rate_hz=DEVICE_SETTINGS.parameters.sample_rate_hz,
+        amplitudes_n=DEVICE_SETTINGS.tests.step_amplitudes_n,
     script:
         "../scripts/device_steps.py"
 
@@ -105,7 +102,7 @@ rule device_summary:
     benchmark:
         PATHS.benchmark("device_summary", "summary")
     params:
-        reference_band_hz=DEVICE["analysis"]["bandwidth_reference_band_hz"],
+        reference_band_hz=DEVICE_SETTINGS.analysis.reference_band_hz,
     script:
         "../scripts/device_summary.py"
 

@@ -2,6 +2,7 @@
 
 import dataclasses
 
+from loper_analysis.steps.device import DeviceSettings
 from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.grf import GRFSettings
 from loper_analysis.steps.ik import IKSettings
@@ -39,6 +40,7 @@ try:
     FRONT_PAGE_SETTINGS = FrontPageSettings.from_config(config)
     PLAN_SETTINGS = PlanningSettings.from_config(config)  # as ``loper-analysis plan`` builds them
     VALIDATION_SETTINGS = ValidationSettings.from_config(config)
+    DEVICE_SETTINGS = DeviceSettings.from_config(config)
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
 

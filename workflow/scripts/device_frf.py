@@ -4,4 +4,4 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import device
 
     p = snakemake.params
-    device.frf(snakemake.input[0], snakemake.output[0], p.sample_rate_hz, p.window_samples, p.overlap_samples)
+    device.frf(snakemake.input[0], snakemake.output[0], p.sample_rate_hz, p.settings)

@@ -4,13 +4,4 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.steps import device
 
     p, out = snakemake.params, snakemake.output
-    device.steps(
-        snakemake.input[0],
-        out.metrics,
-        out.average,
-        p.sample_rate_hz,
-        p.amplitudes_n,
-        p.before_s,
-        p.after_s,
-        p.steady_window_s,
-    )
+    device.steps(snakemake.input[0], out.metrics, out.average, p.sample_rate_hz, p.amplitudes_n, p.settings)

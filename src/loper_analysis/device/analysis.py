@@ -10,15 +10,21 @@ Signals are 1-D arrays of force in N sampled at ``sample_rate_hz``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
 import numpy as np
 import pandas as pd
 from scipy.signal import coherence, csd, welch
 
-from loper_analysis.checks import finite_vector, positive
+from loper_analysis.checks import finite_vector, integer, number, positive
 from loper_analysis.errors import LoperInputError
 from loper_analysis.reference import STUDY_DEVICE
 
 __all__ = [
+    "FRFSettings",
+    "StepSettings",
+    "DeviceAnalysisSettings",
     "frequency_response",
     "bandwidth_hz",
     "step_onsets",
@@ -33,6 +39,7 @@ __all__ = [
     "STEP_BEFORE_S",
     "STEP_AFTER_S",
     "STEADY_WINDOW_S",
+    "STEP_AMPLITUDES_N",
 ]
 
 # Defaults of the device tests' analysis (config ``device.analysis.*``, the same values).
@@ -48,6 +55,104 @@ STEP_BEFORE_S: float = 0.05
 STEP_AFTER_S: float = 0.45
 #: Span after the onset (s) whose mean is the step's steady state (``steady_window_s``).
 STEADY_WINDOW_S: tuple[float, float] = (0.15, 0.3)
+#: Heights (N) of the device tests' steps (config ``device.tests.step_amplitudes_n``): the step trial's profile
+#: (:class:`~loper_analysis.device.trials.DeviceTestSettings`) and the heights its analysis sorts steps by.
+STEP_AMPLITUDES_N: tuple[float, ...] = (20.0, 40.0, 60.0)
+
+
+def _pair(key: str, value) -> tuple[float, float]:
+    """Two finite numbers >= 0 in increasing order (``key``: the config key the message names)."""
+    if isinstance(value, str | bytes) or not hasattr(value, "__len__") or len(value) != 2:
+        raise LoperInputError(f"{key} must be two numbers [low, high], got {value!r}")
+    low, high = (number(key, v, minimum=0.0) for v in value)
+    if not low < high:
+        raise LoperInputError(f"{key} must be [low, high] with low < high, got {list(value)!r}")
+    return low, high
+
+
+@dataclass(frozen=True)
+class FRFSettings:
+    """Welch's method of the frequency response (:func:`frequency_response`).
+
+    ``window_samples``: samples of each Hann-windowed segment (>= 16; ``device.analysis.welch_window_samples``);
+    ``overlap_samples``: samples two segments share (0 .. ``window_samples - 1``;
+    ``device.analysis.welch_overlap_samples``).
+
+    Raises
+    ------
+    LoperInputError
+        A count that is no integer or out of its range, naming its config key and value.
+    """
+
+    window_samples: int = WELCH_WINDOW_SAMPLES
+    overlap_samples: int = WELCH_OVERLAP_SAMPLES
+
+    def __post_init__(self) -> None:
+        window = integer("device.analysis.welch_window_samples", self.window_samples, minimum=16)
+        overlap = integer("device.analysis.welch_overlap_samples", self.overlap_samples, minimum=0)
+        if overlap >= window:
+            raise LoperInputError(
+                f"device.analysis.welch_overlap_samples must be below device.analysis.welch_window_samples "
+                f"({window}), got {overlap}"
+            )
+
+
+@dataclass(frozen=True)
+class StepSettings:
+    """How the step trial's steps are averaged and measured (:func:`step_averages`, :func:`step_table`).
+
+    ``before_s``, ``after_s``: each step's average runs from this long before to this long after its onset
+    (s, > 0; ``device.analysis.step_before_s``, ``step_after_s``); ``steady_window_s``: the span after the onset
+    (s, [low, high]) whose mean is the steady state (``device.analysis.steady_window_s``).
+
+    Raises
+    ------
+    LoperInputError
+        A value out of its range, naming its config key and value.
+    """
+
+    before_s: float = STEP_BEFORE_S
+    after_s: float = STEP_AFTER_S
+    steady_window_s: tuple[float, float] = STEADY_WINDOW_S
+
+    def __post_init__(self) -> None:
+        positive("device.analysis.step_before_s", self.before_s)
+        positive("device.analysis.step_after_s", self.after_s)
+        _pair("device.analysis.steady_window_s", self.steady_window_s)
+
+
+@dataclass(frozen=True)
+class DeviceAnalysisSettings:
+    """The device tests' analysis (config ``device.analysis``): ``frf`` (:class:`FRFSettings`), ``steps``
+    (:class:`StepSettings`) and ``reference_band_hz``, the band (Hz, [low, high]) whose mean gain is the
+    reference of the -3 dB bandwidth (``device.analysis.bandwidth_reference_band_hz``; :func:`device_summary`).
+
+    Raises
+    ------
+    LoperInputError
+        A value out of its range, naming its config key and value.
+    """
+
+    frf: FRFSettings = field(default_factory=FRFSettings)
+    steps: StepSettings = field(default_factory=StepSettings)
+    reference_band_hz: tuple[float, float] = BANDWIDTH_REFERENCE_BAND_HZ
+
+    def __post_init__(self) -> None:
+        _pair("device.analysis.bandwidth_reference_band_hz", self.reference_band_hz)
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> DeviceAnalysisSettings:
+        """The analysis of a validated config: every key of ``device.analysis`` (the bands as tuples)."""
+        a = config["device"]["analysis"]
+        return cls(
+            frf=FRFSettings(window_samples=a["welch_window_samples"], overlap_samples=a["welch_overlap_samples"]),
+            steps=StepSettings(
+                before_s=a["step_before_s"],
+                after_s=a["step_after_s"],
+                steady_window_s=tuple(a["steady_window_s"]),
+            ),
+            reference_band_hz=tuple(a["bandwidth_reference_band_hz"]),
+        )
 
 
 def frequency_response(
@@ -214,7 +319,7 @@ def step_averages(
     desired_n,
     measured_n,
     sample_rate_hz: float,
-    amplitudes_n: tuple[float, ...] = (20.0, 40.0, 60.0),
+    amplitudes_n: tuple[float, ...] = STEP_AMPLITUDES_N,
     before_s: float = STEP_BEFORE_S,
     after_s: float = STEP_AFTER_S,
     min_step_n: float = 5.0,

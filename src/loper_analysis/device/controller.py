@@ -159,12 +159,18 @@ class FreeLeg:
     damping_ns_per_m: float = 10.0
     stiffness_n_per_m: float = 250.0
 
+    @classmethod
+    def from_config(cls, config: Mapping) -> FreeLeg:
+        """The leg of a validated config (``device.leg``: ``mass_kg``, ``damping_ns_per_m``,
+        ``stiffness_n_per_m``)."""
+        return cls(**config["device"]["leg"])
+
     def __post_init__(self) -> None:
         for name, value in asdict(self).items():
             if not np.isfinite(value) or value < 0:
-                raise LoperInputError(f"leg parameter {name} must be finite and >= 0, got {value}")
+                raise LoperInputError(f"device.leg.{name} must be finite and >= 0, got {value}")
         if self.mass_kg <= 0:
-            raise LoperInputError(f"leg parameter mass_kg must be positive, got {self.mass_kg}")
+            raise LoperInputError(f"device.leg.mass_kg must be positive, got {self.mass_kg}")
 
 
 def _plant_matrices(dev: DeviceParameters, leg: FreeLeg | None):

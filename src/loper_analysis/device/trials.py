@@ -13,12 +13,15 @@ records: a 5 V pulse of ``sync_pulse_s`` every ``sync_period_s``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
 
 import numpy as np
 import pandas as pd
 from scipy.signal import butter, sosfilt
 
+from loper_analysis.checks import integer, positive
+from loper_analysis.device.analysis import STEP_AMPLITUDES_N
 from loper_analysis.device.controller import DeviceParameters, FreeLeg, simulate_device
 from loper_analysis.errors import LoperInputError
 
@@ -36,18 +39,49 @@ DEVICE_TRIALS: tuple[str, ...] = ("device-frf", "device-steps")
 
 @dataclass(frozen=True)
 class DeviceTestSettings:
-    """Desired-force profiles of the device tests (config key ``device.tests``)."""
+    """Desired-force profiles of the device tests (config key ``device.tests``, each field the key of its name).
+
+    The broadband trial: ``broadband_duration_s`` (s) of Gaussian noise with SD ``broadband_sd_n`` (N) low-passed
+    at ``broadband_bandwidth_hz`` (Hz); the step trial: each of ``step_amplitudes_n`` (N)
+    ``step_repetitions`` times, ``step_on_s`` on after ``step_off_s`` off (s); both carry the sync output, a
+    ``sync_level_v`` (V) pulse of ``sync_pulse_s`` every ``sync_period_s`` (s).
+
+    Raises
+    ------
+    LoperInputError
+        A value that is not positive (the repetitions: no integer >= 1; the amplitudes: none), naming its config
+        key ``device.tests.<field>`` and the value.
+    """
 
     broadband_duration_s: float = 120.0
     broadband_bandwidth_hz: float = 100.0
     broadband_sd_n: float = 15.0
-    step_amplitudes_n: tuple[float, ...] = (20.0, 40.0, 60.0)
+    step_amplitudes_n: tuple[float, ...] = STEP_AMPLITUDES_N
     step_repetitions: int = 10
     step_on_s: float = 0.5
     step_off_s: float = 0.5
     sync_period_s: float = 1.0
     sync_pulse_s: float = 0.01
     sync_level_v: float = 5.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            key, value = f"device.tests.{f.name}", getattr(self, f.name)
+            if f.name == "step_repetitions":
+                integer(key, value, minimum=1)
+            elif f.name == "step_amplitudes_n":
+                if isinstance(value, str) or not isinstance(value, tuple) or not value:
+                    raise LoperInputError(f"{key} must be a non-empty tuple of heights (N), got {value!r}")
+                for a in value:
+                    positive(key, a)
+            else:
+                positive(key, value)
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> DeviceTestSettings:
+        """The device tests of a validated config: ``device.tests`` (the amplitudes as a tuple)."""
+        tests = config["device"]["tests"]
+        return cls(**{**tests, "step_amplitudes_n": tuple(tests["step_amplitudes_n"])})
 
 
 def broadband_force(settings: DeviceTestSettings, sample_rate_hz: float, rng: np.random.Generator) -> np.ndarray:

@@ -5,15 +5,28 @@ from __future__ import annotations
 import logging
 import zlib
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import pandas as pd
 
+from loper_analysis.device.analysis import DeviceAnalysisSettings, FRFSettings, StepSettings
+from loper_analysis.device.controller import DeviceParameters, FreeLeg
+from loper_analysis.device.trials import DeviceTestSettings
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.robot_log import read_robot_log, write_robot_log
 
-__all__ = ["DEVICE_FLOAT_FORMAT", "device_trial", "log_from_mat", "frf", "steps", "summary", "figures"]
+__all__ = [
+    "DEVICE_FLOAT_FORMAT",
+    "DeviceSettings",
+    "device_trial",
+    "log_from_mat",
+    "frf",
+    "steps",
+    "summary",
+    "figures",
+]
 
 log = logging.getLogger(__name__)
 
@@ -21,26 +34,52 @@ log = logging.getLogger(__name__)
 DEVICE_FLOAT_FORMAT = "%.10g"
 
 
+@dataclass(frozen=True)
+class DeviceSettings:
+    """The device stage's settings: ``parameters`` (the controller and plant,
+    :class:`~loper_analysis.device.controller.DeviceParameters`), ``leg`` (the free-hanging leg of the tests,
+    :class:`~loper_analysis.device.controller.FreeLeg`), ``tests`` (the desired-force profiles,
+    :class:`~loper_analysis.device.trials.DeviceTestSettings`) and ``analysis`` (FRF, steps and the bandwidth's
+    reference band, :class:`~loper_analysis.device.analysis.DeviceAnalysisSettings`)."""
+
+    parameters: DeviceParameters = field(default_factory=DeviceParameters)
+    leg: FreeLeg = field(default_factory=FreeLeg)
+    tests: DeviceTestSettings = field(default_factory=DeviceTestSettings)
+    analysis: DeviceAnalysisSettings = field(default_factory=DeviceAnalysisSettings)
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> DeviceSettings:
+        """The settings of a validated config: ``device.parameters``, ``device.leg``, ``device.tests`` and
+        ``device.analysis``, each read by its type's ``from_config``."""
+        return cls(
+            parameters=DeviceParameters.from_config(config),
+            leg=FreeLeg.from_config(config),
+            tests=DeviceTestSettings.from_config(config),
+            analysis=DeviceAnalysisSettings.from_config(config),
+        )
+
+
 def device_trial(
-    out_path: PathLike, subject: str, trial: str, device: Mapping, leg: Mapping, tests: Mapping, seed: int
+    out_path: PathLike,
+    subject: str,
+    trial: str,
+    device: DeviceParameters,
+    leg: FreeLeg,
+    tests: DeviceTestSettings,
+    seed: int,
 ) -> pd.DataFrame:
     """Simulate one device-test trial of a synthetic subject and write it as a robot log.
 
-    ``device``, ``leg`` and ``tests`` are the keyword arguments of
-    :class:`~loper_analysis.device.controller.DeviceParameters`,
-    :class:`~loper_analysis.device.controller.FreeLeg` and
-    :class:`~loper_analysis.device.trials.DeviceTestSettings`; the seed is
-    derived from ``seed``, the subject and the trial. Returns the safety
+    ``device``: the controller and plant; ``leg``: the free-hanging leg; ``tests``: the desired-force
+    profiles; the seed is derived from ``seed``, the subject and the trial. Returns the safety
     events (time, state, name).
     """
-    from loper_analysis.device.controller import DeviceParameters, FreeLeg, safety_events
-    from loper_analysis.device.trials import DeviceTestSettings, simulate_device_trial
+    from loper_analysis.device.controller import safety_events
+    from loper_analysis.device.trials import simulate_device_trial
 
-    parameters = DeviceParameters(**device)
-    settings = DeviceTestSettings(**{**tests, "step_amplitudes_n": tuple(tests["step_amplitudes_n"])})
     trial_seed = [seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]
-    frame = simulate_device_trial(trial, parameters, FreeLeg(**leg), settings, trial_seed)
-    write_robot_log(out_path, frame, parameters.sample_rate_hz, {"trial": trial, "source": "synthetic"})
+    frame = simulate_device_trial(trial, device, leg, tests, trial_seed)
+    write_robot_log(out_path, frame, device.sample_rate_hz, {"trial": trial, "source": "synthetic"})
     events = safety_events(frame)
     log.info("wrote %s (seed %s)", out_path, trial_seed)
     log.info("safety state changes (time_s, state, name):\n%s", events.to_string(index=False))
@@ -57,10 +96,9 @@ def log_from_mat(mat_path: PathLike, out_path: PathLike, column_map: Mapping, sa
     return frame
 
 
-def frf(
-    log_path: PathLike, out_tsv: PathLike, sample_rate_hz: float, window_samples: int, overlap_samples: int
-) -> pd.DataFrame:
-    """FRF of the broadband trial -> TSV (frequency_hz, gain, phase_deg, coherence)."""
+def frf(log_path: PathLike, out_tsv: PathLike, sample_rate_hz: float, settings: FRFSettings) -> pd.DataFrame:
+    """FRF of the broadband trial (robot log at ``sample_rate_hz``, Hz; Welch's method of ``settings``) -> TSV
+    (frequency_hz, gain, phase_deg, coherence)."""
     from loper_analysis.device.analysis import frequency_response
 
     robot, _ = read_robot_log(log_path, sample_rate_hz)
@@ -68,8 +106,8 @@ def frf(
         robot["force_desired_n"].to_numpy(),
         robot["force_measured_n"].to_numpy(),
         sample_rate_hz,
-        window_samples=window_samples,
-        overlap_samples=overlap_samples,
+        window_samples=settings.window_samples,
+        overlap_samples=settings.overlap_samples,
     )
     write_tsv(table, out_tsv, DEVICE_FLOAT_FORMAT)
     log.info("FRF: %d frequencies", len(table))
@@ -82,19 +120,18 @@ def steps(
     average_tsv: PathLike,
     sample_rate_hz: float,
     amplitudes_n: Sequence[float],
-    before_s: float,
-    after_s: float,
-    steady_window_s,
+    settings: StepSettings,
 ) -> pd.DataFrame:
-    """Step metrics per amplitude and the averaged responses of the step trial."""
+    """Step metrics per amplitude and the averaged responses of the step trial (robot log at ``sample_rate_hz``,
+    Hz; steps of ``amplitudes_n``, N, averaged and measured as ``settings`` says)."""
     from loper_analysis.device.analysis import step_averages, step_table
 
     robot, _ = read_robot_log(log_path, sample_rate_hz)
     fd = robot["force_desired_n"].to_numpy()
     fm = robot["force_measured_n"].to_numpy()
     try:
-        average = step_averages(fd, fm, sample_rate_hz, tuple(amplitudes_n), before_s, after_s)
-        metrics = step_table(average, tuple(steady_window_s))
+        average = step_averages(fd, fm, sample_rate_hz, tuple(amplitudes_n), settings.before_s, settings.after_s)
+        metrics = step_table(average, tuple(settings.steady_window_s))
     except LoperInputError as exc:
         raise LoperInputError(f"{log_path}: {exc}") from exc
     write_tsv(metrics, metrics_tsv, DEVICE_FLOAT_FORMAT)
