@@ -20,6 +20,7 @@ from scipy.signal import coherence, csd, welch
 from loper_analysis.checks import finite_vector, integer, number, positive
 from loper_analysis.errors import LoperInputError
 from loper_analysis.reference import STUDY_DEVICE
+from loper_analysis.study_design import PULSE_FORCE_N
 
 __all__ = [
     "FRFSettings",
@@ -389,7 +390,7 @@ def device_summary(
         "rise_time_ms": float(steps["rise_time_ms"].mean()),
         "overshoot_pct": float(steps["overshoot_pct"].mean()),
     }
-    at40 = steps.loc[np.isclose(steps["amplitude_n"], 40.0), "steady_state_n"]
+    at40 = steps.loc[np.isclose(steps["amplitude_n"], PULSE_FORCE_N), "steady_state_n"]  # steps of the pulse's height
     values["steady_state_40n_n"] = float(at40.iloc[0]) if len(at40) else np.nan
     rows = []
     for metric, (study, unit) in STUDY_DEVICE.items():

@@ -37,6 +37,7 @@ import numpy as np
 from loper_analysis.constants import SEGMENTS, SIDE_SUFFIX
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim
+from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.anthropometry import (
     ANKLE_HEIGHT_FRACTION,
     HAT_COM_FRACTION,
@@ -211,7 +212,9 @@ def build_lower_body_model(height_m: float, mass_kg: float, name: str = "loper_l
     return model
 
 
-def segment_parameters_from_model(model, side: str = "l", brace_markers=BRACE_MARKERS) -> SegmentParameters:
+def segment_parameters_from_model(
+    model, side: str = SIDE_SUFFIX[PERTURBED_SIDE], brace_markers=BRACE_MARKERS
+) -> SegmentParameters:
     """Swing-leg segment table from an ``opensim.Model`` built by :func:`build_lower_body_model` (or scaled from it).
 
     Masses, COM (x, y in the body frame) and the inertia about Z come from the

@@ -27,6 +27,7 @@ import pandas as pd
 
 from loper_analysis.checks import number
 from loper_analysis.errors import LoperInputError
+from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.study_design import PERTURBED_SIDE
 
 __all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs", "trial_stretches"]
@@ -37,7 +38,7 @@ PLANNED_COUNTERFACTUAL: str = "matched_stride"
 
 
 def pulse_force_n(
-    time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = 40.0, order: int = 4
+    time_s, force_n: float, duration_s: float, device=None, cutoff_hz: float = CUTOFF_HZ, order: int = ORDER
 ) -> np.ndarray:
     """The rod force (N, along the rods) of a rectangular desired pulse, at ``time_s`` (s, onset at 0).
 

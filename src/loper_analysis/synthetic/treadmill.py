@@ -59,7 +59,7 @@ def _stances(events: pd.DataFrame) -> tuple[dict[str, list[tuple[float, float]]]
     """
     complete, strides = [], []
     pending: dict[str, tuple[list, list]] = {}
-    for side in ("left", "right"):
+    for side in SIDES:
         ev = events[events["side"] == side].sort_values("time_s", kind="stable")
         kinds, times = ev["event"].tolist(), ev["time_s"].to_numpy(float)
         for i in range(1, len(kinds)):
@@ -230,7 +230,7 @@ def treadmill_grf(
 
     t = np.arange(n) / analog_rate_hz
     cols = {"time_s": t}
-    for side in ("left", "right"):
+    for side in SIDES:
         fz, fx = np.zeros(n), np.zeros(n)
         cx, cy = np.full(n, np.nan), np.full(n, np.nan)
         lateral = 1.0 if side == "left" else -1.0  # +y is left

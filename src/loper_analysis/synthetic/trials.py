@@ -33,10 +33,10 @@ import numpy as np
 import pandas as pd
 from scipy.spatial.transform import Rotation
 
-from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDES
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDE_SUFFIX, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
-from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
+from loper_analysis.study_design import PERTURBED_SIDE, PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = [
@@ -128,7 +128,9 @@ def static_recording(
     return C3DRecording(source=source, marker_labels=labels, markers_m=X, point_rate_hz=lab.marker_rate_hz)
 
 
-def _brace_position_m(coordinates: pd.DataFrame, attachment_m: float, side: str = "l") -> np.ndarray:
+def _brace_position_m(
+    coordinates: pd.DataFrame, attachment_m: float, side: str = SIDE_SUFFIX[PERTURBED_SIDE]
+) -> np.ndarray:
     """Forward position (m) of the brace on the thigh: pelvis_tx + a·sin(pelvis_tilt + hip_flexion)."""
     angle = coordinates["pelvis_tilt"].to_numpy(float) + coordinates[f"hip_flexion_{side}"].to_numpy(float)
     return coordinates["pelvis_tx"].to_numpy(float) + attachment_m * np.sin(angle)
@@ -272,7 +274,7 @@ def simulate_walking_trial(
             np.random.default_rng(schedule_seed),
             0.5,
             duration_s - 0.5,
-            "left",
+            PERTURBED_SIDE,
             perturbation.every_strides,
         )
     if device is None:
@@ -349,7 +351,7 @@ def _fine_answering_every_swing(
         params,
         impedance,
         fm[inside],
-        swing_spans(events, "left"),
+        swing_spans(events, PERTURBED_SIDE),
     )
     fine = fine.copy()
     for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
