@@ -367,7 +367,8 @@ def _plan(args: argparse.Namespace) -> None:
 
 def _ik(args: argparse.Namespace) -> None:
     from loper_analysis.io.readers import read_label_maps
-    from loper_analysis.steps.ik import IKSettings, ik_file
+    from loper_analysis.motion.ik_settings import IKSettings
+    from loper_analysis.steps.ik import ik_file
     from loper_analysis.steps.markers import MarkerSettings
 
     config, line = _read_config(args)
