@@ -202,6 +202,31 @@ def _lab_agreement(angles: pd.DataFrame, lab_angles_tsv: PathLike, res, agreemen
     return table
 
 
+def _angle_outputs(
+    res,
+    angles: pd.DataFrame,
+    warn_rms_m: float,
+    outputs: tuple[PathLike, PathLike | None, PathLike | None, PathLike | None],
+    source: str,
+) -> pd.DataFrame:
+    """What :func:`ik_trial` and :func:`ik_join` end with: the angles checked (:func:`_angle_checks`), compared
+    with the lab's own (:func:`_lab_agreement`), the one-row IK summary (marker RMS error above ``warn_rms_m``, m,
+    counted as poorly fitted) and the angle table written.
+
+    ``outputs`` are the angle table, the summary, the lab's own angles (read) and the agreement table (the last
+    three None: not written, not compared). Returns ``angles``.
+    """
+    angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv = outputs
+    _angle_checks(res, angles, source)
+    if lab_angles_tsv is not None:
+        _lab_agreement(angles, lab_angles_tsv, res, agreement_tsv, source)
+    if summary_tsv is not None:
+        write_tsv(res.summary(warn_rms_m), summary_tsv)
+    write_tsv(angles, angles_tsv)
+    log.info("%d frames, %s", len(angles), list(angles.columns))
+    return angles
+
+
 def ik_trial(
     model_osim: PathLike,
     trc_path: PathLike,
@@ -227,15 +252,9 @@ def ik_trial(
 
     res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, settings)
     angles = joint_angle_table(res.frame(), settings.coordinate_map, source=f"{out_mot} (model {model_osim})")
-    _angle_checks(res, angles, str(trc_path))
-    if lab_angles_tsv is not None:
-        _lab_agreement(angles, lab_angles_tsv, res, agreement_tsv, str(trc_path))
-    if summary_tsv is not None:
-        warn = settings.warn_marker_rms_m
-        write_tsv(res.summary(IK_WARN_RMS_M if warn is None else warn), summary_tsv)
-    write_tsv(angles, angles_tsv)
-    log.info("%d frames, %s", len(angles), list(angles.columns))
-    return angles
+    warn = settings.warn_marker_rms_m
+    outputs = (angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv)
+    return _angle_outputs(res, angles, IK_WARN_RMS_M if warn is None else warn, outputs, str(trc_path))
 
 
 def ik_join(
@@ -263,14 +282,9 @@ def ik_join(
     values = coords.drop(columns="time_s").to_numpy(float)
     none = np.full(len(coords), np.nan)
     joined = IKResult(coords["time_s"].to_numpy(float), values, [], none, none, solved=np.isfinite(values).any(axis=1))
-    _angle_checks(joined, angles, str(out_mot))
-    if lab_angles_tsv is not None:
-        _lab_agreement(angles, lab_angles_tsv, joined, agreement_tsv, str(out_mot))
+    outputs = (angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv)
+    _angle_outputs(joined, angles, IK_WARN_RMS_M, outputs, str(out_mot))
     write_mot(out_mot, coords, in_degrees=True)
-    if summary_tsv is not None:
-        write_tsv(joined.summary(IK_WARN_RMS_M), summary_tsv)
-    write_tsv(angles, angles_tsv)
-    log.info("%d frames, %s", len(angles), list(angles.columns))
     return angles
 
 
