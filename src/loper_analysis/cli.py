@@ -96,7 +96,8 @@ def _markers(args: argparse.Namespace) -> None:
 
 
 def _grf(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.grf import GRFSettings, grf
+    from loper_analysis.gait.grf_settings import GRFSettings
+    from loper_analysis.steps.grf import grf
 
     settings = _stage_settings(
         args, GRFSettings, rotation_deg=_rotation_option(args, args.c3d), threshold_n=args.threshold_n

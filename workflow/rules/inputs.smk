@@ -3,7 +3,7 @@
 import dataclasses
 
 from loper_analysis.steps.events import EventSettings, LoadcellSettings
-from loper_analysis.steps.grf import GRFSettings
+from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps.markers import MarkerSettings
 from loper_analysis.steps.model import ModelSettings
