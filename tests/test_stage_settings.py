@@ -18,10 +18,10 @@ import yaml
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.device import analysis
 from loper_analysis.gait import events, grf, resampling
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.motion import filtering, heading, markers, plausibility
 from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.markers import MarkerSettings
-from loper_analysis.steps.strides import StrideSettings
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

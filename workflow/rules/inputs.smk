@@ -7,7 +7,7 @@ from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps.markers import MarkerSettings
 from loper_analysis.steps.model import ModelSettings
-from loper_analysis.steps.strides import StrideSettings
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.steps.impedance import FitSettings
 from loper_analysis.steps.planning import PlanningSettings
 from loper_analysis.steps.report import FrontPageSettings
