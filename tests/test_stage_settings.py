@@ -17,10 +17,11 @@ import yaml
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.device import analysis
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.gait import events, grf, resampling
 from loper_analysis.gait.stride_settings import StrideSettings
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.motion import filtering, heading, markers, plausibility
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.markers import MarkerSettings
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -24,7 +24,9 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
@@ -32,7 +34,6 @@ from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps import events as event_steps
 from loper_analysis.steps import ik
 from loper_analysis.steps import markers as marker_steps
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake
 

@@ -2,7 +2,8 @@
 
 import dataclasses
 
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
+from loper_analysis.device.loadcell import LoadcellSettings
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps.markers import MarkerSettings
