@@ -27,7 +27,6 @@ from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments,
 from loper_analysis.planning.covariance import StrideCovariance
 from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.steps import strides as stride_steps
-from loper_analysis.steps import transparency as transparency_step
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
 from tests.parameter_sets import ASYMMETRIC
 
@@ -52,7 +51,7 @@ def test_min_valid_strides_is_the_config_value_and_every_default():
         "gait.stride_settings.StrideSettings.min_valid": StrideSettings().min_valid,
         "steps.stride_steps.strides_summary": _default(stride_steps.strides_summary, "min_valid"),
         "transparency.transparency_results": _default(transparency.transparency_results, "min_strides"),
-        "steps.transparency.TransparencySettings.min_strides": transparency_step.TransparencySettings().min_strides,
+        "transparency.TransparencySettings.min_strides": transparency.TransparencySettings().min_strides,
         "outliers.check_enough_strides": _default(outliers.check_enough_strides, "minimum"),
         "ResponseSettings.min_strides": ResponseSettings().min_strides,
     }
