@@ -12,7 +12,7 @@ from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.steps.impedance import FitSettings
 from loper_analysis.steps.planning import PlanningSettings
 from loper_analysis.steps.report import FrontPageSettings
-from loper_analysis.steps.synthetic import LabSessionSettings
+from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.transparency import TransparencySettings
 from loper_analysis.identification.validation import ValidationSettings
 
