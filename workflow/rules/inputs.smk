@@ -11,7 +11,7 @@ from loper_analysis.steps.model import ModelSettings
 from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.steps.impedance import FitSettings
 from loper_analysis.steps.planning import PlanningSettings
-from loper_analysis.steps.report import FrontPageSettings
+from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.transparency import TransparencySettings
 from loper_analysis.identification.validation import ValidationSettings
