@@ -9,9 +9,9 @@ from dataclasses import dataclass, replace
 
 from loper_analysis.io.atomic import PathLike
 from loper_analysis.io.c3d_writer import write_recording
-from loper_analysis.steps.synthetic import SyntheticLabSettings
 from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
 from loper_analysis.synthetic.lab_export import QTMExportSettings
+from loper_analysis.synthetic.lab_session import SyntheticLabSettings
 
 log = logging.getLogger(__name__)
 

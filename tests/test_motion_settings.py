@@ -16,14 +16,14 @@ import pytest
 import yaml
 
 from loper_analysis.cli import main
+from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import read_model, write_model
 from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP, marker_positions
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.grf import GRFSettings
-from loper_analysis.steps.ik import IKSettings
 from loper_analysis.steps.model import ModelSettings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.gait2392_models import GENERIC, scaled_gait2392

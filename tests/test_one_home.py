@@ -20,14 +20,13 @@ from loper_analysis import transparency
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait import events, outliers, strides
 from loper_analysis.gait.outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, iqr_outliers
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.identification import t_quantile
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments, write_segments
 from loper_analysis.planning.covariance import StrideCovariance
 from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.steps import strides as stride_steps
-from loper_analysis.steps import transparency as transparency_step
-from loper_analysis.steps.strides import StrideSettings
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
 from tests.parameter_sets import ASYMMETRIC
 
@@ -49,10 +48,10 @@ def test_min_valid_strides_is_the_config_value_and_every_default():
     defaults = {
         "strides.stride_tables": _default(strides.stride_tables, "min_valid"),
         "strides.stride_summary": _default(strides.stride_summary, "min_valid"),
-        "steps.strides.StrideSettings.min_valid": StrideSettings().min_valid,
+        "gait.stride_settings.StrideSettings.min_valid": StrideSettings().min_valid,
         "steps.stride_steps.strides_summary": _default(stride_steps.strides_summary, "min_valid"),
         "transparency.transparency_results": _default(transparency.transparency_results, "min_strides"),
-        "steps.transparency.TransparencySettings.min_strides": transparency_step.TransparencySettings().min_strides,
+        "transparency.TransparencySettings.min_strides": transparency.TransparencySettings().min_strides,
         "outliers.check_enough_strides": _default(outliers.check_enough_strides, "minimum"),
         "ResponseSettings.min_strides": ResponseSettings().min_strides,
     }

@@ -239,7 +239,8 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     turned to walk along the model's +X, with no per-trial setting, and the joint angles agree."""
     from loper_analysis.io.c3d import read_c3d
     from loper_analysis.io.c3d_writer import write_c3d
-    from loper_analysis.steps.ik import IKSettings, ik_trial
+    from loper_analysis.motion.ik_settings import IKSettings
+    from loper_analysis.steps.ik import ik_trial
     from loper_analysis.steps.markers import markers
 
     rec = read_c3d(WALKING5)

@@ -34,6 +34,7 @@ from loper_analysis.identification.validation import ValidationSettings, validat
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
 from loper_analysis.responses.response_window import WINDOW_KEYS, ResponseWindow
+from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -354,6 +355,35 @@ def test_perturbation_settings_defaults_equal_config_synthetic():
         "every_strides": "synthetic.perturb_every_strides",
     }
     assert _mismatches(defaults, CONFIG, keys) == []
+
+
+#: LabSessionSettings field -> config key (as LabSessionSettings.from_config reads them for the workflow).
+LAB_SESSION_KEYS = {
+    "seed": "seed",
+    "static_duration_s": "synthetic.static_duration_s",
+    "walking_duration_s": "synthetic.walking_duration_s",
+    "timing_cv": "synthetic.timing_cv",
+    "amplitude_cv": "synthetic.amplitude_cv",
+    "pulse_force_n": "synthetic.pulse_force_n",
+    "pulse_duration_s": "synthetic.pulse_duration_s",
+    "perturb_every_strides": "synthetic.perturb_every_strides",
+    "variability": "synthetic.variability",
+    "adaptation_amplitude_change": "synthetic.device_adaptation.amplitude_change",
+    "adaptation_offset_rad": "synthetic.device_adaptation.offset_rad",
+    "adaptation_swing_gain": "synthetic.device_adaptation.swing_gain",
+}
+
+
+def test_lab_session_settings_defaults_equal_config_synthetic():
+    defaults = _defaults(LabSessionSettings)
+    assert _mismatches(defaults, CONFIG, LAB_SESSION_KEYS) == []
+    # the composed settings have their own checks (the design, the lab, the device); the study variability's
+    # fields are named as the config's but for the timing
+    assert set(defaults) - set(LAB_SESSION_KEYS) == {"design", "lab", "device", "study_variability"}
+    v, config = defaults["study_variability"], CONFIG["synthetic"]["study_variability"]
+    names = ("amplitude_cv", "offset_sd_rad", "timing_sd_stride", "swing_gain", "knots_per_stride")
+    ours = (v.amplitude_cv, v.offset_sd_rad, v.timing_sd, v.swing_gain, v.knots_per_stride)
+    assert _plain(ours) == _plain(tuple(config[k] for k in names))
 
 
 # --------------------------------------------------------------------------- the checks can fail

@@ -1,9 +1,11 @@
 """The stages' settings objects: built from the config as the rules build them, and defaulting to its values.
 
-Each stage's settings (:class:`~loper_analysis.steps.markers.MarkerSettings`, ``EventSettings``,
-``LoadcellSettings``, ``StrideSettings``) has one ``from_config``, which the rules (``inputs.smk``) and the
-``loper-analysis`` command call; their defaults are the library's named constants, which must equal
-``config/config.yaml``, so that the library alone and the workflow agree.
+Each stage's settings (:class:`~loper_analysis.motion.trial_markers.MarkerSettings`,
+:class:`~loper_analysis.gait.trial_events.EventSettings`, :class:`~loper_analysis.device.loadcell.LoadcellSettings`,
+:class:`~loper_analysis.gait.grf_settings.GRFSettings`, :class:`~loper_analysis.gait.stride_settings.StrideSettings`,
+:class:`~loper_analysis.transparency.TransparencySettings`) has one ``from_config`` in its library package, which
+the rules (``inputs.smk``) and the ``loper-analysis`` command call; their defaults are the library's named
+constants, which must equal ``config/config.yaml``, so that the library alone and the workflow agree.
 """
 
 from __future__ import annotations
@@ -17,11 +19,14 @@ import yaml
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.device import analysis
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.gait import events, grf, resampling
+from loper_analysis.gait.grf_settings import GRFSettings
+from loper_analysis.gait.stride_settings import StrideSettings
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.motion import filtering, heading, markers, plausibility
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
-from loper_analysis.steps.markers import MarkerSettings
-from loper_analysis.steps.strides import StrideSettings
+from loper_analysis.motion.trial_markers import MarkerSettings
+from loper_analysis.transparency import TransparencySettings
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -52,7 +57,7 @@ CONSTANTS = {
     "analysis.STEADY_WINDOW_S": (analysis.STEADY_WINDOW_S, "device.analysis.steady_window_s"),
 }
 
-SETTINGS = (MarkerSettings, EventSettings, LoadcellSettings, StrideSettings)
+SETTINGS = (MarkerSettings, EventSettings, LoadcellSettings, GRFSettings, StrideSettings, TransparencySettings)
 
 
 def _get(config: dict, path: str):
@@ -93,6 +98,10 @@ def test_defaults_are_what_the_config_builds(settings_type):
         (LoadcellSettings, "filter.order", "order", 2),
         (StrideSettings, "strides.min_valid_strides", "min_valid", 7),
         (StrideSettings, "trials.perturbed_side", "side", "right"),
+        (GRFSettings, "grf.loaded_threshold_n", "threshold_n", 35.0),
+        (GRFSettings, "grf.resting_band_n", "band_n", 4.0),
+        (TransparencySettings, "strides.min_valid_strides", "min_strides", 7),
+        (TransparencySettings, "trials.perturbed_side", "side", "right"),
     ],
 )
 def test_a_changed_config_key_reaches_its_field(settings_type, path, field, value):

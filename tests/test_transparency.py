@@ -1,14 +1,21 @@
 """loper_analysis.transparency: statistics of normalised strides and the transparency table, against analytic
 answers."""
 
+import copy
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.outliers import MIN_VALID_STRIDES
 from loper_analysis.reference import STUDY_TRANSPARENCY_RAD
+from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.transparency import (
     TRANSPARENCY_COLUMNS,
+    TransparencySettings,
     isv_ave,
     mean_sd,
     mean_toe_off_pct,
@@ -16,6 +23,8 @@ from loper_analysis.transparency import (
     transparency_table,
     within_subject_sd,
 )
+
+CONFIG = yaml.safe_load((Path(__file__).resolve().parents[1] / "config" / "config.yaml").read_text())
 
 
 def test_mean_sd_and_within_subject_sd():
@@ -122,3 +131,27 @@ def test_bad_inputs_are_named():
         rmsd(np.zeros(5), np.zeros(6))
     with pytest.raises(LoperInputError, match="sigmas must be finite and >= 0"):
         isv_ave([0.1, np.nan])
+
+
+# --------------------------------------------------------------------------- settings
+
+
+def test_settings_of_the_config_and_the_defaults_agree():
+    """The left leg and at least 5 kept strides, the strides' own."""
+    assert TransparencySettings.from_config(CONFIG) == TransparencySettings() == TransparencySettings("left", 5)
+    assert (PERTURBED_SIDE, MIN_VALID_STRIDES) == ("left", 5)
+
+
+def test_settings_take_the_config_s_side_and_stride_minimum():
+    config = copy.deepcopy(CONFIG)
+    config["trials"]["perturbed_side"] = "right"
+    config["strides"]["min_valid_strides"] = 7
+    assert TransparencySettings.from_config(config) == TransparencySettings(side="right", min_strides=7)
+
+
+@pytest.mark.parametrize(("section", "key"), [("trials", "perturbed_side"), ("strides", "min_valid_strides")])
+def test_settings_name_a_missing_key(section, key):
+    config = copy.deepcopy(CONFIG)
+    del config[section][key]
+    with pytest.raises(KeyError, match=f"^'{key}'$"):
+        TransparencySettings.from_config(config)

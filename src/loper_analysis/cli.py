@@ -96,7 +96,8 @@ def _markers(args: argparse.Namespace) -> None:
 
 
 def _grf(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.grf import GRFSettings, grf
+    from loper_analysis.gait.grf_settings import GRFSettings
+    from loper_analysis.steps.grf import grf
 
     settings = _stage_settings(
         args, GRFSettings, rotation_deg=_rotation_option(args, args.c3d), threshold_n=args.threshold_n
@@ -367,7 +368,8 @@ def _plan(args: argparse.Namespace) -> None:
 
 def _ik(args: argparse.Namespace) -> None:
     from loper_analysis.io.readers import read_label_maps
-    from loper_analysis.steps.ik import IKSettings, ik_file
+    from loper_analysis.motion.ik_settings import IKSettings
+    from loper_analysis.steps.ik import ik_file
     from loper_analysis.steps.markers import MarkerSettings
 
     config, line = _read_config(args)

@@ -9,7 +9,8 @@ Walking with the device is compared with walking without it:
   inter-stride variability ISV_ave = (2 / n_subjects) · Σ σ_subject; the
   device counts as transparent where RMSD < ISV_ave;
 * :func:`transparency_results` - all of it for the pipeline's stride and
-  cycle tables, with the study's values beside ours.
+  cycle tables, with the study's values beside ours; :class:`TransparencySettings`, the leg and the fewest
+  kept strides it follows, from the config.
 
 The study's figure is :func:`loper_analysis.report.figures.transparency.transparency_figure`.
 Angles are in rad, forces in N, time in s. Normalised arrays have shape
@@ -28,11 +29,13 @@ import pandas as pd
 from loper_analysis.constants import JOINTS, angle_column
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
 from loper_analysis.gait.outliers import MIN_VALID_STRIDES
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.strides import phase_cycles
 from loper_analysis.reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
 from loper_analysis.study_design import PERTURBED_SIDE, TRANSPARENCY_CONDITIONS
 
 __all__ = [
+    "TransparencySettings",
     "TRANSPARENCY_PHASES",
     "strides_array",
     "TRANSPARENCY_COLUMNS",
@@ -45,6 +48,33 @@ __all__ = [
     "TransparencyResults",
     "transparency_results",
 ]
+
+
+@dataclass(frozen=True)
+class TransparencySettings:
+    """How the two walking trials are compared (config ``trials.perturbed_side``, ``strides.min_valid_strides``).
+
+    ``side``: the leg whose strides are compared; ``min_strides``: a subject with fewer kept strides in
+    either trial is left out of the comparison (its rows keep the counts, with empty metrics).
+    """
+
+    side: str = PERTURBED_SIDE
+    min_strides: int = MIN_VALID_STRIDES
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> TransparencySettings:
+        """The settings of a validated config: the leg and the fewest kept strides of the strides' settings
+        (:meth:`loper_analysis.gait.stride_settings.StrideSettings.from_config`), which read
+        ``trials.perturbed_side`` and ``strides.min_valid_strides``.
+
+        Raises
+        ------
+        KeyError
+            A key the strides' settings read missing, named.
+        """
+        strides = StrideSettings.from_config(config)
+        return cls(side=strides.side, min_strides=strides.min_valid)
+
 
 #: Phases compared (normalised separately: stance HS -> TO, swing TO -> next HS).
 TRANSPARENCY_PHASES: tuple[str, ...] = ("stance", "swing")

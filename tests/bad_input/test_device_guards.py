@@ -27,9 +27,10 @@ import pytest
 import yaml
 
 from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.steps import events as event_steps
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -22,8 +22,9 @@ from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import read_model, write_model
 from loper_analysis.motion.ik import marker_positions
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
-from loper_analysis.steps.ik import IKSettings, ik_chunk, ik_file
+from loper_analysis.steps.ik import ik_chunk, ik_file
 from loper_analysis.steps.markers import markers as markers_step
 from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale_with_setup, scaled_model
 from tests.gait2392_models import scaled_gait2392

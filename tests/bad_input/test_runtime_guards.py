@@ -25,7 +25,9 @@ import pandas as pd
 import pytest
 
 from loper_analysis.cli import main as cli_main
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
@@ -33,7 +35,6 @@ from loper_analysis.schema import check_yaml_file
 from loper_analysis.steps import events as event_steps
 from loper_analysis.steps import markers as marker_steps
 from loper_analysis.steps import report
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.logs import rule_log
 from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake

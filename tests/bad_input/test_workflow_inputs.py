@@ -24,14 +24,16 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps import events as event_steps
 from loper_analysis.steps import ik
 from loper_analysis.steps import markers as marker_steps
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake
 
@@ -194,7 +196,7 @@ def _ik(cfg: dict, trc: Path):
         trc,
         f"results/ik/{SUBJECT}/{WALK}.mot",
         f"results/ik/{SUBJECT}/{WALK}.angles.tsv",
-        ik.IKSettings.from_config(cfg),
+        IKSettings.from_config(cfg),
     )
 
 
@@ -373,7 +375,7 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
         out,
         tmp_path / "R02.mot",
         tmp_path / "R02.angles.tsv",
-        ik.IKSettings.from_config(cfg),
+        IKSettings.from_config(cfg),
         summary_tsv=summary,
     )
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
@@ -391,7 +393,7 @@ def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_
     marker_steps.markers(
         tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", MarkerSettings.from_config(cfg)
     )
-    given = dataclasses.replace(ik.IKSettings.from_config(cfg), subjects_model=False)
+    given = dataclasses.replace(IKSettings.from_config(cfg), subjects_model=False)
     summary = tmp_path / "ik.tsv"
     model = f"results/model/{SUBJECT}/generic.osim"
     ik.ik_trial(model, out, tmp_path / "a.mot", tmp_path / "a.angles.tsv", given, summary_tsv=summary)
@@ -412,7 +414,7 @@ def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
         f"results/markers/{SUBJECT}/{WALK}.trc",
         tmp_path / "own.mot",
         tmp_path / "own.angles.tsv",
-        ik.IKSettings.from_config(_config(lab)),
+        IKSettings.from_config(_config(lab)),
         summary_tsv=summary,
     )
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
@@ -472,7 +474,7 @@ def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_a
         tmp_path / "sparse.trc",
         tmp_path / "sparse.mot",
         tmp_path / "sparse.angles.tsv",
-        ik.IKSettings(coordinate_map=o["coordinate_map"]),
+        IKSettings(coordinate_map=o["coordinate_map"]),
         summary_tsv=tmp_path / "sparse.ik.tsv",
     )
     blank = angles.drop(columns="time_s").isna().all(axis=1).to_numpy()

@@ -1,12 +1,18 @@
 """loper_analysis.device.loadcell: the robot log's forces and perturbation flag on the mocap frames, against
 known clocks."""
 
+import copy
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
+import yaml
 
 from loper_analysis.device.loadcell import (
     OUTPUT_COLUMNS,
+    SYNC_CHANNEL,
+    LoadcellSettings,
     perturbation_onsets,
     robot_log_frames_and_native,
     robot_log_on_mocap_frames,
@@ -14,6 +20,8 @@ from loper_analysis.device.loadcell import (
 from loper_analysis.errors import LoperInputError
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 from tests.sync_records import ANALOG_HZ, ROBOT_HZ, mocap_view
+
+CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())
 
 FRAME_HZ = 128.0
 FORCE_COMPONENTS = ((8.0, 0.7, 0.3), (5.0, 2.3, 1.1), (3.0, 6.1, 2.0))  # (N, Hz, rad), all < 10 Hz
@@ -149,3 +157,24 @@ def test_perturbation_onsets():
     np.testing.assert_allclose(perturbation_onsets(t, f), [0.3, 0.7])
     with pytest.raises(LoperInputError, match="sample 2"):
         perturbation_onsets(t, np.array([0, 1, 2, 0, 0, 0, 0, 0, 0, 0]))
+
+
+# --------------------------------------------------------------------------- settings
+
+
+def test_settings_of_a_config():
+    """The sync channel is events.sync_channel; the low-pass the walking trials' filter.cutoff_hz and order."""
+    config = copy.deepcopy(CONFIG)
+    config["events"]["sync_channel"] = "trigger"
+    config["filter"].update(cutoff_hz=12.0, order=2)
+    assert LoadcellSettings.from_config(config) == LoadcellSettings("trigger", 12.0, 2)
+    assert LoadcellSettings.from_config(CONFIG) == LoadcellSettings() == LoadcellSettings(SYNC_CHANNEL, 40.0, 4)
+    assert SYNC_CHANNEL == "sync"
+
+
+@pytest.mark.parametrize(("section", "key"), [("events", "sync_channel"), ("filter", "order")])
+def test_settings_name_a_missing_key(section, key):
+    config = copy.deepcopy(CONFIG)
+    del config[section][key]
+    with pytest.raises(KeyError, match=f"^'{key}'$"):
+        LoadcellSettings.from_config(config)

@@ -6,8 +6,8 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.strides import force_phase_metrics, stride_summary, stride_tables
-from loper_analysis.steps.strides import StrideSettings
 
 FS = 1000.0
 

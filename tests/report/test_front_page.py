@@ -6,7 +6,6 @@ The headline tables it shows are tested in test_headline.py.
 from __future__ import annotations
 
 import base64
-import copy
 import math
 import re
 import shutil
@@ -18,12 +17,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-import yaml
 
 from loper_analysis.constants import JOINTS
 from loper_analysis.identification.across_subjects import impedance_summary
 from loper_analysis.identification.group_mean import random_effects_mean
 from loper_analysis.report.front_page import RunSettings, front_page_html
+from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.report.headline import (
     device_comparison,
     impedance_summary_ci,
@@ -31,7 +30,6 @@ from loper_analysis.report.headline import (
     truth_recovery,
     validation_verdict,
 )
-from loper_analysis.steps.report import FrontPageSettings
 from tests.browser import report_screen
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
@@ -316,15 +314,3 @@ def test_the_report_shows_the_headline_tables_on_its_first_screen(tmp_path):
     assert (tmp_path / "first_screen.png").read_bytes()[:4] == b"\x89PNG"
     # the methods text follows the results
     assert measured["boxes"]["lf-run"]["bottom"] > 900
-
-
-def test_the_rule_s_settings_come_from_the_config():
-    """FrontPageSettings.from_config: the shipped config's run settings, and a changed key reaches the page."""
-    config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    run = FrontPageSettings.from_config(config).run
-    assert run.rows() == RunSettings(**SETTINGS).rows()
-    changed = copy.deepcopy(config)
-    changed["identification"]["n_starts"] = 3
-    changed["trials"]["perturbation_onsets_ms"] = [60, 200]
-    rows = dict(FrontPageSettings.from_config(changed).run.rows())
-    assert "3 random starts" in rows["bounds"] and rows["perturbations"].startswith("onsets 60, 200 ms after left")

@@ -7,9 +7,10 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.grf import external_loads_columns, plate_vertical_loads
+from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
-from loper_analysis.steps.grf import GRFSettings, grf
+from loper_analysis.steps.grf import grf
 from tests.io.force_plate_files import (
     channels_for_load,
     plate_corners_mm,

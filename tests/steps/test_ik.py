@@ -10,8 +10,9 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.opensim_tables import read_mot, write_trc
 from loper_analysis.io.osim import write_model
 from loper_analysis.motion.ik import marker_positions
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
-from loper_analysis.steps.ik import IKSettings, ik_chunk, ik_join, ik_trial
+from loper_analysis.steps.ik import ik_chunk, ik_join, ik_trial
 
 FS = 128.0
 

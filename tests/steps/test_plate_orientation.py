@@ -25,11 +25,12 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.grf import external_loads_columns, plate_vertical_loads
+from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.motion.markers import lab_up
 from loper_analysis.steps.events import EventSettings, events
-from loper_analysis.steps.grf import GRFSettings, grf
+from loper_analysis.steps.grf import grf
 from loper_analysis.synthetic.force_plates import plate_frame, wrench_channels
 
 RATE, RATIO = 100.0, 10

@@ -12,7 +12,9 @@ import pandas as pd
 import pytest
 
 from loper_analysis.device.controller import DeviceParameters
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
+from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.io.robot_log import write_robot_log
@@ -22,7 +24,6 @@ from loper_analysis.steps import events as event_steps
 from loper_analysis.steps import ik, model, transparency
 from loper_analysis.steps import markers as marker_steps
 from loper_analysis.steps import strides as stride_steps
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
 from loper_analysis.steps.markers import MarkerSettings
 from loper_analysis.synthetic.trials import (
     LabSettings,

@@ -3,17 +3,18 @@
 import dataclasses
 
 from loper_analysis.steps.device import DeviceSettings
-from loper_analysis.steps.events import EventSettings, LoadcellSettings
-from loper_analysis.steps.grf import GRFSettings
-from loper_analysis.steps.ik import IKSettings
+from loper_analysis.device.loadcell import LoadcellSettings
+from loper_analysis.gait.trial_events import EventSettings
+from loper_analysis.gait.grf_settings import GRFSettings
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps.markers import MarkerSettings
 from loper_analysis.steps.model import ModelSettings
-from loper_analysis.steps.strides import StrideSettings
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.steps.impedance import FitSettings
 from loper_analysis.steps.planning import PlanningSettings
-from loper_analysis.steps.report import FrontPageSettings
-from loper_analysis.steps.synthetic import LabSessionSettings
-from loper_analysis.steps.transparency import TransparencySettings
+from loper_analysis.report.front_page_settings import FrontPageSettings
+from loper_analysis.synthetic.lab_session import LabSessionSettings
+from loper_analysis.transparency import TransparencySettings
 from loper_analysis.identification.validation import ValidationSettings
 
 # the config's sections

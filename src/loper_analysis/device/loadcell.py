@@ -21,6 +21,8 @@ cell must carry the perturbation flag (:func:`check_perturbation_flags`).
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -30,8 +32,11 @@ from loper_analysis.device.clock_sync import ClockMap, clock_map, high_times, ri
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
+from loper_analysis.motion.trial_markers import MarkerSettings
 
 __all__ = [
+    "SYNC_CHANNEL",
+    "LoadcellSettings",
     "OUTPUT_COLUMNS",
     "MIN_UNFLAGGED_PULSES",
     "FORCE_RATIO_RANGE",
@@ -43,6 +48,39 @@ __all__ = [
 ]
 
 log = logging.getLogger(__name__)
+
+#: Analog channel of the robot's sync output in the C3D (config ``events.sync_channel``).
+SYNC_CHANNEL: str = "sync"
+
+
+@dataclass(frozen=True)
+class LoadcellSettings:
+    """The robot log on the mocap clock: the C3D's ``sync_channel`` and the forces' low-pass (``cutoff_hz`` Hz,
+    Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``filter.*``)."""
+
+    sync_channel: str = SYNC_CHANNEL
+    cutoff_hz: float = CUTOFF_HZ
+    order: int = ORDER
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> LoadcellSettings:
+        """The settings of a validated config.
+
+        Parameters
+        ----------
+        config : mapping
+            The validated configuration: ``events.sync_channel`` is read here, the one place it is read; the
+            low-pass is the walking trials' (``filter.cutoff_hz``, Hz, and ``filter.order``,
+            :meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`).
+
+        Raises
+        ------
+        KeyError
+            A key missing, named.
+        """
+        walking = MarkerSettings.from_config(config)
+        return cls(config["events"]["sync_channel"], walking.cutoff_hz, walking.order)
+
 
 #: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.
 OUTPUT_COLUMNS: tuple[str, ...] = ("time_s", "force_measured_n", "force_desired_n", "perturbation")

@@ -17,6 +17,7 @@ from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.events import MIN_STANCE_S, MIN_SWING_S, THRESHOLD_OFF_N, THRESHOLD_ON_N
 from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
+from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.motion.filtering import ORDER
 
 __all__ = [
@@ -67,8 +68,9 @@ class EventSettings:
     @classmethod
     def from_config(cls, config: Mapping) -> EventSettings:
         """The settings of a validated config (``events.*``, ``grf.resting_band_n``, ``grf.max_resting_n``,
-        ``filter.order``, ``markers.lab_to_model_rotation_deg``)."""
-        e = config["events"]
+        ``filter.order``, ``markers.lab_to_model_rotation_deg``); the resting-level rule is the ground reactions'
+        (:meth:`loper_analysis.gait.grf_settings.GRFSettings.from_config`)."""
+        e, grf = config["events"], GRFSettings.from_config(config)
         return cls(
             grf_channels=e["grf_channels"],
             threshold_on_n=e["threshold_on_n"],
@@ -80,8 +82,8 @@ class EventSettings:
             foot_markers=e["foot_markers"],
             plate_sides=e["plate_sides"],
             rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
-            band_n=config["grf"]["resting_band_n"],
-            max_rest_n=config["grf"]["max_resting_n"],
+            band_n=grf.band_n,
+            max_rest_n=grf.max_rest_n,
         )
 
 

@@ -8,6 +8,7 @@ from dataclasses import dataclass, replace
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
 from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
@@ -70,8 +71,10 @@ class ModelSettings:
 
     @classmethod
     def from_config(cls, config: Mapping) -> ModelSettings:
-        """The model settings of a validated config (``markers.*``, ``opensim.*``, ``trials.perturbed_side``)."""
+        """The model settings of a validated config (``markers.*``, ``opensim.*``, ``trials.perturbed_side``); the
+        static pose's coordinate map and IK accuracy are the IK stage's (:meth:`IKSettings.from_config`)."""
         m, o = config["markers"], config["opensim"]
+        ik = IKSettings.from_config(config)
         return cls(
             rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
             static_duration_s=m["static_duration_s"],
@@ -80,8 +83,8 @@ class ModelSettings:
             segment_bodies=o["segment_bodies"],
             side=config["trials"]["perturbed_side"],
             attachment_fraction=o["brace_attachment_fraction"],
-            coordinate_map=o["coordinate_map"],
-            accuracy=o["accuracy"],
+            coordinate_map=ik.coordinate_map,
+            accuracy=ik.accuracy,
         )
 
     def for_generic(self) -> ModelSettings:

@@ -1,44 +1,24 @@
 """The ``events`` step: gait events of a trial, and the robot's load cell on the motion-capture clock.
 
 :func:`events` (a trial without the device), :func:`loadcell` and :func:`events_loadcell` (both from one
-reading of a trial with the device); their settings :class:`EventSettings` and :class:`LoadcellSettings`,
-built from the config by their ``from_config``.
+reading of a trial with the device); their settings :class:`EventSettings` and
+:class:`loper_analysis.device.loadcell.LoadcellSettings`, built from the config by their ``from_config``.
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
-from dataclasses import dataclass
 
 import pandas as pd
 
+from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.gait.trial_events import EventSettings, trial_events
 from loper_analysis.io.atomic import PathLike, write_tsv
 from loper_analysis.io.readers import read_label_maps
-from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
 
-__all__ = ["EventSettings", "LoadcellSettings", "events", "loadcell", "events_loadcell"]
+__all__ = ["EventSettings", "events", "loadcell", "events_loadcell"]
 
 log = logging.getLogger(__name__)
-
-#: Analog channel of the robot's sync output in the C3D (config ``events.sync_channel``).
-SYNC_CHANNEL: str = "sync"
-
-
-@dataclass(frozen=True)
-class LoadcellSettings:
-    """The robot log on the mocap clock: the C3D's ``sync_channel`` and the forces' low-pass (``cutoff_hz`` Hz,
-    Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``filter.*``)."""
-
-    sync_channel: str = SYNC_CHANNEL
-    cutoff_hz: float = CUTOFF_HZ
-    order: int = ORDER
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> LoadcellSettings:
-        """The settings of a validated config."""
-        return cls(config["events"]["sync_channel"], config["filter"]["cutoff_hz"], config["filter"]["order"])
 
 
 def events(

@@ -10,7 +10,8 @@ C3D (ezc3d's platform extraction, :mod:`loper_analysis.io.force_platforms`)
 The vertical is the lab's up direction ``up`` (lab frame): lab +Z unless
 given. A lab that is not Z-up (BTS: Y-up) passes
 ``up=loper_analysis.motion.markers.lab_up(rotation_deg)``, the direction its
-lab-to-model rotation turns into the model's +Y.
+lab-to-model rotation turns into the model's +Y. The settings are
+:class:`loper_analysis.gait.grf_settings.GRFSettings` (config ``grf.*``).
 """
 
 from __future__ import annotations
@@ -19,51 +20,17 @@ import dataclasses
 import logging
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import pandas as pd
 
-from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
-from loper_analysis.gait.grf import LOADED_THRESHOLD_N, MAX_RESTING_N, RESTING_BAND_N
+from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.io.atomic import PathLike
 
-__all__ = ["GRFSettings", "grf", "trial_grf"]
+__all__ = ["grf", "trial_grf"]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class GRFSettings:
-    """How a C3D's force platforms become ground reactions in the model frame (config ``grf.*``, ``markers.*``).
-
-    Attributes
-    ----------
-    rotation_deg : (float, float, float)
-        Lab -> model rotation about the fixed X, Y, Z axes, degrees (``markers.lab_to_model_rotation_deg``).
-    threshold_n : float
-        A plate is loaded above this vertical force over its resting level, N (``grf.loaded_threshold_n``).
-    band_n, max_rest_n : float
-        The resting-level rule, N (``grf.resting_band_n``, ``grf.max_resting_n``;
-        :func:`loper_analysis.gait.grf.resting_level`).
-    """
-
-    rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
-    threshold_n: float = LOADED_THRESHOLD_N
-    band_n: float = RESTING_BAND_N
-    max_rest_n: float = MAX_RESTING_N
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> GRFSettings:
-        """The ground-reaction settings of a validated config (``grf.*``, ``markers.lab_to_model_rotation_deg``)."""
-        g = config["grf"]
-        return cls(
-            rotation_deg=tuple(float(v) for v in config["markers"]["lab_to_model_rotation_deg"]),
-            threshold_n=g["loaded_threshold_n"],
-            band_n=g["resting_band_n"],
-            max_rest_n=g["max_resting_n"],
-        )
 
 
 def grf(

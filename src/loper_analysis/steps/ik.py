@@ -1,6 +1,6 @@
 """File steps of inverse kinematics: OpenSim IK of a trial's TRC to a .mot and the joint-angle table.
 
-:class:`IKSettings` holds the IK settings of the config (``opensim.*``), built by :meth:`IKSettings.from_config`;
+Their settings are :class:`loper_analysis.motion.ik_settings.IKSettings` (config ``opensim.*``);
 :func:`ik_trial`, :func:`ik_chunk` and :func:`ik_join` are the rules' steps, :func:`ik_file` the command's.
 """
 
@@ -8,96 +8,21 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, MIN_IK_MARKERS
+from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_tsv
 from loper_analysis.io.readers import read_tsv
-from loper_analysis.motion.ik import IK_ACCURACY
-from loper_analysis.motion.marker_geometry import GEOMETRY_STOP_CHANGE, GEOMETRY_WARN_CHANGE
-from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
+from loper_analysis.motion.ik_settings import IKSettings
+from loper_analysis.motion.plausibility import IK_WARN_RMS_M
 
-__all__ = ["DEFAULT_MARKER_WEIGHT", "IKSettings", "ik_chunk", "ik_file", "ik_join", "ik_trial"]
+__all__ = ["ik_chunk", "ik_file", "ik_join", "ik_trial"]
 
 log = logging.getLogger(__name__)
-
-#: Weight of every model marker without a weight of its own (config ``opensim.default_marker_weight``).
-DEFAULT_MARKER_WEIGHT: float = 1.0
-
-
-@dataclass(frozen=True)
-class IKSettings:
-    """How a trial's markers are solved for the model's coordinates (config ``opensim.*``).
-
-    Attributes
-    ----------
-    tasks_file : str, optional
-        OpenSim IK task-set XML or TSV (``opensim.ik_tasks``); None: the weights below.
-    default_weight : float
-        Weight of a model marker without an entry in ``marker_weights`` (``opensim.default_marker_weight``).
-    marker_weights : mapping, optional
-        Marker -> weight, 0 leaving a marker out (``opensim.marker_weights``).
-    coordinate_tasks : mapping, optional
-        Coordinate -> ``{"weight": w, "value": rad or None}`` (``opensim.coordinate_tasks``).
-    accuracy : float
-        IK solver accuracy (``opensim.accuracy``).
-    min_markers : int
-        Fewest weighted markers present in a frame for IK to solve it (no config key).
-    max_marker_rms_m, warn_marker_rms_m : float
-        A frame whose marker RMS error (m) exceeds the first counts as failed, the second as poorly fitted
-        (``opensim.max_marker_rms_m``, ``opensim.warn_marker_rms_m``; the second None: no warning).
-    max_rms_fraction : float
-        Share of frames above either level that stops the trial, or warns (``opensim.max_rms_fraction``).
-    coordinate_map : mapping, optional
-        Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``opensim.coordinate_map``); None:
-        :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
-    geometry_warn_change, geometry_stop_change : float
-        Median relative change of the distances between markers on one body, trial against model, above which
-        the trial is warned about or refused as another subject's (``opensim.geometry_warn_change``,
-        ``opensim.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
-    subjects_model : bool
-        Whether the model was scaled to this subject's static trial (True) or given as it is (a ``model_osim``
-        of the subject sheet, the command line's ``--model``): its markers may then sit elsewhere than on the
-        subject, and a change beyond ``geometry_stop_change`` is a warning, unless the distances differ by a
-        factor beyond 1.5 (a unit).
-    """
-
-    tasks_file: PathLike | None = None
-    default_weight: float = DEFAULT_MARKER_WEIGHT
-    marker_weights: Mapping[str, float] | None = None
-    coordinate_tasks: Mapping[str, Mapping] | None = None
-    accuracy: float = IK_ACCURACY
-    min_markers: int = MIN_IK_MARKERS
-    max_marker_rms_m: float = IK_STOP_RMS_M
-    warn_marker_rms_m: float | None = IK_WARN_RMS_M
-    max_rms_fraction: float = IK_MAX_FRACTION
-    coordinate_map: Mapping[str, Mapping] | None = None
-    geometry_warn_change: float = GEOMETRY_WARN_CHANGE
-    geometry_stop_change: float = GEOMETRY_STOP_CHANGE
-    subjects_model: bool = True
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> IKSettings:
-        """The IK settings of a validated config (``opensim.*``)."""
-        o = config["opensim"]
-        return cls(
-            tasks_file=o["ik_tasks"],
-            default_weight=o["default_marker_weight"],
-            marker_weights=o["marker_weights"],
-            coordinate_tasks=o["coordinate_tasks"],
-            accuracy=o["accuracy"],
-            max_marker_rms_m=o["max_marker_rms_m"],
-            warn_marker_rms_m=o["warn_marker_rms_m"],
-            max_rms_fraction=o["max_rms_fraction"],
-            coordinate_map=o["coordinate_map"],
-            geometry_warn_change=o["geometry_warn_change"],
-            geometry_stop_change=o["geometry_stop_change"],
-        )
 
 
 def _checked(res, source: str, settings: IKSettings):
@@ -277,6 +202,31 @@ def _lab_agreement(angles: pd.DataFrame, lab_angles_tsv: PathLike, res, agreemen
     return table
 
 
+def _angle_outputs(
+    res,
+    angles: pd.DataFrame,
+    warn_rms_m: float,
+    outputs: tuple[PathLike, PathLike | None, PathLike | None, PathLike | None],
+    source: str,
+) -> pd.DataFrame:
+    """What :func:`ik_trial` and :func:`ik_join` end with: the angles checked (:func:`_angle_checks`), compared
+    with the lab's own (:func:`_lab_agreement`), the one-row IK summary (marker RMS error above ``warn_rms_m``, m,
+    counted as poorly fitted) and the angle table written.
+
+    ``outputs`` are the angle table, the summary, the lab's own angles (read) and the agreement table (the last
+    three None: not written, not compared). Returns ``angles``.
+    """
+    angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv = outputs
+    _angle_checks(res, angles, source)
+    if lab_angles_tsv is not None:
+        _lab_agreement(angles, lab_angles_tsv, res, agreement_tsv, source)
+    if summary_tsv is not None:
+        write_tsv(res.summary(warn_rms_m), summary_tsv)
+    write_tsv(angles, angles_tsv)
+    log.info("%d frames, %s", len(angles), list(angles.columns))
+    return angles
+
+
 def ik_trial(
     model_osim: PathLike,
     trc_path: PathLike,
@@ -302,15 +252,9 @@ def ik_trial(
 
     res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, settings)
     angles = joint_angle_table(res.frame(), settings.coordinate_map, source=f"{out_mot} (model {model_osim})")
-    _angle_checks(res, angles, str(trc_path))
-    if lab_angles_tsv is not None:
-        _lab_agreement(angles, lab_angles_tsv, res, agreement_tsv, str(trc_path))
-    if summary_tsv is not None:
-        warn = settings.warn_marker_rms_m
-        write_tsv(res.summary(IK_WARN_RMS_M if warn is None else warn), summary_tsv)
-    write_tsv(angles, angles_tsv)
-    log.info("%d frames, %s", len(angles), list(angles.columns))
-    return angles
+    warn = settings.warn_marker_rms_m
+    outputs = (angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv)
+    return _angle_outputs(res, angles, IK_WARN_RMS_M if warn is None else warn, outputs, str(trc_path))
 
 
 def ik_join(
@@ -338,14 +282,9 @@ def ik_join(
     values = coords.drop(columns="time_s").to_numpy(float)
     none = np.full(len(coords), np.nan)
     joined = IKResult(coords["time_s"].to_numpy(float), values, [], none, none, solved=np.isfinite(values).any(axis=1))
-    _angle_checks(joined, angles, str(out_mot))
-    if lab_angles_tsv is not None:
-        _lab_agreement(angles, lab_angles_tsv, joined, agreement_tsv, str(out_mot))
+    outputs = (angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv)
+    _angle_outputs(joined, angles, IK_WARN_RMS_M, outputs, str(out_mot))
     write_mot(out_mot, coords, in_degrees=True)
-    if summary_tsv is not None:
-        write_tsv(joined.summary(IK_WARN_RMS_M), summary_tsv)
-    write_tsv(angles, angles_tsv)
-    log.info("%d frames, %s", len(angles), list(angles.columns))
     return angles
 
 

@@ -15,13 +15,11 @@ from pathlib import Path
 
 from loper_analysis.io.atomic import PathLike, write_text
 from loper_analysis.io.readers import read_bytes, read_tsv
-from loper_analysis.report.front_page import RunSettings
-from loper_analysis.responses.response_window import ResponseWindow
+from loper_analysis.report.front_page_settings import FrontPageSettings
 
 __all__ = [
     "markdown_tables",
     "software_versions",
-    "FrontPageSettings",
     "FrontPageFiles",
     "front_page",
     "snakemake_report_command",
@@ -60,43 +58,6 @@ def software_versions() -> dict[str, str]:
 
 
 @dataclass(frozen=True)
-class FrontPageSettings:
-    """The settings the front page lists: ``run``, the run's
-    :class:`~loper_analysis.report.front_page.RunSettings` (the workflow's configuration)."""
-
-    run: RunSettings
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> FrontPageSettings:
-        """The settings of a validated config: ``seed``, ``trials.perturbation_*`` and ``perturbed_side``,
-        ``filter.*``, the fit window, bounds, starts, noise model and components of ``identification`` and the
-        synthetic lab's ``variability``, ``walking_duration_s`` and pulse."""
-        trials, ident, synthetic = config["trials"], config["identification"], config["synthetic"]
-        window = ResponseWindow.from_config(config)
-        return cls(
-            RunSettings(
-                seed=config["seed"],
-                perturbation_onsets_ms=tuple(trials["perturbation_onsets_ms"]),
-                perturbation_repeats=trials["perturbation_repeats"],
-                perturbed_side=trials["perturbed_side"],
-                filter_cutoff_hz=config["filter"]["cutoff_hz"],
-                filter_order=config["filter"]["order"],
-                window_before_s=window.before_s,
-                window_after_s=window.after_s,
-                stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
-                damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
-                n_starts=ident["n_starts"],
-                noise_model=ident["noise_model"],
-                null_pair_components=ident["null_pair_components"],
-                synthetic_variability=synthetic["variability"],
-                synthetic_walking_duration_s=synthetic["walking_duration_s"],
-                pulse_force_n=synthetic["pulse_force_n"],
-                pulse_duration_s=synthetic["pulse_duration_s"],
-            )
-        )
-
-
-@dataclass(frozen=True)
 class FrontPageFiles:
     """The result files the front page reads.
 
@@ -132,7 +93,8 @@ def front_page(
 
     ``files``: the result tables and figure (:class:`FrontPageFiles`); ``subjects``: subject -> source;
     ``trials``: processed subject -> its walking trials; ``settings``: the run's settings
-    (:class:`FrontPageSettings`); ``versions``: software -> version (default :func:`software_versions`);
+    (:class:`loper_analysis.report.front_page_settings.FrontPageSettings`); ``versions``: software -> version
+    (default :func:`software_versions`);
     ``recorded``: recorded subject -> ``{"scale": path or None, "trials": {trial: {"ik", "agreement",
     "angles_png", "grf_png": path or None}}}``, the files of the section on recorded subjects
     (:func:`loper_analysis.report.subject_quality.recorded_subjects_html`).

@@ -1,56 +1,27 @@
 """The ``strides`` step: a trial's strides of one leg, their outliers and cycles; the summary over trials.
 
-:func:`strides` (one trial, settings :class:`StrideSettings` from the config by
-:meth:`StrideSettings.from_config`) and :func:`strides_summary` (every trial of the study).
+:func:`strides` (one trial, settings :class:`loper_analysis.gait.stride_settings.StrideSettings` from the
+config) and :func:`strides_summary` (every trial of the study).
 """
 
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
-from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION, MIN_VALID_STRIDES
-from loper_analysis.gait.resampling import N_POINTS
+from loper_analysis.gait.outliers import MIN_VALID_STRIDES
+from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.strides import DROPPED_COLUMNS, MAX_OUTSIDE_LOG_FRACTION
 from loper_analysis.io.atomic import PathLike, write_tsv
 from loper_analysis.io.readers import read_tsv
-from loper_analysis.study_design import PERTURBED_SIDE
 
-__all__ = ["StrideSettings", "TrialTables", "strides", "strides_summary"]
+__all__ = ["TrialTables", "strides", "strides_summary"]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class StrideSettings:
-    """Strides of one leg (config ``strides.*``, ``trials.perturbed_side``).
-
-    ``side``: the leg; ``n_points``: samples per time-normalised stride, stance or swing; ``whisker``,
-    ``max_fraction``: the IQR rule (:func:`loper_analysis.gait.outliers.iqr_outliers`); ``min_valid``: the
-    fewest kept strides of an ``ok`` trial.
-    """
-
-    side: str = PERTURBED_SIDE
-    n_points: int = N_POINTS
-    whisker: float = IQR_WHISKER
-    max_fraction: float = MAX_OUTLIER_FRACTION
-    min_valid: int = MIN_VALID_STRIDES
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> StrideSettings:
-        """The settings of a validated config."""
-        s = config["strides"]
-        return cls(
-            side=config["trials"]["perturbed_side"],
-            n_points=s["n_points"],
-            whisker=s["iqr_whisker"],
-            max_fraction=s["max_outlier_fraction"],
-            min_valid=s["min_valid_strides"],
-        )
 
 
 def strides(

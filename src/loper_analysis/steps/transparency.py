@@ -1,7 +1,7 @@
 """File step of the transparency analysis: RMSD vs ISV_ave, interaction force, and the study's figure.
 
 :func:`transparency` reads each subject's :class:`TransparencyFiles` with the settings
-:class:`TransparencySettings` (from the config by :meth:`TransparencySettings.from_config`).
+:class:`loper_analysis.transparency.TransparencySettings` (from the config by its ``from_config``).
 """
 
 from __future__ import annotations
@@ -10,31 +10,13 @@ import logging
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from loper_analysis.gait.outliers import MIN_VALID_STRIDES
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
-from loper_analysis.study_design import PERTURBED_SIDE
+from loper_analysis.transparency import TransparencySettings
 
-__all__ = ["PERTURBED_SIDE", "TransparencySettings", "TransparencyFiles", "transparency"]
+__all__ = ["TransparencyFiles", "transparency"]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class TransparencySettings:
-    """How the two walking trials are compared (config ``trials.perturbed_side``, ``strides.min_valid_strides``).
-
-    ``side``: the leg whose strides are compared; ``min_strides``: a subject with fewer kept strides in
-    either trial is left out of the comparison (its rows keep the counts, with empty metrics).
-    """
-
-    side: str = PERTURBED_SIDE
-    min_strides: int = MIN_VALID_STRIDES
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> TransparencySettings:
-        """The settings of a validated config."""
-        return cls(side=config["trials"]["perturbed_side"], min_strides=config["strides"]["min_valid_strides"])
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,102 @@
+"""The IK stage's settings (:class:`IKSettings`): the tasks, the solver's accuracy and the limits a trial's fit is
+held to, from the config (:meth:`IKSettings.from_config`, section ``opensim``)."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from loper_analysis.constants import MIN_IK_MARKERS
+from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.marker_geometry import GEOMETRY_STOP_CHANGE, GEOMETRY_WARN_CHANGE
+from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
+
+__all__ = ["DEFAULT_MARKER_WEIGHT", "IKSettings"]
+
+#: Weight of every model marker without a weight of its own (config ``opensim.default_marker_weight``).
+DEFAULT_MARKER_WEIGHT: float = 1.0
+
+
+@dataclass(frozen=True)
+class IKSettings:
+    """How a trial's markers are solved for the model's coordinates (config ``opensim.*``).
+
+    Attributes
+    ----------
+    tasks_file : str, optional
+        OpenSim IK task-set XML or TSV (``opensim.ik_tasks``); None: the weights below.
+    default_weight : float
+        Weight of a model marker without an entry in ``marker_weights`` (``opensim.default_marker_weight``).
+    marker_weights : mapping, optional
+        Marker -> weight, 0 leaving a marker out (``opensim.marker_weights``).
+    coordinate_tasks : mapping, optional
+        Coordinate -> ``{"weight": w, "value": rad or None}`` (``opensim.coordinate_tasks``).
+    accuracy : float
+        IK solver accuracy (``opensim.accuracy``).
+    min_markers : int
+        Fewest weighted markers present in a frame for IK to solve it (no config key).
+    max_marker_rms_m, warn_marker_rms_m : float
+        A frame whose marker RMS error (m) exceeds the first counts as failed, the second as poorly fitted
+        (``opensim.max_marker_rms_m``, ``opensim.warn_marker_rms_m``; the second None: no warning).
+    max_rms_fraction : float
+        Share of frames above either level that stops the trial, or warns (``opensim.max_rms_fraction``).
+    coordinate_map : mapping, optional
+        Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``opensim.coordinate_map``); None:
+        :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+    geometry_warn_change, geometry_stop_change : float
+        Median relative change of the distances between markers on one body, trial against model, above which
+        the trial is warned about or refused as another subject's (``opensim.geometry_warn_change``,
+        ``opensim.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
+    subjects_model : bool
+        Whether the model was scaled to this subject's static trial (True) or given as it is (a ``model_osim``
+        of the subject sheet, the command line's ``--model``): its markers may then sit elsewhere than on the
+        subject, and a change beyond ``geometry_stop_change`` is a warning, unless the distances differ by a
+        factor beyond 1.5 (a unit).
+    """
+
+    tasks_file: str | os.PathLike | None = None
+    default_weight: float = DEFAULT_MARKER_WEIGHT
+    marker_weights: Mapping[str, float] | None = None
+    coordinate_tasks: Mapping[str, Mapping] | None = None
+    accuracy: float = IK_ACCURACY
+    min_markers: int = MIN_IK_MARKERS
+    max_marker_rms_m: float = IK_STOP_RMS_M
+    warn_marker_rms_m: float | None = IK_WARN_RMS_M
+    max_rms_fraction: float = IK_MAX_FRACTION
+    coordinate_map: Mapping[str, Mapping] | None = None
+    geometry_warn_change: float = GEOMETRY_WARN_CHANGE
+    geometry_stop_change: float = GEOMETRY_STOP_CHANGE
+    subjects_model: bool = True
+
+    @classmethod
+    def from_config(cls, config: Mapping) -> IKSettings:
+        """The IK settings of a validated config (``opensim.*``; the one place these keys are read).
+
+        Parameters
+        ----------
+        config : mapping
+            The validated configuration; of its section ``opensim`` the keys ``ik_tasks``,
+            ``default_marker_weight``, ``marker_weights``, ``coordinate_tasks``, ``accuracy``,
+            ``max_marker_rms_m`` (m), ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``,
+            ``geometry_warn_change`` and ``geometry_stop_change``.
+
+        Raises
+        ------
+        KeyError
+            A key missing, named.
+        """
+        o = config["opensim"]
+        return cls(
+            tasks_file=o["ik_tasks"],
+            default_weight=o["default_marker_weight"],
+            marker_weights=o["marker_weights"],
+            coordinate_tasks=o["coordinate_tasks"],
+            accuracy=o["accuracy"],
+            max_marker_rms_m=o["max_marker_rms_m"],
+            warn_marker_rms_m=o["warn_marker_rms_m"],
+            max_rms_fraction=o["max_rms_fraction"],
+            coordinate_map=o["coordinate_map"],
+            geometry_warn_change=o["geometry_warn_change"],
+            geometry_stop_change=o["geometry_stop_change"],
+        )

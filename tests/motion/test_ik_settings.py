@@ -1,0 +1,79 @@
+"""The IK stage's settings (motion.ik_settings): every ``opensim`` key the IK reads to its field, the defaults
+the shipped config's, a missing key named; the model stage's static pose takes its accuracy and coordinate map
+from here."""
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.ik_settings import DEFAULT_MARKER_WEIGHT, IKSettings
+from loper_analysis.motion.model_settings import ModelSettings
+
+CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())
+MAP = {"knee_left": {"coordinate": "knee_angle_l", "sign": -1}}
+
+
+def _changed() -> dict:
+    """The shipped config with every key the IK reads set away from its default."""
+    config = copy.deepcopy(CONFIG)
+    config["opensim"].update(
+        ik_tasks="tasks.xml",
+        default_marker_weight=0.5,
+        marker_weights={"LASI": 2.0, "RASI": 0.0},
+        coordinate_tasks={"pelvis_tilt": {"weight": 10.0, "value": None}},
+        accuracy=1e-8,
+        max_marker_rms_m=0.03,
+        warn_marker_rms_m=None,
+        max_rms_fraction=0.25,
+        coordinate_map=MAP,
+        geometry_warn_change=0.08,
+        geometry_stop_change=0.4,
+    )
+    return config
+
+
+def test_every_config_key_reaches_its_field():
+    """Each changed key in its own field; the fewest markers (no key) and the subject's own model keep theirs."""
+    assert IKSettings.from_config(_changed()) == IKSettings(
+        tasks_file="tasks.xml",
+        default_weight=0.5,
+        marker_weights={"LASI": 2.0, "RASI": 0.0},
+        coordinate_tasks={"pelvis_tilt": {"weight": 10.0, "value": None}},
+        accuracy=1e-8,
+        min_markers=IKSettings().min_markers,
+        max_marker_rms_m=0.03,
+        warn_marker_rms_m=None,
+        max_rms_fraction=0.25,
+        coordinate_map=MAP,
+        geometry_warn_change=0.08,
+        geometry_stop_change=0.4,
+        subjects_model=True,
+    )
+
+
+def test_the_shipped_config_gives_the_defaults():
+    """Accuracy 1e-6, weight 1, RMS limits 0.06 / 0.02 m over 10 % of the frames, geometry 5 % / 8 %."""
+    shipped = IKSettings.from_config(CONFIG)
+    assert (shipped.accuracy, IK_ACCURACY, shipped.default_weight, DEFAULT_MARKER_WEIGHT) == (1e-6, 1e-6, 1.0, 1.0)
+    assert (shipped.max_marker_rms_m, shipped.warn_marker_rms_m, shipped.max_rms_fraction) == (0.06, 0.02, 0.1)
+    assert (shipped.geometry_warn_change, shipped.geometry_stop_change) == (0.05, 0.08)
+    assert shipped.tasks_file is None and shipped.marker_weights == {} and shipped.coordinate_tasks == {}
+    assert (shipped.min_markers, shipped.subjects_model) == (IKSettings().min_markers, True)
+
+
+def test_the_scale_report_takes_the_ik_accuracy_and_coordinate_map():
+    """opensim.accuracy and opensim.coordinate_map reach the model stage's static pose as the IK's."""
+    model, ik = ModelSettings.from_config(_changed()), IKSettings.from_config(_changed())
+    assert (model.accuracy, model.coordinate_map) == (ik.accuracy, ik.coordinate_map) == (1e-8, MAP)
+    assert model.for_scaling().accuracy == 1e-8
+
+
+@pytest.mark.parametrize("key", ["accuracy", "geometry_stop_change", "ik_tasks"])
+def test_a_missing_key_is_named(key):
+    config = copy.deepcopy(CONFIG)
+    del config["opensim"][key]
+    with pytest.raises(KeyError, match=f"^'{key}'$"):
+        IKSettings.from_config(config)
