@@ -34,7 +34,6 @@ __all__ = [
     "ModelSettings",
     "ScaleFiles",
     "generic_model",
-    "scaled_model",
     "scale_with_setup",
     "scale",
     "segments_from_model_file",
@@ -58,7 +57,7 @@ class ScaleFiles:
         The scaled model (written atomically).
     setup_xml : path, optional
         A lab's OpenSim ScaleTool setup (:func:`scale_with_setup`); None: the generated model's marker-pair
-        measurements (:func:`scaled_model`).
+        measurements (:func:`scale`).
     static_c3d : path, optional
         The static trial's C3D, whose force plates give the mass when none is given
         (:func:`loper_analysis.motion.static_trial.standing_mass_kg`).
@@ -106,32 +105,6 @@ def generic_model(
     log.info("generic model for %s m, %s kg: %s", height_m, mass_kg, out_osim)
 
 
-def scaled_model(
-    files: ScaleFiles,
-    mass_kg: float | None,
-    settings: ModelSettings = ModelSettings(),
-    height_m: float | None = None,
-    lab_labels: Mapping[str, str] | None = None,
-) -> None:
-    """Personalise the generated model with OpenSim's ScaleTool from a static trial (TRC).
-
-    Each body is scaled uniformly by the ratio of the marker-pair distances in
-    the static trial to those of the model
-    (:data:`loper_analysis.motion.model.SCALE_MEASUREMENTS`); the mass distribution
-    is preserved at ``mass_kg``. The files (but ``files.setup_xml``, which is not read), the window, the static
-    pose, ``height_m`` and ``lab_labels`` are those of :func:`scale_with_setup`; every factor
-    must lie in ``settings.factor_range`` (a factor near 10 or 1000 means markers in
-    another unit than the TRC declares); nothing is written otherwise.
-    """
-    from loper_analysis.io.osim import read_model
-
-    generic_osim = Path(files.generic_osim)
-    if not generic_osim.is_file():
-        raise LoperInputError(f"file not found: {generic_osim}")
-    generated = dataclasses.replace(files, setup_xml=None)
-    _scale(generated_scale_tool(), read_model(generic_osim), generated, None, mass_kg, settings, height_m, lab_labels)
-
-
 def scale(
     files: ScaleFiles,
     mass_kg: float | None,
@@ -140,17 +113,28 @@ def scale(
     lab_labels: Mapping[str, str] | PathLike | None = None,
 ) -> None:
     """The subject's scaled model: with a lab's ScaleTool setup (:func:`scale_with_setup`) when
-    ``files.setup_xml`` is given, else with the generated model's marker-pair measurements (:func:`scaled_model`,
-    which checks no ``settings.segment_bodies``); scale factors outside ``settings.factor_range`` are refused.
+    ``files.setup_xml`` is given, else the generated model personalised with OpenSim's ScaleTool.
+
+    The generated model's bodies are each scaled uniformly by the ratio of the marker-pair distances in the
+    static trial to those of the model (:data:`loper_analysis.motion.model.SCALE_MEASUREMENTS`,
+    :func:`loper_analysis.motion.scaling.generated_scale_tool`), the mass distribution preserved at ``mass_kg``,
+    checking no ``settings.segment_bodies``; the window, the static pose, ``height_m`` and ``lab_labels`` are
+    those of :func:`scale_with_setup`. Every scale factor must lie in ``settings.factor_range`` (a factor near 10
+    or 1000 means markers in another unit than the TRC declares); nothing is written otherwise.
     ``lab_labels`` may be the static trial's markers summary (TSV with the columns ``label`` and ``marker``,
     written by the ``markers`` step)."""
+    from loper_analysis.io.osim import read_model
+
     if isinstance(lab_labels, (str, Path)):
         lab_labels = _lab_labels(lab_labels)
-    if files.setup_xml is None:
-        generated = dataclasses.replace(settings, segment_bodies=None)
-        scaled_model(files, mass_kg, generated, height_m, lab_labels)
-    else:
+    if files.setup_xml is not None:
         scale_with_setup(files, mass_kg, settings, height_m, lab_labels)
+        return
+    generic_osim = Path(files.generic_osim)
+    if not generic_osim.is_file():
+        raise LoperInputError(f"file not found: {generic_osim}")
+    generated = dataclasses.replace(settings, segment_bodies=None)
+    _scale(generated_scale_tool(), read_model(generic_osim), files, None, mass_kg, generated, height_m, lab_labels)
 
 
 def segments_from_model_file(
@@ -286,7 +270,7 @@ def _scale(
     lab_labels: Mapping[str, str] | None = None,
 ) -> None:
     """Read the static trial, run OpenSim's ScaleTool on its scaling window, write the scale report and the model
-    (:func:`scale_with_setup`; ``files.setup_xml`` None: ``tool`` as :func:`scaled_model` built it)."""
+    (:func:`scale_with_setup`; ``files.setup_xml`` None: the generated model's ``tool``, :func:`scale`)."""
     from loper_analysis.io.opensim_tables import read_markers
 
     generic_osim, static_trc, out_osim = Path(files.generic_osim), Path(files.static_trc), files.out_osim
