@@ -26,7 +26,7 @@ from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
 from loper_analysis.steps.ik import ik_chunk, ik_file
 from loper_analysis.steps.markers import markers as markers_step
-from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale_with_setup, scaled_model
+from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale, scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -92,7 +92,7 @@ def test_scaling_the_generated_model_with_a_static_trial_in_the_wrong_unit_is_re
     out = tmp_path / "scaled.osim"
     with pytest.raises(LoperInputError) as err:
         # the motion check off: the numbers 1000 times too large move 1000 times as far
-        scaled_model(ScaleFiles(trial["model"], static, out), 64.9, ModelSettings(max_motion_rms_m=None))
+        scale(ScaleFiles(trial["model"], static, out), 64.9, ModelSettings(max_motion_rms_m=None))
     msg = str(err.value)
     assert str(static) in msg and "scale factor" in msg and "0.5 .. 2" in msg
     thigh = float(msg.split("thigh_r ")[1].split(",")[0])

@@ -1,5 +1,5 @@
 """The scale report's checks: a static pose beyond 15 degrees or away from the lab's own, neighbouring bodies
-scaled unlike each other."""
+scaled unlike each other; the report of one run of ScaleTool, with a marker of known offset."""
 
 from __future__ import annotations
 
@@ -64,3 +64,70 @@ def test_a_model_far_from_the_given_height_is_warned_about():
     assert name == "stature"
     assert "1.50 m tall where the subject's height is 1.80 m (given; -17 %" in text and "height_m" in text
     assert stature_warnings(1.80, float("nan"), "given") == []
+
+
+OFFSET_M = np.array([0.0, 0.0, 0.02])
+
+
+@pytest.fixture(scope="module")
+def standing():
+    """The generated model of a 1.85 m subject, 20 frames (128 Hz) of its markers standing, and the same model with
+    RASI placed 20 mm lateral of where the subject's is."""
+    from loper_analysis.io.osim import quiet_opensim
+    from loper_analysis.motion.ik import marker_positions
+    from loper_analysis.motion.model import MARKERS, build_lower_body_model
+    from loper_analysis.motion.static_trial import StaticPose
+
+    osim = quiet_opensim()
+    model, moved = build_lower_body_model(1.85, 80.0), build_lower_body_model(1.85, 80.0)
+    marker = moved.getMarkerSet().get("RASI")
+    marker.set_location(osim.Vec3(*(marker.get_location().to_numpy() + OFFSET_M)))
+    t = np.arange(20) / 128.0
+    X = marker_positions(model, {"pelvis_ty": np.full(t.size, 0.98)})
+    return model, moved, StaticPose(t, X, list(MARKERS), {}, [], {})
+
+
+def _run(scaled, unplaced, tasks, window):
+    from loper_analysis.io.scale_tool import ScaleToolRun
+
+    return ScaleToolRun(b"", scaled, unplaced, {"pelvis": (1.1, 1.1, 1.1)}, tasks, window)
+
+
+def test_a_runs_report_gives_a_moved_markers_offset_and_the_lab_angles_of_its_window(standing):
+    from loper_analysis.motion.model_settings import ModelSettings
+    from loper_analysis.motion.scale_report import scale_run_report
+
+    model, moved, pose = standing
+    weights = {m: 1e-6 if m == "RASI" else 1.0 for m in pose.labels}  # RASI barely pulls: the pose stays exact
+    run = _run(moved, model, (weights, {}), (pose.time_s[0], pose.time_s[9]))
+    lab = pd.DataFrame({"time_s": pose.time_s, "hip_left_rad": np.linspace(0.0, 0.19, 20)})
+    subject = (80.0, 1.5, "mass: given; height: given", 1.85)
+    table = scale_run_report(run, model, pose, subject, ModelSettings(), lab_labels={"RASI": "S:RASI"}, lab_angles=lab)
+    markers = table[table.kind == "marker"].set_index("name")
+    np.testing.assert_allclose(markers.loc["RASI", "marker_error_m"], 0.02, atol=1e-4)
+    assert markers.drop(index="RASI")["marker_error_m"].max() < 1e-4
+    assert markers["marker_error_before_m"].max() < 1e-4  # the unplaced model's RASI is the subject's
+    assert markers.loc["RASI", "label"] == "S:RASI" and markers.loc["RASI", "marker_weight"] == 1e-6
+    hip = table[(table.kind == "pose") & (table.name == "hip_left")].iloc[0]
+    assert abs(hip.angle_rad) < 1e-4 and hip.lab_angle_rad == pytest.approx(0.045, abs=1e-15)
+    assert table[table.kind == "warning"].name.tolist() == ["stature"]  # 1.85 m where 1.5 m is given
+    assert table[table.kind == "subject"][["mass_kg", "height_m"]].values.tolist() == [[80.0, 1.5]]
+    bodies = table[table.kind == "body"].set_index("name")
+    assert bodies.loc["pelvis", "scale_factor_y"] == 1.1 and bodies.loc["thigh_l", "scale_factor_y"] == 1.0
+
+
+def test_placement_without_scaling_takes_the_generic_markers_as_the_ones_placed(standing):
+    from loper_analysis.motion.model_settings import ModelSettings
+    from loper_analysis.motion.scale_report import scale_run_report
+
+    model, moved, pose = standing
+    weights = {m: 1e-6 if m == "RASI" else 1.0 for m in pose.labels}
+    subject = (80.0, 1.85, "mass: given; height: given", 1.85)
+    window = (pose.time_s[0], pose.time_s[-1])
+    placed = scale_run_report(_run(model, None, (weights, {}), window), moved, pose, subject, ModelSettings())
+    fits = placed[placed.kind == "markers"].set_index("name")
+    assert list(fits.index) == ["before placement", "after placement"]
+    np.testing.assert_allclose(fits.loc["before placement", "marker_error_max_m"], 0.02, atol=1e-4)  # the generic
+    assert fits.loc["before placement", "worst_marker"] == "RASI"
+    scaled_only = scale_run_report(_run(model, None, None, window), moved, pose, subject, ModelSettings())
+    assert scaled_only[scaled_only.kind == "markers"].name.tolist() == ["after scaling"]

@@ -95,6 +95,13 @@ def test_a_trial_is_the_onset_s_within_the_tolerance_of_its_median_onset(pilot):
     assert pilot_onset_series([pilot], m + 13.0, MATCHED) is None
     assert pilot_perturbed_pairs([pilot], m + 13.0, MATCHED) is None
     assert pilot_onset_series([pilot], m + 13.0, MATCHED, onset_tolerance_ms=14.0) is not None
+    # the pairs take the series' options: the wider tolerance gives the same pairs as at the trial's own onset
+    wider = pilot_perturbed_pairs([pilot], m + 13.0, MATCHED, onset_tolerance_ms=14.0, source="wider")
+    own = pilot_perturbed_pairs([pilot], m, MATCHED)
+    assert int(wider["n_pairs"]) == int(own["n_pairs"]) > 0
+    np.testing.assert_array_equal(wider["q_perturbed"], own["q_perturbed"])
+    with pytest.raises(TypeError, match="onset_tolerance"):
+        pilot_perturbed_pairs([pilot], m, MATCHED, onset_tolerance=14.0)
 
 
 def test_a_trial_without_onset_columns_is_passed_over(pilot):

@@ -17,7 +17,7 @@ from loper_analysis.motion.model import (
 from loper_analysis.steps.model import (
     ModelSettings,
     ScaleFiles,
-    scaled_model,
+    scale,
     segments_from_model_file,
 )
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
@@ -50,7 +50,7 @@ def taller_subject():
 def test_scale_tool_recovers_a_larger_subject(model_file, taller_subject, tmp_path):
     truth, t, X = taller_subject
     trc = _static_trc(tmp_path / "static.trc", t, X)
-    scaled_model(ScaleFiles(model_file, trc, tmp_path / "scaled.osim"), 80.0)
+    scale(ScaleFiles(model_file, trc, tmp_path / "scaled.osim"), 80.0)
     p = segment_parameters_from_model(read_model(tmp_path / "scaled.osim"))
     q = segment_parameters_from_model(truth)
     np.testing.assert_allclose(p.mass_kg, q.mass_kg, rtol=1e-9)
@@ -64,12 +64,12 @@ def test_scale_tool_recovers_a_larger_subject(model_file, taller_subject, tmp_pa
 def test_static_trial_with_gaps_scales_as_the_complete_one(model_file, taller_subject, tmp_path):
     _, t, X = taller_subject
     full = _static_trc(tmp_path / "full.trc", t, X)
-    scaled_model(ScaleFiles(model_file, full, tmp_path / "full.osim"), 80.0)
+    scale(ScaleFiles(model_file, full, tmp_path / "full.osim"), 80.0)
     Xg = X.copy()
     Xg[:10, list(MARKERS).index("LKNE")] = np.nan  # hidden while the subject settles
     Xg[7, list(MARKERS).index("RMT1")] = np.nan
     gappy = _static_trc(tmp_path / "gappy.trc", t, Xg)
-    scaled_model(ScaleFiles(model_file, gappy, tmp_path / "gappy.osim"), 80.0)
+    scale(ScaleFiles(model_file, gappy, tmp_path / "gappy.osim"), 80.0)
     p = segment_parameters_from_model(read_model(tmp_path / "gappy.osim"))
     q = segment_parameters_from_model(read_model(tmp_path / "full.osim"))
     np.testing.assert_allclose(p.packed, q.packed, rtol=1e-12)  # the markers stand still: their mean is their place
@@ -85,7 +85,7 @@ def test_static_trial_without_a_measurement_marker_in_its_window_is_refused(mode
         match=r"gappy\.trc: marker\(s\) 'LKNE' missing in every frame of the scaling "
         r"window 0\.0000 \.\. 0\.1484 s \(20 frames\)",
     ):
-        scaled_model(ScaleFiles(model_file, gappy, tmp_path / "never.osim"), 80.0)
+        scale(ScaleFiles(model_file, gappy, tmp_path / "never.osim"), 80.0)
     assert not (tmp_path / "never.osim").exists()
 
 

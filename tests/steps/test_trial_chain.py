@@ -58,7 +58,7 @@ def lab(tmp_path_factory):
     marker_steps.markers(d / "static.c3d", d / "static.trc", settings=MarkerSettings(duration_s=1.0))
     gaps = marker_steps.markers(d / "walk.c3d", d / "walk.trc", d / "walk.gaps.tsv")
     model.generic_model(d / "generic.osim", HEIGHT, MASS)
-    model.scaled_model(model.ScaleFiles(d / "generic.osim", d / "static.trc", d / "scaled.osim"), MASS)
+    model.scale(model.ScaleFiles(d / "generic.osim", d / "static.trc", d / "scaled.osim"), MASS)
     for c in range(2):
         ik.ik_chunk(d / "scaled.osim", d / "walk.trc", d / f"walk.{c}.mot", c, 2)
     angles = ik.ik_join([d / "walk.0.mot", d / "walk.1.mot"], d / "walk.mot", d / "walk.angles.tsv")

@@ -28,6 +28,7 @@ import pandas as pd
 
 from loper_analysis.constants import JOINTS, SIDES
 from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.model_settings import ModelSettings
 
 __all__ = [
     "MAX_NEIGHBOUR_FACTOR_RATIO",
@@ -41,6 +42,7 @@ __all__ = [
     "neighbour_factor_warnings",
     "jointed_bodies",
     "scale_report",
+    "scale_run_report",
     "scaled_model_report",
     "static_fit",
     "static_pose_warnings",
@@ -392,4 +394,61 @@ def scaled_model_report(
         lab_labels=lab_labels,
         lab_angles_rad=lab_static,
         warnings=warnings,
+    )
+
+
+def scale_run_report(
+    run,
+    generic,
+    pose,
+    subject: tuple[float, float, str, float],
+    settings: ModelSettings,
+    *,
+    lab_labels: Mapping[str, str] | None = None,
+    lab_angles: pd.DataFrame | None = None,
+) -> pd.DataFrame:
+    """The scale report (:func:`scaled_model_report`) of one run of OpenSim's ScaleTool.
+
+    Parameters
+    ----------
+    run : loper_analysis.io.scale_tool.ScaleToolRun
+        What the tool wrote: the final model, the model before marker placement, the scale factors, the marker
+        placer's tasks and the window (s).
+    generic : opensim.Model
+        The generic model: the markers placed when the placer ran without scaling.
+    pose : loper_analysis.motion.static_trial.StaticPose
+        The scaling window.
+    subject : (float, float, str, float)
+        Mass (kg), height (m), where they came from, the model's stature (m)
+        (:func:`loper_analysis.motion.scaling.scaled_subject`).
+    settings : ModelSettings
+        ``coordinate_map`` and ``accuracy`` of the static pose's IK.
+    lab_labels : mapping, optional
+        Model marker -> the lab's label.
+    lab_angles : pandas.DataFrame, optional
+        The lab's own joint angles of the static trial (``time_s`` and ``*_rad`` columns), averaged over the
+        run's window (:func:`loper_analysis.motion.lab_angles.window_means`).
+
+    Returns
+    -------
+    pandas.DataFrame
+        :func:`scaled_model_report`'s table, its warnings as rows of kind ``warning``.
+    """
+    from loper_analysis.motion.lab_angles import window_means
+
+    unplaced = run.unplaced
+    if unplaced is None and run.tasks is not None:
+        unplaced = generic  # placement without scaling: the generic markers are the ones placed
+    lab_static = None if lab_angles is None else window_means(lab_angles, run.window_s)
+    return scaled_model_report(
+        run.scaled,
+        unplaced,
+        pose,
+        (run.factors, run.tasks),
+        subject[:3],
+        coordinate_map=settings.coordinate_map,
+        accuracy=settings.accuracy,
+        lab_labels=lab_labels,
+        lab_static=lab_static,
+        model_height_m=subject[3],
     )

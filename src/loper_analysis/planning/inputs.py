@@ -21,6 +21,7 @@ import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -134,23 +135,14 @@ def pilot_onset_series(
     return series
 
 
-def pilot_perturbed_pairs(
-    trials: Sequence[Mapping],
-    onset_ms: float,
-    response=None,
-    *,
-    side: str = PERTURBED_SIDE,
-    onset_tolerance_ms: float = 12.5,
-    source: str = "pilot",
-) -> dict | None:
+def pilot_perturbed_pairs(trials: Sequence[Mapping], onset_ms: float, response=None, **options: Any) -> dict | None:
     """The pilot's kept perturbed pairs at ``onset_ms`` one by one (format of ``null_pairs``), or None.
 
-    ``series["pairs"]`` of :func:`pilot_onset_series` (same arguments); None
-    when no trial is the onset's or no pair is kept.
+    ``series["pairs"]`` of :func:`pilot_onset_series`, which takes ``trials``, ``onset_ms``, ``response``
+    and the keyword ``options`` (``side``, ``onset_tolerance_ms``, ``source``); None when no trial is the
+    onset's or no pair is kept.
     """
-    series = pilot_onset_series(
-        trials, onset_ms, response, side=side, onset_tolerance_ms=onset_tolerance_ms, source=source
-    )
+    series = pilot_onset_series(trials, onset_ms, response, **options)
     if series is None:
         return None
     pairs = series["pairs"]
