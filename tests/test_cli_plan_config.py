@@ -8,7 +8,6 @@ the rule ``planning`` (in ``workflow/rules/inputs.smk``) and the command call.
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import re
 from pathlib import Path
@@ -18,8 +17,7 @@ import pytest
 import yaml
 
 from loper_analysis.cli import _plan_pilot, _plan_settings, _read_config, command_parser, main
-from loper_analysis.config_file import find_schema, load_config, update_config
-from loper_analysis.errors import LoperInputError
+from loper_analysis.config_file import load_config
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.steps.planning import PlanningSettings
 
@@ -44,66 +42,6 @@ def second(project) -> Path:
         project / "config" / "mine.yaml",
         {"identification": {"window_after_s": WINDOW_AFTER_S}, "planning": {"strides": STRIDES}},
     )
-
-
-# --------------------------------------------------------------------------- load_config
-
-
-def test_later_file_updates_the_earlier_recursively(project, second):
-    base = yaml.safe_load(CONFIG.read_text())
-    config, used = load_config(["config/config.yaml", second])
-    assert used == ["config/config.yaml", "config/mine.yaml"]
-    assert config["identification"]["window_after_s"] == WINDOW_AFTER_S and config["planning"]["strides"] == STRIDES
-    # keys the second file does not name keep the first file's values, at every depth
-    assert config["identification"]["window_before_s"] == base["identification"]["window_before_s"]
-    assert config["planning"]["targets"] == base["planning"]["targets"]
-    assert config["device"] == base["device"]
-    # overrides come last; the default file is config/config.yaml of the working directory
-    config, used = load_config(overrides={"planning": {"pulse_force_n": 55.0}})
-    assert used == ["config/config.yaml"] and config["planning"]["pulse_force_n"] == 55.0
-    assert config["planning"]["strides"] == base["planning"]["strides"]
-
-
-def test_update_is_snakemakes():
-    snakemake_utils = pytest.importorskip("snakemake.utils")
-    base = {"a": {"b": 1, "c": [1, 2], "d": None}, "e": 2, "f": {"g": 1}}
-    for over in ({"a": {"c": [3]}}, {"a": {"d": {"x": 1}}}, {"f": 5}, {"e": {"h": {"i": 1}}}, {"a": {}}, {}):
-        ours, theirs = copy.deepcopy(base), copy.deepcopy(base)
-        update_config(ours, over)
-        snakemake_utils.update_config(theirs, over)
-        assert ours == theirs, over
-
-
-def test_bad_key_in_the_second_file_is_named_with_that_file(project):
-    bad = _write(project / "second.yaml", {"planning": {"stridez": [3]}})
-    with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'planning\.stridez': Additional properties"):
-        load_config(["config/config.yaml", bad])
-    bad = _write(project / "second.yaml", {"identification": {"window_after_s": -0.1}})
-    with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'identification\.window_after_s': -0\.1 is "):
-        load_config(["config/config.yaml", bad])
-    # a value the first file sets is named with the first file
-    (project / "config" / "config.yaml").write_text(CONFIG.read_text().replace("n_starts: 10 ", "n_starts: ten "))
-    with pytest.raises(LoperInputError, match=r"^config/config\.yaml: key 'identification\.n_starts': 'ten'"):
-        load_config(["config/config.yaml", _write(project / "ok.yaml", {"seed": 1})])
-
-
-def test_yaml_syntax_error_names_the_file_and_line(project):
-    (project / "broken.yaml").write_text("planning:\n  strides: [10, 20\n  pulse_force_n: 40\n")
-    with pytest.raises(LoperInputError, match=r"broken\.yaml: line \d+, column \d+: YAML syntax error"):
-        load_config(["config/config.yaml", "broken.yaml"])
-
-
-def test_schema_of_the_config_files_project_wins(project, tmp_path_factory):
-    other = tmp_path_factory.mktemp("other")
-    (other / "config").mkdir()
-    (other / "workflow" / "schemas").mkdir(parents=True)
-    _write(other / "workflow" / "schemas" / "config.schema.yaml", {"type": "object", "required": ["only_key"]})
-    path = _write(other / "config" / "config.yaml", {"seed": 1})
-    assert find_schema([path]) == other / "workflow" / "schemas" / "config.schema.yaml"
-    with pytest.raises(LoperInputError, match=r"config\.yaml: key '\(top level\)': 'only_key' is a required"):
-        load_config([path])
-    # no project folder beside the file: the working directory's
-    assert find_schema([other / "loose.yaml"]) == project / "workflow" / "schemas" / "config.schema.yaml"
 
 
 # --------------------------------------------------------------------------- one mapping for the rule and the command

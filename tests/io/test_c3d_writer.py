@@ -1,8 +1,10 @@
-"""C3D files as a motion-capture system exports them (io/c3d_writer.py extras): first frame, force platforms,
-per-channel SCALE/OFFSET and events, read back by ezc3d (in a child process) and by OpenSim where it can."""
+"""io/c3d_writer.py: markers and analog channels read back by ezc3d and by the project's reader; and C3D files as a
+motion-capture system exports them (the extras): first frame, force platforms, per-channel SCALE/OFFSET and
+events, read back by ezc3d (in a child process) and by OpenSim where it can."""
 
 import hashlib
 import json
+import re
 import subprocess
 import sys
 
@@ -12,7 +14,7 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
-from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
+from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d, write_recording
 from loper_analysis.synthetic.force_plates import plate_channels, plate_load
 
 RATE, RATIO = 100.0, 10
@@ -221,3 +223,81 @@ def test_platform_from_mapping_equals_dataclass():
         "CAL_MATRIX": CAL,
     }
     assert ForcePlatform.from_mapping(mapping) == PLATE_4
+
+
+# --------------------------------------------------------------------------- markers and analogs
+
+
+def _markers(n_frames: int = 6) -> np.ndarray:
+    """(n, 2, 3) m: known positions, marker 1 missing in frames 2-3."""
+    k = np.arange(n_frames)[:, None, None]
+    X = np.array([[0.1, 0.2, 0.9], [-0.35, 1.25, 0.05]])[None] + 0.01 * k * np.array([1.0, -2.0, 0.5])
+    X[2:4, 1] = np.nan
+    return X
+
+
+def test_markers_and_analogs_read_back_by_ezc3d_in_the_file_units(tmp_path):
+    X = _markers()
+    A = np.column_stack([np.linspace(-500.0, 700.0, 24), 0.25 * np.arange(24)])
+    path = write_c3d(tmp_path / "a.c3d", ["RASI", "LHEE"], X, 50.0, ["Fz_left", "sync"], A, ["N", "V"], 200.0)
+    c = ezc3d.c3d(str(path))
+    P, AN = c["parameters"]["POINT"], c["parameters"]["ANALOG"]
+    assert list(P["LABELS"]["value"]) == ["RASI", "LHEE"] and list(P["UNITS"]["value"]) == ["mm"]
+    assert float(P["RATE"]["value"][0]) == 50.0 and float(AN["RATE"]["value"][0]) == 200.0
+    assert list(AN["LABELS"]["value"]) == ["Fz_left", "sync"] and list(AN["UNITS"]["value"]) == ["N", "V"]
+    points = np.transpose(c["data"]["points"][:3], (2, 1, 0))  # (frames, markers, xyz)
+    present = np.isfinite(X).all(axis=2)
+    np.testing.assert_allclose(points[present], 1000.0 * X[present], rtol=2e-7)  # mm, float32
+    assert np.isnan(points[~present]).all()  # residual -1: ezc3d reads the point as missing
+    np.testing.assert_array_equal(c["data"]["meta_points"]["residuals"][0] < 0, ~present.T)
+    np.testing.assert_allclose(c["data"]["analogs"][0].T, A, rtol=2e-7)
+
+
+def test_metre_files_hold_the_values_as_given(tmp_path):
+    X = _markers()
+    path = write_c3d(tmp_path / "m.c3d", ["RASI", "LHEE"], X, 50.0, point_unit="m")
+    c = ezc3d.c3d(str(path))
+    assert list(c["parameters"]["POINT"]["UNITS"]["value"]) == ["m"]
+    np.testing.assert_allclose(c["data"]["points"][:3, 0, :].T, X[:, 0], rtol=2e-7)
+    np.testing.assert_allclose(read_c3d(path).markers_m, X, rtol=2e-7)
+
+
+def test_write_recording_round_trips_a_read_file(tmp_path):
+    X = _markers()
+    A = np.column_stack([np.linspace(-5.0, 7.0, 12)])
+    first = write_c3d(tmp_path / "1.c3d", ["RASI", "LHEE"], X, 50.0, ["Fz"], A, ["N"], 100.0, first_frame=7)
+    rec = read_c3d(first)
+    again = read_c3d(write_recording(tmp_path / "2.c3d", rec))
+    assert (again.first_frame, again.marker_labels, again.analog_labels) == (7, ["RASI", "LHEE"], ["Fz"])
+    np.testing.assert_allclose(again.time_s, (7 + np.arange(6)) / 50.0, rtol=1e-12)
+    np.testing.assert_array_equal(again.markers_m, rec.markers_m)
+    np.testing.assert_array_equal(again.analogs, rec.analogs)
+    np.testing.assert_allclose(again.markers_m, X, rtol=2e-7)
+
+
+@pytest.mark.parametrize(
+    "labels, analog_rate_hz, analogs, message",
+    [
+        (["A", "A"], 100.0, np.zeros((12, 1)), "marker_labels duplicated: A"),
+        (["A"], 100.0, np.zeros((12, 1)), "marker_labels must name 2 item(s), got 1"),
+        (
+            ["A", "B"],
+            75.0,
+            np.zeros((9, 1)),
+            "mismatched analog/point rates: ANALOG:RATE = 75 Hz is not an integer multiple of POINT:RATE = 50 Hz "
+            "(ratio 1.5)",
+        ),
+        (
+            ["A", "B"],
+            100.0,
+            np.zeros((11, 1)),
+            "analogs must have shape (n_frames * samples per frame = 12, n_channels = 1), got (11, 1)",
+        ),
+        (["A", "B"], 100.0, np.full((12, 1), np.nan), "analogs[0, 0] = nan is not finite in float32"),
+    ],
+)
+def test_bad_markers_and_analogs_are_refused_and_leave_nothing(tmp_path, labels, analog_rate_hz, analogs, message):
+    path = tmp_path / "bad.c3d"
+    with pytest.raises(LoperInputError, match=re.escape(f"{path}: {message}")):
+        write_c3d(path, labels, _markers(), 50.0, ["Fz"], analogs, ["N"], analog_rate_hz)
+    assert list(tmp_path.iterdir()) == []

@@ -1,0 +1,25 @@
+"""io/marker_templates.py: the templates shipped in the package folder, each read as its YAML file says."""
+
+from __future__ import annotations
+
+import yaml
+
+from loper_analysis.io.marker_templates import TEMPLATE_DIR, read_templates, template_file
+from loper_analysis.motion.marker_templates import template_from_spec
+
+
+def test_every_yaml_file_is_one_template_by_its_stem():
+    templates = read_templates()
+    assert list(templates) == sorted(p.stem for p in TEMPLATE_DIR.glob("*.yaml")) == ["isb", "plugin_gait"]
+    for name, template in templates.items():
+        path = TEMPLATE_DIR / f"{name}.yaml"
+        assert template == template_from_spec(name, yaml.safe_load(path.read_text()), str(path))
+        assert template.name == name
+
+
+def test_each_templates_model_lies_beside_it():
+    for template in read_templates().values():
+        assert template.model == "gait2392_simbody.osim"
+        assert template_file(template.model) == TEMPLATE_DIR / "gait2392_simbody.osim"
+        assert template_file(template.model).is_file()
+    assert read_templates()["isb"].side_prefix == {"left": "L_", "right": "R_"}
