@@ -96,22 +96,3 @@ def test_the_failed_jobs_slurm_outputs_are_found_in_snakemakes_console_once_each
         "/w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log",
         "/w/.snakemake/slurm_logs/group_trial_ik_strides/6.log",
     ]
-
-
-def test_the_summary_names_job_reason_and_output_only_for_jobs_slurm_ended(tmp_path):
-    from loper_analysis.steps.cluster import slurm_failure_lines
-
-    logs = tmp_path / ".snakemake" / "slurm_logs"
-    (logs / "rule_synthetic_lab" / "S02").mkdir(parents=True)
-    (logs / "rule_synthetic_lab" / "S02" / "9.log").write_text("Building DAG of jobs...\n" + MEMORY_KILLED)
-    (logs / "rule_events_loadcell").mkdir()
-    (logs / "rule_events_loadcell" / "12.log").write_text("LoperInputError: data/raw/S01/pert050-1.loper.tsv\n")
-    console = tmp_path / "snakemake.log"
-    console.write_text(
-        CONSOLE.replace("/w/", f"{tmp_path}/")
-        + f"    log: {logs}/rule_events_loadcell/12.log (check log file(s) for error details)\n"
-    )
-    assert slurm_failure_lines(console) == [
-        f"SLURM job 9 (rule_synthetic_lab/S02): killed by SLURM for exceeding its memory: raise the rule's mem_mb "
-        f"under set-resources in the profile (SLURM's output: {logs}/rule_synthetic_lab/S02/9.log)"
-    ]
