@@ -6,6 +6,9 @@ import pytest
 
 from loper_analysis.cluster import check_slurm_submission, failed_slurm_logs, slurm_end_reason, submission_problems
 from loper_analysis.errors import LoperInputError
+from loper_analysis.layout import Paths
+
+PATHS = Paths()
 
 
 def test_nothing_stops_a_submission_to_known_partitions():
@@ -74,20 +77,22 @@ def test_why_slurm_ended_a_job_is_read_from_its_output(output, start):
     assert (reason is None) if start is None else reason.startswith(start)
 
 
-CONSOLE = """Job 0 has been submitted with SLURM jobid 9 (log: /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log).
+#: The rule logs the console names beside the SLURM outputs.
+LAB_LOG, IK_LOG = PATHS.log("synthetic_lab", "S02"), PATHS.log("ik", "S01/pert050-1")
+CONSOLE = f"""Job 0 has been submitted with SLURM jobid 9 (log: /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log).
 [Wed Nov 25 17:06:17 2026]
 Error in rule synthetic_lab:
     message: SLURM-job '9' failed, SLURM status is: 'FAILED'.
-    log: results/logs/synthetic_lab/S02.log, /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log \
+    log: {LAB_LOG}, /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log \
 (check log file(s) for error details)
 [Wed Nov 25 16:59:27 2026]
     message: Error in group trial
     log: /w/.snakemake/slurm_logs/group_trial_ik_strides/6.log (check log file(s) for error details)
     jobs:
         rule ik:
-            log: results/logs/ik/S01/pert050-1.log (check log file(s) for error details)
+            log: {IK_LOG} (check log file(s) for error details)
     Error in rule ik:
-        log: results/logs/ik/S01/pert050-1.log (check log file(s) for error details)
+        log: {IK_LOG} (check log file(s) for error details)
 """
 
 
