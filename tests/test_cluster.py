@@ -6,6 +6,9 @@ import pytest
 
 from loper_analysis.cluster import check_slurm_submission, failed_slurm_logs, slurm_end_reason, submission_problems
 from loper_analysis.errors import LoperInputError
+from loper_analysis.layout import Paths
+
+PATHS = Paths()
 
 
 def test_nothing_stops_a_submission_to_known_partitions():
@@ -74,20 +77,22 @@ def test_why_slurm_ended_a_job_is_read_from_its_output(output, start):
     assert (reason is None) if start is None else reason.startswith(start)
 
 
-CONSOLE = """Job 0 has been submitted with SLURM jobid 9 (log: /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log).
+#: The rule logs the console names beside the SLURM outputs.
+LAB_LOG, IK_LOG = PATHS.log("synthetic_lab", "S02"), PATHS.log("ik", "S01/pert050-1")
+CONSOLE = f"""Job 0 has been submitted with SLURM jobid 9 (log: /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log).
 [Wed Nov 25 17:06:17 2026]
 Error in rule synthetic_lab:
     message: SLURM-job '9' failed, SLURM status is: 'FAILED'.
-    log: results/logs/synthetic_lab/S02.log, /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log \
+    log: {LAB_LOG}, /w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log \
 (check log file(s) for error details)
 [Wed Nov 25 16:59:27 2026]
     message: Error in group trial
     log: /w/.snakemake/slurm_logs/group_trial_ik_strides/6.log (check log file(s) for error details)
     jobs:
         rule ik:
-            log: results/logs/ik/S01/pert050-1.log (check log file(s) for error details)
+            log: {IK_LOG} (check log file(s) for error details)
     Error in rule ik:
-        log: results/logs/ik/S01/pert050-1.log (check log file(s) for error details)
+        log: {IK_LOG} (check log file(s) for error details)
 """
 
 
@@ -95,23 +100,4 @@ def test_the_failed_jobs_slurm_outputs_are_found_in_snakemakes_console_once_each
     assert failed_slurm_logs(CONSOLE) == [
         "/w/.snakemake/slurm_logs/rule_synthetic_lab/S02/9.log",
         "/w/.snakemake/slurm_logs/group_trial_ik_strides/6.log",
-    ]
-
-
-def test_the_summary_names_job_reason_and_output_only_for_jobs_slurm_ended(tmp_path):
-    from loper_analysis.steps.cluster import slurm_failure_lines
-
-    logs = tmp_path / ".snakemake" / "slurm_logs"
-    (logs / "rule_synthetic_lab" / "S02").mkdir(parents=True)
-    (logs / "rule_synthetic_lab" / "S02" / "9.log").write_text("Building DAG of jobs...\n" + MEMORY_KILLED)
-    (logs / "rule_events_loadcell").mkdir()
-    (logs / "rule_events_loadcell" / "12.log").write_text("LoperInputError: data/raw/S01/pert050-1.loper.tsv\n")
-    console = tmp_path / "snakemake.log"
-    console.write_text(
-        CONSOLE.replace("/w/", f"{tmp_path}/")
-        + f"    log: {logs}/rule_events_loadcell/12.log (check log file(s) for error details)\n"
-    )
-    assert slurm_failure_lines(console) == [
-        f"SLURM job 9 (rule_synthetic_lab/S02): killed by SLURM for exceeding its memory: raise the rule's mem_mb "
-        f"under set-resources in the profile (SLURM's output: {logs}/rule_synthetic_lab/S02/9.log)"
     ]

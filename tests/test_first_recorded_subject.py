@@ -12,8 +12,11 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.layout import Paths, fill
 from tests.browser import report_screen
 from tests.workflow_copy import copy_workflow
+
+PATHS = Paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
@@ -90,7 +93,7 @@ def test_inspect_chooses_plug_in_gait_and_writes_what_the_doc_says(walkthrough):
 
 def test_the_scale_report_and_the_hand_run_agree_with_the_doc(walkthrough):
     work, _ = walkthrough
-    report = pd.read_csv(work / "results/model/QCMAS/scale.tsv", sep="\t")
+    report = pd.read_csv(work / fill(PATHS.model.scale, subject="QCMAS"), sep="\t")
     by_hand = pd.read_csv(work / "lab/QCMAS_scale.tsv", sep="\t")
     pd.testing.assert_frame_equal(report, by_hand)
     subject = report[report.kind == "subject"].iloc[0]
@@ -133,13 +136,14 @@ def test_the_scale_report_and_the_hand_run_agree_with_the_doc(walkthrough):
 
 def test_ik_events_and_the_summary_say_what_the_doc_says(walkthrough):
     work, _ = walkthrough
-    static = pd.read_csv(work / "results/markers/QCMAS/static.markers.tsv", sep="\t").iloc[0]
+    static = pd.read_csv(work / fill(PATHS.markers.summary, subject="QCMAS", trial="static"), sep="\t").iloc[0]
     assert static.turn_deg == 90.0
-    ik = pd.read_csv(work / "results/ik/QCMAS/walk-nodevice.ik.tsv", sep="\t").iloc[0]
+    ik = pd.read_csv(work / fill(PATHS.ik.summary, subject="QCMAS", trial="walk-nodevice"), sep="\t").iloc[0]
     assert (ik.n_frames, ik.n_frames_solved, ik.n_frames_left_out) == (216, 216, 0)
     assert round(1000 * ik.marker_rms_mean_m, 1) == 15.8 and ik.worst_marker == "LTHI"
     assert ik.worst_markers_mm == "LTHI 27.8, LKNE 24.3, RTHI 22.0"
-    agree = pd.read_csv(work / "results/ik/QCMAS/walk-nodevice.lab_agreement.tsv", sep="\t").set_index("angle")
+    agree = pd.read_csv(work / fill(PATHS.ik.agreement, subject="QCMAS", trial="walk-nodevice"), sep="\t")
+    agree = agree.set_index("angle")
     figures = {
         a: (round(agree.loc[a, "r"], 3), round(float(np.degrees(agree.loc[a, "rms_diff_rad"])), 1))
         for a in ("hip_left", "hip_right", "knee_left", "knee_right", "ankle_left", "ankle_right")
@@ -148,11 +152,11 @@ def test_ik_events_and_the_summary_say_what_the_doc_says(walkthrough):
         "hip_left": (0.991, 2.5), "hip_right": (0.994, 3.1), "knee_left": (0.998, 4.1),
         "knee_right": (0.997, 4.5), "ankle_left": (0.98, 1.8), "ankle_right": (0.985, 1.3),
     }  # fmt: skip
-    events = pd.read_csv(work / "results/events/QCMAS/walk-nodevice.events.tsv", sep="\t")
+    events = pd.read_csv(work / fill(PATHS.events.events, subject="QCMAS", trial="walk-nodevice"), sep="\t")
     hs = events[events.event == "heel_strike"].time_s.round(3).tolist()
     to = events[events.event == "toe_off"].time_s.round(3).tolist()
     assert hs == [2.461, 3.024, 3.543] and to == [3.183, 3.71, 4.246]
-    summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t").iloc[0]
+    summary = pd.read_csv(work / PATHS.strides.summary, sep="\t").iloc[0]
     assert (summary.subject, summary.status, summary.n_strides, summary.turn_deg) == (
         "QCMAS", "too_few_strides", 1, 270.0,
     )  # fmt: skip
@@ -160,19 +164,21 @@ def test_ik_events_and_the_summary_say_what_the_doc_says(walkthrough):
     assert (
         round(summary.lab_joints_min_r, 3) == 0.98 and round(np.degrees(summary.lab_joints_max_rms_diff_rad), 1) == 4.5
     )
-    assert not (work / "results/validation").exists() and not (work / "results/impedance").exists()
+    assert not (work / PATHS.validation.root).exists() and not (work / PATHS.impedance.root).exists()
 
 
 def test_the_report_shows_the_subject_in_a_browser(walkthrough, tmp_path):
     """The report's front page, opened in headless Chromium: the recorded subject's section and the table of its
     trials are drawn, both figures decode, and the numbers are the tables'."""
     work, _ = walkthrough
-    html = (work / "results/report.html").read_text(errors="replace")
+    html = (work / PATHS.results_dir / "report.html").read_text(errors="replace")
     assert len(html) > 100_000 and "QCMAS" in html
     screen = report_screen()
     if screen.chromium_path() is None:
         pytest.skip("no Chromium at /usr/bin/chromium (or $CHROMIUM): the report cannot be rendered")
-    measured = screen.first_screen(work / "results/report.html", tmp_path / "screen.png", ready_id="lf-trials")
+    measured = screen.first_screen(
+        work / PATHS.results_dir / "report.html", tmp_path / "screen.png", ready_id="lf-trials"
+    )
     boxes = measured["boxes"]
     assert boxes["lf-recorded"]["top"] < 900 and boxes["lf-trials"]["bottom"] > boxes["lf-trials"]["top"]
     assert sorted(alt for alt, width, height in measured["images"] if width > 0 and height > 0) == [
@@ -188,8 +194,8 @@ def test_every_clean_plate_contact_has_its_events_within_15_ms_of_the_plate_s_ow
     from loper_analysis.io.force_platforms import read_force_platforms
 
     work, _ = walkthrough
-    contacts = pd.read_csv(work / "results/events/QCMAS/walk-nodevice.contacts.tsv", sep="\t")
-    events = pd.read_csv(work / "results/events/QCMAS/walk-nodevice.events.tsv", sep="\t")
+    contacts = pd.read_csv(work / fill(PATHS.events.contacts, subject="QCMAS", trial="walk-nodevice"), sep="\t")
+    events = pd.read_csv(work / fill(PATHS.events.events, subject="QCMAS", trial="walk-nodevice"), sep="\t")
     plates = {p.number: p for p in read_force_platforms(ROOT / "tests/data/c3d-parser/QCMAS/walk-nodevice.c3d")}
     clean = contacts[contacts.flag == "ok"]
     assert len(clean) == 3

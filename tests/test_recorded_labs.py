@@ -23,6 +23,7 @@ import yaml
 
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
+from loper_analysis.layout import Paths, fill
 from loper_analysis.motion.markers import rotate_markers
 from loper_analysis.steps.markers import MarkerSettings
 from tests.rajagopal_lab import (
@@ -39,6 +40,8 @@ from tests.rajagopal_lab import (
     write_lab_files,
 )
 from tests.workflow_copy import copy_workflow, snakemake
+
+PATHS = Paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
@@ -87,10 +90,10 @@ def rajagopal(tmp_path_factory):
     res = _run(
         work,
         [
-            "results/strides/summary.tsv",
-            "results/model/R11/scale.tsv",
-            "results/grf/R11/walk-nodevice.grf.mot",
-            "results/model/R11/segments.tsv",
+            PATHS.strides.summary,
+            fill(PATHS.model.scale, subject="R11"),
+            fill(PATHS.grf.mot, subject="R11", trial="walk-nodevice"),
+            fill(PATHS.model.segments, subject="R11"),
         ],
     )
     assert res.returncode == 0, res.stderr[-3000:]
@@ -98,10 +101,11 @@ def rajagopal(tmp_path_factory):
 
 
 def test_scaled_model_is_opensims_scale_tool(rajagopal, tmp_path):
-    ours = read_model(rajagopal / "results/model/R11/scaled.osim")
+    ours = read_model(rajagopal / fill(PATHS.model.scaled, subject="R11"))
     # the workflow turned the static trial about the vertical to face +X (its pelvis markers): the same turn of
     # OpenSim's own static trial
-    turn = pd.read_csv(rajagopal / "results/markers/R11/static.markers.tsv", sep="\t").turn_deg.iloc[0]
+    turn = pd.read_csv(rajagopal / fill(PATHS.markers.summary, subject="R11", trial="static"), sep="\t")
+    turn = turn.turn_deg.iloc[0]
     assert turn == 90.0
     t, X, labels = read_markers(STATIC_TRC)
     write_trc(tmp_path / "static.trc", t, rotate_markers(X, (0.0, turn, 0.0)), labels)
@@ -132,7 +136,7 @@ def test_scaled_model_is_opensims_scale_tool(rajagopal, tmp_path):
 
 
 def test_scale_report_gives_the_mass_from_the_plates(rajagopal):
-    report = pd.read_csv(rajagopal / "results/model/R11/scale.tsv", sep="\t")
+    report = pd.read_csv(rajagopal / fill(PATHS.model.scale, subject="R11"), sep="\t")
     subject = report[report.kind == "subject"].iloc[0]
     assert subject.mass_kg == pytest.approx(SUBJECT_MASS_KG, rel=1e-6)  # weight / Rajagopal2016's 9.80665 m/s²
     assert "force plates 1, 2 of static.c3d" in subject.source and "estimated" in subject.source
@@ -152,21 +156,23 @@ def test_angles_are_opensims_inverse_kinematics_tool(rajagopal, tmp_path):
     # by at most 0.03 deg
     setup = tmp_path / "ik_setup.xml"
     setup.write_text(IK_SETUP.read_text().replace("<accuracy>1e-05</accuracy>", "<accuracy>1e-06</accuracy>"))
-    peer = opensim_ik_reference(rajagopal / "results/model/R11/scaled.osim", setup, WALK_TRC, tmp_path / "peer.mot")
-    ours = read_mot(rajagopal / "results/ik/R11/walk-nodevice.mot")
+    peer = opensim_ik_reference(
+        rajagopal / fill(PATHS.model.scaled, subject="R11"), setup, WALK_TRC, tmp_path / "peer.mot"
+    )
+    ours = read_mot(rajagopal / fill(PATHS.ik.mot, subject="R11", trial="walk-nodevice"))
     assert len(ours) == len(peer) == 238
     np.testing.assert_allclose(ours["time_s"], peer["time_s"], atol=1e-9)
     for name in BODY_COORDINATES:
         scale = 1.0 if name.endswith(("_tx", "_ty", "_tz")) else np.degrees(1.0)  # deg, or m
         rms = np.sqrt(np.mean((scale * (ours[name] - peer[name])) ** 2))
         assert rms < (0.1 if scale != 1.0 else 2e-4), (name, rms)
-    angles = pd.read_csv(rajagopal / "results/ik/R11/walk-nodevice.angles.tsv", sep="\t")
+    angles = pd.read_csv(rajagopal / fill(PATHS.ik.angles, subject="R11", trial="walk-nodevice"), sep="\t")
     np.testing.assert_allclose(angles["knee_left_rad"], ours["knee_angle_l"], rtol=0, atol=1e-8)  # flexion positive
 
 
 def test_events_are_the_plate_contacts(rajagopal):
     mot = read_mot(GRF_MOT)
-    events = pd.read_csv(rajagopal / "results/events/R11/walk-nodevice.events.tsv", sep="\t")
+    events = pd.read_csv(rajagopal / fill(PATHS.events.events, subject="R11", trial="walk-nodevice"), sep="\t")
     for side, s in (("right", "r"), ("left", "l")):
         t, fz = mot["time_s"].to_numpy(), mot[f"ground_force_{s}_vy"].to_numpy()
         strikes = t[1:][(fz[1:] >= 50.0) & (fz[:-1] < 50.0)]
@@ -175,12 +181,12 @@ def test_events_are_the_plate_contacts(rajagopal):
             ours = events[(events.side == side) & (events.event == kind)]["time_s"].to_numpy()
             assert len(ours) == len(expected) > 0, (side, kind)
             assert np.abs(ours - expected).max() <= 1 / 2000 + 1e-9, (side, kind)  # within one analog sample
-    contacts = pd.read_csv(rajagopal / "results/events/R11/walk-nodevice.contacts.tsv", sep="\t")
+    contacts = pd.read_csv(rajagopal / fill(PATHS.events.contacts, subject="R11", trial="walk-nodevice"), sep="\t")
     assert contacts["flag"].tolist() == ["ok"] * 3 and contacts["side"].tolist() == ["right", "left", "right"]
 
 
 def test_the_trial_summary_flags_the_stride_short_trial(rajagopal):
-    summary = pd.read_csv(rajagopal / "results/strides/summary.tsv", sep="\t")
+    summary = pd.read_csv(rajagopal / PATHS.strides.summary, sep="\t")
     row = summary.iloc[0]
     assert (row.subject, row.trial, row.n_strides, row.status) == ("R11", "walk-nodevice", 0, "too_few_strides")
     assert (row.n_frames, row.n_frames_left_out, row.turn_deg) == (238, 0, 0.0)  # walks +X already
@@ -201,25 +207,26 @@ def walking5(tmp_path_factory):
     )
     (work / "data/raw/W05").mkdir(parents=True)
     shutil.copy(WALKING5, work / "data/raw/W05/walk-nodevice.c3d")
-    res = _run(work, ["results/strides/summary.tsv", "results/grf/W05/walk-nodevice.grf.mot"])
+    res = _run(work, [PATHS.strides.summary, fill(PATHS.grf.mot, subject="W05", trial="walk-nodevice")])
     assert res.returncode == 0, res.stderr[-3000:]
     return work
 
 
 def test_walking5_frames_without_markers_are_left_out(walking5):
-    ik = pd.read_csv(walking5 / "results/ik/W05/walk-nodevice.ik.tsv", sep="\t").iloc[0]
-    markers = pd.read_csv(walking5 / "results/markers/W05/walk-nodevice.markers.tsv", sep="\t")
+    ik = pd.read_csv(walking5 / fill(PATHS.ik.summary, subject="W05", trial="walk-nodevice"), sep="\t").iloc[0]
+    markers = pd.read_csv(walking5 / fill(PATHS.markers.summary, subject="W05", trial="walk-nodevice"), sep="\t")
     assert markers["n_frames_too_few_markers"].iloc[0] == 153  # frames 0-134 and 1085-1102 (57 without any)
     assert ik.n_frames == 1103 and ik.n_frames_left_out >= 153  # and those without 3 pelvis markers
-    angles = pd.read_csv(walking5 / "results/ik/W05/walk-nodevice.angles.tsv", sep="\t")
+    angles = pd.read_csv(walking5 / fill(PATHS.ik.angles, subject="W05", trial="walk-nodevice"), sep="\t")
     assert np.isnan(angles["hip_left_rad"].to_numpy()[:135]).all()
     assert angles["time_s"].iloc[0] == 0.0 and len(angles) == 1103
 
 
 def test_walking5_is_turned_to_walk_forward_and_its_angles_are_a_walkers(walking5):
-    markers = pd.read_csv(walking5 / "results/markers/W05/walk-nodevice.markers.tsv", sep="\t").iloc[0]
+    markers = pd.read_csv(walking5 / fill(PATHS.markers.summary, subject="W05", trial="walk-nodevice"), sep="\t")
+    markers = markers.iloc[0]
     assert markers.turn_deg == 180.0 and markers.heading_deg == pytest.approx(182.37, abs=0.01)
-    angles = pd.read_csv(walking5 / "results/ik/W05/walk-nodevice.angles.tsv", sep="\t")
+    angles = pd.read_csv(walking5 / fill(PATHS.ik.angles, subject="W05", trial="walk-nodevice"), sep="\t")
     hip, knee = np.degrees(angles["hip_left_rad"]), np.degrees(angles["knee_left_rad"])
     assert 30.0 < np.nanmax(hip) - np.nanmin(hip) < 60.0  # hip flexion range (measured 56.6 deg)
     assert 50.0 < np.nanmax(knee) < 75.0  # knee flexion peak in swing (measured 68.7 deg)
@@ -228,7 +235,7 @@ def test_walking5_is_turned_to_walk_forward_and_its_angles_are_a_walkers(walking
 
 
 def test_walking5_summary_flags_too_few_strides(walking5):
-    summary = pd.read_csv(walking5 / "results/strides/summary.tsv", sep="\t").iloc[0]
+    summary = pd.read_csv(walking5 / PATHS.strides.summary, sep="\t").iloc[0]
     assert (summary.subject, summary.n_strides, summary.status) == ("W05", 0, "too_few_strides")
     assert summary.n_contacts_flagged == 1  # plate 1: the left heel lands behind it (off_plate)
     assert summary.turn_deg == 180.0 and summary.n_frames_left_out > 150

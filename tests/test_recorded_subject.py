@@ -24,9 +24,12 @@ from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
 from loper_analysis.io.segment_table import read_segments
+from loper_analysis.layout import Paths, fill
 from loper_analysis.motion.segments import segments_from_model
 from tests.lab_export_session import LabExportFiles, LabExportSettings, lab_export_session
 from tests.workflow_copy import copy_workflow, snakemake
+
+PATHS = Paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
@@ -35,7 +38,7 @@ GENERIC = EXAMPLE / "gait2392_simbody.osim"
 MASS_KG = 75.1646  # gait2392's own mass: the scaled model keeps its masses
 FIRST_TIME_S = 1000 / 128.0
 TRUE_IMPEDANCE = {"hip": (55.0, 3.5), "knee": (3.0, 0.1), "ankle": (8.0, 0.3)}  # K (N·m/rad), D (N·m·s/rad)
-TARGETS = ("results/impedance/impedance.tsv", "results/strides/summary.tsv", "results/grf/R01/pert050-1.grf.mot")
+TARGETS = (PATHS.impedance.table, PATHS.strides.summary, fill(PATHS.grf.mot, subject="R01", trial="pert050-1"))
 
 
 def _test_config() -> dict:
@@ -85,7 +88,7 @@ def test_the_raw_files_are_a_labs(lab_run):
 
 def test_segment_table_comes_from_the_scaled_gait2392(lab_run):
     work, _ = lab_run
-    table = read_segments(work / "results/model/R01/segments.tsv")
+    table = read_segments(work / fill(PATHS.model.segments, subject="R01"))
     generic = segments_from_model(read_model(GENERIC), "l", attachment_fraction=0.8)
     np.testing.assert_allclose(table.mass_kg, generic.mass_kg, rtol=1e-9)  # the subject's mass is gait2392's
     np.testing.assert_allclose(table.cart_mass_kg, generic.cart_mass_kg, rtol=1e-9)
@@ -96,7 +99,7 @@ def test_segment_table_comes_from_the_scaled_gait2392(lab_run):
 
 def test_angles_keep_the_files_clock_and_match_the_simulation(lab_run):
     work, truth = lab_run
-    angles = pd.read_csv(work / "results/ik/R01/pert050-1.angles.tsv", sep="\t")
+    angles = pd.read_csv(work / fill(PATHS.ik.angles, subject="R01", trial="pert050-1"), sep="\t")
     assert angles["time_s"].iloc[0] == FIRST_TIME_S
     coordinates = truth["pert050-1"][1].coordinates
     for ours, theirs, sign in (
@@ -113,23 +116,23 @@ def test_events_from_the_plates_match_the_true_gait_events(lab_run):
     work, truth = lab_run
     for trial in ("walk-device", "pert050-1"):
         true = truth[trial][0].mocap_events()
-        events = pd.read_csv(work / f"results/events/R01/{trial}.events.tsv", sep="\t")
+        events = pd.read_csv(work / fill(PATHS.events.events, subject="R01", trial=trial), sep="\t")
         plain = events[events.event.isin(["heel_strike", "toe_off"])]
         for (side, kind), ours in plain.groupby(["side", "event"]):
             expected = true[(true.side == side) & (true.event == kind)]["time_s"].to_numpy() + FIRST_TIME_S
             gaps_ms = [1e3 * np.min(np.abs(expected - t)) for t in ours["time_s"]]
             assert max(gaps_ms) < 5.0, (trial, side, kind)  # measured at most 0.97 ms (1 sample at 1024 Hz)
             assert len(ours) >= len(expected) - 1, (trial, side, kind)  # the first contact is cut by the start
-        contacts = pd.read_csv(work / f"results/events/R01/{trial}.contacts.tsv", sep="\t")
+        contacts = pd.read_csv(work / fill(PATHS.events.contacts, subject="R01", trial=trial), sep="\t")
         clean = contacts[contacts.flag == "ok"]
         assert (clean["side"] == clean["plate"].map({1: "left", 2: "right"})).all()
-    summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t")
+    summary = pd.read_csv(work / PATHS.strides.summary, sep="\t")
     assert summary["n_contacts_flagged"].tolist() == [0, 0] and (summary["status"] == "ok").all()
 
 
 def test_ground_reaction_mot_holds_the_belt_force_in_the_model_frame(lab_run):
     work, truth = lab_run
-    mot = read_mot(work / "results/grf/R01/pert050-1.grf.mot")
+    mot = read_mot(work / fill(PATHS.grf.mot, subject="R01", trial="pert050-1"))
     force = truth["pert050-1"][1].force_n["left"]  # on the body, lab frame (Z up), N
     loaded = mot["1_ground_force_vy"].to_numpy() != 0.0
     assert loaded.mean() > 0.3
@@ -140,7 +143,7 @@ def test_ground_reaction_mot_holds_the_belt_force_in_the_model_frame(lab_run):
 
 def test_impedance_table_recovers_the_true_impedance(lab_run):
     work, _ = lab_run
-    table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t").set_index("joint")
+    table = pd.read_csv(work / PATHS.impedance.table, sep="\t").set_index("joint")
     assert table.loc["ankle", "status"] == "ok", table["reason"]
     # six strides: the hip's K interval is informative, its D interval (1.83 ... 4.84) wider than the study's
     # whole hip D range (1.9-4.6): the data cannot place the hip's damping within it

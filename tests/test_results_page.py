@@ -9,6 +9,10 @@ from pathlib import Path
 
 import pytest
 
+from loper_analysis.layout import Paths
+
+PATHS = Paths()
+
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("results_page", ROOT / "benchmarks" / "results_page.py")
 results_page = importlib.util.module_from_spec(_spec)
@@ -175,15 +179,15 @@ def run(tmp_path, monkeypatch):
     files = {
         "config/config.yaml": CONFIG,
         "config/subjects.tsv": SUBJECTS,
-        "results/impedance/impedance.tsv": impedance_tsv(),
-        "results/impedance/summary.tsv": SUMMARY,
-        "results/validation/summary.tsv": VALIDATION,
-        "results/validation/fits.tsv": FITS_TSV,
-        "results/transparency/rmsd.tsv": RMSD,
-        "results/transparency/force.tsv": FORCE,
-        "results/device/summary.tsv": DEVICE,
-        "results/strides/summary.tsv": STRIDES,
-        "results/planning/answers.txt": ANSWERS,
+        PATHS.impedance.table: impedance_tsv(),
+        PATHS.impedance.summary: SUMMARY,
+        PATHS.validation.summary: VALIDATION,
+        PATHS.validation.fits: FITS_TSV,
+        PATHS.transparency.rmsd: RMSD,
+        PATHS.transparency.force: FORCE,
+        PATHS.device.summary: DEVICE,
+        PATHS.strides.summary: STRIDES,
+        PATHS.planning.answers: ANSWERS,
     }
     for name, text in files.items():
         (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
@@ -255,7 +259,7 @@ def test_the_parts_hold_the_run_and_the_rest_is_kept_byte_for_byte(run, capsys):
     assert results_page.main(["--page", "results.md"]) == 0
     assert (run / "results.md").read_bytes().decode("utf-8") == text
     assert results_page.main(["--page", "results.md", "--check"]) == 0
-    (run / "results/device/summary.tsv").write_text(DEVICE.replace("41.234", "40.111"))
+    (run / PATHS.device.summary).write_text(DEVICE.replace("41.234", "40.111"))
     assert results_page.main(["--page", "results.md", "--check"]) == 1
     assert (run / "results.md").read_bytes().decode("utf-8") == text
     assert results_page.main(["--page", "results.md"]) == 0
@@ -263,11 +267,11 @@ def test_the_parts_hold_the_run_and_the_rest_is_kept_byte_for_byte(run, capsys):
 
 
 def test_a_part_without_its_table_and_extra_config_files(run):
-    (run / "results/device/summary.tsv").unlink()
+    (run / PATHS.device.summary).unlink()
     (run / "config/paper.yaml").write_text("synthetic: {walking_duration_s: 240.0}\n")
     assert results_page.main(["--page", "results.md", "--configfile", "config/paper.yaml"]) == 0
     text = (run / "results.md").read_text(encoding="utf-8")
-    assert part(text, "device").strip() == "*Not in this run: no `results/device/summary.tsv`.*"
+    assert part(text, "device").strip() == f"*Not in this run: no `{PATHS.device.summary}`.*"
     stamp = part(text, "run")
     assert "`snakemake -j2 --configfile config/paper.yaml`" in stamp
     assert "`python benchmarks/results_page.py --configfile config/paper.yaml`" in stamp

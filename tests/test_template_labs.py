@@ -15,8 +15,11 @@ import pandas as pd
 import pytest
 
 from loper_analysis.io.osim import quiet_opensim, read_model
+from loper_analysis.layout import Paths, fill
 from tests.rajagopal_lab import DATA, opensim_ik_reference
 from tests.workflow_copy import ROOT, copy_workflow, snakemake
+
+PATHS = Paths()
 
 pytestmark = pytest.mark.slow  # Snakemake and OpenSim on whole trials
 WALK_TRC = DATA / "Rajagopal_motion_capture_walk.trc"
@@ -66,14 +69,14 @@ def peer(tmp_path_factory):
 def test_the_isb_template_is_chosen_and_the_static_pose_is_upright(r11):
     work, printed = r11
     assert "chosen: isb" in printed and "isb          12 of 12 required" in printed
-    report = pd.read_csv(work / "results/model/R11/scale.tsv", sep="\t")
+    report = pd.read_csv(work / fill(PATHS.model.scale, subject="R11"), sep="\t")
     pose = report[report.kind == "pose"].set_index("name").angle_rad
     assert (np.degrees(pose.abs()) < 15).all() and (report.kind == "warning").sum() == 0
 
 
 def test_hip_knee_and_ankle_agree_with_opensim_s_own_inverse_kinematics(r11, peer):
     work, _ = r11
-    ours = pd.read_csv(work / "results/ik/R11/walk-nodevice.angles.tsv", sep="\t")
+    ours = pd.read_csv(work / fill(PATHS.ik.angles, subject="R11", trial="walk-nodevice"), sep="\t")
     assert len(ours) == len(peer) == 238
     np.testing.assert_allclose(ours["time_s"], peer["time_s"], atol=1e-9)
     for side, s in (("left", "l"), ("right", "r")):
@@ -123,16 +126,20 @@ def test_a_knee_alignment_device_gives_the_model_and_angles_of_the_knee_marker(t
     the same scale factors, static pose and walking angles."""
     plain = _clinical_run(tmp_path / "plain", kad=False)
     device = _clinical_run(tmp_path / "kad", kad=True)
-    a = pd.read_csv(plain / "results/model/QCMAS/scale.tsv", sep="\t")
-    b = pd.read_csv(device / "results/model/QCMAS/scale.tsv", sep="\t")
+    a = pd.read_csv(plain / fill(PATHS.model.scale, subject="QCMAS"), sep="\t")
+    b = pd.read_csv(device / fill(PATHS.model.scale, subject="QCMAS"), sep="\t")
     factors = [t[t.kind == "body"].set_index("name").scale_factor_x for t in (a, b)]
     np.testing.assert_allclose(factors[1], factors[0], rtol=1e-4)
     poses = [t[t.kind == "pose"].set_index("name").angle_rad for t in (a, b)]
     np.testing.assert_allclose(poses[1], poses[0], atol=np.radians(0.05))
-    angles = [pd.read_csv(w / "results/ik/QCMAS/walk-nodevice.angles.tsv", sep="\t") for w in (plain, device)]
+    angles = [
+        pd.read_csv(w / fill(PATHS.ik.angles, subject="QCMAS", trial="walk-nodevice"), sep="\t")
+        for w in (plain, device)
+    ]
     for column in ("hip_left_rad", "knee_left_rad", "ankle_left_rad", "knee_right_rad"):
         np.testing.assert_allclose(angles[1][column], angles[0][column], atol=np.radians(0.05))
-    markers = pd.read_csv(device / "results/markers/QCMAS/static.markers.tsv", sep="\t").set_index("marker")
+    markers = pd.read_csv(device / fill(PATHS.markers.summary, subject="QCMAS", trial="static"), sep="\t")
+    markers = markers.set_index("marker")
     assert markers.loc["LKNE", "label"] == "LKNE (knee alignment device)"
 
 
@@ -154,7 +161,7 @@ def test_a_qtm_lab_with_its_own_labels_gets_its_known_angles_back(tmp_path):
     truth = lab_export_session(files, "Q01", ["walk-nodevice"], 1.80, 75.1646, settings)
     printed = inspect_and_run(work, "Q01", "Q01\trecorded\t75.1646", "subject\tsource\tmass_kg")
     assert "chosen: isb" in printed and "label map: none needed" in printed  # the labels are the template's
-    ours = pd.read_csv(work / "results/ik/Q01/walk-nodevice.angles.tsv", sep="\t")
+    ours = pd.read_csv(work / fill(PATHS.ik.angles, subject="Q01", trial="walk-nodevice"), sep="\t")
     known = truth["walk-nodevice"][1].coordinates
     np.testing.assert_allclose(ours["time_s"], known["time_s"], atol=1e-9)
     for side, s in (("left", "l"), ("right", "r")):

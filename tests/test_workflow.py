@@ -14,7 +14,10 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.layout import Paths, fill
 from tests.workflow_copy import snakemake
+
+PATHS = Paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]
@@ -59,7 +62,7 @@ def finished_run(tmp_path_factory) -> Path:
 
 
 def test_tiny_validation_recovers_truth(finished_run):
-    summary = pd.read_csv(finished_run / "results/validation/summary.tsv", sep="\t")
+    summary = pd.read_csv(finished_run / PATHS.validation.summary, sep="\t")
     assert list(summary.columns[:5]) == ["condition", "parameter", "min_error", "max_error", "sd_error"]
     assert len(summary) == 12
     clean = summary[summary.condition == "no_noise"].set_index("parameter")
@@ -67,11 +70,11 @@ def test_tiny_validation_recovers_truth(finished_run):
     d = [p for p in clean.index if p.startswith("D")]
     assert (clean.loc[k, "max_abs_error"] <= 0.05).all(), clean
     assert (clean.loc[d, "max_abs_error"] <= 0.005).all(), clean
-    errors = pd.read_csv(finished_run / "results/validation/errors.tsv", sep="\t")
+    errors = pd.read_csv(finished_run / PATHS.validation.errors, sep="\t")
     assert len(errors) == 64 * 2 * 6
     assert sorted(errors.combination.unique()) == list(range(64))
     np.testing.assert_allclose(errors.error, errors.estimate - errors.true, atol=1e-12)
-    fits = pd.read_csv(finished_run / "results/validation/fits.tsv", sep="\t")
+    fits = pd.read_csv(finished_run / PATHS.validation.fits, sep="\t")
     assert len(fits) == 128 and fits.success.all()
 
 
@@ -89,11 +92,11 @@ def test_rerun_does_nothing_and_report_builds(finished_run):
 def test_same_config_gives_same_bytes(finished_run, tmp_path):
     work = _project(tmp_path)
     raw = ["data/raw/S01/static.c3d", "data/raw/S01/walk-device.c3d", "data/raw/S01/walk-device.loper.tsv"]
-    res = _snakemake(work, "results/validation/summary.tsv", *raw)
+    res = _snakemake(work, PATHS.validation.summary, *raw)
     assert res.returncode == 0, res.stderr[-3000:]
     for name in ("errors.tsv", "fits.tsv", "summary.tsv"):
-        assert (work / "results/validation" / name).read_bytes() == (
-            finished_run / "results/validation" / name
+        assert (work / PATHS.validation.root / name).read_bytes() == (
+            finished_run / PATHS.validation.root / name
         ).read_bytes(), name
     for name in raw:
         assert (work / name).read_bytes() == (finished_run / name).read_bytes(), name
@@ -123,20 +126,21 @@ def test_impedance_table_from_the_default_run(finished_run):
     """One subject, one 25 s trial at the 50 ms onset: too few perturbations to fit, reported as failed."""
     from loper_analysis.identification.impedance import IMPEDANCE_COLUMNS
 
-    table = pd.read_csv(finished_run / "results/impedance/impedance.tsv", sep="\t")
+    table = pd.read_csv(finished_run / PATHS.impedance.table, sep="\t")
     assert list(table.columns) == list(IMPEDANCE_COLUMNS)
     assert list(table.joint) == ["hip", "knee", "ankle"] and (table.onset_ms == 50).all()
-    counts = pd.read_csv(finished_run / "results/impedance/S01/050.counts.tsv", sep="\t").set_index("trial")
+    counts = pd.read_csv(finished_run / fill(PATHS.impedance.counts, subject="S01", onset=50), sep="\t")
+    counts = counts.set_index("trial")
     # a pulse every 3-5 of ~14 strides: 3 perturbed, all matched and kept (too few for the IQR rule to judge)
     assert counts.loc["total", ["n_perturbed", "n_kept"]].tolist() == [3, 3]
     assert counts.loc["total", "status"] == "too_few_strides"
     assert (table.status == "failed").all() and table.reason.str.contains("3 valid perturbed stride").all()
     assert table.K_nm_per_rad.isna().all()
-    summary = pd.read_csv(finished_run / "results/impedance/summary.tsv", sep="\t")
+    summary = pd.read_csv(finished_run / PATHS.impedance.summary, sep="\t")
     assert len(summary) == 0 and list(summary.columns[:2]) == ["joint", "onset_ms"]  # nothing fitted
-    literature = pd.read_csv(finished_run / "results/impedance/literature.tsv", sep="\t")
+    literature = pd.read_csv(finished_run / PATHS.impedance.literature, sep="\t")
     assert len(literature) == 7 and literature.K_low_nm_per_rad.iloc[0] == 50.0
-    md = (finished_run / "results/report/tables.md").read_text()
+    md = (finished_run / PATHS.report.tables).read_text()
     assert "## Impedance per subject, onset and joint" in md and "| S01 | 50 | hip |" in md
     assert "## Transparency: RMSD vs ISV_ave" in md and "## Validation study" in md
     for fig in ("impedance/impedance.png", "impedance/S01/responses.png", "impedance/S01/fit.png"):
@@ -256,27 +260,27 @@ def test_a_failed_job_leaves_its_message_and_traceback_in_its_log(tmp_path):
     raw = work / "data/raw/R01"
     raw.mkdir(parents=True)
     (raw / "static.c3d").write_bytes((ROOT / "tests/data/opensim-core/walking5.c3d").read_bytes()[:30_000])
-    res = _snakemake(work, "results/markers/R01/static.trc")
+    res = _snakemake(work, fill(PATHS.markers.trc, subject="R01", trial="static"))
     assert res.returncode != 0
     message = "data/raw/R01/static.c3d: truncated file: the header declares 1103 frames but only 22 could be read"
     console = res.stdout + res.stderr
     assert console.count(message) == 1 and "Traceback" not in console
-    assert "results/logs/markers/R01/static.log (check log file(s) for error details)" in console
-    log = (work / "results/logs/markers/R01/static.log").read_text()
+    assert f"{PATHS.log('markers', 'R01/static')} (check log file(s) for error details)" in console
+    log = (work / PATHS.log("markers", "R01/static")).read_text()
     assert f"ERROR loper_analysis.rule: LoperInputError: {message}" in log
     assert "Traceback (most recent call last)" in log and "in read_c3d" in log
     assert log.rstrip().endswith(f"loper_analysis.errors.LoperInputError: {message}")
-    assert not (work / "results/markers").exists()  # nothing half-written
+    assert not (work / PATHS.markers.root).exists()  # nothing half-written
 
 
 def test_device_outputs_from_the_default_run(finished_run):
-    summary = pd.read_csv(finished_run / "results/device/summary.tsv", sep="\t").set_index("metric")
+    summary = pd.read_csv(finished_run / PATHS.device.summary, sep="\t").set_index("metric")
     assert list(summary.columns[:3]) == ["value", "study_value", "unit"]
     for metric in ("bandwidth_hz", "rise_time_ms", "overshoot_pct", "steady_state_40n_n"):
         assert abs(summary.loc[metric, "value"] / summary.loc[metric, "study_value"] - 1) <= 0.15, metric
-    frf = pd.read_csv(finished_run / "results/device/frf.tsv", sep="\t")
+    frf = pd.read_csv(finished_run / PATHS.device.frf, sep="\t")
     assert list(frf.columns) == ["frequency_hz", "gain", "phase_deg", "coherence"]
-    steps = pd.read_csv(finished_run / "results/device/step_metrics.tsv", sep="\t")
+    steps = pd.read_csv(finished_run / PATHS.device.step_metrics, sep="\t")
     assert list(steps.amplitude_n) == [20.0, 40.0, 60.0] and (steps.n_repetitions == 10).all()
     # the logs the analysis read are on disk, in the robot-log format
     head = (finished_run / "data/raw/S01/device-steps.loper.tsv").read_text().splitlines()[:2]
@@ -291,13 +295,13 @@ def test_recorded_subject_without_a_trial_reports_that_onset_missing(finished_ru
     raw.mkdir(parents=True)
     for name in ("static.c3d", "walk-nodevice.c3d", "walk-device.c3d", "walk-device.loper.tsv"):
         shutil.copy(finished_run / "data/raw/S01" / name, raw / name)
-    res = _snakemake(work, "results/impedance/impedance.tsv")
+    res = _snakemake(work, PATHS.impedance.table)
     assert res.returncode == 0, res.stderr[-3000:]
-    table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
+    table = pd.read_csv(work / PATHS.impedance.table, sep="\t")
     assert list(table.joint) == ["hip", "knee", "ankle"] and (table.subject == "R01").all()
     assert (table.status == "missing").all() and (table.reason == "no trial of this onset").all()
     assert table[["K_nm_per_rad", "D_nms_per_rad", "K_true_nm_per_rad", "D_true_nms_per_rad"]].isna().all().all()
-    assert not (work / "results/ik").exists()  # nothing was processed for an onset without trials
+    assert not (work / PATHS.ik.root).exists()  # nothing was processed for an onset without trials
 
 
 def _copy_of(project: Path, dest: Path) -> Path:
@@ -331,22 +335,22 @@ def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_ru
         _cut_c3d(work / f"data/raw/S01/{trial}.c3d", 5.0)
     res = _snakemake(work)
     assert res.returncode == 0, res.stderr[-3000:]
-    summary = pd.read_csv(work / "results/strides/summary.tsv", sep="\t").set_index("trial")
+    summary = pd.read_csv(work / PATHS.strides.summary, sep="\t").set_index("trial")
     assert summary.loc["walk-nodevice", "status"] == "ok"
     for trial in ("walk-device", "pert050-1"):
         assert summary.loc[trial, ["n_strides", "n_kept", "status"]].tolist() == [2, 2, "too_few_strides"], trial
-        strides = pd.read_csv(work / f"results/strides/S01/{trial}.strides.tsv", sep="\t")
+        strides = pd.read_csv(work / fill(PATHS.strides.strides, subject="S01", trial=trial), sep="\t")
         assert len(strides) == 2 and not strides.removed.any()
         assert strides.filter(like="fraction_outlying_").isna().all().all()
-        log = (work / f"results/logs/strides/S01/{trial}.log").read_text()
+        log = (work / PATHS.log("strides", f"S01/{trial}")).read_text()
         assert "2 complete unperturbed left stride(s)" in log and "the outlier rule needs at least 4" in log
-    rmsd = pd.read_csv(work / "results/transparency/rmsd.tsv", sep="\t")
+    rmsd = pd.read_csv(work / PATHS.transparency.rmsd, sep="\t")
     assert len(rmsd) == 12 and (rmsd.n_strides_device == [2] * 6 + [0] * 6).all()
     assert rmsd[["rmsd_rad", "isv_ave_rad", "transparent"]].isna().all().all()
-    assert "subject S01: " in (work / "results/logs/transparency/transparency.log").read_text()
-    table = pd.read_csv(work / "results/impedance/impedance.tsv", sep="\t")
+    assert "subject S01: " in (work / PATHS.log("transparency", "transparency")).read_text()
+    table = pd.read_csv(work / PATHS.impedance.table, sep="\t")
     assert (table.status == "failed").all() and table.reason.str.startswith("0 valid perturbed stride(s)").all()
-    counts = pd.read_csv(work / "results/impedance/S01/050.counts.tsv", sep="\t").set_index("trial")
+    counts = pd.read_csv(work / fill(PATHS.impedance.counts, subject="S01", onset=50), sep="\t").set_index("trial")
     assert counts.loc["total", ["n_perturbed", "status"]].tolist() == [0, "too_few_strides"]
 
 

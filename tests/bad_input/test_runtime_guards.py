@@ -30,6 +30,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.robot_log import write_robot_log
+from loper_analysis.layout import Paths, fill
 from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.schema import check_yaml_file
 from loper_analysis.steps import events as event_steps
@@ -38,6 +39,8 @@ from loper_analysis.steps import report
 from loper_analysis.steps.logs import rule_log
 from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake
+
+PATHS = Paths()
 
 ENOSPC = "[Errno 28] No space left on device"
 POINT_RATE, ANALOG_RATE = 128.0, 1024.0
@@ -473,7 +476,7 @@ def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_co
     k = next(i for i, line in enumerate(lines) if line.startswith("  cutoff_hz: 40.0"))
     lines[k] = lines[k].replace("cutoff_hz: 40.0", "cutoff_hz: [40.0")
     config.write_text("".join(lines))
-    earlier = work / "results/markers/R01/walk.trc"
+    earlier = work / fill(PATHS.markers.trc, subject="R01", trial="walk")
     earlier.parent.mkdir(parents=True)
     earlier.write_text("an earlier result\n")
     res = snakemake(work, "-n", timeout=120)
@@ -487,7 +490,8 @@ def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_co
     assert console.count(message) == 1, console
     assert "not valid JSON or YAML" not in console
     assert earlier.read_text() == "an earlier result\n"
-    assert sorted(p.relative_to(work / "results").as_posix() for p in (work / "results").rglob("*")) == [
+    results = work / PATHS.results_dir
+    assert sorted(p.relative_to(results).as_posix() for p in results.rglob("*")) == [
         "markers",
         "markers/R01",
         "markers/R01/walk.trc",

@@ -31,11 +31,14 @@ from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.motion.ik_settings import IKSettings
+from loper_analysis.layout import Paths, fill
 from loper_analysis.steps import events as event_steps
 from loper_analysis.steps import ik
 from loper_analysis.steps import markers as marker_steps
 from loper_analysis.steps.markers import MarkerSettings
 from tests.workflow_copy import snakemake
+
+PATHS = Paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[2]
@@ -44,11 +47,11 @@ RAW = f"data/raw/{SUBJECT}"
 WALK = "walk-device"
 #: What the project's earlier run made (besides logs and benchmarks).
 GOOD_TARGETS = (
-    f"results/markers/{SUBJECT}/static.trc",
-    f"results/markers/{SUBJECT}/{WALK}.trc",
-    f"results/events/{SUBJECT}/{WALK}.events.tsv",
-    f"results/events/{SUBJECT}/{WALK}.force.tsv",
-    f"results/model/{SUBJECT}/generic.osim",
+    fill(PATHS.markers.trc, subject=SUBJECT, trial="static"),
+    fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
+    fill(PATHS.events.events, subject=SUBJECT, trial=WALK),
+    fill(PATHS.events.force, subject=SUBJECT, trial=WALK),
+    fill(PATHS.model.generic, subject=SUBJECT),
 )
 
 
@@ -160,14 +163,13 @@ def _refused(work: Path, run, words, log: str | None = None) -> str:
 
 def _markers(cfg: dict, c3d: str, label_map=None):
     """The markers rule's step for the walking trial, with its outputs and the config's settings."""
-    out = f"results/markers/{SUBJECT}/{WALK}"
     m = cfg["markers"]
     return marker_steps.markers(
         c3d,
-        f"{out}.trc",
-        f"{out}.gaps.tsv",
+        fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
+        fill(PATHS.markers.gaps, subject=SUBJECT, trial=WALK),
         dataclasses.replace(MarkerSettings.from_config(cfg), label_map=label_map or m["label_map"] or None),
-        summary_out=f"{out}.markers.tsv",
+        summary_out=fill(PATHS.markers.summary, subject=SUBJECT, trial=WALK),
     )
 
 
@@ -175,27 +177,26 @@ def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW
     return event_steps.loadcell(
         c3d,
         log,
-        f"results/events/{SUBJECT}/{WALK}.force.tsv",
+        fill(PATHS.events.force, subject=SUBJECT, trial=WALK),
         LoadcellSettings.from_config(cfg),
     )
 
 
 def _events(cfg: dict, grf_channels: dict):
-    out = f"results/events/{SUBJECT}/{WALK}"
     return event_steps.events(
         f"{RAW}/{WALK}.c3d",
-        f"{out}.events.tsv",
+        fill(PATHS.events.events, subject=SUBJECT, trial=WALK),
         dataclasses.replace(EventSettings.from_config(cfg), grf_channels=grf_channels),
-        contacts_out=f"{out}.contacts.tsv",
+        contacts_out=fill(PATHS.events.contacts, subject=SUBJECT, trial=WALK),
     )
 
 
 def _ik(cfg: dict, trc: Path):
     return ik.ik_trial(
-        f"results/model/{SUBJECT}/generic.osim",
+        fill(PATHS.model.generic, subject=SUBJECT),
         trc,
-        f"results/ik/{SUBJECT}/{WALK}.mot",
-        f"results/ik/{SUBJECT}/{WALK}.angles.tsv",
+        fill(PATHS.ik.mot, subject=SUBJECT, trial=WALK),
+        fill(PATHS.ik.angles, subject=SUBJECT, trial=WALK),
         IKSettings.from_config(cfg),
     )
 
@@ -236,9 +237,9 @@ def test_truncated_c3d_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab)
     (lab / RAW / "pert050-1.c3d").write_bytes(_c3d_bytes(lab)[:300_000])
     message = _refused(
         lab,
-        lambda: _snakemake(lab, f"results/markers/{SUBJECT}/pert050-1.trc"),
+        lambda: _snakemake(lab, fill(PATHS.markers.trc, subject=SUBJECT, trial="pert050-1")),
         [f"{RAW}/pert050-1.c3d: truncated file: the header declares 1024 frames but only"],
-        log=f"results/logs/markers/{SUBJECT}/pert050-1.log",
+        log=PATHS.log("markers", f"{SUBJECT}/pert050-1"),
     )
     assert "Traceback" not in message
 
@@ -255,7 +256,7 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
     """The subject walks off at 0.3 m/s: over the first second (the scaling window) every marker moves 87 mm RMS."""
     from loper_analysis.steps import model
 
-    t, X, labels = read_markers(f"results/markers/{SUBJECT}/static.trc")
+    t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial="static"))
     X[:, :, 0] += 0.3 * (t - t[0])[:, None]
     write_trc(lab / "moving.trc", t, X, labels)
     m = _config(lab)["markers"]
@@ -263,13 +264,15 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
         lab,
         lambda: model.scale(
             model.ScaleFiles(
-                f"results/model/{SUBJECT}/generic.osim", lab / "moving.trc", f"results/model/{SUBJECT}/scaled.osim"
+                fill(PATHS.model.generic, subject=SUBJECT),
+                lab / "moving.trc",
+                fill(PATHS.model.scaled, subject=SUBJECT),
             ),
             MASS_KG,
             model.ModelSettings(
                 static_duration_s=m["static_duration_s"], max_motion_rms_m=m["static_max_motion_rms_m"]
             ),
-            lab_labels=f"results/markers/{SUBJECT}/static.markers.tsv",
+            lab_labels=fill(PATHS.markers.summary, subject=SUBJECT, trial="static"),
         ),
         [
             "moving.trc: the subject does not stand still in the scaling window 0.0000 .. 0.9922 s of the static "
@@ -284,14 +287,14 @@ def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
     """A label mapped to 'LHEEL' (the model's marker is LHEE): not "the static trial lacks LHEE" alone."""
     from loper_analysis.steps import model
 
-    t, X, labels = read_markers(f"results/markers/{SUBJECT}/static.trc")
+    t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial="static"))
     labels[labels.index("LHEE")] = "LHEEL"
     write_trc(lab / "typo.trc", t, X, labels)
     _refused(
         lab,
         lambda: model.scale(
             model.ScaleFiles(
-                f"results/model/{SUBJECT}/generic.osim", lab / "typo.trc", f"results/model/{SUBJECT}/scaled.osim"
+                fill(PATHS.model.generic, subject=SUBJECT), lab / "typo.trc", fill(PATHS.model.scaled, subject=SUBJECT)
             ),
             MASS_KG,
             lab_labels={"LHEEL": "L_FCC"},
@@ -305,7 +308,7 @@ def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
 
 
 def test_model_marker_missing_from_the_trial_stops_ik(lab):
-    t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
+    t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK))
     k = labels.index("LKNE")
     write_trc(lab / "without-LKNE.trc", t, np.delete(X, k, axis=1), labels[:k] + labels[k + 1 :])
     _refused(
@@ -371,7 +374,7 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
         return
     summary = tmp_path / "ik.tsv"
     ik.ik_trial(
-        f"results/model/{SUBJECT}/generic.osim",
+        fill(PATHS.model.generic, subject=SUBJECT),
         out,
         tmp_path / "R02.mot",
         tmp_path / "R02.angles.tsv",
@@ -395,7 +398,7 @@ def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_
     )
     given = dataclasses.replace(IKSettings.from_config(cfg), subjects_model=False)
     summary = tmp_path / "ik.tsv"
-    model = f"results/model/{SUBJECT}/generic.osim"
+    model = fill(PATHS.model.generic, subject=SUBJECT)
     ik.ik_trial(model, out, tmp_path / "a.mot", tmp_path / "a.angles.tsv", given, summary_tsv=summary)
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
     assert row["marker_geometry_change"] > 0.08 and "opensim.geometry_warn_change 0.05" in row["warnings"]
@@ -410,8 +413,8 @@ def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_
 def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
     summary = tmp_path / "ik.tsv"
     ik.ik_trial(
-        f"results/model/{SUBJECT}/generic.osim",
-        f"results/markers/{SUBJECT}/{WALK}.trc",
+        fill(PATHS.model.generic, subject=SUBJECT),
+        fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
         tmp_path / "own.mot",
         tmp_path / "own.angles.tsv",
         IKSettings.from_config(_config(lab)),
@@ -427,14 +430,15 @@ def test_a_static_trial_of_another_subject_stops_the_walking_trials_ik(lab, tmp_
     _other_subject(tmp_path / "R02", 1.55, 50.0)
     shutil.copy(tmp_path / "R02" / "static.c3d", lab / RAW / "static.c3d")
     before = {k: v for k, v in _state(lab).items() if k in GOOD_TARGETS and "static" not in k}
-    res = _snakemake(lab, f"results/ik/{SUBJECT}/{WALK}.mot")
+    res = _snakemake(lab, fill(PATHS.ik.mot, subject=SUBJECT, trial=WALK))
     assert res.returncode != 0
     message = res.stdout + res.stderr
-    assert f"results/markers/{SUBJECT}/{WALK}.trc with results/model/{SUBJECT}/scaled.osim" in message
+    trc, model = fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK), fill(PATHS.model.scaled, subject=SUBJECT)
+    assert f"{trc} with {model}" in message
     assert "opensim.geometry_stop_change 0.08" in message
     after = _state(lab)
     assert {k: after[k] for k in before} == before
-    assert not (lab / f"results/ik/{SUBJECT}/{WALK}.mot").exists()
+    assert not (lab / fill(PATHS.ik.mot, subject=SUBJECT, trial=WALK)).exists()
 
 
 def test_a_static_trial_far_from_the_subjects_height_stops_scaling(lab, tmp_path):
@@ -451,7 +455,9 @@ def test_a_static_trial_far_from_the_subjects_height_stops_scaling(lab, tmp_path
     message = _refused(
         lab,
         lambda: model.scale(
-            model.ScaleFiles(f"results/model/{SUBJECT}/generic.osim", static, f"results/model/{SUBJECT}/scaled.osim"),
+            model.ScaleFiles(
+                fill(PATHS.model.generic, subject=SUBJECT), static, fill(PATHS.model.scaled, subject=SUBJECT)
+            ),
             MASS_KG,
             height_m=HEIGHT_M,
         ),
@@ -465,12 +471,12 @@ def test_a_static_trial_far_from_the_subjects_height_stops_scaling(lab, tmp_path
 
 
 def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_any_stops(lab, tmp_path):
-    t, X, labels = read_markers(f"results/markers/{SUBJECT}/{WALK}.trc")
+    t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK))
     X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only: left out, the rest solved
     write_trc(tmp_path / "sparse.trc", t, X, labels)
     o = _config(lab)["opensim"]
     angles = ik.ik_trial(
-        f"results/model/{SUBJECT}/generic.osim",
+        fill(PATHS.model.generic, subject=SUBJECT),
         tmp_path / "sparse.trc",
         tmp_path / "sparse.mot",
         tmp_path / "sparse.angles.tsv",
@@ -487,8 +493,8 @@ def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_a
         lab,
         lambda: _ik(_config(lab), lab / "none.trc"),
         [
-            f"none.trc with results/model/{SUBJECT}/generic.osim: {len(t)} frame(s) hold fewer than 3 of the 36 "
-            f"weighted markers",
+            f"none.trc with {fill(PATHS.model.generic, subject=SUBJECT)}: {len(t)} frame(s) hold fewer than 3 of the "
+            f"36 weighted markers",
             f"frames 0..{len(t) - 1}",
             "RPSI, LPSI",
         ],
@@ -574,7 +580,7 @@ def test_belt_channels_in_kn_give_the_same_events_and_in_mv_are_refused(lab, tmp
     settings = dataclasses.replace(EventSettings.from_config(cfg), grf_channels=e["grf_channels"])
     kn = _belts_in(lab, tmp_path / "kn.c3d", "kN", 1e-3)
     table = event_steps.events(kn, tmp_path / "e.tsv", settings)
-    good = pd.read_csv(f"results/events/{SUBJECT}/{WALK}.events.tsv", sep="\t")
+    good = pd.read_csv(fill(PATHS.events.events, subject=SUBJECT, trial=WALK), sep="\t")
     assert len(table) == len(good) and np.allclose(table["time_s"], good["time_s"])
     mv = _belts_in(lab, tmp_path / "mv.c3d", "mV", 20.0)
     with pytest.raises(LoperInputError) as err:
@@ -598,7 +604,7 @@ def test_belts_feet_that_cannot_be_confirmed_are_warned(lab, tmp_path):
             tmp_path / "e.tsv",
             EventSettings(grf_channels=e["grf_channels"], foot_markers=e["foot_markers"]),
         )
-    good = pd.read_csv(f"results/events/{SUBJECT}/{WALK}.events.tsv", sep="\t")
+    good = pd.read_csv(fill(PATHS.events.events, subject=SUBJECT, trial=WALK), sep="\t")
     assert len(table) == len(good) and np.allclose(table["time_s"], good["time_s"])
 
 
@@ -674,14 +680,14 @@ def test_bad_robot_log_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab)
     (lab / RAW / "pert050-1.loper.tsv").write_text("".join(_nan_at(_log_lines(lab), 20, 2)))
     _refused(
         lab,
-        lambda: _snakemake(lab, f"results/events/{SUBJECT}/pert050-1.force.tsv"),
+        lambda: _snakemake(lab, fill(PATHS.events.force, subject=SUBJECT, trial="pert050-1")),
         [
             (
                 f"{RAW}/pert050-1.loper.tsv: column 'force_measured_n', sample 16 (t = 0.016 s, line 21): "
                 "non-finite force nan"
             )
         ],
-        log=f"results/logs/events_loadcell/{SUBJECT}/pert050-1.log",
+        log=PATHS.log("events_loadcell", f"{SUBJECT}/pert050-1"),
     )
 
 
@@ -726,7 +732,7 @@ def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab)
     shutil.copy(lab / RAW / f"{WALK}.c3d", lab / RAW / "pert100-1.c3d")  # onsets of the design: 50 ms only
     (lab / RAW / "pert100-1.loper.tsv").write_text("")
     before = _state(lab)
-    res = _snakemake(lab, "-n", "results/strides/summary.tsv")
+    res = _snakemake(lab, "-n", PATHS.strides.summary)
     assert res.returncode == 0, res.stdout[-2000:]
     assert (
         f"warning: {RAW}: pert100-1.c3d, pert100-1.loper.tsv: no trial of the design has this name, not "
@@ -753,8 +759,8 @@ def test_a_raw_file_replaced_with_its_old_time_kept_is_processed_again(lab):
     checksum (a param of every rule that reads raw files) reruns what was made from it, and only that."""
     import os
 
-    trc = lab / f"results/markers/{SUBJECT}/{WALK}.trc"
-    static_trc = lab / f"results/markers/{SUBJECT}/static.trc"
+    trc = lab / fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK)
+    static_trc = lab / fill(PATHS.markers.trc, subject=SUBJECT, trial="static")
     old_trc, old_static = trc.read_bytes(), static_trc.read_bytes()
     assert "Nothing to be done" in _snakemake(lab, "-n", *GOOD_TARGETS).stdout
     raw = lab / RAW / f"{WALK}.c3d"
@@ -777,8 +783,8 @@ def test_a_robot_log_that_ends_half_way_sets_the_trials_status_and_says_so_on_th
     cfg = _config(lab)
     cfg["strides"]["min_valid_strides"] = 3  # an 8-s trial
     (lab / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
-    summary = lab / "results/strides/summary.tsv"
-    res = _snakemake(lab, "results/strides/summary.tsv")
+    summary = lab / PATHS.strides.summary
+    res = _snakemake(lab, PATHS.strides.summary)
     assert res.returncode == 0, res.stderr[-3000:]
     whole = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
     assert whole["status"] == "ok" and whole["n_outside_robot_log"] == 0
@@ -787,7 +793,7 @@ def test_a_robot_log_that_ends_half_way_sets_the_trials_status_and_says_so_on_th
     header = [line for line in lines if line.startswith("#")]
     body = [line for line in lines if not line.startswith("#")]
     log.write_text("".join(header + body[: len(body) // 2 + 1]))  # the header line and the first half
-    res = _snakemake(lab, "results/strides/summary.tsv")
+    res = _snakemake(lab, PATHS.strides.summary)
     assert res.returncode == 0, res.stderr[-3000:]
     cut = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
     n_with_events = cut["n_strides"] + cut["n_outside_robot_log"]
@@ -796,7 +802,7 @@ def test_a_robot_log_that_ends_half_way_sets_the_trials_status_and_says_so_on_th
     said = f"robot log truncated? {cut['n_outside_robot_log']} of the strides with events"
     assert said in cut["warnings"]
     assert f"{SUBJECT} {WALK}: log_truncated; {said}" in res.stderr  # the run's warnings on the console
-    dropped = pd.read_csv(lab / f"results/strides/{SUBJECT}/{WALK}.dropped.tsv", sep="\t")
+    dropped = pd.read_csv(lab / fill(PATHS.strides.dropped, subject=SUBJECT, trial=WALK), sep="\t")
     assert (dropped["reason"] == "outside_robot_log").sum() == cut["n_outside_robot_log"]
 
 
@@ -816,9 +822,9 @@ def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(la
         assert (
             f"note: {RAW}/{trial}.c3d: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the "
             "belt channels (events.grf_channels: {'left': 'Fz_left', 'right': 'Fz_right'}), no OpenSim external "
-            f"loads (results/grf/{SUBJECT}/{trial}.grf.mot)"
+            f"loads ({fill(PATHS.grf.mot, subject=SUBJECT, trial=trial)})"
         ) in res.stderr
-    assert "rule grf:" not in res.stdout and f"results/impedance/{SUBJECT}/100.tsv" in res.stdout
+    assert "rule grf:" not in res.stdout and fill(PATHS.impedance.fit, subject=SUBJECT, onset=100) in res.stdout
     assert _state(lab) == before
 
 
@@ -835,13 +841,13 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
     """Not an error: only the trials on disk are processed (the onset without a trial is reported missing;
     the full run is in tests/test_workflow.py)."""
     before = _state(lab)
-    res = _snakemake(lab, "-n", "results/impedance/impedance.tsv", "results/strides/summary.tsv")
+    res = _snakemake(lab, "-n", PATHS.impedance.table, PATHS.strides.summary)
     assert res.returncode == 0, res.stderr[-2000:]
     trials = set(re.findall(r"^\s+wildcards: subject=R01, trial=(\S+)$", res.stdout, re.MULTILINE))
     assert trials == {WALK}  # its IK and strides: markers, events and forces are already there
     fit = re.search(r"^rule impedance_fit:$(.*?)^$", res.stdout, re.MULTILINE | re.DOTALL)  # every onset's fit
     assert fit and re.search(r"^\s+wildcards: subject=R01$", fit.group(1), re.MULTILINE)
-    assert "results/impedance/R01/050.tsv" in fit.group(1)
+    assert fill(PATHS.impedance.fit, subject="R01", onset=50) in fit.group(1)
     assert _state(lab) == before
 
 

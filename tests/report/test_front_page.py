@@ -21,6 +21,7 @@ import pytest
 from loper_analysis.constants import JOINTS
 from loper_analysis.identification.across_subjects import impedance_summary
 from loper_analysis.identification.group_mean import random_effects_mean
+from loper_analysis.layout import Paths
 from loper_analysis.report.front_page import RunSettings, front_page_html
 from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.report.headline import (
@@ -32,6 +33,8 @@ from loper_analysis.report.headline import (
 )
 from tests.browser import report_screen
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
+
+PATHS = Paths()
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -215,12 +218,12 @@ def _write_results(root: Path) -> None:
             for joint, (k, d) in truth.items():
                 ke, de = k * (1 + 0.1 * rng.standard_normal()), d * (1 + 0.1 * rng.standard_normal())
                 rows.append(impedance_row(s, onset, joint, ke, de, (0.8 * ke, 1.2 * ke), (0.8 * de, 1.2 * de), k, d))
-    impedance = root / "results/impedance"
+    impedance = root / PATHS.impedance.root
     impedance.mkdir(parents=True)
     pd.DataFrame(rows).to_csv(impedance / "impedance.tsv", sep="\t", index=False)
     summary_step(impedance / "impedance.tsv", impedance / "summary.tsv", impedance / "literature.tsv")
     impedance_figure(impedance / "impedance.tsv", impedance / "impedance.png")
-    (root / "results/transparency").mkdir(parents=True)
+    (root / PATHS.transparency.root).mkdir(parents=True)
     pd.DataFrame(
         {
             "subject": ["S01", "all"],
@@ -232,11 +235,11 @@ def _write_results(root: Path) -> None:
             "study_rmsd_rad": 0.071,
             "study_isv_ave_rad": 0.129,
         }
-    ).to_csv(root / "results/transparency/rmsd.tsv", sep="\t", index=False)
-    (root / "results/device").mkdir(parents=True)
-    device_summary().to_csv(root / "results/device/summary.tsv", sep="\t", index=False)
-    (root / "results/validation").mkdir(parents=True)
-    validation_summary().to_csv(root / "results/validation/summary.tsv", sep="\t", index=False)
+    ).to_csv(root / PATHS.transparency.rmsd, sep="\t", index=False)
+    (root / PATHS.device.root).mkdir(parents=True)
+    device_summary().to_csv(root / PATHS.device.summary, sep="\t", index=False)
+    (root / PATHS.validation.root).mkdir(parents=True)
+    validation_summary().to_csv(root / PATHS.validation.summary, sep="\t", index=False)
 
 
 def _front_page(root: Path, versions=VERSIONS) -> str:
@@ -263,17 +266,17 @@ def _front_page(root: Path, versions=VERSIONS) -> str:
 
 def test_the_file_step_writes_the_same_bytes_from_the_same_files(tmp_path):
     _write_results(tmp_path)
-    first = (_front_page(tmp_path), (tmp_path / "results/report/front_page.html").read_bytes())
+    first = (_front_page(tmp_path), (tmp_path / PATHS.report.front_page).read_bytes())
     again = _front_page(tmp_path)
-    assert first[1] == again.encode() == (tmp_path / "results/report/front_page.html").read_bytes()
-    png = (tmp_path / "results/impedance/impedance.png").read_bytes()
+    assert first[1] == again.encode() == (tmp_path / PATHS.report.front_page).read_bytes()
+    png = (tmp_path / PATHS.impedance.figure).read_bytes()
     embedded = re.search(r'src="data:image/png;base64,([^"]+)"', again).group(1)
     assert base64.b64decode(embedded) == png  # the figure, byte for byte
     assert str(tmp_path) not in again and "impedance.png" not in again  # no path on the page
-    summary = pd.read_csv(tmp_path / "results/impedance/summary.tsv", sep="\t")
+    summary = pd.read_csv(tmp_path / PATHS.impedance.summary, sep="\t")
     assert f'data-v="{float(summary.K_group_mean_nm_per_rad.iloc[0])!r}"' in again  # hip, 50 ms, from the file
     assert list(summary.joint) == ["hip"] * 3 + ["knee"] * 3 + ["ankle"] * 3 and (summary.n_subjects == 3).all()
-    assert not list((tmp_path / "results/report").glob(".*partial"))  # written through the atomic writer
+    assert not list((tmp_path / PATHS.report.root).glob(".*partial"))  # written through the atomic writer
 
 
 def test_the_report_shows_the_headline_tables_on_its_first_screen(tmp_path):
@@ -290,7 +293,7 @@ def test_the_report_shows_the_headline_tables_on_its_first_screen(tmp_path):
     shutil.copy(ROOT / "workflow/report/workflow.rst", tmp_path / "workflow/report/workflow.rst")
     (tmp_path / "Snakefile").write_text(
         'configfile: "config/config.yaml"\n\n\nreport: "workflow/report/workflow.rst"\n\n\n'
-        'rule all:\n    input:\n        "results/report/front_page.html",\n'
+        f'rule all:\n    input:\n        "{PATHS.report.front_page}",\n'
     )
     res = subprocess.run(
         [sys.executable, "-m", "snakemake", "--report", "report.html"],

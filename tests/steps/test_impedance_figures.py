@@ -9,7 +9,7 @@ from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.report.figures.impedance import impedance_means
 from loper_analysis.steps.impedance import impedance_figure, subject_figures
-from tests.figures.impedance_tables import (
+from tests.report.figures.impedance_tables import (
     AMPLITUDE_RAD,
     curves_table,
     impedance_table,

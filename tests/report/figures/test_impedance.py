@@ -16,7 +16,7 @@ from loper_analysis.report.figures.impedance import (
     response_peaks,
     responses_figure,
 )
-from tests.figures.impedance_tables import (
+from tests.report.figures.impedance_tables import (
     AMPLITUDE_RAD,
     curves_table,
     impedance_table,

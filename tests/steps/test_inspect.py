@@ -1,4 +1,5 @@
-"""``loper-analysis inspect`` configuring a subject from a marker-set template, on every lab file of the tests."""
+"""``loper-analysis inspect`` configuring a subject from a marker-set template (loper_analysis.steps.inspect), on every
+lab file of the tests."""
 
 from __future__ import annotations
 
@@ -9,10 +10,8 @@ import yaml
 
 from loper_analysis.cli import main
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.marker_templates import read_templates
 from loper_analysis.schema import check_config
 from loper_analysis.steps.inspect import inspect_subject
-from loper_analysis.subject_setup import subject_setup
 
 ROOT = Path(__file__).resolve().parents[2]
 QCMAS = ROOT / "tests" / "data" / "c3d-parser" / "QCMAS"
@@ -47,16 +46,6 @@ def test_inspect_writes_a_schema_valid_config_for_every_lab_file(lab, tmp_path):
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     check_config(_merged(base, doc), ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert result.written[-1] == config_out
-
-
-def test_a_knee_alignment_device_stands_in_for_the_knee_marker_of_the_static_trial():
-    walk = [lab for lab in ["LASI", "RASI", "LPSI", "RPSI", "LKNE", "RKNE", "LANK", "RANK", "LHEE", "RHEE", "LTOE",
-                            "RTOE", "LTHI", "RTHI"]]  # fmt: skip
-    static = [lab for lab in walk if lab not in ("LKNE", "RKNE")] + ["LKAX", "LKD1", "LKD2", "RKAX", "RKD1", "RKD2"]
-    setup = subject_setup(static, [walk], read_templates())
-    assert setup.template.name == "plugin_gait"
-    assert {"LKNE", "RKNE"} <= set(setup.static_markers) and setup.static_only == ()
-    assert set(setup.unmapped) == {"LKAX", "LKD1", "LKD2", "RKAX", "RKD1", "RKD2"}
 
 
 def test_a_config_over_an_input_is_refused_and_nothing_is_written(tmp_path, capsys):
