@@ -357,7 +357,7 @@ def test_recording_checks_its_shapes():
 
 
 def test_c3d_io_leaves_opensim_vector_arguments_working(tmp_path, rng):
-    from loper_analysis.motion.ik import (
+    from loper_analysis.motion.opensim_ik import (
         markers_table,  # passes opensim.StdVectorDouble/String objects
     )
 

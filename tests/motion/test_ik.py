@@ -21,9 +21,9 @@ from loper_analysis.motion.ik import (
     join_chunks,
     joint_angle_table,
     marker_positions,
-    markers_table,
 )
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
+from loper_analysis.motion.opensim_ik import markers_table
 
 FS = 128.0
 GENERIC_RAJAGOPAL = Path(__file__).resolve().parents[1] / "data" / "rajagopal2016" / "Rajagopal2016.osim"
@@ -123,7 +123,8 @@ def test_coordinate_task_locks_the_ankle(model, synthetic):
     np.testing.assert_allclose(res.coordinates[:, k], 0.25, atol=1e-3)
 
 
-def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, tmp_path):
+@pytest.mark.parametrize("solver", ["tree", "opensim"])
+def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, tmp_path, solver):
     osim = quiet_opensim()
     t, _, X = synthetic
     rng = np.random.default_rng(0)
@@ -168,7 +169,10 @@ def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, 
     in_degrees = ref.getTableMetaDataAsString("inDegrees") == "yes"
     ours_w, ours_c = read_ik_tasks(tasks_xml)
     assert ours_w == weights and ours_c == {"ankle_dorsiflexion_r": (10.0, 0.05)}
-    res = inverse_kinematics(model, t, Xn, list(MARKERS), marker_weights=ours_w, coordinate_tasks=ours_c, accuracy=1e-8)
+    res = inverse_kinematics(
+        model, t, Xn, list(MARKERS), marker_weights=ours_w, coordinate_tasks=ours_c, accuracy=1e-8, solver=solver
+    )
+    assert res.solver == solver
     labels = list(ref.getColumnLabels())
     for i, name in enumerate(res.coordinate_names):
         col = ref.getDependentColumn(name).to_numpy()
@@ -321,7 +325,8 @@ def test_a_trial_without_a_frame_to_solve_stops(model, synthetic):
         inverse_kinematics(model, t, X, list(MARKERS), source="walk.trc")
 
 
-def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
+@pytest.mark.parametrize("solver", ["tree", "opensim"])
+def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path, solver):
     """Rajagopal2016 as distributed: locked subtalar, mtp and wrist angles, patella coupled to the knee."""
     from loper_analysis.io.opensim_tables import read_markers
     from loper_analysis.io.osim import read_marker_set
@@ -332,7 +337,10 @@ def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
     t, X, labels = read_markers(WALK_TRC)
     weights, coordinates = read_ik_tasks(IK_SETUP)  # the task set of OpenSim's own IK setup
     assert len(weights) == 39 and weights["R.ASIS"] == 50.0 and coordinates == {}
-    res = inverse_kinematics(model, t[:20], X[:20], labels, marker_weights=weights, coordinate_tasks=coordinates)
+    res = inverse_kinematics(
+        model, t[:20], X[:20], labels, marker_weights=weights, coordinate_tasks=coordinates, solver=solver
+    )
+    assert res.solver == solver  # the tree holds Rajagopal2016's joints and couplers
     names = res.coordinate_names
     assert len(names) == 39 and res.solved.all()
     for locked in ("subtalar_angle_r", "mtp_angle_l", "wrist_flex_r", "wrist_dev_l"):
@@ -346,5 +354,11 @@ def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path):
         r"\(model Rajagopal2016\)",
     ):
         inverse_kinematics(
-            model, t[:2], X[:2], labels, marker_weights=weights, coordinate_tasks={"subtalar": (1.0, None)}
+            model,
+            t[:2],
+            X[:2],
+            labels,
+            marker_weights=weights,
+            coordinate_tasks={"subtalar": (1.0, None)},
+            solver=solver,
         )

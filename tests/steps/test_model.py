@@ -8,12 +8,13 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim, read_model, write_model
 from loper_analysis.io.segment_table import read_segments
-from loper_analysis.motion.ik import marker_positions, markers_table
+from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.model import (
     MARKERS,
     build_lower_body_model,
     segment_parameters_from_model,
 )
+from loper_analysis.motion.opensim_ik import markers_table
 from loper_analysis.steps.model import (
     ModelSettings,
     ScaleFiles,

@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.osim import model_source, quiet_opensim
+from loper_analysis.io.osim import model_source
 from loper_analysis.motion.ik_determinacy import (
     ModelTree,
     model_tree,
@@ -36,10 +36,11 @@ from loper_analysis.motion.markers import frames_with_markers, require_markers_p
 
 __all__ = [
     "IK_ACCURACY",
+    "IK_SOLVER",
+    "IK_SOLVERS",
     "IKResult",
     "IK_SUMMARY_COLUMNS",
     "marker_positions",
-    "markers_table",
     "inverse_kinematics",
     "require_model_markers",
     "ik_task_weights",
@@ -54,6 +55,12 @@ __all__ = [
 #: 1e-5).
 IK_ACCURACY: float = 1e-6
 
+
+#: The IK solvers (config ``opensim.ik_solver``): the model's kinematic tree (:mod:`loper_analysis.motion.tree_ik`)
+#: or OpenSim's ``InverseKinematicsSolver`` (:mod:`loper_analysis.motion.opensim_ik`).
+IK_SOLVERS: tuple[str, ...] = ("tree", "opensim")
+#: The pipeline's IK solver.
+IK_SOLVER: str = "tree"
 
 #: Columns of the one-row IK summary of a trial (:meth:`IKResult.summary`).
 IK_SUMMARY_COLUMNS: tuple[str, ...] = (
@@ -70,6 +77,7 @@ IK_SUMMARY_COLUMNS: tuple[str, ...] = (
     "worst_markers_mm",
     "marker_geometry_change",
     "warnings",
+    "solver",
 )
 
 
@@ -88,7 +96,8 @@ class IKResult:
     ``marker_names``. ``warning``: a poor fit's warning, set by the file step; ``warnings``: other warnings
     of the file step (a joint angle that looks inverted). ``geometry_change``: the median relative change of the
     distances between markers on one body against the model's (:mod:`loper_analysis.motion.marker_geometry`;
-    NaN when not compared).
+    NaN when not compared). ``solver``: the solver that gave the coordinates (``tree``, or ``opensim`` and
+    why).
     """
 
     time_s: np.ndarray
@@ -103,6 +112,7 @@ class IKResult:
     warning: str | None = None
     warnings: list[str] = field(default_factory=list)
     geometry_change: float = float("nan")
+    solver: str = ""
 
     @property
     def n_left_out(self) -> int:
@@ -116,7 +126,7 @@ class IKResult:
         frames whose marker RMS error exceeds ``warn_rms_m`` (m); ``worst_marker`` is the marker with the
         largest RMS error over the trial (``worst_marker_rms_m``; '' and NaN without marker errors),
         ``worst_markers_mm`` the three worst with their RMS error in mm, as text (``LTHI 28.0, RTHI 25.1, ...``);
-        ``warnings`` joins :attr:`warning` and :attr:`warnings` ('' when none).
+        ``warnings`` joins :attr:`warning` and :attr:`warnings` ('' when none); ``solver`` is :attr:`solver`.
         """
         solved = np.ones(self.time_s.size, bool) if self.solved is None else self.solved
         rms = self.marker_rms_m[np.isfinite(self.marker_rms_m)]
@@ -139,6 +149,7 @@ class IKResult:
                     "worst_markers_mm": ", ".join(f"{m} {1e3 * e:.1f}" for m, e in list(per_marker.items())[:3]),
                     "marker_geometry_change": self.geometry_change,
                     "warnings": " | ".join(w for w in [self.warning, *self.warnings] if w),
+                    "solver": self.solver,
                 }
             ],
             columns=list(IK_SUMMARY_COLUMNS),
@@ -205,23 +216,6 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
     return out
 
 
-def markers_table(time_s, markers_m, labels):
-    """An OpenSim ``TimeSeriesTableVec3`` (Units = m) from arrays (n,), (n, m, 3)."""
-    osim = quiet_opensim()
-    t = np.asarray(time_s, float)
-    X = np.asarray(markers_m, float)
-    if X.ndim != 3 or X.shape[2] != 3 or X.shape[0] != t.size or X.shape[1] != len(labels):
-        raise LoperInputError(
-            f"markers_m must have shape (n_frames={t.size}, n_labels={len(labels)}, 3), got {X.shape}"
-        )
-    flat = np.ascontiguousarray(X.reshape(t.size, -1))
-    cols = osim.StdVectorString([f"{lab}_{a}" for lab in labels for a in "xyz"])
-    table = osim.TimeSeriesTable(osim.StdVectorDouble(list(t)), osim.Matrix.createFromMat(flat), cols)
-    v3 = table.packVec3(osim.StdVectorString(["_x", "_y", "_z"]))
-    v3.addTableMetaDataString("Units", "m")
-    return v3
-
-
 def require_model_markers(model, source: str = "") -> None:
     """Refuse a model without markers (an empty MarkerSet: the marker set kept in a file of its own), naming the
     model and where its markers come from."""
@@ -250,8 +244,16 @@ def inverse_kinematics(
     source: str = "",
     undetermined: str = "nan",
     sparse_frames: str = "leave_out",
+    solver: str = IK_SOLVER,
 ) -> IKResult:
-    """OpenSim IK of marker trajectories (m) with one reused solver on an ``opensim.Model``.
+    """IK of marker trajectories (m) on an ``opensim.Model``: OpenSim's objective, solved frame by frame.
+
+    ``solver="tree"`` solves on the model's kinematic tree
+    (:mod:`loper_analysis.motion.tree_ik`, checked against OpenSim's marker
+    positions first); a model the tree does not reproduce (a constraint, a
+    joint or function it does not hold) falls back on OpenSim's solver, and
+    :attr:`IKResult.solver` says so. ``solver="opensim"`` uses OpenSim's
+    ``InverseKinematicsSolver`` (:mod:`loper_analysis.motion.opensim_ik`).
 
     A marker that is NaN in a frame is left out of that frame's solve (OpenSim's
     ``MarkersReference`` drops it). A frame holding fewer than ``min_markers``
@@ -285,9 +287,10 @@ def inverse_kinematics(
         ``undetermined="error"``; a model whose coordinates do not map onto
         the state (naming the .osim file and the coordinate).
     """
-    osim = quiet_opensim()
     labels = list(labels)
     t = np.asarray(time_s, float)
+    if solver not in IK_SOLVERS:
+        raise LoperInputError(f"solver must be one of {IK_SOLVERS}, got {solver!r}")
     if t.ndim != 1 or t.size < 1 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise LoperInputError("time_s must be finite and strictly increasing")
     X, kept_labels, marker_weights = _weighted_markers(model, labels, markers_m, marker_weights, source)
@@ -304,43 +307,81 @@ def inverse_kinematics(
             f"{source or 'markers'}: no weighted marker present determines coordinate(s) "
             + ", ".join(f"{c} ({n} of {t.size} frames)" for c, n in lacking.items())
         )
-    table = markers_table(t, X, kept_labels)
-    weights = osim.SetMarkerWeights()
-    for mk in kept_labels:
-        weights.cloneAndAppend(osim.MarkerWeight(mk, float(marker_weights[mk])))
-    mref = osim.MarkersReference(table, weights)
-    cs = model.getCoordinateSet()
-    names = [cs.get(i).getName() for i in range(cs.getSize())]
-    cref = _coordinate_references(osim, model, names, coordinate_tasks, source)
-    state = model.initSystem()
-    perm = _q_order(model, state, cs)
-    solver = osim.InverseKinematicsSolver(model, mref, cref, float("inf"))
-    solver.setAccuracy(float(accuracy))
     frames = np.flatnonzero(solved)
-    state.setTime(float(t[frames[0]]))
-    solver.assemble(state)
-    Q, E = _tracked(osim, solver, state, t, frames)
-    markers_in_use = range(E.shape[1])
+    Q, E, in_use_names, note = _solution(
+        model,
+        t,
+        X,
+        kept_labels,
+        marker_weights,
+        solver=solver,
+        coordinate_tasks=coordinate_tasks,
+        frames=frames,
+        accuracy=accuracy,
+        source=source,
+    )
     # OpenSim reports 0 (not NaN) for a marker missing in a frame: leave those out of RMS and max
-    in_use_names = [solver.getMarkerNameForIndex(j) for j in markers_in_use]
     in_use = [kept_labels.index(name) for name in in_use_names]
     E[np.isnan(X[:, in_use, :]).any(axis=2)] = np.nan
     with warnings.catch_warnings():  # a frame without any marker gives NaN, silently
         warnings.simplefilter("ignore", RuntimeWarning)
         rms, mx = np.sqrt(np.nanmean(E * E, axis=1)), np.nanmax(E, axis=1)
-    coordinates = Q[:, perm]
+    coordinates = Q
     coordinates[free] = np.nan  # the solver left them at a default or the previous frame's value
     return IKResult(
         time_s=t,
         coordinates=coordinates,
-        coordinate_names=names,
+        coordinate_names=[model.getCoordinateSet().get(i).getName() for i in range(Q.shape[1])],
         marker_rms_m=rms,
         marker_max_m=mx,
         undetermined=lacking,
         solved=solved,
         marker_errors_m=E,
         marker_names=in_use_names,
+        solver=note,
     )
+
+
+def _solution(
+    model, t, X, labels, marker_weights, *, solver, coordinate_tasks, frames, accuracy, source
+) -> tuple[np.ndarray, np.ndarray, list[str], str]:
+    """Coordinates (n_frames, n_coordinates) in coordinate-set order, marker errors (n_frames, n_in_use) in m,
+    the markers in use and the solver that gave them (``tree``, or ``opensim`` with the reason)."""
+    if solver == "tree":
+        from loper_analysis.motion.kinematic_tree import UnsupportedModel
+        from loper_analysis.motion.tree_ik import tree_solution
+
+        try:
+            Q, E = tree_solution(
+                model,
+                t,
+                X,
+                labels,
+                marker_weights,
+                coordinate_tasks=coordinate_tasks,
+                frames=frames,
+                accuracy=accuracy,
+                source=source,
+            )
+            return Q, E, list(labels), "tree"
+        except UnsupportedModel as reason:
+            note = f"opensim: {reason}"
+    else:
+        note = "opensim"
+    from loper_analysis.motion.opensim_ik import opensim_solution
+
+    Q, E, in_use = opensim_solution(
+        model,
+        t,
+        X,
+        labels,
+        marker_weights,
+        coordinate_tasks=coordinate_tasks,
+        frames=frames,
+        accuracy=accuracy,
+        source=source,
+    )
+    return Q, E, in_use, note
 
 
 def _weighted_markers(
@@ -401,44 +442,6 @@ def _frames_to_solve(
     return tree, solved
 
 
-def _coordinate_references(osim, model, names: list[str], coordinate_tasks, source: str):
-    """OpenSim's coordinate references of the coordinate tasks ({coordinate: (weight, value in rad or m, or
-    None for the default)}); ``names`` are the model's coordinates, ``osim`` the opensim module. An unknown
-    coordinate raises LoperInputError."""
-    where = f"{source}: " if source else ""
-    cs = model.getCoordinateSet()
-    cref = osim.SimTKArrayCoordinateReference()
-    for cname, (w, value) in (coordinate_tasks or {}).items():
-        if cname not in names:
-            raise LoperInputError(
-                f"{where}coordinate task on '{cname}': not a coordinate of {model_source(model)}; has {names}"
-            )
-        v = cs.get(cname).getDefaultValue() if value is None else float(value)
-        ref = osim.CoordinateReference(cname, osim.Constant(v))
-        ref.setWeight(float(w))
-        cref.push_back(ref)
-    return cref
-
-
-def _tracked(osim, solver, state, t: np.ndarray, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The generalised coordinates Q (n_frames, n_q) in state order and each marker in use's distance error
-    (n_frames, n_markers_in_use) in m, tracked by the assembled ``solver`` at the frames ``frames`` of ``t`` (s);
-    NaN in the other frames (``osim``: the opensim module)."""
-    Q = np.full((t.size, state.getNQ()), np.nan)
-    n_m = solver.getNumMarkersInUse()
-    E = np.full((t.size, n_m), np.nan)  # marker distance errors (m)
-    errs = osim.SimTKArrayDouble()
-    get_elt, track, set_time, get_q = errs.getElt, solver.track, state.setTime, state.getQ
-    compute_errors, markers_in_use = solver.computeCurrentMarkerErrors, range(n_m)
-    for k in frames:  # the hot loop: one SWIG call per quantity
-        set_time(float(t[k]))
-        track(state)
-        Q[k] = get_q().to_numpy()
-        compute_errors(errs)
-        E[k] = [get_elt(j) for j in markers_in_use]
-    return Q, E
-
-
 def ik_task_weights(
     model,
     labels: Sequence[str],
@@ -484,33 +487,6 @@ def ik_task_weights(
             "in opensim.marker_weights, or an IK task file in opensim.ik_tasks)"
         )
     return weights, coords
-
-
-def _q_order(model, state, cs) -> np.ndarray:
-    """Index into the state's Q of each coordinate of the coordinate set (found by setting distinct values).
-
-    Locked coordinates (Rajagopal2016's subtalar, mtp and wrist angles) are
-    unlocked in a copy of the state for the probe: a locked coordinate keeps
-    its value when set. Coupled coordinates are set without enforcing their
-    constraints, so every coordinate takes its own probe value.
-    """
-    probe = model.initSystem() if state is None else state.__class__(state)
-    values = 0.001 * (np.arange(cs.getSize()) + 1)
-    for i in range(cs.getSize()):
-        coordinate = cs.get(i)
-        if coordinate.getLocked(probe):
-            coordinate.setLocked(probe, False)
-        coordinate.setValue(probe, float(values[i]), False)
-    q = probe.getQ().to_numpy()
-    perm = np.array([int(np.argmin(np.abs(q - v))) for v in values])
-    wrong = [cs.get(i).getName() for i in range(cs.getSize()) if not np.isclose(q[perm[i]], values[i])]
-    shared = sorted({cs.get(i).getName() for i in range(cs.getSize()) for j in range(i) if perm[i] == perm[j]})
-    if wrong or shared:
-        raise LoperInputError(
-            f"{model_source(model)}: coordinate(s) {', '.join(wrong or shared)} do not map one to one onto the "
-            "state's generalised coordinates (Q); IK cannot report them"
-        )
-    return perm
 
 
 def chunk_frames(n_frames: int, n_chunks: int, chunk: int) -> slice:
