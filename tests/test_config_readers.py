@@ -128,6 +128,7 @@ READERS = {
     "opensim.marker_weights": "ik",
     "opensim.coordinate_tasks": "ik",
     "opensim.accuracy": "ik model_scaled",
+    "opensim.ik_solver": "ik model_scaled",
     "opensim.max_marker_rms_m": "ik",
     "opensim.warn_marker_rms_m": "ik",
     "opensim.max_rms_fraction": "ik",

@@ -378,6 +378,7 @@ def _ik(args: argparse.Namespace) -> None:
     given = {
         "tasks_file": args.tasks,
         "accuracy": args.accuracy,
+        "solver": args.solver,
         "max_marker_rms_m": args.max_marker_rms_m,
         "warn_marker_rms_m": args.warn_marker_rms_m,
         "max_rms_fraction": args.max_rms_fraction,

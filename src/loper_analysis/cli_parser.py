@@ -201,6 +201,11 @@ def _add_ik(sub, handlers: Mapping[str, Callable]) -> None:
         "--accuracy", type=float, help="IK solver accuracy (default: opensim.accuracy; OpenSim's own default 1e-5)"
     )
     p.add_argument(
+        "--solver",
+        choices=("tree", "opensim"),
+        help="IK solver (default: opensim.ik_solver): the model's kinematic tree or OpenSim's",
+    )
+    p.add_argument(
         "--max-marker-rms-m",
         type=float,
         help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model mistake; "

@@ -30,8 +30,8 @@ from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
-from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.layout import Paths, fill
+from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.steps import events as event_steps
 from loper_analysis.steps import ik
 from loper_analysis.steps import markers as marker_steps

@@ -8,7 +8,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from loper_analysis.constants import MIN_IK_MARKERS
-from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
 from loper_analysis.motion.marker_geometry import GEOMETRY_STOP_CHANGE, GEOMETRY_WARN_CHANGE
 from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
@@ -34,6 +34,8 @@ class IKSettings:
         Coordinate -> ``{"weight": w, "value": rad or None}`` (``opensim.coordinate_tasks``).
     accuracy : float
         IK solver accuracy (``opensim.accuracy``).
+    solver : str
+        ``tree`` or ``opensim`` (``opensim.ik_solver``; :func:`loper_analysis.motion.ik.inverse_kinematics`).
     min_markers : int
         Fewest weighted markers present in a frame for IK to solve it (no config key).
     max_marker_rms_m, warn_marker_rms_m : float
@@ -60,6 +62,7 @@ class IKSettings:
     marker_weights: Mapping[str, float] | None = None
     coordinate_tasks: Mapping[str, Mapping] | None = None
     accuracy: float = IK_ACCURACY
+    solver: str = IK_SOLVER
     min_markers: int = MIN_IK_MARKERS
     max_marker_rms_m: float = IK_STOP_RMS_M
     warn_marker_rms_m: float | None = IK_WARN_RMS_M
@@ -77,7 +80,7 @@ class IKSettings:
         ----------
         config : mapping
             The validated configuration; of its section ``opensim`` the keys ``ik_tasks``,
-            ``default_marker_weight``, ``marker_weights``, ``coordinate_tasks``, ``accuracy``,
+            ``default_marker_weight``, ``marker_weights``, ``coordinate_tasks``, ``accuracy``, ``ik_solver``,
             ``max_marker_rms_m`` (m), ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``,
             ``geometry_warn_change`` and ``geometry_stop_change``.
 
@@ -93,6 +96,7 @@ class IKSettings:
             marker_weights=o["marker_weights"],
             coordinate_tasks=o["coordinate_tasks"],
             accuracy=o["accuracy"],
+            solver=o["ik_solver"],
             max_marker_rms_m=o["max_marker_rms_m"],
             warn_marker_rms_m=o["warn_marker_rms_m"],
             max_rms_fraction=o["max_rms_fraction"],

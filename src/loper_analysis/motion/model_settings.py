@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
-from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
 from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
 from loper_analysis.study_design import PERTURBED_SIDE
@@ -56,6 +56,8 @@ class ModelSettings:
         (``opensim.coordinate_map``); None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     accuracy : float
         IK solver accuracy of the scale report's static pose (``opensim.accuracy``).
+    solver : str
+        IK solver of the scale report's static pose (``opensim.ik_solver``).
     """
 
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
@@ -68,11 +70,12 @@ class ModelSettings:
     attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
     coordinate_map: Mapping[str, Mapping] | None = None
     accuracy: float = IK_ACCURACY
+    solver: str = IK_SOLVER
 
     @classmethod
     def from_config(cls, config: Mapping) -> ModelSettings:
         """The model settings of a validated config (``markers.*``, ``opensim.*``, ``trials.perturbed_side``); the
-        static pose's coordinate map and IK accuracy are the IK stage's (:meth:`IKSettings.from_config`)."""
+        static pose's coordinate map, IK accuracy and solver are the IK stage's (:meth:`IKSettings.from_config`)."""
         m, o = config["markers"], config["opensim"]
         ik = IKSettings.from_config(config)
         return cls(
@@ -85,6 +88,7 @@ class ModelSettings:
             attachment_fraction=o["brace_attachment_fraction"],
             coordinate_map=ik.coordinate_map,
             accuracy=ik.accuracy,
+            solver=ik.solver,
         )
 
     def for_generic(self) -> ModelSettings:

@@ -27,7 +27,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import JOINTS, SIDES
-from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
 from loper_analysis.motion.model_settings import ModelSettings
 
 __all__ = [
@@ -277,7 +277,7 @@ def _map_coordinate(entry) -> str:
     return entry["coordinate"] if isinstance(entry, Mapping) else entry[0]
 
 
-def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float) -> StaticFit:
+def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float, solver: str = IK_SOLVER) -> StaticFit:
     """Marker errors of the static trial's mean pose on ``model`` and the pose's joint angles: IK with the
     marker placer's weights and tasks of the window's mean, as OpenSim's marker placer takes it.
 
@@ -292,6 +292,8 @@ def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float) ->
         Our angle -> model coordinate and sign; angles whose coordinate the model lacks are left out.
     accuracy : float
         IK solver accuracy.
+    solver : str
+        IK solver (:func:`loper_analysis.motion.ik.inverse_kinematics`).
     """
     from loper_analysis.motion.ik import inverse_kinematics, joint_angle_table
 
@@ -304,6 +306,7 @@ def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float) ->
         marker_weights=weights,
         coordinate_tasks=coords,
         accuracy=accuracy,
+        solver=solver,
     )
     errors = dict(zip(result.marker_names, (float(e) for e in result.marker_errors_m[0])))
     frame = result.frame()
@@ -335,6 +338,7 @@ def scaled_model_report(
     *,
     coordinate_map: Mapping | None = None,
     accuracy: float = IK_ACCURACY,
+    solver: str = IK_SOLVER,
     lab_labels: Mapping[str, str] | None = None,
     lab_static: Mapping[str, float] | None = None,
     model_height_m: float = float("nan"),
@@ -358,6 +362,8 @@ def scaled_model_report(
         ``opensim.coordinate_map``; None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     accuracy : float
         IK accuracy of the static pose (``opensim.accuracy``).
+    solver : str
+        IK solver of the static pose (``opensim.ik_solver``).
     lab_labels, lab_static : mapping, optional
         Model marker -> the lab's label; our angle -> the lab's own static angle (rad).
     model_height_m : float
@@ -377,8 +383,8 @@ def scaled_model_report(
     weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
     weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
     cmap = DEFAULT_COORDINATE_MAP if coordinate_map is None else coordinate_map
-    after = static_fit(scaled, pose, weights, coords, cmap, accuracy)
-    before = None if unplaced is None else static_fit(unplaced, pose, weights, coords, cmap, accuracy)
+    after = static_fit(scaled, pose, weights, coords, cmap, accuracy, solver)
+    before = None if unplaced is None else static_fit(unplaced, pose, weights, coords, cmap, accuracy, solver)
     scaled_factors = {b: f for b, f in factors.items() if not np.allclose(f, 1.0)}
     warnings = static_pose_warnings((before or after).angles_rad, lab_static)
     warnings += neighbour_factor_warnings(scaled_factors, jointed_bodies(scaled))
@@ -448,6 +454,7 @@ def scale_run_report(
         subject[:3],
         coordinate_map=settings.coordinate_map,
         accuracy=settings.accuracy,
+        solver=settings.solver,
         lab_labels=lab_labels,
         lab_static=lab_static,
         model_height_m=subject[3],

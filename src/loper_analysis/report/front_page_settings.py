@@ -35,8 +35,9 @@ class FrontPageSettings:
             (:meth:`loper_analysis.study_design.StudyDesign.from_config`); the low-pass (``filter.cutoff_hz``, Hz,
             ``filter.order``) the walking trials'
             (:meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`); the fit window
-            (``identification.window_before_s``, ``window_after_s``, s) the responses'
-            (:meth:`loper_analysis.responses.response_window.ResponseWindow.from_config`); the bounds (N·m/rad, N·m·s/rad),
+            (``identification.window_before_s``, ``window_after_s``, s) the response window's
+            (:meth:`loper_analysis.responses.response_window.ResponseWindow.from_config`); the bounds
+            (N·m/rad, N·m·s/rad),
             random starts, noise model and projected components of ``identification`` the fit's
             (:meth:`loper_analysis.identification.impedance.IdentificationSettings.from_config`); ``seed`` and
             the synthetic lab's ``variability``, ``walking_duration_s`` (s) and pulse (N, s) the lab's

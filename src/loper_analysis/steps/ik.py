@@ -120,6 +120,7 @@ def _solve(
         accuracy=s.accuracy,
         min_markers=s.min_markers,
         source=source,
+        solver=s.solver,
     )
     res.geometry_change = change
     if warning:
@@ -364,6 +365,7 @@ def ik_file(
             coordinate_tasks=coordinate_tasks,
             accuracy=settings.accuracy,
             min_markers=settings.min_markers,
+            solver=settings.solver,
         )
     except LoperInputError as exc:
         raise LoperInputError(f"{markers_path} with {model_osim}: {exc}") from None
