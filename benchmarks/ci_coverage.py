@@ -18,7 +18,8 @@ chain's IK error, :data:`IK_NOISE_SD`, measured by ``--mode chain --keep DIR`` b
 ``--ik-noise-scale``); the true gait events make the stride
 tables; the robot log goes through the load-cell step's own clock map, filter and resampling; the brace
 markers are the model's; the segment table is the subject's generated model (not scaled from a static
-trial). Then the workflow's :func:`loper_analysis.identification.impedance.fit_onset`. Skips C3D files, markers, IK,
+trial). Then the workflow's :func:`loper_analysis.impedance.identification.impedance.fit_onset`. Skips C3D files,
+markers, IK,
 scaling and event detection.
 
 ``--mode chain`` (the cross-check, ~35-70 min for 34 subjects): builds a copy of the workflow with the
@@ -266,7 +267,7 @@ def coordinate_subject(
     """
     from loper_analysis.constants import JOINTS
     from loper_analysis.device.controller import DeviceParameters
-    from loper_analysis.identification.impedance import fit_onset
+    from loper_analysis.impedance.identification.impedance import fit_onset
     from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
     from loper_analysis.synthetic.subjects import subject_anthropometry
     from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial

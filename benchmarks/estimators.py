@@ -34,7 +34,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from ci_coverage import binomial_interval, run_coordinates, study_lab_config  # noqa: E402
 
-from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE  # noqa: E402
+from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE  # noqa: E402
 from loper_analysis.report.markdown import markdown_table  # noqa: E402
 
 #: (name, identification.counterfactual, identification.interval_scatter, identification.averaging_correction):

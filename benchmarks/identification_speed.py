@@ -12,8 +12,8 @@ import time
 
 import numpy as np
 
-from loper_analysis.identification import identify_impedance, prepare_window
-from loper_analysis.identification.validation import (
+from loper_analysis.impedance.identification import identify_impedance, prepare_window
+from loper_analysis.impedance.identification.validation import (
     ValidationSettings,
     impedance_grid,
     perturbed_trial,

@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
+from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.layout import RESULTS_DIR
-from loper_analysis.responses.response_window import ResponseWindow
 
 
 def covered(time_s: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from loper_analysis.constants import PARAMETERS
-from loper_analysis.identification import prepare_window, response_jacobian
-from loper_analysis.identification.validation import ValidationSettings, perturbed_trial
+from loper_analysis.impedance.identification import prepare_window, response_jacobian
+from loper_analysis.impedance.identification.validation import ValidationSettings, perturbed_trial
 from loper_analysis.reference import STUDY_VALIDATION_NOISE
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 

@@ -18,13 +18,13 @@ import time
 import numpy as np
 from scipy.optimize import least_squares
 
-from loper_analysis.identification import (
+from loper_analysis.impedance.identification import (
     DEFAULT_LOWER,
     DEFAULT_UPPER,
     identify_impedance,
 )
-from loper_analysis.identification.fit import ResidualBatch
-from loper_analysis.identification.validation import (
+from loper_analysis.impedance.identification.fit import ResidualBatch
+from loper_analysis.impedance.identification.validation import (
     ValidationSettings,
     impedance_grid,
     perturbed_trial,

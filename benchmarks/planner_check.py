@@ -12,7 +12,8 @@ the force at the robot's 1000 Hz as the fit takes it; the lab's variability of `
 own fit of all its perturbed strides, the planned impedance; the planner (:mod:`loper_analysis.planning.precision`)
 predicts the SD of every K and D for one stride from the perturbed pairs' scatter. Then ``--repeats``
 independent experiments (other seeds, same subject) are fitted exactly as the pipeline fits them
-(:func:`loper_analysis.identification.impedance.fit_onset`, null-pair noise model, intervals from the perturbed pairs'
+(:func:`loper_analysis.impedance.identification.impedance.fit_onset`, null-pair noise model, intervals from the
+perturbed pairs'
 scatter) with their first N perturbed strides, for each N of ``--strides``; their null pairs come from the
 whole trial. The measured SD is the SD of the estimates over the repeats; the prediction for the same repeats
 is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the table predicted vs measured
@@ -52,12 +53,12 @@ from scipy.stats import t as student_t
 
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
+from loper_analysis.impedance.identification.impedance import IdentificationSettings, fit_onset
+from loper_analysis.impedance.responses import ResponseSettings, null_pair_windows
 from loper_analysis.planning.covariance import conditional_stride_covariance, stretch_covariances, stride_covariance
 from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL, pilot_onset_series, pilot_perturbed_pairs
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.report.markdown import markdown_table
-from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.variability import lab_variability

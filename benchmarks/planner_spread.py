@@ -40,15 +40,15 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from planner_check import ANGLE_NOISE_SD_RAD, HEIGHT_M, MASS_KG, TRUTH, estimates, lab  # noqa: E402
 
 from loper_analysis.constants import PARAMETERS  # noqa: E402
-from loper_analysis.identification import nuisance_projection, null_pair_errors, response_jacobian  # noqa: E402
-from loper_analysis.identification.impedance import IdentificationSettings, fit_onset  # noqa: E402
+from loper_analysis.impedance.identification import nuisance_projection, null_pair_errors, response_jacobian  # noqa: E402
+from loper_analysis.impedance.identification.impedance import IdentificationSettings, fit_onset  # noqa: E402
+from loper_analysis.impedance.responses import ResponseSettings  # noqa: E402
+from loper_analysis.impedance.responses.conditional import shared_weight_terms  # noqa: E402
 from loper_analysis.planning.covariance import conditional_stride_covariance
 from loper_analysis.planning.inputs import pilot_onset_series  # noqa: E402
 from loper_analysis.planning.precision import planning_window  # noqa: E402
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.report.markdown import markdown_table  # noqa: E402
-from loper_analysis.responses import ResponseSettings  # noqa: E402
-from loper_analysis.responses.conditional import shared_weight_terms  # noqa: E402
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry  # noqa: E402
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment  # noqa: E402
 

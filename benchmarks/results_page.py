@@ -278,7 +278,7 @@ def _recovery_row(rows: pd.DataFrame, tolerance: dict) -> list[str]:
 
 def block_truth_recovery(run: Run) -> str:
     """The synthetic subjects' K and D recovered, per joint and onset."""
-    from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE
+    from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
 
     name = run.paths.impedance.table
     t = run.tsv(name)
@@ -409,7 +409,7 @@ def block_validation(run: Run) -> str:
         )
     fits = run.tsv(run.paths.validation.fits)
     if fits is not None:
-        from loper_analysis.identification.fit import AT_BEST_RELATIVE
+        from loper_analysis.impedance.identification.fit import AT_BEST_RELATIVE
 
         fits = run.need(fits, run.paths.validation.fits, ["condition", "n_starts", "n_starts_at_best"])
         parts = []

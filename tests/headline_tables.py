@@ -6,8 +6,8 @@ import math
 
 import pandas as pd
 
-from loper_analysis.identification import t_quantile
-from loper_analysis.identification.impedance import IMPEDANCE_COLUMNS
+from loper_analysis.impedance.identification import t_quantile
+from loper_analysis.impedance.identification.impedance import IMPEDANCE_COLUMNS
 from loper_analysis.reference import STUDY_DEVICE
 
 #: Degrees of freedom of the intervals of these rows (those of a fit with 31 null pairs).

@@ -127,7 +127,7 @@ def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
 
 
 def test_validation_defaults_of_the_library_are_the_configs():
-    from loper_analysis.identification.validation import ValidationSettings, validation_settings
+    from loper_analysis.impedance.identification.validation import ValidationSettings, validation_settings
 
     config = yaml.safe_load(CONFIG.read_text())
     assert ValidationSettings(**validation_settings(config)) == ValidationSettings()

@@ -21,11 +21,11 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.gait import events, outliers, strides
 from loper_analysis.gait.outliers import MIN_STRIDES_FOR_OUTLIERS, MIN_VALID_STRIDES, iqr_outliers
 from loper_analysis.gait.stride_settings import StrideSettings
-from loper_analysis.identification import t_quantile
+from loper_analysis.impedance.identification import t_quantile
+from loper_analysis.impedance.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments, write_segments
 from loper_analysis.planning.covariance import StrideCovariance
-from loper_analysis.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseSettings
 from loper_analysis.steps import strides as stride_steps
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
 from tests.parameter_sets import ASYMMETRIC
@@ -114,8 +114,8 @@ def test_step_modules_do_not_import_each_other():
 
 def test_the_iqr_rule_s_whisker_and_fraction_are_the_config_s_and_every_default():
     from loper_analysis.gait.outliers import IQR_WHISKER, MAX_OUTLIER_FRACTION
-    from loper_analysis.responses import ResponseSettings
-    from loper_analysis.responses.windows import window_outliers
+    from loper_analysis.impedance.responses import ResponseSettings
+    from loper_analysis.impedance.responses.windows import window_outliers
 
     assert (IQR_WHISKER, MAX_OUTLIER_FRACTION) == (
         CONFIG["strides"]["iqr_whisker"],

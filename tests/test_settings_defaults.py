@@ -16,10 +16,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-from loper_analysis import identification
 from loper_analysis.device.controller import DeviceParameters, FreeLeg
 from loper_analysis.device.trials import DeviceTestSettings
-from loper_analysis.identification import (
+from loper_analysis.impedance import identification
+from loper_analysis.impedance.identification import (
     DEFAULT_LOWER,
     DEFAULT_PLAUSIBLE_RANGES,
     DEFAULT_UPPER,
@@ -29,11 +29,11 @@ from loper_analysis.identification import (
     prepare_window,
     refit_with_null_pairs,
 )
-from loper_analysis.identification.impedance import IdentificationSettings, impedance_rows
-from loper_analysis.identification.validation import ValidationSettings, validation_settings
+from loper_analysis.impedance.identification.impedance import IdentificationSettings, impedance_rows
+from loper_analysis.impedance.identification.validation import ValidationSettings, validation_settings
+from loper_analysis.impedance.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
+from loper_analysis.impedance.responses.response_window import WINDOW_KEYS, ResponseWindow
 from loper_analysis.planning.window import PlanSettings
-from loper_analysis.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
-from loper_analysis.responses.response_window import WINDOW_KEYS, ResponseWindow
 from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 

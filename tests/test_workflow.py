@@ -124,7 +124,7 @@ def test_processing_outputs_from_the_default_run(finished_run):
 
 def test_impedance_table_from_the_default_run(finished_run):
     """One subject, one 25 s trial at the 50 ms onset: too few perturbations to fit, reported as failed."""
-    from loper_analysis.identification.impedance import IMPEDANCE_COLUMNS
+    from loper_analysis.impedance.identification.impedance import IMPEDANCE_COLUMNS
 
     table = pd.read_csv(finished_run / PATHS.impedance.table, sep="\t")
     assert list(table.columns) == list(IMPEDANCE_COLUMNS)

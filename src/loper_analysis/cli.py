@@ -215,7 +215,7 @@ def _segments(args: argparse.Namespace) -> None:
 
 
 def _validate(args: argparse.Namespace) -> None:
-    from loper_analysis.identification.validation import ValidationSettings
+    from loper_analysis.impedance.identification.validation import ValidationSettings
     from loper_analysis.steps.validation import validation_chunk
 
     config, line = _read_config(args)

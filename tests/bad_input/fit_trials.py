@@ -1,12 +1,12 @@
-"""Trials for :func:`loper_analysis.identification.impedance.fit_onset` built from the twin strides of
-``tests.responses.twin_strides``: joint angles, stride table, rod force and the two brace markers."""
+"""Trials for :func:`loper_analysis.impedance.identification.impedance.fit_onset` built from the twin strides of
+``tests.impedance.responses.twin_strides``: joint angles, stride table, rod force and the two brace markers."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from loper_analysis.swing_leg.dynamics import segment_coordinates
-from tests.responses.twin_strides import JOINT_COLS, make_trial
+from tests.impedance.responses.twin_strides import JOINT_COLS, make_trial
 
 ONSET_MS = 100  # the planted onsets lie 13 frames (101.6 ms) after toe-off
 
@@ -21,7 +21,7 @@ def brace_markers(trial) -> tuple[np.ndarray, np.ndarray, list[str]]:
 
 
 def fit_inputs(trial) -> dict:
-    """The mapping :func:`loper_analysis.identification.impedance.fit_onset` takes for one trial."""
+    """The mapping :func:`loper_analysis.impedance.identification.impedance.fit_onset` takes for one trial."""
     return {
         "name": trial.name,
         "angles": trial.angles,

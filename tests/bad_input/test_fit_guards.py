@@ -17,15 +17,15 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import identify_impedance
-from loper_analysis.identification.impedance import IdentificationSettings, fit_onset, impedance_rows
-from loper_analysis.identification.validation import (
+from loper_analysis.impedance.identification import identify_impedance
+from loper_analysis.impedance.identification.impedance import IdentificationSettings, fit_onset, impedance_rows
+from loper_analysis.impedance.identification.validation import (
     ValidationSettings,
     perturbed_trial,
     validation_window,
 )
-from loper_analysis.responses import ResponseSettings
-from loper_analysis.responses.response_window import ResponseWindow
+from loper_analysis.impedance.responses import ResponseSettings
+from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.steps.validation import validation_chunk
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.bad_input.fit_trials import ONSET_MS, fit_inputs, walking_trial
@@ -170,7 +170,7 @@ def test_a_grossly_deviant_trial_is_left_out_of_the_null_pairs(onset_trials, cap
     device = walking_trial("walk-device", 3, perturbed=())
     bad = walking_trial("pert300-1", 4, spread=1.0)
     good = [*onset_trials, device]
-    with caplog.at_level(logging.WARNING, logger="loper_analysis.responses.null_pairs"):
+    with caplog.at_level(logging.WARNING, logger="loper_analysis.impedance.responses.null_pairs"):
         with_bad = _fit(onset_trials, 0.25, null=[*good, bad], counterfactual="matched_stride")
     assert "trial pert300-1 left out of the null pairs" in caplog.text
     without = _fit(onset_trials, 0.25, null=good, counterfactual="matched_stride")

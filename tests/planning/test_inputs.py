@@ -12,9 +12,9 @@ import pytest
 
 from loper_analysis.device.analysis import step_metrics
 from loper_analysis.errors import LoperInputError
+from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs, pulse_force_n, trial_stretches
 from loper_analysis.reference import STUDY_DEVICE
-from loper_analysis.responses import ResponseSettings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 

@@ -11,6 +11,7 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.impedance.responses import ResponseSettings, null_pair_windows
 from loper_analysis.planning.covariance import stride_covariance
 from loper_analysis.planning.inputs import pilot_perturbed_pairs
 from loper_analysis.planning.pilot_plan import (
@@ -22,7 +23,6 @@ from loper_analysis.planning.pilot_plan import (
 )
 from loper_analysis.planning.precision import precision_table, target_answer
 from loper_analysis.planning.window import PlanSettings
-from loper_analysis.responses import ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 

@@ -26,7 +26,7 @@ from scipy.stats import t as student_t
 from loper_analysis.cli import main
 from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import (
+from loper_analysis.impedance.identification import (
     cross_validated_covariance,
     identify_impedance,
     nuisance_projection,
@@ -34,8 +34,10 @@ from loper_analysis.identification import (
     response_jacobian,
     simulate_response,
 )
-from loper_analysis.identification.impedance import IdentificationSettings, fit_onset
-from loper_analysis.identification.intervals import t_quantile
+from loper_analysis.impedance.identification.impedance import IdentificationSettings, fit_onset
+from loper_analysis.impedance.identification.intervals import t_quantile
+from loper_analysis.impedance.responses import ResponseSettings, null_pair_windows
+from loper_analysis.impedance.responses.conditional import shared_weight_terms, unit_scatter_variance
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import write_segments
 from loper_analysis.planning.covariance import (
@@ -49,8 +51,6 @@ from loper_analysis.planning.covariance import (
 from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs, pulse_force_n, trial_stretches
 from loper_analysis.planning.precision import precision_table, strides_needed, target_answer
 from loper_analysis.planning.window import PlanSettings, planning_window
-from loper_analysis.responses import ResponseSettings, null_pair_windows
-from loper_analysis.responses.conditional import shared_weight_terms, unit_scatter_variance
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 from loper_analysis.synthetic.response import thigh_normal

@@ -19,8 +19,8 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import JOINTS
-from loper_analysis.identification.across_subjects import impedance_summary
-from loper_analysis.identification.group_mean import random_effects_mean
+from loper_analysis.impedance.identification.across_subjects import impedance_summary
+from loper_analysis.impedance.identification.group_mean import random_effects_mean
 from loper_analysis.layout import Paths
 from loper_analysis.report.front_page import RunSettings, front_page_html
 from loper_analysis.report.front_page_settings import FrontPageSettings

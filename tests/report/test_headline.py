@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.across_subjects import impedance_summary
+from loper_analysis.impedance.identification.across_subjects import impedance_summary
 from loper_analysis.reference import STUDY_DEVICE
 from loper_analysis.report.headline import (
     ci_coverage_p,

@@ -11,9 +11,9 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.impedance import IdentificationSettings
+from loper_analysis.impedance.identification.impedance import IdentificationSettings
+from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.truth import write_truth
-from loper_analysis.responses import ResponseSettings
 from loper_analysis.steps.impedance import FitFiles, FitOutputs, FitSettings, TrialFiles, fit, subject_fits
 
 

@@ -9,7 +9,7 @@ Known answers used here:
 * a physical pendulum (thigh alone, cart pinned by a huge mass);
 * virtual work of the joint torques;
 * the segment table: the frame round trip and its input checks;
-* the compiled RK4 of :mod:`loper_analysis.identification` against SciPy's
+* the compiled RK4 of :mod:`loper_analysis.impedance.identification` against SciPy's
   DOP853 in :func:`loper_analysis.swing_leg.dynamics.simulate`.
 """
 
@@ -20,9 +20,9 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import prepare_window, simulate_response
-from loper_analysis.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
-from loper_analysis.responses.response_window import ResponseWindow
+from loper_analysis.impedance.identification import prepare_window, simulate_response
+from loper_analysis.impedance.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
+from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.swing_leg.dynamics import (
     SegmentParameters,
     attachment_jacobian,

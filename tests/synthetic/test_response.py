@@ -116,7 +116,7 @@ def test_responses_look_like_the_study(trial):
 
 def test_identification_recovers_the_truth_from_the_simulated_swing(trial, params):
     """The response at the 128 Hz frames, identified with the measured forces: the lab and the fit agree."""
-    from loper_analysis.identification import identify_impedance, prepare_window
+    from loper_analysis.impedance.identification import identify_impedance, prepare_window
     from loper_analysis.swing_leg.dynamics import segment_coordinates
 
     free = simulate_walking_trial(

@@ -15,7 +15,7 @@ from loper_analysis.steps.planning import PlanningSettings
 from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.transparency import TransparencySettings
-from loper_analysis.identification.validation import ValidationSettings
+from loper_analysis.impedance.identification.validation import ValidationSettings
 
 # the config's sections
 TRIALS = config["trials"]

@@ -201,7 +201,7 @@ def robot_log_frames_and_native(
     the sample's time mapped to the mocap clock (s), the low-passed forces (N)
     and the flag (0.0/1.0). The robot rate keeps the pulse's edges, which the
     128 Hz frames cut short: the fit takes its force from there
-    (:func:`loper_analysis.identification.prepare_window`, ``force_time_s``).
+    (:func:`loper_analysis.impedance.identification.prepare_window`, ``force_time_s``).
     Same parameters and errors as :func:`robot_log_on_mocap_frames`.
     """
     src = source or "robot log"

@@ -20,7 +20,7 @@ import numpy as np
 
 from loper_analysis.checks import integer
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import (
+from loper_analysis.impedance.identification import (
     cross_validated_covariance,
     nuisance_projection,
     null_pair_errors,
@@ -91,7 +91,7 @@ class StrideCovariance:
 
     def t95(self, n_strides: int) -> float:
         """Student's t at 97.5 % the fit of ``n_strides`` averaged strides uses (inf when it has no dof;
-        :func:`~loper_analysis.identification.t_quantile`, the fit's own)."""
+        :func:`~loper_analysis.impedance.identification.t_quantile`, the fit's own)."""
         dof = int(n_strides) - 1 if self.dof is None else int(self.dof)
         return t_quantile(dof) if dof >= 1 else math.inf
 
@@ -113,17 +113,17 @@ def stride_covariance(
 
     ``impedance`` (6,): the planned values (order :data:`PARAMETERS`; N·m/rad
     and N·m·s/rad), e.g. the pilot's estimate. With the window of
-    :func:`planning_window`, ``J`` = :func:`~loper_analysis.identification.response_jacobian`
+    :func:`planning_window`, ``J`` = :func:`~loper_analysis.impedance.identification.response_jacobian`
     at ``impedance``, the null-pair errors ``E0`` =
-    :func:`~loper_analysis.identification.null_pair_errors`, ``W`` =
-    :func:`~loper_analysis.identification.nuisance_projection` of ``E0``
+    :func:`~loper_analysis.impedance.identification.null_pair_errors`, ``W`` =
+    :func:`~loper_analysis.impedance.identification.nuisance_projection` of ``E0``
     (``settings.null_pair_components`` shapes) and ``M = (W J)^+ W``:
     ``cov_1 = M cov(E) M^T``. For ``N`` strides the covariance is ``cov_1 / N``.
 
     ``E`` are the prediction errors of the pilot's ``perturbed_pairs`` (the
     kept perturbed-minus-matched pairs at this onset one by one, format of
     ``null_pairs``: ``series["pairs"]`` of
-    :func:`loper_analysis.responses.subject_onset_response`): their scatter
+    :func:`loper_analysis.impedance.responses.subject_onset_response`): their scatter
     holds the stride-to-stride deviation *and* each stride's own answer to
     the pulse, the scatter the fit's intervals take
     (``identification.interval_scatter: perturbed_pairs``). Without them, or
@@ -201,11 +201,11 @@ def conditional_stride_covariance(
     ``unit_scatter_variance``), and ``pairs``, its perturbed pairs (with their
     ``prediction_weights`` over the candidates). With the window of
     :func:`planning_window`, the errors ``E0`` of the null pairs, ``J`` at
-    ``impedance`` and ``V`` = :func:`~loper_analysis.identification.cross_validated_covariance`
+    ``impedance`` and ``V`` = :func:`~loper_analysis.impedance.identification.cross_validated_covariance`
     of ``E0`` for one stride, white stride noise of variance ``s^2`` gives
     ``V = s^2 v`` (``v`` the unit scatter variance), and the mean of ``N``
     predicted pairs has ``s^2 (1 / N + |mu|^2 + tr Sigma / N)``
-    (:func:`loper_analysis.responses.conditional.shared_weight_terms` of the
+    (:func:`loper_analysis.impedance.responses.conditional.shared_weight_terms` of the
     pilot's ``P`` perturbed pairs' weights over its candidates). The planned
     experiment perturbs at the pilot's rate, so its candidates grow with
     ``N`` and both weight terms, about inversely proportional to the
@@ -221,7 +221,7 @@ def conditional_stride_covariance(
         (their weights say how much of the candidates' noise the mean keeps),
         a planned value outside the bounds.
     """
-    from loper_analysis.responses.conditional import shared_weight_terms
+    from loper_analysis.impedance.responses.conditional import shared_weight_terms
 
     p = planned_impedance(impedance, settings, source)
     null = series.get("null_pairs") or {}
@@ -293,10 +293,10 @@ def stretch_covariances(
     experiments of that size. Counts held fewer times are left out (plan them
     with the whole pilot); a stretch that cannot be planned (too few
     candidates or no perturbed stride kept) is skipped. ``response``: the
-    response settings (default :class:`~loper_analysis.responses.ResponseSettings`,
+    response settings (default :class:`~loper_analysis.impedance.responses.ResponseSettings`,
     whose counterfactual must be ``conditional``).
     """
-    from loper_analysis.responses import ResponseSettings
+    from loper_analysis.impedance.responses import ResponseSettings
 
     response = ResponseSettings() if response is None else response
     if response.counterfactual != "conditional":

@@ -84,10 +84,11 @@ def pilot_onset_series(
     onset_tolerance_ms: float = 12.5,
     source: str = "pilot",
 ) -> dict | None:
-    """The pilot's response series at ``onset_ms`` (of :func:`~loper_analysis.responses.subject_onset_response`).
+    """The pilot's response series at ``onset_ms`` (of
+    :func:`~loper_analysis.impedance.responses.subject_onset_response`).
 
     ``trials``: ``name``, ``angles`` and ``strides`` tables of the pilot's
-    trials with the device (:mod:`loper_analysis.responses.inputs`). Those
+    trials with the device (:mod:`loper_analysis.impedance.responses.inputs`). Those
     whose perturbed strides' median onset (``onset_s - toe_off_s``) lies
     within ``onset_tolerance_ms`` of ``onset_ms`` are the onset's; their
     pairs are matched (or predicted), windowed and judged for outliers as the
@@ -98,7 +99,7 @@ def pilot_onset_series(
     zero force). None when no trial is the onset's.
     """
     from loper_analysis.errors import TooFewStridesWarning
-    from loper_analysis.responses import ResponseSettings, subject_onset_response
+    from loper_analysis.impedance.responses import ResponseSettings, subject_onset_response
 
     own = []
     for tr in trials:

@@ -19,6 +19,8 @@ import pandas as pd
 from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
+from loper_analysis.impedance.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
+from loper_analysis.impedance.responses.response_window import WINDOW_KEYS
 from loper_analysis.planning.covariance import (
     conditional_stride_covariance,
     pool_onsets,
@@ -28,8 +30,6 @@ from loper_analysis.planning.covariance import (
 from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs
 from loper_analysis.planning.precision import precision_table, target_answer, unplanned_rows
 from loper_analysis.planning.window import PLAN_IDENTIFICATION_KEYS, PlanSettings
-from loper_analysis.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
-from loper_analysis.responses.response_window import WINDOW_KEYS
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = ["STRIDES", "PlanningSettings", "check_plan_request", "pilot_plan", "planned_impedance"]
@@ -72,7 +72,7 @@ class PlanningSettings:
         The planned pulse (N, s) and the identification settings the prediction follows
         (:class:`~loper_analysis.planning.window.PlanSettings`).
     response : ResponseSettings
-        How the pilot's pairs are windowed and judged (:class:`~loper_analysis.responses.ResponseSettings`),
+        How the pilot's pairs are windowed and judged (:class:`~loper_analysis.impedance.responses.ResponseSettings`),
         and the counterfactual planned for: ``conditional`` (the default) takes the fit's cross-validated null
         pairs, ``matched_stride`` the scatter of the pilot's perturbed pairs
         (:func:`~loper_analysis.planning.covariance.conditional_stride_covariance`).
@@ -104,7 +104,7 @@ class PlanningSettings:
             ``strides``, ``targets``: ``planning.strides``, ``planning.targets``; ``plan``: the pulse
             ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s) with the keys of
             ``identification`` the planner follows (the fit window and initial-state span as a
-            :class:`~loper_analysis.responses.ResponseWindow` in s, substeps, projected
+            :class:`~loper_analysis.impedance.responses.ResponseWindow` in s, substeps, projected
             components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad);
             ``response``: the same window and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``, the
             counterfactual planned for ``identification.counterfactual``; ``device``: ``device.parameters``;

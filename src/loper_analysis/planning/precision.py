@@ -1,6 +1,6 @@
 """Planning an experiment: the precision of K and D before anyone walks (method: ``docs/planning.md``).
 
-The null-pair fit (:mod:`loper_analysis.identification.null_pairs`) takes the
+The null-pair fit (:mod:`loper_analysis.impedance.identification.null_pairs`) takes the
 covariance of its estimate by the sandwich ``cov = M C M^T`` with
 ``M = (W J)^+ W``, ``C = cov(E) / N`` (``E`` the prediction errors of pairs
 one by one, ``N`` the perturbed strides averaged, ``W`` the projection of the
@@ -26,10 +26,10 @@ The planner's parts, each in its module:
 
 The identification's own functions build the window, the Jacobian, the
 null-pair errors and the projection
-(:func:`~loper_analysis.identification.prepare_window`,
-:func:`~loper_analysis.identification.response_jacobian`,
-:func:`~loper_analysis.identification.null_pair_errors`,
-:func:`~loper_analysis.identification.nuisance_projection`), so the
+(:func:`~loper_analysis.impedance.identification.prepare_window`,
+:func:`~loper_analysis.impedance.identification.response_jacobian`,
+:func:`~loper_analysis.impedance.identification.null_pair_errors`,
+:func:`~loper_analysis.impedance.identification.nuisance_projection`), so the
 prediction is the fit's own covariance formula.
 """
 
@@ -44,7 +44,7 @@ import pandas as pd
 from loper_analysis.checks import number
 from loper_analysis.constants import JOINTS, PARAMETER_UNITS, PARAMETERS
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import (
+from loper_analysis.impedance.identification import (
     t_quantile,
 )
 from loper_analysis.planning.covariance import StrideCovariance, stride_counts

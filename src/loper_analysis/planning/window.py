@@ -18,19 +18,19 @@ from loper_analysis.checks import number
 from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification import (
+from loper_analysis.impedance.identification import (
     FitBounds,
     PreparedWindow,
     check_interval_scatter,
     prepare_window,
     window_options,
 )
-from loper_analysis.identification.fit import DAMPING_BOUNDS_NMS_PER_RAD, STIFFNESS_BOUNDS_NM_PER_RAD
-from loper_analysis.identification.null_pairs import MIN_NULL_PAIRS, NULL_PAIR_COMPONENTS
-from loper_analysis.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS
+from loper_analysis.impedance.identification.fit import DAMPING_BOUNDS_NMS_PER_RAD, STIFFNESS_BOUNDS_NM_PER_RAD
+from loper_analysis.impedance.identification.null_pairs import MIN_NULL_PAIRS, NULL_PAIR_COMPONENTS
+from loper_analysis.impedance.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS
+from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.planning.inputs import pulse_force_n
-from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
@@ -53,7 +53,7 @@ class PlanSettings(FitBounds):
     """The planned pulse and the identification settings the prediction follows (config ``identification``).
 
     ``pulse_force_n`` (N, desired force) for ``pulse_duration_s`` (s) from the
-    onset; ``window`` (:class:`~loper_analysis.responses.response_window.ResponseWindow`: the fit's
+    onset; ``window`` (:class:`~loper_analysis.impedance.responses.response_window.ResponseWindow`: the fit's
     window and initial-state span, s), ``initial_state_degree``, ``n_substeps``, ``null_pair_components``,
     ``min_null_pairs``, ``interval_scatter`` (whose scatter the fit's
     intervals take, hence their t quantile) and the bounds (N·m/rad,
@@ -110,11 +110,11 @@ def planning_window(
     Reference: the mean of the pilot's unperturbed null-pair strides
     (``null_pairs["q_unperturbed"]`` (M, n, 4) and
     ``pelvis_angle_unperturbed_rad`` (M, n), on the grid ``time_s`` (n,)
-    relative to the onset; :func:`loper_analysis.responses.null_pair_windows`),
+    relative to the onset; :func:`loper_analysis.impedance.responses.null_pair_windows`),
     the mean swing a perturbed stride starts from. The perturbed force is
     :func:`pulse_force_n` along the thigh's forward normal of that swing,
     given to the fit at ``settings.force_rate_hz`` (``force_time_s`` of
-    :func:`~loper_analysis.identification.prepare_window`, as the fit takes
+    :func:`~loper_analysis.impedance.identification.prepare_window`, as the fit takes
     the robot log's samples); the minimal-impedance force and the initial
     deviation are zero (they average out over the perturbed strides).
     ``measured`` is zero: only the model's sensitivities are used.

@@ -31,7 +31,7 @@ import pandas as pd
 
 from loper_analysis.constants import PARAMETER_UNITS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE
+from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
 from loper_analysis.reference import STUDY_SWING_IMPEDANCE
 from loper_analysis.report.headline import (
     COVERAGE_TARGET,

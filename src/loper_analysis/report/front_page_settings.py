@@ -6,10 +6,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass
 
-from loper_analysis.identification.impedance import IdentificationSettings
+from loper_analysis.impedance.identification.impedance import IdentificationSettings
+from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.motion.trial_markers import MarkerSettings
 from loper_analysis.report.front_page import RunSettings
-from loper_analysis.responses.response_window import ResponseWindow
 from loper_analysis.study_design import StudyDesign
 from loper_analysis.synthetic.lab_session import LabSessionSettings
 
@@ -36,10 +36,10 @@ class FrontPageSettings:
             ``filter.order``) the walking trials'
             (:meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`); the fit window
             (``identification.window_before_s``, ``window_after_s``, s) the response window's
-            (:meth:`loper_analysis.responses.response_window.ResponseWindow.from_config`); the bounds
+            (:meth:`loper_analysis.impedance.responses.response_window.ResponseWindow.from_config`); the bounds
             (N·m/rad, N·m·s/rad),
             random starts, noise model and projected components of ``identification`` the fit's
-            (:meth:`loper_analysis.identification.impedance.IdentificationSettings.from_config`); ``seed`` and
+            (:meth:`loper_analysis.impedance.identification.impedance.IdentificationSettings.from_config`); ``seed`` and
             the synthetic lab's ``variability``, ``walking_duration_s`` (s) and pulse (N, s) the lab's
             (:meth:`loper_analysis.synthetic.lab_session.LabSessionSettings.from_config`).
 

@@ -28,7 +28,7 @@ import pandas as pd
 from loper_analysis.checks import integer, number, require_columns, where
 from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.across_subjects import TRUTH_TOLERANCE
+from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
 from loper_analysis.reference import STUDY_DEVICE
 
 __all__ = [
@@ -52,7 +52,7 @@ PARAMETER_KINDS: tuple[str, ...] = ("K", "D")
 #: than 90 % is too narrow, more than 98 % too wide to be informative.
 COVERAGE_TARGET: tuple[float, float] = (0.90, 0.98)
 #: Share of the fits whose K (and D) should lie within tolerance of the truth
-#: (:data:`loper_analysis.identification.across_subjects.TRUTH_TOLERANCE`).
+#: (:data:`loper_analysis.impedance.identification.across_subjects.TRUTH_TOLERANCE`).
 WITHIN_TOLERANCE_TARGET: float = 0.90
 
 
@@ -79,7 +79,8 @@ def impedance_summary_ci(summary: pd.DataFrame, source: str = "") -> pd.DataFram
     summary : pandas.DataFrame
         ``results/impedance/summary.tsv``: ``joint, onset_ms, n_subjects, n_not_identifiable``,
         ``K_group_mean_nm_per_rad``, ``K_group_ci95_low_nm_per_rad``, ``K_group_ci95_high_nm_per_rad``
-        (N·m/rad), the same for D (N·m·s/rad; :func:`loper_analysis.identification.group_mean.random_effects_mean`:
+        (N·m/rad), the same for D (N·m·s/rad;
+        :func:`loper_analysis.impedance.identification.group_mean.random_effects_mean`:
         each fit weighted by its own standard error and the between-subject spread) and ``vaf_pct_mean`` (%).
         No rows: nothing was fitted.
     source : str
@@ -153,7 +154,8 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
     Parameters
     ----------
     impedance : pandas.DataFrame
-        ``results/impedance/impedance.tsv`` (:data:`loper_analysis.identification.impedance.IMPEDANCE_COLUMNS`):
+        ``results/impedance/impedance.tsv``
+        (:data:`loper_analysis.impedance.identification.impedance.IMPEDANCE_COLUMNS`):
         per subject, onset and joint the estimate, its 95 % CI, the truth and
         the error (estimate - truth; K in N·m/rad, D in N·m·s/rad), and ``status``.
     source : str
@@ -168,7 +170,8 @@ def truth_recovery(impedance: pd.DataFrame, source: str = "") -> pd.DataFrame:
         per parameter over the fits: ``K_error_mean_nm_per_rad`` (bias),
         ``K_error_median_abs_nm_per_rad``, ``K_error_median_abs_pct`` (median
         of ``|error| / |truth|``, %; truths of 0 left out),
-        ``K_n_within_tolerance`` (:data:`loper_analysis.identification.across_subjects.TRUTH_TOLERANCE`, the rule of the
+        ``K_n_within_tolerance`` (:data:`loper_analysis.impedance.identification.across_subjects.TRUTH_TOLERANCE`,
+        the rule of the
         across-subject summary) and
         ``K_n_truth_in_ci95`` (the truth inside the fit's 95 % CI, bounds
         included); the same for D. No truth known: no rows.

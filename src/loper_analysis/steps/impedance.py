@@ -15,11 +15,11 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.identification.impedance import IdentificationSettings
+from loper_analysis.impedance.identification.impedance import IdentificationSettings
+from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.truth import read_truth
-from loper_analysis.responses import ResponseSettings
 
 __all__ = [
     "FitSettings",
@@ -41,9 +41,9 @@ log = logging.getLogger(__name__)
 class FitSettings:
     """How a subject's responses are windowed and averaged and its impedance fitted and judged.
 
-    ``response``: :class:`~loper_analysis.responses.ResponseSettings` (fit window and initial-state span in s,
+    ``response``: :class:`~loper_analysis.impedance.responses.ResponseSettings` (fit window and initial-state span in s,
     the IQR rule, the fewest kept pairs); ``identification``:
-    :class:`~loper_analysis.identification.impedance.IdentificationSettings` (noise model, starts, bounds in
+    :class:`~loper_analysis.impedance.identification.impedance.IdentificationSettings` (noise model, starts, bounds in
     N·m/rad and N·m·s/rad, judgement, seed).
     """
 
@@ -131,7 +131,7 @@ class _Tables:
 
 def fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings = FitSettings()) -> pd.DataFrame:
     """Responses and the impedance fit of one subject at one onset
-    (:func:`loper_analysis.identification.impedance.fit_onset`).
+    (:func:`loper_analysis.impedance.identification.impedance.fit_onset`).
 
     ``files`` (:class:`FitFiles`): the onset's trials, the null-pair trials, the segment table, the truth and
     the outputs; ``settings`` (:class:`FitSettings`): the response and identification settings. Writes the
@@ -143,7 +143,7 @@ def fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings = Fi
 
 def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, tables: _Tables) -> pd.DataFrame:
     """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
-    from loper_analysis.identification.impedance import fit_onset
+    from loper_analysis.impedance.identification.impedance import fit_onset
     from loper_analysis.io.opensim_tables import read_markers
     from loper_analysis.io.segment_table import read_segments
 
@@ -216,8 +216,8 @@ def impedance_summary(
     ``upper_bounds`` (K, D): rows with an estimate on its upper bound are left out of the summary;
     ``lower_bounds`` (K, D): where the across-subject intervals are cut (N·m/rad, N·m·s/rad).
     """
-    from loper_analysis.identification.across_subjects import impedance_summary as summarise
-    from loper_analysis.identification.across_subjects import literature_table
+    from loper_analysis.impedance.identification.across_subjects import impedance_summary as summarise
+    from loper_analysis.impedance.identification.across_subjects import literature_table
 
     summary = summarise(
         read_tsv(impedance_tsv, "impedance table"), upper_bounds=upper_bounds, lower_bounds=lower_bounds

@@ -12,7 +12,7 @@ from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 
 if TYPE_CHECKING:  # the identification package is imported by the chunk step only
-    from loper_analysis.identification.validation import ValidationSettings
+    from loper_analysis.impedance.identification.validation import ValidationSettings
 
 __all__ = [
     "VALIDATION_FLOAT_FORMAT",
@@ -48,8 +48,12 @@ def validation_chunk(
     fits_out: PathLike,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Simulate and identify chunk ``chunk`` of ``n_chunks`` of the combinations (``settings``: the study's
-    :class:`~loper_analysis.identification.validation.ValidationSettings`); write its two tables."""
-    from loper_analysis.identification.validation import chunk_combinations, impedance_grid, run_validation_chunk
+    :class:`~loper_analysis.impedance.identification.validation.ValidationSettings`); write its two tables."""
+    from loper_analysis.impedance.identification.validation import (
+        chunk_combinations,
+        impedance_grid,
+        run_validation_chunk,
+    )
     from loper_analysis.io.segment_table import read_segments
 
     study = settings
@@ -71,7 +75,7 @@ def validation_tables(
     summary_out: PathLike,
 ) -> pd.DataFrame:
     """Gather the chunks' tables and write them with the summary beside the study's values; returns the summary."""
-    from loper_analysis.identification.validation import gather_validation_tables
+    from loper_analysis.impedance.identification.validation import gather_validation_tables
 
     errors, fits, summary = gather_validation_tables(
         [read_tsv(p, "error table") for p in error_tsvs], [read_tsv(p, "fit table") for p in fit_tsvs]

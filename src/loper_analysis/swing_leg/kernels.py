@@ -3,7 +3,7 @@
 Everything here works on a packed parameter vector (see
 ``SegmentParameters.packed``) and plain float64 arrays so that numba can compile
 it once (``cache=True``) and the Python layer in :mod:`loper_analysis.swing_leg.dynamics`
-and :mod:`loper_analysis.identification` stays readable.
+and :mod:`loper_analysis.impedance.identification` stays readable.
 
 Packed segment vector ``packed`` (length :data:`N_PACKED`)::
 

@@ -6,7 +6,7 @@ the unperturbed stride is the reference, its inverse dynamics with the
 minimal-impedance force ``F_u`` is the feedforward, and the perturbed leg
 is driven by ``u_ff + u_fb + Ja(q)^T F_p - Ja(q_u)^T F_u`` with
 ``T = -K dtheta - D dtheta'`` per joint. It is integrated with RK4
-(:func:`loper_analysis.identification.simulate_response`) on the analog
+(:func:`loper_analysis.impedance.identification.simulate_response`) on the analog
 grid (1024 Hz), much finer than the 128 Hz the pipeline later sees.
 
 Force direction: the rods push on the brace perpendicular to the thigh, in
@@ -107,8 +107,8 @@ def swing_response(
     :data:`loper_analysis.constants.PARAMETERS`. Zero before
     ``onset_s - before_s``; simulated to ``heel_strike_s``; faded out after.
     """
-    from loper_analysis.identification import prepare_window, simulate_response
-    from loper_analysis.responses.response_window import ResponseWindow
+    from loper_analysis.impedance.identification import prepare_window, simulate_response
+    from loper_analysis.impedance.responses.response_window import ResponseWindow
 
     t = np.asarray(time_s, float)
     th = np.asarray(joint_angles_rad, float)

@@ -7,7 +7,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
-from loper_analysis.identification.validation import CONDITIONS
+from loper_analysis.impedance.identification.validation import CONDITIONS
 from loper_analysis.report.figures import pyplot
 from loper_analysis.report.figures.validation import validation_errors_figure
 

@@ -51,7 +51,8 @@ ANALYSIS_WINDOW_MS: tuple[float, float] = (-25.0, 250.0)
 IMPEDANCE_STATUSES_SHOWN: tuple[str, ...] = ("ok", "not_identifiable")
 
 _RAD_TO_DEG = 180.0 / np.pi
-#: Columns of a response table (:func:`loper_analysis.responses.subject_onset_response`) that the figure draws.
+#: Columns of a response table (:func:`loper_analysis.impedance.responses.subject_onset_response`) that the figure
+#: draws.
 RESPONSE_COLUMNS: tuple[str, ...] = (
     "time_s",
     *(f"{j}_{kind}" for j in JOINTS for kind in ("rad_mean", "rad_sd", "perturbed_rad_mean", "unperturbed_rad_mean")),

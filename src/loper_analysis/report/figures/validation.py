@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
-from loper_analysis.identification.validation import CONDITIONS
+from loper_analysis.impedance.identification.validation import CONDITIONS
 from loper_analysis.report.figures import pyplot
 
 if TYPE_CHECKING:

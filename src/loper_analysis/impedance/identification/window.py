@@ -1,0 +1,544 @@
+"""The identification window: one perturbed/unperturbed pair prepared for the compiled simulation, and its model
+response.
+
+:func:`prepare_window` checks the inputs of one fit and precomputes the
+reference (a cubic spline of the unperturbed coordinates), the feedforward
+(its inverse dynamics with the unperturbed force), the perturbed force and
+the initial deviation; :func:`simulate_response` integrates the deviation
+``e = q_model - q_u`` with fixed-step RK4 for any number of impedance sets
+at once; :func:`prediction_error` is measured minus model. Method:
+``docs/identification.md``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from loper_analysis.checks import finite_rows
+from loper_analysis.errors import LoperInputError
+from loper_analysis.impedance.responses.response_window import (
+    INITIAL_STATE_SPAN_S,
+    WINDOW_AFTER_S,
+    WINDOW_BEFORE_S,
+    ResponseWindow,
+)
+from loper_analysis.swing_leg import kernels
+from loper_analysis.swing_leg.dynamics import SegmentParameters, inverse_dynamics, joint_angles
+
+__all__ = [
+    "WINDOW_FIELDS",
+    "window_options",
+    "WINDOW_BEFORE_S",
+    "WINDOW_AFTER_S",
+    "INITIAL_STATE_SPAN_S",
+    "INITIAL_STATE_DEGREE",
+    "N_SUBSTEPS",
+    "PreparedWindow",
+    "prepare_window",
+    "initial_state_basis",
+    "stage_force_means",
+    "stage_times_s",
+    "per_step",
+    "step_stage_forces",
+    "simulate_deviation",
+    "joint_angle_deviation",
+    "simulate_response",
+    "prediction_error",
+]
+
+# Defaults of the fit's initial state and integration (config ``identification.*``, the same values); the
+# window's span (WINDOW_BEFORE_S, WINDOW_AFTER_S, INITIAL_STATE_SPAN_S) is the responses' own
+# (:class:`loper_analysis.impedance.responses.response_window.ResponseWindow`): the fit covers the window the responses
+# were cut to.
+#: Degree of that polynomial (1: position and rate; ``identification.initial_state_degree``).
+INITIAL_STATE_DEGREE: int = 1
+#: RK4 steps per sample of the data (``identification.n_substeps``).
+N_SUBSTEPS: int = 2
+
+
+@dataclass(frozen=True)
+class PreparedWindow:
+    """Everything the compiled simulation needs for one perturbed/unperturbed pair.
+
+    Stage arrays are sampled every ``step_s / 2`` from the window start
+    (``2 * n_steps + 1`` rows): the reference coordinates ``reference_q``
+    and their first and second derivatives (n_stage, 4; m and rad),
+    ``feedforward`` = u_ff - Ja(q_u)^T F_u, the inverse dynamics of the
+    reference with the unperturbed force (n_stage, 4; N and N·m),
+    ``force_perturbed_n`` (n_steps, 4, 2; N, world x/y: the force at the four
+    stages of every RK4 step) and
+    ``pelvis_deviation`` (n_stage, 2): the perturbed-minus-unperturbed pelvis
+    angle (rad) and its rate (rad/s). ``measured`` (n_out, 3) is the
+    measured perturbed-minus-unperturbed joint angle difference (rad) at the
+    window's samples ``time_s`` (n_out,). ``initial_deviation`` and
+    ``initial_rate`` (4,) are the coordinate deviation and its rate at window
+    start; ``initial_state_cov`` (8, 8) their covariance from the scatter of
+    the pre-onset differences about their polynomial (zero for noise-free
+    data). ``step_s`` is the RK4 step (s), ``n_substeps`` steps per sample.
+
+    Optional, m = 3 n_out values (samples, then hip/knee/ankle):
+    ``residual_weight`` (m, m) multiplies the prediction error before it is
+    squared (:func:`loper_analysis.impedance.identification.nuisance_projection`);
+    ``noise_cov`` (m, m) is the covariance of the prediction error at the true
+    impedance (rad^2, e.g. from :func:`loper_analysis.impedance.identification.null_pair_errors`
+    divided by the number of averaged pairs), from which the CI are taken when given.
+    """
+
+    params: SegmentParameters
+    time_s: np.ndarray
+    measured: np.ndarray
+    reference_q: np.ndarray
+    reference_qd: np.ndarray
+    reference_qdd: np.ndarray
+    feedforward: np.ndarray
+    force_perturbed_n: np.ndarray
+    pelvis_deviation: np.ndarray
+    initial_deviation: np.ndarray
+    initial_rate: np.ndarray
+    step_s: float
+    n_substeps: int
+    initial_state_cov: np.ndarray = field(default_factory=lambda: np.zeros((8, 8)))
+    onset_s: float = 0.0
+    initial_state_span_s: float = INITIAL_STATE_SPAN_S
+    initial_state_degree: int = INITIAL_STATE_DEGREE
+    noise_cov: np.ndarray | None = None
+    residual_weight: np.ndarray | None = None
+
+    @property
+    def n_samples(self) -> int:
+        return len(self.time_s)
+
+
+def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.ndarray:
+    if value is None:
+        return np.zeros((n, width))
+    a = np.asarray(value, dtype=float)
+    if width == 1 and a.ndim == 1:
+        a = a[:, None]
+    a2, _ = finite_rows(name, a, width)
+    if a2.shape[0] != n:
+        raise LoperInputError(f"{name} has {a2.shape[0]} samples, expected {n} like {like}")
+    return a2
+
+
+#: Fields of a settings object (:class:`~loper_analysis.impedance.identification.validation.ValidationSettings`,
+#: :class:`~loper_analysis.planning.window.PlanSettings`) that :func:`prepare_window` takes by name.
+WINDOW_FIELDS: tuple[str, ...] = ("window", "n_substeps", "initial_state_degree")
+
+
+def window_options(settings) -> dict:
+    """:func:`prepare_window`'s window keywords (:data:`WINDOW_FIELDS`) from a settings object holding them."""
+    return {name: getattr(settings, name) for name in WINDOW_FIELDS}
+
+
+def prepare_window(
+    time_s,
+    q_unperturbed,
+    q_perturbed,
+    params: SegmentParameters,
+    onset_s: float,
+    *,
+    force_unperturbed_n=None,
+    force_perturbed_n=None,
+    force_time_s=None,
+    pelvis_angle_unperturbed_rad=None,
+    pelvis_angle_perturbed_rad=None,
+    window: ResponseWindow = ResponseWindow(),
+    n_substeps: int = N_SUBSTEPS,
+    reference_cutoff_hz: float | None = None,
+    q_reference=None,
+    initial_state_degree: int = INITIAL_STATE_DEGREE,
+) -> PreparedWindow:
+    """Check the inputs of one fit and precompute reference, inputs and initial state.
+
+    Parameters
+    ----------
+    time_s : (n,) uniformly sampled time (s); the window must lie inside it.
+    q_unperturbed, q_perturbed : (n, 4) measured coordinates [x (m), thigh,
+        shank, foot (rad)] of the unperturbed and the perturbed stride,
+        aligned so that the onset is at ``onset_s`` in both.
+    force_unperturbed_n, force_perturbed_n : (n, 2) rod force (N, world x/y)
+        at the attachment point; zero when omitted. With ``force_time_s``
+        they are (k, 2) instead, sampled at ``force_time_s``.
+    force_time_s : (k,) optional sample times (s, the clock of ``time_s``)
+        of the forces at their own rate (e.g. the robot log's 1000 Hz). Each
+        force is then the cubic spline through its samples; the feedforward
+        takes ``F_u`` as its mean over each stage's share of the step
+        (:func:`stage_force_means`), and the rod force of the perturbed leg is
+        ``F_u`` plus ``F_p - F_u`` as stage forces that give every RK4 step the
+        exact impulse and timing of the force (:func:`step_stage_forces`), so
+        that a 10 ms edge needs no step shorter than the default. The samples
+        must cover the fit window. Without it the forces are (n, 2) at
+        ``time_s`` and are interpolated linearly at the stage times.
+    pelvis_angle_*_rad : (n,) pelvis angle (rad); zero when omitted.
+    window : the window around the onset (``before_s``, ``after_s``, s) and the span before it for the initial
+        state (``initial_state_span_s``, s;
+        :class:`~loper_analysis.impedance.responses.response_window.ResponseWindow`).
+    n_substeps : RK4 steps per sample (integer >= 1).
+    reference_cutoff_hz : if given, the unperturbed coordinates are low-pass
+        filtered (2nd-order zero-phase Butterworth) before they serve as the
+        reference whose derivatives give ``u_ff``; the measured differences
+        in the prediction error stay unfiltered.
+    q_reference : (n, 4) optional smooth reference coordinates for ``u_ff``
+        and the feedback operating point (e.g. the mean of many unperturbed
+        strides); ``q_unperturbed`` when omitted.
+    initial_state_degree : the initial deviation and
+        its rate at window start come from a least-squares polynomial of this
+        degree through the perturbed-minus-unperturbed coordinates over the
+        last ``window.initial_state_span_s`` before the onset, when the perturbation
+        has not yet acted (robust to measurement noise; exact for smooth data).
+
+    Raises
+    ------
+    LoperInputError
+        Non-finite or wrongly shaped inputs, non-uniform time, a window
+        outside the data, forces at their own rate that do not cover the window.
+    """
+    t = _finite_times("time_s", time_s, 4)
+    dt = _uniform_step_s(t)
+    n = len(t)
+    qu = _column("q_unperturbed", q_unperturbed, n, 4)
+    qp = _column("q_perturbed", q_perturbed, n, 4)
+    tf = None
+    if force_time_s is None:
+        fu = _column("force_unperturbed_n", force_unperturbed_n, n, 2)
+        fpm = _column("force_perturbed_n", force_perturbed_n, n, 2)
+    else:
+        tf = _force_clock(force_time_s)
+        fu = _column("force_unperturbed_n", force_unperturbed_n, len(tf), 2, "force_time_s")
+        fpm = _column("force_perturbed_n", force_perturbed_n, len(tf), 2, "force_time_s")
+    pu = _column("pelvis_angle_unperturbed_rad", pelvis_angle_unperturbed_rad, n, 1)[:, 0]
+    pp = _column("pelvis_angle_perturbed_rad", pelvis_angle_perturbed_rad, n, 1)[:, 0]
+    if not isinstance(window, ResponseWindow):
+        raise LoperInputError(f"window must be a ResponseWindow, got {type(window).__name__}")
+    initial_state_span_s = window.initial_state_span_s
+    i0, i1, n_substeps = _window_samples(t, dt, onset_s, window.before_s, window.after_s, n_substeps)
+    tol = 1e-9 * dt
+
+    # reference: cubic spline of the unperturbed coordinates, at RK4 stage times
+    step = dt / n_substeps
+    n_steps = (i1 - i0) * n_substeps
+    ts = t[i0] + 0.5 * step * np.arange(2 * n_steps + 1)
+    q_ref = qu if q_reference is None else _column("q_reference", q_reference, n, 4)
+    ref_q, ref_qd, ref_qdd = _reference_coordinates(t, dt, q_ref, ts, reference_cutoff_hz)
+    force_u, force_p = _stage_forces(t, fu, fpm, tf, ts, step, n_steps)
+    # u_ff - Ja(q_u)^T F_u = inverse dynamics with the unperturbed force
+    feedforward = inverse_dynamics(ref_q, ref_qd, ref_qdd, params, force_u)
+    dpel_spline = CubicSpline(t, pp - pu)
+    dpel = np.stack([dpel_spline(ts), dpel_spline(ts, 1)], axis=-1)
+    e0, ed0, state_cov = _initial_state(t, qp - qu, i0, onset_s, initial_state_span_s, initial_state_degree, tol)
+    measured = joint_angles(qp[i0 : i1 + 1], pp[i0 : i1 + 1]) - joint_angles(qu[i0 : i1 + 1], pu[i0 : i1 + 1])
+    return PreparedWindow(
+        params=params,
+        time_s=t[i0 : i1 + 1].copy(),
+        measured=measured,
+        reference_q=np.ascontiguousarray(ref_q),
+        reference_qd=np.ascontiguousarray(ref_qd),
+        reference_qdd=np.ascontiguousarray(ref_qdd),
+        feedforward=np.ascontiguousarray(feedforward),
+        force_perturbed_n=np.ascontiguousarray(force_p),
+        pelvis_deviation=np.ascontiguousarray(dpel),
+        initial_deviation=np.ascontiguousarray(e0),
+        initial_rate=np.ascontiguousarray(ed0),
+        step_s=step,
+        n_substeps=n_substeps,
+        initial_state_cov=state_cov,
+        onset_s=float(onset_s),
+        initial_state_span_s=float(initial_state_span_s),
+        initial_state_degree=int(initial_state_degree),
+    )
+
+
+def _uniform_step_s(t: np.ndarray) -> float:
+    """The mean step (s) of the sample times ``t`` (n,), checked to increase uniformly (to 1e-6 of the step)."""
+    dts = np.diff(t)
+    dt = float(np.mean(dts))
+    if dt <= 0 or np.max(np.abs(dts - dt)) > 1e-6 * dt:
+        i = int(np.argmax(np.abs(dts - dt)))
+        raise LoperInputError(f"time_s must be uniformly increasing; step at sample {i} is {dts[i]} s, mean {dt} s")
+    return dt
+
+
+def _window_samples(
+    t: np.ndarray, dt: float, onset_s: float, window_before_s: float, window_after_s: float, n_substeps: int
+) -> tuple[int, int, int]:
+    """First and last sample (indices into ``t``, step ``dt`` s) of the window ``onset_s - window_before_s ..
+    onset_s + window_after_s`` (s), checked to lie inside the data and hold >= 4 samples, and ``n_substeps``
+    checked to be an integer >= 1."""
+    for name, v in (("onset_s", onset_s), ("window_before_s", window_before_s), ("window_after_s", window_after_s)):
+        if not np.isfinite(v):
+            raise LoperInputError(f"{name} must be finite, got {v}")
+    if window_before_s < 0 or window_after_s <= 0:
+        raise LoperInputError(
+            f"window must have window_before_s >= 0 and window_after_s > 0, got {window_before_s}, {window_after_s}"
+        )
+    if int(n_substeps) != n_substeps or n_substeps < 1:
+        raise LoperInputError(f"n_substeps must be an integer >= 1, got {n_substeps}")
+    n_substeps = int(n_substeps)
+    n = len(t)
+    tol = 1e-9 * dt
+    i0 = int(np.ceil((onset_s - window_before_s - t[0]) / dt - 1e-9))
+    i1 = int(np.floor((onset_s + window_after_s - t[0]) / dt + 1e-9))
+    if onset_s - window_before_s < t[0] - tol or i1 > n - 1 or i0 < 0:
+        raise LoperInputError(
+            f"window {onset_s - window_before_s:.4f} .. {onset_s + window_after_s:.4f} s "
+            f"is longer than the data ({t[0]:.4f} .. {t[-1]:.4f} s)"
+        )
+    if i1 - i0 < 3:
+        raise LoperInputError(f"window holds only {i1 - i0 + 1} samples; need >= 4")
+    return i0, i1, n_substeps
+
+
+def _reference_coordinates(
+    t: np.ndarray, dt: float, q_ref: np.ndarray, stage_time_s: np.ndarray, reference_cutoff_hz: float | None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The reference coordinates (m, rad) and their first and second derivatives, each (n_stage, 4) at the
+    stage times: the cubic spline through ``q_ref`` (n, 4) at ``t`` (n,; step ``dt`` s), low-pass filtered
+    first (2nd-order zero-phase Butterworth) when ``reference_cutoff_hz`` is given."""
+    if reference_cutoff_hz is not None:
+        nyq = 0.5 / dt
+        if not 0 < reference_cutoff_hz < nyq:
+            raise LoperInputError(f"reference_cutoff_hz must lie in 0 .. {nyq} Hz, got {reference_cutoff_hz}")
+        from scipy.signal import (  # only here: scipy.signal costs ~1 s to import
+            butter,
+            filtfilt,
+        )
+
+        b, a = butter(2, reference_cutoff_hz / nyq)
+        q_ref = filtfilt(b, a, q_ref, axis=0)
+    spline = CubicSpline(t, q_ref, axis=0)
+    return spline(stage_time_s), spline(stage_time_s, 1), spline(stage_time_s, 2)
+
+
+def _stage_forces(
+    t: np.ndarray,
+    force_u: np.ndarray,
+    force_p: np.ndarray,
+    force_time_s: np.ndarray | None,
+    stage_time_s: np.ndarray,
+    step_s: float,
+    n_steps: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The unperturbed force at the stage times (n_stage, 2) and the perturbed force at the four stages of every
+    RK4 step (n_steps, 4, 2) of ``step_s`` s, N, world x/y.
+
+    ``force_u``, ``force_p``: the forces at ``t`` (n, 2), interpolated linearly; with ``force_time_s`` (k,) the
+    forces (k, 2) at their own rate, which must cover the stage times (:func:`stage_force_means`,
+    :func:`step_stage_forces`).
+    """
+    ts = stage_time_s
+    if force_time_s is None:
+        stage_u = np.stack([np.interp(ts, t, force_u[:, j]) for j in range(2)], axis=-1)
+        return stage_u, per_step(np.stack([np.interp(ts, t, force_p[:, j]) for j in range(2)], axis=-1))
+    tf, step = force_time_s, step_s
+    tol_f = 1e-6 * step
+    if tf[0] > ts[0] + tol_f or tf[-1] < ts[-1] - tol_f:
+        raise LoperInputError(
+            f"the force at its own rate ({tf[0]:.4f} .. {tf[-1]:.4f} s) does not cover the fit window "
+            f"{ts[0]:.4f} .. {ts[-1]:.4f} s"
+        )
+    stage_u = stage_force_means(tf, force_u, ts)
+    return stage_u, per_step(stage_u) + step_stage_forces(tf, force_p - force_u, ts[0], step, n_steps)
+
+
+def _initial_state(
+    t: np.ndarray,
+    deviation: np.ndarray,
+    i0: int,
+    onset_s: float,
+    initial_state_span_s: float,
+    initial_state_degree: int,
+    tol: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The coordinate deviation (4,) and its rate (4,) at window start (sample ``i0``) and their covariance (8, 8).
+
+    From a least-squares polynomial of ``initial_state_degree`` through the perturbed-minus-unperturbed
+    coordinates ``deviation`` (n, 4; m, rad) at ``t`` (n,) over the last ``initial_state_span_s`` (s) up to
+    the onset (``tol`` s of slack); the covariance from the scatter about it (zero without spare samples).
+    """
+    # initial deviation: polynomial through the pre-onset differences, taken
+    # relative to the reference actually simulated
+    sel = (t >= onset_s - initial_state_span_s - tol) & (t <= onset_s + tol)
+    if int(initial_state_degree) != initial_state_degree or initial_state_degree < 0:
+        raise LoperInputError(f"initial_state_degree must be an integer >= 0, got {initial_state_degree}")
+    if sel.sum() < initial_state_degree + 1 or onset_s - initial_state_span_s < t[0] - tol:
+        raise LoperInputError(
+            f"initial state needs data from {onset_s - initial_state_span_s:.4f} s "
+            f"(initial_state_span_s = {initial_state_span_s}) with >= {initial_state_degree + 1} samples; "
+            f"data start at {t[0]:.4f} s"
+        )
+    V = initial_state_basis(t[sel] - t[i0], initial_state_degree)
+    coef, *_ = np.linalg.lstsq(V, deviation[sel], rcond=None)
+    e0 = coef[0]
+    ed0 = coef[1] if initial_state_degree >= 1 else np.zeros(4)
+    n_sel, n_coef = V.shape
+    state_cov = np.zeros((8, 8))
+    if n_sel > n_coef:
+        resid = deviation[sel] - V @ coef
+        var = np.sum(resid**2, axis=0) / (n_sel - n_coef)  # per coordinate
+        C = np.linalg.pinv(V.T @ V)
+        k = min(n_coef, 2)
+        for a in range(4):
+            idx = [a, 4 + a][:k]
+            state_cov[np.ix_(idx, idx)] = var[a] * C[:k, :k]
+    return e0, ed0, state_cov
+
+
+def stage_times_s(window: PreparedWindow) -> np.ndarray:
+    """The RK4 stage times (2 N + 1,) in s of a window: every ``step_s / 2`` from its first sample."""
+    n_steps = (window.n_samples - 1) * window.n_substeps
+    return window.time_s[0] + 0.5 * window.step_s * np.arange(2 * n_steps + 1)
+
+
+def per_step(stage: np.ndarray) -> np.ndarray:
+    """Stage values (2 N + 1, 2) at :func:`stage_times_s` -> the force at the four stages of each step (N, 4, 2).
+
+    Start, middle, middle, end: plain RK4 with the force evaluated at the stage times (the
+    ``force_perturbed_n`` layout of :class:`PreparedWindow`).
+    """
+    return np.stack([stage[:-1:2], stage[1::2], stage[1::2], stage[2::2]], axis=1)
+
+
+def step_stage_forces(
+    force_time_s: np.ndarray, force_n: np.ndarray, start_s: float, step_s: float, n_steps: int
+) -> np.ndarray:
+    """Stage forces (n_steps, 4, 2) that give each RK4 step the exact response of a linear system to the force.
+
+    RK4 on ``y' = A y + b F(t)`` adds per step of length h
+    ``h/6 [(1 + hA + h²A²/2 + h³A³/4) F1 + (2 + hA + h²A²/2) F2 + (2 + hA) F3 + F4] b``;
+    the exact forced response is ``sum_j A^j / j! R_j b`` with the moments
+    ``R_j = int_0^h (h - s)^j F(s) ds``. Equating the powers of A up to the
+    third, RK4's own order, gives ``F1 = 4 R3 / h^4``, ``F1 + F2 = 6 R2 / h^3``,
+    ``F1 + F2 + F3 = 6 R1 / h^2`` and ``F1 + 2 F2 + 2 F3 + F4 = 6 R0 / h``: the
+    step then carries the force's impulse and its timing within the step
+    exactly, however fast its edges (a constant force gives F1 = .. = F4 = F).
+    The force is the cubic spline (not-a-knot) through its samples ``force_n``
+    (k, 2) at ``force_time_s`` (k,); the moments are exact (4-point
+    Gauss-Legendre on every piece between samples and step boundaries).
+    """
+    tf = np.asarray(force_time_s, dtype=float)
+    f = np.asarray(force_n, dtype=float)
+    h = float(step_s)
+    bounds = start_s + h * np.arange(n_steps + 1)
+    inner = tf[(tf > bounds[0]) & (tf < bounds[-1])]
+    edges = np.unique(np.concatenate([bounds, inner]))
+    a, b = edges[:-1], edges[1:]
+    keep = b - a > 1e-12 * h
+    a, b = a[keep], b[keep]
+    mid, half = 0.5 * (a + b), 0.5 * (b - a)
+    step_of = np.clip(np.floor((mid - start_s) / h).astype(int), 0, n_steps - 1)
+    nodes, weights = np.polynomial.legendre.leggauss(4)
+    x = mid[:, None] + half[:, None] * nodes
+    wq = half[:, None] * weights
+    fx = CubicSpline(tf, f, axis=0)(x)  # (n_piece, 4, 2)
+    r = bounds[step_of + 1][:, None] - x  # time to the step's end
+    R = np.zeros((4, n_steps, 2))
+    for j in range(4):
+        np.add.at(R[j], step_of, np.sum((wq * r**j)[..., None] * fx, axis=1))
+    F = np.empty((n_steps, 4, 2))
+    F[:, 0] = 4.0 * R[3] / h**4
+    F[:, 1] = 6.0 * R[2] / h**3 - F[:, 0]
+    F[:, 2] = 6.0 * R[1] / h**2 - F[:, 0] - F[:, 1]
+    F[:, 3] = 6.0 * R[0] / h - F[:, 0] - 2.0 * F[:, 1] - 2.0 * F[:, 2]
+    return F
+
+
+def _finite_times(name: str, value, min_samples: int) -> np.ndarray:
+    """Sample times (s) as a 1-D float array of at least ``min_samples`` finite values; ``name`` in messages."""
+    t = np.asarray(value, dtype=float)
+    if t.ndim != 1 or len(t) < min_samples:
+        raise LoperInputError(f"{name} must be 1-D with >= {min_samples} samples, got shape {t.shape}")
+    if not np.all(np.isfinite(t)):
+        raise LoperInputError(f"{name} is not finite at sample {int(np.argmax(~np.isfinite(t)))}")
+    return t
+
+
+def _force_clock(force_time_s) -> np.ndarray:
+    tf = _finite_times("force_time_s", force_time_s, 2)
+    d = np.diff(tf)
+    if np.any(d <= 0):
+        i = int(np.argmax(d <= 0))
+        raise LoperInputError(f"force_time_s must be strictly increasing; step at sample {i} is {d[i]} s")
+    return tf
+
+
+def stage_force_means(force_time_s: np.ndarray, force_n: np.ndarray, stage_time_s: np.ndarray) -> np.ndarray:
+    """Means (n_stage, 2) of a sampled force over the Simpson cells of RK4 stage times.
+
+    ``stage_time_s`` (2 N + 1,) are the RK4 stage times of N steps of length
+    h, every h / 2 from the window start. RK4 weights a step's start, middle
+    and end by 1/6, 4/6 and 1/6 of h; the cells ``[t - h/6, t + h/6]`` around
+    a step boundary and ``[t - h/3, t + h/3]`` around a midpoint (clipped to
+    the window) therefore tile the window, and the mean of the force over
+    each cell makes every step's stage-weighted force equal the force's exact
+    integral over the step. The force is the cubic spline (not-a-knot) through
+    its samples ``force_n`` (k, 2) at ``force_time_s`` (k,), integrated exactly.
+    """
+    ts = np.asarray(stage_time_s, dtype=float)
+    h = 2.0 * (ts[1] - ts[0])
+    half = np.where(np.arange(len(ts)) % 2 == 0, h / 6.0, h / 3.0)
+    lo = np.maximum(ts - half, ts[0])
+    hi = np.minimum(ts + half, ts[-1])
+    spline = CubicSpline(np.asarray(force_time_s, dtype=float), np.asarray(force_n, dtype=float), axis=0)
+    integral = spline.antiderivative()
+    return (integral(hi) - integral(lo)) / (hi - lo)[:, None]
+
+
+def initial_state_basis(tau: np.ndarray, degree: int) -> np.ndarray:
+    """Polynomial basis (n, degree + 1) in the time ``tau`` (s) from window start."""
+    return np.vander(tau, int(degree) + 1, increasing=True)
+
+
+def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
+    """Model coordinate deviations perturbed - unperturbed (B, n_out, 4) at the window's samples (m, rad).
+
+    ``impedance_sets``: (B, 6) in the order of :data:`~loper_analysis.constants.PARAMETERS`;
+    one batch of the compiled RK4 (:func:`loper_analysis.swing_leg.kernels.simulate_deviation_batch`).
+    """
+    sets = np.ascontiguousarray(np.asarray(impedance_sets, dtype=float))
+    if sets.ndim != 2 or sets.shape[1] != 6 or not np.all(np.isfinite(sets)):
+        raise LoperInputError(f"impedance must be finite with 6 values per row, got shape {sets.shape}")
+    deviation, _ = kernels.simulate_deviation_batch(
+        sets,
+        window.params.packed,
+        window.reference_q,
+        window.reference_qd,
+        window.reference_qdd,
+        window.feedforward,
+        window.force_perturbed_n,
+        window.pelvis_deviation,
+        window.initial_deviation,
+        window.initial_rate,
+        window.step_s,
+        window.n_substeps,
+        window.n_samples,
+    )
+    return deviation
+
+
+def joint_angle_deviation(deviation: np.ndarray, pelvis_angle_deviation_rad: np.ndarray) -> np.ndarray:
+    """Joint-angle deviations (..., n_out, 3) in rad from coordinate deviations (..., n_out, 4) and the pelvis
+    angle's."""
+    e, dpel = deviation, pelvis_angle_deviation_rad
+    return np.stack([dpel - e[..., 1], e[..., 2] - e[..., 1], e[..., 2] - e[..., 3]], axis=-1)
+
+
+def simulate_response(window: PreparedWindow, impedance) -> np.ndarray:
+    """Model joint-angle differences perturbed - unperturbed (n_out, 3) or (B, n_out, 3) in rad.
+
+    ``impedance``: (6,) or (B, 6) in the order of :data:`PARAMETERS`.
+    """
+    impedance = np.asarray(impedance, dtype=float)
+    if impedance.ndim not in (1, 2) or impedance.shape[-1] != 6 or not np.all(np.isfinite(impedance)):
+        raise LoperInputError(f"impedance must be finite with 6 values per row, got shape {impedance.shape}")
+    deviation = simulate_deviation(window, np.atleast_2d(impedance))
+    dth = joint_angle_deviation(deviation, window.pelvis_deviation[:: 2 * window.n_substeps, 0])
+    return dth[0] if impedance.ndim == 1 else dth
+
+
+def prediction_error(window: PreparedWindow, impedance) -> np.ndarray:
+    """PE = measured - model (n_out, 3) or (B, n_out, 3), rad."""
+    return window.measured - simulate_response(window, impedance)
