@@ -13,6 +13,13 @@ Every file of the base run (job logs and timings aside) must be in the new run,
 at its new place where the layout moved it (:data:`MOVED`), with the same bytes;
 files only the new run has are listed. Exit code 1 when a file differs or is
 missing.
+
+With ``--science PCT`` a change that moves numbers in their last digits (another IK
+solver) passes when the science is the same: every stride count, outlier verdict
+and status of the stride tables and the trial summary, every fit's status, stride
+and null-pair counts, and the validation study's files identical, and each fitted
+K and D within PCT % of the base run's (estimates at a bound of 0 within PCT % of
+the joint's largest estimate). The largest differences are printed.
 """
 
 from __future__ import annotations
@@ -24,6 +31,8 @@ import subprocess
 import sys
 import tempfile
 from pathlib import Path
+
+import pandas as pd
 
 from loper_analysis.layout import RAW_DIR, RESULTS_DIR
 
@@ -82,6 +91,51 @@ def compare(base: Path, new: Path) -> int:
     return 1 if problems else 0
 
 
+#: Columns that must not move at all: counts, verdicts and statuses (strides summary, fits).
+EXACT_COLUMNS = {
+    "strides/summary.tsv": ("subject", "trial", "n_strides", "n_perturbed", "n_removed", "n_kept", "status"),
+    "impedance/impedance.tsv": ("subject", "onset_ms", "joint", "status", "n_strides", "n_null_pairs"),
+}
+#: Fitted values held to the tolerance, and their columns.
+FITTED = ("K_nm_per_rad", "D_nms_per_rad")
+
+
+def science(base: Path, new: Path, tolerance_pct: float) -> int:
+    """Print whether two results folders hold the same science within ``tolerance_pct`` (%); 1 when not."""
+    problems = []
+    for rel, columns in EXACT_COLUMNS.items():
+        a, b = (pd.read_csv(d / rel, sep="\t", keep_default_na=False) for d in (base, new))
+        if not a[list(columns)].equals(b[list(columns)]):
+            problems.append(f"{rel}: {', '.join(columns)} differ")
+    for folder in ("validation",):
+        for f in sorted((base / folder).glob("*.tsv")):
+            if not filecmp.cmp(f, new / folder / f.name, shallow=False):
+                problems.append(f"{folder}/{f.name}: bytes differ")
+    for f in sorted((base / "strides").rglob("*.strides.tsv")):
+        a, b = (pd.read_csv(p, sep="\t", keep_default_na=False) for p in (f, new / f.relative_to(base)))
+        verdicts = ["stride", "side", "perturbed", "removed", "reason"]
+        if len(a) != len(b) or not a[verdicts].equals(b[verdicts]):
+            problems.append(f"{f.relative_to(base)}: strides or their verdicts differ")
+    a, b = (pd.read_csv(d / "impedance/impedance.tsv", sep="\t") for d in (base, new))
+    worst = 0.0
+    for column in FITTED:
+        scale = a.groupby("joint")[column].transform(lambda v: v.abs().max())
+        denominator = a[column].abs().where(a[column].abs() > tolerance_pct / 100 * scale, scale)
+        pct = 100 * (b[column] - a[column]).abs() / denominator
+        k = int(pct.idxmax())
+        worst = max(worst, float(pct.max()))
+        print(
+            f"{column}: largest difference {pct.max():.3f} % ({a.subject[k]} {a.onset_ms[k]} ms {a.joint[k]}: "
+            f"{a[column][k]:.6g} -> {b[column][k]:.6g}); median {pct.median():.4f} %"
+        )
+    if worst > tolerance_pct:
+        problems.append(f"a fitted K or D moved by {worst:.3f} % > {tolerance_pct:g} %")
+    for p in problems:
+        print("FAIL", p)
+    print(f"same science within {tolerance_pct:g} %" if not problems else f"{len(problems)} problem(s)")
+    return 1 if problems else 0
+
+
 def _run(checkout: Path, jobs: int) -> Path:
     env = dict(os.environ, PYTHONPATH=str(checkout / "src"))
     subprocess.run([sys.executable, "-m", "compileall", "-q", "src"], cwd=checkout, env=env, check=True)
@@ -112,12 +166,17 @@ def main() -> int:
     parser.add_argument("results", nargs="*", help="BASE_RESULTS NEW_RESULTS")
     parser.add_argument("--build", metavar="REV", help="build REV and the working tree, then compare")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--science", type=float, metavar="PCT", help="compare the science within PCT %%")
     args = parser.parse_args()
     if args.build:
         return build(args.build, args.jobs)
     if len(args.results) != 2:
         parser.error("give BASE_RESULTS and NEW_RESULTS, or --build REV")
-    return compare(Path(args.results[0]), Path(args.results[1]))
+    base, new = Path(args.results[0]), Path(args.results[1])
+    if args.science is not None:
+        compare(base, new)
+        return science(base, new, args.science)
+    return compare(base, new)
 
 
 if __name__ == "__main__":
