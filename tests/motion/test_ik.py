@@ -362,3 +362,31 @@ def test_locked_and_coupled_coordinates_of_rajagopal2016(tmp_path, solver):
             coordinate_tasks={"subtalar": (1.0, None)},
             solver=solver,
         )
+
+
+def test_a_model_the_tree_does_not_hold_is_solved_by_opensim_and_says_why():
+    """A body on a FreeJoint (not in the kinematic tree): the tree solver hands the trial to OpenSim's, and the
+    result names the reason; the coordinates are OpenSim's to the last digit."""
+    osim = quiet_opensim()
+    model = osim.Model()
+    body = osim.Body("block", 1.0, osim.Vec3(0), osim.Inertia(0.1))
+    model.addBody(body)
+    model.addJoint(osim.FreeJoint("free", model.getGround(), body))
+    arm = osim.Body("arm", 1.0, osim.Vec3(0), osim.Inertia(0.1))
+    model.addBody(arm)
+    model.addJoint(osim.PinJoint("pin", body, osim.Vec3(0), osim.Vec3(0), arm, osim.Vec3(0), osim.Vec3(0)))
+    places = [(0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1), (0.1, 0.1, 0.1)]
+    for i, p in enumerate(places):
+        model.addMarker(osim.Marker(f"M{i}", body, osim.Vec3(*p)))
+    model.addMarker(osim.Marker("A", arm, osim.Vec3(0.3, 0, 0)))  # the arm along x, the pin at 0
+    model.initSystem()
+    t = np.arange(5) / 100.0
+    X = np.array([[np.array(p) + [0.01 * k, 0.5, 0.0] for p in [*places, (0.3, 0, 0)]] for k in range(5)])
+    labels = [*(f"M{i}" for i in range(4)), "A"]
+    ours = inverse_kinematics(model, t, X, labels, solver="tree")
+    theirs = inverse_kinematics(model, t, X, labels, solver="opensim")
+    assert ours.solver.startswith("opensim: ") and "joint 'free' is a FreeJoint" in ours.solver
+    assert theirs.solver == "opensim"
+    np.testing.assert_array_equal(ours.coordinates, theirs.coordinates)
+    ty = ours.coordinate_names.index("free_coord_4")
+    np.testing.assert_allclose(ours.coordinates[:, ty], 0.5, atol=1e-6)  # the block lifted by 0.5 m

@@ -347,41 +347,19 @@ def _solution(
 ) -> tuple[np.ndarray, np.ndarray, list[str], str]:
     """Coordinates (n_frames, n_coordinates) in coordinate-set order, marker errors (n_frames, n_in_use) in m,
     the markers in use and the solver that gave them (``tree``, or ``opensim`` with the reason)."""
+    options = {"coordinate_tasks": coordinate_tasks, "frames": frames, "accuracy": accuracy, "source": source}
+    note = "opensim"
     if solver == "tree":
         from loper_analysis.motion.kinematic_tree import UnsupportedModel
         from loper_analysis.motion.tree_ik import tree_solution
 
         try:
-            Q, E = tree_solution(
-                model,
-                t,
-                X,
-                labels,
-                marker_weights,
-                coordinate_tasks=coordinate_tasks,
-                frames=frames,
-                accuracy=accuracy,
-                source=source,
-            )
-            return Q, E, list(labels), "tree"
+            return (*tree_solution(model, t, X, labels, marker_weights, **options), list(labels), "tree")
         except UnsupportedModel as reason:
             note = f"opensim: {reason}"
-    else:
-        note = "opensim"
     from loper_analysis.motion.opensim_ik import opensim_solution
 
-    Q, E, in_use = opensim_solution(
-        model,
-        t,
-        X,
-        labels,
-        marker_weights,
-        coordinate_tasks=coordinate_tasks,
-        frames=frames,
-        accuracy=accuracy,
-        source=source,
-    )
-    return Q, E, in_use, note
+    return (*opensim_solution(model, t, X, labels, marker_weights, **options), note)
 
 
 def _weighted_markers(
