@@ -6,7 +6,6 @@ import pandas as pd
 import pytest
 
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
-from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.strides import force_phase_metrics, stride_summary, stride_tables
 
 FS = 1000.0
@@ -236,49 +235,6 @@ def test_strides_outside_the_robot_log_are_left_out_down_to_none():
     assert list(tables.strides.columns) == STRIDE_COLUMNS and len(tables.strides) == 0
 
 
-def test_the_steps_write_and_summarise_trials_with_zero_and_one_stride(tmp_path):
-    """The files of 0 and 1 strides hold every column; read back as strides_summary reads them they give
-    n_strides 0 and 1 and too_few_strides, next to a trial with enough strides."""
-    from loper_analysis.io.atomic import write_tsv
-    from loper_analysis.io.readers import read_tsv
-    from loper_analysis.steps.strides import strides, strides_summary
-
-    files = {}
-    for n_heel_strikes in (1, 2, 6):
-        angles, events, force = _overground(n_heel_strikes)
-        for name, frame in (("angles", angles), ("events", events), ("force", force)):
-            write_tsv(frame, tmp_path / f"{n_heel_strikes}.{name}.tsv")
-        out = tmp_path / f"{n_heel_strikes}.strides.tsv"
-        with pytest.warns(TooFewStridesWarning) if n_heel_strikes < 6 else _no_warning():
-            strides(
-                tmp_path / f"{n_heel_strikes}.angles.tsv",
-                tmp_path / f"{n_heel_strikes}.events.tsv",
-                out,
-                tmp_path / f"{n_heel_strikes}.cycles.tsv",
-                tmp_path / f"{n_heel_strikes}.force.tsv",
-                StrideSettings(min_valid=5 if n_heel_strikes < 6 else 4),
-            )
-        files[n_heel_strikes] = out
-    assert files[1].read_text() == "\t".join(STRIDE_COLUMNS) + "\n"  # the header only, every column
-    assert (tmp_path / "1.cycles.tsv").read_text().splitlines() == [
-        "stride\tphase\tpoint\tpercent\thip_left_rad\tknee_left_rad\tankle_left_rad\tforce_n"
-    ]
-    back = read_tsv(files[1], "stride table", keep_default_na=False, na_values=[""])
-    assert list(back.columns) == STRIDE_COLUMNS and len(back) == 0
-    keys = [("S01", "overground-0"), ("S01", "overground-1"), ("S01", "overground-5")]
-    table = strides_summary(keys, [files[1], files[2], files[6]], tmp_path / "summary.tsv", min_valid=4)
-    assert table[["trial", "n_strides", "n_perturbed", "n_removed", "n_kept", "status"]].values.tolist() == [
-        ["overground-0", 0, 0, 0, 0, "too_few_strides"],
-        ["overground-1", 1, 0, 0, 1, "too_few_strides"],
-        ["overground-5", 5, 0, 0, 5, "ok"],
-    ]
-    assert np.isnan(table["mean_stride_s"].iloc[0])
-    np.testing.assert_allclose(table["mean_stride_s"].iloc[1:], 1.2, rtol=0, atol=1e-12)
-    written = pd.read_csv(tmp_path / "summary.tsv", sep="\t")
-    assert written["status"].tolist() == ["too_few_strides", "too_few_strides", "ok"]
-    assert written["n_strides"].tolist() == [0, 1, 5]
-
-
 def test_stride_summary_of_an_untyped_empty_table_and_a_table_without_columns():
     empty = pd.DataFrame({c: pd.Series([], dtype=object) for c in STRIDE_COLUMNS})  # as read from a header-only TSV
     row = stride_summary({("S01", "walk"): empty}, min_valid=1).iloc[0]
@@ -290,54 +246,3 @@ def test_stride_summary_of_an_untyped_empty_table_and_a_table_without_columns():
         r"'duration_s'\] missing",
     ):
         stride_summary({("S01", "walk"): pd.DataFrame()})
-
-
-def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
-    """The transparency step on stride tables of 0 and 1 strides (as the strides step writes them): the subject
-    is left out with its counts, nothing crashes; the other subject is compared with itself (RMSD 0)."""
-    from loper_analysis.io.atomic import write_tsv
-    from loper_analysis.steps.strides import strides
-    from loper_analysis.steps.transparency import TransparencyFiles, transparency
-
-    paths = {}
-    for n_heel_strikes in (1, 2, 6):
-        angles, events, force = _overground(n_heel_strikes)
-        for name, frame in (("angles", angles), ("events", events), ("force", force)):
-            write_tsv(frame, tmp_path / f"{n_heel_strikes}.{name}.tsv")
-        with pytest.warns(TooFewStridesWarning) if n_heel_strikes < 6 else _no_warning():
-            strides(
-                tmp_path / f"{n_heel_strikes}.angles.tsv",
-                tmp_path / f"{n_heel_strikes}.events.tsv",
-                tmp_path / f"{n_heel_strikes}.strides.tsv",
-                tmp_path / f"{n_heel_strikes}.cycles.tsv",
-                tmp_path / f"{n_heel_strikes}.force.tsv",
-            )
-        paths[n_heel_strikes] = (tmp_path / f"{n_heel_strikes}.strides.tsv", tmp_path / f"{n_heel_strikes}.cycles.tsv")
-    pairs = {"S01": (6, 6), "S02": (6, 1), "S03": (2, 6)}  # heel strikes without, with the device
-    with pytest.warns(TooFewStridesWarning) as caught:
-        transparency(
-            {s: TransparencyFiles(*paths[a], *paths[b]) for s, (a, b) in pairs.items()},
-            tmp_path / "rmsd.tsv",
-            tmp_path / "force.tsv",
-            tmp_path / "t.png",
-        )
-    assert sorted(str(w.message).split(":")[0] for w in caught) == ["subject S02", "subject S03"]
-    rmsd = pd.read_csv(tmp_path / "rmsd.tsv", sep="\t")
-    assert rmsd.subject.tolist() == ["S01"] * 6 + ["S02"] * 6 + ["S03"] * 6 + ["all"] * 6
-    counts = rmsd.groupby("subject", sort=False)[["n_strides_no_device", "n_strides_device"]].first()
-    assert counts.loc[["S01", "S02", "S03"]].values.tolist() == [[5, 5], [5, 0], [1, 5]]
-    assert rmsd.loc[rmsd.subject.isin(["S02", "S03"]), "rmsd_rad"].isna().all()
-    np.testing.assert_allclose(rmsd.loc[rmsd.subject == "S01", "rmsd_rad"], 0.0, atol=1e-12)
-
-
-def _no_warning():
-    import contextlib
-    import warnings
-
-    @contextlib.contextmanager
-    def guard():
-        with warnings.catch_warnings():
-            warnings.simplefilter("error", TooFewStridesWarning)
-            yield
-
-    return guard()

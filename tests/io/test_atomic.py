@@ -8,8 +8,6 @@ old bytes (or not exist) and no staging file or directory may remain.
 
 from __future__ import annotations
 
-import logging
-
 import numpy as np
 import pandas as pd
 import pytest
@@ -28,7 +26,6 @@ from loper_analysis.io.opensim_tables import write_mot, write_trc
 from loper_analysis.io.osim import write_model
 from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.report.figures import pyplot
-from loper_analysis.steps.logs import rule_log
 
 
 def _entries(directory):
@@ -206,62 +203,3 @@ def test_robot_log_writer_refuses_bad_data_before_writing(tmp_path):
     with pytest.raises(LoperInputError, match="force_desired_n"):
         write_robot_log(target, frame, 1000.0)
     assert _entries(tmp_path) == []
-
-
-def test_rule_log_writes_the_messages_and_the_full_error_when_the_job_fails(tmp_path):
-    log_path = tmp_path / "logs" / "job.log"
-    with pytest.raises(SystemExit) as info:
-        with rule_log(log_path) as log:
-            log.info("reading the trial")
-            logging.getLogger("loper_analysis.steps.processing").warning("a gap of 12 frames")
-            raise LoperInputError("pert050-1.c3d: POINT:UNITS not declared")
-    text = log_path.read_text()
-    assert "INFO loper_analysis.rule: reading the trial" in text
-    assert "WARNING loper_analysis.steps.processing: a gap of 12 frames" in text
-    assert "ERROR loper_analysis.rule: LoperInputError: pert050-1.c3d: POINT:UNITS not declared" in text
-    assert "Traceback (most recent call last)" in text
-    assert _entries(log_path.parent) == ["job.log"]
-    # the job ends with the error in one line (what the console shows), the traceback stays in the log
-    assert str(info.value.code) == f"pert050-1.c3d: POINT:UNITS not declared (traceback in {log_path})"
-    assert isinstance(info.value.__cause__, LoperInputError)
-
-
-def test_rule_log_names_the_type_of_an_unexpected_error_and_lets_interruptions_through(tmp_path):
-    with pytest.raises(SystemExit, match=r"^KeyError: 'sync_channel' \(traceback in "):
-        with rule_log(tmp_path / "a.log"):
-            {}["sync_channel"]
-    assert "KeyError: 'sync_channel'" in (tmp_path / "a.log").read_text()
-    with pytest.raises(KeyboardInterrupt):
-        with rule_log(tmp_path / "b.log"):
-            raise KeyboardInterrupt
-    assert "ERROR loper_analysis.rule: KeyboardInterrupt" in (tmp_path / "b.log").read_text()
-
-
-def test_a_sigterm_ends_the_job_with_its_log_written_and_the_handler_restored(tmp_path):
-    """scancel and SLURM's time limit send SIGTERM: the rule's log must say so before the process ends."""
-    import os
-    import signal
-    import time
-
-    before = signal.getsignal(signal.SIGTERM)
-    with pytest.raises(SystemExit, match=r"^stopped by SIGTERM: the job was cancelled"):
-        with rule_log(tmp_path / "ik.log") as log:
-            log.info("solving 5760 frames")
-            os.kill(os.getpid(), signal.SIGTERM)
-            time.sleep(5)  # the signal arrives long before this ends
-            log.info("never reached")
-    text = (tmp_path / "ik.log").read_text()
-    assert "INFO loper_analysis.rule: solving 5760 frames" in text
-    assert "ERROR loper_analysis.rule: SystemExit: stopped by SIGTERM" in text
-    assert "never reached" not in text
-    assert signal.getsignal(signal.SIGTERM) is before
-    assert _entries(tmp_path) == ["ik.log"]
-
-
-def test_rule_log_captures_warnings(tmp_path):
-    import warnings
-
-    log_path = tmp_path / "job.log"
-    with rule_log(log_path):
-        warnings.warn("only 3 valid strides", UserWarning, stacklevel=1)
-    assert "only 3 valid strides" in log_path.read_text()

@@ -298,3 +298,46 @@ def test_a_span_crops_the_trial_on_the_files_clock(prefixed, tmp_path):
     ):
         markers(prefixed, tmp_path / "never.trc", settings=MarkerSettings(span_s=(5.0, 6.0)))
     assert not (tmp_path / "never.trc").exists()
+
+
+def _standing_markers(rng, n_frames: int = 50) -> np.ndarray:
+    """Four markers about a standing subject in a Z-up lab (m): pelvis about 1 m high, feet on the floor."""
+    base = np.array([[0.10, 0.12, 1.00], [0.10, -0.12, 1.00], [0.05, 0.10, 0.08], [0.05, -0.10, 0.08]])
+    return base + rng.normal(scale=0.002, size=(n_frames, 4, 3))
+
+
+@pytest.mark.parametrize("point_unit", ["mm", "cm", "m"])
+def test_a_written_c3d_reaches_the_trc_in_metres_in_the_model_s_y_up_frame(point_unit, rng, tmp_path):
+    """The default lab -> model rotation, -90 deg about X, takes the lab's (x, y, z) to the model's (x, z, -y),
+    whatever length unit the file declares."""
+    lab = _standing_markers(rng)
+    c3d = write_c3d(tmp_path / "stand.c3d", ["LASI", "RASI", "LTOE", "RTOE"], lab, 100.0, point_unit=point_unit)
+    gaps = markers(
+        c3d,
+        tmp_path / "stand.trc",
+        settings=MarkerSettings(cutoff_hz=None, walking_direction="fixed"),
+        lab_angles_out=tmp_path / "lab_angles.tsv",
+    )
+    t, X, labels = read_markers(tmp_path / "stand.trc")
+    assert labels == ["LASI", "RASI", "LTOE", "RTOE"]
+    np.testing.assert_allclose(t, np.arange(50) / 100.0, rtol=0, atol=1e-12)
+    model = np.stack([lab[..., 0], lab[..., 2], -lab[..., 1]], axis=-1)
+    np.testing.assert_allclose(X, model, rtol=0, atol=1e-6)  # float32 in the file's unit
+    assert len(gaps) == 0 and gaps.attrs["per_marker"][0]["turn_deg"] == 0
+    assert (tmp_path / "lab_angles.tsv").read_text() == "time_s\n"  # no lab angles in the file: the header alone
+
+
+def test_a_trial_walking_along_the_lab_s_minus_y_is_turned_to_walk_along_the_model_s_plus_x(rng, tmp_path):
+    n, rate, speed = 200, 100.0, 1.2
+    lab = _standing_markers(rng, n)
+    lab[..., 1] -= speed * np.arange(n)[:, None] / rate  # walks toward the lab's -Y
+    c3d = write_c3d(tmp_path / "walk.c3d", ["LASI", "RASI", "LTOE", "RTOE"], lab, rate)
+    markers(c3d, tmp_path / "walk.trc", settings=MarkerSettings(cutoff_hz=None), summary_out=tmp_path / "s.tsv")
+    _, X, _ = read_markers(tmp_path / "walk.trc")
+    pelvis = X[:, :2].mean(axis=1)
+    velocity = (pelvis[-1] - pelvis[0]) / ((n - 1) / rate)
+    np.testing.assert_allclose(velocity, [speed, 0.0, 0.0], atol=0.01)
+    np.testing.assert_allclose(X[..., 1], lab[..., 2], atol=1e-6)  # heights: the lab's Z, the model's Y
+    summary = pd.read_csv(tmp_path / "s.tsv", sep="\t").iloc[0]
+    assert summary.heading_deg == pytest.approx(270.0, abs=0.5)  # 0 deg along +X, 90 deg along -Z
+    assert summary.turn_deg == pytest.approx(90.0)
