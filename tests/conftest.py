@@ -57,3 +57,15 @@ def project(tmp_path: Path, monkeypatch) -> Path:
     shutil.copy(ROOT / "workflow/schemas/config.schema.yaml", tmp_path / "workflow/schemas/config.schema.yaml")
     monkeypatch.chdir(tmp_path)
     return tmp_path
+
+
+@pytest.fixture
+def second(project: Path) -> Path:
+    """A file layered over config/config.yaml: a wider fit window and other stride counts
+    (:mod:`tests.config_layers`)."""
+    from tests.config_layers import STRIDES, WINDOW_AFTER_S, write_yaml
+
+    return write_yaml(
+        project / "config" / "mine.yaml",
+        {"identification": {"window_after_s": WINDOW_AFTER_S}, "planning": {"strides": STRIDES}},
+    )

@@ -13,36 +13,17 @@ import re
 from pathlib import Path
 
 import pandas as pd
-import pytest
 import yaml
 
 from loper_analysis.cli import _plan_pilot, _plan_settings, _read_config, command_parser, main
 from loper_analysis.config_file import load_config
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.steps.planning import PlanningSettings
+from tests.config_layers import STRIDES, WINDOW_AFTER_S, write_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config" / "config.yaml"
 SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
-
-#: Values that differ from the library's defaults (PlanSettings, PlanningSettings).
-WINDOW_AFTER_S = 0.3
-STRIDES = [7, 14]
-
-
-def _write(path: Path, data: dict) -> Path:
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
-@pytest.fixture
-def second(project) -> Path:
-    """A file layered over config/config.yaml: a wider fit window and other stride counts."""
-    return _write(
-        project / "config" / "mine.yaml",
-        {"identification": {"window_after_s": WINDOW_AFTER_S}, "planning": {"strides": STRIDES}},
-    )
-
 
 # --------------------------------------------------------------------------- one mapping for the rule and the command
 
@@ -113,7 +94,7 @@ def test_without_a_config_the_library_defaults_serve_and_the_line_says_so(tmp_pa
 
 def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
     """End to end: the config's fit window (shorter than the planned pulse) reaches the planner, which refuses it."""
-    _write(project / "short.yaml", {"identification": {"window_after_s": 0.05}})
+    write_yaml(project / "short.yaml", {"identification": {"window_after_s": 0.05}})
     results = project / "results"
     for path in ("ik/S09/pert050-1.angles.tsv", "strides/S09/pert050-1.strides.tsv"):
         (results / path).parent.mkdir(parents=True, exist_ok=True)

@@ -20,28 +20,10 @@ from loper_analysis.config_file import (
     update_config,
 )
 from loper_analysis.errors import LoperInputError
+from tests.config_layers import STRIDES, WINDOW_AFTER_S, write_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = ROOT / "config" / "config.yaml"
-
-#: Values that differ from the library's defaults (PlanSettings, PlanningSettings).
-WINDOW_AFTER_S = 0.3
-STRIDES = [7, 14]
-
-
-def _write(path: Path, data: dict) -> Path:
-    path.write_text(yaml.safe_dump(data))
-    return path
-
-
-@pytest.fixture
-def second(project) -> Path:
-    """A file layered over config/config.yaml: a wider fit window and other stride counts."""
-    return _write(
-        project / "config" / "mine.yaml",
-        {"identification": {"window_after_s": WINDOW_AFTER_S}, "planning": {"strides": STRIDES}},
-    )
-
 
 # --------------------------------------------------------------------------- load_config
 
@@ -72,16 +54,16 @@ def test_update_is_snakemakes():
 
 
 def test_bad_key_in_the_second_file_is_named_with_that_file(project):
-    bad = _write(project / "second.yaml", {"planning": {"stridez": [3]}})
+    bad = write_yaml(project / "second.yaml", {"planning": {"stridez": [3]}})
     with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'planning\.stridez': Additional properties"):
         load_config(["config/config.yaml", bad])
-    bad = _write(project / "second.yaml", {"identification": {"window_after_s": -0.1}})
+    bad = write_yaml(project / "second.yaml", {"identification": {"window_after_s": -0.1}})
     with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'identification\.window_after_s': -0\.1 is "):
         load_config(["config/config.yaml", bad])
     # a value the first file sets is named with the first file
     (project / "config" / "config.yaml").write_text(CONFIG.read_text().replace("n_starts: 10 ", "n_starts: ten "))
     with pytest.raises(LoperInputError, match=r"^config/config\.yaml: key 'identification\.n_starts': 'ten'"):
-        load_config(["config/config.yaml", _write(project / "ok.yaml", {"seed": 1})])
+        load_config(["config/config.yaml", write_yaml(project / "ok.yaml", {"seed": 1})])
 
 
 def test_yaml_syntax_error_names_the_file_and_line(project):
@@ -94,8 +76,8 @@ def test_schema_of_the_config_files_project_wins(project, tmp_path_factory):
     other = tmp_path_factory.mktemp("other")
     (other / "config").mkdir()
     (other / "workflow" / "schemas").mkdir(parents=True)
-    _write(other / "workflow" / "schemas" / "config.schema.yaml", {"type": "object", "required": ["only_key"]})
-    path = _write(other / "config" / "config.yaml", {"seed": 1})
+    write_yaml(other / "workflow" / "schemas" / "config.schema.yaml", {"type": "object", "required": ["only_key"]})
+    path = write_yaml(other / "config" / "config.yaml", {"seed": 1})
     assert find_schema([path]) == other / "workflow" / "schemas" / "config.schema.yaml"
     with pytest.raises(LoperInputError, match=r"config\.yaml: key '\(top level\)': 'only_key' is a required"):
         load_config([path])

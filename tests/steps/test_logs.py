@@ -14,28 +14,16 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io import timing
 from loper_analysis.steps import logs
 from loper_analysis.steps.logs import PROFILE_VARIABLE, TIMING_PREFIX, rule_log, write_log
+from tests.io.test_timing import FakeClock
 
 
 def _entries(directory):
     return sorted(p.name for p in directory.iterdir())
 
 
-class _Clock:
-    """time.perf_counter and time.time that advance only when told."""
-
-    def __init__(self):
-        self.now = 5000.0
-
-    def perf_counter(self):
-        return self.now
-
-    def time(self):
-        return self.now
-
-
 @pytest.fixture
 def clock(monkeypatch):
-    fake = _Clock()
+    fake = FakeClock()
     monkeypatch.setattr(timing, "time", fake)
     monkeypatch.setattr(logs, "time", fake)
     monkeypatch.setattr(timing, "_state", {"depth": 0, "seconds": 0.0, "import_seconds": 0.0, "first_epoch_s": None})
