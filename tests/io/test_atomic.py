@@ -110,6 +110,39 @@ def test_tsv_writer_gives_the_same_bytes_for_the_same_frame(tmp_path):
     assert (tmp_path / "a.tsv").read_text() == "time_s\tflag\tx\n0\tTrue\t\n0.333333333\tFalse\t2.5e-07\n"
 
 
+def _pandas_tsv(frame: pd.DataFrame, float_format: str) -> bytes:
+    return frame.to_csv(sep="\t", index=False, float_format=float_format, na_rep="", lineterminator="\n").encode()
+
+
+@pytest.mark.parametrize("float_format", ["%.9g", "%.12g", "%.4f"])
+def test_tsv_writer_of_numeric_tables_writes_pandas_own_bytes(tmp_path, float_format, rng):
+    """Tables of float64 and int64 columns are formatted by the writer itself: the bytes must stay pandas'."""
+    n = 2_000
+    frame = pd.DataFrame(
+        {
+            "time_s": np.arange(n) / 1024,
+            "force_N": rng.normal(0, 100, n),
+            "frame": np.arange(n, dtype=np.int64) - 7,
+            "tiny": rng.normal(0, 1e-9, n),
+        }
+    )
+    frame.loc[[3, 9], "force_N"] = np.nan
+    frame.loc[4, "tiny"], frame.loc[5, "tiny"], frame.loc[6, "tiny"] = -0.0, np.inf, -np.inf
+    frame.loc[7, "force_N"], frame.loc[8, "force_N"] = 1e-300, 1e300
+    cases = {
+        "numeric": frame,
+        "numbered columns": frame.set_axis(range(frame.shape[1]), axis=1),
+        "a lone column": frame[["force_N"]],  # pandas quotes its empty cells
+        "a text column": frame.assign(side="left"),
+        "a float32 column": frame.astype({"tiny": np.float32}),
+        "a quoted name": frame.rename(columns={"tiny": 'a "b"'}),
+        "no rows": frame.iloc[:0],
+    }
+    for name, table in cases.items():
+        write_tsv(table, tmp_path / "t.tsv", float_format)
+        assert (tmp_path / "t.tsv").read_bytes() == _pandas_tsv(table, float_format), name
+
+
 def test_figure_writer_leaves_no_partial_png_when_rendering_fails(tmp_path):
     target = tmp_path / "fit.png"
     figure = pyplot().figure()

@@ -24,6 +24,7 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import yaml
 
@@ -50,6 +51,9 @@ TSV_FLOAT_FORMAT = "%.9g"
 FIGURE_DPI = 110
 #: Random characters in a staging directory's name (those of :func:`tempfile.mkdtemp`).
 _STAGE_RANDOM_CHARS = 8
+#: Column types :func:`write_tsv` formats itself; characters that make pandas quote a column name.
+_NUMERIC_COLUMNS = (np.dtype(np.float64), np.dtype(np.int64))
+_QUOTED_CHARACTERS = frozenset('\t"\n\r')
 
 
 def _remove_stale_stages(path: Path) -> None:
@@ -118,11 +122,39 @@ def write_text(path: str | os.PathLike, text: str, what: str = "file") -> Path:
 def write_tsv(frame: pd.DataFrame, path: str | os.PathLike, float_format: str = TSV_FLOAT_FORMAT) -> Path:
     """Write a tidy table as TSV atomically: no index, ``\\n`` line ends, NaN empty, floats by ``float_format``.
 
-    The same frame gives the same bytes.
+    The same frame gives the same bytes: those of pandas' ``to_csv`` with these options.
     """
+    text = _numeric_table_text(frame, float_format)
+    if text is not None:
+        return write_text(path, text, "table")
     with staged(path, "table") as tmp:
         frame.to_csv(tmp, sep="\t", index=False, float_format=float_format, na_rep="", lineterminator="\n")
     return Path(path)
+
+
+def _numeric_table_text(frame: pd.DataFrame, float_format: str) -> str | None:
+    """The TSV text of a table of float64 and int64 columns (two or more, plain names), or None for another.
+
+    The text is byte for byte what pandas' ``to_csv`` writes, which formats each value in Python behind a
+    missing-value check of its own; formatting the columns' Python floats and joining the lines here is about
+    four times faster on the long tables (a 4-minute trial's force at 1 kHz, its IK at 128 Hz).
+    """
+    if frame.shape[1] < 2 or isinstance(frame.columns, pd.MultiIndex):
+        return None  # pandas quotes a lone empty value
+    names = [str(c) for c in frame.columns]
+    if not all(name and not set(name) & _QUOTED_CHARACTERS for name in names):
+        return None  # pandas quotes these names
+    if any(dtype not in _NUMERIC_COLUMNS for dtype in frame.dtypes):
+        return None
+    columns = []
+    for k, dtype in enumerate(frame.dtypes):
+        values = frame.iloc[:, k].tolist()
+        if dtype == np.float64:
+            columns.append(["" if v != v else float_format % v for v in values])
+        else:
+            columns.append([str(v) for v in values])
+    lines = ["\t".join(names), *map("\t".join, zip(*columns))]
+    return "\n".join(lines) + "\n"
 
 
 def write_figure(figure, path: str | os.PathLike, dpi: int = FIGURE_DPI, close: bool = True) -> Path:
