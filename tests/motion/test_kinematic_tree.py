@@ -121,3 +121,32 @@ def test_the_check_catches_a_tree_of_another_model(models):
     with pytest.raises(UnsupportedModel, match=r"places markers up to 0\.0[1-9]"):
         check_against_opensim(longer, kinematic_tree(models["gait2392"]))
     assert CHECK_TOLERANCE_M == 1e-9
+
+
+def test_marker_positions_from_the_tree_are_opensims_with_clamped_locked_and_coupled_coordinates():
+    """``marker_positions`` places long trajectories with the tree: it must set coordinates as OpenSim's
+    ``Coordinate.setValue`` does. A clamped knee given angles beyond its range is placed there (``setValue``
+    does not clamp), a locked coordinate given values stays at its default, and Rajagopal's coupled patella is
+    placed where it is given (couplers not enforced); OpenSim placing the same frames is the answer."""
+    from loper_analysis.motion.ik import TREE_MIN_FRAMES
+    from loper_analysis.motion.opensim_ik import opensim_marker_positions
+
+    rajagopal = read_model(RAJAGOPAL)
+    cs = rajagopal.getCoordinateSet()
+    cs.get("knee_angle_r").setDefaultClamped(True)
+    rajagopal.initSystem()
+    tree = kinematic_tree(rajagopal)
+    assert tree.locked[tree.coordinate_names.index("subtalar_angle_r")]
+    n = TREE_MIN_FRAMES
+    lo, hi = tree.range_q[tree.coordinate_names.index("knee_angle_r")]
+    values = {
+        "knee_angle_r": np.linspace(lo - 0.3, hi + 0.3, n),  # beyond both bounds
+        "subtalar_angle_r": np.full(n, 0.3),  # locked: OpenSim leaves it at its default
+        "knee_angle_l_beta": np.linspace(-0.5, 0.5, n),  # coupled: placed as given
+        "hip_flexion_l": np.linspace(-0.4, 0.8, n),
+    }
+    names = list(tree.marker_names)
+    positions = marker_positions(rajagopal, values, names[::-1])
+    expected = opensim_marker_positions(rajagopal, values, names[::-1])
+    assert np.abs(expected[0] - expected[-1]).max() > 0.1  # the trajectories move the markers
+    np.testing.assert_allclose(positions, expected, rtol=0, atol=1e-12)

@@ -61,6 +61,9 @@ IK_ACCURACY: float = 1e-6
 IK_SOLVERS: tuple[str, ...] = ("tree", "opensim")
 #: The pipeline's IK solver.
 IK_SOLVER: str = "tree"
+#: Frames from which :func:`marker_positions` places markers with the model's kinematic tree: below them
+#: building and checking the tree (about 0.1 s) costs more than OpenSim's own placing (0.1 ms per frame).
+TREE_MIN_FRAMES: int = 1000
 
 #: Columns of the one-row IK summary of a trial (:meth:`IKResult.summary`).
 IK_SUMMARY_COLUMNS: tuple[str, ...] = (
@@ -179,15 +182,23 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
 
     ``coordinate_values`` maps coordinate names to trajectories of one common
     length n, or of length 1 (held for every frame); coordinates not given
-    stay at their defaults. ``marker_names`` selects and orders the markers
+    stay at their defaults, and each is set as OpenSim's ``Coordinate.setValue``
+    sets it (a locked one left at its default, a clamped one as given, couplers
+    not enforced). ``marker_names`` selects and orders the markers
     (default: every model marker, in model order).
+
+    From :data:`TREE_MIN_FRAMES` frames on, the model's kinematic tree places the markers
+    (:mod:`loper_analysis.motion.kinematic_tree`, checked against OpenSim first); OpenSim places them for
+    fewer frames and for a model the tree does not hold.
 
     Raises
     ------
     LoperInputError
         An unknown coordinate or marker, or trajectories of unequal lengths.
     """
-    state = model.initSystem()
+    from loper_analysis.motion.opensim_ik import opensim_marker_positions
+
+    model.initSystem()
     cs = model.getCoordinateSet()
     names = [cs.get(i).getName() for i in range(cs.getSize())]
     unknown = [c for c in coordinate_values if c not in names]
@@ -204,16 +215,23 @@ def marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_nam
     missing = [mk for mk in wanted if mk not in all_markers]
     if missing:
         raise LoperInputError(f"{model_source(model)}: marker(s) {missing} not in the model")
-    # Look the coordinates and markers up once: per-frame lookups through SWIG cost more than the kinematics.
-    coordinates = [(cs.get(c), np.broadcast_to(v, (n,))) for c, v in values.items()]
-    markers = [ms.get(all_markers.index(mk)) for mk in wanted]
-    out = np.empty((n, len(wanted), 3))
-    for k in range(n):
-        for coordinate, v in coordinates:
-            coordinate.setValue(state, float(v[k]), False)
-        model.realizePosition(state)
-        out[k] = [marker.getLocationInGround(state).to_numpy() for marker in markers]
-    return out
+    tree = _checked_tree(model) if n >= TREE_MIN_FRAMES else None
+    if tree is None:
+        return opensim_marker_positions(model, values, wanted)
+    order = [tree.marker_names.index(mk) for mk in wanted]
+    return tree.positions(tree.poses(values, n))[:, order]
+
+
+def _checked_tree(model):
+    """The model's kinematic tree, checked against OpenSim's marker positions; None if the tree does not hold it."""
+    from loper_analysis.motion.kinematic_tree import UnsupportedModel, check_against_opensim, kinematic_tree
+
+    try:
+        tree = kinematic_tree(model)
+        check_against_opensim(model, tree)
+    except UnsupportedModel:
+        return None
+    return tree
 
 
 def require_model_markers(model, source: str = "") -> None:

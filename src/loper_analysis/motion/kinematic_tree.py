@@ -107,6 +107,25 @@ class KinematicTree:
         tree_markers(self.kernel_arrays(), np.array(q, float), P, J)
         return P, J
 
+    def positions(self, Q: np.ndarray) -> np.ndarray:
+        """Every marker's ground position (n, nm, 3) in m at each row of ``Q`` (n, nc), taken as given: coupled
+        coordinates where ``Q`` puts them, as OpenSim places markers for coordinates set without enforcing the
+        constraints."""
+        Q = np.ascontiguousarray(Q, dtype=float)
+        P = np.empty((Q.shape[0], self.marker_body.size, 3))
+        tree_marker_positions(self.kernel_arrays(), Q, P)
+        return P
+
+    def poses(self, values: dict[str, np.ndarray], n: int) -> np.ndarray:
+        """Coordinates (n, nc) for trajectories ``values`` (name -> (n,) or (1,), rad or m), the others at their
+        defaults, as OpenSim's ``Coordinate.setValue`` sets them: a locked coordinate left at its default, a
+        clamped one as given (``setValue`` does not clamp)."""
+        Q = np.tile(self.default_q, (n, 1))
+        for name, v in values.items():
+            Q[:, self.coordinate_names.index(name)] = v
+        Q[:, self.locked] = self.default_q[self.locked]
+        return Q
+
     def kernel_arrays(self) -> tuple:
         """The arrays :func:`tree_markers` takes, in its order."""
         return (
@@ -362,16 +381,31 @@ def _axis_value(kind, linear, piece0, n_pieces, knots, coefficients, x):  # prag
 
 
 @njit(cache=True)
-def _rotation(axis, angle):  # pragma: no cover - compiled
-    """Rotation matrix (3, 3) of ``angle`` rad about the unit ``axis`` (Rodrigues)."""
+def _rotation(axis, angle, R):  # pragma: no cover - compiled
+    """Rotation matrix ``R`` (3, 3), written in place, of ``angle`` rad about the unit ``axis`` (Rodrigues)."""
     c, s = np.cos(angle), np.sin(angle)
     x, y, z = axis[0], axis[1], axis[2]
     C = 1.0 - c
-    R = np.empty((3, 3))
     R[0, 0], R[0, 1], R[0, 2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
     R[1, 0], R[1, 1], R[1, 2] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
     R[2, 0], R[2, 1], R[2, 2] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
-    return R
+
+
+# The products of 3 x 3 matrices and 3-vectors are written out: NumPy's ``@`` on arrays this small costs a
+# call into BLAS each, several times the arithmetic.
+@njit(cache=True)
+def _times_matrix(A, B, out):  # pragma: no cover - compiled
+    """``out`` = ``A`` @ ``B`` for (3, 3) matrices (``out`` distinct from both)."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@njit(cache=True)
+def _times_vector(A, v, out):  # pragma: no cover - compiled
+    """``out`` = ``A`` @ ``v`` for a (3, 3) matrix and a 3-vector (``out`` distinct from ``v``)."""
+    for i in range(3):
+        out[i] = A[i, 0] * v[0] + A[i, 1] * v[1] + A[i, 2] * v[2]
 
 
 @njit(cache=True)
@@ -383,28 +417,45 @@ def _body_frames(arrays, q):  # pragma: no cover - compiled
     nb = parent.size
     R_G, o_G = np.empty((nb, 3, 3)), np.empty((nb, 3))
     w_G, c_G, slope = np.zeros((nb, 6, 3)), np.empty((nb, 3)), np.zeros((nb, 6))
+    R_F, R, R_turned, turn, R_M = (
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+    )
+    o_F, p, v, u = np.empty(3), np.empty(3), np.empty(3), np.empty(3)
     for b in range(nb):
-        R_P = np.eye(3) if parent[b] < 0 else R_G[parent[b]]
-        o_P = np.zeros(3) if parent[b] < 0 else o_G[parent[b]]
-        R_F = R_P @ R_PF[b]
-        o_F = o_P + R_P @ p_PF[b]
-        R = np.eye(3)
-        p = np.zeros(3)
+        if parent[b] < 0:
+            R_F[:] = R_PF[b]
+            o_F[:] = p_PF[b]
+        else:
+            _times_matrix(R_G[parent[b]], R_PF[b], R_F)
+            _times_vector(R_G[parent[b]], p_PF[b], v)
+            o_F[:] = o_G[parent[b]] + v
+        R[:] = 0.0
+        R[0, 0] = R[1, 1] = R[2, 2] = 1.0
+        p[:] = 0.0
         for i in range(6):
             x = q[coordinate[b, i]] if coordinate[b, i] >= 0 else 0.0
             value, slope[b, i] = _axis_value(
                 kind[b, i], linear[b, i], piece0[b, i], n_pieces[b, i], knots, coefficients, x
             )
             if i < 3:  # rotations, each about its axis as the ones before have turned it
-                w_G[b, i] = R_F @ (R @ axes[b, i])
-                R = R @ _rotation(axes[b, i], value)
+                _times_vector(R, axes[b, i], u)
+                _times_vector(R_F, u, w_G[b, i])
+                _rotation(axes[b, i], value, turn)
+                _times_matrix(R, turn, R_turned)
+                R[:] = R_turned
             else:  # translations along the parent frame's axes
                 p += value * axes[b, i]
-                w_G[b, i] = R_F @ axes[b, i]
-        R_M = R_F @ R
-        c_G[b] = o_F + R_F @ p
-        R_G[b] = R_M @ R_MB[b]
-        o_G[b] = c_G[b] + R_M @ p_MB[b]
+                _times_vector(R_F, axes[b, i], w_G[b, i])
+        _times_matrix(R_F, R, R_M)
+        _times_vector(R_F, p, v)
+        c_G[b] = o_F + v
+        _times_matrix(R_M, R_MB[b], R_G[b])
+        _times_vector(R_M, p_MB[b], v)
+        o_G[b] = c_G[b] + v
     return R_G, o_G, w_G, c_G, slope
 
 
@@ -431,7 +482,8 @@ def tree_markers(arrays, q, P, J):  # pragma: no cover - compiled
     R_G, o_G, w_G, c_G, slope = _body_frames(arrays, q)
     for m in range(marker_body.size):
         b = marker_body[m]
-        P[m] = o_G[b] + R_G[b] @ marker_location[m]
+        _times_vector(R_G[b], marker_location[m], P[m])
+        P[m] += o_G[b]
         while b >= 0:
             for i in range(6):
                 c = coordinate[b, i]
@@ -449,6 +501,21 @@ def tree_markers(arrays, q, P, J):  # pragma: no cover - compiled
         for k in range(coupled.shape[0]):  # the chain rule through the couplers
             J[m, :, coupled[k, 1]] += coupled_slope[k] * J[m, :, coupled[k, 0]]
             J[m, :, coupled[k, 0]] = 0.0
+
+
+@njit(cache=True)
+def tree_marker_positions(arrays, Q, P):  # pragma: no cover - compiled
+    """Marker positions ``P`` (n, nm, 3) in m, written in place, at each row of ``Q`` (n, nc) as given.
+
+    ``arrays`` is :meth:`KinematicTree.kernel_arrays`.
+    """
+    marker_body, marker_location = arrays[18], arrays[19]
+    for k in range(Q.shape[0]):
+        R_G, o_G, _, _, _ = _body_frames(arrays, Q[k])
+        for m in range(marker_body.size):
+            b = marker_body[m]
+            _times_vector(R_G[b], marker_location[m], P[k, m])
+            P[k, m] += o_G[b]
 
 
 def _coupled_values(tree: KinematicTree, q: np.ndarray) -> list[tuple[int, int, float]]:
@@ -475,7 +542,7 @@ def check_against_opensim(model, tree: KinematicTree, n_poses: int = 8, seed: in
     from ``seed``), locked coordinates at their defaults and coupled ones following their couplers. Raises
     :class:`UnsupportedModel` when the distance exceeds :data:`CHECK_TOLERANCE_M`.
     """
-    from loper_analysis.motion.ik import marker_positions
+    from loper_analysis.motion.opensim_ik import opensim_marker_positions
 
     rng = np.random.default_rng(seed)
     lo, hi = tree.range_q[:, 0], tree.range_q[:, 1]
@@ -485,7 +552,7 @@ def check_against_opensim(model, tree: KinematicTree, n_poses: int = 8, seed: in
     for q in Q:  # coupled coordinates follow their independent ones
         for dependent, _, value in _coupled_values(tree, q):
             q[dependent] = value
-    expected = marker_positions(model, dict(zip(tree.coordinate_names, Q.T)), list(tree.marker_names))
+    expected = opensim_marker_positions(model, dict(zip(tree.coordinate_names, Q.T)), list(tree.marker_names))
     worst = max(float(np.abs(tree.markers(q)[0] - e).max()) for q, e in zip(Q, expected))
     if not worst <= CHECK_TOLERANCE_M:
         raise UnsupportedModel(

@@ -14,7 +14,7 @@ import numpy as np
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import model_source, quiet_opensim
 
-__all__ = ["markers_table", "opensim_solution"]
+__all__ = ["markers_table", "opensim_marker_positions", "opensim_solution"]
 
 
 def markers_table(time_s, markers_m, labels):
@@ -32,6 +32,26 @@ def markers_table(time_s, markers_m, labels):
     v3 = table.packVec3(osim.StdVectorString(["_x", "_y", "_z"]))
     v3.addTableMetaDataString("Units", "m")
     return v3
+
+
+def opensim_marker_positions(model, coordinate_values: dict[str, np.ndarray], marker_names: list[str]) -> np.ndarray:
+    """Ground positions (n, n_markers, 3) in m of the model's markers ``marker_names``, OpenSim placing them frame
+    by frame for coordinate trajectories ``coordinate_values`` (name -> (n,) or (1,) values, rad or m; the others
+    at their defaults), set without enforcing the constraints. Names are not checked here
+    (:func:`loper_analysis.motion.ik.marker_positions` does)."""
+    state = model.initSystem()
+    cs, ms = model.getCoordinateSet(), model.getMarkerSet()
+    n = max((np.size(v) for v in coordinate_values.values()), default=1)
+    # Look the coordinates and markers up once: per-frame lookups through SWIG cost more than the kinematics.
+    coordinates = [(cs.get(c), np.broadcast_to(np.asarray(v, float), (n,))) for c, v in coordinate_values.items()]
+    markers = [ms.get(name) for name in marker_names]
+    out = np.empty((n, len(markers), 3))
+    for k in range(n):
+        for coordinate, v in coordinates:
+            coordinate.setValue(state, float(v[k]), False)
+        model.realizePosition(state)
+        out[k] = [marker.getLocationInGround(state).to_numpy() for marker in markers]
+    return out
 
 
 def opensim_solution(
