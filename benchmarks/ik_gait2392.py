@@ -1,7 +1,8 @@
 """IK time per frame and agreement with OpenSim: gait2392, Rajagopal2016 and the generated model, same walking.
 
 Usage: python benchmarks/ik_gait2392.py [duration_s] [--models generated,gait2392,rajagopal2016]
-                                        (default 240 s: a 4-minute trial at 128 Hz)
+                                        [--variants "opensim 1e-5,opensim held,tree 1e-6"]
+                                        (default 240 s: a 4-minute trial at 128 Hz; every variant)
 
 One simulated walking trial (the synthetic lab's gait) drives each model: the generated sagittal model with
 its 36 markers, gait2392 (23 coordinates) with its 39 scale markers and Rajagopal2016 (39 coordinates, its
@@ -15,6 +16,8 @@ Markers get 0.5 mm noise. Each model is solved, on one core, by:
 * ``opensim held``: the same at 1e-6 with the coordinates no marker determines (gait2392's mtp angles)
   held at their defaults instead of solved;
 * ``tree 1e-6``: Gauss-Newton on the model's kinematic tree (``opensim.ik_solver: tree``, the default).
+
+``--variants`` names the rows to solve besides the reference, which is always solved.
 
 Printed per row: the solve time, the time per frame of the trial, and the largest RMS difference (deg) of
 hip, knee and ankle flexion (both sides) and pelvis tilt from the reference. The time includes building the
@@ -83,7 +86,11 @@ def _held(model, X: np.ndarray, labels: list[str]) -> dict:
     return {c: (1.0, None) for c, never in zip(tree.coordinates, free.all(axis=0)) if never}
 
 
-def _rows(name: str, model, coordinates, rng) -> list[tuple]:
+REFERENCE = "opensim 1e-6"
+VARIANTS = ("opensim 1e-5", "opensim held", "tree 1e-6")
+
+
+def _rows(name: str, model, coordinates, rng, wanted=VARIANTS) -> list[tuple]:
     markers = model.getMarkerSet()
     labels = [markers.get(i).getName() for i in range(markers.getSize())]
     cs = model.getCoordinateSet()
@@ -99,6 +106,7 @@ def _rows(name: str, model, coordinates, rng) -> list[tuple]:
     }
     if not variants["opensim held"]["coordinate_tasks"]:
         del variants["opensim held"]
+    variants = {k: v for k, v in variants.items() if k == REFERENCE or k in wanted}
     rows, reference = [], None
     for variant, options in variants.items():
         t0 = time.perf_counter()
@@ -114,7 +122,12 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("duration_s", nargs="?", type=float, default=240.0)
     parser.add_argument("--models", default="generated,gait2392,rajagopal2016")
+    parser.add_argument("--variants", default=",".join(VARIANTS), help="rows besides the reference, comma-separated")
     args = parser.parse_args(argv)
+    wanted = [v.strip() for v in args.variants.split(",") if v.strip()]
+    unknown = sorted(set(wanted) - set(VARIANTS))
+    if unknown:
+        parser.error(f"unknown variant(s) {unknown}; choose from {', '.join(VARIANTS)}")
     rng = np.random.default_rng(2024)
     coordinates, _ = walking_kinematics(
         args.duration_s,
@@ -129,13 +142,14 @@ def main(argv: list[str] | None = None) -> None:
     models = _models()
     rows = []
     for name in args.models.split(","):
-        rows += _rows(name, models[name], coordinates if name == "generated" else mapped, rng)
+        rows += _rows(name, models[name], coordinates if name == "generated" else mapped, rng, wanted)
     print(f"IK of {args.duration_s:g} s of walking at {RATE_HZ:g} Hz, one core")
     print("| model | solver | frames | s | ms per frame | largest RMS from opensim 1e-6 (deg) |")
     print("|---|---|---|---|---|---|")
     for name, variant, n, seconds, per_frame, rms in rows:
         print(f"| {name} | {variant} | {n} | {seconds:.1f} | {per_frame:.3f} | {rms:.4f} |")
-    print(f"command: python benchmarks/ik_gait2392.py {args.duration_s:g} --models {args.models}")
+    command = f"python benchmarks/ik_gait2392.py {args.duration_s:g} --models {args.models}"
+    print(f"command: {command} --variants '{args.variants}'")
 
 
 if __name__ == "__main__":
