@@ -1,4 +1,5 @@
-"""gait2392 (``examples/gait2392/``) scaled with known factors, for the tests of scaling and segment tables."""
+"""gait2392 (``examples/gait2392/``) as distributed with its scale markers, and scaled with known factors, for
+the tests of IK, scaling and segment tables."""
 
 from __future__ import annotations
 
@@ -11,6 +12,14 @@ GENERIC = EXAMPLE / "gait2392_simbody.osim"
 MARKER_SET = EXAMPLE / "gait2392_Scale_MarkerSet.xml"
 #: gait2392's total mass (kg): a subject of this mass keeps the model's body masses.
 GENERIC_MASS_KG = 75.1646
+
+
+def gait2392_with_markers():
+    """gait2392 as distributed, with its scale marker set attached, initialised (``opensim.Model``)."""
+    model = read_model(GENERIC)
+    model.updateMarkerSet(read_marker_set(MARKER_SET))
+    model.initSystem()
+    return model
 
 
 def scaled_gait2392(factors: dict[str, float], mass_kg: float, markers: bool = False):

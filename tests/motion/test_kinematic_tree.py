@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from loper_analysis.io.osim import quiet_opensim, read_marker_set, read_model
+from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.kinematic_tree import (
     CHECK_TOLERANCE_M,
@@ -22,24 +22,21 @@ from loper_analysis.motion.kinematic_tree import (
     kinematic_tree,
 )
 from loper_analysis.motion.model import build_lower_body_model
+from tests.gait2392_models import gait2392_with_markers
 
 ROOT = Path(__file__).resolve().parents[2]
-GAIT2392 = ROOT / "examples" / "gait2392"
 RAJAGOPAL = ROOT / "tests" / "data" / "rajagopal2016" / "Rajagopal2016.osim"
-
-
-def _gait2392():
-    model = read_model(GAIT2392 / "gait2392_simbody.osim")
-    model.updateMarkerSet(read_marker_set(GAIT2392 / "gait2392_Scale_MarkerSet.xml"))
-    model.initSystem()
-    return model
 
 
 @pytest.fixture(scope="module")
 def models():
     rajagopal = read_model(RAJAGOPAL)
     rajagopal.initSystem()
-    return {"generated": build_lower_body_model(1.8, 75.0), "gait2392": _gait2392(), "rajagopal2016": rajagopal}
+    return {
+        "generated": build_lower_body_model(1.8, 75.0),
+        "gait2392": gait2392_with_markers(),
+        "rajagopal2016": rajagopal,
+    }
 
 
 @pytest.mark.parametrize("name", ["generated", "gait2392", "rajagopal2016"])

@@ -14,7 +14,6 @@ import numpy as np
 import pytest
 
 from loper_analysis.io.opensim_tables import read_markers
-from loper_analysis.io.osim import read_marker_set, read_model
 from loper_analysis.motion.ik import inverse_kinematics, marker_positions
 from loper_analysis.motion.kinematic_tree import kinematic_tree
 from loper_analysis.motion.model import build_lower_body_model
@@ -22,9 +21,9 @@ from loper_analysis.motion.tree_ik import tree_inverse_kinematics
 from loper_analysis.synthetic.gait_curves import NominalGait
 from loper_analysis.synthetic.lab_export import gait2392_coordinates
 from loper_analysis.synthetic.walking import leg_length_from_height, walking_kinematics
+from tests.gait2392_models import gait2392_with_markers
 
 ROOT = Path(__file__).resolve().parents[2]
-GAIT2392 = ROOT / "examples" / "gait2392"
 STATIC_TRC = ROOT / "tests" / "data" / "gait2392" / "subject01_static.trc"
 #: gait2392's flexion angles and pelvis tilt, the angles the study reads.
 STUDY_ANGLES = ("hip_flexion_r", "knee_angle_r", "ankle_angle_r", "hip_flexion_l", "knee_angle_l", "ankle_angle_l")
@@ -32,16 +31,9 @@ STUDY_ANGLES = ("hip_flexion_r", "knee_angle_r", "ankle_angle_r", "hip_flexion_l
 AGREEMENT_DEG = 0.05
 
 
-def _gait2392():
-    model = read_model(GAIT2392 / "gait2392_simbody.osim")
-    model.updateMarkerSet(read_marker_set(GAIT2392 / "gait2392_Scale_MarkerSet.xml"))
-    model.initSystem()
-    return model
-
-
 @pytest.fixture(scope="module")
 def gait2392():
-    return _gait2392()
+    return gait2392_with_markers()
 
 
 @pytest.fixture(scope="module")
@@ -118,7 +110,7 @@ def test_opensims_tutorial_static_trial_agrees_with_opensim(gait2392):
 
 def test_locked_and_clamped_coordinates_hold(walking):
     """A locked coordinate stays at its default; a clamped one within its range, however the markers pull."""
-    model = _gait2392()
+    model = gait2392_with_markers()
     cs = model.getCoordinateSet()
     cs.get("lumbar_rotation").setDefaultLocked(True)
     cs.get("lumbar_rotation").setDefaultValue(0.1)
