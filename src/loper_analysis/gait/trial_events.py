@@ -22,6 +22,7 @@ from loper_analysis.motion.filtering import ORDER
 
 __all__ = [
     "FOOT_MARKERS",
+    "TOE_MARKERS",
     "GRF_CHANNELS",
     "MIN_JUDGED_STANCES",
     "SWAPPED_BELT_FRACTION",
@@ -35,6 +36,8 @@ log = logging.getLogger(__name__)
 GRF_CHANNELS: Mapping[str, str] = {"left": "Fz_left", "right": "Fz_right"}
 #: Heel marker of each foot, model names (config ``events.foot_markers``).
 FOOT_MARKERS: Mapping[str, str] = {"left": "LHEE", "right": "RHEE"}
+#: Toe marker of each foot, model names: with the heels they tell the foot across two plates (used when present).
+TOE_MARKERS: Mapping[str, str] = {"left": "LTOE", "right": "RTOE"}
 
 
 @dataclass(frozen=True)
@@ -44,7 +47,9 @@ class EventSettings:
     ``grf_channels``: {side: analog channel} of each belt (files without force platforms);
     ``threshold_on_n`` / ``threshold_off_n``: the vertical force (N) rises / falls through these at heel strike /
     toe-off; ``min_stance_s``, ``min_swing_s``: shorter phases are noise (s); ``cutoff_hz``, ``order``: low-pass
-    of a belt's force before thresholding (Hz; None: raw); ``foot_markers``: {side: heel marker}; ``plate_sides``:
+    of a belt's force before thresholding (Hz; None: raw); ``foot_markers``: {side: heel marker}; ``toe_markers``:
+    {side: toe marker}, used when both are in the file, or None (a foot across two plates is then told by its heel
+    alone); ``plate_sides``:
     {side: plate number} as a check, or None; ``label_map``: as
     :class:`~loper_analysis.motion.trial_markers.MarkerSettings`; ``rotation_deg``: lab -> model rotation
     (degrees), which fixes the lab's vertical; ``band_n``, ``max_rest_n``: a plate's resting level (N,
@@ -59,6 +64,7 @@ class EventSettings:
     cutoff_hz: float | None = None
     order: int = ORDER
     foot_markers: Mapping[str, str] | None = field(default_factory=lambda: dict(FOOT_MARKERS))
+    toe_markers: Mapping[str, str] | None = field(default_factory=lambda: dict(TOE_MARKERS))
     plate_sides: Mapping[str, int] | None = None
     label_map: Mapping[str, str] | str | os.PathLike | Sequence | None = None
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
@@ -252,11 +258,23 @@ def _plate_events(rec, platforms: list, s: EventSettings, label_map) -> tuple[pd
         PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i]) for i, n in enumerate(loads.numbers)
     ]
     heels = {side: rotate_markers(rec.markers_m[:, names.index(foot_markers[side]), :], rotation_deg) for side in SIDES}
+    toes = None
+    if s.toe_markers and all(s.toe_markers[side] in names for side in SIDES):
+        toes = {
+            side: rotate_markers(rec.markers_m[:, names.index(s.toe_markers[side]), :], rotation_deg) for side in SIDES
+        }
+    elif s.toe_markers:
+        log.info(
+            "%s: no toe markers %s: a foot across two plates is told by its heel alone",
+            source,
+            " and ".join(s.toe_markers[side] for side in SIDES),
+        )
     # corners and heels are in the model frame, whose up is +Y
     contacts = foot_contacts(
         plates,
         rec.time_s,
         heels,
+        toes_m=toes,
         plate_sides=s.plate_sides,
         threshold_on_n=s.threshold_on_n,
         threshold_off_n=s.threshold_off_n,

@@ -113,8 +113,8 @@ def strides_summary(
     ``strides_tsvs`` holds one stride table per ``(subject, trial)`` of
     ``subject_trials``, in order; of ``files`` (:class:`TrialTables`, same order), ``contacts`` the
     force-plate contact tables written by :func:`events`, whose flagged
-    contacts are counted. A stride table of a trial with 0 strides (its
-    header only, as :func:`strides` writes it) gives ``n_strides`` 0 and the
+    contacts are counted and, with their reasons, added to the trial's warnings. A stride table of a
+    trial with 0 strides (its header only, as :func:`strides` writes it) gives ``n_strides`` 0 and the
     status ``too_few_strides``. ``ik`` (the IK summaries of
     :func:`loper_analysis.steps.ik.ik_trial`) add the frames and those left
     out of IK, the mean marker RMS error, the worst marker, the change of the marker geometry against the
@@ -172,6 +172,8 @@ def strides_summary(
         table = pd.concat([table, *extra], axis=1)
     if "outside_robot_log_fraction" in table:
         table["warnings"] = _with_truncation_warnings(table)
+    if contacts is not None:
+        table["warnings"] = _with_contact_warnings(table, contacts)
     write_tsv(table, out_tsv)
     for row in table[table.status == "too_few_strides"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
@@ -233,6 +235,23 @@ def _with_truncation_warnings(table: pd.DataFrame) -> list[str]:
     ]
     before = table["warnings"] if "warnings" in table else pd.Series([""] * len(table))
     return [" | ".join(w for w in pair if w) for pair in zip(said, before.fillna(""))]
+
+
+def _with_contact_warnings(table: pd.DataFrame, contacts: dict) -> list[str]:
+    """The summary's warnings, with each trial's force-plate contacts left out of the events and their reasons
+    (the contact tables' ``reason`` column; contacts cut by the recording's start or end are no warning)."""
+    before = table["warnings"].fillna("") if "warnings" in table else pd.Series([""] * len(table))
+    out = []
+    for subject, trial, said in zip(table["subject"], table["trial"], before):
+        c = contacts[(subject, trial)]
+        lost = c[~c["flag"].isin(["ok", "incomplete"])] if len(c) and "reason" in c else c.iloc[:0]
+        lines = [
+            f"plate {r.plate} contact {float(r.start_s):.3f}-{float(r.end_s):.3f} s left out of the events "
+            f"({r.flag}): {r.reason}"
+            for r in lost.itertuples()
+        ]
+        out.append(" | ".join(w for w in [str(said), *lines] if w))
+    return out
 
 
 def angles_figure(
