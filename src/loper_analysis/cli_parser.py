@@ -137,7 +137,7 @@ def _add_scale(sub, handlers: Mapping[str, Callable]) -> None:
     p.add_argument(
         "--start",
         type=float,
-        help="first time of the static trial to use (s; default: the setup's time range, else the first "
+        help="first time of the static trial to use (s; default: the setup's time range, else the stillest "
         "markers.static_duration_s)",
     )
     p.add_argument("--end", type=float, help="last time of the static trial to use (s)")

@@ -49,6 +49,25 @@ def test_a_trial_shorter_than_the_static_duration_is_averaged_whole(models):
     assert static.window_s == (t[0], t[-1]) and static.pose.time_s.size == 20
 
 
+def test_without_a_time_range_the_stillest_second_is_the_window(models):
+    """The subject sways forward at 0.1 m/s for the first 1.5 s (29 mm RMS over a second), then stands still."""
+    generic, _, (t, X, labels) = models
+    t3 = np.arange(round(3.0 * RATE_HZ)) / RATE_HZ
+    X3 = np.repeat(X[:1], t3.size, axis=0)
+    X3[:, :, 0] += 0.1 * np.minimum(t3, 1.5)[:, None]
+    static = scaling_pose(generated_scale_tool(), generic, (t3, X3, labels), ModelSettings(), static_trc="static.trc")
+    assert static.window_s == (1.5, t3[192 + 127])  # the first second standing: 128 frames from 1.5 s
+    np.testing.assert_array_equal(static.pose.markers_m, X3[192:320])
+    assert max(static.pose.motion_rms_m.values()) == pytest.approx(0.0, abs=1e-12)
+    # a time range given is taken as it is: the first second moves 29 mm RMS (0.1 m/s over 1 s / sqrt(12)),
+    # within the limit
+    first = scaling_pose(
+        generated_scale_tool(), generic, (t3, X3, labels), ModelSettings(time_range_s=(0.0, 1.0)), static_trc="s"
+    )
+    assert first.window_s == (0.0, 1.0)
+    assert max(first.pose.motion_rms_m.values()) == pytest.approx(0.1 * 1.0 / np.sqrt(12), rel=0.01)
+
+
 def test_markers_in_millimetres_read_as_metres_are_refused_by_their_factors(models):
     generic, _, (t, X, labels) = models
     with pytest.raises(LoperInputError, match=r"static\.trc: scale factor\(s\) outside .*thigh_r 1\d\d\d"):

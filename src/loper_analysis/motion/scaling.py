@@ -79,8 +79,9 @@ def scaling_pose(
     measurements' scale factors must lie in ``settings.factor_range``.
 
     The window (:func:`loper_analysis.motion.static_trial.scale_window_s`) is ``settings.time_range_s`` when
-    given, else the tool's time ranges where they are set, else the first ``settings.static_duration_s`` seconds
-    (None: the whole trial). Within it each marker counts where it is present
+    given, else the tool's time ranges where they are set, else the ``settings.static_duration_s`` seconds where
+    the measurement markers move least (:func:`loper_analysis.motion.static_trial.stillest_window_s`; None: the
+    whole trial). Within it each marker counts where it is present
     (:func:`loper_analysis.motion.static_trial.static_pose`, at most ``settings.max_motion_rms_m`` of motion).
 
     Parameters
@@ -114,6 +115,8 @@ def scaling_pose(
     ranges = {part: scale_tool.time_range(part) for part in (scaler, placer) if part.getApply()}
     ranges = {part: r if time_range_is_set(r) else None for part, r in ranges.items()}  # None where unset
     setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
+    pairs = scale_tool.measurement_pairs(tool)
+    needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     if time_range_s is not None:
         t0, t1 = map(float, time_range_s)
         if not (t0 <= t1 and t0 <= times[-1] + 1e-9 and t1 >= times[0] - 1e-9):
@@ -125,10 +128,17 @@ def scaling_pose(
         ranges = dict.fromkeys(ranges)
     else:
         window = scale_window_s(
-            times, list(ranges.values()), settings.static_duration_s, source=str(static_trc), setting=setting
+            times,
+            list(ranges.values()),
+            settings.static_duration_s,
+            source=str(static_trc),
+            setting=setting,
+            markers_m=X,
+            labels=labels,
+            needed=needed,
+            max_motion_rms_m=settings.max_motion_rms_m,
+            lab_labels=lab_labels,
         )
-    pairs = scale_tool.measurement_pairs(tool)
-    needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     lacking = [m for m in needed if m not in labels]
     if lacking:
         raise LoperInputError(

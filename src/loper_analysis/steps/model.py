@@ -86,7 +86,7 @@ def generic_model(
     """The generic lower-body model (:func:`loper_analysis.motion.model.build_lower_body_model`) for this subject.
 
     Without ``mass_kg`` the mass comes from the force plates the subject
-    stands on in the static trial ``static_c3d``, over its first
+    stands on in the static trial ``static_c3d``, over its stillest
     ``settings.static_duration_s`` seconds (None: all of it; ``settings.rotation_deg`` tells the lab's
     vertical: :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
     """
@@ -97,7 +97,14 @@ def generic_model(
         from loper_analysis.motion.static_trial import scale_window_s
 
         rec, plates = _static_record(static_c3d)
-        window = scale_window_s(rec.time_s, (), settings.static_duration_s, source=str(static_c3d))
+        window = scale_window_s(
+            rec.time_s,
+            (),
+            settings.static_duration_s,
+            str(static_c3d),
+            markers_m=rec.markers_m,
+            labels=rec.marker_labels,
+        )
         mass_kg, source = body_mass_kg(None, rec, plates, window, lab_up(settings.rotation_deg))
         log.info("mass %.2f kg from the %s", mass_kg, source)
     mass_kg, _ = body_mass_kg(mass_kg)
@@ -213,7 +220,7 @@ def scale_with_setup(
     The static trial is averaged over a window
     (:func:`loper_analysis.motion.static_trial.scale_window_s`): ``settings.time_range_s``
     when given, else the setup's time ranges where they are set, else the
-    first ``settings.static_duration_s`` seconds (None: the whole
+    stillest ``settings.static_duration_s`` seconds (None: the whole
     trial). Within it each marker counts where it is present: ScaleTool gets
     the window with every marker's missing frames holding its mean over the
     present ones (:func:`loper_analysis.motion.static_trial.static_pose`).
