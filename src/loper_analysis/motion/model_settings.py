@@ -34,8 +34,9 @@ class ModelSettings:
         Lab -> model rotation about the fixed X, Y, Z axes, degrees: the lab's vertical, for the mass from the
         static trial's force plates (``markers.lab_to_model_rotation_deg``).
     static_duration_s : float or None
-        Without a time range (``time_range_s``, the scale setup's): the first this many seconds of the static
-        trial are averaged, s; None: the whole trial (``markers.static_duration_s``).
+        Without a time range (``time_range_s``, the scale setup's): the stillest this many seconds of the static
+        trial are averaged, s (:func:`loper_analysis.motion.static_trial.stillest_window_s`); None: the whole trial
+        (``markers.static_duration_s``).
     max_motion_rms_m : float or None
         Largest RMS motion of a marker over the window, m: a subject who does not stand still is refused; None:
         not checked (``markers.static_max_motion_rms_m``).
