@@ -53,3 +53,34 @@ def test_a_knee_flexing_negative_is_warned_about_and_a_walking_knee_is_not():
     warnings = inverted_knee_warnings(angles)
     assert len(warnings) == 1 and warnings[0].startswith("knee_right flexes negative (from -52 to 3 deg)")
     assert "opensim.coordinate_map.knee_right.sign" in warnings[0]
+
+
+def test_angles_with_any_suffix_are_read_and_a_missing_one_is_logged(caplog):
+    t = np.arange(5) / 100.0
+    labels = ["LHipAnglesV", "LKneeAngles_M", "LAnkleAngles", "LPelvisAngles_M", "RHipAngles"]
+    values = np.zeros((5, len(labels), 3))
+    values[:, 0, 0] = 30.0
+    values[:, 4, 0] = np.nan  # stored, but without a number
+    with caplog.at_level("INFO", logger="loper_analysis.motion.lab_angles"):
+        table, used = lab_joint_angles(t, labels, ["ANGLES"] * len(labels), values, "deg", "walk.c3d")
+    assert used == {
+        "pelvis_angle": "LPelvisAngles_M",
+        "hip_left": "LHipAnglesV",
+        "knee_left": "LKneeAngles_M",
+        "ankle_left": "LAnkleAngles",
+    }
+    np.testing.assert_allclose(table["hip_left_rad"], np.radians(30.0))
+    assert "hip_right (RHipAngles holds no number)" in caplog.text
+    assert "knee_right (no ANGLES point RKneeAngles (with or without a suffix))" in caplog.text
+
+
+def test_a_comparison_left_out_says_why(caplog):
+    t = np.arange(50) / 100.0
+    ours = pd.DataFrame({"time_s": t, "knee_left_rad": np.sin(t), "hip_left_rad": np.cos(t)})
+    with caplog.at_level("INFO", logger="loper_analysis.motion.lab_angles"):
+        assert lab_agreement(ours, pd.DataFrame({"time_s": t})).empty
+        table = lab_agreement(ours, ours[["time_s", "knee_left_rad"]].iloc[:5])
+    assert "the lab's file stores none of them" in caplog.text
+    assert "(the lab's file lacks them): hip_left" in caplog.text
+    assert "knee_left not compared with the lab's own angle: 5 frame(s) in common, fewer than 10" in caplog.text
+    assert np.isnan(table.loc[0, "r"])

@@ -2,7 +2,7 @@
 
 Vicon Nexus stores Plug-in Gait's joint angles as points (``LHipAngles``,
 ``LKneeAngles``, ``LAnkleAngles``, ``LPelvisAngles`` and the right side's,
-sometimes with a suffix such as ``_M``), listed in ``POINT:ANGLES``, in the
+often with a suffix: ``LHipAngles_M``, ``LHipAnglesV``), listed in ``POINT:ANGLES``, in the
 unit of ``POINT:ANGLE_UNITS`` (degrees). Their x component is the sagittal
 angle in our sense: hip and knee flexion, ankle dorsiflexion and anterior
 pelvic tilt positive. They were computed by another model from the same
@@ -12,11 +12,13 @@ into the scaled model or swapped sides show at once.
 :func:`lab_joint_angles` picks them out of a recording's non-marker points;
 :func:`lab_agreement` compares our angle table with them frame by frame:
 Pearson's r, the RMS difference and the mean offset (ours minus the lab's),
-with a warning beyond :data:`MIN_LAB_R` or :data:`MAX_LAB_RMS_RAD`.
+with a warning beyond :data:`MIN_LAB_R` or :data:`MAX_LAB_RMS_RAD`. An angle that is not compared (the
+file stores no such angle, it holds no number, too few frames in common) is logged with the reason.
 """
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Sequence
 
 import numpy as np
@@ -63,6 +65,7 @@ LAB_AGREEMENT_COLUMNS: tuple[str, ...] = (
     "mean_offset_rad",
     "warning",
 )
+log = logging.getLogger(__name__)
 _ANGLE_UNITS = {"deg": np.pi / 180.0, "degree": np.pi / 180.0, "degrees": np.pi / 180.0, "rad": 1.0, "radian": 1.0}
 
 
@@ -71,14 +74,15 @@ def _bare(label: str) -> str:
 
 
 def _pick(stem: str, labels: Sequence[str]) -> int | None:
-    """Index of the label holding ``stem``: the stem itself, else the first label that starts with it and a suffix
-    (``LHipAngles_M``)."""
+    """Index of the label holding ``stem``: the stem itself, else the first label that is the stem and a suffix
+    after ``_`` (``LHipAngles_M``), else the first that is the stem and any suffix (``LHipAnglesV``)."""
     bare = [_bare(lab) for lab in labels]
     if stem in bare:
         return bare.index(stem)
-    for i, lab in enumerate(bare):
-        if lab.startswith(stem + "_"):
-            return i
+    for prefix in (stem + "_", stem):
+        for i, lab in enumerate(bare):
+            if lab.startswith(prefix) and lab != stem:
+                return i
     return None
 
 
@@ -123,15 +127,24 @@ def lab_joint_angles(
     angles = [(lab, i) for i, (lab, kind) in enumerate(zip(labels, kinds)) if kind == "ANGLES"]
     names = [lab for lab, _ in angles]
     out = {"time_s": np.asarray(time_s, float)}
-    used = {}
+    used, skipped = {}, {}
     for angle, stem in LAB_ANGLE_STEMS.items():
         k = _pick(stem, names)
         if k is None:
+            skipped[angle] = f"no ANGLES point {stem} (with or without a suffix)"
             continue
         column = np.asarray(values, float)[:, angles[k][1], 0] * _ANGLE_UNITS[unit]
         if np.isfinite(column).any():
             out[f"{angle}_rad"] = column
             used[angle] = _bare(names[k])
+        else:
+            skipped[angle] = f"{_bare(names[k])} holds no number"
+    if skipped:
+        where = f"{source}: " if source else ""
+        if not used:
+            log.info("%sno lab joint angle to compare with: %s", where, "; ".join(skipped.values()))
+        else:
+            log.info("%slab angles not read: %s", where, "; ".join(f"{a} ({why})" for a, why in skipped.items()))
     return pd.DataFrame(out), used
 
 
@@ -153,6 +166,11 @@ def lab_agreement(ours: pd.DataFrame, lab: pd.DataFrame, min_frames: int = 10) -
         ``rms_diff_rad`` and ``mean_offset_rad`` (ours minus the lab's), ``warning`` ('' when within
         :data:`MIN_LAB_R` and :data:`MAX_LAB_RMS_RAD`).
     """
+    missing = [c.removesuffix("_rad") for c in ours.columns if c.endswith("_rad") and c not in lab.columns]
+    if missing and len(missing) == sum(c.endswith("_rad") for c in ours.columns):
+        log.info("not compared with the lab's own angles: the lab's file stores none of them")
+    elif missing:
+        log.info("not compared with the lab's own angles (the lab's file lacks them): %s", ", ".join(missing))
     key_ours = np.round(ours["time_s"].to_numpy(float) * 1e6).astype(np.int64)
     key_lab = np.round(lab["time_s"].to_numpy(float) * 1e6).astype(np.int64)
     common, i_ours, i_lab = np.intersect1d(key_ours, key_lab, return_indices=True)
@@ -173,6 +191,11 @@ def lab_agreement(ours: pd.DataFrame, lab: pd.DataFrame, min_frames: int = 10) -
             }
         else:
             row |= {"r": np.nan, "rms_diff_rad": np.nan, "mean_offset_rad": np.nan}
+            log.info(
+                "%s not compared with the lab's own angle: %s",
+                angle,
+                f"{n} frame(s) in common, fewer than {min_frames}" if n < min_frames else "one of them is constant",
+            )
         rows.append(row)
     table = pd.DataFrame(rows, columns=list(LAB_AGREEMENT_COLUMNS))
     table["warning"] = lab_agreement_warnings(table)
