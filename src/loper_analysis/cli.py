@@ -409,6 +409,7 @@ def _ik(args: argparse.Namespace) -> None:
 
 
 def _inspect(args: argparse.Namespace) -> None:
+    from loper_analysis.motion.filtering import CUTOFF_HZ
     from loper_analysis.steps.inspect import inspect_c3d, inspect_subject
     from loper_analysis.subject_setup import NoTemplateFits
 
@@ -418,16 +419,91 @@ def _inspect(args: argparse.Namespace) -> None:
                 f"inspect: --model, --marker-set and --label-map-out take one file, got {len(args.c3d)}; without "
                 "them several files of one subject choose a marker-set template"
             )
+        if args.label_map is not None:
+            raise LoperInputError("inspect: --label-map is for a subject's files matched to the templates (no --model)")
         print(inspect_c3d(args.c3d[0], args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
         return
     config, _ = _read_config(args)
     static_name = "static" if config is None else config["trials"]["static"]
+    label_map = args.label_map or (None if config is None else config["markers"]["label_map"] or None)
+    cutoff = CUTOFF_HZ if config is None else config["filter"]["cutoff_hz"]
+    check = _scaling_dry_run(config)
     try:
-        result = inspect_subject(args.c3d, args.config_out, static_name)
+        result = inspect_subject(args.c3d, args.config_out, static_name, label_map, cutoff, check)
     except NoTemplateFits as exc:
         print(exc.text, end="")
         raise
     print(result.text, end="")
+
+
+#: The mass (kg) the dry run of ``inspect`` scales at: the mass changes no scale factor, and the subject's own
+#: comes later from the sheet or the static trial's plates.
+DRY_RUN_MASS_KG = 70.0
+
+
+def _scaling_dry_run(config: dict | None):
+    """The check ``inspect`` runs on a subject's files before it puts them in place: the ``markers`` step on every
+    trial (the written label maps, rotation and cut-off, as the workflow runs it) and the ``model`` step's
+    :func:`loper_analysis.steps.model.scale` with the written model and ScaleTool setup, into a scratch folder,
+    at :data:`DRY_RUN_MASS_KG`. A failure raises LoperInputError saying what fails and what the lab must add."""
+
+    def check(staged) -> str:
+        from loper_analysis.steps import markers as markers_step
+        from loper_analysis.steps import model as model_step
+
+        m_settings = markers_step.MarkerSettings.from_config(config) if config else markers_step.MarkerSettings()
+        m_settings = dataclasses.replace(m_settings, rotation_deg=staged.rotation_deg, cutoff_hz=staged.cutoff_hz)
+        s_settings = model_step.ModelSettings.from_config(config) if config else model_step.ModelSettings()
+        s_settings = dataclasses.replace(s_settings, rotation_deg=staged.rotation_deg).for_scaling()
+        with tempfile.TemporaryDirectory(prefix="loper-dry-run-") as tmp:
+            for c3d in staged.walking_c3d:
+                maps = tuple(str(p) for p in staged.label_maps[str(c3d)]) or None
+                try:
+                    markers_step.markers(
+                        c3d, Path(tmp) / "walk.trc", settings=dataclasses.replace(m_settings, label_map=maps)
+                    )
+                except LoperInputError as exc:
+                    raise LoperInputError(
+                        f"inspect: nothing written: the walking trial {c3d} fails with the config it would write: "
+                        f"{one_line(exc)}"
+                    ) from None
+            if staged.static_c3d is None:
+                return "  dry run: the walking trials' markers read; no static trial, scaling not tried\n"
+            trc, out = Path(tmp) / "static.trc", Path(tmp) / "scaled.osim"
+            files = model_step.ScaleFiles(staged.files["model"], trc, out, setup_xml=staged.files["scale_setup"])
+            maps = tuple(str(p) for p in staged.label_maps[str(staged.static_c3d)]) or None
+            try:
+                markers_step.markers(
+                    staged.static_c3d, trc, settings=dataclasses.replace(m_settings, label_map=maps).for_static()
+                )
+                model_step.scale(files, DRY_RUN_MASS_KG, s_settings)
+            except LoperInputError as exc:
+                raise LoperInputError(
+                    f"inspect: nothing written: scaling the static trial {staged.static_c3d} with the config it "
+                    f"would write fails: {one_line(exc)}; {_what_to_add(str(exc), staged.setup)}"
+                ) from None
+        return f"  dry run: every trial's markers read and the static trial {staged.static_c3d.name} scaled\n"
+
+    return check
+
+
+def _what_to_add(message: str, setup) -> str:
+    """What the lab must add when scaling its static trial fails: the template markers the message names."""
+    import re
+
+    named = [m for m in setup.template.marker_names if re.search(rf"\b{re.escape(m)}\b", message)]
+    known = set(setup.template.marker_names)
+    pairs = sorted({m for ps, _ in setup.template.measurements.values() for pair in ps for m in pair if m in known})
+    if named:
+        return (
+            f"the lab must add {', '.join(named)} to the static trial (the subject standing still, every marker "
+            "seen), or give their labels in a label map (--label-map)"
+        )
+    return (
+        "the lab must add a static trial in which the subject stands still over the scaling window "
+        f"(markers.static_duration_s) with the scaling markers seen and labelled as the template's "
+        f"({', '.join(pairs)}; a label map row naming the wrong marker shows as a factor out of range)"
+    )
 
 
 def _report(args: argparse.Namespace) -> None:

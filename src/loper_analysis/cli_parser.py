@@ -340,6 +340,13 @@ def _add_inspect(sub, handlers: Mapping[str, Callable]) -> None:
         "--label-map-out", metavar="MAP.tsv", help="write the starter label map (label, marker; needs --model)"
     )
     p.add_argument(
+        "--label-map",
+        metavar="MAP.tsv",
+        help="without --model: the lab's label map (label, marker; TSV or YAML), applied before the labels are "
+        "matched to the templates, e.g. a completed label_map_starter.tsv (rows left empty are skipped); "
+        "default: markers.label_map of the config",
+    )
+    p.add_argument(
         "--config-out",
         metavar="CONFIG.yaml",
         help="without --model: the subject's config (files it names beside it); with --model: a config snippet "

@@ -56,11 +56,14 @@ if TYPE_CHECKING:  # records only; nothing is read here
 
 __all__ = [
     "yaml_flow",
+    "MAX_CUTOFF_RATE_FRACTION",
     "MIN_MARKERS_PER_FRAME",
     "PlateSummary",
     "RecordingSummary",
     "config_snippet",
+    "marker_cutoff_hz",
     "marker_presence",
+    "measurement_losses",
     "plate_summary",
     "recording_summary",
     "sparse_frames",
@@ -496,3 +499,89 @@ def config_snippet(
 
 
 # ---------------------------------------------------------------- text
+
+
+# ---------------------------------------------------------------- what a subject's config may hold
+
+#: Highest low-pass cut-off ``inspect`` writes, as a fraction of the lowest marker rate of the walking trials:
+#: 0.4 of the rate is 0.8 of the Nyquist frequency (half the rate), which the filter must stay below
+#: (:func:`loper_analysis.motion.filtering.check_cutoff` refuses a cut-off at or above it).
+MAX_CUTOFF_RATE_FRACTION = 0.4
+
+
+def marker_cutoff_hz(configured_hz: float | None, rates_hz: Sequence[float]) -> tuple[float | None, str]:
+    """The walking trials' marker low-pass cut-off ``inspect`` writes (``filter.cutoff_hz``) and why.
+
+    The rule: ``min(configured, MAX_CUTOFF_RATE_FRACTION * lowest rate)``. A cut-off must lie below the
+    Nyquist frequency ``rate / 2`` of every trial filtered; 0.4 of the rate (0.8 of the Nyquist frequency)
+    keeps it there with a margin in which the order-4 zero-phase filter still attenuates (its gain at 0.9 of
+    the Nyquist frequency is below 0.01 when the cut-off is 0.4 of the rate). The configured cut-off (40 Hz by
+    default) stands at every rate of 100 Hz and above.
+
+    Parameters
+    ----------
+    configured_hz : float or None
+        The configuration's cut-off (Hz); None or 0: no filter (returned as None).
+    rates_hz : sequence of float
+        Marker rates of the walking trials (Hz).
+
+    Returns
+    -------
+    (float or None, str)
+        The cut-off (Hz) and a comment naming the rule and the numbers.
+    """
+    if not configured_hz:
+        return None, "no low-pass, as configured"
+    configured = float(configured_hz)
+    if not len(rates_hz):
+        return configured, "as configured (no walking trial)"
+    rate = float(min(rates_hz))
+    limit = MAX_CUTOFF_RATE_FRACTION * rate
+    cutoff = min(configured, limit)
+    why = (
+        f"min(configured {configured:g}, {MAX_CUTOFF_RATE_FRACTION:g} x {rate:g} Hz markers = {limit:g}) Hz: "
+        f"below the Nyquist frequency {rate / 2:g} Hz"
+    )
+    return float(f"{cutoff:.6g}"), why
+
+
+def measurement_losses(
+    measurements: Mapping[str, tuple[Sequence[tuple[str, str]], Sequence[str]]],
+    template_markers: Sequence[str],
+    static_markers: Sequence[str],
+    scaled: Sequence[str],
+) -> list[str]:
+    """Lines saying which scaling pairs a static trial's markers drop and which measurements lose every pair.
+
+    Parameters
+    ----------
+    measurements : mapping
+        Name -> (marker pairs, bodies), the template's.
+    template_markers : sequence of str
+        The template's markers: only a pair naming one of them that the static trial lacks counts as dropped.
+    static_markers : sequence of str
+        The template markers the static trial provides.
+    scaled : sequence of str
+        The measurements the written ScaleTool setup holds.
+
+    Returns
+    -------
+    list of str
+        One line per measurement that lost a pair (or all of them); empty when nothing is lost.
+    """
+    known, present, kept = set(template_markers), set(static_markers), set(scaled)
+    lines = []
+    for name, (pairs, bodies) in measurements.items():
+        lost = [(a, b) for a, b in pairs if any(m in known and m not in present for m in (a, b))]
+        absent = sorted({m for pair in lost for m in pair if m in known and m not in present})
+        if name not in kept:
+            lines.append(
+                f"measurement {name}: no pair left ({', '.join(f'{a}-{b}' for a, b in pairs)}; the static trial "
+                f"lacks {', '.join(absent) or 'their markers'}): the generic size of {', '.join(bodies)} is kept"
+            )
+        elif lost:
+            lines.append(
+                f"measurement {name}: pair(s) {', '.join(f'{a}-{b}' for a, b in lost)} left out (the static trial "
+                f"lacks {', '.join(absent)})"
+            )
+    return lines

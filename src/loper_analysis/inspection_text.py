@@ -1,23 +1,36 @@
 """What ``loper-analysis inspect`` prints: a recording's summary (:mod:`loper_analysis.inspection`) and a match of
-its labels to a model's markers (:mod:`loper_analysis.motion.label_matching`) as plain text.
+its labels to a model's markers (:mod:`loper_analysis.motion.label_matching`) as plain text; for a subject's
+files, the template chosen (:func:`template_text`) and the subject's config (:func:`subject_config_text`).
 """
 
 from __future__ import annotations
 
 import textwrap
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-from loper_analysis.inspection import MIN_MARKERS_PER_FRAME, RecordingSummary
+from loper_analysis.inspection import MIN_MARKERS_PER_FRAME, RecordingSummary, yaml_flow
 from loper_analysis.motion.lab_frame import (
     AXIS_NAMES,
     axis_name,
 )
 from loper_analysis.motion.label_matching import LabelMatch
+from loper_analysis.motion.marker_names import strip_subject_prefix
 from loper_analysis.motion.markers import rotate_markers
+from loper_analysis.subject_setup import SubjectSetup, format_fits
 
-__all__ = ["format_label_match", "format_summary"]
+__all__ = [
+    "SubjectFiles",
+    "format_label_match",
+    "format_summary",
+    "mass_height_line",
+    "presence_text",
+    "subject_config_text",
+    "template_text",
+]
 
 
 def _xyz(v, digits: int = 3) -> str:
@@ -256,3 +269,119 @@ def format_label_match(match: LabelMatch, model_name: str, n_model_markers: int)
                 ", ".join(names), width=100, initial_indent="    ", subsequent_indent="    ", break_on_hyphens=False
             )
     return "\n".join(lines) + "\n"
+
+
+# ---------------------------------------------------------------- a subject's config
+
+
+def presence_text(paths: Sequence[Path], kinds: Sequence[str], never: Sequence[Sequence[str]]) -> str:
+    """Lines naming each trial's labels present in no frame (left out of the marker set or the IK tasks)."""
+    lines = [
+        f"  {p.name}: label(s) present in no frame, left out of the "
+        + ("marker set and the scaling" if k == "static" else "IK tasks")
+        + f": {', '.join(strip_subject_prefix(lab) for lab in n)}\n"
+        for p, k, n in zip(paths, kinds, never)
+        if n
+    ]
+    return "".join(lines)
+
+
+@dataclass(frozen=True)
+class SubjectFiles:
+    """What a subject's config is written from (:func:`loper_analysis.steps.inspect.inspect_subject`): the files
+    and their kinds, the template's setup, the first file's summary, the mass and height line, the marker
+    cut-off (Hz) and its reason, whether a static trial is among the files, and each file's marker labels
+    (no subject prefix)."""
+
+    paths: list[Path]
+    kinds: list[str]
+    setup: SubjectSetup
+    summary: RecordingSummary
+    mass_height: str
+    cutoff: tuple[float | None, str]
+    has_static: bool
+    trial_labels: list[list[str]]
+
+
+def subject_config_text(
+    subject: SubjectFiles, files: Mapping[str, str], coordinate_map: Mapping[str, Mapping], losses: Sequence[str]
+) -> str:
+    """The subject's config: every key with a comment (YAML)."""
+    setup, summary, paths = subject.setup, subject.summary, subject.paths
+    t = setup.template
+    rotation = [float(a) for a in summary.rotation_deg]
+    up = axis_name(summary.vertical.axis, summary.vertical.sign)
+    lines = [
+        f"# Settings of the subject recorded in {', '.join(str(p) for p in paths)}, written by loper-analysis inspect.",
+        f"# Marker-set template: {t.name} ({t.title}) on {t.model}.",
+        "# Add the subject to a sheet (subject, source: recorded, ...) named by `subjects:` below, then run",
+        f"#   snakemake -j2 --configfile {files['config']}",
+        f"# {subject.mass_height}",
+        *[f"# scaling: {line}" for line in losses],
+        "# subjects: lab/subjects.tsv          # the subject sheet (add this key)",
+        "markers:",
+        f"  lab_to_model_rotation_deg: {yaml_flow(rotation)}   # up {up} -> model +Y (each walking trial is turned "
+        "to walk along model +X)",
+    ]
+    if "label_map" in files:
+        lines.append(f"  label_map: {yaml_flow(files['label_map'])}   # lab label -> template marker")
+    else:
+        lines.append("  label_map: {}   # the labels every trial holds are the template's marker names")
+    per_trial = {k.partition(":")[2]: v for k, v in files.items() if k.startswith("label_map:")}
+    if per_trial:
+        lines.append(
+            f"  trial_label_maps: {yaml_flow(per_trial)}   # labels only that trial holds (a map naming a label "
+            "its trial lacks is refused)"
+        )
+    cutoff, why = subject.cutoff
+    lines += [
+        "filter:",
+        f"  cutoff_hz: {'null' if cutoff is None else yaml_flow(cutoff)}   # walking trials' markers: {why}",
+        "opensim:",
+        f"  generic_model: {yaml_flow(files['model'])}   # {t.model} as OpenSim distributes it",
+        f"  scale_setup: {yaml_flow(files['scale_setup'])}   # ScaleTool setup; names marker_set.xml beside it",
+        f"  ik_tasks: {yaml_flow(files['ik_tasks'])}   # markers of the walking trials and their weights"
+        + (f"; not tracked (static trial only): {', '.join(setup.static_only)}" if setup.static_only else ""),
+        "  coordinate_map:   # our angle -> model coordinate; each sign read from the model's kinematics",
+    ]
+    lines += [f"    {k}: {yaml_flow(dict(v))}" for k, v in coordinate_map.items()]
+    feet = t.foot_markers
+    lines += ["events:", f"  foot_markers: {yaml_flow(dict(feet))}   # heel markers: assign plate contacts to feet"]
+    kinds_text = ", ".join(f"{p.stem} ({k})" for p, k in zip(paths, subject.kinds))
+    lines.append(f"# trials: {kinds_text}")
+    return "\n".join(lines) + "\n"
+
+
+def mass_height_line(static_rec) -> str:
+    """Where the subject's mass and height will come from when the sheet leaves them empty."""
+    parts = []
+    if static_rec is not None and static_rec.n_force_platforms:
+        parts.append("mass: the static trial's force plates")
+    elif static_rec is not None and "Bodymass" in static_rec.processing:
+        parts.append(f"mass: {static_rec.processing['Bodymass']:.2f} kg (the file's PROCESSING:Bodymass)")
+    if static_rec is not None and "Height" in static_rec.processing:
+        parts.append(f"height: {static_rec.processing['Height'] / 1000:.3f} m (PROCESSING:Height)")
+    return "Without mass or height in the sheet: " + ("; ".join(parts) or "give them in the sheet") + "."
+
+
+def template_text(setup: SubjectSetup) -> str:
+    """The templates' fits, the one chosen and its markers and label map, as text."""
+    t = setup.template
+    return (
+        f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(setup.fits)}\n"
+        f"chosen: {t.name} ({t.title}) on {t.model}\n"
+        f"  static trial markers: {len(setup.static_markers)}; walking trials: {len(setup.walking_markers)}"
+        + (f"; static trial only (not tracked in walking): {', '.join(setup.static_only)}" if setup.static_only else "")
+        + (
+            f"\n  labels without a template marker (kept, not used): {', '.join(setup.unmapped)}"
+            if setup.unmapped
+            else ""
+        )
+        + (
+            "\n  label map: "
+            + ", ".join(f"{lab}->{m}" for lab, m in zip(setup.label_map["label"], setup.label_map["marker"]))
+            if len(setup.label_map)
+            else "\n  label map: none needed"
+        )
+        + "\n"
+    )

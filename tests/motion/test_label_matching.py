@@ -3,6 +3,8 @@ Qualisys/CAST, gait2392 and Rajagopal2016 spellings."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pandas as pd
 
 from loper_analysis.io.readers import read_label_map
@@ -78,3 +80,43 @@ def test_heel_markers_of_each_marker_set():
     assert heel_markers(["R.Heel", "L.Heel"]) == {"left": "L.Heel", "right": "R.Heel"}
     assert heel_markers(["calc_l", "calc_r"]) is None  # not a heel spelling
     assert heel_markers(["LHEE"]) is None
+
+
+def test_the_synonym_table_is_data_and_each_spelling_has_one_landmark(tmp_path):
+    import pytest
+    import yaml
+
+    from loper_analysis.errors import LoperInputError
+    from loper_analysis.io.label_synonyms import LABEL_SYNONYMS_FILE, LANDMARK_SYNONYMS, read_label_synonyms
+
+    doc = yaml.safe_load(LABEL_SYNONYMS_FILE.read_text())
+    assert LANDMARK_SYNONYMS["knee_medial"] == ("kneemed", "mknee", "mkne", "knemed", "mkn", "medkn", "mfc", "fme")
+    assert LANDMARK_SYNONYMS["ankle_medial"] == ("anklemed", "mankle", "mmal", "mma", "med", "medank", "tam")
+    # docs/inspect.md lists every spelling of the table
+    doc_text = (Path(__file__).resolve().parents[2] / "docs" / "inspect.md").read_text()
+    missing = [s for entry in doc["landmarks"].values() for s in entry["spellings"] if f"`{s}`" not in doc_text]
+    assert missing == []
+    bad = tmp_path / "synonyms.yaml"
+    bad.write_text("landmarks:\n  a: {spellings: [MED]}\n  b: {spellings: [Med.]}\n")
+    with pytest.raises(LoperInputError, match="spelling 'med' belongs to landmarks 'a' and 'b'"):
+        read_label_synonyms(bad)
+
+
+def test_qualisys_helen_hayes_and_vicon_spellings_reach_plug_in_gait_markers():
+    pig = ["LTOE", "RTOE", "LMKNE", "RMKNE", "LMMAL", "LANK", "LKNE", "LTIB", "LTHI", "CLAV"]
+    m = match_labels(
+        ["RLA_TOE", "LLA_TOE", "RMed_kn", "LKNEMED", "LMED", "LLMA", "LLFC", "LSHA", "LTH", "STER_NOTCH"], pig
+    )
+    assert {lab: mk for lab, mk, _ in m.pairs} == {
+        "RLA_TOE": "RTOE",
+        "LLA_TOE": "LTOE",
+        "RMed_kn": "RMKNE",
+        "LKNEMED": "LMKNE",
+        "LMED": "LMMAL",
+        "LLMA": "LANK",
+        "LLFC": "LKNE",
+        "LSHA": "LTIB",
+        "LTH": "LTHI",
+        "STER_NOTCH": "CLAV",
+    }
+    assert match_labels(["LMKN", "LMMA"], ["LMKNE", "LMMAL"]).unmatched_labels == ()

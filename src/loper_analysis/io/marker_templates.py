@@ -1,6 +1,8 @@
 """The marker-set templates shipped with the package (``src/loper_analysis/templates/``).
 
-Each ``*.yaml`` file there is one template (:class:`loper_analysis.motion.marker_templates.MarkerTemplate`);
+Each ``*.yaml`` file there but ``label_synonyms.yaml`` (the label matcher's landmark synonyms),
+read by :mod:`loper_analysis.io.label_synonyms`, is one template
+(:class:`loper_analysis.motion.marker_templates.MarkerTemplate`);
 the models they name lie beside them.
 """
 
@@ -12,17 +14,21 @@ from pathlib import Path
 from loper_analysis.io.readers import read_yaml
 from loper_analysis.motion.marker_templates import MarkerTemplate, template_from_spec
 
-__all__ = ["TEMPLATE_DIR", "read_templates", "template_file"]
+__all__ = ["NOT_A_TEMPLATE", "TEMPLATE_DIR", "read_templates", "template_file"]
 
 #: The folder of the templates and their models.
 TEMPLATE_DIR: Path = Path(str(resources.files("loper_analysis") / "templates"))
+#: The YAML file of the folder that is no template: the label matcher's landmark synonyms.
+NOT_A_TEMPLATE = "label_synonyms.yaml"
 
 
 def read_templates() -> dict[str, MarkerTemplate]:
-    """Every template of :data:`TEMPLATE_DIR`, by name (the file's stem), in name order."""
+    """Every template of :data:`TEMPLATE_DIR`, by name (the file's stem), in name order (the synonym table
+    ``label_synonyms.yaml`` is none)."""
     return {
         path.stem: template_from_spec(path.stem, read_yaml(path, "marker-set template"), str(path))
         for path in sorted(TEMPLATE_DIR.glob("*.yaml"))
+        if path.name != NOT_A_TEMPLATE
     }
 
 

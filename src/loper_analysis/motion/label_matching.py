@@ -12,8 +12,9 @@ Label matching (:func:`match_labels`)
     ignoring case and every character but letters and digits (``R.ASIS``,
     ``R_ASIS``, ``RASIS``); the same side (a leading ``L``/``R``,
     ``Left``/``Right``, or a trailing ``_l``/``_r``) and landmark in
-    :data:`LANDMARK_SYNONYMS`. A label with more than one candidate marker,
-    or two labels wanting one marker, is ambiguous and stays unmatched.
+    :data:`LANDMARK_SYNONYMS`, the package's synonym table
+    (``templates/label_synonyms.yaml``, read by :mod:`loper_analysis.io.label_synonyms`). A label with more
+    than one candidate marker, or two labels wanting one marker, is ambiguous and stays unmatched.
 
 Label map (:func:`starter_label_map`)
     The matched labels whose name differs from their marker, as the rows
@@ -32,6 +33,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
+from loper_analysis.io.label_synonyms import LANDMARK_SYNONYMS
 from loper_analysis.motion.marker_names import strip_subject_prefix
 
 __all__ = [
@@ -42,26 +44,6 @@ __all__ = [
     "match_labels",
     "starter_label_map",
 ]
-
-#: Landmark -> spellings (lowercase letters and digits, side removed) in Vicon Plug-in Gait, Qualisys/CAST
-#: (ISB abbreviations), OpenSim's gait2392 and Rajagopal2016 marker sets. A label and a model marker match
-#: through this table when they share side and landmark.
-LANDMARK_SYNONYMS: dict[str, tuple[str, ...]] = {
-    "asis": ("asi", "asis", "ias"),  # LASI, L.ASIS, L_IAS
-    "psis": ("psi", "psis", "ips"),  # LPSI, L.PSIS, L_IPS
-    "sacrum": ("sacr", "sacrum", "sacral", "vsacral"),  # SACR, V.Sacral
-    "heel": ("hee", "heel", "cal", "fcc"),  # LHEE, L.Heel, LCAL, L_FCC
-    "toe": ("toe", "toetip", "ft2"),  # LTOE, L.Toe, L.Toe.Tip, L_FT2
-    "mt1": ("mt1", "met1", "fm1", "toemed"),  # LMT1, L_FM1, L.Toe.Med
-    "mt5": ("mt5", "met5", "fm5", "toelat"),  # LMT5, L_FM5, L.Toe.Lat
-    "knee_lateral": ("kne", "knee", "kneelat", "lknee", "lfc", "fle"),  # LKNE, L.Knee(.Lat), LLFC, L_FLE
-    "knee_medial": ("kneemed", "mknee", "mfc", "fme"),  # L.Knee.Med, L.MKnee, LMFC, L_FME
-    "ankle_lateral": ("ank", "ankle", "anklelat", "lankle", "lmal", "fal"),  # LANK, L.Ankle(.Lat), LLMAL, L_FAL
-    "ankle_medial": ("anklemed", "mankle", "mmal", "tam"),  # L.Ankle.Med, L.MAnkle, LMMAL, L_TAM
-    "acromion": ("sho", "shoulder", "acr", "acromion", "acromium", "sae"),  # LSHO, LACR, L.Acromium, L_SAE
-    "sternum": ("strn", "sternum", "sjn"),  # STRN, Sternum, SJN
-    "head_top": ("tophead", "headtop", "vertex"),  # Top.Head, HEAD_TOP
-}
 
 _SPELLING_TO_LANDMARK = {s: name for name, spellings in LANDMARK_SYNONYMS.items() for s in spellings}
 _NOT_ALNUM = re.compile(r"[^0-9a-z]")

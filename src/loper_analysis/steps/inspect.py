@@ -12,7 +12,7 @@ snippet are written through the atomic writer (:mod:`loper_analysis.io.atomic`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,20 +20,43 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError, one_line
-from loper_analysis.inspection import RecordingSummary, config_snippet, recording_summary, yaml_flow
-from loper_analysis.inspection_text import format_label_match, format_summary
+from loper_analysis.inspection import (
+    RecordingSummary,
+    config_snippet,
+    marker_cutoff_hz,
+    measurement_losses,
+    recording_summary,
+)
+from loper_analysis.inspection_text import (
+    SubjectFiles,
+    format_label_match,
+    format_summary,
+    mass_height_line,
+    presence_text,
+    subject_config_text,
+    template_text,
+)
 from loper_analysis.io.atomic import PathLike, write_bytes, write_text, write_tsv
 from loper_analysis.io.c3d_parameters import param_strings
 from loper_analysis.io.timing import library_import, timed_io
+from loper_analysis.motion.filtering import CUTOFF_HZ
 from loper_analysis.motion.lab_frame import axis_name
 from loper_analysis.motion.label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
 from loper_analysis.motion.marker_names import strip_subject_prefix
-from loper_analysis.subject_setup import NoTemplateFits, SubjectSetup, format_fits
+from loper_analysis.subject_setup import NoTemplateFits, StagedSubject, SubjectSetup, format_fits, trial_label_maps
 
 if TYPE_CHECKING:
     from loper_analysis.io.c3d import C3DRecording
 
-__all__ = ["Inspection", "SubjectInspection", "inspect_c3d", "inspect_subject", "model_marker_names_of"]
+__all__ = [
+    "Inspection",
+    "StagedSubject",
+    "SubjectInspection",
+    "given_label_map",
+    "inspect_c3d",
+    "inspect_subject",
+    "model_marker_names_of",
+]
 
 
 @dataclass(frozen=True)
@@ -270,85 +293,108 @@ def _trial_kind(path: Path, static_name: str) -> str:
     return "static" if path.stem == static_name else "walking"
 
 
-def _subject_config_text(
-    paths: Sequence[Path],
-    kinds: Sequence[str],
-    setup: SubjectSetup,
-    summary: RecordingSummary,
-    files: Mapping[str, str],
-    coordinate_map: Mapping[str, Mapping],
-    mass_height: str,
-) -> str:
-    """The subject's config: every key with a comment (YAML)."""
-    t = setup.template
-    rotation = [float(a) for a in summary.rotation_deg]
-    up = axis_name(summary.vertical.axis, summary.vertical.sign)
-    lines = [
-        f"# Settings of the subject recorded in {', '.join(str(p) for p in paths)}, written by loper-analysis inspect.",
-        f"# Marker-set template: {t.name} ({t.title}) on {t.model}.",
-        "# Add the subject to a sheet (subject, source: recorded, ...) named by `subjects:` below, then run",
-        f"#   snakemake -j2 --configfile {files['config']}",
-        f"# {mass_height}",
-        "# subjects: lab/subjects.tsv          # the subject sheet (add this key)",
-        "markers:",
-        f"  lab_to_model_rotation_deg: {yaml_flow(rotation)}   # up {up} -> model +Y (each walking trial is turned "
-        "to walk along model +X)",
-    ]
-    if "label_map" in files:
-        lines.append(f"  label_map: {yaml_flow(files['label_map'])}   # lab label -> template marker")
+def given_label_map(label_map) -> tuple[dict[str, str], list[Path]]:
+    """A lab's label map as ``inspect`` takes it, and the files it was read from.
+
+    ``label_map`` is a mapping, a TSV (columns ``label``, ``marker``) or YAML file, a list of those (a later
+    entry wins), or None. Unlike the pipeline's reader, a row whose marker is empty (a row of the starter map
+    ``label_map_starter.tsv`` left empty) is skipped: the label keeps its name.
+
+    Raises
+    ------
+    LoperInputError
+        A missing or unreadable file, a table without the two columns, a label given twice in one file.
+    """
+    from loper_analysis.io.readers import read_tsv, read_yaml
+
+    if label_map is None:
+        return {}, []
+    if isinstance(label_map, Mapping):
+        return {str(k).strip(): str(v).strip() for k, v in label_map.items() if v is not None and str(v).strip()}, []
+    if isinstance(label_map, (list, tuple)):
+        merged, files = {}, []
+        for part in label_map:
+            entries, read = given_label_map(part)
+            merged.update(entries)
+            files += read
+        return merged, files
+    path = Path(label_map)
+    if path.suffix.lower() in (".yaml", ".yml"):
+        doc = read_yaml(path, "label map")
+        if not isinstance(doc, Mapping):
+            raise LoperInputError(f"{path}: a label map must be a YAML mapping 'label: marker'")
+        pairs = list(doc.items())
     else:
-        lines.append("  label_map: {}   # the labels are the template's marker names")
-    lines += [
-        "opensim:",
-        f"  generic_model: {yaml_flow(files['model'])}   # {t.model} as OpenSim distributes it",
-        f"  scale_setup: {yaml_flow(files['scale_setup'])}   # ScaleTool setup; names marker_set.xml beside it",
-        f"  ik_tasks: {yaml_flow(files['ik_tasks'])}   # markers of the walking trials and their weights"
-        + (f"; not tracked (static trial only): {', '.join(setup.static_only)}" if setup.static_only else ""),
-        "  coordinate_map:   # our angle -> model coordinate; each sign read from the model's kinematics",
-    ]
-    lines += [f"    {k}: {yaml_flow(dict(v))}" for k, v in coordinate_map.items()]
-    feet = t.foot_markers
-    lines += ["events:", f"  foot_markers: {yaml_flow(dict(feet))}   # heel markers: assign plate contacts to feet"]
-    kinds_text = ", ".join(f"{p.stem} ({k})" for p, k in zip(paths, kinds))
-    lines.append(f"# trials: {kinds_text}")
-    return "\n".join(lines) + "\n"
+        table = read_tsv(path, "label map", ("label", "marker"), dtype=str, keep_default_na=False)
+        pairs = list(zip(table["label"], table["marker"]))
+    out: dict[str, str] = {}
+    for label, marker in pairs:
+        label, marker = str(label).strip(), "" if marker is None else str(marker).strip()
+        if not label or not marker:
+            continue
+        if label in out:
+            raise LoperInputError(f"{path}: label map names label '{label}' twice")
+        out[label] = marker
+    return out, [path]
 
 
-def _mass_height_line(static_rec) -> str:
-    """Where the subject's mass and height will come from when the sheet leaves them empty."""
-    parts = []
-    if static_rec is not None and static_rec.n_force_platforms:
-        parts.append("mass: the static trial's force plates")
-    elif static_rec is not None and "Bodymass" in static_rec.processing:
-        parts.append(f"mass: {static_rec.processing['Bodymass']:.2f} kg (the file's PROCESSING:Bodymass)")
-    if static_rec is not None and "Height" in static_rec.processing:
-        parts.append(f"height: {static_rec.processing['Height'] / 1000:.3f} m (PROCESSING:Height)")
-    return "Without mass or height in the sheet: " + ("; ".join(parts) or "give them in the sheet") + "."
+def _present_labels(rec: C3DRecording) -> tuple[list[str], list[str]]:
+    """A recording's marker labels present in at least one frame, and those never present."""
+    import numpy as np
+
+    present = np.all(np.isfinite(rec.markers_m), axis=2).any(axis=0)
+    labels = list(rec.marker_labels)
+    return [lab for lab, p in zip(labels, present) if p], [lab for lab, p in zip(labels, present) if not p]
 
 
 def inspect_subject(
     c3d_paths: Sequence[PathLike],
     config_out: PathLike | None = None,
     static_name: str = "static",
+    label_map=None,
+    cutoff_hz: float | None = CUTOFF_HZ,
+    check: Callable[[StagedSubject], str] | None = None,
 ) -> SubjectInspection:
     """Inspect a subject's C3D files, choose the marker-set template that fits their labels, and (``config_out``)
     write the subject's config with the files it names beside it.
 
     Each file's kind comes from its name: ``static_name`` (``trials.static``) is the static trial, every other
-    file a walking trial. The template (:func:`loper_analysis.subject_setup.subject_setup`) gives the label
-    map, the marker set of the static trial's markers, a ScaleTool setup naming it, the walking trials' IK
-    tasks (a marker of the static trial only is not tracked) and the heel markers; the coordinate map's signs
-    are read from the template's model
-    (:func:`loper_analysis.motion.marker_templates.template_coordinate_map`).
+    file a walking trial. Labels present in no frame of a trial count as absent from it. The lab's label map
+    (``label_map``: :func:`given_label_map`) renames labels before they are matched. The template
+    (:func:`loper_analysis.subject_setup.subject_setup`) gives the label map, the marker set of the static
+    trial's markers, a ScaleTool setup naming it (a pair of a measurement whose marker the static trial lacks
+    is left out, and a measurement left without a pair is reported), the walking trials' IK tasks (markers of
+    the static trial present in every walking trial) and the heel markers; the coordinate map's signs are read
+    from the template's model (:func:`loper_analysis.motion.marker_templates.template_coordinate_map`); the
+    walking trials' low-pass cut-off is :func:`loper_analysis.inspection.marker_cutoff_hz` of ``cutoff_hz``.
 
     Written beside ``config_out`` (paths in the config as given, so relative ones count from where snakemake
     runs): the model (a copy), ``marker_set.xml``, ``scale_setup.xml``, ``ik_tasks.tsv``, ``label_map.tsv``
-    (when a label differs from its marker), then the config. Everything is built before anything is written.
+    (when a label differs from its marker), then the config. Everything is built in a scratch folder first
+    and ``check`` (the command line's dry run: scaling the static trial) runs on it; only when it passes are
+    the files put in place.
+
+    Parameters
+    ----------
+    c3d_paths : sequence of path-like
+        The subject's C3D files.
+    config_out : path-like, optional
+        The subject's config; None: nothing is written.
+    static_name : str
+        The static trial's name (``trials.static``).
+    label_map : mapping, path-like or list, optional
+        The lab's label map (``markers.label_map`` or ``--label-map``).
+    cutoff_hz : float or None
+        The configured marker low-pass cut-off (Hz, ``filter.cutoff_hz``); None: no filter.
+    check : callable, optional
+        Called with the :class:`StagedSubject`; returns a line for the report or raises LoperInputError
+        (nothing is written then).
 
     Raises
     ------
     LoperInputError
-        A missing or unreadable file; an output path equal to an input.
+        A missing or unreadable file; an output path equal to an input (a C3D file or the label map); the
+        check failing (nothing written).
     loper_analysis.subject_setup.NoTemplateFits
         The labels fit no template: the message lists what was and was not mapped; with ``config_out`` a
         starter map (``label_map_starter.tsv``: every label, the template's marker where one was found) is
@@ -358,16 +404,21 @@ def inspect_subject(
     from loper_analysis.subject_setup import subject_setup
 
     paths = [Path(p) for p in c3d_paths]
-    if config_out is not None and any(Path(config_out).resolve() == p.resolve() for p in paths):
+    given, map_files = given_label_map(label_map)
+    if config_out is not None and any(Path(config_out).resolve() == p.resolve() for p in [*paths, *map_files]):
         raise LoperInputError(f"{config_out}: the config would overwrite an input file")
     kinds = [_trial_kind(p, static_name) for p in paths]
     recs, summaries, text = _recordings_text(paths)
+    present = [_present_labels(r) for r in recs]
+    text += presence_text(paths, kinds, [n for _, n in present])
     static = next((r for r, k in zip(recs, kinds) if k == "static"), None)
-    walking = [r.marker_labels for r, k in zip(recs, kinds) if k == "walking"]
+    static_labels = next((p for p, k in zip(present, kinds) if k == "static"), (None,))[0]
+    walking = [p for p, k in zip(present, kinds) if k == "walking"]
     source = ", ".join(str(p) for p in paths)
-    templates = read_templates()
+    if given:
+        text += f"  label map given: {len(given)} row(s) ({', '.join(str(f) for f in map_files) or 'inline'})\n"
     try:
-        setup = subject_setup(None if static is None else static.marker_labels, walking, templates, source)
+        setup = subject_setup(static_labels, [w for w, _ in walking], read_templates(), source, given)
     except NoTemplateFits as exc:
         exc.text = (
             text + f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(exc.fits)}\n"
@@ -375,16 +426,20 @@ def inspect_subject(
         if config_out is not None:
             raise _starter_map_error(exc, recs, config_out) from None
         raise
-    text += _template_text(setup)
+    text += template_text(setup)
     if static is None:
         text += "  no static trial among the files: its markers were taken from the first walking trial\n"
-    mass_height = _mass_height_line(static)
+    mass_height = mass_height_line(static)
     text += f"  {mass_height}\n"
+    cutoff = marker_cutoff_hz(cutoff_hz, [r.point_rate_hz for r, k in zip(recs, kinds) if k == "walking"])
+    text += f"  filter.cutoff_hz: {cutoff[0]} ({cutoff[1]})\n"
     if config_out is None:
         return SubjectInspection(summaries, setup, text)
 
-    written = _written_subject_files(paths, kinds, setup, summaries[0], config_out, mass_height)
-    text += "\n" + "\n".join(f"wrote {w}" for w in written) + "\n"
+    labels = [[strip_subject_prefix(lab) for lab in r.marker_labels] for r in recs]
+    subject = SubjectFiles(paths, kinds, setup, summaries[0], mass_height, cutoff, static is not None, labels)
+    written, more = _written_subject_files(subject, config_out, check)
+    text += more + "\n" + "\n".join(f"wrote {w}" for w in written) + "\n"
     device = any(k == "walking" and p.stem != "walk-nodevice" and "device" in p.stem for p, k in zip(paths, kinds))
     text += (
         "next: add `subjects:` (a sheet with the row `SUBJECT recorded`) to the config"
@@ -413,51 +468,31 @@ def _recordings_text(paths: Sequence[Path]) -> tuple[list[C3DRecording], list[Re
 def _starter_map_error(exc: NoTemplateFits, recs: Sequence[C3DRecording], config_out: PathLike) -> NoTemplateFits:
     """Write the starter label map (``label_map_starter.tsv`` beside ``config_out``: every label of ``recs``,
     the best template's marker where one was found) and return the error naming it (``exc``'s fits and text)."""
-    best = exc.fits[0].match
-    marker_of = {strip_subject_prefix(lab): m for lab, m, _ in best.pairs}
     labels = list(dict.fromkeys(strip_subject_prefix(lab) for r in recs for lab in r.marker_labels))
     starter = Path(config_out).parent / "label_map_starter.tsv"
-    write_tsv(pd.DataFrame({"label": labels, "marker": [marker_of.get(lab, "") for lab in labels]}), starter)
+    write_tsv(pd.DataFrame({"label": labels, "marker": [exc.mapped.get(lab, "") for lab in labels]}), starter)
     error = NoTemplateFits(
-        f"{exc}; a starter label map to complete: {starter} (then give the lab's model, marker set and "
-        "setups in the config by hand: docs/first_recorded_subject.md)",
+        f"{exc}; a starter label map to complete: {starter} (fill in the template marker of each label you can, "
+        "leave the others empty, then run inspect again with --label-map "
+        f"{starter} or markers.label_map: {starter} in a --configfile; a marker set that is no template's needs "
+        "the lab's model, marker set and setups in the config by hand: docs/first_recorded_subject.md)",
         exc.fits,
+        exc.mapped,
     )
     error.text = exc.text
     return error
 
 
-def _template_text(setup: SubjectSetup) -> str:
-    """The templates' fits, the one chosen and its markers and label map, as text."""
-    t = setup.template
-    return (
-        f"\nMarker-set templates (required marker groups found, markers found):\n{format_fits(setup.fits)}\n"
-        f"chosen: {t.name} ({t.title}) on {t.model}\n"
-        f"  static trial markers: {len(setup.static_markers)}; walking trials: {len(setup.walking_markers)}"
-        + (f"; static trial only (not tracked in walking): {', '.join(setup.static_only)}" if setup.static_only else "")
-        + (
-            f"\n  labels without a template marker (kept, not used): {', '.join(setup.unmapped)}"
-            if setup.unmapped
-            else ""
-        )
-        + (f"\n  label map: {len(setup.label_map)} row(s)" if len(setup.label_map) else "\n  label map: none needed")
-        + "\n"
-    )
+def _measurement_names(tool) -> list[str]:
+    """The measurements of a ScaleTool's model scaler."""
+    ms = tool.getModelScaler().getMeasurementSet()
+    return [ms.get(i).getName() for i in range(ms.getSize())]
 
 
-def _written_subject_files(
-    paths: Sequence[Path],
-    kinds: Sequence[str],
-    setup: SubjectSetup,
-    summary: RecordingSummary,
-    config_out: PathLike,
-    mass_height: str,
-) -> tuple[Path, ...]:
+def _staged_files(subject: SubjectFiles, folder: Path, names: Mapping[str, str]) -> tuple[dict[str, Path], list[str]]:
     """Write the template's model (a copy), marker set, ScaleTool setup, IK tasks, label map (when needed) and
-    then the subject's config (``config_out``) beside it; returns the files written, the config last.
-
-    Everything is built before anything is written; a file that would overwrite an input raises
-    LoperInputError."""
+    the config into ``folder``, the config naming the files by their final paths ``names``; returns the files
+    staged and the scaling's losses (:func:`loper_analysis.inspection.measurement_losses`)."""
     from loper_analysis.io.marker_templates import template_file
     from loper_analysis.io.osim import read_model, write_osim_object
     from loper_analysis.io.readers import read_bytes
@@ -467,35 +502,94 @@ def _written_subject_files(
         template_scale_tool,
     )
 
+    setup = subject.setup
     t = setup.template
-    folder = Path(config_out).parent
     model_path = template_file(t.model)
     model = read_model(model_path)
     coordinate_map = template_coordinate_map(t, model)
     marker_set = template_marker_set(t, setup.static_markers)
     tool = template_scale_tool(t, setup.static_markers, "marker_set.xml")
-    files = {
-        "model": str(folder / t.model),
+    losses = measurement_losses(t.measurements, t.marker_names, setup.static_markers, _measurement_names(tool))
+    staged = {key: folder / Path(name).name for key, name in names.items()}
+    write_bytes(staged["model"], read_bytes(model_path, "OpenSim model"), "OpenSim model")
+    write_osim_object(marker_set, staged["marker_set"], "marker set")
+    write_osim_object(tool, staged["scale_setup"], "ScaleTool setup")
+    write_tsv(setup.ik_tasks, staged["ik_tasks"])
+    for key, table in trial_label_maps(
+        subject.setup.label_map, [p.stem for p in subject.paths], subject.trial_labels
+    ).items():
+        write_tsv(table, staged[key])
+    write_text(staged["config"], subject_config_text(subject, names, coordinate_map, losses), "subject config")
+    return staged, losses
+
+
+def _written_subject_files(
+    subject: SubjectFiles, config_out: PathLike, check: Callable[[StagedSubject], str] | None
+) -> tuple[tuple[Path, ...], str]:
+    """Build the subject's files in a scratch folder (:func:`_staged_files`), run ``check`` on them and, when
+    it passes, put them beside ``config_out`` (the config last); returns the files written and the text of the
+    losses and the check. A file that would overwrite an input, a failing check or a failing write raises
+    LoperInputError with nothing of this run left in place."""
+    import tempfile
+
+    from loper_analysis.io.readers import read_bytes
+
+    setup = subject.setup
+    folder = Path(config_out).parent
+    names = {
+        "model": str(folder / setup.template.model),
         "marker_set": str(folder / "marker_set.xml"),
         "scale_setup": str(folder / "scale_setup.xml"),
         "ik_tasks": str(folder / "ik_tasks.tsv"),
         "config": str(config_out),
     }
-    if len(setup.label_map):
-        files["label_map"] = str(folder / "label_map.tsv")
-    inputs = {p.resolve() for p in paths}
-    clash = [f for f in files.values() if Path(f).resolve() in inputs]
+    maps = trial_label_maps(subject.setup.label_map, [p.stem for p in subject.paths], subject.trial_labels)
+    for key in maps:
+        names[key] = str(folder / ("label_map.tsv" if key == "label_map" else f"label_map_{key[10:]}.tsv"))
+    order = ["model", "marker_set", "scale_setup", "ik_tasks", *maps, "config"]
+    names = {k: names[k] for k in order}
+    inputs = {p.resolve() for p in subject.paths}
+    clash = [f for f in names.values() if Path(f).resolve() in inputs]
     if clash:
         raise LoperInputError(f"{clash[0]}: would overwrite an input file; write the config to another folder")
-    config_text = _subject_config_text(paths, kinds, setup, summary, files, coordinate_map, mass_height)
-    model_bytes = read_bytes(model_path, "OpenSim model")
-    write_bytes(files["model"], model_bytes, "OpenSim model")
-    write_osim_object(marker_set, files["marker_set"], "marker set")
-    write_osim_object(tool, files["scale_setup"], "ScaleTool setup")
-    write_tsv(setup.ik_tasks, files["ik_tasks"])
-    if "label_map" in files:
-        write_tsv(setup.label_map, files["label_map"])
-    write_text(config_out, config_text, "subject config")
-    return tuple(
-        Path(files[k]) for k in ("model", "marker_set", "scale_setup", "ik_tasks", "label_map", "config") if k in files
-    )
+    with tempfile.TemporaryDirectory(prefix="loper-inspect-") as scratch:
+        staged, losses = _staged_files(subject, Path(scratch), names)
+        text = "".join(f"  scaling: {line}\n" for line in losses)
+        if check is not None:
+            static = next((p for p, k in zip(subject.paths, subject.kinds) if k == "static"), None)
+            per_trial = {
+                str(p): tuple(staged[k] for k in ("label_map", f"label_map:{p.stem}") if k in staged)
+                for p in subject.paths
+            }
+            text += check(
+                StagedSubject(
+                    staged,
+                    static if subject.has_static else None,
+                    tuple(p for p, k in zip(subject.paths, subject.kinds) if k == "walking"),
+                    per_trial,
+                    tuple(float(a) for a in subject.summary.rotation_deg),
+                    subject.cutoff[0],
+                    setup,
+                )
+            )
+        contents = {k: read_bytes(staged[k], "staged file") for k in order}
+    _put_in_place({Path(names[k]): contents[k] for k in order})
+    return tuple(Path(names[k]) for k in order), text
+
+
+def _put_in_place(contents: Mapping[Path, bytes]) -> None:
+    """Write each file in order (atomically); when one fails, the files this call wrote are put back as they
+    were (or removed) before the error goes on."""
+    before = {p: p.read_bytes() if p.is_file() else None for p in contents}
+    done = []
+    try:
+        for path, data in contents.items():
+            write_bytes(path, data, path.name)
+            done.append(path)
+    except Exception:
+        for path in done:
+            if before[path] is None:
+                path.unlink(missing_ok=True)
+            else:
+                write_bytes(path, before[path], path.name)
+        raise
