@@ -95,3 +95,18 @@ def test_the_workflow_reads_and_writes_raw_files_in_the_configs_raw_dir(tmp_path
     written = {line.split(": ", 1)[1] for line in run.stdout.splitlines() if line.startswith("    output: ")}
     assert "lab/raw/S01/truth.yaml" in written
     assert not [p for line in written for p in line.split(", ") if p.startswith("data/raw")]
+
+
+def test_ik_reads_the_static_trials_markers_of_a_subject_with_a_static_trial(tmp_path):
+    for subject in ("R01", "R02"):
+        touch(tmp_path / "raw" / subject / "walk-nodevice.c3d")
+    touch(tmp_path / "raw" / "R01" / "static.c3d")
+    rows = {
+        "R01": {"source": "recorded"},
+        "R02": {"source": "recorded", "model_osim": "lab/R02.osim"},  # a model, no static trial
+        "S01": {"source": "synthetic"},
+    }
+    study = study_on(tmp_path, rows)
+    assert study.static_markers("R01") == ["results/markers/R01/static.trc"]
+    assert study.static_markers("S01") == ["results/markers/S01/static.trc"]  # generated with its walks
+    assert study.static_markers("R02") == []  # IK compares with the model's markers

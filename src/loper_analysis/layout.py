@@ -278,6 +278,15 @@ class Study:
         """The model scaled per subject: opensim.generic_model, or the generated model for the subject."""
         return self.config["opensim"]["generic_model"] or fill(self.paths.model.generic, subject=subject)
 
+    def static_markers(self, subject: str) -> list[str]:
+        """The static trial's TRC of a subject with a static trial (generated for a synthetic subject, on disk for a
+        recorded one): IK compares each walking trial's marker geometry with it. Nothing for a subject with only a
+        model (the sheet's model_osim): IK compares with the model's markers."""
+        static = self.design.static
+        if self.source(subject) == "synthetic" or (self.paths.raw_folder(subject) / f"{static}.c3d").is_file():
+            return [fill(self.paths.markers.trc, subject=subject, trial=static)]
+        return []
+
     def static_c3d_for_mass(self, subject: str) -> list[str]:
         """The static trial's C3D when the sheet gives no mass or no height (read for them), else nothing."""
         row = self.rows[subject]

@@ -191,13 +191,14 @@ def _events(cfg: dict, grf_channels: dict):
     )
 
 
-def _ik(cfg: dict, trc: Path):
+def _ik(cfg: dict, trc: Path, static_trc: str | None = None):
     return ik.ik_trial(
         fill(PATHS.model.generic, subject=SUBJECT),
         trc,
         fill(PATHS.ik.mot, subject=SUBJECT, trial=WALK),
         fill(PATHS.ik.angles, subject=SUBJECT, trial=WALK),
         IKSettings.from_config(cfg),
+        static_trc=static_trc,
     )
 
 
@@ -372,11 +373,10 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
     marker_steps.markers(
         tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", MarkerSettings.from_config(cfg)
     )
+    static = fill(PATHS.markers.trc, subject=SUBJECT, trial="static")  # R01's, the reference
     if refused:
-        message = _refused(lab, lambda: _ik(cfg, out), [f"{out} with ", "opensim.geometry_stop_change 0.08"])
-        change = float(
-            re.search(r"differ from the subject's model \(scaled to its static trial\) by ([\d.]+) %", message)[1]
-        )
+        message = _refused(lab, lambda: _ik(cfg, out, static), [f"{out} with ", "opensim.geometry_stop_change 0.08"])
+        change = float(re.search(rf"differ from the same pairs in the static trial {static} by ([\d.]+) %", message)[1])
         assert 9.0 < change < 13.0
         assert re.search(r"ratio 0\.8[6-9]\d", message) and re.search(r"\w+-\w+ \(\w+\) \d+ mm against \d+", message)
         return
@@ -388,6 +388,7 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
         tmp_path / "R02.angles.tsv",
         IKSettings.from_config(cfg),
         summary_tsv=summary,
+        static_trc=static,
     )
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
     assert 0.05 < row["marker_geometry_change"] < 0.08
@@ -430,6 +431,18 @@ def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
     )
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
     assert row["marker_geometry_change"] < 0.005 and "geometry" not in row["warnings"]
+    # and against its own static trial, as the workflow compares it
+    ik.ik_trial(
+        fill(PATHS.model.generic, subject=SUBJECT),
+        fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
+        tmp_path / "own.mot",
+        tmp_path / "own.angles.tsv",
+        IKSettings.from_config(_config(lab)),
+        summary_tsv=summary,
+        static_trc=fill(PATHS.markers.trc, subject=SUBJECT, trial="static"),
+    )
+    row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
+    assert row["marker_geometry_change"] < 0.005 and "geometry" not in row["warnings"]
 
 
 def test_a_static_trial_of_another_subject_stops_the_walking_trials_ik(lab, tmp_path):
@@ -443,6 +456,10 @@ def test_a_static_trial_of_another_subject_stops_the_walking_trials_ik(lab, tmp_
     message = res.stdout + res.stderr
     trc, model = fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK), fill(PATHS.model.scaled, subject=SUBJECT)
     assert f"{trc} with {model}" in message
+    assert (
+        f"differ from the same pairs in the static trial {fill(PATHS.markers.trc, subject=SUBJECT, trial='static')}"
+        in message
+    )
     assert "opensim.geometry_stop_change 0.08" in message
     after = _state(lab)
     assert {k: after[k] for k in before} == before

@@ -1,5 +1,6 @@
-"""Whose markers: a trial's distances between markers on one body against the model's (the generated model,
-its own markers as the trial, and the same trial of a smaller subject)."""
+"""Whose markers: a trial's distances between markers on one body against the static trial's, or the model's (the
+generated model, its own markers as the trial and as the static trial, and the same trial of a smaller subject);
+a clinical lab's real pair in tests/steps/test_ik.py."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from loper_analysis.motion.marker_geometry import (
     MIN_PAIR_DISTANCE_M,
     geometry_change,
     geometry_message,
+    geometry_ratio,
     marker_geometry,
     same_body_marker_pairs,
 )
@@ -56,3 +58,36 @@ def test_missing_frames_and_markers_are_left_out_of_the_distances():
     first = table[(table["marker_a"] == labels[0]) | (table["marker_b"] == labels[0])]
     assert len(first) and (first["n_frames"] == 3).all()
     assert np.abs(table["change"]).max() < 1e-12
+
+
+def test_a_trial_against_a_static_trial_compares_the_pairs_both_hold():
+    model = build_lower_body_model(1.80, 72.0)
+    X, labels = _marker_positions(model)
+    pairs = same_body_marker_pairs(model, labels, min_distance_m=0.0)
+    static = np.repeat(X[None], 3, axis=0)
+    static[0] = np.nan  # a frame without markers
+    # the static trial lacks the first marker: its pairs are not compared
+    table = marker_geometry(pairs, np.repeat(0.9 * X[None], 5, axis=0), labels, static[:, 1:], labels[1:])
+    compared = set(table["marker_a"]) | set(table["marker_b"])
+    assert labels[0] not in compared and len(table) == sum(
+        (a != labels[0]) & (b != labels[0]) & (d >= MIN_PAIR_DISTANCE_M)
+        for a, b, d in zip(pairs["marker_a"], pairs["marker_b"], pairs["model_distance_m"], strict=True)
+    )
+    np.testing.assert_allclose(table["reference_distance_m"] * 0.9, table["trial_distance_m"], rtol=1e-12)
+    assert np.allclose(table["change"], -0.1) and geometry_ratio(table) == pytest.approx(0.9)
+    assert (table["reference_distance_m"] >= MIN_PAIR_DISTANCE_M).all() and (table["n_frames"] == 5).all()
+    text = geometry_message(table, 0.08, "opensim.geometry_stop_change", "results/markers/S01/static.trc")
+    assert text.startswith(
+        "the distances between markers on one body differ from the same pairs in the static trial "
+        "results/markers/S01/static.trc by 10.0 % in the median of "
+    )
+    assert "(limit opensim.geometry_stop_change 0.08; trial/static ratio 0.900)" in text
+    assert "another subject" in text
+    # a walking trial in mm against a static trial in m: a unit, named against the static trial
+    table = marker_geometry(pairs, np.repeat(1000.0 * X[None], 5, axis=0), labels, static, labels)
+    text = geometry_message(table, 0.08, "opensim.geometry_stop_change", "static.trc")
+    assert "trial/static ratio 1000.000" in text and "1000 times the static trial's: markers in another length" in text
+    # without a static trial the model's markers are the reference, and the message says so
+    text = geometry_message(marker_geometry(pairs, np.repeat(0.9 * X[None], 5, axis=0), labels), 0.08, "x")
+    assert "differ from the subject's model's markers (no static trial to compare with) by 10.0 %" in text
+    assert "trial/model ratio 0.900" in text

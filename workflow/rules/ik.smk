@@ -4,10 +4,12 @@
 if OPENSIM["ik_chunks"] == 1:
 
     rule ik:
-        """The whole trial in one job (the default): IK, .mot and angle table."""
+        """The whole trial in one job (the default): IK, .mot and angle table (the marker geometry checked against
+        the static trial's, or the model's without one)."""
         input:
             model=by_subject(STUDY.subject_model),
             trc=PATHS.markers.trc,
+            static=by_subject(STUDY.static_markers),
             lab_angles=PATHS.markers.lab_angles,
         output:
             mot=PATHS.ik.mot,
@@ -32,6 +34,7 @@ else:
         input:
             model=by_subject(STUDY.subject_model),
             trc=PATHS.markers.trc,
+            static=by_subject(STUDY.static_markers),
         output:
             temp(PATHS.ik.chunk),
         log:

@@ -11,6 +11,6 @@ with rule_log(snakemake.log[0]):
         out.angles,
         snakemake.params.settings,
         summary_tsv=out.summary,
-        lab_angles_tsv=snakemake.input.lab_angles,
-        agreement_tsv=out.agreement,
+        lab_angles=(snakemake.input.lab_angles, out.agreement),
+        static_trc=(snakemake.input.static or [None])[0],
     )

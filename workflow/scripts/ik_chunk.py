@@ -11,4 +11,5 @@ with rule_log(snakemake.log[0]):
         int(snakemake.wildcards.chunk),
         p.n_chunks,
         p.settings,
+        (snakemake.input.static or [None])[0],
     )

@@ -60,29 +60,48 @@ def _checked(res, source: str, settings: IKSettings):
     return poor
 
 
-def _geometry_checked(model, markers_m: np.ndarray, labels: Sequence[str], settings: IKSettings, source: str):
-    """Compare the trial's distances between markers on one body with the model's
-    (:func:`loper_analysis.motion.marker_geometry.marker_geometry`): beyond ``settings.geometry_stop_change`` the
-    trial is refused as another subject's, beyond ``settings.geometry_warn_change`` warned about. Returns the
-    median change and the warning (or None)."""
+def _geometry_checked(
+    model,
+    markers_m: np.ndarray,
+    labels: Sequence[str],
+    settings: IKSettings,
+    source: str,
+    static_trc: PathLike | None = None,
+):
+    """Compare the trial's distances between markers on one body with the same pairs in the subject's static
+    trial (``static_trc``, its TRC in the model's names), or without one with the model's markers
+    (:func:`loper_analysis.motion.marker_geometry.marker_geometry`): beyond ``settings.geometry_stop_change``
+    the trial is refused as another subject's, beyond ``settings.geometry_warn_change`` warned about. Against
+    the model, a model not scaled to the subject (``settings.subjects_model`` False) only warns, unless the
+    distances differ by a factor beyond 1.5 (a unit). Returns the median change and the warning (or None)."""
     from loper_analysis.motion.marker_geometry import (
         geometry_change,
         geometry_message,
+        geometry_ratio,
         marker_geometry,
         same_body_marker_pairs,
     )
 
-    table = marker_geometry(same_body_marker_pairs(model, labels), markers_m, labels)
+    if static_trc is None:
+        table = marker_geometry(same_body_marker_pairs(model, labels), markers_m, labels)
+        name, reference, stops = None, "the model's markers", settings.subjects_model
+    else:
+        from loper_analysis.io.opensim_tables import read_markers
+
+        _, static_m, static_labels = read_markers(static_trc)
+        pairs = same_body_marker_pairs(model, labels, min_distance_m=0.0)
+        table = marker_geometry(pairs, markers_m, labels, static_m, static_labels)
+        name, reference, stops = str(static_trc), f"the static trial {static_trc}", True
+        if not len(table):
+            log.warning("%s: no pair of markers on one body is in both this trial and %s: not compared", source, name)
     change = geometry_change(table)
-    log.info("marker geometry against the model: median change %.2f %% over %d pairs", 100 * change, len(table))
-    ratio = float(np.median(table["trial_distance_m"] / table["model_distance_m"])) if len(table) else 1.0
-    stops = settings.subjects_model or not 2 / 3 < ratio < 3 / 2
+    log.info("marker geometry against %s: median change %.2f %% over %d pairs", reference, 100 * change, len(table))
+    stops = stops or not 2 / 3 < geometry_ratio(table) < 3 / 2
     if change > settings.geometry_stop_change and stops:
-        raise LoperInputError(
-            f"{source}: {geometry_message(table, settings.geometry_stop_change, 'opensim.geometry_stop_change')}"
-        )
+        stop = geometry_message(table, settings.geometry_stop_change, "opensim.geometry_stop_change", name)
+        raise LoperInputError(f"{source}: {stop}")
     if change > settings.geometry_warn_change:
-        warning = geometry_message(table, settings.geometry_warn_change, "opensim.geometry_warn_change")
+        warning = geometry_message(table, settings.geometry_warn_change, "opensim.geometry_warn_change", name)
         log.warning("%s: %s", source, warning)
         return change, warning
     return change, None
@@ -95,9 +114,11 @@ def _solve(
     labels: Sequence[str],
     settings: IKSettings,
     source: str = "",
+    static_trc: PathLike | None = None,
 ):
-    """IK of marker arrays with the tasks of ``settings`` (its task file or its weights); returns the
-    :class:`IKResult`."""
+    """IK of marker arrays with the tasks of ``settings`` (its task file or its weights), after the marker
+    geometry's check against the static trial ``static_trc`` (or the model's markers, :func:`_geometry_checked`);
+    returns the :class:`IKResult`."""
     from loper_analysis.io.ik_tasks import read_ik_tasks
     from loper_analysis.io.osim import read_model
     from loper_analysis.motion.coordinate_signs import require_map_signs
@@ -111,7 +132,7 @@ def _solve(
     weights, coords = ik_task_weights(
         model, labels, tasks, s.default_weight, s.marker_weights, s.coordinate_tasks, source
     )
-    change, warning = _geometry_checked(model, markers_m, labels, s, source)
+    change, warning = _geometry_checked(model, markers_m, labels, s, source, static_trc)
     res = inverse_kinematics(
         model,
         time_s,
@@ -137,8 +158,15 @@ def ik_chunk(
     chunk: int,
     n_chunks: int,
     settings: IKSettings = IKSettings(),
+    static_trc: PathLike | None = None,
 ):
     """IK of time chunk ``chunk`` of ``n_chunks`` of a TRC; writes a .mot (degrees), returns the :class:`IKResult`.
+
+    First the distances between markers on one body (median over the chunk's frames) are compared with the
+    same pairs in the subject's static trial ``static_trc`` (the markers step's TRC, in the model's names), or,
+    without one, with the model's markers: a median change beyond ``settings.geometry_stop_change`` stops
+    it as another subject's trial, naming both files and the pairs
+    (:mod:`loper_analysis.motion.marker_geometry`).
 
     The tasks, the solver's accuracy and the limits are those of ``settings`` (:class:`IKSettings`).
     Markers missing (NaN) in a frame are left out of its solve; a frame with
@@ -157,8 +185,9 @@ def ik_chunk(
 
     time_s, X, labels = read_markers(trc_path)
     sel = chunk_frames(len(time_s), n_chunks, chunk)
-    res = _solve(model_osim, time_s[sel], X[sel], labels, settings, source=f"{trc_path} with {model_osim}")
-    _checked(res, f"{trc_path} with {model_osim}", settings)
+    source = f"{trc_path} with {model_osim}"
+    res = _solve(model_osim, time_s[sel], X[sel], labels, settings, source, static_trc)
+    _checked(res, source, settings)
     log.info(
         "%s chunk %d/%d: %d frames (%d solved), marker RMS error mean %.2f mm, max %.2f mm",
         trc_path,
@@ -237,26 +266,29 @@ def ik_trial(
     angles_tsv: PathLike,
     settings: IKSettings = IKSettings(),
     summary_tsv: PathLike | None = None,
-    lab_angles_tsv: PathLike | None = None,
-    agreement_tsv: PathLike | None = None,
+    lab_angles: tuple[PathLike, PathLike | None] | None = None,
+    static_trc: PathLike | None = None,
 ) -> pd.DataFrame:
-    """IK of a whole TRC in one go (:func:`ik_chunk` with ``settings``): the .mot (degrees), the tidy angle table
-    that :func:`ik_join` gives (``settings.coordinate_map``), and (``summary_tsv``) the one-row IK summary
-    (:meth:`loper_analysis.motion.ik.IKResult.summary`, with the worst marker and the warnings).
+    """IK of a whole TRC in one go (:func:`ik_chunk` with ``settings`` and the static trial ``static_trc``):
+    the .mot (degrees), the tidy angle table that :func:`ik_join` gives (``settings.coordinate_map``), and
+    (``summary_tsv``) the one-row IK summary (:meth:`loper_analysis.motion.ik.IKResult.summary`, with the
+    worst marker and the warnings).
 
-    ``lab_angles_tsv``: the lab's own joint angles of the trial (written by the markers step,
-    :func:`loper_analysis.motion.lab_angles.lab_joint_angles`); our angles are compared with them and the
-    agreement per angle written to ``agreement_tsv``
-    (:func:`loper_analysis.motion.lab_angles.lab_agreement`), each joint beyond the limits warned about.
+    ``lab_angles``: ``(lab_angles_tsv, agreement_tsv)``, the lab's own joint angles of the trial (written by
+    the markers step, :func:`loper_analysis.motion.lab_angles.lab_joint_angles`) and where the agreement goes:
+    our angles are compared with them and the agreement per angle written to ``agreement_tsv`` (None: not
+    written; :func:`loper_analysis.motion.lab_angles.lab_agreement`), each joint beyond the limits warned
+    about. ``static_trc``: the subject's static trial (the markers step's TRC), the reference of the marker
+    geometry's check (:func:`ik_chunk`); None: the model's markers.
     A knee that flexes negative is warned about
     (:func:`loper_analysis.motion.plausibility.inverted_knee_warnings`).
     """
     from loper_analysis.motion.ik import joint_angle_table
 
-    res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, settings)
+    res = ik_chunk(model_osim, trc_path, out_mot, 0, 1, settings, static_trc)
     angles = joint_angle_table(res.frame(), settings.coordinate_map, source=f"{out_mot} (model {model_osim})")
     warn = settings.warn_marker_rms_m
-    outputs = (angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv)
+    outputs = (angles_tsv, summary_tsv, *(lab_angles or (None, None)))
     return _angle_outputs(res, angles, IK_WARN_RMS_M if warn is None else warn, outputs, str(trc_path))
 
 
@@ -266,15 +298,14 @@ def ik_join(
     angles_tsv: PathLike,
     settings: IKSettings = IKSettings(),
     summary_tsv: PathLike | None = None,
-    lab_angles_tsv: PathLike | None = None,
-    agreement_tsv: PathLike | None = None,
+    lab_angles: tuple[PathLike, PathLike | None] | None = None,
 ) -> pd.DataFrame:
     """Join IK chunks into one .mot and the tidy angle table (rad, m; :data:`kinematics.ANGLE_COLUMNS`; the
     coordinates of ``settings.coordinate_map``).
 
     ``summary_tsv``: the one-row IK summary of the joined trial (frames left
     out are those without any coordinate; the chunks keep no marker errors,
-    so those columns are NaN). ``lab_angles_tsv`` and ``agreement_tsv`` as in :func:`ik_trial`.
+    so those columns are NaN). ``lab_angles`` as in :func:`ik_trial`.
     """
     from loper_analysis.io.opensim_tables import read_mot, write_mot
     from loper_analysis.motion.ik import IKResult, join_chunks, joint_angle_table
@@ -285,7 +316,7 @@ def ik_join(
     values = coords.drop(columns="time_s").to_numpy(float)
     none = np.full(len(coords), np.nan)
     joined = IKResult(coords["time_s"].to_numpy(float), values, [], none, none, solved=np.isfinite(values).any(axis=1))
-    outputs = (angles_tsv, summary_tsv, lab_angles_tsv, agreement_tsv)
+    outputs = (angles_tsv, summary_tsv, *(lab_angles or (None, None)))
     _angle_outputs(joined, angles, IK_WARN_RMS_M, outputs, str(out_mot))
     write_mot(out_mot, coords, in_degrees=True)
     return angles
