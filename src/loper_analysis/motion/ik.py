@@ -98,7 +98,8 @@ class IKResult:
     marker's distance error (m, NaN where missing), in the order of
     ``marker_names``. ``warning``: a poor fit's warning, set by the file step; ``warnings``: other warnings
     of the file step (a joint angle that looks inverted). ``geometry_change``: the median relative change of the
-    distances between markers on one body against the model's (:mod:`loper_analysis.motion.marker_geometry`;
+    distances between markers on one body against the static trial's, or the model's
+    (:mod:`loper_analysis.motion.marker_geometry`;
     NaN when not compared). ``solver``: the solver that gave the coordinates (``tree``, or ``opensim`` and
     why).
     """

@@ -47,14 +47,15 @@ class IKSettings:
         Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``opensim.coordinate_map``); None:
         :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     geometry_warn_change, geometry_stop_change : float
-        Median relative change of the distances between markers on one body, trial against model, above which
+        Median relative change of the distances between markers on one body, walking trial against the static
+        trial (without one: against the model's markers), above which
         the trial is warned about or refused as another subject's (``opensim.geometry_warn_change``,
         ``opensim.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
     subjects_model : bool
         Whether the model was scaled to this subject's static trial (True) or given as it is (a ``model_osim``
         of the subject sheet, the command line's ``--model``): its markers may then sit elsewhere than on the
-        subject, and a change beyond ``geometry_stop_change`` is a warning, unless the distances differ by a
-        factor beyond 1.5 (a unit).
+        subject, and a change against them beyond ``geometry_stop_change`` is a warning, unless the distances
+        differ by a factor beyond 1.5 (a unit). A comparison with the static trial stops whatever the model.
     """
 
     tasks_file: str | os.PathLike | None = None
