@@ -1,4 +1,5 @@
-"""Force-plate contacts, the foot on each, flags, events and strides: a split-belt treadmill with known answers."""
+"""Force-plate contacts and their events (loper_analysis.gait.contacts): bad input named, events and strides of a
+split-belt treadmill with known answers, walking5's contacts, plates in a Y-up frame."""
 
 import math
 
@@ -6,160 +7,41 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.constants import CONTACT_FLAGS
 from loper_analysis.errors import LoperInputError
-from loper_analysis.gait.contacts import (
-    CONTACT_COLUMNS,
-    PlateForce,
-    contact_events,
-    foot_contacts,
-    plate_contacts,
-)
+from loper_analysis.gait.contacts import CONTACT_COLUMNS, PlateForce, contact_events, foot_contacts
 from loper_analysis.gait.events import EVENT_COLUMNS, flagged_contacts, gait_events
 from loper_analysis.gait.plate_geometry import plate_offsets
 from loper_analysis.gait.strides import strides_from_events
-
-FS = 2000.0  # analog rate, Hz
-MARKER_HZ = 200.0
-DURATION_S = 11.0
-PEAK_N = 700.0
-STANCE_S = 0.7
-PERIOD_S = 1.1
-REST_N = -40.0  # unloaded plates read this (not zeroed)
-ON_N, OFF_N = 50.0, 20.0
-SETTINGS = {"threshold_on_n": ON_N, "threshold_off_n": OFF_N, "min_stance_s": 0.08, "min_swing_s": 0.08}
-# plate 1 under the left belt, plate 2 under the right one (walking along +y, surface z = 0)
-CORNERS = {
-    1: np.array([[-0.50, 0.0, 0.0], [-0.01, 0.0, 0.0], [-0.01, 1.6, 0.0], [-0.50, 1.6, 0.0]]),
-    2: np.array([[0.01, 0.0, 0.0], [0.50, 0.0, 0.0], [0.50, 1.6, 0.0], [0.01, 1.6, 0.0]]),
-}
-HEEL_X = {1: -0.15, 2: 0.15}
-CROSSOVER_X = 0.20  # the left foot's crossover step lands here, on the right belt
-HAND = (2.22, 2.38, 150.0)  # a hand (object) load on plate 1 in the left swing: start, end, peak
-MISSING = (8.60, 8.63)  # the right heel is missing around the start probe of its contact at 8.55 s (8.617 s)
-
-
-def _steps():
-    """(side, plate, heel strike s, toe-off s) of every foot contact; left step 5 crosses over to plate 2."""
-    out = []
-    for k in range(10):
-        out.append(("left", 2 if k == 5 else 1, 0.3 + PERIOD_S * k, 0.3 + PERIOD_S * k + STANCE_S))
-    for k in range(-1, 10):
-        out.append(("right", 2, 0.85 + PERIOD_S * k, 0.85 + PERIOD_S * k + STANCE_S))
-    return out
-
-
-def _hump(t, start, end, peak):
-    inside = (t >= start) & (t <= end)
-    return np.where(inside, peak * np.sin(np.pi * np.clip((t - start) / (end - start), 0, 1)), 0.0)
-
-
-def _crossings(start, end, peak):
-    """Analytic times where a half-sine hump rises through ON_N and falls through OFF_N."""
-    d = end - start
-    return start + d / math.pi * math.asin(ON_N / peak), end - d / math.pi * math.asin(OFF_N / peak)
-
-
-def _heel(side, steps, t):
-    """Heel marker (n, 3) in m: on its plate in stance (moving back with the belt), arcs up to 0.2 m in swing."""
-    mine = sorted((s for s in steps if s[0] == side), key=lambda s: s[2])
-    xyz = np.zeros((t.size, 3))
-    first_x = CROSSOVER_X if (side == "left" and mine[0][1] == 2) else HEEL_X[mine[0][1]]
-    xyz[t < mine[0][2]] = [first_x, 0.7, 0.2]  # in the air before the first step and after the last
-    xyz[t > mine[-1][3]] = [HEEL_X[mine[-1][1]], 0.7, 0.2]
-    for i, (_, plate, hs, to) in enumerate(mine):
-        x = CROSSOVER_X if (side == "left" and plate == 2) else HEEL_X[plate]
-        stance = (t >= hs) & (t <= to)
-        xyz[stance] = np.column_stack(
-            [np.full(stance.sum(), x), 1.1 - 1.0 * (t[stance] - hs), np.full(stance.sum(), 0.05)]
-        )
-        if i + 1 < len(mine):
-            nxt = mine[i + 1]
-            x2 = CROSSOVER_X if (side == "left" and nxt[1] == 2) else HEEL_X[nxt[1]]
-            swing = (t > to) & (t < nxt[2])
-            u = (t[swing] - to) / (nxt[2] - to)
-            xyz[swing] = np.column_stack([x + (x2 - x) * u, 0.4 + 0.7 * u, 0.05 + 0.15 * np.sin(np.pi * u)])
-    return xyz
-
-
-def _trial(rng):
-    steps = _steps()
-    t = np.arange(int(DURATION_S * FS)) / FS
-    raw = {1: np.full(t.size, REST_N), 2: np.full(t.size, REST_N)}
-    for _, plate, hs, to in steps:
-        raw[plate] += _hump(t, hs, to, PEAK_N)
-    raw[1] += _hump(t, *HAND)
-    for p in raw:
-        raw[p] += rng.normal(0.0, 2.0, t.size)
-    tm = np.arange(int(DURATION_S * MARKER_HZ)) / MARKER_HZ
-    heels = {s: _heel(s, steps, tm) for s in ("left", "right")}
-    heels["right"][(tm >= MISSING[0]) & (tm <= MISSING[1])] = np.nan
-    return t, raw, tm, heels, steps
-
-
-def _plates(t, raw):
-    """Force above the resting level: the median of a span where each plate is known to be unloaded."""
-    quiet = {1: (0.0, 0.25), 2: (0.5, 0.8)}
-    out = []
-    for p in (1, 2):
-        a, b = quiet[p]
-        rest = np.median(raw[p][(t >= a) & (t < b)])
-        assert abs(rest - REST_N) < 0.3
-        out.append(PlateForce(p, t, raw[p] - rest, CORNERS[p]))
-    return out
+from tests.gait.belt_walk import (
+    CORNERS,
+    FS,
+    OFF_N,
+    ON_N,
+    PEAK_N,
+    SETTINGS,
+    STANCE_S,
+    belt_steps,
+    belt_walk,
+    crossings,
+    hump,
+    plates_above_rest,
+)
 
 
 @pytest.fixture(scope="module")
 def trial():
-    return _trial(np.random.default_rng(20240612))
+    return belt_walk(np.random.default_rng(20240612))
 
 
 @pytest.fixture(scope="module")
 def judged(trial):
     t, raw, tm, heels, _ = trial
-    return foot_contacts(_plates(t, raw), tm, heels, **SETTINGS, source="S01/walk")
-
-
-def test_plate_contacts_fall_on_the_analytic_crossings_above_the_resting_level(trial):
-    t, raw, *_ = trial
-    plate = _plates(t, raw)[0]
-    found = plate_contacts(plate.time_s, plate.vertical_force_n, **SETTINGS)
-    left = [(hs, to) for side, p, hs, to in _steps() if p == 1]
-    expected = sorted([_crossings(hs, to, PEAK_N) for hs, to in left] + [_crossings(*HAND)])
-    assert len(found) == len(expected) == 10
-    start = found["start_s"].to_numpy()
-    end = found["end_s"].to_numpy()
-    err = np.abs(np.concatenate([start - [e[0] for e in expected], end - [e[1] for e in expected]]))
-    assert err.max() < 0.005  # measured: at most 1.2 ms with 2 N noise
-    assert not found["incomplete"].any()
-    # thresholds on the raw force (rest -40 N not removed) act 40 N higher: heel strikes ~13 ms late
-    raw_found = plate_contacts(t, raw[1], **SETTINGS)
-    late = raw_found["start_s"].to_numpy() - start
-    assert late.min() > 0.010
-
-
-def test_plate_contacts_mark_contacts_cut_by_the_recording(trial):
-    t, raw, *_ = trial
-    plate = _plates(t, raw)[1]
-    found = plate_contacts(plate.time_s, plate.vertical_force_n, **SETTINGS)
-    # loaded at t = 0 (right stance -0.25 .. 0.45 s) and at the end (10.75 .. 11.45 s)
-    assert found["incomplete"].tolist()[0] and found["incomplete"].tolist()[-1]
-    assert found["start_sample"].iloc[0] == 0 and found["end_sample"].iloc[-1] == t.size - 1
-    assert abs(found["end_s"].iloc[0] - _crossings(-0.25, 0.45, PEAK_N)[1]) < 0.005
-    assert not found["incomplete"].iloc[1:-1].any()
-    # never loaded: no contact; loaded throughout: one incomplete contact
-    assert plate_contacts(t, np.zeros(t.size)).empty
-    whole = plate_contacts(t, np.full(t.size, 300.0))
-    assert whole[["start_sample", "end_sample"]].values.tolist() == [[0, t.size - 1]] and whole["incomplete"].all()
-    # a 50 ms unloading is shorter than min_swing_s (0.2 s): still one contact over the whole recording
-    blip = np.full(t.size, 300.0)
-    blip[1000:1100] = 0.0
-    assert plate_contacts(t, blip)[["start_sample", "end_sample"]].values.tolist() == [[0, t.size - 1]]
+    return foot_contacts(plates_above_rest(t, raw), tm, heels, **SETTINGS, source="S01/walk")
 
 
 def test_bad_input_is_named(trial):
     t, raw, tm, heels, _ = trial
-    plates = _plates(t, raw)
+    plates = plates_above_rest(t, raw)
     with pytest.raises(LoperInputError, match=r"walk: heels_m\['right'\] must have shape \(2200, 3\)"):
         foot_contacts(plates, tm, {"left": heels["left"], "right": heels["right"][:-1]}, source="walk")
     with pytest.raises(LoperInputError, match=r"plate numbers must be distinct, got \[1, 1\]"):
@@ -181,43 +63,14 @@ def test_bad_input_is_named(trial):
         )
 
 
-def test_every_contact_gets_its_known_foot_and_flag(judged):
-    assert list(judged.columns) == list(CONTACT_COLUMNS)
-    assert set(judged["flag"]) <= set(CONTACT_FLAGS)
-    # known answer per contact: (plate, analytic start crossing, side, flag)
-    expected = []
-    for side, plate, hs, to in _steps():
-        merged = plate == 2 and 5.2 < hs < 6.4  # right 5.25 s + left crossover 5.8 s + right 6.35 s
-        if hs < 0:
-            expected.append((2, 0.0, "right", "incomplete"))  # loaded when the recording starts
-        elif to > DURATION_S:
-            expected.append((2, _crossings(hs, to, PEAK_N)[0], "right", "incomplete"))
-        elif merged and hs < 5.3:
-            expected.append((2, _crossings(hs, to, PEAK_N)[0], "right", "two_feet"))
-        elif not merged:
-            if abs(hs - 8.55) < 1e-9:  # the right heel is missing at the start probe: foot unknown
-                expected.append((2, _crossings(hs, to, PEAK_N)[0], "", "heel_missing"))
-            else:
-                expected.append((plate, _crossings(hs, to, PEAK_N)[0], side, "ok"))
-    # the hand load: the left heel is up in swing over plate 1, the right one stands on plate 2
-    expected.append((1, _crossings(*HAND)[0], "", "no_foot"))
-    expected.sort(key=lambda e: (e[1], e[0]))
-    assert len(judged) == len(expected) == 20
-    for r, (plate, start, side, flag) in zip(judged.itertuples(), expected):
-        assert (r.plate, r.side, r.flag) == (plate, side, flag)
-        assert abs(r.start_s - start) < 0.005
-    ok = judged[judged["flag"] == "ok"]
-    assert len(ok) == 15 and (ok["side"] == np.where(ok["plate"] == 1, "left", "right")).all()
-
-
 def test_clean_contacts_give_events_at_the_crossings_and_flagged_ones_none(judged):
     ev = contact_events(judged)
     assert list(ev.columns) == list(EVENT_COLUMNS)
     gait = ev[ev["event"].isin(["heel_strike", "toe_off"])]
     assert len(gait) == 30  # 15 clean contacts
     truth = {}
-    for side, _plate, hs, to in _steps():
-        a, b = _crossings(hs, to, PEAK_N)
+    for side, _plate, hs, to in belt_steps():
+        a, b = crossings(hs, to, PEAK_N)
         truth[(side, "heel_strike", round(hs, 2))] = a
         truth[(side, "toe_off", round(hs, 2))] = b
     errors = []
@@ -243,7 +96,7 @@ def test_strides_leave_out_those_whose_swing_spans_a_flagged_contact(judged):
     gait_only = ev[ev["event"].isin(["heel_strike", "toe_off"])]
 
     def hs(t0):  # analytic heel strike (on-threshold crossing) of the step starting at t0
-        return _crossings(t0, t0 + STANCE_S, PEAK_N)[0]
+        return crossings(t0, t0 + STANCE_S, PEAK_N)[0]
 
     left, right = strides_from_events(ev, "left"), strides_from_events(ev, "right")
     # left steps start at 0.3 + 1.1 k; kept: 0.3, 2.5, 3.6, 6.9, 9.1 s. Left out: 1.4 s (the hand load in its
@@ -262,45 +115,13 @@ def test_strides_leave_out_those_whose_swing_spans_a_flagged_contact(judged):
         assert len(hit) == 1 and abs(hit["end_s"].iloc[0] - hs(end)) < 0.005
     # gait_events tables (no flagged rows) are not affected: same strides as before
     t = np.arange(int(4.0 * FS)) / FS
-    f = sum(_hump(t, a, a + STANCE_S, PEAK_N) for a in (0.3, 1.4, 2.5))
+    f = sum(hump(t, a, a + STANCE_S, PEAK_N) for a in (0.3, 1.4, 2.5))
     ev_belt = gait_events(t, f, "left")
     assert len(strides_from_events(ev_belt, "left")) == 2
     with pytest.raises(LoperInputError, match="do not pair up"):
         strides_from_events(
             ev.drop(index=ev.index[(ev["event"] == "flagged_end") & (ev["side"] == "left")][:1]), "left"
         )
-
-
-def test_belt_map_is_only_a_check(trial, judged):
-    t, raw, tm, heels, _ = trial
-    plates = _plates(t, raw)
-    same = foot_contacts(plates, tm, heels, plate_sides={"left": 1, "right": 2}, **SETTINGS)
-    pd.testing.assert_frame_equal(same.drop(columns="belt_side"), judged.drop(columns="belt_side"))
-    assert (same["belt_side"] == np.where(same["plate"] == 1, "left", "right")).all()
-    swapped = foot_contacts(plates, tm, heels, plate_sides={"left": 2, "right": 1}, **SETTINGS)
-    assert (swapped.loc[judged["flag"] == "ok", "flag"] == "wrong_belt").all()
-    assert (swapped["side"] == judged["side"]).all()  # the markers still name the foot
-    ev = contact_events(swapped)
-    assert not ev["event"].isin(["heel_strike", "toe_off"]).any()
-    assert flagged_contacts(ev) == len(swapped)
-    with pytest.raises(LoperInputError, match="plate 3"):
-        foot_contacts(plates, tm, heels, plate_sides={"left": 3}, **SETTINGS)
-
-
-def test_a_single_crossover_step_alone_on_the_other_belt_is_assigned_by_the_markers():
-    t = np.arange(int(3.0 * FS)) / FS
-    tm = np.arange(int(3.0 * MARKER_HZ)) / MARKER_HZ
-    steps = [("left", 1, 0.3, 1.0), ("left", 2, 1.6, 2.3)]  # the right foot stays off both plates
-    f = {1: _hump(t, 0.3, 1.0, PEAK_N), 2: _hump(t, 1.6, 2.3, PEAK_N)}
-    heels = {"left": _heel("left", steps, tm), "right": np.tile([0.0, -0.5, 0.05], (tm.size, 1))}
-    plates = [PlateForce(p, t, f[p], CORNERS[p]) for p in (1, 2)]
-    free = foot_contacts(plates, tm, heels)
-    assert free[["plate", "side", "flag"]].values.tolist() == [[1, "left", "ok"], [2, "left", "ok"]]
-    mapped = foot_contacts(plates, tm, heels, plate_sides={"left": 1, "right": 2})
-    assert mapped["flag"].tolist() == ["ok", "wrong_belt"]
-    ev = contact_events(mapped)
-    assert ev["event"].tolist() == ["heel_strike", "toe_off", "flagged_start", "flagged_end"]
-    assert (ev["side"] == "left").all()
 
 
 WALKING5 = __import__("pathlib").Path(__file__).parents[1] / "data" / "opensim-core" / "walking5.c3d"
@@ -385,7 +206,9 @@ def test_plates_in_a_y_up_frame_with_corners_either_way_round_give_the_same_cont
     round, with up = +Y: every contact, foot, flag and heel distance as in the Z-up frame."""
     t, raw, tm, heels, _ = trial
     Q = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
-    plates = [PlateForce(p.plate, p.time_s, p.vertical_force_n, (p.corners_m @ Q.T)[::-1]) for p in _plates(t, raw)]
+    plates = [
+        PlateForce(p.plate, p.time_s, p.vertical_force_n, (p.corners_m @ Q.T)[::-1]) for p in plates_above_rest(t, raw)
+    ]
     turned = foot_contacts(
         plates, tm, {s: h @ Q.T for s, h in heels.items()}, **SETTINGS, source="S01/walk", up=(0.0, 1.0, 0.0)
     )
@@ -417,77 +240,3 @@ def test_plate_offsets_with_up_either_corner_order_and_a_tilted_plate_refused():
             source="walk",
             up=(0.0, 1.0, 0.0),
         )
-
-
-SYD = __import__("pathlib").Path(__file__).parents[1] / "data" / "c3d-parser" / "SYD" / "walk-nodevice.c3d"
-
-
-@pytest.fixture(scope="module")
-def syd():
-    """SYD's plates (force above the resting level, corners in m), heel and toe markers (m), read with ezc3d, and
-    each plate's own loaded period: its first sample >= 50 N above its resting level to the sample after its
-    last one."""
-    ezc3d = pytest.importorskip("ezc3d")
-    c = ezc3d.c3d(str(SYD), extract_forceplat_data=True)
-    prm = c["parameters"]
-    labels = [s.strip() for s in prm["POINT"]["LABELS"]["value"]]
-    rate, arate = float(prm["POINT"]["RATE"]["value"][0]), float(prm["ANALOG"]["RATE"]["value"][0])
-    t0 = c["header"]["points"]["first_frame"] / rate
-    points = c["data"]["points"][:3] / 1000.0  # mm -> m
-    points[:, np.all(points == 0.0, axis=0)] = np.nan
-    tm = t0 + np.arange(points.shape[2]) / rate
-    feet = {m: points[:, labels.index(m)].T for m in ("LHEE", "RHEE", "LTOE", "RTOE")}
-    plates, loaded = [], {}
-    for k, p in enumerate(c["data"]["platform"], start=1):
-        fz = np.asarray(p["force"][2], dtype=float)
-        t = t0 + np.arange(fz.size) / arate
-        rest = float(np.median(fz[np.argsort(np.abs(fz))[: fz.size // 10]]))  # the tenth of samples nearest zero
-        f = fz - rest
-        plates.append(PlateForce(k, t, f, np.asarray(p["corners"], dtype=float).T / 1000.0))
-        on = np.flatnonzero(f >= ON_N)  # each plate is loaded once in this walk
-        loaded[k] = (t[on[0]], t[on[-1] + 1])
-    heels = {"left": feet["LHEE"], "right": feet["RHEE"]}
-    toes = {"left": feet["LTOE"], "right": feet["RTOE"]}
-    return plates, tm, heels, toes, loaded
-
-
-def test_syd_left_foot_across_two_plates_is_one_contact_from_plate_2_loading_to_plate_1_unloading(syd):
-    """The left heel lands on plate 2 and the toes on plate 1 (the heel 58 mm behind plate 1's edge): one foot
-    contact, heel strike where plate 2 loads, toe-off where plate 1 unloads (not where plate 2 does, 233 ms early)."""
-    plates, tm, heels, toes, loaded = syd
-    (p1_on, p1_off), (p2_on, p2_off) = loaded[1], loaded[2]
-    np.testing.assert_allclose([p2_on, p2_off, p1_on, p1_off], [2.323, 2.700, 2.374, 2.946], atol=0.001)
-    found = foot_contacts(plates, tm, heels, toes_m=toes, source="SYD")
-    assert found[["plate", "side", "flag"]].values.tolist() == [
-        [3, "right", "ok"],
-        [2, "left", "ok"],
-        [1, "left", "ok"],
-    ]
-    assert found["foot_contact"].tolist() == [0, 1, 1]
-    assert found["left_heel_outside_m"].iloc[2] == pytest.approx(0.058, abs=0.002)  # behind plate 1, on plate 2
-    ev = contact_events(found)
-    left = ev[ev["side"] == "left"].set_index("event")["time_s"]
-    assert left.index.tolist() == ["heel_strike", "toe_off"]
-    assert abs(left["heel_strike"] - p2_on) <= 0.015 and abs(left["toe_off"] - p1_off) <= 0.015
-    np.testing.assert_allclose([left["heel_strike"], left["toe_off"]], [2.323, 2.956], atol=1e-9)
-    right = ev[ev["side"] == "right"].set_index("event")["time_s"]
-    assert abs(right["heel_strike"] - loaded[3][0]) <= 0.015 and abs(right["toe_off"] - loaded[3][1]) <= 0.015
-
-
-def test_syd_without_toe_markers_the_plate_under_the_toes_is_dropped_with_its_reason_in_the_log(syd, caplog):
-    plates, tm, heels, _, _ = syd
-    with caplog.at_level("WARNING", logger="loper_analysis.gait.contacts"):
-        found = foot_contacts(plates, tm, heels, source="SYD")
-    p1 = found[found["plate"] == 1].iloc[0]
-    assert (p1["side"], p1["flag"]) == ("", "no_foot")
-    assert (
-        p1["reason"].startswith("no foot found: no heel on the plate at 2.424 s")
-        and "left heel on plate 2" in p1["reason"]
-    )
-    said = [r.getMessage() for r in caplog.records if r.levelname == "WARNING"]
-    assert said == [
-        f"SYD: plate 1 contact 2.374-2.956 s (unknown foot) left out of the events, no_foot: {p1['reason']}"
-    ]
-    # the left foot's events are then plate 2's alone: its toe-off where plate 2 unloads, 233 ms early
-    ev = contact_events(found)
-    assert ev.loc[(ev["side"] == "left") & (ev["event"] == "toe_off"), "time_s"].tolist() == [2.723]

@@ -12,7 +12,16 @@ from loper_analysis.constants import GRAVITY_M_PER_S2
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
 from loper_analysis.io.force_platforms import ForcePlatform
-from loper_analysis.motion.body_size import MASS_LIMIT_KG, body_height_m, body_mass_kg, require_stature
+from loper_analysis.motion.body_size import (
+    HIP_HEIGHT_FRACTION,
+    MASS_LIMIT_KG,
+    body_height_m,
+    body_mass_kg,
+    model_height_m,
+    require_stature,
+    standing_mass_kg,
+)
+from loper_analysis.motion.model import build_lower_body_model
 
 MASS_KG = 70.0
 RATE_HZ, PLATE_HZ = 100.0, 1000.0
@@ -104,3 +113,24 @@ def test_a_model_a_quarter_off_the_height_is_another_subjects():
     with pytest.raises(LoperInputError, match=re.escape("(PROCESSING:Height of a.c3d; -26 %, more than 25 %)")):
         require_stature((1.80, "PROCESSING:Height of a.c3d"), 1.33, "s.osim")
     require_stature((2.10, "estimated from the scaled model"), 1.0, "s.osim")  # nothing to hold it to
+
+
+def test_standing_mass_is_the_weight_over_gravity():
+    t = np.arange(1000) / 1000.0
+    rng = np.random.default_rng(1)
+    plates = np.column_stack([0.52 * 80.0 * 9.80665 + rng.normal(0, 2, t.size), 0.48 * 80.0 * 9.80665 + 0 * t])
+    plates[:100] = 0.0  # stepping on: outside the window
+    assert standing_mass_kg(t, plates, (0.2, 0.999), 9.80665) == pytest.approx(80.0, abs=0.02)  # 2 N noise
+    with pytest.raises(
+        LoperInputError, match=r"s\.c3d: the force plates carry 0\.0 N on average .*outside 20 \.\. 300 kg"
+    ):
+        standing_mass_kg(t, plates, (0.0, 0.05), source="s.c3d")
+    with pytest.raises(LoperInputError, match=r"varies by 71 % .*does not stand still"):
+        standing_mass_kg(t, plates, (0.0, 0.3))  # a third of the window on no plate: SD over mean 0.71
+
+
+def test_height_of_the_generated_model_comes_back():
+    # Winter's proportions: the hip joint centre stands at 0.530 of the height above the metatarsal markers
+    assert HIP_HEIGHT_FRACTION == pytest.approx(0.530, abs=1e-12)
+    for height in (1.55, 1.73, 1.95):
+        assert model_height_m(build_lower_body_model(height, 70.0), "thigh_r") == pytest.approx(height, rel=1e-9)

@@ -1,14 +1,15 @@
-"""Foot contacts on force plates: contacts per plate, the foot on each, flags and the gait events.
+"""Foot contacts on force plates: the contact table of a trial, with the foot, flag and reason of each, and its
+gait events.
 
-* :func:`plate_contacts` - loaded periods of one plate from its vertical force
-  above the resting level (the hysteresis of :func:`loper_analysis.gait.events.load_transitions`);
-* :func:`foot_contacts` - the contacts of every plate, each given a foot from
-  the heel markers shortly after the contact starts, a flag
-  (:data:`loper_analysis.constants.CONTACT_FLAGS`) and, when flagged, the
-  reason in words; the contacts one foot makes on several plates at once
-  joined into one foot contact (the foot told by its heel and toe markers);
+* :func:`foot_contacts` - the contacts of every plate (:func:`loper_analysis.gait.plate_contacts.plate_contacts`), each
+  given a foot from the heel markers shortly after the contact starts, a flag
+  (:data:`loper_analysis.constants.CONTACT_FLAGS`) and, when flagged, the reason in words
+  (:func:`loper_analysis.gait.contact_flags.contact_verdict`); the contacts one foot makes on several plates at once
+  joined into one foot contact (:func:`loper_analysis.gait.foot_across_plates.join_feet`); every flagged contact logged
+  with its reason;
 * :func:`contact_events` - the event table of the clean foot contacts, with
-  the spans of the flagged ones that strides must not cross.
+  the spans of the flagged ones that strides must not cross;
+* :func:`count_flagged` - the contacts left out for a reason.
 
 Time in s, force in N, positions in m (markers and plate corners in one
 frame). ``docs/events.md`` explains the rules.
@@ -19,7 +20,6 @@ from __future__ import annotations
 import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -28,21 +28,21 @@ from loper_analysis.checks import integer, number, time_vector, where
 from loper_analysis.checks import side as check_side
 from loper_analysis.constants import CONTACT_FLAGS, FLAGGED_EVENTS, SIDES
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.contact_flags import ContactScene, contact_verdict, heel_offsets
 from loper_analysis.gait.events import (
     EVENT_COLUMNS,
     MIN_STANCE_S,
     MIN_SWING_S,
     THRESHOLD_OFF_N,
     THRESHOLD_ON_N,
-    load_transitions,
 )
-from loper_analysis.gait.plate_geometry import plate_axes, plate_offsets
+from loper_analysis.gait.foot_across_plates import join_feet
+from loper_analysis.gait.plate_contacts import plate_contacts
+from loper_analysis.gait.plate_geometry import plate_axes
 
 __all__ = [
-    "PLATE_CONTACT_COLUMNS",
     "CONTACT_COLUMNS",
     "PlateForce",
-    "plate_contacts",
     "foot_contacts",
     "contact_events",
     "count_flagged",
@@ -50,8 +50,6 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Columns of :func:`plate_contacts`.
-PLATE_CONTACT_COLUMNS: tuple[str, ...] = ("contact", "start_sample", "end_sample", "start_s", "end_s", "incomplete")
 #: Columns of :func:`foot_contacts` (the heel columns are measured at the start probe).
 CONTACT_COLUMNS: tuple[str, ...] = (
     "plate",
@@ -67,8 +65,6 @@ CONTACT_COLUMNS: tuple[str, ...] = (
     "foot_contact",
     "reason",
 )
-#: Flags of a contact no heel explains by standing on its plate: another plate's contact of the same foot may.
-_JOINABLE = {"no_foot", "off_plate"}
 #: Flags whose contact may hide either foot: they block the strides of both sides.
 _BOTH_SIDES = {"heel_missing", "two_feet", "no_foot"}
 
@@ -94,130 +90,6 @@ class PlateForce:
     time_s: np.ndarray
     vertical_force_n: np.ndarray
     corners_m: np.ndarray
-
-
-def plate_contacts(
-    time_s,
-    vertical_force_n,
-    threshold_on_n: float = THRESHOLD_ON_N,
-    threshold_off_n: float = THRESHOLD_OFF_N,
-    min_stance_s: float = MIN_STANCE_S,
-    min_swing_s: float = MIN_SWING_S,
-    source: str = "",
-) -> pd.DataFrame:
-    """Loaded periods (contacts) of one plate from its vertical force above the resting level.
-
-    A contact starts at the first sample with force ``>= threshold_on_n``
-    (the heel strike of :func:`loper_analysis.gait.events.gait_events`) and ends at
-    the first later sample with force ``<= threshold_off_n`` (the toe-off),
-    with the same hysteresis and minimum durations. A plate loaded when the
-    trial starts (or reaching the loaded state from the dead band first) gives
-    a contact from sample 0, one still loaded at the end a contact to the last
-    sample; both are ``incomplete``. A plate never loaded gives no row.
-
-    Parameters
-    ----------
-    time_s : array_like, shape (n_samples,)
-        Sample times in s, finite and strictly increasing.
-    vertical_force_n : array_like, shape (n_samples,)
-        Vertical force in N above the plate's resting level; finite.
-    threshold_on_n, threshold_off_n : float
-        Loading and unloading thresholds in N above the resting level; on > off.
-    min_stance_s, min_swing_s : float
-        Shortest accepted loaded and unloaded period in s.
-    source : str
-        Name of the trial and plate, quoted in messages.
-
-    Returns
-    -------
-    pandas.DataFrame
-        One row per contact in time order (:data:`PLATE_CONTACT_COLUMNS`):
-        ``contact`` (0, 1, ...), ``start_sample``, ``end_sample`` (int,
-        indices into ``time_s``), ``start_s``, ``end_s`` (s), ``incomplete``
-        (bool). ``attrs["dropped"]``: the periods removed as too short.
-
-    Raises
-    ------
-    LoperInputError
-        As :func:`loper_analysis.gait.events.load_transitions`.
-    """
-    t = time_vector(time_s, source)
-    samples, loading, dropped = load_transitions(
-        t, vertical_force_n, threshold_on_n, threshold_off_n, min_stance_s, min_swing_s, source
-    )
-    starts, ends = list(samples[loading]), list(samples[~loading])
-    open_start = bool(samples.size) and not loading[0]
-    if not samples.size:  # no transition left: loaded throughout or never loaded
-        open_start = _loaded_at_end(
-            np.asarray(vertical_force_n, dtype=float), float(threshold_on_n), float(threshold_off_n)
-        )
-    if open_start:
-        starts.insert(0, 0)
-    open_end = len(starts) > len(ends)
-    if open_end:
-        ends.append(t.size - 1)
-    start = np.asarray(starts, dtype=np.int64)
-    end = np.asarray(ends, dtype=np.int64)
-    incomplete = np.zeros(start.size, dtype=bool)
-    if start.size:
-        incomplete[0] |= open_start
-        incomplete[-1] |= open_end
-    table = pd.DataFrame(
-        {
-            "contact": np.arange(start.size, dtype=np.int64),
-            "start_sample": start,
-            "end_sample": end,
-            "start_s": t[start],
-            "end_s": t[end],
-            "incomplete": incomplete,
-        },
-        columns=list(PLATE_CONTACT_COLUMNS),
-    )
-    table.attrs["dropped"] = dropped
-    return table
-
-
-def _loaded_at_end(f: np.ndarray, on: float, off: float) -> bool:
-    """Whether the hysteresis ends loaded: the force last reached ``on`` after it last fell to ``off``."""
-    high, low = np.flatnonzero(f >= on), np.flatnonzero(f <= off)
-    return bool(high.size) and (not low.size or high[-1] > low[-1])
-
-
-def _at(time_s: np.ndarray, xyz: np.ndarray, when: np.ndarray) -> np.ndarray:
-    """Positions (k, 3) at the times ``when`` (k,), linear between frames; NaN outside the frames or next to a gap."""
-    when = np.asarray(when, dtype=float)
-    j = np.clip(np.searchsorted(time_s, when, side="right") - 1, 0, time_s.size - 2)
-    w = ((when - time_s[j]) / (time_s[j + 1] - time_s[j]))[:, None]
-    out = np.where(w == 0.0, xyz[j], (1.0 - w) * xyz[j] + w * xyz[j + 1])  # a frame time needs only its frame
-    out[(when < time_s[0]) | (when > time_s[-1])] = np.nan
-    return out
-
-
-def _longest_run_s(times: np.ndarray, mask: np.ndarray) -> float:
-    """Longest time span (s) of consecutive True samples; -inf without any."""
-    if not mask.any():
-        return -np.inf
-    edges = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
-    first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
-    return float(np.max(times[last] - times[first]))
-
-
-def _standing_run(times: np.ndarray, on: np.ndarray, above: np.ndarray, max_height_m: float) -> tuple[float, float]:
-    """Longest unbroken stay (start, end in s) of a heel on a plate, leaving out the stays that end with the heel
-    still low but off the plate: a swing heel passing low over the plate and coming down beside its edge.
-
-    ``times`` (s), ``on`` (bool) and ``above`` (m above the surface) per sample of the window; (nan, nan) without
-    any stay.
-    """
-    edges = np.diff(np.concatenate([[0], on.astype(np.int8), [0]]))
-    first, last = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1) - 1
-    best = (np.nan, np.nan)
-    for a, b in zip(first, last):
-        if b + 1 < on.size and above[b + 1] <= max_height_m:  # left the outline, not the ground: it lands off it
-            continue
-        if not times[b] - times[a] <= best[1] - best[0]:
-            best = (float(times[a]), float(times[b]))
-    return best
 
 
 def foot_contacts(
@@ -302,7 +174,7 @@ def foot_contacts(
         ``{"left": plate, "right": plate}``: the plate (belt) each foot should
         use. Only a check (``wrong_belt``); the foot always comes from the markers.
     threshold_on_n, threshold_off_n, min_stance_s, min_swing_s : float
-        Contact detection (:func:`plate_contacts`), N above the resting level and s.
+        Contact detection (:func:`loper_analysis.gait.plate_contacts.plate_contacts`), N above the resting level and s.
     delay_s : float
         Time after the contact's start (before its end) at which the window opens (closes), s.
     dwell_s : float
@@ -360,7 +232,7 @@ def foot_contacts(
     corners = [np.asarray(p.corners_m, dtype=float) for p in plates]
     for name, c in zip(names, corners):
         plate_axes(c, vertical_axis, name, up)
-    scene = _Scene(tm, heels, toes, corners, numbers, vertical_axis, up, delay, dwell, margin, reach, height)
+    scene = ContactScene(tm, heels, toes, corners, numbers, vertical_axis, up, delay, dwell, margin, reach, height)
 
     rows = []
     for k, (plate, name) in enumerate(zip(plates, names)):
@@ -375,169 +247,21 @@ def foot_contacts(
         )
         for c in found.itertuples():
             rows.append(_contact_row(c, k, numbers[k], belt, scene))
-    return _contact_table(_join_feet(rows, scene), source)
+    return _contact_table(join_feet(rows, scene), source)
 
 
-class _Scene(NamedTuple):
-    """What the contacts of a trial are judged against (:func:`foot_contacts`).
-
-    ``marker_time_s`` (n_frames,) in s; ``heels_m``, ``toes_m`` (or None): ``{side: (n_frames, 3)}`` in m;
-    ``corners_m``: per plate its corners (4, 3) in m, ``numbers`` its number; ``vertical_axis`` and ``up``: the
-    vertical; the checked probe delay and dwell time (s), margin, reach and highest heel (m).
-    """
-
-    marker_time_s: np.ndarray
-    heels_m: dict[str, np.ndarray]
-    toes_m: dict[str, np.ndarray] | None
-    corners_m: list[np.ndarray]
-    numbers: list[int]
-    vertical_axis: int | None
-    up: Sequence[float] | None
-    delay_s: float
-    dwell_s: float
-    margin_m: float
-    reach_m: float
-    max_height_m: float
-
-
-def _on(scene: _Scene, outside: np.ndarray, above: np.ndarray) -> np.ndarray:
-    """Whether heels at ``outside`` (m outside the outline) and ``above`` (m above the surface) are on the plate."""
-    return (outside <= scene.margin_m) & (above <= scene.max_height_m)  # NaN: False
-
-
-def _heel_offsets(scene: _Scene, k: int, times: np.ndarray) -> dict[str, dict]:
-    """Per side the heel over plate ``k`` at the window's ``times`` (s).
-
-    ``window``: ``(outside, above)`` (m, each (n_times,)); ``start_on``: on the plate at the start probe;
-    ``missing`` (n_times,): NaN heel; ``on_all`` (n_plates,): on each plate at the start probe; ``elsewhere``
-    (n_times,): inside another plate's outline, outside this one's (it stands on that plate).
-    """
-    start_on, on_all, missing, window, elsewhere = {}, {}, {}, {}, {}
-    for s in SIDES:
-        xyz = _at(scene.marker_time_s, scene.heels_m[s], times)
-        out, above = plate_offsets(xyz, scene.corners_m[k], scene.vertical_axis, up=scene.up)
-        window[s] = (out, above)
-        start_on[s] = _on(scene, out[:1], above[:1])[0]
-        missing[s] = np.isnan(out)
-        # on every plate at the start probe: (n_plates,) outside, height
-        on_all[s] = np.array(
-            [_on(scene, *plate_offsets(xyz[:1], cc, scene.vertical_axis, up=scene.up))[0] for cc in scene.corners_m]
-        )
-        inside = np.zeros(out.shape, dtype=bool)
-        for j, cc in enumerate(scene.corners_m):
-            if j != k:
-                inside |= plate_offsets(xyz, cc, scene.vertical_axis, up=scene.up)[0] == 0
-        elsewhere[s] = inside & (out > 0)
-    return {"window": window, "start_on": start_on, "missing": missing, "on_all": on_all, "elsewhere": elsewhere}
-
-
-class _Verdict(NamedTuple):
-    """A contact's foot (``""`` if unknown or ambiguous), flag (:data:`CONTACT_FLAGS`), reason in words (``""``
-    for ``ok``) and the heels on its plate (at the start probe or dwelling)."""
-
-    side: str
-    flag: str
-    reason: str
-    present: frozenset
-
-
-def _side_and_flag(
-    c,
-    k: int,
-    times: np.ndarray,
-    need: float,
-    heels: Mapping[str, dict],
-    belt_side: str | None,
-    scene: _Scene,
-) -> _Verdict:
-    """The verdict on contact ``c`` (a row of :func:`plate_contacts`) of plate ``k``.
-
-    ``times`` (s): the window's probes and frames; ``need`` (s): the unbroken time on the plate that makes a
-    heel dwell; ``heels``: :func:`_heel_offsets`; ``belt_side``: the side ``plate_sides`` gives the plate (None).
-    """
-    window, start_on, missing, on_all = heels["window"], heels["start_on"], heels["missing"], heels["on_all"]
-    elsewhere = heels["elsewhere"]
-    probe, height = times[0], scene.max_height_m
-    at_start = [s for s in SIDES if start_on[s]]
-    side = at_start[0] if len(at_start) == 1 else ""
-    others = [s for s in SIDES if s != side]
-    # another heel stands on this plate: on it, not inside another plate's outline
-    stays = {s: _standing_run(times, _on(scene, *window[s]) & ~elsewhere[s], window[s][1], height) for s in others}
-    dwells = {s for s in others if stays[s][1] - stays[s][0] >= need}
-    undecided = [
-        s
-        for s in others
-        if s not in dwells and missing[s].any() and _longest_run_s(times, _on(scene, *window[s]) | missing[s]) >= need
-    ]
-    present = frozenset(at_start) | dwells
-    if c.incomplete:
-        when = "the start" if c.start_sample == 0 else "the end"
-        return _Verdict(side, "incomplete", f"the plate is loaded at {when} of the recording", present)
-    gone = [s for s in SIDES if missing[s][0]]
-    if gone or undecided:
-        said = (
-            f"the {' and '.join(gone)} heel marker missing at {probe:.3f} s, where the foot is decided"
-            if gone
-            else f"the {undecided[0]} heel marker missing while it may stand on the plate"
-        )
-        return _Verdict(side, "heel_missing", said, present)
-    if len(present) == 2:
-        if len(at_start) == 2:
-            said = f"two feet on one plate: both heels on it at {probe:.3f} s"
-        else:
-            s = next(iter(dwells))
-            said = (
-                f"two feet on one plate: the {s} heel stands on it from {stays[s][0]:.3f} to {stays[s][1]:.3f} s "
-                f"while the {side} foot is on it"
-            )
-        return _Verdict(side, "two_feet", said, present)
-    if not at_start:
-        # low heels near this plate that stand on no other plate
-        near = {
-            s: window[s][0][0]
-            for s in SIDES
-            if window[s][0][0] <= scene.reach_m and window[s][1][0] <= height and not np.delete(on_all[s], k).any()
-        }
-        if not near:
-            elsewhere = [
-                f"the {s} heel on plate {scene.numbers[j]}" for s in SIDES for j in np.flatnonzero(on_all[s]) if j != k
-            ]
-            said = (
-                f"no foot found: no heel on the plate at {probe:.3f} s, and none low within "
-                f"{scene.reach_m * 1000:.0f} mm of it that stands on no other plate"
-                + (f" ({', '.join(elsewhere)})" if elsewhere else "")
-            )
-            return _Verdict("", "no_foot", said, present)
-        side = min(near, key=near.get)
-        if present - {side}:
-            s = next(iter(present - {side}))
-            said = (
-                f"two feet on one plate: the {s} heel stands on it from {stays[s][0]:.3f} to {stays[s][1]:.3f} s, "
-                f"the {side} heel {near[side] * 1000:.0f} mm off its edge at {probe:.3f} s"
-            )
-            return _Verdict("", "two_feet", said, present)
-        said = (
-            f"heel off the plate's edge: the {side} heel {near[side] * 1000:.0f} mm off it at {probe:.3f} s; the "
-            "foot loaded the plate without its heel, so the loading is not a heel strike"
-        )
-        return _Verdict(side, "off_plate", said, present)
-    if (side if belt_side is None else belt_side) != side:
-        said = f"the {side} foot on the {belt_side} foot's plate (events.plate_sides)"
-        return _Verdict(side, "wrong_belt", said, present)
-    return _Verdict(side, "ok", "", present)
-
-
-def _contact_row(c, k: int, number: int, belt: Mapping[int, str], scene: _Scene) -> dict:
-    """The row (:data:`CONTACT_COLUMNS`) of contact ``c`` (a row of :func:`plate_contacts`) of plate ``k``,
-    numbered ``number``; ``belt``: ``{plate number: side}``. The keys ``_k``, ``_probe`` (s) and ``_present``
-    (the heels on the plate) serve :func:`_join_feet`."""
+def _contact_row(c, k: int, number: int, belt: Mapping[int, str], scene: ContactScene) -> dict:
+    """The row (:data:`CONTACT_COLUMNS`) of contact ``c`` (a row of
+    :func:`loper_analysis.gait.plate_contacts.plate_contacts`) of plate ``k``, numbered ``number``; ``belt``:
+    ``{plate number: side}``. The keys ``_k``, ``_probe`` (s) and ``_present`` (the heels on the plate) serve
+    :func:`loper_analysis.gait.foot_across_plates.join_feet`."""
     mid = 0.5 * (c.start_s + c.end_s)
     ps, pe = min(c.start_s + scene.delay_s, mid), max(c.end_s - scene.delay_s, mid)
     tm = scene.marker_time_s
     times = np.concatenate([[ps], tm[(tm > ps) & (tm < pe)], [pe] if pe > ps else []])
     need = min(scene.dwell_s, pe - ps)
-    heels = _heel_offsets(scene, k, times)
-    verdict = _side_and_flag(c, k, times, need, heels, belt.get(number), scene)
+    heels = heel_offsets(scene, k, times)
+    verdict = contact_verdict(c, k, times, need, heels, belt.get(number), scene)
     window = heels["window"]
     return {
         "plate": number,
@@ -556,55 +280,6 @@ def _contact_row(c, k: int, number: int, belt: Mapping[int, str], scene: _Scene)
         "_probe": ps,
         "_present": verdict.present,
     }
-
-
-def _foot_on(scene: _Scene, side: str, k: int, when: float) -> bool:
-    """Whether the toe or the heel of ``side`` is on plate ``k`` at ``when`` (s); False without toe markers."""
-    if scene.toes_m is None:
-        return False
-    xyz = np.vstack([_at(scene.marker_time_s, m[side], np.array([when])) for m in (scene.toes_m, scene.heels_m)])
-    return bool(_on(scene, *plate_offsets(xyz, scene.corners_m[k], scene.vertical_axis, up=scene.up)).any())
-
-
-def _overlap(a: dict, b: dict) -> bool:
-    """Whether contacts ``a`` and ``b`` (rows) are loaded at once, on different plates."""
-    return a["plate"] != b["plate"] and a["start_s"] < b["end_s"] and b["start_s"] < a["end_s"]
-
-
-def _join_feet(rows: list[dict], scene: _Scene) -> list[dict]:
-    """The rows with the contacts of one foot on several plates joined (:func:`foot_contacts`): a ``no_foot`` or
-    ``off_plate`` contact made ``ok`` for the foot whose heel stands on an overlapping ``ok`` contact's plate and
-    whose toe (or heel) is on this plate at its start probe, the other foot not on it; ``foot_contact`` set."""
-    for b in rows:
-        if b["flag"] not in _JOINABLE:
-            continue
-        feet = [
-            s
-            for s in SIDES
-            if any(a["flag"] == "ok" and a["side"] == s and _overlap(a, b) for a in rows)
-            and _foot_on(scene, s, b["_k"], b["_probe"])
-        ]
-        if len(feet) != 1:
-            continue
-        other = next(s for s in SIDES if s != feet[0])
-        if other in b["_present"] or _foot_on(scene, other, b["_k"], b["_probe"]):
-            continue
-        b.update(side=feet[0], flag="ok", reason="")
-    # one foot contact: the ok contacts of one foot loaded at once (union-find over the rows)
-    root = list(range(len(rows)))
-
-    def find(i: int) -> int:
-        while root[i] != i:
-            i = root[i]
-        return i
-
-    for i, a in enumerate(rows):
-        for j, b in enumerate(rows[:i]):
-            if a["flag"] == b["flag"] == "ok" and a["side"] == b["side"] and _overlap(a, b):
-                root[find(i)] = find(j)
-    for i, r in enumerate(rows):
-        r["_group"] = find(i)
-    return rows
 
 
 def _contact_table(rows: Sequence[dict], source: str) -> pd.DataFrame:

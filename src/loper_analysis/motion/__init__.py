@@ -6,6 +6,7 @@
 * :mod:`.filtering` - zero-phase low-pass filters (markers and forces);
 * :mod:`.plausibility` - body lengths and IK marker errors a good recording can have;
 * :mod:`.model`, :mod:`.static_trial` - the generic OpenSim model and the static trial scaling uses;
+* :mod:`.still_window`, :mod:`.body_size` - the static trial's stillest window; the subject's mass and height;
 * :mod:`.segments` - the swing-leg segment table from any scaled OpenSim model;
 * :mod:`.ik`, :mod:`.ik_determinacy` - inverse kinematics through OpenSim and which coordinates markers determine.
 """

@@ -7,6 +7,7 @@ prefix (everything up to the last ``:``) and then renames labels through the
 ``markers.label_map`` configuration ({lab label: model marker}); labels the
 map does not name keep their stripped name. :func:`require_model_markers`
 refuses a trial in which no label provides a model marker the analysis needs.
+:func:`with_lab_label` names a model marker with the lab label that provides it, in messages.
 
 Labels with inner spaces (BTS exports ``r heel``) are read, renamed and
 written to the TRC as they are; a map key may hold them (``r heel: RHEE``).
@@ -28,6 +29,7 @@ __all__ = [
     "require_model_markers",
     "strip_subject_prefix",
     "unknown_markers_hint",
+    "with_lab_label",
 ]
 
 #: Configuration field of the label map (named in messages).
@@ -164,3 +166,9 @@ def unknown_markers_hint(
         f"; the trial's marker(s) {', '.join(shown)} are not on the model: a typo in the label map "
         "(markers.label_map, markers.trial_label_maps)?"
     )
+
+
+def with_lab_label(marker: str, lab_labels: Mapping[str, str] | None) -> str:
+    """A model marker with the lab label that provides it: ``'RKNE' (model marker R.Knee)``."""
+    label = (lab_labels or {}).get(marker)
+    return f"'{label}' (model marker {marker})" if label and label != marker else f"'{marker}'"

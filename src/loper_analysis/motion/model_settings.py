@@ -35,7 +35,7 @@ class ModelSettings:
         static trial's force plates (``markers.lab_to_model_rotation_deg``).
     static_duration_s : float or None
         Without a time range (``time_range_s``, the scale setup's): the stillest this many seconds of the static
-        trial are averaged, s (:func:`loper_analysis.motion.static_trial.stillest_window_s`); None: the whole trial
+        trial are averaged, s (:func:`loper_analysis.motion.still_window.stillest_window_s`); None: the whole trial
         (``markers.static_duration_s``).
     max_motion_rms_m : float or None
         Largest RMS motion of a marker over the window, m: a subject who does not stand still is refused; None:
