@@ -73,10 +73,10 @@ CHANGES = {
 READERS = {
     "raw_dir": (
         "all device_frf device_log_from_mat device_steps device_trial events events_loadcell grf "
-        "impedance_fit markers synthetic_lab synthetic_truth"
+        "impedance_fit markers model_scaled synthetic_lab synthetic_truth"
     ),
     "seed": "device_trial front_page impedance_fit synthetic_lab synthetic_truth validation_chunk",
-    "trials.static": "markers model_scaled synthetic_lab",
+    "trials.static": "ik markers model_scaled synthetic_lab",
     "trials.no_device": "all events events_loadcell front_page strides strides_summary synthetic_lab transparency",
     "trials.device": "all front_page impedance_fit planning strides_summary synthetic_lab transparency",
     "trials.perturbation_onsets_ms": (

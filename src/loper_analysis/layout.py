@@ -294,6 +294,10 @@ class Study:
             return []
         return [fill(self.paths.raw.c3d, subject=subject, trial=self.design.static)]
 
+    def static_c3d_for_scaling(self, subject: str) -> list[str]:
+        """The static trial's C3D, read for the lab's stored widths (and the mass and height the sheet lacks)."""
+        return [fill(self.paths.raw.c3d, subject=subject, trial=self.design.static)]
+
     def robot_log(self, subject: str, trial: str) -> str:
         """A trial's robot log: the raw ``{trial}.loper.tsv``, or converted from a recorded ``{trial}.mat``."""
         raw = fill(self.paths.raw.robot_log, subject=subject, trial=trial)

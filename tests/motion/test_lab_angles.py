@@ -84,3 +84,19 @@ def test_a_comparison_left_out_says_why(caplog):
     assert "(the lab's file lacks them): hip_left" in caplog.text
     assert "knee_left not compared with the lab's own angle: 5 frame(s) in common, fewer than 10" in caplog.text
     assert np.isnan(table.loc[0, "r"])
+
+
+def test_a_constant_offset_at_the_hip_or_knee_is_warned_about_before_the_rms_limit():
+    """Ours = the lab's + a constant: 6.5 degrees at the knee is warned about (r 1, RMS 6.5 < 10), 5.5 is not; the
+    ankle's offset alone is not judged (Plug-in Gait's tibial torsion and foot options move it)."""
+    t = np.arange(100) / 100.0
+    lab = pd.DataFrame({"time_s": t, "knee_left_rad": 0.6 * np.sin(2 * np.pi * t) + 0.5})
+    lab["ankle_left_rad"] = lab["knee_left_rad"] / 3.0
+    for offset_deg, warned in ((6.5, True), (5.5, False)):
+        ours = lab.copy()
+        ours["knee_left_rad"] += np.radians(offset_deg)
+        ours["ankle_left_rad"] += np.radians(offset_deg)
+        table = lab_agreement(ours, lab).set_index("angle")
+        assert table.loc["knee_left", "rms_diff_rad"] == pytest.approx(np.radians(offset_deg))
+        assert ("mean offset" in table.loc["knee_left", "warning"]) is warned
+        assert table.loc["ankle_left", "warning"] == ""

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import re
 
+import numpy as np
 import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.ik_tasks import read_ik_tasks
-from loper_analysis.io.marker_templates import TEMPLATE_DIR
+from loper_analysis.io.marker_templates import TEMPLATE_DIR, template_file
+from loper_analysis.io.osim import read_model
 from loper_analysis.motion.marker_templates import (
     derived_markers,
     template_fit,
@@ -44,7 +46,10 @@ def test_sided_markers_are_expanded_and_the_left_mirrored(pig, spec):
         assert right.role == left.role == role
     assert pig.marker("RASI").location_m == (0.020, 0.030, 0.128) and pig.marker("LKNE").body == "femur_l"
     assert pig.marker("SACR").location_m == (-0.160, 0.040, 0.000)
-    assert pig.measurements["femur"] == ((("RASI", "RKNE"), ("LASI", "LKNE")), ("femur_r", "femur_l"))
+    assert pig.measurements["femur"] == (
+        (("RHJC", "RKJC"), ("LHJC", "LKJC"), ("RASI", "RKNE"), ("LASI", "LKNE")),
+        ("femur_r", "femur_l"),
+    )
     assert pig.weights == {"anatomical": 10.0, "technical": 1.0}
     assert pig.foot_markers == {"left": "LHEE", "right": "RHEE"} and pig.side_prefix == {"left": "L", "right": "R"}
 
@@ -132,3 +137,74 @@ def test_the_scale_tool_uses_the_pairs_present(pig):
     assert weights["LTHI"] == 1.0 and weights["RASI"] == 10.0 and weights["CLAV"] == 1.0
     assert weights["subtalar_angle_r"] == 1000.0 and "LTOE" not in weights
     assert len(weights) == len(present) + 4
+
+
+def test_with_the_model_the_centres_are_the_models_joints_and_every_other_marker_moves(pig):
+    """The calibration's virtual markers sit at gait2392's own joints (the hip's place in the pelvis as the model
+    file writes it, the knee's at zero flexion, the ankle's), the pelvis's 0.1 m forward of the hips along the
+    template's spines, each foot's 0.1 m above the ankle; they alone are fixed."""
+    model = read_model(template_file(pig.model))
+    present = [*PIG_LABELS, "CLAV"]
+    ms = template_marker_set(pig, present, model)
+    got = {ms.get(i).getName(): ms.get(i) for i in range(ms.getSize())}
+    assert set(got) == set(present) | {
+        "LHJC",
+        "RHJC",
+        "LKJC",
+        "RKJC",
+        "LAJC",
+        "RAJC",
+        "PELVIS_FWD",
+        "LFOOT_UP",
+        "RFOOT_UP",
+    }
+
+    def place(name):
+        loc = got[name].get_location()
+        return got[name].getParentFrameName(), np.array([loc.get(0), loc.get(1), loc.get(2)])
+
+    frame, hip = place("RHJC")
+    assert frame == "/bodyset/pelvis"
+    np.testing.assert_allclose(hip, [-0.0707, -0.0661, 0.0835], atol=1e-12)  # hip_r's location in the pelvis
+    frame, knee = place("LKJC")
+    assert frame == "/bodyset/femur_l"
+    np.testing.assert_allclose(knee, [-0.0045, -0.3958, 0.0], atol=1e-4)  # knee_l's translation at 0 flexion
+    assert place("LAJC")[0] == "/bodyset/tibia_l"
+    np.testing.assert_allclose(place("LAJC")[1], [0.0, -0.43, 0.0], atol=1e-12)  # ankle_l's location in tibia_l
+    frame, forward = place("PELVIS_FWD")
+    assert frame == "/bodyset/pelvis"
+    spines = np.array(pig.marker("LASI").location_m) - np.array(pig.marker("LPSI").location_m)
+    spines[2] = 0.0
+    np.testing.assert_allclose(forward - [-0.0707, -0.0661, 0.0], 0.1 * spines / np.linalg.norm(spines), atol=1e-12)
+    frame, up = place("RFOOT_UP")
+    assert frame == "/bodyset/talus_r"
+    np.testing.assert_allclose(up, [0.0, 0.1, 0.0], atol=1e-12)  # gait2392's talus stands upright at 0
+    assert {n for n, m in got.items() if m.get_fixed()} == {
+        "LHJC",
+        "RHJC",
+        "LKJC",
+        "RKJC",
+        "LAJC",
+        "RAJC",
+        "PELVIS_FWD",
+        "LFOOT_UP",
+        "RFOOT_UP",
+    }
+
+
+def test_with_the_centres_present_the_scale_tool_measures_between_them(pig):
+    tool = template_scale_tool(pig, [*PIG_LABELS, "CLAV"], "marker_set.xml")
+    measurements = tool.getModelScaler().getMeasurementSet()
+    pairs = {}
+    for i in range(measurements.getSize()):
+        ps = measurements.get(i).getMarkerPairSet()
+        pairs[measurements.get(i).getName()] = [
+            (ps.get(k).getMarkerName(0), ps.get(k).getMarkerName(1)) for k in range(ps.getSize())
+        ]
+    assert pairs["pelvis"] == [("RHJC", "LHJC")]
+    assert pairs["femur"] == [("RHJC", "RKJC"), ("LHJC", "LKJC")]
+    assert pairs["tibia"] == [("RKJC", "RAJC"), ("LKJC", "LAJC")]
+    assert pairs["foot"] == [("RHEE", "RTOE"), ("LHEE", "LTOE")]
+    tasks = tool.getMarkerPlacer().getIKTaskSet()
+    weights = {tasks.get(i).getName(): tasks.get(i).getWeight() for i in range(tasks.getSize())}
+    assert weights["RKJC"] == weights["PELVIS_FWD"] == weights["LFOOT_UP"] == 1000.0 and weights["RASI"] == 10.0

@@ -15,15 +15,18 @@ from loper_analysis.motion.scale_report import (
 )
 
 
-def test_a_static_pose_beyond_15_degrees_and_one_away_from_the_lab_are_warned_about():
-    pose = {"hip_left": np.radians(-22.0), "knee_left": np.radians(12.0), "ankle_left": np.radians(3.0)}
-    lab = {"hip_left": np.radians(0.0), "knee_left": np.radians(-8.0), "ankle_left": np.radians(1.0)}
+def test_a_static_pose_beyond_its_joints_limit_and_one_away_from_the_lab_are_warned_about():
+    """Hip beyond 40 degrees, knee beyond 25, ankle beyond 15; hip and knee 5 degrees from the lab's, ankle 10."""
+    pose = {"hip_left": np.radians(-42.0), "knee_left": np.radians(12.0), "ankle_left": np.radians(16.0)}
+    lab = {"hip_left": np.radians(-38.0), "knee_left": np.radians(6.5), "ankle_left": np.radians(7.0)}
     warnings = dict(static_pose_warnings(pose, lab))
-    assert sorted(warnings) == ["static_pose_hip_left", "static_pose_hip_left_lab", "static_pose_knee_left_lab"]
-    assert "hip_left -22.0 deg, beyond +-15 deg" in warnings["static_pose_hip_left"]
-    assert "offset of +20.0 deg" in warnings["static_pose_knee_left_lab"]
+    assert sorted(warnings) == ["static_pose_ankle_left", "static_pose_hip_left", "static_pose_knee_left_lab"]
+    assert "hip_left -42.0 deg, beyond +-40 deg" in warnings["static_pose_hip_left"]
+    assert "ankle_left +16.0 deg, beyond +-15 deg" in warnings["static_pose_ankle_left"]
+    assert "offset of +5.5 deg" in warnings["static_pose_knee_left_lab"]
     assert "opensim.scale_setup" in warnings["static_pose_hip_left"]
-    assert static_pose_warnings({"knee_right": np.radians(14.9)}) == []
+    assert static_pose_warnings({"knee_right": np.radians(24.9), "hip_right": np.radians(39.9)}) == []
+    assert static_pose_warnings({"knee_right": np.radians(4.0)}, {"knee_right": np.radians(-0.9)}) == []
 
 
 def test_neighbouring_factors_more_than_20_percent_apart_are_warned_about():

@@ -36,7 +36,7 @@ rule model_scaled:
         static=fill(PATHS.markers.trc, trial=DESIGN.static),
         static_summary=fill(PATHS.markers.summary, trial=DESIGN.static),
         static_lab_angles=fill(PATHS.markers.lab_angles, trial=DESIGN.static),
-        static_c3d=by_subject(STUDY.static_c3d_for_mass),
+        static_c3d=by_subject(STUDY.static_c3d_for_scaling),
         setup=[OPENSIM["scale_setup"]] if OPENSIM["scale_setup"] else [],
     output:
         model=PATHS.model.scaled,
@@ -55,7 +55,7 @@ rule model_scaled:
         "model"
     params:
         **settings_params(MODEL_SETTINGS.for_scaling()),
-        **raw_checksums(by_subject(STUDY.static_c3d_for_mass)),
+        **raw_checksums(by_subject(STUDY.static_c3d_for_scaling)),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
         scale_setup=OPENSIM["scale_setup"],

@@ -29,6 +29,7 @@ from loper_analysis.errors import LoperInputError
 __all__ = [
     "LAB_AGREEMENT_COLUMNS",
     "LAB_ANGLE_STEMS",
+    "MAX_LAB_OFFSET_RAD",
     "MAX_LAB_RMS_RAD",
     "MIN_LAB_EXCURSION_RAD",
     "MIN_LAB_R",
@@ -52,6 +53,11 @@ LAB_ANGLE_STEMS: dict[str, str] = {
 MIN_LAB_R: float = 0.9
 #: Above this RMS difference from the lab's angle (rad; 10 degrees) a joint is warned about.
 MAX_LAB_RMS_RAD: float = float(np.radians(10.0))
+#: Beyond this mean offset from the lab's angle at the hip or knee (rad; 6 degrees) a joint is warned about: a
+#: calibration that bends the static pose shows as a constant offset long before the RMS limit. Seven clinical labs'
+#: walks through the joint-centre calibration stay within 4.3 degrees of their own Plug-in Gait (a calibration on the
+#: template's marker places gave 6 to 15 degrees).
+MAX_LAB_OFFSET_RAD: float = float(np.radians(6.0))
 #: The correlation is judged only where the lab's angle moves at least this much (rad; 10 degrees, max - min):
 #: the pelvis tilts by 2-4 degrees in walking, where r says more about noise than about agreement.
 MIN_LAB_EXCURSION_RAD: float = float(np.radians(10.0))
@@ -164,7 +170,7 @@ def lab_agreement(ours: pd.DataFrame, lab: pd.DataFrame, min_frames: int = 10) -
     pandas.DataFrame
         One row per angle both tables hold, columns :data:`LAB_AGREEMENT_COLUMNS`: ``r`` (Pearson),
         ``rms_diff_rad`` and ``mean_offset_rad`` (ours minus the lab's), ``warning`` ('' when within
-        :data:`MIN_LAB_R` and :data:`MAX_LAB_RMS_RAD`).
+        :data:`MIN_LAB_R`, :data:`MAX_LAB_RMS_RAD` and, at the hip and knee, :data:`MAX_LAB_OFFSET_RAD`).
     """
     missing = [c.removesuffix("_rad") for c in ours.columns if c.endswith("_rad") and c not in lab.columns]
     if missing and len(missing) == sum(c.endswith("_rad") for c in ours.columns):
@@ -216,6 +222,14 @@ def lab_agreement_warnings(
             problems.append(
                 f"RMS difference {np.degrees(row.rms_diff_rad):.1f} deg > {np.degrees(max_rms_rad):.0f} deg "
                 f"(mean offset {np.degrees(row.mean_offset_rad):+.1f} deg)"
+            )
+        offset = row.mean_offset_rad
+        joint = str(row.angle).split("_")[0]
+        if joint in ("hip", "knee") and np.isfinite(offset) and abs(offset) > MAX_LAB_OFFSET_RAD:
+            problems.append(
+                f"mean offset {np.degrees(offset):+.1f} deg from the lab's own beyond "
+                f"{np.degrees(MAX_LAB_OFFSET_RAD):.0f} deg: the static trial's calibration (the joint centres' "
+                "landmarks in markers.label_map, the lab's widths) or another joint-centre method than the lab's"
             )
         if moves and row.r < 0:
             problems.append("anticorrelated: a sign (opensim.coordinate_map) or swapped sides (markers.label_map)?")

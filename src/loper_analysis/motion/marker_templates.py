@@ -4,13 +4,16 @@ scaling and inverse kinematics need.
 A template (``src/loper_analysis/templates/*.yaml``, read by :mod:`loper_analysis.io.marker_templates`)
 gives, for one marker set on one model:
 
-* each marker's body and location in the body's frame (m; right side, the left mirrored) and its role:
-  *anatomical* markers sit on a bony landmark and keep their place when the marker placer fits the
-  static pose; *technical* ones (wands, clusters, trunk) are moved onto the static trial;
-* the measurements that scale each body (marker pairs), the marker weights of each role, the
-  coordinates held by tasks (subtalar and mtp), the heel markers that assign force-plate contacts to
-  feet, the coordinates of our joint angles and the marker groups a file must hold for the template
-  to fit.
+* each marker's body and location in the body's frame (m; right side, the left mirrored) and its role
+  (*anatomical*: a bony landmark; *technical*: wands, clusters, trunk), which sets its weight;
+* the subject calibration through joint centres (``joint_centres``): virtual markers at the model's hip, knee
+  and ankle centres and a direction marker for the pelvis and each foot
+  (:func:`~loper_analysis.motion.centre_markers.joint_centre_places`), matched to
+  the centres the static trial's markers give (:mod:`loper_analysis.motion.joint_centres`);
+* the measurements that scale each body (marker pairs: between joint centres where the static trial gives them),
+  the marker weights of each role, the coordinates held by tasks (subtalar and mtp), the heel markers that assign
+  force-plate contacts to feet, the coordinates of our joint angles and the marker groups a file must hold for the
+  template to fit.
 
 From a template and a subject's labels this module builds the OpenSim objects: the marker set of the
 markers present (:func:`template_marker_set`), a ScaleTool whose measurements use the pairs present and
@@ -19,10 +22,13 @@ walking trials' markers (:func:`template_ik_tasks`) and the coordinate map with 
 kinematics need (:func:`template_coordinate_map`). :func:`template_fit` tells how well a file's labels
 fit a template.
 
-Keeping the anatomical markers where the template puts them matters: a marker placer that moves every
-marker onto the static trial solves the static pose with the generic markers first, and any error of
-that pose (a hip at -22 degrees, a hyperextended knee) is built into the model as a constant offset of
-every joint angle afterwards, while the IK marker error even drops.
+Why joint centres: the template's places of the anatomical markers are gait2392's, not the subject's. A static
+pose fitted to them bends the joints to reconcile the two (a knee flexed by 10 degrees more than the lab's own
+Plug-in Gait gives), and moving the markers onto the static trial afterwards builds that bend into every walking
+angle. Fitted through the centres instead (segment lengths from the distances between centres, the pose from the
+centres and the two direction markers), the static pose is the subject's, and every marker, anatomical ones
+included, is then moved to where the static trial has it. Without the centres' landmarks the static pose is fitted
+to the template's places, anatomical markers kept there.
 """
 
 from __future__ import annotations
@@ -34,6 +40,13 @@ import pandas as pd
 
 from loper_analysis.constants import SIDE_SUFFIX, SIDES
 from loper_analysis.errors import LoperInputError
+from loper_analysis.motion.centre_markers import (
+    JointCentreSpec,
+    calibration_centres,
+    centre_names,
+    joint_centre_places,
+    joint_centre_spec,
+)
 from loper_analysis.motion.label_matching import LabelMatch, match_labels
 
 __all__ = [
@@ -96,6 +109,9 @@ class MarkerTemplate:
         side suffix).
     fallback_measurement : dict
         Measurement -> the measurement whose factor it takes when none of its pairs is present.
+    joint_centres : JointCentreSpec, optional
+        The subject calibration through joint centres; None: the static pose is fitted with the markers at the
+        template's places, anatomical ones kept there.
     """
 
     name: str
@@ -110,6 +126,7 @@ class MarkerTemplate:
     foot_markers: dict[str, str]
     coordinates: dict[str, str]
     fallback_measurement: dict[str, str]
+    joint_centres: JointCentreSpec | None = None
 
     @property
     def marker_names(self) -> list[str]:
@@ -169,10 +186,11 @@ def template_from_spec(name: str, spec: Mapping, source: str) -> MarkerTemplate:
             foot_markers={side: str(spec["foot_markers"][side]) for side in SIDES},
             coordinates={str(k): str(v) for k, v in spec["coordinates"].items()},
             fallback_measurement={str(k): str(v) for k, v in (spec.get("fallback_measurement") or {}).items()},
+            joint_centres=joint_centre_spec(spec.get("joint_centres"), prefix),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise LoperInputError(f"{source}: not a marker-set template ({type(exc).__name__}: {exc})") from None
-    names = set(template.marker_names) | set(_kad_names(template))
+    names = set(template.marker_names) | set(_kad_names(template)) | set(centre_names(template))
     named = [m for pairs, _ in measurements.values() for pair in pairs for m in pair]
     named += [m for group in template.required for m in group] + list(template.foot_markers.values())
     unknown = sorted(set(named) - names)
@@ -265,31 +283,50 @@ def template_fit(labels: Sequence[str], template: MarkerTemplate) -> TemplateFit
 # ------------------------------------------------------------------ OpenSim objects
 
 
-def template_marker_set(template: MarkerTemplate, names: Sequence[str] | None = None):
-    """An ``opensim.MarkerSet`` of the template's markers (those of ``names`` only, when given): anatomical
-    markers fixed (the marker placer leaves them), technical ones free."""
+def template_marker_set(template: MarkerTemplate, names: Sequence[str] | None = None, model=None):
+    """An ``opensim.MarkerSet`` of the template's markers (those of ``names`` only, when given).
+
+    For a template with joint centres whose landmarks ``names`` holds
+    (:func:`~loper_analysis.motion.centre_markers.calibration_centres`; ``model``, the template's model, is then
+    required), the calibration's virtual markers are added at the model's centres
+    (:func:`~loper_analysis.motion.centre_markers.joint_centre_places`) and fixed, and every other marker is free:
+    the marker placer fits the static pose through the centres and then moves each marker to where the static
+    trial has it. Otherwise anatomical markers are fixed (the marker placer leaves them) and technical ones free."""
     from loper_analysis.io.osim import quiet_opensim
 
     osim = quiet_opensim()
     keep = None if names is None else set(names)
+    centres = {}
+    if calibration_centres(template, names):
+        if model is None:
+            raise LoperInputError(
+                f"template {template.name}: the marker set of a static trial with the joint centres' landmarks needs "
+                f"the model ({template.model}) for the centres' places"
+            )
+        centres = joint_centre_places(template, model)
     out = osim.MarkerSet()
-    for m in template.markers:
-        if keep is not None and m.name not in keep:
+    places = [(m.name, m.body, m.location_m, m.role == "anatomical" and not centres) for m in template.markers]
+    places += [(name, body, location, True) for name, (body, location) in centres.items()]
+    for name, body, location, fixed in places:
+        if keep is not None and name not in keep and name not in centres:
             continue
         marker = osim.Marker()
-        marker.setName(m.name)
-        marker.setParentFrameName(f"/bodyset/{m.body}")
-        marker.set_location(osim.Vec3(*m.location_m))
-        marker.set_fixed(m.role == "anatomical")
+        marker.setName(name)
+        marker.setParentFrameName(f"/bodyset/{body}")
+        marker.set_location(osim.Vec3(*location))
+        marker.set_fixed(fixed)
         out.cloneAndAppend(marker)
     return out
 
 
 def _present_pairs(template: MarkerTemplate, present: set[str]) -> dict[str, tuple[tuple[str, str], ...]]:
-    pairs = {
-        name: tuple(p for p in entry[0] if p[0] in present and p[1] in present)
-        for name, entry in template.measurements.items()
-    }
+    """Each measurement's pairs whose markers are present; where pairs of joint centres are present, those alone."""
+    centres = set(centre_names(template))
+    pairs = {}
+    for name, entry in template.measurements.items():
+        found = tuple(p for p in entry[0] if p[0] in present and p[1] in present)
+        of_centres = tuple(p for p in found if p[0] in centres and p[1] in centres)
+        pairs[name] = of_centres or found
     for name, other in template.fallback_measurement.items():
         if not pairs.get(name):
             pairs[name] = pairs.get(other, ())
@@ -349,7 +386,8 @@ def template_scale_tool(template: MarkerTemplate, static_markers: Sequence[str],
     from loper_analysis.io.osim import quiet_opensim
 
     osim = quiet_opensim()
-    present = set(static_markers) & set(template.marker_names)
+    centres = calibration_centres(template, static_markers)
+    present = (set(static_markers) & set(template.marker_names)) | set(centres)
     measurements = {
         name: (pairs, template.measurements[name][1])
         for name, pairs in _present_pairs(template, present).items()
@@ -368,6 +406,12 @@ def template_scale_tool(template: MarkerTemplate, static_markers: Sequence[str],
             task.setApply(True)
             task.setWeight(template.weights[m.role])
             tasks.cloneAndAppend(task)
+    for name in centres:
+        task = osim.IKMarkerTask()
+        task.setName(name)
+        task.setApply(True)
+        task.setWeight(template.joint_centres.weight)
+        tasks.cloneAndAppend(task)
     for coordinate, value in template.coordinate_tasks.items():
         task = osim.IKCoordinateTask()
         task.setName(coordinate)

@@ -30,7 +30,14 @@ from loper_analysis.motion.static_trial import (
     time_range_is_set,
 )
 
-__all__ = ["ScalingPose", "generated_scale_tool", "scaled_subject", "scaling_mass_kg", "scaling_pose"]
+__all__ = [
+    "ScalingPose",
+    "generated_scale_tool",
+    "scaled_subject",
+    "scaling_mass_kg",
+    "scaling_pose",
+    "with_joint_centres",
+]
 
 
 def generated_scale_tool():
@@ -43,6 +50,42 @@ def generated_scale_tool():
     tool = measured_scale_tool({body: (pairs, [body]) for body, pairs in SCALE_MEASUREMENTS.items()})
     tool.getMarkerPlacer().setApply(False)
     return tool
+
+
+def with_joint_centres(
+    markers: tuple[np.ndarray, np.ndarray, Sequence[str]],
+    spec,
+    widths_m: Mapping[str, float],
+    *,
+    static_trc: str,
+) -> tuple[tuple[np.ndarray, np.ndarray, list[str]], dict[str, str]]:
+    """The static trial with its joint centres appended as markers, and how each was found.
+
+    Parameters
+    ----------
+    markers : (ndarray, ndarray, list of str)
+        The static trial: times (s), shape (n,); marker positions (m), shape (n, n_markers, 3); labels.
+    spec : loper_analysis.motion.marker_templates.JointCentreSpec
+        The centres the model's marker set holds and the landmarks they come from.
+    widths_m : mapping
+        The lab's knee and ankle widths and marker diameter, m
+        (:func:`loper_analysis.motion.joint_centres.widths_from_processing`).
+    static_trc : str
+        The static trial's file, in messages.
+
+    Raises
+    ------
+    LoperInputError
+        A landmark the centres need is missing (:func:`loper_analysis.motion.joint_centres.static_joint_centres`).
+    """
+    from loper_analysis.motion.joint_centres import static_joint_centres
+
+    times, X, labels = markers
+    centres = static_joint_centres(labels, X, spec.landmarks, widths_m, source=static_trc)
+    keep = [i for i, n in enumerate(centres.names) if n in spec.names and n not in labels]
+    names = [*labels, *(centres.names[i] for i in keep)]
+    X = np.concatenate([X, centres.markers_m[:, keep]], axis=1)
+    return (times, X, names), {centres.names[i]: centres.methods[centres.names[i]] for i in keep}
 
 
 @dataclass(frozen=True)
@@ -80,7 +123,7 @@ def scaling_pose(
 
     The window (:func:`loper_analysis.motion.static_trial.scale_window_s`) is ``settings.time_range_s`` when
     given, else the tool's time ranges where they are set, else the ``settings.static_duration_s`` seconds where
-    the measurement markers move least (:func:`loper_analysis.motion.static_trial.stillest_window_s`; None: the
+    the measurement markers move least (:func:`loper_analysis.motion.still_window.stillest_window_s`; None: the
     whole trial). Within it each marker counts where it is present
     (:func:`loper_analysis.motion.static_trial.static_pose`, at most ``settings.max_motion_rms_m`` of motion).
 

@@ -507,7 +507,7 @@ def _staged_files(subject: SubjectFiles, folder: Path, names: Mapping[str, str])
     model_path = template_file(t.model)
     model = read_model(model_path)
     coordinate_map = template_coordinate_map(t, model)
-    marker_set = template_marker_set(t, setup.static_markers)
+    marker_set = template_marker_set(t, setup.static_markers, model)
     tool = template_scale_tool(t, setup.static_markers, "marker_set.xml")
     losses = measurement_losses(t.measurements, t.marker_names, setup.static_markers, _measurement_names(tool))
     staged = {key: folder / Path(name).name for key, name in names.items()}

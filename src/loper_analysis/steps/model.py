@@ -20,8 +20,14 @@ from loper_analysis.io.segment_table import write_segments
 from loper_analysis.motion.body_size import body_mass_kg
 from loper_analysis.motion.markers import lab_up
 from loper_analysis.motion.model_settings import STATIC_DURATION_S, STATIC_MAX_MOTION_RMS_M, ModelSettings
-from loper_analysis.motion.scale_report import SCALE_FLOAT_FORMAT, scale_run_report
-from loper_analysis.motion.scaling import generated_scale_tool, scaled_subject, scaling_mass_kg, scaling_pose
+from loper_analysis.motion.scale_report import SCALE_FLOAT_FORMAT, joint_centre_rows, scale_run_report
+from loper_analysis.motion.scaling import (
+    generated_scale_tool,
+    scaled_subject,
+    scaling_mass_kg,
+    scaling_pose,
+    with_joint_centres,
+)
 from loper_analysis.swing_leg.dynamics import (
     BRACE_ATTACHMENT_FRACTION,
     SegmentParameters,
@@ -60,7 +66,7 @@ class ScaleFiles:
         measurements (:func:`scale`).
     static_c3d : path, optional
         The static trial's C3D, whose force plates give the mass when none is given
-        (:func:`loper_analysis.motion.static_trial.standing_mass_kg`).
+        (:func:`loper_analysis.motion.body_size.standing_mass_kg`).
     report_out : path, optional
         The scale report (TSV, :func:`loper_analysis.motion.scale_report.scale_report`).
     static_lab_angles : path, optional
@@ -88,7 +94,7 @@ def generic_model(
     Without ``mass_kg`` the mass comes from the force plates the subject
     stands on in the static trial ``static_c3d``, over its stillest
     ``settings.static_duration_s`` seconds (None: all of it; ``settings.rotation_deg`` tells the lab's
-    vertical: :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
+    vertical: :func:`loper_analysis.motion.body_size.standing_mass_kg`).
     """
     from loper_analysis.io.osim import write_model
     from loper_analysis.motion.model import build_lower_body_model
@@ -235,7 +241,7 @@ def scale_with_setup(
     mass_kg : float or None
         Subject mass, kg (0 .. 300); None: from the force plates of
         ``files.static_c3d`` (seen along the vertical of ``settings.rotation_deg``:
-        :func:`loper_analysis.motion.static_trial.standing_mass_kg`).
+        :func:`loper_analysis.motion.body_size.standing_mass_kg`).
     settings : ModelSettings
         The window (``time_range_s``, ``static_duration_s``), the static trial's largest marker motion
         (``max_motion_rms_m``), the bodies the scaled model must have (``segment_bodies``), the plausible
@@ -284,10 +290,11 @@ def _scale(
     setup_xml = None if files.setup_xml is None else Path(files.setup_xml)
     if not static_trc.is_file():
         raise LoperInputError(f"file not found: {static_trc}")
+    markers, centre_methods = _with_joint_centres(read_markers(static_trc), generic, files.static_c3d, static_trc)
     static = scaling_pose(
         tool,
         generic,
-        read_markers(static_trc),
+        markers,
         settings,
         static_trc=str(static_trc),
         setup_xml=None if setup_xml is None else str(setup_xml),
@@ -321,6 +328,7 @@ def _scale(
         report = scale_run_report(
             run, generic, static.pose, subject, settings, lab_labels=lab_labels, lab_angles=lab_angles
         )
+        report = joint_centre_rows(report, centre_methods)
         _write_scale_report(report, files)
     write_bytes(out_osim, run.model_osim, "OpenSim model")
     log.info(
@@ -331,6 +339,25 @@ def _scale(
         len(static.pose.time_s),
         mass[0],
     )
+
+
+def _with_joint_centres(markers, generic, static_c3d: PathLike | None, static_trc: Path):
+    """The static trial with the joint centres the generic model's marker set holds (a template's:
+    :func:`loper_analysis.motion.centre_markers.marker_set_centres`), computed with the widths the static C3D
+    stores; unchanged (and no methods) for any other marker set."""
+    from loper_analysis.io.marker_templates import read_templates
+    from loper_analysis.motion.centre_markers import marker_set_centres
+    from loper_analysis.motion.joint_centres import widths_from_processing
+
+    names = scale_tool.object_names(generic.getMarkerSet())
+    spec = marker_set_centres(list(read_templates().values()), names)
+    if spec is None:
+        return markers, {}
+    widths = widths_from_processing(_stored_values(static_c3d)[0])
+    markers, methods = with_joint_centres(markers, spec, widths, static_trc=str(static_trc))
+    for name, how in methods.items():
+        log.info("%s: joint centre %s: %s", static_trc, name, how)
+    return markers, methods
 
 
 def _write_scale_report(report, files: ScaleFiles) -> None:
