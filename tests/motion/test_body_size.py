@@ -3,15 +3,17 @@ the file's PROCESSING values, on a standing subject of known mass built here."""
 
 from __future__ import annotations
 
+import dataclasses
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from loper_analysis.constants import GRAVITY_M_PER_S2
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.c3d import C3DRecording
-from loper_analysis.io.force_platforms import ForcePlatform
+from loper_analysis.io.c3d import C3DRecording, read_c3d
+from loper_analysis.io.force_platforms import ForcePlatform, read_force_platforms
 from loper_analysis.motion.body_size import (
     HIP_HEIGHT_FRACTION,
     MASS_LIMIT_KG,
@@ -20,9 +22,14 @@ from loper_analysis.motion.body_size import (
     model_height_m,
     require_stature,
     standing_mass_kg,
+    standing_plates,
 )
 from loper_analysis.motion.model import build_lower_body_model
 
+QCMAS_STATIC = Path(__file__).resolve().parents[1] / "data/c3d-parser/QCMAS/static.c3d"
+#: Resting levels (N) of the same lab's plates 1, 2 and 4, measured in its walk (tests/data/c3d-parser/QCMAS/
+#: walk-nodevice.c3d, loper_analysis.gait.grf.resting_level): its static trial stores these plates as exact zeros.
+QCMAS_WALK_REST_N = {1: -10.27, 2: -13.74, 4: -14.84}
 MASS_KG = 70.0
 RATE_HZ, PLATE_HZ = 100.0, 1000.0
 LABELS = ["LASI", "RASI", "LHEE", "LTOE", "RHEE", "RTOE"]
@@ -134,3 +141,35 @@ def test_height_of_the_generated_model_comes_back():
     assert HIP_HEIGHT_FRACTION == pytest.approx(0.530, abs=1e-12)
     for height in (1.55, 1.73, 1.95):
         assert model_height_m(build_lower_body_model(height, 70.0), "thigh_r") == pytest.approx(height, rel=1e-9)
+
+
+def test_a_lab_static_counts_the_loaded_plate_only():
+    # QCMAS's static: both feet on plate 3 (708.4 N on average over the 3.23 s), plates 1, 2 and 4 unloaded
+    rec = read_c3d(QCMAS_STATIC)
+    plates = read_force_platforms(QCMAS_STATIC)
+    window = (0.0, float(rec.time_s[-1]))
+    mass, source = body_mass_kg(None, rec, plates, window)
+    assert mass == pytest.approx(708.44 / GRAVITY_M_PER_S2, abs=0.01)  # 72.22 kg
+    assert abs(mass - rec.processing["Bodymass"]) < 2.1  # the lab's 70.23 kg: within 3 %
+    assert source == "force plate 3 of static.c3d (1, 2, 4 unloaded)"
+    # the same plates unzeroed, at the resting levels the lab's walk shows: the unloaded plates add nothing
+    # (summed in, they took 3.96 kg off: 68.26 kg)
+    offset = [
+        dataclasses.replace(p, force_n=p.force_n + [0.0, 0.0, QCMAS_WALK_REST_N.get(p.number, 0.0)]) for p in plates
+    ]
+    assert body_mass_kg(None, rec, offset, window) == (mass, source)
+
+
+def test_each_plates_resting_level_comes_off_where_the_trial_shows_it():
+    t = np.arange(2000) / 1000.0
+    weight = 80.0 * 9.80665
+    stepped_on = np.where(t < 0.4, -40.0, 0.6 * weight - 40.0)  # unzeroed at -40 N, loaded from 0.4 s
+    throughout = np.full(t.size, 0.4 * weight)  # loaded from before the trial: no resting level to measure
+    forces = np.column_stack([stepped_on, throughout, np.full(t.size, -71.0), np.full(t.size, 13.0)])
+    rest, carrying = standing_plates(t, forces, (1.0, 2.0))
+    np.testing.assert_allclose(rest, [-40.0, 0.0, -71.0, 13.0])
+    assert carrying.tolist() == [True, True, False, False]
+    assert standing_mass_kg(t, forces, (1.0, 2.0), 9.80665) == pytest.approx(80.0, rel=1e-12)
+    # 20 N above the resting level: loaded only beyond it
+    _, carrying = standing_plates(t, np.column_stack([np.where(t < 0.4, -40.0, -19.0), np.full(t.size, -15.0)]), (1, 2))
+    assert carrying.tolist() == [True, False]

@@ -5,7 +5,9 @@ file's ``PROCESSING`` parameters, each with where it came from; and the scaled m
   stand on loaded plates (:func:`markers_off_plates`), else ``PROCESSING:Bodymass`` with the reason, else a
   stop asking for ``mass_kg``;
 * :func:`standing_mass_kg` - body mass from the force plates the subject stands on: mean total vertical force
-  over the window divided by gravity;
+  of the loaded plates over the window, each above its resting level, divided by gravity;
+* :func:`standing_plates` - each plate's resting level (where the trial shows it) and whether it carries the
+  subject in the window;
 * :func:`markers_off_plates` - the foot markers (those near the floor) not over a loaded plate: a subject with
   a foot beside the plates weighs less on them than their mass;
 * :func:`body_height_m` - the sheet's height, else ``PROCESSING:Height`` (mm, as Nexus writes it), else the
@@ -28,6 +30,7 @@ import numpy as np
 from loper_analysis.checks import where
 from loper_analysis.constants import GRAVITY_M_PER_S2, LOADED_THRESHOLD_N
 from loper_analysis.errors import LoperInputError
+from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
 from loper_analysis.swing_leg.anthropometry import ANKLE_HEIGHT_FRACTION, WINTER_SEGMENTS
 
 __all__ = [
@@ -43,6 +46,7 @@ __all__ = [
     "model_stature_m",
     "require_stature",
     "standing_mass_kg",
+    "standing_plates",
 ]
 
 #: A given or stored body mass must lie in (0, this] kg.
@@ -60,6 +64,8 @@ FOOT_MARKER_HEIGHT_M: float = 0.15
 PLATE_EDGE_MARGIN_M: float = 0.03
 #: Relative SD of the total vertical force above which a "standing" subject is not standing still.
 _MAX_FORCE_CV = 0.1
+#: Percentile of a plate's vertical force taken as its lowest level (as the grf step's resting level).
+_FLOOR_PERCENTILE = 1.0
 
 
 def body_mass_kg(
@@ -99,11 +105,13 @@ def body_mass_kg(
         return _file_bodymass(recording, "the static trial has no force platforms (FORCE_PLATFORM:USED 0)")
     u = np.asarray(up, float) / np.linalg.norm(up)
     vertical = np.column_stack([p.force_n @ u for p in plates])
-    off = _feet_off_plates(recording, plates, vertical, window, u)
+    _, carrying = standing_plates(plates[0].time_s, vertical, window)
+    loaded = [p for p, on in zip(plates, carrying, strict=True) if on]
+    off = _feet_off_plates(recording, plates, loaded, window, u)
     if off:
         return _file_bodymass(recording, off)
     mass = standing_mass_kg(plates[0].time_s, vertical, window, gravity_m_per_s2, source=recording.source)
-    return mass, f"force plates {', '.join(str(p.number) for p in plates)} of {_name(recording)}"
+    return mass, _plates_source([p.number for p in plates], carrying, _name(recording))
 
 
 def body_height_m(height_m: float | None, processing: Mapping[str, float], stature_m: float, file_name: str):
@@ -161,12 +169,17 @@ def _file_bodymass(recording, why: str) -> tuple[float, str]:
     )
 
 
-def _feet_off_plates(recording, plates, vertical_n: np.ndarray, window, up: np.ndarray) -> str:
+def _plates_source(numbers, carrying, file_name: str) -> str:
+    """Where a mass from the plates came from: the loaded plates (``carrying``) of the file, the others left out."""
+    on = [str(n) for n, c in zip(numbers, carrying, strict=True) if c]
+    off = [str(n) for n, c in zip(numbers, carrying, strict=True) if not c]
+    source = f"force plate{'s' if len(on) > 1 else ''} {', '.join(on)} of {file_name}"
+    return f"{source} ({', '.join(off)} unloaded)" if off else source
+
+
+def _feet_off_plates(recording, plates, loaded, window, up: np.ndarray) -> str:
     """Why the plates do not weigh the whole subject ('' when they do): foot markers of the static trial's mean
-    pose over no loaded plate (:func:`markers_off_plates`)."""
-    t = plates[0].time_s
-    in_window = (t >= window[0] - 1e-9) & (t <= window[1] + 1e-9)
-    loaded = [p for j, p in enumerate(plates) if np.nanmean(vertical_n[in_window, j]) > LOADED_THRESHOLD_N]
+    pose over none of the ``loaded`` plates (:func:`markers_off_plates`)."""
     floor = float(np.mean([p.corners_m @ up for p in plates]))
     frames = (recording.time_s >= window[0] - 1e-9) & (recording.time_s <= window[1] + 1e-9)
     if not frames.any() or not len(recording.marker_labels):
@@ -191,7 +204,8 @@ def standing_mass_kg(
     gravity_m_per_s2: float = GRAVITY_M_PER_S2,
     source: str = "",
 ) -> float:
-    """Body mass (kg) of a subject standing on force plates: mean total vertical force over the window / g.
+    """Body mass (kg) of a subject standing on force plates: mean total vertical force over the window / g, the
+    total over the plates that carry the subject, each above its resting level (:func:`standing_plates`).
 
     Parameters
     ----------
@@ -199,7 +213,7 @@ def standing_mass_kg(
         Shape (n_samples,), s: the plates' sample times.
     vertical_force_n : array_like
         Shape (n_samples,) or (n_samples, n_plates), N: vertical ground
-        reaction of each plate (up positive), summed over the plates.
+        reaction of each plate (up positive), summed over the loaded plates.
     window_s : (float, float)
         The span averaged (s).
     gravity_m_per_s2 : float
@@ -215,7 +229,9 @@ def standing_mass_kg(
     """
     t = np.asarray(time_s, dtype=float)
     F = np.asarray(vertical_force_n, dtype=float)
-    total = F.sum(axis=1) if F.ndim == 2 else F
+    F = F[:, None] if F.ndim == 1 else F
+    rest, carrying = standing_plates(t, F, window_s)
+    total = (F[:, carrying] - rest[carrying]).sum(axis=1)
     sel = (t >= window_s[0] - 1e-9) & (t <= window_s[1] + 1e-9) & np.isfinite(total)
     if not sel.any():
         raise LoperInputError(
@@ -238,6 +254,58 @@ def standing_mass_kg(
             f"window: the subject does not stand still on the plates; give mass_kg in the subject sheet instead"
         )
     return mass
+
+
+def standing_plates(
+    time_s, vertical_force_n, window_s: tuple[float, float], threshold_n: float = LOADED_THRESHOLD_N
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each plate's resting level and whether it carries the subject over a static trial's window.
+
+    Unloaded plates do not read zero (unzeroed plates read -14 .. -71 N at rest in real files): summed in, such
+    a plate would change the mass by kilograms. A plate's resting level is measured where the trial shows the
+    plate unloaded: its lowest level (1st percentile of its vertical force over the trial) within
+    :data:`loper_analysis.gait.grf.MAX_RESTING_N` (100 N, the default of the grf step's limit
+    ``grf.max_resting_n``), the median of the samples within ``RESTING_BAND_N`` (10 N) of it, as
+    :func:`loper_analysis.gait.grf.resting_level` takes it. A plate whose force stays above that
+    level throughout is loaded throughout: its resting level cannot be measured and is taken as 0 (a plate
+    zeroed before the trial). A plate carries the subject when its mean vertical force over the window exceeds
+    its resting level by more than ``threshold_n``: the contact detection's 20 N, five times less than one foot
+    of the lightest subject accepted (half of 20 kg, 98 N); a foot carrying less than 100 N throughout is taken
+    for an unloaded plate (the feet-beside-the-plates check then names it).
+
+    Parameters
+    ----------
+    time_s : array_like
+        Shape (n_samples,), s: the plates' sample times.
+    vertical_force_n : array_like
+        Shape (n_samples, n_plates), N: each plate's vertical ground reaction (up positive).
+    window_s : (float, float)
+        The span averaged (s).
+    threshold_n : float
+        Load above the resting level from which a plate carries the subject (N).
+
+    Returns
+    -------
+    rest_n : numpy.ndarray
+        Shape (n_plates,), N: each plate's resting level (0 where not measurable).
+    carrying : numpy.ndarray
+        Shape (n_plates,), bool: the plates loaded over the window.
+    """
+    t = np.asarray(time_s, dtype=float)
+    F = np.asarray(vertical_force_n, dtype=float).reshape(t.size, -1)
+    in_window = (t >= window_s[0] - 1e-9) & (t <= window_s[1] + 1e-9)
+    rest = np.zeros(F.shape[1])
+    carrying = np.zeros(F.shape[1], dtype=bool)
+    for j, v in enumerate(F.T):
+        finite = np.isfinite(v)
+        if not finite.any():
+            continue
+        floor = float(np.percentile(v[finite], _FLOOR_PERCENTILE))
+        if abs(floor) <= MAX_RESTING_N:
+            rest[j] = float(np.median(v[finite & (v <= floor + RESTING_BAND_N)]))
+        window = v[in_window & finite]
+        carrying[j] = window.size > 0 and float(window.mean()) - rest[j] > threshold_n
+    return rest, carrying
 
 
 def model_height_m(model, thigh_body: str) -> float:
