@@ -19,8 +19,9 @@ from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass_finite_run
 from loper_analysis.motion.heading import MIN_TRAVEL_SPEED_M_PER_S, trial_heading
 from loper_analysis.motion.knee_alignment import kad_knee_markers
 from loper_analysis.motion.label_matching import landmark_indices
+from loper_analysis.motion.level_walking import level_walking_warning, pelvis_height_change_m, plate_heights_m
 from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
-from loper_analysis.motion.markers import MAX_GAP_FRAMES, fill_gaps, gap_summary, rotate_markers
+from loper_analysis.motion.markers import MAX_GAP_FRAMES, fill_gaps, gap_summary, lab_up, rotate_markers
 from loper_analysis.motion.plausibility import EXTENT_RANGE_M, require_marker_extent
 
 __all__ = ["MarkerSettings", "PreparedMarkers", "TRIAL_MARKER_COLUMNS", "prepared_markers"]
@@ -87,10 +88,17 @@ class PreparedMarkers:
     summary: pd.DataFrame
 
 
-def prepared_markers(rec, label_map, settings: MarkerSettings, source: str) -> PreparedMarkers:
+def prepared_markers(
+    rec, label_map, settings: MarkerSettings, source: str, plate_corners_m: Sequence = ()
+) -> PreparedMarkers:
     """The markers of a recording (:class:`loper_analysis.io.c3d.C3DRecording`) named by ``label_map`` (one
     mapping {lab label: model marker}, or several merged in order), cropped, filled, turned and low-passed as
     ``settings`` says (:func:`loper_analysis.steps.markers.markers` tells each step).
+
+    Before the trial's heading and speed, a trial that is not level walking is warned about
+    (:mod:`loper_analysis.motion.level_walking`: its pelvis markers' rise or fall, the heights of the force
+    plates whose corners ``plate_corners_m`` gives, (4, 3) each, m, lab frame); the summary holds the figures
+    and the warning.
 
     Raises
     ------
@@ -114,6 +122,7 @@ def prepared_markers(rec, label_map, settings: MarkerSettings, source: str) -> P
     if s.span_s is not None:
         time_s, raw = _cropped(time_s, raw, s.span_s, source)
     require_marker_extent(raw, source, s.extent_range_m)
+    level = _level_walking(raw, names, rec.point_rate_hz, s.rotation_deg, plate_corners_m, source)
     heading = _heading(raw, names, rec.point_rate_hz, s, source)
     filled, gaps = fill_gaps(raw, s.max_gap_frames, names, source=source, unfillable="keep")
     X = rotate_markers(filled, heading.rotation_deg)
@@ -126,6 +135,8 @@ def prepared_markers(rec, label_map, settings: MarkerSettings, source: str) -> P
         except LoperInputError as exc:
             raise LoperInputError(f"{source}: markers: {exc}") from None
     summary = _trial_marker_summary(gap_summary(raw, X, names, unfiltered), labels, time_s, X, heading)
+    for column, value in zip(LEVEL_WALKING_COLUMNS, level, strict=True):
+        summary[column] = value
     log.info(
         "%s: %d frames at %g Hz, %d markers, %d gap(s) filled",
         source,
@@ -181,6 +192,22 @@ def _heading(raw: np.ndarray, names: list[str], rate_hz: float, s: MarkerSetting
     return heading
 
 
+def _level_walking(raw, names, rate_hz: float, rotation_deg, plate_corners_m, source: str):
+    """The pelvis's rise or fall (m), the plates' height range (m) and the warning of a trial that is not level
+    walking ('' for a level walk), logged (:mod:`loper_analysis.motion.level_walking`)."""
+    up = lab_up(rotation_deg)
+    change = pelvis_height_change_m(raw, names, rate_hz, up)
+    heights = plate_heights_m(plate_corners_m, up)
+    said = level_walking_warning(change, heights)
+    if said:
+        log.warning("%s: %s", source, said)
+    return change, float(np.ptp(heights)) if heights.size else np.nan, said
+
+
+#: The trial's level-walking figures and warning in the markers summary (:func:`prepared_markers`).
+LEVEL_WALKING_COLUMNS: tuple[str, ...] = ("pelvis_height_change_m", "plate_height_range_m", "warnings")
+
+
 #: Columns the markers summary adds to :data:`loper_analysis.motion.markers.GAP_SUMMARY_COLUMNS`: the marker's lab
 #: label, then facts of the whole trial repeated on each row (like ``n_frames``).
 TRIAL_MARKER_COLUMNS: tuple[str, ...] = (
@@ -194,6 +221,7 @@ TRIAL_MARKER_COLUMNS: tuple[str, ...] = (
     "rotation_x_deg",
     "rotation_y_deg",
     "rotation_z_deg",
+    *LEVEL_WALKING_COLUMNS,
 )
 
 

@@ -59,6 +59,11 @@ def markers(
     on the file's clock and ``{angle}_rad``; the header ``time_s`` alone when the file holds none:
     :func:`loper_analysis.motion.lab_angles.lab_joint_angles`).
 
+    A trial whose pelvis rises or falls more than half a stair step, or whose force plates lie at different
+    heights, is warned about as not level walking before its speed is given
+    (:mod:`loper_analysis.motion.level_walking`); the summary's ``pelvis_height_change_m``,
+    ``plate_height_range_m`` and ``warnings`` hold the figures and the warning.
+
     Returns the table of filled gaps (written to ``gaps_out`` when given; one
     row per gap, :data:`loper_analysis.motion.markers.GAP_REPORT_COLUMNS`). The
     per-marker summary (:func:`loper_analysis.motion.markers.gap_summary`, with the
@@ -73,7 +78,8 @@ def markers(
     from loper_analysis.io.opensim_tables import write_trc
 
     rec = read_c3d(c3d_path)
-    prepared = prepared_markers(rec, read_label_maps(settings.label_map), settings, str(c3d_path))
+    corners = _plate_corners(rec, c3d_path)
+    prepared = prepared_markers(rec, read_label_maps(settings.label_map), settings, str(c3d_path), corners)
     gaps, summary = prepared.gaps, prepared.summary
     write_trc(trc_out, prepared.time_s, prepared.markers_m, prepared.names, rate_hz=rec.point_rate_hz)
     if lab_angles_out is not None:
@@ -85,6 +91,21 @@ def markers(
     _log_missing(gaps, summary, str(c3d_path), len(prepared.time_s))
     gaps.attrs["per_marker"] = summary.to_dict("records")
     return gaps
+
+
+def _plate_corners(rec, c3d_path: PathLike) -> list:
+    """The corners of the file's force plates ((4, 3) each, m, lab frame); none without plates, or where the
+    plates cannot be read (said in the log: the events and grf steps stop on them)."""
+    from loper_analysis.errors import LoperInputError
+    from loper_analysis.io.force_platforms import read_force_platforms
+
+    if not rec.n_force_platforms:
+        return []
+    try:
+        return [p.corners_m for p in read_force_platforms(c3d_path)]
+    except LoperInputError as exc:
+        log.info("%s: the force plates' heights are not compared: %s", c3d_path, exc)
+        return []
 
 
 def _write_lab_angles(rec, out: PathLike) -> None:

@@ -119,7 +119,9 @@ def strides_summary(
     :func:`loper_analysis.steps.ik.ik_trial`) add the frames and those left
     out of IK, the mean marker RMS error, the worst marker, the change of the marker geometry against the
     model and the IK warnings, ``markers`` (the markers
-    summaries of :func:`markers`) the trial's walking direction and the turn that made it walk along +X,
+    summaries of :func:`markers`) the trial's walking direction and the turn that made it walk along +X, and
+    first among the warnings a trial that is not level walking (its pelvis's rise or fall, its plates'
+    heights: :mod:`loper_analysis.motion.level_walking`),
     ``agreement`` (our angles against the lab's own, :func:`loper_analysis.steps.ik.ik_trial`) the least
     correlation and the largest RMS difference over the hip, knee and ankle angles compared (NaN where the file
     holds none), ``dropped`` (the strides :func:`strides` could not cut) the strides outside the robot log's span:
@@ -158,12 +160,13 @@ def strides_summary(
             for key, path in zip(keys, files.dropped, strict=True)
         }
     table = stride_summary(tables, min_valid, contacts, dropped)
-    extra, ik_warnings = [], None
+    extra, ik_warnings, level_warnings = [], None, None
     if files.ik is not None:
         columns, ik_warnings = _ik_columns(files.ik)
         extra.append(columns)
     if files.markers is not None:
-        extra.append(_marker_columns(files.markers))
+        columns, level_warnings = _marker_columns(files.markers)
+        extra.append(columns)
     if files.agreement is not None:
         extra.append(_agreement_columns(files.agreement))
     if ik_warnings is not None:
@@ -174,6 +177,9 @@ def strides_summary(
         table["warnings"] = _with_truncation_warnings(table)
     if contacts is not None:
         table["warnings"] = _with_contact_warnings(table, contacts)
+    if level_warnings is not None:
+        before = table["warnings"].fillna("") if "warnings" in table else [""] * len(table)
+        table["warnings"] = [" | ".join(w for w in pair if w) for pair in zip(level_warnings, before)]
     write_tsv(table, out_tsv)
     for row in table[table.status == "too_few_strides"].itertuples():
         log.warning("%s %s: only %d valid strides (minimum %d)", row.subject, row.trial, row.n_kept, min_valid)
@@ -200,16 +206,18 @@ def _ik_columns(paths: Sequence[PathLike]) -> tuple[pd.DataFrame, list[str]]:
     return columns, ["" if pd.isna(r.warnings) else str(r.warnings) for r in ik]
 
 
-def _marker_columns(paths: Sequence[PathLike]) -> pd.DataFrame:
-    """The trials' walking direction, speed and turn, from their markers summaries."""
+def _marker_columns(paths: Sequence[PathLike]) -> tuple[pd.DataFrame, list[str]]:
+    """The trials' walking direction, speed and turn, from their markers summaries, and their level-walking
+    warnings (:mod:`loper_analysis.motion.level_walking`; '' for a level walk)."""
     marks = [read_tsv(path, "markers summary", ("heading_deg", "speed_m_per_s", "turn_deg")).iloc[0] for path in paths]
-    return pd.DataFrame(
+    columns = pd.DataFrame(
         {
             "heading_deg": [float(r.heading_deg) for r in marks],
             "speed_m_per_s": [float(r.speed_m_per_s) for r in marks],
             "turn_deg": [float(r.turn_deg) for r in marks],
         }
     )
+    return columns, ["" if pd.isna(r.get("warnings", "")) else str(r.get("warnings", "")) for r in marks]
 
 
 def _agreement_columns(paths: Sequence[PathLike]) -> pd.DataFrame:
