@@ -20,9 +20,19 @@ from typing import NamedTuple
 import numpy as np
 
 from loper_analysis.constants import SIDES
-from loper_analysis.gait.plate_geometry import plate_offsets
+from loper_analysis.gait.plate_geometry import plate_axes, plate_offsets
 
-__all__ = ["ContactScene", "Verdict", "contact_verdict", "heel_offsets", "on_plate", "positions_at"]
+__all__ = [
+    "ContactScene",
+    "Verdict",
+    "contact_verdict",
+    "first_load",
+    "heel_landing",
+    "heel_offsets",
+    "load_stays_under",
+    "on_plate",
+    "positions_at",
+]
 
 
 class ContactScene(NamedTuple):
@@ -30,7 +40,10 @@ class ContactScene(NamedTuple):
 
     ``marker_time_s`` (n_frames,) in s; ``heels_m``, ``toes_m`` (or None): ``{side: (n_frames, 3)}`` in m;
     ``corners_m``: per plate its corners (4, 3) in m, ``numbers`` its number; ``vertical_axis`` and ``up``: the
-    vertical; the checked probe delay and dwell time (s), margin, reach and highest heel (m).
+    vertical; the checked probe delay and dwell time (s), margin, reach and highest heel (m); ``plates``: per
+    plate its :class:`loper_analysis.gait.contacts.PlateForce` (its ``cop_m`` lets the force decide a heel off the
+    edge and a second foot, :func:`first_load`, :func:`load_stays_under`), and ``threshold_on_n`` (N): the force
+    above which its centre of pressure is used.
     """
 
     marker_time_s: np.ndarray
@@ -45,6 +58,8 @@ class ContactScene(NamedTuple):
     margin_m: float
     reach_m: float
     max_height_m: float
+    plates: Sequence = ()
+    threshold_on_n: float = 50.0
 
 
 def positions_at(time_s: np.ndarray, xyz: np.ndarray, when: np.ndarray) -> np.ndarray:
@@ -118,6 +133,100 @@ def heel_offsets(scene: ContactScene, k: int, times: np.ndarray) -> dict[str, di
     return {"window": window, "start_on": start_on, "missing": missing, "on_all": on_all, "elsewhere": elsewhere}
 
 
+def _plane(scene: ContactScene, k: int):
+    """A function giving points' (..., 3) coordinates (m) in plate ``k``'s plane (..., 2)."""
+    centre, axes = plate_axes(scene.corners_m[k], scene.vertical_axis, "", scene.up)
+    return lambda xyz: (np.asarray(xyz, dtype=float) - centre) @ axes[:2].T
+
+
+def _loaded_cop(scene: ContactScene, k: int, t0: float, t1: float) -> tuple[np.ndarray, ...] | None:
+    """Times (s, (n,)), centre of pressure (m, (n, 3)) and force (N, (n,)) of plate ``k``'s samples in
+    ``[t0, t1]`` loaded at or above ``scene.threshold_on_n``; None when the plate has no centre of pressure."""
+    cop = getattr(scene.plates[k], "cop_m", None) if len(scene.plates) > k else None
+    if cop is None:
+        return None
+    plate = scene.plates[k]
+    t, f = np.asarray(plate.time_s, dtype=float), np.asarray(plate.vertical_force_n, dtype=float)
+    cop = np.asarray(cop, dtype=float)
+    use = (t >= t0) & (t <= t1) & (f >= scene.threshold_on_n) & np.isfinite(cop).all(axis=1)
+    return t[use], cop[use], f[use]
+
+
+def first_load(scene: ContactScene, k: int, start_s: float) -> tuple[float, float, np.ndarray] | None:
+    """Where plate ``k`` takes its first load: the force-weighted mean centre of pressure (m, (3,)) over its
+    samples at or above the on-threshold from the contact's start ``start_s`` (s) for one marker frame
+    interval, with that span's first and last time (s); None without a centre of pressure."""
+    frame = float(np.median(np.diff(scene.marker_time_s)))
+    loads = _loaded_cop(scene, k, start_s, start_s + frame)
+    if loads is None or not loads[0].size:
+        return None
+    t, cop, f = loads
+    return float(t[0]), float(t[-1]), (f[:, None] * cop).sum(axis=0) / f.sum()
+
+
+def heel_landing(scene: ContactScene, k: int, start_s: float, side: str) -> dict | None:
+    """Whether the heel of ``side`` took plate ``k``'s first load (:func:`first_load`): the nearest of the four
+    foot markers (both heels and toes, in the plate's plane, at the first load's time) to its centre of pressure
+    is that heel. None without a centre of pressure or toe markers.
+
+    Returns ``on`` (bool), ``from_s``, ``to_s`` (the first load's span, s), ``heel_m``, ``toe_m`` (the
+    distances of that foot's heel and toe markers, m) and ``nearest`` (the nearest marker, e.g. "left toe").
+    """
+    first = first_load(scene, k, start_s)
+    if first is None or scene.toes_m is None:
+        return None
+    t0, t1, cop = first
+    flat = _plane(scene, k)
+    dist = {}
+    for s in SIDES:
+        for part, markers in (("heel", scene.heels_m), ("toe", scene.toes_m)):
+            xyz = positions_at(scene.marker_time_s, markers[s], np.array([t0]))[0]
+            dist[f"{s} {part}"] = float(np.linalg.norm(flat(xyz) - flat(cop)))
+    seen = {name: d for name, d in dist.items() if np.isfinite(d)}
+    nearest = min(seen, key=seen.get) if seen else ""
+    return {
+        "on": nearest == f"{side} heel",
+        "from_s": t0,
+        "to_s": t1,
+        "heel_m": dist[f"{side} heel"],
+        "toe_m": dist[f"{side} toe"],
+        "nearest": nearest,
+    }
+
+
+def _foot_distance(scene: ContactScene, flat, side: str, t: np.ndarray, cop: np.ndarray) -> np.ndarray:
+    """Distance (m, (n,)) in the plate's plane from the centre of pressure ``cop`` (n, 3) at ``t`` (s) to the
+    foot of ``side``: its heel-toe segment (its heel without toe markers); NaN where a marker is missing."""
+    heel = flat(positions_at(scene.marker_time_s, scene.heels_m[side], t))
+    toe = heel if scene.toes_m is None else flat(positions_at(scene.marker_time_s, scene.toes_m[side], t))
+    c, along = flat(cop), toe - heel
+    length2 = np.sum(along * along, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        w = np.clip(np.where(length2 > 0, np.sum((c - heel) * along, axis=1) / length2, 0.0), 0.0, 1.0)
+    return np.linalg.norm(c - heel - w[:, None] * along, axis=1)
+
+
+def load_stays_under(scene: ContactScene, k: int, own: str, other: str, t0: float, t1: float) -> float | None:
+    """Whether plate ``k`` carries only the foot ``own`` while the heel of ``other`` stands on it, from ``t0`` to
+    ``t1`` (s): its centre of pressure, at every sample at or above the on-threshold, nearer ``own``'s foot
+    (heel-toe segment, :func:`_foot_distance`) than ``other``'s. Both feet on one plate put it between them,
+    under the one that carries more: nearer ``other`` once that foot takes half the load or more.
+
+    Returns
+    -------
+    float or None
+        NaN when the load stays under ``own`` throughout; else the first time (s) it is not nearer ``own``
+        (a missing marker counts as not nearer); None without a centre of pressure or loaded samples.
+    """
+    loads = _loaded_cop(scene, k, t0, t1)
+    if loads is None or not loads[0].size:
+        return None
+    t, cop, _ = loads
+    flat = _plane(scene, k)
+    nearer = _foot_distance(scene, flat, own, t, cop) < _foot_distance(scene, flat, other, t, cop)
+    return np.nan if nearer.all() else float(t[np.argmin(nearer)])
+
+
 class Verdict(NamedTuple):
     """A contact's foot (``""`` if unknown or ambiguous), flag (:data:`loper_analysis.constants.CONTACT_FLAGS`),
     reason in words (``""`` for ``ok``) and the heels on its plate (at the start probe or dwelling)."""
@@ -126,6 +235,47 @@ class Verdict(NamedTuple):
     flag: str
     reason: str
     present: frozenset
+
+
+def _off_edge_heels(scene: ContactScene, k: int, heels: Mapping[str, dict]) -> dict[str, float]:
+    """The low heels (side: m outside the outline at the start probe) within reach of plate ``k`` that stand on
+    no other plate (``heels``: :func:`heel_offsets`)."""
+    window, on_all = heels["window"], heels["on_all"]
+    return {
+        s: window[s][0][0]
+        for s in SIDES
+        if window[s][0][0] <= scene.reach_m
+        and window[s][1][0] <= scene.max_height_m
+        and not np.delete(on_all[s], k).any()
+    }
+
+
+def _off_plate(side: str, near: Mapping[str, float], probe: float, landing: dict | None) -> str:
+    """The reason of an ``off_plate`` contact: the heel's distance off the edge and, with a centre of pressure,
+    where the plate took its first load (:func:`heel_landing`)."""
+    said = f"heel off the plate's edge: the {side} heel {near[side] * 1000:.0f} mm off it at {probe:.3f} s"
+    if landing is not None:
+        said += (
+            f", and the plate's first load (its centre of pressure at {landing['from_s']:.3f}-"
+            f"{landing['to_s']:.3f} s) {landing['heel_m'] * 1000:.0f} mm from the {side} heel marker, nearest the "
+            f"{landing['nearest']} marker ({landing['toe_m'] * 1000:.0f} mm from the {side} toe)"
+        )
+    return said + "; the foot loaded the plate without its heel, so the loading is not a heel strike"
+
+
+def _two_feet(at_start, dwells, stays, side: str, shared: Mapping, probe: float) -> str:
+    """The reason of a ``two_feet`` contact: both heels on the plate at the start probe (s), or the stay (s) of
+    the heel that dwells and, with a centre of pressure, when the load came nearer that foot (``shared``)."""
+    if len(at_start) == 2:
+        return f"two feet on one plate: both heels on it at {probe:.3f} s"
+    s = next(iter(dwells))
+    said = (
+        f"two feet on one plate: the {s} heel stands on it from {stays[s][0]:.3f} to {stays[s][1]:.3f} s "
+        f"while the {side} foot is on it"
+    )
+    if shared.get(s) is not None:
+        said += f"; the plate's centre of pressure nearer the {s} foot than the {side} foot at {shared[s]:.3f} s"
+    return said
 
 
 def contact_verdict(
@@ -141,16 +291,28 @@ def contact_verdict(
 
     ``times`` (s): the window's probes and frames; ``need`` (s): the unbroken time on the plate that makes a
     heel dwell; ``heels``: :func:`heel_offsets`; ``belt_side``: the side ``plate_sides`` gives the plate (None).
+    A heel off the edge whose heel took the plate's first load (:func:`heel_landing`) is the contact's foot;
+    another heel standing on the plate is no second foot while the plate's load stays under the contact's foot
+    (:func:`load_stays_under`).
     """
-    window, start_on, missing, on_all = heels["window"], heels["start_on"], heels["missing"], heels["on_all"]
-    elsewhere = heels["elsewhere"]
+    window, start_on, missing = heels["window"], heels["start_on"], heels["missing"]
     probe, height = times[0], scene.max_height_m
     at_start = [s for s in SIDES if start_on[s]]
     side = at_start[0] if len(at_start) == 1 else ""
+    near, landing = {} if at_start else _off_edge_heels(scene, k, heels), None
+    if near:
+        landing = heel_landing(scene, k, c.start_s, min(near, key=near.get))
+        if landing is not None and landing["on"]:
+            side = min(near, key=near.get)  # its heel took the first load: it landed on the plate
     others = [s for s in SIDES if s != side]
     # another heel stands on this plate: on it, not inside another plate's outline
-    stays = {s: _standing_run(times, on_plate(scene, *window[s]) & ~elsewhere[s], window[s][1], height) for s in others}
+    stays = {
+        s: _standing_run(times, on_plate(scene, *window[s]) & ~heels["elsewhere"][s], window[s][1], height)
+        for s in others
+    }
     dwells = {s for s in others if stays[s][1] - stays[s][0] >= need}
+    shared = {s: load_stays_under(scene, k, side, s, *stays[s]) if side else None for s in dwells}
+    dwells -= {s for s, t in shared.items() if t is not None and np.isnan(t)}  # the load stays under one foot
     undecided = [
         s
         for s in others
@@ -158,7 +320,7 @@ def contact_verdict(
         and missing[s].any()
         and _longest_run_s(times, on_plate(scene, *window[s]) | missing[s]) >= need
     ]
-    present = frozenset(at_start) | dwells
+    present = frozenset(at_start) | dwells | ({side} if side else set())
     if c.incomplete:
         when = "the start" if c.start_sample == 0 else "the end"
         return Verdict(side, "incomplete", f"the plate is loaded at {when} of the recording", present)
@@ -171,25 +333,14 @@ def contact_verdict(
         )
         return Verdict(side, "heel_missing", said, present)
     if len(present) == 2:
-        if len(at_start) == 2:
-            said = f"two feet on one plate: both heels on it at {probe:.3f} s"
-        else:
-            s = next(iter(dwells))
-            said = (
-                f"two feet on one plate: the {s} heel stands on it from {stays[s][0]:.3f} to {stays[s][1]:.3f} s "
-                f"while the {side} foot is on it"
-            )
-        return Verdict(side, "two_feet", said, present)
-    if not at_start:
-        # low heels near this plate that stand on no other plate
-        near = {
-            s: window[s][0][0]
-            for s in SIDES
-            if window[s][0][0] <= scene.reach_m and window[s][1][0] <= height and not np.delete(on_all[s], k).any()
-        }
+        return Verdict(side, "two_feet", _two_feet(at_start, dwells, stays, side, shared, probe), present)
+    if not side and not at_start:
         if not near:
             elsewhere = [
-                f"the {s} heel on plate {scene.numbers[j]}" for s in SIDES for j in np.flatnonzero(on_all[s]) if j != k
+                f"the {s} heel on plate {scene.numbers[j]}"
+                for s in SIDES
+                for j in np.flatnonzero(heels["on_all"][s])
+                if j != k
             ]
             said = (
                 f"no foot found: no heel on the plate at {probe:.3f} s, and none low within "
@@ -205,11 +356,7 @@ def contact_verdict(
                 f"the {side} heel {near[side] * 1000:.0f} mm off its edge at {probe:.3f} s"
             )
             return Verdict("", "two_feet", said, present)
-        said = (
-            f"heel off the plate's edge: the {side} heel {near[side] * 1000:.0f} mm off it at {probe:.3f} s; the "
-            "foot loaded the plate without its heel, so the loading is not a heel strike"
-        )
-        return Verdict(side, "off_plate", said, present)
+        return Verdict(side, "off_plate", _off_plate(side, near, probe, landing), present)
     if (side if belt_side is None else belt_side) != side:
         said = f"the {side} foot on the {belt_side} foot's plate (events.plate_sides)"
         return Verdict(side, "wrong_belt", said, present)

@@ -84,12 +84,16 @@ class PlateForce:
         positive when loaded.
     corners_m : numpy.ndarray, shape (4, 3)
         The plate's corners in m, in order around the plate, in the frame of the markers.
+    cop_m : numpy.ndarray, shape (n_samples, 3), optional
+        The plate's centre of pressure in m, in the frame of the markers (None: not known). Where the plate
+        takes its first load and whether its load stays under one foot (:func:`foot_contacts`).
     """
 
     plate: int
     time_s: np.ndarray
     vertical_force_n: np.ndarray
     corners_m: np.ndarray
+    cop_m: np.ndarray | None = None
 
 
 def foot_contacts(
@@ -143,6 +147,12 @@ def foot_contacts(
       loading is not its heel strike;
     * ``wrong_belt`` - ``plate_sides`` gives the plate to the other side;
     * ``ok`` - one heel on the plate, alone, as configured.
+
+    **The plate's force**, where a plate has its centre of pressure (``cop_m``): a low heel within ``reach_m``
+    but past ``margin_m`` whose heel took the plate's first load (the nearest of the four foot markers to it,
+    :func:`loper_analysis.gait.contact_flags.heel_landing`; toe markers needed) landed on the plate (not
+    ``off_plate``); another heel dwelling on the plate is no second foot while the centre of pressure stays
+    nearer the contact's foot than that one (:func:`loper_analysis.gait.contact_flags.load_stays_under`).
 
     **A foot across plates.** A ``no_foot`` or ``off_plate`` contact that
     overlaps in time an ``ok`` contact of one foot on another plate, with that
@@ -232,7 +242,22 @@ def foot_contacts(
     corners = [np.asarray(p.corners_m, dtype=float) for p in plates]
     for name, c in zip(names, corners):
         plate_axes(c, vertical_axis, name, up)
-    scene = ContactScene(tm, heels, toes, corners, numbers, vertical_axis, up, delay, dwell, margin, reach, height)
+    scene = ContactScene(
+        tm,
+        heels,
+        toes,
+        corners,
+        numbers,
+        vertical_axis,
+        up,
+        delay,
+        dwell,
+        margin,
+        reach,
+        height,
+        plates,
+        threshold_on_n,
+    )
 
     rows = []
     for k, (plate, name) in enumerate(zip(plates, names)):

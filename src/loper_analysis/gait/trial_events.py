@@ -242,7 +242,7 @@ def _plate_events(rec, platforms: list, s: EventSettings, label_map) -> tuple[pd
     from level is refused naming the file, the plate and ``markers.lab_to_model_rotation_deg``.
     """
     from loper_analysis.gait.contacts import PlateForce, contact_events, foot_contacts
-    from loper_analysis.gait.grf import plate_vertical_loads
+    from loper_analysis.gait.grf import plates_loads, vertical_loads
     from loper_analysis.motion.marker_names import model_marker_names, require_model_markers
     from loper_analysis.motion.markers import MODEL_UP, lab_up, rotate_markers
 
@@ -253,9 +253,11 @@ def _plate_events(rec, platforms: list, s: EventSettings, label_map) -> tuple[pd
     names = model_marker_names(rec.marker_labels, label_map, source)
     require_model_markers(names, [foot_markers[side] for side in SIDES], source, rec.marker_labels)
     up = lab_up(rotation_deg)
-    loads = plate_vertical_loads(platforms, rotation_deg, s.band_n, s.max_rest_n, up=up, source=source)
+    each = plates_loads(platforms, 20.0, s.band_n, s.max_rest_n, up, source)  # as grf.plate_vertical_loads
+    loads = vertical_loads(each, rotation_deg)
     plates = [
-        PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i]) for i, n in enumerate(loads.numbers)
+        PlateForce(n, loads.time_s, loads.vertical_n[:, i], loads.corners_m[i], rotate_markers(p.cop_m, rotation_deg))
+        for i, (n, p) in enumerate(zip(loads.numbers, each))
     ]
     heels = {side: rotate_markers(rec.markers_m[:, names.index(foot_markers[side]), :], rotation_deg) for side in SIDES}
     toes = None
