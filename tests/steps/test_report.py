@@ -34,3 +34,49 @@ def test_the_run_s_warnings_are_gathered_for_the_console(tmp_path):
         "S1 pert: too_few_strides",
     ]
     assert run_warnings(tmp_path / "none.tsv") == []
+
+
+#: A workflow of four result files, made one rule at a time.
+TINY_SNAKEFILE = """
+rule all:
+    input:
+        "results/a.txt",
+        "results/b.txt",
+        "results/c.txt",
+        "results/d.txt",
+
+
+rule one:
+    output:
+        "results/{name}.txt",
+    shell:
+        "echo {wildcards.name} > {output}"
+"""
+
+
+def test_a_report_before_the_workflow_has_run_names_the_missing_results_and_the_command(tmp_path, monkeypatch, capsys):
+    """After one target only, ``loper-analysis report`` stops in one line naming the first missing result files
+    and ``snakemake -j2`` (with the config files given), exit status 2; after the whole run it writes the report."""
+    import subprocess
+    import sys
+
+    from loper_analysis.cli import main
+
+    (tmp_path / "Snakefile").write_text(TINY_SNAKEFILE)
+    (tmp_path / "extra.yaml").write_text("note: 1\n")
+    monkeypatch.chdir(tmp_path)
+    subprocess.run([sys.executable, "-m", "snakemake", "-j1", "results/b.txt"], check=True, capture_output=True)
+    capsys.readouterr()
+    assert main(["report", "report.html"]) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        "loper-analysis report: report.html: the workflow has not built 3 of its result files (results/a.txt, "
+        "results/c.txt, results/d.txt): run the whole workflow first (snakemake -j2), then the report again: no "
+        "report was written\n"
+    )
+    assert main(["report", "report.html", "--configfile", "extra.yaml"]) == 2
+    assert "(snakemake -j2 --configfile extra.yaml)" in capsys.readouterr().err
+    assert not (tmp_path / "report.html").exists()
+    subprocess.run([sys.executable, "-m", "snakemake", "-j1"], check=True, capture_output=True)
+    assert main(["report", "report.html"]) == 0
+    assert (tmp_path / "report.html").read_bytes().rstrip().endswith(b"</html>")

@@ -24,6 +24,7 @@ __all__ = [
     "front_page",
     "snakemake_report_command",
     "check_report_complete",
+    "missing_results",
     "write_report",
 ]
 
@@ -261,6 +262,41 @@ def _configfiles(snakemake_args: Sequence[str]) -> list[str]:
     return files
 
 
+#: Result files named in the message when the workflow has not built them all.
+_MISSING_SHOWN = 3
+
+
+def missing_results(snakemake_args: Sequence[str] = (), cwd: PathLike | None = None) -> list[str]:
+    """The workflow's result files not built yet, in Snakemake's order: the rows of
+    ``python -m snakemake --summary ARGS`` (run in ``cwd``) whose status is ``missing`` (temporary files the
+    run removed are not). Empty when the summary cannot be made: the report command then says why."""
+    argv = [sys.executable, "-m", "snakemake", "--summary", *(str(a) for a in snakemake_args)]
+    run = subprocess.run(argv, cwd=cwd, capture_output=True, text=True, check=False)
+    if run.returncode != 0:
+        return []
+    rows = [line.split("\t") for line in run.stdout.splitlines()]
+    if not rows or rows[0][:1] != ["output_file"] or "status" not in rows[0]:
+        return []
+    status = rows[0].index("status")
+    return [row[0] for row in rows[1:] if len(row) > status and row[status] == "missing"]
+
+
+def _require_results(target: Path, snakemake_args: Sequence[str], cwd: PathLike | None, kept: str) -> None:
+    """Stop, naming the first missing result files and the command that builds them, before a report on a
+    workflow that has not run to the end (Snakemake's own message names one file and no remedy)."""
+    from loper_analysis.errors import LoperInputError
+
+    missing = missing_results(snakemake_args, cwd)
+    if not missing:
+        return
+    shown = ", ".join(missing[:_MISSING_SHOWN]) + (", ..." if len(missing) > _MISSING_SHOWN else "")
+    configs = "".join(f" --configfile {path}" for path in _configfiles(snakemake_args))
+    raise LoperInputError(
+        f"{target}: the workflow has not built {len(missing)} of its result files ({shown}): "
+        f"run the whole workflow first (snakemake -j2{configs}), then the report again: {kept}"
+    )
+
+
 def write_report(
     target: PathLike,
     command: Callable[[Path], Sequence[str]] | None = None,
@@ -282,12 +318,16 @@ def write_report(
     byte for byte and the temporary file is removed. Returns ``target``.
     Config files among ``snakemake_args`` are checked first
     (:func:`loper_analysis.schema.check_yaml_file`): Snakemake's own message
-    for a syntax error names neither the file nor the line.
+    for a syntax error names neither the file nor the line. Then the workflow's
+    result files must all be there (:func:`missing_results`): after building one
+    subject's targets only, the message names the first missing files and the
+    command that builds them (``snakemake -j2`` with the same config files).
 
     Raises
     ------
     LoperInputError
-        A config file given in ``snakemake_args`` does not parse; the command
+        A config file given in ``snakemake_args`` does not parse; result files
+        of the workflow are missing; the command
         failed (its exit status is named), wrote no file or an incomplete one;
         the report cannot be moved into place.
     """
@@ -296,11 +336,12 @@ def write_report(
     from loper_analysis.schema import check_yaml_file
 
     target = Path(target)
+    kept = "the previous report is kept" if target.exists() else "no report was written"
     if command is None:
         for path in _configfiles(snakemake_args):
             check_yaml_file(Path(cwd or ".") / path)
+        _require_results(target, snakemake_args, cwd, kept)
         command = snakemake_report_command(snakemake_args)
-    kept = "the previous report is kept" if target.exists() else "no report was written"
     main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _stop_on_sigterm) if main_thread else None
     try:
