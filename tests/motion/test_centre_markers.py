@@ -11,7 +11,8 @@ from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.motion.centre_markers import calibration_centres, joint_centre_places, marker_set_centres
 
 PIG_LABELS = [f"{s}{c}" for s in "LR" for c in ("ASI", "PSI", "THI", "KNE", "TIB", "ANK", "HEE", "TOE")]
-CENTRES = ["LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC", "PELVIS_FWD", "LFOOT_UP", "RFOOT_UP"]
+CENTRES = ["LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC", "PELVIS_FRONT", "PELVIS_BACK", "LKNEE_LAT", "LKNEE_MED",
+           "LFOOT_UP", "LFOOT_DOWN", "RKNEE_LAT", "RKNEE_MED", "RFOOT_UP", "RFOOT_DOWN"]  # fmt: skip
 
 
 @pytest.fixture(scope="module")
@@ -44,6 +45,10 @@ def test_the_centres_sit_at_the_models_own_joints_in_the_default_pose(pig):
         np.testing.assert_allclose(back.to_numpy(), ground, atol=1e-12)
     np.testing.assert_allclose(places["LHJC"][1], (-0.0707, -0.0661, -0.0835), atol=1e-12)
     assert places["RFOOT_UP"] == ("talus_r", pytest.approx((0.0, 0.1, 0.0), abs=1e-12))
+    assert places["RFOOT_DOWN"] == ("talus_r", pytest.approx((0.0, -0.1, 0.0), abs=1e-12))
+    knee = np.array(places["LKJC"][1])  # the knee's axis: gait2392's femur z, lateral to the left for the left knee
+    np.testing.assert_allclose(places["LKNEE_LAT"][1], knee + [0.0, 0.0, -0.1], atol=1e-12)
+    np.testing.assert_allclose(places["LKNEE_MED"][1], knee + [0.0, 0.0, 0.1], atol=1e-12)
 
 
 def test_a_marker_set_is_told_by_its_centres(pig):

@@ -115,8 +115,11 @@ def test_direction_markers_point_forward_along_the_spines_and_up_from_the_ankles
     g = {n: X[0, labels.index(n)] for n in ("LASI", "RASI", "LPSI", "RPSI")}
     forward = 0.5 * (g["LASI"] + g["RASI"] - g["LPSI"] - g["RPSI"])
     hips = 0.5 * (got["LHJC"] + got["RHJC"])
-    np.testing.assert_allclose(got["PELVIS_FWD"], hips + DIRECTION_LEVER_M * forward / np.linalg.norm(forward))
+    unit = forward / np.linalg.norm(forward)
+    np.testing.assert_allclose(got["PELVIS_FRONT"], hips + DIRECTION_LEVER_M * unit)
+    np.testing.assert_allclose(got["PELVIS_BACK"], hips - DIRECTION_LEVER_M * unit)
     np.testing.assert_allclose(got["LFOOT_UP"], got["LAJC"] + [0, 0, DIRECTION_LEVER_M])
+    np.testing.assert_allclose(got["LFOOT_DOWN"], got["LAJC"] - [0, 0, DIRECTION_LEVER_M])
     assert centres.methods["LKJC"] == "midpoint of LKNE and LMKNE"
 
 

@@ -35,6 +35,19 @@ def test_neighbouring_factors_more_than_20_percent_apart_are_warned_about():
     warnings = neighbour_factor_warnings(factors, pairs)
     assert [name for name, _ in warnings] == ["scale_talus_r_calcn_r"]
     assert "differ by 22 %: talus_r 1.090, calcn_r 1.330" in warnings[0][1]
+    assert "a marker of the measurement placed elsewhere" in warnings[0][1]
+
+
+def test_neighbours_both_scaled_between_joint_centres_are_said_to_differ_in_proportion():
+    """A child's pelvis (hip centres 107 mm apart: 0.643 of gait2392's) on a femur of 0.992: the factors differ
+    by 54 %, from the subject's proportions, not a marker placed elsewhere; a foot measured by its markers next to
+    a talus scaled between centres keeps the marker's wording."""
+    factors = {"pelvis": (0.643,) * 3, "femur_r": (0.992,) * 3, "talus_r": (0.907,) * 3, "calcn_r": (0.535,) * 3}
+    pairs = [("pelvis", "femur_r"), ("talus_r", "calcn_r")]
+    warnings = dict(neighbour_factor_warnings(factors, pairs, {"pelvis", "femur_r", "talus_r"}))
+    assert "differ by 54 %" in warnings["scale_pelvis_femur_r"]
+    assert "both between the static trial's joint centres" in warnings["scale_pelvis_femur_r"]
+    assert "a marker of the measurement placed elsewhere" in warnings["scale_talus_r_calcn_r"]
 
 
 def test_the_report_holds_the_errors_before_and_after_placement_and_the_pose():

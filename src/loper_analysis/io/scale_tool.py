@@ -103,6 +103,19 @@ def measurement_pairs(tool) -> dict[str, list[tuple[str, str]]]:
     return out
 
 
+def measurement_bodies(tool) -> dict[str, list[str]]:
+    """Bodies each applied measurement of a ScaleTool scales (empty when its model scaler does not measure)."""
+    names = measurement_pairs(tool)
+    measurements = tool.getModelScaler().getMeasurementSet()
+    out = {}
+    for i in range(measurements.getSize()):
+        m = measurements.get(i)
+        if m.getName() in names:
+            scales = m.getBodyScaleSet()
+            out[m.getName()] = [scales.get(j).getName() for j in range(scales.getSize())]
+    return out
+
+
 def measurement_markers(tool) -> set[str]:
     """Markers of the applied measurements of a ScaleTool (empty when its model scaler does not measure)."""
     return {m for pairs in measurement_pairs(tool).values() for pair in pairs for m in pair}

@@ -47,18 +47,26 @@ class JointCentreSpec:
         The centres' weight when the static pose is fitted.
     foot_bodies : dict
         Side -> the foot's body (its direction marker's).
+    others_weight : float
+        Every other marker's weight in that fit: they only settle the turns the centres leave free (the femur's
+        about its axis when the knee is straight), and pull the pose no further.
     """
 
     centres: dict[str, tuple[str, str]]
     landmarks: Landmarks
     weight: float
     foot_bodies: dict[str, str]
+    others_weight: float = 0.1
 
     @property
     def names(self) -> list[str]:
         """The virtual markers: the centres, the pelvis's and each foot's direction markers."""
         lm = self.landmarks
-        return [*self.centres, PELVIS_DIRECTION, *(lm.foot_direction(side) for side in SIDES)]
+        return [
+            *self.centres,
+            *PELVIS_DIRECTION,
+            *(name for side in SIDES for name in (*lm.knee_axis(side), *lm.foot_direction(side))),
+        ]
 
 
 def joint_centre_spec(spec, prefix: Mapping[str, str]) -> JointCentreSpec | None:
@@ -72,7 +80,7 @@ def joint_centre_spec(spec, prefix: Mapping[str, str]) -> JointCentreSpec | None
             centres[f"{prefix[side]}{code}"] = (str(parent).format(s=s), str(child).format(s=s))
     landmarks = Landmarks(**{str(k): str(v or "") for k, v in spec["landmarks"].items()}, prefix=dict(prefix))
     feet = {side: str(spec["foot_body"]).format(s=SIDE_SUFFIX[side]) for side in SIDES}
-    return JointCentreSpec(centres, landmarks, float(spec["weight"]), feet)
+    return JointCentreSpec(centres, landmarks, float(spec["weight"]), feet, float(spec["others_weight"]))
 
 
 def marker_set_centres(templates: Sequence[MarkerTemplate], marker_names: Sequence[str]) -> JointCentreSpec | None:
@@ -95,10 +103,10 @@ def centre_names(template: MarkerTemplate) -> list[str]:
 def joint_centre_places(template: MarkerTemplate, model) -> dict[str, tuple[str, tuple[float, float, float]]]:
     """Each virtual marker of the calibration -> (body, location in its frame, m) on ``model``, in the model's
     default pose: a joint centre is the child body's origin in the parent body's frame; the pelvis's direction
-    marker lies :data:`~loper_analysis.motion.joint_centres.DIRECTION_LEVER_M` from the hips' midpoint along the
-    line from the template's posterior spines (or sacrum) to its anterior spines, a foot's straight up from the ankle
-    centre (against the model's gravity: the foot stands flat in the default pose). Empty for a template without
-    joint centres.
+    markers lie :data:`~loper_analysis.motion.joint_centres.DIRECTION_LEVER_M` ahead of and behind the hips' midpoint
+    along the line from the template's posterior spines (or sacrum) to its anterior spines, a foot's above and below
+    the ankle centre (against the model's gravity: the foot stands flat in the default pose). Empty for a template
+    without joint centres.
 
     Raises
     ------
@@ -150,12 +158,19 @@ def joint_centre_places(template: MarkerTemplate, model) -> dict[str, tuple[str,
     hips = 0.5 * (centre_ground[lm.centre("left", "HJC")] + centre_ground[lm.centre("right", "HJC")])
     pelvis = spec.centres[lm.centre("left", "HJC")][0]
     unit = (front - back) / np.linalg.norm(front - back)
-    out[PELVIS_DIRECTION] = (pelvis, in_body(pelvis, hips + DIRECTION_LEVER_M * unit))
+    for name, sign in zip(PELVIS_DIRECTION, (1.0, -1.0)):
+        out[name] = (pelvis, in_body(pelvis, hips + sign * DIRECTION_LEVER_M * unit))
+    for side, lateral in (("left", -1.0), ("right", 1.0)):  # the knee's axis: gait2392's knee turns about z
+        knee = centre_ground[lm.centre(side, "KJC")]
+        femur = spec.centres[lm.centre(side, "KJC")][0]
+        for name, sign in zip(lm.knee_axis(side), (1.0, -1.0)):
+            out[name] = (femur, in_body(femur, knee + sign * lateral * DIRECTION_LEVER_M * np.array([0.0, 0.0, 1.0])))
     up = -model.getGravity().to_numpy()
     for side in SIDES:
         ankle = centre_ground[lm.centre(side, "AJC")]
         foot = spec.foot_bodies[side]
-        out[lm.foot_direction(side)] = (foot, in_body(foot, ankle + DIRECTION_LEVER_M * up / np.linalg.norm(up)))
+        for name, sign in zip(lm.foot_direction(side), (1.0, -1.0)):
+            out[name] = (foot, in_body(foot, ankle + sign * DIRECTION_LEVER_M * up / np.linalg.norm(up)))
     return out
 
 

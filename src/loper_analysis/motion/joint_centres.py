@@ -23,15 +23,20 @@ so that a standing subject comes out near neutral whatever the places of the lab
 * **Ankle**, likewise: the midpoint of the malleoli; the chord of the knee centre, the shank wand and the lateral
   malleolus with half the ankle width plus the marker radius; without a wand, along the pelvis's medial axis.
 
-Two segments are not oriented by their centres alone: the pelvis turns about the line of its hip centres, the foot
-about the ankle's axis. Each gets a virtual marker :data:`DIRECTION_LEVER_M` from its centre: ``PELVIS_FWD`` from
-the hips' midpoint along the line from the posterior spines' midpoint (or the sacrum) to the anterior spines' (the
-pelvis's forward axis); ``LFOOT_UP`` and ``RFOOT_UP`` straight up from the ankle centre, as a foot stands flat on
-the floor in a static trial whatever the heights of its heel and toe markers (Plug-in Gait's "foot flat"; the foot's
-turn about the vertical is left to the leg). On the model the same lines are the template's posterior to anterior
-spines and the vertical of its default pose, in which the foot stands flat
-(:func:`loper_analysis.motion.centre_markers.joint_centre_places`), so the segment's orientation in the static
-pose is the one its landmarks give, however far the template's places lie from the subject's.
+Three segments are not oriented by their centres alone: the pelvis turns about the line of its hip centres, the
+femur about its own axis, the foot about the ankle's axis. Each gets a pair of virtual markers
+:data:`DIRECTION_LEVER_M` either side of its centre: ``PELVIS_FRONT`` and ``PELVIS_BACK`` ahead of and behind the hips'
+midpoint along the line from the posterior spines' midpoint (or the sacrum) to the anterior spines' (the pelvis's
+forward axis); ``LKNEE_LAT`` and ``LKNEE_MED`` (and the right's) along the knee's flexion axis, the line from the
+knee's centre to the lateral knee marker (the medial marker's line, the device's axis or the chord's, whichever
+found the centre); ``LFOOT_UP`` and ``LFOOT_DOWN`` (and the
+right's) above and below the ankle centre, as a foot stands flat on the floor in a static trial whatever the heights
+of its heel and toe markers (Plug-in Gait's "foot flat"; the foot's turn about the vertical is left to the leg). On
+the model the same lines are the template's posterior to anterior spines and the vertical of its default pose, in
+which the foot stands flat (:func:`loper_analysis.motion.centre_markers.joint_centre_places`), so the segment's
+orientation in the static pose is the one its landmarks give, however far the template's places lie from the
+subject's. A pair, not one marker: the model's lever scales with its body, the trial's does not, and a pair's
+mismatch pulls its centre no way.
 
 Widths and lengths are the lab's measurements (Vicon Nexus stores ``LKneeWidth``, ``RAnkleWidth``, ``LLegLength``,
 ``LAsisTrocanterDistance``, ``InterAsisDistance`` and ``MarkerDiameter`` in mm in the C3D's ``PROCESSING`` group:
@@ -53,6 +58,7 @@ __all__ = [
     "ANKLE_OFFSET_PER_SHANK",
     "DIRECTION_LEVER_M",
     "FOOT_DIRECTION",
+    "KNEE_AXIS",
     "PELVIS_DIRECTION",
     "KNEE_OFFSET_PER_THIGH",
     "MARKER_DIAMETER_M",
@@ -79,10 +85,12 @@ ANKLE_OFFSET_PER_SHANK: float = 0.060 / 0.430
 
 #: Distance of a direction marker from its centre (m): long enough that an orientation weighs like the centres.
 DIRECTION_LEVER_M: float = 0.1
-#: The pelvis's direction marker.
-PELVIS_DIRECTION: str = "PELVIS_FWD"
-#: A foot's direction marker, after the side's prefix ``L``/``R``.
-FOOT_DIRECTION: str = "FOOT_UP"
+#: The pelvis's direction markers, ahead of and behind the hips' midpoint.
+PELVIS_DIRECTION: tuple[str, str] = ("PELVIS_FRONT", "PELVIS_BACK")
+#: A foot's direction markers, above and below the ankle's centre, after the side's prefix ``L``/``R``.
+FOOT_DIRECTION: tuple[str, str] = ("FOOT_UP", "FOOT_DOWN")
+#: A knee's axis markers, lateral and medial of the knee's centre along its flexion axis, after the side's prefix.
+KNEE_AXIS: tuple[str, str] = ("KNEE_LAT", "KNEE_MED")
 
 
 @dataclass(frozen=True)
@@ -110,9 +118,13 @@ class Landmarks:
         """A sided marker's name ("" for a landmark the marker set lacks: code "")."""
         return f"{self.prefix[side]}{code}" if code else ""
 
-    def foot_direction(self, side: str) -> str:
-        """The name of a foot's direction marker."""
-        return f"{self.prefix[side]}{FOOT_DIRECTION}"
+    def knee_axis(self, side: str) -> tuple[str, str]:
+        """The names of a knee's axis markers (lateral, medial)."""
+        return tuple(f"{self.prefix[side]}{name}" for name in KNEE_AXIS)
+
+    def foot_direction(self, side: str) -> tuple[str, str]:
+        """The names of a foot's direction markers (up, down)."""
+        return tuple(f"{self.prefix[side]}{name}" for name in FOOT_DIRECTION)
 
     def centre(self, side: str, joint: str) -> str:
         """The name of a joint centre's virtual marker (``joint``: ``HJC``, ``KJC`` or ``AJC``)."""
@@ -367,71 +379,89 @@ def static_joint_centres(
         methods[names[-1]] = hip_method
     medial_axis = {"left": z, "right": -z}
     for side in SIDES:
-        knee, how = _knee_centre(side, get, hips[side], medial_axis[side], widths, radius, lm)
+        knee, how = _distal_centre(side, get, hips[side], medial_axis[side], widths, radius, lm, _joints(lm)["KJC"])
         names.append(lm.centre(side, "KJC"))
         centres.append(knee)
         methods[names[-1]] = how
     for side in SIDES:
         knee = centres[names.index(lm.centre(side, "KJC"))]
-        ankle, how = _ankle_centre(side, get, knee, medial_axis[side], widths, radius, lm)
+        ankle, how = _distal_centre(side, get, knee, medial_axis[side], widths, radius, lm, _joints(lm)["AJC"])
         names.append(lm.centre(side, "AJC"))
         centres.append(ankle)
         methods[names[-1]] = how
     forward = _unit(0.5 * (lasi + rasi) - posterior)
-    names.append(PELVIS_DIRECTION)
-    centres.append(0.5 * (hips["left"] + hips["right"]) + DIRECTION_LEVER_M * forward)
-    methods[PELVIS_DIRECTION] = f"pelvis forward: {back} to the anterior spines, from the hips' midpoint"
-    for side in SIDES:
-        ankle = centres[names.index(lm.centre(side, "AJC"))]
-        names.append(lm.foot_direction(side))
-        centres.append(ankle + DIRECTION_LEVER_M * np.asarray(up, float) / np.linalg.norm(up))
-        methods[names[-1]] = f"foot up: the vertical from {lm.centre(side, 'AJC')} (the foot flat on the floor)"
+    _add_directions(names, centres, methods, get, lm, (forward, back, np.asarray(up, float)))
     return JointCentres(tuple(names), np.stack(centres, axis=1), methods)
 
 
-def _knee_centre(side, get, hip, medial_axis, widths, radius, lm: Landmarks):
-    """One knee's centre and how it was found."""
-    lateral = get(lm.name(side, lm.knee_lateral))
-    medial = get(lm.name(side, lm.knee_medial))
-    lateral_name = lm.name(side, lm.knee_lateral)
+def _add_directions(names: list, centres: list, methods: dict, get, lm: Landmarks, axes) -> None:
+    """Append the direction pairs (see the module's text) to the centres found: ``axes`` are the pelvis's forward
+    axis (n, 3), the word for its posterior landmarks and the vertical (3,)."""
+    forward, back, up = axes
+    hips_mid = 0.5 * (centres[names.index(lm.centre("left", "HJC"))] + centres[names.index(lm.centre("right", "HJC"))])
+    for name, sign, where in zip(PELVIS_DIRECTION, (1.0, -1.0), ("ahead of", "behind")):
+        names.append(name)
+        centres.append(hips_mid + sign * DIRECTION_LEVER_M * forward)
+        methods[name] = f"pelvis forward ({back} to the anterior spines), {where} the hips' midpoint"
+    for side in SIDES:  # the knee's flexion axis: from its centre to the lateral marker, whichever way found
+        knee = centres[names.index(lm.centre(side, "KJC"))]
+        lateral = _unit(get(lm.name(side, lm.knee_lateral)) - knee)
+        for name, sign, where in zip(lm.knee_axis(side), (1.0, -1.0), ("lateral", "medial")):
+            names.append(name)
+            centres.append(knee + sign * DIRECTION_LEVER_M * lateral)
+            methods[name] = f"knee flexion axis: {lm.centre(side, 'KJC')} to {lm.name(side, lm.knee_lateral)}, {where}"
+    vertical = up / np.linalg.norm(up)
+    for side in SIDES:
+        ankle = centres[names.index(lm.centre(side, "AJC"))]
+        for name, sign, where in zip(lm.foot_direction(side), (1.0, -1.0), ("above", "below")):
+            names.append(name)
+            centres.append(ankle + sign * DIRECTION_LEVER_M * vertical)
+            methods[name] = f"foot flat on the floor: the vertical {where} {lm.centre(side, 'AJC')}"
+
+
+@dataclass(frozen=True)
+class _Joint:
+    """What finds one distal joint's centre: its markers' codes, its width's key, its proximal centre's word, the
+    model's proportion without a width, and a knee alignment device's axis marker (knees only)."""
+
+    joint: str
+    lateral: str
+    medial: str
+    wand: str
+    segment: str
+    proximal: str
+    proportion: float
+    kad_axis: str = ""
+
+
+def _joints(lm: Landmarks) -> dict[str, _Joint]:
+    return {
+        "KJC": _Joint("knee", lm.knee_lateral, lm.knee_medial, lm.thigh_wand, "thigh", "hip", KNEE_OFFSET_PER_THIGH,
+                      lm.kad_axis),
+        "AJC": _Joint("ankle", lm.ankle_lateral, lm.ankle_medial, lm.shank_wand, "shank", "knee",
+                      ANKLE_OFFSET_PER_SHANK),
+    }  # fmt: skip
+
+
+def _distal_centre(side, get, proximal, medial_axis, widths, radius, lm: Landmarks, j: _Joint):
+    """One knee's or ankle's centre (:class:`_Joint`) and how it was found."""
+    lateral_name = lm.name(side, j.lateral)
+    lateral, medial = get(lateral_name), get(lm.name(side, j.medial))
     if medial is not None and np.isfinite(medial).all(axis=1).any():
-        return 0.5 * (lateral + medial), f"midpoint of {lateral_name} and {lm.name(side, lm.knee_medial)}"
-    width = widths.get(f"knee_{side}")
+        return 0.5 * (lateral + medial), f"midpoint of {lateral_name} and {lm.name(side, j.medial)}"
+    width = widths.get(f"{j.joint}_{side}")
     if width is not None:
-        offset, said = 0.5 * width + radius, f"half the knee width {width * 1000:.1f} mm + marker radius"
+        offset, said = 0.5 * width + radius, f"half the {j.joint} width {width * 1000:.1f} mm + marker radius"
     else:
-        offset = KNEE_OFFSET_PER_THIGH * np.linalg.norm(lateral - hip, axis=1)
-        said = "no knee width stored: the model's proportion of the hip to knee distance"
-    axis = get(lm.name(side, lm.kad_axis))
+        offset = j.proportion * np.linalg.norm(lateral - proximal, axis=1)
+        said = f"no {j.joint} width stored: the model's proportion of the {j.proximal} to {j.joint} distance"
+    axis = get(lm.name(side, j.kad_axis))
     if axis is not None and np.isfinite(axis).all(axis=1).any():
         centre = lateral + np.atleast_1d(offset)[:, None] * _unit(lateral - axis)
-        return centre, f"knee alignment device: {lateral_name} along its axis by {said}"
-    wand = get(lm.name(side, lm.thigh_wand))
+        return centre, f"{j.joint} alignment device: {lateral_name} along its axis by {said}"
+    wand = get(lm.name(side, j.wand))
     if wand is not None and np.isfinite(wand).all(axis=1).any():
-        return chord_centre(
-            hip, wand, lateral, offset
-        ), f"chord of the hip centre, thigh wand and {lateral_name}, {said}"
-    centre = lateral + np.atleast_1d(offset)[:, None] * medial_axis
-    return centre, f"{lateral_name} along the pelvis's medial axis by {said}"
-
-
-def _ankle_centre(side, get, knee, medial_axis, widths, radius, lm: Landmarks):
-    """One ankle's centre and how it was found."""
-    lateral = get(lm.name(side, lm.ankle_lateral))
-    medial = get(lm.name(side, lm.ankle_medial))
-    lateral_name = lm.name(side, lm.ankle_lateral)
-    if medial is not None and np.isfinite(medial).all(axis=1).any():
-        return 0.5 * (lateral + medial), f"midpoint of {lateral_name} and {lm.name(side, lm.ankle_medial)}"
-    width = widths.get(f"ankle_{side}")
-    if width is not None:
-        offset, said = 0.5 * width + radius, f"half the ankle width {width * 1000:.1f} mm + marker radius"
-    else:
-        offset = ANKLE_OFFSET_PER_SHANK * np.linalg.norm(lateral - knee, axis=1)
-        said = "no ankle width stored: the model's proportion of the knee to ankle distance"
-    wand = get(lm.name(side, lm.shank_wand))
-    if wand is not None and np.isfinite(wand).all(axis=1).any():
-        return chord_centre(
-            knee, wand, lateral, offset
-        ), f"chord of the knee centre, shank wand and {lateral_name}, {said}"
+        how = f"chord of the {j.proximal} centre, {j.segment} wand and {lateral_name}, {said}"
+        return chord_centre(proximal, wand, lateral, offset), how
     centre = lateral + np.atleast_1d(offset)[:, None] * medial_axis
     return centre, f"{lateral_name} along the pelvis's medial axis by {said}"

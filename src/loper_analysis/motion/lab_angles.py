@@ -55,7 +55,7 @@ MIN_LAB_R: float = 0.9
 MAX_LAB_RMS_RAD: float = float(np.radians(10.0))
 #: Beyond this mean offset from the lab's angle at the hip or knee (rad; 6 degrees) a joint is warned about: a
 #: calibration that bends the static pose shows as a constant offset long before the RMS limit. Seven clinical labs'
-#: walks through the joint-centre calibration stay within 4.3 degrees of their own Plug-in Gait (a calibration on the
+#: walks through the joint-centre calibration stay within 4.9 degrees of their own Plug-in Gait (a calibration on the
 #: template's marker places gave 6 to 15 degrees).
 MAX_LAB_OFFSET_RAD: float = float(np.radians(6.0))
 #: The correlation is judged only where the lab's angle moves at least this much (rad; 10 degrees, max - min):

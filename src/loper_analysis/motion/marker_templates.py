@@ -404,7 +404,7 @@ def template_scale_tool(template: MarkerTemplate, static_markers: Sequence[str],
             task = osim.IKMarkerTask()
             task.setName(m.name)
             task.setApply(True)
-            task.setWeight(template.weights[m.role])
+            task.setWeight(template.joint_centres.others_weight if centres else template.weights[m.role])
             tasks.cloneAndAppend(task)
     for name in centres:
         task = osim.IKMarkerTask()

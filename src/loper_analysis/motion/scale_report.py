@@ -21,7 +21,7 @@ each warning naming the setting to check.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -64,8 +64,8 @@ MAX_STATIC_FLEXION_RAD: dict[str, float] = {
     "ankle": float(np.radians(15.0)),
 }
 #: A static pose's joint angle further than this from the lab's own static angle (rad) is warned about. The joint-
-#: centre calibration gives the seven clinical labs' static hip and knee within 3 degrees of their own (ankle within
-#: 9: Plug-in Gait turns the ankle by the tibial torsion a lab enters); a calibration on the template's marker places
+#: centre calibration gives the seven clinical labs' static hip and knee within 1.9 degrees of their own (ankle within
+#: 5.2: Plug-in Gait turns the ankle by the tibial torsion a lab enters); a calibration on the template's marker places
 #: gave 6 to 17 degrees at hip and knee.
 MAX_STATIC_LAB_DIFF_RAD: dict[str, float] = {
     "hip": float(np.radians(5.0)),
@@ -155,25 +155,36 @@ def static_pose_warnings(
 
 
 def neighbour_factor_warnings(
-    factors: Mapping[str, Sequence[float]], neighbours: Sequence[tuple[str, str]]
+    factors: Mapping[str, Sequence[float]],
+    neighbours: Sequence[tuple[str, str]],
+    between_centres: Collection[str] = (),
 ) -> list[tuple[str, str]]:
     """(name, warning) for each pair of jointed bodies whose (mean) scale factors differ by more than
-    :data:`MAX_NEIGHBOUR_FACTOR_RATIO`; bodies a measurement did not scale are skipped."""
+    :data:`MAX_NEIGHBOUR_FACTOR_RATIO`; bodies a measurement did not scale are skipped. Two bodies both scaled
+    between joint centres (``between_centres``) differ in the subject's proportions, not by a marker placed
+    elsewhere: the warning says so."""
     out = []
     for parent, child in neighbours:
         if parent not in factors or child not in factors:
             continue
         a, b = float(np.mean(factors[parent])), float(np.mean(factors[child]))
         if a > 0 and b > 0 and max(a, b) / min(a, b) > MAX_NEIGHBOUR_FACTOR_RATIO:
-            out.append(
-                (
-                    f"scale_{parent}_{child}",
-                    f"scale factors of neighbouring bodies differ by {100 * (max(a, b) / min(a, b) - 1):.0f} %: "
-                    f"{parent} {a:.3f}, {child} {b:.3f} (more than {100 * (MAX_NEIGHBOUR_FACTOR_RATIO - 1):.0f} %): "
-                    "a marker of the measurement placed elsewhere on the subject than on the model? (the "
-                    "measurements and marker set of opensim.scale_setup)",
-                )
+            said = (
+                f"scale factors of neighbouring bodies differ by {100 * (max(a, b) / min(a, b) - 1):.0f} %: "
+                f"{parent} {a:.3f}, {child} {b:.3f} (more than {100 * (MAX_NEIGHBOUR_FACTOR_RATIO - 1):.0f} %): "
             )
+            if parent in between_centres and child in between_centres:
+                said += (
+                    "both between the static trial's joint centres: the subject's proportions are not the model's "
+                    "(the model's masses and inertias follow each factor); if unexpected, check the leg lengths "
+                    "and widths the static trial stores and the hip centre's method in this report"
+                )
+            else:
+                said += (
+                    "a marker of the measurement placed elsewhere on the subject than on the model? (the "
+                    "measurements and marker set of opensim.scale_setup)"
+                )
+            out.append((f"scale_{parent}_{child}", said))
     return out
 
 
@@ -361,6 +372,7 @@ def scaled_model_report(
     lab_labels: Mapping[str, str] | None = None,
     lab_static: Mapping[str, float] | None = None,
     model_height_m: float = float("nan"),
+    between_centres: Collection[str] = (),
 ) -> pd.DataFrame:
     """The scale report (:func:`scale_report`) of a scaled model, with its checks.
 
@@ -388,6 +400,8 @@ def scaled_model_report(
     model_height_m : float
         The scaled model's stature (m; :func:`loper_analysis.motion.body_size.model_height_m`), compared with
         the subject's height (:func:`stature_warnings`); NaN: not compared.
+    between_centres : collection of str
+        The bodies scaled between joint centres (:func:`neighbour_factor_warnings`).
 
     Returns
     -------
@@ -406,7 +420,7 @@ def scaled_model_report(
     before = None if unplaced is None else static_fit(unplaced, pose, weights, coords, cmap, accuracy, solver)
     scaled_factors = {b: f for b, f in factors.items() if not np.allclose(f, 1.0)}
     warnings = static_pose_warnings((before or after).angles_rad, lab_static)
-    warnings += neighbour_factor_warnings(scaled_factors, jointed_bodies(scaled))
+    warnings += neighbour_factor_warnings(scaled_factors, jointed_bodies(scaled), between_centres)
     warnings += stature_warnings(subject[1], model_height_m, subject[2])
     return scale_report(
         _names(scaled.getBodySet()),
@@ -445,6 +459,7 @@ def scale_run_report(
     *,
     lab_labels: Mapping[str, str] | None = None,
     lab_angles: pd.DataFrame | None = None,
+    between_centres: Collection[str] = (),
 ) -> pd.DataFrame:
     """The scale report (:func:`scaled_model_report`) of one run of OpenSim's ScaleTool.
 
@@ -467,6 +482,8 @@ def scale_run_report(
     lab_angles : pandas.DataFrame, optional
         The lab's own joint angles of the static trial (``time_s`` and ``*_rad`` columns), averaged over the
         run's window (:func:`loper_analysis.motion.lab_angles.window_means`).
+    between_centres : collection of str
+        The bodies scaled between joint centres (:func:`neighbour_factor_warnings`).
 
     Returns
     -------
@@ -491,4 +508,5 @@ def scale_run_report(
         lab_labels=lab_labels,
         lab_static=lab_static,
         model_height_m=subject[3],
+        between_centres=between_centres,
     )

@@ -326,7 +326,14 @@ def _scale(
     if files.report_out is not None:
         lab_angles = None if files.static_lab_angles is None else _lab_angles(files.static_lab_angles)
         report = scale_run_report(
-            run, generic, static.pose, subject, settings, lab_labels=lab_labels, lab_angles=lab_angles
+            run,
+            generic,
+            static.pose,
+            subject,
+            settings,
+            lab_labels=lab_labels,
+            lab_angles=lab_angles,
+            between_centres=_between_centres(tool, centre_methods),
         )
         report = joint_centre_rows(report, centre_methods)
         _write_scale_report(report, files)
@@ -358,6 +365,17 @@ def _with_joint_centres(markers, generic, static_c3d: PathLike | None, static_tr
     for name, how in methods.items():
         log.info("%s: joint centre %s: %s", static_trc, name, how)
     return markers, methods
+
+
+def _between_centres(tool, centre_methods) -> set[str]:
+    """The bodies the tool scales by measurements between joint centres only."""
+    pairs, bodies = scale_tool.measurement_pairs(tool), scale_tool.measurement_bodies(tool)
+    return {
+        body
+        for name, measured in pairs.items()
+        if measured and all(a in centre_methods and b in centre_methods for a, b in measured)
+        for body in bodies.get(name, [])
+    }
 
 
 def _write_scale_report(report, files: ScaleFiles) -> None:
