@@ -181,3 +181,22 @@ def test_a_word_for_a_number_an_empty_sheet_and_a_missing_one_are_named(tmp_path
         read_subject_sheet(sheet)
     with pytest.raises(LoperInputError, match=rf"^{tmp_path / 'none.tsv'}: subject sheet not found$"):
         read_subject_sheet(tmp_path / "none.tsv")
+
+
+def test_a_subject_or_trial_named_like_a_missing_value_stays_a_name(tmp_path):
+    """The subject IDs' rule allows ``NA``, ``None``, ``null``, ``nan``: the sheet and every table the pipeline
+    writes read them back as names; a number column still reads an empty cell (and ``NA``) as missing."""
+    from loper_analysis.io.atomic import write_tsv
+    from loper_analysis.io.readers import read_subject_sheet, read_tsv
+
+    sheet = tmp_path / "subjects.tsv"
+    sheet.write_text("subject\tsource\tmass_kg\nNA\tsynthetic\t70\nnull\trecorded\t\nnan\trecorded\t61.5\n")
+    read = read_subject_sheet(sheet)
+    assert read["subject"].tolist() == ["NA", "null", "nan"] and read["mass_kg"].isna().tolist() == [False, True, False]
+    table = pd.DataFrame({"subject": ["NA", "None"], "trial": ["null", "walk"], "rmsd_rad": [np.nan, 0.25]})
+    write_tsv(table, tmp_path / "t.tsv")
+    back = read_tsv(tmp_path / "t.tsv")
+    assert back["subject"].tolist() == ["NA", "None"] and back["trial"].tolist() == ["null", "walk"]
+    assert np.isnan(back["rmsd_rad"][0]) and back["rmsd_rad"][1] == 0.25
+    (tmp_path / "n.tsv").write_text("subject\tx\nS01\tNA\n")  # another tool's NA in a number column: missing
+    assert np.isnan(read_tsv(tmp_path / "n.tsv")["x"][0])

@@ -16,12 +16,39 @@ from loper_analysis.io.timing import timed_io
 __all__ = ["read_bytes", "read_label_map", "read_label_maps", "read_subject_sheet", "read_tsv", "read_yaml"]
 
 
+#: Columns that hold names (a subject ``NA``, a trial ``null``): text, missing only when empty.
+NAME_COLUMNS: tuple[str, ...] = ("subject", "trial")
+#: What pandas reads as missing by default (its documented list), kept for every other column.
+PANDAS_NA_VALUES: tuple[str, ...] = (
+    "", "#N/A", "#N/A N/A", "#NA", "-1.#IND", "-1.#QNAN", "-NaN", "-nan", "1.#IND", "1.#QNAN", "<NA>", "N/A", "NA",
+    "NULL", "NaN", "None", "n/a", "nan", "null",
+)  # fmt: skip
+
+
+def _name_columns_as_text(path: Path, read_csv: dict) -> dict:
+    """``read_csv`` with the name columns of the file's header (:data:`NAME_COLUMNS`) read as text, missing only
+    when empty; unchanged when the caller sets its own missing values or the file has no such column."""
+    if "keep_default_na" in read_csv or "na_values" in read_csv:
+        return read_csv
+    with path.open(encoding="utf-8", errors="replace") as fh:
+        header = fh.readline().rstrip("\r\n").split("\t")
+    names = [c for c in header if c in NAME_COLUMNS]
+    if not names:
+        return read_csv
+    na = {c: ([""] if c in names else list(PANDAS_NA_VALUES)) for c in header}
+    dtype = read_csv.get("dtype")
+    if dtype is None or isinstance(dtype, dict):
+        dtype = {**dict.fromkeys(names, str), **(dtype or {})}
+    return {**read_csv, "keep_default_na": False, "na_values": na, "dtype": dtype}
+
+
 @timed_io
 def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str] = (), **read_csv) -> pd.DataFrame:
     """A TSV table; an empty file (zero bytes) gives an empty frame.
 
     ``columns`` must be present in a table that has rows; ``read_csv`` goes to
-    :func:`pandas.read_csv`.
+    :func:`pandas.read_csv`. The name columns (:data:`NAME_COLUMNS`) are text, missing only when empty (a
+    subject named ``NA`` stays ``NA``), unless ``read_csv`` sets its own missing values.
 
     Raises
     ------
@@ -34,7 +61,7 @@ def read_tsv(path: str | os.PathLike, what: str = "table", columns: Sequence[str
     if path.stat().st_size == 0:
         return pd.DataFrame()
     try:
-        table = pd.read_csv(path, sep="\t", **read_csv)
+        table = pd.read_csv(path, sep="\t", **_name_columns_as_text(path, read_csv))
     except pd.errors.EmptyDataError:
         return pd.DataFrame()
     except (OSError, pd.errors.ParserError, UnicodeDecodeError, ValueError) as exc:
@@ -157,7 +184,8 @@ def read_subject_sheet(path: str | os.PathLike) -> pd.DataFrame:
 
     Encodings: UTF-16 with a byte-order mark (a spreadsheet's "Unicode text"), UTF-8 with or without one, else
     Latin-1; Windows or old Mac line ends; lines starting with ``#`` and blank lines are skipped; empty cells at
-    a row's end beyond the header's columns (trailing tabs) are dropped. ``subject`` is text; ``age_yr``,
+    a row's end beyond the header's columns (trailing tabs) are dropped. ``subject`` is text (``NA`` a name, not a
+    missing value; only an empty cell is missing in the text columns); ``age_yr``,
     ``height_m`` and ``mass_kg`` numbers (empty: NaN).
 
     Raises
@@ -191,7 +219,11 @@ def read_subject_sheet(path: str | os.PathLike) -> pd.DataFrame:
             if column in SHEET_NUMBER_COLUMNS:
                 _sheet_number(value, path, n, column)
         kept.append("\t".join(cells))
-    return pd.read_csv(io.StringIO("\n".join(kept) + "\n"), sep="\t", dtype={"subject": str})
+    text = ["subject", "source", "sex", "model_osim"]  # missing only when empty: a subject may be named NA
+    na = {c: ([""] if c in text else list(PANDAS_NA_VALUES)) for c in header}
+    return pd.read_csv(
+        io.StringIO("\n".join(kept) + "\n"), sep="\t", dtype={"subject": str}, keep_default_na=False, na_values=na
+    )
 
 
 def _sheet_number(text: str, path: Path, line: int, column: str) -> float:
