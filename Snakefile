@@ -6,22 +6,25 @@ from snakemake.utils import min_version
 min_version("9.0")
 
 
-# A syntax error or a key given twice in a config file as one line naming the file, line and column (Snakemake's
-# own message names neither, and YAML keeps a repeated key's second value silently). Files given with --configfile
-# are read by Snakemake while it parses its command line, before this runs: their syntax is Snakemake's to judge,
-# their repeated keys are checked here.
-if os.path.exists("config/config.yaml"):  # a missing file: Snakemake's own message
-    from snakemake.exceptions import WorkflowError
+# Every config file read before Snakemake's loader builds its values (which runs a YTE template's expressions as
+# Python): a syntax error or a key given twice as one line naming the file, line and column (Snakemake's own message
+# names neither, and YAML keeps a repeated key's second value silently); a YTE template (__use_yte__), a Python tag
+# (!!python/object...) or an alias bomb refused, naming the file and the construct. This stands before the
+# configfile: directive, so config/config.yaml is judged before Snakemake reads it. Files given with --configfile
+# are read by Snakemake 9 while it parses its command line, before this runs: a template among them has been
+# rendered by then, and is refused here all the same, before any rule or job.
+from snakemake.exceptions import WorkflowError
 
-    from loper_analysis.errors import LoperInputError
-    from loper_analysis.schema import check_yaml_file
+from loper_analysis.errors import LoperInputError
+from loper_analysis.schema import check_yaml_file
 
-    try:
-        for _file in ["config/config.yaml", *map(str, workflow.config_settings.configfiles)]:
+try:
+    for _file in ["config/config.yaml", *map(str, workflow.config_settings.configfiles)]:
+        if os.path.exists(_file):  # a missing file: Snakemake's own message
             _relative = os.path.relpath(_file)
             check_yaml_file(_file if _relative.startswith("..") else _relative)
-    except LoperInputError as exc:
-        raise WorkflowError(str(exc)) from None
+except LoperInputError as exc:
+    raise WorkflowError(str(exc)) from None
 
 
 configfile: "config/config.yaml"

@@ -119,7 +119,8 @@ def test_a_yte_template_is_refused_and_a_false_flag_dropped(tmp_path, monkeypatc
     monkeypatch.chdir(tmp_path)
     Path("t.yaml").write_text("__use_yte__: true\nseed: 1\n")
     with _refused(
-        "t.yaml: key '__use_yte__': True: a YTE template is rendered by Snakemake only; give the rendered file"
+        "t.yaml: line 1, column 1: key '__use_yte__': a YTE template, whose expressions Snakemake would run as "
+        "Python: refused; the config file must hold the plain values (render it yourself if you trust it)"
     ):
         read_config_file("t.yaml")
     Path("t.yaml").write_text("__use_yte__: false\nseed: 1\n")

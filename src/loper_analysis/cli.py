@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from loper_analysis.cli_checks import check_option_limits, refuse_overwriting
+from loper_analysis.cli_checks import check_option_limits, refuse_config_code, refuse_overwriting
 from loper_analysis.cli_parser import build_parser
 from loper_analysis.errors import LoperInputError, one_line
 from loper_analysis.layout import Paths, fill
@@ -539,6 +539,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         refuse_overwriting(args)
         check_option_limits(args)
+        refuse_config_code(args)
         args.func(args)
     except Exception as exc:
         if args.traceback:

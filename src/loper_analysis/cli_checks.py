@@ -3,7 +3,10 @@ limits of its config key.
 
 :func:`refuse_overwriting` compares the files a command reads with those it writes (the same path, a link or a
 hard link); :func:`check_option_limits` holds each option with a config counterpart to that key's range, type and
-enumeration in the workflow's schema (:data:`OPTION_KEYS`), so the command and the workflow accept the same values.
+enumeration in the workflow's schema (:data:`OPTION_KEYS`), so the command and the workflow accept the same values,
+and refuses every numeric option that is NaN or infinite (:func:`refuse_non_finite_options`).
+:func:`refuse_config_code` reads the config files ``report`` passes on to Snakemake before Snakemake does, whose
+loader would run a YTE template as Python.
 """
 
 from __future__ import annotations
@@ -15,7 +18,13 @@ from pathlib import Path
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["OPTION_KEYS", "check_option_limits", "refuse_overwriting"]
+__all__ = [
+    "OPTION_KEYS",
+    "check_option_limits",
+    "refuse_config_code",
+    "refuse_non_finite_options",
+    "refuse_overwriting",
+]
 
 #: Options naming a file a subcommand reads, and those naming a file it writes.
 _INPUT_OPTIONS: tuple[str, ...] = ("c3d", "model", "setup", "static", "markers", "segments", "tasks", "label_map",
@@ -104,8 +113,44 @@ OPTION_KEYS: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
 _OFF_WITH_ZERO: set[tuple[str, str]] = {("markers", "cutoff_hz"), ("scale", "cutoff_hz"), ("scale", "max_motion_rms_m")}
 
 
+def refuse_config_code(args: argparse.Namespace) -> None:
+    """Refuse, before Snakemake is started, a config file ``report`` passes on with ``--configfile`` that holds a YTE
+    template, a Python tag or an alias bomb (:func:`loper_analysis.schema.check_yaml_file`): Snakemake renders a
+    template while it reads its command line, before the workflow's own check.
+
+    Raises
+    ------
+    LoperInputError
+        Naming the file, the place and the construct.
+    """
+    if args.command != "report":
+        return
+    from loper_analysis.schema import check_yaml_file
+    from loper_analysis.steps.report import _configfiles
+
+    for path in _configfiles(getattr(args, "snakemake_args", None) or []):
+        if Path(path).is_file():  # a missing file: Snakemake's own message
+            check_yaml_file(path)
+
+
+def refuse_non_finite_options(args: argparse.Namespace) -> None:
+    """Refuse every numeric option given as ``nan``, ``inf`` or ``-inf`` (Python's ``float`` reads them as numbers,
+    and a limit lets NaN through: every comparison with it is false), whether or not it has a config key.
+
+    Raises
+    ------
+    LoperInputError
+        Naming the option and its value.
+    """
+    from loper_analysis.schema import refuse_non_finite_option
+
+    for attr, value in vars(args).items():
+        refuse_non_finite_option(value, "--" + attr.replace("_", "-"))
+
+
 def check_option_limits(args: argparse.Namespace) -> None:
-    """Hold every option given to the limits of its config key (one schema for the workflow and the command).
+    """Hold every option given to the limits of its config key (one schema for the workflow and the command), and
+    every numeric option to a finite number (:func:`refuse_non_finite_options`).
 
     Raises
     ------
@@ -115,6 +160,7 @@ def check_option_limits(args: argparse.Namespace) -> None:
     from loper_analysis.config_file import find_schema
     from loper_analysis.schema import check_value
 
+    refuse_non_finite_options(args)
     keys = OPTION_KEYS.get(args.command, {})
     given = {a: getattr(args, a) for a in keys if getattr(args, a, None) is not None}
     given = {a: v for a, v in given.items() if not ((args.command, a) in _OFF_WITH_ZERO and v == 0)}

@@ -89,7 +89,9 @@ def read_config_file(path: str | os.PathLike) -> dict:
     """One configuration file as Snakemake's ``load_configfile`` reads it: JSON, else YAML (a mapping at the top).
 
     The syntax is checked first (:func:`loper_analysis.schema.check_yaml_file`),
-    so that an error names the file, the line and the column.
+    so that an error names the file, the line and the column, and nothing in
+    the file is run or built: a YTE template, a Python tag and an alias bomb
+    are refused before the values are read.
 
     Parameters
     ----------
@@ -105,7 +107,8 @@ def read_config_file(path: str | os.PathLike) -> dict:
     ------
     LoperInputError
         The file cannot be read, is not YAML/JSON, holds no mapping at its top
-        level, or is a YTE template (``__use_yte__``), which only Snakemake renders.
+        level, is a YTE template (``__use_yte__``), holds a Python tag or aliases
+        expanding past :data:`loper_analysis.schema.MAX_VALUES` values.
     """
     shown = shown_path(path)
     check_yaml_file(path)
@@ -114,19 +117,14 @@ def read_config_file(path: str | os.PathLike) -> dict:
         data = json.loads(text)
     except ValueError:
         try:
-            data = yaml.load(text, Loader=yaml.FullLoader)
-        except yaml.YAMLError as exc:  # accepted by the safe composer, refused by the loader (e.g. a Python tag)
+            data = yaml.safe_load(text)  # no Python tag reaches it (check_yaml_file): Snakemake's loader gives the same
+        except yaml.YAMLError as exc:  # accepted by the composer, refused by the loader
             raise LoperInputError(f"{shown}: YAML error: {' '.join(str(exc).split())}") from None
     if not isinstance(data, dict):
         raise LoperInputError(
             f"{shown}: the config file must hold keys at its top level (key: value), found a {type(data).__name__}"
         )
-    if data.get("__use_yte__"):
-        raise LoperInputError(
-            f"{shown}: key '__use_yte__': {data['__use_yte__']!r}: a YTE template is rendered by "
-            "Snakemake only; give the rendered file"
-        )
-    data.pop("__use_yte__", None)
+    data.pop("__use_yte__", None)  # false: a template is refused by check_yaml_file
     return data
 
 

@@ -6,11 +6,19 @@ A workflow's configuration is built in layers: the default file, then each
 that set an offending key (:func:`config_origin`), so the message points at
 the file or option to fix. :func:`check_yaml_file` reads a configuration
 file before Snakemake does, so that a syntax error names the file, the line
-and the column.
+and the column, and so that nothing in it is run or built: a YTE template
+(``__use_yte__``, whose expressions Snakemake evaluates as Python), a Python
+tag (``!!python/object/apply:...``) or aliases that expand past
+:data:`MAX_VALUES` values (an alias bomb) are refused. :func:`check_config`
+refuses a number that is not finite (``.nan``, ``.inf``), which the schema's
+limits let through, and :func:`check_project_paths` a file or folder outside
+the project folder unless ``allow_outside_project`` says so.
 """
 
 from __future__ import annotations
 
+import math
+import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -19,7 +27,30 @@ import yaml
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["ConfigLayers", "check_config", "check_table", "check_value", "check_yaml_file", "config_origin"]
+__all__ = [
+    "MAX_VALUES",
+    "OUTSIDE_KEYS",
+    "ConfigLayers",
+    "check_config",
+    "check_project_paths",
+    "check_table",
+    "check_value",
+    "check_yaml_file",
+    "config_origin",
+    "refuse_non_finite_option",
+]
+
+#: The most values (mappings, lists and scalars, each alias counted as what it stands for) a config file or a
+#: configuration may hold: the study's config holds about 700; aliases that expand past this are an alias bomb.
+MAX_VALUES = 100_000
+#: The keys naming a file or folder that must lie in the project folder unless ``allow_outside_project`` is true.
+OUTSIDE_KEYS = ("subjects", "raw_dir")
+#: The standard YAML tags (``tag:yaml.org,2002:...``) a config file may use; any other tag is refused.
+_PLAIN_TAGS = frozenset(
+    "tag:yaml.org,2002:" + name
+    for name in ("str", "int", "float", "bool", "null", "map", "seq", "timestamp", "binary", "set", "omap", "pairs",
+                 "merge", "value")
+)  # fmt: skip
 
 #: The configuration's layers, highest priority first: ``(name, mapping)``, e.g.
 #: ``[("--config", {...}), ("my.yaml", {...}), ("config/config.yaml", {...})]``.
@@ -84,6 +115,12 @@ def check_config(
     the message names the layer that set the offending key instead (an unknown
     key is named itself, a missing one by its parent), falling back to ``source``.
     """
+
+    def origin(path: Sequence) -> str:
+        return config_origin(path, layers, source)
+
+    _count_values(data, origin)  # before any walk: an alias bomb is refused in its expanded size, not walked
+    _refuse_non_finite(data, origin)
     errors = sorted(_validator(schema_path).iter_errors(data), key=lambda e: list(map(str, e.absolute_path)))
     if errors:
         e = errors[0]
@@ -91,7 +128,93 @@ def check_config(
         key = ".".join(map(str, path)) or "(top level)"
         more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
         raise LoperInputError(f"{config_origin(path, layers, source)}: key '{key}': {e.message}{more}")
-    _check_relations(data, lambda path: config_origin(path, layers, source))
+    _check_relations(data, origin)
+
+
+def _count_values(data, origin) -> None:
+    """Refuse a configuration of more than :data:`MAX_VALUES` values, counted as expanded (shared or recursive
+    containers, which YAML aliases make, counted once per place they appear, each container's size computed once)."""
+    sizes: dict[int, int] = {}
+    busy: set[int] = set()
+
+    def size(node, path: tuple) -> int:
+        if not isinstance(node, (dict, list)):
+            return 1
+        if id(node) in sizes:
+            return sizes[id(node)]
+        if id(node) in busy:
+            raise LoperInputError(f"{origin(path)}: key '{'.'.join(map(str, path))}': holds itself (a recursive alias)")
+        busy.add(id(node))
+        items = node.items() if isinstance(node, dict) else enumerate(node)
+        total = 1 + sum(size(v, (*path, k)) for k, v in items)
+        busy.discard(id(node))
+        if total > MAX_VALUES:
+            raise LoperInputError(
+                f"{origin(path)}: key '{'.'.join(map(str, path)) or '(top level)'}': expands to more than "
+                f"{MAX_VALUES} values (aliases repeating aliases: an alias bomb): refused unread; write the values out"
+            )
+        sizes[id(node)] = total
+        return total
+
+    size(data, ())
+
+
+def _refuse_non_finite(node, origin, path: tuple = ()) -> None:
+    """Refuse a number that is not finite (``.nan``, ``.inf``, ``-.inf`` in YAML, ``NaN`` in JSON): the schema's
+    minimum and maximum let NaN through (every comparison with it is false), and no setting means infinity."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            _refuse_non_finite(v, origin, (*path, k))
+    elif isinstance(node, list):
+        for k, v in enumerate(node):
+            _refuse_non_finite(v, origin, (*path, k))
+    elif isinstance(node, float) and not math.isfinite(node):
+        raise LoperInputError(
+            f"{origin(path)}: key '{'.'.join(map(str, path))}': {node} is not a finite number: give a number (NaN and "
+            "infinity are no setting)"
+        )
+
+
+def check_project_paths(config: Mapping, project: str | os.PathLike, origin) -> None:
+    """Refuse ``subjects`` or ``raw_dir`` (:data:`OUTSIDE_KEYS`) outside the project folder unless the config says
+    ``allow_outside_project: true``: nothing outside is read, so no message shows a line of a file that is not the
+    project's.
+
+    A path is inside when, relative paths taken from ``project``, it lies in ``project`` as written (``..``
+    resolved by name: a link inside the project folder is the project's own) or once links are followed.
+
+    Parameters
+    ----------
+    config : mapping
+        The validated configuration.
+    project : path
+        The project folder (the working directory of the workflow).
+    origin : callable
+        ``origin(key_path) -> str``: the file or option that set a key (:func:`config_origin`).
+
+    Raises
+    ------
+    LoperInputError
+        Naming the file or option, the key, the value and the project folder.
+    """
+    if config.get("allow_outside_project") is True:
+        return
+    root = os.path.abspath(project)
+    for key in OUTSIDE_KEYS:
+        value = config.get(key)
+        if not isinstance(value, str):
+            continue
+        full = os.path.join(root, value)
+        inside = _within(os.path.normpath(full), root) or _within(os.path.realpath(full), os.path.realpath(root))
+        if not inside:
+            raise LoperInputError(
+                f"{origin((key,))}: key '{key}': '{value}' is outside the project folder {root}: refused unread; "
+                "move it into the project folder, or set allow_outside_project: true to use files outside it"
+            )
+
+
+def _within(path: str, root: str) -> bool:
+    return path == root or path.startswith(root.rstrip(os.sep) + os.sep)
 
 
 #: Parts of a key's name that make a two-number list an interval [low, high].
@@ -175,6 +298,7 @@ def check_value(value, schema_path: str | Path, key_path: Sequence[str], name: s
     """
     import jsonschema
 
+    refuse_non_finite_option(value, name)
     node = yaml.safe_load(Path(schema_path).read_text())
     for key in key_path:
         node = node["properties"][key]
@@ -183,6 +307,20 @@ def check_value(value, schema_path: str | Path, key_path: Sequence[str], name: s
         raise LoperInputError(
             f"{name} {value!r}: {errors[0].message} (the limits of {'.'.join(key_path)} in {Path(schema_path).name})"
         )
+
+
+def refuse_non_finite_option(value, name: str) -> None:
+    """Refuse a command's option value that is NaN or infinite (``--max-marker-rms-m nan``): Python reads ``nan``
+    and ``inf`` as numbers, and limits let NaN through.
+
+    Raises
+    ------
+    LoperInputError
+        Naming the option and its value.
+    """
+    for item in value if isinstance(value, (list, tuple)) else [value]:
+        if isinstance(item, float) and not math.isfinite(item):
+            raise LoperInputError(f"{name} {item}: not a finite number: give a number (NaN and infinity are no value)")
 
 
 def check_table(table: pd.DataFrame, schema_path: str | Path, source: str) -> None:
@@ -205,8 +343,8 @@ def _mark(mark) -> str:
 def check_yaml_file(path: str | Path, what: str = "config file") -> None:
     """Refuse a YAML (or JSON) file that does not parse into a mapping, in one line naming the file and the place.
 
-    Only the syntax is checked (the document is composed, no value is built),
-    so a file this accepts is read by Snakemake's own loader; the values are
+    Only the syntax is checked (the document is composed, no value is built,
+    nothing is evaluated), so a file this accepts is read by Snakemake's own loader; the values are
     checked by :func:`check_config`. Snakemake's own message for a syntax
     error names neither the file nor the line.
 
@@ -223,7 +361,8 @@ def check_yaml_file(path: str | Path, what: str = "config file") -> None:
         The file cannot be read or is not UTF-8; a YAML syntax error, e.g.
         ``config/config.yaml: line 73, column 8: YAML syntax error: expected ',' or ']', but got ':'
         (while parsing a flow sequence that starts at line 72, column 14)``; a file that holds no mapping of
-        keys at its top level.
+        keys at its top level; a YTE template (``__use_yte__``), a tag other than YAML's own
+        (``!!python/object/apply:...``), aliases expanding past :data:`MAX_VALUES` values.
     """
     try:
         data = Path(path).read_bytes()
@@ -251,7 +390,65 @@ def check_yaml_file(path: str | Path, what: str = "config file") -> None:
     if not documents or not isinstance(documents[0], yaml.MappingNode):
         found = "nothing" if not documents else f"a {documents[0].id} at {_mark(documents[0].start_mark)}"
         raise LoperInputError(f"{path}: the {what} must hold keys at its top level (key: value), found {found}")
+    _refuse_template(documents[0], path, what)
+    for document in documents:
+        _refuse_code_and_bombs(document, path, what)
     _refuse_duplicate_keys(documents[0], path, what)
+
+
+def _refuse_template(top: yaml.MappingNode, path, what: str) -> None:
+    """Refuse a YTE template: Snakemake renders a config file whose top level says ``__use_yte__: true``, running
+    its expressions as Python (``?...`` values, ``__definitions__``)."""
+    for key, value in top.value:
+        if isinstance(key, yaml.ScalarNode) and key.value == "__use_yte__":
+            off = isinstance(value, yaml.ScalarNode) and value.tag.endswith(":bool") and value.value.lower() in (
+                "false", "no", "off")  # fmt: skip
+            if not off:
+                raise LoperInputError(
+                    f"{path}: {_mark(key.start_mark)}: key '__use_yte__': a YTE template, whose expressions "
+                    f"Snakemake would run as Python: refused; the {what} must hold the plain values (render it "
+                    "yourself if you trust it)"
+                )
+
+
+def _tag(tag: str) -> str:
+    return "!!" + tag.removeprefix("tag:yaml.org,2002:") if tag.startswith("tag:yaml.org,2002:") else tag
+
+
+def _refuse_code_and_bombs(document: yaml.Node, path, what: str) -> None:
+    """Refuse a tag other than YAML's standard ones (``!!python/object/apply:os.system`` builds a Python object, a
+    call), and aliases that expand past :data:`MAX_VALUES` values or into themselves; each node is looked at once,
+    however often aliases repeat it, so an alias bomb is refused at once."""
+    sizes: dict[int, int] = {}
+    busy: set[int] = set()
+
+    def size(node: yaml.Node) -> int:
+        if id(node) in sizes:
+            return sizes[id(node)]
+        if id(node) in busy:
+            raise LoperInputError(f"{path}: {_mark(node.start_mark)}: an alias of a value inside itself: refused")
+        if node.tag not in _PLAIN_TAGS:
+            raise LoperInputError(
+                f"{path}: {_mark(node.start_mark)}: tag '{_tag(node.tag)}': the {what} may hold plain values only "
+                "(a Python tag builds an object or calls code): refused; give the value itself"
+            )
+        busy.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            total = 1 + sum(size(k) + size(v) for k, v in node.value)
+        elif isinstance(node, yaml.SequenceNode):
+            total = 1 + sum(size(v) for v in node.value)
+        else:
+            total = 1
+        busy.discard(id(node))
+        if total > MAX_VALUES:
+            raise LoperInputError(
+                f"{path}: {_mark(node.start_mark)}: this value's aliases expand to more than {MAX_VALUES} values "
+                "(aliases repeating aliases: an alias bomb): refused unread; write the values out"
+            )
+        sizes[id(node)] = total
+        return total
+
+    size(document)
 
 
 def _refuse_duplicate_keys(node, path, what: str, parents: tuple[str, ...] = ()) -> None:

@@ -14,7 +14,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.readers import read_subject_sheet
 from loper_analysis.layout import Paths, Study, fill, subject_rows
-from loper_analysis.schema import check_config, check_table, config_origin
+from loper_analysis.schema import check_config, check_project_paths, check_table, config_origin
 from loper_analysis.steps.cluster import requested_partitions
 from loper_analysis.study_checks import check_subjects, raw_file_warnings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
@@ -35,6 +35,8 @@ try:
     # one short message naming the file or option, the key and the value; then Snakemake's own validation
     check_config(config, _SCHEMAS / "config.schema.yaml", "config/config.yaml", CONFIG_LAYERS)
     validate(config, "../schemas/config.schema.yaml")
+    # subjects and raw_dir in the project folder (the working directory) unless allow_outside_project says so
+    check_project_paths(config, Path.cwd(), lambda key_path: config_source(*key_path))
     _subjects_path = Path(config["subjects"])
     if not _subjects_path.is_file():
         raise LoperInputError(f"{config_source('subjects')}: key 'subjects': file '{_subjects_path}' not found")
