@@ -311,11 +311,13 @@ def _copy_of(project: Path, dest: Path) -> Path:
 
 
 def _cut_c3d(path: Path, seconds: float) -> None:
-    """Keep the first ``seconds`` of a C3D (markers and analogs), as a recording stopped early."""
+    """Keep the first ``seconds`` of a synthetic subject's C3D (markers and analogs), as a recording stopped early;
+    written as the synthetic lab's own (its manifest vouches for the new content)."""
     from dataclasses import replace
 
     from loper_analysis.io.c3d import read_c3d
     from loper_analysis.io.c3d_writer import write_recording
+    from loper_analysis.io.generated import generated
 
     rec = read_c3d(path)
     n = round(seconds * rec.point_rate_hz)
@@ -324,7 +326,8 @@ def _cut_c3d(path: Path, seconds: float) -> None:
         "outputs": rec.outputs[:n],
         "analogs": rec.analogs[: n * rec.samples_per_frame],
     }
-    write_recording(path, replace(rec, **cut))
+    with generated(path, "synthetic_lab", "C3D file") as tmp:
+        write_recording(tmp, replace(rec, **cut))
 
 
 def test_trials_with_too_few_strides_are_flagged_and_the_run_goes_on(finished_run, tmp_path):

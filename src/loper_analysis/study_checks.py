@@ -1,5 +1,6 @@
-"""The study's inputs checked before any job runs: the subject sheet's rows against the config and the raw
-folders against the trial design."""
+"""The study's inputs checked before any job runs: the subject sheet's rows against the config, the raw
+folders against the trial design, a synthetic subject's folder holding no recording the synthetic lab would write
+over, and no recording standing for two trials."""
 
 from __future__ import annotations
 
@@ -7,11 +8,24 @@ from collections.abc import Callable
 from pathlib import Path
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.raw_files import RAW_SUFFIXES, raw_file_present, refuse_miscased_raw_files, unmatched_raw_files
+from loper_analysis.io.generated import MANIFEST_SUFFIX, unvouched_files
+from loper_analysis.io.raw_files import (
+    RAW_SUFFIXES,
+    raw_file_present,
+    refuse_miscased_raw_files,
+    repeated_files,
+    unmatched_raw_files,
+)
 from loper_analysis.layout import Study, fill
 from loper_analysis.synthetic.subjects import true_impedance
 
-__all__ = ["check_subjects", "raw_file_warnings"]
+__all__ = [
+    "check_recordings",
+    "check_subjects",
+    "raw_file_warnings",
+    "refuse_recordings_in_synthetic_folders",
+    "refuse_repeated_recordings",
+]
 
 
 def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None:
@@ -69,17 +83,19 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
         )
 
 
-def raw_file_warnings(study: Study) -> list[str]:
+def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
     """Check every recorded subject's raw folder: a path that is not a readable file, or a file named in
     another case, stops the run (never a trial silently left out); returns a warning per folder naming the
-    files that match no trial of the design.
+    files that match no trial of the design. Given the subject sheet's name ``sheet``, the raw folders'
+    recordings are checked first (:func:`check_recordings`).
 
     Raises
     ------
     LoperInputError
         Naming the file.
     """
-
+    if sheet is not None:
+        check_recordings(study, sheet)
     said, trials, t = [], study.design.trials(), study.config["trials"]
     for s in (s for s, row in study.rows.items() if row["source"] == "recorded"):
         raw = study.paths.raw_folder(s)
@@ -96,3 +112,75 @@ def raw_file_warnings(study: Study) -> list[str]:
                 f"{t['perturbation_repeats']})"
             )
     return said
+
+
+def refuse_recordings_in_synthetic_folders(study: Study, sheet: str) -> None:
+    """A synthetic subject's raw folder holds only raw files the workflow generated (vouched for by their manifests,
+    :mod:`loper_analysis.io.generated`): the synthetic lab would write over any other, a recording.
+
+    ``sheet``: the subject sheet's name.
+
+    Raises
+    ------
+    LoperInputError
+        Naming the sheet, the subject's row, the folder, the files and what to do.
+    """
+    for s in (s for s, row in study.rows.items() if row["source"] == "synthetic"):
+        raw = study.paths.raw_folder(s)
+        foreign = unvouched_files(raw)
+        if not foreign:
+            continue
+        manifests = sorted(p.name for p in raw.glob(f"*{MANIFEST_SUFFIX}"))
+        names = ", ".join(f"{name} ({why})" for name, why in foreign)
+        earlier = (
+            ""
+            if manifests
+            else f" (no manifest *{MANIFEST_SUFFIX} in the folder: files the synthetic lab wrote before it kept one "
+            "are not told from recordings either; delete those and they are generated again)"
+        )
+        raise LoperInputError(
+            f"{sheet}: subject '{s}', column source: 'synthetic', but its raw folder {raw} holds raw files the "
+            f"workflow did not generate: {names}; the synthetic lab would write over them. If they are the "
+            f"subject's recordings, mark the row 'recorded'; if the subject is to be simulated, move these files "
+            f"out of {raw}{earlier}"
+        )
+
+
+def refuse_repeated_recordings(study: Study) -> None:
+    """Every trial of the recorded subjects has its own recording: no raw file is another trial's (of the same
+    subject or of another), by link or by copy (:func:`loper_analysis.io.raw_files.repeated_files`); the fit would
+    pool the same strides twice and report too narrow an interval.
+
+    Raises
+    ------
+    LoperInputError
+        Naming both files of every such pair, and how they are the same.
+    """
+    trials = study.design.trials()
+    paths = [
+        study.paths.raw_folder(s) / f"{trial}{suffix}"
+        for s, row in study.rows.items()
+        if row["source"] == "recorded"
+        for trial in trials
+        for suffix in RAW_SUFFIXES
+    ]
+    repeats = repeated_files(paths)
+    if repeats:
+        lines = [f"{repeat} is the same recording as {first} ({how})" for repeat, first, how in repeats]
+        raise LoperInputError(
+            "; ".join(lines) + ": one recording stands for one trial (the fit would pool its strides twice); put "
+            "each trial's own recording in its place, or remove the repeated file"
+        )
+
+
+def check_recordings(study: Study, sheet: str) -> None:
+    """No recording written over by the synthetic lab (:func:`refuse_recordings_in_synthetic_folders`), none
+    standing for two trials (:func:`refuse_repeated_recordings`).
+
+    Raises
+    ------
+    LoperInputError
+        From either check.
+    """
+    refuse_recordings_in_synthetic_folders(study, sheet)
+    refuse_repeated_recordings(study)

@@ -63,6 +63,7 @@ def test_a_short_session_on_disk(tmp_path):
         "pert050-1.c3d",
         "pert050-1.loper.tsv",
         "static.c3d",
+        "synthetic_lab.generated.sha256",  # the checksums of the files the lab wrote
         "truth.yaml",
         "walk-device.c3d",
         "walk-device.loper.tsv",

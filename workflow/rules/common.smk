@@ -71,7 +71,7 @@ try:
     STUDY = Study(SUBJECT_ROWS, StudyDesign.from_config(config["trials"]), PATHS, config, _plates, _note)
     DESIGN = STUDY.design
     check_subjects(STUDY, str(_subjects_path), config_source)
-    for _line in raw_file_warnings(STUDY):
+    for _line in raw_file_warnings(STUDY, str(_subjects_path)):  # and check_recordings
         _note(_line)
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None

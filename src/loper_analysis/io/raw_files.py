@@ -21,6 +21,7 @@ __all__ = [
     "content_checksum",
     "raw_file_present",
     "refuse_miscased_raw_files",
+    "repeated_files",
     "unmatched_raw_files",
 ]
 
@@ -112,3 +113,44 @@ def content_checksum(path: str | os.PathLike) -> str:
                 digest.update(block)
         _CHECKSUMS[key] = digest.hexdigest()
     return _CHECKSUMS[key]
+
+
+def repeated_files(paths: Iterable[str | os.PathLike]) -> list[tuple[Path, Path, str]]:
+    """The files among ``paths`` that are another one of them: the same file (a symbolic or hard link to it) or
+    a copy of its content.
+
+    Sizes are compared first; only files of equal size are read (their SHA-256, :func:`content_checksum`).
+    Empty files and paths that are not files are left to the readers.
+
+    Returns
+    -------
+    list of (Path, Path, str)
+        ``(repeat, first, how)`` in the order of ``paths``: ``repeat`` is the same as the earlier ``first``;
+        ``how`` says how (``"a symbolic link to the same file"``, ``"a hard link to the same file"``,
+        ``"a copy: the same content"``).
+    """
+    files = [Path(p) for p in paths if Path(p).is_file()]
+    stats = {p: os.stat(p) for p in files}
+    by_size: dict[int, list[Path]] = {}
+    for p in files:
+        if stats[p].st_size > 0:
+            by_size.setdefault(stats[p].st_size, []).append(p)
+    out = []
+    for group in (g for g in by_size.values() if len(g) > 1):
+        firsts: dict[tuple, Path] = {}
+        for p in group:
+            inode = (stats[p].st_dev, stats[p].st_ino)
+            if inode in firsts:
+                first = firsts[inode]
+                link = "symbolic" if p.is_symlink() or first.is_symlink() else "hard"
+                out.append((p, first, f"a {link} link to the same file"))
+                continue
+            checksum = content_checksum(p)
+            first = firsts.get(("sha256", checksum))
+            firsts[inode] = p
+            if first is not None:
+                out.append((p, first, "a copy: the same content"))
+            else:
+                firsts[("sha256", checksum)] = p
+    order = {p: k for k, p in enumerate(files)}
+    return sorted(out, key=lambda item: order[item[0]])

@@ -14,6 +14,7 @@ from loper_analysis.device.controller import DeviceParameters, FreeLeg
 from loper_analysis.device.trials import DeviceTestSettings
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
+from loper_analysis.io.generated import generated, refuse_foreign_files
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.robot_log import read_robot_log, write_robot_log
 
@@ -73,13 +74,21 @@ def device_trial(
     ``device``: the controller and plant; ``leg``: the free-hanging leg; ``tests``: the desired-force
     profiles; the seed is derived from ``seed``, the subject and the trial. Returns the safety
     events (time, state, name).
+
+    Raises
+    ------
+    LoperInputError
+        ``out_path`` holds a file the workflow did not generate (a recording): nothing is written
+        (:func:`loper_analysis.io.generated.refuse_foreign_files`).
     """
     from loper_analysis.device.controller import safety_events
     from loper_analysis.device.trials import simulate_device_trial
 
+    refuse_foreign_files([out_path], f"the simulated device test {trial}")  # before the work
     trial_seed = [seed, zlib.crc32(subject.encode()), zlib.crc32(trial.encode())]
     frame = simulate_device_trial(trial, device, leg, tests, trial_seed)
-    write_robot_log(out_path, frame, device.sample_rate_hz, {"trial": trial, "source": "synthetic"})
+    with generated(out_path, trial, "robot log") as tmp:  # its checksum in {trial}.generated.sha256
+        write_robot_log(tmp, frame, device.sample_rate_hz, {"trial": trial, "source": "synthetic"})
     events = safety_events(frame)
     log.info("wrote %s (seed %s)", out_path, trial_seed)
     log.info("safety state changes (time_s, state, name):\n%s", events.to_string(index=False))

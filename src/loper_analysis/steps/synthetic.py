@@ -3,7 +3,8 @@
 :func:`lab_session` records a synthetic subject's session as the workflow's raw files
 (:class:`LabSessionFiles`) with the settings of :class:`loper_analysis.synthetic.lab_session.LabSessionSettings`
 (built from the whole validated config by its ``from_config``). A session as a lab exports it (QTM files,
-MATLAB logs) is the tests' own (``tests/lab_export_session.py``).
+MATLAB logs) is the tests' own (``tests/lab_export_session.py``). The lab never writes over a file it did not
+write itself (:mod:`loper_analysis.io.generated`).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike
 from loper_analysis.io.c3d_writer import write_recording
+from loper_analysis.io.generated import generated, refuse_foreign_files
 from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.io.truth import read_truth, write_truth
 from loper_analysis.study_design import StudyDesign
@@ -24,6 +26,9 @@ from loper_analysis.synthetic.lab_session import LabSessionSettings
 __all__ = ["LabSessionFiles", "lab_session", "truth"]
 
 log = logging.getLogger(__name__)
+
+#: The synthetic lab's manifest of the files it wrote: ``{raw folder}/synthetic_lab.generated.sha256``.
+WRITER = "synthetic_lab"
 
 
 @dataclass(frozen=True)
@@ -119,17 +124,25 @@ def lab_session(subject: str, row: Mapping, files: LabSessionFiles, settings: La
     answers the measured minimal-impedance force with the mean over the
     onsets of its true K and D (with the onset's own in perturbation trials);
     ``"gentle"`` is the earlier lab.
+
+    Each file written is entered with its checksum in the folder's ``synthetic_lab.generated.sha256``
+    (:mod:`loper_analysis.io.generated`); a file already there must be one of them.
+
+    Raises
+    ------
+    LoperInputError
+        A file to write is already there and the workflow did not write it (a recording): named with its folder,
+        before anything is written.
     """
 
     from loper_analysis.synthetic.trials import subject_static_recording, subject_walking_trial
     from loper_analysis.synthetic.variability import lab_variability
 
     s = settings
+    refuse_foreign_files([files.static_c3d, *files.c3d.values(), *files.robot_logs.values()], "the synthetic lab")
     height_m, mass_kg = row["height_m"], row["mass_kg"]
-    write_recording(
-        files.static_c3d,
-        subject_static_recording(subject, height_m, mass_kg, s.static_duration_s, s.lab, s.seed),
-    )
+    with generated(files.static_c3d, WRITER, "C3D file") as tmp:
+        write_recording(tmp, subject_static_recording(subject, height_m, mass_kg, s.static_duration_s, s.lab, s.seed))
     log.info("static trial of %s: %s", subject, files.static_c3d)
     true = read_truth(files.truth_yaml)
     variability, adaptation, minimal_impedance = lab_variability(s.variability_settings(), s.seed, subject, true)
@@ -158,8 +171,10 @@ def lab_session(subject: str, row: Mapping, files: LabSessionFiles, settings: La
             adaptation=adaptation,
             minimal_impedance=minimal_impedance,
         )
-        write_recording(c3d, recording)
+        with generated(c3d, WRITER, "C3D file") as tmp:
+            write_recording(tmp, recording)
         if robot_log is not None:
-            write_robot_log(robot_log, walk.robot, s.lab.robot_rate_hz, {"clock": "robot"})
+            with generated(robot_log, WRITER, "robot log") as tmp:
+                write_robot_log(tmp, walk.robot, s.lab.robot_rate_hz, {"clock": "robot"})
         log.info("%s: true events:\n%s", trial, walk.mocap_events().to_string(index=False))
         log.info("%s: perturbations:\n%s", trial, walk.schedule.to_string(index=False))
