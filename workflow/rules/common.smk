@@ -35,8 +35,7 @@ try:
     # one short message naming the file or option, the key and the value; then Snakemake's own validation
     check_config(config, _SCHEMAS / "config.schema.yaml", "config/config.yaml", CONFIG_LAYERS)
     validate(config, "../schemas/config.schema.yaml")
-    # subjects and raw_dir in the project folder (the working directory) unless allow_outside_project says so
-    check_project_paths(config, Path.cwd(), lambda key_path: config_source(*key_path))
+    check_project_paths(config, Path.cwd(), lambda key_path: config_source(*key_path))  # allow_outside_project
     _subjects_path = Path(config["subjects"])
     if not _subjects_path.is_file():
         raise LoperInputError(f"{config_source('subjects')}: key 'subjects': file '{_subjects_path}' not found")
