@@ -701,7 +701,8 @@ def test_robot_log_of_another_trial_is_refused(lab):
 
 def test_bad_robot_log_of_a_new_trial_stops_its_job_with_one_line_and_a_log(lab):
     """Through Snakemake: a new perturbation trial whose log holds a NaN."""
-    shutil.copy(lab / RAW / f"{WALK}.c3d", lab / RAW / "pert050-1.c3d")
+    # another recording (the same walk recorded at another time: one recording stands for one trial)
+    shutil.copy(lab / "elsewhere" / f"{WALK}.c3d", lab / RAW / "pert050-1.c3d")
     (lab / RAW / "pert050-1.loper.tsv").write_text("".join(_nan_at(_log_lines(lab), 20, 2)))
     _refused(
         lab,
@@ -838,8 +839,8 @@ def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(la
     cfg["device"]["subject"] = None
     cfg["trials"]["perturbation_onsets_ms"] = [100]  # the synthetic truth has 50, 175 and 300 ms
     (lab / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
-    for suffix in (".c3d", ".loper.tsv"):
-        shutil.copy(lab / RAW / f"{WALK}{suffix}", lab / RAW / f"pert100-1{suffix}")
+    for suffix in (".c3d", ".loper.tsv"):  # another recording of the walk (one recording stands for one trial)
+        shutil.copy(lab / "elsewhere" / f"{WALK}{suffix}", lab / RAW / f"pert100-1{suffix}")
     before = _state(lab)
     res = _snakemake(lab, "-n")
     assert res.returncode == 0, res.stdout[-3000:]
