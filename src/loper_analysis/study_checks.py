@@ -84,8 +84,9 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
 
 
 def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
-    """Check every recorded subject's raw folder: a path that is not a readable file, or a file named in
-    another case, stops the run (never a trial silently left out); returns a warning per folder naming the
+    """Check every recorded subject's raw folder: a path that is not a readable file, a file named in
+    another case, or two robot logs of one trial (its ``.loper.tsv`` and ``.mat``) stops the run (never a trial
+    silently left out, nor one of two logs silently read); returns a warning per folder naming the
     files that match no trial of the design. Given the subject sheet's name ``sheet``, the raw folders'
     recordings are checked first (:func:`check_recordings`).
 
@@ -100,8 +101,18 @@ def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
     for s in (s for s, row in study.rows.items() if row["source"] == "recorded"):
         raw = study.paths.raw_folder(s)
         for trial in trials:
-            for suffix in RAW_SUFFIXES:
-                raw_file_present(raw / f"{trial}{suffix}", f"raw file of trial '{trial}' of subject '{s}'")
+            present = [
+                raw / f"{trial}{suffix}"
+                for suffix in RAW_SUFFIXES
+                if raw_file_present(raw / f"{trial}{suffix}", f"raw file of trial '{trial}' of subject '{s}'")
+            ]
+            logs = [p for p in present if p.name != f"{trial}.c3d"]
+            if len(logs) > 1:  # a .loper.tsv and a .mat: the trial's robot log would be one of them, unsaid
+                raise LoperInputError(
+                    f"{' and '.join(map(str, logs))}: two robot logs of trial '{trial}' of subject '{s}'; a trial "
+                    "has one (its .loper.tsv or the robot's .mat export): keep one and move the other out of "
+                    f"{raw}"
+                )
         refuse_miscased_raw_files(raw, trials)
         unmatched = unmatched_raw_files(raw, trials)
         if unmatched:

@@ -768,6 +768,25 @@ def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab)
     assert _state(lab) == before
 
 
+@pytest.mark.parametrize("trial", [WALK, "device-frf"])
+def test_two_robot_logs_of_one_trial_stop_the_run_naming_both(lab, trial):
+    """A .loper.tsv beside a .mat of the same trial, whatever its kind: one would be read and the other ignored."""
+    from scipy.io import savemat
+
+    if trial != WALK:  # a log of its own (a copy of another trial's would be refused as that)
+        lines = (lab / RAW / f"{WALK}.loper.tsv").read_text().splitlines(keepends=True)
+        (lab / RAW / f"{trial}.loper.tsv").write_text("".join(lines[: len(lines) // 2]))
+    savemat(lab / RAW / f"{trial}.mat", {"force": np.zeros((4, 2))})
+    _refused(
+        lab,
+        lambda: _snakemake(lab, "-n"),
+        [
+            f"{RAW}/{trial}.loper.tsv and {RAW}/{trial}.mat: two robot logs of trial '{trial}' of subject '{SUBJECT}'",
+            f"keep one and move the other out of {RAW}",
+        ],
+    )
+
+
 @pytest.mark.parametrize("name", [f"{WALK}.C3D", f"{WALK}.Loper.tsv"])
 def test_a_raw_file_named_in_another_case_stops_the_run_naming_it(lab, name):
     """An export's upper-case suffix: on a case-sensitive file system the trial would be left out without a word."""
