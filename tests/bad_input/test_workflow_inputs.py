@@ -587,6 +587,27 @@ def test_belt_channels_swapped_are_refused_from_the_heel_markers(lab):
     )
 
 
+def test_heel_markers_given_for_the_other_feet_are_refused(lab):
+    """The left heel lies right of the right heel along the pelvis's right axis: every contact would change side."""
+    cfg = _config(lab)
+    settings = dataclasses.replace(EventSettings.from_config(cfg), foot_markers={"left": "RHEE", "right": "LHEE"})
+    _refused(
+        lab,
+        lambda: event_steps.events(
+            f"{RAW}/{WALK}.c3d",
+            fill(PATHS.events.events, subject=SUBJECT, trial=WALK),
+            settings,
+            contacts_out=fill(PATHS.events.contacts, subject=SUBJECT, trial=WALK),
+        ),
+        [
+            f"{RAW}/{WALK}.c3d: events.foot_markers (--feet) left RHEE, right LHEE: the heel given for the left foot "
+            "lies ",
+            "mm to the right of the one given for the right foot",
+            "(here perhaps left LHEE, right RHEE)",
+        ],
+    )
+
+
 def _belts_in(lab: Path, path: Path, unit: str, factor: float) -> Path:
     """The trial with its vertical belt channels written in ``unit`` (values times ``factor``)."""
     rec = read_c3d(lab / RAW / f"{WALK}.c3d")

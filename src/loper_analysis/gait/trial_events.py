@@ -101,6 +101,7 @@ def trial_events(
     feet the heel markers confirm (as :func:`loper_analysis.steps.events.events` describes)."""
     from loper_analysis.gait.contacts import count_flagged
 
+    _check_heel_sides(rec, s, label_map)
     if rec.n_force_platforms:
         table, contacts = _plate_events(rec, platforms, s, label_map)
         log.info("contacts:\n%s", contacts.to_string(index=False))
@@ -156,6 +157,57 @@ def _channel_events(rec, s: EventSettings) -> pd.DataFrame:
             )
         )
     return pd.concat(tables, ignore_index=True).sort_values(["time_s", "side"], kind="stable", ignore_index=True)
+
+
+def _check_heel_sides(rec, s: EventSettings, label_map) -> None:
+    """Stop when the heel markers given for the feet (``events.foot_markers``, ``--feet``) lie on the other sides:
+    the left heel's mean position relative to the right heel, along the pelvis's right axis (a left pelvis marker
+    to its right partner: ASIS, else PSIS), must be negative
+    (:func:`loper_analysis.gait.foot_checks.heel_lateral_offset_m`). Not judged (logged) without both heels or
+    without a pelvis pair."""
+    from loper_analysis.gait.foot_checks import heel_lateral_offset_m
+    from loper_analysis.motion.label_matching import side_landmark_indices
+    from loper_analysis.motion.marker_names import model_marker_names
+
+    feet = s.foot_markers
+    if not feet or not rec.marker_labels:
+        return
+    source = rec.source
+    names = model_marker_names(rec.marker_labels, label_map, source)
+    if any(feet[side] not in names for side in SIDES):
+        return  # the events say which heel is missing
+    pair = None
+    for landmark in ("asis", "psis"):
+        ends = [side_landmark_indices(names, [landmark], side) for side in SIDES]
+        if all(len(e) == 1 for e in ends):
+            pair = (ends[0][0], ends[1][0])
+            break
+    if pair is None:
+        log.info("%s: the heel markers' sides are not checked: no left and right ASIS or PSIS marker", source)
+        return
+    X = rec.markers_m
+    offset = heel_lateral_offset_m(
+        X[:, names.index(feet["left"])], X[:, names.index(feet["right"])], X[:, pair[0]], X[:, pair[1]]
+    )
+    pelvis = f"{names[pair[0]]} -> {names[pair[1]]}"
+    if not np.isfinite(offset):
+        log.info("%s: the heel markers' sides are not checked: no frame holds both heels and %s", source, pelvis)
+        return
+    log.info(
+        "%s: left heel %s %.0f mm from right heel %s along the pelvis's right axis (%s), mean",
+        source,
+        feet["left"],
+        offset * 1000,
+        feet["right"],
+        pelvis,
+    )
+    if offset >= 0:
+        raise LoperInputError(
+            f"{source}: events.foot_markers (--feet) left {feet['left']}, right {feet['right']}: the heel given "
+            f"for the left foot lies {offset * 1000:.0f} mm to the right of the one given for the right foot (mean "
+            f"over the trial along the pelvis's left-right axis, {pelvis}); a left heel lies left of the right one. "
+            f"Give each foot its own heel marker (here perhaps left {feet['right']}, right {feet['left']})"
+        )
 
 
 #: Fewest stances of a belt, with both heels seen at mid-stance, that can confirm the belt's foot.

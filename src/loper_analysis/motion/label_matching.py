@@ -42,6 +42,7 @@ __all__ = [
     "heel_markers",
     "landmark_indices",
     "match_labels",
+    "side_landmark_indices",
     "starter_label_map",
 ]
 
@@ -184,6 +185,13 @@ def landmark_indices(names: Sequence[str], landmarks: Sequence[str]) -> list[int
     """Indices of the names that spell one of ``landmarks`` (keys of :data:`LANDMARK_SYNONYMS`), either side."""
     wanted = set(landmarks)
     return [i for i, name in enumerate(names) if any(lm in wanted for _, lm in _landmarks(str(name)))]
+
+
+def side_landmark_indices(names: Sequence[str], landmarks: Sequence[str], side: str) -> list[int]:
+    """Indices of the names that spell one of ``landmarks`` (keys of :data:`LANDMARK_SYNONYMS`) of one side
+    (``"left"`` or ``"right"``: a leading ``L``/``Left``, ``R``/``Right``, or a trailing ``_l``/``_r``)."""
+    wanted, s = set(landmarks), str(side)[:1].lower()
+    return [i for i, name in enumerate(names) if any(lm in wanted and sd == s for sd, lm in _landmarks(str(name)))]
 
 
 def heel_markers(names: Sequence[str]) -> dict[str, str] | None:
