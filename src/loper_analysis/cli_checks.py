@@ -75,13 +75,19 @@ OPTION_KEYS: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
         "cutoff_hz": ("config", ("filter", "cutoff_hz")),
         "order": ("config", ("filter", "order")),
         "max_gap_frames": ("config", ("markers", "max_gap_frames")),
+        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
     },
-    "grf": {"threshold_n": ("config", ("grf", "loaded_threshold_n"))},
+    "grf": {
+        "threshold_n": ("config", ("grf", "loaded_threshold_n")),
+        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
+    },
     "events": {
         "threshold_on_n": ("config", ("events", "threshold_on_n")),
         "threshold_off_n": ("config", ("events", "threshold_off_n")),
+        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
     },
     "scale": {
+        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
         "mass_kg": ("subjects", ("mass_kg",)),
         "max_motion_rms_m": ("config", ("markers", "static_max_motion_rms_m")),
         "cutoff_hz": ("config", ("filter", "cutoff_hz")),
@@ -93,6 +99,7 @@ OPTION_KEYS: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
         "attachment_fraction": ("config", ("opensim", "brace_attachment_fraction")),
     },
     "ik": {
+        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
         "accuracy": ("config", ("opensim", "accuracy")),
         "max_marker_rms_m": ("config", ("opensim", "max_marker_rms_m")),
         "warn_marker_rms_m": ("config", ("opensim", "warn_marker_rms_m")),

@@ -73,7 +73,7 @@ def subset_trc(trial, path, names):
 
 
 def test_c3d_in_mm_declared_as_m_is_refused_by_the_markers_step(trial, tmp_path):
-    lab_X = trial["X"] @ np.array([[1, 0, 0], [0, 0, 1], [0, -1, 0]], float).T  # model Y-up -> lab Z-up
+    lab_X = trial["X"] @ np.array([[1, 0, 0], [0, 0, -1], [0, 1, 0]], float).T  # model Y-up -> lab Z-up
     good = write_c3d(tmp_path / "good.c3d", list(MARKERS), lab_X, FS, point_unit="mm")
     bad = write_c3d(tmp_path / "bad.c3d", list(MARKERS), 1000.0 * lab_X, FS, point_unit="m")  # mm numbers, "m"
     gaps = markers_step(good, tmp_path / "good.trc")

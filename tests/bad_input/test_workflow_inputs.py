@@ -253,6 +253,21 @@ def test_label_map_entry_the_file_lacks_is_refused(lab):
     )
 
 
+def test_a_rotation_that_hangs_the_subject_below_the_floor_is_refused(lab):
+    """[90, 0, 0] for the Z-up lab: the pelvis lies along the model's -Y from the feet; the message offers the sign."""
+    cfg = _config(lab)
+    cfg["markers"]["lab_to_model_rotation_deg"] = [90, 0, 0]
+    _refused(
+        lab,
+        lambda: _markers(cfg, f"{RAW}/{WALK}.c3d"),
+        [
+            f"{RAW}/{WALK}.c3d: markers.lab_to_model_rotation_deg (--rotate-deg) [90, 0, 0] does not stand the "
+            "subject up: its pelvis lies along the model's -Y from its feet",
+            "the markers' up is model -Y: try [-90, 0, 0]",
+        ],
+    )
+
+
 def test_static_trial_in_which_the_subject_moves_is_refused(lab):
     """The subject walks off at 0.3 m/s: over any second every marker moves 87 mm RMS; the message names the
     stillest second (by the markers' noise), found here by brute force over every start frame."""

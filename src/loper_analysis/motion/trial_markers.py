@@ -126,6 +126,7 @@ def prepared_markers(
     heading = _heading(raw, names, rec.point_rate_hz, s, source)
     filled, gaps = fill_gaps(raw, s.max_gap_frames, names, source=source, unfillable="keep")
     X = rotate_markers(filled, heading.rotation_deg)
+    _require_upright(X, names, s.rotation_deg, heading.rotation_deg, source)
     unfiltered = None
     if s.cutoff_hz:
         try:
@@ -168,6 +169,55 @@ def _require_markers(rec, source: str) -> None:
             len(rec.output_labels),
             ", ".join(f"{k} {n}" for k, n in kinds.items()),
         )
+
+
+def _require_upright(X: np.ndarray, names: list[str], rotation_deg, turned_deg, source: str) -> None:
+    """Stop when the lab-to-model rotation hangs the subject upside down, warn when it lays it down: the markers' up
+    (feet to pelvis, :func:`loper_analysis.motion.upright.markers_up`) more than
+    :data:`~loper_analysis.motion.upright.MAX_UPSIDE_DOWN_DEG` from the model's +Y is nearest its -Y (a stop);
+    more than :data:`~loper_analysis.motion.upright.MAX_TILT_DEG`, nearest a horizontal axis (a warning: the lab's
+    frame kept as it is, ``[0, 0, 0]``, is a way to compare with another reader). ``X``: the markers turned by
+    ``turned_deg`` (``rotation_deg`` and the trial's turn about the vertical); the rotation offered instead is
+    ``rotation_deg``'s. Not judged (logged) without a pelvis marker and a foot marker, or when the frames'
+    feet-to-pelvis directions disagree (below :data:`~loper_analysis.motion.upright.MIN_AGREEMENT`: no body)."""
+    from loper_analysis.motion.upright import (
+        MAX_TILT_DEG,
+        MAX_UPSIDE_DOWN_DEG,
+        MIN_AGREEMENT,
+        markers_up,
+        nearest_axis,
+        upright_rotation_deg,
+    )
+
+    upper = landmark_indices(names, ["asis", "psis", "sacrum"])
+    lower = landmark_indices(names, ["heel", "toe", "mt1", "mt5", "ankle_lateral", "ankle_medial"])
+    up, n, agreement = markers_up(X, upper, lower)
+    if not n or agreement < MIN_AGREEMENT:
+        log.info(
+            "%s: the subject's up is not checked: %s",
+            source,
+            "no frame with a pelvis marker and a foot marker"
+            if not n
+            else f"the feet-to-pelvis directions of its frames disagree (agreement {agreement:.2f}, at least "
+            f"{MIN_AGREEMENT:g} for a body)",
+        )
+        return
+    tilt = float(np.degrees(np.arccos(np.clip(up[1], -1.0, 1.0))))
+    log.info("%s: the markers' up (feet to pelvis) lies %.1f deg from the model's +Y", source, tilt)
+    if tilt <= MAX_TILT_DEG:
+        return
+    lab = up @ rotate_markers(np.eye(3), turned_deg).T  # back to the lab: R.T @ up
+    axis = nearest_axis(rotate_markers(lab, rotation_deg))
+    given = ", ".join(f"{v:g}" for v in rotation_deg)
+    better = ", ".join(f"{v:g}" for v in upright_rotation_deg(rotation_deg, axis))
+    said = (
+        f"{source}: markers.lab_to_model_rotation_deg (--rotate-deg) [{given}] does not stand the subject up: "
+        f"its pelvis lies along the model's {axis} from its feet ({tilt:.0f} deg from the model's up, +Y; mean "
+        f"over {n} frames), so the markers' up is model {axis}: try [{better}]"
+    )
+    if tilt > MAX_UPSIDE_DOWN_DEG:
+        raise LoperInputError(said)
+    log.warning("%s (the subject lies on its side or its back, more than %g deg from +Y)", said, MAX_TILT_DEG)
 
 
 def _heading(raw: np.ndarray, names: list[str], rate_hz: float, s: MarkerSettings, source: str):
