@@ -16,6 +16,7 @@ import hashlib
 import re
 import shutil
 import subprocess
+import warnings
 from dataclasses import replace
 from pathlib import Path
 
@@ -621,6 +622,24 @@ def test_heel_markers_given_for_the_other_feet_are_refused(lab):
             "(here perhaps left LHEE, right RHEE)",
         ],
     )
+
+
+def test_a_walk_stored_backwards_is_warned_about_by_the_events_step(lab, tmp_path):
+    """Frames in reverse time: every belt stance ends with the toe risen more than the heel, as a landing does."""
+    rec = read_c3d(lab / RAW / f"{WALK}.c3d")
+    backward = tmp_path / "backward.c3d"
+    write_recording(backward, replace(rec, markers_m=rec.markers_m[::-1].copy(), analogs=rec.analogs[::-1].copy()))
+    settings = EventSettings.from_config(_config(lab))
+    before = _state(lab)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UserWarning)  # the trial as recorded: not a word
+        event_steps.events(f"{RAW}/{WALK}.c3d", tmp_path / "forward.tsv", settings)
+    with pytest.warns(UserWarning, match="time seems to run backwards in this file") as said:
+        event_steps.events(backward, tmp_path / "backward.tsv", settings)
+    (message,) = [str(w.message) for w in said if "backwards" in str(w.message)]
+    assert message.startswith(f"{backward}: time seems to run backwards in this file: 8 of its 8 foot contact(s) ")
+    assert "export the trial forward" in message
+    assert _state(lab) == before
 
 
 def _belts_in(lab: Path, path: Path, unit: str, factor: float) -> Path:

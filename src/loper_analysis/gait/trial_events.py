@@ -106,6 +106,7 @@ def trial_events(
         table, contacts = _plate_events(rec, platforms, s, label_map)
         log.info("contacts:\n%s", contacts.to_string(index=False))
         table.attrs["n_contacts_flagged"] = count_flagged(contacts["flag"])
+        _warn_time_reversed(rec, s, label_map, _plate_stances(contacts))
         return table, contacts
     if not s.grf_channels:
         raise LoperInputError(
@@ -115,6 +116,7 @@ def trial_events(
     table = _channel_events(rec, s)
     _check_belt_feet(rec, table, s, label_map)
     table.attrs["n_contacts_flagged"] = 0
+    _warn_time_reversed(rec, s, label_map, _belt_stances(table))
     return table, pd.DataFrame(columns=["plate", "contact", "side", "flag"])
 
 
@@ -207,6 +209,104 @@ def _check_heel_sides(rec, s: EventSettings, label_map) -> None:
             f"for the left foot lies {offset * 1000:.0f} mm to the right of the one given for the right foot (mean "
             f"over the trial along the pelvis's left-right axis, {pelvis}); a left heel lies left of the right one. "
             f"Give each foot its own heel marker (here perhaps left {feet['right']}, right {feet['left']})"
+        )
+
+
+#: Contact flags whose foot and whole contact are known: their ends are toe-offs (as the time-direction check reads
+#: them), whether or not they give events.
+_WHOLE_CONTACT_FLAGS = ("ok", "off_plate", "wrong_belt")
+
+
+def _plate_stances(contacts: pd.DataFrame) -> dict[str, list[tuple[float, float]]]:
+    """{side: [(start, end) s]} of the force plates' foot contacts with a known foot, a foot across plates as one;
+    under ``"either"`` the contacts no heel stood in at their start (``no_foot``), of one foot still unknown."""
+    out: dict[str, list[tuple[float, float]]] = {side: [] for side in SIDES}
+    unknown = contacts[contacts["flag"] == "no_foot"]
+    out["either"] = [(float(a), float(b)) for a, b in zip(unknown["start_s"], unknown["end_s"])]
+    rows = contacts[contacts["side"].isin(SIDES) & contacts["flag"].isin(_WHOLE_CONTACT_FLAGS)]
+    if "foot_contact" in rows.columns:
+        key = rows["foot_contact"].where(rows["foot_contact"] >= 0, -1 - np.arange(len(rows)))
+    else:
+        key = pd.Series(np.arange(len(rows)), index=rows.index)
+    for (_, side), group in rows.groupby([key, rows["side"]], sort=True):
+        out[side].append((float(group["start_s"].min()), float(group["end_s"].max())))
+    return out
+
+
+def _belt_stances(table: pd.DataFrame) -> dict[str, list[tuple[float, float]]]:
+    """{side: [(heel strike, next toe-off) s]} of the belts' event table."""
+    out: dict[str, list[tuple[float, float]]] = {side: [] for side in SIDES}
+    for side in SIDES:
+        mine = table[table["side"] == side].sort_values("time_s", kind="stable")
+        start = None
+        for event, time in zip(mine["event"], mine["time_s"]):
+            if event == "heel_strike":
+                start = float(time)
+            elif event == "toe_off" and start is not None:
+                out[side].append((start, float(time)))
+                start = None
+    return out
+
+
+def _toe_indices(names: list[str], s: EventSettings, side: str) -> list[int]:
+    """Indices of a foot's toe markers: ``toe_markers`` when both are in the file, else the names that spell a toe
+    or a first or fifth metatarsal head of that side."""
+    from loper_analysis.motion.label_matching import side_landmark_indices
+
+    if s.toe_markers and all(s.toe_markers[k] in names for k in SIDES):
+        return [names.index(s.toe_markers[side])]
+    return side_landmark_indices(names, ["toe", "mt1", "mt5"], side)
+
+
+def _warn_time_reversed(rec, s: EventSettings, label_map, stances: dict[str, list[tuple[float, float]]]) -> None:
+    """Warn when the trial's frames seem stored in reverse time: in most of its foot contacts the toe has risen
+    more than the heel at the contact's end, where a foot walking forward leaves the ground toe last
+    (:func:`loper_analysis.gait.foot_checks.toe_off_heel_lead_m`). A warning, not a stop: a foot that leaves the
+    ground flat (the margin is a few centimetres) should not refuse a trial. Not judged (logged) without a toe
+    marker of each foot or a contact with both markers at its end."""
+    from loper_analysis.gait.foot_checks import lower_foot, toe_off_heel_lead_m
+    from loper_analysis.motion.marker_names import model_marker_names
+    from loper_analysis.motion.markers import lab_up
+
+    feet, source = s.foot_markers, rec.source
+    if not feet or not rec.marker_labels:
+        return
+    names = model_marker_names(rec.marker_labels, label_map, source)
+    toes = {side: _toe_indices(names, s, side) for side in SIDES}
+    if any(feet[side] not in names or not toes[side] for side in SIDES):
+        log.info("%s: the time direction is not checked: no heel and toe marker of each foot", source)
+        return
+    up = lab_up(s.rotation_deg)
+    heel = {side: rec.markers_m[:, names.index(feet[side]), :] @ up for side in SIDES}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a frame without any toe marker: NaN
+        toe = {side: np.nanmean(rec.markers_m[:, toes[side], :] @ up, axis=1) for side in SIDES}
+    mine = {side: list(stances[side]) for side in SIDES}
+    for start, end in stances.get("either", []):  # the standing foot: the one whose toe is the lower
+        side = lower_foot(rec.time_s, toe, start, end)
+        if side is not None:
+            mine[side].append((start, end))
+    leads = [toe_off_heel_lead_m(rec.time_s, heel[side], toe[side], mine[side]) for side in SIDES]
+    lead = np.concatenate(leads)
+    lead = lead[np.isfinite(lead)]
+    if not lead.size:
+        log.info("%s: the time direction is not checked: no foot contact with its heel and toe seen at its end", source)
+        return
+    median_mm, n_back = float(np.median(lead)) * 1000, int((lead < 0).sum())
+    log.info(
+        "%s: at the end of its %d foot contact(s) the heel had risen %.0f mm more than the toe (median)",
+        source,
+        lead.size,
+        median_mm,
+    )
+    if median_mm < 0:
+        warnings.warn(
+            f"{source}: time seems to run backwards in this file: {n_back} of its {lead.size} foot contact(s) end "
+            f"with the toe risen more than the heel (by {-median_mm:.0f} mm, median), as a landing does; a foot "
+            "walking forward leaves the ground toe last. Are the frames stored in reverse order (a trial exported "
+            "backwards)? Its events, strides and every result from them would run backwards too; export the trial "
+            "forward",
+            stacklevel=2,
         )
 
 
