@@ -324,9 +324,9 @@ def belt_c3d(tmp_path_factory) -> Path:
     t = np.arange(n) / POINT_RATE
     markers = np.stack(
         [
-            np.stack([0.3 + 0.01 * np.sin(t), 0.2 + 0.0 * t, 0.1 + 0.0 * t], -1),
+            np.stack([0.3 + 0.01 * np.sin(t), 0.2 + 0.0 * t, 0.95 + 0.0 * t], -1),  # lab Z up: the pelvis high,
             np.stack([0.3 + 0.0 * t, 0.5 + 0.0 * t, 0.9 + 0.01 * np.cos(t)], -1),
-            np.stack([0.6 + 0.0 * t, 0.2 + 0.0 * t, 1.0 + 0.0 * t], -1),
+            np.stack([0.6 + 0.0 * t, 0.2 + 0.0 * t, 0.05 + 0.0 * t], -1),  # the heel low (the subject stands)
         ],
         axis=1,
     )
