@@ -58,6 +58,10 @@ def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
         "loads (results/grf/R01/walk-nodevice.grf.mot) for this trial"
     ]
     assert "results/validation/summary.tsv" in targets and "results/device/summary.tsv" not in targets
+    # nor does the Markdown of the run's tables ask for it (the default run would build the device tests then)
+    assert "Device" not in study.markdown_sections() and "results/device/summary.tsv" not in set(
+        study.markdown_sections().values()
+    )
 
 
 def test_a_fits_files_are_its_onsets_own_trials_and_the_null_pairs(tmp_path):

@@ -444,8 +444,9 @@ class Study:
             "Literature": p.impedance.literature,
             "Strides per trial": p.strides.summary,
             "Validation study": p.validation.summary,
-            "Device": p.device.summary,
         }
+        if self.device_targets():  # no device tests without a device subject (device.subject null)
+            sections["Device"] = p.device.summary
         if self.transparency_subjects():
             sections["Transparency: RMSD vs ISV_ave"] = p.transparency.rmsd
             sections["Transparency: interaction force"] = p.transparency.force
