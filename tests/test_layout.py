@@ -114,3 +114,18 @@ def test_ik_reads_the_static_trials_markers_of_a_subject_with_a_static_trial(tmp
     assert study.static_markers("R01") == ["results/markers/R01/static.trc"]
     assert study.static_markers("S01") == ["results/markers/S01/static.trc"]  # generated with its walks
     assert study.static_markers("R02") == []  # IK compares with the model's markers
+
+
+def test_the_workflow_compiles_the_packages_bytecode_when_it_starts(tmp_path):
+    """The README's set-up runs no `compileall`: the Snakefile compiles the package once, before any job (each job
+    would compile it again otherwise). A module's bytecode removed comes back with a dry run."""
+    import importlib.util
+
+    import loper_analysis.gait.events as module
+
+    cached = Path(importlib.util.cache_from_source(module.__file__))
+    cached.unlink(missing_ok=True)
+    copy_workflow(tmp_path)
+    res = snakemake(tmp_path, "-n", "-q")
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert cached.is_file() and cached.stat().st_mtime >= Path(module.__file__).stat().st_mtime
