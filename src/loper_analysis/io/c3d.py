@@ -63,7 +63,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.c3d_layout import check_complete, check_rates
+from loper_analysis.io.c3d_layout import check_complete, check_rates, check_zeroed_tail
 from loper_analysis.io.c3d_parameters import (
     EVENT_COLUMNS,
     param_float,
@@ -387,8 +387,10 @@ def read_c3d(path: str | os.PathLike) -> C3DRecording:
         number of samples per frame than the header (word 10) and the data
         block hold; ``ANALOG:USED`` unlike the header's analog values per
         frame (word 3); a data block the size of the other storage format
-        than ``POINT:SCALE`` declares; malformed ``EVENT:TIMES``. The
-        message names the file.
+        than ``POINT:SCALE`` declares; malformed ``EVENT:TIMES``; last
+        frames holding zero bytes only (an interrupted copy or export: the
+        message names the first zeroed frame, its time and the zeroed
+        share). The message names the file.
     """
     path = Path(path)
     return recording_from_ezc3d(_open_c3d(path), path)
@@ -416,6 +418,8 @@ def recording_from_ezc3d(c3d, path: str | os.PathLike) -> C3DRecording:
             f"{source}: {samples.shape[0]} analog samples for {n_frames} frames at {ratio} samples per frame"
         )
     check_complete(c3d, path, n_frames, 4 * n_points + n_channels * ratio)
+    if n_points:  # an interrupted copy: the last frames zeroed (analog-only files are left as they are)
+        check_zeroed_tail(c3d, path, n_frames, 4 * n_points + n_channels * ratio, point_rate, n_channels)
     if n_points:
         points, missing = _points_from(c3d)
     else:

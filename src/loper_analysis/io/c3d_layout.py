@@ -15,7 +15,15 @@ from loper_analysis.io.c3d_parameters import (
     param_value,
 )
 
-__all__ = ["check_complete", "check_rates", "check_storage_format", "header_frames", "raw_header"]
+__all__ = [
+    "check_complete",
+    "check_rates",
+    "check_storage_format",
+    "check_zeroed_tail",
+    "header_frames",
+    "raw_header",
+    "zeroed_tail_frames",
+]
 
 
 #: Size of a C3D block (header, parameter and data sections start on block boundaries), bytes.
@@ -171,6 +179,67 @@ def check_complete(c3d, path: Path, n_frames: int, words_per_frame: int) -> None
             f"{source}: truncated file: {n_frames} frames of {words_per_frame} words need {needed} bytes, "
             f"the file has {size}"
         )
+
+
+#: Frames read at a time when looking for the zeroed frames at a data block's end.
+_TAIL_CHUNK_FRAMES = 4096
+
+
+def zeroed_tail_frames(path: Path, data_start: int, n_frames: int, frame_bytes: int) -> int:
+    """How many of the last frames of the data block hold nothing but zero bytes (0 when the last one holds any).
+
+    ``data_start``: ``POINT:DATA_START`` (1-based block); ``frame_bytes``: one frame's record, every point's
+    four words (X, Y, Z, residual) and every analog sample. A recorded frame never holds only zero bytes: a
+    marker seen has its coordinates, a marker missing has residual -1 (QTM, Nexus, ezc3d and
+    :mod:`loper_analysis.io.c3d_writer` all write it so), and analog channels hold the converter's noise. The
+    frames are read from the end backwards, a chunk at a time.
+    """
+    if n_frames <= 0 or frame_bytes <= 0:
+        return 0
+    offset = (int(data_start) - 1) * _BLOCK_BYTES
+    zeroed, end = 0, n_frames
+    with path.open("rb") as fh:
+        while end > 0:
+            begin = max(end - _TAIL_CHUNK_FRAMES, 0)
+            fh.seek(offset + begin * frame_bytes)
+            chunk = np.frombuffer(fh.read((end - begin) * frame_bytes), np.uint8)
+            rows = chunk[: (chunk.size // frame_bytes) * frame_bytes].reshape(-1, frame_bytes).any(axis=1)
+            held = np.flatnonzero(rows)
+            if held.size:
+                return zeroed + (rows.size - 1 - int(held[-1]))
+            zeroed += rows.size
+            end = begin
+    return zeroed
+
+
+def check_zeroed_tail(
+    c3d, path: Path, n_frames: int, words_per_frame: int, point_rate_hz: float, n_channels: int
+) -> None:
+    """Refuse a file whose last frames hold zero bytes only: an interrupted copy or export.
+
+    The frames' bytes all 0 read as every marker at exactly (0, 0, 0) with a valid residual (and every analog
+    sample 0); the reader would take them as frames where every marker is missing, and the trial would go on with
+    its first part only. No recorded file holds such a frame (:func:`zeroed_tail_frames`), so one zeroed frame at
+    the end is refused, naming the first zeroed frame, its time and the zeroed share of the trial.
+    """
+    params = c3d["parameters"]
+    start = param_value(params, "POINT", "DATA_START")
+    scale = param_value(params, "POINT", "SCALE")
+    scale_value = None if scale is None or len(scale) == 0 else float(np.ravel(scale)[0])
+    word_bytes = 4 if scale_value is None or not np.isfinite(scale_value) or scale_value < 0 else 2
+    zeroed = zeroed_tail_frames(path, int(start[0]), n_frames, words_per_frame * word_bytes)
+    if not zeroed:
+        return
+    first = n_frames - zeroed + 1  # 1-based frame of the file
+    analogs = ", every analog sample 0" if n_channels else ""
+    pct = 100.0 * zeroed / n_frames
+    share = f"{pct:.0f}" if pct >= 1 else f"{pct:.1g}"
+    raise LoperInputError(
+        f"{path}: the last {zeroed} of {n_frames} frames ({share} % of the trial) hold "
+        f"zeros only, from frame {first} at {(first - 1) / point_rate_hz:.3f} s on (every marker at exactly "
+        f"(0, 0, 0){analogs}): likely an interrupted copy or export: the file's last {zeroed} frames hold zeros; "
+        "copy or export the trial again from the capture system"
+    )
 
 
 def _blocks(n_bytes: int) -> int:
