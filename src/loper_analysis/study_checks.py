@@ -1,13 +1,16 @@
 """The study's inputs checked before any job runs: the subject sheet's rows against the config, the raw
 folders against the trial design, a synthetic subject's folder holding no recording the synthetic lab would write
-over, and no recording standing for two trials."""
+over, no recording standing for two trials, and subject IDs short enough for the file names built from them."""
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
 
+import pandas as pd
+
 from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import stage_name
 from loper_analysis.io.generated import MANIFEST_SUFFIX, unvouched_files
 from loper_analysis.io.raw_files import (
     RAW_SUFFIXES,
@@ -16,16 +19,82 @@ from loper_analysis.io.raw_files import (
     repeated_files,
     unmatched_raw_files,
 )
-from loper_analysis.layout import Study, fill
+from loper_analysis.layout import RAW_FILES, RESULT_FILES, Paths, Study, fill
+from loper_analysis.schema import check_table
 from loper_analysis.synthetic.subjects import true_impedance
 
 __all__ = [
+    "NAME_MAX",
+    "SUBJECT_LOG_KEYS",
     "check_recordings",
+    "check_subject_ids",
+    "check_subject_sheet",
     "check_subjects",
+    "subject_file_names",
+    "subject_id_limit",
     "raw_file_warnings",
     "refuse_recordings_in_synthetic_folders",
     "refuse_repeated_recordings",
 ]
+
+
+#: The most bytes a file or folder name holds: NAME_MAX of Linux and macOS, and NTFS's 255 UTF-16 units.
+NAME_MAX = 255
+#: The wildcards of the rules' logs and benchmarks that hold a subject (:meth:`Paths.log`, :meth:`Paths.benchmark`).
+SUBJECT_LOG_KEYS: tuple[str, ...] = ("{subject}", "{subject}/{trial}", "{subject}/{trial}.{chunk}")
+#: What a rule's log adds to its name for the job's profile (``{log}.prof``, :mod:`loper_analysis.steps.logs`).
+PROFILE_SUFFIX = ".prof"
+
+
+def subject_file_names() -> list[str]:
+    """Every file or folder name built from a subject ID (``{subject}`` in it), longest first: the names of the
+    raw and result patterns (:mod:`loper_analysis.layout`), the logs (and their profiles) and benchmarks, each also
+    as the staging directory the writers create beside it (:func:`loper_analysis.io.atomic.stage_name`)."""
+    paths = Paths()
+    patterns = [
+        *(f"{paths.raw_dir}/{p}" for p in RAW_FILES.values()),
+        *(f"{paths.results_dir}/{stage}/{p}" for stage, files in RESULT_FILES.items() for p in files.values()),
+    ]
+    for key in SUBJECT_LOG_KEYS:
+        log = paths.log("rule", key)
+        patterns += [log, log + PROFILE_SUFFIX, paths.benchmark("rule", key)]
+    names = {part for pattern in patterns for part in pattern.split("/") if "{subject}" in part}
+    return sorted(names | {stage_name(n) for n in names}, key=lambda n: (-len(n), n))
+
+
+def subject_id_limit() -> tuple[int, str]:
+    """The longest subject ID every name built from it fits (:data:`NAME_MAX` bytes), and the longest such name."""
+    longest = subject_file_names()[0]
+    return NAME_MAX - (len(longest.encode()) - len("{subject}")), longest
+
+
+def check_subject_ids(subjects: pd.DataFrame, sheet: str) -> None:
+    """Refuse a subject ID too long for the file names built from it (:func:`subject_id_limit`), before any job:
+    the job would fail with the operating system's "File name too long".
+
+    Raises
+    ------
+    LoperInputError
+        Naming the sheet, the row (1-based, after the header), the ID's length and the limit.
+    """
+    if "subject" not in subjects.columns:
+        return
+    limit, longest = subject_id_limit()
+    for n, subject in enumerate(subjects["subject"], start=1):
+        length = len(str(subject).encode())
+        if length > limit:
+            raise LoperInputError(
+                f"{sheet}: row {n}, column 'subject': the subject ID '{str(subject)[:24]}...' is {length} characters "
+                f"long; at most {limit} fit: a file name holds at most {NAME_MAX} bytes and the longest one built "
+                f"from an ID, '{longest}', adds {len(longest.encode()) - len('{subject}')}"
+            )
+
+
+def check_subject_sheet(subjects: pd.DataFrame, schema_path: str | Path, sheet: str) -> None:
+    """Every row of the subject sheet against its schema (:func:`loper_analysis.schema.check_table`), the subject
+    IDs' length first (:func:`check_subject_ids`: its message gives the length and the limit)."""
+    check_subject_ids(subjects, sheet)
+    check_table(subjects, schema_path, sheet)
 
 
 def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None:

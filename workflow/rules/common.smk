@@ -14,9 +14,9 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.readers import read_subject_sheet
 from loper_analysis.layout import Paths, Study, fill, subject_rows
-from loper_analysis.schema import check_config, check_project_paths, check_table, config_origin
+from loper_analysis.schema import check_config, check_project_paths, config_origin
 from loper_analysis.steps.cluster import requested_partitions
-from loper_analysis.study_checks import check_subjects, raw_file_warnings
+from loper_analysis.study_checks import check_subject_sheet, check_subjects, raw_file_warnings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
@@ -40,7 +40,7 @@ try:
     if not _subjects_path.is_file():
         raise LoperInputError(f"{config_source('subjects')}: key 'subjects': file '{_subjects_path}' not found")
     subjects = read_subject_sheet(_subjects_path)
-    check_table(subjects, _SCHEMAS / "subjects.schema.yaml", str(_subjects_path))
+    check_subject_sheet(subjects, _SCHEMAS / "subjects.schema.yaml", str(_subjects_path))  # IDs' length first
     validate(subjects, "../schemas/subjects.schema.yaml")
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None

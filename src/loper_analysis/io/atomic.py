@@ -35,6 +35,7 @@ __all__ = [
     "PathLike",
     "TSV_FLOAT_FORMAT",
     "FIGURE_DPI",
+    "stage_name",
     "staged",
     "write_bytes",
     "write_text",
@@ -54,6 +55,12 @@ _STAGE_RANDOM_CHARS = 8
 #: Column types :func:`write_tsv` formats itself; characters that make pandas quote a column name.
 _NUMERIC_COLUMNS = (np.dtype(np.float64), np.dtype(np.int64))
 _QUOTED_CHARACTERS = frozenset('\t"\n\r')
+
+
+def stage_name(name: str) -> str:
+    """The name of the staging directory of a file named ``name`` (its random characters shown as ``X``):
+    ``.{name}.XXXXXXXX.partial``, the longest name the writers create for that file."""
+    return f".{name}.{'X' * _STAGE_RANDOM_CHARS}.partial"
 
 
 def _remove_stale_stages(path: Path) -> None:
