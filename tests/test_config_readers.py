@@ -179,7 +179,7 @@ READERS = {
     "identification.min_null_pairs": "impedance_fit planning",
     "planning.pilot_subject": "planning",
     "planning.strides": "planning",
-    "planning.pulse_force_n": "planning",
+    "planning.pulse_force_n": "events_loadcell planning",
     "planning.pulse_duration_s": "planning",
     "planning.targets": "planning",
     "validation.subject_height_m": "validation_segments",

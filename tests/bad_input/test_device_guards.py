@@ -415,3 +415,108 @@ def test_a_load_cell_logged_in_another_unit_is_refused_from_the_pulses(trial, tm
         assert word in message
     ratio = float(message.split("column 'force_measured_n' is ")[1].split(" times")[0])
     assert ratio == pytest.approx(factor * 0.95, rel=0.1)
+
+
+@pytest.mark.parametrize(
+    ("factor", "ratio", "cause"),
+    [
+        (1e-3, 1e-3, "the log's forces look like kN instead of N (ratio about 0.001)"),
+        (1e3, 1e3, "the log's forces look like mN instead of N (ratio about 1000)"),
+    ],
+    ids=["kN", "mN"],
+)
+def test_both_force_columns_in_another_unit_are_refused_from_the_configured_pulse(
+    trial, tmp_path, factor, ratio, cause
+):
+    """Both force columns in kN (pulses of 0.04 where the study applies 40 N): measured over desired stays ~1, and
+    the desired pulses stayed below the 1 N from which that ratio is judged, so nothing stopped the log until the
+    fit failed on its VAF. The desired pulses' amplitude against the configured perturbation force
+    (planning.pulse_force_n, 40 N) names the log, the column, both amplitudes and the unit."""
+    from loper_analysis.device.loadcell import require_force_unit, require_pulse_amplitude
+
+    robot = trial["walk"].robot
+    on = robot["perturbation"].to_numpy() == 1
+    assert require_pulse_amplitude(robot["force_desired_n"], on, 40.0) == pytest.approx(1.0, abs=0.01)
+    fd, fm = factor * robot["force_desired_n"], factor * robot["force_measured_n"]
+    if factor < 1:  # the unit check of the measured force alone cannot judge these pulses
+        assert np.isnan(require_force_unit(fd, fm, on))
+    log = _log_with(trial, tmp_path, "units.loper.tsv", force_desired_n=fd, force_measured_n=fm)
+    message = _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [
+            f"{log} / ",
+            ": column 'force_desired_n': the perturbation pulses reach ",
+            "times the configured perturbation force of 40 N (planning.pulse_force_n; accepted 0.1 .. 10 times)",
+            cause,
+            "must hold newtons",
+        ],
+    )
+    amplitude = float(message.split("pulses reach ")[1].split(" ")[0])
+    assert amplitude == pytest.approx(40.0 * factor, rel=0.01)
+    got = float(message.split("), ")[1].split(" times")[0])
+    assert got == pytest.approx(ratio, rel=0.01)
+
+
+def test_a_minimal_impedance_log_has_no_pulses_to_judge(trial):
+    """Without flagged samples the desired force's amplitude is not judged (nothing is asked of the robot)."""
+    from loper_analysis.device.loadcell import require_pulse_amplitude
+
+    robot = trial["still"].robot
+    assert np.isnan(require_pulse_amplitude(1e-3 * robot["force_desired_n"], robot["perturbation"], 40.0))
+
+
+# --------------------------------------------------------------------------- a sync channel of noise
+
+
+def _noise_c3d(trial, tmp_path, seed: int) -> Path:
+    """The trial's C3D with its sync channel replaced by seeded noise about the train's mid level (2.5 +- 1 V)."""
+    from loper_analysis.io.c3d_writer import write_recording
+
+    rec = trial["rec"]
+    analogs = rec.analogs.copy()
+    k = rec.analog_labels.index(trial["lab"].sync_channel)
+    analogs[:, k] = np.random.default_rng(seed).normal(2.5, 1.0, analogs.shape[0])
+    c3d = tmp_path / "noise.c3d"
+    write_recording(c3d, replace(rec, analogs=analogs, source=str(c3d)))
+    return c3d
+
+
+_NO_TRAIN = [
+    "no pulse train: ",
+    " crossings of the halfway level ",
+    "levels not two-valued",
+    "a pulse train at least 8",
+]
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_a_mocap_sync_channel_of_noise_is_refused_as_no_pulse_train(trial, tmp_path, seed):
+    """The C3D's sync channel holds noise (an unplugged cable): named as such, with the channel and the file,
+    before the edges are matched (it was blamed on 'different trains')."""
+    c3d = _noise_c3d(trial, tmp_path, seed)
+    message = _refused(
+        tmp_path,
+        c3d,
+        trial["raw"] / "pert050-1.loper.tsv",
+        [str(c3d), "mocap sync channel 'sync': ", *_NO_TRAIN, "the channel holds noise", "unplugged sync cable"],
+    )
+    assert "different trains" not in message
+    crossings = int(message.split("no pulse train: ")[1].split(" ")[0])
+    assert crossings > 1000  # ~0.5 of 12 s x 1024 samples; the train has ~2 per second
+    separation = float(message.split("apart, a pulse train")[0].split("lie only ")[1].split(" ")[0])
+    assert 1.5 < separation < 4.0
+
+
+def test_a_robot_sync_of_noise_is_refused_as_no_pulse_train(trial, tmp_path):
+    """The robot log's sync_v holds noise: the log and its column are named."""
+    n = len(trial["walk"].robot)
+    noise = np.random.default_rng(3).uniform(0.0, 5.0, n)
+    log = _log_with(trial, tmp_path, "noise.loper.tsv", sync_v=noise)
+    _refused(
+        tmp_path,
+        trial["raw"] / "pert050-1.c3d",
+        log,
+        [f"{log} / ", "robot log column 'sync_v': ", *_NO_TRAIN, "unplugged sync cable"],
+    )

@@ -5,9 +5,11 @@ import numpy as np
 import pytest
 
 from loper_analysis.device.clock_sync import (
+    MIN_LEVEL_SEPARATION,
     MIN_MATCHED_EDGES,
     ClockMap,
     clock_map,
+    require_pulse_train,
     rising_edges,
 )
 from loper_analysis.errors import LoperInputError
@@ -127,3 +129,73 @@ def test_clock_map_refuses_a_clock_jump():
     m[m.size // 2 :] += 0.02  # 20 ms jump half-way
     with pytest.raises(LoperInputError, match="trial-j: sync edges do not lie on one line"):
         clock_map(r, m, source="trial-j")
+
+
+# ---------------------------------------------------------------------------
+# a pulse train at all
+
+
+def _mocap_train(seed: int, noise_v: float = 0.0) -> np.ndarray:
+    """60 s of the robot's sync train as the mocap analog input records it (5 V, 10 ms pulses), plus noise."""
+    starts = sync_pulse_starts(60.0, seed)
+    x = mocap_view(starts, 1.3, 80.0, 0.0, 60.0, 60.0)
+    return x + np.random.default_rng(seed).normal(0.0, noise_v, x.size)
+
+
+@pytest.mark.parametrize("noise_v", [0.0, 0.01, 0.1, 0.3])
+def test_a_sync_train_passes_as_a_pulse_train(noise_v):
+    """The train at 1 % duty, noiseless or with up to 0.3 V of noise on its 5 V swing (a separation of ~17)."""
+    got = require_pulse_train(_mocap_train(5, noise_v), ANALOG_HZ, source="trial-t")
+    assert got["separation"] >= MIN_LEVEL_SEPARATION
+    assert abs(got["low_v"]) < 0.05 and abs(got["high_v"] - 5.0) < 0.1
+    assert got["middle_fraction"] < 0.01
+    n_edges = rising_edges(_mocap_train(5, noise_v), ANALOG_HZ).size
+    assert got["crossings"] == 2 * n_edges  # up and down, once per edge
+
+
+def _replaced_by(kind: str, n: int, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) / ANALOG_HZ
+    return {
+        "gaussian": lambda: rng.normal(2.5, 1.0, n),
+        "uniform": lambda: rng.uniform(0.0, 5.0, n),
+        "mains": lambda: 0.3 * np.sin(2 * np.pi * 50.0 * t) + rng.normal(0.0, 0.01, n),
+    }[kind]()
+
+
+@pytest.mark.parametrize("kind", ["gaussian", "uniform", "mains"])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_sync_channel_of_noise_is_no_pulse_train(kind, seed):
+    """The sync record with its channel replaced by seeded noise (or mains hum): without the check its random
+    edges reached the matching and were blamed on different trains; now the channel is named as holding noise."""
+    x = _replaced_by(kind, _mocap_train(seed).size, seed)
+    with pytest.raises(LoperInputError) as info:
+        require_pulse_train(x, ANALOG_HZ, source="trial-n.c3d: mocap sync channel 'sync'")
+    message = str(info.value)
+    assert message.startswith("trial-n.c3d: mocap sync channel 'sync': no pulse train: ")
+    for words in ("crossings of the halfway level", "in 60 s", "levels not two-valued", "a pulse train at least 8"):
+        assert words in message
+    assert "the channel holds noise. An unplugged sync cable, or the wrong channel?" in message
+    separation = float(message.split("lie only ")[1].split(" ")[0])
+    assert separation < 4.5  # noise 2 to 3, a sine 3.9: far below 8
+    crossings = int(message.split("no pulse train: ")[1].split(" ")[0])
+    assert crossings > 1000
+
+
+def test_noise_edges_alone_were_blamed_on_different_trains():
+    """What the check replaces: noise has edges enough for the matching, which then blames the trains."""
+    robot = pulse_train_at(np.arange(60000) / ROBOT_HZ, sync_pulse_starts(60.0, 4))
+    noise = _replaced_by("gaussian", 61440, 4)
+    edges = rising_edges(noise, ANALOG_HZ)
+    assert edges.size > 100
+    with pytest.raises(LoperInputError, match="different trains"):
+        clock_map(rising_edges(robot, ROBOT_HZ), edges, source="trial-n")
+
+
+def test_signals_without_two_values_are_left_to_rising_edges():
+    """Empty, all-NaN and flat signals: rising_edges names them (see test_rising_edges_refusals)."""
+    for x in (np.array([]), np.full(100, np.nan), np.full(100, 5.0)):
+        assert require_pulse_train(x, ANALOG_HZ) == {}
+    gappy = _mocap_train(6)
+    gappy[1000:1500] = np.nan
+    assert require_pulse_train(gappy, ANALOG_HZ)["separation"] >= MIN_LEVEL_SEPARATION

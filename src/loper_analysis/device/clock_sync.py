@@ -21,6 +21,10 @@ also compares each paired pulse's high time (rising to next falling edge,
 :func:`high_times`) in both records when given them, and refuses records that
 disagree.
 
+Noise: before the edges are matched, :func:`require_pulse_train` checks that a sync signal looks like a pulse
+train at all (two levels, each much narrower than the swing between them); a channel holding noise (an
+unplugged cable, the wrong channel) would otherwise give random edges and a refusal blaming "different trains".
+
 Edge-time convention: an edge is placed where the straight line between the
 last sample below and the first sample at or above the threshold crosses it,
 so a sharp step sampled at rate f_s is located to within +-0.5 / f_s, without
@@ -41,7 +45,16 @@ import numpy as np
 from loper_analysis.checks import positive
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["MIN_MATCHED_EDGES", "HIGH_TIME_TOLERANCE", "ClockMap", "rising_edges", "high_times", "clock_map"]
+__all__ = [
+    "MIN_MATCHED_EDGES",
+    "HIGH_TIME_TOLERANCE",
+    "MIN_LEVEL_SEPARATION",
+    "ClockMap",
+    "rising_edges",
+    "high_times",
+    "require_pulse_train",
+    "clock_map",
+]
 
 #: Fewest edges that must pair up between the two records for a clock map.
 MIN_MATCHED_EDGES = 4
@@ -50,6 +63,11 @@ _GATE_FACTOR = 10.0
 #: Largest accepted difference of a pulse's high time between the two records, as a share of the pulse's period
 #: (added to ``2 * tolerance_s``): 5 % tells a duty ratio d from 1 - d unless d lies within about 0.47 .. 0.53.
 HIGH_TIME_TOLERANCE = 0.05
+#: Smallest separation of a pulse train's two levels, in units of their spread (:func:`require_pulse_train`): each
+#: level's robust SD at most 1/8 of the swing keeps the hysteresis band of :func:`rising_edges` (a quarter of the
+#: swing from either level) at least 2 SDs from it. Noise gives 2 to 3 (Gaussian 2.3, uniform 2.7), a mains sine
+#: 3.9, a 5 V train with 0.1 V of noise about 50.
+MIN_LEVEL_SEPARATION = 8.0
 
 
 @dataclass(frozen=True)
@@ -187,6 +205,76 @@ def high_times(
     ok = has & (f < nxt)
     out[ok] = f[ok] - rising[ok]
     return out
+
+
+def require_pulse_train(signal_v, sample_rate_hz: float, source: str = "") -> dict:
+    """Refuse a sync signal that is no pulse train (noise, an unplugged cable) before its edges are matched.
+
+    The finite samples are split in two where the split separates them best (Otsu: largest between-class
+    variance); each class's level is its median, its spread its robust SD (1.4826 x MAD). A pulse train sits at
+    one of two levels but for its edges: they lie at least :data:`MIN_LEVEL_SEPARATION` (8) larger spreads
+    apart. Noise gives 2 to 3 and is refused, naming the levels, the share of samples in the middle half between
+    them and the crossings of the halfway level. Signals with fewer than two distinct finite values (empty, all
+    NaN, flat) are left to :func:`rising_edges`, which names them.
+
+    Parameters
+    ----------
+    signal_v : array_like, shape (n,)
+        Sync signal, V (NaN = missing).
+    sample_rate_hz : float
+        Sampling rate, Hz (for the duration named in the message).
+    source : str
+        Names the signal (file, channel) in error messages.
+
+    Returns
+    -------
+    dict
+        ``low_v``, ``high_v`` (levels, V), ``separation`` (their distance over the larger spread; inf without
+        noise), ``middle_fraction``, ``crossings``; empty when the signal was left to :func:`rising_edges`.
+
+    Raises
+    ------
+    LoperInputError
+        A separation below :data:`MIN_LEVEL_SEPARATION`: "no pulse train", naming the source, what the signal
+        holds and the likely cause.
+    """
+    src = source or "sync signal"
+    rate = positive("sample_rate_hz", sample_rate_hz, src)
+    x = np.asarray(signal_v, dtype=float)
+    if x.ndim != 1:
+        return {}
+    finite = x[np.isfinite(x)]
+    v = np.sort(finite)
+    if v.size < 2 or v[0] == v[-1]:
+        return {}
+    n = v.size
+    k = np.arange(1, n)
+    c = np.cumsum(v - v[0])  # shifted for conditioning
+    m0 = c[:-1] / k
+    m1 = (c[-1] - c[:-1]) / (n - k)
+    between = (k / n) * (1 - k / n) * (m1 - m0) ** 2
+    between[v[1:] == v[:-1]] = -1.0  # split only between distinct values
+    i = int(np.argmax(between)) + 1
+    low, high = v[:i], v[i:]
+    lo_v, hi_v = float(np.median(low)), float(np.median(high))
+    spread = 1.4826 * max(float(np.median(np.abs(low - lo_v))), float(np.median(np.abs(high - hi_v))))
+    swing = hi_v - lo_v
+    sep = swing / spread if spread > 0 else math.inf
+    mid = float(np.mean((finite > lo_v + swing / 4) & (finite < hi_v - swing / 4)))
+    half = 0.5 * (lo_v + hi_v)
+    above = finite >= half
+    crossings = int(np.count_nonzero(above[1:] != above[:-1]))
+    out = {"low_v": lo_v, "high_v": hi_v, "separation": sep, "middle_fraction": mid, "crossings": crossings}
+    if sep >= MIN_LEVEL_SEPARATION:
+        return out
+    raise LoperInputError(
+        f"{src}: no pulse train: {crossings} crossings of the halfway level {half:.4g} V in "
+        f"{x.size / rate:.4g} s, levels not two-valued (the samples spread about {lo_v:.4g} and {hi_v:.4g} V "
+        f"by {spread:.3g} V, so the two levels lie only {sep:.2f} times their spread apart, a pulse train at "
+        f"least {MIN_LEVEL_SEPARATION:g}; {mid:.0%} of the samples lie in the middle half between them, where a "
+        "pulse train only passes at its edges): the channel holds noise. An unplugged sync cable, or the wrong "
+        "channel?"
+    )
 
 
 def _levels(signal_v, threshold_v: float | None, src: str) -> tuple[np.ndarray, float, float]:

@@ -9,9 +9,11 @@ the mocap clock -> linear interpolation of the forces, nearest-sample pick of
 the perturbation flag, at the mocap frame times (128 Hz); the same filtered
 forces at every robot sample, on the mocap clock, for the identification.
 
-Three checks guard against records that would give wrong numbers without an
-error (``docs/device.md``, "Checks on the robot's records"): the measured force must be in the unit of the
-desired one, N (:func:`require_force_unit`), the sync pulses
+Checks guard against records that would give wrong numbers, or a misleading error later
+(``docs/device.md``, "Checks on the robot's records"): each sync signal must look like a pulse train
+(:func:`loper_analysis.device.clock_sync.require_pulse_train`), the desired force's pulses must be about the
+configured perturbation force (:func:`require_pulse_amplitude`: both forces in kN are caught here), the measured
+force must be in the unit of the desired one, N (:func:`require_force_unit`), the sync pulses
 must have the same high time in both records (an inverted sync, e.g. an
 active-low robot output, shifts the clock map by the pulse width;
 :func:`loper_analysis.device.clock_sync.clock_map`), and force pulses in the load
@@ -21,6 +23,7 @@ cell must carry the perturbation flag (:func:`check_perturbation_flags`).
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -28,11 +31,12 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.checks import positive
-from loper_analysis.device.clock_sync import ClockMap, clock_map, high_times, rising_edges
+from loper_analysis.device.clock_sync import ClockMap, clock_map, high_times, require_pulse_train, rising_edges
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
 from loper_analysis.motion.trial_markers import MarkerSettings
+from loper_analysis.study_design import PULSE_FORCE_N
 
 __all__ = [
     "SYNC_CHANNEL",
@@ -40,7 +44,9 @@ __all__ = [
     "OUTPUT_COLUMNS",
     "MIN_UNFLAGGED_PULSES",
     "FORCE_RATIO_RANGE",
+    "PULSE_AMPLITUDE_RANGE",
     "require_force_unit",
+    "require_pulse_amplitude",
     "robot_log_on_mocap_frames",
     "robot_log_frames_and_native",
     "check_perturbation_flags",
@@ -55,12 +61,15 @@ SYNC_CHANNEL: str = "sync"
 
 @dataclass(frozen=True)
 class LoadcellSettings:
-    """The robot log on the mocap clock: the C3D's ``sync_channel`` and the forces' low-pass (``cutoff_hz`` Hz,
-    Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``filter.*``)."""
+    """The robot log on the mocap clock: the C3D's ``sync_channel``, the forces' low-pass (``cutoff_hz`` Hz,
+    Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``filter.*``) and the
+    study's perturbation force ``pulse_force_n`` (N; config ``planning.pulse_force_n``), which the desired force's
+    pulses are checked against (:func:`require_pulse_amplitude`)."""
 
     sync_channel: str = SYNC_CHANNEL
     cutoff_hz: float = CUTOFF_HZ
     order: int = ORDER
+    pulse_force_n: float = PULSE_FORCE_N
 
     @classmethod
     def from_config(cls, config: Mapping) -> LoadcellSettings:
@@ -71,7 +80,8 @@ class LoadcellSettings:
         config : mapping
             The validated configuration: ``events.sync_channel`` is read here, the one place it is read; the
             low-pass is the walking trials' (``filter.cutoff_hz``, Hz, and ``filter.order``,
-            :meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`).
+            :meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`); the perturbation force is
+            the study's planned pulse (``planning.pulse_force_n``, N).
 
         Raises
         ------
@@ -79,7 +89,9 @@ class LoadcellSettings:
             A key missing, named.
         """
         walking = MarkerSettings.from_config(config)
-        return cls(config["events"]["sync_channel"], walking.cutoff_hz, walking.order)
+        return cls(
+            config["events"]["sync_channel"], walking.cutoff_hz, walking.order, config["planning"]["pulse_force_n"]
+        )
 
 
 #: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.
@@ -95,6 +107,9 @@ FORCE_RATIO_RANGE: tuple[float, float] = (0.5, 2.0)
 #: Smallest peak desired force during the flagged samples (N) for that ratio to be judged (a log without the
 #: desired pulses cannot be).
 MIN_DESIRED_PULSE_N: float = 1.0
+#: Accepted range of the desired pulses' amplitude over the configured perturbation force: outside, a unit (kN
+#: gives 0.001, mN 1000) or a log of another protocol. A decade either way: the study's pulses vary far less.
+PULSE_AMPLITUDE_RANGE: tuple[float, float] = (0.1, 10.0)
 #: A force pulse counts as flagged if the flag is 1 anywhere from this long before its start to this long after
 #: its end, s (the load cell follows the flag by the robot's delays, ~15 ms).
 _FLAG_MARGIN_S = 0.1
@@ -106,9 +121,12 @@ def robot_log_on_mocap_frames(
     """The robot log's forces and perturbation flag on the motion-capture frames.
 
     ``options`` are the keyword settings of :func:`robot_log_frames_and_native` (``cutoff_hz``, ``order``,
-    ``source``, ``analog_start_s``, ``max_drift``, ``tolerance_s``, ``sync_channel``), described below.
+    ``source``, ``analog_start_s``, ``max_drift``, ``tolerance_s``, ``sync_channel``, ``pulse_force_n``),
+    described below.
 
-    1. Clock map (:func:`loper_analysis.device.clock_sync.clock_map`) from the rising edges of the log's
+    1. Both sync signals must look like pulse trains
+       (:func:`loper_analysis.device.clock_sync.require_pulse_train`); then the
+       clock map (:func:`loper_analysis.device.clock_sync.clock_map`) from the rising edges of the log's
        ``sync_v`` (robot clock: ``time_s`` at the interpolated sample index)
        and of ``mocap_sync_v`` (mocap clock: ``analog_start_s + index /
        analog_rate_hz``); the pulses' high times
@@ -121,8 +139,9 @@ def robot_log_on_mocap_frames(
        interpolated at ``frame_time_s``; ``perturbation`` taken from the
        nearest robot sample (never interpolated), so a flag's onset lands
        within one mocap frame (plus half a robot sample) of its mapped time.
-    4. Force pulses in the low-passed ``force_measured_n`` must carry the
-       ``perturbation`` flag (:func:`check_perturbation_flags`).
+    4. The desired pulses must be about ``pulse_force_n`` (:func:`require_pulse_amplitude`), the measured
+       force in the desired one's unit (:func:`require_force_unit`), and force pulses in the low-passed
+       ``force_measured_n`` must carry the ``perturbation`` flag (:func:`check_perturbation_flags`).
 
     :func:`robot_log_frames_and_native` also returns the filtered forces at
     the robot's own samples.
@@ -158,6 +177,9 @@ def robot_log_on_mocap_frames(
         Passed to :func:`loper_analysis.device.clock_sync.clock_map`.
     sync_channel : str
         Name of the mocap sync channel, for messages.
+    pulse_force_n : float, optional
+        The configured perturbation force, N (config ``planning.pulse_force_n``); None: the desired pulses'
+        amplitude is not checked.
 
     Returns
     -------
@@ -172,9 +194,13 @@ def robot_log_on_mocap_frames(
     LoperInputError
         Missing columns, a ``time_s`` step inconsistent with ``log_rate_hz``,
         non-finite forces or frame times, an all-NaN or flat sync signal in
-        either record, a clock map refused by :func:`loper_analysis.device.clock_sync.clock_map` (also: sync
-        pulses whose high times disagree between the records, e.g. an inverted robot sync), no frame
-        inside the log's span, force pulses without perturbation flags (:func:`check_perturbation_flags`).
+        either record, a sync signal that is no pulse train (noise:
+        :func:`loper_analysis.device.clock_sync.require_pulse_train`), a clock map refused by
+        :func:`loper_analysis.device.clock_sync.clock_map` (also: sync pulses whose high times disagree between
+        the records, e.g. an inverted robot sync), no frame
+        inside the log's span, desired pulses far from ``pulse_force_n`` (:func:`require_pulse_amplitude`: both
+        forces in kN), a measured force in another unit (:func:`require_force_unit`), force pulses without
+        perturbation flags (:func:`check_perturbation_flags`).
     """
     return robot_log_frames_and_native(log, log_rate_hz, mocap_sync_v, analog_rate_hz, frame_time_s, **options)[0]
 
@@ -193,6 +219,7 @@ def robot_log_frames_and_native(
     max_drift: float = 1e-3,
     tolerance_s: float = 3e-3,
     sync_channel: str = "",
+    pulse_force_n: float | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """:func:`robot_log_on_mocap_frames` and the same forces at the robot log's own samples.
 
@@ -233,6 +260,8 @@ def robot_log_frames_and_native(
     for col in _FORCE_COLUMNS:
         out[col] = np.interp(frames, t_mapped, native[col], left=np.nan, right=np.nan)
     flag = _perturbation_flag(log, src)
+    if pulse_force_n is not None:
+        require_pulse_amplitude(log["force_desired_n"].to_numpy(dtype=float), flag, pulse_force_n, src)
     require_force_unit(native["force_desired_n"], native["force_measured_n"], flag, src)
     check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
     pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
@@ -279,6 +308,8 @@ def _sync_clock_map(
     robot_name = "robot log column 'sync_v'"
     mocap_name = f"mocap sync channel '{sync_channel}'" if sync_channel else "mocap sync channel"
     robot_sync = log["sync_v"].to_numpy(dtype=float, na_value=np.nan)
+    require_pulse_train(robot_sync, rate, source=f"{src}: {robot_name}")
+    require_pulse_train(mocap_sync_v, arate, source=f"{src}: {mocap_name}")
     robot_rel = rising_edges(robot_sync, rate, source=f"{src}: {robot_name}")
     mocap_rel = rising_edges(mocap_sync_v, arate, source=f"{src}: {mocap_name}")
     robot_edges = np.interp(robot_rel * rate, np.arange(t_log.size), t_log)
@@ -316,6 +347,66 @@ def _perturbation_flag(log: pd.DataFrame, src: str) -> np.ndarray:
         k = int(np.flatnonzero(~np.isin(flag, (0.0, 1.0)))[0])
         raise LoperInputError(f"{src}: column 'perturbation', sample {k}: value {flag[k]!r} is not 0 or 1")
     return flag
+
+
+def require_pulse_amplitude(desired_n, flag, pulse_force_n: float, source: str = "") -> float:
+    """Refuse a robot log whose desired perturbation pulses are far from the configured perturbation force.
+
+    The amplitude of the desired pulses is the median ``|desired_n|`` over the flagged samples where it exceeds
+    half its largest magnitude there (the pulses' plateau). Its ratio to ``|pulse_force_n|`` must lie within
+    :data:`PULSE_AMPLITUDE_RANGE` (0.1 .. 10). A log in kN gives about 0.001: with both force columns in kN,
+    :func:`require_force_unit` sees a ratio of 1 and the fit would fail later on its VAF without naming the
+    force. Logs without flagged samples (minimal-impedance trials) or whose desired force is zero throughout them
+    (no desired pulses logged) cannot be judged and pass.
+
+    Parameters
+    ----------
+    desired_n : array_like, shape (n,)
+        The log's ``force_desired_n`` as logged (N).
+    flag : array_like, shape (n,)
+        The log's ``perturbation`` column, 0/1.
+    pulse_force_n : float
+        The configured perturbation force, N (config ``planning.pulse_force_n``; its sign is the direction).
+    source : str
+        Names the robot log in messages.
+
+    Returns
+    -------
+    float
+        The ratio of the pulses' amplitude to ``|pulse_force_n|`` (NaN when not judged).
+
+    Raises
+    ------
+    LoperInputError
+        A ratio outside :data:`PULSE_AMPLITUDE_RANGE`, naming the file, the column, the measured amplitude, the
+        configured force and the likely cause (kN, mN); a zero or non-finite ``pulse_force_n``.
+    """
+    src = source or "robot log"
+    configured = abs(float(pulse_force_n))
+    if not (math.isfinite(configured) and configured > 0):
+        raise LoperInputError(f"{src}: pulse_force_n must be a finite non-zero force (N), got {pulse_force_n!r}")
+    fd = np.abs(np.asarray(desired_n, float))
+    on = (np.asarray(flag, float) == 1) & np.isfinite(fd)
+    if not on.any() or not np.max(fd[on]) > 0:
+        return float("nan")
+    strong = on & (fd > 0.5 * np.max(fd[on]))
+    amplitude = float(np.median(fd[strong]))
+    ratio = amplitude / configured
+    lo, hi = PULSE_AMPLITUDE_RANGE
+    if lo <= ratio <= hi:
+        return ratio
+    if 0.0003 < ratio < 0.003:
+        cause = "the log's forces look like kN instead of N (ratio about 0.001)"
+    elif 300 < ratio < 3000:
+        cause = "the log's forces look like mN instead of N (ratio about 1000)"
+    else:
+        cause = "a force in another unit, or a log of another protocol"
+    raise LoperInputError(
+        f"{src}: column 'force_desired_n': the perturbation pulses reach {amplitude:.4g} (median over the "
+        f"{int(strong.sum())} flagged samples of their plateau), {ratio:.4g} times the configured perturbation "
+        f"force of {configured:g} N (planning.pulse_force_n; accepted {lo:g} .. {hi:g} times): {cause}. Both force "
+        "columns, force_desired_n and force_measured_n, must hold newtons"
+    )
 
 
 def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:

@@ -83,11 +83,13 @@ def loadcell(
 ) -> pd.DataFrame:
     """The robot log's forces on the mocap frames (sync-pulse clock map, low-pass, mocap rate).
 
-    ``settings`` (:class:`LoadcellSettings`): the C3D's sync channel and the forces' low-pass.
+    ``settings`` (:class:`LoadcellSettings`): the C3D's sync channel, the forces' low-pass and the study's
+    perturbation force, which the desired pulses are checked against.
 
     ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
     Nothing is written when the records are refused, among others for sync pulses whose high times
-    disagree between the robot log and the C3D (an inverted sync) or force pulses without perturbation
+    disagree between the robot log and the C3D (an inverted sync), a sync signal of noise, desired pulses far
+    from the perturbation force (forces in kN) or force pulses without perturbation
     flags (:func:`loper_analysis.device.loadcell.robot_log_frames_and_native`).
     """
     from loper_analysis.io.c3d import read_c3d
@@ -124,6 +126,7 @@ def _loadcell_of(rec, log_path, s: LoadcellSettings) -> tuple[pd.DataFrame, pd.D
         order=s.order,
         source=f"{log_path} / {c3d_path}",
         sync_channel=sync_channel,
+        pulse_force_n=s.pulse_force_n,
     )
     cm = out.attrs.get("clock_map")
     if cm is not None:
