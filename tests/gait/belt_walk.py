@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from loper_analysis.gait.contacts import PlateForce
+from loper_analysis.gait.contacts import PlateForce, foot_contacts
 
 FS = 2000.0  # analog rate, Hz
 MARKER_HZ = 200.0
@@ -96,3 +96,13 @@ def plates_above_rest(t, raw):
         assert abs(rest - REST_N) < 0.3
         out.append(PlateForce(p, t, raw[p] - rest, CORNERS[p]))
     return out
+
+
+#: The seed of the belt walk the contact tests judge.
+WALK_SEED = 20240612
+
+
+def judged_walk(trial):
+    """The contact table of a belt walk (:func:`belt_walk`), judged with :data:`SETTINGS`."""
+    t, raw, tm, heels, _ = trial
+    return foot_contacts(plates_above_rest(t, raw), tm, heels, **SETTINGS, source="S01/walk")

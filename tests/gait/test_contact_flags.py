@@ -17,24 +17,25 @@ from tests.gait.belt_walk import (
     MARKER_HZ,
     PEAK_N,
     SETTINGS,
+    WALK_SEED,
     belt_steps,
     belt_walk,
     crossings,
     heel_path,
     hump,
+    judged_walk,
     plates_above_rest,
 )
 
 
 @pytest.fixture(scope="module")
 def trial():
-    return belt_walk(np.random.default_rng(20240612))
+    return belt_walk(np.random.default_rng(WALK_SEED))
 
 
 @pytest.fixture(scope="module")
 def judged(trial):
-    t, raw, tm, heels, _ = trial
-    return foot_contacts(plates_above_rest(t, raw), tm, heels, **SETTINGS, source="S01/walk")
+    return judged_walk(trial)
 
 
 def test_every_contact_gets_its_known_foot_and_flag(judged):
@@ -152,6 +153,7 @@ def test_two_feet_loading_one_plate_stay_two_feet_with_the_centre_of_pressure_in
     found = _one_plate(_TWO, moving, end_s=1.3)
     r = found.iloc[0]
     assert (r["flag"], r["side"]) == ("two_feet", "")  # both heels on it at the start probe
+    # 0.471 s: the start probe's time, sample instants of a built force (arithmetic, not a solver's output)
     assert r["reason"] == "two feet on one plate: both heels on it at 0.471 s"
     # the right foot arrives at 0.7 s (in the air over the plate before): its stay makes it a second foot
     late = {"left": _TWO["left"], "right": _TWO["right"]}

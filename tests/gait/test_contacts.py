@@ -20,23 +20,24 @@ from tests.gait.belt_walk import (
     PEAK_N,
     SETTINGS,
     STANCE_S,
+    WALK_SEED,
     belt_steps,
     belt_walk,
     crossings,
     hump,
+    judged_walk,
     plates_above_rest,
 )
 
 
 @pytest.fixture(scope="module")
 def trial():
-    return belt_walk(np.random.default_rng(20240612))
+    return belt_walk(np.random.default_rng(WALK_SEED))
 
 
 @pytest.fixture(scope="module")
 def judged(trial):
-    t, raw, tm, heels, _ = trial
-    return foot_contacts(plates_above_rest(t, raw), tm, heels, **SETTINGS, source="S01/walk")
+    return judged_walk(trial)
 
 
 def test_bad_input_is_named(trial):
