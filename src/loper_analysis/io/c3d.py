@@ -34,6 +34,9 @@ Reading (:func:`read_c3d`)
       multiple must equal the analog samples per frame of the raw header
       (word 10, which describes the data block); ``POINT:RATE`` must equal
       the header's frame rate (words 11-12).
+    * Files of all three processor types of the standard are read: Intel and
+      DEC by ezc3d, MIPS (SGI, big-endian) through its Intel twin
+      (:mod:`loper_analysis.io.c3d_byte_order`).
     * ezc3d accepts some damaged files silently (a file cut inside its
       parameter section comes back with garbage frames, one cut inside its
       data with fewer frames and a header lowered to match), so the file
@@ -63,6 +66,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.io.c3d_byte_order import ezc3d_readable
 from loper_analysis.io.c3d_layout import check_complete, check_rates, check_zeroed_tail
 from loper_analysis.io.c3d_parameters import (
     EVENT_COLUMNS,
@@ -291,7 +295,10 @@ def _open_c3d(path: Path):
     if not path.is_file():  # ezc3d does not return on a directory
         raise LoperInputError(f"{source}: not a regular file")
     try:
-        return ezc3d.c3d(source)
+        with ezc3d_readable(path) as readable:  # a MIPS file through its Intel twin
+            return ezc3d.c3d(str(readable))
+    except LoperInputError:
+        raise
     except Exception as exc:  # ezc3d raises OSError, RuntimeError, ValueError, ... for damaged files
         raise LoperInputError(
             f"{source}: not a readable C3D file (truncated, damaged or another format): {type(exc).__name__}: {exc}"

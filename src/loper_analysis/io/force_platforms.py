@@ -73,6 +73,7 @@ import numpy as np
 from loper_analysis.constants import LAB_Z_UP
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, C3DRecording, read_c3d, recording_from_ezc3d
+from loper_analysis.io.c3d_byte_order import ezc3d_readable
 from loper_analysis.io.timing import library_import, timed_io
 
 __all__ = [
@@ -179,7 +180,10 @@ def _open(path: Path, extract: bool):
     if not path.is_file():
         raise LoperInputError(f"{source}: C3D file not found" if not path.exists() else f"{source}: not a regular file")
     try:
-        return ezc3d.c3d(source, extract_forceplat_data=extract)
+        with ezc3d_readable(path) as readable:  # a MIPS file through its Intel twin
+            return ezc3d.c3d(str(readable), extract_forceplat_data=extract)
+    except LoperInputError:
+        raise
     except Exception as exc:  # ezc3d raises RuntimeError, ValueError, ... for damaged files and bad parameters
         return exc
 

@@ -37,8 +37,8 @@ from loper_analysis.inspection_text import (
     template_text,
 )
 from loper_analysis.io.atomic import PathLike, write_bytes, write_text, write_tsv
-from loper_analysis.io.c3d_parameters import param_strings
-from loper_analysis.io.timing import library_import, timed_io
+from loper_analysis.io.c3d_parameter_section import read_parameter
+from loper_analysis.io.timing import timed_io
 from loper_analysis.motion.filtering import CUTOFF_HZ
 from loper_analysis.motion.lab_frame import axis_name
 from loper_analysis.motion.label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
@@ -87,16 +87,9 @@ class Inspection:
 
 @timed_io
 def _point_unit(path: Path) -> str:
-    """``POINT:UNITS`` of a C3D file as declared ("" when absent); the file has been read by read_c3d already."""
-    with library_import():
-        import ezc3d
-
-    try:
-        params = ezc3d.c3d(str(path))["parameters"]
-    except Exception as exc:  # ezc3d raises RuntimeError, ValueError, ... for damaged files
-        raise LoperInputError(f"{path}: not a readable C3D file: {type(exc).__name__}: {exc}") from exc
-    units = param_strings(params, "POINT", "UNITS")
-    return units[0] if units else ""
+    """``POINT:UNITS`` of a C3D file as declared ("" when absent), from its parameter section."""
+    units = read_parameter(path, "POINT", "UNITS")
+    return units.split()[0] if isinstance(units, str) and units.split() else ""
 
 
 def _recording(path: Path) -> tuple:
