@@ -17,6 +17,7 @@ from snakemake.exceptions import WorkflowError
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.schema import check_yaml_file
+from loper_analysis.stages import STAGES
 
 try:
     for _file in ["config/config.yaml", *map(str, workflow.config_settings.configfiles)]:
@@ -46,19 +47,12 @@ report: "workflow/report/workflow.rst"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/inputs.smk"
-include: "workflow/rules/synthetic.smk"
-include: "workflow/rules/markers.smk"
-include: "workflow/rules/model.smk"
-include: "workflow/rules/ik.smk"
-include: "workflow/rules/grf.smk"
-include: "workflow/rules/events.smk"
-include: "workflow/rules/strides.smk"
-include: "workflow/rules/transparency.smk"
-include: "workflow/rules/device.smk"
-include: "workflow/rules/impedance.smk"
-include: "workflow/rules/planning.smk"
-include: "workflow/rules/validation.smk"
-include: "workflow/rules/report.smk"
+
+
+# every stage's rules, in the order of the workflow's graph (loper_analysis.stages.STAGES)
+for _stage in STAGES:
+
+    include: _stage.rule_file
 
 
 rule all:

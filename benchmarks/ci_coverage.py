@@ -124,7 +124,7 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def _settings(config: dict):
     """ResponseSettings and IdentificationSettings as the workflow's rule impedance_fit builds them."""
-    from loper_analysis.steps.impedance import FitSettings
+    from loper_analysis.stages.impedance.step import FitSettings
 
     settings = FitSettings.from_config(config)
     return settings.response, settings.identification

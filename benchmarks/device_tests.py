@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from loper_analysis.steps import device
+from loper_analysis.stages.device import step as device
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -4,7 +4,7 @@ Usage: python benchmarks/rule_times.py [results]
 
 Reads Snakemake's benchmark file of every job (``results/benchmarks/{rule}/...tsv``, column ``s``: the
 job's wall time, from launch to exit) and the last line of the job's log (``results/logs/{rule}/...log``,
-written by ``loper_analysis.steps.rule_log``): the wall time from the job's first file access to its end,
+written by ``loper_analysis.stages.rule_log``): the wall time from the job's first file access to its end,
 the part of it spent reading and writing files, and the first imports of OpenSim or ezc3d made by a reader.
 Per job:
 

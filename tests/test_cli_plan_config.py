@@ -2,7 +2,7 @@
 
 :func:`loper_analysis.config_file.load_config` reads ``config/config.yaml``
 and further files over it; the planner's settings come from one classmethod,
-:meth:`loper_analysis.steps.planning.PlanningSettings.from_config`, which both
+:meth:`loper_analysis.stages.planning.step.PlanningSettings.from_config`, which both
 the rule ``planning`` (in ``workflow/rules/inputs.smk``) and the command call.
 """
 
@@ -18,7 +18,7 @@ import yaml
 from loper_analysis.cli import _plan_pilot, _plan_settings, _read_config, command_parser, main
 from loper_analysis.config_file import load_config
 from loper_analysis.planning.window import PlanSettings
-from loper_analysis.steps.planning import PlanningSettings
+from loper_analysis.stages.planning.step import PlanningSettings
 from tests.config_layers import STRIDES, WINDOW_AFTER_S, write_yaml
 
 ROOT = Path(__file__).resolve().parents[1]

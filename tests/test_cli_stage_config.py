@@ -1,8 +1,8 @@
 """``loper-analysis markers`` and ``events`` take their settings from the workflow's configuration.
 
 Run in a project folder, each command builds its stage's settings as the rule does
-(:meth:`~loper_analysis.steps.markers.MarkerSettings.from_config`,
-:meth:`~loper_analysis.steps.events.EventSettings.from_config`) from ``config/config.yaml`` and any
+(:meth:`~loper_analysis.stages.markers.step.MarkerSettings.from_config`,
+:meth:`~loper_analysis.stages.events.step.EventSettings.from_config`) from ``config/config.yaml`` and any
 ``--configfile``, says which files it read, and lets an option given on the command line win.
 """
 

@@ -22,7 +22,7 @@ from loper_analysis.io.osim import read_model
 from loper_analysis.io.segment_table import read_segments
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.model import ScaleFiles, scale_with_setup
+from loper_analysis.stages.model.step import ScaleFiles, scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -9,9 +9,13 @@ from pathlib import Path
 
 import pytest
 
+from loper_analysis.stages import STAGES
+
 ROOT = Path(__file__).resolve().parents[1]
 RULES = ROOT / "workflow" / "rules"
-STEPS = ROOT / "src" / "loper_analysis" / "steps"
+STAGES_DIR = ROOT / "src" / "loper_analysis" / "stages"
+#: Every stage's file step.
+STEP_FILES = sorted(STAGES_DIR.glob("*/step.py"))
 #: Rule files without a stage: config checks and targets, settings and input functions.
 SHARED_RULE_FILES = {"common", "inputs"}
 #: Results folders a stage writes besides its own (``docs/code_layout.md``).
@@ -19,12 +23,19 @@ OTHER_FOLDERS: dict[str, set[str]] = {}
 #: Most parameters a file step takes (a settings object and a bundle of files instead of long lists).
 MAX_STEP_PARAMETERS = 8
 
-STAGES = sorted(p.stem for p in RULES.glob("*.smk") if p.stem not in SHARED_RULE_FILES)
+STAGE_NAMES = [stage.name for stage in STAGES]
 
 
-@pytest.mark.parametrize("stage", STAGES)
+def test_the_stages_are_the_rule_files_and_the_slices():
+    """One list of stages: every rule file but the shared ones is a stage's, and every slice is listed."""
+    assert sorted(STAGE_NAMES) == sorted(p.stem for p in RULES.glob("*.smk") if p.stem not in SHARED_RULE_FILES)
+    assert sorted(STAGE_NAMES) == sorted(p.parent.name for p in STEP_FILES)
+    assert all((STAGES_DIR / name / "files.py").is_file() for name in STAGE_NAMES)
+
+
+@pytest.mark.parametrize("stage", STAGE_NAMES)
 def test_each_rule_file_has_its_file_step_and_writes_to_its_folder(stage):
-    assert (STEPS / f"{stage}.py").is_file()
+    assert (STAGES_DIR / stage / "step.py").is_file()
     outputs = "\n".join(_output_blocks((RULES / f"{stage}.smk").read_text()))
     folders = set(re.findall(r"PATHS\.([a-z_]+)\.", outputs)) - {"raw"}
     if stage == "synthetic":
@@ -58,8 +69,8 @@ def _n_parameters(f: ast.FunctionDef) -> int:
 
 def test_no_file_step_takes_more_than_eight_parameters():
     long = [
-        f"{p.stem}.{f.name}: {_n_parameters(f)}"
-        for p in sorted(STEPS.glob("*.py"))
+        f"{p.parent.name}.{f.name}: {_n_parameters(f)}"
+        for p in STEP_FILES
         for f in _functions(p)
         if _n_parameters(f) > MAX_STEP_PARAMETERS
     ]
@@ -76,19 +87,18 @@ def _functions_of(source: str):
 
 
 def test_no_file_step_imports_another():
-    steps = {p.stem for p in STEPS.glob("*.py")} - {"__init__", "logs"}
     found = []
-    for p in sorted(STEPS.glob("*.py")):
+    for p in STEP_FILES:
         for n in ast.walk(ast.parse(p.read_text())):
             if isinstance(n, ast.ImportFrom) and n.module:
                 names = [n.module] + [f"{n.module}.{a.name}" for a in n.names]
                 found += [
-                    f"{p.stem} -> {m}"
+                    f"{p.parent.name} -> {m}"
                     for m in names
-                    if m.split(".")[:2] == ["loper_analysis", "steps"]
+                    if m.split(".")[:2] == ["loper_analysis", "stages"]
                     and len(m.split(".")) > 2
-                    and m.split(".")[2] in steps
-                    and m.split(".")[2] != p.stem
+                    and m.split(".")[2] in STAGE_NAMES
+                    and m.split(".")[2] != p.parent.name
                 ]
     assert found == []
 
@@ -101,7 +111,7 @@ FILE_CALLS = re.compile(
 #: The file layer: formats, the file steps, the command line, the config's readers and the study's files (layout).
 FILE_LAYER = (
     "io/",
-    "steps/",
+    "stages/",
     "cli.py",
     "cli_parser.py",
     "cli_checks.py",
@@ -153,7 +163,7 @@ def test_each_rule_calls_its_own_stages_step():
     for smk in RULES.glob("*.smk"):
         for script in re.findall(r'"\.\./scripts/(\w+)\.py"', smk.read_text()):
             text = (ROOT / "workflow" / "scripts" / f"{script}.py").read_text()
-            steps = set(re.findall(r"from loper_analysis\.steps import (\w+)", text)) - {"rule_log"}
+            steps = set(re.findall(r"from loper_analysis\.stages\.(\w+) import step\b", text))
             if steps != {smk.stem}:
                 wrong.append(f"{smk.name}: {script}.py calls {sorted(steps)}")
     assert wrong == []
@@ -283,7 +293,7 @@ def test_library_functions_take_their_options_by_name():
     found = []
     for path in src.rglob("*.py"):
         rel = path.relative_to(src).as_posix()
-        if rel.startswith("steps/"):
+        if rel.startswith("stages/"):
             continue
         for f in _functions(path):
             a = f.args

@@ -27,7 +27,7 @@ from loper_analysis.motion.lab_frame import vertical_axis, walking_direction
 from loper_analysis.motion.label_matching import heel_markers, match_labels, starter_label_map
 from loper_analysis.motion.marker_names import model_marker_names
 from loper_analysis.schema import check_config
-from loper_analysis.steps.inspect import inspect_c3d, model_marker_names_of
+from loper_analysis.stages.inspect import inspect_c3d, model_marker_names_of
 
 ROOT = Path(__file__).resolve().parents[1]
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"

@@ -9,7 +9,7 @@ import pytest
 from loper_analysis.inspection_text import format_label_match, format_summary
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.motion.label_matching import match_labels
-from loper_analysis.steps.inspect import inspect_c3d
+from loper_analysis.stages.inspect import inspect_c3d
 
 RATE_HZ, N_FRAMES, FIRST_FRAME = 100.0, 100, 10
 LABELS = ["S:HEAD", "S:LASI", "S:RASI", "S:LHEE", "S:RHEE"]

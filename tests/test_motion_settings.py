@@ -24,7 +24,7 @@ from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP, marker_positions
 from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.model import ModelSettings
+from loper_analysis.stages.model.step import ModelSettings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.gait2392_models import GENERIC, scaled_gait2392
 

@@ -26,7 +26,7 @@ from loper_analysis.impedance.responses import MIN_PAIRS_FOR_OUTLIERS, ResponseS
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments, write_segments
 from loper_analysis.planning.covariance import StrideCovariance
-from loper_analysis.steps import strides as stride_steps
+from loper_analysis.stages.strides import step as stride_steps
 from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
 from tests.parameter_sets import ASYMMETRIC
 

@@ -25,7 +25,7 @@ from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
 from loper_analysis.layout import Paths, fill
 from loper_analysis.motion.markers import rotate_markers
-from loper_analysis.steps.markers import MarkerSettings
+from loper_analysis.stages.markers.step import MarkerSettings
 from tests.rajagopal_lab import (
     GENERIC_OSIM,
     GRF_MOT,
@@ -247,8 +247,8 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     from loper_analysis.io.c3d import read_c3d
     from loper_analysis.io.c3d_writer import write_c3d
     from loper_analysis.motion.ik_settings import IKSettings
-    from loper_analysis.steps.ik import ik_trial
-    from loper_analysis.steps.markers import markers
+    from loper_analysis.stages.ik.step import ik_trial
+    from loper_analysis.stages.markers.step import markers
 
     rec = read_c3d(WALKING5)
     write_c3d(

@@ -247,10 +247,10 @@ def test_every_job_runs_its_step_inside_its_log():
     for name in scripts:
         tree = ast.parse((ROOT / "workflow/scripts" / name).read_text())
         first, second, *rest = tree.body
-        assert ast.unparse(first) == "from loper_analysis.steps import rule_log", name
+        assert ast.unparse(first) == "from loper_analysis.stages import rule_log", name
         assert isinstance(second, ast.With) and not rest, name
         assert ast.unparse(second.items[0].context_expr) == "rule_log(snakemake.log[0])", name
-        assert isinstance(second.body[0], ast.ImportFrom) and second.body[0].module == "loper_analysis.steps", name
+        assert isinstance(second.body[0], ast.ImportFrom) and second.body[0].module == "loper_analysis.stages", name
 
 
 def test_a_failed_job_leaves_its_message_and_traceback_in_its_log(tmp_path):

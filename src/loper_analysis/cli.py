@@ -71,7 +71,7 @@ def _stage_settings(args: argparse.Namespace, settings_type, **given):
 
 
 def _markers(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.markers import MarkerSettings, markers
+    from loper_analysis.stages.markers.step import MarkerSettings, markers
 
     settings = _stage_settings(
         args,
@@ -97,7 +97,7 @@ def _markers(args: argparse.Namespace) -> None:
 
 def _grf(args: argparse.Namespace) -> None:
     from loper_analysis.gait.grf_settings import GRFSettings
-    from loper_analysis.steps.grf import grf
+    from loper_analysis.stages.grf.step import grf
 
     settings = _stage_settings(
         args, GRFSettings, rotation_deg=_rotation_option(args, args.c3d), threshold_n=args.threshold_n
@@ -122,7 +122,7 @@ def _plates(text: str | None) -> dict[str, int] | None:
 
 
 def _events(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.events import EventSettings, events
+    from loper_analysis.stages.events.step import EventSettings, events
 
     settings = _stage_settings(
         args,
@@ -141,8 +141,8 @@ def _events(args: argparse.Namespace) -> None:
 
 def _scale(args: argparse.Namespace) -> None:
     from loper_analysis.io.readers import read_label_maps
-    from loper_analysis.steps.markers import MarkerSettings, markers
-    from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale_with_setup
+    from loper_analysis.stages.markers.step import MarkerSettings, markers
+    from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale_with_setup
 
     config, line = _read_config(args)
     print(line)
@@ -199,7 +199,7 @@ def _scale(args: argparse.Namespace) -> None:
 
 
 def _segments(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.model import ModelSettings, anthropometric_segments, segments_from_model_file
+    from loper_analysis.stages.model.step import ModelSettings, anthropometric_segments, segments_from_model_file
 
     if args.model is not None:
         if args.height_m is not None or args.mass_kg is not None:
@@ -216,7 +216,7 @@ def _segments(args: argparse.Namespace) -> None:
 
 def _validate(args: argparse.Namespace) -> None:
     from loper_analysis.impedance.identification.validation import ValidationSettings
-    from loper_analysis.steps.validation import validation_chunk
+    from loper_analysis.stages.validation.step import validation_chunk
 
     config, line = _read_config(args)
     print(line)
@@ -272,7 +272,7 @@ def _plan_settings(args: argparse.Namespace, config: dict | None):
     :meth:`loper_analysis.planning.pilot_plan.PlanningSettings.from_config`), else the library's defaults; then the
     options given on the command line (targets given replace the config's).
     """
-    from loper_analysis.steps.planning import PlanningSettings
+    from loper_analysis.stages.planning.step import PlanningSettings
 
     settings = PlanningSettings() if config is None else PlanningSettings.from_config(config)
     pulse = {k: v for k, v in (("pulse_force_n", args.force_n), ("pulse_duration_s", args.duration_s)) if v is not None}
@@ -305,7 +305,7 @@ def _plan_pilot(args: argparse.Namespace, config: dict | None) -> tuple[str | No
 
 def _plan(args: argparse.Namespace) -> None:
     from loper_analysis.planning.precision import PLAN_COLUMNS
-    from loper_analysis.steps.planning import PilotFiles, PilotTrial, plan
+    from loper_analysis.stages.planning.step import PilotFiles, PilotTrial, plan
 
     config, line = _read_config(args)
     print(line)
@@ -369,8 +369,8 @@ def _plan(args: argparse.Namespace) -> None:
 def _ik(args: argparse.Namespace) -> None:
     from loper_analysis.io.readers import read_label_maps
     from loper_analysis.motion.ik_settings import IKSettings
-    from loper_analysis.steps.ik import ik_file
-    from loper_analysis.steps.markers import MarkerSettings
+    from loper_analysis.stages.ik.step import ik_file
+    from loper_analysis.stages.markers.step import MarkerSettings
 
     config, line = _read_config(args)
     print(line)
@@ -410,7 +410,7 @@ def _ik(args: argparse.Namespace) -> None:
 
 def _inspect(args: argparse.Namespace) -> None:
     from loper_analysis.motion.filtering import CUTOFF_HZ
-    from loper_analysis.steps.inspect import inspect_c3d, inspect_subject
+    from loper_analysis.stages.inspect import inspect_c3d, inspect_subject
     from loper_analysis.subject_setup import NoTemplateFits
 
     if args.model is not None or args.marker_set is not None or args.label_map_out is not None:
@@ -444,12 +444,12 @@ DRY_RUN_MASS_KG = 70.0
 def _scaling_dry_run(config: dict | None):
     """The check ``inspect`` runs on a subject's files before it puts them in place: the ``markers`` step on every
     trial (the written label maps, rotation and cut-off, as the workflow runs it) and the ``model`` step's
-    :func:`loper_analysis.steps.model.scale` with the written model and ScaleTool setup, into a scratch folder,
+    :func:`loper_analysis.stages.model.step.scale` with the written model and ScaleTool setup, into a scratch folder,
     at :data:`DRY_RUN_MASS_KG`. A failure raises LoperInputError saying what fails and what the lab must add."""
 
     def check(staged) -> str:
-        from loper_analysis.steps import markers as markers_step
-        from loper_analysis.steps import model as model_step
+        from loper_analysis.stages.markers import step as markers_step
+        from loper_analysis.stages.model import step as model_step
 
         m_settings = markers_step.MarkerSettings.from_config(config) if config else markers_step.MarkerSettings()
         m_settings = dataclasses.replace(m_settings, rotation_deg=staged.rotation_deg, cutoff_hz=staged.cutoff_hz)
@@ -507,7 +507,7 @@ def _what_to_add(message: str, setup) -> str:
 
 
 def _report(args: argparse.Namespace) -> None:
-    from loper_analysis.steps.report import write_report
+    from loper_analysis.stages.report.step import write_report
 
     target = write_report(args.target, snakemake_args=args.snakemake_args)
     print(f"{target}: report written ({target.stat().st_size / 1e6:.1f} MB)")

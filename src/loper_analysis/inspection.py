@@ -1,7 +1,7 @@
 """What a lab's C3D file holds: markers, force platforms, channels and events, summarised and printed.
 
 The library side of ``loper-analysis inspect`` (the file side is
-:mod:`loper_analysis.steps.inspect`). Every function takes arrays or
+:mod:`loper_analysis.stages.inspect`). Every function takes arrays or
 records already read (:class:`~loper_analysis.io.c3d.C3DRecording`,
 :class:`~loper_analysis.io.force_platforms.ForcePlatform`) and returns new
 objects; :func:`loper_analysis.inspection_text.format_summary` and

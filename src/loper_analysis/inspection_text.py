@@ -288,7 +288,7 @@ def presence_text(paths: Sequence[Path], kinds: Sequence[str], never: Sequence[S
 
 @dataclass(frozen=True)
 class SubjectFiles:
-    """What a subject's config is written from (:func:`loper_analysis.steps.inspect.inspect_subject`): the files
+    """What a subject's config is written from (:func:`loper_analysis.stages.inspect.inspect_subject`): the files
     and their kinds, the template's setup, the first file's summary, the mass and height line, the marker
     cut-off (Hz) and its reason, whether a static trial is among the files, and each file's marker labels
     (no subject prefix)."""

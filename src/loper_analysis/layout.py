@@ -25,6 +25,7 @@ from pathlib import Path
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages import STAGES
 from loper_analysis.study_design import StudyDesign
 
 __all__ = ["RAW_DIR", "RESULTS_DIR", "RAW_FILES", "RESULT_FILES", "Paths", "Study", "fill", "subject_rows"]
@@ -42,76 +43,8 @@ RAW_FILES: dict[str, str] = {
     "truth": "{subject}/truth.yaml",
 }
 
-#: Every result file: stage folder -> name -> pattern under ``results/{stage}/``.
-RESULT_FILES: dict[str, dict[str, str]] = {
-    "markers": {
-        "trc": "{subject}/{trial}.trc",
-        "gaps": "{subject}/{trial}.gaps.tsv",
-        "summary": "{subject}/{trial}.markers.tsv",
-        "lab_angles": "{subject}/{trial}.lab_angles.tsv",
-    },
-    "model": {
-        "generic": "{subject}/generic.osim",
-        "scaled": "{subject}/scaled.osim",
-        "scale": "{subject}/scale.tsv",
-        "segments": "{subject}/segments.tsv",
-    },
-    "ik": {
-        "mot": "{subject}/{trial}.mot",
-        "chunk": "{subject}/{trial}.chunk{chunk}.mot",
-        "angles": "{subject}/{trial}.angles.tsv",
-        "summary": "{subject}/{trial}.ik.tsv",
-        "agreement": "{subject}/{trial}.lab_agreement.tsv",
-    },
-    "grf": {"mot": "{subject}/{trial}.grf.mot", "figure": "{subject}/{trial}.grf.png"},
-    "events": {
-        "events": "{subject}/{trial}.events.tsv",
-        "contacts": "{subject}/{trial}.contacts.tsv",
-        "force": "{subject}/{trial}.force.tsv",
-        "force_native": "{subject}/{trial}.force_native.tsv",
-    },
-    "strides": {
-        "strides": "{subject}/{trial}.strides.tsv",
-        "cycles": "{subject}/{trial}.cycles.tsv",
-        "dropped": "{subject}/{trial}.dropped.tsv",
-        "figure": "{subject}/{trial}.angles.png",
-        "summary": "summary.tsv",
-    },
-    "transparency": {"rmsd": "rmsd.tsv", "force": "force.tsv", "figure": "transparency.png"},
-    "device": {
-        "robot_log": "{subject}/{trial}.loper.tsv",
-        "frf": "frf.tsv",
-        "step_metrics": "step_metrics.tsv",
-        "step_average": "step_average.tsv",
-        "summary": "summary.tsv",
-        "bode": "bode.png",
-        "steps": "steps.png",
-    },
-    "impedance": {
-        "response": "{subject}/{onset}.response.tsv",
-        "counts": "{subject}/{onset}.counts.tsv",
-        "fit": "{subject}/{onset}.tsv",
-        "curves": "{subject}/{onset}.curves.tsv",
-        "force": "{subject}/{onset}.force.tsv",
-        "responses_figure": "{subject}/responses.png",
-        "fit_figure": "{subject}/fit.png",
-        "table": "impedance.tsv",
-        "summary": "summary.tsv",
-        "literature": "literature.tsv",
-        "figure": "impedance.png",
-    },
-    "planning": {"plan": "plan.tsv", "answers": "answers.txt"},
-    "validation": {
-        "segments": "segments.tsv",
-        "chunk_errors": "chunks/{chunk}.errors.tsv",
-        "chunk_fits": "chunks/{chunk}.fits.tsv",
-        "errors": "errors.tsv",
-        "fits": "fits.tsv",
-        "summary": "summary.tsv",
-        "figure": "errors.png",
-    },
-    "report": {"tables": "tables.md", "front_page": "front_page.html"},
-}
+#: Every result file: stage folder -> name -> pattern under ``results/{stage}/``, from the stages' slices.
+RESULT_FILES: dict[str, dict[str, str]] = {stage.name: dict(stage.files) for stage in STAGES if stage.files}
 
 
 def subject_rows(sheet: pd.DataFrame, seed: int) -> dict[str, dict]:
@@ -457,7 +390,7 @@ class Study:
         """Files of a subject's fit at every onset (ms -> ``FitFiles``, the config's order): the onset's own
         trials (angles, strides, force at 128 Hz and at the robot rate, markers), the null-pair trials (angles,
         strides), the segment table, a synthetic truth and the outputs."""
-        from loper_analysis.steps.impedance import FitFiles, FitOutputs, TrialFiles
+        from loper_analysis.stages.impedance.step import FitFiles, FitOutputs, TrialFiles
 
         s, p = subject, self.paths
 
@@ -503,7 +436,7 @@ class Study:
     def planning_files(self, pilot: str):
         """The pilot's angle and stride tables of its trials with the device, its segment table and fit rows
         (``PilotFiles``)."""
-        from loper_analysis.steps.planning import PilotFiles, PilotTrial
+        from loper_analysis.stages.planning.step import PilotFiles, PilotTrial
 
         p = self.paths
         return PilotFiles(
@@ -521,7 +454,7 @@ class Study:
     def transparency_files(self) -> dict:
         """Stride and cycle tables of the transparency pair of every subject that walked both trials (subject ->
         ``TransparencyFiles``)."""
-        from loper_analysis.steps.transparency import TransparencyFiles
+        from loper_analysis.stages.transparency.step import TransparencyFiles
 
         st, d = self.paths.strides, self.design
         return {

@@ -42,7 +42,7 @@ __all__ = [
 NAME_MAX = 255
 #: The wildcards of the rules' logs and benchmarks that hold a subject (:meth:`Paths.log`, :meth:`Paths.benchmark`).
 SUBJECT_LOG_KEYS: tuple[str, ...] = ("{subject}", "{subject}/{trial}", "{subject}/{trial}.{chunk}")
-#: What a rule's log adds to its name for the job's profile (``{log}.prof``, :mod:`loper_analysis.steps.logs`).
+#: What a rule's log adds to its name for the job's profile (``{log}.prof``, :mod:`loper_analysis.stages.logs`).
 PROFILE_SUFFIX = ".prof"
 
 

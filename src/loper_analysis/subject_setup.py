@@ -1,7 +1,7 @@
 """A subject's settings from its files: the marker-set template that fits its labels, and what follows from it.
 
 ``loper-analysis inspect`` with a subject's static and walking trials and no model
-(:func:`loper_analysis.steps.inspect.inspect_subject`) asks this module which template fits the labels
+(:func:`loper_analysis.stages.inspect.inspect_subject`) asks this module which template fits the labels
 (:func:`subject_setup`): every template's required marker groups are checked against the labels of all
 files (:func:`loper_analysis.motion.marker_templates.template_fit`); the template with the largest share
 of its groups found wins (then the most markers). From it follow the label map (the lab's labels whose
@@ -185,7 +185,7 @@ def format_fits(fits: Sequence[TemplateFit]) -> str:
 @dataclass(frozen=True)
 class StagedSubject:
     """A subject's files built in a scratch folder, not yet in place: what a dry run (``check`` of
-    :func:`loper_analysis.steps.inspect.inspect_subject`) reads.
+    :func:`loper_analysis.stages.inspect.inspect_subject`) reads.
 
     Attributes
     ----------

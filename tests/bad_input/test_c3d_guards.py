@@ -25,9 +25,9 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.force_platforms import read_force_platforms
-from loper_analysis.steps.events import EventSettings, events
-from loper_analysis.steps.grf import grf
-from loper_analysis.steps.markers import markers as markers_step
+from loper_analysis.stages.events.step import EventSettings, events
+from loper_analysis.stages.grf.step import grf
+from loper_analysis.stages.markers.step import markers as markers_step
 from loper_analysis.synthetic.force_plates import wrench_channels
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -19,7 +19,7 @@ from loper_analysis.cli import main
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_layout import zeroed_tail_frames
-from loper_analysis.steps.markers import markers as markers_step
+from loper_analysis.stages.markers.step import markers as markers_step
 from tests.bad_input.test_c3d_guards import (
     N_FRAMES,
     RATE,

@@ -9,7 +9,7 @@ Two faults pass every other check of the load-cell step:
   stride counts as perturbed and the trial ends as ``too_few_strides``.
 
 Each refusal goes through the file step of rule ``events_loadcell``
-(:func:`loper_analysis.steps.event_steps.events_loadcell`) with the rule's settings from the config, and
+(:func:`loper_analysis.stages.events.step.events_loadcell`) with the rule's settings from the config, and
 must name the file, the field and the values, and leave the outputs of an earlier run as they were. The
 good records pass with the numbers they gave before: the clock map of the edges alone, within 1 ms
 of the simulated clocks.
@@ -30,7 +30,7 @@ from loper_analysis.device.clock_sync import clock_map, high_times, rising_edges
 from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.trial_events import EventSettings
-from loper_analysis.steps import events as event_steps
+from loper_analysis.stages.events import step as event_steps
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -364,7 +364,7 @@ def test_mat_export_without_its_flag_variable_is_refused(trial, tmp_path):
     """A MATLAB export whose column map leaves the flag out (zeros): converted by rule device_log_from_mat's
     step, then refused by the load-cell step."""
     from loper_analysis.io.robot_log_mat import write_robot_log_mat
-    from loper_analysis.steps.device import log_from_mat
+    from loper_analysis.stages.device.step import log_from_mat
 
     names = yaml.safe_load((ROOT / "config/config.yaml").read_text())["device"]["mat_column_map"]
     column_map = {**names, "perturbation": None}  # the lab's map, the flag left out

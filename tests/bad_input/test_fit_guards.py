@@ -26,7 +26,7 @@ from loper_analysis.impedance.identification.validation import (
 )
 from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.impedance.responses.response_window import ResponseWindow
-from loper_analysis.steps.validation import validation_chunk
+from loper_analysis.stages.validation.step import validation_chunk
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.bad_input.fit_trials import ONSET_MS, fit_inputs, walking_trial
 

@@ -54,7 +54,7 @@ def test_a_rotation_that_lays_the_subject_down_is_warned_about_and_kept(tmp_path
     subject lies along the model's +Z, 90 deg from +Y, a warning naming the rotation that stands it up."""
     import logging
 
-    from loper_analysis.steps.markers import MarkerSettings, markers
+    from loper_analysis.stages.markers.step import MarkerSettings, markers
 
     caplog.set_level(logging.WARNING)
     walking5, out = DATA / "opensim-core/walking5.c3d", tmp_path / "w5.trc"

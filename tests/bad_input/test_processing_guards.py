@@ -24,9 +24,9 @@ from loper_analysis.io.osim import read_model, write_model
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
-from loper_analysis.steps.ik import ik_chunk, ik_file
-from loper_analysis.steps.markers import markers as markers_step
-from loper_analysis.steps.model import ModelSettings, ScaleFiles, scale, scale_with_setup
+from loper_analysis.stages.ik.step import ik_chunk, ik_file
+from loper_analysis.stages.markers.step import markers as markers_step
+from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale, scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 
 ROOT = Path(__file__).resolve().parents[2]

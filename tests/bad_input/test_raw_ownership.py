@@ -151,7 +151,7 @@ def test_the_synthetic_labs_own_files_are_generated_again_and_listed_in_its_mani
 
 
 def test_the_labs_step_refuses_to_write_over_a_file_it_did_not_write(lab):
-    from loper_analysis.steps.synthetic import LabSessionFiles, lab_session
+    from loper_analysis.stages.synthetic.step import LabSessionFiles, lab_session
     from loper_analysis.study_design import StudyDesign
     from loper_analysis.synthetic.lab_session import LabSessionSettings
 
@@ -179,7 +179,7 @@ def test_the_labs_step_refuses_to_write_over_a_file_it_did_not_write(lab):
 
 
 def test_the_device_tests_step_writes_its_manifest_and_refuses_a_recorded_log(lab):
-    from loper_analysis.steps.device import DeviceSettings, device_trial
+    from loper_analysis.stages.device.step import DeviceSettings, device_trial
 
     cfg = yaml.safe_load((lab / "config/config.yaml").read_text())
     s = DeviceSettings.from_config(cfg)

@@ -33,11 +33,11 @@ from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.layout import Paths, fill
 from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.schema import check_yaml_file
-from loper_analysis.steps import events as event_steps
-from loper_analysis.steps import markers as marker_steps
-from loper_analysis.steps import report
-from loper_analysis.steps.logs import rule_log
-from loper_analysis.steps.markers import MarkerSettings
+from loper_analysis.stages.events import step as event_steps
+from loper_analysis.stages.logs import rule_log
+from loper_analysis.stages.markers import step as marker_steps
+from loper_analysis.stages.markers.step import MarkerSettings
+from loper_analysis.stages.report import step as report
 from tests.workflow_copy import snakemake
 
 PATHS = Paths()
@@ -136,7 +136,7 @@ def test_the_job_process_exits_1_with_one_line_on_stderr(old_log):
         "def full(self, data):\n"
         "    raise OSError(errno.ENOSPC, 'No space left on device', str(self))\n"
         "pathlib.Path.write_bytes = full\n"
-        "from loper_analysis.steps import rule_log\n"
+        "from loper_analysis.stages import rule_log\n"
         f"with rule_log({str(old_log)!r}) as log:\n"
         "    log.info('grf: 2 force platforms')\n"
     )

@@ -16,7 +16,7 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import read_model
-from loper_analysis.steps.model import ModelSettings, generic_model
+from loper_analysis.stages.model.step import ModelSettings, generic_model
 
 STATIC = Path(__file__).resolve().parents[1] / "data/c3d-parser/QCMAS/static.c3d"
 

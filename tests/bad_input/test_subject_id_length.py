@@ -63,7 +63,7 @@ def test_every_log_and_benchmark_key_of_the_rules_is_counted():
         keys |= set(re.findall(r'PATHS\.(?:log|benchmark)\(\s*"[^"]*",\s*(f?"[^"]*")', rules.read_text()))
     with_subject = {k for k in keys if "subject" in k}
     assert with_subject and {k.strip('"') for k in with_subject} <= set(SUBJECT_LOG_KEYS), with_subject
-    assert 'prof = f"{path}' + PROFILE_SUFFIX + '"' in (ROOT / "src/loper_analysis/steps/logs.py").read_text()
+    assert 'prof = f"{path}' + PROFILE_SUFFIX + '"' in (ROOT / "src/loper_analysis/stages/logs.py").read_text()
 
 
 def test_the_subject_schema_holds_the_same_limit():

@@ -19,7 +19,7 @@ import pytest
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import ForcePlatform, write_recording
 from loper_analysis.motion.label_matching import heel_markers
-from loper_analysis.steps.events import EventSettings, events
+from loper_analysis.stages.events.step import EventSettings, events
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 LABS = ("AUC", "FMC", "MH", "QCMAS", "RBWH", "RCH", "SYD")

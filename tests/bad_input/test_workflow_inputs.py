@@ -33,10 +33,10 @@ from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
 from loper_analysis.layout import Paths, fill
 from loper_analysis.motion.ik_settings import IKSettings
-from loper_analysis.steps import events as event_steps
-from loper_analysis.steps import ik
-from loper_analysis.steps import markers as marker_steps
-from loper_analysis.steps.markers import MarkerSettings
+from loper_analysis.stages.events import step as event_steps
+from loper_analysis.stages.ik import step as ik
+from loper_analysis.stages.markers import step as marker_steps
+from loper_analysis.stages.markers.step import MarkerSettings
 from tests.workflow_copy import snakemake
 
 PATHS = Paths()
@@ -272,7 +272,7 @@ def test_a_rotation_that_hangs_the_subject_below_the_floor_is_refused(lab):
 def test_static_trial_in_which_the_subject_moves_is_refused(lab):
     """The subject walks off at 0.3 m/s: over any second every marker moves 87 mm RMS; the message names the
     stillest second (by the markers' noise), found here by brute force over every start frame."""
-    from loper_analysis.steps import model
+    from loper_analysis.stages.model import step as model
 
     t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial="static"))
     X[:, :, 0] += 0.3 * (t - t[0])[:, None]
@@ -310,7 +310,7 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
 
 def test_label_map_typo_in_a_model_name_is_named_as_such_by_scaling(lab):
     """A label mapped to 'LHEEL' (the model's marker is LHEE): not "the static trial lacks LHEE" alone."""
-    from loper_analysis.steps import model
+    from loper_analysis.stages.model import step as model
 
     t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial="static"))
     labels[labels.index("LHEE")] = "LHEEL"
@@ -483,7 +483,7 @@ def test_a_static_trial_of_another_subject_stops_the_walking_trials_ik(lab, tmp_
 
 
 def test_a_static_trial_far_from_the_subjects_height_stops_scaling(lab, tmp_path):
-    from loper_analysis.steps import model
+    from loper_analysis.stages.model import step as model
 
     _other_subject(tmp_path / "R02", 1.25, 30.0)
     static = tmp_path / "static.trc"

@@ -19,8 +19,8 @@ from loper_analysis.motion.level_walking import (
     pelvis_height_change_m,
 )
 from loper_analysis.motion.marker_names import model_marker_names
-from loper_analysis.steps.markers import MarkerSettings, markers
-from loper_analysis.steps.strides import TrialTables, strides_summary
+from loper_analysis.stages.markers.step import MarkerSettings, markers
+from loper_analysis.stages.strides.step import TrialTables, strides_summary
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 #: Each level walk's pelvis rise (+) or fall (-) (m) and its plates' height range (m; NaN: no plates), measured

@@ -1,6 +1,6 @@
 """Whose markers: a trial's distances between markers on one body against the static trial's, or the model's (the
 generated model, its own markers as the trial and as the static trial, and the same trial of a smaller subject);
-a clinical lab's real pair in tests/steps/test_ik.py."""
+a clinical lab's real pair in tests/stages/ik/test_step.py."""
 
 from __future__ import annotations
 

@@ -21,7 +21,7 @@ from loper_analysis.io.osim import quiet_opensim, read_model, write_model
 from loper_analysis.io.segment_table import read_segments, write_segments
 from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
 from loper_analysis.motion.segments import segments_from_model
-from loper_analysis.steps.model import ModelSettings, segments_from_model_file
+from loper_analysis.stages.model.step import ModelSettings, segments_from_model_file
 from tests.gait2392_models import scaled_gait2392
 
 DATA = Path(__file__).parents[2] / "examples" / "gait2392"

@@ -207,8 +207,8 @@ def test_nothing_fitted_and_no_impedance_experiment_are_said():
 def _write_results(root: Path) -> None:
     """A small results set in the shapes of a default run: 3 synthetic subjects × 3 onsets × 3 joints, with the
     library's summary and figure, the transparency, device and validation tables."""
-    from loper_analysis.steps.impedance import impedance_figure
-    from loper_analysis.steps.impedance import impedance_summary as summary_step
+    from loper_analysis.stages.impedance.step import impedance_figure
+    from loper_analysis.stages.impedance.step import impedance_summary as summary_step
 
     rows = []
     rng = np.random.default_rng(7)
@@ -243,7 +243,7 @@ def _write_results(root: Path) -> None:
 
 
 def _front_page(root: Path, versions=VERSIONS) -> str:
-    from loper_analysis.steps.report import FrontPageFiles, front_page
+    from loper_analysis.stages.report.step import FrontPageFiles, front_page
 
     r = root / "results"
     files = FrontPageFiles(

@@ -8,7 +8,7 @@ import pytest
 from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.truth import read_truth
-from loper_analysis.steps.synthetic import truth as truth_step
+from loper_analysis.stages.synthetic.step import truth as truth_step
 from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
 
 K = {50: [55, 3, 8], 175: [38, 0.5, 8]}

@@ -15,7 +15,7 @@ from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.readers import read_subject_sheet
 from loper_analysis.layout import Paths, Study, fill, subject_rows
 from loper_analysis.schema import check_config, check_project_paths, config_origin
-from loper_analysis.steps.cluster import requested_partitions
+from loper_analysis.stages.cluster_failures import requested_partitions
 from loper_analysis.study_checks import check_subject_sheet, check_subjects, raw_file_warnings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
 
@@ -97,7 +97,7 @@ onstart:
 
 onsuccess:
     # what the run found wrong, on the console (each also in its job's log and in its table)
-    from loper_analysis.steps.report import run_warnings
+    from loper_analysis.stages.report.step import run_warnings
 
     _said = run_warnings(
         PATHS.strides.summary, [fill(PATHS.model.scale, subject=s) for s in STUDY.scaled_subjects()]
@@ -109,7 +109,7 @@ onsuccess:
 onerror:
     # a SLURM run: say which failed jobs SLURM itself ended, and why (memory, time limit, cancel)
     if workflow.executor_plugin is not None and workflow.executor_plugin.name == "slurm":
-        from loper_analysis.steps.cluster import slurm_failure_lines
+        from loper_analysis.stages.cluster_failures import slurm_failure_lines
 
         for _path in [log] if isinstance(log, (str, Path)) else log:  # Snakemake 9 passes a list of logs
             for _line in slurm_failure_lines(_path):

@@ -2,16 +2,16 @@
 
 import dataclasses
 
-from loper_analysis.steps.device import DeviceSettings
+from loper_analysis.stages.device.step import DeviceSettings
 from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.motion.ik_settings import IKSettings
-from loper_analysis.steps.markers import MarkerSettings
-from loper_analysis.steps.model import ModelSettings
+from loper_analysis.stages.markers.step import MarkerSettings
+from loper_analysis.stages.model.step import ModelSettings
 from loper_analysis.gait.stride_settings import StrideSettings
-from loper_analysis.steps.impedance import FitSettings
-from loper_analysis.steps.planning import PlanningSettings
+from loper_analysis.stages.impedance.step import FitSettings
+from loper_analysis.stages.planning.step import PlanningSettings
 from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.transparency import TransparencySettings

@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import events
+    from loper_analysis.stages.events import step as events
 
     out = snakemake.output
     events.events(snakemake.input.c3d, out.events, snakemake.params.settings, contacts_out=out.contacts)

@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import report
+    from loper_analysis.stages.report import step as report
 
     p = snakemake.params
     report.front_page(

@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import ik
+    from loper_analysis.stages.ik import step as ik
 
     out = snakemake.output
     ik.ik_trial(

@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import markers
+    from loper_analysis.stages.markers import step as markers
 
     out = snakemake.output
     markers.markers(

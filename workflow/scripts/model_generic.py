@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import model
+    from loper_analysis.stages.model import step as model
 
     p = snakemake.params
     model.generic_model(

@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import strides
+    from loper_analysis.stages.strides import step as strides
 
     p, i = snakemake.params, snakemake.input
     strides.strides_summary(

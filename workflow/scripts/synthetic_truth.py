@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import synthetic
+    from loper_analysis.stages.synthetic import step as synthetic
 
     p = snakemake.params
     synthetic.truth(

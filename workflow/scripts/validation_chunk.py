@@ -1,7 +1,7 @@
-from loper_analysis.steps import rule_log
+from loper_analysis.stages import rule_log
 
 with rule_log(snakemake.log[0]):
-    from loper_analysis.steps import validation
+    from loper_analysis.stages.validation import step as validation
 
     out = snakemake.output
     validation.validation_chunk(

@@ -98,7 +98,7 @@ def trial_events(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The event table and the contact table (empty without force platforms) of a recording and its force
     platforms: the plates with the heel markers (named by ``label_map``), or one analog channel per belt whose
-    feet the heel markers confirm (as :func:`loper_analysis.steps.events.events` describes)."""
+    feet the heel markers confirm (as :func:`loper_analysis.stages.events.step.events` describes)."""
     from loper_analysis.gait.contacts import count_flagged
 
     _check_heel_sides(rec, s, label_map)

@@ -4,7 +4,7 @@ Every reader of :mod:`loper_analysis.io` runs under :func:`timed_io` and
 every write under the atomic writer's :func:`~loper_analysis.io.atomic.staged`,
 which uses :func:`io_clock`. Nested calls (a reader calling another) count
 once. :func:`io_times` gives the total and the moment of the first file
-access; :func:`loper_analysis.steps.rule_log` writes them to the job's log,
+access; :func:`loper_analysis.stages.rule_log` writes them to the job's log,
 and ``benchmarks/rule_times.py`` turns them into the split.
 """
 

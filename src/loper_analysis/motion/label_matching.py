@@ -1,7 +1,7 @@
 """Matching a lab's marker labels to a model's markers by name, with a table of landmark synonyms.
 
 Used by ``loper-analysis inspect`` (:mod:`loper_analysis.inspection`,
-:mod:`loper_analysis.steps.inspect`) to pair a C3D file's labels with an
+:mod:`loper_analysis.stages.inspect`) to pair a C3D file's labels with an
 OpenSim model's markers and to write a starter label map from the pairs.
 
 Label matching (:func:`match_labels`)

@@ -93,7 +93,7 @@ def prepared_markers(
 ) -> PreparedMarkers:
     """The markers of a recording (:class:`loper_analysis.io.c3d.C3DRecording`) named by ``label_map`` (one
     mapping {lab label: model marker}, or several merged in order), cropped, filled, turned and low-passed as
-    ``settings`` says (:func:`loper_analysis.steps.markers.markers` tells each step).
+    ``settings`` says (:func:`loper_analysis.stages.markers.step.markers` tells each step).
 
     Before the trial's heading and speed, a trial that is not level walking is warned about
     (:mod:`loper_analysis.motion.level_walking`: its pelvis markers' rise or fall, the heights of the force

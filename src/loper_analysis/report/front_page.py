@@ -1,7 +1,7 @@
 """The front page of the Snakemake report: what was run, the headline numbers and the main figure, as HTML.
 
 Renders the headline tables of :mod:`loper_analysis.report.headline` (as the file
-step :func:`loper_analysis.steps.report.front_page` computes them from the
+step :func:`loper_analysis.stages.report.step.front_page` computes them from the
 result tables) into one HTML fragment, which ``workflow/report/workflow.rst``
 pulls into the report's "Workflow" panel above the methods text:
 

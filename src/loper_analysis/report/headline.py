@@ -1,7 +1,7 @@
 """The headline numbers of a run, as tables: impedance with confidence intervals, truth recovery and verdicts.
 
 Pure functions from the result tables (pandas frames, as the file step
-:func:`loper_analysis.steps.report.front_page` reads them) to the tables the
+:func:`loper_analysis.stages.report.step.front_page` reads them) to the tables the
 front page (:mod:`loper_analysis.report.front_page`) shows:
 
 * :func:`impedance_summary_ci` - the across-subject summary with the 95 %

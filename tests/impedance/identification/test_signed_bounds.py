@@ -13,7 +13,7 @@ from loper_analysis.impedance.identification import identify_impedance
 from loper_analysis.impedance.identification.status import joint_status
 from loper_analysis.impedance.identification.validation import perturbed_trial
 from loper_analysis.impedance.identification.window import prepare_window, window_options
-from loper_analysis.steps.impedance import FitSettings
+from loper_analysis.stages.impedance.step import FitSettings
 from tests.impedance.identification.validation_windows import PARAMS, SETTINGS
 
 #: Hip, knee, ankle K (N·m/rad) and D (N·m·s/rad): the knee's K and D just below zero (within noise of a

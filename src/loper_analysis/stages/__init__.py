@@ -1,0 +1,53 @@
+"""The pipeline's stages, one slice each, and the file layer they share.
+
+:data:`STAGES` lists every stage in the order of the workflow's graph (a
+stage reads only the results of stages before it). Each slice
+``loper_analysis.stages.<name>`` holds the stage's file step (``step``: reads
+its input files, calls the library, which works on arrays and tables only,
+and writes exactly its declared outputs through the atomic writer,
+:mod:`loper_analysis.io.atomic`) and its result files (``files``). The
+workflow's rule includes, the results folders (:data:`loper_analysis.layout.RESULT_FILES`)
+and the layout's tests are built from this list.
+
+Shared by every stage: :func:`rule_log` (a rule's script runs its step inside
+it: messages, warnings and, on failure, the full error go to the job's log);
+besides the stages, :mod:`.inspect` (the ``inspect`` command's file step) and
+:mod:`.cluster_failures` (why SLURM ended the failed jobs of a run).
+"""
+
+from loper_analysis.stages import (
+    device,
+    events,
+    grf,
+    ik,
+    impedance,
+    markers,
+    model,
+    planning,
+    report,
+    strides,
+    synthetic,
+    transparency,
+    validation,
+)
+from loper_analysis.stages.logs import rule_log
+from loper_analysis.stages.stage import Stage
+
+#: Every stage, in the order of the workflow's graph.
+STAGES: tuple[Stage, ...] = (
+    synthetic.STAGE,
+    markers.STAGE,
+    model.STAGE,
+    ik.STAGE,
+    grf.STAGE,
+    events.STAGE,
+    strides.STAGE,
+    transparency.STAGE,
+    device.STAGE,
+    impedance.STAGE,
+    planning.STAGE,
+    validation.STAGE,
+    report.STAGE,
+)
+
+__all__ = ["STAGES", "Stage", "rule_log"]

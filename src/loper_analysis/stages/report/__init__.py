@@ -1,0 +1,11 @@
+"""The report stage: the Markdown rendering of the result tables and the report's front page.
+
+``step`` is its file step (the rules' scripts and the command line call it), ``files`` its result files.
+"""
+
+from loper_analysis.stages.report.files import FILES
+from loper_analysis.stages.stage import Stage
+
+STAGE = Stage(name="report", files=FILES)
+
+__all__ = ["STAGE"]

@@ -1,0 +1,36 @@
+"""What a stage of the pipeline owns, as one record: its name and its result files.
+
+A stage's name is the address of everything it owns: its slice
+``loper_analysis/stages/<name>/`` (the file step ``step.py`` and the result
+files ``files.py``), its rule file ``workflow/rules/<name>.smk`` and its
+results folder ``results/<name>/``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+__all__ = ["Stage"]
+
+
+@dataclass(frozen=True)
+class Stage:
+    """One stage of the pipeline.
+
+    Attributes
+    ----------
+    name : str
+        The stage's name: its slice, rule file and results folder.
+    files : mapping
+        Its result files: name -> pattern under ``results/<name>/`` (Snakemake wildcards in braces); empty for a
+        stage that writes elsewhere (the synthetic lab writes raw files).
+    """
+
+    name: str
+    files: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def rule_file(self) -> str:
+        """The stage's rule file, relative to the project's folder."""
+        return f"workflow/rules/{self.name}.smk"

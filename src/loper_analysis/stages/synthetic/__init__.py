@@ -1,0 +1,11 @@
+"""The synthetic stage: the synthetic lab: raw files of synthetic subjects with known impedance.
+
+``step`` is its file step (the rules' scripts and the command line call it), ``files`` its result files.
+"""
+
+from loper_analysis.stages.stage import Stage
+from loper_analysis.stages.synthetic.files import FILES
+
+STAGE = Stage(name="synthetic", files=FILES)
+
+__all__ = ["STAGE"]

@@ -1,0 +1,11 @@
+"""The transparency stage: the device's transparency: RMSD against within-subject variability.
+
+``step`` is its file step (the rules' scripts and the command line call it), ``files`` its result files.
+"""
+
+from loper_analysis.stages.stage import Stage
+from loper_analysis.stages.transparency.files import FILES
+
+STAGE = Stage(name="transparency", files=FILES)
+
+__all__ = ["STAGE"]

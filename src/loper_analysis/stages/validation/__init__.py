@@ -1,0 +1,11 @@
+"""The validation stage: the validation study of the identification.
+
+``step`` is its file step (the rules' scripts and the command line call it), ``files`` its result files.
+"""
+
+from loper_analysis.stages.stage import Stage
+from loper_analysis.stages.validation.files import FILES
+
+STAGE = Stage(name="validation", files=FILES)
+
+__all__ = ["STAGE"]
