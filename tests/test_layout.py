@@ -8,6 +8,9 @@ from pathlib import Path
 import pytest
 
 from loper_analysis.layout import RESULT_FILES, Paths, fill
+from loper_analysis.stages.impedance.files import fit_files, fit_inputs
+from loper_analysis.stages.planning.files import planning_files
+from loper_analysis.stages.report.files import markdown_sections
 from tests.study_files import CONFIG, study_on, touch
 from tests.workflow_copy import copy_workflow, snakemake
 
@@ -59,8 +62,8 @@ def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
     ]
     assert "results/validation/summary.tsv" in targets and "results/device/summary.tsv" not in targets
     # nor does the Markdown of the run's tables ask for it (the default run would build the device tests then)
-    assert "Device" not in study.markdown_sections() and "results/device/summary.tsv" not in set(
-        study.markdown_sections().values()
+    assert "Device" not in markdown_sections(study) and "results/device/summary.tsv" not in set(
+        markdown_sections(study).values()
     )
 
 
@@ -69,7 +72,7 @@ def test_a_fits_files_are_its_onsets_own_trials_and_the_null_pairs(tmp_path):
     for t in ("static", "walk-device", "pert050-1", "pert175-1"):
         touch(raw / f"{t}.c3d")
     study = study_on(tmp_path, {"R01": {"source": "recorded"}})
-    fits = study.fit_files("R01")
+    fits = fit_files(study, "R01")
     assert list(fits) == [50, 175, 300]
     assert list(fits[50].trials) == ["pert050-1"] and fits[50].trials["pert050-1"].force == (
         "results/events/R01/pert050-1.force.tsv"
@@ -77,9 +80,9 @@ def test_a_fits_files_are_its_onsets_own_trials_and_the_null_pairs(tmp_path):
     assert list(fits[50].null_trials) == ["walk-device", "pert050-1", "pert175-1"]
     assert fits[300].trials == {} and fits[300].null_trials == {}  # a missing onset reads nothing
     assert fits[175].outputs.curves == "results/impedance/R01/175.curves.tsv" and fits[175].truth is None
-    inputs = study.fit_inputs("R01")
+    inputs = fit_inputs(study, "R01")
     assert len(inputs) == len(set(inputs)) and "results/markers/R01/pert175-1.trc" in inputs
-    assert study.planning_files("R01").impedance == tuple(
+    assert planning_files(study, "R01").impedance == tuple(
         f"results/impedance/R01/{o}.tsv" for o in ("050", "175", "300")
     )
 

@@ -305,7 +305,8 @@ def _plan_pilot(args: argparse.Namespace, config: dict | None) -> tuple[str | No
 
 def _plan(args: argparse.Namespace) -> None:
     from loper_analysis.planning.precision import PLAN_COLUMNS
-    from loper_analysis.stages.planning.step import PilotFiles, PilotTrial, plan
+    from loper_analysis.stages.planning.files import PilotFiles, PilotTrial
+    from loper_analysis.stages.planning.step import plan
 
     config, line = _read_config(args)
     print(line)

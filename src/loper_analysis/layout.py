@@ -17,7 +17,6 @@ The workflow's rules, the command line and the benchmarks ask these two.
 
 from __future__ import annotations
 
-import string
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,6 +25,7 @@ import pandas as pd
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.stages import STAGES
+from loper_analysis.stages.stage import fill
 from loper_analysis.study_design import StudyDesign
 
 __all__ = ["RAW_DIR", "RESULTS_DIR", "RAW_FILES", "RESULT_FILES", "Paths", "Study", "fill", "subject_rows"]
@@ -60,20 +60,6 @@ def subject_rows(sheet: pd.DataFrame, seed: int) -> dict[str, dict]:
         if row["source"] == "synthetic":
             row.update(subject_anthropometry(row, seed))
     return rows
-
-
-class _Keep(dict):
-    """Format fields: the given ones filled, the others kept as wildcards."""
-
-    def __missing__(self, key: str) -> str:
-        return "{" + key + "}"
-
-
-def fill(pattern: str, **fields) -> str:
-    """``pattern`` with the given wildcards filled and the others left as they are (``{onset}`` of an int is
-    written with three digits)."""
-    values = {k: f"{v:03d}" if k == "onset" and isinstance(v, int) else str(v) for k, v in fields.items()}
-    return string.Formatter().vformat(pattern, (), _Keep(values))
 
 
 class Folder:
@@ -367,147 +353,3 @@ class Study:
             *self.device_targets(),
             self.paths.report.front_page,
         ]
-
-    def markdown_sections(self) -> dict[str, str]:
-        """Heading -> result table, for the Markdown rendering of the run's tables."""
-        p = self.paths
-        sections = {
-            "Impedance per subject, onset and joint": p.impedance.table,
-            "Across-subject summary": p.impedance.summary,
-            "Literature": p.impedance.literature,
-            "Strides per trial": p.strides.summary,
-            "Validation study": p.validation.summary,
-        }
-        if self.device_targets():  # no device tests without a device subject (device.subject null)
-            sections["Device"] = p.device.summary
-        if self.transparency_subjects():
-            sections["Transparency: RMSD vs ISV_ave"] = p.transparency.rmsd
-            sections["Transparency: interaction force"] = p.transparency.force
-        return sections
-
-    # --- bundles of files ------------------------------------------------------------------------------------
-    def fit_files(self, subject: str) -> dict:
-        """Files of a subject's fit at every onset (ms -> ``FitFiles``, the config's order): the onset's own
-        trials (angles, strides, force at 128 Hz and at the robot rate, markers), the null-pair trials (angles,
-        strides), the segment table, a synthetic truth and the outputs."""
-        from loper_analysis.stages.impedance.step import FitFiles, FitOutputs, TrialFiles
-
-        s, p = subject, self.paths
-
-        def trial_files(t: str, own: bool) -> TrialFiles:
-            tables = dict(
-                angles=fill(p.ik.angles, subject=s, trial=t), strides=fill(p.strides.strides, subject=s, trial=t)
-            )
-            if own:
-                tables.update(
-                    force=fill(p.events.force, subject=s, trial=t),
-                    markers=fill(p.markers.trc, subject=s, trial=t),
-                    force_native=fill(p.events.force_native, subject=s, trial=t),
-                )
-            return TrialFiles(**tables)
-
-        def null_trials(onset: int) -> list[str]:
-            # none for a white-noise fit or a missing onset (reported without any input)
-            if self.config["identification"]["noise_model"] != "null_pairs" or not self.onset_trials(s, onset):
-                return []
-            return self.null_pair_trials(s)
-
-        outputs = ("response", "counts", "fit", "curves", "force")
-        return {
-            o: FitFiles(
-                trials={t: trial_files(t, True) for t in self.onset_trials(s, o)},
-                segments=fill(p.model.segments, subject=s),
-                outputs=FitOutputs(**{k: fill(getattr(p.impedance, k), subject=s, onset=o) for k in outputs}),
-                null_trials={t: trial_files(t, False) for t in null_trials(o)},
-                truth=fill(p.raw.truth, subject=s) if self.source(s) == "synthetic" else None,
-            )
-            for o in self.design.perturbation_onsets_ms
-        }
-
-    def fit_inputs(self, subject: str) -> list[str]:
-        """Every file a subject's fits read (:meth:`fit_files`), each once."""
-        paths = []
-        for files in self.fit_files(subject).values():
-            paths += [files.segments, *([files.truth] if files.truth else [])]
-            for trial in (*files.trials.values(), *files.null_trials.values()):
-                paths += [path for path in vars(trial).values() if path is not None]
-        return list(dict.fromkeys(paths))
-
-    def planning_files(self, pilot: str):
-        """The pilot's angle and stride tables of its trials with the device, its segment table and fit rows
-        (``PilotFiles``)."""
-        from loper_analysis.stages.planning.step import PilotFiles, PilotTrial
-
-        p = self.paths
-        return PilotFiles(
-            trials={
-                t: PilotTrial(
-                    angles=fill(p.ik.angles, subject=pilot, trial=t),
-                    strides=fill(p.strides.strides, subject=pilot, trial=t),
-                )
-                for t in self.null_pair_trials(pilot)
-            },
-            segments=fill(p.model.segments, subject=pilot),
-            impedance=tuple(self.onset_files("impedance", "fit", pilot)),
-        )
-
-    def transparency_files(self) -> dict:
-        """Stride and cycle tables of the transparency pair of every subject that walked both trials (subject ->
-        ``TransparencyFiles``)."""
-        from loper_analysis.stages.transparency.step import TransparencyFiles
-
-        st, d = self.paths.strides, self.design
-        return {
-            s: TransparencyFiles(
-                no_device_strides=fill(st.strides, subject=s, trial=d.no_device),
-                no_device_cycles=fill(st.cycles, subject=s, trial=d.no_device),
-                device_strides=fill(st.strides, subject=s, trial=d.device),
-                device_cycles=fill(st.cycles, subject=s, trial=d.device),
-            )
-            for s in self.transparency_subjects()
-        }
-
-    def recorded_quality_files(self) -> dict:
-        """The files of the front page's section on recorded subjects: per recorded subject its scale report
-        (None with a model from the sheet) and per walking trial its IK summary, agreement with the lab's own
-        angles and figures (the force plates' None without plates)."""
-        p, out, scaled = self.paths, {}, set(self.scaled_subjects())
-        for s in self.processed_subjects():
-            if self.source(s) != "recorded":
-                continue
-            trials = {
-                t: {
-                    "ik": fill(p.ik.summary, subject=s, trial=t),
-                    "agreement": fill(p.ik.agreement, subject=s, trial=t),
-                    "angles_png": fill(p.strides.figure, subject=s, trial=t),
-                    "grf_png": fill(p.grf.figure, subject=s, trial=t) if self.has_force_platforms(s, t) else None,
-                }
-                for t in self.subject_trials(s)
-            }
-            scale = fill(p.model.scale, subject=s) if s in scaled else None
-            out[s] = {"scale": scale, "trials": trials}
-        return out
-
-    def front_page_inputs(self) -> dict:
-        """The tables the front page reads, named as the fields of ``FrontPageFiles``: the validation and device
-        summaries when built, the impedance tables and main figure with perturbation trials, the transparency
-        table with a subject who walked both trials, the recorded subjects' quality files."""
-        p = self.paths
-        out = {"validation": p.validation.summary} if self.validation_targets() else {}
-        if self.device_targets():
-            out["device"] = p.device.summary
-        targets = set(self.processing_targets())
-        if p.impedance.table in targets:
-            out.update(impedance=p.impedance.table, summary=p.impedance.summary, figure=p.impedance.figure)
-        if p.transparency.rmsd in targets:
-            out["rmsd"] = p.transparency.rmsd
-        recorded = self.recorded_quality_files()
-        if recorded:
-            out["strides"] = p.strides.summary
-            out["quality"] = [
-                path
-                for entry in recorded.values()
-                for path in [entry["scale"], *(f for files in entry["trials"].values() for f in files.values())]
-                if path is not None
-            ]
-        return out

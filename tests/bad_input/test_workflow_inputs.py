@@ -4,7 +4,7 @@ under results/ or data/ (but the failed job's log) and leaves the results of ear
 One module-wide project holds a recorded subject R01 (a static trial and a walking trial with the device,
 written by the simulated lab) whose markers, events and forces were already processed. Each test breaks
 one input in a copy of it. Where the readers' refusals are tested in detail elsewhere (tests/io,
-tests/steps), this suite runs the rule's file step on the project's paths, with the rule's settings
+tests/stages), this suite runs the rule's file step on the project's paths, with the rule's settings
 from the config; a few cases go through Snakemake itself (real jobs, or dry runs for the checks made
 before any work starts).
 """

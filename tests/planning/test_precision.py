@@ -406,7 +406,8 @@ def test_plan_command_bad_input_exits_2(pilot_results, args, message, capsys):
 
 def test_failed_pilot_fit_stops_the_command_and_is_noted_by_the_workflow(pilot_results, tmp_path):
     """A pilot onset without an estimate: ``raise`` names it; ``note`` (the rule) writes rows without a prediction."""
-    from loper_analysis.stages.planning.step import PilotFiles, PilotTrial, PlanningSettings, plan
+    from loper_analysis.stages.planning.files import PilotFiles, PilotTrial
+    from loper_analysis.stages.planning.step import PlanningSettings, plan
 
     failed = pd.DataFrame(
         {

@@ -1,5 +1,7 @@
 # Perturbation analysis: responses (matched strides) and impedance fits per subject and onset, aggregate tables.
 
+from loper_analysis.stages.impedance.files import fit_files, fit_inputs
+
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
@@ -14,7 +16,7 @@ rule impedance_fit:
     """Responses and impedance fits of one subject at every onset, in one job: the onsets share the null-pair
     trials, so a change to any of the subject's trials reruns every onset's fit anyway."""
     input:
-        by_subject(STUDY.fit_inputs),
+        lambda wc: fit_inputs(STUDY, wc.subject),
     output:
         response=expand(PATHS.impedance.response, onset=ONSETS, allow_missing=True),
         counts=expand(PATHS.impedance.counts, onset=ONSETS, allow_missing=True),
@@ -27,7 +29,7 @@ rule impedance_fit:
         PATHS.benchmark("impedance_fit", "{subject}")
     params:
         **settings_params(FIT_SETTINGS),
-        fits=by_subject(STUDY.fit_files),
+        fits=lambda wc: fit_files(STUDY, wc.subject),
     script:
         "../scripts/impedance_fit.py"
 

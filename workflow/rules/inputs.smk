@@ -112,23 +112,3 @@ def by_subject(method):
 def by_trial(method):
     """An input function of the wildcards from a STUDY method of the subject and trial."""
     return lambda wildcards: method(wildcards.subject, wildcards.trial)
-
-
-def transparency_inputs(wildcards) -> list[str]:
-    """Every table of the transparency pairs."""
-    return [path for files in STUDY.transparency_files().values() for path in dataclasses.astuple(files)]
-
-
-def planning_pilot() -> str:
-    """The pilot subject: planning.pilot_subject, else the first processed subject."""
-    try:
-        return STUDY.planning_pilot(config_source("planning", "pilot_subject"))
-    except LoperInputError as exc:
-        raise WorkflowError(str(exc)) from None
-
-
-def planning_inputs(wildcards) -> list[str]:
-    """Every file the planner reads."""
-    files = STUDY.planning_files(planning_pilot())
-    tables = [path for trial in files.trials.values() for path in (trial.angles, trial.strides)]
-    return [*tables, files.segments, *files.impedance]

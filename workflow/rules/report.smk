@@ -1,6 +1,8 @@
 # The report: its front page (what was run, the headline numbers and the main figure, as one HTML fragment
 # that workflow/report/workflow.rst pulls in above the methods text) and every result table in Markdown.
 
+from loper_analysis.stages.report.files import front_page_inputs, markdown_sections, recorded_quality_files
+
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
@@ -11,7 +13,7 @@ localrules:
 
 rule front_page:
     input:
-        unpack(lambda wc: STUDY.front_page_inputs()),
+        unpack(lambda wc: front_page_inputs(STUDY)),
     output:
         PATHS.report.front_page,
     log:
@@ -22,14 +24,14 @@ rule front_page:
         **settings_params(FRONT_PAGE_SETTINGS),
         subjects=SUBJECT_SOURCE,
         trials={s: STUDY.subject_trials(s) for s in STUDY.processed_subjects()},
-        recorded=STUDY.recorded_quality_files(),
+        recorded=recorded_quality_files(STUDY),
     script:
         "../scripts/front_page.py"
 
 
 rule tables_markdown:
     input:
-        list(STUDY.markdown_sections().values()),
+        list(markdown_sections(STUDY).values()),
     output:
         PATHS.report.tables,
     log:
@@ -37,6 +39,6 @@ rule tables_markdown:
     benchmark:
         PATHS.benchmark("tables_markdown", "tables")
     params:
-        headings=list(STUDY.markdown_sections()),
+        headings=list(markdown_sections(STUDY)),
     script:
         "../scripts/tables_markdown.py"

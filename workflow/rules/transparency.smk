@@ -1,5 +1,12 @@
 # Transparency of the device in minimal-impedance mode: RMSD with vs without it against ISV_ave.
 
+from loper_analysis.stages.transparency.files import transparency_files
+
+
+def transparency_inputs(wildcards) -> list[str]:
+    """Every table of the transparency pairs."""
+    return [path for files in transparency_files(STUDY).values() for path in dataclasses.astuple(files)]
+
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
@@ -35,6 +42,6 @@ rule transparency:
         PATHS.benchmark("transparency", "transparency")
     params:
         **settings_params(TRANSPARENCY_SETTINGS),
-        files=STUDY.transparency_files(),
+        files=transparency_files(STUDY),
     script:
         "../scripts/transparency.py"

@@ -14,7 +14,8 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification.impedance import IdentificationSettings
 from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.truth import write_truth
-from loper_analysis.stages.impedance.step import FitFiles, FitOutputs, FitSettings, TrialFiles, fit, subject_fits
+from loper_analysis.stages.impedance.files import FitFiles, FitOutputs, TrialFiles
+from loper_analysis.stages.impedance.step import FitSettings, fit, subject_fits
 
 
 def test_onset_without_trials_writes_missing_rows(tmp_path):

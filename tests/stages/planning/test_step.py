@@ -9,7 +9,8 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import write_segments
-from loper_analysis.stages.planning.step import PilotFiles, PilotTrial, PlanningSettings, plan
+from loper_analysis.stages.planning.files import PilotFiles, PilotTrial
+from loper_analysis.stages.planning.step import PlanningSettings, plan
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 SETTINGS = PlanningSettings(onsets_ms=(50,), strides=(5, 10))

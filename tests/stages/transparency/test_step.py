@@ -6,7 +6,7 @@ import pytest
 
 from loper_analysis.errors import TooFewStridesWarning
 from tests.gait.test_strides import _overground
-from tests.steps.test_strides import _no_warning
+from tests.stages.strides.test_step import _no_warning
 
 
 def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
@@ -14,7 +14,8 @@ def test_transparency_leaves_out_a_subject_with_zero_or_one_stride(tmp_path):
     is left out with its counts, nothing crashes; the other subject is compared with itself (RMSD 0)."""
     from loper_analysis.io.atomic import write_tsv
     from loper_analysis.stages.strides.step import strides
-    from loper_analysis.stages.transparency.step import TransparencyFiles, transparency
+    from loper_analysis.stages.transparency.files import TransparencyFiles
+    from loper_analysis.stages.transparency.step import transparency
 
     paths = {}
     for n_heel_strikes in (1, 2, 6):

@@ -20,12 +20,10 @@ from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.truth import read_truth
+from loper_analysis.stages.impedance.files import FitFiles
 
 __all__ = [
     "FitSettings",
-    "TrialFiles",
-    "FitOutputs",
-    "FitFiles",
     "fit",
     "subject_fits",
     "impedance_table",
@@ -58,62 +56,6 @@ class FitSettings:
             response=ResponseSettings.from_config(config),
             identification=IdentificationSettings.from_config(config),
         )
-
-
-@dataclass(frozen=True)
-class TrialFiles:
-    """The files of one trial a fit reads.
-
-    ``angles`` and ``strides``: its joint-angle and stride tables (TSV), for every trial. A trial of the
-    onset itself also gives ``force`` (the load cell on the marker frames, TSV) and ``markers`` (TRC, for
-    the brace markers), and optionally ``force_native`` (the load cell at the robot rate,
-    ``{trial}.force_native.tsv``, from which the fit then takes its force).
-    """
-
-    angles: PathLike
-    strides: PathLike
-    force: PathLike | None = None
-    markers: PathLike | None = None
-    force_native: PathLike | None = None
-
-
-@dataclass(frozen=True)
-class FitOutputs:
-    """The files one fit writes (TSV): the mean ``response``, the stride ``counts``, the ``fit`` rows, the fit
-    ``curves`` and, optionally, the mean ``force`` the model saw."""
-
-    response: PathLike
-    counts: PathLike
-    fit: PathLike
-    curves: PathLike
-    force: PathLike | None = None
-
-
-@dataclass(frozen=True)
-class FitFiles:
-    """The files of one subject's fit at one onset.
-
-    ``trials``: the onset's own trials (name -> :class:`TrialFiles` with ``force`` and ``markers``), in the
-    order the fit takes them; ``null_trials``: the trials whose unperturbed strides are the null pairs
-    (their ``angles`` and ``strides`` are read); ``segments``: the segment table (read when the onset has a
-    trial); ``outputs``: what the fit writes; ``truth``: a synthetic subject's ``truth.yaml`` (None: recorded).
-
-    Raises
-    ------
-    LoperInputError
-        An own trial without its force or markers file (naming the trial).
-    """
-
-    trials: Mapping[str, TrialFiles]
-    segments: PathLike
-    outputs: FitOutputs
-    null_trials: Mapping[str, TrialFiles] = field(default_factory=dict)
-    truth: PathLike | None = None
-
-    def __post_init__(self):
-        for name, files in self.trials.items():
-            if files.force is None or files.markers is None:
-                raise LoperInputError(f"fit files: trial {name} of the onset needs its force and markers files")
 
 
 class _Tables:

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
 
 import pandas as pd
 
@@ -26,36 +25,11 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_text, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.planning.pilot_plan import STRIDES, PlanningSettings, check_plan_request, pilot_plan
+from loper_analysis.stages.planning.files import PilotFiles
 
-__all__ = ["STRIDES", "PlanningSettings", "PilotTrial", "PilotFiles", "plan"]
+__all__ = ["STRIDES", "PlanningSettings", "plan"]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class PilotTrial:
-    """A pilot trial walked with the device: its joint-angle and stride tables (TSV)."""
-
-    angles: PathLike
-    strides: PathLike
-
-
-@dataclass(frozen=True)
-class PilotFiles:
-    """The pilot's files the planner reads.
-
-    ``trials``: the pilot's trials walked with the device (name -> :class:`PilotTrial`): their unperturbed
-    strides are the null pairs; the perturbed strides of the trials at an onset are its perturbed pairs
-    (:func:`loper_analysis.planning.inputs.pilot_perturbed_pairs`), whose scatter the prediction takes
-    (the null pairs' when there are none, with a note in the rows). ``segments``: the segment table of the
-    subject to plan for (the pilot's, or another subject's). ``impedance``: impedance rows
-    (``results/impedance/{subject}/{onset}.tsv`` or ``results/impedance/impedance.tsv``) whose pilot estimates
-    are the planned impedance (none: the values are given to :func:`plan`).
-    """
-
-    trials: Mapping[str, PilotTrial]
-    segments: PathLike
-    impedance: tuple[PathLike, ...] = ()
 
 
 def plan(

@@ -1,10 +1,83 @@
-"""The report stage's result files: name -> pattern under ``results/report/`` (wildcards in braces)."""
+"""The report stage's files: its result files (name -> pattern under ``results/report/``) and the tables the front
+page and the Markdown rendering read."""
 
 from __future__ import annotations
 
-__all__ = ["FILES"]
+from typing import TYPE_CHECKING
+
+from loper_analysis.stages.stage import fill
+
+if TYPE_CHECKING:
+    from loper_analysis.layout import Study
+
+__all__ = ["FILES", "front_page_inputs", "markdown_sections", "recorded_quality_files"]
 
 FILES: dict[str, str] = {
     "tables": "tables.md",
     "front_page": "front_page.html",
 }
+
+
+def recorded_quality_files(study: Study) -> dict:
+    """The files of the front page's section on recorded subjects: per recorded subject its scale report
+    (None with a model from the sheet) and per walking trial its IK summary, agreement with the lab's own
+    angles and figures (the force plates' None without plates)."""
+    p, out, scaled = study.paths, {}, set(study.scaled_subjects())
+    for s in study.processed_subjects():
+        if study.source(s) != "recorded":
+            continue
+        trials = {
+            t: {
+                "ik": fill(p.ik.summary, subject=s, trial=t),
+                "agreement": fill(p.ik.agreement, subject=s, trial=t),
+                "angles_png": fill(p.strides.figure, subject=s, trial=t),
+                "grf_png": fill(p.grf.figure, subject=s, trial=t) if study.has_force_platforms(s, t) else None,
+            }
+            for t in study.subject_trials(s)
+        }
+        scale = fill(p.model.scale, subject=s) if s in scaled else None
+        out[s] = {"scale": scale, "trials": trials}
+    return out
+
+
+def front_page_inputs(study: Study) -> dict:
+    """The tables the front page reads, named as the fields of ``FrontPageFiles``: the validation and device
+    summaries when built, the impedance tables and main figure with perturbation trials, the transparency
+    table with a subject who walked both trials, the recorded subjects' quality files."""
+    p = study.paths
+    out = {"validation": p.validation.summary} if study.validation_targets() else {}
+    if study.device_targets():
+        out["device"] = p.device.summary
+    targets = set(study.processing_targets())
+    if p.impedance.table in targets:
+        out.update(impedance=p.impedance.table, summary=p.impedance.summary, figure=p.impedance.figure)
+    if p.transparency.rmsd in targets:
+        out["rmsd"] = p.transparency.rmsd
+    recorded = recorded_quality_files(study)
+    if recorded:
+        out["strides"] = p.strides.summary
+        out["quality"] = [
+            path
+            for entry in recorded.values()
+            for path in [entry["scale"], *(f for files in entry["trials"].values() for f in files.values())]
+            if path is not None
+        ]
+    return out
+
+
+def markdown_sections(study: Study) -> dict[str, str]:
+    """Heading -> result table, for the Markdown rendering of the run's tables."""
+    p = study.paths
+    sections = {
+        "Impedance per subject, onset and joint": p.impedance.table,
+        "Across-subject summary": p.impedance.summary,
+        "Literature": p.impedance.literature,
+        "Strides per trial": p.strides.summary,
+        "Validation study": p.validation.summary,
+    }
+    if study.device_targets():  # no device tests without a device subject (device.subject null)
+        sections["Device"] = p.device.summary
+    if study.transparency_subjects():
+        sections["Transparency: RMSD vs ISV_ave"] = p.transparency.rmsd
+        sections["Transparency: interaction force"] = p.transparency.force
+    return sections

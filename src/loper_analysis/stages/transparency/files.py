@@ -1,11 +1,46 @@
-"""The transparency stage's result files: name -> pattern under ``results/transparency/`` (wildcards in braces)."""
+"""The transparency stage's files: its result files (name -> pattern under ``results/transparency/``) and the
+stride and cycle tables of each subject's pair of trials."""
 
 from __future__ import annotations
 
-__all__ = ["FILES"]
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from loper_analysis.io.atomic import PathLike
+from loper_analysis.stages.stage import fill
+
+if TYPE_CHECKING:
+    from loper_analysis.layout import Study
+
+__all__ = ["FILES", "TransparencyFiles", "transparency_files"]
 
 FILES: dict[str, str] = {
     "rmsd": "rmsd.tsv",
     "force": "force.tsv",
     "figure": "transparency.png",
 }
+
+
+@dataclass(frozen=True)
+class TransparencyFiles:
+    """One subject's stride and cycle tables (TSV) of walking without and with the device."""
+
+    no_device_strides: PathLike
+    no_device_cycles: PathLike
+    device_strides: PathLike
+    device_cycles: PathLike
+
+
+def transparency_files(study: Study) -> dict:
+    """Stride and cycle tables of the transparency pair of every subject that walked both trials (subject ->
+    ``TransparencyFiles``)."""
+    st, d = study.paths.strides, study.design
+    return {
+        s: TransparencyFiles(
+            no_device_strides=fill(st.strides, subject=s, trial=d.no_device),
+            no_device_cycles=fill(st.cycles, subject=s, trial=d.no_device),
+            device_strides=fill(st.strides, subject=s, trial=d.device),
+            device_cycles=fill(st.cycles, subject=s, trial=d.device),
+        )
+        for s in study.transparency_subjects()
+    }

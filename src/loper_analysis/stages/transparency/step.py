@@ -8,25 +8,15 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass
 
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
+from loper_analysis.stages.transparency.files import TransparencyFiles
 from loper_analysis.transparency import TransparencySettings
 
-__all__ = ["TransparencyFiles", "transparency"]
+__all__ = ["transparency"]
 
 log = logging.getLogger(__name__)
-
-
-@dataclass(frozen=True)
-class TransparencyFiles:
-    """One subject's stride and cycle tables (TSV) of walking without and with the device."""
-
-    no_device_strides: PathLike
-    no_device_cycles: PathLike
-    device_strides: PathLike
-    device_cycles: PathLike
 
 
 def transparency(
