@@ -47,7 +47,7 @@ __all__ = [
 
 #: Degree of OpenSim's GCV splines of the coordinates (the InverseDynamicsTool's).
 SPLINE_DEGREE = 5
-#: Column suffix -> unit suffix of the generalised forces and of their powers.
+#: Column suffixes of the generalised forces (N·m, N) and of their powers (W).
 _MOMENT, _FORCE, _POWER = "_moment_nm", "_force_n", "_power_w"
 _AXES = "xyz"
 
