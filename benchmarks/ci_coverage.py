@@ -51,6 +51,7 @@ from scipy.stats import beta
 
 from loper_analysis.layout import Paths, fill
 from loper_analysis.report.markdown import markdown_table
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.study_design import StudyDesign
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -124,9 +125,8 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
 
 def _settings(config: dict):
     """ResponseSettings and IdentificationSettings as the workflow's rule impedance_fit builds them."""
-    from loper_analysis.stages.impedance.step import FitSettings
 
-    settings = FitSettings.from_config(config)
+    settings = stage_settings(config, "impedance")
     return settings.response, settings.identification
 
 

@@ -16,12 +16,13 @@ from pathlib import Path
 import yaml
 
 from loper_analysis.stages.device import step as device
+from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    settings = device.DeviceSettings.from_config(yaml.safe_load((ROOT / "config/config.yaml").read_text()))
+    settings = stage_settings(yaml.safe_load((ROOT / "config/config.yaml").read_text()), "device")
     rate = settings.parameters.sample_rate_hz
     analysis = settings.analysis
     with tempfile.TemporaryDirectory() as tmp:

@@ -25,8 +25,8 @@ import numpy as np
 import pandas as pd
 import yaml
 
-from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.layout import RESULTS_DIR
+from loper_analysis.stages.settings import stage_settings
 
 
 def covered(time_s: np.ndarray, spans: list[tuple[float, float]]) -> np.ndarray:
@@ -63,7 +63,7 @@ def main() -> None:
     for f in args.configfile:
         for key, value in (yaml.safe_load(Path(f).read_text()) or {}).items():
             cfg[key] = {**cfg.get(key, {}), **value} if isinstance(value, dict) else value
-    window, trials = ResponseWindow.from_config(cfg), cfg["trials"]
+    window, trials = stage_settings(cfg, "impedance").response.window, cfg["trials"]
     before = window.initial_state_span_s + window.before_s
     onsets_s = [o / 1e3 for o in trials["perturbation_onsets_ms"]]
     rows = []

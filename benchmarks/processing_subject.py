@@ -31,7 +31,7 @@ import pandas as pd
 import yaml
 
 from loper_analysis.layout import Paths, fill
-from loper_analysis.study_design import StudyDesign
+from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
 PATHS = Paths()
@@ -72,7 +72,7 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None, model: str = "
         (work / "config/subjects.tsv").write_text(
             "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
         )
-        trials = StudyDesign.from_config(cfg["trials"]).walking_trials()
+        trials = stage_settings(cfg, "study").design.walking_trials()
         subject, extra = "S01", []
         t0 = time.perf_counter()
         if model == "gait2392":

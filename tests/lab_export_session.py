@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import logging
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields
 
 from loper_analysis.io.atomic import PathLike
 from loper_analysis.io.c3d_writer import write_recording
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
 from loper_analysis.synthetic.lab_export import QTMExportSettings
 from loper_analysis.synthetic.lab_session import SyntheticLabSettings
@@ -40,8 +41,11 @@ class LabExportSettings(SyntheticLabSettings):
 
     @classmethod
     def from_config(cls, config: Mapping) -> LabExportSettings:
-        """The settings of the whole validated config (``export`` keeps its defaults: no config key)."""
-        return replace(super().from_config(config), brace_fraction=config["opensim"]["brace_attachment_fraction"])
+        """The settings of the whole validated config: the synthetic lab's recording and the model's rod
+        attachment (``export`` keeps its defaults: no config key)."""
+        lab = stage_settings(config, "synthetic")
+        recording = {f.name: getattr(lab, f.name) for f in fields(SyntheticLabSettings)}
+        return cls(**recording, brace_fraction=stage_settings(config, "model").attachment_fraction)
 
 
 @dataclass(frozen=True)

@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import copy
 from pathlib import Path
 
 import yaml
 
 from loper_analysis.layout import Paths, Study
-from loper_analysis.study_design import StudyDesign
+from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -21,7 +22,7 @@ def study_on(tmp_path: Path, rows: dict, **config) -> Study:
     said: list[str] = []
     study = Study(
         rows,
-        StudyDesign.from_config(cfg["trials"]),
+        stage_settings(cfg, "study").design,
         Paths(str(tmp_path / "raw")),
         cfg,
         has_plates=lambda path: path.name != "walk-nodevice.c3d",
@@ -36,3 +37,10 @@ def touch(path: Path, data: bytes = b"x") -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_bytes(data)
     return path
+
+
+def device_config(**sections) -> dict:
+    """The shipped config with the given sections of ``device`` (``leg``, ``tests``, ``analysis``, ...) replaced."""
+    config = copy.deepcopy(CONFIG)
+    config["device"].update(sections)
+    return config

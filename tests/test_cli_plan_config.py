@@ -19,6 +19,7 @@ from loper_analysis.cli import _plan_pilot, _plan_settings, _read_config, comman
 from loper_analysis.config_file import load_config
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.stages.planning.step import PlanningSettings
+from loper_analysis.stages.settings import stage_settings
 from tests.config_layers import STRIDES, WINDOW_AFTER_S, write_yaml
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,7 +31,7 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 def test_rule_takes_its_params_from_the_shared_builder():
     rules = ROOT / "workflow" / "rules"
-    assert "PLAN_SETTINGS = PlanningSettings.from_config(config)" in (rules / "inputs.smk").read_text()
+    assert 'PLAN_SETTINGS = stage_settings(config, "planning")' in (rules / "inputs.smk").read_text()
     assert "**settings_params(PLAN_SETTINGS)," in (rules / "planning.smk").read_text()
     # the rule's script reads the pilot, its files and the one settings object, nothing else
     script = (ROOT / "workflow" / "scripts" / "planning.py").read_text()
@@ -39,7 +40,7 @@ def test_rule_takes_its_params_from_the_shared_builder():
 
 def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
     config, _ = load_config(["config/config.yaml", second])
-    rule = PlanningSettings.from_config(config)
+    rule = stage_settings(config, "planning")
     args = command_parser().parse_args(["plan", "--configfile", str(second)])
     read, line = _read_config(args)
     assert line == "config: config/config.yaml, config/mine.yaml (later files override earlier ones)"
@@ -79,7 +80,7 @@ def test_options_given_override_the_config(project, second):
     assert settings.strides == (5,) and settings.plan.pulse_force_n == 30.0 and settings.onsets_ms == (125.0,)
     assert settings.targets == ({"joint": "hip", "parameter": "K", "percent": 10.0},)
     assert settings.plan.window.after_s == WINDOW_AFTER_S  # no option: the config's
-    assert settings.plan.pulse_duration_s == PlanningSettings.from_config(load_config()[0]).plan.pulse_duration_s
+    assert settings.plan.pulse_duration_s == stage_settings(load_config()[0], "planning").plan.pulse_duration_s
 
 
 def test_without_a_config_the_library_defaults_serve_and_the_line_says_so(tmp_path, monkeypatch):
@@ -159,6 +160,6 @@ def test_planning_defaults_are_the_configs_but_onsets_and_targets():
     """Without a config the planner takes the onsets of the pilot's impedance rows and has no targets; every
     other setting of the library equals config/config.yaml's."""
     config = yaml.safe_load(CONFIG.read_text())
-    built = PlanningSettings.from_config(config)
+    built = stage_settings(config, "planning")
     assert dataclasses.replace(built, onsets_ms=None, targets=()) == PlanningSettings()
     assert built.onsets_ms == tuple(config["trials"]["perturbation_onsets_ms"]) and built.targets

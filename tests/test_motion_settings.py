@@ -25,6 +25,7 @@ from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
 from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.stages.model.step import ModelSettings
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from tests.gait2392_models import GENERIC, scaled_gait2392
 
@@ -49,15 +50,15 @@ def _configure(project: Path, **sections: dict) -> None:
 
 
 def test_model_and_grf_settings_of_the_shipped_config_are_the_defaults():
-    model = ModelSettings.from_config(SHIPPED)
+    model = stage_settings(SHIPPED, "model")
     # the coordinate map written out in the config is the library's default map, for which None stands
     assert {k: (v["coordinate"], v["sign"]) for k, v in model.coordinate_map.items()} == DEFAULT_COORDINATE_MAP
     assert dataclasses.replace(model, coordinate_map=None) == ModelSettings()
-    assert GRFSettings.from_config(SHIPPED) == GRFSettings()
+    assert stage_settings(SHIPPED, "grf") == GRFSettings()
 
 
 def test_ik_settings_of_the_shipped_config_are_the_defaults():
-    settings = IKSettings.from_config(SHIPPED)
+    settings = stage_settings(SHIPPED, "ik")
     # the config writes "none" as empty mappings and the coordinate map out; the library's None stands for them
     assert settings.marker_weights == {} and settings.coordinate_tasks == {}
     shipped_map = {k: (v["coordinate"], v["sign"]) for k, v in settings.coordinate_map.items()}
@@ -71,9 +72,9 @@ def test_a_changed_config_key_changes_the_settings():
     config["opensim"]["accuracy"] = 1e-8
     config["grf"]["loaded_threshold_n"] = 35.0
     config["markers"]["static_duration_s"] = None
-    assert IKSettings.from_config(config).accuracy == 1e-8
-    assert GRFSettings.from_config(config).threshold_n == 35.0
-    assert ModelSettings.from_config(config).static_duration_s is None
+    assert stage_settings(config, "ik").accuracy == 1e-8
+    assert stage_settings(config, "grf").threshold_n == 35.0
+    assert stage_settings(config, "model").static_duration_s is None
 
 
 # --------------------------------------------------------------------------- segments

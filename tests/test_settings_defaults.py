@@ -34,6 +34,7 @@ from loper_analysis.impedance.identification.validation import ValidationSetting
 from loper_analysis.impedance.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
 from loper_analysis.impedance.responses.response_window import WINDOW_KEYS, ResponseWindow
 from loper_analysis.planning.window import PlanSettings
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 
@@ -153,7 +154,7 @@ def test_response_window_defaults_equal_config_identification():
         "initial_state_span_s": "identification.initial_state_span_s",
     }
     assert _mismatches(_defaults(ResponseWindow), CONFIG, WINDOW_KEYS) == []
-    assert ResponseWindow.from_config(CONFIG) == ResponseWindow()
+    assert stage_settings(CONFIG, "impedance").response.window == ResponseWindow()
 
 
 def test_response_settings_defaults_equal_config_identification_and_strides():
@@ -268,7 +269,7 @@ def test_keyword_defaults_equal_config(function, keys):
 
 
 def test_prepare_window_default_window_is_the_configs():
-    assert _signature_defaults(prepare_window)["window"] == ResponseWindow.from_config(CONFIG)
+    assert _signature_defaults(prepare_window)["window"] == stage_settings(CONFIG, "impedance").response.window
 
 
 def test_prepared_window_and_identify_defaults_agree_with_config():
@@ -328,7 +329,7 @@ def test_plan_settings_defaults_equal_config():
     defaults = _defaults(PlanSettings)
     assert set(defaults) == set(keys) | {"window"}
     assert _mismatches(defaults, CONFIG, keys) == []
-    assert defaults["window"] == ResponseWindow.from_config(CONFIG)
+    assert defaults["window"] == stage_settings(CONFIG, "impedance").response.window
 
 
 # --------------------------------------------------------------------------- synthetic lab

@@ -26,6 +26,7 @@ from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.motion import filtering, heading, markers, plausibility
 from loper_analysis.motion.trial_markers import MarkerSettings
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.transparency import TransparencySettings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -113,6 +114,6 @@ def test_a_changed_config_key_reaches_its_field(settings_type, path, field, valu
 
 
 def test_the_static_trial_is_neither_filled_nor_filtered():
-    static = MarkerSettings.from_config(CONFIG).for_static()
+    static = stage_settings(CONFIG, "markers").for_static()
     assert (static.max_gap_frames, static.cutoff_hz) == (0, None)
     assert static.rotation_deg == tuple(CONFIG["markers"]["lab_to_model_rotation_deg"])

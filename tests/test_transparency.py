@@ -12,6 +12,7 @@ import yaml
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.outliers import MIN_VALID_STRIDES
 from loper_analysis.reference import STUDY_TRANSPARENCY_RAD
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.transparency import (
     TRANSPARENCY_COLUMNS,
@@ -138,7 +139,7 @@ def test_bad_inputs_are_named():
 
 def test_settings_of_the_config_and_the_defaults_agree():
     """The left leg and at least 5 kept strides, the strides' own."""
-    assert TransparencySettings.from_config(CONFIG) == TransparencySettings() == TransparencySettings("left", 5)
+    assert stage_settings(CONFIG, "transparency") == TransparencySettings() == TransparencySettings("left", 5)
     assert (PERTURBED_SIDE, MIN_VALID_STRIDES) == ("left", 5)
 
 
@@ -146,12 +147,12 @@ def test_settings_take_the_config_s_side_and_stride_minimum():
     config = copy.deepcopy(CONFIG)
     config["trials"]["perturbed_side"] = "right"
     config["strides"]["min_valid_strides"] = 7
-    assert TransparencySettings.from_config(config) == TransparencySettings(side="right", min_strides=7)
+    assert stage_settings(config, "transparency") == TransparencySettings(side="right", min_strides=7)
 
 
 @pytest.mark.parametrize(("section", "key"), [("trials", "perturbed_side"), ("strides", "min_valid_strides")])
 def test_settings_name_a_missing_key(section, key):
     config = copy.deepcopy(CONFIG)
     del config[section][key]
-    with pytest.raises(KeyError, match=f"^'{key}'$"):
-        TransparencySettings.from_config(config)
+    with pytest.raises(LoperInputError, match=f"^config: key '{section}.{key}' missing: "):
+        stage_settings(config, "transparency")

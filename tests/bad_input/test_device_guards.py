@@ -31,6 +31,7 @@ from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.stages.events import step as event_steps
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -41,7 +42,7 @@ OUTPUTS = ("events", "contacts", "force", "native")
 def _settings() -> tuple[EventSettings, LoadcellSettings]:
     """The settings rule events_loadcell passes to the step (built in inputs.smk from config/config.yaml)."""
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    return EventSettings.from_config(cfg), LoadcellSettings.from_config(cfg)
+    return stage_settings(cfg, "events").events, stage_settings(cfg, "events").loadcell
 
 
 @pytest.fixture(scope="module")

@@ -21,6 +21,7 @@ import yaml
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.layout import Paths, fill
+from loper_analysis.stages.settings import stage_settings
 from tests.workflow_copy import copy_workflow, snakemake
 
 pytestmark = pytest.mark.slow  # Snakemake runs the simulated lab (pytest -m "not slow" leaves them out)
@@ -152,13 +153,11 @@ def test_the_synthetic_labs_own_files_are_generated_again_and_listed_in_its_mani
 
 def test_the_labs_step_refuses_to_write_over_a_file_it_did_not_write(lab):
     from loper_analysis.stages.synthetic.step import LabSessionFiles, lab_session
-    from loper_analysis.study_design import StudyDesign
-    from loper_analysis.synthetic.lab_session import LabSessionSettings
 
     raw = _recorded(lab)
     cfg = yaml.safe_load((lab / "config/config.yaml").read_text())
-    settings = LabSessionSettings.from_config(cfg)
-    design = StudyDesign.from_config(cfg["trials"])
+    settings = stage_settings(cfg, "synthetic")
+    design = stage_settings(cfg, "study").design
     trials = design.walking_trials()
     files = LabSessionFiles.in_design_order(
         design,
@@ -179,10 +178,10 @@ def test_the_labs_step_refuses_to_write_over_a_file_it_did_not_write(lab):
 
 
 def test_the_device_tests_step_writes_its_manifest_and_refuses_a_recorded_log(lab):
-    from loper_analysis.stages.device.step import DeviceSettings, device_trial
+    from loper_analysis.stages.device.step import device_trial
 
     cfg = yaml.safe_load((lab / "config/config.yaml").read_text())
-    s = DeviceSettings.from_config(cfg)
+    s = stage_settings(cfg, "device")
     out = lab / "data/raw/S01/device-steps.loper.tsv"
     for _ in range(2):  # written, then generated again over its own file
         device_trial(out, "S01", "device-steps", s.parameters, s.leg, s.tests, 1)

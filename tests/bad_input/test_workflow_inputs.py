@@ -25,7 +25,6 @@ import pandas as pd
 import pytest
 import yaml
 
-from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d import read_c3d
@@ -37,6 +36,7 @@ from loper_analysis.stages.events import step as event_steps
 from loper_analysis.stages.ik import step as ik
 from loper_analysis.stages.markers import step as marker_steps
 from loper_analysis.stages.markers.step import MarkerSettings
+from loper_analysis.stages.settings import stage_settings
 from tests.workflow_copy import snakemake
 
 PATHS = Paths()
@@ -169,7 +169,7 @@ def _markers(cfg: dict, c3d: str, label_map=None):
         c3d,
         fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
         fill(PATHS.markers.gaps, subject=SUBJECT, trial=WALK),
-        dataclasses.replace(MarkerSettings.from_config(cfg), label_map=label_map or m["label_map"] or None),
+        dataclasses.replace(stage_settings(cfg, "markers"), label_map=label_map or m["label_map"] or None),
         summary_out=fill(PATHS.markers.summary, subject=SUBJECT, trial=WALK),
     )
 
@@ -179,7 +179,7 @@ def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW
         c3d,
         log,
         fill(PATHS.events.force, subject=SUBJECT, trial=WALK),
-        LoadcellSettings.from_config(cfg),
+        stage_settings(cfg, "events").loadcell,
     )
 
 
@@ -187,7 +187,7 @@ def _events(cfg: dict, grf_channels: dict):
     return event_steps.events(
         f"{RAW}/{WALK}.c3d",
         fill(PATHS.events.events, subject=SUBJECT, trial=WALK),
-        dataclasses.replace(EventSettings.from_config(cfg), grf_channels=grf_channels),
+        dataclasses.replace(stage_settings(cfg, "events").events, grf_channels=grf_channels),
         contacts_out=fill(PATHS.events.contacts, subject=SUBJECT, trial=WALK),
     )
 
@@ -198,7 +198,7 @@ def _ik(cfg: dict, trc: Path, static_trc: str | None = None):
         trc,
         fill(PATHS.ik.mot, subject=SUBJECT, trial=WALK),
         fill(PATHS.ik.angles, subject=SUBJECT, trial=WALK),
-        IKSettings.from_config(cfg),
+        stage_settings(cfg, "ik"),
         static_trc=static_trc,
     )
 
@@ -387,7 +387,7 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
     cfg = _config(lab)
     out = tmp_path / "R02.trc"
     marker_steps.markers(
-        tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", MarkerSettings.from_config(cfg)
+        tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", stage_settings(cfg, "markers")
     )
     static = fill(PATHS.markers.trc, subject=SUBJECT, trial="static")  # R01's, the reference
     if refused:
@@ -402,7 +402,7 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
         out,
         tmp_path / "R02.mot",
         tmp_path / "R02.angles.tsv",
-        IKSettings.from_config(cfg),
+        stage_settings(cfg, "ik"),
         summary_tsv=summary,
         static_trc=static,
     )
@@ -419,9 +419,9 @@ def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_
     cfg = _config(lab)
     out = tmp_path / "R02.trc"
     marker_steps.markers(
-        tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", MarkerSettings.from_config(cfg)
+        tmp_path / "R02" / f"{WALK}.c3d", out, tmp_path / "R02.gaps.tsv", stage_settings(cfg, "markers")
     )
-    given = dataclasses.replace(IKSettings.from_config(cfg), subjects_model=False)
+    given = dataclasses.replace(stage_settings(cfg, "ik"), subjects_model=False)
     summary = tmp_path / "ik.tsv"
     model = fill(PATHS.model.generic, subject=SUBJECT)
     ik.ik_trial(model, out, tmp_path / "a.mot", tmp_path / "a.angles.tsv", given, summary_tsv=summary)
@@ -442,7 +442,7 @@ def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
         fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
         tmp_path / "own.mot",
         tmp_path / "own.angles.tsv",
-        IKSettings.from_config(_config(lab)),
+        stage_settings(_config(lab), "ik"),
         summary_tsv=summary,
     )
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
@@ -453,7 +453,7 @@ def test_own_walking_trial_keeps_its_geometry(lab, tmp_path):
         fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK),
         tmp_path / "own.mot",
         tmp_path / "own.angles.tsv",
-        IKSettings.from_config(_config(lab)),
+        stage_settings(_config(lab), "ik"),
         summary_tsv=summary,
         static_trc=fill(PATHS.markers.trc, subject=SUBJECT, trial="static"),
     )
@@ -491,7 +491,7 @@ def test_a_static_trial_far_from_the_subjects_height_stops_scaling(lab, tmp_path
         tmp_path / "R02" / "static.c3d",
         static,
         tmp_path / "static.gaps.tsv",
-        MarkerSettings.from_config(_config(lab)).for_static(),
+        stage_settings(_config(lab), "markers").for_static(),
     )
     message = _refused(
         lab,
@@ -606,7 +606,7 @@ def test_belt_channels_swapped_are_refused_from_the_heel_markers(lab):
 def test_heel_markers_given_for_the_other_feet_are_refused(lab):
     """The left heel lies right of the right heel along the pelvis's right axis: every contact would change side."""
     cfg = _config(lab)
-    settings = dataclasses.replace(EventSettings.from_config(cfg), foot_markers={"left": "RHEE", "right": "LHEE"})
+    settings = dataclasses.replace(stage_settings(cfg, "events").events, foot_markers={"left": "RHEE", "right": "LHEE"})
     _refused(
         lab,
         lambda: event_steps.events(
@@ -629,7 +629,7 @@ def test_a_walk_stored_backwards_is_warned_about_by_the_events_step(lab, tmp_pat
     rec = read_c3d(lab / RAW / f"{WALK}.c3d")
     backward = tmp_path / "backward.c3d"
     write_recording(backward, replace(rec, markers_m=rec.markers_m[::-1].copy(), analogs=rec.analogs[::-1].copy()))
-    settings = EventSettings.from_config(_config(lab))
+    settings = stage_settings(_config(lab), "events").events
     before = _state(lab)
     with warnings.catch_warnings():
         warnings.simplefilter("error", UserWarning)  # the trial as recorded: not a word
@@ -657,7 +657,7 @@ def _belts_in(lab: Path, path: Path, unit: str, factor: float) -> Path:
 def test_belt_channels_in_kn_give_the_same_events_and_in_mv_are_refused(lab, tmp_path):
     cfg = _config(lab)
     e = cfg["events"]
-    settings = dataclasses.replace(EventSettings.from_config(cfg), grf_channels=e["grf_channels"])
+    settings = dataclasses.replace(stage_settings(cfg, "events").events, grf_channels=e["grf_channels"])
     kn = _belts_in(lab, tmp_path / "kn.c3d", "kN", 1e-3)
     table = event_steps.events(kn, tmp_path / "e.tsv", settings)
     good = pd.read_csv(fill(PATHS.events.events, subject=SUBJECT, trial=WALK), sep="\t")

@@ -9,7 +9,6 @@ import pytest
 from scipy.signal import cont2discrete, dlsim, freqz
 
 from loper_analysis.device.analysis import (
-    DeviceAnalysisSettings,
     FRFSettings,
     StepSettings,
     average_step,
@@ -24,6 +23,8 @@ from loper_analysis.device.analysis import (
 from loper_analysis.device.controller import DeviceParameters, FreeLeg, simulate_device
 from loper_analysis.device.trials import DeviceTestSettings, simulate_device_trial
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages.settings import stage_settings
+from tests.study_files import device_config
 
 FS = 1000.0
 
@@ -180,7 +181,7 @@ ANALYSIS = {
 
 
 def test_analysis_settings_from_config_hold_every_key():
-    settings = DeviceAnalysisSettings.from_config({"device": {"analysis": ANALYSIS}})
+    settings = stage_settings(device_config(analysis=ANALYSIS), "device").analysis
     assert settings.frf == FRFSettings(window_samples=4000, overlap_samples=100)
     assert settings.steps == StepSettings(before_s=0.04, after_s=0.5, steady_window_s=(0.2, 0.35))
     assert settings.reference_band_hz == (0.4, 1.5)
@@ -210,5 +211,5 @@ def test_analysis_settings_from_config_hold_every_key():
 )
 def test_a_bad_analysis_value_is_refused_naming_its_key(key, value, message):
     with pytest.raises(LoperInputError) as info:
-        DeviceAnalysisSettings.from_config({"device": {"analysis": {**ANALYSIS, key: value}}})
+        _ = stage_settings(device_config(analysis={**ANALYSIS, key: value}), "device").analysis
     assert str(info.value) == message

@@ -18,6 +18,8 @@ from loper_analysis.device.controller import (
     simulate_device,
 )
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages.settings import stage_settings
+from tests.study_files import device_config
 
 DEV = DeviceParameters()
 QUIET = DeviceParameters(loadcell_noise_sd_n=0.0, loadcell_resolution_n=0.0)
@@ -144,9 +146,9 @@ def test_bad_inputs_are_refused():
 
 
 def test_free_leg_from_config_holds_every_key():
-    leg = FreeLeg.from_config(
-        {"device": {"leg": {"mass_kg": 9.5, "damping_ns_per_m": 4.0, "stiffness_n_per_m": 120.0}}}
-    )
+    leg = stage_settings(
+        device_config(leg={"mass_kg": 9.5, "damping_ns_per_m": 4.0, "stiffness_n_per_m": 120.0}), "device"
+    ).leg
     assert (leg.mass_kg, leg.damping_ns_per_m, leg.stiffness_n_per_m) == (9.5, 4.0, 120.0)
 
 
@@ -161,5 +163,5 @@ def test_free_leg_from_config_holds_every_key():
 def test_a_bad_leg_value_is_refused_naming_its_key(key, value, message):
     leg = {"mass_kg": 14.0, "damping_ns_per_m": 10.0, "stiffness_n_per_m": 250.0, key: value}
     with pytest.raises(LoperInputError) as info:
-        FreeLeg.from_config({"device": {"leg": leg}})
+        _ = stage_settings(device_config(leg=leg), "device").leg
     assert str(info.value) == message

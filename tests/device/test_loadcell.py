@@ -18,6 +18,7 @@ from loper_analysis.device.loadcell import (
     robot_log_on_mocap_frames,
 )
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.synthetic.sync import pulse_train_at, sync_pulse_starts
 from tests.sync_records import ANALOG_HZ, ROBOT_HZ, mocap_view
 
@@ -167,8 +168,8 @@ def test_settings_of_a_config():
     config = copy.deepcopy(CONFIG)
     config["events"]["sync_channel"] = "trigger"
     config["filter"].update(cutoff_hz=12.0, order=2)
-    assert LoadcellSettings.from_config(config) == LoadcellSettings("trigger", 12.0, 2)
-    assert LoadcellSettings.from_config(CONFIG) == LoadcellSettings() == LoadcellSettings(SYNC_CHANNEL, 40.0, 4)
+    assert stage_settings(config, "events").loadcell == LoadcellSettings("trigger", 12.0, 2)
+    assert stage_settings(CONFIG, "events").loadcell == LoadcellSettings() == LoadcellSettings(SYNC_CHANNEL, 40.0, 4)
     assert SYNC_CHANNEL == "sync"
 
 
@@ -176,5 +177,5 @@ def test_settings_of_a_config():
 def test_settings_name_a_missing_key(section, key):
     config = copy.deepcopy(CONFIG)
     del config[section][key]
-    with pytest.raises(KeyError, match=f"^'{key}'$"):
-        LoadcellSettings.from_config(config)
+    with pytest.raises(LoperInputError, match=f"^config: key '{section}.{key}' missing: "):
+        _ = stage_settings(config, "events").loadcell

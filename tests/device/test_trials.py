@@ -15,6 +15,8 @@ from loper_analysis.device.trials import (
     sync_signal,
 )
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages.settings import stage_settings
+from tests.study_files import device_config
 
 FS = 1000.0
 
@@ -102,7 +104,7 @@ TESTS = {
 
 
 def test_device_test_settings_from_config_hold_every_key():
-    settings = DeviceTestSettings.from_config({"device": {"tests": TESTS}})
+    settings = stage_settings(device_config(tests=TESTS), "device").tests
     assert dataclasses.asdict(settings) == {**TESTS, "step_amplitudes_n": (10.0, 30.0)}
 
 
@@ -117,5 +119,5 @@ def test_device_test_settings_from_config_hold_every_key():
 )
 def test_a_bad_device_test_value_is_refused_naming_its_key(key, value, message):
     with pytest.raises(LoperInputError) as info:
-        DeviceTestSettings.from_config({"device": {"tests": {**TESTS, key: value}}})
+        _ = stage_settings(device_config(tests={**TESTS, key: value}), "device").tests
     assert str(info.value) == message

@@ -13,6 +13,7 @@ import yaml
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.trial_events import EventSettings, trial_events
 from loper_analysis.io.c3d import C3DRecording
+from loper_analysis.stages.settings import stage_settings
 
 RATE_HZ, ANALOG_HZ, DURATION_S = 100.0, 1000.0, 6.0
 #: Each belt's stances [heel strike, toe-off) in s: 0.7 s stances, 1.2 s strides, 0.1 s double support.
@@ -104,7 +105,7 @@ def test_missing_channels_or_settings_are_named():
 
 def test_settings_from_the_config_file(repo_root):
     config = yaml.safe_load((repo_root / "config" / "config.yaml").read_text())
-    s = EventSettings.from_config(config)
+    s = stage_settings(config, "events").events
     e = config["events"]
     assert (s.threshold_on_n, s.threshold_off_n, s.min_stance_s, s.min_swing_s) == (
         e["threshold_on_n"],

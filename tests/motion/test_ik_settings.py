@@ -8,9 +8,10 @@ from pathlib import Path
 import pytest
 import yaml
 
+from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.ik import IK_ACCURACY
 from loper_analysis.motion.ik_settings import DEFAULT_MARKER_WEIGHT, IKSettings
-from loper_analysis.motion.model_settings import ModelSettings
+from loper_analysis.stages.settings import stage_settings
 
 CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())
 MAP = {"knee_left": {"coordinate": "knee_angle_l", "sign": -1}}
@@ -37,7 +38,7 @@ def _changed() -> dict:
 
 def test_every_config_key_reaches_its_field():
     """Each changed key in its own field; the fewest markers (no key) and the subject's own model keep theirs."""
-    assert IKSettings.from_config(_changed()) == IKSettings(
+    assert stage_settings(_changed(), "ik") == IKSettings(
         tasks_file="tasks.xml",
         default_weight=0.5,
         marker_weights={"LASI": 2.0, "RASI": 0.0},
@@ -56,7 +57,7 @@ def test_every_config_key_reaches_its_field():
 
 def test_the_shipped_config_gives_the_defaults():
     """Accuracy 1e-6, weight 1, RMS limits 0.06 / 0.02 m over 10 % of the frames, geometry 5 % / 8 %."""
-    shipped = IKSettings.from_config(CONFIG)
+    shipped = stage_settings(CONFIG, "ik")
     assert (shipped.accuracy, IK_ACCURACY, shipped.default_weight, DEFAULT_MARKER_WEIGHT) == (1e-6, 1e-6, 1.0, 1.0)
     assert (shipped.max_marker_rms_m, shipped.warn_marker_rms_m, shipped.max_rms_fraction) == (0.06, 0.02, 0.1)
     assert (shipped.geometry_warn_change, shipped.geometry_stop_change) == (0.05, 0.08)
@@ -66,7 +67,7 @@ def test_the_shipped_config_gives_the_defaults():
 
 def test_the_scale_report_takes_the_ik_accuracy_and_coordinate_map():
     """opensim.accuracy and opensim.coordinate_map reach the model stage's static pose as the IK's."""
-    model, ik = ModelSettings.from_config(_changed()), IKSettings.from_config(_changed())
+    model, ik = stage_settings(_changed(), "model"), stage_settings(_changed(), "ik")
     assert (model.accuracy, model.coordinate_map) == (ik.accuracy, ik.coordinate_map) == (1e-8, MAP)
     assert model.for_scaling().accuracy == 1e-8
 
@@ -75,5 +76,5 @@ def test_the_scale_report_takes_the_ik_accuracy_and_coordinate_map():
 def test_a_missing_key_is_named(key):
     config = copy.deepcopy(CONFIG)
     del config["opensim"][key]
-    with pytest.raises(KeyError, match=f"^'{key}'$"):
-        IKSettings.from_config(config)
+    with pytest.raises(LoperInputError, match=f"^config: key 'opensim.{key}' missing: the ik settings read it$"):
+        stage_settings(config, "ik")

@@ -7,6 +7,7 @@ from pathlib import Path
 import yaml
 
 from loper_analysis.motion.model_settings import STATIC_DURATION_S, STATIC_MAX_MOTION_RMS_M, ModelSettings
+from loper_analysis.stages.settings import stage_settings
 
 CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())
 BODIES = {"thigh": ["femur_{s}"], "shank": ["tibia_{s}"], "foot": ["talus_{s}", "calcn_{s}?"]}
@@ -25,7 +26,7 @@ def _changed() -> ModelSettings:
         accuracy=1e-8,
     )
     config["trials"]["perturbed_side"] = "right"
-    return ModelSettings.from_config(config)
+    return stage_settings(config, "model")
 
 
 def test_every_config_key_reaches_its_field():

@@ -23,6 +23,7 @@ from loper_analysis.planning.pilot_plan import (
 )
 from loper_analysis.planning.precision import precision_table, target_answer
 from loper_analysis.planning.window import PlanSettings
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
 
@@ -35,20 +36,20 @@ PLAN = PlanSettings(interval_scatter="perturbed_pairs")
 
 def test_settings_of_the_shipped_config():
     """Onsets, stride counts, targets and the null-trial ratio are the config's."""
-    settings = PlanningSettings.from_config(CONFIG)
+    settings = stage_settings(CONFIG, "planning")
     assert settings.onsets_ms == (50, 175, 300)
     assert settings.strides == (10, 20, 40) == STRIDES
     assert settings.targets == tuple(CONFIG["planning"]["targets"])
     assert settings.max_null_trial_ratio == CONFIG["identification"]["max_null_trial_ratio"]
-    assert settings.plan == PlanSettings.from_config(CONFIG)
-    assert settings.response == ResponseSettings.from_config(CONFIG)
+    assert settings.plan == stage_settings(CONFIG, "planning").plan
+    assert settings.response == stage_settings(CONFIG, "impedance").response
 
 
 @pytest.mark.parametrize(
     ("path", "message"),
     [
         (("identification", "counterfactual"), "config: key 'identification.counterfactual' missing: "),
-        (("device",), "config: key 'device' missing: the planner needs 'device.parameters'"),
+        (("device",), "config: key 'device' missing: the device settings read it$"),
         (("planning", "pulse_force_n"), "config: key 'planning.pulse_force_n' missing: "),
     ],
 )
@@ -59,7 +60,7 @@ def test_a_missing_key_is_named(path, message):
         node = node[key]
     del node[path[-1]]
     with pytest.raises(LoperInputError, match=f"^{message}"):
-        PlanningSettings.from_config(config)
+        stage_settings(config, "planning")
 
 
 def _rows(knee_k: float = 3.0, status: str = "ok") -> pd.DataFrame:

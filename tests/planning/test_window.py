@@ -15,6 +15,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.planning.inputs import pulse_force_n
 from loper_analysis.planning.window import PlanSettings, null_pair_arrays, planned_impedance, planning_window
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -36,7 +37,7 @@ def test_from_config_reads_every_key_the_planner_follows():
         stiffness_bounds_nm_per_rad=[1.0, 150.0],
         damping_bounds_nms_per_rad=[0.5, 8.0],
     )
-    settings = PlanSettings.from_config(config)
+    settings = stage_settings(config, "planning").plan
     assert settings == PlanSettings(
         pulse_force_n=35.0,
         pulse_duration_s=0.08,
@@ -55,7 +56,7 @@ def test_from_config_reads_every_key_the_planner_follows():
 
 
 def test_the_shipped_config_plans_a_40_n_pulse_of_100_ms():
-    settings = PlanSettings.from_config(CONFIG)
+    settings = stage_settings(CONFIG, "planning").plan
     assert (settings.pulse_force_n, settings.pulse_duration_s) == (40.0, 0.1)
     assert settings == PlanSettings()
 

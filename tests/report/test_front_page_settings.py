@@ -7,8 +7,10 @@ from pathlib import Path
 import pytest
 import yaml
 
+from loper_analysis.errors import LoperInputError
 from loper_analysis.report.front_page import RunSettings
 from loper_analysis.report.front_page_settings import FrontPageSettings
+from loper_analysis.stages.settings import stage_settings
 
 CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())
 #: The shipped config's run settings, written out.
@@ -35,7 +37,7 @@ SHIPPED = RunSettings(
 
 def test_the_shipped_config_s_run_settings():
     """Every value, and the repr the front page rule's params compare (onsets and bounds as tuples)."""
-    settings = FrontPageSettings.from_config(CONFIG)
+    settings = stage_settings(CONFIG, "report")
     assert settings == FrontPageSettings(SHIPPED)
     assert repr(settings) == repr(FrontPageSettings(SHIPPED))
 
@@ -55,11 +57,11 @@ def test_every_key_the_page_lists_reaches_its_row():
         null_pair_components=4,
     )
     config["synthetic"].update(variability="gentle", walking_duration_s=30.0, pulse_force_n=30.0, pulse_duration_s=0.08)
-    assert FrontPageSettings.from_config(config).run == RunSettings(
+    assert stage_settings(config, "report").run == RunSettings(
         *(7, (60, 200), 3, "right", 12.0, 2, 0.03, 0.2, (1.0, 150.0), (0.5, 8.0)),
         *(3, "white", 4, "gentle", 30.0, 30.0, 0.08),
     )
-    rows = dict(FrontPageSettings.from_config(config).run.rows())
+    rows = dict(stage_settings(config, "report").run.rows())
     assert "3 random starts" in rows["bounds"] and rows["perturbations"].startswith("onsets 60, 200 ms after right")
 
 
@@ -72,5 +74,5 @@ def test_a_missing_key_is_named(path):
     for name in path[:-1]:
         node = node[name]
     del node[path[-1]]
-    with pytest.raises(KeyError, match=f"^'{path[-1]}'$"):
-        FrontPageSettings.from_config(config)
+    with pytest.raises(LoperInputError, match=f"^config: key '{'.'.join(path)}' missing: "):
+        stage_settings(config, "report")

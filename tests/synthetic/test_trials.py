@@ -12,6 +12,7 @@ import pytest
 import yaml
 
 from loper_analysis.motion.model import COORDINATES, build_lower_body_model
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.trials import (
     LabSettings,
@@ -104,7 +105,7 @@ def test_lab_settings_follow_the_config():
     )
     config["markers"]["lab_to_model_rotation_deg"] = [90.0, 0.0, 0.0]
     config["events"]["sync_channel"] = "loper_sync"
-    assert LabSettings.from_config(config) == LabSettings(
+    assert stage_settings(config, "synthetic").lab == LabSettings(
         marker_noise_sd_m=0.001,
         n_gaps=5,
         max_gap_frames=4,

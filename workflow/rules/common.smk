@@ -17,7 +17,8 @@ from loper_analysis.layout import Paths, Study, fill, subject_rows
 from loper_analysis.schema import check_config, check_project_paths, config_origin
 from loper_analysis.stages.cluster_failures import requested_partitions
 from loper_analysis.study_checks import check_subject_sheet, check_subjects, raw_file_warnings
-from loper_analysis.study_design import DEVICE_TESTS, StudyDesign
+from loper_analysis.stages.settings import stage_settings
+from loper_analysis.study_design import DEVICE_TESTS
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
 
@@ -67,7 +68,7 @@ try:
     #: subject -> its sheet row (a synthetic subject's missing anthropometrics drawn from the study's subjects)
     SUBJECT_ROWS = subject_rows(subjects, config["seed"])
     SUBJECT_SOURCE = {s: row["source"] for s, row in SUBJECT_ROWS.items()}
-    STUDY = Study(SUBJECT_ROWS, StudyDesign.from_config(config["trials"]), PATHS, config, _plates, _note)
+    STUDY = Study(SUBJECT_ROWS, stage_settings(config, "study").design, PATHS, config, _plates, _note)
     DESIGN = STUDY.design
     check_subjects(STUDY, str(_subjects_path), config_source)
     for _line in raw_file_warnings(STUDY, str(_subjects_path)):  # and check_recordings

@@ -2,20 +2,7 @@
 
 import dataclasses
 
-from loper_analysis.stages.device.step import DeviceSettings
-from loper_analysis.device.loadcell import LoadcellSettings
-from loper_analysis.gait.trial_events import EventSettings
-from loper_analysis.gait.grf_settings import GRFSettings
-from loper_analysis.motion.ik_settings import IKSettings
-from loper_analysis.stages.markers.step import MarkerSettings
-from loper_analysis.stages.model.step import ModelSettings
-from loper_analysis.gait.stride_settings import StrideSettings
-from loper_analysis.stages.impedance.step import FitSettings
-from loper_analysis.stages.planning.step import PlanningSettings
-from loper_analysis.report.front_page_settings import FrontPageSettings
-from loper_analysis.synthetic.lab_session import LabSessionSettings
-from loper_analysis.transparency import TransparencySettings
-from loper_analysis.impedance.identification.validation import ValidationSettings
+from loper_analysis.stages.settings import stage_settings
 
 # the config's sections
 TRIALS = config["trials"]
@@ -26,22 +13,22 @@ SYNTH = config["synthetic"]
 IK_CHUNKS = [f"{i:03d}" for i in range(OPENSIM["ik_chunks"])]
 ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
 
-# the settings of the stages' rules
-MODEL_SETTINGS = ModelSettings.from_config(config)
-IK_SETTINGS = IKSettings.from_config(config)
-GRF_SETTINGS = GRFSettings.from_config(config)
-MARKER_SETTINGS = MarkerSettings.from_config(config)
-EVENT_SETTINGS = EventSettings.from_config(config)
-LOADCELL_SETTINGS = LoadcellSettings.from_config(config)
-STRIDE_SETTINGS = StrideSettings.from_config(config)
-LAB_SESSION_SETTINGS = LabSessionSettings.from_config(config)
+# the settings of the stages' rules, each built by its stage's reader (loper_analysis.stages.settings)
 try:
-    FIT_SETTINGS = FitSettings.from_config(config)
-    TRANSPARENCY_SETTINGS = TransparencySettings.from_config(config)
-    FRONT_PAGE_SETTINGS = FrontPageSettings.from_config(config)
-    PLAN_SETTINGS = PlanningSettings.from_config(config)  # as ``loper-analysis plan`` builds them
-    VALIDATION_SETTINGS = ValidationSettings.from_config(config)
-    DEVICE_SETTINGS = DeviceSettings.from_config(config)
+    MODEL_SETTINGS = stage_settings(config, "model")
+    IK_SETTINGS = stage_settings(config, "ik")
+    GRF_SETTINGS = stage_settings(config, "grf")
+    MARKER_SETTINGS = stage_settings(config, "markers")
+    EVENT_SETTINGS = stage_settings(config, "events").events
+    LOADCELL_SETTINGS = stage_settings(config, "events").loadcell
+    STRIDE_SETTINGS = stage_settings(config, "strides")
+    LAB_SESSION_SETTINGS = stage_settings(config, "synthetic")
+    FIT_SETTINGS = stage_settings(config, "impedance")
+    TRANSPARENCY_SETTINGS = stage_settings(config, "transparency")
+    FRONT_PAGE_SETTINGS = stage_settings(config, "report")
+    PLAN_SETTINGS = stage_settings(config, "planning")  # as ``loper-analysis plan`` builds them
+    VALIDATION_SETTINGS = stage_settings(config, "validation")
+    DEVICE_SETTINGS = stage_settings(config, "device")
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
 
@@ -60,7 +47,7 @@ def label_map_files(wildcards) -> list[str]:
     return [m for m in STUDY.label_maps(wildcards.trial) if isinstance(m, str)]
 
 
-def marker_settings(wildcards) -> MarkerSettings:
+def marker_settings(wildcards):
     """A trial's marker settings: its label maps and span; the static trial neither filled nor filtered."""
     spans = config["markers"]["trial_spans_s"]
     span = spans.get(f"{wildcards.subject}/{wildcards.trial}", spans.get(wildcards.trial))
@@ -72,12 +59,12 @@ def marker_settings(wildcards) -> MarkerSettings:
     return settings.for_static() if wildcards.trial == TRIALS["static"] else settings
 
 
-def event_settings(wildcards) -> EventSettings:
+def event_settings(wildcards):
     """A trial's event settings: the config's with the trial's label maps."""
     return dataclasses.replace(EVENT_SETTINGS, label_map=tuple(STUDY.label_maps(wildcards.trial)) or None)
 
 
-def ik_settings(wildcards) -> IKSettings:
+def ik_settings(wildcards):
     """A subject's IK settings: the marker geometry judged against a model scaled here (a stop) or given in the
     subject sheet (a warning)."""
     return dataclasses.replace(IK_SETTINGS, subjects_model="model_osim" not in SUBJECT_ROWS[wildcards.subject])

@@ -13,7 +13,7 @@ from loper_analysis.impedance.identification import identify_impedance
 from loper_analysis.impedance.identification.status import joint_status
 from loper_analysis.impedance.identification.validation import perturbed_trial
 from loper_analysis.impedance.identification.window import prepare_window, window_options
-from loper_analysis.stages.impedance.step import FitSettings
+from loper_analysis.stages.settings import stage_settings
 from tests.impedance.identification.validation_windows import PARAMS, SETTINGS
 
 #: Hip, knee, ankle K (N·m/rad) and D (N·m·s/rad): the knee's K and D just below zero (within noise of a
@@ -71,7 +71,7 @@ def test_the_config_layer_sets_negative_lower_bounds_for_the_fit_only():
     config, _ = load_config(
         [root / "config/config.yaml", root / "config/paper.yaml", root / "config/signed_bounds.yaml"]
     )
-    settings = FitSettings.from_config(config).identification
+    settings = stage_settings(config, "impedance").identification
     np.testing.assert_array_equal(settings.lower, LOWER)
     assert config["subjects"] == "config/subjects_paper.tsv"  # the layers below stay
     # the plausible ranges (sizes a joint may have) stay non-negative

@@ -11,8 +11,6 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.impedance.identification.validation import ValidationSettings
-from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.impedance.responses.response_window import (
     INITIAL_STATE_SPAN_S,
     WINDOW_AFTER_S,
@@ -20,6 +18,7 @@ from loper_analysis.impedance.responses.response_window import (
     ResponseWindow,
 )
 from loper_analysis.planning.window import PlanSettings
+from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[3]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -32,21 +31,21 @@ def _config(before_s: float, after_s: float, span_s: float) -> dict:
 
 
 def test_from_config_reads_the_three_keys():
-    window = ResponseWindow.from_config(_config(0.03, 0.4, 0.12))
+    window = stage_settings(_config(0.03, 0.4, 0.12), "impedance").response.window
     assert (window.before_s, window.after_s, window.initial_state_span_s) == (0.03, 0.4, 0.12)
 
 
 def test_the_defaults_are_the_shipped_configs():
     assert (WINDOW_BEFORE_S, WINDOW_AFTER_S, INITIAL_STATE_SPAN_S) == (0.025, 0.25, 0.1)
-    assert ResponseWindow.from_config(CONFIG) == ResponseWindow(0.025, 0.25, 0.1) == ResponseWindow()
+    assert stage_settings(CONFIG, "impedance").response.window == ResponseWindow(0.025, 0.25, 0.1) == ResponseWindow()
 
 
 def test_fit_planner_and_validation_hold_the_one_window_of_the_config():
     config = _config(0.03, 0.4, 0.12)
     window = ResponseWindow(before_s=0.03, after_s=0.4, initial_state_span_s=0.12)
-    assert ResponseSettings.from_config(config).window == window
-    assert PlanSettings.from_config(config).window == window
-    assert ValidationSettings.from_config(config).window == window
+    assert stage_settings(config, "impedance").response.window == window
+    assert stage_settings(config, "planning").plan.window == window
+    assert stage_settings(config, "validation").window == window
 
 
 @pytest.mark.parametrize(
@@ -66,7 +65,7 @@ def test_a_bad_field_is_refused_naming_its_key_and_value(field, key, value):
 
 def test_a_bad_config_value_is_refused_by_from_config_naming_the_key():
     with pytest.raises(LoperInputError, match=r"^identification\.initial_state_span_s .* got -0\.5$"):
-        ResponseWindow.from_config(_config(0.025, 0.25, -0.5))
+        _ = stage_settings(_config(0.025, 0.25, -0.5), "impedance").response.window
 
 
 def test_a_pulse_as_long_as_the_window_after_the_onset_is_seen_whole():

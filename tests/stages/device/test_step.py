@@ -18,6 +18,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.robot_log import read_robot_log, write_robot_log
 from loper_analysis.stages.device import step as device
 from loper_analysis.stages.device.step import DeviceSettings
+from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -111,7 +112,7 @@ def test_declared_rate_must_match(logs, tmp_path):
 
 def test_device_settings_of_the_shipped_config_are_the_library_defaults():
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    assert DeviceSettings.from_config(config) == DeviceSettings()
+    assert stage_settings(config, "device") == DeviceSettings()
 
 
 def test_device_settings_from_config_take_each_section_to_its_part():
@@ -120,7 +121,7 @@ def test_device_settings_from_config_take_each_section_to_its_part():
     config["device"]["tests"]["step_amplitudes_n"] = [30.0]
     config["device"]["analysis"]["welch_window_samples"] = 2000
     config["device"]["parameters"]["lever_arm_m"] = 0.6
-    settings = DeviceSettings.from_config(config)
+    settings = stage_settings(config, "device")
     assert settings.leg.mass_kg == 9.0 and settings.tests.step_amplitudes_n == (30.0,)
     assert settings.analysis.frf == FRFSettings(window_samples=2000, overlap_samples=50)
     assert settings.parameters.lever_arm_m == 0.6

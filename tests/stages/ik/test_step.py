@@ -25,7 +25,8 @@ from loper_analysis.motion.marker_geometry import (
 from loper_analysis.motion.model import MARKERS, build_lower_body_model
 from loper_analysis.stages.ik.step import ik_chunk, ik_join, ik_trial
 from loper_analysis.stages.inspect import inspect_subject
-from loper_analysis.stages.markers.step import MarkerSettings, markers
+from loper_analysis.stages.markers.step import markers
+from loper_analysis.stages.settings import stage_settings
 
 FS = 128.0
 ROOT = Path(__file__).resolve().parents[2]
@@ -95,7 +96,7 @@ def rch(tmp_path_factory):
     for section, keys in yaml.safe_load((lab / "config.yaml").read_text()).items():
         config.setdefault(section, {}).update(keys)
     label_map = config["markers"]["label_map"]  # as the workflow passes it to every trial
-    settings = dataclasses.replace(MarkerSettings.from_config(config), label_map=(label_map,) if label_map else None)
+    settings = dataclasses.replace(stage_settings(config, "markers"), label_map=(label_map,) if label_map else None)
     trcs = {}
     for name, c3d, trial_settings in (
         ("static", LABS / "RCH/static.c3d", settings.for_static()),
@@ -109,7 +110,7 @@ def rch(tmp_path_factory):
     walk_labels = read_markers(trcs["walk"])[2]
     names = [model.getMarkerSet().get(i).getName() for i in range(model.getMarkerSet().getSize())]
     loose = dataclasses.replace(
-        IKSettings.from_config(config),
+        stage_settings(config, "ik"),
         tasks_file=None,
         marker_weights={name: 0.0 for name in names if name not in walk_labels},
         max_marker_rms_m=np.inf,

@@ -15,7 +15,8 @@ from loper_analysis.impedance.identification.impedance import IdentificationSett
 from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.truth import write_truth
 from loper_analysis.stages.impedance.files import FitFiles, FitOutputs, TrialFiles
-from loper_analysis.stages.impedance.step import FitSettings, fit, subject_fits
+from loper_analysis.stages.impedance.step import fit, subject_fits
+from loper_analysis.stages.settings import stage_settings
 
 
 def test_onset_without_trials_writes_missing_rows(tmp_path):
@@ -40,7 +41,7 @@ CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "confi
 def test_settings_of_the_config():
     """The response settings of the shipped config are the library's defaults; the identification's besides the
     seed and the plausible ranges (the config's own); a changed key reaches its field."""
-    settings = FitSettings.from_config(CONFIG)
+    settings = stage_settings(CONFIG, "impedance")
     assert settings.response == ResponseSettings()
     ident = CONFIG["identification"]
     expected = dataclasses.replace(
@@ -50,7 +51,7 @@ def test_settings_of_the_config():
     changed = copy.deepcopy(CONFIG)
     changed["identification"]["min_vaf_pct"] = 12.5
     changed["strides"]["min_valid_strides"] = 8
-    settings = FitSettings.from_config(changed)
+    settings = stage_settings(changed, "impedance")
     assert settings.identification.min_vaf_pct == 12.5 and settings.response.min_strides == 8
 
 

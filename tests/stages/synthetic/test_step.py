@@ -12,9 +12,9 @@ import yaml
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.robot_log import read_robot_log
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.stages.synthetic.step import LabSessionFiles, lab_session, truth
 from loper_analysis.study_design import StudyDesign
-from loper_analysis.synthetic.lab_session import LabSessionSettings
 from loper_analysis.synthetic.subjects import subject_anthropometry
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -36,7 +36,7 @@ def test_a_short_session_on_disk(tmp_path):
     config = copy.deepcopy(CONFIG)
     config["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     config["synthetic"]["walking_duration_s"] = 10.0
-    settings = LabSessionSettings.from_config(config)
+    settings = stage_settings(config, "synthetic")
     row = subject_anthropometry({"subject": "S09", "source": "synthetic"}, settings.seed)
     s = config["synthetic"]
     ident = config["identification"]

@@ -1,0 +1,33 @@
+"""The ik stage's settings (config ``opensim.*``, the keys of inverse kinematics)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from loper_analysis.motion.ik_settings import IKSettings
+
+__all__ = ["NEEDS", "read_settings"]
+
+NEEDS: tuple[str, ...] = ()
+
+
+def read_settings(config: Mapping) -> IKSettings:
+    """The IK settings of a validated config: of ``opensim``, ``ik_tasks``, ``default_marker_weight``,
+    ``marker_weights``, ``coordinate_tasks``, ``accuracy``, ``ik_solver``, ``max_marker_rms_m`` (m),
+    ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``, ``geometry_warn_change`` and
+    ``geometry_stop_change``."""
+    o = config["opensim"]
+    return IKSettings(
+        tasks_file=o["ik_tasks"],
+        default_weight=o["default_marker_weight"],
+        marker_weights=o["marker_weights"],
+        coordinate_tasks=o["coordinate_tasks"],
+        accuracy=o["accuracy"],
+        solver=o["ik_solver"],
+        max_marker_rms_m=o["max_marker_rms_m"],
+        warn_marker_rms_m=o["warn_marker_rms_m"],
+        max_rms_fraction=o["max_rms_fraction"],
+        coordinate_map=o["coordinate_map"],
+        geometry_warn_change=o["geometry_warn_change"],
+        geometry_stop_change=o["geometry_stop_change"],
+    )

@@ -1,0 +1,60 @@
+"""The synthetic lab's settings (config ``synthetic.*``), with the study's design and seed, the markers' lab
+axes, the load cell's sync channel and the device."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+from loper_analysis.motion.trial_markers import MarkerSettings
+from loper_analysis.stages.device.step import DeviceSettings
+from loper_analysis.stages.events.settings import EventsSettings
+from loper_analysis.stages.study.settings import StudySettings
+from loper_analysis.synthetic.lab_session import LabSessionSettings
+from loper_analysis.synthetic.trials import LabSettings
+from loper_analysis.synthetic.variability import GaitVariability
+
+__all__ = ["NEEDS", "read_settings"]
+
+NEEDS: tuple[str, ...] = ("study", "markers", "events", "device")
+
+
+def read_settings(
+    config: Mapping, study: StudySettings, markers: MarkerSettings, events: EventsSettings, device: DeviceSettings
+) -> LabSessionSettings:
+    """The synthetic lab of a validated config: ``synthetic.*`` (durations in s, noise in m and N, the robot
+    clock's offset in s and drift in ppm, the pulse in N and s, the variability and the device adaptation);
+    the trials and seed the study's, the lab's axes the markers' rotation, the sync channel the load cell's,
+    the device's parameters the device's. The rates, the robot log's margin and the belts' channel names keep
+    their defaults."""
+    s = config["synthetic"]
+    v, a = s["study_variability"], s["device_adaptation"]
+    lab = LabSettings(
+        marker_noise_sd_m=s["marker_noise_sd_m"],
+        n_gaps=s["marker_gaps_per_trial"],
+        max_gap_frames=s["max_gap_frames"],
+        grf_noise_sd_n=s["grf_noise_sd_n"],
+        clock_offset_s=s["clock_offset_s"],
+        clock_drift_ppm=s["clock_drift_ppm"],
+        lab_to_model_rotation_deg=markers.rotation_deg,
+        sync_channel=events.loadcell.sync_channel,
+    )
+    return LabSessionSettings(
+        seed=study.seed,
+        design=study.design,
+        lab=lab,
+        device=device.parameters,
+        static_duration_s=s["static_duration_s"],
+        walking_duration_s=s["walking_duration_s"],
+        timing_cv=s["timing_cv"],
+        amplitude_cv=s["amplitude_cv"],
+        pulse_force_n=s["pulse_force_n"],
+        pulse_duration_s=s["pulse_duration_s"],
+        perturb_every_strides=tuple(s["perturb_every_strides"]),
+        variability=s["variability"],
+        study_variability=GaitVariability(
+            v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"], v["knots_per_stride"]
+        ),
+        adaptation_amplitude_change=tuple(a["amplitude_change"]),
+        adaptation_offset_rad=tuple(a["offset_rad"]),
+        adaptation_swing_gain=tuple(a["swing_gain"]),
+    )
