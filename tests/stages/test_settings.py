@@ -1,0 +1,119 @@
+"""Each stage's settings reader (``stages/<stage>/settings.py``) against the shipped config: every key of the
+config is read by exactly one reader, a reader takes the stages it needs from their readers, a missing key is
+named with its section and reader, and the settings the workflow builds are those of the readers."""
+
+from __future__ import annotations
+
+import copy
+import importlib
+from collections.abc import Mapping
+
+import pytest
+
+from loper_analysis.errors import LoperInputError
+from loper_analysis.stages import STAGES
+from loper_analysis.stages.settings import stage_settings
+from tests.study_files import CONFIG
+
+READERS = ["study", *(stage.name for stage in STAGES)]
+#: Keys of the shipped config that no settings reader reads: the workflow's own (the rules' layout and the raw
+#: folders' checks read them); each with where it is read.
+NOT_SETTINGS = {
+    "opensim.generic_model": "layout.Study.generic_model",
+    "opensim.scale_setup": "the model rules' inputs",
+    "opensim.ik_chunks": "the ik rules' chunks",
+    "device.subject": "layout.Study.device_log",
+    "markers.label_map": "layout.Study.label_maps",
+    "markers.trial_label_maps": "layout.Study.label_maps",
+    "markers.trial_spans_s": "the markers rule's settings",
+    "planning.pilot_subject": "layout.Study.planning_pilot",
+    "validation.n_chunks": "the validation rules' chunks",
+    "synthetic.stiffness_nm_per_rad": "the synthetic truth rule",
+    "synthetic.damping_nms_per_rad": "the synthetic truth rule",
+    "synthetic.between_subject_cv": "the synthetic truth rule",
+    "validation.subject_height_m": "the validation segments rule",
+    "validation.subject_mass_kg": "the validation segments rule",
+    "validation.attachment_fraction_of_thigh": "the validation segments rule",
+    "device.mat_column_map": "the device's .mat conversion rule",
+}
+
+
+class _Recording(Mapping):
+    """A config whose sections' keys, when read, are recorded as ``section.key`` (top-level values as ``key``)."""
+
+    def __init__(self, data: Mapping, read: set[str], path: str = ""):
+        self._data, self._read, self._path = data, read, path
+
+    def __getitem__(self, key):
+        name = f"{self._path}.{key}" if self._path else key
+        value = self._data[key]
+        if isinstance(value, Mapping) and not self._path:
+            return _Recording(value, self._read, name)
+        self._read.add(name)
+        return value
+
+    def __iter__(self):
+        return iter(self._data)
+
+    def __len__(self):
+        return len(self._data)
+
+
+def _keys(config: Mapping) -> set[str]:
+    """``section.key`` of every key of a section, and the top-level values."""
+    out = set()
+    for key, value in config.items():
+        out |= {f"{key}.{k}" for k in value} if isinstance(value, Mapping) else {key}
+    return out
+
+
+def _read_by(name: str) -> set[str]:
+    reader = importlib.import_module(f"loper_analysis.stages.{name}.settings")
+    read: set[str] = set()
+    reader.read_settings(_Recording(CONFIG, read), **{n: stage_settings(CONFIG, n) for n in reader.NEEDS})
+    return read
+
+
+def test_every_config_key_is_read_by_one_reader_or_named_as_no_setting():
+    readers: dict[str, list[str]] = {}
+    for name in READERS:
+        for key in _read_by(name):
+            readers.setdefault(key, []).append(name)
+    twice = {key: names for key, names in readers.items() if len(names) > 1}
+    assert twice == {}
+    unread = _keys(CONFIG) - set(readers) - set(NOT_SETTINGS)
+    assert unread == set()
+    assert not set(NOT_SETTINGS) & set(readers)  # a key listed as no setting is not read by a reader after all
+    assert set(NOT_SETTINGS) <= _keys(CONFIG)
+
+
+def test_each_reader_needs_only_readers_that_exist_and_builds_without_its_needs_keys():
+    for name in READERS:
+        reader = importlib.import_module(f"loper_analysis.stages.{name}.settings")
+        assert set(reader.NEEDS) <= set(READERS) - {name}, name
+        assert stage_settings(CONFIG, name) is not None
+
+
+@pytest.mark.parametrize(
+    ("key", "reader", "asked"),
+    [("identification.counterfactual", "impedance", "planning"), ("trials.perturbed_side", "study", "strides"),
+     ("filter.order", "markers", "events"), ("seed", "study", "validation")],
+)  # fmt: skip
+def test_a_missing_key_is_named_with_its_section_and_reader(key, reader, asked):
+    config = copy.deepcopy(CONFIG)
+    section, _, name = key.rpartition(".")
+    del (config[section] if section else config)[name]
+    with pytest.raises(LoperInputError, match=f"^config: key '{key}' missing: the {reader} settings read it$"):
+        stage_settings(config, asked)
+
+
+def test_the_planner_models_the_load_cell_the_events_stage_filters_with():
+    """``filter.cutoff_hz`` and ``filter.order`` reach the planner's model of the load cell, and the device's
+    rate the planned force's."""
+    config = copy.deepcopy(CONFIG)
+    config["filter"].update(cutoff_hz=25.0, order=2)
+    config["device"]["parameters"]["sample_rate_hz"] = 500
+    plan = stage_settings(config, "planning").plan
+    loadcell = stage_settings(config, "events").loadcell
+    assert (plan.force_cutoff_hz, plan.force_order) == (loadcell.cutoff_hz, loadcell.order) == (25.0, 2)
+    assert plan.force_rate_hz == 500.0
