@@ -250,7 +250,9 @@ def test_every_job_runs_its_step_inside_its_log():
         assert ast.unparse(first) == "from loper_analysis.stages import rule_log", name
         assert isinstance(second, ast.With) and not rest, name
         assert ast.unparse(second.items[0].context_expr) == "rule_log(snakemake.log[0])", name
-        assert isinstance(second.body[0], ast.ImportFrom) and second.body[0].module == "loper_analysis.stages", name
+        step = second.body[0]  # the stage's file step: from loper_analysis.stages.<stage> import step as ...
+        assert isinstance(step, ast.ImportFrom) and step.module.startswith("loper_analysis.stages."), name
+        assert [a.name for a in step.names] == ["step"], name
 
 
 def test_a_failed_job_leaves_its_message_and_traceback_in_its_log(tmp_path):

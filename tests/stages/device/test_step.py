@@ -20,7 +20,7 @@ from loper_analysis.stages.device import step as device
 from loper_analysis.stages.device.step import DeviceSettings
 from loper_analysis.stages.settings import stage_settings
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 SHORT = DeviceTestSettings(broadband_duration_s=30.0, step_repetitions=3)
 STEP_ARGS = (1000.0, (20.0, 40.0, 60.0), StepSettings(before_s=0.05, after_s=0.45, steady_window_s=(0.15, 0.3)))

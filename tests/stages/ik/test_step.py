@@ -29,7 +29,7 @@ from loper_analysis.stages.markers.step import markers
 from loper_analysis.stages.settings import stage_settings
 
 FS = 128.0
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 LABS = ROOT / "tests" / "data" / "c3d-parser"
 
 

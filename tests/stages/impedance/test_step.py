@@ -35,7 +35,7 @@ def test_onset_without_trials_writes_missing_rows(tmp_path):
     assert pd.read_csv(out[2], sep="\t").status.tolist() == ["missing"] * 3
 
 
-CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "config.yaml").read_text())
+CONFIG = yaml.safe_load((Path(__file__).resolve().parents[3] / "config" / "config.yaml").read_text())
 
 
 def test_settings_of_the_config():

@@ -23,7 +23,7 @@ from loper_analysis.io.osim import quiet_opensim
 from loper_analysis.motion.markers import GAP_REPORT_COLUMNS, GAP_SUMMARY_COLUMNS
 from loper_analysis.stages.markers.step import TRIAL_MARKER_COLUMNS, MarkerSettings, markers
 
-DATA = Path(__file__).parents[1] / "data" / "opensim-core"
+DATA = Path(__file__).parents[2] / "data" / "opensim-core"
 WALKING5 = DATA / "walking5.c3d"
 
 

@@ -25,7 +25,7 @@ from loper_analysis.motion.segments import segments_from_model
 from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale_with_setup
 from tests.gait2392_models import scaled_gait2392
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 DATA = ROOT / "examples" / "gait2392"
 GENERIC = DATA / "gait2392_simbody.osim"
 MARKER_SET = DATA / "gait2392_Scale_MarkerSet.xml"

@@ -22,7 +22,7 @@ from loper_analysis.stages.markers.step import MarkerSettings, markers
 from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale_with_setup
 
 pytestmark = pytest.mark.slow  # OpenSim's ScaleTool on whole static trials
-DATA = Path(__file__).resolve().parents[1] / "data"
+DATA = Path(__file__).resolve().parents[2] / "data"
 QCMAS = DATA / "c3d-parser" / "QCMAS"
 TUTORIAL = DATA / "gait2392"
 GAIT2392 = template_file("gait2392_simbody.osim")

@@ -17,7 +17,7 @@ from loper_analysis.stages.synthetic.step import LabSessionFiles, lab_session, t
 from loper_analysis.study_design import StudyDesign
 from loper_analysis.synthetic.subjects import subject_anthropometry
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 
