@@ -293,63 +293,15 @@ class Study:
         s_t = [(s, t) for s in self.processed_subjects() for t in self.subject_trials(s)]
         return any(self.design.onset_ms(t) is not None for _, t in s_t)
 
-    def processing_targets(self) -> list[str]:
-        """Stride tables of every processed trial, the models, impedance and planning, transparency."""
-        p, out, scaled = self.paths, [], set(self.scaled_subjects())
-        for s in self.processed_subjects():
-            out.append(fill(p.model.segments, subject=s))
-            if s in scaled:
-                out.append(fill(p.model.scale, subject=s))
-            if self.source(s) == "synthetic":
-                out.append(fill(p.raw.truth, subject=s))
-            out += [fill(p.strides.strides, subject=s, trial=t) for t in self.subject_trials(s)]
-            if self.source(s) == "recorded":  # lab files: their force platforms as OpenSim external loads
-                plated = [t for t in self.subject_trials(s) if self.has_force_platforms(s, t)]
-                out += [fill(p.grf.mot, subject=s, trial=t) for t in plated]
-                out += self.recorded_figures(s)
-        if out:
-            out.append(p.strides.summary)
-        if self.identifies_impedance():
-            out += [p.impedance.table, p.impedance.summary, p.impedance.literature, p.impedance.figure]
-            out.append(p.report.tables)
-            out += [
-                fill(getattr(p.impedance, f), subject=s)
-                for s in self.processed_subjects()
-                for f in ("responses_figure", "fit_figure")
-            ]
-            out += [p.planning.plan, p.planning.answers]
-        if self.transparency_subjects():
-            out += [p.transparency.rmsd, p.transparency.force, p.transparency.figure]
-        return out
+    def has_validation(self) -> bool:
+        """Whether the validation study is built: for a study with perturbation trials, or without subjects."""
+        return not self.processed_subjects() or self.identifies_impedance()
 
-    def recorded_figures(self, subject: str) -> list[str]:
-        """A recorded subject's joint-angle figure of every walking trial and force-plate figure of those with
-        plates."""
-        trials, p = self.subject_trials(subject), self.paths
-        out = [fill(p.strides.figure, subject=subject, trial=t) for t in trials]
-        return out + [
-            fill(p.grf.figure, subject=subject, trial=t) for t in trials if self.has_force_platforms(subject, t)
-        ]
-
-    def validation_targets(self) -> list[str]:
-        """The validation study's tables and figure: for a study with perturbation trials, or without subjects."""
-        targets = self.processing_targets()
-        if targets and self.paths.impedance.table not in targets:
-            return []
-        v = self.paths.validation
-        return [v.summary, v.errors, v.fits, v.figure]
-
-    def device_targets(self) -> list[str]:
-        """The device tests' results: none without a device subject (device.subject null)."""
-        if self.config["device"]["subject"] is None:
-            return []
-        return [self.paths.device.summary, self.paths.device.bode, self.paths.device.steps]
+    def has_device_tests(self) -> bool:
+        """Whether the device tests are built: with a device subject (device.subject not null)."""
+        return self.config["device"]["subject"] is not None
 
     def all_targets(self) -> list[str]:
-        """Everything a run builds by default."""
-        return [
-            *self.processing_targets(),
-            *self.validation_targets(),
-            *self.device_targets(),
-            self.paths.report.front_page,
-        ]
+        """Everything a run builds by default: every stage's targets (``targets`` of its files), in the order of
+        the stages."""
+        return [path for stage in STAGES if stage.targets is not None for path in stage.targets(self)]

@@ -9,8 +9,9 @@ results folder ``results/<name>/``.
 from __future__ import annotations
 
 import string
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 __all__ = ["Stage", "fill"]
 
@@ -26,10 +27,14 @@ class Stage:
     files : mapping
         Its result files: name -> pattern under ``results/<name>/`` (Snakemake wildcards in braces); empty for a
         stage that writes elsewhere (the synthetic lab writes raw files).
+    targets : callable or None
+        ``targets(study) -> list of paths``: what a run builds of this stage by default for a
+        :class:`~loper_analysis.layout.Study` (None: only what later stages read).
     """
 
     name: str
     files: Mapping[str, str] = field(default_factory=dict)
+    targets: Callable[[Any], list[str]] | None = None
 
     @property
     def rule_file(self) -> str:

@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
-__all__ = ["FILES"]
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from loper_analysis.layout import Study
+
+__all__ = ["FILES", "targets"]
 
 FILES: dict[str, str] = {
     "robot_log": "{subject}/{trial}.loper.tsv",
@@ -13,3 +18,9 @@ FILES: dict[str, str] = {
     "bode": "bode.png",
     "steps": "steps.png",
 }
+
+
+def targets(study: Study) -> list[str]:
+    """The device tests' summary and figures, with a device subject (``device.subject`` not null)."""
+    d = study.paths.device
+    return [d.summary, d.bode, d.steps] if study.has_device_tests() else []

@@ -14,7 +14,7 @@ from loper_analysis.stages.stage import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "FitFiles", "FitOutputs", "TrialFiles", "fit_files", "fit_inputs"]
+__all__ = ["FILES", "FitFiles", "FitOutputs", "TrialFiles", "fit_files", "fit_inputs", "targets"]
 
 FILES: dict[str, str] = {
     "response": "{subject}/{onset}.response.tsv",
@@ -130,3 +130,13 @@ def fit_inputs(study: Study, subject: str) -> list[str]:
         for trial in (*files.trials.values(), *files.null_trials.values()):
             paths += [path for path in vars(trial).values() if path is not None]
     return list(dict.fromkeys(paths))
+
+
+def targets(study: Study) -> list[str]:
+    """With perturbation trials: the impedance tables, their figure and every processed subject's figures."""
+    if not study.identifies_impedance():
+        return []
+    p = study.paths.impedance
+    figures = ("responses_figure", "fit_figure")
+    subjects = [fill(getattr(p, f), subject=s) for s in study.processed_subjects() for f in figures]
+    return [p.table, p.summary, p.literature, p.figure, *subjects]

@@ -13,7 +13,7 @@ from loper_analysis.stages.stage import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "PilotFiles", "PilotTrial", "planning_files"]
+__all__ = ["FILES", "PilotFiles", "PilotTrial", "planning_files", "targets"]
 
 FILES: dict[str, str] = {
     "plan": "plan.tsv",
@@ -62,3 +62,9 @@ def planning_files(study: Study, pilot: str):
         segments=fill(p.model.segments, subject=pilot),
         impedance=tuple(study.onset_files("impedance", "fit", pilot)),
     )
+
+
+def targets(study: Study) -> list[str]:
+    """With perturbation trials: the plan and its answers."""
+    p = study.paths.planning
+    return [p.plan, p.answers] if study.identifies_impedance() else []

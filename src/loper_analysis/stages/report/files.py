@@ -10,7 +10,7 @@ from loper_analysis.stages.stage import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "front_page_inputs", "markdown_sections", "recorded_quality_files"]
+__all__ = ["FILES", "front_page_inputs", "markdown_sections", "recorded_quality_files", "targets"]
 
 FILES: dict[str, str] = {
     "tables": "tables.md",
@@ -45,13 +45,12 @@ def front_page_inputs(study: Study) -> dict:
     summaries when built, the impedance tables and main figure with perturbation trials, the transparency
     table with a subject who walked both trials, the recorded subjects' quality files."""
     p = study.paths
-    out = {"validation": p.validation.summary} if study.validation_targets() else {}
-    if study.device_targets():
+    out = {"validation": p.validation.summary} if study.has_validation() else {}
+    if study.has_device_tests():
         out["device"] = p.device.summary
-    targets = set(study.processing_targets())
-    if p.impedance.table in targets:
+    if study.identifies_impedance():
         out.update(impedance=p.impedance.table, summary=p.impedance.summary, figure=p.impedance.figure)
-    if p.transparency.rmsd in targets:
+    if study.transparency_subjects():
         out["rmsd"] = p.transparency.rmsd
     recorded = recorded_quality_files(study)
     if recorded:
@@ -75,9 +74,15 @@ def markdown_sections(study: Study) -> dict[str, str]:
         "Strides per trial": p.strides.summary,
         "Validation study": p.validation.summary,
     }
-    if study.device_targets():  # no device tests without a device subject (device.subject null)
+    if study.has_device_tests():  # no device tests without a device subject (device.subject null)
         sections["Device"] = p.device.summary
     if study.transparency_subjects():
         sections["Transparency: RMSD vs ISV_ave"] = p.transparency.rmsd
         sections["Transparency: interaction force"] = p.transparency.force
     return sections
+
+
+def targets(study: Study) -> list[str]:
+    """The Markdown rendering of the tables (with perturbation trials) and the front page."""
+    r = study.paths.report
+    return [*([r.tables] if study.identifies_impedance() else []), r.front_page]

@@ -4,8 +4,8 @@
 """
 
 from loper_analysis.stages.stage import Stage
-from loper_analysis.stages.strides.files import FILES
+from loper_analysis.stages.strides.files import FILES, targets
 
-STAGE = Stage(name="strides", files=FILES)
+STAGE = Stage(name="strides", files=FILES, targets=targets)
 
 __all__ = ["STAGE"]

@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
-__all__ = ["FILES"]
+from typing import TYPE_CHECKING
+
+from loper_analysis.stages.stage import fill
+
+if TYPE_CHECKING:
+    from loper_analysis.layout import Study
+
+__all__ = ["FILES", "targets"]
 
 FILES: dict[str, str] = {
     "strides": "{subject}/{trial}.strides.tsv",
@@ -11,3 +18,14 @@ FILES: dict[str, str] = {
     "figure": "{subject}/{trial}.angles.png",
     "summary": "summary.tsv",
 }
+
+
+def targets(study: Study) -> list[str]:
+    """Every processed trial's stride table, a recorded subject's joint-angle figure of each walking trial, and
+    the stride summary."""
+    p, out = study.paths, []
+    for s in study.processed_subjects():
+        out += [fill(p.strides.strides, subject=s, trial=t) for t in study.subject_trials(s)]
+        if study.source(s) == "recorded":
+            out += [fill(p.strides.figure, subject=s, trial=t) for t in study.subject_trials(s)]
+    return [*out, p.strides.summary] if study.processed_subjects() else out

@@ -4,8 +4,8 @@
 """
 
 from loper_analysis.stages.stage import Stage
-from loper_analysis.stages.synthetic.files import FILES
+from loper_analysis.stages.synthetic.files import FILES, targets
 
-STAGE = Stage(name="synthetic", files=FILES)
+STAGE = Stage(name="synthetic", files=FILES, targets=targets)
 
 __all__ = ["STAGE"]

@@ -2,6 +2,19 @@
 
 from __future__ import annotations
 
-__all__ = ["FILES"]
+from typing import TYPE_CHECKING
+
+from loper_analysis.stages.stage import fill
+
+if TYPE_CHECKING:
+    from loper_analysis.layout import Study
+
+__all__ = ["FILES", "targets"]
 
 FILES: dict[str, str] = {}
+
+
+def targets(study: Study) -> list[str]:
+    """The truth of every processed synthetic subject (its raw files follow from the stages that read them)."""
+    rows = [s for s in study.processed_subjects() if study.source(s) == "synthetic"]
+    return [fill(study.paths.raw.truth, subject=s) for s in rows]

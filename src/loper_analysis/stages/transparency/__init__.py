@@ -4,8 +4,8 @@
 """
 
 from loper_analysis.stages.stage import Stage
-from loper_analysis.stages.transparency.files import FILES
+from loper_analysis.stages.transparency.files import FILES, targets
 
-STAGE = Stage(name="transparency", files=FILES)
+STAGE = Stage(name="transparency", files=FILES, targets=targets)
 
 __all__ = ["STAGE"]

@@ -12,7 +12,7 @@ from loper_analysis.stages.stage import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "TransparencyFiles", "transparency_files"]
+__all__ = ["FILES", "TransparencyFiles", "transparency_files", "targets"]
 
 FILES: dict[str, str] = {
     "rmsd": "rmsd.tsv",
@@ -44,3 +44,9 @@ def transparency_files(study: Study) -> dict:
         )
         for s in study.transparency_subjects()
     }
+
+
+def targets(study: Study) -> list[str]:
+    """The transparency tables and figure, with a subject who walked both trials of the pair."""
+    t = study.paths.transparency
+    return [t.rmsd, t.force, t.figure] if study.transparency_subjects() else []

@@ -4,8 +4,8 @@
 """
 
 from loper_analysis.stages.stage import Stage
-from loper_analysis.stages.validation.files import FILES
+from loper_analysis.stages.validation.files import FILES, targets
 
-STAGE = Stage(name="validation", files=FILES)
+STAGE = Stage(name="validation", files=FILES, targets=targets)
 
 __all__ = ["STAGE"]

@@ -2,7 +2,12 @@
 
 from __future__ import annotations
 
-__all__ = ["FILES"]
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from loper_analysis.layout import Study
+
+__all__ = ["FILES", "targets"]
 
 FILES: dict[str, str] = {
     "segments": "segments.tsv",
@@ -13,3 +18,9 @@ FILES: dict[str, str] = {
     "summary": "summary.tsv",
     "figure": "errors.png",
 }
+
+
+def targets(study: Study) -> list[str]:
+    """The validation study's tables and figure: for a study with perturbation trials, or without subjects."""
+    v = study.paths.validation
+    return [v.summary, v.errors, v.fits, v.figure] if study.has_validation() else []
