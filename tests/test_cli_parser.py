@@ -22,15 +22,15 @@ def parser():
 def test_subcommands_in_help_order_each_with_its_handler(parser):
     assert SUBCOMMANDS == (
         "markers",
-        "grf",
-        "events",
         "scale",
         "segments",
         "ik",
-        "validate",
+        "grf",
+        "events",
         "plan",
-        "inspect",
+        "validate",
         "report",
+        "inspect",
     )
     assert parser.prog == "loper-analysis" and parser.description == "the description"
     minimal = {

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages.command import stage_commands
 
 __all__ = [
     "OPTION_KEYS",
@@ -68,56 +69,14 @@ def refuse_overwriting(args: argparse.Namespace) -> None:
                 )
 
 
-#: Each command's options with a config counterpart: option -> (schema file, key path); a value is held to the key's
-#: limits (:func:`check_option_limits`). ``subjects`` is the subject sheet's schema.
+#: Each command's options with a config counterpart: option -> (schema file, key path), from the stages' commands
+#: (:attr:`loper_analysis.stages.command.Command.option_keys`); a value is held to the key's limits
+#: (:func:`check_option_limits`). ``subjects`` is the subject sheet's schema.
 OPTION_KEYS: dict[str, dict[str, tuple[str, tuple[str, ...]]]] = {
-    "markers": {
-        "cutoff_hz": ("config", ("filter", "cutoff_hz")),
-        "order": ("config", ("filter", "order")),
-        "max_gap_frames": ("config", ("markers", "max_gap_frames")),
-        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-    },
-    "grf": {
-        "threshold_n": ("config", ("grf", "loaded_threshold_n")),
-        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-    },
-    "events": {
-        "threshold_on_n": ("config", ("events", "threshold_on_n")),
-        "threshold_off_n": ("config", ("events", "threshold_off_n")),
-        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-    },
-    "scale": {
-        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-        "mass_kg": ("subjects", ("mass_kg",)),
-        "max_motion_rms_m": ("config", ("markers", "static_max_motion_rms_m")),
-        "cutoff_hz": ("config", ("filter", "cutoff_hz")),
-        "max_gap_frames": ("config", ("markers", "max_gap_frames")),
-    },
-    "segments": {
-        "mass_kg": ("subjects", ("mass_kg",)),
-        "height_m": ("subjects", ("height_m",)),
-        "attachment_fraction": ("config", ("opensim", "brace_attachment_fraction")),
-    },
-    "ik": {
-        "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-        "accuracy": ("config", ("opensim", "accuracy")),
-        "max_marker_rms_m": ("config", ("opensim", "max_marker_rms_m")),
-        "warn_marker_rms_m": ("config", ("opensim", "warn_marker_rms_m")),
-        "max_rms_fraction": ("config", ("opensim", "max_rms_fraction")),
-    },
-    "validate": {
-        "n_starts": ("config", ("identification", "n_starts")),
-        "n_chunks": ("config", ("validation", "n_chunks")),
-        "seed": ("config", ("seed",)),
-    },
-    "plan": {
-        "force_n": ("config", ("planning", "pulse_force_n")),
-        "duration_s": ("config", ("planning", "pulse_duration_s")),
-        "strides": ("config", ("planning", "strides")),
-    },
+    c.name: dict(c.option_keys) for c in stage_commands() if c.option_keys
 }
 #: Options whose 0 switches their step off (their help says so), beside the key's limits.
-_OFF_WITH_ZERO: set[tuple[str, str]] = {("markers", "cutoff_hz"), ("scale", "cutoff_hz"), ("scale", "max_motion_rms_m")}
+_OFF_WITH_ZERO: set[tuple[str, str]] = {(c.name, o) for c in stage_commands() for o in c.off_with_zero}
 
 
 def refuse_config_code(args: argparse.Namespace) -> None:
