@@ -172,6 +172,32 @@ def _frames_in_loads(coordinates: pd.DataFrame, grf: pd.DataFrame, source: str) 
     return coordinates[keep].reset_index(drop=True)
 
 
+def _solved_coordinates(coordinates: pd.DataFrame, source: str) -> pd.DataFrame:
+    """The IK coordinates without the columns IK left undetermined (NaN throughout: they stay at the model's
+    default, as in OpenSim's tool) and restricted to the longest run of frames where all others are finite."""
+    values = coordinates.drop(columns="time_s")
+    unsolved = [c for c in values.columns if values[c].isna().all()]
+    if unsolved:
+        log.info("%s: coordinates %s not determined by IK (NaN): left at the model's default", source, unsolved)
+    finite = np.isfinite(values.drop(columns=unsolved).to_numpy(dtype=float)).all(axis=1)
+    kept = coordinates.drop(columns=unsolved)
+    if finite.all():
+        return kept
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], finite.astype(int), [0]])))
+    starts, ends = edges[0::2], edges[1::2]
+    if starts.size == 0:
+        raise LoperInputError(f"{source}: no IK frame with every coordinate finite")
+    k = int(np.argmax(ends - starts))
+    log.warning(
+        "%s: %d IK frame(s) with non-finite coordinates; the longest finite run, frames %d .. %d, is used",
+        source,
+        int((~finite).sum()),
+        starts[k],
+        ends[k] - 1,
+    )
+    return kept.iloc[starts[k] : ends[k]].reset_index(drop=True)
+
+
 def _check_heel_strikes(contacts: pd.DataFrame, events: pd.DataFrame, source: str) -> None:
     """Warn when a counted contact's start is not a heel strike of its side in the event table."""
     for side in SIDES:
@@ -186,7 +212,7 @@ def _check_heel_strikes(contacts: pd.DataFrame, events: pd.DataFrame, source: st
 def _moments(trial: _Trial, settings: DynamicsSettings, source: str) -> tuple[pd.DataFrame, dict]:
     """The moments' time series (with ``valid_<side>``) and each side's valid intervals (k, 2), s."""
     cmap = DEFAULT_COORDINATE_MAP if settings.coordinate_map is None else settings.coordinate_map
-    frames = _frames_in_loads(trial.coordinates, trial.grf, source)
+    frames = _frames_in_loads(_solved_coordinates(trial.coordinates, source), trial.grf, source)
     t = frames["time_s"].to_numpy(dtype=float)
     coordinates = frames.drop(columns="time_s")
     loads = foot_loads(trial.grf, trial.contacts, settings.foot_bodies)
@@ -225,7 +251,10 @@ def _figure(summary: pd.DataFrame, title: str):
             ax.set_title(joint if i == 0 else "")
             ax.set_ylabel(label if j == 0 else "")
             ax.set_xlabel("gait cycle (%)" if i == 1 else "")
-    axes[0, 0].legend(fontsize=8)
+    if summary.empty:
+        axes[0, 0].text(0.5, 0.5, "no stride in its leg's valid times", transform=axes[0, 0].transAxes, ha="center")
+    else:
+        axes[0, 0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
     return fig
