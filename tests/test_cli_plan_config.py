@@ -31,8 +31,11 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 
 def test_rule_takes_its_params_from_the_shared_builder():
     rules = ROOT / "workflow" / "rules"
-    assert 'PLAN_SETTINGS = stage_settings(config, "planning")' in (rules / "inputs.smk").read_text()
-    assert "**settings_params(PLAN_SETTINGS)," in (rules / "planning.smk").read_text()
+    assert (
+        "SETTINGS = {stage.name: stage_settings(config, stage.name) for stage in STAGES}"
+        in (rules / "inputs.smk").read_text()
+    )
+    assert '**settings_params(SETTINGS["planning"]),' in (rules / "planning.smk").read_text()
     # the rule's script reads the pilot, its files and the one settings object, nothing else
     script = (ROOT / "workflow" / "scripts" / "planning.py").read_text()
     assert set(re.findall(r"\bp\.(\w+)", script)) == {"files", "subject", "settings"}

@@ -115,6 +115,7 @@ FILE_LAYER = (
     "cli.py",
     "cli_parser.py",
     "cli_checks.py",
+    "cli_options.py",
     "config_file.py",
     "schema.py",
     "layout.py",

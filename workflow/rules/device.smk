@@ -21,9 +21,9 @@ rule device_trial:
     group:
         "device"
     params:
-        **settings_params(DEVICE_SETTINGS.parameters, "device"),
-        **settings_params(DEVICE_SETTINGS.leg, "leg"),
-        **settings_params(DEVICE_SETTINGS.tests, "tests"),
+        **settings_params(SETTINGS["device"].parameters, "device"),
+        **settings_params(SETTINGS["device"].leg, "leg"),
+        **settings_params(SETTINGS["device"].tests, "tests"),
         seed=config["seed"],
     script:
         "../scripts/device_trial.py"
@@ -41,7 +41,7 @@ rule device_log_from_mat:
     params:
         **raw_checksums(PATHS.raw.mat),
         column_map=DEVICE["mat_column_map"],
-        sample_rate_hz=DEVICE_SETTINGS.parameters.sample_rate_hz,
+        sample_rate_hz=SETTINGS["device"].parameters.sample_rate_hz,
     script:
         "../scripts/device_log_from_mat.py"
 
@@ -59,8 +59,8 @@ rule device_frf:
         "device"
     params:
         **raw_checksums(lambda wildcards: STUDY.device_log("device-frf")),
-        **settings_params(DEVICE_SETTINGS.analysis.frf),
-        sample_rate_hz=DEVICE_SETTINGS.parameters.sample_rate_hz,
+        **settings_params(SETTINGS["device"].analysis.frf),
+        sample_rate_hz=SETTINGS["device"].parameters.sample_rate_hz,
     script:
         "../scripts/device_frf.py"
 
@@ -79,9 +79,9 @@ rule device_steps:
         "device"
     params:
         **raw_checksums(lambda wildcards: STUDY.device_log("device-steps")),
-        **settings_params(DEVICE_SETTINGS.analysis.steps),
-        sample_rate_hz=DEVICE_SETTINGS.parameters.sample_rate_hz,
-        amplitudes_n=DEVICE_SETTINGS.tests.step_amplitudes_n,
+        **settings_params(SETTINGS["device"].analysis.steps),
+        sample_rate_hz=SETTINGS["device"].parameters.sample_rate_hz,
+        amplitudes_n=SETTINGS["device"].tests.step_amplitudes_n,
     script:
         "../scripts/device_steps.py"
 
@@ -102,7 +102,7 @@ rule device_summary:
     benchmark:
         PATHS.benchmark("device_summary", "summary")
     params:
-        reference_band_hz=DEVICE_SETTINGS.analysis.reference_band_hz,
+        reference_band_hz=SETTINGS["device"].analysis.reference_band_hz,
     script:
         "../scripts/device_summary.py"
 

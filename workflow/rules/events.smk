@@ -50,7 +50,7 @@ rule events_loadcell:
         "trial"
     params:
         **settings_params(event_settings, "events"),
-        **settings_params(LOADCELL_SETTINGS, "loadcell"),
+        **settings_params(SETTINGS["events"].loadcell, "loadcell"),
         **raw_checksums(PATHS.raw.c3d, by_trial(STUDY.robot_log)),
     script:
         "../scripts/events_loadcell.py"

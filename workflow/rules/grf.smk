@@ -14,7 +14,7 @@ rule grf:
     benchmark:
         PATHS.benchmark("grf", "{subject}/{trial}")
     params:
-        **settings_params(GRF_SETTINGS),
+        **settings_params(SETTINGS["grf"]),
         **raw_checksums(PATHS.raw.c3d),
     script:
         "../scripts/grf.py"

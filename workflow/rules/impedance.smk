@@ -28,7 +28,7 @@ rule impedance_fit:
     benchmark:
         PATHS.benchmark("impedance_fit", "{subject}")
     params:
-        **settings_params(FIT_SETTINGS),
+        **settings_params(SETTINGS["impedance"]),
         fits=lambda wc: fit_files(STUDY, wc.subject),
     script:
         "../scripts/impedance_fit.py"

@@ -2,6 +2,7 @@
 
 import dataclasses
 
+from loper_analysis.stages import STAGES
 from loper_analysis.stages.settings import stage_settings
 
 # the config's sections
@@ -13,22 +14,9 @@ SYNTH = config["synthetic"]
 IK_CHUNKS = [f"{i:03d}" for i in range(OPENSIM["ik_chunks"])]
 ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
 
-# the settings of the stages' rules, each built by its stage's reader (loper_analysis.stages.settings)
+# every stage's settings, each built by its stage's reader (loper_analysis.stages.settings)
 try:
-    MODEL_SETTINGS = stage_settings(config, "model")
-    IK_SETTINGS = stage_settings(config, "ik")
-    GRF_SETTINGS = stage_settings(config, "grf")
-    MARKER_SETTINGS = stage_settings(config, "markers")
-    EVENT_SETTINGS = stage_settings(config, "events").events
-    LOADCELL_SETTINGS = stage_settings(config, "events").loadcell
-    STRIDE_SETTINGS = stage_settings(config, "strides")
-    LAB_SESSION_SETTINGS = stage_settings(config, "synthetic")
-    FIT_SETTINGS = stage_settings(config, "impedance")
-    TRANSPARENCY_SETTINGS = stage_settings(config, "transparency")
-    FRONT_PAGE_SETTINGS = stage_settings(config, "report")
-    PLAN_SETTINGS = stage_settings(config, "planning")  # as ``loper-analysis plan`` builds them
-    VALIDATION_SETTINGS = stage_settings(config, "validation")
-    DEVICE_SETTINGS = stage_settings(config, "device")
+    SETTINGS = {stage.name: stage_settings(config, stage.name) for stage in STAGES}
 except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
 
@@ -52,7 +40,7 @@ def marker_settings(wildcards):
     spans = config["markers"]["trial_spans_s"]
     span = spans.get(f"{wildcards.subject}/{wildcards.trial}", spans.get(wildcards.trial))
     settings = dataclasses.replace(
-        MARKER_SETTINGS,
+        SETTINGS["markers"],
         label_map=tuple(STUDY.label_maps(wildcards.trial)) or None,
         span_s=None if span is None else tuple(span),
     )
@@ -61,13 +49,13 @@ def marker_settings(wildcards):
 
 def event_settings(wildcards):
     """A trial's event settings: the config's with the trial's label maps."""
-    return dataclasses.replace(EVENT_SETTINGS, label_map=tuple(STUDY.label_maps(wildcards.trial)) or None)
+    return dataclasses.replace(SETTINGS["events"].events, label_map=tuple(STUDY.label_maps(wildcards.trial)) or None)
 
 
 def ik_settings(wildcards):
     """A subject's IK settings: the marker geometry judged against a model scaled here (a stop) or given in the
     subject sheet (a warning)."""
-    return dataclasses.replace(IK_SETTINGS, subjects_model="model_osim" not in SUBJECT_ROWS[wildcards.subject])
+    return dataclasses.replace(SETTINGS["ik"], subjects_model="model_osim" not in SUBJECT_ROWS[wildcards.subject])
 
 
 def trial_group(wildcards) -> str:
@@ -99,3 +87,11 @@ def by_subject(method):
 def by_trial(method):
     """An input function of the wildcards from a STUDY method of the subject and trial."""
     return lambda wildcards: method(wildcards.subject, wildcards.trial)
+
+
+def planning_pilot() -> str:
+    """The pilot subject: planning.pilot_subject, else the first processed subject."""
+    try:
+        return STUDY.planning_pilot(config_source("planning", "pilot_subject"))
+    except LoperInputError as exc:
+        raise WorkflowError(str(exc)) from None

@@ -20,7 +20,7 @@ rule model_generic:
     benchmark:
         PATHS.benchmark("model_generic", "{subject}")
     params:
-        **settings_params(MODEL_SETTINGS.for_generic()),
+        **settings_params(SETTINGS["model"].for_generic()),
         **raw_checksums(by_subject(STUDY.static_c3d_for_mass)),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject]["height_m"],
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
@@ -54,7 +54,7 @@ rule model_scaled:
     group:
         "model"
     params:
-        **settings_params(MODEL_SETTINGS.for_scaling()),
+        **settings_params(SETTINGS["model"].for_scaling()),
         **raw_checksums(by_subject(STUDY.static_c3d_for_scaling)),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
@@ -74,6 +74,6 @@ rule model_segments:
     benchmark:
         PATHS.benchmark("model_segments", "{subject}")
     params:
-        **settings_params(MODEL_SETTINGS.for_segments()),
+        **settings_params(SETTINGS["model"].for_segments()),
     script:
         "../scripts/model_segments.py"

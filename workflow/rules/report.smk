@@ -21,7 +21,7 @@ rule front_page:
     benchmark:
         PATHS.benchmark("front_page", "front_page")
     params:
-        **settings_params(FRONT_PAGE_SETTINGS),
+        **settings_params(SETTINGS["report"]),
         subjects=SUBJECT_SOURCE,
         trials={s: STUDY.subject_trials(s) for s in STUDY.processed_subjects()},
         recorded=recorded_quality_files(STUDY),

@@ -23,7 +23,7 @@ rule strides:
     group:
         "trial"
     params:
-        **settings_params(STRIDE_SETTINGS),
+        **settings_params(SETTINGS["strides"]),
     script:
         "../scripts/strides.py"
 
@@ -49,7 +49,7 @@ rule strides_summary:
         PATHS.benchmark("strides_summary", "summary")
     params:
         subject_trial=[(s, t) for s in STUDY.processed_subjects() for t in STUDY.subject_trials(s)],
-        min_valid=STRIDE_SETTINGS.min_valid,
+        min_valid=SETTINGS["strides"].min_valid,
     script:
         "../scripts/strides_summary.py"
 

@@ -45,7 +45,7 @@ rule synthetic_lab:
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
-        **settings_params(LAB_SESSION_SETTINGS),
+        **settings_params(SETTINGS["synthetic"]),
         row=lambda wc: SUBJECT_ROWS[wc.subject],
     script:
         "../scripts/synthetic_lab.py"

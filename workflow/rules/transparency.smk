@@ -1,11 +1,6 @@
 # Transparency of the device in minimal-impedance mode: RMSD with vs without it against ISV_ave.
 
-from loper_analysis.stages.transparency.files import transparency_files
-
-
-def transparency_inputs(wildcards) -> list[str]:
-    """Every table of the transparency pairs."""
-    return [path for files in transparency_files(STUDY).values() for path in dataclasses.astuple(files)]
+from loper_analysis.stages.transparency.files import transparency_files, transparency_inputs
 
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
@@ -16,7 +11,7 @@ localrules:
 
 rule transparency:
     input:
-        transparency_inputs,
+        lambda wc: transparency_inputs(STUDY),
     output:
         rmsd=report(
             PATHS.transparency.rmsd,
@@ -41,7 +36,7 @@ rule transparency:
     benchmark:
         PATHS.benchmark("transparency", "transparency")
     params:
-        **settings_params(TRANSPARENCY_SETTINGS),
+        **settings_params(SETTINGS["transparency"]),
         files=transparency_files(STUDY),
     script:
         "../scripts/transparency.py"

@@ -35,7 +35,7 @@ rule validation_chunk:
     benchmark:
         PATHS.benchmark("validation_chunk", "{chunk}")
     params:
-        **settings_params(VALIDATION_SETTINGS),
+        **settings_params(SETTINGS["validation"]),
         n_chunks=config["validation"]["n_chunks"],
     script:
         "../scripts/validation_chunk.py"

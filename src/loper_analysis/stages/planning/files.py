@@ -68,3 +68,10 @@ def targets(study: Study) -> list[str]:
     """With perturbation trials: the plan and its answers."""
     p = study.paths.planning
     return [p.plan, p.answers] if study.identifies_impedance() else []
+
+
+def planning_inputs(study: Study, pilot: str) -> list[str]:
+    """Every file the planner reads for the pilot (:func:`planning_files`)."""
+    files = planning_files(study, pilot)
+    tables = [path for trial in files.trials.values() for path in (trial.angles, trial.strides)]
+    return [*tables, files.segments, *files.impedance]

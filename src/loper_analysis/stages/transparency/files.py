@@ -3,6 +3,7 @@ stride and cycle tables of each subject's pair of trials."""
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -50,3 +51,8 @@ def targets(study: Study) -> list[str]:
     """The transparency tables and figure, with a subject who walked both trials of the pair."""
     t = study.paths.transparency
     return [t.rmsd, t.force, t.figure] if study.transparency_subjects() else []
+
+
+def transparency_inputs(study: Study) -> list[str]:
+    """Every table of the transparency pairs (:func:`transparency_files`)."""
+    return [path for files in transparency_files(study).values() for path in dataclasses.astuple(files)]
