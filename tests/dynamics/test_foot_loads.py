@@ -276,3 +276,4 @@ def test_a_foot_across_two_plates_counts_only_when_both_are_ok():
     unknown = _contacts([(1, "left", "ok", 0.0, 0.6), (5, "", "incomplete", 0.9, 1.2), (3, "left", "ok", 1.0, 1.6)])
     np.testing.assert_array_equal(valid_intervals(unknown, "left"), [[0.0, 0.6], [1.0, 1.6]])
     assert valid_intervals(_contacts([(1, "right", "edge", 0.0, 0.6)]), "right").shape == (0, 2)
+    assert valid_intervals(_contacts([]), "right").shape == (0, 2) and counted_contacts(_contacts([]), "left").empty

@@ -144,10 +144,9 @@ def counted_contacts(contacts: pd.DataFrame, side: str) -> pd.DataFrame:
         The rows of the counted foot contacts (same columns, ``foot_contact`` filled), by start time.
     """
     table = _check_contacts(contacts)
-    good = table.groupby("foot_contact")[["flag", "side"]].apply(
-        lambda g: bool(((g["flag"] == _OK) & (g["side"] == side)).all())
-    )
-    keep = table["foot_contact"].map(good).fillna(False).astype(bool)
+    row_ok = (table["flag"] == _OK) & (table["side"] == side)
+    bad_feet = set(table.loc[~row_ok, "foot_contact"])
+    keep = row_ok & ~table["foot_contact"].isin(bad_feet)
     return table[keep].sort_values("start_s", kind="stable").reset_index(drop=True)
 
 
