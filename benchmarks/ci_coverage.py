@@ -52,7 +52,6 @@ from scipy.stats import beta
 from loper_analysis.layout import Paths, fill
 from loper_analysis.report.markdown import markdown_table
 from loper_analysis.stages.settings import stage_settings
-from loper_analysis.study_design import StudyDesign
 
 ROOT = Path(__file__).resolve().parents[1]
 PATHS = Paths()
@@ -273,14 +272,14 @@ def coordinate_subject(
     from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial
     from loper_analysis.synthetic.variability import lab_variability
 
-    syn, trials, seed = config["synthetic"], config["trials"], int(config["seed"])
+    syn, seed = config["synthetic"], int(config["seed"])
     row = subject_anthropometry({"subject": subject, "source": "synthetic"}, seed)
     truth = _truth(subject, config)
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
     device = DeviceParameters(**config["device"]["parameters"])
     model = build_lower_body_model(row["height_m"], row["mass_kg"])
     params = segment_parameters_from_model(model)
-    design = StudyDesign.from_config(trials)
+    design = stage_settings(config, "study").design
     onsets = list(design.perturbation_onsets_ms)
     variability, adaptation, minimal_impedance = lab_variability(syn, seed, subject, truth)
     unknown = set(without) - set(LAB_PARTS)

@@ -112,10 +112,11 @@ def test_command_prints_the_config_and_plans_with_its_window(project, capsys):
 
 
 def test_validation_defaults_of_the_library_are_the_configs():
-    from loper_analysis.impedance.identification.validation import ValidationSettings, validation_settings
+    from loper_analysis.impedance.identification.validation import ValidationSettings
+    from loper_analysis.stages.settings import stage_settings
 
     config = yaml.safe_load(CONFIG.read_text())
-    assert ValidationSettings(**validation_settings(config)) == ValidationSettings()
+    assert stage_settings(config, "validation") == ValidationSettings()
 
 
 def test_validate_command_runs_with_the_configs_settings(project, capsys):

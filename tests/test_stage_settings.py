@@ -79,9 +79,26 @@ def test_library_constant_equals_the_config(name):
     assert _plain(value) == _plain(_get(CONFIG, key)), f"{name} = {value!r}, but {key} = {_get(CONFIG, key)!r}"
 
 
+#: Each settings type and the stage's settings (and part of them) it is.
+READ_AS = {
+    MarkerSettings: ("markers", None),
+    EventSettings: ("events", "events"),
+    LoadcellSettings: ("events", "loadcell"),
+    GRFSettings: ("grf", None),
+    StrideSettings: ("strides", None),
+    TransparencySettings: ("transparency", None),
+}
+
+
+def _read(settings_type, config: dict):
+    stage, part = READ_AS[settings_type]
+    settings = stage_settings(config, stage)
+    return settings if part is None else getattr(settings, part)
+
+
 @pytest.mark.parametrize("settings_type", SETTINGS, ids=lambda t: t.__name__)
 def test_defaults_are_what_the_config_builds(settings_type):
-    built, default = settings_type.from_config(CONFIG), settings_type()
+    built, default = _read(settings_type, CONFIG), settings_type()
     for f in dataclasses.fields(settings_type):
         assert _plain(getattr(default, f.name)) == _plain(getattr(built, f.name)), f.name
 
@@ -109,7 +126,7 @@ def test_a_changed_config_key_reaches_its_field(settings_type, path, field, valu
     config = copy.deepcopy(CONFIG)
     *parents, key = path.split(".")
     _get(config, ".".join(parents))[key] = value
-    assert getattr(settings_type.from_config(config), field) == value
+    assert getattr(_read(settings_type, config), field) == value
     assert getattr(settings_type(), field) != value
 
 

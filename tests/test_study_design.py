@@ -8,14 +8,15 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages.settings import stage_settings
 from loper_analysis.study_design import DEVICE_TESTS, StudyDesign, perturbation_trial_name
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_the_library_default_is_the_config_default():
-    trials = yaml.safe_load((ROOT / "config/config.yaml").read_text())["trials"]
-    assert StudyDesign() == StudyDesign.from_config(trials)
+    config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    assert StudyDesign() == stage_settings(config, "study").design
 
 
 def test_trials_of_the_default_design():

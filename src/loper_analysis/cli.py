@@ -83,10 +83,11 @@ def _scaling_dry_run(config: dict | None):
     def check(staged) -> str:
         from loper_analysis.stages.markers import step as markers_step
         from loper_analysis.stages.model import step as model_step
+        from loper_analysis.stages.settings import stage_settings
 
-        m_settings = markers_step.MarkerSettings.from_config(config) if config else markers_step.MarkerSettings()
+        m_settings = stage_settings(config, "markers") if config else markers_step.MarkerSettings()
         m_settings = dataclasses.replace(m_settings, rotation_deg=staged.rotation_deg, cutoff_hz=staged.cutoff_hz)
-        s_settings = model_step.ModelSettings.from_config(config) if config else model_step.ModelSettings()
+        s_settings = stage_settings(config, "model") if config else model_step.ModelSettings()
         s_settings = dataclasses.replace(s_settings, rotation_deg=staged.rotation_deg).for_scaling()
         with tempfile.TemporaryDirectory(prefix="loper-dry-run-") as tmp:
             for c3d in staged.walking_c3d:

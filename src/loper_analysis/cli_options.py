@@ -13,13 +13,13 @@ import dataclasses
 from pathlib import Path
 
 __all__ = [
+    "command_settings",
     "add_configfile_option",
     "add_label_map_option",
     "add_rotate_option",
     "label_map",
     "read_config",
     "rotation_option",
-    "stage_settings",
     "walking_direction",
 ]
 
@@ -90,12 +90,19 @@ def label_map(path: str | None) -> dict[str, str] | None:
     return None if path is None else read_label_map(path)
 
 
-def stage_settings(args: argparse.Namespace, settings_type, **given):
-    """A stage's settings: the config's (:func:`read_config`, its line printed), else the library's defaults;
-    then each option in ``given`` that is not None."""
+def command_settings(args: argparse.Namespace, stage: str, default, part: str | None = None, **given):
+    """A stage's settings for a subcommand: the config's (:func:`read_config`, its line printed; built by the
+    stage's reader, :func:`loper_analysis.stages.settings.stage_settings`, and of them ``part`` when given), else
+    ``default`` (the library's defaults); then each option in ``given`` that is not None."""
+    from loper_analysis.stages.settings import stage_settings
+
     config, line = read_config(args)
     print(line)
-    settings = settings_type() if config is None else settings_type.from_config(config)
+    if config is None:
+        settings = default
+    else:
+        settings = stage_settings(config, stage)
+        settings = settings if part is None else getattr(settings, part)
     if config is not None and "label_map" in given and given["label_map"] is None:
         given["label_map"] = config["markers"]["label_map"] or None
     return dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})

@@ -14,7 +14,7 @@ wires what is decided and tested here.
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from loper_analysis.errors import LoperInputError
@@ -82,18 +82,6 @@ class StudyDesign:
     perturbation_onsets_ms: tuple[int, ...] = (50, 175, 300)
     perturbation_repeats: int = 2
     perturbed_side: str = PERTURBED_SIDE
-
-    @classmethod
-    def from_config(cls, trials: Mapping) -> StudyDesign:
-        """The design of the config's ``trials`` section (validated by the schema)."""
-        return cls(
-            static=str(trials["static"]),
-            no_device=str(trials["no_device"]),
-            device=str(trials["device"]),
-            perturbation_onsets_ms=tuple(int(o) for o in trials["perturbation_onsets_ms"]),
-            perturbation_repeats=int(trials["perturbation_repeats"]),
-            perturbed_side=str(trials["perturbed_side"]),
-        )
 
     def perturbation_trials(self, onset_ms: int | None = None) -> list[str]:
         """Names of the perturbation trials, onset by onset (only ``onset_ms``'s when given)."""

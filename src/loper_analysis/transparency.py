@@ -29,7 +29,6 @@ import pandas as pd
 from loper_analysis.constants import JOINTS, angle_column
 from loper_analysis.errors import LoperInputError, TooFewStridesWarning
 from loper_analysis.gait.outliers import MIN_VALID_STRIDES
-from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.strides import phase_cycles
 from loper_analysis.reference import STUDY_INTERACTION_FORCE_N, STUDY_TRANSPARENCY_RAD
 from loper_analysis.study_design import PERTURBED_SIDE, TRANSPARENCY_CONDITIONS
@@ -60,20 +59,6 @@ class TransparencySettings:
 
     side: str = PERTURBED_SIDE
     min_strides: int = MIN_VALID_STRIDES
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> TransparencySettings:
-        """The settings of a validated config: the leg and the fewest kept strides of the strides' settings
-        (:meth:`loper_analysis.gait.stride_settings.StrideSettings.from_config`), which read
-        ``trials.perturbed_side`` and ``strides.min_valid_strides``.
-
-        Raises
-        ------
-        KeyError
-            A key the strides' settings read missing, named.
-        """
-        strides = StrideSettings.from_config(config)
-        return cls(side=strides.side, min_strides=strides.min_valid)
 
 
 #: Phases compared (normalised separately: stance HS -> TO, swing TO -> next HS).

@@ -10,7 +10,6 @@ Signals are 1-D arrays of force in N sampled at ``sample_rate_hz``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -140,20 +139,6 @@ class DeviceAnalysisSettings:
 
     def __post_init__(self) -> None:
         _pair("device.analysis.bandwidth_reference_band_hz", self.reference_band_hz)
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> DeviceAnalysisSettings:
-        """The analysis of a validated config: every key of ``device.analysis`` (the bands as tuples)."""
-        a = config["device"]["analysis"]
-        return cls(
-            frf=FRFSettings(window_samples=a["welch_window_samples"], overlap_samples=a["welch_overlap_samples"]),
-            steps=StepSettings(
-                before_s=a["step_before_s"],
-                after_s=a["step_after_s"],
-                steady_window_s=tuple(a["steady_window_s"]),
-            ),
-            reference_band_hz=tuple(a["bandwidth_reference_band_hz"]),
-        )
 
 
 def frequency_response(

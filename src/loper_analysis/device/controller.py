@@ -44,7 +44,6 @@ exponential, zero-order hold on the velocity command).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -121,11 +120,6 @@ class DeviceParameters:
     motor_cutoff_torque_nm: float = 120.0
     servo_cutoff_position_rad: float = 1.34
 
-    @classmethod
-    def from_config(cls, config: Mapping) -> DeviceParameters:
-        """The device of a validated config (``device.parameters``)."""
-        return cls(**config["device"]["parameters"])
-
     def __post_init__(self) -> None:
         for name, value in asdict(self).items():
             if not np.isfinite(value):
@@ -158,12 +152,6 @@ class FreeLeg:
     mass_kg: float = 14.0
     damping_ns_per_m: float = 10.0
     stiffness_n_per_m: float = 250.0
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> FreeLeg:
-        """The leg of a validated config (``device.leg``: ``mass_kg``, ``damping_ns_per_m``,
-        ``stiffness_n_per_m``)."""
-        return cls(**config["device"]["leg"])
 
     def __post_init__(self) -> None:
         for name, value in asdict(self).items():

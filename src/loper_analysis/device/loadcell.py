@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,7 +34,6 @@ from loper_analysis.device.clock_sync import ClockMap, clock_map, high_times, re
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
-from loper_analysis.motion.trial_markers import MarkerSettings
 from loper_analysis.study_design import PULSE_FORCE_N
 
 __all__ = [
@@ -70,28 +68,6 @@ class LoadcellSettings:
     cutoff_hz: float = CUTOFF_HZ
     order: int = ORDER
     pulse_force_n: float = PULSE_FORCE_N
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> LoadcellSettings:
-        """The settings of a validated config.
-
-        Parameters
-        ----------
-        config : mapping
-            The validated configuration: ``events.sync_channel`` is read here, the one place it is read; the
-            low-pass is the walking trials' (``filter.cutoff_hz``, Hz, and ``filter.order``,
-            :meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`); the perturbation force is
-            the study's planned pulse (``planning.pulse_force_n``, N).
-
-        Raises
-        ------
-        KeyError
-            A key missing, named.
-        """
-        walking = MarkerSettings.from_config(config)
-        return cls(
-            config["events"]["sync_channel"], walking.cutoff_hz, walking.order, config["planning"]["pulse_force_n"]
-        )
 
 
 #: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.

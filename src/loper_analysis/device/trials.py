@@ -13,7 +13,6 @@ records: a 5 V pulse of ``sync_pulse_s`` every ``sync_period_s``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 import numpy as np
@@ -76,12 +75,6 @@ class DeviceTestSettings:
                     positive(key, a)
             else:
                 positive(key, value)
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> DeviceTestSettings:
-        """The device tests of a validated config: ``device.tests`` (the amplitudes as a tuple)."""
-        tests = config["device"]["tests"]
-        return cls(**{**tests, "step_amplitudes_n": tuple(tests["step_amplitudes_n"])})
 
 
 def broadband_force(settings: DeviceTestSettings, sample_rate_hz: float, rng: np.random.Generator) -> np.ndarray:

@@ -1,14 +1,12 @@
 """The ground-reaction stage's settings (:class:`GRFSettings`): how a C3D's force platforms become ground
-reactions in the model frame, from the config (:meth:`GRFSettings.from_config`, section ``grf``)."""
+reactions in the model frame, from the config (section ``grf``, read by :mod:`loper_analysis.stages.grf.settings`)."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, LOADED_THRESHOLD_N
 from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
-from loper_analysis.motion.trial_markers import MarkerSettings
 
 __all__ = ["GRFSettings"]
 
@@ -32,27 +30,3 @@ class GRFSettings:
     threshold_n: float = LOADED_THRESHOLD_N
     band_n: float = RESTING_BAND_N
     max_rest_n: float = MAX_RESTING_N
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> GRFSettings:
-        """The ground-reaction settings of a validated config.
-
-        Parameters
-        ----------
-        config : mapping
-            The validated configuration: ``grf.loaded_threshold_n``, ``grf.resting_band_n`` and
-            ``grf.max_resting_n`` (N) are read here, the one place they are read; the rotation is the markers'
-            (:meth:`loper_analysis.motion.trial_markers.MarkerSettings.from_config`).
-
-        Raises
-        ------
-        KeyError
-            A key missing, named.
-        """
-        g = config["grf"]
-        return cls(
-            rotation_deg=MarkerSettings.from_config(config).rotation_deg,
-            threshold_n=g["loaded_threshold_n"],
-            band_n=g["resting_band_n"],
-            max_rest_n=g["max_resting_n"],
-        )

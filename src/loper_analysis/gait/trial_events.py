@@ -17,7 +17,6 @@ from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.events import MIN_STANCE_S, MIN_SWING_S, THRESHOLD_OFF_N, THRESHOLD_ON_N
 from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
-from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.motion.filtering import ORDER
 
 __all__ = [
@@ -70,27 +69,6 @@ class EventSettings:
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
     band_n: float = RESTING_BAND_N
     max_rest_n: float = MAX_RESTING_N
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> EventSettings:
-        """The settings of a validated config (``events.*``, ``grf.resting_band_n``, ``grf.max_resting_n``,
-        ``filter.order``, ``markers.lab_to_model_rotation_deg``); the resting-level rule is the ground reactions'
-        (:meth:`loper_analysis.gait.grf_settings.GRFSettings.from_config`)."""
-        e, grf = config["events"], GRFSettings.from_config(config)
-        return cls(
-            grf_channels=e["grf_channels"],
-            threshold_on_n=e["threshold_on_n"],
-            threshold_off_n=e["threshold_off_n"],
-            min_stance_s=e["min_stance_s"],
-            min_swing_s=e["min_swing_s"],
-            cutoff_hz=e["grf_cutoff_hz"],
-            order=config["filter"]["order"],
-            foot_markers=e["foot_markers"],
-            plate_sides=e["plate_sides"],
-            rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
-            band_n=grf.band_n,
-            max_rest_n=grf.max_rest_n,
-        )
 
 
 def trial_events(

@@ -1,5 +1,5 @@
 """The IK stage's settings (:class:`IKSettings`): the tasks, the solver's accuracy and the limits a trial's fit is
-held to, from the config (:meth:`IKSettings.from_config`, section ``opensim``)."""
+held to, from the config (section ``opensim``, read by :mod:`loper_analysis.stages.ik.settings`)."""
 
 from __future__ import annotations
 
@@ -72,36 +72,3 @@ class IKSettings:
     geometry_warn_change: float = GEOMETRY_WARN_CHANGE
     geometry_stop_change: float = GEOMETRY_STOP_CHANGE
     subjects_model: bool = True
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> IKSettings:
-        """The IK settings of a validated config (``opensim.*``; the one place these keys are read).
-
-        Parameters
-        ----------
-        config : mapping
-            The validated configuration; of its section ``opensim`` the keys ``ik_tasks``,
-            ``default_marker_weight``, ``marker_weights``, ``coordinate_tasks``, ``accuracy``, ``ik_solver``,
-            ``max_marker_rms_m`` (m), ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``,
-            ``geometry_warn_change`` and ``geometry_stop_change``.
-
-        Raises
-        ------
-        KeyError
-            A key missing, named.
-        """
-        o = config["opensim"]
-        return cls(
-            tasks_file=o["ik_tasks"],
-            default_weight=o["default_marker_weight"],
-            marker_weights=o["marker_weights"],
-            coordinate_tasks=o["coordinate_tasks"],
-            accuracy=o["accuracy"],
-            solver=o["ik_solver"],
-            max_marker_rms_m=o["max_marker_rms_m"],
-            warn_marker_rms_m=o["warn_marker_rms_m"],
-            max_rms_fraction=o["max_rms_fraction"],
-            coordinate_map=o["coordinate_map"],
-            geometry_warn_change=o["geometry_warn_change"],
-            geometry_stop_change=o["geometry_stop_change"],
-        )

@@ -1,5 +1,5 @@
 """The model stage's settings (:class:`ModelSettings`): how the subject's model is built, scaled and turned into a
-segment table, from the config (:meth:`ModelSettings.from_config`)."""
+segment table, from the config (read by :mod:`loper_analysis.stages.model.settings`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,6 @@ from dataclasses import dataclass, replace
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
-from loper_analysis.motion.ik_settings import IKSettings
 from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
 from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
@@ -72,25 +71,6 @@ class ModelSettings:
     coordinate_map: Mapping[str, Mapping] | None = None
     accuracy: float = IK_ACCURACY
     solver: str = IK_SOLVER
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> ModelSettings:
-        """The model settings of a validated config (``markers.*``, ``opensim.*``, ``trials.perturbed_side``); the
-        static pose's coordinate map, IK accuracy and solver are the IK stage's (:meth:`IKSettings.from_config`)."""
-        m, o = config["markers"], config["opensim"]
-        ik = IKSettings.from_config(config)
-        return cls(
-            rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
-            static_duration_s=m["static_duration_s"],
-            max_motion_rms_m=m["static_max_motion_rms_m"],
-            factor_range=tuple(float(v) for v in o["scale_factor_range"]),
-            segment_bodies=o["segment_bodies"],
-            side=config["trials"]["perturbed_side"],
-            attachment_fraction=o["brace_attachment_fraction"],
-            coordinate_map=ik.coordinate_map,
-            accuracy=ik.accuracy,
-            solver=ik.solver,
-        )
 
     def for_generic(self) -> ModelSettings:
         """What the generated model reads (the static trial's window and vertical, for a mass from its plates),

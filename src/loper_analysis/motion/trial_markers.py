@@ -55,20 +55,6 @@ class MarkerSettings:
     duration_s: float | None = None
     required_markers: tuple[str, ...] | None = None
 
-    @classmethod
-    def from_config(cls, config: Mapping) -> MarkerSettings:
-        """The walking trials' settings from a validated config (``markers.*``, ``filter.*``)."""
-        m, f = config["markers"], config["filter"]
-        return cls(
-            rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
-            walking_direction=m["walking_direction"],
-            min_travel_speed_m_per_s=float(m["min_travel_speed_m_per_s"]),
-            max_gap_frames=int(m["max_gap_frames"]),
-            cutoff_hz=f["cutoff_hz"],
-            order=int(f["order"]),
-            extent_range_m=tuple(float(v) for v in m["extent_range_m"]),
-        )
-
     def for_static(self) -> MarkerSettings:
         """The static trial's settings: neither filled nor filtered (scaling averages each marker over the frames
         it is present in, as OpenSim's ScaleTool reads a lab's static trial)."""

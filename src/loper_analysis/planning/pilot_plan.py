@@ -2,13 +2,12 @@
 to the targets, from the pilot's tables (method: ``docs/planning.md``).
 
 :class:`PlanningSettings` holds what the planner follows (built from the config by
-:meth:`PlanningSettings.from_config`, for the rule ``planning`` and ``loper-analysis plan`` alike);
+:mod:`loper_analysis.stages.planning.settings`, for the rule ``planning`` and ``loper-analysis plan`` alike);
 :func:`pilot_plan` runs the onsets, pools the perturbed pairs' excess scatter over them and words the answers.
 """
 
 from __future__ import annotations
 
-import copy
 import logging
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -20,7 +19,6 @@ from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
-from loper_analysis.impedance.responses.response_window import WINDOW_KEYS
 from loper_analysis.planning.covariance import (
     conditional_stride_covariance,
     pool_onsets,
@@ -29,7 +27,7 @@ from loper_analysis.planning.covariance import (
 )
 from loper_analysis.planning.inputs import pilot_onset_series, pilot_perturbed_pairs
 from loper_analysis.planning.precision import precision_table, target_answer, unplanned_rows
-from loper_analysis.planning.window import PLAN_IDENTIFICATION_KEYS, PlanSettings
+from loper_analysis.planning.window import PlanSettings
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
 __all__ = ["STRIDES", "PlanningSettings", "check_plan_request", "pilot_plan", "planned_impedance"]
@@ -38,20 +36,6 @@ log = logging.getLogger(__name__)
 
 #: Counts of perturbed strides averaged that the planner predicts for (config ``planning.strides``).
 STRIDES: tuple[int, ...] = (10, 20, 40)
-
-#: The config keys the planner reads beside its own section, by section.
-_PLANNER_KEYS = {
-    "planning": ("pulse_force_n", "pulse_duration_s"),
-    "identification": (
-        *(key.removeprefix("identification.") for key in WINDOW_KEYS.values()),
-        *PLAN_IDENTIFICATION_KEYS,
-        "stiffness_bounds_nm_per_rad",
-        "damping_bounds_nms_per_rad",
-        "counterfactual",
-    ),
-    "strides": ("iqr_whisker", "max_outlier_fraction", "min_valid_strides"),
-    "device": ("parameters",),
-}
 
 
 @dataclass(frozen=True)
@@ -90,55 +74,6 @@ class PlanningSettings:
     response: ResponseSettings = field(default_factory=ResponseSettings)
     device: DeviceParameters = field(default_factory=DeviceParameters)
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> PlanningSettings:
-        """The planner's settings from the workflow's configuration: the rule ``planning`` and
-        ``loper-analysis plan`` both take theirs from here, so that the two cannot drift apart.
-
-        Parameters
-        ----------
-        config : mapping
-            The validated configuration (``config/config.yaml`` and its layers;
-            :func:`loper_analysis.config_file.load_config`). ``onsets_ms``: ``trials.perturbation_onsets_ms``;
-            ``strides``, ``targets``: ``planning.strides``, ``planning.targets``; ``plan``: the pulse
-            ``planning.pulse_force_n`` (N) and ``planning.pulse_duration_s`` (s) with the keys of
-            ``identification`` the planner follows (the fit window and initial-state span as a
-            :class:`~loper_analysis.impedance.responses.ResponseWindow` in s, substeps, projected
-            components, null-pair minimum, interval scatter and the K, D bounds in N·m/rad, N·m·s/rad);
-            ``response``: the same window and ``strides.iqr_whisker``, ``strides.max_outlier_fraction``, the
-            counterfactual planned for ``identification.counterfactual``; ``device``: ``device.parameters``;
-            ``max_null_trial_ratio``: ``identification.max_null_trial_ratio``.
-
-        Raises
-        ------
-        LoperInputError
-            A key the planner needs is missing (naming it), or the settings cannot serve (e.g. a pulse
-            longer than the fit window after the onset).
-        """
-
-        def get(*keys):
-            node = config
-            for n, key in enumerate(keys):
-                if not isinstance(node, Mapping) or key not in node:
-                    raise LoperInputError(
-                        f"config: key '{'.'.join(keys[: n + 1])}' missing: the planner needs '{'.'.join(keys)}'"
-                    )
-                node = node[key]
-            return copy.deepcopy(node)
-
-        for section, keys in _PLANNER_KEYS.items():  # a config made by hand for the command: one message
-            for key in keys:
-                get(section, key)
-        return cls(
-            onsets_ms=tuple(get("trials", "perturbation_onsets_ms")),
-            strides=tuple(get("planning", "strides")),
-            targets=tuple(get("planning", "targets")),
-            plan=PlanSettings.from_config(config),
-            response=ResponseSettings.from_config(config),
-            device=DeviceParameters.from_config(config),
-            max_null_trial_ratio=get("identification", "max_null_trial_ratio"),
-        )
 
 
 def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:

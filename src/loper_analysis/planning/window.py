@@ -38,7 +38,7 @@ __all__ = ["PLAN_IDENTIFICATION_KEYS", "null_pair_arrays", "planned_impedance", 
 
 
 #: Keys of config ``identification`` the planner follows as they are (beside the window's, which
-#: :meth:`ResponseWindow.from_config` reads; the bounds become tuples).
+#: the impedance stage's reader reads; the bounds become tuples).
 PLAN_IDENTIFICATION_KEYS: tuple[str, ...] = (
     "initial_state_degree",
     "n_substeps",
@@ -75,20 +75,6 @@ class PlanSettings(FitBounds):
     force_cutoff_hz: float = CUTOFF_HZ
     force_order: int = ORDER
     force_rate_hz: float = DeviceParameters.sample_rate_hz
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> PlanSettings:
-        """The settings of a validated config: the pulse of ``planning`` (N, s) and the keys of
-        ``identification`` the prediction follows."""
-        ident = config["identification"]
-        return cls(
-            pulse_force_n=config["planning"]["pulse_force_n"],
-            pulse_duration_s=config["planning"]["pulse_duration_s"],
-            window=ResponseWindow.from_config(config),
-            **{key: ident[key] for key in PLAN_IDENTIFICATION_KEYS},
-            stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
-            damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
-        )
 
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)

@@ -5,8 +5,8 @@ with ``seed``, ``trials``, ``device.parameters``, ``markers.lab_to_model_rotatio
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.study_design import SEED, StudyDesign
@@ -62,7 +62,8 @@ class SyntheticLabSettings:
         The trials (``trials``): the static trial's name, the trial walked without the device
         (``no_device``) and each trial's perturbation onset (:meth:`StudyDesign.onset_ms`).
     lab : LabSettings
-        Rates, noise, gaps, robot clock, lab axes and sync channel (:meth:`LabSettings.from_config`).
+        Rates, noise, gaps, robot clock, lab axes and sync channel (the synthetic stage's reader,
+        :mod:`loper_analysis.stages.synthetic.settings`).
     device : DeviceParameters
         The simulated LOPER (``device.parameters``).
     static_duration_s, walking_duration_s : float
@@ -88,24 +89,6 @@ class SyntheticLabSettings:
     pulse_force_n: float = PerturbationSettings.force_n
     pulse_duration_s: float = PerturbationSettings.duration_s
     perturb_every_strides: tuple[int, int] = PerturbationSettings.every_strides
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> SyntheticLabSettings:
-        """The settings of the whole validated config (a subclass's own fields keep their defaults)."""
-        s = config["synthetic"]
-        return cls(
-            seed=config["seed"],
-            design=StudyDesign.from_config(config["trials"]),
-            lab=LabSettings.from_config(config),
-            device=DeviceParameters.from_config(config),
-            static_duration_s=s["static_duration_s"],
-            walking_duration_s=s["walking_duration_s"],
-            timing_cv=s["timing_cv"],
-            amplitude_cv=s["amplitude_cv"],
-            pulse_force_n=s["pulse_force_n"],
-            pulse_duration_s=s["pulse_duration_s"],
-            perturb_every_strides=tuple(s["perturb_every_strides"]),
-        )
 
     def perturbation(self, onset_ms: int | None, impedance: Sequence[float]) -> PerturbationSettings | None:
         """The pulses of a trial with onset ``onset_ms`` (ms after toe-off; None: no pulses), answered with
@@ -143,22 +126,6 @@ class LabSessionSettings(SyntheticLabSettings):
     adaptation_amplitude_change: tuple[float, float, float] = ADAPTATION_AMPLITUDE_CHANGE
     adaptation_offset_rad: tuple[float, float, float] = ADAPTATION_OFFSET_RAD
     adaptation_swing_gain: tuple[float, float, float] = ADAPTATION_SWING_GAIN
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> LabSessionSettings:
-        """The settings of the whole validated config."""
-        s = config["synthetic"]
-        v, a = s["study_variability"], s["device_adaptation"]
-        return replace(
-            super().from_config(config),
-            variability=s["variability"],
-            study_variability=GaitVariability(
-                v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"], v["knots_per_stride"]
-            ),
-            adaptation_amplitude_change=tuple(a["amplitude_change"]),
-            adaptation_offset_rad=tuple(a["offset_rad"]),
-            adaptation_swing_gain=tuple(a["swing_gain"]),
-        )
 
     def variability_settings(self) -> dict:
         """The ``synthetic`` keys :func:`loper_analysis.synthetic.variability.lab_variability` reads."""

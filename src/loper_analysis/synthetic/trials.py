@@ -26,7 +26,7 @@ writing them is the file layer's job.
 from __future__ import annotations
 
 import zlib
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -70,23 +70,6 @@ class LabSettings:
     lab_to_model_rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
     grf_prefix: tuple[str, str] = ("_left", "_right")  # channel suffix per belt: Fz_left, Fz_right
     sync_channel: str = "sync"
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> LabSettings:
-        """The lab of the whole validated config: noise, gaps and robot clock of ``synthetic``, the lab's axes
-        (``markers.lab_to_model_rotation_deg``) and sync channel (``events.sync_channel``); the rates, the robot
-        log's margin and the belts' channel names keep their defaults."""
-        s = config["synthetic"]
-        return cls(
-            marker_noise_sd_m=s["marker_noise_sd_m"],
-            n_gaps=s["marker_gaps_per_trial"],
-            max_gap_frames=s["max_gap_frames"],
-            grf_noise_sd_n=s["grf_noise_sd_n"],
-            clock_offset_s=s["clock_offset_s"],
-            clock_drift_ppm=s["clock_drift_ppm"],
-            lab_to_model_rotation_deg=tuple(config["markers"]["lab_to_model_rotation_deg"]),
-            sync_channel=config["events"]["sync_channel"],
-        )
 
 
 def _model_to_lab(points_m: np.ndarray, rotation_deg: Sequence[float]) -> np.ndarray:

@@ -25,7 +25,6 @@ The rules of a fitted row are :func:`loper_analysis.impedance.identification.joi
 
 from __future__ import annotations
 
-import copy
 import logging
 import warnings
 from collections.abc import Mapping, Sequence
@@ -157,31 +156,6 @@ class IdentificationSettings(FitBounds):
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
     seed: int = 0
     averaging_correction: bool = True
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> IdentificationSettings:
-        """The settings of a validated config: ``identification.*`` (its fit window and counterfactual aside,
-        the responses') and ``seed``."""
-        ident = config["identification"]
-        return cls(
-            noise_model=ident["noise_model"],
-            interval_scatter=ident["interval_scatter"],
-            null_pair_components=ident["null_pair_components"],
-            min_null_pairs=ident["min_null_pairs"],
-            initial_state_degree=ident["initial_state_degree"],
-            n_starts=ident["n_starts"],
-            n_substeps=ident["n_substeps"],
-            tolerance=ident["tolerance"],
-            merge_tolerance=ident["merge_tolerance"],
-            stiffness_bounds_nm_per_rad=tuple(ident["stiffness_bounds_nm_per_rad"]),
-            damping_bounds_nms_per_rad=tuple(ident["damping_bounds_nms_per_rad"]),
-            max_ci_fraction=ident["max_ci_fraction"],
-            plausible_ranges=copy.deepcopy(ident["plausible_ranges"]),
-            min_vaf_pct=ident["min_vaf_pct"],
-            max_null_trial_ratio=ident["max_null_trial_ratio"],
-            averaging_correction=ident["averaging_correction"],
-            seed=config["seed"],
-        )
 
     def __post_init__(self):
         if self.noise_model not in NOISE_MODELS:

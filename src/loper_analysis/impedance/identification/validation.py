@@ -15,7 +15,6 @@ the perturbed and the unperturbed generalised coordinates.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -46,7 +45,6 @@ from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordin
 
 __all__ = [
     "ValidationSettings",
-    "validation_settings",
     "impedance_grid",
     "chunk_combinations",
     "nominal_swing",
@@ -99,47 +97,6 @@ class ValidationSettings:
 
     def __post_init__(self):
         self.window.check_in_swing(self.onset_s, self.swing_duration_s)
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> ValidationSettings:
-        """The settings of a validated config (:func:`validation_settings`)."""
-        return cls(**validation_settings(config))
-
-
-def validation_settings(config: Mapping) -> dict:
-    """Keyword arguments of :class:`ValidationSettings` from a validated config (sections ``validation``,
-    ``identification`` and ``seed``): what the workflow's validation rules and ``loper-analysis validate`` use."""
-    v, ident = config["validation"], config["identification"]
-    k_lo, k_hi = ident["stiffness_bounds_nm_per_rad"]
-    d_lo, d_hi = ident["damping_bounds_nms_per_rad"]
-    return dict(
-        stiffness_levels_nm_per_rad=tuple(v["stiffness_levels_nm_per_rad"]),
-        damping_levels_nms_per_rad=tuple(v["damping_levels_nms_per_rad"]),
-        **{
-            key: v[key]
-            for key in (
-                "sample_rate_hz",
-                "swing_duration_s",
-                "onset_s",
-                "pulse_force_n",
-                "pulse_duration_s",
-                "pulse_rise_time_s",
-                "pulse_overshoot_pct",
-                "force_rate_hz",
-                "force_direction_deg",
-                "noise_peak_to_peak",
-                "truth_substeps",
-            )
-        },
-        seed=config["seed"],
-        window=ResponseWindow.from_config(config),
-        **{
-            key: ident[key]
-            for key in ("n_starts", "n_substeps", "tolerance", "merge_tolerance", "initial_state_degree")
-        },
-        lower=(k_lo, d_lo) * 3,
-        upper=(k_hi, d_hi) * 3,
-    )
 
 
 def impedance_grid(stiffness_levels, damping_levels) -> np.ndarray:

@@ -10,7 +10,6 @@ validation study.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 from loper_analysis.checks import number
@@ -62,17 +61,6 @@ class ResponseWindow:
     def __post_init__(self) -> None:
         for name, key in WINDOW_KEYS.items():
             number(key, getattr(self, name), minimum=0.0)
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> ResponseWindow:
-        """The window of a validated config: ``identification.window_before_s``, ``window_after_s`` and
-        ``initial_state_span_s`` (s)."""
-        ident = config["identification"]
-        return cls(
-            before_s=ident["window_before_s"],
-            after_s=ident["window_after_s"],
-            initial_state_span_s=ident["initial_state_span_s"],
-        )
 
     def check_pulse(self, pulse_duration_s: float) -> None:
         """Refuse a planned pulse (``pulse_duration_s``, s, > 0) that lasts beyond the window after the onset.

@@ -82,20 +82,6 @@ class ResponseSettings:
     min_strides: int = MIN_VALID_STRIDES
     counterfactual: str = "conditional"
 
-    @classmethod
-    def from_config(cls, config: Mapping) -> ResponseSettings:
-        """The settings of a validated config: the fit window, initial-state span and counterfactual of
-        ``identification``, the IQR rule and fewest kept strides of ``strides`` (the fit's and the planner's
-        alike)."""
-        ident, strides = config["identification"], config["strides"]
-        return cls(
-            window=ResponseWindow.from_config(config),
-            whisker=strides["iqr_whisker"],
-            max_fraction=strides["max_outlier_fraction"],
-            min_strides=strides["min_valid_strides"],
-            counterfactual=ident["counterfactual"],
-        )
-
     def __post_init__(self):
         if self.counterfactual not in COUNTERFACTUALS:
             raise LoperInputError(

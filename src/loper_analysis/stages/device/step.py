@@ -48,17 +48,6 @@ class DeviceSettings:
     tests: DeviceTestSettings = field(default_factory=DeviceTestSettings)
     analysis: DeviceAnalysisSettings = field(default_factory=DeviceAnalysisSettings)
 
-    @classmethod
-    def from_config(cls, config: Mapping) -> DeviceSettings:
-        """The settings of a validated config: ``device.parameters``, ``device.leg``, ``device.tests`` and
-        ``device.analysis``, each read by its type's ``from_config``."""
-        return cls(
-            parameters=DeviceParameters.from_config(config),
-            leg=FreeLeg.from_config(config),
-            tests=DeviceTestSettings.from_config(config),
-            analysis=DeviceAnalysisSettings.from_config(config),
-        )
-
 
 def device_trial(
     out_path: PathLike,

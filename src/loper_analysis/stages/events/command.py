@@ -56,9 +56,11 @@ def _plates(text: str | None) -> dict[str, int] | None:
 def _events(args: argparse.Namespace) -> None:
     from loper_analysis.stages.events.step import EventSettings, events
 
-    settings = cli_options.stage_settings(
+    settings = cli_options.command_settings(
         args,
-        EventSettings,
+        "events",
+        EventSettings(),
+        "events",
         threshold_on_n=args.threshold_on_n,
         threshold_off_n=args.threshold_off_n,
         foot_markers=None if args.feet is None else dict(zip(("left", "right"), args.feet)),

@@ -2,7 +2,8 @@
 
 :func:`events` (a trial without the device), :func:`loadcell` and :func:`events_loadcell` (both from one
 reading of a trial with the device); their settings :class:`EventSettings` and
-:class:`loper_analysis.device.loadcell.LoadcellSettings`, built from the config by their ``from_config``.
+:class:`loper_analysis.device.loadcell.LoadcellSettings`, built from the config by
+:mod:`loper_analysis.stages.events.settings`.
 """
 
 from __future__ import annotations

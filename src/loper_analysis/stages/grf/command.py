@@ -27,8 +27,12 @@ def _grf(args: argparse.Namespace) -> None:
     from loper_analysis.gait.grf_settings import GRFSettings
     from loper_analysis.stages.grf.step import grf
 
-    settings = cli_options.stage_settings(
-        args, GRFSettings, rotation_deg=cli_options.rotation_option(args, args.c3d), threshold_n=args.threshold_n
+    settings = cli_options.command_settings(
+        args,
+        "grf",
+        GRFSettings(),
+        rotation_deg=cli_options.rotation_option(args, args.c3d),
+        threshold_n=args.threshold_n,
     )
     table = grf(args.c3d, args.out, settings)
     n_plates = (table.shape[1] - 1) // 9

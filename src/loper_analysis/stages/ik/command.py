@@ -61,10 +61,11 @@ def _ik(args: argparse.Namespace) -> None:
     from loper_analysis.motion.ik_settings import IKSettings
     from loper_analysis.stages.ik.step import ik_file
     from loper_analysis.stages.markers.step import MarkerSettings
+    from loper_analysis.stages.settings import stage_settings
 
     config, line = cli_options.read_config(args)
     print(line)
-    settings = IKSettings() if config is None else IKSettings.from_config(config)
+    settings = IKSettings() if config is None else stage_settings(config, "ik")
     given = {
         "tasks_file": args.tasks,
         "accuracy": args.accuracy,
@@ -75,7 +76,7 @@ def _ik(args: argparse.Namespace) -> None:
     }
     settings = dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None}, subjects_model=False)
     # a C3D holds the lab's labels in the lab's frame (the config's markers.*); a TRC the model's already
-    lab = MarkerSettings() if config is None else MarkerSettings.from_config(config)
+    lab = MarkerSettings() if config is None else stage_settings(config, "markers")
     label_map = cli_options.label_map(args.label_map)
     if label_map is None and config is not None and str(args.markers).lower().endswith(".c3d"):
         label_map = read_label_maps(config["markers"]["label_map"] or None)

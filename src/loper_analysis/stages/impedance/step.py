@@ -2,7 +2,7 @@
 
 :func:`fit` and :func:`subject_fits` read the files of a :class:`FitFiles` bundle (per trial a
 :class:`TrialFiles`, the outputs a :class:`FitOutputs`) with the settings :class:`FitSettings`
-(from the config by :meth:`FitSettings.from_config`).
+(from the config by :mod:`loper_analysis.stages.impedance.settings`).
 """
 
 from __future__ import annotations
@@ -47,15 +47,6 @@ class FitSettings:
 
     response: ResponseSettings = field(default_factory=ResponseSettings)
     identification: IdentificationSettings = field(default_factory=IdentificationSettings)
-
-    @classmethod
-    def from_config(cls, config: Mapping) -> FitSettings:
-        """The settings of a validated config: ``identification.*``, ``strides.iqr_whisker``,
-        ``strides.max_outlier_fraction``, ``strides.min_valid_strides`` and ``seed``."""
-        return cls(
-            response=ResponseSettings.from_config(config),
-            identification=IdentificationSettings.from_config(config),
-        )
 
 
 class _Tables:

@@ -33,9 +33,10 @@ def _add_markers(p: argparse.ArgumentParser) -> None:
 def _markers(args: argparse.Namespace) -> None:
     from loper_analysis.stages.markers.step import MarkerSettings, markers
 
-    settings = cli_options.stage_settings(
+    settings = cli_options.command_settings(
         args,
-        MarkerSettings,
+        "markers",
+        MarkerSettings(),
         rotation_deg=cli_options.rotation_option(args, args.c3d),
         walking_direction=cli_options.walking_direction(args),
         cutoff_hz=args.cutoff_hz,

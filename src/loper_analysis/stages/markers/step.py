@@ -1,7 +1,7 @@
 """The ``markers`` step: a C3D's markers in the model's names and frame, gaps filled, low-passed, as a TRC.
 
 :func:`markers` is the rule's and ``loper-analysis markers``' step; :class:`MarkerSettings` its settings,
-built from the config by :meth:`MarkerSettings.from_config`.
+built from the config by :mod:`loper_analysis.stages.markers.settings`.
 """
 
 from __future__ import annotations

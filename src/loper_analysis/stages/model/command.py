@@ -60,10 +60,11 @@ def _scale(args: argparse.Namespace) -> None:
     from loper_analysis.io.readers import read_label_maps
     from loper_analysis.stages.markers.step import MarkerSettings, markers
     from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale_with_setup
+    from loper_analysis.stages.settings import stage_settings
 
     config, line = cli_options.read_config(args)
     print(line)
-    settings = ModelSettings() if config is None else ModelSettings.from_config(config)
+    settings = ModelSettings() if config is None else stage_settings(config, "model")
     given = {
         "rotation_deg": cli_options.rotation_option(args, args.static),
         "time_range_s": None if args.start is None else (args.start, args.end),
@@ -141,8 +142,8 @@ def _segments(args: argparse.Namespace) -> None:
             raise LoperInputError("segments: give either --model or --height-m and --mass-kg, not both")
     elif args.height_m is None or args.mass_kg is None:
         raise LoperInputError("segments: give --model SCALED.osim, or --height-m and --mass-kg")
-    settings = cli_options.stage_settings(
-        args, ModelSettings, side=args.side, attachment_fraction=args.attachment_fraction
+    settings = cli_options.command_settings(
+        args, "model", ModelSettings(), side=args.side, attachment_fraction=args.attachment_fraction
     )
     if args.model is not None:
         segments_from_model_file(args.model, args.out, settings)

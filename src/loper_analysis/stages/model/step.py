@@ -1,6 +1,7 @@
 """File steps of the subject's OpenSim model: the generic model, scaling to the static trial, the segment table.
 
-:class:`ModelSettings` holds the model stage's settings of the config, built by :meth:`ModelSettings.from_config`;
+:class:`ModelSettings` holds the model stage's settings of the config, built by
+:mod:`loper_analysis.stages.model.settings`;
 :class:`ScaleFiles` the files of one scaling.
 """
 

@@ -104,12 +104,13 @@ def _first_subject(subjects_tsv: str, paths: Paths) -> str:
 
 def plan_settings(args: argparse.Namespace, config: dict | None):
     """The planner's settings: those of the rule ``planning`` (the config's,
-    :meth:`loper_analysis.planning.pilot_plan.PlanningSettings.from_config`), else the library's defaults; then the
+    :func:`loper_analysis.stages.planning.settings.read_settings`), else the library's defaults; then the
     options given on the command line (targets given replace the config's).
     """
     from loper_analysis.stages.planning.step import PlanningSettings
+    from loper_analysis.stages.settings import stage_settings
 
-    settings = PlanningSettings() if config is None else PlanningSettings.from_config(config)
+    settings = PlanningSettings() if config is None else stage_settings(config, "planning")
     pulse = {k: v for k, v in (("pulse_force_n", args.force_n), ("pulse_duration_s", args.duration_s)) if v is not None}
     given = {
         "onsets_ms": None if args.onset_ms is None else tuple(args.onset_ms),

@@ -11,7 +11,7 @@ counterfactual, counts the pilot holds at least twice at an onset are planned
 from its stretches of that size,
 :func:`loper_analysis.planning.covariance.stretch_covariances`), with the settings
 :class:`PlanningSettings`, which the rule ``planning`` and ``loper-analysis
-plan`` both build with :meth:`PlanningSettings.from_config`.
+plan`` both build with :mod:`loper_analysis.stages.planning.settings`.
 """
 
 from __future__ import annotations

@@ -2,7 +2,8 @@
 
 :func:`lab_session` records a synthetic subject's session as the workflow's raw files
 (:class:`LabSessionFiles`) with the settings of :class:`loper_analysis.synthetic.lab_session.LabSessionSettings`
-(built from the whole validated config by its ``from_config``). A session as a lab exports it (QTM files,
+(built from the validated config by :mod:`loper_analysis.stages.synthetic.settings`). A session as a lab exports
+it (QTM files,
 MATLAB logs) is the tests' own (``tests/lab_export_session.py``). The lab never writes over a file it did not
 write itself (:mod:`loper_analysis.io.generated`).
 """

@@ -1,7 +1,8 @@
 """File step of the transparency analysis: RMSD vs ISV_ave, interaction force, and the study's figure.
 
 :func:`transparency` reads each subject's :class:`TransparencyFiles` with the settings
-:class:`loper_analysis.transparency.TransparencySettings` (from the config by its ``from_config``).
+:class:`loper_analysis.transparency.TransparencySettings` (from the config by
+:mod:`loper_analysis.stages.transparency.settings`).
 """
 
 from __future__ import annotations

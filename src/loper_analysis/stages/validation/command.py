@@ -25,11 +25,12 @@ def _add_validate(p: argparse.ArgumentParser) -> None:
 
 def _validate(args: argparse.Namespace) -> None:
     from loper_analysis.impedance.identification.validation import ValidationSettings
+    from loper_analysis.stages.settings import stage_settings
     from loper_analysis.stages.validation.step import validation_chunk
 
     config, line = cli_options.read_config(args)
     print(line)
-    settings = ValidationSettings() if config is None else ValidationSettings.from_config(config)
+    settings = ValidationSettings() if config is None else stage_settings(config, "validation")
     given = {k: v for k, v in (("n_starts", args.n_starts), ("seed", args.seed)) if v is not None}
     settings = dataclasses.replace(settings, **given)
     n_chunks = args.n_chunks if args.n_chunks is not None else (config or {}).get("validation", {}).get("n_chunks", 1)
