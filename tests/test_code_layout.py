@@ -4,6 +4,8 @@ another."""
 from __future__ import annotations
 
 import ast
+import importlib
+import inspect
 import re
 from pathlib import Path
 
@@ -303,3 +305,15 @@ def test_library_functions_take_their_options_by_name():
             if len(positional) > MAX_STEP_PARAMETERS and name not in MANY_POSITIONAL and not f.name.startswith("_"):
                 found.append(f"{name}: {len(positional)}")
     assert found == []
+
+
+@pytest.mark.parametrize("stage", STAGES, ids=lambda s: s.name)
+def test_each_slice_is_whole_a_reader_and_a_rule_for_every_file(stage):
+    """A slice whose settings have no reader, or a result file no rule of its rule file writes, is incomplete."""
+    reader = importlib.import_module(f"loper_analysis.stages.{stage.name}.settings")
+    assert isinstance(reader.NEEDS, tuple) and callable(reader.read_settings)
+    params = inspect.signature(reader.read_settings).parameters
+    assert list(params) == ["config", *reader.NEEDS], stage.name  # each stage it needs passed in by name
+    outputs = "\n".join(_output_blocks((RULES / f"{stage.name}.smk").read_text()))
+    unwritten = [name for name in stage.files if f"PATHS.{stage.name}.{name}" not in outputs]
+    assert unwritten == [], stage.name

@@ -67,6 +67,8 @@ CHANGES = {
     "events.foot_markers": {"left": "LCAL", "right": "RCAL"},
     "events.plate_sides": {"left": 2, "right": 1},
     "device.mat_column_map": {"time_s": "time"},
+    "dynamics.foot_bodies.left": "toes_l",
+    "dynamics.foot_bodies.right": "toes_r",
 }
 
 #: Config key -> the rules that read it (the front page reads the run's headline settings).
@@ -77,12 +79,17 @@ READERS = {
     ),
     "seed": "device_trial front_page impedance_fit synthetic_lab synthetic_truth validation_chunk",
     "trials.static": "ik markers model_scaled synthetic_lab",
-    "trials.no_device": "all events events_loadcell front_page strides strides_summary synthetic_lab transparency",
-    "trials.device": "all front_page impedance_fit planning strides_summary synthetic_lab transparency",
-    "trials.perturbation_onsets_ms": (
-        "all front_page impedance_figures impedance_fit impedance_table planning strides_summary synthetic_lab"
+    "trials.no_device": (
+        "all dynamics_trials events events_loadcell front_page strides strides_summary synthetic_lab transparency"
     ),
-    "trials.perturbation_repeats": "all front_page impedance_fit planning strides_summary synthetic_lab",
+    "trials.device": "all dynamics_trials front_page impedance_fit planning strides_summary synthetic_lab transparency",
+    "trials.perturbation_onsets_ms": (
+        "all dynamics_trials front_page impedance_figures impedance_fit impedance_table planning strides_summary "
+        "synthetic_lab"
+    ),
+    "trials.perturbation_repeats": (
+        "all dynamics_trials front_page impedance_fit planning strides_summary synthetic_lab"
+    ),
     "trials.perturbed_side": "front_page model_segments strides synthetic_lab transparency",
     "synthetic.walking_duration_s": "front_page synthetic_lab",
     "synthetic.static_duration_s": "synthetic_lab",
@@ -136,7 +143,7 @@ READERS = {
     "opensim.geometry_stop_change": "ik",
     "opensim.scale_factor_range": "model_scaled",
     "opensim.ik_chunks": "ik ik_chunk ik_join",
-    "opensim.coordinate_map": "ik model_scaled",
+    "opensim.coordinate_map": "dynamics ik model_scaled",
     "grf.loaded_threshold_n": "grf",
     "grf.resting_band_n": "events events_loadcell grf",
     "grf.max_resting_n": "events events_loadcell grf",
@@ -149,7 +156,10 @@ READERS = {
     "events.foot_markers": "events events_loadcell",
     "events.plate_sides": "events events_loadcell",
     "events.grf_cutoff_hz": "events events_loadcell",
-    "strides.n_points": "strides",
+    "strides.n_points": "dynamics strides",
+    "dynamics.cutoff_hz": "dynamics",
+    "dynamics.foot_bodies.left": "dynamics",
+    "dynamics.foot_bodies.right": "dynamics",
     "strides.iqr_whisker": "impedance_fit planning strides",
     "strides.max_outlier_fraction": "impedance_fit planning strides",
     "strides.min_valid_strides": "impedance_fit planning strides strides_summary transparency",

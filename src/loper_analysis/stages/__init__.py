@@ -17,6 +17,7 @@ besides the stages, :mod:`.inspect` (the ``inspect`` command's file step) and
 
 from loper_analysis.stages import (
     device,
+    dynamics,
     events,
     grf,
     ik,
@@ -42,6 +43,7 @@ STAGES: tuple[Stage, ...] = (
     grf.STAGE,
     events.STAGE,
     strides.STAGE,
+    dynamics.STAGE,
     transparency.STAGE,
     device.STAGE,
     impedance.STAGE,

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import logging
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -41,7 +41,11 @@ __all__ = [
     "DynamicsSettings",
     "NoKnownLoadWarning",
     "inverse_dynamics",
+    "trial_table",
 ]
+
+#: Columns of the study's table of trials (:func:`trial_table`).
+TRIAL_COLUMNS: tuple[str, ...] = ("subject", "trial", "inverse_dynamics", "n_cycles_left", "n_cycles_right", "reason")
 
 log = logging.getLogger(__name__)
 
@@ -313,3 +317,32 @@ def inverse_dynamics(
         cycles.groupby("side")["stride"].nunique().to_dict(),
     )
     return cycles
+
+
+def trial_table(
+    cycles: Mapping[tuple[str, str], PathLike], without: Sequence[tuple[str, str, str]], out: PathLike
+) -> pd.DataFrame:
+    """The study's processed trials and their inverse dynamics: ``computed`` with the normalised cycles per side,
+    or ``none`` with the reason.
+
+    Parameters
+    ----------
+    cycles : mapping
+        (subject, trial) -> the cycles TSV of a trial with inverse dynamics.
+    without : sequence of (str, str, str)
+        Subject, trial and the reason of every trial without.
+    out : path-like
+        The table (:data:`TRIAL_COLUMNS`), one row per trial, subjects and trials in the given order.
+    """
+    from loper_analysis.io.readers import read_tsv
+
+    rows = []
+    for (subject, trial), path in cycles.items():
+        table = read_tsv(path, "cycle table", ("stride", "side"))
+        counts = table.groupby("side")["stride"].nunique() if len(table) else pd.Series(dtype=int)
+        n = {side: int(counts.get(side, 0)) for side in SIDES}
+        rows.append((subject, trial, "computed", n["left"], n["right"], ""))
+    rows += [(subject, trial, "none", 0, 0, reason) for subject, trial, reason in without]
+    table = pd.DataFrame(rows, columns=list(TRIAL_COLUMNS))
+    write_tsv(table, out)
+    return table

@@ -72,6 +72,7 @@ def markdown_sections(study: Study) -> dict[str, str]:
         "Across-subject summary": p.impedance.summary,
         "Literature": p.impedance.literature,
         "Strides per trial": p.strides.summary,
+        "Inverse dynamics per trial": p.dynamics.trials,
         "Validation study": p.validation.summary,
     }
     if study.has_device_tests():  # no device tests without a device subject (device.subject null)
