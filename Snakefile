@@ -17,7 +17,7 @@ from snakemake.exceptions import WorkflowError
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.schema import check_yaml_file
-from loper_analysis.stages import STAGES
+from loper_analysis.stages import STAGES, all_targets
 
 try:
     for _file in ["config/config.yaml", *map(str, workflow.config_settings.configfiles)]:
@@ -58,4 +58,4 @@ for _stage in STAGES:
 rule all:
     default_target: True
     input:
-        STUDY.all_targets(),
+        all_targets(STUDY),

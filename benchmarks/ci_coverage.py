@@ -49,12 +49,13 @@ import pandas as pd
 import yaml
 from scipy.stats import beta
 
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
 from loper_analysis.report.markdown import markdown_table
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
-PATHS = Paths()
+PATHS = study_paths()
 #: Columns of the angle table that get IK-like noise, and the noise measured in the whole chain (``--mode chain
 #: --keep``: IK angle minus true coordinate, minimal-impedance trials of C014 and C030, 0.5 mm marker noise,
 #: 40 Hz marker filter, generated model): SD (m, rad) and correlations. The noise is close to white noise

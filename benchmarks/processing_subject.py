@@ -30,11 +30,12 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
-PATHS = Paths()
+PATHS = study_paths()
 
 
 def _lab_session(work: Path, cfg: dict, trials: list[str]) -> tuple[str, list[str]]:

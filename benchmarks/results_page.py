@@ -38,7 +38,8 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from loper_analysis.layout import RESULTS_DIR, Paths
+from loper_analysis.layout import RESULTS_DIR
+from loper_analysis.stages import study_paths
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_PAGE = ROOT / "docs" / "results.md"
@@ -130,7 +131,7 @@ class Run:
 
     def __init__(self, results: Path, configfiles: list[str]):
         self.results = results
-        self.paths = Paths(results_dir=str(results))
+        self.paths = study_paths(results_dir=str(results))
         self.configfiles = [DEFAULT_CONFIG, *configfiles]
         self.config: dict = {}
         for name in self.configfiles:

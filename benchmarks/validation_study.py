@@ -17,10 +17,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from loper_analysis.layout import Paths
+from loper_analysis.stages import study_paths
 
 ROOT = Path(__file__).resolve().parents[1]
-PATHS = Paths()
+PATHS = study_paths()
 
 
 def main() -> None:

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import yaml
 
-from loper_analysis.layout import Paths, Study
+from loper_analysis.layout import Study
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,7 +24,7 @@ def study_on(tmp_path: Path, rows: dict, **config) -> Study:
     study = Study(
         rows,
         stage_settings(cfg, "study").design,
-        Paths(str(tmp_path / "raw")),
+        study_paths(str(tmp_path / "raw")),
         cfg,
         has_plates=lambda path: path.name != "walk-nodevice.c3d",
         note=said.append,

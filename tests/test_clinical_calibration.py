@@ -16,10 +16,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import study_paths
 from tests.workflow_copy import ROOT, copy_workflow, snakemake
 
-PATHS = Paths()
+PATHS = study_paths()
 pytestmark = pytest.mark.slow  # inspect and Snakemake on a lab's pair
 DATA = ROOT / "tests" / "data" / "c3d-parser"
 

@@ -6,9 +6,9 @@ import pytest
 
 from loper_analysis.cluster import check_slurm_submission, failed_slurm_logs, slurm_end_reason, submission_problems
 from loper_analysis.errors import LoperInputError
-from loper_analysis.layout import Paths
+from loper_analysis.stages import study_paths
 
-PATHS = Paths()
+PATHS = study_paths()
 
 
 def test_nothing_stops_a_submission_to_known_partitions():

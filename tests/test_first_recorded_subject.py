@@ -12,11 +12,12 @@ import pandas as pd
 import pytest
 import yaml
 
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import study_paths
 from tests.browser import report_screen
 from tests.workflow_copy import copy_workflow
 
-PATHS = Paths()
+PATHS = study_paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]

@@ -7,7 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from loper_analysis.layout import RESULT_FILES, Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import RESULT_FILES, all_targets, study_paths
 from loper_analysis.stages.impedance.files import fit_files, fit_inputs
 from loper_analysis.stages.planning.files import planning_files
 from loper_analysis.stages.report.files import markdown_sections
@@ -18,7 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_patterns_are_the_folders_and_names_of_the_docs():
-    paths = Paths("lab/raw")
+    paths = study_paths("lab/raw")
     assert paths.ik.angles == "results/ik/{subject}/{trial}.angles.tsv"
     assert paths.impedance.fit == "results/impedance/{subject}/{onset}.tsv"
     assert paths.raw.c3d == "lab/raw/{subject}/{trial}.c3d"
@@ -30,15 +31,15 @@ def test_patterns_are_the_folders_and_names_of_the_docs():
 
 def test_an_unknown_file_or_folder_is_named():
     with pytest.raises(AttributeError, match=r"results/ik: no file 'angle' \(files: mot, chunk, angles"):
-        _ = Paths().ik.angle
+        _ = study_paths().ik.angle
     with pytest.raises(AttributeError, match="no results folder 'kinematics'"):
-        _ = Paths().kinematics
+        _ = study_paths().kinematics
 
 
 def test_fill_leaves_the_wildcards_not_given():
-    assert fill(Paths().ik.angles, trial="static") == "results/ik/{subject}/static.angles.tsv"
-    assert fill(Paths().impedance.fit, subject="S01", onset=50) == "results/impedance/S01/050.tsv"
-    assert fill(Paths().impedance.fit, subject="S01", onset="175") == "results/impedance/S01/175.tsv"
+    assert fill(study_paths().ik.angles, trial="static") == "results/ik/{subject}/static.angles.tsv"
+    assert fill(study_paths().impedance.fit, subject="S01", onset=50) == "results/impedance/S01/050.tsv"
+    assert fill(study_paths().impedance.fit, subject="S01", onset="175") == "results/impedance/S01/175.tsv"
 
 
 def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
@@ -52,7 +53,7 @@ def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
     assert len(study.subject_trials("S01")) == 8  # every walking trial of the design
     assert study.processed_subjects() == ["R01", "S01"]
     assert study.transparency_subjects() == ["S01"]
-    targets = study.all_targets()
+    targets = all_targets(study)
     # plates in pert050-1 only: its external loads and force-plate figure, one note for the other trial
     assert "results/grf/R01/pert050-1.grf.mot" in targets and "results/grf/R01/walk-nodevice.grf.mot" not in targets
     assert study.said == [

@@ -23,8 +23,9 @@ import yaml
 
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_model
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
 from loper_analysis.motion.markers import rotate_markers
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.markers.step import MarkerSettings
 from tests.rajagopal_lab import (
     GENERIC_OSIM,
@@ -41,7 +42,7 @@ from tests.rajagopal_lab import (
 )
 from tests.workflow_copy import copy_workflow, snakemake
 
-PATHS = Paths()
+PATHS = study_paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]

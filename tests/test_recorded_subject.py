@@ -24,12 +24,13 @@ from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import read_model
 from loper_analysis.io.segment_table import read_segments
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
 from loper_analysis.motion.segments import segments_from_model
+from loper_analysis.stages import study_paths
 from tests.lab_export_session import LabExportFiles, LabExportSettings, lab_export_session
 from tests.workflow_copy import copy_workflow, snakemake
 
-PATHS = Paths()
+PATHS = study_paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[1]

@@ -9,9 +9,9 @@ from pathlib import Path
 
 import pytest
 
-from loper_analysis.layout import Paths
+from loper_analysis.stages import study_paths
 
-PATHS = Paths()
+PATHS = study_paths()
 
 ROOT = Path(__file__).resolve().parents[1]
 _spec = importlib.util.spec_from_file_location("results_page", ROOT / "benchmarks" / "results_page.py")

@@ -15,11 +15,12 @@ import pandas as pd
 import pytest
 
 from loper_analysis.io.osim import quiet_opensim, read_model
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import study_paths
 from tests.rajagopal_lab import DATA, opensim_ik_reference
 from tests.workflow_copy import ROOT, copy_workflow, snakemake
 
-PATHS = Paths()
+PATHS = study_paths()
 
 pytestmark = pytest.mark.slow  # Snakemake and OpenSim on whole trials
 WALK_TRC = DATA / "Rajagopal_motion_capture_walk.trc"

@@ -17,6 +17,7 @@ The workflow's rules, the command line and the benchmarks ask these two.
 
 from __future__ import annotations
 
+import string
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,11 +25,9 @@ from pathlib import Path
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.stages import STAGES
-from loper_analysis.stages.stage import fill
 from loper_analysis.study_design import StudyDesign
 
-__all__ = ["RAW_DIR", "RESULTS_DIR", "RAW_FILES", "RESULT_FILES", "Paths", "Study", "fill", "subject_rows"]
+__all__ = ["RAW_DIR", "RESULTS_DIR", "RAW_FILES", "Paths", "Study", "fill", "subject_rows"]
 
 #: The raw files' folder unless the config's ``raw_dir`` says otherwise.
 RAW_DIR = "data/raw"
@@ -42,9 +41,6 @@ RAW_FILES: dict[str, str] = {
     "mat": "{subject}/{trial}.mat",
     "truth": "{subject}/truth.yaml",
 }
-
-#: Every result file: stage folder -> name -> pattern under ``results/{stage}/``, from the stages' slices.
-RESULT_FILES: dict[str, dict[str, str]] = {stage.name: dict(stage.files) for stage in STAGES if stage.files}
 
 
 def subject_rows(sheet: pd.DataFrame, seed: int) -> dict[str, dict]:
@@ -60,6 +56,20 @@ def subject_rows(sheet: pd.DataFrame, seed: int) -> dict[str, dict]:
         if row["source"] == "synthetic":
             row.update(subject_anthropometry(row, seed))
     return rows
+
+
+class _Keep(dict):
+    """Format fields: the given ones filled, the others kept as wildcards."""
+
+    def __missing__(self, key: str) -> str:
+        return "{" + key + "}"
+
+
+def fill(pattern: str, **fields) -> str:
+    """``pattern`` with the given wildcards filled and the others left as they are (``{onset}`` of an int is
+    written with three digits)."""
+    values = {k: f"{v:03d}" if k == "onset" and isinstance(v, int) else str(v) for k, v in fields.items()}
+    return string.Formatter().vformat(pattern, (), _Keep(values))
 
 
 class Folder:
@@ -81,12 +91,16 @@ class Folder:
 
 class Paths:
     """Every file pattern of a study: ``raw`` (the raw folder, the config's ``raw_dir``) and one attribute per
-    results folder (:data:`RESULT_FILES`), plus the rules' logs and benchmarks."""
+    results folder (``result_files``: folder -> name -> pattern, the stages' files,
+    :data:`loper_analysis.stages.RESULT_FILES`), plus the rules' logs and benchmarks."""
 
-    def __init__(self, raw_dir: str = RAW_DIR, results_dir: str = RESULTS_DIR):
+    def __init__(
+        self, result_files: Mapping[str, Mapping[str, str]], raw_dir: str = RAW_DIR, results_dir: str = RESULTS_DIR
+    ):
         self.raw_dir, self.results_dir = str(raw_dir).rstrip("/"), str(results_dir).rstrip("/")
         self.raw = Folder(self.raw_dir, RAW_FILES)
-        for stage, files in RESULT_FILES.items():
+        self._folders = tuple(result_files)
+        for stage, files in result_files.items():
             setattr(self, stage, Folder(f"{self.results_dir}/{stage}", files))
 
     def log(self, rule: str, key: str) -> str:
@@ -102,7 +116,7 @@ class Paths:
         return Path(self.raw_dir) / subject
 
     def __getattr__(self, name: str) -> Folder:  # for type checkers: the stage folders are set in __init__
-        raise AttributeError(f"no results folder '{name}' (folders: {', '.join(RESULT_FILES)})")
+        raise AttributeError(f"no results folder '{name}' (folders: {', '.join(self.__dict__.get('_folders', ()))})")
 
 
 @dataclass
@@ -300,8 +314,3 @@ class Study:
     def has_device_tests(self) -> bool:
         """Whether the device tests are built: with a device subject (device.subject not null)."""
         return self.config["device"]["subject"] is not None
-
-    def all_targets(self) -> list[str]:
-        """Everything a run builds by default: every stage's targets (``targets`` of its files), in the order of
-        the stages."""
-        return [path for stage in STAGES if stage.targets is not None for path in stage.targets(self)]

@@ -19,8 +19,9 @@ from loper_analysis.io.raw_files import (
     repeated_files,
     unmatched_raw_files,
 )
-from loper_analysis.layout import RAW_FILES, RESULT_FILES, Paths, Study, fill
+from loper_analysis.layout import RAW_FILES, Study, fill
 from loper_analysis.schema import check_table
+from loper_analysis.stages import RESULT_FILES, study_paths
 from loper_analysis.synthetic.subjects import true_impedance
 
 __all__ = [
@@ -50,7 +51,7 @@ def subject_file_names() -> list[str]:
     """Every file or folder name built from a subject ID (``{subject}`` in it), longest first: the names of the
     raw and result patterns (:mod:`loper_analysis.layout`), the logs (and their profiles) and benchmarks, each also
     as the staging directory the writers create beside it (:func:`loper_analysis.io.atomic.stage_name`)."""
-    paths = Paths()
+    paths = study_paths()
     patterns = [
         *(f"{paths.raw_dir}/{p}" for p in RAW_FILES.values()),
         *(f"{paths.results_dir}/{stage}/{p}" for stage, files in RESULT_FILES.items() for p in files.values()),

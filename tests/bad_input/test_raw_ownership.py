@@ -20,13 +20,14 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.settings import stage_settings
 from tests.workflow_copy import copy_workflow, snakemake
 
 pytestmark = pytest.mark.slow  # Snakemake runs the simulated lab (pytest -m "not slow" leaves them out)
 
-PATHS = Paths()
+PATHS = study_paths()
 SHEET = "subject\tsource\theight_m\tmass_kg\nS01\tsynthetic\t1.8\t72\n"
 #: R01's recordings: copies of S01's files (the trials of the design, perturbation trial pert050-2 left out).
 RECORDINGS = ("static.c3d", "walk-device.c3d", "walk-device.loper.tsv", "pert050-1.c3d", "pert050-1.loper.tsv")

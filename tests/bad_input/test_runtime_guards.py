@@ -30,9 +30,10 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.robot_log import write_robot_log
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
 from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.schema import check_yaml_file
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.events import step as event_steps
 from loper_analysis.stages.logs import rule_log
 from loper_analysis.stages.markers import step as marker_steps
@@ -40,7 +41,7 @@ from loper_analysis.stages.markers.step import MarkerSettings
 from loper_analysis.stages.report import step as report
 from tests.workflow_copy import snakemake
 
-PATHS = Paths()
+PATHS = study_paths()
 
 ENOSPC = "[Errno 28] No space left on device"
 POINT_RATE, ANALOG_RATE = 128.0, 1024.0

@@ -30,8 +30,9 @@ from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.io.opensim_tables import read_markers, write_trc
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
 from loper_analysis.motion.ik_settings import IKSettings
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.events import step as event_steps
 from loper_analysis.stages.ik import step as ik
 from loper_analysis.stages.markers import step as marker_steps
@@ -39,7 +40,7 @@ from loper_analysis.stages.markers.step import MarkerSettings
 from loper_analysis.stages.settings import stage_settings
 from tests.workflow_copy import snakemake
 
-PATHS = Paths()
+PATHS = study_paths()
 
 pytestmark = pytest.mark.slow  # Snakemake runs on whole trials (pytest -m "not slow" leaves them out)
 ROOT = Path(__file__).resolve().parents[2]

@@ -21,7 +21,6 @@ import pytest
 from loper_analysis.constants import JOINTS
 from loper_analysis.impedance.identification.across_subjects import impedance_summary
 from loper_analysis.impedance.identification.group_mean import random_effects_mean
-from loper_analysis.layout import Paths
 from loper_analysis.report.front_page import RunSettings, front_page_html
 from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.report.headline import (
@@ -31,10 +30,11 @@ from loper_analysis.report.headline import (
     truth_recovery,
     validation_verdict,
 )
+from loper_analysis.stages import study_paths
 from tests.browser import report_screen
 from tests.headline_tables import device_summary, impedance_row, impedance_table, validation_summary
 
-PATHS = Paths()
+PATHS = study_paths()
 
 ROOT = Path(__file__).resolve().parents[2]
 

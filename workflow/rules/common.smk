@@ -13,12 +13,13 @@ from loper_analysis.config_file import config_layers
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.readers import read_subject_sheet
-from loper_analysis.layout import Paths, Study, fill, subject_rows
+from loper_analysis.layout import Study, fill, subject_rows
 from loper_analysis.schema import check_config, check_project_paths, config_origin
 from loper_analysis.stages.cluster_failures import requested_partitions
 from loper_analysis.study_checks import check_subject_sheet, check_subjects, raw_file_warnings
 from loper_analysis.stages.settings import stage_settings
 from loper_analysis.study_design import DEVICE_TESTS
+from loper_analysis.stages import study_paths
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
 
@@ -63,7 +64,7 @@ def _plates(path) -> bool:
 
 
 #: Every file's path (loper_analysis.layout): PATHS the patterns, STUDY the subjects' trials, bundles and targets.
-PATHS = Paths(config["raw_dir"])
+PATHS = study_paths(config["raw_dir"])
 try:
     #: subject -> its sheet row (a synthetic subject's missing anthropometrics drawn from the study's subjects)
     SUBJECT_ROWS = subject_rows(subjects, config["seed"])

@@ -6,7 +6,7 @@ stage reads only the results of stages before it). Each slice
 its input files, calls the library, which works on arrays and tables only,
 and writes exactly its declared outputs through the atomic writer,
 :mod:`loper_analysis.io.atomic`) and its result files (``files``). The
-workflow's rule includes, the results folders (:data:`loper_analysis.layout.RESULT_FILES`)
+workflow's rule includes, the results folders (:data:`RESULT_FILES`, :func:`study_paths`)
 and the layout's tests are built from this list.
 
 Shared by every stage: :func:`rule_log` (a rule's script runs its step inside
@@ -15,6 +15,7 @@ besides the stages, :mod:`.inspect` (the ``inspect`` command's file step) and
 :mod:`.cluster_failures` (why SLURM ended the failed jobs of a run).
 """
 
+from loper_analysis.layout import RAW_DIR, RESULTS_DIR, Paths, Study
 from loper_analysis.stages import (
     device,
     dynamics,
@@ -52,4 +53,20 @@ STAGES: tuple[Stage, ...] = (
     report.STAGE,
 )
 
-__all__ = ["STAGES", "Stage", "rule_log"]
+#: Every result file: stage folder -> name -> pattern under ``results/{stage}/``, from the stages' files.
+RESULT_FILES: dict[str, dict[str, str]] = {stage.name: dict(stage.files) for stage in STAGES if stage.files}
+
+
+def study_paths(raw_dir: str = RAW_DIR, results_dir: str = RESULTS_DIR) -> Paths:
+    """Every file pattern of a study (:class:`~loper_analysis.layout.Paths`) with the stages' result files:
+    ``study_paths().ik.angles`` is ``results/ik/{subject}/{trial}.angles.tsv``."""
+    return Paths(RESULT_FILES, raw_dir, results_dir)
+
+
+def all_targets(study: Study) -> list[str]:
+    """Everything a run builds by default: every stage's targets (its files' ``targets``), in the stages'
+    order."""
+    return [path for stage in STAGES if stage.targets is not None for path in stage.targets(study)]
+
+
+__all__ = ["RESULT_FILES", "STAGES", "Stage", "all_targets", "rule_log", "study_paths"]

@@ -1,4 +1,4 @@
-"""What a stage of the pipeline owns, as one record: its name and its result files; file patterns filled.
+"""What a stage of the pipeline owns, as one record: its name, its result files and its targets.
 
 A stage's name is the address of everything it owns: its slice
 ``loper_analysis/stages/<name>/`` (the file step ``step.py`` and the result
@@ -8,12 +8,11 @@ results folder ``results/<name>/``.
 
 from __future__ import annotations
 
-import string
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["Stage", "fill"]
+__all__ = ["Stage"]
 
 
 @dataclass(frozen=True)
@@ -40,17 +39,3 @@ class Stage:
     def rule_file(self) -> str:
         """The stage's rule file, relative to the project's folder."""
         return f"workflow/rules/{self.name}.smk"
-
-
-class _Keep(dict):
-    """Format fields: the given ones filled, the others kept as wildcards."""
-
-    def __missing__(self, key: str) -> str:
-        return "{" + key + "}"
-
-
-def fill(pattern: str, **fields) -> str:
-    """``pattern`` with the given wildcards filled and the others left as they are (``{onset}`` of an int is
-    written with three digits)."""
-    values = {k: f"{v:03d}" if k == "onset" and isinstance(v, int) else str(v) for k, v in fields.items()}
-    return string.Formatter().vformat(pattern, (), _Keep(values))

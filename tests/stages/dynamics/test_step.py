@@ -18,7 +18,8 @@ import yaml
 from loper_analysis.dynamics.joint_cycles import CYCLE_COLUMNS, SUMMARY_COLUMNS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import read_model
-from loper_analysis.layout import Paths, fill
+from loper_analysis.layout import fill
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.dynamics.step import (
     DynamicsFiles,
     DynamicsOutputs,
@@ -32,7 +33,7 @@ pytestmark = pytest.mark.slow  # the workflow's upstream rules on a whole record
 
 ROOT = Path(__file__).resolve().parents[3]
 LABS = ROOT / "tests/data/c3d-parser"
-PATHS = Paths()
+PATHS = study_paths()
 SUBJECT, TRIAL = "RCH", "walk-nodevice"
 SIDE_JOINTS = [(side, joint) for side in ("left", "right") for joint in ("hip", "knee", "ankle")]
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from loper_analysis.layout import fill
 from loper_analysis.stages.dynamics.step import DynamicsFiles
-from loper_analysis.stages.stage import fill
 
 if TYPE_CHECKING:
     from loper_analysis.layout import Study

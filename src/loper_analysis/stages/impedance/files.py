@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike
-from loper_analysis.stages.stage import fill
+from loper_analysis.layout import fill
 
 if TYPE_CHECKING:
     from loper_analysis.layout import Study

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 from loper_analysis import cli_options
 from loper_analysis.errors import LoperInputError
+from loper_analysis.stages import study_paths
 from loper_analysis.stages.command import Command
 
 if TYPE_CHECKING:
@@ -140,7 +141,7 @@ def plan_pilot(args: argparse.Namespace, config: dict | None) -> tuple[str | Non
 
 
 def _plan(args: argparse.Namespace) -> None:
-    from loper_analysis.layout import Paths, fill
+    from loper_analysis.layout import fill
     from loper_analysis.planning.precision import PLAN_COLUMNS
     from loper_analysis.stages.planning.files import PilotFiles, PilotTrial
     from loper_analysis.stages.planning.step import plan
@@ -149,7 +150,7 @@ def _plan(args: argparse.Namespace) -> None:
     print(line)
     settings = plan_settings(args, config)
     pilot, sheet, exclude = plan_pilot(args, config)
-    paths = Paths(results_dir=args.results)
+    paths = study_paths(results_dir=args.results)
     subject = pilot or _first_subject(sheet, paths)
     angles = Path(fill(paths.ik.angles, subject=subject))
     suffix = angles.name.format(trial="")  # ".angles.tsv"

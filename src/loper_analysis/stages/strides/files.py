@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from loper_analysis.stages.stage import fill
+from loper_analysis.layout import fill
 
 if TYPE_CHECKING:
     from loper_analysis.layout import Study

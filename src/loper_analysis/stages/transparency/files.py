@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from loper_analysis.io.atomic import PathLike
-from loper_analysis.stages.stage import fill
+from loper_analysis.layout import fill
 
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
