@@ -21,12 +21,12 @@ def pig():
 
 
 def test_a_static_trial_yields_the_centres_only_with_every_landmark(pig):
-    assert calibration_centres(pig, PIG_LABELS) == CENTRES
+    assert calibration_centres(pig.joint_centres, PIG_LABELS) == CENTRES
     sacrum = [m for m in PIG_LABELS if not m.endswith("PSI")] + ["SACR"]
-    assert calibration_centres(pig, sacrum) == CENTRES  # the sacrum for the posterior spines
+    assert calibration_centres(pig.joint_centres, sacrum) == CENTRES  # the sacrum for the posterior spines
     for lacking in ("RPSI", "LANK", "RTOE"):
-        assert calibration_centres(pig, [m for m in PIG_LABELS if m != lacking]) == [], lacking
-    assert calibration_centres(read_templates()["isb"], PIG_LABELS) == []  # a template without centres
+        assert calibration_centres(pig.joint_centres, [m for m in PIG_LABELS if m != lacking]) == [], lacking
+    assert calibration_centres(read_templates()["isb"].joint_centres, PIG_LABELS) == []  # a template without centres
 
 
 def test_the_centres_sit_at_the_models_own_joints_in_the_default_pose(pig):
@@ -34,7 +34,7 @@ def test_the_centres_sit_at_the_models_own_joints_in_the_default_pose(pig):
     model file writes it, the knee's at zero flexion (its translation functions), the ankle's."""
     osim = quiet_opensim()
     model = read_model(template_file(pig.model))
-    places = joint_centre_places(pig, model)
+    places = joint_centre_places(pig.joint_centres, pig.locations(), model, "template plugin_gait")
     assert set(places) == set(CENTRES)
     state = model.initSystem()
     for name, (parent, child) in pig.joint_centres.centres.items():
@@ -53,6 +53,12 @@ def test_the_centres_sit_at_the_models_own_joints_in_the_default_pose(pig):
 
 def test_a_marker_set_is_told_by_its_centres(pig):
     templates = list(read_templates().values())
-    assert marker_set_centres(templates, [*PIG_LABELS, *CENTRES]) == pig.joint_centres  # read twice: equal
-    assert marker_set_centres(templates, PIG_LABELS) is None  # written before the centres: its places are fitted
-    assert marker_set_centres(templates, ["R.ASIS", "L.ASIS", "R.Heel"]) is None  # a lab's own marker set
+    assert (
+        marker_set_centres([t.joint_centres for t in templates], [*PIG_LABELS, *CENTRES]) == pig.joint_centres
+    )  # read twice: equal
+    assert (
+        marker_set_centres([t.joint_centres for t in templates], PIG_LABELS) is None
+    )  # written before the centres: its places are fitted
+    assert (
+        marker_set_centres([t.joint_centres for t in templates], ["R.ASIS", "L.ASIS", "R.Heel"]) is None
+    )  # a lab's own marker set

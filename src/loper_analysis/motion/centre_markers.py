@@ -12,14 +12,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 from loper_analysis.constants import SIDE_SUFFIX, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.joint_centres import DIRECTION_LEVER_M, PELVIS_DIRECTION, Landmarks
-
-if TYPE_CHECKING:
-    from loper_analysis.motion.marker_templates import MarkerTemplate
 
 __all__ = [
     "JointCentreSpec",
@@ -83,37 +79,42 @@ def joint_centre_spec(spec, prefix: Mapping[str, str]) -> JointCentreSpec | None
     return JointCentreSpec(centres, landmarks, float(spec["weight"]), feet, float(spec["others_weight"]))
 
 
-def marker_set_centres(templates: Sequence[MarkerTemplate], marker_names: Sequence[str]) -> JointCentreSpec | None:
-    """The joint centres of the template whose centres' virtual markers a model's marker set holds (None: the
-    marker set holds no template's centres: a lab's own marker set, or one written before the calibration through
-    joint centres)."""
+def marker_set_centres(specs: Sequence[JointCentreSpec | None], marker_names: Sequence[str]) -> JointCentreSpec | None:
+    """Of the templates' joint centres (``specs``, None for a template without), those whose virtual markers a
+    model's marker set holds (None: the marker set holds no template's centres: a lab's own marker set, or one
+    written before the calibration through joint centres)."""
     have = set(marker_names)
-    for template in templates:
-        names = centre_names(template)
+    for spec in specs:
+        names = centre_names(spec)
         if names and all(n in have for n in names):
-            return template.joint_centres
+            return spec
     return None
 
 
-def centre_names(template: MarkerTemplate) -> list[str]:
-    """The template's virtual markers (none without joint centres)."""
-    return [] if template.joint_centres is None else template.joint_centres.names
+def centre_names(spec: JointCentreSpec | None) -> list[str]:
+    """A template's virtual markers of its joint centres ``spec`` (none without joint centres)."""
+    return [] if spec is None else spec.names
 
 
-def joint_centre_places(template: MarkerTemplate, model) -> dict[str, tuple[str, tuple[float, float, float]]]:
-    """Each virtual marker of the calibration -> (body, location in its frame, m) on ``model``, in the model's
+def joint_centre_places(
+    spec: JointCentreSpec | None,
+    landmarks: Mapping[str, tuple[str, tuple[float, float, float]]],
+    model,
+    source: str,
+) -> dict[str, tuple[str, tuple[float, float, float]]]:
+    """Each virtual marker of the calibration ``spec`` -> (body, location in its frame, m) on ``model``, in the model's
     default pose: a joint centre is the child body's origin in the parent body's frame; the pelvis's direction
     markers lie :data:`~loper_analysis.motion.joint_centres.DIRECTION_LEVER_M` ahead of and behind the hips' midpoint
     along the line from the template's posterior spines (or sacrum) to its anterior spines, a foot's above and below
     the ankle centre (against the model's gravity: the foot stands flat in the default pose). Empty for a template
-    without joint centres.
+    without joint centres. ``landmarks``: the template's markers, name -> (body, location in its frame, m);
+    ``source``: the template, as the messages name it.
 
     Raises
     ------
     LoperInputError
-        A body or landmark the template names that the model or template lacks.
+        A body or landmark the template names that the model or template lacks (naming ``source``).
     """
-    spec = template.joint_centres
     if spec is None:
         return {}
     import numpy as np
@@ -128,7 +129,7 @@ def joint_centre_places(template: MarkerTemplate, model) -> dict[str, tuple[str,
 
     def body(name: str, what: str):
         if not bodies.contains(name):
-            raise LoperInputError(f"template {template.name}: {what} on body {name}, which {template.model} lacks")
+            raise LoperInputError(f"{source}: {what} on body {name}, which its model lacks")
         return bodies.get(name)
 
     def in_ground(name: str, location) -> np.ndarray:
@@ -140,10 +141,10 @@ def joint_centre_places(template: MarkerTemplate, model) -> dict[str, tuple[str,
         return (float(p[0]), float(p[1]), float(p[2]))
 
     def landmark(name: str) -> np.ndarray:
-        if name not in template.marker_names:
-            raise LoperInputError(f"template {template.name}: the calibration's landmark {name} is not its marker")
-        m = template.marker(name)
-        return in_ground(m.body, m.location_m)
+        if name not in landmarks:
+            raise LoperInputError(f"{source}: the calibration's landmark {name} is not its marker")
+        body_name, location = landmarks[name]
+        return in_ground(body_name, location)
 
     out, centre_ground = {}, {}
     for name, (parent, child) in spec.centres.items():
@@ -174,12 +175,11 @@ def joint_centre_places(template: MarkerTemplate, model) -> dict[str, tuple[str,
     return out
 
 
-def calibration_centres(template: MarkerTemplate, static_markers: Sequence[str] | None) -> list[str]:
-    """The joint centres' virtual markers a static trial holding ``static_markers`` (model names, derived ones
-    included) yields: all of the template's when it holds both anterior spines, the posterior spines or the sacrum,
-    the lateral knee and ankle markers, the heel and toe markers, else none (the calibration then keeps the
-    template's places)."""
-    spec = template.joint_centres
+def calibration_centres(spec: JointCentreSpec | None, static_markers: Sequence[str] | None) -> list[str]:
+    """The joint centres' virtual markers (of a template's ``spec``) a static trial holding ``static_markers``
+    (model names, derived ones included) yields: all of them when it holds both anterior spines, the posterior
+    spines or the sacrum, the lateral knee and ankle markers, the heel and toe markers, else none (the calibration
+    then keeps the template's places)."""
     if spec is None or static_markers is None:
         return []
     lm, have = spec.landmarks, set(static_markers)

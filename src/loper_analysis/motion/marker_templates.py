@@ -133,6 +133,10 @@ class MarkerTemplate:
         """The template's marker names, in order."""
         return [m.name for m in self.markers]
 
+    def locations(self) -> dict[str, tuple[str, tuple[float, float, float]]]:
+        """Every marker: name -> (body, location in the body's frame, m)."""
+        return {m.name: (m.body, tuple(m.location_m)) for m in self.markers}
+
     def marker(self, name: str) -> TemplateMarker:
         """The template marker of that name."""
         return next(m for m in self.markers if m.name == name)
@@ -190,7 +194,7 @@ def template_from_spec(name: str, spec: Mapping, source: str) -> MarkerTemplate:
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise LoperInputError(f"{source}: not a marker-set template ({type(exc).__name__}: {exc})") from None
-    names = set(template.marker_names) | set(_kad_names(template)) | set(centre_names(template))
+    names = set(template.marker_names) | set(_kad_names(template)) | set(centre_names(template.joint_centres))
     named = [m for pairs, _ in measurements.values() for pair in pairs for m in pair]
     named += [m for group in template.required for m in group] + list(template.foot_markers.values())
     unknown = sorted(set(named) - names)
@@ -297,13 +301,15 @@ def template_marker_set(template: MarkerTemplate, names: Sequence[str] | None = 
     osim = quiet_opensim()
     keep = None if names is None else set(names)
     centres = {}
-    if calibration_centres(template, names):
+    if calibration_centres(template.joint_centres, names):
         if model is None:
             raise LoperInputError(
                 f"template {template.name}: the marker set of a static trial with the joint centres' landmarks needs "
                 f"the model ({template.model}) for the centres' places"
             )
-        centres = joint_centre_places(template, model)
+        centres = joint_centre_places(
+            template.joint_centres, template.locations(), model, f"template {template.name} ({template.model})"
+        )
     out = osim.MarkerSet()
     places = [(m.name, m.body, m.location_m, m.role == "anatomical" and not centres) for m in template.markers]
     places += [(name, body, location, True) for name, (body, location) in centres.items()]
@@ -321,7 +327,7 @@ def template_marker_set(template: MarkerTemplate, names: Sequence[str] | None = 
 
 def _present_pairs(template: MarkerTemplate, present: set[str]) -> dict[str, tuple[tuple[str, str], ...]]:
     """Each measurement's pairs whose markers are present; where pairs of joint centres are present, those alone."""
-    centres = set(centre_names(template))
+    centres = set(centre_names(template.joint_centres))
     pairs = {}
     for name, entry in template.measurements.items():
         found = tuple(p for p in entry[0] if p[0] in present and p[1] in present)
@@ -386,7 +392,7 @@ def template_scale_tool(template: MarkerTemplate, static_markers: Sequence[str],
     from loper_analysis.io.osim import quiet_opensim
 
     osim = quiet_opensim()
-    centres = calibration_centres(template, static_markers)
+    centres = calibration_centres(template.joint_centres, static_markers)
     present = (set(static_markers) & set(template.marker_names)) | set(centres)
     measurements = {
         name: (pairs, template.measurements[name][1])

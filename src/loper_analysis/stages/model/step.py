@@ -358,7 +358,7 @@ def _with_joint_centres(markers, generic, static_c3d: PathLike | None, static_tr
     from loper_analysis.motion.joint_centres import widths_from_processing
 
     names = scale_tool.object_names(generic.getMarkerSet())
-    spec = marker_set_centres(list(read_templates().values()), names)
+    spec = marker_set_centres([t.joint_centres for t in read_templates().values()], names)
     if spec is None:
         return markers, {}
     widths = widths_from_processing(_stored_values(static_c3d)[0])
