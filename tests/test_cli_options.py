@@ -8,6 +8,7 @@ import pytest
 
 from loper_analysis import cli_options
 from loper_analysis.motion.trial_markers import MarkerSettings
+from loper_analysis.stages.command import command_settings
 from tests.config_layers import STRIDES
 
 
@@ -45,7 +46,7 @@ def test_without_a_config_the_librarys_defaults_serve_and_the_line_says_so(parse
     monkeypatch.chdir(tmp_path)
     config, line = cli_options.read_config(parser.parse_args([]))
     assert config is None and line.startswith("config: none (no config/config.yaml in ")
-    settings = cli_options.command_settings(parser.parse_args([]), "markers", MarkerSettings(), order=2, cutoff_hz=None)
+    settings = command_settings(parser.parse_args([]), "markers", MarkerSettings(), order=2, cutoff_hz=None)
     assert settings == MarkerSettings(order=2)
     assert capsys.readouterr().out.startswith("config: none")
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.marker_templates import read_templates
+from loper_analysis.stages.templates import read_templates
 from loper_analysis.subject_setup import NoTemplateFits, format_fits, subject_setup
 
 #: Plug-in Gait's lower-body markers as a walking trial holds them.

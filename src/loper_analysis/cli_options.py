@@ -9,11 +9,9 @@ see (:func:`read_config`, :func:`stage_settings`).
 from __future__ import annotations
 
 import argparse
-import dataclasses
 from pathlib import Path
 
 __all__ = [
-    "command_settings",
     "add_configfile_option",
     "add_label_map_option",
     "add_rotate_option",
@@ -88,24 +86,6 @@ def label_map(path: str | None) -> dict[str, str] | None:
     from loper_analysis.io.readers import read_label_map
 
     return None if path is None else read_label_map(path)
-
-
-def command_settings(args: argparse.Namespace, stage: str, default, part: str | None = None, **given):
-    """A stage's settings for a subcommand: the config's (:func:`read_config`, its line printed; built by the
-    stage's reader, :func:`loper_analysis.stages.settings.stage_settings`, and of them ``part`` when given), else
-    ``default`` (the library's defaults); then each option in ``given`` that is not None."""
-    from loper_analysis.stages.settings import stage_settings
-
-    config, line = read_config(args)
-    print(line)
-    if config is None:
-        settings = default
-    else:
-        settings = stage_settings(config, stage)
-        settings = settings if part is None else getattr(settings, part)
-    if config is not None and "label_map" in given and given["label_map"] is None:
-        given["label_map"] = config["markers"]["label_map"] or None
-    return dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})
 
 
 def read_config(args: argparse.Namespace) -> tuple[dict | None, str]:

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 __all__ = [
     "LOADED_THRESHOLD_N",
+    "MAX_RESTING_N",
+    "RESTING_BAND_N",
     "SIDES",
     "SIDE_SUFFIX",
     "JOINTS",
@@ -102,3 +104,10 @@ def parameter_column(kind: str, what: str = "") -> str:
     """
     middle = f"_{what}" if what else ""
     return f"{kind}{middle}_{UNIT_SUFFIX[kind]}"
+
+
+#: A force plate's resting level: samples within this of a plate's lowest vertical force are unloaded (N; config
+#: ``grf.resting_band_n``) ...
+RESTING_BAND_N: float = 10.0
+#: ... and their median, the resting level, must lie within +- this (N; ``grf.max_resting_n``).
+MAX_RESTING_N: float = 100.0

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import yaml
 
-from loper_analysis.io.marker_templates import NOT_A_TEMPLATE, TEMPLATE_DIR, read_templates, template_file
+from loper_analysis.io.marker_templates import NOT_A_TEMPLATE, TEMPLATE_DIR, template_file
 from loper_analysis.motion.marker_templates import template_from_spec
+from loper_analysis.stages.templates import read_templates
 
 
 def test_every_yaml_file_but_the_synonym_table_is_one_template_by_its_stem():

@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from loper_analysis.io.marker_templates import read_templates, template_file
+from loper_analysis.io.marker_templates import template_file
 from loper_analysis.io.osim import quiet_opensim, read_model
 from loper_analysis.motion.centre_markers import calibration_centres, joint_centre_places, marker_set_centres
+from loper_analysis.stages.templates import read_templates
 
 PIG_LABELS = [f"{s}{c}" for s in "LR" for c in ("ASI", "PSI", "THI", "KNE", "TIB", "ANK", "HEE", "TOE")]
 CENTRES = ["LHJC", "RHJC", "LKJC", "RKJC", "LAJC", "RAJC", "PELVIS_FRONT", "PELVIS_BACK", "LKNEE_LAT", "LKNEE_MED",

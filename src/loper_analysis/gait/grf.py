@@ -62,7 +62,13 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.checks import number, where
-from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, LAB_Z_UP, LOADED_THRESHOLD_N
+from loper_analysis.constants import (
+    LAB_TO_MODEL_ROTATION_DEG,
+    LAB_Z_UP,
+    LOADED_THRESHOLD_N,
+    MAX_RESTING_N,
+    RESTING_BAND_N,
+)
 from loper_analysis.errors import LoperInputError
 from loper_analysis.motion.markers import rotate_markers
 
@@ -84,10 +90,6 @@ __all__ = [
     "vertical_loads",
 ]
 
-#: Samples within this of a plate's lowest vertical force are unloaded (N; config ``grf.resting_band_n``) ...
-RESTING_BAND_N: float = 10.0
-#: ... and their median, the resting level, must lie within +- this (N; ``grf.max_resting_n``).
-MAX_RESTING_N: float = 100.0
 
 #: Column suffixes of one plate in the external-loads table (force N, point m, torque N·m).
 EXTERNAL_LOADS_SUFFIXES: tuple[str, ...] = (

@@ -28,9 +28,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from loper_analysis.checks import where
-from loper_analysis.constants import GRAVITY_M_PER_S2, LOADED_THRESHOLD_N
+from loper_analysis.constants import GRAVITY_M_PER_S2, LOADED_THRESHOLD_N, MAX_RESTING_N, RESTING_BAND_N
 from loper_analysis.errors import LoperInputError
-from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
 from loper_analysis.swing_leg.anthropometry import ANKLE_HEIGHT_FRACTION, WINTER_SEGMENTS
 
 __all__ = [
@@ -264,7 +263,7 @@ def standing_plates(
     Unloaded plates do not read zero (unzeroed plates read -14 .. -71 N at rest in real files): summed in, such
     a plate would change the mass by kilograms. A plate's resting level is measured where the trial shows the
     plate unloaded: its lowest level (1st percentile of its vertical force over the trial) within
-    :data:`loper_analysis.gait.grf.MAX_RESTING_N` (100 N, the default of the grf step's limit
+    :data:`loper_analysis.constants.MAX_RESTING_N` (100 N, the default of the grf step's limit
     ``grf.max_resting_n``), the median of the samples within ``RESTING_BAND_N`` (10 N) of it, as
     :func:`loper_analysis.gait.grf.resting_level` takes it. A plate whose force stays above that
     level throughout is loaded throughout: its resting level cannot be measured and is taken as 0 (a plate

@@ -8,14 +8,17 @@ command's parser, handlers and option limits are built from the stages.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib
 import importlib.util
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 
+from loper_analysis import cli_options
 from loper_analysis.stages import STAGES
+from loper_analysis.stages.settings import stage_settings
 
-__all__ = ["Command", "stage_commands"]
+__all__ = ["Command", "stage_commands", "command_settings"]
 
 
 @dataclass(frozen=True)
@@ -59,3 +62,20 @@ def stage_commands() -> tuple[Command, ...]:
         if importlib.util.find_spec(name) is not None:
             commands += importlib.import_module(name).COMMANDS
     return tuple(commands)
+
+
+def command_settings(args: argparse.Namespace, stage: str, default, part: str | None = None, **given):
+    """A stage's settings for a subcommand: the config's (:func:`loper_analysis.cli_options.read_config`, its line
+    printed; built by the stage's reader, :func:`loper_analysis.stages.settings.stage_settings`, and of them
+    ``part`` when given), else ``default`` (the library's defaults); then each option in ``given`` that is not
+    None."""
+    config, line = cli_options.read_config(args)
+    print(line)
+    if config is None:
+        settings = default
+    else:
+        settings = stage_settings(config, stage)
+        settings = settings if part is None else getattr(settings, part)
+    if config is not None and "label_map" in given and given["label_map"] is None:
+        given["label_map"] = config["markers"]["label_map"] or None
+    return dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})

@@ -393,7 +393,7 @@ def inspect_subject(
         starter map (``label_map_starter.tsv``: every label, the template's marker where one was found) is
         written beside it and nothing else.
     """
-    from loper_analysis.io.marker_templates import read_templates
+    from loper_analysis.stages.templates import read_templates
     from loper_analysis.subject_setup import subject_setup
 
     paths = [Path(p) for p in c3d_paths]

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from loper_analysis.io.marker_templates import read_templates, template_file
+from loper_analysis.io.marker_templates import template_file
 from loper_analysis.io.opensim_tables import write_trc
 from loper_analysis.io.osim import quiet_opensim, read_model, write_osim_object
 from loper_analysis.motion.ik import inverse_kinematics
@@ -24,6 +24,7 @@ from loper_analysis.motion.marker_templates import (
     template_scale_tool,
 )
 from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale_with_setup
+from loper_analysis.stages.templates import read_templates
 
 pytestmark = pytest.mark.slow  # OpenSim's ScaleTool and IK
 

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.io.marker_templates import read_templates, template_file
+from loper_analysis.io.marker_templates import template_file
 from loper_analysis.io.opensim_tables import read_markers
 from loper_analysis.io.osim import quiet_opensim, read_model, write_osim_object
 from loper_analysis.motion.marker_templates import (
@@ -20,6 +20,7 @@ from loper_analysis.motion.marker_templates import (
 )
 from loper_analysis.stages.markers.step import MarkerSettings, markers
 from loper_analysis.stages.model.step import ModelSettings, ScaleFiles, scale_with_setup
+from loper_analysis.stages.templates import read_templates
 
 pytestmark = pytest.mark.slow  # OpenSim's ScaleTool on whole static trials
 DATA = Path(__file__).resolve().parents[2] / "data"

@@ -6,7 +6,7 @@ import argparse
 
 from loper_analysis import cli_options
 from loper_analysis.errors import LoperInputError
-from loper_analysis.stages.command import Command
+from loper_analysis.stages.command import Command, command_settings
 
 __all__ = ["COMMANDS"]
 
@@ -56,7 +56,7 @@ def _plates(text: str | None) -> dict[str, int] | None:
 def _events(args: argparse.Namespace) -> None:
     from loper_analysis.stages.events.step import EventSettings, events
 
-    settings = cli_options.command_settings(
+    settings = command_settings(
         args,
         "events",
         EventSettings(),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from loper_analysis import cli_options
-from loper_analysis.stages.command import Command
+from loper_analysis.stages.command import Command, command_settings
 
 __all__ = ["COMMANDS"]
 
@@ -27,7 +27,7 @@ def _grf(args: argparse.Namespace) -> None:
     from loper_analysis.gait.grf_settings import GRFSettings
     from loper_analysis.stages.grf.step import grf
 
-    settings = cli_options.command_settings(
+    settings = command_settings(
         args,
         "grf",
         GRFSettings(),

@@ -6,7 +6,7 @@ import argparse
 import dataclasses
 
 from loper_analysis import cli_options
-from loper_analysis.stages.command import Command
+from loper_analysis.stages.command import Command, command_settings
 
 __all__ = ["COMMANDS"]
 
@@ -33,7 +33,7 @@ def _add_markers(p: argparse.ArgumentParser) -> None:
 def _markers(args: argparse.Namespace) -> None:
     from loper_analysis.stages.markers.step import MarkerSettings, markers
 
-    settings = cli_options.command_settings(
+    settings = command_settings(
         args,
         "markers",
         MarkerSettings(),

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from loper_analysis import cli_options
 from loper_analysis.errors import LoperInputError
-from loper_analysis.stages.command import Command
+from loper_analysis.stages.command import Command, command_settings
 
 __all__ = ["COMMANDS"]
 
@@ -142,7 +142,7 @@ def _segments(args: argparse.Namespace) -> None:
             raise LoperInputError("segments: give either --model or --height-m and --mass-kg, not both")
     elif args.height_m is None or args.mass_kg is None:
         raise LoperInputError("segments: give --model SCALED.osim, or --height-m and --mass-kg")
-    settings = cli_options.command_settings(
+    settings = command_settings(
         args, "model", ModelSettings(), side=args.side, attachment_fraction=args.attachment_fraction
     )
     if args.model is not None:

@@ -353,9 +353,9 @@ def _with_joint_centres(markers, generic, static_c3d: PathLike | None, static_tr
     """The static trial with the joint centres the generic model's marker set holds (a template's:
     :func:`loper_analysis.motion.centre_markers.marker_set_centres`), computed with the widths the static C3D
     stores; unchanged (and no methods) for any other marker set."""
-    from loper_analysis.io.marker_templates import read_templates
     from loper_analysis.motion.centre_markers import marker_set_centres
     from loper_analysis.motion.joint_centres import widths_from_processing
+    from loper_analysis.stages.templates import read_templates
 
     names = scale_tool.object_names(generic.getMarkerSet())
     spec = marker_set_centres([t.joint_centres for t in read_templates().values()], names)
