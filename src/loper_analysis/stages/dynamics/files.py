@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from loper_analysis.errors import LoperInputError
 from loper_analysis.layout import fill
 from loper_analysis.stages.dynamics.step import DynamicsFiles
 
@@ -49,7 +50,23 @@ def trials_without(study: Study) -> list[tuple[str, str, str]]:
 
 def dynamics_files(study: Study, subject: str, trial: str) -> DynamicsFiles:
     """The files of one trial's inverse dynamics: the subject's model, the trial's IK, ground reactions, contacts,
-    events and strides."""
+    events and strides.
+
+    Raises
+    ------
+    LoperInputError
+        A trial that gets no inverse dynamics (a synthetic subject's, or one without force platforms), naming it
+        and why.
+    """
+    if (subject, trial) not in dynamics_trials(study):
+        why = (
+            NO_PLATES
+            if study.source(subject) == "recorded"
+            else ("a synthetic subject's trials hold the belts' vertical forces only (no centre of pressure)")
+        )
+        raise LoperInputError(
+            f"{subject}/{trial}: no inverse dynamics: {why}; {study.paths.dynamics.trials} says which trials have it"
+        )
     p, s, t = study.paths, subject, trial
     return DynamicsFiles(
         model_osim=study.subject_model(s),
