@@ -19,11 +19,12 @@ from loper_analysis.dynamics.foot_loads import (
 from loper_analysis.dynamics.inverse_dynamics import FootLoad, generalized_forces
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.opensim_tables import read_mot
-from loper_analysis.io.osim import quiet_opensim, read_model
+from loper_analysis.io.osim import read_model
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.motion.markers import lab_up
 from loper_analysis.stages.grf.step import grf
 from loper_analysis.stages.settings import stage_settings
+from tests.opensim_inverse_dynamics import opensim_inverse_dynamics
 from tests.stages.dynamics.test_step import LABS, ROOT, recorded_trial
 
 CUTOFF_HZ = 6.0
@@ -33,30 +34,6 @@ GAIT2392 = ROOT / "src/loper_analysis/templates/gait2392_simbody.osim"
 
 
 # ---------------------------------------------------------------- against OpenSim's tool on RCH's five plates
-
-
-def _opensim_inverse_dynamics(model_osim, coordinates_mot, loads_xml, out, times) -> pd.DataFrame:
-    """OpenSim's InverseDynamicsTool with an ExternalLoads file, every model force excluded."""
-    osim = quiet_opensim()
-    model = osim.Model(str(model_osim))
-    tool = osim.InverseDynamicsTool()
-    tool.setModel(model)
-    tool.setCoordinatesFileName(str(coordinates_mot))
-    tool.setLowpassCutoffFrequency(CUTOFF_HZ)
-    tool.setExternalLoadsFileName(str(loads_xml))
-    tool.setStartTime(times[0])
-    tool.setEndTime(times[-1])
-    excluded = osim.ArrayStr()
-    excluded.append("All")
-    tool.setExcludedForces(excluded)
-    tool.setResultsDir(str(out))
-    tool.setOutputGenForceFileName("id.sto")
-    assert tool.run()
-    table = osim.TimeSeriesTable(str(out / "id.sto"))
-    names = list(table.getColumnLabels())
-    t = np.array(table.getIndependentColumn())
-    values = table.getMatrix().to_numpy().reshape(t.size, len(names))
-    return pd.DataFrame({"time_s": t, **{n: values[:, j] for j, n in enumerate(names)}})
 
 
 @pytest.fixture(scope="module")
@@ -87,7 +64,7 @@ def rch(tmp_path_factory):
     ik = read_mot(files["ik"])
     ik = ik[(ik["time_s"] >= table["time_s"].iloc[0]) & (ik["time_s"] <= table["time_s"].iloc[-1])]
     t = ik["time_s"].to_numpy()
-    reference = _opensim_inverse_dynamics(files["model"], files["ik"], out / "walk.loads.xml", out, t)
+    reference = opensim_inverse_dynamics(files["model"], files["ik"], out / "walk.loads.xml", out, t, CUTOFF_HZ)
     loads = foot_loads(ground, contacts)
     model = read_model(files["model"])
     ours = generalized_forces(model, t, ik.drop(columns="time_s"), list(loads.values()), cutoff_hz=CUTOFF_HZ)

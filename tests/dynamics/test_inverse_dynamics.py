@@ -19,6 +19,7 @@ from loper_analysis.dynamics.inverse_dynamics import (
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.opensim_tables import read_mot
 from loper_analysis.io.osim import quiet_opensim, read_marker_set, read_model, write_model
+from tests.opensim_inverse_dynamics import opensim_inverse_dynamics
 from tests.rajagopal_lab import DATA, GENERIC_OSIM, GRF_MOT, IK_SETUP, MARKER_SET, WALK_TRC, opensim_ik_reference
 
 GRF_XML = DATA / "Rajagopal_grf_walk.xml"
@@ -67,33 +68,15 @@ def walk(tmp_path_factory):
 
 
 def _opensim_inverse_dynamics(model_osim, coordinates_mot, out) -> pd.DataFrame:
-    """OpenSim's InverseDynamicsTool on ``coordinates_mot`` with the walk's ExternalLoads, all model forces
-    excluded; its generalised forces (``time`` -> ``time_s``, columns as OpenSim names them)."""
+    """OpenSim's InverseDynamicsTool on ``coordinates_mot`` with the walk's ExternalLoads
+    (:func:`tests.opensim_inverse_dynamics.opensim_inverse_dynamics`)."""
     osim = quiet_opensim()
     tree = ET.parse(GRF_XML)  # the setup's data file is relative to OpenSim's folders: point it at ours
     tree.getroot().find(".//datafile").text = str(GRF_MOT)
     tree.getroot().find(".//external_loads_model_kinematics_file").text = "Unassigned"
     tree.write(out / "grf_walk.xml")
     times = osim.TimeSeriesTable(str(coordinates_mot)).getIndependentColumn()
-    model = osim.Model(str(model_osim))  # kept alive while the tool runs
-    tool = osim.InverseDynamicsTool()
-    tool.setModel(model)
-    tool.setCoordinatesFileName(str(coordinates_mot))
-    tool.setLowpassCutoffFrequency(CUTOFF_HZ)
-    tool.setExternalLoadsFileName(str(out / "grf_walk.xml"))
-    tool.setStartTime(times[0])
-    tool.setEndTime(times[-1])
-    excluded = osim.ArrayStr()
-    excluded.append("All")
-    tool.setExcludedForces(excluded)
-    tool.setResultsDir(str(out))
-    tool.setOutputGenForceFileName("walk_id.sto")
-    assert tool.run()
-    table = osim.TimeSeriesTable(str(out / "walk_id.sto"))
-    names = list(table.getColumnLabels())
-    time_s = np.array(table.getIndependentColumn())
-    values = table.getMatrix().to_numpy().reshape(time_s.size, len(names))
-    return pd.DataFrame({"time_s": time_s, **{name: values[:, j] for j, name in enumerate(names)}})
+    return opensim_inverse_dynamics(model_osim, coordinates_mot, out / "grf_walk.xml", out, times, CUTOFF_HZ)
 
 
 @pytest.mark.slow  # OpenSim's IK and ID tools on the whole Rajagopal2016 walk (6 s)
