@@ -100,8 +100,9 @@ class IKResult:
     of the file step (a joint angle that looks inverted). ``geometry_change``: the median relative change of the
     distances between markers on one body against the static trial's, or the model's
     (:mod:`loper_analysis.motion.marker_geometry`;
-    NaN when not compared). ``solver``: the solver that gave the coordinates (``tree``, or ``opensim`` and
-    why).
+    NaN when not compared). ``solver``: the solver that gave the coordinates (``tree`` or ``opensim``);
+    ``fallback_reason``: why OpenSim's solver served when the tree's was asked for (the model's joint the tree
+    does not hold, or its check against OpenSim failing; '' otherwise).
     """
 
     time_s: np.ndarray
@@ -117,6 +118,7 @@ class IKResult:
     warnings: list[str] = field(default_factory=list)
     geometry_change: float = float("nan")
     solver: str = ""
+    fallback_reason: str = ""
 
     @property
     def n_left_out(self) -> int:
@@ -130,7 +132,8 @@ class IKResult:
         frames whose marker RMS error exceeds ``warn_rms_m`` (m); ``worst_marker`` is the marker with the
         largest RMS error over the trial (``worst_marker_rms_m``; '' and NaN without marker errors),
         ``worst_markers_mm`` the three worst with their RMS error in mm, as text (``LTHI 28.0, RTHI 25.1, ...``);
-        ``warnings`` joins :attr:`warning` and :attr:`warnings` ('' when none); ``solver`` is :attr:`solver`.
+        ``warnings`` joins :attr:`warning` and :attr:`warnings` ('' when none); ``solver`` is :attr:`solver`, with
+        :attr:`fallback_reason` after a colon when there is one (``opensim: joint 'free' is a FreeJoint ...``).
         """
         solved = np.ones(self.time_s.size, bool) if self.solved is None else self.solved
         rms = self.marker_rms_m[np.isfinite(self.marker_rms_m)]
@@ -153,7 +156,7 @@ class IKResult:
                     "worst_markers_mm": ", ".join(f"{m} {1e3 * e:.1f}" for m, e in list(per_marker.items())[:3]),
                     "marker_geometry_change": self.geometry_change,
                     "warnings": " | ".join(w for w in [self.warning, *self.warnings] if w),
-                    "solver": self.solver,
+                    "solver": f"{self.solver}: {self.fallback_reason}" if self.fallback_reason else self.solver,
                 }
             ],
             columns=list(IK_SUMMARY_COLUMNS),
@@ -327,7 +330,7 @@ def inverse_kinematics(
             + ", ".join(f"{c} ({n} of {t.size} frames)" for c, n in lacking.items())
         )
     frames = np.flatnonzero(solved)
-    Q, E, in_use_names, note = _solution(
+    Q, E, in_use_names, used, reason = _solution(
         model,
         t,
         X,
@@ -357,28 +360,30 @@ def inverse_kinematics(
         solved=solved,
         marker_errors_m=E,
         marker_names=in_use_names,
-        solver=note,
+        solver=used,
+        fallback_reason=reason,
     )
 
 
 def _solution(
     model, t, X, labels, marker_weights, *, solver, coordinate_tasks, frames, accuracy, source
-) -> tuple[np.ndarray, np.ndarray, list[str], str]:
+) -> tuple[np.ndarray, np.ndarray, list[str], str, str]:
     """Coordinates (n_frames, n_coordinates) in coordinate-set order, marker errors (n_frames, n_in_use) in m,
-    the markers in use and the solver that gave them (``tree``, or ``opensim`` with the reason)."""
+    the markers in use, the solver that gave them (``tree`` or ``opensim``) and why OpenSim's served when the
+    tree's was asked for ('' otherwise)."""
     options = {"coordinate_tasks": coordinate_tasks, "frames": frames, "accuracy": accuracy, "source": source}
-    note = "opensim"
+    reason = ""
     if solver == "tree":
         from loper_analysis.motion.kinematic_tree import UnsupportedModel
         from loper_analysis.motion.tree_ik import tree_solution
 
         try:
-            return (*tree_solution(model, t, X, labels, marker_weights, **options), list(labels), "tree")
-        except UnsupportedModel as reason:
-            note = f"opensim: {reason}"
+            return (*tree_solution(model, t, X, labels, marker_weights, **options), list(labels), "tree", "")
+        except UnsupportedModel as exc:
+            reason = str(exc)
     from loper_analysis.motion.opensim_ik import opensim_solution
 
-    return (*opensim_solution(model, t, X, labels, marker_weights, **options), note)
+    return (*opensim_solution(model, t, X, labels, marker_weights, **options), "opensim", reason)
 
 
 def _weighted_markers(

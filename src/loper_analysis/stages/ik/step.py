@@ -37,8 +37,8 @@ def _checked(res, source: str, settings: IKSettings):
     if poor:
         log.warning("%s", poor)
     res.warning = poor
-    if res.solver.startswith("opensim:"):
-        log.info("%s: solved with OpenSim's IK solver, %s", source, res.solver.removeprefix("opensim: "))
+    if res.fallback_reason:
+        log.info("%s: solved with OpenSim's IK solver, %s", source, res.fallback_reason)
     if res.n_left_out:
         t = res.time_s[res.solved]
         log.warning(
