@@ -4,8 +4,11 @@ named with its section and reader, and the settings the workflow builds are thos
 
 from __future__ import annotations
 
+import ast
 import copy
+import dataclasses
 import importlib
+import inspect
 from collections.abc import Mapping
 
 import pytest
@@ -117,3 +120,58 @@ def test_the_planner_models_the_load_cell_the_events_stage_filters_with():
     loadcell = stage_settings(config, "events").loadcell
     assert (plan.force_cutoff_hz, plan.force_order) == (loadcell.cutoff_hz, loadcell.order) == (25.0, 2)
     assert plan.force_rate_hz == 500.0
+
+
+#: Fields of the settings types that no reader sets, each a value the stage's code owns rather than a setting,
+#: with why (the test below fails for any other field a reader leaves at its default).
+NOT_SETTINGS_FIELDS = {
+    "MarkerSettings.label_map": "a trial's label maps, given per trial by the markers rule (markers.label_map ...)",
+    "MarkerSettings.span_s": "a trial's span, given per trial by the markers rule (markers.trial_spans_s)",
+    "MarkerSettings.duration_s": "an option of the markers step for a caller (keep the first seconds); the workflow "
+    "keeps every frame",
+    "MarkerSettings.required_markers": "an option of the markers step for a caller (markers that must be found)",
+    "EventSettings.toe_markers": "the template's toe markers (model names); a file without them: found by name",
+    "IKSettings.min_markers": "the fewest weighted markers that determine a frame: a property of the method",
+    "EventSettings.label_map": "a trial's label maps, given per trial by the events rule",
+    "IKSettings.subjects_model": "whether the model comes from the subject sheet, given per subject by the rule",
+    "ModelSettings.time_range_s": "the static trial's window, from the ScaleTool setup or the scale command",
+    "ResponseSettings.rate_hz": "the grid rate of the responses, the study's motion-capture rate (128 Hz)",
+    "LabSettings.*": "the synthetic lab's rates, robot log margin and belt channels (documented defaults)",
+    "ValidationSettings.reference_cutoff_hz": "the study fits the unfiltered reference (no config key)",
+}
+
+
+def _constructed_fields(reader, module) -> dict[str, set[str]]:
+    """Settings type -> the fields its constructor gets in the reader's source: by keyword, by position (the
+    first fields), or all of them when a mapping is unpacked into it (``**section``, every key of a section)."""
+    tree = ast.parse(inspect.getsource(reader))
+    out: dict[str, set[str]] = {}
+    for node in ast.walk(tree):
+        if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id[:1].isupper()):
+            continue
+        settings_type = getattr(module, node.func.id, None)
+        if settings_type is None or not dataclasses.is_dataclass(settings_type):
+            continue
+        names = [f.name for f in dataclasses.fields(settings_type) if f.init]
+        given = {k.arg for k in node.keywords if k.arg} | set(names[: len(node.args)])
+        if any(k.arg is None for k in node.keywords):
+            given = set(names)
+        out.setdefault(node.func.id, set()).update(given)
+    return out
+
+
+@pytest.mark.parametrize("name", READERS)
+def test_every_field_a_reader_builds_is_read_or_named_as_no_setting(name):
+    """A field that a reader leaves at its default is either listed in NOT_SETTINGS_FIELDS, with why, or a
+    setting whose key was forgotten (a key that silently does nothing, as the planner's load cell once did)."""
+    reader = importlib.import_module(f"loper_analysis.stages.{name}.settings")
+    built = {type(stage_settings(CONFIG, name)).__name__}
+    for type_name, given in _constructed_fields(reader.read_settings, reader).items():
+        settings_type = getattr(reader, type_name)
+        left = {f.name for f in dataclasses.fields(settings_type) if f.init} - given
+        unnamed = {
+            f"{type_name}.{field}"
+            for field in left
+            if f"{type_name}.{field}" not in NOT_SETTINGS_FIELDS and f"{type_name}.*" not in NOT_SETTINGS_FIELDS
+        }
+        assert unnamed == set(), (name, built, unnamed)
