@@ -19,7 +19,7 @@ and once with each candidate departure from what the identification model assume
   own twin (the study's matching finds it at distance 0), so what remains is the model's;
 * ``exact_counterfactual_no_variability``: that, with the gentle lab's variability.
 
-``--study-fit``: the study's fit of the mean response (``identification.averaging_correction: false``) instead of
+``--study-fit``: the study's fit of the mean response (``impedance.averaging_correction: false``) instead of
 the default with the averaging term.
 
 Prints, per variant, onset, joint and parameter, over the fitted rows (``ok`` or ``not_identifiable``):
@@ -96,11 +96,11 @@ def main() -> None:
     ap.add_argument("--ik-noise-scale", type=float, default=1.0, help="IK-like noise, times the chain's (0: none)")
     ap.add_argument("--keep", type=Path, help="write every variant's impedance rows here (TSV, one per variant)")
     ap.add_argument("--configfile", nargs="+", default=[], help="config files layered over config/config.yaml")
-    ap.add_argument("--study-fit", action="store_true", help="identification.averaging_correction: false")
+    ap.add_argument("--study-fit", action="store_true", help="impedance.averaging_correction: false")
     args = ap.parse_args()
     config = study_lab_config(args.configfile, args.seed)
     if args.study_fit:
-        config["identification"]["averaging_correction"] = False
+        config["impedance"]["averaging_correction"] = False
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     tables = []
     for variant in args.variants:

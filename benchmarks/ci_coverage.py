@@ -143,10 +143,10 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     coords = walk.mocap_coordinates(lab.marker_rate_hz)
     t = coords["time_s"].to_numpy()
     angles = {"time_s": t}
-    cutoff, order = config["filter"]["cutoff_hz"], config["filter"]["order"]
+    cutoff, order = config["markers"]["filter"]["cutoff_hz"], config["markers"]["filter"]["order"]
     white = lowpass(rng.normal(size=(t.size, len(IK_NOISE_COLUMNS))), lab.marker_rate_hz, cutoff, order)
     noise = (white / white.std(axis=0)) @ np.linalg.cholesky(IK_NOISE_CORR).T * IK_NOISE_SD * noise_scale
-    for name, entry in config["opensim"]["coordinate_map"].items():
+    for name, entry in config["ik"]["coordinate_map"].items():
         column = f"{name}_m" if name == "pelvis_x" else f"{name}_rad"
         value = entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
         if column in IK_NOISE_COLUMNS:
@@ -236,7 +236,7 @@ def _truth(subject: str, config: dict) -> dict:
     """The synthetic subject's true K and D per onset and joint, as the workflow draws them."""
     from loper_analysis.synthetic.subjects import true_impedance
 
-    syn, ident = config["synthetic"], config["identification"]
+    syn, ident = config["synthetic"], config["impedance"]
     return true_impedance(
         subject,
         int(config["seed"]),
@@ -404,7 +404,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
     syn, seed = config["synthetic"], int(config["seed"])
     lab = LabSettings(clock_offset_s=syn["clock_offset_s"], clock_drift_ppm=syn["clock_drift_ppm"])
     diffs: dict[str, list] = {a: [] for a in _ANGLES}
-    trial = config["trials"]["device"]
+    trial = config["study"]["device"]
     angles = fill(PATHS.ik.angles, subject="*", trial=trial)
     subjects = sorted(p.parent.name for p in work.glob(angles))[:max_subjects]
     for subject in subjects:
@@ -429,7 +429,7 @@ def chain_ik_noise(work: Path, config: dict, max_subjects: int = 3) -> pd.Series
         coords = walk.mocap_coordinates(lab.marker_rate_hz)
         ik = read_tsv(work / fill(PATHS.ik.angles, subject=subject, trial=trial), "angle table")
         for a in _ANGLES:
-            entry = config["opensim"]["coordinate_map"][a]
+            entry = config["ik"]["coordinate_map"][a]
             column = f"{a}_m" if a == "pelvis_x" else f"{a}_rad"
             d = ik[column].to_numpy(float) - entry["sign"] * coords[entry["coordinate"]].to_numpy(float)
             diffs[a].append(d[np.isfinite(d)] - np.nanmean(d))
@@ -479,13 +479,13 @@ def main() -> None:
     ap.add_argument(
         "--interval-scatter",
         choices=("perturbed_pairs", "null_pairs"),
-        help="identification.interval_scatter (coordinates mode; default: the config's)",
+        help="impedance.interval_scatter (coordinates mode; default: the config's)",
     )
     args = ap.parse_args()
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     config["seed"] = args.seed
     if args.interval_scatter:
-        config["identification"]["interval_scatter"] = args.interval_scatter
+        config["impedance"]["interval_scatter"] = args.interval_scatter
     names = [f"C{k:03d}" for k in range(1, args.subjects + 1)]
     t0 = time.perf_counter()
     if args.mode == "coordinates":

@@ -37,7 +37,7 @@ from ci_coverage import binomial_interval, run_coordinates, study_lab_config  # 
 from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE  # noqa: E402
 from loper_analysis.report.markdown import markdown_table  # noqa: E402
 
-#: (name, identification.counterfactual, identification.interval_scatter, identification.averaging_correction):
+#: (name, impedance.counterfactual, impedance.interval_scatter, impedance.averaging_correction):
 #: the study's method (its matched stride, the fit of the mean, intervals from the perturbed pairs' scatter) and the
 #: default (the conditional counterfactual, the averaging term, intervals from its cross-validated null pairs).
 ESTIMATORS = (

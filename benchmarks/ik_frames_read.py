@@ -4,7 +4,7 @@ Usage: python benchmarks/ik_frames_read.py [results] [--configfile config/config
 
 Per perturbation trial, the share of its frames that
 
-* the fits sample directly: the window of each perturbed stride (``identification.initial_state_span_s`` +
+* the fits sample directly: the window of each perturbed stride (``impedance.initial_state_span_s`` +
   ``window_before_s`` before its onset to ``window_after_s`` after it), the same span of every unperturbed
   stride at the delays after toe-off of the onset's perturbed strides (the matching candidates) and at every
   onset of the study (the null pairs, which come from every trial with the device), each widened by
@@ -63,7 +63,7 @@ def main() -> None:
     for f in args.configfile:
         for key, value in (yaml.safe_load(Path(f).read_text()) or {}).items():
             cfg[key] = {**cfg.get(key, {}), **value} if isinstance(value, dict) else value
-    window, trials = stage_settings(cfg, "impedance").response.window, cfg["trials"]
+    window, trials = stage_settings(cfg, "impedance").response.window, cfg["study"]
     before = window.initial_state_span_s + window.before_s
     onsets_s = [o / 1e3 for o in trials["perturbation_onsets_ms"]]
     rows = []

@@ -11,11 +11,11 @@ own markers), the last two with their coordinates mapped from ours
 Markers get 0.5 mm noise. Each model is solved, on one core, by:
 
 * ``opensim 1e-6``: OpenSim's ``InverseKinematicsSolver`` at the pipeline's accuracy, every coordinate
-  solved: the reference (``opensim.ik_solver: opensim``);
+  solved: the reference (``ik.ik_solver: opensim``);
 * ``opensim 1e-5``: the same at OpenSim's default accuracy;
 * ``opensim held``: the same at 1e-6 with the coordinates no marker determines (gait2392's mtp angles)
   held at their defaults instead of solved;
-* ``tree 1e-6``: Gauss-Newton on the model's kinematic tree (``opensim.ik_solver: tree``, the default).
+* ``tree 1e-6``: Gauss-Newton on the model's kinematic tree (``ik.ik_solver: tree``, the default).
 
 ``--variants`` names the rows to solve besides the reference, which is always solved.
 

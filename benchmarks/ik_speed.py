@@ -43,7 +43,7 @@ def main(n: int = 30720) -> None:
             ]
         )
 
-    # the pipeline's default (config opensim.accuracy) is 1e-6; looser ones show what speed would cost
+    # the pipeline's default (config ik.accuracy) is 1e-6; looser ones show what speed would cost
     for accuracy in (1e-4, 1e-5, 1e-6, 1e-8):
         t0 = time.perf_counter()
         res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=accuracy)

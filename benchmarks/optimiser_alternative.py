@@ -4,7 +4,7 @@ Usage: python benchmarks/optimiser_alternative.py [n_cases]
 
 On validation-study windows (random K/D combinations, without and with
 noise) both optimisers start from the same 10 random points with the same
-tolerance (config identification.tolerance, 1e-6) and the same batched
+tolerance (config impedance.tolerance, 1e-6) and the same batched
 forward-difference Jacobian; the best start of each is polished to 1e-14 as
 the pipeline does. Prints the time per identification and how often each
 ends more than 0.1 % above the other's cost.

@@ -29,7 +29,7 @@ planner assumes; the prediction for the repeats is the mean of ``sd_of(n_i)^2`` 
 pilot holds at least twice, the workflow's plan and this prediction come from the pilot's stretches of N perturbed
 strides (:func:`loper_analysis.planning.covariance.stretch_covariances`; ``predicted_from`` says which, and
 ``whole_pilot_predicted_sd`` gives the whole pilot's extrapolation beside it). Repeats whose fit
-fails or falls back to the matched stride (fewer than ``identification.min_null_pairs`` candidates) are left
+fails or falls back to the matched stride (fewer than ``impedance.min_null_pairs`` candidates) are left
 out and listed.
 
 ``--pilots-from-repeats``: one pilot is one draw. Every kept repeat also plans exactly as the pilot does (from

@@ -1,7 +1,7 @@
 """Processing one subject's 8 walking trials end to end (read -> IK -> strides) with `snakemake -j2`.
 
 Usage: python benchmarks/processing_subject.py [walking_duration_s [ik_chunks]] [--model gait2392]
-       (defaults: 240 s, the study's trials; the config's opensim.ik_chunks; the generated model)
+       (defaults: 240 s, the study's trials; the config's ik.ik_chunks; the generated model)
 
 Copies the workflow into a temporary directory with one subject, generates its
 raw files first (not timed: C3D + robot logs, as a lab records them), then
@@ -68,7 +68,7 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None, model: str = "
         cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
         cfg["synthetic"]["walking_duration_s"] = duration_s
         if ik_chunks is not None:
-            cfg["opensim"]["ik_chunks"] = ik_chunks
+            cfg["ik"]["ik_chunks"] = ik_chunks
         (work / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
         (work / "config/subjects.tsv").write_text(
             "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
@@ -78,7 +78,7 @@ def main(duration_s: float = 240.0, ik_chunks: int | None = None, model: str = "
         t0 = time.perf_counter()
         if model == "gait2392":
             subject, extra = _lab_session(work, cfg, trials)
-        raw = [fill(PATHS.raw.c3d, subject=subject, trial=t) for t in [cfg["trials"]["static"], *trials]]
+        raw = [fill(PATHS.raw.c3d, subject=subject, trial=t) for t in [cfg["study"]["static"], *trials]]
 
         def run(*targets: str) -> None:
             res = subprocess.run(

@@ -187,7 +187,7 @@ def block_run(run: Run) -> str:
         if "source" in subjects.columns:
             kinds = subjects["source"].value_counts()
             design.append(f"{len(subjects)} subjects (" + ", ".join(f"{n} {k}" for k, n in kinds.items()) + ")")
-    trials = cfg.get("trials", {})
+    trials = cfg.get("study", {})
     synthetic = cfg.get("synthetic", {})
     if "seed" in cfg:
         design.append(f"seed {cfg['seed']}")

@@ -33,7 +33,7 @@ class LabExportSettings(SyntheticLabSettings):
         How the files look (first frame, label prefix, gaps, plates and channels).
     brace_fraction : float
         The brace markers' centre and the rod attachment along the left thigh (fraction of its length from the
-        hip; ``opensim.brace_attachment_fraction``).
+        hip; ``model.brace_attachment_fraction``).
     """
 
     export: QTMExportSettings = QTMExportSettings()

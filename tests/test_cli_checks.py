@@ -59,7 +59,8 @@ def test_a_link_to_an_input_is_the_input(parser, tmp_path, monkeypatch):
         ),
         (
             ["markers", "t.c3d", "--out", "t.trc", "--order", "12"],
-            "--order 12: 12 is greater than the maximum of 8 (the limits of filter.order in config.schema.yaml)",
+            "--order 12: 12 is greater than the maximum of 8 (the limits of markers.filter.order in "
+            "config.schema.yaml)",
         ),
         (
             ["validate", "--segments", "s", "--errors", "e", "--fits", "f", "--seed", "-1"],

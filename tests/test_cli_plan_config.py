@@ -53,11 +53,11 @@ def test_command_and_rule_settings_are_one_for_the_same_config(project, second):
     assert PlanSettings().window.after_s != WINDOW_AFTER_S and PlanningSettings().strides != tuple(STRIDES)
     assert command.plan.window.after_s == command.response.window.after_s == WINDOW_AFTER_S
     assert command.strides == tuple(STRIDES)
-    assert command.onsets_ms == tuple(config["trials"]["perturbation_onsets_ms"])
+    assert command.onsets_ms == tuple(config["study"]["perturbation_onsets_ms"])
     assert _plan_pilot(args, read) == (
         config["planning"]["pilot_subject"],
         config["subjects"],
-        [config["trials"]["no_device"]],
+        [config["study"]["no_device"]],
     )
 
 
@@ -166,4 +166,4 @@ def test_planning_defaults_are_the_configs_but_onsets_and_targets():
     config = yaml.safe_load(CONFIG.read_text())
     built = stage_settings(config, "planning")
     assert dataclasses.replace(built, onsets_ms=None, targets=()) == PlanningSettings()
-    assert built.onsets_ms == tuple(config["trials"]["perturbation_onsets_ms"]) and built.targets
+    assert built.onsets_ms == tuple(config["study"]["perturbation_onsets_ms"]) and built.targets

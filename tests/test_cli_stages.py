@@ -235,7 +235,7 @@ def test_a_model_without_the_bodies_and_a_file_that_is_no_model(tmp_path, capsys
     (tmp_path / "m.osim").write_text(text)
     out = tmp_path / "s.tsv"
     assert main(["segments", "--model", str(tmp_path / "m.osim"), "--out", str(out)]) == 2
-    _one_line_error(capsys, "m.osim", "opensim.segment_bodies")
+    _one_line_error(capsys, "m.osim", "model.segment_bodies")
     (tmp_path / "not.osim").write_text("this is no model\n")
     assert main(["segments", "--model", str(tmp_path / "not.osim"), "--out", str(out)]) == 2
     _one_line_error(capsys, "not.osim")

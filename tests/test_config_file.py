@@ -32,9 +32,9 @@ def test_later_file_updates_the_earlier_recursively(project, second):
     base = yaml.safe_load(CONFIG.read_text())
     config, used = load_config(["config/config.yaml", second])
     assert used == ["config/config.yaml", "config/mine.yaml"]
-    assert config["identification"]["window_after_s"] == WINDOW_AFTER_S and config["planning"]["strides"] == STRIDES
+    assert config["impedance"]["window_after_s"] == WINDOW_AFTER_S and config["planning"]["strides"] == STRIDES
     # keys the second file does not name keep the first file's values, at every depth
-    assert config["identification"]["window_before_s"] == base["identification"]["window_before_s"]
+    assert config["impedance"]["window_before_s"] == base["impedance"]["window_before_s"]
     assert config["planning"]["targets"] == base["planning"]["targets"]
     assert config["device"] == base["device"]
     # overrides come last; the default file is config/config.yaml of the working directory
@@ -57,12 +57,12 @@ def test_bad_key_in_the_second_file_is_named_with_that_file(project):
     bad = write_yaml(project / "second.yaml", {"planning": {"stridez": [3]}})
     with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'planning\.stridez': Additional properties"):
         load_config(["config/config.yaml", bad])
-    bad = write_yaml(project / "second.yaml", {"identification": {"window_after_s": -0.1}})
-    with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'identification\.window_after_s': -0\.1 is "):
+    bad = write_yaml(project / "second.yaml", {"impedance": {"window_after_s": -0.1}})
+    with pytest.raises(LoperInputError, match=r"^second\.yaml: key 'impedance\.window_after_s': -0\.1 is "):
         load_config(["config/config.yaml", bad])
     # a value the first file sets is named with the first file
     (project / "config" / "config.yaml").write_text(CONFIG.read_text().replace("n_starts: 10 ", "n_starts: ten "))
-    with pytest.raises(LoperInputError, match=r"^config/config\.yaml: key 'identification\.n_starts': 'ten'"):
+    with pytest.raises(LoperInputError, match=r"^config/config\.yaml: key 'impedance\.n_starts': 'ten'"):
         load_config(["config/config.yaml", write_yaml(project / "ok.yaml", {"seed": 1})])
 
 
@@ -136,7 +136,7 @@ def test_overrides_win_over_every_file_and_are_not_changed(project, second):
     overrides = {"planning": {"strides": [3]}}
     config, _ = load_config(["config/config.yaml", second], overrides)
     assert config["planning"]["strides"] == [3]
-    assert config["identification"]["window_after_s"] == WINDOW_AFTER_S
+    assert config["impedance"]["window_after_s"] == WINDOW_AFTER_S
     config["planning"]["strides"].append(4)
     assert overrides == {"planning": {"strides": [3]}}
 

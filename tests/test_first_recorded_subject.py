@@ -80,10 +80,10 @@ def test_inspect_chooses_plug_in_gait_and_writes_what_the_doc_says(walkthrough):
         "config.yaml", "gait2392_simbody.osim", "ik_tasks.tsv", "marker_set.xml", "scale_setup.xml",
     ]  # fmt: skip
     config = yaml.safe_load((lab / "config.yaml").read_text())
-    assert config["opensim"]["coordinate_map"]["knee_left"] == {"coordinate": "knee_angle_l", "sign": -1}
-    assert config["opensim"]["coordinate_map"]["pelvis_angle"] == {"coordinate": "pelvis_tilt", "sign": -1}
+    assert config["ik"]["coordinate_map"]["knee_left"] == {"coordinate": "knee_angle_l", "sign": -1}
+    assert config["ik"]["coordinate_map"]["pelvis_angle"] == {"coordinate": "pelvis_tilt", "sign": -1}
     assert config["events"]["foot_markers"] == {"left": "LHEE", "right": "RHEE"}
-    assert config["markers"] == {"lab_to_model_rotation_deg": [-90, 0, 0], "label_map": {}}
+    assert config["markers"] == {"lab_to_model_rotation_deg": [-90, 0, 0], "label_map": {}, "filter": {"cutoff_hz": 40}}
     tasks = pd.read_csv(lab / "ik_tasks.tsv", sep="\t")
     assert "LMKNE" not in set(tasks["name"]) and {"LKNE", "LTHI", "LTOE"} <= set(tasks["name"])
     # the generic model is OpenSim's gait2392 as distributed

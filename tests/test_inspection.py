@@ -383,7 +383,7 @@ def test_inspect_command_on_walking5(tmp_path, capsys, walking5):
     doc = yaml.safe_load(snippet.read_text())
     assert doc["markers"] == {"lab_to_model_rotation_deg": [-90, 0, 0], "label_map": str(map_tsv)}
     assert doc["events"] == {"foot_markers": {"left": "L.Heel", "right": "R.Heel"}}
-    assert doc["opensim"] == {"generic_model": str(GAIT2392)}
+    assert doc["model"] == {"generic_model": str(GAIT2392)}
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     check_config(_merged(base, doc), ROOT / "workflow" / "schemas" / "config.schema.yaml")
     assert not [p for p in (tmp_path / "out").iterdir() if p.name.startswith(".")]  # no staging left behind

@@ -69,9 +69,9 @@ def test_ik_settings_of_the_shipped_config_are_the_defaults():
 
 def test_a_changed_config_key_changes_the_settings():
     config = yaml.safe_load(CONFIG.read_text())
-    config["opensim"]["accuracy"] = 1e-8
+    config["ik"]["accuracy"] = 1e-8
     config["grf"]["loaded_threshold_n"] = 35.0
-    config["markers"]["static_duration_s"] = None
+    config["model"]["static_duration_s"] = None
     assert stage_settings(config, "ik").accuracy == 1e-8
     assert stage_settings(config, "grf").threshold_n == 35.0
     assert stage_settings(config, "model").static_duration_s is None
@@ -81,7 +81,7 @@ def test_a_changed_config_key_changes_the_settings():
 
 
 def test_segments_takes_the_config_and_an_option_wins(project, capsys):
-    _configure(project, opensim={"brace_attachment_fraction": 0.6})
+    _configure(project, model={"brace_attachment_fraction": 0.6})
     assert main(["segments", "--height-m", "1.8", "--mass-kg", "70", "--out", "config.tsv"]) == 0
     assert "config: config/config.yaml" in capsys.readouterr().out
     np.testing.assert_allclose(
@@ -95,7 +95,7 @@ def test_segments_takes_the_config_and_an_option_wins(project, capsys):
 
 
 def test_segments_of_a_model_take_the_configured_side(project):
-    _configure(project, trials={"perturbed_side": "right"})
+    _configure(project, study={"perturbed_side": "right"})
     assert main(["segments", "--model", str(GENERIC), "--out", "right.tsv"]) == 0
     assert main(["segments", "--model", str(GENERIC), "--side", "left", "--out", "left.tsv"]) == 0
     model = read_model(GENERIC)
@@ -133,10 +133,10 @@ def test_ik_takes_the_config_limits_and_options_win(project, capsys):
     X = X + np.random.default_rng(1).normal(0, 0.002, X.shape)  # 2 mm marker noise
     write_trc(project / "trial.trc", t, X, list(MARKERS))
     argv = ["ik", "--model", str(model), "--markers", "trial.trc", "--out", "trial.mot"]
-    _configure(project, opensim={"max_marker_rms_m": 1e-4, "warn_marker_rms_m": 1e-5})
+    _configure(project, ik={"max_marker_rms_m": 1e-4, "warn_marker_rms_m": 1e-5})
     assert main(argv) == 2
     captured = capsys.readouterr()
-    assert "config: config/config.yaml" in captured.out and "opensim.max_marker_rms_m" in captured.err
+    assert "config: config/config.yaml" in captured.out and "ik.max_marker_rms_m" in captured.err
     assert not (project / "trial.mot").exists()
     assert main([*argv, "--max-marker-rms-m", "0.06", "--warn-marker-rms-m", "0.02"]) == 0
     captured = capsys.readouterr()
@@ -164,10 +164,10 @@ def test_scale_takes_the_configs_window_and_motion_limit_and_options_win(project
         files = ["--model", str(GENERIC), "--setup", str(SCALE_SETUP), "--static", str(moving_static)]
         return ["scale", *files, "--mass-kg", "80", "--out", out, *options]
 
-    # the whole trial (markers.static_duration_s 1 s): the knee marker moves 25 mm RMS, over the config's 10 mm
+    # the whole trial (model.static_duration_s 1 s): the knee marker moves 25 mm RMS, over the config's 10 mm
     _configure(project, markers={"static_max_motion_rms_m": 0.01})
     assert main(argv("never.osim")) == 2
-    assert "markers.static_max_motion_rms_m 0.01 m" in capsys.readouterr().err
+    assert "model.static_max_motion_rms_m 0.01 m" in capsys.readouterr().err
     # the limit given as 0 is no limit
     assert main(argv("unchecked.osim", "--max-motion-rms-m", "0")) == 0
     assert "config: config/config.yaml" in capsys.readouterr().out
@@ -179,5 +179,5 @@ def test_scale_takes_the_configs_window_and_motion_limit_and_options_win(project
     np.testing.assert_allclose(thigh / generic_thigh, 1.10, rtol=1e-6)
     # a window given on the command line wins over the config's
     assert main(argv("window.osim", "--start", "0", "--end", "0.19")) == 2
-    assert "markers.static_max_motion_rms_m" in capsys.readouterr().err
+    assert "model.static_max_motion_rms_m" in capsys.readouterr().err
     assert not (project / "never.osim").exists() and not (project / "window.osim").exists()

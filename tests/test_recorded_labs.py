@@ -257,9 +257,7 @@ def test_walking5_and_the_same_walk_the_other_way_give_the_same_angles(tmp_path)
     )
     model = ROOT / "examples" / "rajagopal2016" / "Rajagopal2016.osim"
     tasks = ROOT / "examples" / "rajagopal2016" / "lower_body_ik_tasks.tsv"
-    coordinate_map = yaml.safe_load((ROOT / "examples/rajagopal2016/config.yaml").read_text())["opensim"][
-        "coordinate_map"
-    ]
+    coordinate_map = yaml.safe_load((ROOT / "examples/rajagopal2016/config.yaml").read_text())["ik"]["coordinate_map"]
     angles = {}
     for name, c3d in (("minus_x", WALKING5), ("plus_x", tmp_path / "plus_x.c3d")):
         markers(

@@ -21,7 +21,7 @@ _spec.loader.exec_module(results_page)
 CONFIG = """\
 subjects: config/subjects.tsv
 seed: 7
-trials: {perturbation_onsets_ms: [50, 175], perturbation_repeats: 1}
+study: {perturbation_onsets_ms: [50, 175], perturbation_repeats: 1}
 synthetic: {walking_duration_s: 30.0, variability: study}
 """
 SUBJECTS = "subject\tsource\nA1\tsynthetic\nB2\tsynthetic\n"

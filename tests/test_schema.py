@@ -28,8 +28,8 @@ def test_shipped_config_and_sheet_are_valid():
 @pytest.mark.parametrize(
     ("section", "key", "value", "words"),
     [
-        ("identification", "n_starts", 0, ["identification.n_starts", "0"]),
-        ("identification", "n_starts", "ten", ["identification.n_starts", "'ten'"]),
+        ("impedance", "n_starts", 0, ["impedance.n_starts", "0"]),
+        ("impedance", "n_starts", "ten", ["impedance.n_starts", "'ten'"]),
         ("validation", "noise_peak_to_peak", -0.01, ["validation.noise_peak_to_peak", "-0.01"]),
         ("validation", "colour", "red", ["validation", "colour"]),
     ],
@@ -45,10 +45,8 @@ def test_bad_config_names_key_and_value(section, key, value, words):
 
 def test_unknown_key_is_named_by_its_full_path():
     cfg = _config()
-    cfg["identification"]["n_stars"] = 3
-    with pytest.raises(
-        LoperInputError, match=r"^config.yaml: key 'identification.n_stars': .*'n_stars' was unexpected"
-    ):
+    cfg["impedance"]["n_stars"] = 3
+    with pytest.raises(LoperInputError, match=r"^config.yaml: key 'impedance.n_stars': .*'n_stars' was unexpected"):
         check_config(cfg, CONFIG_SCHEMA, "config.yaml")
 
 
@@ -56,20 +54,20 @@ def test_unknown_key_is_named_by_its_full_path():
     ("key_path", "origin"),
     [
         (["seed"], "--config"),  # the command line wins over every file
-        (["identification", "n_starts"], "late.yaml"),  # the last --configfile wins over an earlier one
-        (["identification", "tolerance"], "early.yaml"),
-        (["trials", "perturbation_onsets_ms", 1], "early.yaml"),  # a list item
-        (["trials", "perturbation_onsets_ms", 5], "config/config.yaml"),  # beyond the list: nobody set it
+        (["impedance", "n_starts"], "late.yaml"),  # the last --configfile wins over an earlier one
+        (["impedance", "tolerance"], "early.yaml"),
+        (["study", "perturbation_onsets_ms", 1], "early.yaml"),  # a list item
+        (["study", "perturbation_onsets_ms", 5], "config/config.yaml"),  # beyond the list: nobody set it
         (["validation", "n_chunks"], "config/config.yaml"),
     ],
 )
 def test_config_origin_is_the_highest_layer_that_sets_the_key(key_path, origin):
     layers = [
         ("--config", {"seed": 3}),
-        ("late.yaml", {"identification": {"n_starts": 2}}),
+        ("late.yaml", {"impedance": {"n_starts": 2}}),
         (
             "early.yaml",
-            {"identification": {"n_starts": 1, "tolerance": 1e-6}, "trials": {"perturbation_onsets_ms": [50, 175]}},
+            {"impedance": {"n_starts": 1, "tolerance": 1e-6}, "study": {"perturbation_onsets_ms": [50, 175]}},
         ),
     ]
     assert config_origin(key_path, layers, "config/config.yaml") == origin
@@ -78,17 +76,17 @@ def test_config_origin_is_the_highest_layer_that_sets_the_key(key_path, origin):
 @pytest.mark.parametrize(
     ("layers", "expected"),
     [
-        ([("--config", {"identification": {"n_starts": "ten"}})], "--config: key 'identification.n_starts': 'ten'"),
+        ([("--config", {"impedance": {"n_starts": "ten"}})], "--config: key 'impedance.n_starts': 'ten'"),
         (
-            [("--config", {"seed": 1}), ("lab.yaml", {"identification": {"n_starts": "ten"}})],
-            "lab.yaml: key 'identification.n_starts': 'ten'",
+            [("--config", {"seed": 1}), ("lab.yaml", {"impedance": {"n_starts": "ten"}})],
+            "lab.yaml: key 'impedance.n_starts': 'ten'",
         ),
-        ([("lab.yaml", {"seed": 1})], "config/config.yaml: key 'identification.n_starts': 'ten'"),
+        ([("lab.yaml", {"seed": 1})], "config/config.yaml: key 'impedance.n_starts': 'ten'"),
     ],
 )
 def test_bad_value_names_the_layer_that_set_it(layers, expected):
     cfg = _config()
-    cfg["identification"]["n_starts"] = "ten"
+    cfg["impedance"]["n_starts"] = "ten"
     with pytest.raises(LoperInputError) as info:
         check_config(cfg, CONFIG_SCHEMA, "config/config.yaml", layers)
     assert str(info.value).startswith(expected), str(info.value)

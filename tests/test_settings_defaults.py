@@ -92,12 +92,12 @@ RESPONSE_KEYS = {
     "whisker": "strides.iqr_whisker",
     "max_fraction": "strides.max_outlier_fraction",
     "min_strides": "strides.min_valid_strides",
-    "counterfactual": "identification.counterfactual",
+    "counterfactual": "impedance.counterfactual",
 }
 #: IdentificationSettings field -> config key: the same name under ``identification`` (as the impedance_fit rule
 #: passes them), except ``plausible_ranges`` (default None stands for DEFAULT_PLAUSIBLE_RANGES) and ``seed``.
 IDENTIFICATION_KEYS = {
-    f.name: f"identification.{f.name}"
+    f.name: f"impedance.{f.name}"
     for f in dataclasses.fields(IdentificationSettings)
     if f.name not in ("plausible_ranges", "seed")
 }
@@ -149,9 +149,9 @@ def test_free_leg_and_device_test_defaults_equal_config():
 
 def test_response_window_defaults_equal_config_identification():
     assert WINDOW_KEYS == {
-        "before_s": "identification.window_before_s",
-        "after_s": "identification.window_after_s",
-        "initial_state_span_s": "identification.initial_state_span_s",
+        "before_s": "impedance.window_before_s",
+        "after_s": "impedance.window_after_s",
+        "initial_state_span_s": "impedance.initial_state_span_s",
     }
     assert _mismatches(_defaults(ResponseWindow), CONFIG, WINDOW_KEYS) == []
     assert stage_settings(CONFIG, "impedance").response.window == ResponseWindow()
@@ -174,7 +174,7 @@ def test_identification_settings_defaults_equal_config_identification():
     assert defaults["plausible_ranges"] is None
     config_ranges = {
         joint: (tuple(r["stiffness_nm_per_rad"]), tuple(r["damping_nms_per_rad"]))
-        for joint, r in CONFIG["identification"]["plausible_ranges"].items()
+        for joint, r in CONFIG["impedance"]["plausible_ranges"].items()
     }
     assert _plain(DEFAULT_PLAUSIBLE_RANGES) == config_ranges
     # seed differs on purpose: the workflow passes the config's seed; the library default follows
@@ -184,34 +184,34 @@ def test_identification_settings_defaults_equal_config_identification():
 
 
 def test_every_identification_key_has_a_checked_default():
-    checked = set(IDENTIFICATION_KEYS.values()) | {v for v in RESPONSE_KEYS.values() if v.startswith("identification.")}
+    checked = set(IDENTIFICATION_KEYS.values()) | {v for v in RESPONSE_KEYS.values() if v.startswith("impedance.")}
     checked |= set(WINDOW_KEYS.values())
-    checked |= {"identification.plausible_ranges"}
-    assert {f"identification.{k}" for k in CONFIG["identification"]} == checked
+    checked |= {"impedance.plausible_ranges"}
+    assert {f"impedance.{k}" for k in CONFIG["impedance"]} == checked
 
 
 def test_identification_constants_equal_config_identification():
     constants = {
-        "WINDOW_BEFORE_S": "identification.window_before_s",
-        "WINDOW_AFTER_S": "identification.window_after_s",
-        "INITIAL_STATE_SPAN_S": "identification.initial_state_span_s",
-        "INITIAL_STATE_DEGREE": "identification.initial_state_degree",
-        "N_SUBSTEPS": "identification.n_substeps",
-        "N_STARTS": "identification.n_starts",
-        "FIT_TOLERANCE": "identification.tolerance",
-        "MERGE_TOLERANCE": "identification.merge_tolerance",
-        "NULL_PAIR_COMPONENTS": "identification.null_pair_components",
-        "MIN_NULL_PAIRS": "identification.min_null_pairs",
-        "STIFFNESS_BOUNDS_NM_PER_RAD": "identification.stiffness_bounds_nm_per_rad",
-        "DAMPING_BOUNDS_NMS_PER_RAD": "identification.damping_bounds_nms_per_rad",
-        "MAX_CI_FRACTION": "identification.max_ci_fraction",
-        "MIN_VAF_PCT": "identification.min_vaf_pct",
+        "WINDOW_BEFORE_S": "impedance.window_before_s",
+        "WINDOW_AFTER_S": "impedance.window_after_s",
+        "INITIAL_STATE_SPAN_S": "impedance.initial_state_span_s",
+        "INITIAL_STATE_DEGREE": "impedance.initial_state_degree",
+        "N_SUBSTEPS": "impedance.n_substeps",
+        "N_STARTS": "impedance.n_starts",
+        "FIT_TOLERANCE": "impedance.tolerance",
+        "MERGE_TOLERANCE": "impedance.merge_tolerance",
+        "NULL_PAIR_COMPONENTS": "impedance.null_pair_components",
+        "MIN_NULL_PAIRS": "impedance.min_null_pairs",
+        "STIFFNESS_BOUNDS_NM_PER_RAD": "impedance.stiffness_bounds_nm_per_rad",
+        "DAMPING_BOUNDS_NMS_PER_RAD": "impedance.damping_bounds_nms_per_rad",
+        "MAX_CI_FRACTION": "impedance.max_ci_fraction",
+        "MIN_VAF_PCT": "impedance.min_vaf_pct",
     }
     values = {name: getattr(identification, name) for name in constants}
     assert _mismatches(values, CONFIG, constants) == []
     k, d = (
-        CONFIG["identification"]["stiffness_bounds_nm_per_rad"],
-        CONFIG["identification"]["damping_bounds_nms_per_rad"],
+        CONFIG["impedance"]["stiffness_bounds_nm_per_rad"],
+        CONFIG["impedance"]["damping_bounds_nms_per_rad"],
     )
     assert DEFAULT_LOWER.tolist() == [k[0], d[0]] * 3
     assert DEFAULT_UPPER.tolist() == [k[1], d[1]] * 3
@@ -222,44 +222,44 @@ KEYWORD_DEFAULTS = [
     (
         prepare_window,
         {
-            "n_substeps": "identification.n_substeps",
-            "initial_state_degree": "identification.initial_state_degree",
+            "n_substeps": "impedance.n_substeps",
+            "initial_state_degree": "impedance.initial_state_degree",
         },
     ),
     (
         identify_impedance,
         {
-            "n_starts": "identification.n_starts",
-            "tolerance": "identification.tolerance",
-            "merge_tolerance": "identification.merge_tolerance",
+            "n_starts": "impedance.n_starts",
+            "tolerance": "impedance.tolerance",
+            "merge_tolerance": "impedance.merge_tolerance",
         },
     ),
     (
         refit_with_null_pairs,
         {
-            "n_components": "identification.null_pair_components",
-            "min_null_pairs": "identification.min_null_pairs",
+            "n_components": "impedance.null_pair_components",
+            "min_null_pairs": "impedance.min_null_pairs",
         },
     ),
     (
         joint_status,
-        {"max_ci_fraction": "identification.max_ci_fraction", "min_vaf_pct": "identification.min_vaf_pct"},
+        {"max_ci_fraction": "impedance.max_ci_fraction", "min_vaf_pct": "impedance.min_vaf_pct"},
     ),
     (
         impedance_rows,
-        {"max_ci_fraction": "identification.max_ci_fraction", "min_vaf_pct": "identification.min_vaf_pct"},
+        {"max_ci_fraction": "impedance.max_ci_fraction", "min_vaf_pct": "impedance.min_vaf_pct"},
     ),
     (
         window_outliers,
         {
-            "before_s": "identification.window_before_s",
-            "after_s": "identification.window_after_s",
+            "before_s": "impedance.window_before_s",
+            "after_s": "impedance.window_after_s",
             "whisker": "strides.iqr_whisker",
             "max_fraction": "strides.max_outlier_fraction",
         },
     ),
-    (too_short, {"window_after_s": "identification.window_after_s"}),
-    (match_unperturbed, {"before_s": "identification.window_before_s"}),
+    (too_short, {"window_after_s": "impedance.window_after_s"}),
+    (match_unperturbed, {"before_s": "impedance.window_before_s"}),
 ]
 
 
@@ -275,16 +275,16 @@ def test_prepare_window_default_window_is_the_configs():
 def test_prepared_window_and_identify_defaults_agree_with_config():
     fields = {f.name: f.default for f in dataclasses.fields(PreparedWindow)}
     keys = {
-        "initial_state_span_s": "identification.initial_state_span_s",
-        "initial_state_degree": "identification.initial_state_degree",
+        "initial_state_span_s": "impedance.initial_state_span_s",
+        "initial_state_degree": "impedance.initial_state_degree",
     }
     assert _mismatches(fields, CONFIG, keys) == []
     fit = _signature_defaults(identify_impedance)
     assert fit["lower"] is DEFAULT_LOWER and fit["upper"] is DEFAULT_UPPER
     rows = _signature_defaults(impedance_rows)
     k, d = (
-        CONFIG["identification"]["stiffness_bounds_nm_per_rad"],
-        CONFIG["identification"]["damping_bounds_nms_per_rad"],
+        CONFIG["impedance"]["stiffness_bounds_nm_per_rad"],
+        CONFIG["impedance"]["damping_bounds_nms_per_rad"],
     )
     assert _plain(rows["lower"]) == (k[0], d[0]) and _plain(rows["upper"]) == (k[1], d[1])
 
@@ -310,7 +310,7 @@ def test_plan_settings_defaults_equal_config():
         "pulse_force_n": "planning.pulse_force_n",
         "pulse_duration_s": "planning.pulse_duration_s",
         **{
-            name: f"identification.{name}"
+            name: f"impedance.{name}"
             for name in (
                 "initial_state_degree",
                 "n_substeps",
@@ -323,8 +323,8 @@ def test_plan_settings_defaults_equal_config():
         },
         # the load cell's low-pass is the walking trials' filter; the pulse reaches the fit at the robot-log rate,
         # which is the device's control rate
-        "force_cutoff_hz": "filter.cutoff_hz",
-        "force_order": "filter.order",
+        "force_cutoff_hz": "markers.filter.cutoff_hz",
+        "force_order": "markers.filter.order",
         "force_rate_hz": "device.parameters.sample_rate_hz",
     }
     defaults = _defaults(PlanSettings)
@@ -394,7 +394,7 @@ def test_lab_session_settings_defaults_equal_config_synthetic():
 @pytest.mark.parametrize(
     ("path", "value"),
     [
-        ("identification.window_before_s", 0.03),
+        ("impedance.window_before_s", 0.03),
         ("strides.iqr_whisker", 2.0),
         ("device.parameters.lead_time_s", 0.018),
     ],
@@ -420,7 +420,7 @@ def test_a_changed_config_value_is_a_mismatch(path, value):
 
 def test_a_changed_default_is_a_mismatch():
     changed = _defaults(IdentificationSettings) | {"n_starts": 11}
-    assert _mismatches(changed, CONFIG, IDENTIFICATION_KEYS) == ["n_starts = 11, but identification.n_starts = 10"]
+    assert _mismatches(changed, CONFIG, IDENTIFICATION_KEYS) == ["n_starts = 11, but impedance.n_starts = 10"]
     device = _defaults(DeviceParameters) | {"servo_delay_s": 0.003}
     keys = {n: f"device.parameters.{n}" for n in device}
     assert _mismatches(device, CONFIG, keys) == ["servo_delay_s = 0.003, but device.parameters.servo_delay_s = 0.002"]

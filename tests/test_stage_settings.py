@@ -34,8 +34,8 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 #: library constant -> config key of the same value
 CONSTANTS = {
-    "filtering.CUTOFF_HZ": (filtering.CUTOFF_HZ, "filter.cutoff_hz"),
-    "filtering.ORDER": (filtering.ORDER, "filter.order"),
+    "filtering.CUTOFF_HZ": (filtering.CUTOFF_HZ, "markers.filter.cutoff_hz"),
+    "filtering.ORDER": (filtering.ORDER, "markers.filter.order"),
     "markers.MAX_GAP_FRAMES": (markers.MAX_GAP_FRAMES, "markers.max_gap_frames"),
     "heading.MIN_TRAVEL_SPEED_M_PER_S": (heading.MIN_TRAVEL_SPEED_M_PER_S, "markers.min_travel_speed_m_per_s"),
     "plausibility.EXTENT_RANGE_M": (plausibility.EXTENT_RANGE_M, "markers.extent_range_m"),
@@ -107,19 +107,19 @@ def test_defaults_are_what_the_config_builds(settings_type):
     ("settings_type", "path", "field", "value"),
     [
         (MarkerSettings, "markers.max_gap_frames", "max_gap_frames", 3),
-        (MarkerSettings, "filter.cutoff_hz", "cutoff_hz", 12.0),
+        (MarkerSettings, "markers.filter.cutoff_hz", "cutoff_hz", 12.0),
         (MarkerSettings, "markers.walking_direction", "walking_direction", "fixed"),
         (EventSettings, "events.threshold_on_n", "threshold_on_n", 80.0),
         (EventSettings, "grf.max_resting_n", "max_rest_n", 50.0),
         (EventSettings, "events.grf_channels", "grf_channels", {"left": "belt_l", "right": "belt_r"}),
         (LoadcellSettings, "events.sync_channel", "sync_channel", "trigger"),
-        (LoadcellSettings, "filter.order", "order", 2),
+        (LoadcellSettings, "markers.filter.order", "order", 2),
         (StrideSettings, "strides.min_valid_strides", "min_valid", 7),
-        (StrideSettings, "trials.perturbed_side", "side", "right"),
+        (StrideSettings, "study.perturbed_side", "side", "right"),
         (GRFSettings, "grf.loaded_threshold_n", "threshold_n", 35.0),
         (GRFSettings, "grf.resting_band_n", "band_n", 4.0),
         (TransparencySettings, "strides.min_valid_strides", "min_strides", 7),
-        (TransparencySettings, "trials.perturbed_side", "side", "right"),
+        (TransparencySettings, "study.perturbed_side", "side", "right"),
     ],
 )
 def test_a_changed_config_key_reaches_its_field(settings_type, path, field, value):

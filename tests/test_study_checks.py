@@ -46,11 +46,11 @@ def test_a_scaled_model_must_exist_and_a_generated_model_needs_the_height(tmp_pa
     with pytest.raises(
         LoperInputError,
         match=r"^subjects.tsv: recorded subject 'R02' needs height_m: the generated model \(config/mine.yaml: "
-        r"opensim.generic_model null\)",
+        r"model.generic_model null\)",
     ):
         check_subjects(study, "subjects.tsv", _source)
-    lab_model = {**CONFIG["opensim"], "generic_model": "gait2392.osim"}
-    check_subjects(study_on(tmp_path, {"R02": {"source": "recorded"}}, device={"subject": None}, opensim=lab_model),
+    lab_model = {**CONFIG["model"], "generic_model": "gait2392.osim"}
+    check_subjects(study_on(tmp_path, {"R02": {"source": "recorded"}}, device={"subject": None}, model=lab_model),
                    "subjects.tsv", _source)  # fmt: skip
 
 
@@ -65,16 +65,14 @@ def test_synthetic_subjects_need_a_truth_for_every_onset_inside_the_bounds(tmp_p
     with pytest.raises(
         LoperInputError,
         match=r"^config/mine.yaml: key 'synthetic.stiffness_nm_per_rad': no truth for onset\(s\) \[300\] ms of "
-        r"trials.perturbation_onsets_ms$",
+        r"study.perturbation_onsets_ms$",
     ):
         check_subjects(study_on(tmp_path, rows, device={"subject": None}, synthetic=fewer), "subjects.tsv", _source)
-    ident = {**CONFIG["identification"], "stiffness_bounds_nm_per_rad": [0.0, 0.5]}
+    ident = {**CONFIG["impedance"], "stiffness_bounds_nm_per_rad": [0.0, 0.5]}
     with pytest.raises(
         LoperInputError, match=r"^subject S01, onset \d+ ms, hip: true .* lies outside the identification"
     ):
-        check_subjects(
-            study_on(tmp_path, rows, device={"subject": None}, identification=ident), "subjects.tsv", _source
-        )
+        check_subjects(study_on(tmp_path, rows, device={"subject": None}, impedance=ident), "subjects.tsv", _source)
 
 
 def test_the_device_subject_must_be_in_the_sheet(tmp_path):
@@ -95,7 +93,7 @@ def test_raw_folders_refuse_a_miscased_file_and_list_strangers(tmp_path):
     study = study_on(tmp_path, {"R01": {"source": "recorded"}, "S01": {"source": "synthetic"}})
     (warning,) = raw_file_warnings(study)
     assert warning.startswith(f"warning: {raw}: walk-fast.c3d, walk-slow.mat: no trial of the design has this name")
-    assert "trials.perturbation_onsets_ms [50, 175, 300] and trials.perturbation_repeats 2)" in warning
+    assert "study.perturbation_onsets_ms [50, 175, 300] and study.perturbation_repeats 2)" in warning
     touch(raw / "pert175-2.C3D")
     with pytest.raises(
         LoperInputError,

@@ -145,12 +145,12 @@ def test_settings_of_the_config_and_the_defaults_agree():
 
 def test_settings_take_the_config_s_side_and_stride_minimum():
     config = copy.deepcopy(CONFIG)
-    config["trials"]["perturbed_side"] = "right"
+    config["study"]["perturbed_side"] = "right"
     config["strides"]["min_valid_strides"] = 7
     assert stage_settings(config, "transparency") == TransparencySettings(side="right", min_strides=7)
 
 
-@pytest.mark.parametrize(("section", "key"), [("trials", "perturbed_side"), ("strides", "min_valid_strides")])
+@pytest.mark.parametrize(("section", "key"), [("study", "perturbed_side"), ("strides", "min_valid_strides")])
 def test_settings_name_a_missing_key(section, key):
     config = copy.deepcopy(CONFIG)
     del config[section][key]

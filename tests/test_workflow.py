@@ -33,13 +33,13 @@ def _project(tmp: Path, **changes) -> Path:
     cfg["validation"].update(
         stiffness_levels_nm_per_rad=[0.0, 150.0], damping_levels_nms_per_rad=[0.0, 4.0], n_chunks=2
     )
-    cfg["identification"]["n_starts"] = 3
+    cfg["impedance"]["n_starts"] = 3
     # one synthetic subject, short trials, one perturbation trial
     (tmp / "config/subjects.tsv").write_text(
         "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
     )
     cfg["synthetic"]["walking_duration_s"] = 25.0
-    cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
+    cfg["study"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     for key, value in changes.items():
         section, _, name = key.partition("__")
         if name:
@@ -156,8 +156,8 @@ def test_impedance_table_from_the_default_run(finished_run):
 @pytest.mark.parametrize(
     ("changes", "expected"),
     [
-        ({"identification__n_stars": 3}, "key 'identification.n_stars'"),
-        ({"identification__n_starts": "ten"}, "key 'identification.n_starts': 'ten'"),
+        ({"impedance__n_stars": 3}, "key 'impedance.n_stars'"),
+        ({"impedance__n_starts": "ten"}, "key 'impedance.n_starts': 'ten'"),
         ({"validation__n_chunks": 0}, "key 'validation.n_chunks': 0"),
         ({"subjects": "config/nowhere.tsv"}, "key 'subjects': file 'config/nowhere.tsv' not found"),
     ],
@@ -432,9 +432,9 @@ def _dry_run_rules(work: Path, *args: str) -> dict[str, set[str]]:
             {"events", "events_loadcell", "strides", "strides_summary", "impedance_fit", "transparency"},
         ),
         # a setting of the subjects' fits only (the validation study does not use it)
-        ("identification", "min_vaf_pct", 1.0, {"impedance_fit"}),
+        ("impedance", "min_vaf_pct", 1.0, {"impedance_fit"}),
         # a setting of the segment table only: never the generic or scaled model, nor IK after them
-        ("opensim", "brace_attachment_fraction", 0.75, {"model_segments", "impedance_fit"}),
+        ("model", "brace_attachment_fraction", 0.75, {"model_segments", "impedance_fit"}),
     ],
 )
 def test_a_changed_setting_reruns_only_what_depends_on_it(finished_run, tmp_path, section, key, value, expected):

@@ -57,9 +57,9 @@ def _inspect(args: argparse.Namespace) -> None:
         print(inspect_c3d(args.c3d[0], args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
         return
     config, _ = read_config(args)
-    static_name = "static" if config is None else config["trials"]["static"]
+    static_name = "static" if config is None else config["study"]["static"]
     label_map = args.label_map or (None if config is None else config["markers"]["label_map"] or None)
-    cutoff = CUTOFF_HZ if config is None else config["filter"]["cutoff_hz"]
+    cutoff = CUTOFF_HZ if config is None else config["markers"]["filter"]["cutoff_hz"]
     check = _scaling_dry_run(config)
     try:
         result = inspect_subject(args.c3d, args.config_out, static_name, label_map, cutoff, check)
@@ -135,7 +135,7 @@ def _what_to_add(message: str, setup) -> str:
         )
     return (
         "the lab must add a static trial in which the subject stands still over the scaling window "
-        f"(markers.static_duration_s) with the scaling markers seen and labelled as the template's "
+        f"(model.static_duration_s) with the scaling markers seen and labelled as the template's "
         f"({', '.join(pairs)}; a label map row naming the wrong marker shows as a factor out of range)"
     )
 

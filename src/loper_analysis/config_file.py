@@ -20,11 +20,13 @@ from __future__ import annotations
 import copy
 import json
 import os
+import sys
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import yaml
 
+from loper_analysis.config_sections import translated
 from loper_analysis.errors import LoperInputError
 from loper_analysis.schema import check_config, check_yaml_file
 
@@ -54,7 +56,10 @@ def config_layers(command_line: Mapping, files: Sequence, load) -> list[tuple[st
     given, last to first, as ``(its name as typed, its values)`` (:func:`loper_analysis.schema.config_origin`).
 
     ``load(path) -> dict`` reads one file (Snakemake's ``load_configfile`` in the workflow)."""
-    return [("--config", dict(command_line))] + [(shown_path(f), load(str(f)) or {}) for f in reversed(list(files))]
+    layers = [("--config", dict(command_line))] + [(shown_path(f), load(str(f)) or {}) for f in reversed(list(files))]
+    for _, values in layers:  # a file of the former layout: its keys at their places now
+        translated(values)
+    return layers
 
 
 def update_config(config: dict, overwrite_config: Mapping) -> None:
@@ -197,10 +202,14 @@ def load_config(
     config: dict = {}
     for path in files:
         data = read_config_file(path)
+        moves = translated(data)
+        if moves:
+            print(f"config: {shown_path(path)} is in the former layout, read as: {'; '.join(moves)}", file=sys.stderr)
         layers.append((shown_path(path), data))
         update_config(config, data)
     if overrides:
         overrides = copy.deepcopy(dict(overrides))
+        translated(overrides)
         update_config(config, overrides)
         layers.append((OVERRIDES, overrides))
     schema_path = Path(schema) if schema is not None else find_schema(files)

@@ -457,7 +457,7 @@ def config_snippet(
     foot_markers : mapping, optional
         ``events.foot_markers`` ``{"left": ..., "right": ...}`` (model names).
     generic_model : str, optional
-        ``opensim.generic_model`` (.osim).
+        ``model.generic_model`` (.osim).
     notes : mapping of str to str, optional
         A comment per key (``"rotation"``, ``"label_map"``, ``"foot_markers"``, ``"generic_model"``).
     header : sequence of str
@@ -466,7 +466,7 @@ def config_snippet(
     Returns
     -------
     str
-        The YAML document (keys under ``markers``, ``events``, ``opensim``), to be merged over the configuration.
+        The YAML document (keys under ``markers``, ``events``, ``model``), to be merged over the configuration.
     """
     notes = dict(notes or {})
 
@@ -494,7 +494,7 @@ def config_snippet(
             ),
         ]
     if generic_model is not None:
-        out += ["opensim:", line("generic_model", str(generic_model), notes.get("generic_model", ""))]
+        out += ["model:", line("generic_model", str(generic_model), notes.get("generic_model", ""))]
     return "\n".join(out) + "\n"
 
 
@@ -510,7 +510,7 @@ MAX_CUTOFF_RATE_FRACTION = 0.4
 
 
 def marker_cutoff_hz(configured_hz: float | None, rates_hz: Sequence[float]) -> tuple[float | None, str]:
-    """The walking trials' marker low-pass cut-off ``inspect`` writes (``filter.cutoff_hz``) and why.
+    """The walking trials' marker low-pass cut-off ``inspect`` writes (``markers.filter.cutoff_hz``) and why.
 
     The rule: ``min(configured, MAX_CUTOFF_RATE_FRACTION * lowest rate)``. A cut-off must lie below the
     Nyquist frequency ``rate / 2`` of every trial filtered; 0.4 of the rate (0.8 of the Nyquist frequency)

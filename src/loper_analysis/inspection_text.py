@@ -335,11 +335,12 @@ def subject_config_text(
         )
     cutoff, why = subject.cutoff
     lines += [
-        "filter:",
-        f"  cutoff_hz: {'null' if cutoff is None else yaml_flow(cutoff)}   # walking trials' markers: {why}",
-        "opensim:",
+        "  filter:",
+        f"    cutoff_hz: {'null' if cutoff is None else yaml_flow(cutoff)}   # walking trials' markers: {why}",
+        "model:",
         f"  generic_model: {yaml_flow(files['model'])}   # {t.model} as OpenSim distributes it",
         f"  scale_setup: {yaml_flow(files['scale_setup'])}   # ScaleTool setup; names marker_set.xml beside it",
+        "ik:",
         f"  ik_tasks: {yaml_flow(files['ik_tasks'])}   # markers of the walking trials and their weights"
         + (f"; not tracked (static trial only): {', '.join(setup.static_only)}" if setup.static_only else ""),
         "  coordinate_map:   # our angle -> model coordinate; each sign read from the model's kinematics",

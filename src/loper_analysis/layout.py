@@ -132,7 +132,7 @@ class Study:
     paths : Paths
         The file patterns.
     config : mapping
-        The workflow's config (the keys read: ``trials``, ``events``, ``identification.noise_model``,
+        The workflow's config (the keys read: ``trials``, ``events``, ``impedance.noise_model``,
         ``device.subject``, ``validation``, ``planning.pilot_subject``).
     has_plates : callable
         ``has_plates(path) -> bool``: whether a C3D has force platforms (read once per file).
@@ -208,8 +208,8 @@ class Study:
         return self.rows[subject].get("model_osim") or fill(self.paths.model.scaled, subject=subject)
 
     def generic_model(self, subject: str) -> str:
-        """The model scaled per subject: opensim.generic_model, or the generated model for the subject."""
-        return self.config["opensim"]["generic_model"] or fill(self.paths.model.generic, subject=subject)
+        """The model scaled per subject: model.generic_model, or the generated model for the subject."""
+        return self.config["model"]["generic_model"] or fill(self.paths.model.generic, subject=subject)
 
     def static_markers(self, subject: str) -> list[str]:
         """The static trial's TRC of a subject with a static trial (generated for a synthetic subject, on disk for a

@@ -83,7 +83,7 @@ def config_origin(key_path: Sequence, layers: ConfigLayers | None, default: str 
     Parameters
     ----------
     key_path : sequence of str or int
-        Keys from the top of the configuration (``["identification", "n_starts"]``).
+        Keys from the top of the configuration (``["impedance", "n_starts"]``).
     layers : sequence of (name, mapping), optional
         The configuration's layers, highest priority first (:data:`ConfigLayers`).
     default : str
@@ -127,8 +127,28 @@ def check_config(
         path = _offending_path(e)
         key = ".".join(map(str, path)) or "(top level)"
         more = f" (and {len(errors) - 1} more problem(s))" if len(errors) > 1 else ""
-        raise LoperInputError(f"{config_origin(path, layers, source)}: key '{key}': {e.message}{more}")
+        where = _elsewhere(schema_path, path) if e.validator == "additionalProperties" else ""
+        raise LoperInputError(f"{config_origin(path, layers, source)}: key '{key}': {e.message}{where}{more}")
     _check_relations(data, origin)
+
+
+def _schema_keys(node: Mapping, path: tuple = ()):
+    """(dotted path, key) of every key the schema defines, sections and their keys (definitions aside)."""
+    for name, sub in (node.get("properties") or {}).items():
+        yield ".".join((*path, name)), name
+        if isinstance(sub, Mapping):
+            yield from _schema_keys(sub, (*path, name))
+
+
+def _elsewhere(schema_path: str | Path, path: Sequence) -> str:
+    """For a key the schema does not know at ``path``: where a key of that name belongs (a key in the wrong
+    section), as the end of a message; '' when no section has it."""
+    import yaml
+
+    name = str(path[-1]) if path else ""
+    schema = yaml.safe_load(Path(schema_path).read_text())
+    places = [dotted for dotted, key in _schema_keys(schema) if key == name]
+    return f"; a key '{name}' belongs in {' or '.join(repr(p) for p in places)}: move it there" if places else ""
 
 
 def _count_values(data, origin) -> None:
@@ -221,8 +241,8 @@ def _within(path: str, root: str) -> bool:
 _INTERVAL_WORDS = ("range", "bounds", "span", "window")
 #: (lower, upper) keys of one setting: the first must not exceed the second.
 _ORDERED_KEYS = (
-    (("opensim", "warn_marker_rms_m"), ("opensim", "max_marker_rms_m")),
-    (("opensim", "geometry_warn_change"), ("opensim", "geometry_stop_change")),
+    (("ik", "warn_marker_rms_m"), ("ik", "max_marker_rms_m")),
+    (("ik", "geometry_warn_change"), ("ik", "geometry_stop_change")),
 )
 
 
@@ -256,13 +276,13 @@ def _check_relations(config: dict, origin) -> None:
                 f"{origin(lower)}: key '{'.'.join(lower)}' {a} exceeds '{'.'.join(upper)}' {b} (from "
                 f"{origin(upper)}): the warning level must not be above the level that stops"
             )
-    trials = config.get("trials")
+    trials = config.get("study")
     if isinstance(trials, dict) and isinstance(trials.get("static"), str):
         for other in ("no_device", "device"):
             if trials.get(other) == trials["static"]:
                 raise LoperInputError(
-                    f"{origin(('trials', 'static'))}: key 'trials.static': '{trials['static']}' is also the walking "
-                    f"trial trials.{other}: the static trial is a standing trial of its own (e.g. 'static')"
+                    f"{origin(('study', 'static'))}: key 'study.static': '{trials['static']}' is also the walking "
+                    f"trial study.{other}: the static trial is a standing trial of its own (e.g. 'static')"
                 )
 
 

@@ -113,7 +113,7 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
     for s, row in study.rows.items():
         c3d = fill(study.paths.raw.c3d, subject=s, trial=static)
         if row["source"] == "synthetic":  # the truth must lie inside the identification bounds
-            synth, ident = c["synthetic"], c["identification"]
+            synth, ident = c["synthetic"], c["impedance"]
             true_impedance(
                 s,
                 c["seed"],
@@ -133,10 +133,10 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
                 f"{sheet}: recorded subject '{s}' has no static trial {c3d} (raw files are named "
                 f"{study.paths.raw.c3d}), nor a scaled model (column model_osim)"
             )
-        elif c["opensim"]["generic_model"] is None and "height_m" not in row:
+        elif c["model"]["generic_model"] is None and "height_m" not in row:
             raise LoperInputError(
                 f"{sheet}: recorded subject '{s}' needs height_m: the generated model "
-                f"({source('opensim', 'generic_model')}: opensim.generic_model null) is built from height "
+                f"({source('opensim', 'generic_model')}: model.generic_model null) is built from height "
                 "(a lab's model, such as gait2392, needs none)"
             )
     onsets = {int(o) for o in c["synthetic"]["stiffness_nm_per_rad"]}
@@ -144,7 +144,7 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
     if any(r["source"] == "synthetic" for r in study.rows.values()) and missing:
         raise LoperInputError(
             f"{source('synthetic', 'stiffness_nm_per_rad')}: key 'synthetic.stiffness_nm_per_rad': no truth "
-            f"for onset(s) {sorted(missing)} ms of trials.perturbation_onsets_ms"
+            f"for onset(s) {sorted(missing)} ms of study.perturbation_onsets_ms"
         )
     device = c["device"]["subject"]
     if device is not None and device not in study.rows:
@@ -167,7 +167,7 @@ def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
     """
     if sheet is not None:
         check_recordings(study, sheet)
-    said, trials, t = [], study.design.trials(), study.config["trials"]
+    said, trials, t = [], study.design.trials(), study.config["study"]
     for s in (s for s, row in study.rows.items() if row["source"] == "recorded"):
         raw = study.paths.raw_folder(s)
         for trial in trials:
@@ -188,8 +188,8 @@ def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
         if unmatched:
             said.append(
                 f"warning: {raw}: {', '.join(unmatched)}: no trial of the design has this name, not analysed "
-                f"(trials: {', '.join(trials)}; from trials.static, trials.no_device, trials.device, "
-                f"trials.perturbation_onsets_ms {t['perturbation_onsets_ms']} and trials.perturbation_repeats "
+                f"(trials: {', '.join(trials)}; from study.static, study.no_device, study.device, "
+                f"study.perturbation_onsets_ms {t['perturbation_onsets_ms']} and study.perturbation_repeats "
                 f"{t['perturbation_repeats']})"
             )
     return said

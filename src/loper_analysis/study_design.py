@@ -31,7 +31,7 @@ __all__ = [
     "perturbation_trial_name",
 ]
 
-#: The leg the robot perturbs, whose swing is identified (config ``trials.perturbed_side``).
+#: The leg the robot perturbs, whose swing is identified (config ``study.perturbed_side``).
 PERTURBED_SIDE: str = "left"
 #: The study's perturbation: a rectangular desired force along the thigh (N) ... (config
 #: ``synthetic.pulse_force_n``, ``planning.pulse_force_n``, ``validation.pulse_force_n``)

@@ -201,7 +201,7 @@ class StagedSubject:
     rotation_deg : tuple of float
         ``markers.lab_to_model_rotation_deg`` written (degrees).
     cutoff_hz : float or None
-        ``filter.cutoff_hz`` written (Hz).
+        ``markers.filter.cutoff_hz`` written (Hz).
     setup : SubjectSetup
         The template and what follows.
     """

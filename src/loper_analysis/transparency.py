@@ -51,7 +51,7 @@ __all__ = [
 
 @dataclass(frozen=True)
 class TransparencySettings:
-    """How the two walking trials are compared (config ``trials.perturbed_side``, ``strides.min_valid_strides``).
+    """How the two walking trials are compared (config ``study.perturbed_side``, ``strides.min_valid_strides``).
 
     ``side``: the leg whose strides are compared; ``min_strides``: a subject with fewer kept strides in
     either trial is left out of the comparison (its rows keep the counts, with empty metrics).

@@ -22,14 +22,14 @@ def test_a_repeated_key_is_named_with_both_lines_at_any_depth(tmp_path):
     check_yaml_file(path)  # no repeat: no error
 
 
-def test_a_second_filter_block_in_the_config_or_a_configfile_stops_the_run(tmp_path):
+def test_a_second_section_block_in_the_config_or_a_configfile_stops_the_run(tmp_path):
     copy_workflow(tmp_path)
     config = tmp_path / "config" / "config.yaml"
     original = config.read_text()
-    config.write_text(original + "\nfilter:\n  cutoff_hz: 20.0\n")
+    config.write_text(original + "\ndynamics:\n  cutoff_hz: 20.0\n")
     res = snakemake(tmp_path, "-n", "-q")
     said = res.stdout + res.stderr
-    assert res.returncode != 0 and "config/config.yaml: key 'filter' is given twice in the config file" in said
+    assert res.returncode != 0 and "config/config.yaml: key 'dynamics' is given twice in the config file" in said
     config.write_text(original)
     (tmp_path / "mine.yaml").write_text("seed: 3\nseed: 4\n")
     res = snakemake(tmp_path, "-n", "-q", "--configfile", "mine.yaml")

@@ -19,11 +19,11 @@ CONFIG = ROOT / "config" / "config.yaml"
 @pytest.mark.parametrize(
     ("section", "key", "value"),
     [
-        ("identification", "min_vaf_pct", ".nan"),
+        ("impedance", "min_vaf_pct", ".nan"),
         ("strides", "iqr_whisker", ".nan"),
         ("synthetic", "walking_duration_s", ".nan"),
         ("synthetic", "walking_duration_s", ".inf"),
-        ("filter", "cutoff_hz", "-.inf"),
+        ("dynamics", "cutoff_hz", "-.inf"),
     ],
 )
 def test_a_nan_or_infinite_key_in_a_configfile_is_named_with_its_file(tmp_path, section, key, value):
@@ -51,7 +51,7 @@ def test_the_workflow_refuses_nan_from_a_configfile_or_the_command_line(tmp_path
     (work / "mine.yaml").write_text("identification:\n  min_vaf_pct: .nan\n")
     res = snakemake(work, "-n", "-q", "--configfile", "mine.yaml")
     said = res.stdout + res.stderr
-    assert res.returncode == 1 and "mine.yaml: key 'identification.min_vaf_pct': nan is not a finite" in said, said
+    assert res.returncode == 1 and "mine.yaml: key 'impedance.min_vaf_pct': nan is not a finite" in said, said
     res = snakemake(work, "-n", "-q", "--config", "seed=nan")
     said = res.stdout + res.stderr
     assert res.returncode == 1 and "--config: key 'seed': nan is not a finite" in said, said

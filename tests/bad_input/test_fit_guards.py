@@ -2,7 +2,7 @@
 
 * a fit window longer than the validation study's simulated swing is refused, naming the key;
 * a subject fit whose strides are too short for the window fails with a reason naming
-  ``identification.window_after_s``, its value and the longest window the strides allow;
+  ``impedance.window_after_s``, its value and the longest window the strides allow;
 * an estimate on an upper bound is ``not_identifiable``, a VAF below the floor ``failed``;
 * a trial whose unperturbed strides are grossly deviant is left out of every onset's null pairs.
 """
@@ -45,7 +45,7 @@ def test_validation_refuses_a_window_after_the_heel_strike(after, limit):
     with pytest.raises(LoperInputError) as info:
         ValidationSettings(window=ResponseWindow(after_s=after))
     message = str(info.value)
-    assert f"identification.window_after_s = {after:g} s" in message
+    assert f"impedance.window_after_s = {after:g} s" in message
     assert f"at most {limit}" in message and "validation.swing_duration_s = 0.6 s" in message
     assert "validation.onset_s = 0.05 s" in message
 
@@ -53,7 +53,7 @@ def test_validation_refuses_a_window_after_the_heel_strike(after, limit):
 def test_validation_refuses_a_window_before_toe_off():
     with pytest.raises(LoperInputError) as info:
         ValidationSettings(window=ResponseWindow(before_s=0.1))
-    assert "identification.window_before_s = 0.1 s" in str(info.value) and "at most 0.05 s" in str(info.value)
+    assert "impedance.window_before_s = 0.1 s" in str(info.value) and "at most 0.05 s" in str(info.value)
 
 
 def test_validation_accepts_the_window_up_to_the_heel_strike():
@@ -63,7 +63,7 @@ def test_validation_accepts_the_window_up_to_the_heel_strike():
 
 def test_validation_chunk_step_refuses_before_writing(tmp_path):
     out = [tmp_path / "errors.tsv", tmp_path / "fits.tsv"]
-    with pytest.raises(LoperInputError, match=r"identification\.window_after_s = 1 s"):
+    with pytest.raises(LoperInputError, match=r"impedance\.window_after_s = 1 s"):
         validation_chunk(tmp_path / "segments.tsv", ValidationSettings(window=ResponseWindow(after_s=1.0)), 0, 2, *out)
     assert not any(p.exists() for p in out)
 
@@ -98,7 +98,7 @@ def test_a_window_longer_than_every_swing_names_the_key(onset_trials):
     reason = rows.reason.iloc[0]
     assert reason.startswith("0 valid perturbed stride(s), fewer than 4: not fitted")
     assert "8 of 8 perturbed stride(s) too short" in reason
-    assert "onset 100 ms + identification.window_after_s = 1 s" in reason
+    assert "onset 100 ms + impedance.window_after_s = 1 s" in reason
     assert f"the longest swing leaves {LONGEST_AFTER_ONSET_S:.3g} s after the onset" in reason  # 0.383 s
     total = result.counts.set_index("trial").loc["total"]
     assert (total.n_perturbed, total.n_too_short, total.n_kept) == (8, 8, 0)
@@ -110,7 +110,7 @@ def test_strides_too_short_are_dropped_one_by_one(onset_trials):
     total = result.counts.set_index("trial").loc["total"]
     assert (total.n_too_short, total.n_kept) == (6, 2)
     assert "6 of 8 perturbed stride(s) too short" in result.rows.reason.iloc[0]
-    assert "identification.window_after_s = 0.38 s" in result.rows.reason.iloc[0]
+    assert "impedance.window_after_s = 0.38 s" in result.rows.reason.iloc[0]
     # enough strides left: the fit runs and its reason does not mention the window
     fitted = _fit(onset_trials, 0.38, min_strides=2, noise_model="white")
     assert fitted.rows.n_strides.tolist() == [2, 2, 2] and not fitted.rows.reason.str.contains("window_after").any()
@@ -133,7 +133,7 @@ def test_a_response_of_the_wrong_sign_puts_k_on_its_upper_bound(truth_window):
     rows = impedance_rows(fit, "S01", 50, 12).set_index("joint")
     assert rows.loc["knee", "status"] == "not_identifiable"
     assert (
-        "K_knee = 200 N·m/rad at its upper bound 200 N·m/rad (identification.stiffness_bounds_nm_per_rad)"
+        "K_knee = 200 N·m/rad at its upper bound 200 N·m/rad (impedance.stiffness_bounds_nm_per_rad)"
         in rows.loc["knee", "reason"]
     )
     # the fit is polished by least_squares at xtol/ftol 1e-14: its VAF holds to 1e-9 (the same with the kernels
@@ -149,10 +149,10 @@ def test_a_vaf_below_the_floor_fails_the_joint(truth_window):
     rows = impedance_rows(fit, "S01", 50, 12).set_index("joint")
     assert rows.status.tolist() == ["failed", "not_identifiable", "failed"]
     # the reason quotes the fit's own VAF (-63.9, 16.8 %): the value is checked above, the wording here
-    assert rows.loc["hip", "reason"].startswith(f"VAF {hip_vaf:.1f} % below identification.min_vaf_pct = 0 %")
+    assert rows.loc["hip", "reason"].startswith(f"VAF {hip_vaf:.1f} % below impedance.min_vaf_pct = 0 %")
     assert "K_hip = 200 N·m/rad at its upper bound" in rows.loc["hip", "reason"]
     strict = impedance_rows(fit, "S01", 50, 12, min_vaf_pct=20.0).set_index("joint")
-    assert f"VAF {knee_vaf:.1f} % below identification.min_vaf_pct = 20 %" in strict.loc["knee", "reason"]
+    assert f"VAF {knee_vaf:.1f} % below impedance.min_vaf_pct = 20 %" in strict.loc["knee", "reason"]
     assert strict.loc["knee", "status"] == "failed"
 
 

@@ -24,17 +24,17 @@ CASES = {
     "a negative IK limit": (
         ["ik", "--model", "m.osim", "--markers", "t.c3d", "--out", "{d}/o.mot", "--max-marker-rms-m", "-1"],
         "--max-marker-rms-m -1.0",
-        "opensim.max_marker_rms_m",
+        "ik.max_marker_rms_m",
     ),  # fmt: skip
     "a filter of order 12": (
         ["markers", "t.c3d", "--out", "{d}/t.trc", "--order", "12"],
         "--order 12",
-        "filter.order",
+        "markers.filter.order",
     ),  # fmt: skip
     "no starts": (
         ["validate", "--segments", "s.tsv", "--errors", "{d}/e.tsv", "--fits", "{d}/f.tsv", "--n-starts", "0"],
         "--n-starts 0",
-        "identification.n_starts",
+        "impedance.n_starts",
     ),  # fmt: skip
 }
 
@@ -49,7 +49,7 @@ def test_an_option_past_its_keys_limits_stops_naming_option_value_and_key(case, 
 
 
 def test_zero_switches_a_filter_off_and_every_mapped_key_exists(tmp_path, capsys):
-    # filter.cutoff_hz must exceed 0, but --cutoff-hz 0 switches the filter off: the missing file is what stops
+    # markers.filter.cutoff_hz must exceed 0, but --cutoff-hz 0 switches the filter off: the missing file is what stops
     assert main(["markers", str(tmp_path / "t.c3d"), "--out", str(tmp_path / "t.trc"), "--cutoff-hz", "0"]) == 2
     assert "C3D file not found" in capsys.readouterr().err
     from loper_analysis.config_file import find_schema

@@ -127,14 +127,14 @@ def test_ik_with_markers_1000_times_too_far_apart_fails_naming_the_rms_and_the_l
     with pytest.raises(LoperInputError) as err:  # the marker geometry says it first
         ik_chunk(trial["model"], trc, out, 0, 1)
     msg = str(err.value)
-    assert str(trc) in msg and "opensim.geometry_stop_change" in msg and "ratio 1000.000" in msg
+    assert str(trc) in msg and "ik.geometry_stop_change" in msg and "ratio 1000.000" in msg
     assert "1000 times the model's: markers in another length unit (the file's POINT:UNITS)" in msg
     assert not out.exists()
     with pytest.raises(LoperInputError) as err:  # and IK's marker error, without the geometry check
         ik_chunk(trial["model"], trc, out, 0, 1, IKSettings(geometry_stop_change=np.inf))
     msg = str(err.value)
     assert str(trc) in msg and "IK marker RMS error exceeds 60 mm" in msg and f"in {N} of {N} frames" in msg
-    assert "opensim.max_marker_rms_m" in msg
+    assert "ik.max_marker_rms_m" in msg
     mean_rms_mm = float(msg.split("mean RMS ")[1].split(" mm")[0])
     assert mean_rms_mm > 1e5  # hundreds of metres
     assert not out.exists()
@@ -148,7 +148,7 @@ def test_ik_on_a_model_without_markers_says_it_has_none_and_where_they_come_from
         ik_file(generic, trial["trc"], out)
     msg = str(err.value)
     assert f"{generic} (model 3DGaitModel2392) has no markers (its MarkerSet is empty)" in msg
-    assert "gait2392_Scale_MarkerSet.xml" in msg and "opensim.scale_setup" in msg and "--config-out" in msg
+    assert "gait2392_Scale_MarkerSet.xml" in msg and "model.scale_setup" in msg and "--config-out" in msg
     assert not out.exists()
 
 

@@ -46,7 +46,7 @@ def project(tmp_path_factory) -> Path:
     work = copy_workflow(tmp_path_factory.mktemp("owned"))
     cfg = yaml.safe_load((work / "config/config.yaml").read_text())
     cfg["device"]["subject"] = None
-    cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=2)
+    cfg["study"].update(perturbation_onsets_ms=[50], perturbation_repeats=2)
     cfg["synthetic"]["walking_duration_s"] = 10.0
     (work / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
     (work / "config/subjects.tsv").write_text(SHEET)

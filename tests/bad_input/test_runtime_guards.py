@@ -263,27 +263,27 @@ def test_the_report_subcommand_names_a_config_file_with_a_syntax_error_before_ru
 
 def test_cutoffs_the_filter_cannot_use_are_refused_naming_the_setting_the_value_and_the_rate():
     x = np.random.default_rng(1).normal(size=600)
-    kw = {"setting": "filter.cutoff_hz", "rate_name": "POINT:RATE", "source": "walk.c3d"}
+    kw = {"setting": "markers.filter.cutoff_hz", "rate_name": "POINT:RATE", "source": "walk.c3d"}
     cases = [
         (
             1e-9,
-            "walk.c3d: filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz): an "
+            "walk.c3d: markers.filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz): an "
             "order-4 Butterworth at 1.6e-11 of the Nyquist frequency is numerically unsound (its gain at 0 Hz is "
-            "inf, not 1); raise filter.cutoff_hz",
+            "inf, not 1); raise markers.filter.cutoff_hz",
         ),
         (
             64.0,
-            "walk.c3d: filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = "
+            "walk.c3d: markers.filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = "
             "128 Hz), got 64 Hz",
         ),
         (
             0.0,
-            "walk.c3d: filter.cutoff_hz must be a positive, finite frequency below the Nyquist frequency 64 Hz of "
-            "POINT:RATE = 128 Hz, got 0.0",
+            "walk.c3d: markers.filter.cutoff_hz must be a positive, finite frequency below the Nyquist frequency "
+            "64 Hz of POINT:RATE = 128 Hz, got 0.0",
         ),
         (
             float("inf"),
-            "walk.c3d: filter.cutoff_hz must be a positive, finite frequency below the Nyquist "
+            "walk.c3d: markers.filter.cutoff_hz must be a positive, finite frequency below the Nyquist "
             "frequency 64 Hz of POINT:RATE = 128 Hz, got inf",
         ),
     ]
@@ -380,9 +380,10 @@ def test_grf_cutoff_is_named_by_its_config_key_and_the_event_table_is_kept(belt_
     [
         (
             100.0,
-            "filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = 128 Hz), got 100 Hz",
+            "markers.filter.cutoff_hz must lie in 0 .. 64 Hz (below the Nyquist frequency of POINT:RATE = 128 Hz), "
+            "got 100 Hz",
         ),
-        (1e-9, "filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz)"),
+        (1e-9, "markers.filter.cutoff_hz = 1e-09 Hz is too low for POINT:RATE = 128 Hz (Nyquist 64 Hz)"),
     ],
     ids=["above-nyquist", "singular"],
 )
@@ -397,7 +398,7 @@ def test_marker_cutoff_is_named_by_its_config_key_and_the_trc_is_kept(belt_c3d, 
 
 
 def test_load_cell_cutoff_above_the_robot_logs_nyquist_names_the_log_and_the_config_key(belt_c3d, tmp_path):
-    """filter.cutoff_hz also low-passes the robot log's forces, at the log's own rate (here 60 Hz)."""
+    """markers.filter.cutoff_hz also low-passes the robot log's forces, at the log's own rate (here 60 Hz)."""
     rate = 60.0
     n = 120
     log_path = tmp_path / "walk-nodevice.loper.tsv"
@@ -423,7 +424,7 @@ def test_load_cell_cutoff_above_the_robot_logs_nyquist_names_the_log_and_the_con
     with pytest.raises(LoperInputError) as info:
         event_steps.loadcell(belt_c3d, log_path, out, LoadcellSettings(sync_channel="Fz_left", cutoff_hz=40.0))
     assert str(info.value) == (
-        f"{log_path}: filter.cutoff_hz must lie in 0 .. 30 Hz (below the Nyquist frequency of "
+        f"{log_path}: markers.filter.cutoff_hz must lie in 0 .. 30 Hz (below the Nyquist frequency of "
         "the log's sample_rate_hz = 60 Hz), got 40 Hz"
     )
     assert _digest(out) == before
@@ -476,7 +477,7 @@ def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_co
     work = workflow_dir
     config = work / "config/config.yaml"
     lines = config.read_text().splitlines(keepends=True)
-    k = next(i for i, line in enumerate(lines) if line.startswith("  cutoff_hz: 40.0"))
+    k = next(i for i, line in enumerate(lines) if line.startswith("    cutoff_hz: 40.0"))
     lines[k] = lines[k].replace("cutoff_hz: 40.0", "cutoff_hz: [40.0")
     config.write_text("".join(lines))
     earlier = work / fill(PATHS.markers.trc, subject="R01", trial="walk")
@@ -488,7 +489,7 @@ def test_a_syntax_error_in_config_yaml_stops_snakemake_with_the_file_line_and_co
     message = (
         f"config/config.yaml: line {k + 2}, column {lines[k + 1].index(':') + 1}: "
         f"YAML syntax error: expected ',' or ']', but got ':' (while parsing a flow sequence that starts at "
-        f"line {k + 1}, column 14)"
+        f"line {k + 1}, column {lines[k].index('[') + 1})"
     )
     assert console.count(message) == 1, console
     assert "not valid JSON or YAML" not in console

@@ -83,7 +83,7 @@ def project(tmp_path_factory) -> Path:
         (shutil.copytree if src.is_dir() else shutil.copy)(src, work / item)
     cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
     cfg["device"]["subject"] = SUBJECT
-    cfg["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
+    cfg["study"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     (work / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
     (work / "config/subjects.tsv").write_text(
         f"subject\tsource\theight_m\tmass_kg\n{SUBJECT}\trecorded\t{HEIGHT_M}\t{MASS_KG}\n"
@@ -278,7 +278,7 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
     t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial="static"))
     X[:, :, 0] += 0.3 * (t - t[0])[:, None]
     write_trc(lab / "moving.trc", t, X, labels)
-    m = _config(lab)["markers"]
+    m = _config(lab)["model"]
     n = int(np.sum(t < t[0] + m["static_duration_s"] - 1e-9))
     largest = [
         np.nanmax(np.sqrt(np.nanmean(np.sum((X[s : s + n] - np.nanmean(X[s : s + n], axis=0)) ** 2, axis=2), axis=0)))
@@ -303,8 +303,8 @@ def test_static_trial_in_which_the_subject_moves_is_refused(lab):
             f"moving.trc: the subject does not stand still in the scaling window {t[s]:.4f} .. {t[s + n - 1]:.4f} s "
             "of the static trial: marker(s) ",
             " 87 mm, ",
-            f"and {len(labels) - 5} more move more than markers.static_max_motion_rms_m 0.05 m RMS about their mean; "
-            f"it is the stillest 1 s (markers.static_duration_s) of the static trial ({t[0]:.4f} .. {t[-1]:.4f} s",
+            f"and {len(labels) - 5} more move more than model.static_max_motion_rms_m 0.05 m RMS about their mean; "
+            f"it is the stillest 1 s (model.static_duration_s) of the static trial ({t[0]:.4f} .. {t[-1]:.4f} s",
         ],
     )
 
@@ -344,8 +344,8 @@ def test_model_marker_missing_from_the_trial_stops_ik(lab):
             "without-LKNE.trc with ",
             "generic.osim: marker(s) ['LKNE'] of the model's marker set are missing",
             "markers.label_map",
-            "opensim.marker_weights",
-            "opensim.ik_tasks",
+            "ik.marker_weights",
+            "ik.ik_tasks",
         ],
     )
 
@@ -392,7 +392,7 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
     )
     static = fill(PATHS.markers.trc, subject=SUBJECT, trial="static")  # R01's, the reference
     if refused:
-        message = _refused(lab, lambda: _ik(cfg, out, static), [f"{out} with ", "opensim.geometry_stop_change 0.08"])
+        message = _refused(lab, lambda: _ik(cfg, out, static), [f"{out} with ", "ik.geometry_stop_change 0.08"])
         change = float(re.search(rf"differ from the same pairs in the static trial {static} by ([\d.]+) %", message)[1])
         assert 9.0 < change < 13.0
         assert re.search(r"ratio 0\.8[6-9]\d", message) and re.search(r"\w+-\w+ \(\w+\) \d+ mm against \d+", message)
@@ -409,8 +409,8 @@ def test_a_walking_trial_of_another_subject_is_refused_or_warned_by_its_marker_g
     )
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
     assert 0.05 < row["marker_geometry_change"] < 0.08
-    assert "opensim.geometry_warn_change 0.05" in row["warnings"]
-    assert any("opensim.geometry_warn_change" in r.getMessage() for r in caplog.records if r.levelname == "WARNING")
+    assert "ik.geometry_warn_change 0.05" in row["warnings"]
+    assert any("ik.geometry_warn_change" in r.getMessage() for r in caplog.records if r.levelname == "WARNING")
 
 
 def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_on_a_unit(lab, tmp_path):
@@ -427,7 +427,7 @@ def test_a_model_given_as_it_is_warns_about_another_subjects_geometry_and_stops_
     model = fill(PATHS.model.generic, subject=SUBJECT)
     ik.ik_trial(model, out, tmp_path / "a.mot", tmp_path / "a.angles.tsv", given, summary_tsv=summary)
     row = pd.read_csv(summary, sep="\t", keep_default_na=False).iloc[0]
-    assert row["marker_geometry_change"] > 0.08 and "opensim.geometry_warn_change 0.05" in row["warnings"]
+    assert row["marker_geometry_change"] > 0.08 and "ik.geometry_warn_change 0.05" in row["warnings"]
     t, X, labels = read_markers(out)
     write_trc(tmp_path / "km.trc", t, 1000.0 * X, labels)
     message = _refused(
@@ -477,7 +477,7 @@ def test_a_static_trial_of_another_subject_stops_the_walking_trials_ik(lab, tmp_
         f"differ from the same pairs in the static trial {fill(PATHS.markers.trc, subject=SUBJECT, trial='static')}"
         in message
     )
-    assert "opensim.geometry_stop_change 0.08" in message
+    assert "ik.geometry_stop_change 0.08" in message
     after = _state(lab)
     assert {k: after[k] for k in before} == before
     assert not (lab / fill(PATHS.ik.mot, subject=SUBJECT, trial=WALK)).exists()
@@ -516,7 +516,7 @@ def test_frames_with_fewer_than_three_markers_are_left_out_and_a_trial_without_a
     t, X, labels = read_markers(fill(PATHS.markers.trc, subject=SUBJECT, trial=WALK))
     X[100:103, 2:] = np.nan  # frames 100-102 keep RASI and LASI only: left out, the rest solved
     write_trc(tmp_path / "sparse.trc", t, X, labels)
-    o = _config(lab)["opensim"]
+    o = _config(lab)["ik"]
     angles = ik.ik_trial(
         fill(PATHS.model.generic, subject=SUBJECT),
         tmp_path / "sparse.trc",
@@ -820,7 +820,7 @@ def test_raw_files_that_match_no_trial_of_the_design_are_named_in_a_warning(lab)
         f"warning: {RAW}: pert100-1.c3d, pert100-1.loper.tsv: no trial of the design has this name, not "
         "analysed (trials: static, walk-nodevice, walk-device, pert050-1, device-frf, device-steps; "
     ) in res.stderr
-    assert "trials.perturbation_onsets_ms [50] and trials.perturbation_repeats 1" in res.stderr
+    assert "study.perturbation_onsets_ms [50] and study.perturbation_repeats 1" in res.stderr
     assert _state(lab) == before
 
 
@@ -912,7 +912,7 @@ def test_recorded_only_study_with_belt_channels_and_its_own_onsets_is_planned(la
     per belt instead of force platforms: events from the channels, no external loads, said in a note."""
     cfg = _config(lab)
     cfg["device"]["subject"] = None
-    cfg["trials"]["perturbation_onsets_ms"] = [100]  # the synthetic truth has 50, 175 and 300 ms
+    cfg["study"]["perturbation_onsets_ms"] = [100]  # the synthetic truth has 50, 175 and 300 ms
     (lab / "config/config.yaml").write_text(yaml.safe_dump(cfg, sort_keys=False))
     for suffix in (".c3d", ".loper.tsv"):  # another recording of the walk (one recording stands for one trial)
         shutil.copy(lab / "elsewhere" / f"{WALK}{suffix}", lab / RAW / f"pert100-1{suffix}")
@@ -958,7 +958,7 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
         (
             {"config/lab.yaml": {"identification": {"n_starts": "ten"}}},
             ["--configfile", "config/lab.yaml"],
-            ["config/lab.yaml: key 'identification.n_starts': 'ten' is not of type 'integer'"],
+            ["config/lab.yaml: key 'impedance.n_starts': 'ten' is not of type 'integer'"],
         ),
         ({}, ["--config", "seed=-1"], ["--config: key 'seed': -1 is less than the minimum of 0"]),
         (
@@ -969,13 +969,13 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
         (
             {"config/lab.yaml": {"filter": {"cutoff_hz": -40.0}}},
             ["--configfile", "config/lab.yaml", "--config", "seed=7"],
-            ["config/lab.yaml: key 'filter.cutoff_hz': -40.0"],
+            ["config/lab.yaml: key 'markers.filter.cutoff_hz': -40.0"],
         ),
         (
             {"config/lab.yaml": {"identification": {"stiffness_bounds_nm_per_rad": [200.0, 0.0]}}},
             ["--configfile", "config/lab.yaml"],
             [
-                "config/lab.yaml: key 'identification.stiffness_bounds_nm_per_rad': [200.0, 0.0] is reversed or "
+                "config/lab.yaml: key 'impedance.stiffness_bounds_nm_per_rad': [200.0, 0.0] is reversed or "
                 "empty: give [low, high] with low below high"
             ],
         ),
@@ -983,7 +983,7 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
             {"config/lab.yaml": {"trials": {"static": "walk-nodevice"}}},
             ["--configfile", "config/lab.yaml"],
             [
-                "config/lab.yaml: key 'trials.static': 'walk-nodevice' is also the walking trial trials.no_device: "
+                "config/lab.yaml: key 'study.static': 'walk-nodevice' is also the walking trial study.no_device: "
                 "the static trial is a standing trial of its own"
             ],
         ),
@@ -991,7 +991,7 @@ def test_recorded_subject_without_some_trials_is_planned_without_them(lab):
             {"config/lab.yaml": {"opensim": {"geometry_warn_change": 0.2}}},
             ["--configfile", "config/lab.yaml"],
             [
-                "config/lab.yaml: key 'opensim.geometry_warn_change' 0.2 exceeds 'opensim.geometry_stop_change' 0.08 "
+                "config/lab.yaml: key 'ik.geometry_warn_change' 0.2 exceeds 'ik.geometry_stop_change' 0.08 "
                 "(from config/config.yaml)"
             ],
         ),

@@ -164,18 +164,21 @@ def test_perturbation_onsets():
 
 
 def test_settings_of_a_config():
-    """The sync channel is events.sync_channel; the low-pass the walking trials' filter.cutoff_hz and order."""
+    """The sync channel is events.sync_channel; the low-pass the walking trials' markers.filter.cutoff_hz and order."""
     config = copy.deepcopy(CONFIG)
     config["events"]["sync_channel"] = "trigger"
-    config["filter"].update(cutoff_hz=12.0, order=2)
+    config["markers"]["filter"].update(cutoff_hz=12.0, order=2)
     assert stage_settings(config, "events").loadcell == LoadcellSettings("trigger", 12.0, 2)
     assert stage_settings(CONFIG, "events").loadcell == LoadcellSettings() == LoadcellSettings(SYNC_CHANNEL, 40.0, 4)
     assert SYNC_CHANNEL == "sync"
 
 
-@pytest.mark.parametrize(("section", "key"), [("events", "sync_channel"), ("filter", "order")])
-def test_settings_name_a_missing_key(section, key):
+@pytest.mark.parametrize("path", [("events", "sync_channel"), ("markers", "filter", "order")])
+def test_settings_name_a_missing_key(path):
     config = copy.deepcopy(CONFIG)
-    del config[section][key]
-    with pytest.raises(LoperInputError, match=f"^config: key '{section}.{key}' missing: "):
+    node = config
+    for name in path[:-1]:
+        node = node[name]
+    del node[path[-1]]
+    with pytest.raises(LoperInputError, match=f"^config: key '{'.'.join(path)}' missing: "):
         _ = stage_settings(config, "events").loadcell

@@ -17,7 +17,7 @@ CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "confi
 def test_every_config_key_reaches_its_field():
     config = copy.deepcopy(CONFIG)
     config["strides"].update(n_points=51, iqr_whisker=2.0, max_outlier_fraction=0.2, min_valid_strides=7)
-    config["trials"]["perturbed_side"] = "right"
+    config["study"]["perturbed_side"] = "right"
     assert stage_settings(config, "strides") == StrideSettings(
         side="right", n_points=51, whisker=2.0, max_fraction=0.2, min_valid=7
     )
@@ -28,7 +28,7 @@ def test_the_shipped_config_gives_the_defaults():
     assert stage_settings(CONFIG, "strides") == StrideSettings() == StrideSettings("left", 101, 1.5, 0.2, 5)
 
 
-@pytest.mark.parametrize(("section", "key"), [("strides", "n_points"), ("trials", "perturbed_side")])
+@pytest.mark.parametrize(("section", "key"), [("strides", "n_points"), ("study", "perturbed_side")])
 def test_a_missing_key_is_named(section, key):
     config = copy.deepcopy(CONFIG)
     del config[section][key]

@@ -117,5 +117,5 @@ def test_settings_from_the_config_file(repo_root):
     assert (s.band_n, s.max_rest_n, s.order) == (
         config["grf"]["resting_band_n"],
         config["grf"]["max_resting_n"],
-        config["filter"]["order"],
+        config["markers"]["filter"]["order"],
     )

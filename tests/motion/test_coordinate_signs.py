@@ -41,9 +41,9 @@ def test_knee_sign_differs_between_the_models_opensim_distributes(model, knee):
 
 def test_a_knee_sign_that_contradicts_gait2392_stops_naming_the_key():
     model = read_model(GAIT2392)
-    require_map_signs(model, _lab_map(-1.0), str(GAIT2392), "opensim.coordinate_map")  # right: no error
+    require_map_signs(model, _lab_map(-1.0), str(GAIT2392), "ik.coordinate_map")  # right: no error
     with pytest.raises(LoperInputError) as err:
-        require_map_signs(model, _lab_map(1.0), str(GAIT2392), "opensim.coordinate_map")
+        require_map_signs(model, _lab_map(1.0), str(GAIT2392), "ik.coordinate_map")
     text = str(err.value)
-    assert "opensim.coordinate_map.knee_left.sign: -1" in text and "opensim.coordinate_map.knee_right.sign: -1" in text
+    assert "ik.coordinate_map.knee_left.sign: -1" in text and "ik.coordinate_map.knee_right.sign: -1" in text
     assert "knee_angle_l" in text and "hip_left" not in text

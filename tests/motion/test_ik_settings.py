@@ -20,7 +20,7 @@ MAP = {"knee_left": {"coordinate": "knee_angle_l", "sign": -1}}
 def _changed() -> dict:
     """The shipped config with every key the IK reads set away from its default."""
     config = copy.deepcopy(CONFIG)
-    config["opensim"].update(
+    config["ik"].update(
         ik_tasks="tasks.xml",
         default_marker_weight=0.5,
         marker_weights={"LASI": 2.0, "RASI": 0.0},
@@ -66,7 +66,7 @@ def test_the_shipped_config_gives_the_defaults():
 
 
 def test_the_scale_report_takes_the_ik_accuracy_and_coordinate_map():
-    """opensim.accuracy and opensim.coordinate_map reach the model stage's static pose as the IK's."""
+    """ik.accuracy and ik.coordinate_map reach the model stage's static pose as the IK's."""
     model, ik = stage_settings(_changed(), "model"), stage_settings(_changed(), "ik")
     assert (model.accuracy, model.coordinate_map) == (ik.accuracy, ik.coordinate_map) == (1e-8, MAP)
     assert model.for_scaling().accuracy == 1e-8
@@ -75,6 +75,6 @@ def test_the_scale_report_takes_the_ik_accuracy_and_coordinate_map():
 @pytest.mark.parametrize("key", ["accuracy", "geometry_stop_change", "ik_tasks"])
 def test_a_missing_key_is_named(key):
     config = copy.deepcopy(CONFIG)
-    del config["opensim"][key]
-    with pytest.raises(LoperInputError, match=f"^config: key 'opensim.{key}' missing: the ik settings read it$"):
+    del config["ik"][key]
+    with pytest.raises(LoperInputError, match=f"^config: key 'ik.{key}' missing: the ik settings read it$"):
         stage_settings(config, "ik")

@@ -52,7 +52,7 @@ def test_a_knee_flexing_negative_is_warned_about_and_a_walking_knee_is_not():
     angles = pd.DataFrame({"knee_left_rad": knee, "knee_right_rad": -knee})
     warnings = inverted_knee_warnings(angles)
     assert len(warnings) == 1 and warnings[0].startswith("knee_right flexes negative (from -52 to 3 deg)")
-    assert "opensim.coordinate_map.knee_right.sign" in warnings[0]
+    assert "ik.coordinate_map.knee_right.sign" in warnings[0]
 
 
 def test_angles_with_any_suffix_are_read_and_a_missing_one_is_logged(caplog):

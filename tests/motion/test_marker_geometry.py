@@ -42,8 +42,8 @@ def test_the_models_own_markers_have_its_distances_and_a_smaller_subjects_differ
     order = [small_labels.index(n) for n in labels]
     s02 = marker_geometry(pairs, np.repeat(small[order][None], 5, axis=0), labels)
     assert 0.08 < geometry_change(s02) < 0.1
-    text = geometry_message(other, 0.08, "opensim.geometry_stop_change")
-    assert "by 10.0 % in the median of" in text and "opensim.geometry_stop_change 0.08" in text
+    text = geometry_message(other, 0.08, "ik.geometry_stop_change")
+    assert "by 10.0 % in the median of" in text and "ik.geometry_stop_change 0.08" in text
     assert "ratio 0.900" in text and " mm against " in text
 
 
@@ -76,16 +76,16 @@ def test_a_trial_against_a_static_trial_compares_the_pairs_both_hold():
     np.testing.assert_allclose(table["reference_distance_m"] * 0.9, table["trial_distance_m"], rtol=1e-12)
     assert np.allclose(table["change"], -0.1) and geometry_ratio(table) == pytest.approx(0.9)
     assert (table["reference_distance_m"] >= MIN_PAIR_DISTANCE_M).all() and (table["n_frames"] == 5).all()
-    text = geometry_message(table, 0.08, "opensim.geometry_stop_change", "results/markers/S01/static.trc")
+    text = geometry_message(table, 0.08, "ik.geometry_stop_change", "results/markers/S01/static.trc")
     assert text.startswith(
         "the distances between markers on one body differ from the same pairs in the static trial "
         "results/markers/S01/static.trc by 10.0 % in the median of "
     )
-    assert "(limit opensim.geometry_stop_change 0.08; trial/static ratio 0.900)" in text
+    assert "(limit ik.geometry_stop_change 0.08; trial/static ratio 0.900)" in text
     assert "another subject" in text
     # a walking trial in mm against a static trial in m: a unit, named against the static trial
     table = marker_geometry(pairs, np.repeat(1000.0 * X[None], 5, axis=0), labels, static, labels)
-    text = geometry_message(table, 0.08, "opensim.geometry_stop_change", "static.trc")
+    text = geometry_message(table, 0.08, "ik.geometry_stop_change", "static.trc")
     assert "trial/static ratio 1000.000" in text and "1000 times the static trial's: markers in another length" in text
     # without a static trial the model's markers are the reference, and the message says so
     text = geometry_message(marker_geometry(pairs, np.repeat(0.9 * X[None], 5, axis=0), labels), 0.08, "x")

@@ -17,15 +17,16 @@ MAP = {"hip": {"coordinate": "hip_flexion_{s}", "sign": 1}}
 def _changed() -> ModelSettings:
     """Settings from the shipped config with every key the model stage reads set away from its default."""
     config = yaml.safe_load(yaml.safe_dump(CONFIG))
-    config["markers"].update(lab_to_model_rotation_deg=[0, 0, 90], static_duration_s=0.5, static_max_motion_rms_m=0.02)
-    config["opensim"].update(
+    config["markers"].update(lab_to_model_rotation_deg=[0, 0, 90])
+    config["model"].update(
+        static_duration_s=0.5,
+        static_max_motion_rms_m=0.02,
         scale_factor_range=[0.7, 1.4],
         segment_bodies=BODIES,
         brace_attachment_fraction=0.6,
-        coordinate_map=MAP,
-        accuracy=1e-8,
     )
-    config["trials"]["perturbed_side"] = "right"
+    config["ik"].update(coordinate_map=MAP, accuracy=1e-8)
+    config["study"]["perturbed_side"] = "right"
     return stage_settings(config, "model")
 
 

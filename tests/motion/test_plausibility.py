@@ -56,7 +56,7 @@ def test_ik_fit_warns_at_20_mm_and_stops_at_60_mm_by_default():
     assert warning.startswith(
         "walk1.trc: IK marker RMS error exceeds 20 mm in 100 of 100 frames (100.0 %); mean RMS 23.3 mm, largest 35 mm"
     )
-    assert "opensim.warn_marker_rms_m" in warning
+    assert "ik.warn_marker_rms_m" in warning
     assert require_ik_fit(np.full(100, 0.012), "walk1.trc") is None
     assert require_ik_fit(tutorial, "walk1.trc", warn_rms_m=None) is None
     # a unit or label mistake: 97 mm in every frame (a trial walked the other way, before it was turned)
@@ -64,7 +64,7 @@ def test_ik_fit_warns_at_20_mm_and_stops_at_60_mm_by_default():
         LoperInputError,
         match=r"walk\.trc: IK marker RMS error exceeds 60 mm in 100 of 100 frames "
         r"\(100\.0 % > 10 %\); mean RMS 97 mm, largest 97 mm: wrong marker "
-        r"unit, labels or model\? \(limit: opensim\.max_marker_rms_m\)",
+        r"unit, labels or model\? \(limit: ik\.max_marker_rms_m\)",
     ):
         require_ik_fit(np.full(100, 0.097), "walk.trc")
     # 10 % of the frames over 60 mm is still allowed (e.g. a marker swapped for a moment), 11 % is not

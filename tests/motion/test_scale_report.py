@@ -24,7 +24,7 @@ def test_a_static_pose_beyond_its_joints_limit_and_one_away_from_the_lab_are_war
     assert "hip_left -42.0 deg, beyond +-40 deg" in warnings["static_pose_hip_left"]
     assert "ankle_left +16.0 deg, beyond +-15 deg" in warnings["static_pose_ankle_left"]
     assert "offset of +5.5 deg" in warnings["static_pose_knee_left_lab"]
-    assert "opensim.scale_setup" in warnings["static_pose_hip_left"]
+    assert "model.scale_setup" in warnings["static_pose_hip_left"]
     assert static_pose_warnings({"knee_right": np.radians(24.9), "hip_right": np.radians(39.9)}) == []
     assert static_pose_warnings({"knee_right": np.radians(4.0)}, {"knee_right": np.radians(-0.9)}) == []
 

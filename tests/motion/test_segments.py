@@ -238,12 +238,12 @@ def test_missing_body_names_file_setting_and_body(tmp_path):
     bodies = {"thigh": ["femur_{s}"], "shank": ["shin_{s}"], "foot": ["talus_{s}", "calcn_{s}"]}
     with pytest.raises(
         LoperInputError,
-        match=r"gait2392_simbody\.osim: opensim\.segment_bodies: shank body 'shin_l' "
+        match=r"gait2392_simbody\.osim: model\.segment_bodies: shank body 'shin_l' "
         r"is not in the model \(its bodies: pelvis, femur_r",
     ):
         segments_from_model_file(GAIT2392, tmp_path / "never.tsv", ModelSettings(side="left", segment_bodies=bodies))
     assert not (tmp_path / "never.tsv").exists()
-    with pytest.raises(LoperInputError, match=r"gait2392_simbody\.osim: opensim\.segment_bodies: thigh body 'thigh_l'"):
+    with pytest.raises(LoperInputError, match=r"gait2392_simbody\.osim: model\.segment_bodies: thigh body 'thigh_l'"):
         segments_from_model(
             read_model(GAIT2392), "l", {"thigh": ["thigh_{s}"], "shank": ["tibia_{s}"], "foot": ["toes_{s}"]}
         )

@@ -88,7 +88,7 @@ def test_marker_motion_is_the_rms_distance_from_the_mean_and_a_moving_subject_st
         LoperInputError,
         match=r"static\.trc: the subject does not stand still in the scaling window "
         r"0\.0000 \.\. 0\.0900 s of the static trial: marker\(s\) 'Subject:RTOE' "
-        r"\(model marker TOE\) 30 mm move more than markers\.static_max_motion_rms_m "
+        r"\(model marker TOE\) 30 mm move more than model\.static_max_motion_rms_m "
         r"0\.02 m RMS",
     ):
         static_pose(

@@ -85,10 +85,10 @@ def test_a_trial_with_no_still_window_stops_naming_the_stillest():
         LoperInputError,
         match=r"^static\.trc: the subject does not stand still in the scaling window 2\.0000 \.\. 2\.9900 s of the "
         r"static trial: marker\(s\) 'Subject:RTOE' \(model marker TOE\) 60 mm move more than "
-        r"markers\.static_max_motion_rms_m 0\.05 m RMS about their mean; it is the stillest 1 s "
-        r"\(markers\.static_duration_s\) of the static trial \(0\.0000 \.\. 5\.9900 s, 501 windows compared\): set "
+        r"model\.static_max_motion_rms_m 0\.05 m RMS about their mean; it is the stillest 1 s "
+        r"\(model\.static_duration_s\) of the static trial \(0\.0000 \.\. 5\.9900 s, 501 windows compared\): set "
         r"a time range where the subject stands still \(time_range of scale_setup\.xml\), a shorter "
-        r"markers\.static_duration_s or a larger markers\.static_max_motion_rms_m$",
+        r"model\.static_duration_s or a larger model\.static_max_motion_rms_m$",
     ):
         scale_window_s(
             t,

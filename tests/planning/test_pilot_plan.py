@@ -40,7 +40,7 @@ def test_settings_of_the_shipped_config():
     assert settings.onsets_ms == (50, 175, 300)
     assert settings.strides == (10, 20, 40) == STRIDES
     assert settings.targets == tuple(CONFIG["planning"]["targets"])
-    assert settings.max_null_trial_ratio == CONFIG["identification"]["max_null_trial_ratio"]
+    assert settings.max_null_trial_ratio == CONFIG["impedance"]["max_null_trial_ratio"]
     assert settings.plan == stage_settings(CONFIG, "planning").plan
     assert settings.response == stage_settings(CONFIG, "impedance").response
 
@@ -48,7 +48,7 @@ def test_settings_of_the_shipped_config():
 @pytest.mark.parametrize(
     ("path", "message"),
     [
-        (("identification", "counterfactual"), "config: key 'identification.counterfactual' missing: "),
+        (("impedance", "counterfactual"), "config: key 'impedance.counterfactual' missing: "),
         (("device",), "config: key 'device' missing: the device settings read it$"),
         (("planning", "pulse_force_n"), "config: key 'planning.pulse_force_n' missing: "),
     ],

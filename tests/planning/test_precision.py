@@ -272,9 +272,7 @@ def test_pulse_longer_than_the_window_is_refused():
 def test_pilot_without_null_pairs_is_refused(params, pilot):
     _, _, null, _ = pilot
     few = {k: (v[:5] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
-    with pytest.raises(
-        LoperInputError, match=r"pilot: 5 null pair\(s\), fewer than identification.null_pair_components"
-    ):
+    with pytest.raises(LoperInputError, match=r"pilot: 5 null pair\(s\), fewer than impedance.null_pair_components"):
         stride_covariance(few, params, TRUTH)
     none = {k: (v[:0] if isinstance(v, np.ndarray) and v.ndim >= 2 else v) for k, v in null.items()}
     with pytest.raises(LoperInputError, match="no null pairs"):
@@ -372,7 +370,7 @@ def test_plan_command_takes_the_working_directory_s_config_and_an_option_wins(pi
     (tmp_path / "workflow/schemas").mkdir(parents=True)
     shutil.copy(root / "workflow/schemas/config.schema.yaml", tmp_path / "workflow/schemas/config.schema.yaml")
     config = yaml.safe_load((root / "config/config.yaml").read_text())
-    config["trials"]["perturbation_onsets_ms"] = [50]
+    config["study"]["perturbation_onsets_ms"] = [50]
     config["planning"].update(strides=[7, 30], targets=[])
     (tmp_path / "config/config.yaml").write_text(yaml.safe_dump(config))
     monkeypatch.chdir(tmp_path)
@@ -391,7 +389,7 @@ def test_plan_command_takes_the_working_directory_s_config_and_an_option_wins(pi
         (
             ["--trials", "pert050-2"],
             "S09, onset 50 ms: 0 unperturbed stride(s) predicted from the others at this onset, fewer than "
-            "identification.null_pair_components + 3",
+            "impedance.null_pair_components + 3",
         ),
     ],
 )

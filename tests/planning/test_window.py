@@ -25,7 +25,7 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 def test_from_config_reads_every_key_the_planner_follows():
     config = copy.deepcopy(CONFIG)
     config["planning"].update(pulse_force_n=35.0, pulse_duration_s=0.08)
-    config["identification"].update(
+    config["impedance"].update(
         window_before_s=0.03,
         window_after_s=0.3,
         initial_state_span_s=0.12,
@@ -66,11 +66,11 @@ def test_the_shipped_config_plans_a_40_n_pulse_of_100_ms():
     [
         ({"pulse_force_n": math.nan}, r"^pulse_force_n must be"),
         ({"force_rate_hz": 0.0}, r"^force_rate_hz must be > 0 Hz, got 0$"),
-        ({"interval_scatter": "bootstrap"}, r"^identification\.interval_scatter must be one of .*, got 'bootstrap'$"),
+        ({"interval_scatter": "bootstrap"}, r"^impedance\.interval_scatter must be one of .*, got 'bootstrap'$"),
         (
             {"pulse_duration_s": 0.3},
             r"^pulse_duration_s = 0\.3 s is longer than the fit window after the onset "
-            r"\(identification\.window_after_s = 0\.25 s\)",
+            r"\(impedance\.window_after_s = 0\.25 s\)",
         ),
         ({"pulse_duration_s": -0.1}, r"^pulse_duration_s must be > 0 s, got -0\.1 s$"),
     ],

@@ -45,9 +45,9 @@ def test_the_shipped_config_s_run_settings():
 def test_every_key_the_page_lists_reaches_its_row():
     config = copy.deepcopy(CONFIG)
     config["seed"] = 7
-    config["trials"].update(perturbation_onsets_ms=[60, 200], perturbation_repeats=3, perturbed_side="right")
-    config["filter"].update(cutoff_hz=12.0, order=2)
-    config["identification"].update(
+    config["study"].update(perturbation_onsets_ms=[60, 200], perturbation_repeats=3, perturbed_side="right")
+    config["markers"]["filter"].update(cutoff_hz=12.0, order=2)
+    config["impedance"].update(
         window_before_s=0.03,
         window_after_s=0.2,
         stiffness_bounds_nm_per_rad=[1.0, 150.0],
@@ -66,7 +66,7 @@ def test_every_key_the_page_lists_reaches_its_row():
 
 
 @pytest.mark.parametrize(
-    "path", [("identification", "n_starts"), ("filter", "cutoff_hz"), ("synthetic", "pulse_force_n"), ("seed",)]
+    "path", [("impedance", "n_starts"), ("markers", "filter", "cutoff_hz"), ("synthetic", "pulse_force_n"), ("seed",)]
 )
 def test_a_missing_key_is_named(path):
     config = copy.deepcopy(CONFIG)

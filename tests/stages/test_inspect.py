@@ -41,7 +41,7 @@ def test_inspect_writes_a_schema_valid_config_for_every_lab_file(lab, tmp_path):
     assert result.setup.template.name == template
     doc = yaml.safe_load(config_out.read_text())
     for key in ("generic_model", "scale_setup", "ik_tasks"):
-        assert Path(doc["opensim"][key]).is_file(), key
+        assert Path(doc["ik" if key == "ik_tasks" else "model"][key]).is_file(), key
     assert (config_out.parent / "marker_set.xml").is_file()
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     check_config(_merged(base, doc), ROOT / "workflow" / "schemas" / "config.schema.yaml")

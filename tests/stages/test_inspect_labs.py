@@ -62,7 +62,7 @@ def test_auc_qualisys_labels_choose_plug_in_gait_with_every_required_group(tmp_p
     }
     doc = yaml.safe_load((tmp_path / "AUC" / "config.yaml").read_text())
     assert doc["markers"]["trial_label_maps"] == {"static": str(tmp_path / "AUC" / "label_map_static.tsv")}
-    assert doc["filter"]["cutoff_hz"] == 40  # 120 Hz markers: min(40, 0.4 x 120 = 48)
+    assert doc["markers"]["filter"]["cutoff_hz"] == 40  # 120 Hz markers: min(40, 0.4 x 120 = 48)
 
 
 #: Medial spellings of Vicon labs and the template marker each is.
@@ -161,7 +161,7 @@ def test_a_60_hz_lab_gets_a_cut_off_below_its_nyquist_frequency(tmp_path):
         write_recording(folder / f"{name}.c3d", slow)
     out = tmp_path / "S" / "config.yaml"
     result = inspect_subject([folder / "static.c3d", folder / "walk-nodevice.c3d"], out, cutoff_hz=40.0)
-    cutoff = yaml.safe_load(out.read_text())["filter"]["cutoff_hz"]
+    cutoff = yaml.safe_load(out.read_text())["markers"]["filter"]["cutoff_hz"]
     assert cutoff == pytest.approx(24.0) and cutoff < 30.0
     assert "min(configured 40, 0.4 x 60 Hz markers = 24) Hz: below the Nyquist frequency 30 Hz" in result.text
 

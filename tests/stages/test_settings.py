@@ -22,9 +22,9 @@ READERS = ["study", *(stage.name for stage in STAGES)]
 #: Keys of the shipped config that no settings reader reads: the workflow's own (the rules' layout and the raw
 #: folders' checks read them); each with where it is read.
 NOT_SETTINGS = {
-    "opensim.generic_model": "layout.Study.generic_model",
-    "opensim.scale_setup": "the model rules' inputs",
-    "opensim.ik_chunks": "the ik rules' chunks",
+    "model.generic_model": "layout.Study.generic_model",
+    "model.scale_setup": "the model rules' inputs",
+    "ik.ik_chunks": "the ik rules' chunks",
     "device.subject": "layout.Study.device_log",
     "markers.label_map": "layout.Study.label_maps",
     "markers.trial_label_maps": "layout.Study.label_maps",
@@ -99,22 +99,25 @@ def test_each_reader_needs_only_readers_that_exist_and_builds_without_its_needs_
 
 @pytest.mark.parametrize(
     ("key", "reader", "asked"),
-    [("identification.counterfactual", "impedance", "planning"), ("trials.perturbed_side", "study", "strides"),
-     ("filter.order", "markers", "events"), ("seed", "study", "validation")],
+    [("impedance.counterfactual", "impedance", "planning"), ("study.perturbed_side", "study", "strides"),
+     ("markers.filter.order", "markers", "events"), ("seed", "study", "validation")],
 )  # fmt: skip
 def test_a_missing_key_is_named_with_its_section_and_reader(key, reader, asked):
     config = copy.deepcopy(CONFIG)
-    section, _, name = key.rpartition(".")
-    del (config[section] if section else config)[name]
+    *sections, name = key.split(".")
+    node = config
+    for section in sections:
+        node = node[section]
+    del node[name]
     with pytest.raises(LoperInputError, match=f"^config: key '{key}' missing: the {reader} settings read it$"):
         stage_settings(config, asked)
 
 
 def test_the_planner_models_the_load_cell_the_events_stage_filters_with():
-    """``filter.cutoff_hz`` and ``filter.order`` reach the planner's model of the load cell, and the device's
-    rate the planned force's."""
+    """``markers.filter.cutoff_hz`` and ``markers.filter.order`` reach the planner's model of the load cell, and the
+    device's rate the planned force's."""
     config = copy.deepcopy(CONFIG)
-    config["filter"].update(cutoff_hz=25.0, order=2)
+    config["markers"]["filter"].update(cutoff_hz=25.0, order=2)
     config["device"]["parameters"]["sample_rate_hz"] = 500
     plan = stage_settings(config, "planning").plan
     loadcell = stage_settings(config, "events").loadcell

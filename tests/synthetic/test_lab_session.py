@@ -38,11 +38,11 @@ def test_from_config_reads_every_key_it_maps():
     config = copy.deepcopy(CONFIG)
     s = config["synthetic"]
     config["seed"] = 7
-    config["trials"]["no_device"] = "walk-free"
+    config["study"]["no_device"] = "walk-free"
     config["markers"]["lab_to_model_rotation_deg"] = [0.0, 0.0, 0.0]
     config["events"]["sync_channel"] = "trigger"
     config["device"]["parameters"]["servo_delay_s"] = 0.003
-    config["opensim"]["brace_attachment_fraction"] = 0.7
+    config["model"]["brace_attachment_fraction"] = 0.7
     s.update(
         walking_duration_s=30.0,
         static_duration_s=1.5,

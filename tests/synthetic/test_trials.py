@@ -34,7 +34,7 @@ def params():
     return segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
 
 
-@pytest.mark.parametrize("onset_ms", CONFIG["trials"]["perturbation_onsets_ms"])
+@pytest.mark.parametrize("onset_ms", CONFIG["study"]["perturbation_onsets_ms"])
 def test_perturbations_start_the_configured_ms_after_a_left_toe_off(onset_ms, params):
     perturbation = PerturbationSettings(onset_s=onset_ms / 1000.0, impedance=IMPEDANCE, every_strides=(1, 1))
     trial = simulate_walking_trial(DURATION_S, LabSettings(), 7, HEIGHT_M, params, perturbation=perturbation)

@@ -10,6 +10,7 @@ from snakemake.common.configfile import load_configfile
 
 from loper_analysis.cluster import check_slurm_submission
 from loper_analysis.config_file import config_layers
+from loper_analysis.config_sections import translated
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_parameter_section import force_platforms_used
 from loper_analysis.io.readers import read_subject_sheet
@@ -32,6 +33,11 @@ def config_source(*key_path) -> str:
     """The file or command-line option that set a config key (config/config.yaml unless overridden)."""
     return config_origin(key_path, CONFIG_LAYERS, "config/config.yaml")
 
+
+# a config file of the former layout (trials, filter, opensim, identification): each key read at its place now, said once
+_moved = translated(config)
+if _moved:
+    print(f"config: keys of the former layout read at their places now: {'; '.join(_moved)}", file=sys.stderr)
 
 try:
     # one short message naming the file or option, the key and the value; then Snakemake's own validation

@@ -1,7 +1,7 @@
 # Inverse kinematics (OpenSim): joint angles per trial, in one job or in time chunks joined.
 
 
-if OPENSIM["ik_chunks"] == 1:
+if IK["ik_chunks"] == 1:
 
     rule ik:
         """The whole trial in one job (the default): IK, .mot and angle table (the marker geometry checked against
@@ -30,7 +30,7 @@ if OPENSIM["ik_chunks"] == 1:
 else:
 
     rule ik_chunk:
-        """One of opensim.ik_chunks time chunks of a trial (long trials, many cores)."""
+        """One of ik.ik_chunks time chunks of a trial (long trials, many cores)."""
         input:
             model=by_subject(STUDY.subject_model),
             trc=PATHS.markers.trc,
@@ -45,7 +45,7 @@ else:
             "trial"
         params:
             **settings_params(ik_settings),
-            n_chunks=OPENSIM["ik_chunks"],
+            n_chunks=IK["ik_chunks"],
         script:
             "../scripts/ik_chunk.py"
 

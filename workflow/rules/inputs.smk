@@ -6,12 +6,13 @@ from loper_analysis.stages import STAGES
 from loper_analysis.stages.settings import stage_settings
 
 # the config's sections
-TRIALS = config["trials"]
-OPENSIM = config["opensim"]
-IDENT = config["identification"]
+TRIALS = config["study"]
+MODEL = config["model"]
+IK = config["ik"]
+IDENT = config["impedance"]
 DEVICE = config["device"]
 SYNTH = config["synthetic"]
-IK_CHUNKS = [f"{i:03d}" for i in range(OPENSIM["ik_chunks"])]
+IK_CHUNKS = [f"{i:03d}" for i in range(IK["ik_chunks"])]
 ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
 
 # every stage's settings, each built by its stage's reader (loper_analysis.stages.settings)

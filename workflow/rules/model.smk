@@ -10,7 +10,7 @@ localrules:
 
 
 rule model_generic:
-    """The generated sagittal model (used when opensim.generic_model is null)."""
+    """The generated sagittal model (used when model.generic_model is null)."""
     input:
         static_c3d=by_subject(STUDY.static_c3d_for_mass),
     output:
@@ -29,7 +29,7 @@ rule model_generic:
 
 
 rule model_scaled:
-    """The generic model scaled to the static trial (OpenSim's ScaleTool, with opensim.scale_setup when given), and
+    """The generic model scaled to the static trial (OpenSim's ScaleTool, with model.scale_setup when given), and
     the scale report: scale factors per body, marker errors after scaling, the mass and height used."""
     input:
         generic=by_subject(STUDY.generic_model),
@@ -37,7 +37,7 @@ rule model_scaled:
         static_summary=fill(PATHS.markers.summary, trial=DESIGN.static),
         static_lab_angles=fill(PATHS.markers.lab_angles, trial=DESIGN.static),
         static_c3d=by_subject(STUDY.static_c3d_for_scaling),
-        setup=[OPENSIM["scale_setup"]] if OPENSIM["scale_setup"] else [],
+        setup=[MODEL["scale_setup"]] if MODEL["scale_setup"] else [],
     output:
         model=PATHS.model.scaled,
         report=report(
@@ -58,13 +58,13 @@ rule model_scaled:
         **raw_checksums(by_subject(STUDY.static_c3d_for_scaling)),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
-        scale_setup=OPENSIM["scale_setup"],
+        scale_setup=MODEL["scale_setup"],
     script:
         "../scripts/model_scaled.py"
 
 
 rule model_segments:
-    """The swing leg's segment table, exported from the subject's model (opensim.segment_bodies)."""
+    """The swing leg's segment table, exported from the subject's model (model.segment_bodies)."""
     input:
         by_subject(STUDY.subject_model),
     output:

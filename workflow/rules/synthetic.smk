@@ -21,8 +21,8 @@ rule synthetic_truth:
         stiffness=SYNTH["stiffness_nm_per_rad"],
         damping=SYNTH["damping_nms_per_rad"],
         cv=SYNTH["between_subject_cv"],
-        stiffness_bounds=config["identification"]["stiffness_bounds_nm_per_rad"],
-        damping_bounds=config["identification"]["damping_bounds_nms_per_rad"],
+        stiffness_bounds=config["impedance"]["stiffness_bounds_nm_per_rad"],
+        damping_bounds=config["impedance"]["damping_bounds_nms_per_rad"],
         seed=config["seed"],
     script:
         "../scripts/synthetic_truth.py"

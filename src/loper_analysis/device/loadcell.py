@@ -60,7 +60,7 @@ SYNC_CHANNEL: str = "sync"
 @dataclass(frozen=True)
 class LoadcellSettings:
     """The robot log on the mocap clock: the C3D's ``sync_channel``, the forces' low-pass (``cutoff_hz`` Hz,
-    Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``filter.*``) and the
+    Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``markers.filter.*``) and the
     study's perturbation force ``pulse_force_n`` (N; config ``planning.pulse_force_n``), which the desired force's
     pulses are checked against (:func:`require_pulse_amplitude`)."""
 

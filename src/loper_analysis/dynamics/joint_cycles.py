@@ -74,7 +74,7 @@ def joint_coordinates(coordinate_map: Mapping) -> dict[tuple[str, str], tuple[st
     """(side, joint) -> (model coordinate, sign ±1) of the coordinate map's ``<joint>_<side>`` entries.
 
     ``coordinate_map`` maps our angle names to ``(coordinate, sign)`` or ``{"coordinate": name, "sign": ±1}``
-    (``opensim.coordinate_map``; :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`). Joints it leaves out
+    (``ik.coordinate_map``; :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`). Joints it leaves out
     are left out.
     """
     out = {}

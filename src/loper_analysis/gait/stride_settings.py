@@ -14,7 +14,7 @@ __all__ = ["StrideSettings"]
 
 @dataclass(frozen=True)
 class StrideSettings:
-    """Strides of one leg (config ``strides.*``, ``trials.perturbed_side``).
+    """Strides of one leg (config ``strides.*``, ``study.perturbed_side``).
 
     ``side``: the leg; ``n_points``: samples per time-normalised stride, stance or swing; ``whisker``,
     ``max_fraction``: the IQR rule (:func:`loper_analysis.gait.outliers.iqr_outliers`); ``min_valid``: the

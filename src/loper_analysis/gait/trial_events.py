@@ -41,7 +41,7 @@ TOE_MARKERS: Mapping[str, str] = {"left": "LTOE", "right": "RTOE"}
 
 @dataclass(frozen=True)
 class EventSettings:
-    """How heel strikes and toe-offs are found (config ``events.*``, ``grf.*``, ``filter.order``).
+    """How heel strikes and toe-offs are found (config ``events.*``, ``grf.*``, ``markers.filter.order``).
 
     ``grf_channels``: {side: analog channel} of each belt (files without force platforms);
     ``threshold_on_n`` / ``threshold_off_n``: the vertical force (N) rises / falls through these at heel strike /

@@ -14,9 +14,9 @@ __all__ = ["DC_GAIN_TOLERANCE", "check_cutoff", "lowpass", "lowpass_finite_runs"
 #: below 2e-5 down to a cut-off of 1e-6 of Nyquist, 6e-5 .. 1e-3 at 1e-7 and 0.02 .. 0.1 at 1e-8, and at 1e-9
 #: and below the design divides by zero (``LinAlgError: Singular matrix`` in sosfiltfilt). Order 1 stays sound.
 DC_GAIN_TOLERANCE = 1e-3
-#: Cut-off (Hz) of the markers' and forces' low-pass (config ``filter.cutoff_hz``).
+#: Cut-off (Hz) of the markers' and forces' low-pass (config ``markers.filter.cutoff_hz``).
 CUTOFF_HZ: float = 40.0
-#: Designed Butterworth order, run forward and backward (config ``filter.order``).
+#: Designed Butterworth order, run forward and backward (config ``markers.filter.order``).
 ORDER: int = 4
 
 

@@ -51,12 +51,12 @@ __all__ = [
     "joint_angle_table",
 ]
 
-#: Accuracy of OpenSim's IK solver in the pipeline's IK (config ``opensim.accuracy``; OpenSim's own default is
+#: Accuracy of OpenSim's IK solver in the pipeline's IK (config ``ik.accuracy``; OpenSim's own default is
 #: 1e-5).
 IK_ACCURACY: float = 1e-6
 
 
-#: The IK solvers (config ``opensim.ik_solver``): the model's kinematic tree (:mod:`loper_analysis.motion.tree_ik`)
+#: The IK solvers (config ``ik.ik_solver``): the model's kinematic tree (:mod:`loper_analysis.motion.tree_ik`)
 #: or OpenSim's ``InverseKinematicsSolver`` (:mod:`loper_analysis.motion.opensim_ik`).
 IK_SOLVERS: tuple[str, ...] = ("tree", "opensim")
 #: The pipeline's IK solver.
@@ -248,7 +248,7 @@ def require_model_markers(model, source: str = "") -> None:
         f"{where}{model_source(model)} has no markers (its MarkerSet is empty): IK and scaling fit the model's "
         "markers. Give the model with its marker set: the marker set file that came with it (OpenSim's "
         "gait2392_Scale_MarkerSet.xml beside gait2392_simbody.osim) is attached by the ScaleTool setup's "
-        "<MarkerSet> (opensim.scale_setup), or `loper-analysis inspect STATIC WALK --config-out ...` writes a "
+        "<MarkerSet> (model.scale_setup), or `loper-analysis inspect STATIC WALK --config-out ...` writes a "
         "model with its markers"
     )
 
@@ -478,7 +478,7 @@ def ik_task_weights(
         names = [ms.get(i).getName() for i in range(ms.getSize())]
         extra = sorted(set(marker_weights or {}) - set(names))
         if extra:
-            raise LoperInputError(f"opensim.marker_weights: marker(s) {extra} are not in {model_source(model)}")
+            raise LoperInputError(f"ik.marker_weights: marker(s) {extra} are not in {model_source(model)}")
         weights = {m: float((marker_weights or {}).get(m, default_weight)) for m in names}
         coords = {c: (float(v["weight"]), v.get("value")) for c, v in (coordinate_tasks or {}).items()}
     missing = [m for m, w in weights.items() if w > 0 and m not in labels]
@@ -486,7 +486,7 @@ def ik_task_weights(
         raise LoperInputError(
             f"{source}: marker(s) {missing} of the model's marker set are missing from the file "
             "(map the lab's labels to them in markers.label_map, or leave them out of IK: weight 0 "
-            "in opensim.marker_weights, or an IK task file in opensim.ik_tasks)"
+            "in ik.marker_weights, or an IK task file in ik.ik_tasks)"
         )
     return weights, coords
 

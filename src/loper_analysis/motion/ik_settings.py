@@ -14,7 +14,7 @@ from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, I
 
 __all__ = ["DEFAULT_MARKER_WEIGHT", "IKSettings"]
 
-#: Weight of every model marker without a weight of its own (config ``opensim.default_marker_weight``).
+#: Weight of every model marker without a weight of its own (config ``ik.default_marker_weight``).
 DEFAULT_MARKER_WEIGHT: float = 1.0
 
 
@@ -25,32 +25,32 @@ class IKSettings:
     Attributes
     ----------
     tasks_file : str, optional
-        OpenSim IK task-set XML or TSV (``opensim.ik_tasks``); None: the weights below.
+        OpenSim IK task-set XML or TSV (``ik.ik_tasks``); None: the weights below.
     default_weight : float
-        Weight of a model marker without an entry in ``marker_weights`` (``opensim.default_marker_weight``).
+        Weight of a model marker without an entry in ``marker_weights`` (``ik.default_marker_weight``).
     marker_weights : mapping, optional
-        Marker -> weight, 0 leaving a marker out (``opensim.marker_weights``).
+        Marker -> weight, 0 leaving a marker out (``ik.marker_weights``).
     coordinate_tasks : mapping, optional
-        Coordinate -> ``{"weight": w, "value": rad or None}`` (``opensim.coordinate_tasks``).
+        Coordinate -> ``{"weight": w, "value": rad or None}`` (``ik.coordinate_tasks``).
     accuracy : float
-        IK solver accuracy (``opensim.accuracy``).
+        IK solver accuracy (``ik.accuracy``).
     solver : str
-        ``tree`` or ``opensim`` (``opensim.ik_solver``; :func:`loper_analysis.motion.ik.inverse_kinematics`).
+        ``tree`` or ``opensim`` (``ik.ik_solver``; :func:`loper_analysis.motion.ik.inverse_kinematics`).
     min_markers : int
         Fewest weighted markers present in a frame for IK to solve it (no config key).
     max_marker_rms_m, warn_marker_rms_m : float
         A frame whose marker RMS error (m) exceeds the first counts as failed, the second as poorly fitted
-        (``opensim.max_marker_rms_m``, ``opensim.warn_marker_rms_m``; the second None: no warning).
+        (``ik.max_marker_rms_m``, ``ik.warn_marker_rms_m``; the second None: no warning).
     max_rms_fraction : float
-        Share of frames above either level that stops the trial, or warns (``opensim.max_rms_fraction``).
+        Share of frames above either level that stops the trial, or warns (``ik.max_rms_fraction``).
     coordinate_map : mapping, optional
-        Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``opensim.coordinate_map``); None:
+        Angle -> ``{"coordinate": name, "sign": +-1}`` of the angle table (``ik.coordinate_map``); None:
         :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     geometry_warn_change, geometry_stop_change : float
         Median relative change of the distances between markers on one body, walking trial against the static
         trial (without one: against the model's markers), above which
-        the trial is warned about or refused as another subject's (``opensim.geometry_warn_change``,
-        ``opensim.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
+        the trial is warned about or refused as another subject's (``ik.geometry_warn_change``,
+        ``ik.geometry_stop_change``; :mod:`loper_analysis.motion.marker_geometry`).
     subjects_model : bool
         Whether the model was scaled to this subject's static trial (True) or given as it is (a ``model_osim``
         of the subject sheet, the command line's ``--model``): its markers may then sit elsewhere than on the

@@ -232,7 +232,7 @@ def lab_agreement_warnings(
                 "landmarks in markers.label_map, the lab's widths) or another joint-centre method than the lab's"
             )
         if moves and row.r < 0:
-            problems.append("anticorrelated: a sign (opensim.coordinate_map) or swapped sides (markers.label_map)?")
+            problems.append("anticorrelated: a sign (ik.coordinate_map) or swapped sides (markers.label_map)?")
         out.append("; ".join(problems))
     return out
 

@@ -37,9 +37,9 @@ __all__ = [
 #: Shortest reference distance of a pair compared (m): shorter pairs are dominated by noise and skin motion.
 MIN_PAIR_DISTANCE_M: float = 0.05
 #: Median absolute relative change of the pairs' distances above which a trial is warned about
-#: (config ``opensim.geometry_warn_change``).
+#: (config ``ik.geometry_warn_change``).
 GEOMETRY_WARN_CHANGE: float = 0.05
-#: ... and above which the trial is refused as another subject's (config ``opensim.geometry_stop_change``).
+#: ... and above which the trial is refused as another subject's (config ``ik.geometry_stop_change``).
 GEOMETRY_STOP_CHANGE: float = 0.08
 #: Columns of :func:`marker_geometry`'s table.
 GEOMETRY_COLUMNS = ("body", "marker_a", "marker_b", "n_frames", "reference_distance_m", "trial_distance_m", "change")

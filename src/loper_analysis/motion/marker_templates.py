@@ -447,7 +447,7 @@ def template_ik_tasks(template: MarkerTemplate, walking_markers: Sequence[str]) 
 
 
 def template_coordinate_map(template: MarkerTemplate, model) -> dict[str, dict[str, object]]:
-    """The coordinate map (``opensim.coordinate_map``) of a template's model, each sign read from the model's
+    """The coordinate map (``ik.coordinate_map``) of a template's model, each sign read from the model's
     kinematics (:func:`loper_analysis.motion.coordinate_signs.map_signs`).
 
     Raises

@@ -15,17 +15,17 @@ from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
 __all__ = ["STATIC_DURATION_S", "STATIC_MAX_MOTION_RMS_M", "ModelSettings"]
 
 #: Scaling averages the first this many seconds of the static trial when the scale setup sets no time range (s;
-#: config ``markers.static_duration_s``).
+#: config ``model.static_duration_s``).
 STATIC_DURATION_S: float = 1.0
 #: A static-trial marker moving more than this over the scaling window stops scaling (m, RMS about its mean;
-#: config ``markers.static_max_motion_rms_m``).
+#: config ``model.static_max_motion_rms_m``).
 STATIC_MAX_MOTION_RMS_M: float = 0.05
 
 
 @dataclass(frozen=True)
 class ModelSettings:
     """How the subject's model is built, scaled and turned into a segment table (config ``markers.*``,
-    ``opensim.*``, ``trials.perturbed_side``).
+    ``opensim.*``, ``study.perturbed_side``).
 
     Attributes
     ----------
@@ -35,29 +35,29 @@ class ModelSettings:
     static_duration_s : float or None
         Without a time range (``time_range_s``, the scale setup's): the stillest this many seconds of the static
         trial are averaged, s (:func:`loper_analysis.motion.still_window.stillest_window_s`); None: the whole trial
-        (``markers.static_duration_s``).
+        (``model.static_duration_s``).
     max_motion_rms_m : float or None
         Largest RMS motion of a marker over the window, m: a subject who does not stand still is refused; None:
-        not checked (``markers.static_max_motion_rms_m``).
+        not checked (``model.static_max_motion_rms_m``).
     time_range_s : (float, float), optional
         The window, s, overriding the setup's time ranges and ``static_duration_s`` (no config key).
     factor_range : (float, float)
-        Least and largest plausible factor of a measurement (``opensim.scale_factor_range``).
+        Least and largest plausible factor of a measurement (``model.scale_factor_range``).
     segment_bodies : mapping, optional
-        Segment -> body names with ``{s}`` for the side suffix (``opensim.segment_bodies``); None: the model's
+        Segment -> body names with ``{s}`` for the side suffix (``model.segment_bodies``); None: the model's
         own kind.
     side : {"left", "right"}
-        The leg of the segment table (``trials.perturbed_side``).
+        The leg of the segment table (``study.perturbed_side``).
     attachment_fraction : float
         Rod attachment as a fraction of the thigh length, for a model without brace markers
-        (``opensim.brace_attachment_fraction``).
+        (``model.brace_attachment_fraction``).
     coordinate_map : mapping, optional
         Our angle -> model coordinate and sign, for the static pose of the scale report
-        (``opensim.coordinate_map``); None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+        (``ik.coordinate_map``); None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     accuracy : float
-        IK solver accuracy of the scale report's static pose (``opensim.accuracy``).
+        IK solver accuracy of the scale report's static pose (``ik.accuracy``).
     solver : str
-        IK solver of the scale report's static pose (``opensim.ik_solver``).
+        IK solver of the scale report's static pose (``ik.ik_solver``).
     """
 
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG

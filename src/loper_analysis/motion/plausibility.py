@@ -52,7 +52,7 @@ IK_WARN_RMS_M = 0.02
 #: Share of frames above either level that stops (or warns about) a trial.
 IK_MAX_FRACTION = 0.1
 #: Scale factors outside this range are refused as a unit, label or model mistake
-#: (config ``opensim.scale_factor_range``).
+#: (config ``model.scale_factor_range``).
 SCALE_FACTOR_RANGE: tuple[float, float] = (0.5, 2.0)
 #: Range (m) of the largest distance between a trial's markers (config ``markers.extent_range_m``): outside
 #: it the numbers are in another unit than the file declares.
@@ -168,7 +168,7 @@ KNEE_SIGN_MIN_RAD: float = float(np.radians(-20.0))
 KNEE_SIGN_MAX_RAD: float = float(np.radians(10.0))
 
 
-def inverted_knee_warnings(angles, setting: str = "opensim.coordinate_map") -> list[str]:
+def inverted_knee_warnings(angles, setting: str = "ik.coordinate_map") -> list[str]:
     """Warnings for knees that flex negative: a walking knee flexes to 60 degrees in swing and barely
     hyperextends, so a knee angle that reaches below -20 degrees and never above 10 degrees has the wrong sign.
 
@@ -232,7 +232,7 @@ def require_ik_fit(
         raise LoperInputError(
             f"{where(source)}IK marker RMS error exceeds {1e3 * max_rms_m:g} mm in {int(over.sum())} of {rms.size} "
             f"frames ({100 * over.mean():.1f} % > {100 * max_fraction:g} %); {stats}: wrong marker unit, labels or "
-            "model? (limit: opensim.max_marker_rms_m)"
+            "model? (limit: ik.max_marker_rms_m)"
         )
     if warn_rms_m is None:
         return None
@@ -241,6 +241,6 @@ def require_ik_fit(
         return (
             f"{where(source)}IK marker RMS error exceeds {1e3 * warn_rms_m:g} mm in {int(poor.sum())} of "
             f"{rms.size} frames ({100 * poor.mean():.1f} %); {stats}: check the marker placement on the model "
-            "(scaling) and the IK weights (warning level: opensim.warn_marker_rms_m)"
+            "(scaling) and the IK weights (warning level: ik.warn_marker_rms_m)"
         )
     return None

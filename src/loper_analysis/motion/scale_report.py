@@ -117,7 +117,7 @@ class StaticFit:
 def static_pose_warnings(
     angles_rad: Mapping[str, float],
     lab_angles_rad: Mapping[str, float] | None = None,
-    setting: str = "opensim.scale_setup",
+    setting: str = "model.scale_setup",
 ) -> list[tuple[str, str]]:
     """(name, warning) for each joint of a static pose beyond :data:`MAX_STATIC_FLEXION_RAD`, or further than
     :data:`MAX_STATIC_LAB_DIFF_RAD` from the lab's own static angle."""
@@ -182,7 +182,7 @@ def neighbour_factor_warnings(
             else:
                 said += (
                     "a marker of the measurement placed elsewhere on the subject than on the model? (the "
-                    "measurements and marker set of opensim.scale_setup)"
+                    "measurements and marker set of model.scale_setup)"
                 )
             out.append((f"scale_{parent}_{child}", said))
     return out
@@ -390,11 +390,11 @@ def scaled_model_report(
     subject : (float, float, str)
         Mass (kg), height (m), where they came from.
     coordinate_map : mapping, optional
-        ``opensim.coordinate_map``; None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
+        ``ik.coordinate_map``; None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     accuracy : float
-        IK accuracy of the static pose (``opensim.accuracy``).
+        IK accuracy of the static pose (``ik.accuracy``).
     solver : str
-        IK solver of the static pose (``opensim.ik_solver``).
+        IK solver of the static pose (``ik.ik_solver``).
     lab_labels, lab_static : mapping, optional
         Model marker -> the lab's label; our angle -> the lab's own static angle (rad).
     model_height_m : float

@@ -157,7 +157,7 @@ def scaling_pose(
     scaler, placer = tool.getModelScaler(), tool.getMarkerPlacer()
     ranges = {part: scale_tool.time_range(part) for part in (scaler, placer) if part.getApply()}
     ranges = {part: r if time_range_is_set(r) else None for part, r in ranges.items()}  # None where unset
-    setting = f"time_range of {setup_xml}" if setup_xml is not None else "markers.static_duration_s"
+    setting = f"time_range of {setup_xml}" if setup_xml is not None else "model.static_duration_s"
     pairs = scale_tool.measurement_pairs(tool)
     needed = sorted({m for p in pairs.values() for pair in p for m in pair})
     if time_range_s is not None:

@@ -72,7 +72,7 @@ __all__ = [
 ]
 
 #: The configuration setting that holds the mapping (named in error messages).
-SEGMENT_BODIES_SETTING = "opensim.segment_bodies"
+SEGMENT_BODIES_SETTING = "model.segment_bodies"
 #: gait2392 and Rajagopal2016 (OpenSim's own naming); ``?`` marks a body used only where the model has it.
 DEFAULT_SEGMENT_BODIES: dict[str, tuple[str, ...]] = {
     "thigh": ("femur_{s}",),
@@ -111,7 +111,7 @@ def segment_body_names(
     LoperInputError
         A segment missing from the mapping or without bodies, a side other
         than ``l``/``r``, or a required body the model lacks (the message
-        names the model file, the setting ``opensim.segment_bodies`` and the body).
+        names the model file, the setting ``model.segment_bodies`` and the body).
     """
     if side not in ("l", "r"):
         raise LoperInputError(f"side must be 'l' or 'r' (OpenSim suffix), got {side!r}")
@@ -260,7 +260,7 @@ def segments_from_model(
     Raises
     ------
     LoperInputError
-        A configured body missing (naming the file, ``opensim.segment_bodies``
+        A configured body missing (naming the file, ``model.segment_bodies``
         and the body), an attachment fraction outside 0 .. 1, or a table the
         dynamics model refuses.
     """

@@ -118,7 +118,7 @@ def scale_window_s(
             raise LoperInputError(
                 f"{where(source)}{setting} {start:g} .. {end:g} s holds no frame of the static trial "
                 f"({t[0]:.4f} .. {t[-1]:.4f} s, the file's clock): set it to a span of the trial, or to -1 -1 to "
-                "use markers.static_duration_s"
+                "use model.static_duration_s"
             )
         return float(inside[0]), float(inside[-1])
     if duration_s is None:
@@ -200,7 +200,7 @@ def static_pose(
         The file and the setting that chose the window, for messages.
     max_motion_rms_m : float, optional
         Largest RMS motion (m) of a marker about its mean over the window
-        (``markers.static_max_motion_rms_m``); None: not checked.
+        (``model.static_max_motion_rms_m``); None: not checked.
 
     Raises
     ------
@@ -233,14 +233,14 @@ def static_pose(
         raise LoperInputError(
             f"{where(source)}marker(s) {names} missing in every frame of the scaling window {start:.4f} .. "
             f"{end:.4f} s ({int(sel.sum())} frames) of the static trial: choose a window where they are present "
-            f"({setting}, or markers.static_duration_s)"
+            f"({setting}, or model.static_duration_s)"
         )
     keep = [j for j in range(len(labels)) if present[:, j].any()]
     motion = {labels[j]: motion_rms_m(W[present[:, j], j]) for j in keep}
     if max_motion_rms_m is not None:
         message = moving_message(motion, (start, end), max_motion_rms_m, lab_labels, source)
         if message:
-            raise LoperInputError(f"{message}; choose a still window ({setting}, or markers.static_duration_s)")
+            raise LoperInputError(f"{message}; choose a still window ({setting}, or model.static_duration_s)")
     filled = {}
     for j in keep:
         gap = ~present[:, j]

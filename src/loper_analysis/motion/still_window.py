@@ -101,12 +101,12 @@ def stillest_window_s(
     labels : sequence of str
         Marker names, one per marker.
     duration_s : float
-        Length of the window, s (``markers.static_duration_s``).
+        Length of the window, s (``model.static_duration_s``).
     needed : sequence of str
         The markers the scale factors are measured between (the measurements' marker pairs).
     max_motion_rms_m : float, optional
         Largest RMS motion (m) of a marker about its mean over the window
-        (``markers.static_max_motion_rms_m``); None: not checked.
+        (``model.static_max_motion_rms_m``); None: not checked.
     lab_labels : mapping of str to str, optional
         Model marker -> the lab's label in the C3D file, for messages.
     source, setting : str
@@ -160,9 +160,9 @@ def stillest_window_s(
         if message:
             hint = f"a time range where the subject stands still ({setting}), " if "time_range" in setting else ""
             raise LoperInputError(
-                f"{message}; it is the stillest {float(duration_s):g} s (markers.static_duration_s) of the static "
+                f"{message}; it is the stillest {float(duration_s):g} s (model.static_duration_s) of the static "
                 f"trial ({t[0]:.4f} .. {t[-1]:.4f} s, {still.n_windows} windows compared): set {hint}a shorter "
-                "markers.static_duration_s or a larger markers.static_max_motion_rms_m"
+                "model.static_duration_s or a larger model.static_max_motion_rms_m"
             )
     return still
 
@@ -240,7 +240,7 @@ def moving_message(
     return (
         f"{where(source)}the subject does not stand still in the scaling window {window_s[0]:.4f} .. "
         f"{window_s[1]:.4f} s of the static trial: marker(s) {shown}{more} move more than "
-        f"markers.static_max_motion_rms_m {max_motion_rms_m:g} m RMS about their mean"
+        f"model.static_max_motion_rms_m {max_motion_rms_m:g} m RMS about their mean"
     )
 
 

@@ -31,7 +31,8 @@ log = logging.getLogger(__name__)
 
 @dataclass(frozen=True)
 class MarkerSettings:
-    """How a trial's markers are named, cropped, filled, turned and filtered (config ``markers.*``, ``filter.*``).
+    """How a trial's markers are named, cropped, filled, turned and filtered (config ``markers.*``, with its
+    ``filter``).
 
     ``rotation_deg``: lab -> model rotation about the fixed X, Y, Z axes (degrees); ``walking_direction``:
     ``"auto"`` turns a travelling trial to walk along the model's +X, ``"fixed"`` keeps ``rotation_deg``;
@@ -117,7 +118,13 @@ def prepared_markers(
     if s.cutoff_hz:
         try:
             X, unfiltered = lowpass_finite_runs(
-                X, rec.point_rate_hz, s.cutoff_hz, s.order, axis=0, setting="filter.cutoff_hz", rate_name="POINT:RATE"
+                X,
+                rec.point_rate_hz,
+                s.cutoff_hz,
+                s.order,
+                axis=0,
+                setting="markers.filter.cutoff_hz",
+                rate_name="POINT:RATE",
             )
         except LoperInputError as exc:
             raise LoperInputError(f"{source}: markers: {exc}") from None

@@ -126,7 +126,7 @@ def stride_covariance(
     :func:`loper_analysis.impedance.responses.subject_onset_response`): their scatter
     holds the stride-to-stride deviation *and* each stride's own answer to
     the pulse, the scatter the fit's intervals take
-    (``identification.interval_scatter: perturbed_pairs``). Without them, or
+    (``impedance.interval_scatter: perturbed_pairs``). Without them, or
     with fewer than :data:`MIN_PERTURBED_PAIRS`, ``E = E0`` and the note says
     the prediction lacks the response's variability. The t quantile is the
     fit's: ``N - 1`` degrees of freedom with ``interval_scatter``
@@ -144,14 +144,14 @@ def stride_covariance(
     need = r + 2
     if n_pairs < need:
         raise LoperInputError(
-            f"{source}: {n_pairs} null pair(s), fewer than identification.null_pair_components + 2 = {need}: "
+            f"{source}: {n_pairs} null pair(s), fewer than impedance.null_pair_components + 2 = {need}: "
             "the pilot needs unperturbed strides walked with the device (their deviation is what the prediction "
             "scales)"
         )
     notes = []
     if n_pairs < settings.min_null_pairs:
         notes.append(
-            f"{n_pairs} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+            f"{n_pairs} null pairs, fewer than impedance.min_null_pairs = {settings.min_null_pairs}: "
             "the pilot's own fits kept the white-noise fit; the prediction is that of a null-pair fit"
         )
     window = planning_window(null_pairs, params, settings, device, source)
@@ -230,7 +230,7 @@ def conditional_stride_covariance(
     if n_null < r + 3 or "unit_scatter_variance" not in null:
         raise LoperInputError(
             f"{source}: {n_null} unperturbed stride(s) predicted from the others at this onset, fewer than "
-            f"identification.null_pair_components + 3 = {r + 3}: the conditional counterfactual's intervals "
+            f"impedance.null_pair_components + 3 = {r + 3}: the conditional counterfactual's intervals "
             "need the onset's own unperturbed strides"
         )
     pairs = series.get("pairs") or {}
@@ -239,12 +239,12 @@ def conditional_stride_covariance(
         raise LoperInputError(
             f"{source}: no perturbed stride of the pilot at this onset: the conditional counterfactual's plan "
             "needs the pilot's perturbed strides (their prediction weights); plan with "
-            "identification.counterfactual: matched_stride instead"
+            "impedance.counterfactual: matched_stride instead"
         )
     notes = []
     if n_null < settings.min_null_pairs:
         notes.append(
-            f"{n_null} null pairs, fewer than identification.min_null_pairs = {settings.min_null_pairs}: "
+            f"{n_null} null pairs, fewer than impedance.min_null_pairs = {settings.min_null_pairs}: "
             "the pilot's own fits fell back to the matched stride"
         )
     window = planning_window(null, params, settings, device, source)
@@ -327,7 +327,7 @@ def _mean_covariance(covs: Sequence[StrideCovariance], n: int, min_null_pairs: i
     few = sum(c.n_null_pairs < min_null_pairs for c in covs)
     if few:
         notes.append(
-            f"{few} of them with fewer than identification.min_null_pairs = {min_null_pairs} null pairs: "
+            f"{few} of them with fewer than impedance.min_null_pairs = {min_null_pairs} null pairs: "
             "a fit of that size would fall back to the matched stride"
         )
     return StrideCovariance(

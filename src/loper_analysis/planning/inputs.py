@@ -34,7 +34,7 @@ from loper_analysis.study_design import PERTURBED_SIDE
 __all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs", "trial_stretches"]
 
 #: The counterfactual the planner predicts for when none is given: the study's matched stride, whose pairs' scatter
-#: the prediction scales (``docs/planning.md``); the workflow plans for ``identification.counterfactual``.
+#: the prediction scales (``docs/planning.md``); the workflow plans for ``impedance.counterfactual``.
 PLANNED_COUNTERFACTUAL: str = "matched_stride"
 
 

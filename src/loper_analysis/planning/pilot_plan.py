@@ -209,7 +209,7 @@ def _onset_covariance(pool, onset, counts, params, values, settings: PlanningSet
             raise LoperInputError(
                 f"{where}: no trial of the pilot is perturbed at this onset: the conditional "
                 "counterfactual's plan takes the onset's own strides (or plan with "
-                "identification.counterfactual: matched_stride)"
+                "impedance.counterfactual: matched_stride)"
             )
         planned = conditional_stride_covariance(series, params, values, plan, dev, source=where)
         return planned, stretch_covariances(

@@ -150,7 +150,7 @@ def _snippet(
         "rotation": rotation,
         "label_map": "lab label -> model marker; check every row, add the unmatched labels you need",
         "foot_markers": "heel markers (model names) that assign plate contacts to feet",
-        "generic_model": "scaled per subject with opensim.scale_setup, your ScaleTool setup"
+        "generic_model": "scaled per subject with model.scale_setup, your ScaleTool setup"
         + (" (it names the marker set)" if with_marker_set else ""),
     }
     header = [
@@ -184,7 +184,7 @@ def inspect_c3d(
     config_out : path-like, optional
         YAML snippet: ``markers.lab_to_model_rotation_deg``, ``markers.label_map`` (the map
         written, or inline), ``events.foot_markers`` (when both heels are found) and
-        ``opensim.generic_model`` (with a model).
+        ``model.generic_model`` (with a model).
 
     Returns
     -------
@@ -242,7 +242,7 @@ def inspect_c3d(
             f"{config_out}: config snippet (markers.lab_to_model_rotation_deg"
             + (", markers.label_map" if label_map is not None else "")
             + (", events.foot_markers" if feet else "")
-            + (", opensim.generic_model" if model is not None else "")
+            + (", model.generic_model" if model is not None else "")
             + ")"
         )
     if written:
@@ -351,7 +351,7 @@ def inspect_subject(
     """Inspect a subject's C3D files, choose the marker-set template that fits their labels, and (``config_out``)
     write the subject's config with the files it names beside it.
 
-    Each file's kind comes from its name: ``static_name`` (``trials.static``) is the static trial, every other
+    Each file's kind comes from its name: ``static_name`` (``study.static``) is the static trial, every other
     file a walking trial. Labels present in no frame of a trial count as absent from it. The lab's label map
     (``label_map``: :func:`given_label_map`) renames labels before they are matched. The template
     (:func:`loper_analysis.subject_setup.subject_setup`) gives the label map, the marker set of the static
@@ -374,11 +374,11 @@ def inspect_subject(
     config_out : path-like, optional
         The subject's config; None: nothing is written.
     static_name : str
-        The static trial's name (``trials.static``).
+        The static trial's name (``study.static``).
     label_map : mapping, path-like or list, optional
         The lab's label map (``markers.label_map`` or ``--label-map``).
     cutoff_hz : float or None
-        The configured marker low-pass cut-off (Hz, ``filter.cutoff_hz``); None: no filter.
+        The configured marker low-pass cut-off (Hz, ``markers.filter.cutoff_hz``); None: no filter.
     check : callable, optional
         Called with the :class:`StagedSubject`; returns a line for the report or raises LoperInputError
         (nothing is written then).
@@ -425,7 +425,7 @@ def inspect_subject(
     mass_height = mass_height_line(static)
     text += f"  {mass_height}\n"
     cutoff = marker_cutoff_hz(cutoff_hz, [r.point_rate_hz for r, k in zip(recs, kinds) if k == "walking"])
-    text += f"  filter.cutoff_hz: {cutoff[0]} ({cutoff[1]})\n"
+    text += f"  markers.filter.cutoff_hz: {cutoff[0]} ({cutoff[1]})\n"
     if config_out is None:
         return SubjectInspection(summaries, setup, text)
 

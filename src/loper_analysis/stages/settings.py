@@ -14,6 +14,7 @@ import importlib
 from collections.abc import Mapping
 from typing import Any
 
+from loper_analysis.config_sections import SUBSECTIONS
 from loper_analysis.errors import LoperInputError
 
 __all__ = ["stage_settings"]
@@ -43,9 +44,10 @@ class _Keys(Mapping):
             name = ".".join((*self._path, key))
             raise LoperInputError(f"config: key '{name}' missing: the {self._reader} settings read it")
         value = self._data[key]
-        if isinstance(value, Mapping) and not self._path:  # a section; deeper mappings are values
-            return _Keys(value, (key,), self._reader)
-        return value
+        path = (*self._path, key)
+        if isinstance(value, Mapping) and (not self._path or ".".join(path) in SUBSECTIONS):  # a section
+            return _Keys(value, path, self._reader)
+        return value  # deeper mappings are values
 
     def __iter__(self):
         return iter(self._data)

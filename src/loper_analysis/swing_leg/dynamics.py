@@ -53,7 +53,7 @@ __all__ = [
 ]
 
 #: Where the robot's brace sits along the thigh, as a fraction of its length from the hip (config
-#: ``opensim.brace_attachment_fraction``); a model's brace markers win.
+#: ``model.brace_attachment_fraction``); a model's brace markers win.
 BRACE_ATTACHMENT_FRACTION: float = 0.8
 
 _SEGMENT_COLUMNS = ("mass_kg", "inertia_kg_m2", "length_m", "com_x_m", "com_y_m")

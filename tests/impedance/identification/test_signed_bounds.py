@@ -76,6 +76,6 @@ def test_the_config_layer_sets_negative_lower_bounds_for_the_fit_only():
     assert config["subjects"] == "config/subjects_paper.tsv"  # the layers below stay
     # the plausible ranges (sizes a joint may have) stay non-negative
     schema = yaml.safe_load((root / "workflow/schemas/config.schema.yaml").read_text())
-    config["identification"]["plausible_ranges"]["knee"]["stiffness_nm_per_rad"] = [-1.0, 3.5]
+    config["impedance"]["plausible_ranges"]["knee"]["stiffness_nm_per_rad"] = [-1.0, 3.5]
     with pytest.raises(ValidationError, match="-1.0 is less than the minimum of 0"):
         validate(config, schema)

@@ -40,12 +40,12 @@ def test_the_upper_bound_within_the_tolerance_is_not_identifiable():
     assert s == "not_identifiable"
     assert reason == (
         "K_knee = 200 N·m/rad at its upper bound 200 N·m/rad "
-        "(identification.stiffness_bounds_nm_per_rad): the data ask for more stiffness than the bounds allow"
+        "(impedance.stiffness_bounds_nm_per_rad): the data ask for more stiffness than the bounds allow"
     )
     assert status((200.0 - 2.5e-4, 0.1)) == ("ok", "")
     s, reason = status((3.0, 10.0))
     assert s == "not_identifiable" and reason.startswith(
-        "D_knee = 10 N·m·s/rad at its upper bound 10 N·m·s/rad (identification.damping_bounds_nms_per_rad)"
+        "D_knee = 10 N·m·s/rad at its upper bound 10 N·m·s/rad (impedance.damping_bounds_nms_per_rad)"
     )
 
 
@@ -66,7 +66,7 @@ def test_the_vaf_floor(vaf, expected):
     assert s == expected
     if expected == "failed":
         assert reason == (
-            f"VAF {vaf:.3g} % below identification.min_vaf_pct = 0 %: the model does not describe the knee response"
+            f"VAF {vaf:.3g} % below impedance.min_vaf_pct = 0 %: the model does not describe the knee response"
         )
 
 
@@ -107,7 +107,7 @@ def test_an_interval_holding_zero_and_the_study_range_is_not_identifiable():
     assert s == "not_identifiable"
     assert reason == (
         "D_knee = 0.055 N·m·s/rad, 95 % CI 0 … 0.33 N·m·s/rad: holds both 0 and the plausible range "
-        "0.02–0.14 N·m·s/rad (identification.plausible_ranges), the data cannot tell the damping from 0"
+        "0.02–0.14 N·m·s/rad (impedance.plausible_ranges), the data cannot tell the damping from 0"
     )
 
 
@@ -155,7 +155,7 @@ def test_an_interval_wider_than_the_plausible_range_is_not_identifiable():
     assert s == "not_identifiable"
     assert reason == (
         "D_knee = 0.2 N·m·s/rad, 95 % CI 0.03 … 0.37 N·m·s/rad: wider than the plausible range 0.02–0.14 N·m·s/rad "
-        "(identification.plausible_ranges), the data cannot place the damping within it"
+        "(impedance.plausible_ranges), the data cannot place the damping within it"
     )
     # a little narrower than the range (0.115): informative; a little wider (0.125): not; wholly above the range:
     # says D is above it

@@ -131,5 +131,5 @@ def test_candidates_whose_swing_cannot_hold_the_window_are_left_out(rng):
 
 
 def test_unknown_counterfactual_is_refused():
-    with pytest.raises(LoperInputError, match="identification.counterfactual.*'nearest'"):
+    with pytest.raises(LoperInputError, match="impedance.counterfactual.*'nearest'"):
         ResponseSettings(counterfactual="nearest")

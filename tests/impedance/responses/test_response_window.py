@@ -26,7 +26,7 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 def _config(before_s: float, after_s: float, span_s: float) -> dict:
     config = copy.deepcopy(CONFIG)
-    config["identification"].update(window_before_s=before_s, window_after_s=after_s, initial_state_span_s=span_s)
+    config["impedance"].update(window_before_s=before_s, window_after_s=after_s, initial_state_span_s=span_s)
     return config
 
 
@@ -51,10 +51,10 @@ def test_fit_planner_and_validation_hold_the_one_window_of_the_config():
 @pytest.mark.parametrize(
     ("field", "key", "value"),
     [
-        ("before_s", "identification.window_before_s", -0.01),
-        ("after_s", "identification.window_after_s", -0.1),
-        ("initial_state_span_s", "identification.initial_state_span_s", math.inf),
-        ("after_s", "identification.window_after_s", math.nan),
+        ("before_s", "impedance.window_before_s", -0.01),
+        ("after_s", "impedance.window_after_s", -0.1),
+        ("initial_state_span_s", "impedance.initial_state_span_s", math.inf),
+        ("after_s", "impedance.window_after_s", math.nan),
     ],
 )
 def test_a_bad_field_is_refused_naming_its_key_and_value(field, key, value):
@@ -64,7 +64,7 @@ def test_a_bad_field_is_refused_naming_its_key_and_value(field, key, value):
 
 
 def test_a_bad_config_value_is_refused_by_from_config_naming_the_key():
-    with pytest.raises(LoperInputError, match=r"^identification\.initial_state_span_s .* got -0\.5$"):
+    with pytest.raises(LoperInputError, match=r"^impedance\.initial_state_span_s .* got -0\.5$"):
         _ = stage_settings(_config(0.025, 0.25, -0.5), "impedance").response.window
 
 
@@ -77,14 +77,14 @@ def test_a_pulse_longer_than_the_window_after_the_onset_is_refused():
         ResponseWindow(after_s=0.25).check_pulse(0.3)
     assert str(info.value) == (
         "pulse_duration_s = 0.3 s is longer than the fit window after the onset "
-        "(identification.window_after_s = 0.25 s): the fit would not see its end"
+        "(impedance.window_after_s = 0.25 s): the fit would not see its end"
     )
     with pytest.raises(LoperInputError, match=r"^pulse_duration_s must be > 0 s, got 0 s$"):
         ResponseWindow().check_pulse(0.0)
 
 
 def test_the_planner_refuses_a_pulse_past_its_window():
-    with pytest.raises(LoperInputError, match=r"identification\.window_after_s = 0\.2 s"):
+    with pytest.raises(LoperInputError, match=r"impedance\.window_after_s = 0\.2 s"):
         PlanSettings(pulse_duration_s=0.21, window=ResponseWindow(after_s=0.2))
 
 
@@ -96,9 +96,9 @@ def test_a_window_inside_the_swing_passes_up_to_its_ends():
 @pytest.mark.parametrize(
     ("window", "onset_s", "swing_s", "expected"),
     [
-        (ResponseWindow(after_s=0.56), 0.05, 0.6, "identification.window_after_s = 0.56 s does not fit"),
+        (ResponseWindow(after_s=0.56), 0.05, 0.6, "impedance.window_after_s = 0.56 s does not fit"),
         (ResponseWindow(after_s=0.56), 0.05, 0.6, "at most 0.55 s (validation.swing_duration_s = 0.6 s"),
-        (ResponseWindow(before_s=0.06), 0.05, 0.6, "identification.window_before_s = 0.06 s does not fit"),
+        (ResponseWindow(before_s=0.06), 0.05, 0.6, "impedance.window_before_s = 0.06 s does not fit"),
         (ResponseWindow(before_s=0.06), 0.05, 0.6, "at most 0.05 s (validation.onset_s)"),
         (ResponseWindow(), 0.7, 0.6, "validation.onset_s = 0.7 s lies outside the simulated swing 0 .. 0.6 s"),
         (ResponseWindow(), 0.05, 0.0, "validation.swing_duration_s must be positive, got 0 s"),

@@ -15,6 +15,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.config_file import update_config
 from loper_analysis.dynamics.joint_cycles import CYCLE_COLUMNS, SUMMARY_COLUMNS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import read_model
@@ -74,11 +75,7 @@ def recorded_trial(work: Path, subject: str = SUBJECT, trial: str = TRIAL) -> di
     )
     assert res.returncode == 0, res.stderr[-3000:]
     config = yaml.safe_load((work / "config/config.yaml").read_text())
-    for section, keys in yaml.safe_load(lab_config.read_text()).items():
-        if isinstance(keys, dict):
-            config.setdefault(section, {}).update(keys)
-        else:
-            config[section] = keys
+    update_config(config, yaml.safe_load(lab_config.read_text()))  # as Snakemake layers --configfile
     return {"work": work, "config": config, "files": {k: work / v for k, v in files.items()}}
 
 
@@ -99,7 +96,7 @@ def dynamics_files(trial: dict, **replaced) -> DynamicsFiles:
 
 def lab_settings(trial: dict) -> DynamicsSettings:
     """The step's settings with the lab's coordinate map (gait2392: knee_angle_* sign -1)."""
-    return DynamicsSettings(coordinate_map=trial["config"]["opensim"]["coordinate_map"])
+    return DynamicsSettings(coordinate_map=trial["config"]["ik"]["coordinate_map"])
 
 
 @pytest.fixture(scope="module")

@@ -11,6 +11,7 @@ import pandas as pd
 import pytest
 import yaml
 
+from loper_analysis.config_file import update_config
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.opensim_tables import read_markers, read_mot, write_trc
 from loper_analysis.io.osim import read_marker_set, read_model, write_model
@@ -93,8 +94,7 @@ def rch(tmp_path_factory):
     lab = tmp / "lab"
     inspect_subject([LABS / "RCH/static.c3d", LABS / "RCH/walk-nodevice.c3d"], lab / "config.yaml")
     config = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    for section, keys in yaml.safe_load((lab / "config.yaml").read_text()).items():
-        config.setdefault(section, {}).update(keys)
+    update_config(config, yaml.safe_load((lab / "config.yaml").read_text()))  # as Snakemake layers --configfile
     label_map = config["markers"]["label_map"]  # as the workflow passes it to every trial
     settings = dataclasses.replace(stage_settings(config, "markers"), label_map=(label_map,) if label_map else None)
     trcs = {}
@@ -168,7 +168,7 @@ def test_a_clinical_walk_against_another_labs_static_trial_stops_its_ik(rch, tmp
     assert message.startswith(f"{trcs['walk']} with {model_osim}: the distances between markers on one body ")
     assert f"differ from the same pairs in the static trial {trcs['QCMAS static']} by {100 * change:.1f} %" in message
     assert (
-        f"in the median of {len(table)} pairs (limit opensim.geometry_stop_change 0.08; trial/static ratio "
+        f"in the median of {len(table)} pairs (limit ik.geometry_stop_change 0.08; trial/static ratio "
         f"{ratio:.3f})" in message
     )
     assert ": RHEE-RTOE (calcn_r) 104 mm against 192, LHEE-LTOE (calcn_l) 109 mm against 196" in message
@@ -189,5 +189,5 @@ def test_without_a_static_trial_the_walk_is_compared_with_the_models_markers_and
     assert f"differ from the subject's model's markers (no static trial to compare with) by {100 * change:.1f} %" in (
         message
     )
-    assert f"(limit opensim.geometry_stop_change 0.08; trial/model ratio {ratio:.3f})" in message
+    assert f"(limit ik.geometry_stop_change 0.08; trial/model ratio {ratio:.3f})" in message
     assert not out.exists()

@@ -43,13 +43,13 @@ def test_settings_of_the_config():
     seed and the plausible ranges (the config's own); a changed key reaches its field."""
     settings = stage_settings(CONFIG, "impedance")
     assert settings.response == ResponseSettings()
-    ident = CONFIG["identification"]
+    ident = CONFIG["impedance"]
     expected = dataclasses.replace(
         IdentificationSettings(), seed=CONFIG["seed"], plausible_ranges=ident["plausible_ranges"]
     )
     assert settings.identification == expected
     changed = copy.deepcopy(CONFIG)
-    changed["identification"]["min_vaf_pct"] = 12.5
+    changed["impedance"]["min_vaf_pct"] = 12.5
     changed["strides"]["min_valid_strides"] = 8
     settings = stage_settings(changed, "impedance")
     assert settings.identification.min_vaf_pct == 12.5 and settings.response.min_strides == 8

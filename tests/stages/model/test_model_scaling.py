@@ -244,7 +244,7 @@ def test_scaled_model_without_the_configured_bodies_is_refused(lab, tmp_path):
     with pytest.raises(
         LoperInputError,
         match=r"never\.osim \(scaled from .*gait2392_simbody\.osim\): "
-        r"opensim\.segment_bodies: thigh body 'thigh_l' is not in the model",
+        r"model\.segment_bodies: thigh body 'thigh_l' is not in the model",
     ):
         scale_with_setup(
             _files(lab / "scale_setup.xml", lab / "static.trc", tmp_path / "never.osim"),

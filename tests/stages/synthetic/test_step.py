@@ -34,12 +34,12 @@ def test_the_rules_file_lists_by_trial():
 
 def test_a_short_session_on_disk(tmp_path):
     config = copy.deepcopy(CONFIG)
-    config["trials"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
+    config["study"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     config["synthetic"]["walking_duration_s"] = 10.0
     settings = stage_settings(config, "synthetic")
     row = subject_anthropometry({"subject": "S09", "source": "synthetic"}, settings.seed)
     s = config["synthetic"]
-    ident = config["identification"]
+    ident = config["impedance"]
     truth(
         tmp_path / "truth.yaml",
         row,

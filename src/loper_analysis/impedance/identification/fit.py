@@ -57,18 +57,18 @@ __all__ = [
     "variance_accounted_for",
 ]
 
-#: Default bounds of every K (N·m/rad; ``identification.stiffness_bounds_nm_per_rad``) ...
+#: Default bounds of every K (N·m/rad; ``impedance.stiffness_bounds_nm_per_rad``) ...
 STIFFNESS_BOUNDS_NM_PER_RAD: tuple[float, float] = (0.0, 200.0)
-#: ... and of every D (N·m·s/rad; ``identification.damping_bounds_nms_per_rad``).
+#: ... and of every D (N·m·s/rad; ``impedance.damping_bounds_nms_per_rad``).
 DAMPING_BOUNDS_NMS_PER_RAD: tuple[float, float] = (0.0, 10.0)
 #: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS` (:func:`parameter_bounds` of the two above).
 DEFAULT_LOWER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[0], DAMPING_BOUNDS_NMS_PER_RAD[0]] * 3, float)
 DEFAULT_UPPER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[1], DAMPING_BOUNDS_NMS_PER_RAD[1]] * 3, float)
-#: Random starts drawn uniformly inside the bounds (``identification.n_starts``).
+#: Random starts drawn uniformly inside the bounds (``impedance.n_starts``).
 N_STARTS: int = 10
-#: Relative cost/step tolerance of the multistart phase (``identification.tolerance``).
+#: Relative cost/step tolerance of the multistart phase (``impedance.tolerance``).
 FIT_TOLERANCE: float = 1e-6
-#: Starts this close (fraction of the bounds, every parameter) continue as one (``identification.merge_tolerance``).
+#: Starts this close (fraction of the bounds, every parameter) continue as one (``impedance.merge_tolerance``).
 MERGE_TOLERANCE: float = 1e-2
 #: A start has reached the best when its final cost is within this fraction above the lowest start cost.
 AT_BEST_RELATIVE = 1e-3

@@ -16,7 +16,7 @@ and a status (``docs/identification.md``):
   another joint it trades off against), or spans more than
   ``max_ci_fraction`` of its bound range;
 * ``missing``: no trial of that onset;
-* ``failed``: too few strides (the reason names ``identification.window_after_s``
+* ``failed``: too few strides (the reason names ``impedance.window_after_s``
   when strides were too short for the window), the optimiser did not
   converge, or the joint's VAF is below ``min_vaf_pct``; ``reason`` says why.
 
@@ -159,9 +159,7 @@ class IdentificationSettings(FitBounds):
 
     def __post_init__(self):
         if self.noise_model not in NOISE_MODELS:
-            raise LoperInputError(
-                f"identification.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}"
-            )
+            raise LoperInputError(f"impedance.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}")
         check_interval_scatter(self.interval_scatter)
 
     def fit_options(self) -> dict:
@@ -265,7 +263,7 @@ def _plausible_range(plausible_ranges: Mapping | None, joint: str):
     entry = plausible_ranges.get(joint)
     if not isinstance(entry, Mapping) or not {"stiffness_nm_per_rad", "damping_nms_per_rad"} <= set(entry):
         raise LoperInputError(
-            f"identification.plausible_ranges: the {joint} needs stiffness_nm_per_rad and "
+            f"impedance.plausible_ranges: the {joint} needs stiffness_nm_per_rad and "
             f"damping_nms_per_rad ([low, high] each), got {entry!r}"
         )
     return (tuple(entry["stiffness_nm_per_rad"]), tuple(entry["damping_nms_per_rad"]))
@@ -378,14 +376,14 @@ def status_rows(
 def too_short_reason(
     n_short: int, n_perturbed: int, onset_ms: float, window_after_s: float, longest_after_onset_s: float
 ) -> str:
-    """Why perturbed strides were dropped as too short, naming ``identification.window_after_s`` and its value.
+    """Why perturbed strides were dropped as too short, naming ``impedance.window_after_s`` and its value.
 
     ``longest_after_onset_s``: the most swing time (s) any perturbed stride leaves after its onset,
     the longest window that keeps a stride.
     """
     text = (
         f"{n_short} of {n_perturbed} perturbed stride(s) too short for the fit window: their swing ends "
-        f"before onset {onset_ms:g} ms + identification.window_after_s = {window_after_s:g} s"
+        f"before onset {onset_ms:g} ms + impedance.window_after_s = {window_after_s:g} s"
     )
     if np.isfinite(longest_after_onset_s):
         text += f" (the longest swing leaves {max(longest_after_onset_s, 0.0):.3g} s after the onset)"
@@ -430,10 +428,10 @@ def fit_onset(
         ``name``, ``angles``, ``strides`` of the trials whose unperturbed
         strides give the null pairs (e.g. all the subject's walking trials
         with the device; the onset's own trials when empty). Used with
-        ``identification.noise_model`` ``null_pairs``: the white fit first,
+        ``impedance.noise_model`` ``null_pairs``: the white fit first,
         then :func:`loper_analysis.impedance.identification.refit_with_null_pairs`. A
         trial whose null pairs deviate more than
-        ``identification.max_null_trial_ratio`` times the other trials' is
+        ``impedance.max_null_trial_ratio`` times the other trials' is
         left out of them (:func:`loper_analysis.impedance.responses.deviant_trials`);
         the rows' reason names it. With ``response.counterfactual``
         ``conditional`` the null pairs are instead the onset's own unperturbed
@@ -529,7 +527,7 @@ def _onset_response(
     (:func:`loper_analysis.impedance.responses.subject_onset_response`),
     the response settings they were made with and why those differ from ``response`` ("" when they do not).
 
-    With the conditional counterfactual and fewer unperturbed strides than ``identification.min_null_pairs``,
+    With the conditional counterfactual and fewer unperturbed strides than ``impedance.min_null_pairs``,
     the matched stride instead (a warning in the log).
     """
     r, fallback = response, ""
@@ -541,7 +539,7 @@ def _onset_response(
             # too few unperturbed strides in the onset's trials to judge the prediction: the study's matched stride
             fallback = (
                 f"matched stride instead of the conditional counterfactual: {n_candidates} unperturbed stride(s) of "
-                f"the onset's trials, fewer than identification.min_null_pairs = {identification.min_null_pairs}"
+                f"the onset's trials, fewer than impedance.min_null_pairs = {identification.min_null_pairs}"
             )
             log.warning("%s, onset %s ms: %s", subject, onset_ms, fallback)
             r = replace(r, counterfactual="matched_stride")

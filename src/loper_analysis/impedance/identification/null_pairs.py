@@ -45,11 +45,11 @@ __all__ = [
     "refit_with_null_pairs",
 ]
 
-#: Deviation shapes projected out of the prediction error (``identification.null_pair_components``).
+#: Deviation shapes projected out of the prediction error (``impedance.null_pair_components``).
 NULL_PAIR_COMPONENTS: int = 6
-#: Fewer null pairs: the white fit stands (``identification.min_null_pairs``).
+#: Fewer null pairs: the white fit stands (``impedance.min_null_pairs``).
 MIN_NULL_PAIRS: int = 30
-#: Whose scatter gives the refit's 95 % intervals (``identification.interval_scatter``): the perturbed pairs
+#: Whose scatter gives the refit's 95 % intervals (``impedance.interval_scatter``): the perturbed pairs
 #: averaged in the window, the null pairs, or the null pairs each judged by a projection made without it
 #: (:func:`refit_with_null_pairs`, :func:`cross_validated_covariance`).
 INTERVAL_SCATTERS: tuple[str, ...] = ("perturbed_pairs", "null_pairs", "cross_validated_null_pairs")
@@ -59,7 +59,7 @@ def check_interval_scatter(value: str) -> str:
     """``value`` when it is one of :data:`INTERVAL_SCATTERS`, else a LoperInputError naming the config key."""
     if value not in INTERVAL_SCATTERS:
         raise LoperInputError(
-            f"identification.interval_scatter must be one of {', '.join(INTERVAL_SCATTERS)}, got {value!r}"
+            f"impedance.interval_scatter must be one of {', '.join(INTERVAL_SCATTERS)}, got {value!r}"
         )
     return value
 

@@ -59,7 +59,7 @@ MIN_VAF_PCT: float = 0.0
 #: An estimate within this fraction of its bound range of a bound lies on the bound.
 AT_BOUND_FRACTION: float = 1e-6
 #: A K or D whose 95 % CI spans more than this share of its bound range is not identifiable (1: only an unbounded
-#: one; ``identification.max_ci_fraction``).
+#: one; ``impedance.max_ci_fraction``).
 MAX_CI_FRACTION: float = 1.0
 
 #: A parameter whose estimate correlates at least this strongly (absolute) with one of another joint trades off
@@ -74,8 +74,8 @@ DEFAULT_PLAUSIBLE_RANGES: dict[str, tuple[tuple[float, float], tuple[float, floa
 }
 
 _PARAMETERS = (
-    ("K", "N·m/rad", "identification.stiffness_bounds_nm_per_rad", "stiffness"),
-    ("D", "N·m·s/rad", "identification.damping_bounds_nms_per_rad", "damping"),
+    ("K", "N·m/rad", "impedance.stiffness_bounds_nm_per_rad", "stiffness"),
+    ("D", "N·m·s/rad", "impedance.damping_bounds_nms_per_rad", "damping"),
 )
 
 
@@ -85,7 +85,7 @@ def check_plausible_range(joint: str, plausible_range) -> np.ndarray:
     r = np.asarray(plausible_range, dtype=float)
     if r.shape != (2, 2) or not np.all(np.isfinite(r)) or np.any(r[:, 0] < 0) or np.any(r[:, 0] >= r[:, 1]):
         raise LoperInputError(
-            f"identification.plausible_ranges of the {joint}: K and D each need [low, high] with "
+            f"impedance.plausible_ranges of the {joint}: K and D each need [low, high] with "
             f"0 <= low < high, got {np.asarray(plausible_range).tolist()}"
         )
     return r
@@ -195,12 +195,12 @@ def joint_status(
         if low[i] <= floor + at_bound_fraction * span[i] and high[i] >= r_high:
             unidentifiable.append(
                 f"{interval}: holds both {floor:g} and the plausible range {r_low:g}–{r_high:g} {unit} "
-                f"(identification.plausible_ranges), the data cannot tell the {what} from {floor:g}"
+                f"(impedance.plausible_ranges), the data cannot tell the {what} from {floor:g}"
             )
         elif widths[i] >= r_high - r_low and low[i] <= r_high and high[i] >= r_low:
             text = (
                 f"{interval}: wider than the plausible range {r_low:g}–{r_high:g} {unit} "
-                f"(identification.plausible_ranges), the data cannot place the {what} within it"
+                f"(impedance.plausible_ranges), the data cannot place the {what} within it"
             )
             if coupling[i] is not None and abs(float(coupling[i][1])) >= COUPLING_CORRELATION:
                 other, r = coupling[i][0], float(coupling[i][1])
@@ -225,7 +225,7 @@ def _vaf_findings(joint: str, vaf_pct: float, min_vaf_pct: float) -> list[str]:
         failed.append(f"VAF of the {joint} undefined: its measured response is zero over the fit window")
     elif vaf_pct < min_vaf_pct:
         failed.append(
-            f"VAF {vaf_pct:.3g} % below identification.min_vaf_pct = {min_vaf_pct:g} %: "
+            f"VAF {vaf_pct:.3g} % below impedance.min_vaf_pct = {min_vaf_pct:g} %: "
             f"the model does not describe the {joint} response"
         )
     return failed

@@ -49,13 +49,13 @@ __all__ = [
     "prediction_error",
 ]
 
-# Defaults of the fit's initial state and integration (config ``identification.*``, the same values); the
+# Defaults of the fit's initial state and integration (config ``impedance.*``, the same values); the
 # window's span (WINDOW_BEFORE_S, WINDOW_AFTER_S, INITIAL_STATE_SPAN_S) is the responses' own
 # (:class:`loper_analysis.impedance.responses.response_window.ResponseWindow`): the fit covers the window the responses
 # were cut to.
-#: Degree of that polynomial (1: position and rate; ``identification.initial_state_degree``).
+#: Degree of that polynomial (1: position and rate; ``impedance.initial_state_degree``).
 INITIAL_STATE_DEGREE: int = 1
-#: RK4 steps per sample of the data (``identification.n_substeps``).
+#: RK4 steps per sample of the data (``impedance.n_substeps``).
 N_SUBSTEPS: int = 2
 
 

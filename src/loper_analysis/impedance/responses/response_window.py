@@ -2,8 +2,8 @@
 validation study.
 
 * :class:`ResponseWindow` - how long before and after the onset the responses are cut and fitted, and the span
-  before them the fit's initial state is taken from (config ``identification.window_before_s``,
-  ``identification.window_after_s``, ``identification.initial_state_span_s``), with the checks of the window
+  before them the fit's initial state is taken from (config ``impedance.window_before_s``,
+  ``impedance.window_after_s``, ``impedance.initial_state_span_s``), with the checks of the window
   against a planned pulse (:meth:`ResponseWindow.check_pulse`) and a simulated swing
   (:meth:`ResponseWindow.check_in_swing`).
 """
@@ -17,20 +17,20 @@ from loper_analysis.errors import LoperInputError
 
 __all__ = ["INITIAL_STATE_SPAN_S", "WINDOW_AFTER_S", "WINDOW_BEFORE_S", "WINDOW_KEYS", "ResponseWindow"]
 
-# The analysis window around each onset (config ``identification.*``, the same values): every default of these
+# The analysis window around each onset (config ``impedance.*``, the same values): every default of these
 # settings in the library (responses, identification, validation, planning) refers to these.
-#: The window starts this long before the perturbation onset (s; ``identification.window_before_s``) ...
+#: The window starts this long before the perturbation onset (s; ``impedance.window_before_s``) ...
 WINDOW_BEFORE_S: float = 0.025
-#: ... and ends this long after it (s; ``identification.window_after_s``).
+#: ... and ends this long after it (s; ``impedance.window_after_s``).
 WINDOW_AFTER_S: float = 0.25
-#: Pre-onset span of the fit's initial-state polynomial (s; ``identification.initial_state_span_s``).
+#: Pre-onset span of the fit's initial-state polynomial (s; ``impedance.initial_state_span_s``).
 INITIAL_STATE_SPAN_S: float = 0.1
 
 #: Field of :class:`ResponseWindow` -> its config key.
 WINDOW_KEYS: dict[str, str] = {
-    "before_s": "identification.window_before_s",
-    "after_s": "identification.window_after_s",
-    "initial_state_span_s": "identification.initial_state_span_s",
+    "before_s": "impedance.window_before_s",
+    "after_s": "impedance.window_after_s",
+    "initial_state_span_s": "impedance.initial_state_span_s",
 }
 
 
@@ -41,12 +41,12 @@ class ResponseWindow:
     Attributes
     ----------
     before_s : float
-        The window starts this long before the onset (s, >= 0; ``identification.window_before_s``).
+        The window starts this long before the onset (s, >= 0; ``impedance.window_before_s``).
     after_s : float
-        ... and ends this long after it (s, >= 0; ``identification.window_after_s``).
+        ... and ends this long after it (s, >= 0; ``impedance.window_after_s``).
     initial_state_span_s : float
         The span before the window's start whose perturbed-minus-unperturbed coordinates give the fit's initial
-        state (s, >= 0; ``identification.initial_state_span_s``).
+        state (s, >= 0; ``impedance.initial_state_span_s``).
 
     Raises
     ------
@@ -69,7 +69,7 @@ class ResponseWindow:
         ------
         LoperInputError
             A non-finite or non-positive duration, or one longer than ``after_s``: the fit would not see the
-            pulse's end (the message names ``identification.window_after_s`` and both values).
+            pulse's end (the message names ``impedance.window_after_s`` and both values).
         """
         d = number("pulse_duration_s", pulse_duration_s)
         if d <= 0:
@@ -77,7 +77,7 @@ class ResponseWindow:
         if d > self.after_s:
             raise LoperInputError(
                 f"pulse_duration_s = {d:g} s is longer than the fit window after the onset "
-                f"(identification.window_after_s = {self.after_s:g} s): the fit would not see its end"
+                f"(impedance.window_after_s = {self.after_s:g} s): the fit would not see its end"
             )
 
     def check_in_swing(self, onset_s: float, swing_duration_s: float) -> None:
@@ -107,13 +107,13 @@ class ResponseWindow:
         room_after = swing_duration_s - onset_s
         if self.after_s > room_after + 1e-12:
             raise LoperInputError(
-                f"identification.window_after_s = {self.after_s:g} s does not fit in the simulated swing of the "
+                f"impedance.window_after_s = {self.after_s:g} s does not fit in the simulated swing of the "
                 f"validation study: the window must end by the heel strike, so it may be at most {room_after:g} s "
                 f"(validation.swing_duration_s = {swing_duration_s:g} s - validation.onset_s = {onset_s:g} s)"
             )
         if self.before_s > onset_s + 1e-12:
             raise LoperInputError(
-                f"identification.window_before_s = {self.before_s:g} s does not fit in the simulated swing of the "
+                f"impedance.window_before_s = {self.before_s:g} s does not fit in the simulated swing of the "
                 f"validation study: the window must start after toe-off, so it may be at most {onset_s:g} s "
                 f"(validation.onset_s)"
             )

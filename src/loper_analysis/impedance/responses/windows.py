@@ -51,7 +51,7 @@ __all__ = [
     "window_outliers",
 ]
 
-#: The unperturbed reference of a perturbed stride (``identification.counterfactual``): the study's one
+#: The unperturbed reference of a perturbed stride (``impedance.counterfactual``): the study's one
 #: matched stride, or the conditional mean over all unperturbed strides
 #: (:mod:`loper_analysis.impedance.responses.conditional`).
 COUNTERFACTUALS: tuple[str, ...] = ("matched_stride", "conditional")
@@ -85,8 +85,7 @@ class ResponseSettings:
     def __post_init__(self):
         if self.counterfactual not in COUNTERFACTUALS:
             raise LoperInputError(
-                f"identification.counterfactual must be one of {', '.join(COUNTERFACTUALS)}, "
-                f"got {self.counterfactual!r}"
+                f"impedance.counterfactual must be one of {', '.join(COUNTERFACTUALS)}, got {self.counterfactual!r}"
             )
 
 

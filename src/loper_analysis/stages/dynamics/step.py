@@ -116,7 +116,7 @@ class DynamicsSettings:
     foot_bodies : mapping of str to str
         Side -> the model body the foot's ground load acts on.
     coordinate_map : mapping, optional
-        Our angles -> model coordinate and sign (``opensim.coordinate_map``); None:
+        Our angles -> model coordinate and sign (``ik.coordinate_map``); None:
         :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
     n_points : int
         Points per normalised gait cycle (0 .. 100 %).

@@ -113,7 +113,7 @@ def _loadcell_of(rec, log_path, s: LoadcellSettings) -> tuple[pd.DataFrame, pd.D
         rate,
         s.cutoff_hz,
         s.order,
-        setting="filter.cutoff_hz",
+        setting="markers.filter.cutoff_hz",
         rate_name="the log's sample_rate_hz",
         source=str(log_path),
     )

@@ -19,7 +19,7 @@ def _add_ik(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="output .mot (angles in degrees, OpenSim's convention)")
     p.add_argument(
         "--tasks",
-        help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: opensim.ik_tasks, else "
+        help="OpenSim IK task-set XML or TSV (name, kind, weight[, value]); default: ik.ik_tasks, else "
         "every model marker found in the file, weight 1",
     )
     p.add_argument("--start", type=float, help="first time (s) to solve")
@@ -27,29 +27,29 @@ def _add_ik(p: argparse.ArgumentParser) -> None:
     cli_options.add_label_map_option(p)
     cli_options.add_rotate_option(p, heading=True)
     p.add_argument(
-        "--accuracy", type=float, help="IK solver accuracy (default: opensim.accuracy; OpenSim's own default 1e-5)"
+        "--accuracy", type=float, help="IK solver accuracy (default: ik.accuracy; OpenSim's own default 1e-5)"
     )
     p.add_argument(
         "--solver",
         choices=("tree", "opensim"),
-        help="IK solver (default: opensim.ik_solver): the model's kinematic tree or OpenSim's",
+        help="IK solver (default: ik.ik_solver): the model's kinematic tree or OpenSim's",
     )
     p.add_argument(
         "--max-marker-rms-m",
         type=float,
         help="a frame whose marker RMS error exceeds this (m) counts as failed (a unit, label or model mistake; "
-        "default: opensim.max_marker_rms_m)",
+        "default: ik.max_marker_rms_m)",
     )
     p.add_argument(
         "--warn-marker-rms-m",
         type=float,
         help="a frame whose marker RMS error exceeds this (m) counts as poorly fitted (a warning; default: "
-        "opensim.warn_marker_rms_m)",
+        "ik.warn_marker_rms_m)",
     )
     p.add_argument(
         "--max-rms-fraction",
         type=float,
-        help="fail (warn) when more frames than this share fail (fit poorly; default: opensim.max_rms_fraction)",
+        help="fail (warn) when more frames than this share fail (fit poorly; default: ik.max_rms_fraction)",
     )
     cli_options.add_configfile_option(p)
 
@@ -108,10 +108,10 @@ COMMANDS: tuple[Command, ...] = (
         run=_ik,
         option_keys={
             "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-            "accuracy": ("config", ("opensim", "accuracy")),
-            "max_marker_rms_m": ("config", ("opensim", "max_marker_rms_m")),
-            "warn_marker_rms_m": ("config", ("opensim", "warn_marker_rms_m")),
-            "max_rms_fraction": ("config", ("opensim", "max_rms_fraction")),
+            "accuracy": ("config", ("ik", "accuracy")),
+            "max_marker_rms_m": ("config", ("ik", "max_marker_rms_m")),
+            "warn_marker_rms_m": ("config", ("ik", "warn_marker_rms_m")),
+            "max_rms_fraction": ("config", ("ik", "max_rms_fraction")),
         },
     ),
 )

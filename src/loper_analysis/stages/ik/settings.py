@@ -16,7 +16,7 @@ def read_settings(config: Mapping) -> IKSettings:
     ``marker_weights``, ``coordinate_tasks``, ``accuracy``, ``ik_solver``, ``max_marker_rms_m`` (m),
     ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``, ``geometry_warn_change`` and
     ``geometry_stop_change``."""
-    o = config["opensim"]
+    o = config["ik"]
     return IKSettings(
         tasks_file=o["ik_tasks"],
         default_weight=o["default_marker_weight"],

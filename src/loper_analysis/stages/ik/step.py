@@ -98,10 +98,10 @@ def _geometry_checked(
     log.info("marker geometry against %s: median change %.2f %% over %d pairs", reference, 100 * change, len(table))
     stops = stops or not 2 / 3 < geometry_ratio(table) < 3 / 2
     if change > settings.geometry_stop_change and stops:
-        stop = geometry_message(table, settings.geometry_stop_change, "opensim.geometry_stop_change", name)
+        stop = geometry_message(table, settings.geometry_stop_change, "ik.geometry_stop_change", name)
         raise LoperInputError(f"{source}: {stop}")
     if change > settings.geometry_warn_change:
-        warning = geometry_message(table, settings.geometry_warn_change, "opensim.geometry_warn_change", name)
+        warning = geometry_message(table, settings.geometry_warn_change, "ik.geometry_warn_change", name)
         log.warning("%s: %s", source, warning)
         return change, warning
     return change, None
@@ -127,7 +127,7 @@ def _solve(
     s = settings
     model = read_model(model_osim)
     cmap = DEFAULT_COORDINATE_MAP if s.coordinate_map is None else s.coordinate_map
-    require_map_signs(model, cmap, str(model_osim), "opensim.coordinate_map")
+    require_map_signs(model, cmap, str(model_osim), "ik.coordinate_map")
     tasks = read_ik_tasks(s.tasks_file) if s.tasks_file else None
     weights, coords = ik_task_weights(
         model, labels, tasks, s.default_weight, s.marker_weights, s.coordinate_tasks, source

@@ -1,4 +1,4 @@
-"""The impedance stage's settings (config ``identification.*``), with the strides' outlier rule and the study's
+"""The impedance stage's settings (config ``impedance.*``), with the strides' outlier rule and the study's
 seed."""
 
 from __future__ import annotations
@@ -19,11 +19,11 @@ NEEDS: tuple[str, ...] = ("study", "strides")
 
 
 def read_settings(config: Mapping, study: StudySettings, strides: StrideSettings) -> FitSettings:
-    """The fit's settings of a validated config: the response window (``identification.window_before_s``,
+    """The fit's settings of a validated config: the response window (``impedance.window_before_s``,
     ``window_after_s``, ``initial_state_span_s``, s), the counterfactual and every other key of
     ``identification`` (bounds in N·m/rad and N·m·s/rad); the IQR rule and fewest kept strides are the
     strides', the seed the study's."""
-    ident = config["identification"]
+    ident = config["impedance"]
     window = ResponseWindow(
         before_s=ident["window_before_s"],
         after_s=ident["window_after_s"],

@@ -19,9 +19,13 @@ def _add_markers(p: argparse.ArgumentParser) -> None:
     cli_options.add_label_map_option(p)
     cli_options.add_rotate_option(p, heading=True)
     p.add_argument(
-        "--cutoff-hz", type=float, help="zero-phase Butterworth low-pass (Hz); 0: no filter (default: filter.cutoff_hz)"
+        "--cutoff-hz",
+        type=float,
+        help="zero-phase Butterworth low-pass (Hz); 0: no filter (default: markers.filter.cutoff_hz)",
     )
-    p.add_argument("--order", type=int, help="designed filter order, run forward and backward (default: filter.order)")
+    p.add_argument(
+        "--order", type=int, help="designed filter order, run forward and backward (default: markers.filter.order)"
+    )
     p.add_argument(
         "--max-gap-frames",
         type=int,
@@ -64,8 +68,8 @@ COMMANDS: tuple[Command, ...] = (
         add_arguments=_add_markers,
         run=_markers,
         option_keys={
-            "cutoff_hz": ("config", ("filter", "cutoff_hz")),
-            "order": ("config", ("filter", "order")),
+            "cutoff_hz": ("config", ("markers", "filter", "cutoff_hz")),
+            "order": ("config", ("markers", "filter", "order")),
             "max_gap_frames": ("config", ("markers", "max_gap_frames")),
             "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
         },

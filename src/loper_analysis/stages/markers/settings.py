@@ -1,4 +1,4 @@
-"""The markers stage's settings: the walking trials' (config ``markers.*`` and ``filter.*``)."""
+"""The markers stage's settings: the walking trials' (config ``markers.*`` and ``markers.filter.*``)."""
 
 from __future__ import annotations
 
@@ -14,8 +14,9 @@ NEEDS: tuple[str, ...] = ()
 def read_settings(config: Mapping) -> MarkerSettings:
     """The walking trials' marker settings of a validated config: ``markers.lab_to_model_rotation_deg`` (deg),
     ``walking_direction``, ``min_travel_speed_m_per_s``, ``max_gap_frames``, ``extent_range_m`` (m) and the
-    low-pass ``filter.cutoff_hz`` (Hz) and ``filter.order``."""
-    m, f = config["markers"], config["filter"]
+    low-pass ``markers.filter.cutoff_hz`` (Hz) and ``markers.filter.order``."""
+    m = config["markers"]
+    f = m["filter"]
     return MarkerSettings(
         rotation_deg=tuple(float(v) for v in m["lab_to_model_rotation_deg"]),
         walking_direction=m["walking_direction"],

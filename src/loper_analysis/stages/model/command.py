@@ -33,7 +33,7 @@ def _add_scale(p: argparse.ArgumentParser) -> None:
         "--start",
         type=float,
         help="first time of the static trial to use (s; default: the setup's time range, else the stillest "
-        "markers.static_duration_s)",
+        "model.static_duration_s)",
     )
     p.add_argument("--end", type=float, help="last time of the static trial to use (s)")
     p.add_argument(
@@ -41,7 +41,7 @@ def _add_scale(p: argparse.ArgumentParser) -> None:
         type=float,
         help="refuse a static trial with a marker moving "
         "more than this (m, RMS about its mean over the window; 0: not checked; default: "
-        "markers.static_max_motion_rms_m)",
+        "model.static_max_motion_rms_m)",
     )
     cli_options.add_label_map_option(p)
     cli_options.add_rotate_option(p)
@@ -120,7 +120,7 @@ def _add_segments(p: argparse.ArgumentParser) -> None:
     """The ``segments`` subcommand's arguments."""
     p.add_argument("--model", help="scaled OpenSim model (.osim): gait2392, Rajagopal2016 or the generated model")
     p.add_argument(
-        "--side", choices=("left", "right"), help="the swing leg (with --model; default: trials.perturbed_side)"
+        "--side", choices=("left", "right"), help="the swing leg (with --model; default: study.perturbed_side)"
     )
     p.add_argument("--height-m", type=float, help="without --model: Winter's table from height ...")
     p.add_argument("--mass-kg", type=float, help="... and body mass")
@@ -128,7 +128,7 @@ def _add_segments(p: argparse.ArgumentParser) -> None:
         "--attachment-fraction",
         type=float,
         help="brace position along the thigh (fraction of its length; a model's brace markers win; default: "
-        "opensim.brace_attachment_fraction)",
+        "model.brace_attachment_fraction)",
     )
     p.add_argument("--out", required=True, help="output TSV")
     cli_options.add_configfile_option(p)
@@ -162,8 +162,8 @@ COMMANDS: tuple[Command, ...] = (
         option_keys={
             "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
             "mass_kg": ("subjects", ("mass_kg",)),
-            "max_motion_rms_m": ("config", ("markers", "static_max_motion_rms_m")),
-            "cutoff_hz": ("config", ("filter", "cutoff_hz")),
+            "max_motion_rms_m": ("config", ("model", "static_max_motion_rms_m")),
+            "cutoff_hz": ("config", ("markers", "filter", "cutoff_hz")),
             "max_gap_frames": ("config", ("markers", "max_gap_frames")),
         },
         off_with_zero=frozenset({"cutoff_hz", "max_motion_rms_m"}),
@@ -176,7 +176,7 @@ COMMANDS: tuple[Command, ...] = (
         option_keys={
             "mass_kg": ("subjects", ("mass_kg",)),
             "height_m": ("subjects", ("height_m",)),
-            "attachment_fraction": ("config", ("opensim", "brace_attachment_fraction")),
+            "attachment_fraction": ("config", ("model", "brace_attachment_fraction")),
         },
     ),
 )

@@ -1,5 +1,5 @@
 """The model stage's settings: scaling and the segment table (config ``opensim.*`` of the model,
-``markers.static_*``), with the markers' rotation, the IK's static pose and the study's leg."""
+``model.static_*``), with the markers' rotation, the IK's static pose and the study's leg."""
 
 from __future__ import annotations
 
@@ -16,11 +16,11 @@ NEEDS: tuple[str, ...] = ("study", "markers", "ik")
 
 
 def read_settings(config: Mapping, study: StudySettings, markers: MarkerSettings, ik: IKSettings) -> ModelSettings:
-    """The model settings of a validated config: ``markers.static_duration_s`` (s),
-    ``markers.static_max_motion_rms_m`` (m), ``opensim.scale_factor_range``, ``segment_bodies`` and
+    """The model settings of a validated config: ``model.static_duration_s`` (s),
+    ``model.static_max_motion_rms_m`` (m), ``model.scale_factor_range``, ``segment_bodies`` and
     ``brace_attachment_fraction``; the rotation is the markers', the static pose's coordinate map, accuracy and
     solver the IK's, the leg the study's."""
-    m, o = config["markers"], config["opensim"]
+    m = o = config["model"]
     return ModelSettings(
         rotation_deg=markers.rotation_deg,
         static_duration_s=m["static_duration_s"],

@@ -168,7 +168,7 @@ def segments_from_model_file(
         The table (:func:`loper_analysis.io.segment_table.write_segments`), written atomically.
     settings : ModelSettings
         ``side`` (the swing leg, ``"left"`` or ``"right"``), ``segment_bodies`` (segment -> body names with
-        ``{s}`` for the side suffix, setting ``opensim.segment_bodies``; ``None``: the model's own kind) and
+        ``{s}`` for the side suffix, setting ``model.segment_bodies``; ``None``: the model's own kind) and
         ``attachment_fraction`` (rod attachment as a fraction of the thigh length, for a model without brace
         markers).
 

@@ -41,7 +41,7 @@ def _add_plan(p: argparse.ArgumentParser) -> None:
         "table in RESULTS/ik/SUBJECT but --exclude-trials)",
     )
     p.add_argument(
-        "--exclude-trials", nargs="*", help="trials without the device (default: trials.no_device, else walk-nodevice)"
+        "--exclude-trials", nargs="*", help="trials without the device (default: study.no_device, else walk-nodevice)"
     )
     p.add_argument("--segments", help="segment table of the subject to plan for (default: the pilot's)")
     p.add_argument(
@@ -60,7 +60,7 @@ def _add_plan(p: argparse.ArgumentParser) -> None:
         "--onset-ms",
         type=float,
         nargs="+",
-        help="onsets after toe-off (ms; default: trials.perturbation_onsets_ms, else those of the impedance rows)",
+        help="onsets after toe-off (ms; default: study.perturbation_onsets_ms, else those of the impedance rows)",
     )
     p.add_argument(
         "--strides", type=int, nargs="+", help="perturbed strides averaged (default: planning.strides, else 10 20 40)"
@@ -129,14 +129,14 @@ def plan_settings(args: argparse.Namespace, config: dict | None):
 def plan_pilot(args: argparse.Namespace, config: dict | None) -> tuple[str | None, str, list[str]]:
     """The pilot subject (``--subject``, else ``planning.pilot_subject``; None: the first of the subject sheet),
     the subject sheet (``--subjects``, else the config's ``subjects``, else ``config/subjects.tsv``) and the
-    trials without the device (``--exclude-trials``, else ``trials.no_device``, else the library's)."""
+    trials without the device (``--exclude-trials``, else ``study.no_device``, else the library's)."""
     from loper_analysis.study_design import StudyDesign
 
     pilot = args.subject or (None if config is None else config["planning"]["pilot_subject"])
     sheet = args.subjects or ("config/subjects.tsv" if config is None else config["subjects"])
     exclude = args.exclude_trials
     if exclude is None:
-        exclude = [StudyDesign().no_device if config is None else config["trials"]["no_device"]]
+        exclude = [StudyDesign().no_device if config is None else config["study"]["no_device"]]
     return pilot, sheet, exclude
 
 
@@ -214,10 +214,10 @@ COMMANDS: tuple[Command, ...] = (
         "subject's processed trials, with the settings of the workflow's rule 'planning'. Settings, "
         "highest priority first: (1) options given here; (2) the config: config/config.yaml of the "
         "working directory with each --configfile over it, as Snakemake layers them (onsets: "
-        "trials.perturbation_onsets_ms; strides, targets, pulse and pilot: planning.*; fit window, "
-        "initial state, bounds, null pairs and the counterfactual planned for: identification.*; outliers: "
+        "study.perturbation_onsets_ms; strides, targets, pulse and pilot: planning.*; fit window, "
+        "initial state, bounds, null pairs and the counterfactual planned for: impedance.*; outliers: "
         "strides.iqr_whisker, "
-        "strides.max_outlier_fraction; device: device.parameters; excluded trial: trials.no_device; "
+        "strides.max_outlier_fraction; device: device.parameters; excluded trial: study.no_device; "
         "subject sheet: subjects); (3) without any config file, the library's defaults (said in the "
         "first line printed, which names the config file(s) used).",
         add_arguments=_add_plan,

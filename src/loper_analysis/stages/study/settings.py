@@ -1,4 +1,4 @@
-"""The study's settings: the trial design (config ``trials``), ``seed``, ``subjects`` and ``raw_dir``."""
+"""The study's settings: the trial design (config ``study``), ``seed``, ``subjects`` and ``raw_dir``."""
 
 from __future__ import annotations
 
@@ -24,8 +24,8 @@ class StudySettings:
 
 
 def read_settings(config: Mapping) -> StudySettings:
-    """The study of a validated config (``trials.*``, ``seed``, ``subjects``, ``raw_dir``)."""
-    trials = config["trials"]
+    """The study of a validated config (``study.*``, ``seed``, ``subjects``, ``raw_dir``)."""
+    trials = config["study"]
     design = StudyDesign(
         static=str(trials["static"]),
         no_device=str(trials["no_device"]),

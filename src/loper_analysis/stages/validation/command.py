@@ -17,7 +17,7 @@ def _add_validate(p: argparse.ArgumentParser) -> None:
     p.add_argument("--segments", required=True, help="segment table TSV")
     p.add_argument("--chunk", type=int, default=0)
     p.add_argument("--n-chunks", type=int, help="chunks of the study (default: validation.n_chunks of the config)")
-    p.add_argument("--n-starts", type=int, help="multistart starts (default: identification.n_starts)")
+    p.add_argument("--n-starts", type=int, help="multistart starts (default: impedance.n_starts)")
     p.add_argument("--seed", type=int, help="seed (default: the config's seed)")
     p.add_argument("--errors", required=True, help="output TSV, one row per combination x condition x parameter")
     p.add_argument("--fits", required=True, help="output TSV, one row per combination x condition")
@@ -44,12 +44,12 @@ COMMANDS: tuple[Command, ...] = (
         help="one chunk of the validation study (the study's design)",
         description="Simulate and identify one chunk of the validation study with the settings of the workflow's "
         "validation rules: config/config.yaml of the working directory with each --configfile over it "
-        "(validation.*, identification.*, seed); options given here win; without any config file the "
+        "(validation.*, impedance.*, seed); options given here win; without any config file the "
         "library's defaults (said in the first line printed).",
         add_arguments=_add_validate,
         run=_validate,
         option_keys={
-            "n_starts": ("config", ("identification", "n_starts")),
+            "n_starts": ("config", ("impedance", "n_starts")),
             "n_chunks": ("config", ("validation", "n_chunks")),
             "seed": ("config", ("seed",)),
         },
