@@ -21,8 +21,8 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import read_model
 from loper_analysis.layout import fill
 from loper_analysis.stages import study_paths
+from loper_analysis.stages.dynamics.files import DynamicsFiles
 from loper_analysis.stages.dynamics.step import (
-    DynamicsFiles,
     DynamicsOutputs,
     DynamicsSettings,
     NoKnownLoadWarning,

@@ -3,16 +3,17 @@ trial's inverse dynamics reads, the trials it runs for and those it cannot, and 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.io.atomic import PathLike
 from loper_analysis.layout import fill
-from loper_analysis.stages.dynamics.step import DynamicsFiles
 
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "NO_PLATES", "dynamics_files", "dynamics_trials", "targets", "trials_without"]
+__all__ = ["FILES", "NO_PLATES", "DynamicsFiles", "dynamics_files", "dynamics_trials", "targets", "trials_without"]
 
 FILES: dict[str, str] = {
     "moments": "{subject}/{trial}.moments.tsv",
@@ -27,6 +28,30 @@ NO_PLATES = (
     "no force platforms in the C3D (FORCE_PLATFORM:USED 0 or absent): the belts' vertical forces carry no centre "
     "of pressure, horizontal force or free moment, which inverse dynamics needs"
 )
+
+
+@dataclass(frozen=True)
+class DynamicsFiles:
+    """The files one trial's inverse dynamics reads.
+
+    Attributes
+    ----------
+    model_osim : path-like
+        The subject's scaled OpenSim model (``results/model/{subject}/scaled.osim``); its total mass is the body mass.
+    ik_mot : path-like
+        The IK coordinates (``.mot``; degrees when ``inDegrees=yes``).
+    grf_mot : path-like
+        The ground reactions (``grf`` step's ``.grf.mot``, model frame, with each plate's COP columns).
+    contacts_tsv, events_tsv, strides_tsv : path-like
+        The ``events`` step's contacts and events, the ``strides`` step's stride table.
+    """
+
+    model_osim: PathLike
+    ik_mot: PathLike
+    grf_mot: PathLike
+    contacts_tsv: PathLike
+    events_tsv: PathLike
+    strides_tsv: PathLike
 
 
 def dynamics_trials(study: Study) -> list[tuple[str, str]]:

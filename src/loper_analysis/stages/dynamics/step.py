@@ -33,10 +33,10 @@ from loper_analysis.dynamics.joint_cycles import (
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP
+from loper_analysis.stages.dynamics.files import DynamicsFiles
 
 __all__ = [
     "CUTOFF_HZ",
-    "DynamicsFiles",
     "DynamicsOutputs",
     "DynamicsSettings",
     "NoKnownLoadWarning",
@@ -55,30 +55,6 @@ CUTOFF_HZ: float = 6.0
 
 class NoKnownLoadWarning(UserWarning):
     """A trial in which a leg's foot load is never known: no ``ok`` contact of that side, no cycles."""
-
-
-@dataclass(frozen=True)
-class DynamicsFiles:
-    """The files one trial's inverse dynamics reads.
-
-    Attributes
-    ----------
-    model_osim : path-like
-        The subject's scaled OpenSim model (``results/model/{subject}/scaled.osim``); its total mass is the body mass.
-    ik_mot : path-like
-        The IK coordinates (``.mot``; degrees when ``inDegrees=yes``).
-    grf_mot : path-like
-        The ground reactions (``grf`` step's ``.grf.mot``, model frame, with each plate's COP columns).
-    contacts_tsv, events_tsv, strides_tsv : path-like
-        The ``events`` step's contacts and events, the ``strides`` step's stride table.
-    """
-
-    model_osim: PathLike
-    ik_mot: PathLike
-    grf_mot: PathLike
-    contacts_tsv: PathLike
-    events_tsv: PathLike
-    strides_tsv: PathLike
 
 
 @dataclass(frozen=True)
