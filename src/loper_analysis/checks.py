@@ -25,7 +25,6 @@ __all__ = [
     "number",
     "positive",
     "integer",
-    "choice",
     "side",
     "time_vector",
     "uniform_step_s",
@@ -91,14 +90,6 @@ def integer(name: str, value, source: str = "", minimum: int | None = None) -> i
         bound = f" >= {minimum}" if minimum is not None else ""
         raise LoperInputError(f"{where(source)}{name} must be an integer{bound}, got {value!r}")
     return int(value)
-
-
-def choice(name: str, value, options: Sequence, source: str = ""):
-    """One of ``options``."""
-    if value not in options:
-        listed = " or ".join(repr(o) for o in options)
-        raise LoperInputError(f"{where(source)}{name} must be {listed}, got {value!r}")
-    return value
 
 
 def side(value: str, source: str = "") -> str:

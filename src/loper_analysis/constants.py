@@ -32,12 +32,10 @@ __all__ = [
     "SIDES",
     "SIDE_SUFFIX",
     "JOINTS",
-    "COORDINATES",
     "SEGMENTS",
     "PARAMETERS",
     "PARAMETER_UNITS",
     "UNIT_SUFFIX",
-    "EVENTS",
     "FLAGGED_EVENTS",
     "CONTACT_FLAGS",
     "PHASES",
@@ -45,7 +43,6 @@ __all__ = [
     "LAB_TO_MODEL_ROTATION_DEG",
     "GRAVITY_M_PER_S2",
     "MIN_IK_MARKERS",
-    "TRIAL_KINDS",
     "angle_column",
     "parameter_column",
 ]
@@ -56,8 +53,6 @@ SIDES: tuple[str, ...] = ("left", "right")
 SIDE_SUFFIX: dict[str, str] = {"left": "l", "right": "r"}
 #: Joints of the swing leg, in model order.
 JOINTS: tuple[str, ...] = ("hip", "knee", "ankle")
-#: Generalised coordinates of the swing-leg model (cart x in m, segment angles in rad).
-COORDINATES: tuple[str, ...] = ("pelvis_x", "thigh", "shank", "foot")
 #: Rigid segments of the swing leg, proximal to distal.
 SEGMENTS: tuple[str, ...] = ("thigh", "shank", "foot")
 #: Identified parameters, in the order of every parameter vector.
@@ -66,8 +61,6 @@ PARAMETERS: tuple[str, ...] = ("K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", 
 PARAMETER_UNITS: dict[str, str] = {p: ("N·m/rad" if p.startswith("K") else "N·m·s/rad") for p in PARAMETERS}
 #: Unit suffix of stiffness (K) and damping (D) in column names.
 UNIT_SUFFIX: dict[str, str] = {"K": "nm_per_rad", "D": "nms_per_rad"}
-#: Gait events, in the order they appear in event tables.
-EVENTS: tuple[str, ...] = ("heel_strike", "toe_off")
 #: Rows of an event table that bound a flagged foot contact (no gait event; strides must not span it).
 FLAGGED_EVENTS: tuple[str, ...] = ("flagged_start", "flagged_end")
 #: Verdicts on a force-plate contact (``docs/events.md``): ``ok`` gives events, every other one does not.
@@ -83,8 +76,6 @@ LAB_Z_UP: tuple[float, float, float] = (0.0, 0.0, 1.0)
 LAB_TO_MODEL_ROTATION_DEG: tuple[float, float, float] = (-90.0, 0.0, 0.0)
 #: Fewest weighted markers present in a frame for IK to solve it (three fix one rigid body).
 MIN_IK_MARKERS: int = 3
-#: Kinds of trial, as label maps and spans are keyed (besides the trial's own name).
-TRIAL_KINDS: tuple[str, ...] = ("static", "walking")
 
 
 #: A force plate is loaded above this vertical force over its resting level (N; config

@@ -57,7 +57,6 @@ __all__ = [
     "combine_plate_loads",
     "counted_contacts",
     "foot_loads",
-    "plate_numbers",
     "valid_intervals",
     "valid_mask",
 ]
@@ -82,12 +81,6 @@ def _grf_time(grf: pd.DataFrame) -> np.ndarray:
     if t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise LoperInputError(f"grf: {name} must hold at least 2 finite, strictly increasing times")
     return t
-
-
-def plate_numbers(grf: pd.DataFrame) -> list[int]:
-    """The plate numbers n of a ground-reaction table with all nine ``{n}_ground_*`` columns, ascending."""
-    numbers = sorted({int(c.split("_", 1)[0]) for c in grf.columns if c.split("_", 1)[0].isdigit()})
-    return [n for n in numbers if all(c in grf.columns for c in _plate_columns(n))]
 
 
 def _plate_columns(n: int) -> list[str]:

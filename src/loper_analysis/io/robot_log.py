@@ -112,7 +112,6 @@ _INT_COLUMNS = ("perturbation", "safety_state")
 _FLOAT_COLUMNS = tuple(c for c in COLUMNS if c not in _INT_COLUMNS)
 _FORCE_COLUMNS = ("force_desired_n", "force_measured_n")
 _MAY_BE_NAN = ("motor_angle_rad", "motor_velocity_rad_s", "sync_v")
-_RESERVED_KEYS = ("format", "sample_rate_hz")
 _KEY_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
 _TIME_FORMAT = "%.15g"
 _VALUE_FORMAT = "%.9g"

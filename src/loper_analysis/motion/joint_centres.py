@@ -67,7 +67,6 @@ __all__ = [
     "chord_centre",
     "davis_hip_centres",
     "harrington_hip_centres",
-    "horizontal",
     "static_joint_centres",
     "widths_from_processing",
 ]
@@ -182,13 +181,6 @@ def widths_from_processing(processing: Mapping[str, float]) -> dict[str, float]:
 def _unit(v: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         return v / np.linalg.norm(v, axis=-1, keepdims=True)
-
-
-def horizontal(v, up: Sequence[float] = (0.0, 1.0, 0.0)) -> np.ndarray:
-    """``v`` (..., 3) without its component along the vertical ``up``."""
-    u = np.asarray(up, float) / np.linalg.norm(up)
-    v = np.asarray(v, float)
-    return v - np.sum(v * u, axis=-1, keepdims=True) * u
 
 
 def _pelvis_frame(lasi, rasi, posterior):

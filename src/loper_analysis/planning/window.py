@@ -34,18 +34,7 @@ from loper_analysis.planning.inputs import pulse_force_n
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["PLAN_IDENTIFICATION_KEYS", "null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
-
-
-#: Keys of config ``identification`` the planner follows as they are (beside the window's, which
-#: the impedance stage's reader reads; the bounds become tuples).
-PLAN_IDENTIFICATION_KEYS: tuple[str, ...] = (
-    "initial_state_degree",
-    "n_substeps",
-    "null_pair_components",
-    "min_null_pairs",
-    "interval_scatter",
-)
+__all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
 
 
 @dataclass(frozen=True)

@@ -28,7 +28,6 @@ import numpy as np
 from numba import njit
 
 __all__ = [
-    "N_COORD",
     "N_PACKED",
     "CART_MASS",
     "ATTACHMENT",
@@ -41,7 +40,6 @@ __all__ = [
     "simulate_deviation_batch",
 ]
 
-N_COORD = 4
 #: Length of the packed parameter vector and the index of its scalar entries.
 N_PACKED = 18
 CART_MASS = 0
