@@ -12,11 +12,8 @@ from loper_analysis.motion.model import (
     build_lower_body_model,
     segment_parameters_from_model,
 )
-from loper_analysis.swing_leg.dynamics import (
-    segment_com_positions,
-    segment_coordinates,
-    segment_parameters_from_anthropometry,
-)
+from loper_analysis.swing_leg.dynamics import segment_coordinates, segment_parameters_from_anthropometry
+from tests.swing_leg.reference_dynamics import segment_com_positions
 
 
 @pytest.fixture(scope="module")

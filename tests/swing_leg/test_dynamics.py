@@ -10,7 +10,7 @@ Known answers used here:
 * virtual work of the joint torques;
 * the segment table: the frame round trip and its input checks;
 * the compiled RK4 of :mod:`loper_analysis.impedance.identification` against SciPy's
-  DOP853 in :func:`loper_analysis.swing_leg.dynamics.simulate`.
+  DOP853 in :func:`tests.swing_leg.reference_dynamics.simulate`.
 """
 
 from __future__ import annotations
@@ -23,22 +23,19 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification import prepare_window, simulate_response
 from loper_analysis.impedance.identification.validation import ValidationSettings, nominal_swing, perturbed_trial
 from loper_analysis.impedance.responses.response_window import ResponseWindow
-from loper_analysis.swing_leg.dynamics import (
-    SegmentParameters,
+from loper_analysis.swing_leg.dynamics import SegmentParameters, inverse_dynamics, joint_angles, segment_coordinates
+from tests.parameter_sets import ASYMMETRIC, WINTER
+from tests.swing_leg.reference_dynamics import (
     attachment_jacobian,
     attachment_position,
     coriolis_forces,
     forward_dynamics,
     generalized_joint_forces,
     gravity_forces,
-    inverse_dynamics,
-    joint_angles,
     mass_matrix,
     segment_com_positions,
-    segment_coordinates,
     simulate,
 )
-from tests.parameter_sets import ASYMMETRIC, WINTER
 
 PARAMETER_SETS = {"winter": WINTER, "asymmetric": ASYMMETRIC}
 

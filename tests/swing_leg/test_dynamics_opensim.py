@@ -26,8 +26,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from loper_analysis.swing_leg.dynamics import (
-    SegmentParameters,
+from loper_analysis.swing_leg.dynamics import SegmentParameters
+from tests.opensim_swing_leg import SEGMENT_NAMES, OpenSimLeg
+from tests.parameter_sets import ASYMMETRIC, WINTER
+from tests.swing_leg.reference_dynamics import (
     attachment_jacobian,
     attachment_position,
     forward_dynamics,
@@ -35,8 +37,6 @@ from loper_analysis.swing_leg.dynamics import (
     segment_com_positions,
     simulate,
 )
-from tests.opensim_swing_leg import SEGMENT_NAMES, OpenSimLeg
-from tests.parameter_sets import ASYMMETRIC, WINTER
 
 PARAMETER_SETS = {"winter_1.73m_64.9kg": WINTER, "asymmetric": ASYMMETRIC}
 

@@ -13,13 +13,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from loper_analysis.swing_leg import kernels
-from loper_analysis.swing_leg.dynamics import (
-    forward_dynamics,
-    generalized_joint_forces,
-    inverse_dynamics,
-    joint_angles,
-)
+from loper_analysis.swing_leg.dynamics import inverse_dynamics, joint_angles
 from tests.parameter_sets import ASYMMETRIC, WINTER
+from tests.swing_leg.reference_dynamics import forward_dynamics, generalized_joint_forces
 
 
 def test_segment_slots_and_scalars_fill_the_packed_vector_once_each():
