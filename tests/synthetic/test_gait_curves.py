@@ -4,15 +4,66 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.interpolate import CubicSpline
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.synthetic.gait_curves import (
-    CURVE_KEYPOINTS_DEG,
-    NominalGait,
-    fourier_from_keypoints,
-)
+from loper_analysis.synthetic.gait_curves import FourierSeries, NominalGait
 
 GAIT = NominalGait()
+
+#: Key points the default joint-angle curves were fitted to: (stride fraction, degrees); heel strike at 0, toe-off at
+#: 0.65 (read off the textbook curves' general shape, not digitised).
+CURVE_KEYPOINTS_DEG: dict[str, tuple[tuple[float, float], ...]] = {
+    "hip_flexion": (
+        (0.00, 25.0),
+        (0.10, 24.0),
+        (0.30, 10.0),
+        (0.50, -5.0),
+        (0.58, -10.0),
+        (0.65, -3.0),
+        (0.73, 15.0),
+        (0.83, 27.0),
+        (0.92, 26.5),
+    ),
+    "knee_flexion": (
+        (0.00, 5.0),
+        (0.06, 10.0),
+        (0.15, 15.0),
+        (0.26, 10.0),
+        (0.40, 5.0),
+        (0.48, 7.0),
+        (0.56, 16.0),
+        (0.65, 38.0),
+        (0.71, 55.0),
+        (0.76, 60.0),
+        (0.80, 57.0),
+        (0.86, 35.0),
+        (0.92, 14.0),
+        (0.97, 6.0),
+    ),
+    "ankle_dorsiflexion": (
+        (0.00, 0.0),
+        (0.07, -5.0),
+        (0.16, -1.0),
+        (0.30, 5.0),
+        (0.47, 10.0),
+        (0.55, 7.0),
+        (0.61, -3.0),
+        (0.68, -12.0),
+        (0.73, -6.0),
+        (0.79, 1.0),
+        (0.87, 3.0),
+        (0.94, 1.0),
+    ),
+}
+
+
+def fourier_from_keypoints(phase, values, n_harmonics: int = 8, n_samples: int = 1000) -> FourierSeries:
+    """The first ``n_harmonics`` harmonics of the periodic cubic spline through the key points (``phase`` in [0, 1)
+    from 0, strictly increasing; the curve closes at 1 with its value at 0)."""
+    spline = CubicSpline(np.append(phase, 1.0), np.append(values, values[0]), bc_type="periodic")
+    F = np.fft.rfft(spline(np.arange(n_samples) / n_samples)) / n_samples
+    return FourierSeries(F[0].real, 2.0 * F[1 : n_harmonics + 1].real, -2.0 * F[1 : n_harmonics + 1].imag)
 
 
 def test_default_coefficients_are_the_fit_of_the_documented_keypoints():

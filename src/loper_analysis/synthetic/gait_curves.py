@@ -8,12 +8,11 @@ The curves are **not a data set**: they are smooth approximations shaped
 after the textbook normal-gait curves (D. A. Winter, *Biomechanics and Motor
 Control of Human Movement*, 4th ed., 2009, ch. 4 and appendix; J. Perry and
 J. M. Burnfield, *Gait Analysis*, 2nd ed., 2010) with amplitudes somewhat
-reduced for slow walking. A handful of key points per joint
-(:data:`CURVE_KEYPOINTS_DEG`, read off the general shape, not digitised) is
-interpolated by a periodic cubic spline and truncated to
-:data:`N_HARMONICS` harmonics (:func:`fourier_from_keypoints`); the
-resulting coefficients are the defaults of :class:`NominalGait` (in rad) and
-reproduce the key points within 0.4 degrees:
+reduced for slow walking. A handful of key points per joint (read off the
+general shape, not digitised) is interpolated by a periodic cubic spline and
+truncated to 8 harmonics; the resulting coefficients are the defaults of
+:class:`NominalGait` (in rad) and reproduce the key points within 0.4 degrees
+(``tests/synthetic/test_gait_curves.py`` holds the key points and checks both):
 
 * hip flexion: +25 deg at heel strike, -10 deg in late stance (58 %),
   +27.6 deg peak in late swing (86 %), range 37.6 deg;
@@ -51,72 +50,22 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline, CubicSpline
+from scipy.interpolate import CubicHermiteSpline
 
 from loper_analysis.errors import LoperInputError
 
 __all__ = [
-    "CURVE_KEYPOINTS_DEG",
     "CURVE_STANCE_FRACTION",
     "CURVE_JOINTS",
-    "N_HARMONICS",
     "HIP_FLEXION_RAD",
     "KNEE_FLEXION_RAD",
     "ANKLE_DORSIFLEXION_RAD",
     "FourierSeries",
     "NominalGait",
-    "fourier_from_keypoints",
 ]
 
 #: Toe-off of the key-point curves, fraction of the stride (slow walking).
 CURVE_STANCE_FRACTION: float = 0.65
-#: Harmonics kept in the joint-angle Fourier series.
-N_HARMONICS: int = 8
-#: Key points of the joint-angle curves: (stride fraction, degrees); heel strike at 0, toe-off at 0.65.
-CURVE_KEYPOINTS_DEG: dict[str, tuple[tuple[float, float], ...]] = {
-    "hip_flexion": (
-        (0.00, 25.0),
-        (0.10, 24.0),
-        (0.30, 10.0),
-        (0.50, -5.0),
-        (0.58, -10.0),
-        (0.65, -3.0),
-        (0.73, 15.0),
-        (0.83, 27.0),
-        (0.92, 26.5),
-    ),
-    "knee_flexion": (
-        (0.00, 5.0),
-        (0.06, 10.0),
-        (0.15, 15.0),
-        (0.26, 10.0),
-        (0.40, 5.0),
-        (0.48, 7.0),
-        (0.56, 16.0),
-        (0.65, 38.0),
-        (0.71, 55.0),
-        (0.76, 60.0),
-        (0.80, 57.0),
-        (0.86, 35.0),
-        (0.92, 14.0),
-        (0.97, 6.0),
-    ),
-    "ankle_dorsiflexion": (
-        (0.00, 0.0),
-        (0.07, -5.0),
-        (0.16, -1.0),
-        (0.30, 5.0),
-        (0.47, 10.0),
-        (0.55, 7.0),
-        (0.61, -3.0),
-        (0.68, -12.0),
-        (0.73, -6.0),
-        (0.79, 1.0),
-        (0.87, 3.0),
-        (0.94, 1.0),
-    ),
-}
-#: Columns of the events frame.
 #: Joint coordinates of the curves (the generic model's names without the side suffix).
 CURVE_JOINTS: tuple[str, ...] = ("hip_flexion", "knee_flexion", "ankle_dorsiflexion")
 
@@ -169,53 +118,7 @@ def _second_harmonic(mean: float, amplitude: float, peak_phase: float) -> Fourie
     return FourierSeries(mean, (0.0, amplitude * np.cos(w)), (0.0, amplitude * np.sin(w)))
 
 
-def fourier_from_keypoints(phase, values, n_harmonics: int = N_HARMONICS, n_samples: int = 1000) -> FourierSeries:
-    """Fourier series of the periodic cubic spline through key points.
-
-    Parameters
-    ----------
-    phase : array_like, shape (k,)
-        Stride fractions in [0, 1), strictly increasing; the curve closes at 1
-        with the value at ``phase[0]`` (which must be 0).
-    values : array_like, shape (k,)
-        Curve values at the key points (any unit; the series has the same).
-    n_harmonics : int
-        Harmonics kept (>= 1, < n_samples / 2).
-    n_samples : int
-        Samples of the spline per stride for the discrete Fourier transform.
-
-    Returns
-    -------
-    FourierSeries
-
-    Raises
-    ------
-    LoperInputError
-        Fewer than 3 key points, phases not strictly increasing in [0, 1) or
-        not starting at 0, non-finite values, bad ``n_harmonics``.
-    """
-    p = np.asarray(phase, float)
-    v = np.asarray(values, float)
-    if p.ndim != 1 or p.shape != v.shape or p.size < 3:
-        raise LoperInputError(f"phase and values must be 1-D of equal length >= 3, got {p.shape} and {v.shape}")
-    if not (np.all(np.isfinite(p)) and np.all(np.isfinite(v))):
-        raise LoperInputError("phase and values must be finite")
-    if p[0] != 0.0 or p[-1] >= 1.0 or np.any(np.diff(p) <= 0):
-        raise LoperInputError(f"phase must start at 0 and increase strictly below 1, got {p.tolist()}")
-    if not 1 <= n_harmonics < n_samples // 2:
-        raise LoperInputError(f"n_harmonics must lie in 1 .. {n_samples // 2 - 1}, got {n_harmonics}")
-    spline = CubicSpline(np.append(p, 1.0), np.append(v, v[0]), bc_type="periodic")
-    y = spline(np.arange(n_samples) / n_samples)
-    F = np.fft.rfft(y) / n_samples
-    return FourierSeries(
-        float(F[0].real),
-        tuple(float(c) for c in 2.0 * F[1 : n_harmonics + 1].real),
-        tuple(float(s) for s in -2.0 * F[1 : n_harmonics + 1].imag),
-    )
-
-
-# Generated by fourier_from_keypoints(phase, radians(degrees)) from CURVE_KEYPOINTS_DEG
-# (the tests check that they still agree).
+# The Fourier series of the key points in radians (the tests check that they still agree).
 HIP_FLEXION_RAD = FourierSeries(
     0.219964,
     (0.294783, -0.056611, -0.028353, 0.010437, -0.004039, 0.000187, -0.000035, 0.000464),
