@@ -115,7 +115,6 @@ def lab_export_session(
 
     from loper_analysis.io.osim import quiet_opensim, read_model
     from loper_analysis.io.readers import read_tsv
-    from loper_analysis.io.robot_log_mat import write_robot_log_mat
     from loper_analysis.motion.segments import segments_from_model
     from loper_analysis.synthetic.lab_export import (
         ROBOT_LOG_MAT_VARIABLES,
@@ -124,6 +123,7 @@ def lab_export_session(
         qtm_walking_export,
     )
     from loper_analysis.synthetic.trials import simulate_walking_trial
+    from tests.io.robot_log_mat_files import write_robot_log_mat
 
     def seeded(*names: str) -> np.random.SeedSequence:
         return np.random.SeedSequence([int(settings.seed), *(zlib.crc32(n.encode()) for n in (subject, *names))])

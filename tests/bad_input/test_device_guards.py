@@ -364,8 +364,8 @@ def test_one_missing_flag_is_a_warning(trial, tmp_path, caplog):
 def test_mat_export_without_its_flag_variable_is_refused(trial, tmp_path):
     """A MATLAB export whose column map leaves the flag out (zeros): converted by rule device_log_from_mat's
     step, then refused by the load-cell step."""
-    from loper_analysis.io.robot_log_mat import write_robot_log_mat
     from loper_analysis.stages.device.step import log_from_mat
+    from tests.io.robot_log_mat_files import write_robot_log_mat
 
     names = yaml.safe_load((ROOT / "config/config.yaml").read_text())["device"]["mat_column_map"]
     column_map = {**names, "perturbation": None}  # the lab's map, the flag left out

@@ -199,7 +199,7 @@ MAT_NAMES = {
 
 
 def test_mat_writer_round_trip_and_fixed_bytes(tmp_path):
-    from loper_analysis.io.robot_log_mat import MAT_HEADER_TEXT, write_robot_log_mat
+    from tests.io.robot_log_mat_files import MAT_HEADER_TEXT, write_robot_log_mat
 
     frame = make_frame()
     mat = write_robot_log_mat(tmp_path / "rec.loper.mat", frame, FS, MAT_NAMES, time_scale=0.001)
@@ -226,7 +226,7 @@ def test_mat_writer_round_trip_and_fixed_bytes(tmp_path):
     ],
 )
 def test_mat_writer_refuses_bad_names_and_leaves_nothing(tmp_path, names, match):
-    from loper_analysis.io.robot_log_mat import write_robot_log_mat
+    from tests.io.robot_log_mat_files import write_robot_log_mat
 
     with pytest.raises(LoperInputError, match=match):
         write_robot_log_mat(tmp_path / "rec.mat", make_frame(), FS, names)

@@ -1,9 +1,7 @@
-"""Robot logs exported from MATLAB (.mat), read into the ``loper-log 1`` frame of :mod:`loper_analysis.io.robot_log`,
-and written as such an export (:func:`write_robot_log_mat`)."""
+"""Robot logs exported from MATLAB (.mat), read into the ``loper-log 1`` frame of :mod:`loper_analysis.io.robot_log`."""
 
 from __future__ import annotations
 
-import io
 import math
 import os
 from collections.abc import Mapping
@@ -14,14 +12,10 @@ import pandas as pd
 
 from loper_analysis.checks import positive
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.atomic import write_bytes
 from loper_analysis.io.robot_log import COLUMNS, FORMAT_NAME, validated_log
 from loper_analysis.io.timing import timed_io
 
-__all__ = ["MAT_HEADER_TEXT", "MAT_OPTIONAL", "read_robot_log_mat", "write_robot_log_mat"]
-
-#: Descriptive text of the .mat header (116 bytes, blank-padded); fixed, so the same log gives the same bytes.
-MAT_HEADER_TEXT = "MATLAB 5.0 MAT-file, robot log written by loper-analysis"
+__all__ = ["MAT_OPTIONAL", "read_robot_log_mat"]
 
 #: Columns a .mat export may leave out (mapped to None): they are then zeros.
 MAT_OPTIONAL: tuple[str, ...] = ("sync_v", "perturbation", "safety_state")
@@ -136,69 +130,3 @@ def read_robot_log_mat(
         vectors.setdefault(col, np.zeros(n))
     frame = validated_log(pd.DataFrame({c: vectors[c] for c in COLUMNS}), rate, source)
     return frame, {"format": FORMAT_NAME, "sample_rate_hz": rate, "source": source}
-
-
-def write_robot_log_mat(
-    path: str | os.PathLike,
-    frame: pd.DataFrame,
-    sample_rate_hz: float,
-    variable_names: Mapping[str, str] | None = None,
-    time_scale: float = 1.0,
-) -> Path:
-    """Write a robot log as a MATLAB export (.mat, version 5), atomically; returns ``path``.
-
-    Every column becomes one double column vector (n, 1), named by
-    ``variable_names`` (our column -> variable; default: the column names);
-    ``time_s`` is written divided by ``time_scale`` (0.001: milliseconds). The
-    file reads back with :func:`read_robot_log_mat` given the same names as
-    ``column_map`` and the same ``time_scale``. The header text is fixed
-    (:data:`MAT_HEADER_TEXT`, no creation date): the same log gives the same bytes.
-
-    Parameters
-    ----------
-    path : str or path-like
-        Target ``.mat`` file.
-    frame : pandas.DataFrame
-        Shape (n, 8): the columns :data:`~loper_analysis.io.robot_log.COLUMNS`,
-        passing every check of the log format.
-    sample_rate_hz : float
-        Sample rate (Hz) the time steps must match.
-    variable_names : mapping of str to str, optional
-        A MATLAB name (letter first, then letters, digits, ``_``; at most 63
-        characters) for every column, all different.
-    time_scale : float
-        Seconds per unit of the written time variable.
-
-    Raises
-    ------
-    LoperInputError
-        A log that fails the format's checks, a bad or incomplete name map, a
-        non-positive ``time_scale``, or a failed write; nothing is left behind.
-    """
-    import re
-
-    from scipy.io import savemat
-
-    source = str(path)
-    log = validated_log(frame, sample_rate_hz, source)
-    names = {c: c for c in COLUMNS} if variable_names is None else dict(variable_names)
-    missing = [c for c in COLUMNS if c not in names]
-    unknown = [str(c) for c in names if c not in COLUMNS]
-    if missing or unknown:
-        raise LoperInputError(
-            f"{source}: variable_names must name exactly the columns {', '.join(COLUMNS)} "
-            f"(missing: {', '.join(missing) or 'none'}; unknown: {', '.join(unknown) or 'none'})"
-        )
-    for col, var in names.items():
-        if not isinstance(var, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]{0,62}", var):
-            raise LoperInputError(f"{source}: variable name {var!r} of column '{col}' is not a MATLAB name")
-    if len(set(names.values())) != len(names):
-        raise LoperInputError(f"{source}: variable_names must be all different, got {sorted(names.values())}")
-    scale = positive("time_scale", time_scale, source)
-    variables = {names[c]: log[c].to_numpy(dtype=np.float64)[:, np.newaxis] for c in COLUMNS}
-    variables[names["time_s"]] = variables[names["time_s"]] / scale
-    buffer = io.BytesIO()
-    savemat(buffer, variables, format="5", oned_as="column")
-    data = bytearray(buffer.getvalue())
-    data[:116] = MAT_HEADER_TEXT.encode("ascii").ljust(116, b" ")
-    return write_bytes(path, bytes(data), "robot log (.mat)")
