@@ -11,8 +11,8 @@ from loper_analysis.io.atomic import PathLike
 from loper_analysis.io.c3d_writer import write_recording
 from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
-from loper_analysis.synthetic.lab_export import QTMExportSettings
 from loper_analysis.synthetic.lab_session import SyntheticLabSettings
+from tests.qtm_export import QTMExportSettings
 
 log = logging.getLogger(__name__)
 
@@ -84,12 +84,12 @@ def lab_export_session(
     Writes ``{static}.c3d`` (the static trial of ``settings.design``) and per
     trial of ``trials`` ``{trial}.c3d``, plus ``{trial}.mat`` for every trial
     but the design's ``no_device``
-    (:func:`loper_analysis.synthetic.lab_export.qtm_walking_export`, variables
-    :data:`~loper_analysis.synthetic.lab_export.ROBOT_LOG_MAT_VARIABLES`, time
+    (:func:`tests.qtm_export.qtm_walking_export`, variables
+    :data:`~tests.qtm_export.ROBOT_LOG_MAT_VARIABLES`, time
     in s). The markers are those of ``files.label_map_tsv`` (columns ``label``,
     ``marker``) on the model ``files.model_osim`` with the marker set
     ``files.marker_set_xml``, plus the two brace markers ``LBRA_P`` and ``LBRA_D``
-    on the left thigh (:func:`loper_analysis.synthetic.lab_export.add_brace_markers`,
+    on the left thigh (:func:`tests.qtm_export.add_brace_markers`,
     centred at ``settings.brace_fraction`` of the thigh length; their labels are their
     names unless the map lists them); the kinematics are simulated for a
     subject of ``height_m`` and ``mass_kg``, and the perturbation responses
@@ -116,14 +116,9 @@ def lab_export_session(
     from loper_analysis.io.osim import quiet_opensim, read_model
     from loper_analysis.io.readers import read_tsv
     from loper_analysis.motion.segments import segments_from_model
-    from loper_analysis.synthetic.lab_export import (
-        ROBOT_LOG_MAT_VARIABLES,
-        add_brace_markers,
-        qtm_static_export,
-        qtm_walking_export,
-    )
     from loper_analysis.synthetic.trials import simulate_walking_trial
     from tests.io.robot_log_mat_files import write_robot_log_mat
+    from tests.qtm_export import ROBOT_LOG_MAT_VARIABLES, add_brace_markers, qtm_static_export, qtm_walking_export
 
     def seeded(*names: str) -> np.random.SeedSequence:
         return np.random.SeedSequence([int(settings.seed), *(zlib.crc32(n.encode()) for n in (subject, *names))])
