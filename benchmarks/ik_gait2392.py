@@ -10,12 +10,13 @@ own markers), the last two with their coordinates mapped from ours
 (:data:`loper_analysis.synthetic.lab_export.GAIT2392_COORDINATES`; Rajagopal2016's arms at their defaults).
 Markers get 0.5 mm noise. Each model is solved, on one core, by:
 
-* ``opensim 1e-6``: OpenSim's ``InverseKinematicsSolver`` at the pipeline's accuracy, every coordinate
-  solved: the reference (``ik.ik_solver: opensim``);
+* ``opensim 1e-6``: OpenSim's ``InverseKinematicsSolver`` at the pipeline's accuracy (``ik.opensim_accuracy``),
+  every coordinate solved: the reference (``ik.ik_solver: opensim``);
 * ``opensim 1e-5``: the same at OpenSim's default accuracy;
 * ``opensim held``: the same at 1e-6 with the coordinates no marker determines (gait2392's mtp angles)
   held at their defaults instead of solved;
-* ``tree 1e-6``: Gauss-Newton on the model's kinematic tree (``ik.ik_solver: tree``, the default).
+* ``tree 1e-6``: Gauss-Newton on the model's kinematic tree (``ik.ik_solver: tree``, the default) at the
+  pipeline's step tolerance (``ik.tree_step_tolerance``, rad or m).
 
 ``--variants`` names the rows to solve besides the reference, which is always solved.
 
@@ -99,10 +100,10 @@ def _rows(name: str, model, coordinates, rng, wanted=VARIANTS) -> list[tuple]:
     X = marker_positions(model, values, labels) + rng.normal(0.0, 0.5e-3, (len(coordinates), len(labels), 3))
     t = coordinates["time_s"].to_numpy(float)
     variants = {
-        "opensim 1e-6": {"solver": "opensim", "accuracy": 1e-6},
-        "opensim 1e-5": {"solver": "opensim", "accuracy": 1e-5},
-        "opensim held": {"solver": "opensim", "accuracy": 1e-6, "coordinate_tasks": _held(model, X, labels)},
-        "tree 1e-6": {"solver": "tree", "accuracy": 1e-6},
+        "opensim 1e-6": {"solver": "opensim", "opensim_accuracy": 1e-6},
+        "opensim 1e-5": {"solver": "opensim", "opensim_accuracy": 1e-5},
+        "opensim held": {"solver": "opensim", "opensim_accuracy": 1e-6, "coordinate_tasks": _held(model, X, labels)},
+        "tree 1e-6": {"solver": "tree", "tree_step_tolerance": 1e-6},
     }
     if not variants["opensim held"]["coordinate_tasks"]:
         del variants["opensim held"]

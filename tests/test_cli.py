@@ -105,7 +105,9 @@ def test_ik_command_matches_opensims_tool(tmp_path, capsys, solver, atol):
             "0.1",
             "--end",
             "0.4",
-            "--accuracy",
+            "--tree-step-tolerance",
+            "1e-8",
+            "--opensim-accuracy",
             "1e-8",
             "--solver",
             solver,
@@ -117,6 +119,19 @@ def test_ik_command_matches_opensims_tool(tmp_path, capsys, solver, atol):
     np.testing.assert_allclose(ours.time_s, ref.time_s, atol=1e-9)
     for c in ref.columns[1:]:
         np.testing.assert_allclose(ours[c], ref[c], atol=atol, err_msg=c)
+
+
+def test_ik_command_refuses_the_former_accuracy_naming_its_two_options(tmp_path, capsys):
+    """``--accuracy`` set the tree solver's step tolerance and OpenSim's accuracy at once: refused, naming the two
+    options that replace it, before anything is read."""
+    out = tmp_path / "out.mot"
+    with pytest.raises(SystemExit) as stop:
+        main(["ik", "--model", "m.osim", "--markers", "t.trc", "--out", str(out), "--accuracy", "1e-6"])
+    assert stop.value.code == 2 and not out.exists()
+    err = capsys.readouterr().err
+    assert "--accuracy is no longer an option" in err
+    assert "--tree-step-tolerance" in err and "ik.tree_step_tolerance" in err
+    assert "--opensim-accuracy" in err and "ik.opensim_accuracy" in err
 
 
 def test_ik_command_names_a_missing_marker(tmp_path, capsys):

@@ -69,10 +69,10 @@ def test_ik_settings_of_the_shipped_config_are_the_defaults():
 
 def test_a_changed_config_key_changes_the_settings():
     config = yaml.safe_load(CONFIG.read_text())
-    config["ik"]["accuracy"] = 1e-8
+    config["ik"]["tree_step_tolerance"] = 1e-8
     config["grf"]["loaded_threshold_n"] = 35.0
     config["model"]["static_duration_s"] = None
-    assert stage_settings(config, "ik").accuracy == 1e-8
+    assert stage_settings(config, "ik").tree_step_tolerance == 1e-8
     assert stage_settings(config, "grf").threshold_n == 35.0
     assert stage_settings(config, "model").static_duration_s is None
 

@@ -14,14 +14,19 @@ former key                                its place now
 ``scale_factor_range``
 every other ``opensim.*``                 ``ik.*``
 ``identification.*``                      ``impedance.*``
+``ik.accuracy``, ``opensim.accuracy``     ``ik.tree_step_tolerance`` and
+                                          ``ik.opensim_accuracy``, both
 ========================================  =====================================
+
+The former ``accuracy`` was both the tree solver's step tolerance and OpenSim's solver's accuracy; its value goes
+to both keys, so a former file is read with the meaning it had.
 """
 
 from __future__ import annotations
 
 from collections.abc import MutableMapping
 
-__all__ = ["MODEL_KEYS", "MOVED_SECTIONS", "SUBSECTIONS", "new_place", "translated"]
+__all__ = ["MODEL_KEYS", "MOVED_SECTIONS", "SPLIT_KEYS", "SUBSECTIONS", "new_place", "new_places", "translated"]
 
 #: Sections inside a stage's section (dotted): a stage's part with keys of its own.
 SUBSECTIONS: tuple[str, ...] = ("markers.filter",)
@@ -37,6 +42,9 @@ MODEL_KEYS: tuple[str, ...] = (
 )
 #: Keys of the former ``markers`` section that are the model stage's.
 _MARKERS_TO_MODEL = ("static_duration_s", "static_max_motion_rms_m")
+#: Former keys of two meanings (dotted, at their place after the sections' moves) -> the keys, one per meaning,
+#: that each take the former value.
+SPLIT_KEYS: dict[str, tuple[str, ...]] = {"ik.accuracy": ("ik.tree_step_tolerance", "ik.opensim_accuracy")}
 
 
 def new_place(section: str, key: str) -> str:
@@ -46,6 +54,19 @@ def new_place(section: str, key: str) -> str:
     if section == "markers" and key in _MARKERS_TO_MODEL:
         return f"model.{key}"
     return f"{MOVED_SECTIONS[section]}.{key}"
+
+
+def new_places(section: str, key: str) -> tuple[str, ...]:
+    """The places now (dotted) of key ``key`` of the former section ``section``: one, or a split key's several."""
+    place = new_place(section, key)
+    return SPLIT_KEYS.get(place, (place,))
+
+
+def _move(config: MutableMapping, old: str, places: tuple[str, ...], value) -> str:
+    """Put ``value`` at each of ``places``; the move as said, ``"old -> new"`` (``"old -> a and b"``)."""
+    for place in places:
+        _put(config, place, value)
+    return f"{old} -> {' and '.join(places)}"
 
 
 def _put(config: MutableMapping, path: str, value) -> None:
@@ -60,7 +81,8 @@ def _put(config: MutableMapping, path: str, value) -> None:
 
 def translated(config: MutableMapping) -> list[str]:
     """Move every key of the former layout in ``config`` to its place now, in place (a moved key wins over the
-    value at its new place: it was set later or by the user); the moves made, ``"old -> new"``, in order."""
+    value at its new place: it was set later or by the user), a split key's value to each of its keys
+    (:data:`SPLIT_KEYS`); the moves made, ``"old -> new"`` (``"old -> a and b"``), in order."""
     moves = []
     for section in (*MOVED_SECTIONS, "opensim"):
         values = config.get(section)
@@ -68,12 +90,15 @@ def translated(config: MutableMapping) -> list[str]:
             continue
         del config[section]
         for key, value in values.items():
-            _put(config, new_place(section, key), value)
-            moves.append(f"{section}.{key} -> {new_place(section, key)}")
+            moves.append(_move(config, f"{section}.{key}", new_places(section, key), value))
     markers = config.get("markers")
     if isinstance(markers, MutableMapping):
         for key in _MARKERS_TO_MODEL:
             if key in markers:
-                _put(config, new_place("markers", key), markers.pop(key))
-                moves.append(f"markers.{key} -> {new_place('markers', key)}")
+                moves.append(_move(config, f"markers.{key}", (new_place("markers", key),), markers.pop(key)))
+    for old, places in SPLIT_KEYS.items():
+        section, _, key = old.partition(".")
+        values = config.get(section)
+        if isinstance(values, MutableMapping) and key in values:
+            moves.append(_move(config, old, places, values.pop(key)))
     return moves

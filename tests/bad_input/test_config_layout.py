@@ -1,7 +1,7 @@
 """A config in the former layout (sections ``trials``, ``filter``, ``opensim``, ``identification``; the static
-trial's keys under ``markers``) is read once through the translation, which says on the console where each of its
-keys stands now; a key in the wrong section is refused in one line naming the key and where it belongs; nothing
-is written either way."""
+trial's keys under ``markers``; ``ik.accuracy``, now two keys) is read once through the translation, which says on
+the console where each of its keys stands now; a key in the wrong section is refused in one line naming the key and
+where it belongs; nothing is written either way."""
 
 from __future__ import annotations
 
@@ -25,7 +25,8 @@ OLD_LAYOUT = (
 )
 MOVES = (
     "trials.perturbation_repeats -> study.perturbation_repeats; filter.cutoff_hz -> markers.filter.cutoff_hz; "
-    "identification.n_starts -> impedance.n_starts; opensim.accuracy -> ik.accuracy; "
+    "identification.n_starts -> impedance.n_starts; "
+    "opensim.accuracy -> ik.tree_step_tolerance and ik.opensim_accuracy; "
     "opensim.brace_attachment_fraction -> model.brace_attachment_fraction; "
     "markers.static_duration_s -> model.static_duration_s"
 )
@@ -37,9 +38,33 @@ def test_the_former_layout_is_read_at_the_new_places_and_said(tmp_path, capsys):
     config, _ = load_config(["config/config.yaml", old])
     assert f"config: {old} is in the former layout, read as: {MOVES}" in capsys.readouterr().err
     assert config["study"]["perturbation_repeats"] == 1 and config["markers"]["filter"]["cutoff_hz"] == 12.0
-    assert config["ik"]["accuracy"] == 1e-5 and config["model"]["brace_attachment_fraction"] == 0.7
+    assert config["ik"]["tree_step_tolerance"] == config["ik"]["opensim_accuracy"] == 1e-5
+    assert "accuracy" not in config["ik"] and config["model"]["brace_attachment_fraction"] == 0.7
     assert config["model"]["static_duration_s"] == 0.5 and config["impedance"]["n_starts"] == 3
     assert not {"trials", "filter", "opensim", "identification"} & set(config)
+
+
+def test_the_former_ik_accuracy_is_read_at_both_its_keys_and_said(tmp_path, capsys):
+    """``ik.accuracy`` was both the tree solver's step tolerance and OpenSim's solver's accuracy: its value goes
+    to both keys (over the shipped config's), so the file is read with the meaning it had."""
+    old = tmp_path / "old.yaml"
+    old.write_text("ik: {accuracy: 1.0e-5, ik_solver: opensim}\n")
+    config, _ = load_config(["config/config.yaml", old])
+    said = "ik.accuracy -> ik.tree_step_tolerance and ik.opensim_accuracy"
+    assert f"config: {old} is in the former layout, read as: {said}\n" in capsys.readouterr().err
+    assert config["ik"]["tree_step_tolerance"] == config["ik"]["opensim_accuracy"] == 1e-5
+    assert "accuracy" not in config["ik"] and config["ik"]["ik_solver"] == "opensim"
+
+
+def test_a_split_key_goes_to_each_of_its_keys_over_their_values():
+    """The translation itself: a former ``ik.accuracy`` (or ``opensim.accuracy``) wins over both new keys."""
+    config = {"ik": {"accuracy": 1e-5, "tree_step_tolerance": 1e-8, "opensim_accuracy": 1e-7}}
+    assert translated(config) == ["ik.accuracy -> ik.tree_step_tolerance and ik.opensim_accuracy"]
+    assert config == {"ik": {"tree_step_tolerance": 1e-5, "opensim_accuracy": 1e-5}}
+    config = {"opensim": {"accuracy": 1e-4}}
+    assert translated(config) == ["opensim.accuracy -> ik.tree_step_tolerance and ik.opensim_accuracy"]
+    assert config == {"ik": {"tree_step_tolerance": 1e-4, "opensim_accuracy": 1e-4}}
+    assert translated(config) == []  # the layout now: nothing to move
 
 
 def test_the_shipped_config_translated_from_its_former_layout_is_itself():
@@ -50,6 +75,8 @@ def test_the_shipped_config_translated_from_its_former_layout_is_itself():
     former["markers"].update({k: c["model"][k] for k in ("static_duration_s", "static_max_motion_rms_m")})
     former["trials"], former["identification"], former["filter"] = c["study"], c["impedance"], c["markers"]["filter"]
     former["opensim"] = {**{k: v for k, v in c["model"].items() if not k.startswith("static_")}, **c["ik"]}
+    assert former["opensim"].pop("tree_step_tolerance") == former["opensim"].pop("opensim_accuracy")
+    former["opensim"]["accuracy"] = c["ik"]["opensim_accuracy"]  # one key for both then
     moves = translated(former)
     assert len(moves) == 6 + 2 + 20 + 2 + 18 and former == c
 

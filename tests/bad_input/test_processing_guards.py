@@ -201,7 +201,7 @@ def test_thirty_markers_leave_only_the_left_foot_undetermined(trial, tmp_path):
 
 
 def test_full_marker_set_output_is_unchanged(trial, tmp_path):
-    res = ik_file(trial["model"], trial["trc"], tmp_path / "all.mot", IKSettings(accuracy=1e-8))
+    res = ik_file(trial["model"], trial["trc"], tmp_path / "all.mot", IKSettings(tree_step_tolerance=1e-8))
     assert res.undetermined == {} and np.isfinite(res.coordinates).all()
     np.testing.assert_allclose(res.frame()["knee_flexion_l"], trial["truth"]["knee_flexion_l"], atol=1e-4)
 

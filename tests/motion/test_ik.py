@@ -39,9 +39,9 @@ def model(model_path):
     return read_model(model_path)
 
 
-#: The solver's accuracy at which IK is held to recover known angles and join chunks bit-close (the pipeline
-#: solves at ``IK_ACCURACY``, 1e-6).
-TIGHT_ACCURACY = 1e-8
+#: The tree solver's step tolerance (rad or m) at which IK is held to recover known angles and join chunks
+#: bit-close (the pipeline solves at ``TREE_STEP_TOLERANCE``, 1e-6).
+TIGHT_STEP_TOLERANCE = 1e-8
 
 
 def _truth(n=256):
@@ -81,7 +81,7 @@ def test_marker_positions_hold_length_one_trajectories_and_select_markers(model,
 
 def test_ik_recovers_known_angles(model, synthetic):
     t, truth, X = synthetic
-    res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=TIGHT_ACCURACY)
+    res = inverse_kinematics(model, t, X, list(MARKERS), tree_step_tolerance=TIGHT_STEP_TOLERANCE)
     for i, name in enumerate(res.coordinate_names):
         err = np.abs(res.coordinates[:, i] - truth[name]).max()
         assert err < np.deg2rad(0.1) / 10, (name, err)  # well inside the 0.1 deg requirement
@@ -170,7 +170,15 @@ def test_matches_opensims_inverse_kinematics_tool(model_path, model, synthetic, 
     ours_w, ours_c = read_ik_tasks(tasks_xml)
     assert ours_w == weights and ours_c == {"ankle_dorsiflexion_r": (10.0, 0.05)}
     res = inverse_kinematics(
-        model, t, Xn, list(MARKERS), marker_weights=ours_w, coordinate_tasks=ours_c, accuracy=1e-8, solver=solver
+        model,
+        t,
+        Xn,
+        list(MARKERS),
+        marker_weights=ours_w,
+        coordinate_tasks=ours_c,
+        tree_step_tolerance=1e-8,
+        opensim_accuracy=1e-8,
+        solver=solver,
     )
     assert res.solver == solver
     labels = list(ref.getColumnLabels())
@@ -209,11 +217,13 @@ def test_tsv_tasks_and_bad_input(model, synthetic, tmp_path):
 
 def test_chunks_join_seamlessly(model, synthetic):
     t, _, X = synthetic
-    whole = inverse_kinematics(model, t, X, list(MARKERS), accuracy=TIGHT_ACCURACY).frame()
+    whole = inverse_kinematics(model, t, X, list(MARKERS), tree_step_tolerance=TIGHT_STEP_TOLERANCE).frame()
     parts = []
     for c in range(3):
         sel = chunk_frames(len(t), 3, c)
-        parts.append(inverse_kinematics(model, t[sel], X[sel], list(MARKERS), accuracy=TIGHT_ACCURACY).frame())
+        parts.append(
+            inverse_kinematics(model, t[sel], X[sel], list(MARKERS), tree_step_tolerance=TIGHT_STEP_TOLERANCE).frame()
+        )
     assert [len(p) for p in parts] == [85, 86, 85]
     joined = join_chunks(parts)
     np.testing.assert_array_equal(joined.time_s, whole.time_s)
@@ -252,12 +262,12 @@ def test_joint_angle_table_maps_names_and_signs():
 def test_nan_marker_is_left_out_of_its_frames_known_angles(model, synthetic):
     """OpenSim 4.6's MarkersReference drops a NaN marker in its frames: exact markers of known angles with
     LKNE and RHEE missing in some frames give the known angles (measured within 1.1e-8 rad, markers within
-    7.6e-10 m, at accuracy 1e-10; 8.5e-7 rad at the default 1e-8)."""
+    7.6e-10 m, at a tolerance of 1e-10; 8.5e-7 rad at 1e-8)."""
     t, truth, X = synthetic
     X = X.copy()
     X[40:120, list(MARKERS).index("LKNE")] = np.nan
     X[::3, list(MARKERS).index("RHEE")] = np.nan
-    res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=1e-10)
+    res = inverse_kinematics(model, t, X, list(MARKERS), tree_step_tolerance=1e-10)
     for i, name in enumerate(res.coordinate_names):
         err = np.abs(res.coordinates[:, i] - truth[name]).max()
         assert err < 1e-6, (name, err)
@@ -300,7 +310,7 @@ def test_frames_outside_the_capture_volume_are_left_out(model, synthetic):
     X = X.copy()
     X[:10] = np.nan
     X[50:53, [list(MARKERS).index(m) for m in ("RPSI", "LPSI")]] = np.nan  # pelvis placed by the thighs alone
-    res = inverse_kinematics(model, t, X, list(MARKERS), accuracy=1e-10)
+    res = inverse_kinematics(model, t, X, list(MARKERS), tree_step_tolerance=1e-10)
     expected = np.ones(t.size, bool)
     expected[:10] = expected[50:53] = False
     np.testing.assert_array_equal(res.solved, expected)

@@ -1,6 +1,6 @@
 """The IK stage's settings (motion.ik_settings): every ``opensim`` key the IK reads to its field, the defaults
-the shipped config's, a missing key named; the model stage's static pose takes its accuracy and coordinate map
-from here."""
+the shipped config's, a missing key named; the model stage's static pose takes its solvers' tolerances and
+coordinate map from here."""
 
 import copy
 from pathlib import Path
@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.ik import IK_ACCURACY
+from loper_analysis.motion.ik import OPENSIM_ACCURACY, TREE_STEP_TOLERANCE
 from loper_analysis.motion.ik_settings import DEFAULT_MARKER_WEIGHT, IKSettings
 from loper_analysis.stages.settings import stage_settings
 
@@ -25,7 +25,8 @@ def _changed() -> dict:
         default_marker_weight=0.5,
         marker_weights={"LASI": 2.0, "RASI": 0.0},
         coordinate_tasks={"pelvis_tilt": {"weight": 10.0, "value": None}},
-        accuracy=1e-8,
+        tree_step_tolerance=1e-8,
+        opensim_accuracy=1e-7,
         max_marker_rms_m=0.03,
         warn_marker_rms_m=None,
         max_rms_fraction=0.25,
@@ -43,7 +44,8 @@ def test_every_config_key_reaches_its_field():
         default_weight=0.5,
         marker_weights={"LASI": 2.0, "RASI": 0.0},
         coordinate_tasks={"pelvis_tilt": {"weight": 10.0, "value": None}},
-        accuracy=1e-8,
+        tree_step_tolerance=1e-8,
+        opensim_accuracy=1e-7,
         min_markers=IKSettings().min_markers,
         max_marker_rms_m=0.03,
         warn_marker_rms_m=None,
@@ -56,23 +58,28 @@ def test_every_config_key_reaches_its_field():
 
 
 def test_the_shipped_config_gives_the_defaults():
-    """Accuracy 1e-6, weight 1, RMS limits 0.06 / 0.02 m over 10 % of the frames, geometry 5 % / 8 %."""
+    """Tree step tolerance and OpenSim's accuracy 1e-6, weight 1, RMS limits 0.06 / 0.02 m over 10 % of the
+    frames, geometry 5 % / 8 %."""
     shipped = stage_settings(CONFIG, "ik")
-    assert (shipped.accuracy, IK_ACCURACY, shipped.default_weight, DEFAULT_MARKER_WEIGHT) == (1e-6, 1e-6, 1.0, 1.0)
+    assert shipped.tree_step_tolerance == TREE_STEP_TOLERANCE == 1e-6
+    assert shipped.opensim_accuracy == OPENSIM_ACCURACY == 1e-6
+    assert (shipped.default_weight, DEFAULT_MARKER_WEIGHT) == (1.0, 1.0)
     assert (shipped.max_marker_rms_m, shipped.warn_marker_rms_m, shipped.max_rms_fraction) == (0.06, 0.02, 0.1)
     assert (shipped.geometry_warn_change, shipped.geometry_stop_change) == (0.05, 0.08)
     assert shipped.tasks_file is None and shipped.marker_weights == {} and shipped.coordinate_tasks == {}
     assert (shipped.min_markers, shipped.subjects_model) == (IKSettings().min_markers, True)
 
 
-def test_the_scale_report_takes_the_ik_accuracy_and_coordinate_map():
-    """ik.accuracy and ik.coordinate_map reach the model stage's static pose as the IK's."""
+def test_the_scale_report_takes_the_ik_tolerances_and_coordinate_map():
+    """ik.tree_step_tolerance, ik.opensim_accuracy and ik.coordinate_map reach the model stage's static pose as
+    the IK's, each tolerance for its own solver."""
     model, ik = stage_settings(_changed(), "model"), stage_settings(_changed(), "ik")
-    assert (model.accuracy, model.coordinate_map) == (ik.accuracy, ik.coordinate_map) == (1e-8, MAP)
-    assert model.for_scaling().accuracy == 1e-8
+    assert (ik.tree_step_tolerance, ik.opensim_accuracy, ik.coordinate_map) == (1e-8, 1e-7, MAP)
+    assert (model.accuracy, model.coordinate_map) == ((1e-8, 1e-7), MAP)
+    assert model.for_scaling().accuracy == (1e-8, 1e-7)
 
 
-@pytest.mark.parametrize("key", ["accuracy", "geometry_stop_change", "ik_tasks"])
+@pytest.mark.parametrize("key", ["tree_step_tolerance", "opensim_accuracy", "geometry_stop_change", "ik_tasks"])
 def test_a_missing_key_is_named(key):
     config = copy.deepcopy(CONFIG)
     del config["ik"][key]

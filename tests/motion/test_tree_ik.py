@@ -1,9 +1,9 @@
 """IK on the kinematic tree (loper_analysis.motion.tree_ik) against OpenSim's InverseKinematicsSolver.
 
 Peer engine: OpenSim's solver on the same model, markers, weights and tasks, at the pipeline's accuracy
-(1e-6). The tree must reach the same angles (within 0.05 deg RMS for hip, knee and ankle flexion and pelvis
-tilt) and an objective no worse than OpenSim's, on simulated gait2392 walking and on OpenSim's gait2392
-tutorial static trial (a file recorded by others).
+(``ik.opensim_accuracy``, 1e-6). The tree must reach the same angles (within 0.05 deg RMS for hip, knee and
+ankle flexion and pelvis tilt) and an objective no worse than OpenSim's, on simulated gait2392 walking and on
+OpenSim's gait2392 tutorial static trial (a file recorded by others).
 """
 
 from __future__ import annotations
@@ -29,8 +29,9 @@ STATIC_TRC = ROOT / "tests" / "data" / "gait2392" / "subject01_static.trc"
 STUDY_ANGLES = ("hip_flexion_r", "knee_angle_r", "ankle_angle_r", "hip_flexion_l", "knee_angle_l", "ankle_angle_l")
 #: Largest RMS difference (deg) from OpenSim's solver allowed for the study's angles.
 AGREEMENT_DEG = 0.05
-#: The tree solver's accuracy (its default): it stops when a step moves no coordinate by more than this (rad or m).
-IK_ACCURACY = 1e-6
+#: The tree solver's step tolerance (its default, ``ik.tree_step_tolerance``): it stops when a step moves no
+#: coordinate by more than this (rad or m).
+STEP_TOLERANCE = 1e-6
 
 
 @pytest.fixture(scope="module")
@@ -142,12 +143,12 @@ def test_frames_left_out_are_nan_and_errors_are_distances(rng):
         tree, X, list(tree.marker_names), np.ones(len(tree.marker_names)), frames=np.array([0, 2, 3])
     )
     assert np.isnan(solution.coordinates[[1, 4]]).all() and np.isnan(solution.marker_errors_m[[1, 4]]).all()
-    # the solver's accuracy, not its last digits: it stops once a step moves no coordinate by more than 1e-6
+    # the solver's step tolerance, not its last digits: it stops once a step moves no coordinate by more than 1e-6
     # (rad or m; measured 1e-10), which moves a marker by less than 1e-6 m on this model's < 1 m long legs
-    np.testing.assert_allclose(solution.coordinates[[0, 2]], q[[0, 2]], atol=IK_ACCURACY)
+    np.testing.assert_allclose(solution.coordinates[[0, 2]], q[[0, 2]], atol=STEP_TOLERANCE)
     assert solution.converged[[0, 2, 3]].all() and not solution.converged[[1, 4]].any()
-    assert solution.marker_errors_m[0].max() < IK_ACCURACY
+    assert solution.marker_errors_m[0].max() < STEP_TOLERANCE
     # the planar model cannot follow a marker out of its plane: the fit keeps the pose, the marker its 4 mm
-    assert solution.marker_errors_m[3, 2] == pytest.approx(0.004, abs=IK_ACCURACY)
-    assert np.delete(solution.marker_errors_m[3], 2).max() < IK_ACCURACY
-    np.testing.assert_allclose(solution.coordinates[3], q[3], atol=IK_ACCURACY)
+    assert solution.marker_errors_m[3, 2] == pytest.approx(0.004, abs=STEP_TOLERANCE)
+    assert np.delete(solution.marker_errors_m[3], 2).max() < STEP_TOLERANCE
+    np.testing.assert_allclose(solution.coordinates[3], q[3], atol=STEP_TOLERANCE)

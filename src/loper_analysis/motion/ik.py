@@ -35,6 +35,8 @@ from loper_analysis.motion.ik_determinacy import (
 from loper_analysis.motion.markers import frames_with_markers, require_markers_per_frame
 
 __all__ = [
+    "OPENSIM_ACCURACY",
+    "TREE_STEP_TOLERANCE",
     "IK_ACCURACY",
     "IK_SOLVER",
     "IK_SOLVERS",
@@ -51,9 +53,15 @@ __all__ = [
     "joint_angle_table",
 ]
 
-#: Accuracy of OpenSim's IK solver in the pipeline's IK (config ``ik.accuracy``; OpenSim's own default is
-#: 1e-5).
-IK_ACCURACY: float = 1e-6
+#: The tree solver's step tolerance (rad or m; config ``ik.tree_step_tolerance``): it stops a frame when its last
+#: step moved no coordinate by more than this (:mod:`loper_analysis.motion.tree_ik`).
+TREE_STEP_TOLERANCE: float = 1e-6
+#: Accuracy of OpenSim's ``InverseKinematicsSolver`` (config ``ik.opensim_accuracy``): unitless, roughly the
+#: number of correct digits asked of the weighted objective's minimum (OpenSim's own default is 1e-5).
+OPENSIM_ACCURACY: float = 1e-6
+#: Both solvers' tolerances at once, ``(TREE_STEP_TOLERANCE, OPENSIM_ACCURACY)``: the default of the model stage's
+#: static pose (:attr:`loper_analysis.motion.model_settings.ModelSettings.accuracy`).
+IK_ACCURACY: tuple[float, float] = (TREE_STEP_TOLERANCE, OPENSIM_ACCURACY)
 
 
 #: The IK solvers (config ``ik.ik_solver``): the model's kinematic tree (:mod:`loper_analysis.motion.tree_ik`)
@@ -261,7 +269,8 @@ def inverse_kinematics(
     *,
     marker_weights: dict[str, float] | None = None,
     coordinate_tasks: dict[str, tuple[float, float | None]] | None = None,
-    accuracy: float = IK_ACCURACY,
+    tree_step_tolerance: float = TREE_STEP_TOLERANCE,
+    opensim_accuracy: float = OPENSIM_ACCURACY,
     min_markers: int = 3,
     source: str = "",
     undetermined: str = "nan",
@@ -276,6 +285,10 @@ def inverse_kinematics(
     joint or function it does not hold) falls back on OpenSim's solver, and
     :attr:`IKResult.solver` says so. ``solver="opensim"`` uses OpenSim's
     ``InverseKinematicsSolver`` (:mod:`loper_analysis.motion.opensim_ik`).
+    Each solver stops at its own tolerance: the tree's when its last step
+    moved no coordinate by more than ``tree_step_tolerance`` (rad or m),
+    OpenSim's at its unitless ``opensim_accuracy`` (also when it serves in
+    the tree's place).
 
     A marker that is NaN in a frame is left out of that frame's solve (OpenSim's
     ``MarkersReference`` drops it). A frame holding fewer than ``min_markers``
@@ -339,7 +352,8 @@ def inverse_kinematics(
         solver=solver,
         coordinate_tasks=coordinate_tasks,
         frames=frames,
-        accuracy=accuracy,
+        tree_step_tolerance=tree_step_tolerance,
+        opensim_accuracy=opensim_accuracy,
         source=source,
     )
     # OpenSim reports 0 (not NaN) for a marker missing in a frame: leave those out of RMS and max
@@ -366,24 +380,31 @@ def inverse_kinematics(
 
 
 def _solution(
-    model, t, X, labels, marker_weights, *, solver, coordinate_tasks, frames, accuracy, source
+    model, t, X, labels, marker_weights, *, solver, tree_step_tolerance, opensim_accuracy, **options
 ) -> tuple[np.ndarray, np.ndarray, list[str], str, str]:
     """Coordinates (n_frames, n_coordinates) in coordinate-set order, marker errors (n_frames, n_in_use) in m,
     the markers in use, the solver that gave them (``tree`` or ``opensim``) and why OpenSim's served when the
-    tree's was asked for ('' otherwise)."""
-    options = {"coordinate_tasks": coordinate_tasks, "frames": frames, "accuracy": accuracy, "source": source}
+    tree's was asked for ('' otherwise); each solver at its own tolerance, ``options`` (``coordinate_tasks``,
+    ``frames``, ``source``) to both."""
     reason = ""
     if solver == "tree":
         from loper_analysis.motion.kinematic_tree import UnsupportedModel
         from loper_analysis.motion.tree_ik import tree_solution
 
         try:
-            return (*tree_solution(model, t, X, labels, marker_weights, **options), list(labels), "tree", "")
+            Q, E = tree_solution(
+                model, t, X, labels, marker_weights, tree_step_tolerance=tree_step_tolerance, **options
+            )
+            return Q, E, list(labels), "tree", ""
         except UnsupportedModel as exc:
             reason = str(exc)
     from loper_analysis.motion.opensim_ik import opensim_solution
 
-    return (*opensim_solution(model, t, X, labels, marker_weights, **options), "opensim", reason)
+    return (
+        *opensim_solution(model, t, X, labels, marker_weights, accuracy=opensim_accuracy, **options),
+        "opensim",
+        reason,
+    )
 
 
 def _weighted_markers(

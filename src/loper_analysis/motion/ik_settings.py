@@ -1,4 +1,4 @@
-"""The IK stage's settings (:class:`IKSettings`): the tasks, the solver's accuracy and the limits a trial's fit is
+"""The IK stage's settings (:class:`IKSettings`): the tasks, the solvers' tolerances and the limits a trial's fit is
 held to, from the config (section ``opensim``, read by :mod:`loper_analysis.stages.ik.settings`)."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 
 from loper_analysis.constants import MIN_IK_MARKERS
-from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
+from loper_analysis.motion.ik import IK_SOLVER, OPENSIM_ACCURACY, TREE_STEP_TOLERANCE
 from loper_analysis.motion.marker_geometry import GEOMETRY_STOP_CHANGE, GEOMETRY_WARN_CHANGE
 from loper_analysis.motion.plausibility import IK_MAX_FRACTION, IK_STOP_RMS_M, IK_WARN_RMS_M
 
@@ -32,8 +32,12 @@ class IKSettings:
         Marker -> weight, 0 leaving a marker out (``ik.marker_weights``).
     coordinate_tasks : mapping, optional
         Coordinate -> ``{"weight": w, "value": rad or None}`` (``ik.coordinate_tasks``).
-    accuracy : float
-        IK solver accuracy (``ik.accuracy``).
+    tree_step_tolerance : float
+        The tree solver stops a frame when its last step moved no coordinate by more than this (rad or m;
+        ``ik.tree_step_tolerance``).
+    opensim_accuracy : float
+        Accuracy of OpenSim's ``InverseKinematicsSolver``, unitless: roughly the number of correct digits asked
+        of the weighted objective's minimum (``ik.opensim_accuracy``); also when it serves in the tree's place.
     solver : str
         ``tree`` or ``opensim`` (``ik.ik_solver``; :func:`loper_analysis.motion.ik.inverse_kinematics`).
     min_markers : int
@@ -62,7 +66,8 @@ class IKSettings:
     default_weight: float = DEFAULT_MARKER_WEIGHT
     marker_weights: Mapping[str, float] | None = None
     coordinate_tasks: Mapping[str, Mapping] | None = None
-    accuracy: float = IK_ACCURACY
+    tree_step_tolerance: float = TREE_STEP_TOLERANCE
+    opensim_accuracy: float = OPENSIM_ACCURACY
     solver: str = IK_SOLVER
     min_markers: int = MIN_IK_MARKERS
     max_marker_rms_m: float = IK_STOP_RMS_M
@@ -72,3 +77,10 @@ class IKSettings:
     geometry_warn_change: float = GEOMETRY_WARN_CHANGE
     geometry_stop_change: float = GEOMETRY_STOP_CHANGE
     subjects_model: bool = True
+
+    @property
+    def accuracy(self) -> tuple[float, float]:
+        """``(tree_step_tolerance, opensim_accuracy)``: both solvers' tolerances at once, as the model stage's
+        reader passes the IK's to its static pose
+        (:attr:`loper_analysis.motion.model_settings.ModelSettings.accuracy`)."""
+        return (self.tree_step_tolerance, self.opensim_accuracy)

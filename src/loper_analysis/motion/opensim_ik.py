@@ -71,7 +71,8 @@ def opensim_solution(
     frames : ndarray of int
         The frames to solve, increasing; the others are NaN.
     accuracy : float
-        The solver's accuracy.
+        The solver's accuracy (``setAccuracy``; config ``ik.opensim_accuracy``): unitless, roughly the number
+        of correct digits asked of the weighted objective's minimum (1e-6: about six; OpenSim's default 1e-5).
 
     Returns
     -------

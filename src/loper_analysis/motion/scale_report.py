@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import JOINTS, SIDES
-from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
+from loper_analysis.motion.ik import IK_SOLVER, OPENSIM_ACCURACY, TREE_STEP_TOLERANCE
 from loper_analysis.motion.model_settings import ModelSettings
 
 __all__ = [
@@ -307,7 +307,17 @@ def _map_coordinate(entry) -> str:
     return entry["coordinate"] if isinstance(entry, Mapping) else entry[0]
 
 
-def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float, solver: str = IK_SOLVER) -> StaticFit:
+def static_fit(
+    model,
+    pose,
+    weights,
+    coords,
+    coordinate_map,
+    *,
+    tree_step_tolerance: float = TREE_STEP_TOLERANCE,
+    opensim_accuracy: float = OPENSIM_ACCURACY,
+    solver: str = IK_SOLVER,
+) -> StaticFit:
     """Marker errors of the static trial's mean pose on ``model`` and the pose's joint angles: IK with the
     marker placer's weights and tasks of the window's mean, as OpenSim's marker placer takes it.
 
@@ -320,8 +330,8 @@ def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float, so
         Marker -> weight; coordinate -> (weight, value or None).
     coordinate_map : mapping
         Our angle -> model coordinate and sign; angles whose coordinate the model lacks are left out.
-    accuracy : float
-        IK solver accuracy.
+    tree_step_tolerance, opensim_accuracy : float
+        The tree solver's step tolerance (rad or m) and OpenSim's solver's unitless accuracy.
     solver : str
         IK solver (:func:`loper_analysis.motion.ik.inverse_kinematics`).
     """
@@ -335,7 +345,8 @@ def static_fit(model, pose, weights, coords, coordinate_map, accuracy: float, so
         pose.labels,
         marker_weights=weights,
         coordinate_tasks=coords,
-        accuracy=accuracy,
+        tree_step_tolerance=tree_step_tolerance,
+        opensim_accuracy=opensim_accuracy,
         solver=solver,
     )
     errors = dict(zip(result.marker_names, (float(e) for e in result.marker_errors_m[0])))
@@ -367,7 +378,8 @@ def scaled_model_report(
     subject: tuple[float, float, str],
     *,
     coordinate_map: Mapping | None = None,
-    accuracy: float = IK_ACCURACY,
+    tree_step_tolerance: float = TREE_STEP_TOLERANCE,
+    opensim_accuracy: float = OPENSIM_ACCURACY,
     solver: str = IK_SOLVER,
     lab_labels: Mapping[str, str] | None = None,
     lab_static: Mapping[str, float] | None = None,
@@ -391,8 +403,9 @@ def scaled_model_report(
         Mass (kg), height (m), where they came from.
     coordinate_map : mapping, optional
         ``ik.coordinate_map``; None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
-    accuracy : float
-        IK accuracy of the static pose (``ik.accuracy``).
+    tree_step_tolerance, opensim_accuracy : float
+        The static pose's IK tolerances: the tree solver's step (rad or m, ``ik.tree_step_tolerance``) and
+        OpenSim's solver's unitless accuracy (``ik.opensim_accuracy``).
     solver : str
         IK solver of the static pose (``ik.ik_solver``).
     lab_labels, lab_static : mapping, optional
@@ -416,8 +429,9 @@ def scaled_model_report(
     weights, coords = tasks if tasks is not None else ({m: 1.0 for m in pose.labels if m in model_markers}, {})
     weights = {m: w for m, w in weights.items() if w > 0 and m in model_markers and m in pose.labels}
     cmap = DEFAULT_COORDINATE_MAP if coordinate_map is None else coordinate_map
-    after = static_fit(scaled, pose, weights, coords, cmap, accuracy, solver)
-    before = None if unplaced is None else static_fit(unplaced, pose, weights, coords, cmap, accuracy, solver)
+    ik = {"tree_step_tolerance": tree_step_tolerance, "opensim_accuracy": opensim_accuracy, "solver": solver}
+    after = static_fit(scaled, pose, weights, coords, cmap, **ik)
+    before = None if unplaced is None else static_fit(unplaced, pose, weights, coords, cmap, **ik)
     scaled_factors = {b: f for b, f in factors.items() if not np.allclose(f, 1.0)}
     warnings = static_pose_warnings((before or after).angles_rad, lab_static)
     warnings += neighbour_factor_warnings(scaled_factors, jointed_bodies(scaled), between_centres)
@@ -476,7 +490,8 @@ def scale_run_report(
         Mass (kg), height (m), where they came from, the model's stature (m)
         (:func:`loper_analysis.motion.scaling.scaled_subject`).
     settings : ModelSettings
-        ``coordinate_map`` and ``accuracy`` of the static pose's IK.
+        ``coordinate_map``, ``accuracy`` (the IK's ``(tree_step_tolerance, opensim_accuracy)``) and ``solver``
+        of the static pose's IK.
     lab_labels : mapping, optional
         Model marker -> the lab's label.
     lab_angles : pandas.DataFrame, optional
@@ -496,6 +511,7 @@ def scale_run_report(
     if unplaced is None and run.tasks is not None:
         unplaced = generic  # placement without scaling: the generic markers are the ones placed
     lab_static = None if lab_angles is None else window_means(lab_angles, run.window_s)
+    tree_step_tolerance, opensim_accuracy = settings.accuracy
     return scaled_model_report(
         run.scaled,
         unplaced,
@@ -503,7 +519,8 @@ def scale_run_report(
         (run.factors, run.tasks),
         subject[:3],
         coordinate_map=settings.coordinate_map,
-        accuracy=settings.accuracy,
+        tree_step_tolerance=tree_step_tolerance,
+        opensim_accuracy=opensim_accuracy,
         solver=settings.solver,
         lab_labels=lab_labels,
         lab_static=lab_static,

@@ -9,8 +9,9 @@ values ``r_c``) by Gauss-Newton steps with Levenberg-Marquardt damping, starting
 solution (the first frame from the model's default pose, as OpenSim's solver assembles it). Marker positions
 and their exact Jacobian come from :func:`loper_analysis.motion.kinematic_tree.tree_markers`, compiled, so a
 frame costs a few passes over the tree instead of an optimiser's calls into OpenSim. A frame has converged
-when its last step moved no coordinate by more than ``accuracy`` (rad or m). Locked coordinates stay at their
-default values and clamped ones within their range, as in OpenSim.
+when its last step moved no coordinate by more than ``tree_step_tolerance`` (rad or m; config
+``ik.tree_step_tolerance``). Locked coordinates stay at their default values and clamped ones within their
+range, as in OpenSim.
 """
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def tree_inverse_kinematics(
     task_coordinates: np.ndarray | None = None,
     task_weights: np.ndarray | None = None,
     task_values: np.ndarray | None = None,
-    accuracy: float = 1e-6,
+    tree_step_tolerance: float = 1e-6,
     max_iterations: int = MAX_ITERATIONS,
 ) -> TreeSolution:
     """Solve IK for marker trajectories ``markers_m`` (n_frames, n_markers, 3) in m, NaN where missing.
@@ -74,8 +75,8 @@ def tree_inverse_kinematics(
         The frames to solve, in increasing order (default: all); the others are NaN.
     task_coordinates, task_weights, task_values : ndarray, shape (n_tasks,)
         Coordinate tasks: index into the tree's coordinates, weight, value (rad or m).
-    accuracy : float
-        Convergence: the largest coordinate step (rad or m) of the last iteration.
+    tree_step_tolerance : float
+        Convergence: a frame stops when its last step moved no coordinate by more than this (rad or m).
     max_iterations : int
         Steps per frame at the most.
     """
@@ -102,7 +103,7 @@ def tree_inverse_kinematics(
         tree.clamped,
         tree.range_q[:, 0].copy(),
         tree.range_q[:, 1].copy(),
-        float(accuracy),
+        float(tree_step_tolerance),
         int(max_iterations),
     )
     converged = np.zeros(n, bool)
@@ -196,7 +197,7 @@ def _bounded_step(H, g, lam, free, clamped, lo, hi, q):  # pragma: no cover - co
 
 @njit(cache=True)
 def _solve_frames(
-    arrays, X, w, frames, tc, tw, tv, q, free, clamped, lo, hi, accuracy, max_iterations
+    arrays, X, w, frames, tc, tw, tv, q, free, clamped, lo, hi, step_tolerance, max_iterations
 ):  # pragma: no cover - compiled
     """Coordinates (n, nc), marker errors (n, nm) and steps per frame (n,; max_iterations + 1: not
     converged) of the frames ``frames`` of ``X``, starting from ``q`` (changed in place); ``arrays``: the
@@ -230,14 +231,14 @@ def _solve_frames(
                 tree_markers(arrays, q_try, P_try, J_try)
                 cost_try = _cost(P_try, X[k], w, present, q_try, tc, tw, tv, w_total)
                 steps += 1
-                if cost_try <= cost or largest <= accuracy:
+                if cost_try <= cost or largest <= step_tolerance:
                     q[:], P[:], J[:], cost = q_try, P_try, J_try, cost_try
                     lam = max(lam / 10.0, 1e-9)
                     break
                 lam = min(lam * 10.0, 1e12)
                 if steps > max_iterations:
                     break
-            if largest <= accuracy or steps > max_iterations or cost_before - cost <= FLAT * cost_before:
+            if largest <= step_tolerance or steps > max_iterations or cost_before - cost <= FLAT * cost_before:
                 break
         iterations[k] = steps
         Q[k] = q
@@ -248,7 +249,7 @@ def _solve_frames(
 
 
 def tree_solution(
-    model, t, X, labels, marker_weights, *, coordinate_tasks, frames, accuracy, source
+    model, t, X, labels, marker_weights, *, coordinate_tasks, frames, tree_step_tolerance, source
 ) -> tuple[np.ndarray, np.ndarray]:
     """IK on the kinematic tree of an ``opensim.Model``, in the terms of
     :func:`loper_analysis.motion.opensim_ik.opensim_solution`: coordinates (n_frames, n_coordinates) in
@@ -283,6 +284,6 @@ def tree_solution(
         task_coordinates=np.array([c for c, _, _ in tasks], np.int64),
         task_weights=np.array([w for _, w, _ in tasks], float),
         task_values=np.array([v for _, _, v in tasks], float),
-        accuracy=accuracy,
+        tree_step_tolerance=tree_step_tolerance,
     )
     return solution.coordinates, solution.marker_errors_m

@@ -55,7 +55,7 @@ def trial(tmp_path_factory):
 
 def test_chunks_joined_through_files_equal_the_whole_trial(trial, tmp_path):
     model_osim, trc, truth = trial
-    fine = IKSettings(accuracy=1e-8)
+    fine = IKSettings(tree_step_tolerance=1e-8)
     whole = ik_trial(model_osim, trc, tmp_path / "whole.mot", tmp_path / "whole.angles.tsv", fine)
     np.testing.assert_allclose(whole.knee_left_rad, truth["knee_flexion_l"], atol=np.deg2rad(0.1) / 10)
     mots = [tmp_path / f"chunk{c}.mot" for c in range(3)]

@@ -197,7 +197,7 @@ def test_a_walking_pose_comes_back_through_the_calibrated_model(calibrated):
     markers = _markers(subject, _pose(subject, WALK), template)
     names = [n for n in sorted(markers) if not n.endswith(("MKNE", "MMAL"))]  # static trial only
     X = np.stack([markers[n] for n in names])[None]
-    res = inverse_kinematics(scaled, np.zeros(1), X, names, accuracy=1e-8, solver="opensim")
+    res = inverse_kinematics(scaled, np.zeros(1), X, names, opensim_accuracy=1e-8, solver="opensim")
     frame = res.frame().iloc[0]
     for coordinate, value in WALK.items():
         assert np.degrees(frame[coordinate] - value) == pytest.approx(0.0, abs=0.25), coordinate

@@ -12,6 +12,17 @@ from loper_analysis.stages.command import Command
 __all__ = ["COMMANDS"]
 
 
+class _FormerAccuracy(argparse.Action):
+    """The former ``--accuracy``, one value for both solvers: refused, naming the two options that replace it."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        parser.error(
+            "--accuracy is no longer an option (it set two different things): give --tree-step-tolerance (the tree "
+            "solver's step, rad or m; ik.tree_step_tolerance) and/or --opensim-accuracy (OpenSim's solver's "
+            "accuracy; ik.opensim_accuracy)"
+        )
+
+
 def _add_ik(p: argparse.ArgumentParser) -> None:
     """The ``ik`` subcommand's arguments."""
     p.add_argument("--model", required=True, help="OpenSim model (.osim)")
@@ -27,8 +38,18 @@ def _add_ik(p: argparse.ArgumentParser) -> None:
     cli_options.add_label_map_option(p)
     cli_options.add_rotate_option(p, heading=True)
     p.add_argument(
-        "--accuracy", type=float, help="IK solver accuracy (default: ik.accuracy; OpenSim's own default 1e-5)"
+        "--tree-step-tolerance",
+        type=float,
+        help="the tree solver stops a frame when its last step moved no coordinate by more than this (rad or m; "
+        "default: ik.tree_step_tolerance)",
     )
+    p.add_argument(
+        "--opensim-accuracy",
+        type=float,
+        help="accuracy of OpenSim's IK solver, unitless: roughly the number of correct digits asked of the "
+        "weighted objective's minimum (default: ik.opensim_accuracy; OpenSim's own default 1e-5)",
+    )
+    p.add_argument("--accuracy", action=_FormerAccuracy, help=argparse.SUPPRESS)
     p.add_argument(
         "--solver",
         choices=("tree", "opensim"),
@@ -68,7 +89,8 @@ def _ik(args: argparse.Namespace) -> None:
     settings = IKSettings() if config is None else stage_settings(config, "ik")
     given = {
         "tasks_file": args.tasks,
-        "accuracy": args.accuracy,
+        "tree_step_tolerance": args.tree_step_tolerance,
+        "opensim_accuracy": args.opensim_accuracy,
         "solver": args.solver,
         "max_marker_rms_m": args.max_marker_rms_m,
         "warn_marker_rms_m": args.warn_marker_rms_m,
@@ -108,7 +130,8 @@ COMMANDS: tuple[Command, ...] = (
         run=_ik,
         option_keys={
             "rotate_deg": ("config", ("markers", "lab_to_model_rotation_deg")),
-            "accuracy": ("config", ("ik", "accuracy")),
+            "tree_step_tolerance": ("config", ("ik", "tree_step_tolerance")),
+            "opensim_accuracy": ("config", ("ik", "opensim_accuracy")),
             "max_marker_rms_m": ("config", ("ik", "max_marker_rms_m")),
             "warn_marker_rms_m": ("config", ("ik", "warn_marker_rms_m")),
             "max_rms_fraction": ("config", ("ik", "max_rms_fraction")),

@@ -13,16 +13,17 @@ NEEDS: tuple[str, ...] = ()
 
 def read_settings(config: Mapping) -> IKSettings:
     """The IK settings of a validated config: of ``opensim``, ``ik_tasks``, ``default_marker_weight``,
-    ``marker_weights``, ``coordinate_tasks``, ``accuracy``, ``ik_solver``, ``max_marker_rms_m`` (m),
-    ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``, ``geometry_warn_change`` and
-    ``geometry_stop_change``."""
+    ``marker_weights``, ``coordinate_tasks``, ``tree_step_tolerance`` (rad or m), ``opensim_accuracy``,
+    ``ik_solver``, ``max_marker_rms_m`` (m), ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``,
+    ``geometry_warn_change`` and ``geometry_stop_change``."""
     o = config["ik"]
     return IKSettings(
         tasks_file=o["ik_tasks"],
         default_weight=o["default_marker_weight"],
         marker_weights=o["marker_weights"],
         coordinate_tasks=o["coordinate_tasks"],
-        accuracy=o["accuracy"],
+        tree_step_tolerance=o["tree_step_tolerance"],
+        opensim_accuracy=o["opensim_accuracy"],
         solver=o["ik_solver"],
         max_marker_rms_m=o["max_marker_rms_m"],
         warn_marker_rms_m=o["warn_marker_rms_m"],

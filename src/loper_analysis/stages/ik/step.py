@@ -140,7 +140,8 @@ def _solve(
         labels,
         marker_weights=weights,
         coordinate_tasks=coords,
-        accuracy=s.accuracy,
+        tree_step_tolerance=s.tree_step_tolerance,
+        opensim_accuracy=s.opensim_accuracy,
         min_markers=s.min_markers,
         source=source,
         solver=s.solver,
@@ -168,7 +169,7 @@ def ik_chunk(
     it as another subject's trial, naming both files and the pairs
     (:mod:`loper_analysis.motion.marker_geometry`).
 
-    The tasks, the solver's accuracy and the limits are those of ``settings`` (:class:`IKSettings`).
+    The tasks, the solvers' tolerances and the limits are those of ``settings`` (:class:`IKSettings`).
     Markers missing (NaN) in a frame are left out of its solve; a frame with
     fewer than ``min_markers`` weighted markers (or with markers on the pelvis
     only) is left out of IK: NaN in every coordinate, with a warning giving
@@ -340,7 +341,7 @@ def ik_file(
     model frame
     (default -90 0 0 for a C3D, Qualisys Z-up -> OpenSim Y-up; 0 0 0 for a TRC). ``span_s`` (start, end), s on
     the file's clock, is the part solved (None, or None for either end: from the first or to the last frame).
-    Of ``settings`` (:class:`IKSettings`) the task file, the accuracy, ``min_markers`` and the limits count:
+    Of ``settings`` (:class:`IKSettings`) the task file, the tolerances, ``min_markers`` and the limits count:
     without a task file every model marker found in the file gets weight 1. Frames with
     too few markers are left out (NaN), with a warning. A fit that only a
     mistake explains (marker RMS error above ``max_marker_rms_m`` m in more
@@ -396,7 +397,8 @@ def ik_file(
             labels,
             marker_weights=weights,
             coordinate_tasks=coordinate_tasks,
-            accuracy=settings.accuracy,
+            tree_step_tolerance=settings.tree_step_tolerance,
+            opensim_accuracy=settings.opensim_accuracy,
             min_markers=settings.min_markers,
             solver=settings.solver,
         )
