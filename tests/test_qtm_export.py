@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from loper_analysis.device.loadcell import robot_log_on_mocap_frames
+from loper_analysis.device.loadcell import robot_log_frames_and_native
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.robot_log_mat import read_robot_log_mat
 from loper_analysis.motion.ik import inverse_kinematics
@@ -125,7 +125,7 @@ def test_robot_log_maps_onto_mocap_frames_that_start_at_7_8_s(session):
     log, _ = read_robot_log_mat(out / "pert050-1.mat", ROBOT_LOG_MAT_VARIABLES, 1000.0)
     walk, _ = truth["pert050-1"]
     pd.testing.assert_frame_equal(log, walk.robot, check_exact=True, check_dtype=False)
-    frames = robot_log_on_mocap_frames(log, 1000.0, rec.analog(LAB.sync_channel), rec.analog_rate_hz, rec.time_s)
+    frames, _ = robot_log_frames_and_native(log, 1000.0, rec.analog(LAB.sync_channel), rec.analog_rate_hz, rec.time_s)
     cm = frames.attrs["clock_map"]
     t_robot = log["time_s"].to_numpy()[::500]
     true_mocap = 7.8125 - LAB.clock_offset_s + (1.0 + 1e-6 * LAB.clock_drift_ppm) * t_robot  # robot clock -> file clock

@@ -15,7 +15,6 @@ from loper_analysis.device.loadcell import (
     LoadcellSettings,
     perturbation_onsets,
     robot_log_frames_and_native,
-    robot_log_on_mocap_frames,
 )
 from loper_analysis.errors import LoperInputError
 from loper_analysis.stages.settings import stage_settings
@@ -26,6 +25,11 @@ CONFIG = yaml.safe_load((Path(__file__).resolve().parents[2] / "config" / "confi
 
 FRAME_HZ = 128.0
 FORCE_COMPONENTS = ((8.0, 0.7, 0.3), (5.0, 2.3, 1.1), (3.0, 6.1, 2.0))  # (N, Hz, rad), all < 10 Hz
+
+
+def robot_log_on_mocap_frames(*records, **options) -> pd.DataFrame:
+    """The frame table of :func:`robot_log_frames_and_native` (its forces on the mocap frames)."""
+    return robot_log_frames_and_native(*records, **options)[0]
 
 
 def force(t):

@@ -1,6 +1,6 @@
 """The robot log on the motion-capture clock: forces resampled at the mocap frames, perturbation onsets.
 
-Chain (``docs/processing.md``, :func:`robot_log_on_mocap_frames`): rising
+Chain (``docs/processing.md``, :func:`robot_log_frames_and_native`): rising
 edges of the log's ``sync_v`` and of the mocap sync channel -> clock map
 (:mod:`loper_analysis.device.clock_sync`) -> zero-phase 4th-order 40 Hz
 Butterworth of the forces at the robot rate
@@ -45,7 +45,6 @@ __all__ = [
     "PULSE_AMPLITUDE_RANGE",
     "require_force_unit",
     "require_pulse_amplitude",
-    "robot_log_on_mocap_frames",
     "robot_log_frames_and_native",
     "check_perturbation_flags",
     "perturbation_onsets",
@@ -70,7 +69,7 @@ class LoadcellSettings:
     pulse_force_n: float = PULSE_FORCE_N
 
 
-#: Columns of :func:`robot_log_on_mocap_frames` (and of both tables of :func:`robot_log_frames_and_native`), in order.
+#: Columns of both tables of :func:`robot_log_frames_and_native`, in order.
 OUTPUT_COLUMNS: tuple[str, ...] = ("time_s", "force_measured_n", "force_desired_n", "perturbation")
 
 _LOG_COLUMNS = ("time_s", "force_desired_n", "force_measured_n", "sync_v", "perturbation")
@@ -91,14 +90,24 @@ PULSE_AMPLITUDE_RANGE: tuple[float, float] = (0.1, 10.0)
 _FLAG_MARGIN_S = 0.1
 
 
-def robot_log_on_mocap_frames(
-    log: pd.DataFrame, log_rate_hz: float, mocap_sync_v, analog_rate_hz: float, frame_time_s, **options
-) -> pd.DataFrame:
-    """The robot log's forces and perturbation flag on the motion-capture frames.
-
-    ``options`` are the keyword settings of :func:`robot_log_frames_and_native` (``cutoff_hz``, ``order``,
-    ``source``, ``analog_start_s``, ``max_drift``, ``tolerance_s``, ``sync_channel``, ``pulse_force_n``),
-    described below.
+def robot_log_frames_and_native(
+    log: pd.DataFrame,
+    log_rate_hz: float,
+    mocap_sync_v,
+    analog_rate_hz: float,
+    frame_time_s,
+    *,
+    cutoff_hz: float = CUTOFF_HZ,
+    order: int = ORDER,
+    source: str = "",
+    analog_start_s: float | None = None,
+    max_drift: float = 1e-3,
+    tolerance_s: float = 3e-3,
+    sync_channel: str = "",
+    pulse_force_n: float | None = None,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The robot log's forces and perturbation flag on the motion-capture frames, and the same forces at the robot
+    log's own samples.
 
     1. Both sync signals must look like pulse trains
        (:func:`loper_analysis.device.clock_sync.require_pulse_train`); then the
@@ -119,8 +128,9 @@ def robot_log_on_mocap_frames(
        force in the desired one's unit (:func:`require_force_unit`), and force pulses in the low-passed
        ``force_measured_n`` must carry the ``perturbation`` flag (:func:`check_perturbation_flags`).
 
-    :func:`robot_log_frames_and_native` also returns the filtered forces at
-    the robot's own samples.
+    The robot rate keeps the pulse's edges, which the 128 Hz frames cut
+    short: the fit takes its force from the second table
+    (:func:`loper_analysis.impedance.identification.prepare_window`, ``force_time_s``).
 
     Gap policy: frames outside the robot log's mapped span (first to last
     sample) get NaN in every column but ``time_s``, which is why
@@ -159,11 +169,15 @@ def robot_log_on_mocap_frames(
 
     Returns
     -------
-    pandas.DataFrame, shape (n_frames, 4)
+    frames : pandas.DataFrame, shape (n_frames, 4)
         Columns :data:`OUTPUT_COLUMNS`: ``time_s`` (s, mocap clock, =
         ``frame_time_s``), ``force_measured_n``, ``force_desired_n`` (N),
         ``perturbation`` (0.0/1.0, NaN outside the log). ``attrs["clock_map"]``
         holds the :class:`loper_analysis.device.clock_sync.ClockMap`.
+    native : pandas.DataFrame, shape (n_samples, 4)
+        The same columns at every robot sample (``log_rate_hz``): ``time_s``
+        the sample's time mapped to the mocap clock (s), the low-passed forces
+        (N) and the flag (0.0/1.0).
 
     Raises
     ------
@@ -177,35 +191,6 @@ def robot_log_on_mocap_frames(
         inside the log's span, desired pulses far from ``pulse_force_n`` (:func:`require_pulse_amplitude`: both
         forces in kN), a measured force in another unit (:func:`require_force_unit`), force pulses without
         perturbation flags (:func:`check_perturbation_flags`).
-    """
-    return robot_log_frames_and_native(log, log_rate_hz, mocap_sync_v, analog_rate_hz, frame_time_s, **options)[0]
-
-
-def robot_log_frames_and_native(
-    log: pd.DataFrame,
-    log_rate_hz: float,
-    mocap_sync_v,
-    analog_rate_hz: float,
-    frame_time_s,
-    *,
-    cutoff_hz: float = CUTOFF_HZ,
-    order: int = ORDER,
-    source: str = "",
-    analog_start_s: float | None = None,
-    max_drift: float = 1e-3,
-    tolerance_s: float = 3e-3,
-    sync_channel: str = "",
-    pulse_force_n: float | None = None,
-) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """:func:`robot_log_on_mocap_frames` and the same forces at the robot log's own samples.
-
-    Returns the frame table of :func:`robot_log_on_mocap_frames` and a table
-    with the same columns at every robot sample (``log_rate_hz``): ``time_s``
-    the sample's time mapped to the mocap clock (s), the low-passed forces (N)
-    and the flag (0.0/1.0). The robot rate keeps the pulse's edges, which the
-    128 Hz frames cut short: the fit takes its force from there
-    (:func:`loper_analysis.impedance.identification.prepare_window`, ``force_time_s``).
-    Same parameters and errors as :func:`robot_log_on_mocap_frames`.
     """
     src = source or "robot log"
     if not isinstance(log, pd.DataFrame):
