@@ -4,14 +4,23 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.filtering import (
-    lowpass,
-    lowpass_finite_runs,
-    lowpass_gain,
-    min_run_samples,
-)
+from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, check_cutoff, lowpass, lowpass_finite_runs
 
 FS = 128.0
+
+
+def lowpass_gain(frequency_hz, sample_rate_hz: float, cutoff_hz: float = CUTOFF_HZ, order: int = ORDER) -> np.ndarray:
+    """Magnitude response of :func:`lowpass` (the designed filter's gain squared) at ``frequency_hz``."""
+    from scipy.signal import sosfreqz
+
+    sos = check_cutoff(sample_rate_hz, cutoff_hz, order)
+    _, h = sosfreqz(sos, worN=np.atleast_1d(np.asarray(frequency_hz, float)), fs=sample_rate_hz)
+    return np.abs(h) ** 2
+
+
+def min_run_samples(sample_rate_hz: float, cutoff_hz: float, order: int) -> int:
+    """Fewest samples :func:`lowpass` accepts: one more than the padding of ``sosfiltfilt`` (3 * (2 * sections + 1))."""
+    return 3 * (2 * len(check_cutoff(sample_rate_hz, cutoff_hz, order)) + 1) + 1
 
 
 @pytest.mark.parametrize("freq", [2.0, 10.0, 40.0, 50.0])

@@ -6,7 +6,7 @@ import numpy as np
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["DC_GAIN_TOLERANCE", "check_cutoff", "lowpass", "lowpass_finite_runs", "lowpass_gain", "min_run_samples"]
+__all__ = ["DC_GAIN_TOLERANCE", "check_cutoff", "lowpass", "lowpass_finite_runs"]
 
 
 #: Largest relative error of the designed filter's gain at 0 Hz: beyond it a cut-off is too low for the rate
@@ -154,7 +154,7 @@ def lowpass(
 
     The forward-backward pass squares the magnitude response: the gain at
     ``cutoff_hz`` is 0.5 (-6 dB) and the roll-off that of order ``2 * order``
-    (see :func:`lowpass_gain`). ``signal`` is an array sampled along ``axis``
+    (``tests/motion/test_filtering.py`` checks both on sinusoids). ``signal`` is an array sampled along ``axis``
     (e.g. (n_frames, n_markers, 3) markers in m, or (n_samples,) forces in N);
     it must be finite (fill marker gaps first). Returns a new array of the same
     shape. ``setting``, ``rate_name`` and ``source`` name the cut-off, the rate
@@ -187,20 +187,6 @@ def lowpass(
     return sosfiltfilt(sos, x, axis=axis)
 
 
-def min_run_samples(
-    sample_rate_hz: float,
-    cutoff_hz: float = CUTOFF_HZ,
-    order: int = ORDER,
-    *,
-    setting: str = "cutoff_hz",
-    rate_name: str = "sample_rate_hz",
-    source: str = "",
-) -> int:
-    """Fewest samples :func:`lowpass` accepts: one more than the padding of ``sosfiltfilt`` (3 * (2 * sections + 1))."""
-    sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
-    return _padlen(sos) + 1
-
-
 def _finite_runs(finite: np.ndarray) -> list[tuple[int, int]]:
     """Runs of True in a 1-D bool array as (start, stop) index pairs, stop exclusive."""
     edges = np.diff(np.r_[0, finite.astype(np.int8), 0])
@@ -223,8 +209,8 @@ def lowpass_finite_runs(
     Every 1-D series along ``axis`` (e.g. one coordinate of one marker of
     (n_frames, n_markers, 3) markers in m) is cut at its NaN samples and each
     finite run is filtered forward and backward as a signal of its own, with
-    ``sosfiltfilt``'s padding at both of its ends. A run of fewer than
-    :func:`min_run_samples` samples is too short for that padding and is left
+    ``sosfiltfilt``'s padding at both of its ends. A run no longer than that
+    padding (3 * (2 * sections + 1) samples, 15 for order 4) is too short for it and is left
     as it is (unfiltered, reported in the returned mask): dropping it would
     lose real samples, while the filter's edge transients would dominate it
     anyway. A signal without NaN gives exactly :func:`lowpass`'s result (and
@@ -276,21 +262,3 @@ def lowpass_finite_runs(
             else:
                 out[start:stop, cols] = sosfiltfilt(sos, flat[start:stop, cols], axis=0)
     return np.moveaxis(out.reshape(moved.shape), 0, axis), np.moveaxis(short.reshape(moved.shape), 0, axis)
-
-
-def lowpass_gain(
-    frequency_hz,
-    sample_rate_hz: float,
-    cutoff_hz: float = CUTOFF_HZ,
-    order: int = ORDER,
-    *,
-    setting: str = "cutoff_hz",
-    rate_name: str = "sample_rate_hz",
-    source: str = "",
-) -> np.ndarray:
-    """Magnitude response of :func:`lowpass` (the designed filter's gain squared) at ``frequency_hz``."""
-    sos = check_cutoff(sample_rate_hz, cutoff_hz, order, setting=setting, rate_name=rate_name, source=source)
-    from scipy.signal import sosfreqz
-
-    _, h = sosfreqz(sos, worN=np.atleast_1d(np.asarray(frequency_hz, float)), fs=sample_rate_hz)
-    return np.abs(h) ** 2
