@@ -39,6 +39,7 @@ from loper_analysis.stages.logs import rule_log
 from loper_analysis.stages.markers import step as marker_steps
 from loper_analysis.stages.markers.step import MarkerSettings
 from loper_analysis.stages.report import step as report
+from tests.stages.events.loadcell_step import loadcell
 from tests.workflow_copy import snakemake
 
 PATHS = study_paths()
@@ -422,7 +423,7 @@ def test_load_cell_cutoff_above_the_robot_logs_nyquist_names_the_log_and_the_con
     out.write_text("time_s\tforce_measured_n\n0\t0\n")
     before = _digest(out)
     with pytest.raises(LoperInputError) as info:
-        event_steps.loadcell(belt_c3d, log_path, out, LoadcellSettings(sync_channel="Fz_left", cutoff_hz=40.0))
+        loadcell(belt_c3d, log_path, out, LoadcellSettings(sync_channel="Fz_left", cutoff_hz=40.0))
     assert str(info.value) == (
         f"{log_path}: markers.filter.cutoff_hz must lie in 0 .. 30 Hz (below the Nyquist frequency of "
         "the log's sample_rate_hz = 60 Hz), got 40 Hz"

@@ -38,6 +38,7 @@ from loper_analysis.stages.ik import step as ik
 from loper_analysis.stages.markers import step as marker_steps
 from loper_analysis.stages.markers.step import MarkerSettings
 from loper_analysis.stages.settings import stage_settings
+from tests.stages.events.loadcell_step import loadcell
 from tests.workflow_copy import snakemake
 
 PATHS = study_paths()
@@ -176,7 +177,7 @@ def _markers(cfg: dict, c3d: str, label_map=None):
 
 
 def _loadcell(cfg: dict, log: str = f"{RAW}/{WALK}.loper.tsv", c3d: str = f"{RAW}/{WALK}.c3d"):
-    return event_steps.loadcell(
+    return loadcell(
         c3d,
         log,
         fill(PATHS.events.force, subject=SUBJECT, trial=WALK),

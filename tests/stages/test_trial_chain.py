@@ -33,6 +33,7 @@ from loper_analysis.synthetic.trials import (
     subject_static_recording,
     walking_recording,
 )
+from tests.stages.events.loadcell_step import loadcell
 
 HEIGHT, MASS = 1.75, 70.0
 LAB = LabSettings()
@@ -67,7 +68,7 @@ def lab(tmp_path_factory):
     found = event_steps.events(
         d / "walk.c3d", d / "walk.events.tsv", EventSettings(grf_channels={"left": "Fz_left", "right": "Fz_right"})
     )
-    force = event_steps.loadcell(d / "walk.c3d", d / "walk.loper.tsv", d / "walk.force.tsv")
+    force = loadcell(d / "walk.c3d", d / "walk.loper.tsv", d / "walk.force.tsv")
     strides = stride_steps.strides(
         d / "walk.angles.tsv",
         d / "walk.events.tsv",
@@ -324,7 +325,7 @@ def test_events_and_loadcell_from_one_reading_write_the_bytes_of_the_two_steps(l
         EventSettings(grf_channels=grf),
         contacts_out=tmp_path / "alone.contacts.tsv",
     )
-    event_steps.loadcell(
+    loadcell(
         d / "walk.c3d", d / "walk.loper.tsv", tmp_path / "alone.force.tsv", native_out=tmp_path / "alone.native.tsv"
     )
     table, force = event_steps.events_loadcell(

@@ -1,4 +1,4 @@
-"""The file step of the impedance fit (loper_analysis.stages.impedance.step.fit) on files in tmp_path."""
+"""The file step of the impedance fit (loper_analysis.stages.impedance.step.subject_fits) on files in tmp_path."""
 
 from __future__ import annotations
 
@@ -15,7 +15,7 @@ from loper_analysis.impedance.identification.impedance import IdentificationSett
 from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.truth import write_truth
 from loper_analysis.stages.impedance.files import FitFiles, FitOutputs, TrialFiles
-from loper_analysis.stages.impedance.step import fit, subject_fits
+from loper_analysis.stages.impedance.step import subject_fits
 from loper_analysis.stages.settings import stage_settings
 
 
@@ -28,7 +28,7 @@ def test_onset_without_trials_writes_missing_rows(tmp_path):
     files = FitFiles(
         trials={}, segments=tmp_path / "segments.tsv", outputs=FitOutputs(*out), truth=tmp_path / "truth.yaml"
     )
-    rows = fit("S01", 175, files)
+    rows = subject_fits("S01", {175: files})
     assert (rows.status == "missing").all() and rows.K_nm_per_rad.isna().all()
     assert (rows.K_true_nm_per_rad == 40.0).all()
     assert all(p.is_file() for p in out)

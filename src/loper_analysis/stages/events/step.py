@@ -1,7 +1,7 @@
 """The ``events`` step: gait events of a trial, and the robot's load cell on the motion-capture clock.
 
-:func:`events` (a trial without the device), :func:`loadcell` and :func:`events_loadcell` (both from one
-reading of a trial with the device); their settings :class:`EventSettings` and
+:func:`events` (a trial without the device) and :func:`events_loadcell` (the events and the load cell's forces
+from one reading of a trial with the device); their settings :class:`EventSettings` and
 :class:`loper_analysis.device.loadcell.LoadcellSettings`, built from the config by
 :mod:`loper_analysis.stages.events.settings`.
 """
@@ -17,7 +17,7 @@ from loper_analysis.gait.trial_events import EventSettings, trial_events
 from loper_analysis.io.atomic import PathLike, write_tsv
 from loper_analysis.io.readers import read_label_maps
 
-__all__ = ["EventSettings", "events", "loadcell", "events_loadcell"]
+__all__ = ["EventSettings", "events", "events_loadcell"]
 
 log = logging.getLogger(__name__)
 
@@ -73,30 +73,6 @@ def _write_events(
 
 #: Significant digits of the robot-rate force table: its times need microseconds over long trials.
 NATIVE_FLOAT_FORMAT = "%.12g"
-
-
-def loadcell(
-    c3d_path: PathLike,
-    log_path: PathLike,
-    out_tsv: PathLike,
-    settings: LoadcellSettings = LoadcellSettings(),
-    native_out: PathLike | None = None,
-) -> pd.DataFrame:
-    """The robot log's forces on the mocap frames (sync-pulse clock map, low-pass, mocap rate).
-
-    ``settings`` (:class:`LoadcellSettings`): the C3D's sync channel, the forces' low-pass and the study's
-    perturbation force, which the desired pulses are checked against.
-
-    ``native_out``: also the same filtered forces at the robot log's own rate, on the mocap clock.
-    Nothing is written when the records are refused, among others for sync pulses whose high times
-    disagree between the robot log and the C3D (an inverted sync), a sync signal of noise, desired pulses far
-    from the perturbation force (forces in kN) or force pulses without perturbation
-    flags (:func:`loper_analysis.device.loadcell.robot_log_frames_and_native`).
-    """
-    from loper_analysis.io.c3d import read_c3d
-
-    out, native = _loadcell_of(read_c3d(c3d_path), log_path, settings)
-    return _write_loadcell(out, native, out_tsv, native_out)
 
 
 def _loadcell_of(rec, log_path, s: LoadcellSettings) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -157,7 +133,15 @@ def events_loadcell(
     event_settings: EventSettings = EventSettings(),
     loadcell_settings: LoadcellSettings = LoadcellSettings(),
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """:func:`events` and :func:`loadcell` of one trial with the device, from one reading of its C3D.
+    """:func:`events` of one trial with the device and the robot log's forces on the mocap frames (sync-pulse clock
+    map, low-pass, mocap rate), from one reading of its C3D.
+
+    ``loadcell_settings`` (:class:`LoadcellSettings`): the C3D's sync channel, the forces' low-pass and the study's
+    perturbation force, which the desired pulses are checked against. ``native_out``: the same filtered forces at
+    the robot log's own rate, on the mocap clock. The records are refused, among others, for sync pulses whose high
+    times disagree between the robot log and the C3D (an inverted sync), a sync signal of noise, desired pulses far
+    from the perturbation force (forces in kN) or force pulses without perturbation flags
+    (:func:`loper_analysis.device.loadcell.robot_log_frames_and_native`).
 
     Nothing is written unless both succeed. Returns the event table and the force table on the mocap frames.
     """

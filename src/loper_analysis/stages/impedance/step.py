@@ -1,6 +1,6 @@
 """File steps of the impedance analysis: the fit per subject and onset, the aggregate tables, the figures.
 
-:func:`fit` and :func:`subject_fits` read the files of a :class:`FitFiles` bundle (per trial a
+:func:`subject_fits` reads the files of a :class:`FitFiles` bundle (per trial a
 :class:`TrialFiles`, the outputs a :class:`FitOutputs`) with the settings :class:`FitSettings`
 (from the config by :mod:`loper_analysis.stages.impedance.settings`).
 """
@@ -24,7 +24,6 @@ from loper_analysis.stages.impedance.files import FitFiles
 
 __all__ = [
     "FitSettings",
-    "fit",
     "subject_fits",
     "impedance_table",
     "impedance_summary",
@@ -62,20 +61,16 @@ class _Tables:
         return self._frames[key]
 
 
-def fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings = FitSettings()) -> pd.DataFrame:
+def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, tables: _Tables) -> pd.DataFrame:
     """Responses and the impedance fit of one subject at one onset
-    (:func:`loper_analysis.impedance.identification.impedance.fit_onset`).
+    (:func:`loper_analysis.impedance.identification.impedance.fit_onset`), the subject's tables read through
+    ``tables`` (shared by its onsets).
 
     ``files`` (:class:`FitFiles`): the onset's trials, the null-pair trials, the segment table, the truth and
     the outputs; ``settings`` (:class:`FitSettings`): the response and identification settings. Writes the
     mean response, the stride counts, the fit rows, the fit curves and (when ``files.outputs.force`` is
     given) the mean forces the model saw; returns the rows.
     """
-    return _fit(subject, onset_ms, files, settings, _Tables())
-
-
-def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, tables: _Tables) -> pd.DataFrame:
-    """:func:`fit` with the subject's tables read through ``tables`` (shared by its onsets)."""
     from loper_analysis.impedance.identification.impedance import fit_onset
     from loper_analysis.io.opensim_tables import read_markers
     from loper_analysis.io.segment_table import read_segments
@@ -119,10 +114,12 @@ def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, ta
 
 
 def subject_fits(subject: str, fits: Mapping[int, FitFiles], settings: FitSettings = FitSettings()) -> pd.DataFrame:
-    """:func:`fit` of one subject at every onset in one process, each table read once.
+    """Responses and the impedance fit of one subject at every onset in one process, each table read once.
 
-    ``fits`` maps each onset (ms after toe-off) to its :class:`FitFiles`; the onsets are fitted in its
-    order. Returns every onset's fit rows.
+    ``fits`` maps each onset (ms after toe-off) to its :class:`FitFiles` (the onset's trials, the null-pair
+    trials, the segment table, the truth and the outputs); the onsets are fitted in its order. Writes per onset
+    the mean response, the stride counts, the fit rows, the fit curves and (when ``outputs.force`` is given)
+    the mean forces the model saw. Returns every onset's fit rows.
     """
     tables = _Tables()
     rows = [_fit(subject, int(onset), files, settings, tables) for onset, files in fits.items()]
