@@ -27,7 +27,7 @@ from loper_analysis.io.atomic import write_tsv
 from loper_analysis.io.segment_table import SEGMENT_FLOAT_FORMAT, read_segments, write_segments
 from loper_analysis.planning.covariance import StrideCovariance
 from loper_analysis.stages.strides import step as stride_steps
-from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, TRIAL_CONDITIONS, StudyDesign
+from loper_analysis.study_design import TRANSPARENCY_CONDITIONS, StudyDesign
 from tests.parameter_sets import ASYMMETRIC
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -79,8 +79,9 @@ def test_planning_takes_the_fit_s_t_quantile_with_the_same_numbers(dof):
 def test_condition_names_have_one_meaning():
     assert not hasattr(transparency, "CONDITIONS")
     assert TRANSPARENCY_CONDITIONS == ("no_device", "device")
-    assert set(TRANSPARENCY_CONDITIONS) <= set(TRIAL_CONDITIONS)
     design = StudyDesign()
+    conditions = {design.condition(trial) for trial in design.trials()}
+    assert conditions == {"static", *TRANSPARENCY_CONDITIONS, "perturbation", "device_test"}
     assert (design.condition(design.no_device), design.condition(design.device)) == TRANSPARENCY_CONDITIONS
 
 

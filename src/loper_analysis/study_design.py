@@ -26,7 +26,6 @@ __all__ = [
     "PULSE_FORCE_N",
     "SEED",
     "TRANSPARENCY_CONDITIONS",
-    "TRIAL_CONDITIONS",
     "StudyDesign",
     "perturbation_trial_name",
 ]
@@ -46,8 +45,6 @@ DEVICE_TESTS: tuple[str, ...] = ("device-frf", "device-steps")
 #: Conditions of the transparency pair, compared by :mod:`loper_analysis.transparency`: walking without the robot,
 #: and with it in minimal-impedance mode.
 TRANSPARENCY_CONDITIONS: tuple[str, ...] = ("no_device", "device")
-#: A trial's condition (:meth:`StudyDesign.condition`).
-TRIAL_CONDITIONS: tuple[str, ...] = ("static", *TRANSPARENCY_CONDITIONS, "perturbation", "device_test")
 _PERTURBATION_NAME = re.compile(r"^pert(\d{3})-([1-9]\d*)$")
 
 
@@ -104,7 +101,8 @@ class StudyDesign:
         return int(match.group(1))
 
     def condition(self, trial: str) -> str:
-        """The trial's condition (:data:`TRIAL_CONDITIONS`).
+        """The trial's condition: ``static``, ``no_device``, ``device`` (:data:`TRANSPARENCY_CONDITIONS`),
+        ``perturbation`` or ``device_test``.
 
         Raises
         ------
