@@ -8,7 +8,7 @@ from pathlib import Path
 import yaml
 
 from loper_analysis.layout import Study
-from loper_analysis.stages import study_paths
+from loper_analysis.stages import STAGES, study_paths
 from loper_analysis.stages.settings import stage_settings
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -17,15 +17,16 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 def study_on(tmp_path: Path, rows: dict, **config) -> Study:
     """The study of ``rows`` (subject -> sheet row) with the raw folder ``tmp_path/raw`` and the default config
-    with ``config``'s sections replaced; a C3D has plates unless it is ``walk-nodevice.c3d``; the notes said are
-    kept in ``study.said``."""
-    cfg = {**CONFIG, **config}
+    with the keys of ``config``'s sections replaced (``device={"subject": None}``); a C3D has plates unless it is
+    ``walk-nodevice.c3d``; the notes said are kept in ``study.said``."""
+    cfg = copy.deepcopy(CONFIG)
+    for section, keys in config.items():
+        cfg[section].update(keys)
     said: list[str] = []
     study = Study(
         rows,
-        stage_settings(cfg, "study").design,
+        {name: stage_settings(cfg, name) for name in ("study", *(stage.name for stage in STAGES))},
         study_paths(str(tmp_path / "raw")),
-        cfg,
         has_plates=lambda path: path.name != "walk-nodevice.c3d",
         note=said.append,
     )

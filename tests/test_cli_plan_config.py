@@ -32,8 +32,8 @@ SCHEMA = ROOT / "workflow" / "schemas" / "config.schema.yaml"
 def test_rule_takes_its_params_from_the_shared_builder():
     rules = ROOT / "workflow" / "rules"
     assert (
-        "SETTINGS = {stage.name: stage_settings(config, stage.name) for stage in STAGES}"
-        in (rules / "inputs.smk").read_text()
+        'SETTINGS = {name: stage_settings(config, name) for name in ("study", *(stage.name for stage in STAGES))}'
+        in (rules / "common.smk").read_text()
     )
     assert '**settings_params(SETTINGS["planning"]),' in (rules / "planning.smk").read_text()
     # the rule's script reads the pilot, its files and the one settings object, nothing else

@@ -380,8 +380,8 @@ def test_lab_session_settings_defaults_equal_config_synthetic():
     defaults = _defaults(LabSessionSettings)
     assert _mismatches(defaults, CONFIG, LAB_SESSION_KEYS) == []
     # the composed settings have their own checks (the design, the lab, the device); the study variability's
-    # fields are named as the config's but for the timing
-    assert set(defaults) - set(LAB_SESSION_KEYS) == {"design", "lab", "device", "study_variability"}
+    # fields are named as the config's but for the timing; the true impedance is the study's choice (None: none)
+    assert set(defaults) - set(LAB_SESSION_KEYS) == {"design", "lab", "device", "study_variability", "truth"}
     v, config = defaults["study_variability"], CONFIG["synthetic"]["study_variability"]
     names = ("amplitude_cv", "offset_sd_rad", "timing_sd_stride", "swing_gain", "knots_per_stride")
     ours = (v.amplitude_cv, v.offset_sd_rad, v.timing_sd, v.swing_gain, v.knots_per_stride)

@@ -34,6 +34,7 @@ from loper_analysis.cli_options import read_config
 from loper_analysis.cli_parser import STAGE_COMMANDS, build_parser
 from loper_analysis.errors import LoperInputError, one_line
 from loper_analysis.stages.planning.command import plan_pilot, plan_settings
+from loper_analysis.stages.settings import stage_settings
 
 __all__ = ["command_parser", "main"]
 
@@ -57,9 +58,10 @@ def _inspect(args: argparse.Namespace) -> None:
         print(inspect_c3d(args.c3d[0], args.model, args.marker_set, args.label_map_out, args.config_out).text, end="")
         return
     config, _ = read_config(args)
-    static_name = "static" if config is None else config["study"]["static"]
-    label_map = args.label_map or (None if config is None else config["markers"]["label_map"] or None)
-    cutoff = CUTOFF_HZ if config is None else config["markers"]["filter"]["cutoff_hz"]
+    marker_settings = None if config is None else stage_settings(config, "markers")
+    static_name = "static" if config is None else stage_settings(config, "study").design.static
+    label_map = args.label_map or (None if marker_settings is None else marker_settings.label_map)
+    cutoff = CUTOFF_HZ if marker_settings is None else marker_settings.cutoff_hz
     check = _scaling_dry_run(config)
     try:
         result = inspect_subject(args.c3d, args.config_out, static_name, label_map, cutoff, check)

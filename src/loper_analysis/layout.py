@@ -21,6 +21,7 @@ import string
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -127,13 +128,12 @@ class Study:
     ----------
     rows : mapping
         Subject -> its subject-sheet row (``source``, optional ``model_osim``, ``mass_kg``, ``height_m``).
-    design : StudyDesign
-        The trial design.
+    settings : mapping
+        Stage name -> its settings, as its reader builds them (:func:`loper_analysis.stages.settings.stage_settings`;
+        ``"study"``: the study's). Read here: the study's design and subject sheet, the device tests' subject,
+        the generic model, the markers' label maps, the planner's pilot and the events' belt channels.
     paths : Paths
         The file patterns.
-    config : mapping
-        The workflow's config (the keys read: ``trials``, ``events``, ``impedance.noise_model``,
-        ``device.subject``, ``validation``, ``planning.pilot_subject``).
     has_plates : callable
         ``has_plates(path) -> bool``: whether a C3D has force platforms (read once per file).
     note : callable
@@ -141,12 +141,16 @@ class Study:
     """
 
     rows: Mapping[str, Mapping]
-    design: StudyDesign
+    settings: Mapping[str, Any]
     paths: Paths
-    config: Mapping
     has_plates: Callable[[Path], bool]
     note: Callable[[str], None] = print
     _plates: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def design(self) -> StudyDesign:
+        """The trial design (the study's settings)."""
+        return self.settings["study"].design
 
     # --- subjects and trials -------------------------------------------------------------------------------
     def source(self, subject: str) -> str:
@@ -197,7 +201,7 @@ class Study:
             if not self._plates[key]:
                 self.note(
                     f"note: {path}: no force platforms (FORCE_PLATFORM:USED 0 or absent): events from the belt "
-                    f"channels (events.grf_channels: {self.config['events']['grf_channels']}), no OpenSim "
+                    f"channels (events.grf_channels: {self.settings['events'].events.grf_channels}), no OpenSim "
                     f"external loads ({fill(self.paths.grf.mot, subject=subject, trial=trial)}) for this trial"
                 )
         return self._plates[key]
@@ -209,7 +213,7 @@ class Study:
 
     def generic_model(self, subject: str) -> str:
         """The model scaled per subject: model.generic_model, or the generated model for the subject."""
-        return self.config["model"]["generic_model"] or fill(self.paths.model.generic, subject=subject)
+        return self.settings["model"].generic_model or fill(self.paths.model.generic, subject=subject)
 
     def static_markers(self, subject: str) -> list[str]:
         """The static trial's TRC of a subject with a static trial (generated for a synthetic subject, on disk for a
@@ -241,7 +245,7 @@ class Study:
 
     def device_log(self, trial: str) -> str | list:
         """The robot log of a device test (none without a device subject)."""
-        subject = self.config["device"]["subject"]
+        subject = self.settings["device"].subject
         if subject is None:
             return []
         mat = fill(self.paths.raw.mat, subject=subject, trial=trial)
@@ -252,10 +256,7 @@ class Study:
     def label_maps(self, trial: str) -> list:
         """The label maps of a trial, merged in this order: markers.label_map, then its kind's and its own from
         markers.trial_label_maps (each inline, a mapping, or a file, a path)."""
-        markers = self.config["markers"]
-        per_trial = markers["trial_label_maps"]
-        maps = [markers["label_map"], per_trial.get(self.design.kind(trial)), per_trial.get(trial)]
-        return [m for m in maps if m]
+        return self.settings["markers"].label_maps(trial, self.design.kind(trial))
 
     def recorded_checksums(self, paths: list[str]) -> dict[str, str]:
         """Path -> content checksum of the raw files among ``paths`` of recorded subjects (generated raw files
@@ -289,15 +290,16 @@ class Study:
         subjects = self.processed_subjects() if subject is None else [subject]
         return [fill(pattern, subject=s, onset=o) for s in subjects for o in self.design.perturbation_onsets_ms]
 
-    def planning_pilot(self, source: str = "planning.pilot_subject") -> str:
-        """The pilot subject: planning.pilot_subject, else the first processed subject."""
-        pilot = self.config["planning"]["pilot_subject"]
+    def planning_pilot(self, source: str = "planning.pilot_subject", sheet: str | None = None) -> str:
+        """The pilot subject: planning.pilot_subject, else the first processed subject. ``source``: the file or
+        option that set the key; ``sheet``: the subject sheet's name (the study's by default)."""
+        pilot = self.settings["planning"].pilot_subject
         if pilot is None:
             return self.processed_subjects()[0]
         if pilot not in self.processed_subjects():
             raise LoperInputError(
                 f"{source}: key 'planning.pilot_subject': subject '{pilot}' is not a processed subject of "
-                f"{self.config['subjects']}"
+                f"{sheet or self.settings['study'].subjects}"
             )
         return pilot
 
@@ -313,4 +315,4 @@ class Study:
 
     def has_device_tests(self) -> bool:
         """Whether the device tests are built: with a device subject (device.subject not null)."""
-        return self.config["device"]["subject"] is not None
+        return self.settings["device"].subject is not None

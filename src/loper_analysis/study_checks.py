@@ -22,7 +22,6 @@ from loper_analysis.io.raw_files import (
 from loper_analysis.layout import RAW_FILES, Study, fill
 from loper_analysis.schema import check_table
 from loper_analysis.stages import RESULT_FILES, study_paths
-from loper_analysis.synthetic.subjects import true_impedance
 
 __all__ = [
     "NAME_MAX",
@@ -109,20 +108,12 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
     LoperInputError
         Naming the sheet or the config file, the subject, the column or key and the value.
     """
-    c, static = study.config, study.design.static
+    settings, static = study.settings, study.design.static
+    truth = settings["synthetic"].truth
     for s, row in study.rows.items():
         c3d = fill(study.paths.raw.c3d, subject=s, trial=static)
         if row["source"] == "synthetic":  # the truth must lie inside the identification bounds
-            synth, ident = c["synthetic"], c["impedance"]
-            true_impedance(
-                s,
-                c["seed"],
-                synth["stiffness_nm_per_rad"],
-                synth["damping_nms_per_rad"],
-                synth["between_subject_cv"],
-                ident["stiffness_bounds_nm_per_rad"],
-                ident["damping_bounds_nms_per_rad"],
-            )
+            truth.of(s, settings["study"].seed)
         elif "model_osim" in row:  # an already scaled model: no static trial, no scaling
             if not Path(row["model_osim"]).is_file():
                 raise LoperInputError(
@@ -133,20 +124,20 @@ def check_subjects(study: Study, sheet: str, source: Callable[..., str]) -> None
                 f"{sheet}: recorded subject '{s}' has no static trial {c3d} (raw files are named "
                 f"{study.paths.raw.c3d}), nor a scaled model (column model_osim)"
             )
-        elif c["model"]["generic_model"] is None and "height_m" not in row:
+        elif settings["model"].generic_model is None and "height_m" not in row:
             raise LoperInputError(
                 f"{sheet}: recorded subject '{s}' needs height_m: the generated model "
-                f"({source('opensim', 'generic_model')}: model.generic_model null) is built from height "
+                f"({source('model', 'generic_model')}: model.generic_model null) is built from height "
                 "(a lab's model, such as gait2392, needs none)"
             )
-    onsets = {int(o) for o in c["synthetic"]["stiffness_nm_per_rad"]}
+    onsets = {int(o) for o in truth.stiffness_nm_per_rad}
     missing = set(study.design.perturbation_onsets_ms) - onsets
     if any(r["source"] == "synthetic" for r in study.rows.values()) and missing:
         raise LoperInputError(
             f"{source('synthetic', 'stiffness_nm_per_rad')}: key 'synthetic.stiffness_nm_per_rad': no truth "
             f"for onset(s) {sorted(missing)} ms of study.perturbation_onsets_ms"
         )
-    device = c["device"]["subject"]
+    device = settings["device"].subject
     if device is not None and device not in study.rows:
         raise LoperInputError(
             f"{source('device', 'subject')}: key 'device.subject': subject '{device}' is not in {sheet}"
@@ -167,7 +158,7 @@ def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
     """
     if sheet is not None:
         check_recordings(study, sheet)
-    said, trials, t = [], study.design.trials(), study.config["study"]
+    said, trials, design = [], study.design.trials(), study.design
     for s in (s for s, row in study.rows.items() if row["source"] == "recorded"):
         raw = study.paths.raw_folder(s)
         for trial in trials:
@@ -189,8 +180,8 @@ def raw_file_warnings(study: Study, sheet: str | None = None) -> list[str]:
             said.append(
                 f"warning: {raw}: {', '.join(unmatched)}: no trial of the design has this name, not analysed "
                 f"(trials: {', '.join(trials)}; from study.static, study.no_device, study.device, "
-                f"study.perturbation_onsets_ms {t['perturbation_onsets_ms']} and study.perturbation_repeats "
-                f"{t['perturbation_repeats']})"
+                f"study.perturbation_onsets_ms {list(design.perturbation_onsets_ms)} and study.perturbation_repeats "
+                f"{design.perturbation_repeats})"
             )
     return said
 

@@ -75,8 +75,8 @@ def test_the_scale_report_takes_the_ik_tolerances_and_coordinate_map():
     the IK's, each tolerance for its own solver."""
     model, ik = stage_settings(_changed(), "model"), stage_settings(_changed(), "ik")
     assert (ik.tree_step_tolerance, ik.opensim_accuracy, ik.coordinate_map) == (1e-8, 1e-7, MAP)
-    assert (model.accuracy, model.coordinate_map) == ((1e-8, 1e-7), MAP)
-    assert model.for_scaling().accuracy == (1e-8, 1e-7)
+    assert (model.tree_step_tolerance, model.opensim_accuracy, model.coordinate_map) == (1e-8, 1e-7, MAP)
+    assert (model.for_scaling().tree_step_tolerance, model.for_scaling().opensim_accuracy) == (1e-8, 1e-7)
 
 
 @pytest.mark.parametrize("key", ["tree_step_tolerance", "opensim_accuracy", "geometry_stop_change", "ik_tasks"])

@@ -43,7 +43,8 @@ def test_every_config_key_reaches_its_field():
         side="right",
         attachment_fraction=0.6,
         coordinate_map=MAP,
-        accuracy=(1e-8, 1e-7),
+        tree_step_tolerance=1e-8,
+        opensim_accuracy=1e-7,
     )
     assert isinstance(settings.rotation_deg, tuple) and isinstance(settings.factor_range[0], float)
 

@@ -21,24 +21,7 @@ from tests.study_files import CONFIG
 READERS = ["study", *(stage.name for stage in STAGES)]
 #: Keys of the shipped config that no settings reader reads: the workflow's own (the rules' layout and the raw
 #: folders' checks read them); each with where it is read.
-NOT_SETTINGS = {
-    "model.generic_model": "layout.Study.generic_model",
-    "model.scale_setup": "the model rules' inputs",
-    "ik.ik_chunks": "the ik rules' chunks",
-    "device.subject": "layout.Study.device_log",
-    "markers.label_map": "layout.Study.label_maps",
-    "markers.trial_label_maps": "layout.Study.label_maps",
-    "markers.trial_spans_s": "the markers rule's settings",
-    "planning.pilot_subject": "layout.Study.planning_pilot",
-    "validation.n_chunks": "the validation rules' chunks",
-    "synthetic.stiffness_nm_per_rad": "the synthetic truth rule",
-    "synthetic.damping_nms_per_rad": "the synthetic truth rule",
-    "synthetic.between_subject_cv": "the synthetic truth rule",
-    "validation.subject_height_m": "the validation segments rule",
-    "validation.subject_mass_kg": "the validation segments rule",
-    "validation.attachment_fraction_of_thigh": "the validation segments rule",
-    "device.mat_column_map": "the device's .mat conversion rule",
-}
+NOT_SETTINGS: dict[str, str] = {}
 
 
 class _Recording(Mapping):

@@ -30,7 +30,11 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 def test_the_defaults_are_the_configs():
     assert stage_settings(CONFIG, "synthetic").lab == LabSettings()
-    assert stage_settings(CONFIG, "synthetic") == LabSessionSettings()
+    # the true impedance is the study's choice (no default of the library): the config's, inside the fit's bounds
+    settings = stage_settings(CONFIG, "synthetic")
+    assert settings.truth.stiffness_nm_per_rad["50"] == [55.0, 3.0, 8.0] and settings.truth.between_subject_cv == 0.15
+    assert settings.truth.stiffness_bounds_nm_per_rad == (0.0, 200.0)
+    assert dataclasses.replace(settings, truth=None) == LabSessionSettings()
     assert LabExportSettings.from_config(CONFIG) == LabExportSettings()
 
 

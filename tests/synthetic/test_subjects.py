@@ -9,7 +9,7 @@ from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.truth import read_truth
 from loper_analysis.stages.synthetic.step import truth as truth_step
-from loper_analysis.synthetic.subjects import subject_anthropometry, true_impedance
+from loper_analysis.synthetic.subjects import ImpedanceTruth, subject_anthropometry, true_impedance
 
 K = {50: [55, 3, 8], 175: [38, 0.5, 8]}
 D = {50: [3.5, 0.1, 0.3], 175: [2.2, 0.04, 0.3]}
@@ -50,7 +50,7 @@ def test_true_impedance_scatters_about_the_group_values(truth):
 
 def test_truth_step_writes_the_true_impedance(tmp_path, anthropometry, truth):
     path = tmp_path / "S07" / "truth.yaml"
-    returned = truth_step(path, anthropometry, K, D, 0.15, (0.0, 200.0), (0.0, 10.0), 2024)
+    returned = truth_step(path, anthropometry, ImpedanceTruth(K, D, 0.15, (0.0, 200.0), (0.0, 10.0)), 2024)
     assert returned == truth
     assert read_truth(path) == truth
 

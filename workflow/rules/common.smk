@@ -20,7 +20,7 @@ from loper_analysis.stages.cluster_failures import requested_partitions
 from loper_analysis.study_checks import check_subject_sheet, check_subjects, raw_file_warnings
 from loper_analysis.stages.settings import stage_settings
 from loper_analysis.study_design import DEVICE_TESTS
-from loper_analysis.stages import study_paths
+from loper_analysis.stages import STAGES, study_paths
 
 _SCHEMAS = Path(workflow.basedir) / "workflow" / "schemas"
 
@@ -44,7 +44,9 @@ try:
     check_config(config, _SCHEMAS / "config.schema.yaml", "config/config.yaml", CONFIG_LAYERS)
     validate(config, "../schemas/config.schema.yaml")
     check_project_paths(config, Path.cwd(), lambda key_path: config_source(*key_path))  # allow_outside_project
-    _subjects_path = Path(config["subjects"])
+    #: every stage's settings, each built by its stage's reader (loper_analysis.stages.settings)
+    SETTINGS = {name: stage_settings(config, name) for name in ("study", *(stage.name for stage in STAGES))}
+    _subjects_path = Path(SETTINGS["study"].subjects)
     if not _subjects_path.is_file():
         raise LoperInputError(f"{config_source('subjects')}: key 'subjects': file '{_subjects_path}' not found")
     subjects = read_subject_sheet(_subjects_path)
@@ -70,12 +72,12 @@ def _plates(path) -> bool:
 
 
 #: Every file's path (loper_analysis.layout): PATHS the patterns, STUDY the subjects' trials, bundles and targets.
-PATHS = study_paths(config["raw_dir"])
+PATHS = study_paths(SETTINGS["study"].raw_dir)
 try:
     #: subject -> its sheet row (a synthetic subject's missing anthropometrics drawn from the study's subjects)
-    SUBJECT_ROWS = subject_rows(subjects, config["seed"])
+    SUBJECT_ROWS = subject_rows(subjects, SETTINGS["study"].seed)
     SUBJECT_SOURCE = {s: row["source"] for s, row in SUBJECT_ROWS.items()}
-    STUDY = Study(SUBJECT_ROWS, stage_settings(config, "study").design, PATHS, config, _plates, _note)
+    STUDY = Study(SUBJECT_ROWS, SETTINGS, PATHS, _plates, _note)
     DESIGN = STUDY.design
     check_subjects(STUDY, str(_subjects_path), config_source)
     for _line in raw_file_warnings(STUDY, str(_subjects_path)):  # and check_recordings
@@ -84,7 +86,7 @@ except LoperInputError as exc:
     raise WorkflowError(str(exc)) from None
 _synthetic = [s for s, src in SUBJECT_SOURCE.items() if src == "synthetic"]
 SYNTHETIC_PATTERN = "|".join(_synthetic) if _synthetic else "(?!)"
-VALIDATION_CHUNKS = [f"{i:03d}" for i in range(config["validation"]["n_chunks"])]
+VALIDATION_CHUNKS = [f"{i:03d}" for i in range(SETTINGS["validation"].n_chunks)]
 
 
 wildcard_constraints:

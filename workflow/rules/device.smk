@@ -24,7 +24,7 @@ rule device_trial:
         **settings_params(SETTINGS["device"].parameters, "device"),
         **settings_params(SETTINGS["device"].leg, "leg"),
         **settings_params(SETTINGS["device"].tests, "tests"),
-        seed=config["seed"],
+        seed=SETTINGS["study"].seed,
     script:
         "../scripts/device_trial.py"
 
@@ -40,7 +40,7 @@ rule device_log_from_mat:
         PATHS.benchmark("device_log_from_mat", "{subject}/{trial}")
     params:
         **raw_checksums(PATHS.raw.mat),
-        column_map=DEVICE["mat_column_map"],
+        column_map=SETTINGS["device"].mat_column_map,
         sample_rate_hz=SETTINGS["device"].parameters.sample_rate_hz,
     script:
         "../scripts/device_log_from_mat.py"

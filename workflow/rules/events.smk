@@ -16,7 +16,7 @@ rule events:
     benchmark:
         PATHS.benchmark("events", "{subject}/{trial}")
     wildcard_constraints:
-        trial=TRIALS["no_device"],
+        trial=DESIGN.no_device,
     group:
         "trial"
     params:
@@ -45,7 +45,7 @@ rule events_loadcell:
         PATHS.benchmark("events_loadcell", "{subject}/{trial}")
     wildcard_constraints:
         # any trial but the one without the device (the lookahead ends at the wildcard's end, not the path's)
-        trial=f"(?!{re.escape(TRIALS['no_device'])}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
+        trial=f"(?!{re.escape(DESIGN.no_device)}(?![A-Za-z0-9-]))[A-Za-z0-9-]+",
     group:
         "trial"
     params:

@@ -1,7 +1,7 @@
 # Inverse kinematics (OpenSim): joint angles per trial, in one job or in time chunks joined.
 
 
-if IK["ik_chunks"] == 1:
+if SETTINGS["ik"].n_chunks == 1:
 
     rule ik:
         """The whole trial in one job (the default): IK, .mot and angle table (the marker geometry checked against
@@ -45,7 +45,7 @@ else:
             "trial"
         params:
             **settings_params(ik_settings),
-            n_chunks=IK["ik_chunks"],
+            n_chunks=SETTINGS["ik"].n_chunks,
         script:
             "../scripts/ik_chunk.py"
 

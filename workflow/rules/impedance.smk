@@ -73,8 +73,8 @@ rule impedance_summary:
     benchmark:
         PATHS.benchmark("impedance_summary", "summary")
     params:
-        upper_bounds=(IDENT["stiffness_bounds_nm_per_rad"][1], IDENT["damping_bounds_nms_per_rad"][1]),
-        lower_bounds=(IDENT["stiffness_bounds_nm_per_rad"][0], IDENT["damping_bounds_nms_per_rad"][0]),
+        upper_bounds=fit_bounds(1),
+        lower_bounds=fit_bounds(0),
     script:
         "../scripts/impedance_summary.py"
 
@@ -103,7 +103,7 @@ rule impedance_figures:
     benchmark:
         PATHS.benchmark("impedance_figures", "{subject}")
     params:
-        onsets=TRIALS["perturbation_onsets_ms"],
+        onsets=list(DESIGN.perturbation_onsets_ms),
     script:
         "../scripts/impedance_figures.py"
 

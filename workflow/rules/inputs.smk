@@ -1,25 +1,10 @@
-# The rules' settings from the config, and their input functions: each asks STUDY (loper_analysis.layout).
+# The rules' settings (SETTINGS, built in common.smk by each stage's reader) and their input functions: each asks
+# STUDY (loper_analysis.layout).
 
 import dataclasses
 
-from loper_analysis.stages import STAGES
-from loper_analysis.stages.settings import stage_settings
-
-# the config's sections
-TRIALS = config["study"]
-MODEL = config["model"]
-IK = config["ik"]
-IDENT = config["impedance"]
-DEVICE = config["device"]
-SYNTH = config["synthetic"]
-IK_CHUNKS = [f"{i:03d}" for i in range(IK["ik_chunks"])]
-ONSETS = [f"{o:03d}" for o in TRIALS["perturbation_onsets_ms"]]
-
-# every stage's settings, each built by its stage's reader (loper_analysis.stages.settings)
-try:
-    SETTINGS = {stage.name: stage_settings(config, stage.name) for stage in STAGES}
-except LoperInputError as exc:
-    raise WorkflowError(str(exc)) from None
+IK_CHUNKS = [f"{i:03d}" for i in range(SETTINGS["ik"].n_chunks)]
+ONSETS = [f"{o:03d}" for o in DESIGN.perturbation_onsets_ms]
 
 
 def settings_params(settings, name: str = "settings") -> dict:
@@ -31,6 +16,12 @@ def settings_params(settings, name: str = "settings") -> dict:
     return {name: settings, f"{name}_repr": repr(settings)}
 
 
+def fit_bounds(end: int) -> tuple[float, float]:
+    """The fit's (stiffness, damping) bound at ``end`` 0 (lower) or 1 (upper), N·m/rad and N·m·s/rad."""
+    fit = SETTINGS["impedance"].identification
+    return (fit.stiffness_bounds_nm_per_rad[end], fit.damping_bounds_nms_per_rad[end])
+
+
 def label_map_files(wildcards) -> list[str]:
     """The label-map files among a trial's maps (inputs, so that a changed file reruns the trial)."""
     return [m for m in STUDY.label_maps(wildcards.trial) if isinstance(m, str)]
@@ -38,14 +29,8 @@ def label_map_files(wildcards) -> list[str]:
 
 def marker_settings(wildcards):
     """A trial's marker settings: its label maps and span; the static trial neither filled nor filtered."""
-    spans = config["markers"]["trial_spans_s"]
-    span = spans.get(f"{wildcards.subject}/{wildcards.trial}", spans.get(wildcards.trial))
-    settings = dataclasses.replace(
-        SETTINGS["markers"],
-        label_map=tuple(STUDY.label_maps(wildcards.trial)) or None,
-        span_s=None if span is None else tuple(span),
-    )
-    return settings.for_static() if wildcards.trial == TRIALS["static"] else settings
+    settings = SETTINGS["markers"].for_trial(wildcards.subject, wildcards.trial, DESIGN.kind(wildcards.trial))
+    return settings.for_static() if wildcards.trial == DESIGN.static else settings
 
 
 def event_settings(wildcards):
@@ -62,7 +47,7 @@ def ik_settings(wildcards):
 def trial_group(wildcards) -> str:
     """Cluster job group (ignored locally): a walking trial's markers, IK, events and strides run as one SLURM
     job ("trial"); the static trial's markers join the subject's scaling ("model")."""
-    return "model" if wildcards.trial == TRIALS["static"] else "trial"
+    return "model" if wildcards.trial == DESIGN.static else "trial"
 
 
 def raw_checksums(*files) -> dict:

@@ -37,7 +37,7 @@ rule model_scaled:
         static_summary=fill(PATHS.markers.summary, trial=DESIGN.static),
         static_lab_angles=fill(PATHS.markers.lab_angles, trial=DESIGN.static),
         static_c3d=by_subject(STUDY.static_c3d_for_scaling),
-        setup=[MODEL["scale_setup"]] if MODEL["scale_setup"] else [],
+        setup=[SETTINGS["model"].scale_setup] if SETTINGS["model"].scale_setup else [],
     output:
         model=PATHS.model.scaled,
         report=report(
@@ -58,7 +58,7 @@ rule model_scaled:
         **raw_checksums(by_subject(STUDY.static_c3d_for_scaling)),
         mass_kg=lambda wc: SUBJECT_ROWS[wc.subject].get("mass_kg"),
         height_m=lambda wc: SUBJECT_ROWS[wc.subject].get("height_m"),
-        scale_setup=MODEL["scale_setup"],
+        scale_setup=SETTINGS["model"].scale_setup,
     script:
         "../scripts/model_scaled.py"
 

@@ -17,13 +17,9 @@ rule synthetic_truth:
     wildcard_constraints:
         subject=SYNTHETIC_PATTERN,
     params:
+        **settings_params(SETTINGS["synthetic"].truth, "truth"),
         row=lambda wc: SUBJECT_ROWS[wc.subject],
-        stiffness=SYNTH["stiffness_nm_per_rad"],
-        damping=SYNTH["damping_nms_per_rad"],
-        cv=SYNTH["between_subject_cv"],
-        stiffness_bounds=config["impedance"]["stiffness_bounds_nm_per_rad"],
-        damping_bounds=config["impedance"]["damping_bounds_nms_per_rad"],
-        seed=config["seed"],
+        seed=SETTINGS["study"].seed,
     script:
         "../scripts/synthetic_truth.py"
 

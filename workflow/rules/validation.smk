@@ -17,9 +17,9 @@ rule validation_segments:
     benchmark:
         PATHS.benchmark("validation_segments", "segments")
     params:
-        height_m=config["validation"]["subject_height_m"],
-        mass_kg=config["validation"]["subject_mass_kg"],
-        attachment_fraction=config["validation"]["attachment_fraction_of_thigh"],
+        height_m=SETTINGS["validation"].subject_height_m,
+        mass_kg=SETTINGS["validation"].subject_mass_kg,
+        attachment_fraction=SETTINGS["validation"].attachment_fraction_of_thigh,
     script:
         "../scripts/validation_segments.py"
 
@@ -36,7 +36,7 @@ rule validation_chunk:
         PATHS.benchmark("validation_chunk", "{chunk}")
     params:
         **settings_params(SETTINGS["validation"]),
-        n_chunks=config["validation"]["n_chunks"],
+        n_chunks=SETTINGS["validation"].n_chunks,
     script:
         "../scripts/validation_chunk.py"
 

@@ -4,6 +4,4 @@ with rule_log(snakemake.log[0]):
     from loper_analysis.stages.synthetic import step as synthetic
 
     p = snakemake.params
-    synthetic.truth(
-        snakemake.output[0], p.row, p.stiffness, p.damping, p.cv, p.stiffness_bounds, p.damping_bounds, p.seed
-    )
+    synthetic.truth(snakemake.output[0], p.row, p.truth, p.seed)

@@ -37,7 +37,6 @@ from loper_analysis.motion.markers import frames_with_markers, require_markers_p
 __all__ = [
     "OPENSIM_ACCURACY",
     "TREE_STEP_TOLERANCE",
-    "IK_ACCURACY",
     "IK_SOLVER",
     "IK_SOLVERS",
     "IKResult",
@@ -59,9 +58,6 @@ TREE_STEP_TOLERANCE: float = 1e-6
 #: Accuracy of OpenSim's ``InverseKinematicsSolver`` (config ``ik.opensim_accuracy``): unitless, roughly the
 #: number of correct digits asked of the weighted objective's minimum (OpenSim's own default is 1e-5).
 OPENSIM_ACCURACY: float = 1e-6
-#: Both solvers' tolerances at once, ``(TREE_STEP_TOLERANCE, OPENSIM_ACCURACY)``: the default of the model stage's
-#: static pose (:attr:`loper_analysis.motion.model_settings.ModelSettings.accuracy`).
-IK_ACCURACY: tuple[float, float] = (TREE_STEP_TOLERANCE, OPENSIM_ACCURACY)
 
 
 #: The IK solvers (config ``ik.ik_solver``): the model's kinematic tree (:mod:`loper_analysis.motion.tree_ik`)

@@ -60,6 +60,9 @@ class IKSettings:
         of the subject sheet, the command line's ``--model``): its markers may then sit elsewhere than on the
         subject, and a change against them beyond ``geometry_stop_change`` is a warning, unless the distances
         differ by a factor beyond 1.5 (a unit). A comparison with the static trial stops whatever the model.
+    n_chunks : int
+        The time chunks a trial's IK is split into, one job each, joined afterwards (``ik.ik_chunks``; 1: one
+        job per trial).
     """
 
     tasks_file: str | os.PathLike | None = None
@@ -77,10 +80,4 @@ class IKSettings:
     geometry_warn_change: float = GEOMETRY_WARN_CHANGE
     geometry_stop_change: float = GEOMETRY_STOP_CHANGE
     subjects_model: bool = True
-
-    @property
-    def accuracy(self) -> tuple[float, float]:
-        """``(tree_step_tolerance, opensim_accuracy)``: both solvers' tolerances at once, as the model stage's
-        reader passes the IK's to its static pose
-        (:attr:`loper_analysis.motion.model_settings.ModelSettings.accuracy`)."""
-        return (self.tree_step_tolerance, self.opensim_accuracy)
+    n_chunks: int = 1

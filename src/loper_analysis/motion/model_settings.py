@@ -7,7 +7,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
-from loper_analysis.motion.ik import IK_ACCURACY, IK_SOLVER
+from loper_analysis.motion.ik import IK_SOLVER, OPENSIM_ACCURACY, TREE_STEP_TOLERANCE
 from loper_analysis.motion.plausibility import SCALE_FACTOR_RANGE
 from loper_analysis.study_design import PERTURBED_SIDE
 from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION
@@ -54,10 +54,17 @@ class ModelSettings:
     coordinate_map : mapping, optional
         Our angle -> model coordinate and sign, for the static pose of the scale report
         (``ik.coordinate_map``); None: :data:`loper_analysis.motion.ik.DEFAULT_COORDINATE_MAP`.
-    accuracy : float
-        IK solver accuracy of the scale report's static pose (``ik.accuracy``).
+    tree_step_tolerance, opensim_accuracy : float
+        The tree solver's step tolerance (rad or m) and OpenSim's solver's unitless accuracy for the scale report's
+        static pose (``ik.tree_step_tolerance``, ``ik.opensim_accuracy``).
     solver : str
         IK solver of the scale report's static pose (``ik.ik_solver``).
+    generic_model : str, optional
+        The OpenSim model scaled per subject (``model.generic_model``); None: a sagittal model generated per
+        subject.
+    scale_setup : str, optional
+        An OpenSim ScaleTool setup file whose measurements, marker pairs and time range scaling follows
+        (``model.scale_setup``); None: the measurements of the model's kind.
     """
 
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
@@ -69,8 +76,11 @@ class ModelSettings:
     side: str = PERTURBED_SIDE
     attachment_fraction: float = BRACE_ATTACHMENT_FRACTION
     coordinate_map: Mapping[str, Mapping] | None = None
-    accuracy: float = IK_ACCURACY
+    tree_step_tolerance: float = TREE_STEP_TOLERANCE
+    opensim_accuracy: float = OPENSIM_ACCURACY
     solver: str = IK_SOLVER
+    generic_model: str | None = None
+    scale_setup: str | None = None
 
     def for_generic(self) -> ModelSettings:
         """What the generated model reads (the static trial's window and vertical, for a mass from its plates),

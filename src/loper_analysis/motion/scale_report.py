@@ -490,8 +490,8 @@ def scale_run_report(
         Mass (kg), height (m), where they came from, the model's stature (m)
         (:func:`loper_analysis.motion.scaling.scaled_subject`).
     settings : ModelSettings
-        ``coordinate_map``, ``accuracy`` (the IK's ``(tree_step_tolerance, opensim_accuracy)``) and ``solver``
-        of the static pose's IK.
+        ``coordinate_map``, ``tree_step_tolerance``, ``opensim_accuracy`` and ``solver`` of the static pose's
+        IK.
     lab_labels : mapping, optional
         Model marker -> the lab's label.
     lab_angles : pandas.DataFrame, optional
@@ -511,7 +511,6 @@ def scale_run_report(
     if unplaced is None and run.tasks is not None:
         unplaced = generic  # placement without scaling: the generic markers are the ones placed
     lab_static = None if lab_angles is None else window_means(lab_angles, run.window_s)
-    tree_step_tolerance, opensim_accuracy = settings.accuracy
     return scaled_model_report(
         run.scaled,
         unplaced,
@@ -519,8 +518,8 @@ def scale_run_report(
         (run.factors, run.tasks),
         subject[:3],
         coordinate_map=settings.coordinate_map,
-        tree_step_tolerance=tree_step_tolerance,
-        opensim_accuracy=opensim_accuracy,
+        tree_step_tolerance=settings.tree_step_tolerance,
+        opensim_accuracy=settings.opensim_accuracy,
         solver=settings.solver,
         lab_labels=lab_labels,
         lab_static=lab_static,

@@ -41,7 +41,9 @@ class MarkerSettings:
     (Hz; None or 0: none); ``extent_range_m``: the markers' largest distance (m) a file in the declared unit
     can have; ``label_map``: {lab label: model marker}, a file, or a sequence of them merged in order;
     ``span_s``: (start, end) on the file's clock (s) or None; ``duration_s``: keep the first seconds or None;
-    ``required_markers``: model markers that must be found, or None.
+    ``required_markers``: model markers that must be found, or None; ``trial_label_maps``: a trial kind's or
+    trial's label map (by kind or name) added to ``label_map``, and ``trial_spans_s``: a trial's span (by
+    ``{subject}/{trial}`` or trial name), both for :meth:`for_trial` (empty: none).
     """
 
     rotation_deg: tuple[float, float, float] = LAB_TO_MODEL_ROTATION_DEG
@@ -55,6 +57,27 @@ class MarkerSettings:
     span_s: tuple[float, float] | None = None
     duration_s: float | None = None
     required_markers: tuple[str, ...] | None = None
+    trial_label_maps: Mapping[str, Mapping[str, str] | str] = dataclasses.field(default_factory=dict)
+    trial_spans_s: Mapping[str, Sequence[float]] = dataclasses.field(default_factory=dict)
+
+    def label_maps(self, trial: str, kind: str) -> list:
+        """The label maps of ``trial`` (of kind ``kind``), merged in this order: ``label_map``, then the kind's and
+        the trial's of ``trial_label_maps`` (each a mapping or a file's path)."""
+        per_trial = self.trial_label_maps
+        return [m for m in (self.label_map, per_trial.get(kind), per_trial.get(trial)) if m]
+
+    def for_trial(self, subject: str, trial: str, kind: str) -> MarkerSettings:
+        """The settings of one trial: its label maps (:meth:`label_maps`) as ``label_map``, its span as ``span_s``
+        (``trial_spans_s`` by ``{subject}/{trial}``, else by trial name), no per-trial tables."""
+        spans = self.trial_spans_s
+        span = spans.get(f"{subject}/{trial}", spans.get(trial))
+        return dataclasses.replace(
+            self,
+            label_map=tuple(self.label_maps(trial, kind)) or None,
+            span_s=None if span is None else tuple(span),
+            trial_label_maps={},
+            trial_spans_s={},
+        )
 
     def for_static(self) -> MarkerSettings:
         """The static trial's settings: neither filled nor filtered (scaling averages each marker over the frames

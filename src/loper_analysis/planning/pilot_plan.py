@@ -65,6 +65,8 @@ class PlanningSettings:
     max_null_trial_ratio : float or None
         A pilot trial whose null pairs deviate more than this multiple of the other trials' is left out of
         the null pairs (None: never).
+    pilot_subject : str or None
+        The subject whose recordings the planner takes as the pilot (None: the study's first processed subject).
     """
 
     onsets_ms: tuple[float, ...] | None = None
@@ -74,6 +76,7 @@ class PlanningSettings:
     response: ResponseSettings = field(default_factory=ResponseSettings)
     device: DeviceParameters = field(default_factory=DeviceParameters)
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
+    pilot_subject: str | None = None
 
 
 def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: str) -> np.ndarray:

@@ -77,5 +77,5 @@ def command_settings(args: argparse.Namespace, stage: str, default, part: str | 
         settings = stage_settings(config, stage)
         settings = settings if part is None else getattr(settings, part)
     if config is not None and "label_map" in given and given["label_map"] is None:
-        given["label_map"] = config["markers"]["label_map"] or None
+        given["label_map"] = stage_settings(config, "markers").label_map
     return dataclasses.replace(settings, **{k: v for k, v in given.items() if v is not None})

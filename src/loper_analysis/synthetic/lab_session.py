@@ -6,10 +6,11 @@ with ``seed``, ``trials``, ``device.parameters``, ``markers.lab_to_model_rotatio
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.study_design import SEED, StudyDesign
+from loper_analysis.synthetic.subjects import ImpedanceTruth
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 from loper_analysis.synthetic.variability import GaitVariability
 from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
@@ -76,6 +77,10 @@ class SyntheticLabSettings:
         The perturbation: rectangular desired force (N, forward) and its duration (s).
     perturb_every_strides : (int, int)
         A perturbation every ``min`` to ``max`` strides (uniform at random).
+    truth : ImpedanceTruth or None
+        The subjects' true impedance (:class:`~loper_analysis.synthetic.subjects.ImpedanceTruth`), drawn once per
+        subject into its ``truth.yaml``; the session reads that file, so the truth is no part of its settings'
+        repr (a rule's rerun trigger) or equality.
     """
 
     seed: int = SEED
@@ -89,6 +94,7 @@ class SyntheticLabSettings:
     pulse_force_n: float = PerturbationSettings.force_n
     pulse_duration_s: float = PerturbationSettings.duration_s
     perturb_every_strides: tuple[int, int] = PerturbationSettings.every_strides
+    truth: ImpedanceTruth | None = field(default=None, repr=False, compare=False)
 
     def perturbation(self, onset_ms: int | None, impedance: Sequence[float]) -> PerturbationSettings | None:
         """The pulses of a trial with onset ``onset_ms`` (ms after toe-off; None: no pulses), answered with

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import zlib
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,7 +24,7 @@ from loper_analysis.constants import JOINTS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.reference import STUDY_SUBJECTS
 
-__all__ = ["subject_anthropometry", "true_impedance"]
+__all__ = ["ImpedanceTruth", "subject_anthropometry", "true_impedance"]
 
 
 def _rng(seed: int, subject: str, what: str) -> np.random.Generator:
@@ -59,6 +60,31 @@ def subject_anthropometry(row: Mapping, seed: int) -> dict:
     if not 0.0 < out["mass_kg"] <= 300.0:
         raise LoperInputError(f"subject {subject}: mass_kg = {out['mass_kg']} kg is outside (0, 300] kg")
     return out
+
+
+@dataclass(frozen=True)
+class ImpedanceTruth:
+    """The synthetic subjects' true impedance: the group values per onset (ms) ``[hip, knee, ankle]`` in
+    N·m/rad (``stiffness_nm_per_rad``) and N·m·s/rad (``damping_nms_per_rad``), a subject's log-normal spread
+    around them (``between_subject_cv``), and the identification's bounds a true value must lie inside."""
+
+    stiffness_nm_per_rad: Mapping[str, Sequence[float]]
+    damping_nms_per_rad: Mapping[str, Sequence[float]]
+    between_subject_cv: float
+    stiffness_bounds_nm_per_rad: tuple[float, float] = (0.0, 200.0)
+    damping_bounds_nms_per_rad: tuple[float, float] = (0.0, 10.0)
+
+    def of(self, subject: str, seed: int) -> dict:
+        """True K, D per onset and joint of ``subject`` (:func:`true_impedance`)."""
+        return true_impedance(
+            subject,
+            seed,
+            self.stiffness_nm_per_rad,
+            self.damping_nms_per_rad,
+            self.between_subject_cv,
+            self.stiffness_bounds_nm_per_rad,
+            self.damping_bounds_nms_per_rad,
+        )
 
 
 def true_impedance(

@@ -4,6 +4,7 @@ written."""
 from __future__ import annotations
 
 import copy
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -111,8 +112,12 @@ def test_declared_rate_must_match(logs, tmp_path):
 
 
 def test_device_settings_of_the_shipped_config_are_the_library_defaults():
+    """The device's numbers; which subject holds the device tests and how a .mat export is named are the
+    study's choice (S01 and the robot's export names in the shipped config), no default of the library."""
     config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    assert stage_settings(config, "device") == DeviceSettings()
+    settings = stage_settings(config, "device")
+    assert (settings.subject, settings.mat_column_map["force_measured_n"]) == ("S01", "Fm")
+    assert dataclasses.replace(settings, subject=None, mat_column_map=None) == DeviceSettings()
 
 
 def test_device_settings_from_config_take_each_section_to_its_part():

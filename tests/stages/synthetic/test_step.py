@@ -38,18 +38,7 @@ def test_a_short_session_on_disk(tmp_path):
     config["synthetic"]["walking_duration_s"] = 10.0
     settings = stage_settings(config, "synthetic")
     row = subject_anthropometry({"subject": "S09", "source": "synthetic"}, settings.seed)
-    s = config["synthetic"]
-    ident = config["impedance"]
-    truth(
-        tmp_path / "truth.yaml",
-        row,
-        s["stiffness_nm_per_rad"],
-        s["damping_nms_per_rad"],
-        s["between_subject_cv"],
-        ident["stiffness_bounds_nm_per_rad"],
-        ident["damping_bounds_nms_per_rad"],
-        settings.seed,
-    )
+    truth(tmp_path / "truth.yaml", row, settings.truth, settings.seed)
     trials = settings.design.walking_trials()
     files = LabSessionFiles.in_design_order(
         settings.design,
@@ -71,6 +60,7 @@ def test_a_short_session_on_disk(tmp_path):
     ]
     walking = read_c3d(tmp_path / "pert050-1.c3d")
     assert walking.markers_m.shape[0] == round(10.0 * settings.lab.marker_rate_hz)
-    assert read_c3d(tmp_path / "static.c3d").markers_m.shape[0] == round(s["static_duration_s"] * 128.0)
+    static_frames = round(config["synthetic"]["static_duration_s"] * 128.0)
+    assert read_c3d(tmp_path / "static.c3d").markers_m.shape[0] == static_frames
     robot, header = read_robot_log(tmp_path / "pert050-1.loper.tsv", settings.lab.robot_rate_hz)
     assert header["clock"] == "robot" and len(robot) > 10 * settings.lab.robot_rate_hz

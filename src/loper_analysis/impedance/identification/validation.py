@@ -41,7 +41,7 @@ from loper_analysis.impedance.identification import (
 from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.reference import STUDY_DEVICE, STUDY_VALIDATION_NO_NOISE, STUDY_VALIDATION_NOISE
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N, SEED
-from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
+from loper_analysis.swing_leg.dynamics import BRACE_ATTACHMENT_FRACTION, SegmentParameters, segment_coordinates
 
 __all__ = [
     "ValidationSettings",
@@ -69,6 +69,10 @@ class ValidationSettings:
     ``window``: the fit window and initial-state span
     (:class:`~loper_analysis.impedance.responses.response_window.ResponseWindow`, s), checked to lie inside the
     simulated swing ``0 .. swing_duration_s`` around ``onset_s`` (:meth:`ResponseWindow.check_in_swing`).
+    ``subject_height_m`` (m), ``subject_mass_kg`` (kg) and ``attachment_fraction_of_thigh`` (the rod's place on
+    the thigh from the hip): the representative subject whose segments are simulated (read from the segment
+    table by the simulations, so no part of the repr, a rule's rerun trigger); ``n_chunks``: the parallel jobs
+    the combinations are split into.
     """
 
     stiffness_levels_nm_per_rad: tuple[float, ...] = (0.0, 75.0, 150.0)
@@ -94,6 +98,10 @@ class ValidationSettings:
     seed: int = SEED
     lower: tuple[float, ...] = tuple(DEFAULT_LOWER)
     upper: tuple[float, ...] = tuple(DEFAULT_UPPER)
+    subject_height_m: float = field(default=1.73, repr=False)
+    subject_mass_kg: float = field(default=64.9, repr=False)
+    attachment_fraction_of_thigh: float = field(default=BRACE_ATTACHMENT_FRACTION, repr=False)
+    n_chunks: int = 2
 
     def __post_init__(self):
         self.window.check_in_swing(self.onset_s, self.swing_duration_s)

@@ -18,7 +18,8 @@ NEEDS: tuple[str, ...] = ()
 def read_settings(config: Mapping) -> DeviceSettings:
     """The device's settings of a validated config: ``device.parameters``, ``device.leg`` (``mass_kg``,
     ``damping_ns_per_m``, ``stiffness_n_per_m``), ``device.tests`` and ``device.analysis`` (the Welch window,
-    the step windows in s and the bandwidth's reference band in Hz)."""
+    the step windows in s and the bandwidth's reference band in Hz), ``device.subject`` and
+    ``device.mat_column_map``."""
     d = config["device"]
     tests, a = d["tests"], d["analysis"]
     return DeviceSettings(
@@ -32,4 +33,6 @@ def read_settings(config: Mapping) -> DeviceSettings:
             ),
             reference_band_hz=tuple(a["bandwidth_reference_band_hz"]),
         ),
+        subject=d["subject"],
+        mat_column_map=d["mat_column_map"],
     )

@@ -40,13 +40,17 @@ class DeviceSettings:
     """The device stage's settings: ``parameters`` (the controller and plant,
     :class:`~loper_analysis.device.controller.DeviceParameters`), ``leg`` (the free-hanging leg of the tests,
     :class:`~loper_analysis.device.controller.FreeLeg`), ``tests`` (the desired-force profiles,
-    :class:`~loper_analysis.device.trials.DeviceTestSettings`) and ``analysis`` (FRF, steps and the bandwidth's
-    reference band, :class:`~loper_analysis.device.analysis.DeviceAnalysisSettings`)."""
+    :class:`~loper_analysis.device.trials.DeviceTestSettings`), ``analysis`` (FRF, steps and the bandwidth's
+    reference band, :class:`~loper_analysis.device.analysis.DeviceAnalysisSettings`), ``subject`` (whose raw
+    folder holds the device tests' logs; None: no device tests) and ``mat_column_map`` (robot-log column -> the
+    variable of a robot's ``.mat`` export holding it; None: no ``.mat`` export read)."""
 
     parameters: DeviceParameters = field(default_factory=DeviceParameters)
     leg: FreeLeg = field(default_factory=FreeLeg)
     tests: DeviceTestSettings = field(default_factory=DeviceTestSettings)
     analysis: DeviceAnalysisSettings = field(default_factory=DeviceAnalysisSettings)
+    subject: str | None = None
+    mat_column_map: Mapping[str, str] | None = None
 
 
 def device_trial(

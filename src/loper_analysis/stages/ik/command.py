@@ -101,7 +101,7 @@ def _ik(args: argparse.Namespace) -> None:
     lab = MarkerSettings() if config is None else stage_settings(config, "markers")
     label_map = cli_options.label_map(args.label_map)
     if label_map is None and config is not None and str(args.markers).lower().endswith(".c3d"):
-        label_map = read_label_maps(config["markers"]["label_map"] or None)
+        label_map = read_label_maps(stage_settings(config, "markers").label_map)
     result = ik_file(
         args.model,
         args.markers,

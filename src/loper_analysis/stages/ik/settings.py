@@ -15,7 +15,7 @@ def read_settings(config: Mapping) -> IKSettings:
     """The IK settings of a validated config: of ``opensim``, ``ik_tasks``, ``default_marker_weight``,
     ``marker_weights``, ``coordinate_tasks``, ``tree_step_tolerance`` (rad or m), ``opensim_accuracy``,
     ``ik_solver``, ``max_marker_rms_m`` (m), ``warn_marker_rms_m`` (m), ``max_rms_fraction``, ``coordinate_map``,
-    ``geometry_warn_change`` and ``geometry_stop_change``."""
+    ``geometry_warn_change``, ``geometry_stop_change`` and ``ik_chunks``."""
     o = config["ik"]
     return IKSettings(
         tasks_file=o["ik_tasks"],
@@ -31,4 +31,5 @@ def read_settings(config: Mapping) -> IKSettings:
         coordinate_map=o["coordinate_map"],
         geometry_warn_change=o["geometry_warn_change"],
         geometry_stop_change=o["geometry_stop_change"],
+        n_chunks=o["ik_chunks"],
     )

@@ -105,7 +105,7 @@ def fit_files(study: Study, subject: str) -> dict:
 
     def null_trials(onset: int) -> list[str]:
         # none for a white-noise fit or a missing onset (reported without any input)
-        if study.config["impedance"]["noise_model"] != "null_pairs" or not study.onset_trials(s, onset):
+        if study.settings["impedance"].identification.noise_model != "null_pairs" or not study.onset_trials(s, onset):
             return []
         return study.null_pair_trials(s)
 

@@ -13,8 +13,9 @@ NEEDS: tuple[str, ...] = ()
 
 def read_settings(config: Mapping) -> MarkerSettings:
     """The walking trials' marker settings of a validated config: ``markers.lab_to_model_rotation_deg`` (deg),
-    ``walking_direction``, ``min_travel_speed_m_per_s``, ``max_gap_frames``, ``extent_range_m`` (m) and the
-    low-pass ``markers.filter.cutoff_hz`` (Hz) and ``markers.filter.order``."""
+    ``walking_direction``, ``min_travel_speed_m_per_s``, ``max_gap_frames``, ``extent_range_m`` (m), the label
+    maps ``label_map`` and ``trial_label_maps``, the spans ``trial_spans_s`` (s) and the low-pass
+    ``markers.filter.cutoff_hz`` (Hz) and ``markers.filter.order``."""
     m = config["markers"]
     f = m["filter"]
     return MarkerSettings(
@@ -25,4 +26,7 @@ def read_settings(config: Mapping) -> MarkerSettings:
         cutoff_hz=f["cutoff_hz"],
         order=int(f["order"]),
         extent_range_m=tuple(float(v) for v in m["extent_range_m"]),
+        label_map=m["label_map"] or None,
+        trial_label_maps=m["trial_label_maps"],
+        trial_spans_s=m["trial_spans_s"],
     )

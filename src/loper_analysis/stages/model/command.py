@@ -80,10 +80,10 @@ def _scale(args: argparse.Namespace) -> None:
             trc = Path(tmp) / (static.stem + ".trc")
             label_map = cli_options.label_map(args.label_map)
             if label_map is None and config is not None:
-                label_map = read_label_maps(config["markers"]["label_map"] or None)
+                label_map = read_label_maps(stage_settings(config, "markers").label_map)
             frame = MarkerSettings(
                 rotation_deg=settings.rotation_deg,
-                walking_direction="auto" if config is None else config["markers"]["walking_direction"],
+                walking_direction="auto" if config is None else stage_settings(config, "markers").walking_direction,
                 max_gap_frames=args.max_gap_frames,
                 cutoff_hz=args.cutoff_hz or None,
                 label_map=label_map,

@@ -17,9 +17,9 @@ NEEDS: tuple[str, ...] = ("study", "markers", "ik")
 
 def read_settings(config: Mapping, study: StudySettings, markers: MarkerSettings, ik: IKSettings) -> ModelSettings:
     """The model settings of a validated config: ``model.static_duration_s`` (s),
-    ``model.static_max_motion_rms_m`` (m), ``model.scale_factor_range``, ``segment_bodies`` and
-    ``brace_attachment_fraction``; the rotation is the markers', the static pose's coordinate map, accuracy and
-    solver the IK's, the leg the study's."""
+    ``model.static_max_motion_rms_m`` (m), ``model.scale_factor_range``, ``segment_bodies``,
+    ``brace_attachment_fraction``, ``generic_model`` and ``scale_setup``; the rotation is the markers', the static
+    pose's coordinate map, tolerances and solver the IK's, the leg the study's."""
     m = o = config["model"]
     return ModelSettings(
         rotation_deg=markers.rotation_deg,
@@ -30,6 +30,9 @@ def read_settings(config: Mapping, study: StudySettings, markers: MarkerSettings
         side=study.design.perturbed_side,
         attachment_fraction=o["brace_attachment_fraction"],
         coordinate_map=ik.coordinate_map,
-        accuracy=ik.accuracy,
+        tree_step_tolerance=ik.tree_step_tolerance,
+        opensim_accuracy=ik.opensim_accuracy,
         solver=ik.solver,
+        generic_model=o["generic_model"],
+        scale_setup=o["scale_setup"],
     )

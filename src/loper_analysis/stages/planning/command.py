@@ -15,6 +15,7 @@ from loper_analysis import cli_options
 from loper_analysis.errors import LoperInputError
 from loper_analysis.stages import study_paths
 from loper_analysis.stages.command import Command
+from loper_analysis.stages.settings import stage_settings
 
 if TYPE_CHECKING:
     from loper_analysis.layout import Paths
@@ -132,11 +133,12 @@ def plan_pilot(args: argparse.Namespace, config: dict | None) -> tuple[str | Non
     trials without the device (``--exclude-trials``, else ``study.no_device``, else the library's)."""
     from loper_analysis.study_design import StudyDesign
 
-    pilot = args.subject or (None if config is None else config["planning"]["pilot_subject"])
-    sheet = args.subjects or ("config/subjects.tsv" if config is None else config["subjects"])
+    study = None if config is None else stage_settings(config, "study")
+    pilot = args.subject or (None if config is None else stage_settings(config, "planning").pilot_subject)
+    sheet = args.subjects or ("config/subjects.tsv" if study is None else study.subjects)
     exclude = args.exclude_trials
     if exclude is None:
-        exclude = [StudyDesign().no_device if config is None else config["study"]["no_device"]]
+        exclude = [StudyDesign().no_device if study is None else study.design.no_device]
     return pilot, sheet, exclude
 
 

@@ -22,7 +22,7 @@ def read_settings(
     config: Mapping, study: StudySettings, markers: MarkerSettings, device: DeviceSettings, impedance: FitSettings
 ) -> PlanningSettings:
     """The planner's settings of a validated config: the rule ``planning`` and ``loper-analysis plan`` both take
-    theirs from here. ``planning.strides``, ``targets`` and the pulse ``pulse_force_n`` (N),
+    theirs from here. ``planning.strides``, ``targets``, ``pilot_subject`` and the pulse ``pulse_force_n`` (N),
     ``pulse_duration_s`` (s); the onsets the study's; the fit window, substeps, projected components, null-pair
     minimum, interval scatter, bounds (N·m/rad, N·m·s/rad), counterfactual and null-trial ratio the fit's; the
     load cell's low-pass (Hz, order) the markers' (as the events stage filters the force); the force's rate
@@ -51,4 +51,5 @@ def read_settings(
         response=impedance.response,
         device=device.parameters,
         max_null_trial_ratio=fit.max_null_trial_ratio,
+        pilot_subject=p["pilot_subject"],
     )

@@ -8,25 +8,33 @@ from collections.abc import Mapping
 from loper_analysis.motion.trial_markers import MarkerSettings
 from loper_analysis.stages.device.step import DeviceSettings
 from loper_analysis.stages.events.settings import EventsSettings
+from loper_analysis.stages.impedance.step import FitSettings
 from loper_analysis.stages.study.settings import StudySettings
 from loper_analysis.synthetic.lab_session import LabSessionSettings
+from loper_analysis.synthetic.subjects import ImpedanceTruth
 from loper_analysis.synthetic.trials import LabSettings
 from loper_analysis.synthetic.variability import GaitVariability
 
 __all__ = ["NEEDS", "read_settings"]
 
-NEEDS: tuple[str, ...] = ("study", "markers", "events", "device")
+NEEDS: tuple[str, ...] = ("study", "markers", "events", "device", "impedance")
 
 
 def read_settings(
-    config: Mapping, study: StudySettings, markers: MarkerSettings, events: EventsSettings, device: DeviceSettings
+    config: Mapping,
+    study: StudySettings,
+    markers: MarkerSettings,
+    events: EventsSettings,
+    device: DeviceSettings,
+    impedance: FitSettings,
 ) -> LabSessionSettings:
     """The synthetic lab of a validated config: ``synthetic.*`` (durations in s, noise in m and N, the robot
     clock's offset in s and drift in ppm, the pulse in N and s, the variability and the device adaptation);
     the trials and seed the study's, the lab's axes the markers' rotation, the sync channel the load cell's,
-    the device's parameters the device's. The rates, the robot log's margin and the belts' channel names keep
-    their defaults."""
-    s = config["synthetic"]
+    the device's parameters the device's; the true impedance (``stiffness_nm_per_rad``, ``damping_nms_per_rad``
+    per onset, ``between_subject_cv``) inside the fit's bounds. The rates, the robot log's margin and the belts'
+    channel names keep their defaults."""
+    s, fit = config["synthetic"], impedance.identification
     v, a = s["study_variability"], s["device_adaptation"]
     lab = LabSettings(
         marker_noise_sd_m=s["marker_noise_sd_m"],
@@ -57,4 +65,11 @@ def read_settings(
         adaptation_amplitude_change=tuple(a["amplitude_change"]),
         adaptation_offset_rad=tuple(a["offset_rad"]),
         adaptation_swing_gain=tuple(a["swing_gain"]),
+        truth=ImpedanceTruth(
+            stiffness_nm_per_rad=s["stiffness_nm_per_rad"],
+            damping_nms_per_rad=s["damping_nms_per_rad"],
+            between_subject_cv=s["between_subject_cv"],
+            stiffness_bounds_nm_per_rad=fit.stiffness_bounds_nm_per_rad,
+            damping_bounds_nms_per_rad=fit.damping_bounds_nms_per_rad,
+        ),
     )

@@ -23,6 +23,7 @@ from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.io.truth import read_truth, write_truth
 from loper_analysis.study_design import StudyDesign
 from loper_analysis.synthetic.lab_session import LabSessionSettings
+from loper_analysis.synthetic.subjects import ImpedanceTruth
 
 __all__ = ["LabSessionFiles", "lab_session", "truth"]
 
@@ -79,32 +80,14 @@ class LabSessionFiles:
         )
 
 
-def truth(
-    out_yaml: PathLike,
-    row: Mapping,
-    stiffness_nm_per_rad: Mapping,
-    damping_nms_per_rad: Mapping,
-    between_subject_cv: float,
-    stiffness_bounds,
-    damping_bounds,
-    seed: int,
-) -> dict:
-    """``truth.yaml`` of a synthetic subject: its anthropometrics and true K, D per onset and joint.
+def truth(out_yaml: PathLike, row: Mapping, truth: ImpedanceTruth, seed: int) -> dict:
+    """``truth.yaml`` of a synthetic subject: its anthropometrics and true K, D per onset and joint, drawn from
+    ``truth`` with the study's ``seed``.
 
     ``row`` is the subject's row of the subject sheet with its anthropometrics
     (:func:`loper_analysis.synthetic.subjects.subject_anthropometry`).
     """
-    from loper_analysis.synthetic.subjects import true_impedance
-
-    impedance = true_impedance(
-        row["subject"],
-        seed,
-        stiffness_nm_per_rad,
-        damping_nms_per_rad,
-        between_subject_cv,
-        stiffness_bounds,
-        damping_bounds,
-    )
+    impedance = truth.of(row["subject"], seed)
     write_truth(out_yaml, row, impedance)
     log.info("truth of %s: %s", row["subject"], impedance)
     return impedance

@@ -26,6 +26,10 @@ _AS_THEY_ARE = (
     "force_direction_deg",
     "noise_peak_to_peak",
     "truth_substeps",
+    "subject_height_m",
+    "subject_mass_kg",
+    "attachment_fraction_of_thigh",
+    "n_chunks",
 )
 
 
