@@ -137,8 +137,16 @@ results_digest "$WORK/slurm" | diff "$WORK/local.sha256" - >"$WORK/diff.txt" ||
 echo "ok: the rerun completed, outputs equal the local run's"
 
 step "bad input: an unreadable robot log fails once, its message in the rule's log"
+# a lab's own log: S01 marked 'recorded' (a synthetic subject's folder holds only what the synthetic lab wrote,
+# and a run stops before any job on a file it did not write)
 log_file=data/raw/S01/pert050-1.loper.tsv
 cp "$WORK/slurm/$log_file" "$WORK/robot_log.keep"
+cp "$WORK/slurm/config/subjects.tsv" "$WORK/subjects.keep"
+sed -i 's/^S01\tsynthetic\t/S01\trecorded\t/' "$WORK/slurm/config/subjects.tsv"
+grep -q "^S01	recorded	" "$WORK/slurm/config/subjects.tsv" || fail "could not mark S01 recorded in config/subjects.tsv"
+# first with its log intact: a recorded subject's jobs watch their raw files' content, so they run once more
+rc=$(cluster_run "$WORK/slurm" "$WORK/recorded.log" results/strides/S01/pert050-1.strides.tsv)
+[ "$rc" = 0 ] || fail "the run with S01 marked recorded ended with status $rc: $WORK/recorded.log"
 printf 'time_s\tforce_n\nnot-a-number\t1\n' >"$WORK/slurm/$log_file"
 rc=$(cluster_run "$WORK/slurm" "$WORK/badinput.log" results/strides/S01/pert050-1.strides.tsv)
 [ "$rc" != 0 ] || fail "a run on an unreadable robot log succeeded: $WORK/badinput.log"
@@ -151,6 +159,7 @@ for out in results/events/S01/pert050-1.events.tsv results/loadcell/S01/pert050-
 done
 no_staged_files "$WORK/slurm"
 cp "$WORK/robot_log.keep" "$WORK/slurm/$log_file"
+cp "$WORK/subjects.keep" "$WORK/slurm/config/subjects.tsv"
 echo "ok: one submission; the rule's log says: $(grep -m1 -o "LoperInputError.*" "$rule_log" | cut -c1-160)"
 
 step "bad input: a job killed by SLURM for memory"
