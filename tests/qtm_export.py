@@ -41,9 +41,9 @@ from loper_analysis.constants import GRAVITY_M_PER_S2, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
 from loper_analysis.io.c3d_writer import ForcePlatform
-from loper_analysis.synthetic.force_plates import plate_channels, plate_frame, wrench_channels
 from loper_analysis.synthetic.lab_export import GAIT2392_COORDINATES, gait2392_coordinates
 from loper_analysis.synthetic.trials import LabSettings, WalkingTrial
+from tests.force_plate_channels import plate_channels, plate_frame, wrench_channels
 
 __all__ = [
     "ROBOT_LOG_MAT_VARIABLES",

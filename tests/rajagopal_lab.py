@@ -53,7 +53,7 @@ import pandas as pd
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d
 from loper_analysis.io.opensim_tables import read_markers, read_mot
 from loper_analysis.io.osim import quiet_opensim
-from loper_analysis.synthetic.force_plates import plate_channels, wrench_channels
+from tests.force_plate_channels import plate_channels, wrench_channels
 
 DATA = Path(__file__).resolve().parent / "data" / "rajagopal2016"
 GENERIC_OSIM = DATA / "Rajagopal2016.osim"

@@ -28,7 +28,7 @@ from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.stages.events.step import EventSettings, events
 from loper_analysis.stages.grf.step import grf
 from loper_analysis.stages.markers.step import markers as markers_step
-from loper_analysis.synthetic.force_plates import wrench_channels
+from tests.force_plate_channels import wrench_channels
 
 ROOT = Path(__file__).resolve().parents[2]
 WALKING5 = ROOT / "tests" / "data" / "opensim-core" / "walking5.c3d"

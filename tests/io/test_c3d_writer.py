@@ -15,8 +15,7 @@ import pytest
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import read_c3d
 from loper_analysis.io.c3d_writer import ForcePlatform, write_c3d, write_recording
-from loper_analysis.synthetic.force_plates import plate_channels
-from tests.synthetic.plate_reading import plate_load
+from tests.force_plate_channels import plate_channels, plate_load
 
 RATE, RATIO = 100.0, 10
 

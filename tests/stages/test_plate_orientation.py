@@ -31,7 +31,7 @@ from loper_analysis.io.force_platforms import read_force_platforms
 from loper_analysis.motion.markers import lab_up
 from loper_analysis.stages.events.step import EventSettings, events
 from loper_analysis.stages.grf.step import grf
-from loper_analysis.synthetic.force_plates import plate_frame, wrench_channels
+from tests.force_plate_channels import plate_frame, wrench_channels
 
 RATE, RATIO = 100.0, 10
 DURATION_S = 2.4

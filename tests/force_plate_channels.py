@@ -1,4 +1,5 @@
-"""Force-platform channels of a known load: what a plate's six outputs read for a force at a point.
+"""Force-platform channels of a known load, for the tests' synthetic recordings: what a plate's six outputs read for
+a force at a point, and the load read back from them (:func:`plate_load`).
 
 The inverse of what C3D readers (ezc3d, OpenSim's ``C3DFileAdapter``) do with
 the ``FORCE_PLATFORM`` group (:class:`loper_analysis.io.c3d_writer.ForcePlatform`):
@@ -26,7 +27,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import LENGTH_UNITS_PER_M
 from loper_analysis.io.c3d_writer import ForcePlatform
 
-__all__ = ["plate_channels", "plate_frame", "wrench_channels"]
+__all__ = ["plate_channels", "plate_frame", "plate_load", "wrench_channels"]
 
 
 def plate_frame(plate: ForcePlatform) -> tuple[np.ndarray, np.ndarray]:
@@ -104,3 +105,20 @@ def plate_channels(plate: ForcePlatform, force_n, cop_m, free_moment_nm=0.0, poi
     R, centre = plate_frame(plate)
     up = -R[:, 2] if R[2, 2] < 0 else R[:, 2]
     return wrench_channels(plate, F, np.cross(P - centre, F) + T[:, None] * up, point_unit)
+
+
+def plate_load(plate: ForcePlatform, channels, point_unit: str = "mm") -> dict[str, np.ndarray]:
+    """Force (n, 3) N, centre of pressure (n, 3) m and free moment (n,) N·m, lab frame, from the six channels
+    (n, 6): the reading a C3D reader makes (the inverse of :func:`plate_channels`); the centre of pressure is NaN
+    where the normal force is zero."""
+    W = np.atleast_2d(np.asarray(channels, dtype=float))
+    if plate.type == 4:
+        W = W @ np.asarray(plate.cal_matrix).T
+    f, m_sensor = W[:, :3], W[:, 3:] / LENGTH_UNITS_PER_M[point_unit]
+    m_centre = m_sensor + np.cross(f, np.asarray(plate.origin_m, dtype=float))
+    R, centre = plate_frame(plate)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cop_plate = np.column_stack([-m_centre[:, 1] / f[:, 2], m_centre[:, 0] / f[:, 2], np.zeros(len(f))])
+    free = m_centre[:, 2] - (cop_plate[:, 0] * f[:, 1] - cop_plate[:, 1] * f[:, 0])
+    sign = -1.0 if R[2, 2] < 0 else 1.0
+    return {"force_n": f @ R.T, "cop_m": cop_plate @ R.T + centre, "free_moment_nm": sign * free}

@@ -1,6 +1,5 @@
-"""Force-platform channels of a known load (loper_analysis.synthetic.force_plates): the plate's frame from its
-corners, the six channels of a force at a point worked out by hand, and the load read back from them
-(tests/synthetic/plate_reading.py)."""
+"""Force-platform channels of a known load (tests/force_plate_channels.py): the plate's frame from its corners, the
+six channels of a force at a point worked out by hand, and the load read back from them."""
 
 from __future__ import annotations
 
@@ -9,8 +8,7 @@ import pytest
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d_writer import ForcePlatform
-from loper_analysis.synthetic.force_plates import plate_channels, plate_frame, wrench_channels
-from tests.synthetic.plate_reading import plate_load
+from tests.force_plate_channels import plate_channels, plate_frame, plate_load, wrench_channels
 
 CENTRE = np.array([0.3, 0.25, 0.0])
 HALF = np.array([0.2, 0.3, 0.0])
