@@ -134,8 +134,8 @@ def _trial_inputs(walk, model, lab, config: dict, noise_scale: float, rng: np.ra
     """Angle table (IK-like noise, ``noise_scale`` times the chain's), stride table, force table and brace markers of
     one simulated trial, as the fit reads them."""
     from loper_analysis.device.loadcell import robot_log_frames_and_native
+    from loper_analysis.filtering import lowpass
     from loper_analysis.gait.strides import stride_tables
-    from loper_analysis.motion.filtering import lowpass
     from loper_analysis.motion.ik import marker_positions
     from loper_analysis.motion.model import BRACE_MARKERS
     from loper_analysis.synthetic.sync import pulse_train_at

@@ -43,7 +43,7 @@ _plan_pilot, _plan_settings, _read_config = plan_pilot, plan_settings, read_conf
 
 
 def _inspect(args: argparse.Namespace) -> None:
-    from loper_analysis.motion.filtering import CUTOFF_HZ
+    from loper_analysis.filtering import CUTOFF_HZ
     from loper_analysis.stages.inspect import inspect_c3d, inspect_subject
     from loper_analysis.subject_setup import NoTemplateFits
 

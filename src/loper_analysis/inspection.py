@@ -505,7 +505,7 @@ def config_snippet(
 
 #: Highest low-pass cut-off ``inspect`` writes, as a fraction of the lowest marker rate of the walking trials:
 #: 0.4 of the rate is 0.8 of the Nyquist frequency (half the rate), which the filter must stay below
-#: (:func:`loper_analysis.motion.filtering.check_cutoff` refuses a cut-off at or above it).
+#: (:func:`loper_analysis.filtering.check_cutoff` refuses a cut-off at or above it).
 MAX_CUTOFF_RATE_FRACTION = 0.4
 
 

@@ -27,11 +27,11 @@ import pytest
 from loper_analysis.cli import main as cli_main
 from loper_analysis.device.loadcell import LoadcellSettings
 from loper_analysis.errors import LoperInputError
+from loper_analysis.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.gait.trial_events import EventSettings
 from loper_analysis.io.c3d_writer import write_c3d
 from loper_analysis.io.robot_log import write_robot_log
 from loper_analysis.layout import fill
-from loper_analysis.motion.filtering import DC_GAIN_TOLERANCE, check_cutoff, lowpass, lowpass_finite_runs
 from loper_analysis.schema import check_yaml_file
 from loper_analysis.stages import study_paths
 from loper_analysis.stages.events import step as event_steps

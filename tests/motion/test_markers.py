@@ -281,7 +281,7 @@ def test_only_weighted_markers_count():
 
 
 def test_summary_counts_frames_the_filter_left_unfiltered(trial):
-    from loper_analysis.motion.filtering import lowpass_finite_runs
+    from loper_analysis.filtering import lowpass_finite_runs
 
     gappy = trial.copy()
     gappy[50:60, 1] = np.nan

@@ -10,11 +10,11 @@ import re
 
 import pytest
 
+from loper_analysis import timing
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io import timing
 from loper_analysis.stages import logs
 from loper_analysis.stages.logs import PROFILE_VARIABLE, TIMING_PREFIX, rule_log, write_log
-from tests.io.test_timing import FakeClock
+from tests.test_timing import FakeClock
 
 
 def _entries(directory):

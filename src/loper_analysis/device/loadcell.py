@@ -4,7 +4,7 @@ Chain (``docs/processing.md``, :func:`robot_log_frames_and_native`): rising
 edges of the log's ``sync_v`` and of the mocap sync channel -> clock map
 (:mod:`loper_analysis.device.clock_sync`) -> zero-phase 4th-order 40 Hz
 Butterworth of the forces at the robot rate
-(:func:`loper_analysis.motion.filtering.lowpass`) -> robot sample times mapped to
+(:func:`loper_analysis.filtering.lowpass`) -> robot sample times mapped to
 the mocap clock -> linear interpolation of the forces, nearest-sample pick of
 the perturbation flag, at the mocap frame times (128 Hz); the same filtered
 forces at every robot sample, on the mocap clock, for the identification.
@@ -33,7 +33,7 @@ from loper_analysis.checks import positive
 from loper_analysis.device.clock_sync import ClockMap, clock_map, high_times, require_pulse_train, rising_edges
 from loper_analysis.device.pulse import find_force_pulses
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass
+from loper_analysis.filtering import CUTOFF_HZ, ORDER, lowpass
 from loper_analysis.study_design import PULSE_FORCE_N
 
 __all__ = [
@@ -118,7 +118,7 @@ def robot_log_frames_and_native(
        (:func:`loper_analysis.device.clock_sync.high_times`) must agree between the
        two (same polarity).
     2. ``force_measured_n`` and ``force_desired_n`` low-passed at the robot
-       rate (:func:`~loper_analysis.motion.filtering.lowpass`: zero-phase
+       rate (:func:`~loper_analysis.filtering.lowpass`: zero-phase
        Butterworth, ``order``, ``cutoff_hz``) before resampling.
     3. Robot sample times mapped to the mocap clock; forces linearly
        interpolated at ``frame_time_s``; ``perturbation`` taken from the
@@ -289,7 +289,7 @@ def _sync_clock_map(
 
 def _filtered_forces(log: pd.DataFrame, rate: float, cutoff_hz: float, order: int, src: str) -> dict[str, np.ndarray]:
     """The log's measured and desired forces (N, shape (n_samples,)) low-passed at the robot rate ``rate``
-    (Hz; :func:`loper_analysis.motion.filtering.lowpass`), by column."""
+    (Hz; :func:`loper_analysis.filtering.lowpass`), by column."""
     forces = {}
     for col in _FORCE_COLUMNS:
         f = log[col].to_numpy(dtype=float, na_value=np.nan)

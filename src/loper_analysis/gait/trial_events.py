@@ -15,9 +15,9 @@ import pandas as pd
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDES
 from loper_analysis.errors import LoperInputError
+from loper_analysis.filtering import ORDER
 from loper_analysis.gait.events import MIN_STANCE_S, MIN_SWING_S, THRESHOLD_OFF_N, THRESHOLD_ON_N
 from loper_analysis.gait.grf import MAX_RESTING_N, RESTING_BAND_N
-from loper_analysis.motion.filtering import ORDER
 
 __all__ = [
     "FOOT_MARKERS",
@@ -100,8 +100,8 @@ def trial_events(
 
 def _channel_events(rec, s: EventSettings) -> pd.DataFrame:
     """Events from one named vertical-GRF analog channel per belt of a read C3D."""
+    from loper_analysis.filtering import lowpass
     from loper_analysis.gait.events import gait_events
-    from loper_analysis.motion.filtering import lowpass
 
     c3d_path, grf_channels = rec.source, s.grf_channels
     missing = [side for side in SIDES if grf_channels[side] not in rec.analog_labels]

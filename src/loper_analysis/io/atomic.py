@@ -29,7 +29,7 @@ import pandas as pd
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.timing import io_clock
+from loper_analysis.timing import io_clock
 
 __all__ = [
     "PathLike",
@@ -78,7 +78,7 @@ def staged(path: str | os.PathLike, what: str = "file") -> Iterator[Path]:
     file in error messages. Staging directories of the same target left by a
     writer that was killed (SIGKILL, power loss) are removed first: a target
     has one writer at a time, so they can only be stale. The body's wall
-    time counts as file I/O (:mod:`loper_analysis.io.timing`).
+    time counts as file I/O (:mod:`loper_analysis.timing`).
 
     Raises
     ------

@@ -76,7 +76,7 @@ from loper_analysis.io.c3d_parameters import (
     read_events,
 )
 from loper_analysis.io.c3d_points import MARKER, point_kinds, point_units
-from loper_analysis.io.timing import library_import, timed_io
+from loper_analysis.timing import library_import, timed_io
 
 __all__ = [
     "LENGTH_UNITS_PER_M",

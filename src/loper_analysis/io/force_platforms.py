@@ -74,7 +74,7 @@ from loper_analysis.constants import LAB_Z_UP
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, C3DRecording, read_c3d, recording_from_ezc3d
 from loper_analysis.io.c3d_byte_order import ezc3d_readable
-from loper_analysis.io.timing import library_import, timed_io
+from loper_analysis.timing import library_import, timed_io
 
 __all__ = [
     "CALIBRATED_TYPES",

@@ -10,7 +10,7 @@ import pandas as pd
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.osim import quiet_opensim
-from loper_analysis.io.timing import timed_io
+from loper_analysis.timing import timed_io
 
 __all__ = ["read_ik_tasks", "task_set_tasks"]
 

@@ -54,7 +54,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import staged
 from loper_analysis.io.c3d import LENGTH_UNITS_PER_M, read_c3d
 from loper_analysis.io.osim import quiet_opensim
-from loper_analysis.io.timing import timed_io
+from loper_analysis.timing import timed_io
 
 log = logging.getLogger(__name__)
 

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import staged
-from loper_analysis.io.timing import library_import, timed_io
+from loper_analysis.timing import library_import, timed_io
 
 __all__ = [
     "quiet_opensim",

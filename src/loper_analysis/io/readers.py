@@ -11,7 +11,7 @@ import pandas as pd
 import yaml
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.timing import timed_io
+from loper_analysis.timing import timed_io
 
 __all__ = ["read_bytes", "read_label_map", "read_label_maps", "read_subject_sheet", "read_tsv", "read_yaml"]
 

@@ -55,7 +55,7 @@ import pandas as pd
 from loper_analysis.checks import positive
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import write_bytes
-from loper_analysis.io.timing import timed_io
+from loper_analysis.timing import timed_io
 
 __all__ = [
     "FORMAT_NAME",

@@ -13,7 +13,7 @@ import pandas as pd
 from loper_analysis.checks import positive
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.robot_log import COLUMNS, FORMAT_NAME, validated_log
-from loper_analysis.io.timing import timed_io
+from loper_analysis.timing import timed_io
 
 __all__ = ["MAT_OPTIONAL", "read_robot_log_mat"]
 

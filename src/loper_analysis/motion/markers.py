@@ -193,7 +193,7 @@ def gap_summary(raw_m, processed_m, labels: Sequence[str], unfiltered=None) -> p
         One name per marker.
     unfiltered : array_like of bool, optional
         Shape (n_frames, n_markers) or (n_frames, n_markers, 3): samples left
-        unfiltered by :func:`loper_analysis.motion.filtering.lowpass_finite_runs`.
+        unfiltered by :func:`loper_analysis.filtering.lowpass_finite_runs`.
 
     Returns
     -------

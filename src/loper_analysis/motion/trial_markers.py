@@ -15,7 +15,7 @@ import pandas as pd
 
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, MIN_IK_MARKERS
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, lowpass_finite_runs
+from loper_analysis.filtering import CUTOFF_HZ, ORDER, lowpass_finite_runs
 from loper_analysis.motion.heading import MIN_TRAVEL_SPEED_M_PER_S, trial_heading
 from loper_analysis.motion.knee_alignment import kad_knee_markers
 from loper_analysis.motion.label_matching import landmark_indices

@@ -28,7 +28,7 @@ import pandas as pd
 
 from loper_analysis.checks import number
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
+from loper_analysis.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.study_design import PERTURBED_SIDE
 
 __all__ = ["PLANNED_COUNTERFACTUAL", "pulse_force_n", "pilot_onset_series", "pilot_perturbed_pairs", "trial_stretches"]
@@ -53,7 +53,7 @@ def pulse_force_n(
     ``time_s``. Zero before the onset.
     """
     from loper_analysis.device.controller import DeviceParameters, simulate_device
-    from loper_analysis.motion.filtering import lowpass
+    from loper_analysis.filtering import lowpass
 
     t = np.asarray(time_s, dtype=float)
     if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)):

@@ -18,6 +18,7 @@ from loper_analysis.checks import number
 from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
+from loper_analysis.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.impedance.identification import (
     FitBounds,
     PreparedWindow,
@@ -29,7 +30,6 @@ from loper_analysis.impedance.identification.fit import DAMPING_BOUNDS_NMS_PER_R
 from loper_analysis.impedance.identification.null_pairs import MIN_NULL_PAIRS, NULL_PAIR_COMPONENTS
 from loper_analysis.impedance.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS
 from loper_analysis.impedance.responses.response_window import ResponseWindow
-from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER
 from loper_analysis.planning.inputs import pulse_force_n
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters

@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING
 import pandas as pd
 
 from loper_analysis.errors import LoperInputError, one_line
+from loper_analysis.filtering import CUTOFF_HZ
 from loper_analysis.inspection import (
     RecordingSummary,
     config_snippet,
@@ -38,12 +39,11 @@ from loper_analysis.inspection_text import (
 )
 from loper_analysis.io.atomic import PathLike, write_bytes, write_text, write_tsv
 from loper_analysis.io.c3d_parameter_section import read_parameter
-from loper_analysis.io.timing import timed_io
-from loper_analysis.motion.filtering import CUTOFF_HZ
 from loper_analysis.motion.lab_frame import axis_name
 from loper_analysis.motion.label_matching import LabelMatch, heel_markers, match_labels, starter_label_map
 from loper_analysis.motion.marker_names import strip_subject_prefix
 from loper_analysis.subject_setup import NoTemplateFits, StagedSubject, SubjectSetup, format_fits, trial_label_maps
+from loper_analysis.timing import timed_io
 
 if TYPE_CHECKING:
     from loper_analysis.io.c3d import C3DRecording

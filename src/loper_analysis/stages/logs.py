@@ -14,7 +14,7 @@ from collections.abc import Iterator
 
 from loper_analysis.errors import one_line
 from loper_analysis.io.atomic import write_text
-from loper_analysis.io.timing import io_times
+from loper_analysis.timing import io_times
 
 __all__ = ["LOG_FORMAT", "PROFILE_VARIABLE", "TIMING_PREFIX", "rule_log", "timing_line", "write_log"]
 
@@ -26,7 +26,7 @@ TIMING_PREFIX = "job time:"
 
 def timing_line(end_epoch_s: float | None = None) -> str:
     """The job's time split: wall seconds from its first file access to now, of which file I/O, and the
-    library imports made inside readers and writers (start-up, not I/O; :mod:`loper_analysis.io.timing`)."""
+    library imports made inside readers and writers (start-up, not I/O; :mod:`loper_analysis.timing`)."""
     io_s, import_s, first = io_times()
     end = time.time() if end_epoch_s is None else end_epoch_s
     after_first = 0.0 if first is None else max(end - first, 0.0)

@@ -83,7 +83,7 @@ def _loadcell_of(rec, log_path, s: LoadcellSettings) -> tuple[pd.DataFrame, pd.D
     c3d_path, sync_channel = rec.source, s.sync_channel
     frame, meta = read_robot_log(log_path)
     rate = float(meta["sample_rate_hz"])
-    from loper_analysis.motion.filtering import check_cutoff  # the robot log's forces are low-passed at its own rate
+    from loper_analysis.filtering import check_cutoff  # the robot log's forces are low-passed at its own rate
 
     check_cutoff(
         rate,

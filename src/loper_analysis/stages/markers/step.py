@@ -39,7 +39,7 @@ def markers(
     and gaps at the trial's ends stay NaN and are written to the TRC as
     missing. The low-pass (``cutoff_hz`` Hz, Butterworth of ``order`` run
     forward and backward; None or 0: no filter) runs over each run of present
-    frames on its own (:func:`loper_analysis.motion.filtering.lowpass_finite_runs`).
+    frames on its own (:func:`loper_analysis.filtering.lowpass_finite_runs`).
     Times are the file's own, ``(first_frame + k) / rate``; ``duration_s``
     keeps the first ``duration_s`` seconds of the trial, ``span_s`` (start,
     end) the frames between two times of the file's clock (a crop set per

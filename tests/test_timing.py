@@ -1,4 +1,4 @@
-"""The I/O clock behind the job-time split (io/timing.py, stages/logs.py, benchmarks/rule_times.py).
+"""The I/O clock behind the job-time split (timing.py, stages/logs.py, benchmarks/rule_times.py).
 
 A fake clock drives the module, so every number is exact.
 """
@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
-from loper_analysis.io import timing
+from loper_analysis import timing
 from loper_analysis.stages.logs import timing_line
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[1]
 
 
 class FakeClock:

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.motion.filtering import CUTOFF_HZ, ORDER, check_cutoff, lowpass, lowpass_finite_runs
+from loper_analysis.filtering import CUTOFF_HZ, ORDER, check_cutoff, lowpass, lowpass_finite_runs
 
 FS = 128.0
 

@@ -78,7 +78,7 @@ def check_cutoff(
     """
     import warnings
 
-    from loper_analysis.io.timing import library_import
+    from loper_analysis.timing import library_import
 
     with library_import():  # imported here: scipy.signal costs ~0.6 s, and most rules never filter
         from scipy.signal import butter, sosfilt_zi
@@ -154,7 +154,7 @@ def lowpass(
 
     The forward-backward pass squares the magnitude response: the gain at
     ``cutoff_hz`` is 0.5 (-6 dB) and the roll-off that of order ``2 * order``
-    (``tests/motion/test_filtering.py`` checks both on sinusoids). ``signal`` is an array sampled along ``axis``
+    (``tests/test_filtering.py`` checks both on sinusoids). ``signal`` is an array sampled along ``axis``
     (e.g. (n_frames, n_markers, 3) markers in m, or (n_samples,) forces in N);
     it must be finite (fill marker gaps first). Returns a new array of the same
     shape. ``setting``, ``rate_name`` and ``source`` name the cut-off, the rate
