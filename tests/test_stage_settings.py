@@ -17,7 +17,8 @@ from pathlib import Path
 import pytest
 import yaml
 
-from loper_analysis import filtering, heading, markers, plausibility
+from loper_analysis import filtering
+from loper_analysis.motion import heading, markers, plausibility
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.device import analysis
 from loper_analysis.device.loadcell import LoadcellSettings
