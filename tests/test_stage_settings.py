@@ -18,7 +18,6 @@ import pytest
 import yaml
 
 from loper_analysis import filtering
-from loper_analysis.motion import heading, markers, plausibility
 from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG
 from loper_analysis.device import analysis
 from loper_analysis.device.loadcell import LoadcellSettings
@@ -26,6 +25,7 @@ from loper_analysis.gait import events, grf, resampling
 from loper_analysis.gait.grf_settings import GRFSettings
 from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.gait.trial_events import EventSettings
+from loper_analysis.motion import heading, markers, plausibility
 from loper_analysis.motion.trial_markers import MarkerSettings
 from loper_analysis.stages.settings import stage_settings
 from loper_analysis.transparency import TransparencySettings
