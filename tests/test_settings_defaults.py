@@ -1,9 +1,10 @@
-"""Library defaults agree with the shipped configuration (``config/config.yaml``) and its schema.
+"""The library's named constants and the keyword defaults of its functions agree with the shipped configuration
+(``config/config.yaml``) and its schema.
 
-A setting is written in the config (what the workflow passes) and as a default in the library (what a direct
-call gets). Each test pairs the defaults of one settings class with the config keys the workflow fills it from,
-so that changing either side alone fails here. A default without a config key, or one that differs from the
-config on purpose, is named and asserted explicitly.
+The settings types' defaults are checked stage by stage against what each stage's reader builds of the shipped
+config (``tests/stages/test_settings.py``). A function whose keyword stands for a config key (a fit's number of
+starts, a window's length) and a constant the code names are paired here with their key, so that changing either
+side alone fails.
 """
 
 from __future__ import annotations
@@ -16,12 +17,10 @@ from pathlib import Path
 import pytest
 import yaml
 
-from loper_analysis.device.controller import DeviceParameters, FreeLeg
-from loper_analysis.device.trials import DeviceTestSettings
+from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.impedance import identification
 from loper_analysis.impedance.identification import (
     DEFAULT_LOWER,
-    DEFAULT_PLAUSIBLE_RANGES,
     DEFAULT_UPPER,
     PreparedWindow,
     identify_impedance,
@@ -30,13 +29,9 @@ from loper_analysis.impedance.identification import (
     refit_with_null_pairs,
 )
 from loper_analysis.impedance.identification.impedance import IdentificationSettings, impedance_rows
-from loper_analysis.impedance.identification.validation import ValidationSettings
 from loper_analysis.impedance.responses import ResponseSettings, match_unperturbed, too_short, window_outliers
 from loper_analysis.impedance.responses.response_window import WINDOW_KEYS, ResponseWindow
-from loper_analysis.planning.window import PlanSettings
 from loper_analysis.stages.settings import stage_settings
-from loper_analysis.synthetic.lab_session import LabSessionSettings
-from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -101,29 +96,7 @@ IDENTIFICATION_KEYS = {
     for f in dataclasses.fields(IdentificationSettings)
     if f.name not in ("plausible_ranges", "seed")
 }
-#: LabSettings field -> config key (as LabSettings.from_config reads them for the workflow).
-LAB_KEYS = {
-    "marker_noise_sd_m": "synthetic.marker_noise_sd_m",
-    "n_gaps": "synthetic.marker_gaps_per_trial",
-    "max_gap_frames": "synthetic.max_gap_frames",
-    "grf_noise_sd_n": "synthetic.grf_noise_sd_n",
-    "clock_offset_s": "synthetic.clock_offset_s",
-    "clock_drift_ppm": "synthetic.clock_drift_ppm",
-    "lab_to_model_rotation_deg": "markers.lab_to_model_rotation_deg",
-    "sync_channel": "events.sync_channel",
-}
-
-
 # --------------------------------------------------------------------------- device
-
-
-def test_device_parameters_defaults_equal_config_device_parameters():
-    fields = [f.name for f in dataclasses.fields(DeviceParameters)]
-    assert len(fields) == 24
-    assert sorted(CONFIG["device"]["parameters"]) == sorted(fields)
-    keys = {name: f"device.parameters.{name}" for name in fields}
-    assert _mismatches(_defaults(DeviceParameters), CONFIG, keys) == []
-    assert DeviceParameters(**CONFIG["device"]["parameters"]) == DeviceParameters()
 
 
 def test_device_parameters_schema_names_are_the_dataclass_fields():
@@ -134,53 +107,7 @@ def test_device_parameters_schema_names_are_the_dataclass_fields():
     assert schema["additionalProperties"] is False
 
 
-def test_free_leg_and_device_test_defaults_equal_config():
-    leg = [f.name for f in dataclasses.fields(FreeLeg)]
-    assert sorted(CONFIG["device"]["leg"]) == sorted(leg)
-    assert set(SCHEMA["properties"]["device"]["properties"]["leg"]["properties"]) == set(leg)
-    assert _mismatches(_defaults(FreeLeg), CONFIG, {n: f"device.leg.{n}" for n in leg}) == []
-    tests = [f.name for f in dataclasses.fields(DeviceTestSettings)]
-    assert sorted(CONFIG["device"]["tests"]) == sorted(tests)
-    assert _mismatches(_defaults(DeviceTestSettings), CONFIG, {n: f"device.tests.{n}" for n in tests}) == []
-
-
 # --------------------------------------------------------------------------- responses and identification
-
-
-def test_response_window_defaults_equal_config_identification():
-    assert WINDOW_KEYS == {
-        "before_s": "impedance.window_before_s",
-        "after_s": "impedance.window_after_s",
-        "initial_state_span_s": "impedance.initial_state_span_s",
-    }
-    assert _mismatches(_defaults(ResponseWindow), CONFIG, WINDOW_KEYS) == []
-    assert stage_settings(CONFIG, "impedance").response.window == ResponseWindow()
-
-
-def test_response_settings_defaults_equal_config_identification_and_strides():
-    defaults = _defaults(ResponseSettings)
-    assert _mismatches(defaults, CONFIG, RESPONSE_KEYS) == []
-    assert defaults["window"] == ResponseWindow()
-    # rate_hz has no config key (the workflow leaves it at its default): the response grid runs at the study's
-    # motion-capture rate, the rate of the validation's simulated measurements and of the synthetic lab's markers
-    assert set(defaults) - set(RESPONSE_KEYS) == {"rate_hz", "window"}
-    assert defaults["rate_hz"] == CONFIG["validation"]["sample_rate_hz"] == LabSettings().marker_rate_hz
-
-
-def test_identification_settings_defaults_equal_config_identification():
-    defaults = _defaults(IdentificationSettings)
-    assert _mismatches(defaults, CONFIG, IDENTIFICATION_KEYS) == []
-    # plausible_ranges: None stands for DEFAULT_PLAUSIBLE_RANGES, which must be the config's ranges
-    assert defaults["plausible_ranges"] is None
-    config_ranges = {
-        joint: (tuple(r["stiffness_nm_per_rad"]), tuple(r["damping_nms_per_rad"]))
-        for joint, r in CONFIG["impedance"]["plausible_ranges"].items()
-    }
-    assert _plain(DEFAULT_PLAUSIBLE_RANGES) == config_ranges
-    # seed differs on purpose: the workflow passes the config's seed; the library default follows
-    # identify_impedance's own seed (0), so that the default settings fit as a bare identify_impedance call does
-    assert defaults["seed"] == _signature_defaults(identify_impedance)["seed"] == 0
-    assert defaults["seed"] != CONFIG["seed"]
 
 
 def test_every_identification_key_has_a_checked_default():
@@ -292,100 +219,10 @@ def test_prepared_window_and_identify_defaults_agree_with_config():
 # --------------------------------------------------------------------------- validation and planning
 
 
-def test_validation_settings_defaults_equal_validation_settings_of_config():
-    given = {
-        f.name: getattr(stage_settings(CONFIG, "validation"), f.name) for f in dataclasses.fields(ValidationSettings)
-    }
-    defaults = _defaults(ValidationSettings)
-    different = [
-        f"{k} = {defaults[k]!r}, config gives {v!r}" for k, v in given.items() if _plain(defaults[k]) != _plain(v)
-    ]
-    assert different == []
-    # reference_cutoff_hz has no config key: the study fits the unfiltered reference (None)
-    assert defaults["reference_cutoff_hz"] is None
-
-
-def test_plan_settings_defaults_equal_config():
-    keys = {
-        "pulse_force_n": "planning.pulse_force_n",
-        "pulse_duration_s": "planning.pulse_duration_s",
-        **{
-            name: f"impedance.{name}"
-            for name in (
-                "initial_state_degree",
-                "n_substeps",
-                "null_pair_components",
-                "min_null_pairs",
-                "interval_scatter",
-                "stiffness_bounds_nm_per_rad",
-                "damping_bounds_nms_per_rad",
-            )
-        },
-        # the load cell's low-pass is the walking trials' filter; the pulse reaches the fit at the robot-log rate,
-        # which is the device's control rate
-        "force_cutoff_hz": "markers.filter.cutoff_hz",
-        "force_order": "markers.filter.order",
-        "force_rate_hz": "device.parameters.sample_rate_hz",
-    }
-    defaults = _defaults(PlanSettings)
-    assert set(defaults) == set(keys) | {"window"}
-    assert _mismatches(defaults, CONFIG, keys) == []
-    assert defaults["window"] == stage_settings(CONFIG, "impedance").response.window
-
-
 # --------------------------------------------------------------------------- synthetic lab
 
 
-def test_lab_settings_defaults_equal_config_synthetic():
-    defaults = _defaults(LabSettings)
-    assert _mismatches(defaults, CONFIG, LAB_KEYS) == []
-    # no config key of their own; each agrees with the config value it stands for
-    unmapped = set(defaults) - set(LAB_KEYS)
-    assert unmapped == {"marker_rate_hz", "analog_rate_hz", "robot_rate_hz", "robot_margin_s", "grf_prefix"}
-    assert defaults["robot_rate_hz"] == CONFIG["device"]["parameters"]["sample_rate_hz"]  # robot log = control rate
-    assert defaults["marker_rate_hz"] == CONFIG["validation"]["sample_rate_hz"]  # the study's motion-capture rate
-    channels = CONFIG["events"]["grf_channels"]
-    assert tuple(f"Fz{suffix}" for suffix in defaults["grf_prefix"]) == (channels["left"], channels["right"])
-    # analog_rate_hz (1024 Hz) and robot_margin_s (2 s) are properties of the simulated lab only
-
-
-def test_perturbation_settings_defaults_equal_config_synthetic():
-    defaults = {f.name: f.default for f in dataclasses.fields(PerturbationSettings)}
-    keys = {
-        "force_n": "synthetic.pulse_force_n",
-        "duration_s": "synthetic.pulse_duration_s",
-        "every_strides": "synthetic.perturb_every_strides",
-    }
-    assert _mismatches(defaults, CONFIG, keys) == []
-
-
-#: LabSessionSettings field -> config key (as LabSessionSettings.from_config reads them for the workflow).
-LAB_SESSION_KEYS = {
-    "seed": "seed",
-    "static_duration_s": "synthetic.static_duration_s",
-    "walking_duration_s": "synthetic.walking_duration_s",
-    "timing_cv": "synthetic.timing_cv",
-    "amplitude_cv": "synthetic.amplitude_cv",
-    "pulse_force_n": "synthetic.pulse_force_n",
-    "pulse_duration_s": "synthetic.pulse_duration_s",
-    "perturb_every_strides": "synthetic.perturb_every_strides",
-    "variability": "synthetic.variability",
-    "adaptation_amplitude_change": "synthetic.device_adaptation.amplitude_change",
-    "adaptation_offset_rad": "synthetic.device_adaptation.offset_rad",
-    "adaptation_swing_gain": "synthetic.device_adaptation.swing_gain",
-}
-
-
-def test_lab_session_settings_defaults_equal_config_synthetic():
-    defaults = _defaults(LabSessionSettings)
-    assert _mismatches(defaults, CONFIG, LAB_SESSION_KEYS) == []
-    # the composed settings have their own checks (the design, the lab, the device); the study variability's
-    # fields are named as the config's but for the timing; the true impedance is the study's choice (None: none)
-    assert set(defaults) - set(LAB_SESSION_KEYS) == {"design", "lab", "device", "study_variability", "truth"}
-    v, config = defaults["study_variability"], CONFIG["synthetic"]["study_variability"]
-    names = ("amplitude_cv", "offset_sd_rad", "timing_sd_stride", "swing_gain", "knots_per_stride")
-    ours = (v.amplitude_cv, v.offset_sd_rad, v.timing_sd, v.swing_gain, v.knots_per_stride)
-    assert _plain(ours) == _plain(tuple(config[k] for k in names))
+# analog_rate_hz (1024 Hz) and robot_margin_s (2 s) are properties of the simulated lab only
 
 
 # --------------------------------------------------------------------------- the checks can fail

@@ -111,7 +111,6 @@ def test_the_planner_models_the_load_cell_the_events_stage_filters_with():
 #: Fields of the settings types that no reader sets, each a value the stage's code owns rather than a setting,
 #: with why (the test below fails for any other field a reader leaves at its default).
 NOT_SETTINGS_FIELDS = {
-    "MarkerSettings.label_map": "a trial's label maps, given per trial by the markers rule (markers.label_map ...)",
     "MarkerSettings.span_s": "a trial's span, given per trial by the markers rule (markers.trial_spans_s)",
     "MarkerSettings.duration_s": "an option of the markers step for a caller (keep the first seconds); the workflow "
     "keeps every frame",
@@ -161,3 +160,101 @@ def test_every_field_a_reader_builds_is_read_or_named_as_no_setting(name):
             if f"{type_name}.{field}" not in NOT_SETTINGS_FIELDS and f"{type_name}.*" not in NOT_SETTINGS_FIELDS
         }
         assert unnamed == set(), (name, built, unnamed)
+
+
+# ---------------------------------------------------------------------------------------------------------------------
+# the library's defaults: each stage's settings type, built with no argument, is what its reader builds of the
+# shipped config, field by field and in every nested settings type, but for the fields named below
+
+#: Fields whose shipped value is the study's choice, with no default in the library (None or empty there), and why.
+STUDY_CHOICES = {
+    "LabSessionSettings.truth": "the synthetic subjects' true impedance (the study's; the lab reads its truth.yaml)",
+    "DeviceSettings.subject": "which subject's folder holds the device tests (None: no device tests)",
+    "DeviceSettings.mat_column_map": "the names of a robot's .mat export (None: no export read)",
+    "IdentificationSettings.seed": "the study's seed",
+    "PlanningSettings.onsets_ms": "the study's onsets (None: the pilot's)",
+    "PlanningSettings.targets": "the precisions the study asks for",
+}
+
+
+def _default_map(value):
+    """The library's default for ``None`` of a coordinate map, as the config spells a map."""
+    from loper_analysis.motion.ik import DEFAULT_COORDINATE_MAP
+
+    return {a: {"coordinate": c, "sign": s} for a, (c, s) in DEFAULT_COORDINATE_MAP.items()} if value is None else value
+
+
+def _default_ranges(value):
+    """The library's default for ``None`` of the plausible ranges, as the config spells them."""
+    from loper_analysis.impedance.identification import DEFAULT_PLAUSIBLE_RANGES
+
+    if value is not None:
+        return value
+    names = ("stiffness_nm_per_rad", "damping_nms_per_rad")
+    return {joint: dict(zip(names, ranges, strict=True)) for joint, ranges in DEFAULT_PLAUSIBLE_RANGES.items()}
+
+
+#: Fields whose default None (or empty) stands for the value the shipped config spells out: how to read it.
+SAME_MEANING = {
+    "ModelSettings.coordinate_map": _default_map,
+    "IKSettings.coordinate_map": _default_map,
+    "DynamicsSettings.coordinate_map": _default_map,
+    "IKSettings.marker_weights": lambda value: value or {},
+    "IKSettings.coordinate_tasks": lambda value: value or {},
+    "IdentificationSettings.plausible_ranges": _default_ranges,
+}
+
+
+def _plain(value):
+    if isinstance(value, list | tuple):
+        return tuple(_plain(v) for v in value)
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
+
+
+def _differing(default, built) -> set[str]:
+    """``Type.field`` of every field (in nested settings types too) where ``default`` and ``built`` differ, as read
+    through :data:`SAME_MEANING`."""
+    out = set()
+    for f in dataclasses.fields(default):
+        name = f"{type(default).__name__}.{f.name}"
+        have, want = getattr(default, f.name), getattr(built, f.name)
+        if dataclasses.is_dataclass(have) and type(have) is type(want):
+            out |= _differing(have, want)
+            continue
+        read = SAME_MEANING.get(name, lambda value: value)
+        if _plain(read(have)) != _plain(read(want)):
+            out.add(name)
+    return out
+
+
+@pytest.mark.parametrize("name", [stage.name for stage in STAGES if stage.name != "report"])
+def test_the_librarys_defaults_are_what_the_shipped_config_builds(name):
+    """A direct call of the library and the workflow at its shipped config compute with the same numbers. The
+    report's settings have no default (its run settings are the other stages'), the study's neither."""
+    built = stage_settings(CONFIG, name)
+    assert _differing(type(built)(), built) == {key for key in STUDY_CHOICES if _owner(key, built)}
+
+
+def _owner(key: str, settings) -> bool:
+    """Whether ``Type.field`` belongs to ``settings`` or a settings type nested in it."""
+    type_name = key.split(".")[0]
+    if type(settings).__name__ == type_name:
+        return True
+    return any(
+        dataclasses.is_dataclass(getattr(settings, f.name)) and _owner(key, getattr(settings, f.name))
+        for f in dataclasses.fields(settings)
+    )
+
+
+def test_a_changed_default_or_config_value_is_found():
+    from loper_analysis.device.controller import DeviceParameters
+
+    built = stage_settings(CONFIG, "device")
+    changed = dataclasses.replace(built, parameters=dataclasses.replace(built.parameters, servo_delay_s=0.003))
+    assert _differing(type(built)(), changed) - set(STUDY_CHOICES) == {"DeviceParameters.servo_delay_s"}
+    assert DeviceParameters().servo_delay_s == CONFIG["device"]["parameters"]["servo_delay_s"] != 0.003
+    config = copy.deepcopy(CONFIG)
+    config["markers"]["filter"]["cutoff_hz"] = 12.0
+    assert _differing(type(built := stage_settings(config, "markers"))(), built) == {"MarkerSettings.cutoff_hz"}
