@@ -7,7 +7,7 @@ Usage: python benchmarks/ik_gait2392.py [duration_s] [--models generated,gait239
 One simulated walking trial (the synthetic lab's gait) drives each model: the generated sagittal model with
 its 36 markers, gait2392 (23 coordinates) with its 39 scale markers and Rajagopal2016 (39 coordinates, its
 own markers), the last two with their coordinates mapped from ours
-(:data:`loper_analysis.synthetic.lab_export.GAIT2392_COORDINATES`; Rajagopal2016's arms at their defaults).
+(:data:`loper_analysis.synthetic.gait2392_coordinates.GAIT2392_COORDINATES`; Rajagopal2016's arms at their defaults).
 Markers get 0.5 mm noise. Each model is solved, on one core, by:
 
 * ``opensim 1e-6``: OpenSim's ``InverseKinematicsSolver`` at the pipeline's accuracy (``ik.opensim_accuracy``),
@@ -37,8 +37,8 @@ from loper_analysis.io.osim import read_marker_set, read_model
 from loper_analysis.motion.ik import inverse_kinematics, marker_positions
 from loper_analysis.motion.ik_determinacy import model_tree, undetermined_coordinates
 from loper_analysis.motion.model import build_lower_body_model
+from loper_analysis.synthetic.gait2392_coordinates import gait2392_coordinates
 from loper_analysis.synthetic.gait_curves import NominalGait
-from loper_analysis.synthetic.lab_export import gait2392_coordinates
 from loper_analysis.synthetic.walking import leg_length_from_height, walking_kinematics
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -6,7 +6,7 @@ contents a real lab would hand over, with their quirks:
 
 * markers: the gait2392 scale markers on a given OpenSim model (gait2392 or
   a scaled copy) at the simulated coordinates mapped onto gait2392's
-  (:data:`loper_analysis.synthetic.lab_export.GAIT2392_COORDINATES`, signs checked against OpenSim's body
+  (:data:`loper_analysis.synthetic.gait2392_coordinates.GAIT2392_COORDINATES`, signs checked against OpenSim's body
   positions in the tests), the pelvis lifted so that the feet reach the floor
   (:func:`floor_offset_m`), turned into the lab frame (Z up: the inverse of
   ``lab_to_model_rotation_deg``), with noise, short gaps and long gaps (in
@@ -41,7 +41,7 @@ from loper_analysis.constants import GRAVITY_M_PER_S2, SIDES
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
 from loper_analysis.io.c3d_writer import ForcePlatform
-from loper_analysis.synthetic.lab_export import GAIT2392_COORDINATES, gait2392_coordinates
+from loper_analysis.synthetic.gait2392_coordinates import GAIT2392_COORDINATES, gait2392_coordinates
 from loper_analysis.synthetic.trials import LabSettings, WalkingTrial
 from tests.force_plate_channels import plate_channels, plate_frame, wrench_channels
 

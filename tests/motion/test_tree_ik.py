@@ -18,8 +18,8 @@ from loper_analysis.motion.ik import inverse_kinematics, marker_positions
 from loper_analysis.motion.kinematic_tree import kinematic_tree
 from loper_analysis.motion.model import build_lower_body_model
 from loper_analysis.motion.tree_ik import tree_inverse_kinematics
+from loper_analysis.synthetic.gait2392_coordinates import gait2392_coordinates
 from loper_analysis.synthetic.gait_curves import NominalGait
-from loper_analysis.synthetic.lab_export import gait2392_coordinates
 from loper_analysis.synthetic.walking import leg_length_from_height, walking_kinematics
 from tests.gait2392_models import gait2392_with_markers
 

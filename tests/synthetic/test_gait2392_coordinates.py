@@ -1,4 +1,4 @@
-"""Our coordinates as gait2392's (loper_analysis.synthetic.lab_export): each mapped coordinate moves the same
+"""Our coordinates as gait2392's (loper_analysis.synthetic.gait2392_coordinates): each mapped coordinate moves the same
 segment the same way in both models."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 
 from loper_analysis.motion.ik import marker_positions
 from loper_analysis.motion.model import COORDINATES, build_lower_body_model
-from loper_analysis.synthetic.lab_export import GAIT2392_COORDINATES, gait2392_coordinates
+from loper_analysis.synthetic.gait2392_coordinates import GAIT2392_COORDINATES, gait2392_coordinates
 from tests.gait2392_models import gait2392_with_markers
 
 
