@@ -317,3 +317,104 @@ def test_each_slice_is_whole_a_reader_and_a_rule_for_every_file(stage):
     outputs = "\n".join(_output_blocks((RULES / f"{stage.name}.smk").read_text()))
     unwritten = [name for name in stage.files if f"PATHS.{stage.name}.{name}" not in outputs]
     assert unwritten == [], stage.name
+
+
+#: Private names one module takes from another, each by the importing module (``docs/code_layout.md``, Layers).
+PRIVATE_IMPORTS = {"cli_checks.py: loper_analysis.stages.report.step._configfiles"}
+
+
+def private_imports(source: str) -> list[str]:
+    """The package's ``_name`` names a source imports (``from loper_analysis.x import _name``)."""
+    return [
+        f"{n.module}.{a.name}"
+        for n in ast.walk(ast.parse(source))
+        if isinstance(n, ast.ImportFrom) and (n.module or "").startswith("loper_analysis")
+        for a in n.names
+        if a.name.startswith("_") and not a.name.startswith("__")
+    ]
+
+
+def test_no_module_imports_another_modules_private_names_but_the_one_named():
+    src = ROOT / "src" / "loper_analysis"
+    found = {
+        f"{p.relative_to(src).as_posix()}: {name}" for p in src.rglob("*.py") for name in private_imports(p.read_text())
+    }
+    assert found == PRIVATE_IMPORTS
+
+
+def test_the_private_import_check_sees_one_inside_a_function():
+    source = "from loper_analysis.io import readers\ndef f():\n    from loper_analysis.gait.grf import _rest, up\n"
+    assert private_imports(source) == ["loper_analysis.gait.grf._rest"]
+
+
+def test_no_module_of_the_package_holds_the_snakemake_object():
+    """Only the rules' scripts see ``snakemake``; the package takes what they pass on."""
+    src = ROOT / "src" / "loper_analysis"
+    found = [
+        f"{p.relative_to(src).as_posix()}:{n.lineno}"
+        for p in src.rglob("*.py")
+        for n in ast.walk(ast.parse(p.read_text()))
+        if (isinstance(n, ast.Name) and n.id == "snakemake") or (isinstance(n, ast.arg) and n.arg == "snakemake")
+    ]
+    assert found == []
+
+
+@pytest.mark.parametrize("stage", STAGES, ids=lambda s: s.name)
+def test_the_result_files_are_the_slices_files(stage):
+    """``stages.RESULT_FILES`` (hence ``PATHS``) is built from each slice's ``files.FILES``."""
+    from loper_analysis.stages import RESULT_FILES
+
+    files = importlib.import_module(f"loper_analysis.stages.{stage.name}.files").FILES
+    assert dict(stage.files) == dict(files)
+    assert RESULT_FILES.get(stage.name, {}) == dict(files)
+
+
+def test_the_snakefile_includes_each_stages_rule_file_through_stages():
+    """The Snakefile includes the shared rule files, then every stage's by ``STAGES``; ``rule all`` asks every
+    stage's targets."""
+    text = (ROOT / "Snakefile").read_text()
+    includes = re.findall(r"^\s*include:\s*(.+?)\s*$", text, re.M)
+    assert includes == ['"workflow/rules/common.smk"', '"workflow/rules/inputs.smk"', "_stage.rule_file"]
+    assert re.search(r"^for _stage in STAGES:\n\n?\s+include: _stage\.rule_file$", text, re.M)
+    assert re.search(r"^rule all:\n(?:\s+.*\n)*?\s+input:\n\s+all_targets\(STUDY\),", text, re.M)
+
+
+def _rules(text: str) -> dict[str, str]:
+    """Rule name -> its text, of one rule file."""
+    parts = re.split(r"^\s*rule (\w+):\s*$", text, flags=re.M)
+    return dict(zip(parts[1::2], parts[2::2]))
+
+
+def test_every_rule_names_its_outputs_log_and_benchmark():
+    missing = []
+    for smk in sorted(RULES.glob("*.smk")):
+        for name, body in _rules(smk.read_text()).items():
+            sections = set(re.findall(r"^\s+(\w+):\s*$", body, re.M))
+            missing += [f"{name}: {s}" for s in ("output", "log", "benchmark", "script") if s not in sections]
+    assert missing == []
+
+
+def test_each_rules_script_calls_one_function_of_its_step():
+    """A rule's script calls one function of its stage's ``step.py`` (a bundle of files aside: a class)."""
+    wrong = []
+    for script in sorted((ROOT / "workflow" / "scripts").glob("*.py")):
+        tree = ast.parse(script.read_text())
+        alias = next(
+            a.asname or a.name
+            for n in ast.walk(tree)
+            if isinstance(n, ast.ImportFrom) and n.module and n.module.startswith("loper_analysis.stages.")
+            for a in n.names
+            if a.name == "step"
+        )
+        called = {
+            n.func.attr
+            for n in ast.walk(tree)
+            if isinstance(n, ast.Call)
+            and isinstance(n.func, ast.Attribute)
+            and isinstance(n.func.value, ast.Name)
+            and n.func.value.id == alias
+            and not n.func.attr[0].isupper()
+        }
+        if len(called) != 1:
+            wrong.append(f"{script.name}: {sorted(called)}")
+    assert wrong == []
