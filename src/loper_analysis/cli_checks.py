@@ -92,9 +92,9 @@ def refuse_config_code(args: argparse.Namespace) -> None:
     if args.command != "report":
         return
     from loper_analysis.schema import check_yaml_file
-    from loper_analysis.stages.report.step import _configfiles
+    from loper_analysis.stages.report.step import configfiles_given
 
-    for path in _configfiles(getattr(args, "snakemake_args", None) or []):
+    for path in configfiles_given(getattr(args, "snakemake_args", None) or []):
         if Path(path).is_file():  # a missing file: Snakemake's own message
             check_yaml_file(path)
 

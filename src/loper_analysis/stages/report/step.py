@@ -23,6 +23,7 @@ __all__ = [
     "FrontPageFiles",
     "front_page",
     "snakemake_report_command",
+    "configfiles_given",
     "check_report_complete",
     "missing_results",
     "write_report",
@@ -246,7 +247,7 @@ def _stop_on_sigterm(signum: int, frame) -> None:
     raise SystemExit(f"stopped by {signal.Signals(signum).name}")
 
 
-def _configfiles(snakemake_args: Sequence[str]) -> list[str]:
+def configfiles_given(snakemake_args: Sequence[str]) -> list[str]:
     """The files given with ``--configfile``/``--configfiles`` (one or more each, or ``--configfile=FILE``)."""
     files, taking = [], False
     for arg in map(str, snakemake_args):
@@ -290,7 +291,7 @@ def _require_results(target: Path, snakemake_args: Sequence[str], cwd: PathLike 
     if not missing:
         return
     shown = ", ".join(missing[:_MISSING_SHOWN]) + (", ..." if len(missing) > _MISSING_SHOWN else "")
-    configs = "".join(f" --configfile {path}" for path in _configfiles(snakemake_args))
+    configs = "".join(f" --configfile {path}" for path in configfiles_given(snakemake_args))
     raise LoperInputError(
         f"{target}: the workflow has not built {len(missing)} of its result files ({shown}): "
         f"run the whole workflow first (snakemake -j2{configs}), then the report again: {kept}"
@@ -338,7 +339,7 @@ def write_report(
     target = Path(target)
     kept = "the previous report is kept" if target.exists() else "no report was written"
     if command is None:
-        for path in _configfiles(snakemake_args):
+        for path in configfiles_given(snakemake_args):
             check_yaml_file(Path(cwd or ".") / path)
         _require_results(target, snakemake_args, cwd, kept)
         command = snakemake_report_command(snakemake_args)
