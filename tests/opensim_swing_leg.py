@@ -17,9 +17,11 @@ In joint angles (pelvis angle zero): ``phi_1 = theta_hip``,
 
 Generalised forces enter through CoordinateActuators and the rod force
 ``F = (F_x, F_y)`` through two PointActuators at the body point
-``(0, -attachment_m)`` of the thigh with the direction fixed in ground; all six
-use optimal force 1 and the actuation override, a discrete state variable that
-holds the value during a Manager integration.
+``(0, -attachment_m)`` of the thigh with the direction fixed in ground (and,
+for parameters with a ``shank_attachment_m``, a second rod's through two more
+at ``(0, -shank_attachment_m)`` of the shank); all use optimal force 1 and the
+actuation override, a discrete state variable that holds the value during a
+Manager integration.
 
 :class:`PerturbedSwingLeg` (further below) is the perturbed swing with joint
 impedance feedback, built from OpenSim components only.
@@ -90,18 +92,22 @@ class OpenSimLeg:
             model.addForce(act)
             self.coord_actuators.append(act)
         self.force_actuators = []
-        for k, direction in enumerate(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))):
-            act = osim.PointActuator("thigh")
-            act.setName(f"rod_force_{'xy'[k]}")
-            act.set_point(osim.Vec3(0.0, -p.attachment_m, 0.0))
-            act.set_point_is_global(False)
-            act.set_direction(osim.Vec3(*direction))
-            act.set_force_is_global(True)
-            act.setOptimalForce(1.0)
-            act.setMinControl(-np.inf)
-            act.setMaxControl(np.inf)
-            model.addForce(act)
-            self.force_actuators.append(act)
+        rods = [("thigh", "rod_force", p.attachment_m)]
+        if p.shank_attachment_m is not None:
+            rods.append(("shank", "shank_rod_force", p.shank_attachment_m))
+        for body, name, distance in rods:
+            for k, direction in enumerate(((1.0, 0.0, 0.0), (0.0, 1.0, 0.0))):
+                act = osim.PointActuator(body)
+                act.setName(f"{name}_{'xy'[k]}")
+                act.set_point(osim.Vec3(0.0, -distance, 0.0))
+                act.set_point_is_global(False)
+                act.set_direction(osim.Vec3(*direction))
+                act.set_force_is_global(True)
+                act.setOptimalForce(1.0)
+                act.setMinControl(-np.inf)
+                act.setMaxControl(np.inf)
+                model.addForce(act)
+                self.force_actuators.append(act)
 
         self.state = model.initSystem()
         self.model = model
@@ -114,9 +120,11 @@ class OpenSimLeg:
 
     # ------------------------------------------------------------ state
 
-    def set_state(self, q, qd, u=None, force=None) -> None:
+    def set_state(self, q, qd, u=None, force=None, shank_force=None) -> None:
         u = np.zeros(4) if u is None else u
         force = np.zeros(2) if force is None else force
+        if len(self.force_actuators) == 4:
+            force = np.r_[force, np.zeros(2) if shank_force is None else shank_force]
         s = self.state
         s.setTime(0.0)
         s.setQ(osim.Vector([float(v) for v in A_INV @ q]))
@@ -163,8 +171,8 @@ class OpenSimLeg:
 
     # ------------------------------------------------------------ simulation
 
-    def simulate(self, time_s, q0, qd0, u, force) -> np.ndarray:
-        self.set_state(q0, qd0, u, force)
+    def simulate(self, time_s, q0, qd0, u, force, shank_force=None) -> np.ndarray:
+        self.set_state(q0, qd0, u, force, shank_force)
         self.state.setTime(float(time_s[0]))
         manager = osim.Manager(self.model)
         manager.setIntegratorAccuracy(1e-12)

@@ -20,6 +20,8 @@ from loper_analysis.swing_leg.dynamics import SegmentParameters, _checked_terms,
 __all__ = [
     "attachment_jacobian",
     "attachment_position",
+    "shank_attachment_jacobian",
+    "shank_attachment_position",
     "coriolis_forces",
     "forward_dynamics",
     "generalized_joint_forces",
@@ -56,10 +58,17 @@ def gravity_forces(q, params: SegmentParameters) -> np.ndarray:
 
 
 def attachment_jacobian(q, params: SegmentParameters) -> np.ndarray:
-    """Jacobian of the rod attachment point, (2, 4) or (n, 2, 4) (m/m, m/rad)."""
+    """Jacobian of the thigh rod's attachment point, (2, 4) or (n, 2, 4) (m/m, m/rad)."""
     q2, single = finite_rows("q", q, 4)
     _, _, Ja = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
-    return _out(Ja, single)
+    return _out(Ja[:, :2], single)
+
+
+def shank_attachment_jacobian(q, params: SegmentParameters) -> np.ndarray:
+    """Jacobian of the shank rod's attachment point, (2, 4) or (n, 2, 4) (m/m, m/rad)."""
+    q2, single = finite_rows("q", q, 4)
+    _, _, Ja = kernels.terms_batch(q2, np.zeros_like(q2), params.packed)
+    return _out(Ja[:, 2:], single)
 
 
 def _rot(q: np.ndarray, v: tuple[float, float]) -> np.ndarray:
@@ -86,10 +95,19 @@ def attachment_position(q, params: SegmentParameters) -> np.ndarray:
     return _out(pos, single)
 
 
-def forward_dynamics(q, qd, u, params: SegmentParameters, force_n=None) -> np.ndarray:
-    """Accelerations q'' (n, 4) from M q'' = -C + G + u + Ja^T F."""
+def shank_attachment_position(q, params: SegmentParameters) -> np.ndarray:
+    """World position (n, 2) of the shank rod's attachment point (m)."""
+    q2, single = finite_rows("q", q, 4)
+    knee = np.stack([q2[:, 0], np.zeros(len(q2))], axis=-1) + _rot(q2[:, 1], (0.0, -params.length_m[0]))
+    return _out(knee + _rot(q2[:, 2], (0.0, -params.shank_attachment_m)), single)
+
+
+def forward_dynamics(q, qd, u, params: SegmentParameters, force_n=None, shank_force_n=None) -> np.ndarray:
+    """Accelerations q'' (n, 4) from M q'' = -C + G + u + Ja^T F + Js^T F_s."""
     u2, F, M, h, Ja, single = _checked_terms(q, qd, "u", u, params, force_n)
-    rhs = h + u2 + np.einsum("nji,nj->ni", Ja, F)
+    rhs = h + u2 + np.einsum("nji,nj->ni", Ja[:, :2], F)
+    if shank_force_n is not None:
+        rhs = rhs + np.einsum("nji,nj->ni", Ja[:, 2:], _force(shank_force_n, len(u2)))
     return _out(np.linalg.solve(M, rhs[..., None])[..., 0], single)
 
 
@@ -112,6 +130,7 @@ def simulate(
     *,
     u_ff=None,
     force_n=None,
+    shank_force_n=None,
     impedance=None,
     reference_joint_angles_rad=None,
     reference_joint_velocities_rad_s=None,
@@ -123,7 +142,8 @@ def simulate(
     """Forward simulation with SciPy's DOP853 (the reference integrator).
 
     Inputs sampled at ``time_s`` (n,) are linearly interpolated: ``u_ff`` (n, 4),
-    ``force_n`` (n, 2) at the attachment point, pelvis angle and rate (n,).
+    ``force_n`` (n, 2) at the thigh rod's attachment point, ``shank_force_n`` (n, 2) at the shank rod's, pelvis
+    angle and rate (n,).
     With ``impedance = (K_hip, D_hip, K_knee, D_knee, K_ankle, D_ankle)`` the
     joints get ``T = -K (theta - theta_ref) - D (theta' - theta_ref')`` with
     the reference angles/rates (n, 3) (zero when omitted).
@@ -139,7 +159,7 @@ def simulate(
     x0, _ = finite_rows("q0", q0, 4)
     v0, _ = finite_rows("qd0", qd0, 4)
     uff = np.zeros((n, 4)) if u_ff is None else finite_rows("u_ff", u_ff, 4)[0]
-    F = _force(force_n, n)
+    F = np.hstack([_force(force_n, n), _force(shank_force_n, n)])
     _same_rows(("time_s", t[:, None]), ("u_ff", uff), ("force_n", F))
 
     def col(name, value, width):
@@ -161,19 +181,19 @@ def simulate(
     packed = params.packed
     M = np.empty((4, 4))
     h = np.empty(4)
-    Ja = np.empty((2, 4))
+    Ja = np.empty((4, 4))
     inputs = np.hstack([uff, F, pel, peld, th_ref, thd_ref])
 
     def rhs(time, y):
         q, qd = y[:4], y[4:]
         z = _interp_columns(time, t, inputs)
         kernels.terms(q, qd, packed, M, h, Ja)
-        r = h + z[:4] + Ja.T @ z[4:6]
+        r = h + z[:4] + Ja.T @ z[4:8]
         if impedance is not None:
-            pel_t, peld_t = z[6], z[7]
+            pel_t, peld_t = z[8], z[9]
             th = np.array([pel_t - q[1], q[2] - q[1], q[2] - q[3]])
             thd = np.array([peld_t - qd[1], qd[2] - qd[1], qd[2] - qd[3]])
-            T = -p[0::2] * (th - z[8:11]) - p[1::2] * (thd - z[11:14])
+            T = -p[0::2] * (th - z[10:13]) - p[1::2] * (thd - z[13:16])
             r = r + generalized_joint_forces(T)
         return np.concatenate([qd, np.linalg.solve(M, r)])
 

@@ -34,6 +34,8 @@ from tests.swing_leg.reference_dynamics import (
     gravity_forces,
     mass_matrix,
     segment_com_positions,
+    shank_attachment_jacobian,
+    shank_attachment_position,
     simulate,
 )
 
@@ -227,6 +229,24 @@ def _fields(p: SegmentParameters) -> np.ndarray:
 def test_segment_parameters_frame_round_trip(params):
     back = SegmentParameters.from_frame(params.to_frame())
     np.testing.assert_array_equal(_fields(back), _fields(params))
+    assert back.shank_attachment_m is None
+    two = params.replace(shank_attachment_m=0.3)
+    frame = two.to_frame().set_index("segment")
+    assert frame.loc["shank", "attachment_m"] == 0.3 and np.isnan(frame.loc["foot", "attachment_m"])
+    assert SegmentParameters.from_frame(two.to_frame()) == two
+
+
+def test_shank_attachment_jacobian_is_derivative_of_its_position(params):
+    two = params.replace(shank_attachment_m=0.8 * params.length_m[1])
+    _, q, _ = random_states(5)
+    fd = central_difference(lambda x: shank_attachment_position(x, two), q, 1e-6)
+    np.testing.assert_allclose(shank_attachment_jacobian(q, two), fd, rtol=0, atol=1e-9)
+    # the point sits shank_attachment_m below the knee along the shank
+    pos = shank_attachment_position(q, two)
+    knee = np.column_stack([q[:, 0], np.zeros(len(q))]) + params.length_m[0] * np.column_stack(
+        [-np.sin(q[:, 1]), -np.cos(q[:, 1])]
+    )
+    np.testing.assert_allclose(np.linalg.norm(pos - knee, axis=1), two.shank_attachment_m, rtol=1e-14)
 
 
 @pytest.mark.parametrize(
@@ -242,6 +262,9 @@ def test_segment_parameters_frame_round_trip(params):
         ({"mass_kg": (6.0, float("nan"), 1.0)}, ["mass_kg", "nan"]),
         ({"com_y_m": (-0.2, -0.2)}, ["com_y_m", "(2,)"]),
         ({"gravity_m_per_s2": -1.0}, ["gravity_m_per_s2", "-1.0"]),
+        ({"shank_attachment_m": 0.6}, ["shank_attachment_m", "shank", "0.6"]),
+        ({"shank_attachment_m": -0.05}, ["shank_attachment_m", "-0.05"]),
+        ({"shank_attachment_m": float("nan")}, ["shank_attachment_m", "nan"]),
     ],
 )
 def test_segment_parameters_reject_bad_values(changes, words):

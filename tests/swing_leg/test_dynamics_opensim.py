@@ -18,7 +18,8 @@ Generalised forces enter through CoordinateActuators and the rod force
 ``(0, -attachment_m)`` of the thigh with the direction fixed in ground; all six
 use optimal force 1 and the actuation override, a discrete state variable that
 holds the value during a Manager integration. The OpenSim model is
-:class:`tests.opensim_swing_leg.OpenSimLeg`.
+:class:`tests.opensim_swing_leg.OpenSimLeg`. With a second rod just above the ankle (``shank_attachment_m``),
+two more PointActuators push at that point of the shank.
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ from tests.swing_leg.reference_dynamics import (
     forward_dynamics,
     mass_matrix,
     segment_com_positions,
+    shank_attachment_jacobian,
+    shank_attachment_position,
     simulate,
 )
 
@@ -139,3 +142,76 @@ def test_simulation_matches_opensim_manager(params):
     np.testing.assert_allclose(q_sim[-1], q_ref[-1], rtol=0, atol=1e-6)
     np.testing.assert_allclose(q_sim[:, 0], q_ref[:, 0], rtol=0, atol=1e-6)
     np.testing.assert_allclose(q_sim[:, 1:], q_ref[:, 1:], rtol=0, atol=1e-6)
+
+
+# ---------------------------------------------------------------- a second rod at the shank
+
+#: A second rod's attachment on the shank, from the knee (m): just above the ankle of either parameter set.
+SHANK_ROD_FRACTION = 0.85
+
+
+def _two_rods(params: SegmentParameters) -> SegmentParameters:
+    return params.replace(shank_attachment_m=SHANK_ROD_FRACTION * params.length_m[1])
+
+
+def test_the_shank_rods_point_and_its_jacobian_match_opensim(params):
+    """The shank rod's point (position and velocity) as OpenSim's station on the shank; the thigh rod's unchanged."""
+    two = _two_rods(params)
+    leg = OpenSimLeg(two)
+    station = (0.0, -two.shank_attachment_m, 0.0)
+    for q, qd, _, _ in _random_states(10, seed=11):
+        leg.set_state(q, qd)
+        np.testing.assert_allclose(
+            leg.station_in_ground("shank", station)[:2], shank_attachment_position(q, two), atol=1e-14
+        )
+        v = leg.station_velocity_in_ground("shank", station)[:2]
+        np.testing.assert_allclose(v, shank_attachment_jacobian(q, two) @ qd, rtol=0, atol=1e-13)
+        np.testing.assert_array_equal(attachment_jacobian(q, two), attachment_jacobian(q, params))
+
+
+def test_forward_dynamics_with_both_rods_match_opensim(params):
+    """Accelerations under both rods' forces (random states, inputs and forces) as OpenSim's, and each rod's force
+    component alone (no gravity masking it) moves the leg as OpenSim's does."""
+    two = _two_rods(params)
+    leg = OpenSimLeg(two)
+    rng = np.random.default_rng(5)
+    for q, qd, u, force in _random_states(20, seed=99):
+        shank_force = rng.uniform(-60.0, 60.0, 2)
+        leg.set_state(q, qd, u, force, shank_force)
+        qdd_ref = leg.accelerations()
+        qdd = forward_dynamics(q, qd, u, two, force, shank_force)
+        assert np.linalg.norm(qdd - qdd_ref) / np.linalg.norm(qdd_ref) < 1e-8
+    p0 = two.replace(gravity_m_per_s2=0.0)
+    leg0 = OpenSimLeg(p0)
+    q, qd = np.array([0.1, 0.3, -0.4, 0.7]), np.zeros(4)
+    for k in range(2):
+        shank_force = np.eye(2)[k] * 10.0
+        leg0.set_state(q, qd, None, None, shank_force)
+        qdd_ref = leg0.accelerations()
+        qdd = forward_dynamics(q, qd, np.zeros(4), p0, None, shank_force)
+        assert np.abs(qdd_ref).max() > 0.1  # the push moves the leg
+        np.testing.assert_allclose(qdd, qdd_ref, rtol=0, atol=1e-10 * np.linalg.norm(qdd_ref))
+
+
+def test_simulation_with_both_rods_matches_opensim_manager(params):
+    two = _two_rods(params)
+    q0 = np.array([0.05, 0.4, 0.1, -0.2])
+    qd0 = np.array([0.3, -2.0, 1.5, 3.0])
+    u = np.array([5.0, 10.0, -4.0, 1.5])
+    force, shank_force = np.array([20.0, -15.0]), np.array([-25.0, 10.0])
+    time_s = np.linspace(0.0, 0.3, 31)
+    q_ref = OpenSimLeg(two).simulate(time_s, q0, qd0, u, force, shank_force)
+    q_sim, _ = simulate(
+        time_s,
+        q0,
+        qd0,
+        two,
+        u_ff=np.tile(u, (len(time_s), 1)),
+        force_n=np.tile(force, (len(time_s), 1)),
+        shank_force_n=np.tile(shank_force, (len(time_s), 1)),
+    )
+    q_one, _ = simulate(
+        time_s, q0, qd0, two, u_ff=np.tile(u, (len(time_s), 1)), force_n=np.tile(force, (len(time_s), 1))
+    )
+    assert np.abs(q_sim - q_one)[-1, 1:].max() > 0.01  # the shank rod's push changes the motion
+    np.testing.assert_allclose(q_sim, q_ref, rtol=0, atol=1e-6)

@@ -9,7 +9,9 @@ Equations of motion (``docs/swing_leg_model.md``)::
   (flexion and dorsiflexion positive).
 * ``Ja`` is the Jacobian (2 x 4) of the rod attachment point on the thigh, at
   ``attachment_m`` from the hip along the thigh axis; ``F = (F_x, F_y)`` in N,
-  world frame (x forward, y up).
+  world frame (x forward, y up). A second rod may push on the shank, at
+  ``shank_attachment_m`` from the knee along the shank axis: its point's
+  Jacobian and force enter the same way (``+ Js(q)^T F_s``).
 
 Segment parameters come from :class:`SegmentParameters` (SI units). The heavy
 lifting is compiled in :mod:`loper_analysis.swing_leg.kernels`; this module offers the
@@ -67,7 +69,9 @@ class SegmentParameters:
     Per-segment tuples are ordered thigh, shank, foot. COM positions are in the
     segment frame: origin at the proximal joint, x forward, y up in the neutral
     pose (so a thigh COM 0.18 m below the hip is ``com_y_m = -0.18``). The
-    distal joint of thigh and shank lies at ``(0, -length_m)``.
+    distal joint of thigh and shank lies at ``(0, -length_m)``. ``attachment_m``: the thigh rod's point, from the
+    hip along the thigh (m); ``shank_attachment_m``: a second rod's point on the shank, from the knee along the
+    shank (m), or None without one.
     """
 
     cart_mass_kg: float
@@ -78,6 +82,7 @@ class SegmentParameters:
     com_y_m: tuple[float, float, float]
     attachment_m: float
     gravity_m_per_s2: float = GRAVITY_M_PER_S2
+    shank_attachment_m: float | None = None
     _packed: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -99,6 +104,13 @@ class SegmentParameters:
             raise LoperInputError(
                 f"attachment_m must lie on the thigh (0 .. {self.length_m[0]} m), got {self.attachment_m}"
             )
+        if self.shank_attachment_m is not None:
+            ds = float(self.shank_attachment_m)
+            if not (np.isfinite(ds) and 0 <= ds <= self.length_m[1]):
+                raise LoperInputError(
+                    f"shank_attachment_m must lie on the shank (0 .. {self.length_m[1]} m from the knee), got {ds}"
+                )
+            object.__setattr__(self, "shank_attachment_m", ds)
         if self.gravity_m_per_s2 < 0:
             raise LoperInputError(f"gravity_m_per_s2 must be >= 0, got {self.gravity_m_per_s2}")
         packed = np.empty(kernels.N_PACKED)
@@ -113,12 +125,13 @@ class SegmentParameters:
             ]
         packed[kernels.ATTACHMENT] = self.attachment_m
         packed[kernels.GRAVITY] = self.gravity_m_per_s2
+        packed[kernels.SHANK_ATTACHMENT] = 0.0 if self.shank_attachment_m is None else self.shank_attachment_m
         packed.setflags(write=False)
         object.__setattr__(self, "_packed", packed)
 
     @property
     def packed(self) -> np.ndarray:
-        """Parameter vector (18,) in the layout of :mod:`loper_analysis.swing_leg.kernels`."""
+        """Parameter vector (19,) in the layout of :mod:`loper_analysis.swing_leg.kernels`."""
         return self._packed
 
     @property
@@ -140,7 +153,8 @@ class SegmentParameters:
         ]
         for i, seg in enumerate(SEGMENTS):
             row = {"segment": seg} | {c: getattr(self, c)[i] for c in _SEGMENT_COLUMNS}
-            row["attachment_m"] = self.attachment_m if seg == "thigh" else np.nan
+            row["attachment_m"] = {"thigh": self.attachment_m, "shank": self.shank_attachment_m}.get(seg)
+            row["attachment_m"] = np.nan if row["attachment_m"] is None else row["attachment_m"]
             row["gravity_m_per_s2"] = np.nan
             rows.append(row)
         return pd.DataFrame(rows)
@@ -170,11 +184,13 @@ class SegmentParameters:
         gravity = GRAVITY_M_PER_S2
         if "gravity_m_per_s2" in df.columns and pd.notna(df.loc["cart", "gravity_m_per_s2"]):
             gravity = number("cart", "gravity_m_per_s2")
+        shank = None if pd.isna(df.loc["shank", "attachment_m"]) else number("shank", "attachment_m")
         try:
             return cls(
                 cart_mass_kg=number("cart", "mass_kg"),
                 attachment_m=number("thigh", "attachment_m"),
                 gravity_m_per_s2=gravity,
+                shank_attachment_m=shank,
                 **values,
             )
         except LoperInputError as exc:
@@ -245,7 +261,8 @@ def _out(a: np.ndarray, single: bool) -> np.ndarray:
 
 
 def _checked_terms(q, qd, name: str, values, params: SegmentParameters, force_n):
-    """Checked (n, 4) ``values`` and force (n, 2), the terms M, h, Ja at (q, q'), and whether q was one state."""
+    """Checked (n, 4) ``values`` and force (n, 2), the terms M, h, Ja (n, 4, 4: thigh rod, shank rod) at (q, q'),
+    and whether q was one state."""
     q2, single = finite_rows("q", q, 4)
     qd2, _ = finite_rows("qd", qd, 4)
     v2, _ = finite_rows(name, values, 4)
@@ -254,13 +271,19 @@ def _checked_terms(q, qd, name: str, values, params: SegmentParameters, force_n)
     return v2, _force(force_n, len(q2)), M, h, Ja, single
 
 
-def inverse_dynamics(q, qd, qdd, params: SegmentParameters, force_n=None) -> np.ndarray:
-    """Generalised forces u (n, 4) that produce q'' at (q, q') under the external force.
+def inverse_dynamics(q, qd, qdd, params: SegmentParameters, force_n=None, shank_force_n=None) -> np.ndarray:
+    """Generalised forces u (n, 4) that produce q'' at (q, q') under the rods' forces.
 
-    ``u = M q'' + C - G - Ja^T F``; units N (cart) and N m (segments).
+    ``u = M q'' + C - G - Ja^T F - Js^T F_s``; units N (cart) and N m (segments). ``force_n``: the thigh rod's
+    force (n, 2) or (2,), N, world x/y; ``shank_force_n``: the shank rod's, for parameters with a
+    ``shank_attachment_m`` (None: no shank rod).
     """
     qdd2, F, M, h, Ja, single = _checked_terms(q, qd, "qdd", qdd, params, force_n)
-    u = np.einsum("nij,nj->ni", M, qdd2) - h - np.einsum("nji,nj->ni", Ja, F)
+    u = np.einsum("nij,nj->ni", M, qdd2) - h - np.einsum("nji,nj->ni", np.ascontiguousarray(Ja[:, :2]), F)
+    if shank_force_n is not None:
+        if params.shank_attachment_m is None:
+            raise LoperInputError("shank_force_n given, but the segment parameters have no shank_attachment_m")
+        u = u - np.einsum("nji,nj->ni", np.ascontiguousarray(Ja[:, 2:]), _force(shank_force_n, len(qdd2)))
     return _out(u, single)
 
 

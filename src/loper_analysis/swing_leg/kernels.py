@@ -13,8 +13,12 @@ Packed segment vector ``packed`` (length :data:`N_PACKED`)::
     packed[segment_slot(i) + 2]        length (m): proximal joint -> distal joint along -y
     packed[segment_slot(i) + 3]        COM x in the segment frame (m)
     packed[segment_slot(i) + 4]        COM y in the segment frame (m)
-    packed[ATTACHMENT]                 rod attachment distance from the hip along the thigh (m)
+    packed[ATTACHMENT]                 thigh rod's attachment distance from the hip along the thigh (m)
     packed[GRAVITY]                    gravity (m/s^2)
+    packed[SHANK_ATTACHMENT]           shank rod's attachment distance from the knee along the shank (m)
+
+The rods' Jacobian ``Ja`` (4 x 4) stacks the thigh rod's attachment point (rows 0, 1: world x, y) over the
+shank rod's (rows 2, 3); a rod force vector is ``(F_x, F_y)`` of the thigh rod, then of the shank rod (N).
 
 Segment frame: origin at the proximal joint, x forward and y up when the
 segment angle is zero (segment hanging). The global angle q_i is positive when
@@ -32,6 +36,7 @@ __all__ = [
     "CART_MASS",
     "ATTACHMENT",
     "GRAVITY",
+    "SHANK_ATTACHMENT",
     "segment_slot",
     "terms",
     "solve4",
@@ -41,10 +46,11 @@ __all__ = [
 ]
 
 #: Length of the packed parameter vector and the index of its scalar entries.
-N_PACKED = 18
+N_PACKED = 19
 CART_MASS = 0
 ATTACHMENT = 16
 GRAVITY = 17
+SHANK_ATTACHMENT = 18
 
 
 def segment_slot(i: int) -> int:
@@ -54,7 +60,7 @@ def segment_slot(i: int) -> int:
 
 @njit(cache=True, inline="always")
 def terms(q, qd, packed, M, h, Ja):
-    """Fill M (4x4), h = G - C (4,) and the attachment Jacobian Ja (2x4) in place.
+    """Fill M (4x4), h = G - C (4,) and the rods' attachment Jacobian Ja (4x4: thigh rod, shank rod) in place.
 
     Closed form for the cart + three segments, unrolled so that the hot loop
     stays in registers. For segment i the COM Jacobian column of an earlier
@@ -129,6 +135,16 @@ def terms(q, qd, packed, M, h, Ja):
     for a in range(2, 4):
         Ja[0, a] = 0.0
         Ja[1, a] = 0.0
+    # the shank rod's point: the knee (a1 of the thigh) and ds along the shank
+    ds = packed[SHANK_ATTACHMENT]
+    Ja[2, 0] = 1.0
+    Ja[3, 0] = 0.0
+    Ja[2, 1] = a1x
+    Ja[3, 1] = a1y
+    Ja[2, 2] = -ds * c2
+    Ja[3, 2] = ds * s2
+    Ja[2, 3] = 0.0
+    Ja[3, 3] = 0.0
 
 
 @njit(cache=True, inline="always")
@@ -159,11 +175,11 @@ def solve4(M, r, out):
 
 @njit(cache=True)
 def terms_batch(q, qd, packed):
-    """M (n,4,4), h (n,4), Ja (n,2,4) for n states."""
+    """M (n,4,4), h (n,4), Ja (n,4,4) for n states."""
     n = q.shape[0]
     M = np.empty((n, 4, 4))
     h = np.empty((n, 4))
-    Ja = np.empty((n, 2, 4))
+    Ja = np.empty((n, 4, 4))
     for k in range(n):
         terms(q[k], qd[k], packed, M[k], h[k], Ja[k])
     return M, h, Ja
@@ -189,8 +205,9 @@ def feedback_torques(e, ed, dpel, dpeld, p, T):
 
 
 @njit(cache=True, inline="always")
-def _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, h, Ja, rhs, T, qdd, state):
-    """Acceleration of the deviation e = q - q_ref at stage index k, rod force fp (2,).
+def _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, fs, dpel, M, h, Ja, rhs, T, qdd, state):
+    """Acceleration of the deviation e = q - q_ref at stage index k, rod forces fp (2,) at the thigh and fs (2,)
+    at the shank.
 
     Fills qdd; ``state`` (2, 4) is work space.
     """
@@ -201,27 +218,27 @@ def _deviation_rhs(k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, M, 
         qd[a] = ref_qd[k, a] + ed[a]
     terms(q, qd, packed, M, h, Ja)
     feedback_torques(e, ed, dpel[k, 0], dpel[k, 1], p, T)
-    rhs[0] = h[0] + w[k, 0] + Ja[0, 0] * fp[0] + Ja[1, 0] * fp[1]
-    rhs[1] = h[1] + w[k, 1] - T[0] - T[1] + Ja[0, 1] * fp[0] + Ja[1, 1] * fp[1]
-    rhs[2] = h[2] + w[k, 2] + T[1] + T[2] + Ja[0, 2] * fp[0] + Ja[1, 2] * fp[1]
-    rhs[3] = h[3] + w[k, 3] - T[2] + Ja[0, 3] * fp[0] + Ja[1, 3] * fp[1]
+    rhs[0] = h[0] + w[k, 0] + Ja[0, 0] * fp[0] + Ja[1, 0] * fp[1] + Ja[2, 0] * fs[0] + Ja[3, 0] * fs[1]
+    rhs[1] = h[1] + w[k, 1] - T[0] - T[1] + Ja[0, 1] * fp[0] + Ja[1, 1] * fp[1] + Ja[2, 1] * fs[0] + Ja[3, 1] * fs[1]
+    rhs[2] = h[2] + w[k, 2] + T[1] + T[2] + Ja[0, 2] * fp[0] + Ja[1, 2] * fp[1] + Ja[2, 2] * fs[0] + Ja[3, 2] * fs[1]
+    rhs[3] = h[3] + w[k, 3] - T[2] + Ja[0, 3] * fp[0] + Ja[1, 3] * fp[1] + Ja[2, 3] * fs[0] + Ja[3, 3] * fs[1]
     solve4(M, rhs, qdd)
     for a in range(4):
         qdd[a] -= ref_qdd[k, a]
 
 
 @njit(cache=True)
-def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0, ed0, dt, n_sub, n_out):
+def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, fs, dpel, e0, ed0, dt, n_sub, n_out):
     """RK4 of the deviation dynamics for a batch of parameter sets.
 
     The model trajectory is q = q_ref + e with
-    M(q) q'' = h(q, q') + w + u_fb + Ja(q)^T F_p, w = u_ff - Ja(q_ref)^T F_u,
+    M(q) q'' = h(q, q') + w + u_fb + Ja(q)^T F_p, w = u_ff - Ja(q_ref)^T F_u (F: both rods' forces),
     so e stays exactly 0 without perturbation (q_ref'' is subtracted).
 
     P: (B, 6) parameter sets; stage arrays (ref_q, ref_qd, ref_qdd, w: (2 N + 1, 4);
     dpel: (2 N + 1, 2)) sampled every dt / 2 from the window start; fp (N, 4, 2)
-    the rod force at the four stages of each of the N steps; e0, ed0: (4,) initial deviation; n_sub RK4 steps per
-    output sample.
+    the thigh rod's force at the four stages of each of the N steps, fs (N, 4, 2) the shank rod's; e0, ed0: (4,)
+    initial deviation; n_sub RK4 steps per output sample.
     Returns E (B, n_out, 4) deviations and Ed (B, n_out, 4) their rates at the
     output samples (sample 0 = initial state).
     """
@@ -230,7 +247,7 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
     Ed = np.empty((B, n_out, 4))
     M = np.empty((4, 4))
     h = np.empty(4)
-    Ja = np.empty((2, 4))
+    Ja = np.empty((4, 4))
     rhs = np.empty(4)
     T = np.empty(3)
     e = np.empty(4)
@@ -254,15 +271,15 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
         st = 0
         for o in range(1, n_out):
             for _ in range(n_sub):
-                k = 2 * st
+                k, kh, ke, fpk, fsk = 2 * st, 2 * st + 1, 2 * st + 2, fp[st], fs[st]
                 _deviation_rhs(
-                    k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 0], dpel, M, h, Ja, rhs, T, k1, state
+                    k, e, ed, p, packed, ref_q, ref_qd, ref_qdd, w, fpk[0], fsk[0], dpel, M, h, Ja, rhs, T, k1, state
                 )
                 for a in range(4):
                     et[a] = e[a] + 0.5 * dt * ed[a]
                     edt[a] = ed[a] + 0.5 * dt * k1[a]
                 _deviation_rhs(
-                    k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 1], dpel, M, h, Ja, rhs, T, k2, state
+                    kh, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fpk[1], fsk[1], dpel, M, h, Ja, rhs, T, k2, state
                 )
                 for a in range(4):
                     v2[a] = edt[a]
@@ -270,7 +287,7 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
                     et[a] = e[a] + 0.5 * dt * v2[a]
                     edt[a] = ed[a] + 0.5 * dt * k2[a]
                 _deviation_rhs(
-                    k + 1, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 2], dpel, M, h, Ja, rhs, T, k3, state
+                    kh, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fpk[2], fsk[2], dpel, M, h, Ja, rhs, T, k3, state
                 )
                 for a in range(4):
                     v3[a] = edt[a]
@@ -278,7 +295,7 @@ def simulate_deviation_batch(P, packed, ref_q, ref_qd, ref_qdd, w, fp, dpel, e0,
                     et[a] = e[a] + dt * v3[a]
                     edt[a] = ed[a] + dt * k3[a]
                 _deviation_rhs(
-                    k + 2, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fp[st, 3], dpel, M, h, Ja, rhs, T, k4, state
+                    ke, et, edt, p, packed, ref_q, ref_qd, ref_qdd, w, fpk[3], fsk[3], dpel, M, h, Ja, rhs, T, k4, state
                 )
                 for a in range(4):
                     e[a] += dt / 6.0 * (ed[a] + 2.0 * v2[a] + 2.0 * v3[a] + edt[a])

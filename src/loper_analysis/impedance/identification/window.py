@@ -68,8 +68,9 @@ class PreparedWindow:
     and their first and second derivatives (n_stage, 4; m and rad),
     ``feedforward`` = u_ff - Ja(q_u)^T F_u, the inverse dynamics of the
     reference with the unperturbed force (n_stage, 4; N and N·m),
-    ``force_perturbed_n`` (n_steps, 4, 2; N, world x/y: the force at the four
-    stages of every RK4 step) and
+    ``force_perturbed_n`` (n_steps, 4, 2; N, world x/y: the thigh rod's force at the four
+    stages of every RK4 step), ``shank_force_perturbed_n`` (the same of a second rod at the shank, or None
+    without one) and
     ``pelvis_deviation`` (n_stage, 2): the perturbed-minus-unperturbed pelvis
     angle (rad) and its rate (rad/s). ``measured`` (n_out, 3) is the
     measured perturbed-minus-unperturbed joint angle difference (rad) at the
@@ -106,6 +107,7 @@ class PreparedWindow:
     initial_state_degree: int = INITIAL_STATE_DEGREE
     noise_cov: np.ndarray | None = None
     residual_weight: np.ndarray | None = None
+    shank_force_perturbed_n: np.ndarray | None = None
 
     @property
     def n_samples(self) -> int:
@@ -144,6 +146,8 @@ def prepare_window(
     force_unperturbed_n=None,
     force_perturbed_n=None,
     force_time_s=None,
+    shank_force_unperturbed_n=None,
+    shank_force_perturbed_n=None,
     pelvis_angle_unperturbed_rad=None,
     pelvis_angle_perturbed_rad=None,
     window: ResponseWindow = ResponseWindow(),
@@ -173,6 +177,8 @@ def prepare_window(
         that a 10 ms edge needs no step shorter than the default. The samples
         must cover the fit window. Without it the forces are (n, 2) at
         ``time_s`` and are interpolated linearly at the stage times.
+    shank_force_unperturbed_n, shank_force_perturbed_n : a second rod's force at the shank (N, world x/y), as the
+        thigh rod's and on its clock; for ``params`` with a ``shank_attachment_m``; None: no shank rod.
     pelvis_angle_*_rad : (n,) pelvis angle (rad); zero when omitted.
     window : the window around the onset (``before_s``, ``after_s``, s) and the span before it for the initial
         state (``initial_state_span_s``, s;
@@ -210,6 +216,7 @@ def prepare_window(
         tf = _force_clock(force_time_s)
         fu = _column("force_unperturbed_n", force_unperturbed_n, len(tf), 2, "force_time_s")
         fpm = _column("force_perturbed_n", force_perturbed_n, len(tf), 2, "force_time_s")
+    su, sp = _shank_forces(params, shank_force_unperturbed_n, shank_force_perturbed_n, n if tf is None else len(tf))
     pu = _column("pelvis_angle_unperturbed_rad", pelvis_angle_unperturbed_rad, n, 1)[:, 0]
     pp = _column("pelvis_angle_perturbed_rad", pelvis_angle_perturbed_rad, n, 1)[:, 0]
     if not isinstance(window, ResponseWindow):
@@ -225,8 +232,9 @@ def prepare_window(
     q_ref = qu if q_reference is None else _column("q_reference", q_reference, n, 4)
     ref_q, ref_qd, ref_qdd = _reference_coordinates(t, dt, q_ref, ts, reference_cutoff_hz)
     force_u, force_p = _stage_forces(t, fu, fpm, tf, ts, step, n_steps)
-    # u_ff - Ja(q_u)^T F_u = inverse dynamics with the unperturbed force
-    feedforward = inverse_dynamics(ref_q, ref_qd, ref_qdd, params, force_u)
+    shank_u, shank_p = (None, None) if su is None else _stage_forces(t, su, sp, tf, ts, step, n_steps)
+    # u_ff - Ja(q_u)^T F_u = inverse dynamics with the unperturbed force (of both rods)
+    feedforward = inverse_dynamics(ref_q, ref_qd, ref_qdd, params, force_u, shank_u)
     dpel_spline = CubicSpline(t, pp - pu)
     dpel = np.stack([dpel_spline(ts), dpel_spline(ts, 1)], axis=-1)
     e0, ed0, state_cov = _initial_state(t, qp - qu, i0, onset_s, initial_state_span_s, initial_state_degree, tol)
@@ -249,6 +257,22 @@ def prepare_window(
         onset_s=float(onset_s),
         initial_state_span_s=float(initial_state_span_s),
         initial_state_degree=int(initial_state_degree),
+        shank_force_perturbed_n=None if shank_p is None else np.ascontiguousarray(shank_p),
+    )
+
+
+def _shank_forces(params: SegmentParameters, unperturbed, perturbed, k: int):
+    """The shank rod's forces (k, 2) each (zero when one is omitted), or (None, None) without either."""
+    if unperturbed is None and perturbed is None:
+        return None, None
+    if params.shank_attachment_m is None:
+        raise LoperInputError(
+            "a shank rod's force is given, but the segment parameters place no rod on the shank "
+            "(shank_attachment_m None)"
+        )
+    return (
+        _column("shank_force_unperturbed_n", unperturbed, k, 2, "the thigh rod's force"),
+        _column("shank_force_perturbed_n", perturbed, k, 2, "the thigh rod's force"),
     )
 
 
@@ -509,6 +533,7 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
         window.reference_qdd,
         window.feedforward,
         window.force_perturbed_n,
+        _shank_force(window),
         window.pelvis_deviation,
         window.initial_deviation,
         window.initial_rate,
@@ -517,6 +542,13 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
         window.n_samples,
     )
     return deviation
+
+
+def _shank_force(window: PreparedWindow) -> np.ndarray:
+    """The shank rod's stage forces (n_steps, 4, 2), zero without a shank rod."""
+    if window.shank_force_perturbed_n is None:
+        return np.zeros_like(window.force_perturbed_n)
+    return window.shank_force_perturbed_n
 
 
 def joint_angle_deviation(deviation: np.ndarray, pelvis_angle_deviation_rad: np.ndarray) -> np.ndarray:
