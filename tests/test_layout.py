@@ -8,10 +8,9 @@ from pathlib import Path
 import pytest
 
 from loper_analysis.layout import fill
-from loper_analysis.stages import RESULT_FILES, all_targets, study_paths
+from loper_analysis.stages import RESULT_FILES, STAGES, all_targets, report_tables, study_paths
 from loper_analysis.stages.impedance.files import fit_files, fit_inputs
 from loper_analysis.stages.planning.files import planning_files
-from loper_analysis.stages.report.files import markdown_sections
 from tests.study_files import CONFIG, study_on, touch
 from tests.workflow_copy import copy_workflow, snakemake
 
@@ -63,8 +62,8 @@ def test_a_recorded_subjects_trials_are_those_on_disk(tmp_path):
     ]
     assert "results/validation/summary.tsv" in targets and "results/device/summary.tsv" not in targets
     # nor does the Markdown of the run's tables ask for it (the default run would build the device tests then)
-    assert "Device" not in markdown_sections(study) and "results/device/summary.tsv" not in set(
-        markdown_sections(study).values()
+    assert "Device" not in report_tables(study) and "results/device/summary.tsv" not in set(
+        report_tables(study).values()
     )
 
 
@@ -133,3 +132,24 @@ def test_the_workflow_compiles_the_packages_bytecode_when_it_starts(tmp_path):
     res = snakemake(tmp_path, "-n", "-q")
     assert res.returncode == 0, res.stderr[-2000:]
     assert cached.is_file() and cached.stat().st_mtime >= Path(module.__file__).stat().st_mtime
+
+
+def test_the_report_tables_are_each_stages_own_tables_in_the_stages_order(tmp_path):
+    """The Markdown rendering's tables come from the stages that own them, in the workflow's order, each a file of
+    its own stage's folder."""
+    study = study_on(tmp_path, {"S01": {"source": "synthetic"}})
+    tables = report_tables(study)
+    assert list(tables) == [
+        "Strides per trial",
+        "Inverse dynamics per trial",
+        "Transparency: RMSD vs ISV_ave",
+        "Transparency: interaction force",
+        "Device",
+        "Impedance per subject, onset and joint",
+        "Across-subject summary",
+        "Literature",
+        "Validation study",
+    ]
+    for stage in STAGES:
+        for path in (stage.tables(study) if stage.tables else {}).values():
+            assert path.startswith(f"results/{stage.name}/"), (stage.name, path)

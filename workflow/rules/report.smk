@@ -1,7 +1,8 @@
 # The report: its front page (what was run, the headline numbers and the main figure, as one HTML fragment
 # that workflow/report/workflow.rst pulls in above the methods text) and every result table in Markdown.
 
-from loper_analysis.stages.report.files import front_page_inputs, markdown_sections, recorded_quality_files
+from loper_analysis.stages import report_tables
+from loper_analysis.stages.report.files import front_page_inputs, recorded_quality_files
 
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
@@ -31,7 +32,7 @@ rule front_page:
 
 rule tables_markdown:
     input:
-        list(markdown_sections(STUDY).values()),
+        list(report_tables(STUDY).values()),
     output:
         PATHS.report.tables,
     log:
@@ -39,6 +40,6 @@ rule tables_markdown:
     benchmark:
         PATHS.benchmark("tables_markdown", "tables")
     params:
-        headings=list(markdown_sections(STUDY)),
+        headings=list(report_tables(STUDY)),
     script:
         "../scripts/tables_markdown.py"

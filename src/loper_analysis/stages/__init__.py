@@ -69,4 +69,12 @@ def all_targets(study: Study) -> list[str]:
     return [path for stage in STAGES if stage.targets is not None for path in stage.targets(study)]
 
 
-__all__ = ["RESULT_FILES", "STAGES", "Stage", "all_targets", "rule_log", "study_paths"]
+def report_tables(study: Study) -> dict[str, str]:
+    """The tables of the run's Markdown rendering (``results/report/tables.md``): heading -> table, every stage's
+    ``tables`` in the stages' order."""
+    return {
+        heading: path for stage in STAGES if stage.tables is not None for heading, path in stage.tables(study).items()
+    }
+
+
+__all__ = ["RESULT_FILES", "STAGES", "Stage", "all_targets", "report_tables", "rule_log", "study_paths"]

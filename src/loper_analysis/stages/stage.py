@@ -29,11 +29,15 @@ class Stage:
     targets : callable or None
         ``targets(study) -> list of paths``: what a run builds of this stage by default for a
         :class:`~loper_analysis.layout.Study` (None: only what later stages read).
+    tables : callable or None
+        ``tables(study) -> {heading: path}``: the stage's tables in the Markdown rendering of the run's tables
+        (``results/report/tables.md``), in its order (None: none).
     """
 
     name: str
     files: Mapping[str, str] = field(default_factory=dict)
     targets: Callable[[Any], list[str]] | None = None
+    tables: Callable[[Any], dict[str, str]] | None = None
 
     @property
     def rule_file(self) -> str:

@@ -3,9 +3,9 @@
 ``step`` is its file step, ``files`` its result files and targets, ``settings`` its reader.
 """
 
-from loper_analysis.stages.dynamics.files import FILES, targets
+from loper_analysis.stages.dynamics.files import FILES, report_tables, targets
 from loper_analysis.stages.stage import Stage
 
-STAGE = Stage(name="dynamics", files=FILES, targets=targets)
+STAGE = Stage(name="dynamics", files=FILES, targets=targets, tables=report_tables)
 
 __all__ = ["STAGE"]

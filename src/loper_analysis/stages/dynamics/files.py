@@ -13,7 +13,16 @@ from loper_analysis.layout import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "NO_PLATES", "DynamicsFiles", "dynamics_files", "dynamics_trials", "targets", "trials_without"]
+__all__ = [
+    "FILES",
+    "report_tables",
+    "NO_PLATES",
+    "DynamicsFiles",
+    "dynamics_files",
+    "dynamics_trials",
+    "targets",
+    "trials_without",
+]
 
 FILES: dict[str, str] = {
     "moments": "{subject}/{trial}.moments.tsv",
@@ -109,3 +118,8 @@ def targets(study: Study) -> list[str]:
     d = study.paths.dynamics
     out = [fill(getattr(d, f), subject=s, trial=t) for s, t in dynamics_trials(study) for f in ("cycles", "figure")]
     return [*out, d.trials] if study.processed_subjects() else out
+
+
+def report_tables(study: Study) -> dict[str, str]:
+    """Heading -> table of the run's Markdown tables: every trial's inverse dynamics or why not."""
+    return {"Inverse dynamics per trial": study.paths.dynamics.trials}

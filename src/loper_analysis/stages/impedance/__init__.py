@@ -3,9 +3,9 @@
 ``step`` is its file step (the rules' scripts and the command line call it), ``files`` its result files.
 """
 
-from loper_analysis.stages.impedance.files import FILES, targets
+from loper_analysis.stages.impedance.files import FILES, report_tables, targets
 from loper_analysis.stages.stage import Stage
 
-STAGE = Stage(name="impedance", files=FILES, targets=targets)
+STAGE = Stage(name="impedance", files=FILES, targets=targets, tables=report_tables)
 
 __all__ = ["STAGE"]

@@ -14,7 +14,7 @@ from loper_analysis.layout import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "FitFiles", "FitOutputs", "TrialFiles", "fit_files", "fit_inputs", "targets"]
+__all__ = ["FILES", "report_tables", "FitFiles", "FitOutputs", "TrialFiles", "fit_files", "fit_inputs", "targets"]
 
 FILES: dict[str, str] = {
     "response": "{subject}/{onset}.response.tsv",
@@ -140,3 +140,13 @@ def targets(study: Study) -> list[str]:
     figures = ("responses_figure", "fit_figure")
     subjects = [fill(getattr(p, f), subject=s) for s in study.processed_subjects() for f in figures]
     return [p.table, p.summary, p.literature, p.figure, *subjects]
+
+
+def report_tables(study: Study) -> dict[str, str]:
+    """Heading -> table of the run's Markdown tables: the impedance per subject, its summary, the literature."""
+    p = study.paths.impedance
+    return {
+        "Impedance per subject, onset and joint": p.table,
+        "Across-subject summary": p.summary,
+        "Literature": p.literature,
+    }

@@ -10,7 +10,7 @@ from loper_analysis.layout import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "front_page_inputs", "markdown_sections", "recorded_quality_files", "targets"]
+__all__ = ["FILES", "front_page_inputs", "recorded_quality_files", "targets"]
 
 FILES: dict[str, str] = {
     "tables": "tables.md",
@@ -62,25 +62,6 @@ def front_page_inputs(study: Study) -> dict:
             if path is not None
         ]
     return out
-
-
-def markdown_sections(study: Study) -> dict[str, str]:
-    """Heading -> result table, for the Markdown rendering of the run's tables."""
-    p = study.paths
-    sections = {
-        "Impedance per subject, onset and joint": p.impedance.table,
-        "Across-subject summary": p.impedance.summary,
-        "Literature": p.impedance.literature,
-        "Strides per trial": p.strides.summary,
-        "Inverse dynamics per trial": p.dynamics.trials,
-        "Validation study": p.validation.summary,
-    }
-    if study.has_device_tests():  # no device tests without a device subject (device.subject null)
-        sections["Device"] = p.device.summary
-    if study.transparency_subjects():
-        sections["Transparency: RMSD vs ISV_ave"] = p.transparency.rmsd
-        sections["Transparency: interaction force"] = p.transparency.force
-    return sections
 
 
 def targets(study: Study) -> list[str]:

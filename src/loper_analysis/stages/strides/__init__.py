@@ -4,8 +4,8 @@
 """
 
 from loper_analysis.stages.stage import Stage
-from loper_analysis.stages.strides.files import FILES, targets
+from loper_analysis.stages.strides.files import FILES, report_tables, targets
 
-STAGE = Stage(name="strides", files=FILES, targets=targets)
+STAGE = Stage(name="strides", files=FILES, targets=targets, tables=report_tables)
 
 __all__ = ["STAGE"]

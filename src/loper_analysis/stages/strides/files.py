@@ -9,7 +9,7 @@ from loper_analysis.layout import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "targets"]
+__all__ = ["FILES", "report_tables", "targets"]
 
 FILES: dict[str, str] = {
     "strides": "{subject}/{trial}.strides.tsv",
@@ -29,3 +29,8 @@ def targets(study: Study) -> list[str]:
         if study.source(s) == "recorded":
             out += [fill(p.strides.figure, subject=s, trial=t) for t in study.subject_trials(s)]
     return [*out, p.strides.summary] if study.processed_subjects() else out
+
+
+def report_tables(study: Study) -> dict[str, str]:
+    """Heading -> table of the run's Markdown tables: the strides per trial."""
+    return {"Strides per trial": study.paths.strides.summary}

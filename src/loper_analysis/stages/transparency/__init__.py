@@ -4,8 +4,8 @@
 """
 
 from loper_analysis.stages.stage import Stage
-from loper_analysis.stages.transparency.files import FILES, targets
+from loper_analysis.stages.transparency.files import FILES, report_tables, targets
 
-STAGE = Stage(name="transparency", files=FILES, targets=targets)
+STAGE = Stage(name="transparency", files=FILES, targets=targets, tables=report_tables)
 
 __all__ = ["STAGE"]

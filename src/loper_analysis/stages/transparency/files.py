@@ -13,7 +13,7 @@ from loper_analysis.layout import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "TransparencyFiles", "transparency_files", "targets"]
+__all__ = ["FILES", "report_tables", "TransparencyFiles", "transparency_files", "targets"]
 
 FILES: dict[str, str] = {
     "rmsd": "rmsd.tsv",
@@ -56,3 +56,11 @@ def targets(study: Study) -> list[str]:
 def transparency_inputs(study: Study) -> list[str]:
     """Every table of the transparency pairs (:func:`transparency_files`)."""
     return [path for files in transparency_files(study).values() for path in dataclasses.astuple(files)]
+
+
+def report_tables(study: Study) -> dict[str, str]:
+    """Heading -> table of the run's Markdown tables: the transparency's, with a subject who walked both trials."""
+    if not study.transparency_subjects():
+        return {}
+    t = study.paths.transparency
+    return {"Transparency: RMSD vs ISV_ave": t.rmsd, "Transparency: interaction force": t.force}

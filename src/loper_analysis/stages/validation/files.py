@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "targets"]
+__all__ = ["FILES", "report_tables", "targets"]
 
 FILES: dict[str, str] = {
     "segments": "segments.tsv",
@@ -24,3 +24,8 @@ def targets(study: Study) -> list[str]:
     """The validation study's tables and figure: for a study with perturbation trials, or without subjects."""
     v = study.paths.validation
     return [v.summary, v.errors, v.fits, v.figure] if study.has_validation() else []
+
+
+def report_tables(study: Study) -> dict[str, str]:
+    """Heading -> table of the run's Markdown tables: the validation study's summary."""
+    return {"Validation study": study.paths.validation.summary}
