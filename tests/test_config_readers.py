@@ -1,18 +1,21 @@
 """Each config key reruns exactly the rules that read it: every setting of ``config/config.yaml`` changed in turn,
 and the rules whose params or files change (what Snakemake's params and input triggers rerun) compared with the
-readers listed here. A setting that reran a rule not reading it would redo work (and, upstream, everything after
-it); one that reran none would be a setting nothing reads."""
+readers each stage lists in ``tests/stages/<stage>/config_readers.py``. A setting that reran a rule not reading it
+would redo work (and, upstream, everything after it); one that reran none would be a setting nothing reads."""
 
 from __future__ import annotations
 
 import copy
 import fnmatch
+import importlib
+import importlib.util
 import re
 from pathlib import Path
 
 import pytest
 import yaml
 
+from loper_analysis.stages import STAGES
 from tests.rule_params import rule_signatures
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -71,156 +74,13 @@ CHANGES = {
     "dynamics.foot_bodies.right": "toes_r",
 }
 
-#: Config key -> the rules that read it (the front page reads the run's headline settings).
+#: Config key -> the rules that read it (the front page reads the run's headline settings): each stage's own keys in
+#: ``tests/stages/<stage>/config_readers.py`` (the study's and the top-level keys in ``tests/stages/study/``).
 READERS = {
-    "raw_dir": (
-        "all device_frf device_log_from_mat device_steps device_trial events events_loadcell grf "
-        "impedance_fit markers model_scaled synthetic_lab synthetic_truth"
-    ),
-    "seed": "device_trial front_page impedance_fit synthetic_lab synthetic_truth validation_chunk",
-    "study.static": "ik markers model_scaled synthetic_lab",
-    "study.no_device": (
-        "all dynamics_trials events events_loadcell front_page strides strides_summary synthetic_lab transparency"
-    ),
-    "study.device": "all dynamics_trials front_page impedance_fit planning strides_summary synthetic_lab transparency",
-    "study.perturbation_onsets_ms": (
-        "all dynamics_trials front_page impedance_figures impedance_fit impedance_table planning strides_summary "
-        "synthetic_lab"
-    ),
-    "study.perturbation_repeats": (
-        "all dynamics_trials front_page impedance_fit planning strides_summary synthetic_lab"
-    ),
-    "study.perturbed_side": "front_page model_segments strides synthetic_lab transparency",
-    "synthetic.walking_duration_s": "front_page synthetic_lab",
-    "synthetic.static_duration_s": "synthetic_lab",
-    "synthetic.variability": "front_page synthetic_lab",
-    "synthetic.timing_cv": "synthetic_lab",
-    "synthetic.amplitude_cv": "synthetic_lab",
-    "synthetic.study_variability": "synthetic_lab",
-    "synthetic.device_adaptation": "synthetic_lab",
-    "synthetic.marker_noise_sd_m": "synthetic_lab",
-    "synthetic.marker_gaps_per_trial": "synthetic_lab",
-    "synthetic.max_gap_frames": "synthetic_lab",
-    "synthetic.grf_noise_sd_n": "synthetic_lab",
-    "synthetic.clock_offset_s": "synthetic_lab",
-    "synthetic.clock_drift_ppm": "synthetic_lab",
-    "synthetic.pulse_force_n": "front_page synthetic_lab",
-    "synthetic.pulse_duration_s": "front_page synthetic_lab",
-    "synthetic.perturb_every_strides": "synthetic_lab",
-    "synthetic.between_subject_cv": "synthetic_truth",
-    "synthetic.stiffness_nm_per_rad.50": "synthetic_truth",
-    "synthetic.stiffness_nm_per_rad.175": "synthetic_truth",
-    "synthetic.stiffness_nm_per_rad.300": "synthetic_truth",
-    "synthetic.damping_nms_per_rad.50": "synthetic_truth",
-    "synthetic.damping_nms_per_rad.175": "synthetic_truth",
-    "synthetic.damping_nms_per_rad.300": "synthetic_truth",
-    "markers.lab_to_model_rotation_deg": "events events_loadcell grf markers model_generic model_scaled synthetic_lab",
-    "markers.walking_direction": "markers",
-    "markers.min_travel_speed_m_per_s": "markers",
-    "markers.max_gap_frames": "markers",
-    "model.static_duration_s": "model_generic model_scaled",
-    "model.static_max_motion_rms_m": "model_scaled",
-    "markers.extent_range_m": "markers",
-    "markers.label_map": "events events_loadcell markers",
-    "markers.trial_label_maps": "events events_loadcell markers",
-    "markers.trial_spans_s": "markers",
-    "markers.filter.cutoff_hz": "events_loadcell front_page markers planning",
-    "markers.filter.order": "events events_loadcell front_page markers planning",
-    "model.generic_model": "model_scaled",
-    "model.scale_setup": "model_scaled",
-    "model.segment_bodies": "model_scaled model_segments",
-    "model.brace_attachment_fraction": "model_segments",
-    "ik.ik_tasks": "ik",
-    "ik.default_marker_weight": "ik",
-    "ik.marker_weights": "ik",
-    "ik.coordinate_tasks": "ik",
-    "ik.tree_step_tolerance": "ik model_scaled",
-    "ik.opensim_accuracy": "ik model_scaled",
-    "ik.ik_solver": "ik model_scaled",
-    "ik.max_marker_rms_m": "ik",
-    "ik.warn_marker_rms_m": "ik",
-    "ik.max_rms_fraction": "ik",
-    "ik.geometry_warn_change": "ik",
-    "ik.geometry_stop_change": "ik",
-    "model.scale_factor_range": "model_scaled",
-    "ik.ik_chunks": "ik ik_chunk ik_join",
-    "ik.coordinate_map": "dynamics ik model_scaled",
-    "grf.loaded_threshold_n": "grf",
-    "grf.resting_band_n": "events events_loadcell grf",
-    "grf.max_resting_n": "events events_loadcell grf",
-    "events.grf_channels": "events events_loadcell",
-    "events.sync_channel": "events_loadcell synthetic_lab",
-    "events.threshold_on_n": "events events_loadcell",
-    "events.threshold_off_n": "events events_loadcell",
-    "events.min_stance_s": "events events_loadcell",
-    "events.min_swing_s": "events events_loadcell",
-    "events.foot_markers": "events events_loadcell",
-    "events.plate_sides": "events events_loadcell",
-    "events.grf_cutoff_hz": "events events_loadcell",
-    "strides.n_points": "dynamics strides",
-    "dynamics.cutoff_hz": "dynamics",
-    "dynamics.foot_bodies.left": "dynamics",
-    "dynamics.foot_bodies.right": "dynamics",
-    "strides.iqr_whisker": "impedance_fit planning strides",
-    "strides.max_outlier_fraction": "impedance_fit planning strides",
-    "strides.min_valid_strides": "impedance_fit planning strides strides_summary transparency",
-    "impedance.window_before_s": "front_page impedance_fit planning validation_chunk",
-    "impedance.window_after_s": "front_page impedance_fit planning validation_chunk",
-    "impedance.stiffness_bounds_nm_per_rad": (
-        "front_page impedance_fit impedance_summary planning synthetic_truth validation_chunk"
-    ),
-    "impedance.damping_bounds_nms_per_rad": (
-        "front_page impedance_fit impedance_summary planning synthetic_truth validation_chunk"
-    ),
-    "impedance.n_starts": "front_page impedance_fit validation_chunk",
-    "impedance.n_substeps": "impedance_fit planning validation_chunk",
-    "impedance.tolerance": "impedance_fit validation_chunk",
-    "impedance.merge_tolerance": "impedance_fit validation_chunk",
-    "impedance.initial_state_span_s": "impedance_fit planning validation_chunk",
-    "impedance.initial_state_degree": "impedance_fit planning validation_chunk",
-    "impedance.min_vaf_pct": "impedance_fit",
-    "impedance.max_null_trial_ratio": "impedance_fit planning",
-    "impedance.plausible_ranges": "impedance_fit",
-    "impedance.max_ci_fraction": "impedance_fit",
-    "impedance.noise_model": "front_page impedance_fit",
-    "impedance.counterfactual": "impedance_fit planning",
-    "impedance.interval_scatter": "impedance_fit planning",
-    "impedance.averaging_correction": "impedance_fit",
-    "impedance.null_pair_components": "front_page impedance_fit planning",
-    "impedance.min_null_pairs": "impedance_fit planning",
-    "planning.pilot_subject": "planning",
-    "planning.strides": "planning",
-    "planning.pulse_force_n": "events_loadcell planning",
-    "planning.pulse_duration_s": "planning",
-    "planning.targets": "planning",
-    "validation.subject_height_m": "validation_segments",
-    "validation.subject_mass_kg": "validation_segments",
-    "validation.attachment_fraction_of_thigh": "validation_segments",
-    "validation.stiffness_levels_nm_per_rad": "validation_chunk",
-    "validation.damping_levels_nms_per_rad": "validation_chunk",
-    "validation.sample_rate_hz": "validation_chunk",
-    "validation.swing_duration_s": "validation_chunk",
-    "validation.onset_s": "validation_chunk",
-    "validation.pulse_force_n": "validation_chunk",
-    "validation.pulse_duration_s": "validation_chunk",
-    "validation.pulse_rise_time_s": "validation_chunk",
-    "validation.pulse_overshoot_pct": "validation_chunk",
-    "validation.force_rate_hz": "validation_chunk",
-    "validation.force_direction_deg": "validation_chunk",
-    "validation.noise_peak_to_peak": "validation_chunk",
-    "validation.truth_substeps": "validation_chunk",
-    "validation.n_chunks": "validation_chunk validation_gather",
-    "device.subject": "device_frf device_steps",
-    "device.parameters": "device_frf device_log_from_mat device_steps device_trial planning synthetic_lab",
-    "device.leg": "device_trial",
-    "device.tests": "device_trial",
-    "device.analysis.welch_window_samples": "device_frf",
-    "device.analysis.welch_overlap_samples": "device_frf",
-    "device.analysis.bandwidth_reference_band_hz": "device_summary",
-    "device.analysis.step_before_s": "device_steps",
-    "device.analysis.step_after_s": "device_steps",
-    "device.analysis.steady_window_s": "device_steps",
-    "device.mat_column_map": "device_log_from_mat",
+    key: rules
+    for name in ("study", *(stage.name for stage in STAGES))
+    if importlib.util.find_spec(f"tests.stages.{name}.config_readers") is not None
+    for key, rules in importlib.import_module(f"tests.stages.{name}.config_readers").READERS.items()
 }
 
 
@@ -318,3 +178,14 @@ def test_each_stages_row_lists_the_settings_its_rules_read():
         if unlisted or unread:
             missing[stage] = unlisted + [f"{p} (read by none)" for p in unread]
     assert missing == {}
+
+
+def test_each_stages_readers_are_its_own_sections_keys():
+    """A stage's file of readers lists the keys of its own section only (the study's: its section and the
+    top-level keys), so that a stage's keys and their rules live with its tests."""
+    for name in ("study", *(stage.name for stage in STAGES)):
+        if importlib.util.find_spec(f"tests.stages.{name}.config_readers") is None:
+            continue
+        keys = importlib.import_module(f"tests.stages.{name}.config_readers").READERS
+        own = {k for k in keys if k.split(".")[0] == name or (name == "study" and "." not in k)}
+        assert set(keys) == own, name
