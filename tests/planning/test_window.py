@@ -141,3 +141,27 @@ def test_planning_window_refuses_a_pilot_without_null_pairs():
     params = segment_parameters_from_anthropometry(1.73, 64.9)
     with pytest.raises(LoperInputError, match=r"^pilot: no null pairs: the pilot needs unperturbed strides"):
         planning_window(_null_pairs(0), params)
+
+
+def test_a_planned_second_rod_pushes_the_shank_along_its_normal_beside_the_thigh_rod():
+    """With ``shank_pulse_force_n`` the window holds a second rod's pulse at 85 % of the shank (the same device's
+    response, along the shank's forward normal); the thigh rod's pulse is the one planned without it."""
+    params = segment_parameters_from_anthropometry(1.73, 64.9)
+    one = planning_window(_null_pairs(), params)
+    two = planning_window(_null_pairs(), params, PlanSettings(shank_pulse_force_n=30.0))
+    assert one.shank_force_perturbed_n is None and one.params.shank_attachment_m is None
+    assert two.params.shank_attachment_m == pytest.approx(0.85 * params.length_m[1], rel=1e-12)
+    np.testing.assert_array_equal(two.force_perturbed_n, one.force_perturbed_n)
+    shank = two.shank_force_perturbed_n
+    q_shank = REFERENCE[2]
+    normal = np.array([math.cos(q_shank), -math.sin(q_shank)])
+    np.testing.assert_allclose(shank[..., 0] * normal[1] - shank[..., 1] * normal[0], 0.0, atol=1e-9)
+    rate = DeviceParameters.sample_rate_hz
+    t_force = np.arange(math.ceil(-0.1015625 * rate), math.floor(0.296875 * rate) + 1) / rate
+    assert (shank @ normal).max() == pytest.approx(pulse_force_n(t_force, 30.0, 0.1).max(), rel=0.05)
+
+
+@pytest.mark.parametrize("fraction", [0.0, 1.5, float("nan")])
+def test_a_shank_point_off_the_shank_is_refused(fraction):
+    with pytest.raises(LoperInputError, match="shank_attachment_fraction"):
+        PlanSettings(shank_pulse_force_n=30.0, shank_attachment_fraction=fraction)

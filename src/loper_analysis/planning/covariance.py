@@ -161,12 +161,18 @@ def stride_covariance(
     WJ = W @ J
     M = np.linalg.pinv(WJ.T @ WJ, rcond=1e-13) @ WJ.T @ W
     n_pert = 0
-    if perturbed_pairs is not None:
+    if perturbed_pairs is not None and settings.shank_pulse_force_n:
+        notes.append(
+            "a second rod planned: the pilot's perturbed pairs, pushed at the thigh alone, do not show that "
+            "design's response; the null pairs' scatter taken"
+        )
+    elif perturbed_pairs is not None:
         _, _, n_pert = null_pair_arrays(perturbed_pairs, f"{source}, perturbed pairs")
     if n_pert >= MIN_PERTURBED_PAIRS:
         E, scatter = null_pair_errors(window, p, perturbed_pairs), "perturbed_pairs"
     else:
         E, scatter = E0, "null_pairs"
+    if n_pert < MIN_PERTURBED_PAIRS and not (perturbed_pairs is not None and settings.shank_pulse_force_n):
         notes.append(
             (
                 f"{n_pert} perturbed pair(s) of the pilot at this onset, fewer than {MIN_PERTURBED_PAIRS}"

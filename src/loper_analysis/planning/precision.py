@@ -73,6 +73,7 @@ PLAN_COLUMNS: tuple[str, ...] = (
     "ci95_half_width_pct",
     "pulse_force_n",
     "pulse_duration_s",
+    "shank_pulse_force_n",
     "n_null_pairs",
     "n_perturbed_pairs",
     "scatter",
@@ -127,6 +128,7 @@ def precision_table(
                         "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
                         "pulse_force_n": float(settings.pulse_force_n),
                         "pulse_duration_s": float(settings.pulse_duration_s),
+                        "shank_pulse_force_n": float(settings.shank_pulse_force_n),
                         "n_null_pairs": sc.n_null_pairs,
                         "n_perturbed_pairs": sc.n_perturbed_pairs,
                         "scatter": sc.scatter,
@@ -151,6 +153,7 @@ def unplanned_rows(
             "n_strides": n,
             "pulse_force_n": float(settings.pulse_force_n),
             "pulse_duration_s": float(settings.pulse_duration_s),
+            "shank_pulse_force_n": float(settings.shank_pulse_force_n),
             "note": note,
         }
         for joint in JOINTS

@@ -69,6 +69,18 @@ def _add_plan(p: argparse.ArgumentParser) -> None:
     p.add_argument("--force-n", type=float, help="pulse: desired force (N; default: planning.pulse_force_n, else 40)")
     p.add_argument("--duration-s", type=float, help="pulse duration (s; default: planning.pulse_duration_s, else 0.1)")
     p.add_argument(
+        "--shank-force-n",
+        type=float,
+        help="a second rod just above the ankle, pushed with the thigh: its pulse (N; default: "
+        "planning.shank_pulse_force_n, else 0: the thigh rod alone)",
+    )
+    p.add_argument(
+        "--shank-attachment-fraction",
+        type=float,
+        help="that rod's point on the shank, as a fraction of the shank's length from the knee (default: "
+        "planning.shank_attachment_fraction, else 0.85)",
+    )
+    p.add_argument(
         "--target",
         nargs=3,
         action="append",
@@ -113,7 +125,13 @@ def plan_settings(args: argparse.Namespace, config: dict | None):
     from loper_analysis.stages.settings import stage_settings
 
     settings = PlanningSettings() if config is None else stage_settings(config, "planning")
-    pulse = {k: v for k, v in (("pulse_force_n", args.force_n), ("pulse_duration_s", args.duration_s)) if v is not None}
+    options = (
+        ("pulse_force_n", args.force_n),
+        ("pulse_duration_s", args.duration_s),
+        ("shank_pulse_force_n", args.shank_force_n),
+        ("shank_attachment_fraction", args.shank_attachment_fraction),
+    )
+    pulse = {k: v for k, v in options if v is not None}
     given = {
         "onsets_ms": None if args.onset_ms is None else tuple(args.onset_ms),
         "strides": None if args.strides is None else tuple(args.strides),
@@ -227,6 +245,8 @@ COMMANDS: tuple[Command, ...] = (
         option_keys={
             "force_n": ("config", ("planning", "pulse_force_n")),
             "duration_s": ("config", ("planning", "pulse_duration_s")),
+            "shank_force_n": ("config", ("planning", "shank_pulse_force_n")),
+            "shank_attachment_fraction": ("config", ("planning", "shank_attachment_fraction")),
             "strides": ("config", ("planning", "strides")),
         },
     ),
