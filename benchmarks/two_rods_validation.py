@@ -25,10 +25,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from loper_analysis.constants import PARAMETERS  # noqa: E402
-from loper_analysis.impedance.identification import prepare_window  # noqa: E402
-from loper_analysis.impedance.identification.validation import validation_pulse  # noqa: E402
-from loper_analysis.impedance.identification.window import window_options  # noqa: E402
-from tests.impedance.identification.test_two_rods import STUDY_TRUTH, TWO_RODS, _trial  # noqa: E402
+from loper_analysis.impedance.identification.validation import two_rod_trial, validation_window  # noqa: E402
+from tests.impedance.identification.test_two_rods import STUDY_TRUTH, TWO_RODS  # noqa: E402
 from tests.impedance.identification.validation_windows import SETTINGS, fit  # noqa: E402
 
 DESIGNS = {"thigh rod": (1.0, 0.0), "both rods": (1.0, 1.0)}
@@ -43,25 +41,19 @@ def tolerance(truth: np.ndarray) -> np.ndarray:
 
 def design_fits(thigh: float, shank: float, n_strides: int, n_fits: int) -> tuple[np.ndarray, ...]:
     """Estimates, interval lows and highs (n_fits, 6) of one design at noise / sqrt(n_strides)."""
-    t, qu, qp, pelvis, t_force = _trial(STUDY_TRUTH, shank, thigh)
-    pulse = validation_pulse(t_force, SETTINGS)
+    trial = two_rod_trial(TWO_RODS, STUDY_TRUTH, SETTINGS, shank, thigh)
+    qu, qp = trial[1], trial[2]
     half = 0.5 * SETTINGS.noise_peak_to_peak / np.sqrt(n_strides)
     est, low, high = [], [], []
     for draw in range(n_fits):
         rng = np.random.default_rng([2024, n_strides, draw])
-        window = prepare_window(
-            t,
+        window = validation_window(
+            TWO_RODS,
+            SETTINGS,
+            trial[:6],
             qu + rng.uniform(-half, half, qu.shape),
             qp + rng.uniform(-half, half, qp.shape),
-            TWO_RODS,
-            SETTINGS.onset_s,
-            force_perturbed_n=thigh * pulse,
-            shank_force_perturbed_n=shank * pulse,
-            force_time_s=t_force,
-            pelvis_angle_unperturbed_rad=pelvis,
-            pelvis_angle_perturbed_rad=pelvis,
-            q_reference=qu,
-            **window_options(SETTINGS),
+            shank_force_perturbed_n=trial[6],
         )
         result = fit(window, n_starts=3, seed=draw)
         est.append(result.estimate)

@@ -8,17 +8,19 @@ trials); the fit sees the forces sampled at the robot's 1 kHz, as it sees a robo
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 import numpy as np
 import pytest
 
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.errors import LoperInputError
-from loper_analysis.impedance.identification import prepare_window, response_jacobian, simulate_deviation
-from loper_analysis.impedance.identification.validation import nominal_swing, validation_pulse
-from loper_analysis.impedance.identification.window import per_step, stage_times_s, window_options
-from loper_analysis.impedance.responses.response_window import ResponseWindow
+from loper_analysis.impedance.identification import prepare_window, response_jacobian
+from loper_analysis.impedance.identification.validation import (
+    perturbed_trial,
+    two_rod_trial,
+    validation_pulse,
+    validation_window,
+)
+from loper_analysis.impedance.identification.window import window_options
 from tests.impedance.identification.validation_windows import PARAMS, SETTINGS, fit
 
 #: The second rod just above the ankle: 85 % of the shank's length below the knee.
@@ -28,54 +30,13 @@ STUDY_TRUTH = np.array([55.0, 3.5, 3.0, 0.1, 8.0, 0.3])
 
 
 def _trial(truth, shank_scale: float, thigh_scale: float = 1.0):
-    """Samples (time_s, q_u, q_p, pelvis) and the robot clock (force_time_s) of a stride pushed at the thigh
-    (``thigh_scale`` × the study's pulse) and at the shank (``shank_scale`` × it), both from the onset."""
-    s = SETTINGS
-    t_start = s.onset_s - s.window.before_s - 0.1
-    t_end = s.onset_s + s.window.after_s + 0.05
-    t = t_start + np.arange(int(np.floor((t_end - t_start) * s.sample_rate_hz)) + 1) / s.sample_rate_hz
-    qu, pelvis = nominal_swing(t, s.swing_duration_s)
-    truth_window = prepare_window(
-        t,
-        qu,
-        qu,
-        TWO_RODS,
-        s.onset_s,
-        shank_force_perturbed_n=np.zeros((len(t), 2)),
-        pelvis_angle_unperturbed_rad=pelvis,
-        pelvis_angle_perturbed_rad=pelvis,
-        window=ResponseWindow(before_s=s.window.before_s, after_s=t[-1] - s.onset_s),
-        n_substeps=s.truth_substeps,
-    )
-    pulse = validation_pulse(stage_times_s(truth_window), s)
-    truth_window = replace(
-        truth_window,
-        force_perturbed_n=per_step(thigh_scale * pulse),
-        shank_force_perturbed_n=per_step(shank_scale * pulse),
-    )
-    qp = qu.copy()
-    qp[len(t) - truth_window.n_samples :] += simulate_deviation(truth_window, np.asarray(truth, float)[None])[0]
-    t_force = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * s.force_rate_hz + 1e-9)) + 1) / s.force_rate_hz
-    return t, qu, qp, pelvis, t_force
+    """A stride pushed at the thigh (``thigh_scale`` × the study's pulse) and at the shank (``shank_scale`` × it)."""
+    return two_rod_trial(TWO_RODS, truth, SETTINGS, shank_scale, thigh_scale)
 
 
-def _window(trial, shank_scale: float, thigh_scale: float = 1.0):
-    t, qu, qp, pelvis, t_force = trial
-    pulse = validation_pulse(t_force, SETTINGS)
-    return prepare_window(
-        t,
-        qu,
-        qp,
-        TWO_RODS,
-        SETTINGS.onset_s,
-        force_perturbed_n=thigh_scale * pulse,
-        shank_force_perturbed_n=shank_scale * pulse,
-        force_time_s=t_force,
-        pelvis_angle_unperturbed_rad=pelvis,
-        pelvis_angle_perturbed_rad=pelvis,
-        q_reference=qu,
-        **window_options(SETTINGS),
-    )
+def _window(trial, *_):
+    """The window the fit sees: the coordinates at 128 Hz, both rods' forces at the robot's 1 kHz."""
+    return validation_window(TWO_RODS, SETTINGS, trial[:6], shank_force_perturbed_n=trial[6])
 
 
 @pytest.mark.parametrize(("thigh", "shank"), [(1.0, 1.0), (0.0, 1.0)], ids=["both-rods", "shank-rod-alone"])
@@ -114,7 +75,7 @@ def test_both_rods_identify_the_knee_and_the_ankle_more_precisely_than_the_thigh
 
 
 def test_a_shank_force_without_a_shank_rod_is_refused():
-    t, qu, qp, pelvis, t_force = _trial(STUDY_TRUTH, 1.0)
+    t, qu, qp, _, _, t_force, _ = _trial(STUDY_TRUTH, 1.0)
     with pytest.raises(LoperInputError, match="shank_attachment_m"):
         prepare_window(
             t,
@@ -126,3 +87,13 @@ def test_a_shank_force_without_a_shank_rod_is_refused():
             force_time_s=t_force,
             **window_options(SETTINGS),
         )
+
+
+def test_without_the_shank_push_the_two_rod_stride_is_the_one_rod_stride_to_the_bit():
+    one = perturbed_trial(PARAMS, STUDY_TRUTH, SETTINGS)
+    two = _trial(STUDY_TRUTH, 0.0)
+    for a, b in zip(one, two[:6], strict=True):
+        np.testing.assert_array_equal(a, b)
+    np.testing.assert_array_equal(two[6], 0.0)
+    with pytest.raises(LoperInputError, match="shank_attachment_m"):
+        two_rod_trial(PARAMS, STUDY_TRUTH, SETTINGS)

@@ -49,6 +49,7 @@ __all__ = [
     "chunk_combinations",
     "nominal_swing",
     "perturbed_trial",
+    "two_rod_trial",
     "validation_pulse",
     "with_pulse_at_stages",
     "validation_window",
@@ -175,10 +176,36 @@ def perturbed_trial(params: SegmentParameters, impedance, settings: ValidationSe
     deviation = simulate_deviation(window, np.asarray(impedance, dtype=float)[None])
     qp = qu.copy()
     qp[n - window.n_samples :] += deviation[0]
-    t_force = (
-        t[0] + np.arange(int(np.floor((t[-1] - t[0]) * settings.force_rate_hz + 1e-9)) + 1) / settings.force_rate_hz
-    )
+    t_force = _robot_clock(t, settings)
     return t, qu, qp, validation_pulse(t_force, settings), pelvis, t_force
+
+
+def two_rod_trial(params: SegmentParameters, impedance, settings: ValidationSettings, shank_scale=1.0, thigh_scale=1.0):
+    """Noise-free samples of a stride pushed by two rods: :func:`perturbed_trial`'s, the study's pulse at the thigh
+    times ``thigh_scale`` and the same pulse at the shank times ``shank_scale`` (``params`` with a
+    ``shank_attachment_m``), both commanded at the onset.
+
+    Returns (time_s (n,), q_u (n, 4), q_p (n, 4), force_p (k, 2), pelvis (n,), force_time_s (k,), shank_force_p
+    (k, 2)); the first six as :func:`perturbed_trial` returns them, so that ``validation_window(params, settings,
+    trial[:6], shank_force_perturbed_n=trial[6])`` is the window the fit sees.
+    """
+    if params.shank_attachment_m is None:
+        raise LoperInputError("two_rod_trial: the segment parameters place no rod on the shank (shank_attachment_m)")
+    t, qu, pelvis, window = _truth_window(params, settings)
+    pulse = validation_pulse(stage_times_s(window), settings)
+    window = replace(
+        window, force_perturbed_n=per_step(thigh_scale * pulse), shank_force_perturbed_n=per_step(shank_scale * pulse)
+    )
+    qp = qu.copy()
+    qp[len(t) - window.n_samples :] += simulate_deviation(window, np.asarray(impedance, dtype=float)[None])[0]
+    t_force = _robot_clock(t, settings)
+    force = validation_pulse(t_force, settings)
+    return t, qu, qp, thigh_scale * force, pelvis, t_force, shank_scale * force
+
+
+def _robot_clock(t: np.ndarray, settings: ValidationSettings) -> np.ndarray:
+    """The robot log's sample times (s) at ``force_rate_hz`` over the samples ``t``, on their clock."""
+    return t[0] + np.arange(int(np.floor((t[-1] - t[0]) * settings.force_rate_hz + 1e-9)) + 1) / settings.force_rate_hz
 
 
 _TRUTH_WINDOWS: dict = {}
