@@ -11,6 +11,7 @@ import yaml
 
 from loper_analysis.device.loadcell import (
     OUTPUT_COLUMNS,
+    SHANK_OUTPUT_COLUMNS,
     SYNC_CHANNEL,
     LoadcellSettings,
     perturbation_onsets,
@@ -186,3 +187,71 @@ def test_settings_name_a_missing_key(path):
     del node[path[-1]]
     with pytest.raises(LoperInputError, match=f"^config: key '{'.'.join(path)}' missing: "):
         _ = stage_settings(config, "events").loadcell
+
+
+def _with_shank_rod(log: pd.DataFrame, pulse_n: float = 30.0) -> pd.DataFrame:
+    """``log`` with a second rod's load cell: its desired force a ``pulse_n`` N pulse wherever the flag is set, its
+    measured force the analytic signal at half the thigh's size."""
+    flag = log["perturbation"].to_numpy()
+    t = log["time_s"].to_numpy()
+    return log.assign(shank_force_desired_n=pulse_n * flag, shank_force_measured_n=0.5 * force(t) + pulse_n * flag)
+
+
+def test_a_second_rods_load_cell_is_filtered_and_mapped_as_the_thigh_rods():
+    """With the shank rod's columns both tables gain them; on the mocap frames the shank's measured force is its
+    analytic signal (half the thigh's plus the pulses) within the thigh's own tolerance, and the thigh rod's
+    columns are the same as without a second rod, bit for bit."""
+    offset_s, ppm, robot_t0_s = 3.217, 150.0, 0.0
+    log, sync, frames, _ = make_trial(offset_s, ppm, robot_t0_s, seed=21)
+    one = robot_log_frames_and_native(log, ROBOT_HZ, sync, ANALOG_HZ, frames, source="S01/walk")
+    two = robot_log_frames_and_native(
+        _with_shank_rod(log), ROBOT_HZ, sync, ANALOG_HZ, frames, source="S01/walk", shank_pulse_force_n=30.0
+    )
+    for a, b in zip(one, two):
+        assert tuple(b.columns) == (*OUTPUT_COLUMNS, *SHANK_OUTPUT_COLUMNS)
+        pd.testing.assert_frame_equal(b[list(OUTPUT_COLUMNS)], a)
+    native = two[1]
+    t_robot = log["time_s"].to_numpy()
+    interior = (t_robot > 0.25) & (t_robot < t_robot[-1] - 0.25)
+    far = interior & (np.convolve(log["perturbation"].to_numpy(), np.ones(201), "same") == 0)  # 100 ms from pulses
+    slope = sum(a * 2 * np.pi * f for a, f, _ in FORCE_COMPONENTS)
+    np.testing.assert_allclose(
+        native["shank_force_measured_n"][far], 0.5 * force(t_robot[far]), atol=0.5 * slope * 0.2e-3 + 0.01
+    )
+
+
+def test_a_second_rod_configured_without_its_columns_is_refused_naming_the_key():
+    log, sync, frames, _ = make_trial(3.217, 150.0, 0.0, seed=21)
+    with pytest.raises(LoperInputError) as err:
+        robot_log_frames_and_native(log, ROBOT_HZ, sync, ANALOG_HZ, frames, source="S01/walk", shank_pulse_force_n=30.0)
+    assert str(err.value) == (
+        "S01/walk: planning.shank_pulse_force_n = 30 N plans a second rod at the shank, but the robot log holds no "
+        "shank_force_desired_n and shank_force_measured_n columns (its load cell); record them, or set "
+        "planning.shank_pulse_force_n to 0 for the thigh rod alone"
+    )
+
+
+def test_shank_pulses_in_a_design_without_a_second_rod_are_refused_naming_the_key():
+    log, sync, frames, _ = make_trial(3.217, 150.0, 0.0, seed=21)
+    with pytest.raises(LoperInputError, match=r"shank_force_desired_n' pulses to 30 N, but planning\.shank_pulse"):
+        robot_log_frames_and_native(
+            _with_shank_rod(log), ROBOT_HZ, sync, ANALOG_HZ, frames, source="S01/walk", shank_pulse_force_n=0.0
+        )
+    # a rod attached but never pushed (its desired force 0) is a design without shank pulses: accepted
+    quiet = _with_shank_rod(log).assign(shank_force_desired_n=0.0)
+    out, _ = robot_log_frames_and_native(quiet, ROBOT_HZ, sync, ANALOG_HZ, frames, shank_pulse_force_n=0.0)
+    assert "shank_force_measured_n" in out.columns
+
+
+def test_a_shank_rods_pulses_in_kn_are_refused_naming_its_column_and_key():
+    log, sync, frames, _ = make_trial(3.217, 150.0, 0.0, seed=21)
+    kn = _with_shank_rod(log, pulse_n=0.03)
+    with pytest.raises(LoperInputError, match=r"column 'shank_force_desired_n'.*planning\.shank_pulse_force_n.*kN"):
+        robot_log_frames_and_native(kn, ROBOT_HZ, sync, ANALOG_HZ, frames, shank_pulse_force_n=30.0)
+
+
+def test_one_shank_column_without_its_pair_is_refused():
+    log, sync, frames, _ = make_trial(3.217, 150.0, 0.0, seed=21)
+    half = _with_shank_rod(log).drop(columns=["shank_force_desired_n"])
+    with pytest.raises(LoperInputError, match="shank_force_measured_n without its pair"):
+        robot_log_frames_and_native(half, ROBOT_HZ, sync, ANALOG_HZ, frames, shank_pulse_force_n=30.0)

@@ -9,6 +9,7 @@ from loper_analysis.io.robot_log import (
     COLUMNS,
     FORMAT_NAME,
     SAFETY_STATES,
+    SHANK_COLUMNS,
     UNITS,
     read_robot_log,
     write_robot_log,
@@ -52,6 +53,10 @@ def refusal(path, **kwargs) -> str:
 # ---------------------------------------------------------------------------
 # constants
 
+#: What the refusals add about a second rod's load cell.
+MISSING_TAIL = ", and a robot with a second rod at the shank also shank_force_desired_n and shank_force_measured_n"
+UNKNOWN_TAIL = " (and, with a second rod at the shank, shank_force_desired_n and shank_force_measured_n)"
+
 
 def test_constants():
     assert FORMAT_NAME == "loper-log 1"
@@ -74,7 +79,10 @@ def test_constants():
         "sync_v": "V",
         "perturbation": "1",
         "safety_state": "1",
+        "shank_force_desired_n": "N",
+        "shank_force_measured_n": "N",
     }
+    assert SHANK_COLUMNS == ("shank_force_desired_n", "shank_force_measured_n")
     assert SAFETY_STATES == {
         0: "ok",
         1: "limited",
@@ -174,7 +182,9 @@ def test_missing_columns_are_named(log_file):
     keep = [j for j, c in enumerate(COLUMNS) if c not in ("force_measured_n", "sync_v")]
     bad = with_lines(log_file, ["\t".join(r) if r[0].startswith("#") else "\t".join(r[j] for j in keep) for r in lines])
     assert refusal(bad) == (
-        f"{bad}: missing column(s) force_measured_n, sync_v; a robot log has the columns " + ", ".join(COLUMNS)
+        f"{bad}: missing column(s) force_measured_n, sync_v; a robot log has the columns "
+        + ", ".join(COLUMNS)
+        + MISSING_TAIL
     )
 
 
@@ -185,12 +195,17 @@ def test_unknown_columns_are_refused(log_file):
         lines[i] += "\t21.5\tx"
     bad = with_lines(log_file, lines)
     assert refusal(bad) == (
-        f"{bad}: unknown column(s) temperature_c, note; a robot log has exactly the columns " + ", ".join(COLUMNS)
+        f"{bad}: unknown column(s) temperature_c, note; a robot log has exactly the columns "
+        + ", ".join(COLUMNS)
+        + UNKNOWN_TAIL
     )
     lines = log_file.read_text().splitlines()
     lines[FIRST_LINE - 2] += "\t"
     bad = with_lines(log_file, lines)
-    assert refusal(bad) == f"{bad}: unknown column(s) ''; a robot log has exactly the columns " + ", ".join(COLUMNS)
+    assert (
+        refusal(bad)
+        == f"{bad}: unknown column(s) ''; a robot log has exactly the columns " + ", ".join(COLUMNS) + UNKNOWN_TAIL
+    )
 
 
 def test_reordered_columns_are_refused(log_file):
@@ -405,10 +420,10 @@ def test_writer_refuses_what_the_reader_refuses(tmp_path):
 
     frame = make_frame()
     assert message(frame.drop(columns=["sync_v"])) == (
-        f"{src}: missing column(s) sync_v; a robot log has the columns " + ", ".join(COLUMNS)
+        f"{src}: missing column(s) sync_v; a robot log has the columns " + ", ".join(COLUMNS) + MISSING_TAIL
     )
     assert message(frame.assign(extra=1.0)) == (
-        f"{src}: unknown column(s) extra; a robot log has exactly the columns " + ", ".join(COLUMNS)
+        f"{src}: unknown column(s) extra; a robot log has exactly the columns " + ", ".join(COLUMNS) + UNKNOWN_TAIL
     )
     assert message(frame.iloc[:1]) == f"{src}: 1 sample(s); a robot log needs at least 2"
     assert message(frame, rate=500) == (
@@ -452,3 +467,24 @@ def test_reader_accepts_crlf_and_trailing_blank_lines(tmp_path, log_file):
     b, meta_b = read_robot_log(log_file)
     pd.testing.assert_frame_equal(a, b, check_exact=True)
     assert meta_a == meta_b
+
+
+def test_a_second_rods_load_cell_round_trips_after_the_columns(tmp_path):
+    """A log with the shank rod's two columns is written with them after :data:`COLUMNS` and read back to the
+    values the file holds; one of them alone is refused naming the other."""
+    frame = make_frame()
+    rng = np.random.default_rng(3)
+    frame = frame.assign(
+        shank_force_desired_n=30.0 * rng.random(len(frame)), shank_force_measured_n=rng.random(len(frame))
+    )
+    path = tmp_path / "two.loper.tsv"
+    write_robot_log(path, frame, FS)
+    header = [line for line in path.read_text().splitlines() if not line.startswith("#")][0]
+    assert tuple(header.split("\t")) == (*COLUMNS, *SHANK_COLUMNS)
+    back, _ = read_robot_log(path)
+    expected = rounded(frame[list(COLUMNS)]).assign(
+        **{c: np.array([float(f"{v:.9g}") for v in frame[c]]) for c in SHANK_COLUMNS}
+    )
+    pd.testing.assert_frame_equal(back, expected)
+    with pytest.raises(LoperInputError, match="missing column.s. shank_force_measured_n"):
+        write_robot_log(tmp_path / "half.loper.tsv", frame.drop(columns=["shank_force_measured_n"]), FS)

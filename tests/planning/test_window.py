@@ -17,6 +17,7 @@ from loper_analysis.planning.inputs import pulse_force_n
 from loper_analysis.planning.window import PlanSettings, null_pair_arrays, planned_impedance, planning_window
 from loper_analysis.stages.settings import stage_settings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
+from loper_analysis.swing_leg.rods import ShankRod
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -162,6 +163,27 @@ def test_a_planned_second_rod_pushes_the_shank_along_its_normal_beside_the_thigh
 
 
 @pytest.mark.parametrize("fraction", [0.0, 1.5, float("nan")])
-def test_a_shank_point_off_the_shank_is_refused(fraction):
-    with pytest.raises(LoperInputError, match="shank_attachment_fraction"):
-        PlanSettings(shank_pulse_force_n=30.0, shank_attachment_fraction=fraction)
+def test_a_shank_point_off_the_shank_is_refused_naming_its_key(fraction):
+    with pytest.raises(LoperInputError, match=r"device\.shank_rod\.attachment_fraction"):
+        ShankRod(attachment_fraction=fraction)
+
+
+@pytest.mark.parametrize("angle_deg", [90.0, -95.0, float("inf")])
+def test_a_shank_push_along_the_shank_or_backwards_is_refused_naming_its_key(angle_deg):
+    with pytest.raises(LoperInputError, match=r"device\.shank_rod\.direction_deg"):
+        ShankRod(direction_rad=math.radians(angle_deg))
+
+
+def test_a_tilted_shank_rod_pushes_along_the_normal_turned_toward_the_ankle():
+    """At 30 degrees toward the ankle the planned shank force is the normal's turned by 30 degrees: its component
+    along the shank's distal axis is sin 30 of its size (analytic)."""
+    params = segment_parameters_from_anthropometry(1.73, 64.9)
+    tilted = planning_window(
+        _null_pairs(), params, PlanSettings(shank_pulse_force_n=30.0, shank_rod=ShankRod(direction_rad=math.pi / 6))
+    )
+    q_shank = REFERENCE[2]
+    distal = np.array([-math.sin(q_shank), -math.cos(q_shank)])
+    shank = tilted.shank_force_perturbed_n
+    size = np.linalg.norm(shank, axis=-1)
+    big = size > 0.5 * size.max()
+    np.testing.assert_allclose((shank @ distal)[big] / size[big], 0.5, atol=1e-6)

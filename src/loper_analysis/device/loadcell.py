@@ -40,12 +40,14 @@ __all__ = [
     "SYNC_CHANNEL",
     "LoadcellSettings",
     "OUTPUT_COLUMNS",
+    "SHANK_OUTPUT_COLUMNS",
     "MIN_UNFLAGGED_PULSES",
     "FORCE_RATIO_RANGE",
     "PULSE_AMPLITUDE_RANGE",
     "require_force_unit",
     "require_pulse_amplitude",
     "robot_log_frames_and_native",
+    "check_shank_rod",
     "check_perturbation_flags",
     "perturbation_onsets",
 ]
@@ -61,16 +63,22 @@ class LoadcellSettings:
     """The robot log on the mocap clock: the C3D's ``sync_channel``, the forces' low-pass (``cutoff_hz`` Hz,
     Butterworth of ``order``, run forward and backward; config ``events.sync_channel``, ``markers.filter.*``) and the
     study's perturbation force ``pulse_force_n`` (N; config ``planning.pulse_force_n``), which the desired force's
-    pulses are checked against (:func:`require_pulse_amplitude`)."""
+    pulses are checked against (:func:`require_pulse_amplitude`), and a second rod's at the shank
+    ``shank_pulse_force_n`` (N; ``planning.shank_pulse_force_n``; 0: the logs hold no shank pulses)."""
 
     sync_channel: str = SYNC_CHANNEL
     cutoff_hz: float = CUTOFF_HZ
     order: int = ORDER
     pulse_force_n: float = PULSE_FORCE_N
+    shank_pulse_force_n: float = 0.0
 
 
-#: Columns of both tables of :func:`robot_log_frames_and_native`, in order.
+#: Columns of both tables of :func:`robot_log_frames_and_native`, in order ...
 OUTPUT_COLUMNS: tuple[str, ...] = ("time_s", "force_measured_n", "force_desired_n", "perturbation")
+#: ... and after them, from a log with a second rod at the shank, its load cell's forces (N).
+SHANK_OUTPUT_COLUMNS: tuple[str, ...] = ("shank_force_measured_n", "shank_force_desired_n")
+#: The config key that says whether the logs hold a second rod's pulses.
+SHANK_PULSE_KEY = "planning.shank_pulse_force_n"
 
 _LOG_COLUMNS = ("time_s", "force_desired_n", "force_measured_n", "sync_v", "perturbation")
 _FORCE_COLUMNS = ("force_measured_n", "force_desired_n")
@@ -105,6 +113,7 @@ def robot_log_frames_and_native(
     tolerance_s: float = 3e-3,
     sync_channel: str = "",
     pulse_force_n: float | None = None,
+    shank_pulse_force_n: float | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The robot log's forces and perturbation flag on the motion-capture frames, and the same forces at the robot
     log's own samples.
@@ -166,15 +175,20 @@ def robot_log_frames_and_native(
     pulse_force_n : float, optional
         The configured perturbation force, N (config ``planning.pulse_force_n``); None: the desired pulses'
         amplitude is not checked.
+    shank_pulse_force_n : float, optional
+        A second rod's configured pulse at the shank, N (``planning.shank_pulse_force_n``): above 0 the log
+        must hold that rod's load cell (``shank_force_desired_n``, ``shank_force_measured_n``) with pulses
+        about this size; 0: the log must hold no shank pulses. None: not checked. A log with the shank
+        columns gives their low-passed forces in both tables (:data:`SHANK_OUTPUT_COLUMNS`).
 
     Returns
     -------
-    frames : pandas.DataFrame, shape (n_frames, 4)
-        Columns :data:`OUTPUT_COLUMNS`: ``time_s`` (s, mocap clock, =
+    frames : pandas.DataFrame, shape (n_frames, 4), or (n_frames, 6) with a shank rod
+        Columns :data:`OUTPUT_COLUMNS` (then :data:`SHANK_OUTPUT_COLUMNS`): ``time_s`` (s, mocap clock, =
         ``frame_time_s``), ``force_measured_n``, ``force_desired_n`` (N),
         ``perturbation`` (0.0/1.0, NaN outside the log). ``attrs["clock_map"]``
         holds the :class:`loper_analysis.device.clock_sync.ClockMap`.
-    native : pandas.DataFrame, shape (n_samples, 4)
+    native : pandas.DataFrame, shape (n_samples, 4) or (n_samples, 6)
         The same columns at every robot sample (``log_rate_hz``): ``time_s``
         the sample's time mapped to the mocap clock (s), the low-passed forces
         (N) and the flag (0.0/1.0).
@@ -190,7 +204,8 @@ def robot_log_frames_and_native(
         the records, e.g. an inverted robot sync), no frame
         inside the log's span, desired pulses far from ``pulse_force_n`` (:func:`require_pulse_amplitude`: both
         forces in kN), a measured force in another unit (:func:`require_force_unit`), force pulses without
-        perturbation flags (:func:`check_perturbation_flags`).
+        perturbation flags (:func:`check_perturbation_flags`); a second rod configured without its columns, or
+        shank pulses in a log whose design has none (:func:`check_shank_rod`).
     """
     src = source or "robot log"
     if not isinstance(log, pd.DataFrame):
@@ -216,22 +231,68 @@ def robot_log_frames_and_native(
             f"{src}: no mocap frame ({frames[0]:.6g} .. {frames[-1]:.6g} s) lies within the robot log's span on "
             f"the mocap clock ({t_mapped[0]:.6g} .. {t_mapped[-1]:.6g} s)"
         )
-    native = {"time_s": t_mapped, **_filtered_forces(log, rate, cutoff_hz, order, src)}
+    shank = check_shank_rod(log, shank_pulse_force_n, src)
+    columns = (*OUTPUT_COLUMNS, *(SHANK_OUTPUT_COLUMNS if shank else ()))
+    native = {"time_s": t_mapped, **_filtered_forces(log, rate, cutoff_hz, order, src, shank)}
     out = {"time_s": frames}
-    for col in _FORCE_COLUMNS:
+    for col in (c for c in columns if c in native and c != "time_s"):
         out[col] = np.interp(frames, t_mapped, native[col], left=np.nan, right=np.nan)
     flag = _perturbation_flag(log, src)
     if pulse_force_n is not None:
         require_pulse_amplitude(log["force_desired_n"].to_numpy(dtype=float), flag, pulse_force_n, src)
     require_force_unit(native["force_desired_n"], native["force_measured_n"], flag, src)
+    if shank and shank_pulse_force_n:
+        require_pulse_amplitude(
+            log["shank_force_desired_n"].to_numpy(dtype=float), flag, shank_pulse_force_n, src, "shank_force_desired_n"
+        )
+        require_force_unit(native["shank_force_desired_n"], native["shank_force_measured_n"], flag, src, "shank_force_")
     check_perturbation_flags(native["force_measured_n"], flag, rate, t_log, src)
     pos = np.clip(np.searchsorted(t_mapped, frames), 1, t_mapped.size - 1)
     nearest = np.where(frames - t_mapped[pos - 1] <= t_mapped[pos] - frames, pos - 1, pos)
     out["perturbation"] = np.where(inside, flag[nearest], np.nan)
     native["perturbation"] = flag
-    result = pd.DataFrame(out, columns=list(OUTPUT_COLUMNS))
+    result = pd.DataFrame(out, columns=list(columns))
     result.attrs["clock_map"] = cm
-    return result, pd.DataFrame(native, columns=list(OUTPUT_COLUMNS))
+    return result, pd.DataFrame(native, columns=list(columns))
+
+
+def check_shank_rod(log: pd.DataFrame, shank_pulse_force_n: float | None, source: str = "") -> bool:
+    """Whether the robot log holds a second rod's load cell at the shank, checked against the design.
+
+    ``shank_pulse_force_n`` (N; ``planning.shank_pulse_force_n``): above 0 the log must hold both
+    ``shank_force_desired_n`` and ``shank_force_measured_n``; 0 (the thigh rod alone) its desired shank force, if
+    any, must stay below :data:`MIN_DESIRED_PULSE_N` (a rod attached but not pushed); None: not checked.
+
+    Raises
+    ------
+    LoperInputError
+        One shank column without the other; a second rod configured without its columns; shank pulses in a log
+        whose design has none. Each names the file, the columns and ``planning.shank_pulse_force_n``.
+    """
+    src = source or "robot log"
+    present = [c for c in ("shank_force_desired_n", "shank_force_measured_n") if c in log.columns]
+    if len(present) == 1:
+        raise LoperInputError(
+            f"{src}: robot log holds {present[0]} without its pair; a second rod's load cell needs both "
+            "shank_force_desired_n and shank_force_measured_n (N)"
+        )
+    if shank_pulse_force_n is None:
+        return bool(present)
+    if shank_pulse_force_n and not present:
+        raise LoperInputError(
+            f"{src}: {SHANK_PULSE_KEY} = {shank_pulse_force_n:g} N plans a second rod at the shank, but the robot log "
+            "holds no shank_force_desired_n and shank_force_measured_n columns (its load cell); record them, or set "
+            f"{SHANK_PULSE_KEY} to 0 for the thigh rod alone"
+        )
+    if present and not shank_pulse_force_n:
+        desired = log["shank_force_desired_n"].to_numpy(dtype=float, na_value=np.nan)
+        peak = float(np.nanmax(np.abs(desired))) if desired.size else 0.0
+        if peak >= MIN_DESIRED_PULSE_N:
+            raise LoperInputError(
+                f"{src}: the robot log's column 'shank_force_desired_n' pulses to {peak:.4g} N, but "
+                f"{SHANK_PULSE_KEY} is 0 (the thigh rod alone): set it to the shank rod's planned pulse (N)"
+            )
+    return bool(present)
 
 
 def _log_times(log: pd.DataFrame, rate: float, src: str) -> np.ndarray:
@@ -287,11 +348,13 @@ def _sync_clock_map(
     )
 
 
-def _filtered_forces(log: pd.DataFrame, rate: float, cutoff_hz: float, order: int, src: str) -> dict[str, np.ndarray]:
-    """The log's measured and desired forces (N, shape (n_samples,)) low-passed at the robot rate ``rate``
-    (Hz; :func:`loper_analysis.filtering.lowpass`), by column."""
+def _filtered_forces(
+    log: pd.DataFrame, rate: float, cutoff_hz: float, order: int, src: str, shank: bool = False
+) -> dict[str, np.ndarray]:
+    """The log's measured and desired forces (N, shape (n_samples,)), with ``shank`` the shank rod's too,
+    low-passed at the robot rate ``rate`` (Hz; :func:`loper_analysis.filtering.lowpass`), by column."""
     forces = {}
-    for col in _FORCE_COLUMNS:
+    for col in (*_FORCE_COLUMNS, *(SHANK_OUTPUT_COLUMNS if shank else ())):
         f = log[col].to_numpy(dtype=float, na_value=np.nan)
         try:
             f = lowpass(f, rate, cutoff_hz, order)
@@ -310,7 +373,9 @@ def _perturbation_flag(log: pd.DataFrame, src: str) -> np.ndarray:
     return flag
 
 
-def require_pulse_amplitude(desired_n, flag, pulse_force_n: float, source: str = "") -> float:
+def require_pulse_amplitude(
+    desired_n, flag, pulse_force_n: float, source: str = "", column: str = "force_desired_n"
+) -> float:
     """Refuse a robot log whose desired perturbation pulses are far from the configured perturbation force.
 
     The amplitude of the desired pulses is the median ``|desired_n|`` over the flagged samples where it exceeds
@@ -330,6 +395,9 @@ def require_pulse_amplitude(desired_n, flag, pulse_force_n: float, source: str =
         The configured perturbation force, N (config ``planning.pulse_force_n``; its sign is the direction).
     source : str
         Names the robot log in messages.
+    column : str
+        The column ``desired_n`` is (``force_desired_n``, or the shank rod's ``shank_force_desired_n``, whose
+        configured force is ``planning.shank_pulse_force_n``), named in messages.
 
     Returns
     -------
@@ -343,6 +411,7 @@ def require_pulse_amplitude(desired_n, flag, pulse_force_n: float, source: str =
         configured force and the likely cause (kN, mN); a zero or non-finite ``pulse_force_n``.
     """
     src = source or "robot log"
+    key = SHANK_PULSE_KEY if column.startswith("shank_") else "planning.pulse_force_n"
     configured = abs(float(pulse_force_n))
     if not (math.isfinite(configured) and configured > 0):
         raise LoperInputError(f"{src}: pulse_force_n must be a finite non-zero force (N), got {pulse_force_n!r}")
@@ -363,14 +432,14 @@ def require_pulse_amplitude(desired_n, flag, pulse_force_n: float, source: str =
     else:
         cause = "a force in another unit, or a log of another protocol"
     raise LoperInputError(
-        f"{src}: column 'force_desired_n': the perturbation pulses reach {amplitude:.4g} (median over the "
+        f"{src}: column '{column}': the perturbation pulses reach {amplitude:.4g} (median over the "
         f"{int(strong.sum())} flagged samples of their plateau), {ratio:.4g} times the configured perturbation "
-        f"force of {configured:g} N (planning.pulse_force_n; accepted {lo:g} .. {hi:g} times): {cause}. Both force "
-        "columns, force_desired_n and force_measured_n, must hold newtons"
+        f"force of {configured:g} N ({key}; accepted {lo:g} .. {hi:g} times): {cause}. Both force "
+        f"columns, {column} and {column.replace('desired', 'measured')}, must hold newtons"
     )
 
 
-def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:
+def require_force_unit(desired_n, measured_n, flag, source: str = "", prefix: str = "force_") -> float:
     """Refuse a robot log whose measured force is not in the desired force's unit (N).
 
     During the flagged perturbation pulses the load cell measures about the force the controller asks for: the
@@ -387,6 +456,8 @@ def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:
         The log's ``perturbation`` column, 0/1.
     source : str
         Names the robot log in messages.
+    prefix : str
+        The columns' prefix (``force_``, or ``shank_force_`` for a second rod's load cell), named in messages.
 
     Returns
     -------
@@ -414,7 +485,7 @@ def require_force_unit(desired_n, measured_n, flag, source: str = "") -> float:
         else "uncalibrated (a voltage, in mV or V), or in another unit"
     )
     raise LoperInputError(
-        f"{source or 'robot log'}: column 'force_measured_n' is {ratio:.4g} times column 'force_desired_n' during "
+        f"{source or 'robot log'}: column '{prefix}measured_n' is {ratio:.4g} times column '{prefix}desired_n' during "
         f"the {int(strong.sum())} samples of the flagged perturbation pulses (median; accepted {lo:g} .. {hi:g}): "
         f"is the load cell logged {unit}? Both columns must hold newtons"
     )

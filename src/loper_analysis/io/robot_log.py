@@ -17,11 +17,12 @@ tab-separated values::
   ``loper-log 1``) and ``sample_rate_hz`` are required; any other key is free
   metadata, read back as a string.
 * Then one row of column names, which carry their units (:data:`UNITS`):
-  exactly :data:`COLUMNS`, in that order; missing, unknown, duplicated or
-  reordered columns are refused.
+  exactly :data:`COLUMNS`, in that order, and for a robot with a second rod
+  just above the ankle its load cell's :data:`SHANK_COLUMNS` after them (both
+  or neither); missing, unknown, duplicated or reordered columns are refused.
 * Then one data row per sample: ``time_s`` strictly increasing with steps of
   ``1 / sample_rate_hz`` (each within 1 %); ``force_desired_n`` and
-  ``force_measured_n`` finite; ``motor_angle_rad``, ``motor_velocity_rad_s``
+  ``force_measured_n`` (and the shank rod's two forces) finite; ``motor_angle_rad``, ``motor_velocity_rad_s``
   and ``sync_v`` may be ``nan`` (missing) but not infinite; ``perturbation``
   0 or 1; ``safety_state`` one of the codes of :data:`SAFETY_STATES`. At
   least 2 samples.
@@ -60,10 +61,12 @@ from loper_analysis.timing import timed_io
 __all__ = [
     "FORMAT_NAME",
     "COLUMNS",
+    "SHANK_COLUMNS",
     "UNITS",
     "SAFETY_STATES",
     "TIME_STEP_TOLERANCE",
     "validated_log",
+    "log_columns",
     "read_robot_log",
     "write_robot_log",
 ]
@@ -82,6 +85,9 @@ COLUMNS: tuple[str, ...] = (
     "perturbation",
     "safety_state",
 )
+#: The load cell of a second rod just above the ankle, after :data:`COLUMNS` in a log that has one: its desired
+#: and measured force (N, along the rod, forward positive).
+SHANK_COLUMNS: tuple[str, ...] = ("shank_force_desired_n", "shank_force_measured_n")
 
 #: Unit of each column ("1": dimensionless flag or code).
 UNITS: dict[str, str] = {
@@ -93,6 +99,8 @@ UNITS: dict[str, str] = {
     "sync_v": "V",  # sync signal sent to the motion-capture analog input
     "perturbation": "1",  # 0/1 flag
     "safety_state": "1",  # integer code, see SAFETY_STATES
+    "shank_force_desired_n": "N",  # a second rod's desired force
+    "shank_force_measured_n": "N",  # its load cell
 }
 
 #: Safety-state codes of the ``safety_state`` column.
@@ -110,7 +118,7 @@ TIME_STEP_TOLERANCE = 0.01
 
 _INT_COLUMNS = ("perturbation", "safety_state")
 _FLOAT_COLUMNS = tuple(c for c in COLUMNS if c not in _INT_COLUMNS)
-_FORCE_COLUMNS = ("force_desired_n", "force_measured_n")
+_FORCE_COLUMNS = ("force_desired_n", "force_measured_n", *SHANK_COLUMNS)
 _MAY_BE_NAN = ("motor_angle_rad", "motor_velocity_rad_s", "sync_v")
 _KEY_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_.\-]*\Z")
 _TIME_FORMAT = "%.15g"
@@ -156,21 +164,29 @@ def _as_float(series: pd.Series, column: str, source: str, time: np.ndarray | No
     return out
 
 
+def log_columns(names) -> tuple[str, ...]:
+    """The columns of a log whose columns are ``names``, in file order: :data:`COLUMNS`, then
+    :data:`SHANK_COLUMNS` when ``names`` holds any of them."""
+    return (*COLUMNS, *SHANK_COLUMNS) if any(c in SHANK_COLUMNS for c in names) else COLUMNS
+
+
 def _check_column_names(names: list[str], source: str, where: str) -> None:
     """Refuse duplicated, missing or unknown columns (``where`` prefixes the duplicate message)."""
     duplicated = sorted({c for c in names if names.count(c) > 1})
     if duplicated:
         raise LoperInputError(f"{source}: {where}duplicated column(s) {', '.join(duplicated)}")
-    missing = [c for c in COLUMNS if c not in names]
+    expected = log_columns(names)
+    missing = [c for c in expected if c not in names]
     if missing:
         raise LoperInputError(
-            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}"
+            f"{source}: missing column(s) {', '.join(missing)}; a robot log has the columns {', '.join(COLUMNS)}, "
+            f"and a robot with a second rod at the shank also {' and '.join(SHANK_COLUMNS)}"
         )
-    unknown = [c or "''" for c in names if c not in COLUMNS]
+    unknown = [c or "''" for c in names if c not in expected]
     if unknown:
         raise LoperInputError(
             f"{source}: unknown column(s) {', '.join(unknown)}; a robot log has exactly the columns "
-            f"{', '.join(COLUMNS)}"
+            f"{', '.join(COLUMNS)} (and, with a second rod at the shank, {' and '.join(SHANK_COLUMNS)})"
         )
 
 
@@ -197,7 +213,7 @@ def validated_log(
     Returns
     -------
     pandas.DataFrame
-        Shape (n, 8): columns in :data:`COLUMNS` order, float64 except
+        Shape (n, 8), or (n, 10) with :data:`SHANK_COLUMNS`: columns in that order, float64 except
         ``perturbation`` and ``safety_state`` (int64), index ``0..n-1``.
     """
     if not isinstance(frame, pd.DataFrame):
@@ -210,9 +226,10 @@ def validated_log(
         raise LoperInputError(f"{source}: {n} sample(s); a robot log needs at least 2")
 
     frame = frame.set_axis(names, axis=1)
+    columns = log_columns(names)
     time = _as_float(frame["time_s"], "time_s", source, None)
     data = {"time_s": time}
-    for col in COLUMNS[1:]:
+    for col in columns[1:]:
         data[col] = _as_float(frame[col], col, source, time)
 
     def fail(column: str, i: int, problem: str):
@@ -237,7 +254,7 @@ def validated_log(
             f"time step {1e3 * step[i - 1]:.6g} ms since sample {i - 1} deviates {_percent(100 * deviation[i - 1])} % "
             f"from 1/sample_rate_hz = {1e3 / rate:.6g} ms (tolerance {100 * TIME_STEP_TOLERANCE:g} %)",
         )
-    for col in _FORCE_COLUMNS:
+    for col in (c for c in _FORCE_COLUMNS if c in data):
         bad = np.flatnonzero(~np.isfinite(data[col]))
         if bad.size:
             fail(col, bad[0], f"non-finite force {data[col][bad[0]]}")
@@ -256,10 +273,10 @@ def validated_log(
         codes = ", ".join(f"{k} {v}" for k, v in SAFETY_STATES.items())
         fail("safety_state", bad[0], f"unknown safety state {safety[bad[0]]:g} (codes: {codes})")
 
-    out = pd.DataFrame({c: data[c] for c in _FLOAT_COLUMNS}, index=pd.RangeIndex(n))
+    out = pd.DataFrame({c: data[c] for c in columns if c not in _INT_COLUMNS}, index=pd.RangeIndex(n))
     for col in _INT_COLUMNS:
         out[col] = data[col].astype(np.int64)
-    return out[list(COLUMNS)]
+    return out[list(columns)]
 
 
 # ---------------------------------------------------------------------------
@@ -284,7 +301,7 @@ def write_robot_log(
         Target file (``*.loper.tsv``; a missing directory is created). An existing
         file is replaced.
     frame : pandas.DataFrame
-        Shape (n, 8), n >= 2: exactly the columns :data:`COLUMNS` (any order;
+        Shape (n, 8) or (n, 10), n >= 2: exactly the columns :data:`COLUMNS` (any order;
         written in :data:`COLUMNS` order), units as in :data:`UNITS`. It must
         pass every check of :func:`read_robot_log`; the index is ignored.
     sample_rate_hz : float, default 1000.0
@@ -335,10 +352,11 @@ def write_robot_log(
                 f"whitespace, got {text!r}"
             )
         header.append(f"# {key}: {text}")
-    header.append("\t".join(COLUMNS))
+    columns = log_columns(clean.columns)
+    header.append("\t".join(columns))
 
     cells = []
-    for col in COLUMNS:
+    for col in columns:
         values = clean[col].tolist()
         if col in _INT_COLUMNS:
             cells.append([str(v) for v in values])
@@ -381,7 +399,7 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
     Returns
     -------
     frame : pandas.DataFrame
-        Shape (n, 8), n >= 2: columns :data:`COLUMNS` (units :data:`UNITS`),
+        Shape (n, 8) or (n, 10), n >= 2: columns :data:`COLUMNS` (and :data:`SHANK_COLUMNS`; units :data:`UNITS`),
         float64 except ``perturbation`` and ``safety_state`` (int64); index
         ``0..n-1`` is the sample number.
     metadata : dict
@@ -437,29 +455,32 @@ def read_robot_log(path: str | os.PathLike, sample_rate_hz: float | None = None)
     names = [c.strip() for c in lines[k].split("\t")]
     header_line = k + 1
     _check_column_names(names, source, f"line {header_line}: ")
-    if tuple(names) != COLUMNS:
+    columns = log_columns(names)
+    if tuple(names) != columns:
         raise LoperInputError(
             f"{source}: line {header_line}: columns in the order {', '.join(names)}; a robot log has them in "
-            f"the order {', '.join(COLUMNS)}"
+            f"the order {', '.join(columns)}"
         )
 
     rows = lines[k + 1 :]
     first_line = header_line + 1
-    data = _parse_rows(rows, source, first_line)
+    data = _parse_rows(rows, source, first_line, columns)
     frame = validated_log(pd.DataFrame(data), rate, source, first_line)
     return frame, meta
 
 
-def _parse_rows(rows: list[str], source: str, first_line: int) -> dict[str, np.ndarray]:
-    """Data rows -> one float64 array per column; names the first malformed row or cell."""
-    width = len(COLUMNS)
+def _parse_rows(
+    rows: list[str], source: str, first_line: int, names: tuple[str, ...] = COLUMNS
+) -> dict[str, np.ndarray]:
+    """Data rows -> one float64 array per column of ``names``; names the first malformed row or cell."""
+    width = len(names)
     if rows:  # fast path (C parser); any doubt -> the checking path below
         try:
             table = np.loadtxt(io.StringIO("\n".join(rows)), delimiter="\t", dtype=np.float64, ndmin=2, comments=None)
         except ValueError:
             table = None
         if table is not None and table.shape == (len(rows), width):
-            return {col: np.ascontiguousarray(table[:, j]) for j, col in enumerate(COLUMNS)}
+            return {col: np.ascontiguousarray(table[:, j]) for j, col in enumerate(names)}
     split = [row.split("\t") for row in rows]
     for i, fields in enumerate(split):
         if len(fields) != width:
@@ -470,6 +491,6 @@ def _parse_rows(rows: list[str], source: str, first_line: int) -> dict[str, np.n
     columns = list(zip(*split)) if split else [()] * width
     time = _parse_floats(list(columns[0]), "time_s", source, first_line, None)
     data = {"time_s": time}
-    for j, col in enumerate(COLUMNS[1:], start=1):
+    for j, col in enumerate(names[1:], start=1):
         data[col] = _parse_floats(list(columns[j]), col, source, first_line, time)
     return data

@@ -33,11 +33,9 @@ from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.planning.inputs import pulse_force_n
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters
+from loper_analysis.swing_leg.rods import ShankRod, segment_normal, shank_rod_direction
 
-__all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window", "SHANK_ATTACHMENT_FRACTION"]
-
-#: A second rod's point on the shank, as a fraction of the shank's length from the knee: just above the ankle.
-SHANK_ATTACHMENT_FRACTION: float = 0.85
+__all__ = ["null_pair_arrays", "planned_impedance", "PlanSettings", "planning_window"]
 
 
 @dataclass(frozen=True)
@@ -51,9 +49,9 @@ class PlanSettings(FitBounds):
     intervals take, hence their t quantile) and the bounds (N·m/rad,
     N·m·s/rad) as the fit uses them; ``force_cutoff_hz`` and ``force_order``
     the load cell's low-pass; ``force_rate_hz`` the rate of the pulse given
-    to the fit (the robot log's). ``shank_pulse_force_n`` (N): a second rod's pulse, just above the ankle at
-    ``shank_attachment_fraction`` of the shank's length from the knee, pushed with the thigh's (same timing and
-    device, along the shank's forward normal); 0: the thigh rod alone.
+    to the fit (the robot log's). ``shank_pulse_force_n`` (N): a second rod's pulse, just above the ankle where
+    ``shank_rod`` (:class:`~loper_analysis.swing_leg.rods.ShankRod`) places and points it, pushed with the
+    thigh's (same timing and device); 0: the thigh rod alone.
     """
 
     pulse_force_n: float = PULSE_FORCE_N
@@ -70,16 +68,11 @@ class PlanSettings(FitBounds):
     force_order: int = ORDER
     force_rate_hz: float = DeviceParameters.sample_rate_hz
     shank_pulse_force_n: float = 0.0
-    shank_attachment_fraction: float = SHANK_ATTACHMENT_FRACTION
+    shank_rod: ShankRod = field(default_factory=ShankRod)
 
     def __post_init__(self):
         number("pulse_force_n", self.pulse_force_n)
         number("shank_pulse_force_n", self.shank_pulse_force_n)
-        if not 0.0 < number("shank_attachment_fraction", self.shank_attachment_fraction) <= 1.0:
-            raise LoperInputError(
-                "shank_attachment_fraction must lie in (0, 1] (a point of the shank, as a fraction of its length "
-                f"from the knee), got {self.shank_attachment_fraction:g}"
-            )
         check_interval_scatter(self.interval_scatter)
         if number("force_rate_hz", self.force_rate_hz) <= 0:
             raise LoperInputError(f"force_rate_hz must be > 0 Hz, got {self.force_rate_hz:g}")
@@ -102,15 +95,13 @@ def planning_window(
     the mean swing a perturbed stride starts from. The perturbed force is
     :func:`pulse_force_n` along the thigh's forward normal of that swing (and, with
     ``settings.shank_pulse_force_n``, a second rod's along the shank's, at
-    ``settings.shank_attachment_fraction`` of the shank),
+    the point and angle of ``settings.shank_rod``),
     given to the fit at ``settings.force_rate_hz`` (``force_time_s`` of
     :func:`~loper_analysis.impedance.identification.prepare_window`, as the fit takes
     the robot log's samples); the minimal-impedance force and the initial
     deviation are zero (they average out over the perturbed strides).
     ``measured`` is zero: only the model's sensitivities are used.
     """
-    from loper_analysis.synthetic.response import thigh_normal
-
     t, arrays, n_pairs = null_pair_arrays(null_pairs, source)
     if n_pairs < 1:
         raise LoperInputError(f"{source}: no null pairs: the pilot needs unperturbed strides walked with the device")
@@ -126,10 +117,10 @@ def planning_window(
         settings.force_cutoff_hz,
         settings.force_order,
     )
-    force_vector = force[:, None] * thigh_normal(np.interp(t_force, t, q_ref[:, 1]))
+    force_vector = force[:, None] * segment_normal(np.interp(t_force, t, q_ref[:, 1]))
     shank = {}
     if settings.shank_pulse_force_n:
-        params = params.replace(shank_attachment_m=settings.shank_attachment_fraction * params.length_m[1])
+        params = params.replace(shank_attachment_m=settings.shank_rod.attachment_m(params.length_m[1]))
         shank_force = pulse_force_n(
             t_force,
             settings.shank_pulse_force_n,
@@ -138,7 +129,8 @@ def planning_window(
             settings.force_cutoff_hz,
             settings.force_order,
         )
-        shank_vector = shank_force[:, None] * thigh_normal(np.interp(t_force, t, q_ref[:, 2]))
+        shank_direction = shank_rod_direction(np.interp(t_force, t, q_ref[:, 2]), settings.shank_rod)
+        shank_vector = shank_force[:, None] * shank_direction
         shank = {"shank_force_perturbed_n": shank_vector, "shank_force_unperturbed_n": np.zeros_like(shank_vector)}
     return prepare_window(
         t,

@@ -18,7 +18,7 @@ builds the same inputs directly:
 * ``strides``: :func:`loper_analysis.gait.strides.stride_tables` from the true
   events and that force table;
 * ``markers``: two brace markers along the (noisy) thigh, from which
-  :func:`loper_analysis.impedance.identification.impedance.brace_force_direction` gives the rods'
+  :func:`loper_analysis.impedance.responses.rod_directions.brace_force_direction` gives the rods'
   direction.
 
 The result is a trial mapping for :func:`loper_analysis.impedance.identification.impedance.fit_onset`.

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.study_design import SEED, StudyDesign
+from loper_analysis.swing_leg.rods import ShankRod
 from loper_analysis.synthetic.subjects import ImpedanceTruth
 from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings
 from loper_analysis.synthetic.variability import GaitVariability
@@ -77,6 +78,9 @@ class SyntheticLabSettings:
         The perturbation: rectangular desired force (N, forward) and its duration (s).
     perturb_every_strides : (int, int)
         A perturbation every ``min`` to ``max`` strides (uniform at random).
+    shank_pulse_force_n : float
+        A second rod's pulse just above the ankle (N, with the thigh's; 0: no second rod), where ``shank_rod``
+        (:class:`~loper_analysis.swing_leg.rods.ShankRod`, the device's) places and points it.
     truth : ImpedanceTruth or None
         The subjects' true impedance (:class:`~loper_analysis.synthetic.subjects.ImpedanceTruth`), drawn once per
         subject into its ``truth.yaml``; the session reads that file, so the truth is no part of its settings'
@@ -94,6 +98,8 @@ class SyntheticLabSettings:
     pulse_force_n: float = PerturbationSettings.force_n
     pulse_duration_s: float = PerturbationSettings.duration_s
     perturb_every_strides: tuple[int, int] = PerturbationSettings.every_strides
+    shank_pulse_force_n: float = 0.0
+    shank_rod: ShankRod = ShankRod()
     truth: ImpedanceTruth | None = field(default=None, repr=False, compare=False)
 
     def perturbation(self, onset_ms: int | None, impedance: Sequence[float]) -> PerturbationSettings | None:
@@ -107,6 +113,8 @@ class SyntheticLabSettings:
             self.pulse_force_n,
             self.pulse_duration_s,
             tuple(self.perturb_every_strides),
+            self.shank_pulse_force_n,
+            self.shank_rod,
         )
 
 

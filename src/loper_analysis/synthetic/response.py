@@ -14,7 +14,9 @@ the sagittal plane, forward positive: ``(cos q_thigh, -sin q_thigh)`` for a
 thigh segment angle ``q_thigh``. ``F_p`` follows the perturbed thigh (a
 fixed-point iteration: simulate, turn the force with the new thigh angle,
 simulate again), ``F_u`` the unperturbed one. The pipeline reads the same
-direction from the two brace markers.
+direction from the two brace markers. A second rod just above the ankle
+(:class:`~loper_analysis.swing_leg.rods.ShankRod`) pushes along the shank's
+normal turned by the rod's angle, following the perturbed shank the same way.
 
 The cart (pelvis translation) deviates freely in the model; its deviation
 is not written to the markers (the stance leg holds the pelvis on the
@@ -31,6 +33,7 @@ import pandas as pd
 from loper_analysis.errors import LoperInputError
 from loper_analysis.study_design import PERTURBED_SIDE, PULSE_DURATION_S, PULSE_FORCE_N
 from loper_analysis.swing_leg.dynamics import SegmentParameters, segment_coordinates
+from loper_analysis.swing_leg.rods import ShankRod, segment_normal, shank_rod_direction
 
 __all__ = ["perturbation_schedule", "pulse_train", "thigh_normal", "swing_response", "swing_responses", "swing_spans"]
 
@@ -78,8 +81,7 @@ def pulse_train(time_s, onsets_s, force_n: float = PULSE_FORCE_N, duration_s: fl
 
 def thigh_normal(q_thigh_rad) -> np.ndarray:
     """Unit vectors (n, 2) perpendicular to the thigh, pointing forward, world x/y."""
-    q = np.asarray(q_thigh_rad, float)
-    return np.stack([np.cos(q), -np.sin(q)], axis=-1)
+    return segment_normal(q_thigh_rad)
 
 
 def swing_response(
@@ -98,6 +100,8 @@ def swing_response(
     fade_s: float = 0.2,
     n_substeps: int = 2,
     iterations: int = 3,
+    shank_force_n: tuple | None = None,
+    shank_rod: ShankRod | None = None,
 ) -> np.ndarray:
     """Joint-angle deviations (n, 3) rad (hip, knee, ankle) caused by one pulse.
 
@@ -106,6 +110,8 @@ def swing_response(
     without the pulse (N); ``impedance`` the 6 true values in the order of
     :data:`loper_analysis.constants.PARAMETERS`. Zero before
     ``onset_s - before_s``; simulated to ``heel_strike_s``; faded out after.
+    ``shank_force_n``: a second rod's load-cell force with and without the pulse, ((n,), (n,)) in N, pushing
+    where ``shank_rod`` places it (``params.shank_attachment_m`` must be that point); None: the thigh rod alone.
     """
     from loper_analysis.impedance.identification import prepare_window, simulate_response
     from loper_analysis.impedance.responses.response_window import ResponseWindow
@@ -118,10 +124,18 @@ def swing_response(
     if not (t[0] <= onset_s - before_s - 0.04 and heel_strike_s <= t[-1]):
         raise LoperInputError(f"swing_response: data {t[0]:.3f} .. {t[-1]:.3f} s do not cover the swing")
     fu = fu_mag[:, None] * thigh_normal(qu[:, 1])
+    shank = {}
+    shank_rod = ShankRod() if shank_rod is None else shank_rod
+    if shank_force_n is not None:
+        sp_mag, su_mag = (np.asarray(f, float) for f in shank_force_n)
+        shank["shank_force_unperturbed_n"] = su_mag[:, None] * shank_rod_direction(qu[:, 2], shank_rod)
     dth = np.zeros_like(th)
     for _ in range(iterations):
         q_thigh = qu[:, 1] - dth[:, 0]  # the pelvis is an input: d(theta_hip) = -d(q_thigh)
         fp = fp_mag[:, None] * thigh_normal(q_thigh)
+        if shank_force_n is not None:  # d(q_shank) = d(q_thigh) + d(theta_knee)
+            q_shank = q_thigh + qu[:, 2] - qu[:, 1] + dth[:, 1]
+            shank["shank_force_perturbed_n"] = sp_mag[:, None] * shank_rod_direction(q_shank, shank_rod)
         window = prepare_window(
             t,
             qu,
@@ -134,6 +148,7 @@ def swing_response(
             pelvis_angle_perturbed_rad=pel,
             window=ResponseWindow(before_s=before_s, after_s=heel_strike_s - onset_s, initial_state_span_s=0.04),
             n_substeps=n_substeps,
+            **shank,
         )
         response = simulate_response(window, np.asarray(impedance, float))
         i0 = int(np.searchsorted(t, window.time_s[0] - 1e-9))
@@ -161,6 +176,8 @@ def swing_responses(
     swings,
     *,
     n_substeps: int = 2,
+    shank_force_n=None,
+    shank_rod: ShankRod | None = None,
 ) -> np.ndarray:
     """Joint-angle deviations (n, 3) rad of every swing driven by the measured force, against walking without it.
 
@@ -171,7 +188,8 @@ def swing_responses(
     (its minimal-impedance force, and the pulses where there are any) through
     the swing-leg dynamics with ``impedance`` (the 6 values of
     :data:`loper_analysis.constants.PARAMETERS`). Swings whose span
-    (toe-off - 0.3 s .. heel strike + 0.35 s) leaves ``time_s`` are skipped.
+    (toe-off - 0.3 s .. heel strike + 0.35 s) leaves ``time_s`` are skipped. ``shank_force_n`` (n,): a
+    second rod's load-cell force (N) where ``shank_rod`` places it, felt the same way; None: no second rod.
     """
     t = np.asarray(time_s, float)
     th = np.asarray(joint_angles_rad, float)
@@ -195,6 +213,8 @@ def swing_responses(
             heel_strike,
             before_s=before,
             n_substeps=n_substeps,
+            shank_force_n=None if shank_force_n is None else (np.asarray(shank_force_n)[sl], zero[sl]),
+            shank_rod=shank_rod,
         )
     return delta
 

@@ -37,6 +37,8 @@ from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDE_SUFFIX, SID
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
 from loper_analysis.study_design import PERTURBED_SIDE, PULSE_DURATION_S, PULSE_FORCE_N
+from loper_analysis.swing_leg.dynamics import segment_coordinates
+from loper_analysis.swing_leg.rods import ShankRod
 from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = [
@@ -119,6 +121,16 @@ def _brace_position_m(
     return coordinates["pelvis_tx"].to_numpy(float) + attachment_m * np.sin(angle)
 
 
+def _shank_rod_position_m(coordinates: pd.DataFrame, params, side: str = SIDE_SUFFIX[PERTURBED_SIDE]) -> np.ndarray:
+    """Forward position (m) of a second rod's point on the shank, ``params.shank_attachment_m`` below the knee."""
+    q = segment_coordinates(
+        coordinates[[f"hip_flexion_{side}", f"knee_flexion_{side}", f"ankle_dorsiflexion_{side}"]].to_numpy(float),
+        -coordinates["pelvis_tilt"].to_numpy(float),
+        coordinates["pelvis_tx"].to_numpy(float),
+    )
+    return q[:, 0] - params.length_m[0] * np.sin(q[:, 1]) - params.shank_attachment_m * np.sin(q[:, 2])
+
+
 @dataclass(frozen=True)
 class PerturbationSettings:
     """LOPER force pulses of an impedance trial and the impedance the subject answers with."""
@@ -128,6 +140,8 @@ class PerturbationSettings:
     force_n: float = PULSE_FORCE_N
     duration_s: float = PULSE_DURATION_S
     every_strides: tuple[int, int] = (3, 5)
+    shank_force_n: float = 0.0  # a second rod's pulse just above the ankle, with the thigh's (N); 0: none
+    shank_rod: ShankRod = ShankRod()
 
 
 @dataclass
@@ -226,6 +240,11 @@ def simulate_walking_trial(
     perturbation's impedance in a trial with pulses and ``minimal_impedance``
     otherwise; None: only the pulses act (their force minus that of a run
     without them).
+
+    With ``perturbation.shank_force_n`` a second device pushes just above the ankle where
+    ``perturbation.shank_rod`` places it, with the thigh's pulses (same onsets and duration), driven by the
+    brace motion of that point; its desired and measured force are the robot log's ``shank_force_desired_n`` and
+    ``shank_force_measured_n`` and the leg answers both rods.
     """
     from loper_analysis.device.controller import simulate_device
     from loper_analysis.synthetic.response import perturbation_schedule, pulse_train
@@ -277,12 +296,31 @@ def simulate_walking_trial(
     )
     sim = simulate_device(fd, device, None, brace_position_m=brace, seed=device_seed)
     robot = _robot_frame(t_robot, sim, fd, pulse_train_at(t_robot, starts))
+    shank = None
+    if perturbation is not None and perturbation.shank_force_n:
+        (shank_seed,) = ss.spawn(1)  # after the four above: a trial without a shank rod keeps its seeds
+        rod = perturbation.shank_rod
+        params = params.replace(shank_attachment_m=rod.attachment_m(params.length_m[1]))
+        shank_brace = np.interp(t_mocap, t_fine, _shank_rod_position_m(fine, params))
+        shank_brace -= shank_brace.mean()
+        fd_shank = pulse_train(t_robot, onsets_robot, perturbation.shank_force_n, perturbation.duration_s)
+        shank_sim = simulate_device(fd_shank, device, None, brace_position_m=shank_brace, seed=shank_seed)
+        robot = robot.assign(
+            shank_force_desired_n=shank_sim["force_desired_n"].to_numpy(),
+            shank_force_measured_n=shank_sim["force_measured_n"].to_numpy(),
+        )
+        shank = (rod, shank_brace, shank_seed)
     if minimal_impedance is not None:
         impedance = perturbation.impedance if perturbation is not None else tuple(minimal_impedance)
-        fine = _fine_answering_every_swing(fine, events, t_robot, robot, lab, params, impedance)
+        fine = _fine_answering_every_swing(fine, events, t_robot, robot, lab, params, impedance, shank)
     elif perturbation is not None and len(schedule):
         free = simulate_device(0 * t_robot, device, None, brace_position_m=brace, seed=device_seed)
-        fine = _fine_answering_pulses(fine, schedule, t_robot, (robot, free), lab, params, perturbation.impedance)
+        if shank is not None:
+            free_shank = simulate_device(0 * t_robot, device, None, brace_position_m=shank[1], seed=shank[2])
+            free = free.assign(shank_force_measured_n=free_shank["force_measured_n"].to_numpy())
+        fine = _fine_answering_pulses(
+            fine, schedule, t_robot, (robot, free), lab, params, perturbation.impedance, shank
+        )
     return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
 
 
@@ -314,15 +352,21 @@ def _fine_answering_every_swing(
     lab: LabSettings,
     params,
     impedance: Sequence[float],
+    shank=None,
 ) -> pd.DataFrame:
     """The fine coordinates (rad) with every left swing within the robot log answering the measured force (N)
     with ``impedance`` (:func:`loper_analysis.synthetic.response.swing_responses`); ``t_robot`` (s) on the robot
-    clock."""
+    clock. ``shank``: None, or the second rod (its :class:`~loper_analysis.swing_leg.rods.ShankRod` first), whose
+    measured force (the robot log's ``shank_force_measured_n``) the leg answers too."""
     from loper_analysis.synthetic.response import swing_responses, swing_spans
 
     scale = 1.0 + 1e-6 * lab.clock_drift_ppm
     t_fine = fine["time_s"].to_numpy()
     fm = np.interp((t_fine + lab.clock_offset_s) / scale, t_robot, robot["force_measured_n"].to_numpy())
+    shank_options = {}
+    if shank is not None:
+        fs = np.interp((t_fine + lab.clock_offset_s) / scale, t_robot, robot["shank_force_measured_n"].to_numpy())
+        shank_options = {"shank_rod": shank[0]}
     angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
     t_span = -lab.clock_offset_s + scale * t_robot[[0, -1]]
     inside = (t_fine >= t_span[0]) & (t_fine <= t_span[1])
@@ -335,6 +379,8 @@ def _fine_answering_every_swing(
         impedance,
         fm[inside],
         swing_spans(events, PERTURBED_SIDE),
+        shank_force_n=fs[inside] if shank is not None else None,
+        **shank_options,
     )
     fine = fine.copy()
     for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):
@@ -350,10 +396,12 @@ def _fine_answering_pulses(
     lab: LabSettings,
     params,
     impedance: Sequence[float],
+    shank=None,
 ) -> pd.DataFrame:
     """The fine coordinates (rad) with the left leg answering each scheduled pulse with ``impedance``: the
     difference of the measured force (N) of the device runs with and without the pulses (``runs``, on the robot
-    clock ``t_robot`` in s) around each pulse (:func:`loper_analysis.synthetic.response.swing_response`)."""
+    clock ``t_robot`` in s) around each pulse (:func:`loper_analysis.synthetic.response.swing_response`); with
+    ``shank`` (its :class:`~loper_analysis.swing_leg.rods.ShankRod` first) the second rod's the same way."""
     from loper_analysis.synthetic.response import swing_response
 
     robot, free = runs
@@ -362,6 +410,8 @@ def _fine_answering_pulses(
     to_robot_fine = (t_fine + lab.clock_offset_s) / scale
     fp = np.interp(to_robot_fine, t_robot, robot["force_measured_n"].to_numpy())
     fu = np.interp(to_robot_fine, t_robot, free["force_measured_n"].to_numpy())
+    if shank is not None:
+        sp, su = (np.interp(to_robot_fine, t_robot, r["shank_force_measured_n"].to_numpy()) for r in runs)
     angles = fine[["hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l"]].to_numpy()
     pelvis_angle = -fine["pelvis_tilt"].to_numpy()
     delta = np.zeros_like(angles)
@@ -380,6 +430,7 @@ def _fine_answering_pulses(
             fu[sl],
             row.onset_s,
             row.heel_strike_s,
+            **({} if shank is None else {"shank_force_n": (sp[sl], su[sl]), "shank_rod": shank[0]}),
         )
     fine = fine.copy()
     for i, c in enumerate(("hip_flexion_l", "knee_flexion_l", "ankle_dorsiflexion_l")):

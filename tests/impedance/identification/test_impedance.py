@@ -12,7 +12,6 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification import identify_impedance
 from loper_analysis.impedance.identification.impedance import (
     IMPEDANCE_COLUMNS,
-    brace_force_direction,
     fit_onset,
     impedance_rows,
     status_rows,
@@ -22,6 +21,7 @@ from loper_analysis.impedance.identification.validation import (
     perturbed_trial,
     validation_window,
 )
+from loper_analysis.impedance.responses.rod_directions import brace_force_direction
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 
 TRUTH = (60.0, 3.0, 5.0, 0.2, 20.0, 0.5)

@@ -13,4 +13,6 @@ READERS = {
     "device.analysis.step_after_s": "device_steps",
     "device.analysis.steady_window_s": "device_steps",
     "device.mat_column_map": "device_log_from_mat",
+    "device.shank_rod.attachment_fraction": "impedance_fit planning synthetic_lab",
+    "device.shank_rod.direction_deg": "impedance_fit planning synthetic_lab",
 }

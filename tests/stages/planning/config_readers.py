@@ -6,7 +6,6 @@ READERS = {
     "planning.strides": "planning",
     "planning.pulse_force_n": "events_loadcell planning",
     "planning.pulse_duration_s": "planning",
-    "planning.shank_pulse_force_n": "planning",
-    "planning.shank_attachment_fraction": "planning",
+    "planning.shank_pulse_force_n": "events_loadcell planning",
     "planning.targets": "planning",
 }

@@ -18,6 +18,7 @@ READERS = {
     "synthetic.pulse_force_n": "front_page synthetic_lab",
     "synthetic.pulse_duration_s": "front_page synthetic_lab",
     "synthetic.perturb_every_strides": "synthetic_lab",
+    "synthetic.shank_pulse_force_n": "synthetic_lab",
     "synthetic.between_subject_cv": "synthetic_truth",
     "synthetic.stiffness_nm_per_rad.50": "synthetic_truth",
     "synthetic.stiffness_nm_per_rad.175": "synthetic_truth",

@@ -64,15 +64,17 @@ from loper_analysis.impedance.responses import (
     ResponseSettings,
     subject_onset_response,
 )
+from loper_analysis.impedance.responses.rod_directions import brace_force_direction, shank_force_direction
 from loper_analysis.swing_leg.dynamics import SegmentParameters
+from loper_analysis.swing_leg.rods import ShankRod
 
 __all__ = [
     "IMPEDANCE_COLUMNS",
     "NOISE_MODELS",
     "IdentificationSettings",
     "OnsetFit",
-    "brace_force_direction",
     "FORCE_COLUMNS",
+    "SHANK_FORCE_COLUMNS",
     "force_table",
     "impedance_rows",
     "status_rows",
@@ -202,16 +204,22 @@ FORCE_COLUMNS: tuple[str, ...] = (
     "force_unperturbed_x_n",
     "force_unperturbed_y_n",
 )
+#: Columns :func:`force_table` adds for a second rod at the shank.
+SHANK_FORCE_COLUMNS: tuple[str, ...] = tuple(f"shank_{c}" for c in FORCE_COLUMNS[1:])
 
 
 def force_table(series: Mapping) -> pd.DataFrame:
     """The mean rod forces of a response as the fit receives them (columns :data:`FORCE_COLUMNS`).
 
     ``time_s`` relative to the onset (s): ``series["force_time_s"]`` (the robot rate) when the response
-    carries it, else the response's grid; the perturbed and matched unperturbed mean force vectors (N, world x/y).
+    carries it, else the response's grid; the perturbed and matched unperturbed mean force vectors (N, world x/y);
+    with a second rod at the shank its vectors after them (:data:`SHANK_FORCE_COLUMNS`).
     """
     t = series.get("force_time_s", series["time_s"])
     fp, fu = series["force_perturbed_n"], series["force_unperturbed_n"]
+    if np.shape(fp)[-1] == 4:
+        shank = dict(zip(SHANK_FORCE_COLUMNS, (fp[:, 2], fp[:, 3], fu[:, 2], fu[:, 3])))
+        return force_table({**series, "force_perturbed_n": fp[:, :2], "force_unperturbed_n": fu[:, :2]}).assign(**shank)
     return pd.DataFrame(
         {
             "time_s": t,
@@ -222,32 +230,6 @@ def force_table(series: Mapping) -> pd.DataFrame:
         },
         columns=list(FORCE_COLUMNS),
     )
-
-
-def brace_force_direction(
-    markers_m: np.ndarray, labels: Sequence[str], brace=("LBRA_P", "LBRA_D"), source: str = ""
-) -> np.ndarray:
-    """Unit vectors (n, 2), world x/y of the model frame, along which the rods push.
-
-    The two brace markers lie on the thigh, proximal and distal; the rods push
-    perpendicular to their line, forward: the proximal-minus-distal direction
-    turned by -90 degrees in the sagittal (x, y) plane. ``markers_m`` is
-    (n, n_markers, 3) in the model frame (X forward, Y up), e.g. a TRC of the
-    pipeline.
-    """
-    labels = list(labels)
-    missing = [b for b in brace if b not in labels]
-    if missing:
-        raise LoperInputError(f"{source}: brace marker(s) {missing} not in the marker data")
-    p = markers_m[:, labels.index(brace[0]), :2]
-    d = markers_m[:, labels.index(brace[1]), :2]
-    up = p - d
-    norm = np.linalg.norm(up, axis=1)
-    if not np.all(np.isfinite(norm)) or np.any(norm < 1e-3):
-        bad = int(np.argmax(~np.isfinite(norm) | (norm < 1e-3)))
-        raise LoperInputError(f"{source}: brace markers {brace} missing or coincident at frame {bad}")
-    up /= norm[:, None]
-    return np.stack([up[:, 1], -up[:, 0]], axis=-1)
 
 
 def _truth_columns(row: dict, truth: Mapping | None, joint: str) -> None:
@@ -403,6 +385,7 @@ def fit_onset(
     null_trials: Sequence[Mapping] = (),
     response: ResponseSettings = ResponseSettings(),
     identification: IdentificationSettings = IdentificationSettings(),
+    shank_rod: ShankRod | None = None,
 ) -> OnsetFit:
     """Responses and the impedance fit of one subject at one onset.
 
@@ -438,6 +421,12 @@ def fit_onset(
         strides, each predicted from the others
         (:func:`loper_analysis.impedance.responses.conditional.conditional_null_pairs`).
     response, identification : settings
+    shank_rod : ShankRod, optional
+        Where a second rod just above the ankle pushes (:class:`~loper_analysis.swing_leg.rods.ShankRod`; None:
+        the default place and push). Used when the trials' ``force`` (and ``force_native``) tables hold that rod's
+        load cell, ``shank_force_measured_n``: the fit then takes both rods' forces, the shank rod's along the
+        shank's normal (from the joint angles) turned by the rod's angle, at ``params``' shank length times
+        the rod's attachment fraction. Trials must agree on whether they hold it.
 
     Returns
     -------
@@ -447,7 +436,17 @@ def fit_onset(
         counts = pd.DataFrame([{"trial": "total", "status": "missing", "reason": "no trial of this onset"}])
         rows = status_rows(subject, onset_ms, "missing", "no trial of this onset", truth=truth)
         return OnsetFit(pd.DataFrame(), counts, rows, _no_curves())
-    inputs = [_response_input(tr) for tr in trials]
+    inputs = [_response_input(tr, shank_rod) for tr in trials]
+    two_rods = {np.shape(i["force_direction"])[1] == 4 for i in inputs}
+    if len(two_rods) > 1:
+        names = [str(i["name"]) for i in inputs if np.shape(i["force_direction"])[1] == 4]
+        raise LoperInputError(
+            f"{subject}, onset {onset_ms} ms: trial(s) {', '.join(names)} hold a second rod's load cell "
+            "(shank_force_measured_n) and the others do not: one fit takes one design"
+        )
+    if two_rods == {True}:
+        rod = ShankRod() if shank_rod is None else shank_rod
+        params = params.replace(shank_attachment_m=rod.attachment_m(params.length_m[1]))
     mean, counts, series, r, fallback = _onset_response(inputs, onset_ms, subject, response, identification)
     total = counts[counts["trial"] == "total"].iloc[0]
     n_kept = int(total["n_kept"])
@@ -498,20 +497,25 @@ def fit_onset(
     return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series))
 
 
-def _response_input(trial: Mapping) -> dict:
+def _response_input(trial: Mapping, shank_rod: ShankRod | None = None) -> dict:
     """One trial as :func:`loper_analysis.impedance.responses.subject_onset_response` takes it: its frames, with
-    the rods'
-    force direction (n, 2) from the brace markers of ``trial["markers"]`` (:func:`brace_force_direction`)."""
+    the rods' force direction (n, 2) from the brace markers of ``trial["markers"]`` (:func:`brace_force_direction`);
+    (n, 4) when its force table holds a second rod's load cell, that rod's direction after the thigh rod's
+    (:func:`shank_force_direction`)."""
     t, X, labels = trial["markers"]
     angles = trial["angles"]
     if len(t) != len(angles) or not np.allclose(t, angles["time_s"].to_numpy(), atol=1e-6):
         raise LoperInputError(f"{trial['name']}: marker frames differ from the joint angles' frames")
+    direction = brace_force_direction(X, labels, source=str(trial["name"]))
+    if "shank_force_measured_n" in trial["force"].columns:
+        rod = ShankRod() if shank_rod is None else shank_rod
+        direction = np.concatenate([direction, shank_force_direction(angles, rod, str(trial["name"]))], axis=1)
     return {
         "name": trial["name"],
         "angles": angles,
         "strides": trial["strides"],
         "force": trial["force"],
-        "force_direction": brace_force_direction(X, labels, source=str(trial["name"])),
+        "force_direction": direction,
         "force_native": trial.get("force_native"),
     }
 

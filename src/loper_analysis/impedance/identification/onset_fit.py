@@ -1,6 +1,7 @@
 """Parts of one onset's fit (:func:`loper_analysis.impedance.identification.impedance.fit_onset`).
 
 * :func:`mean_response_window` - the identification window of the onset's mean response;
+* :func:`force_keywords` - the rods' forces as the window takes them;
 * :func:`fit_null_pairs` - the null pairs whose deviation weights the fit's prediction errors;
 * :func:`fit_curves` - the measured and model responses of the fit.
 """
@@ -18,7 +19,22 @@ from loper_analysis.impedance.identification.window import PreparedWindow, prepa
 from loper_analysis.impedance.responses import ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["mean_response_window", "fit_null_pairs", "fit_curves"]
+__all__ = ["mean_response_window", "force_keywords", "fit_null_pairs", "fit_curves"]
+
+
+def force_keywords(perturbed_n, unperturbed_n) -> dict:
+    """:func:`~loper_analysis.impedance.identification.prepare_window`'s force keywords of the rods' forces
+    (N, (k, 2): the thigh rod's; (k, 4): the thigh rod's, then a second rod's at the shank, as the responses
+    carry them)."""
+    fp, fu = np.asarray(perturbed_n, dtype=float), np.asarray(unperturbed_n, dtype=float)
+    if fp.shape[-1] == 2:
+        return {"force_unperturbed_n": unperturbed_n, "force_perturbed_n": perturbed_n}
+    return {
+        "force_unperturbed_n": fu[..., :2],
+        "force_perturbed_n": fp[..., :2],
+        "shank_force_unperturbed_n": fu[..., 2:],
+        "shank_force_perturbed_n": fp[..., 2:],
+    }
 
 
 def mean_response_window(series: Mapping, params: SegmentParameters, options: Mapping) -> PreparedWindow:
@@ -30,8 +46,7 @@ def mean_response_window(series: Mapping, params: SegmentParameters, options: Ma
         series["q_perturbed"],
         params,
         0.0,
-        force_unperturbed_n=series["force_unperturbed_n"],
-        force_perturbed_n=series["force_perturbed_n"],
+        **force_keywords(series["force_perturbed_n"], series["force_unperturbed_n"]),
         force_time_s=series.get("force_time_s"),
         pelvis_angle_unperturbed_rad=series["pelvis_angle_unperturbed_rad"],
         pelvis_angle_perturbed_rad=series["pelvis_angle_perturbed_rad"],

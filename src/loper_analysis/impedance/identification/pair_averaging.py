@@ -26,6 +26,7 @@ from dataclasses import replace
 import numpy as np
 
 from loper_analysis.impedance.identification.fit import ImpedanceFit, identify_impedance
+from loper_analysis.impedance.identification.onset_fit import force_keywords
 from loper_analysis.impedance.identification.window import PreparedWindow, prepare_window, simulate_response
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
@@ -41,9 +42,10 @@ def pair_windows(pairs: Mapping, params: SegmentParameters, **window_options) ->
     ``pairs``: the responses' per-pair series (:func:`loper_analysis.impedance.responses.subject_onset_response`,
     ``series["pairs"]``): ``time_s`` (n,), ``q_perturbed`` / ``q_unperturbed`` (n_pairs, n, 4; m, rad),
     ``pelvis_angle_perturbed_rad`` / ``pelvis_angle_unperturbed_rad`` (n_pairs, n), ``force_perturbed_n``
-    / ``force_unperturbed_n`` (n_pairs, k, 2; N) and, when the force has its own rate, ``force_time_s``
-    (k,). ``window_options``: :func:`~loper_analysis.impedance.identification.window.prepare_window`'s keywords,
-    those of the mean window.
+    / ``force_unperturbed_n`` (n_pairs, k, 2; N; (n_pairs, k, 4) with a second rod:
+    :func:`~loper_analysis.impedance.identification.onset_fit.force_keywords`) and, when the force has its own
+    rate, ``force_time_s`` (k,). ``window_options``:
+    :func:`~loper_analysis.impedance.identification.window.prepare_window`'s keywords, those of the mean window.
     """
     out = []
     for i in range(int(pairs["n_pairs"])):
@@ -54,8 +56,7 @@ def pair_windows(pairs: Mapping, params: SegmentParameters, **window_options) ->
                 pairs["q_perturbed"][i],
                 params,
                 0.0,
-                force_unperturbed_n=pairs["force_unperturbed_n"][i],
-                force_perturbed_n=pairs["force_perturbed_n"][i],
+                **force_keywords(pairs["force_perturbed_n"][i], pairs["force_unperturbed_n"][i]),
                 force_time_s=pairs.get("force_time_s"),
                 pelvis_angle_unperturbed_rad=pairs["pelvis_angle_unperturbed_rad"][i],
                 pelvis_angle_perturbed_rad=pairs["pelvis_angle_perturbed_rad"][i],

@@ -27,7 +27,11 @@ from loper_analysis.impedance.responses.conditional import (
 )
 from loper_analysis.impedance.responses.inputs import trial_angles, trial_name, trial_table
 from loper_analysis.impedance.responses.matching import match_in_window, stride_table, too_short
-from loper_analysis.impedance.responses.native_force import native_force_rate_hz, native_force_windows
+from loper_analysis.impedance.responses.native_force import (
+    native_force_rate_hz,
+    native_force_windows,
+    rod_magnitudes,
+)
 from loper_analysis.impedance.responses.sampling import TIME_TOLERANCE_S
 from loper_analysis.impedance.responses.windows import (
     AnalysisGrid,
@@ -77,18 +81,26 @@ def _trial_inputs(trial: Mapping, k: int, side: str, source: str):
             f"{where_f}: time_s ({tf.size} frames) differs from the angles' frames in {where_a} ({t.size} frames)"
         )
     direction = np.asarray(trial["force_direction"], dtype=float)
-    if direction.shape != (t.size, 2):
-        raise LoperInputError(f"{name}: force_direction must have shape ({t.size}, 2), got {direction.shape}")
-    with np.errstate(invalid="ignore"):
-        off = np.flatnonzero(np.abs(np.hypot(direction[:, 0], direction[:, 1]) - 1.0) > 1e-6)
-    if off.size:
-        i = int(off[0])
+    if direction.ndim != 2 or direction.shape[0] != t.size or direction.shape[1] not in (2, 4):
         raise LoperInputError(
-            f"{name}: force_direction at frame {i} (t = {t[i]:.4f} s) is not a unit vector: {direction[i].tolist()}"
+            f"{name}: force_direction must have shape ({t.size}, 2), or ({t.size}, 4) with a second rod, "
+            f"got {direction.shape}"
         )
-    magnitude = force["force_measured_n"].to_numpy(float)
-    columns["force"] = magnitude
-    columns["force_vector"] = magnitude[:, None] * direction  # NaN frames stay NaN
+    for r in range(direction.shape[1] // 2):
+        with np.errstate(invalid="ignore"):
+            off = np.flatnonzero(np.abs(np.hypot(direction[:, 2 * r], direction[:, 2 * r + 1]) - 1.0) > 1e-6)
+        if off.size:
+            i = int(off[0])
+            raise LoperInputError(
+                f"{name}: force_direction at frame {i} (t = {t[i]:.4f} s) is not a unit vector: "
+                f"{direction[i, 2 * r : 2 * r + 2].tolist()}"
+            )
+    magnitude = rod_magnitudes(force, direction, where_f)
+    columns["force"] = magnitude if magnitude.ndim == 1 else magnitude[:, 0]
+    if magnitude.ndim == 1:
+        columns["force_vector"] = magnitude[:, None] * direction  # NaN frames stay NaN
+    else:  # each rod's force along its own direction, side by side
+        columns["force_vector"] = np.repeat(magnitude, 2, axis=1) * direction
     native = None
     if trial.get("force_native") is not None:
         native, where_n = trial_table(trial, "force_native", name, ("time_s", "force_measured_n"))

@@ -35,7 +35,7 @@ import numpy as np
 from loper_analysis.checks import bool_column, where
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.resampling import window_times_s
-from loper_analysis.impedance.responses.native_force import finite_spans, force_vectors
+from loper_analysis.impedance.responses.native_force import finite_spans, force_vectors, rod_magnitudes
 from loper_analysis.impedance.responses.sampling import SplineSampler
 from loper_analysis.impedance.responses.windows import window_coordinates
 
@@ -244,7 +244,7 @@ class CandidatePool:
                 table, direction = native
                 nat = (
                     table["time_s"].to_numpy(float),
-                    table["force_measured_n"].to_numpy(float),
+                    rod_magnitudes(table, direction, name),
                     np.asarray(t, float),
                     np.asarray(direction, float),
                 )
@@ -286,7 +286,7 @@ class CandidatePool:
                 tn, fm, tf, _ = tr.native
                 step = tr.native_step_s
                 ok &= (lo >= max(tn[0], tf[0]) - 1e-9) & (hi <= min(tn[-1], tf[-1]) + 1e-9)
-                ok &= finite_spans(tn, fm, lo - step, hi + step)
+                ok &= finite_spans(tn, fm if fm.ndim == 1 else fm.sum(axis=1), lo - step, hi + step)
             if not ok.any():
                 continue
             targets = anchors[ok, None] + self.grid

@@ -7,6 +7,10 @@ load cell's force (low-passed, on the mocap clock:
 interpolated on a relative grid at the robot rate around each onset and
 anchor, and multiplied by the rod direction from the brace markers, whose
 frames are linearly interpolated to the same times and normalised.
+
+With a second rod at the shank the direction has four columns (the thigh rod's x/y, then the shank rod's) and
+the tables hold that rod's load cell too (``shank_force_measured_n``): each rod's force is formed the same way
+and the vectors stand side by side, (..., 4) in N.
 """
 
 from __future__ import annotations
@@ -18,7 +22,27 @@ from loper_analysis.checks import require_columns, where
 from loper_analysis.errors import LoperInputError
 from loper_analysis.gait.resampling import window_times_s
 
-__all__ = ["native_force_rate_hz", "native_force_windows", "force_vectors", "finite_spans"]
+__all__ = [
+    "ROD_FORCE_COLUMNS",
+    "native_force_rate_hz",
+    "native_force_windows",
+    "force_vectors",
+    "finite_spans",
+    "rod_magnitudes",
+]
+
+#: The load cells' columns, one per rod: the thigh rod's, then a second rod's at the shank.
+ROD_FORCE_COLUMNS: tuple[str, ...] = ("force_measured_n", "shank_force_measured_n")
+
+
+def rod_magnitudes(table: pd.DataFrame, direction, source: str = "") -> np.ndarray:
+    """The load cells' forces (N) of the rods ``direction`` (n_frames, 2 per rod) points: (n,) for the thigh rod
+    alone, (n, 2) with the shank rod (its column ``shank_force_measured_n`` must be in ``table``)."""
+    n_rods = np.shape(direction)[-1] // 2
+    if n_rods == 1:
+        return require_columns(table, ROD_FORCE_COLUMNS[:1], source)["force_measured_n"].to_numpy(float)
+    columns = ROD_FORCE_COLUMNS[:n_rods]
+    return require_columns(table, columns, source)[list(columns)].to_numpy(float)
 
 
 def native_force_rate_hz(native: pd.DataFrame, source: str = "") -> float:
@@ -31,13 +55,19 @@ def native_force_rate_hz(native: pd.DataFrame, source: str = "") -> float:
 
 
 def force_vectors(targets, robot_time_s, magnitude_n, frame_time_s, direction) -> np.ndarray:
-    """Rod-force vectors (N) at ``targets`` (s, any shape): the robot-rate magnitude ``magnitude_n`` (N) at
-    ``robot_time_s`` and the frames' rod ``direction`` (n_frames, 2) at ``frame_time_s``, both linearly
-    interpolated, the direction normalised. Shape ``targets.shape + (2,)``."""
-    m = np.interp(targets, robot_time_s, magnitude_n)
-    d = np.stack([np.interp(targets, frame_time_s, direction[:, j]) for j in range(2)], axis=-1)
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
-    return m[..., None] * d
+    """Rod-force vectors (N) at ``targets`` (s, any shape): the robot-rate magnitude ``magnitude_n`` (N; (n,),
+    or (n, R) for R rods) at ``robot_time_s`` and the frames' rod ``direction`` (n_frames, 2 R) at
+    ``frame_time_s``, both linearly interpolated, each rod's direction normalised. Shape
+    ``targets.shape + (2 R,)``."""
+    magnitude = np.asarray(magnitude_n, dtype=float)
+    rods = [magnitude] if magnitude.ndim == 1 else [magnitude[:, r] for r in range(magnitude.shape[1])]
+    out = []
+    for r, mag in enumerate(rods):
+        m = np.interp(targets, robot_time_s, mag)
+        d = np.stack([np.interp(targets, frame_time_s, direction[:, 2 * r + j]) for j in range(2)], axis=-1)
+        d /= np.linalg.norm(d, axis=-1, keepdims=True)
+        out.append(m[..., None] * d)
+    return out[0] if len(out) == 1 else np.concatenate(out, axis=-1)
 
 
 def finite_spans(time_s, values, lo_s, hi_s) -> np.ndarray:
@@ -64,8 +94,9 @@ def native_force_windows(
     Parameters
     ----------
     frame_time_s : (n_frames,) frame times (s) of ``direction``.
-    direction : (n_frames, 2) unit vectors of the rod force (world x/y).
-    native : DataFrame with ``time_s`` (s, mocap clock) and ``force_measured_n`` (N) at the robot's samples.
+    direction : (n_frames, 2) unit vectors of the rod force (world x/y); (n_frames, 4) with a second rod.
+    native : DataFrame with ``time_s`` (s, mocap clock) and ``force_measured_n`` (N) at the robot's samples
+    (and ``shank_force_measured_n`` with a second rod).
     matches : ``onset_s`` and ``matched_anchor_s`` (s) per pair
     (:func:`~loper_analysis.impedance.responses.match_unperturbed`).
     start_s, end_s : the window relative to the onset (s), as for
@@ -75,7 +106,7 @@ def native_force_windows(
 
     Returns
     -------
-    (perturbed, unperturbed), each (n_pairs, n_grid, 2) in N on the grid
+    (perturbed, unperturbed), each (n_pairs, n_grid, 2) in N ((..., 4) with a second rod) on the grid
     ``loper_analysis.gait.resampling.window_times_s(-start_s, end_s, rate_hz)``.
 
     Raises
@@ -85,7 +116,8 @@ def native_force_windows(
     """
     table = require_columns(native, ("time_s", "force_measured_n"), source)
     tn = table["time_s"].to_numpy(float)
-    fm = table["force_measured_n"].to_numpy(float)
+    fm = rod_magnitudes(table, direction, source)
+    fm_all = fm if fm.ndim == 1 else fm.sum(axis=1)  # non-finite where any rod's is
     tf = np.asarray(frame_time_s, dtype=float)
     u = np.asarray(direction, dtype=float)
     grid = window_times_s(-start_s, end_s, rate_hz)
@@ -95,7 +127,7 @@ def native_force_windows(
         targets = anchors[:, None] + grid
         lo, hi = targets[:, 0], targets[:, -1]
         ok = (lo >= max(tn[0], tf[0]) - 1e-9) & (hi <= min(tn[-1], tf[-1]) + 1e-9)
-        ok &= finite_spans(tn, fm, lo - 1.0 / rate_hz, hi + 1.0 / rate_hz)
+        ok &= finite_spans(tn, fm_all, lo - 1.0 / rate_hz, hi + 1.0 / rate_hz)
         for i in np.flatnonzero(~ok)[:1]:
             raise LoperInputError(
                 f"{where(source)}the {what} force window of stride {matches['stride'].iloc[i]} "

@@ -3,12 +3,14 @@ analysis)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 from loper_analysis.device.analysis import DeviceAnalysisSettings, FRFSettings, StepSettings
 from loper_analysis.device.controller import DeviceParameters, FreeLeg
 from loper_analysis.device.trials import DeviceTestSettings
 from loper_analysis.stages.device.step import DeviceSettings
+from loper_analysis.swing_leg.rods import ShankRod
 
 __all__ = ["NEEDS", "read_settings"]
 
@@ -19,7 +21,9 @@ def read_settings(config: Mapping) -> DeviceSettings:
     """The device's settings of a validated config: ``device.parameters``, ``device.leg`` (``mass_kg``,
     ``damping_ns_per_m``, ``stiffness_n_per_m``), ``device.tests`` and ``device.analysis`` (the Welch window,
     the step windows in s and the bandwidth's reference band in Hz), ``device.subject`` and
-    ``device.mat_column_map``."""
+    ``device.mat_column_map``; the second rod's point (``device.shank_rod.attachment_fraction`` of the shank's
+    length from the knee) and push (``direction_deg`` from the shank's forward normal, toward the ankle positive;
+    converted to rad)."""
     d = config["device"]
     tests, a = d["tests"], d["analysis"]
     return DeviceSettings(
@@ -35,4 +39,8 @@ def read_settings(config: Mapping) -> DeviceSettings:
         ),
         subject=d["subject"],
         mat_column_map=d["mat_column_map"],
+        shank_rod=ShankRod(
+            attachment_fraction=d["shank_rod"]["attachment_fraction"],
+            direction_rad=math.radians(d["shank_rod"]["direction_deg"]),
+        ),
     )

@@ -17,6 +17,7 @@ from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.generated import generated, refuse_foreign_files
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.robot_log import read_robot_log, write_robot_log
+from loper_analysis.swing_leg.rods import ShankRod
 
 __all__ = [
     "DEVICE_FLOAT_FORMAT",
@@ -43,7 +44,9 @@ class DeviceSettings:
     :class:`~loper_analysis.device.trials.DeviceTestSettings`), ``analysis`` (FRF, steps and the bandwidth's
     reference band, :class:`~loper_analysis.device.analysis.DeviceAnalysisSettings`), ``subject`` (whose raw
     folder holds the device tests' logs; None: no device tests) and ``mat_column_map`` (robot-log column -> the
-    variable of a robot's ``.mat`` export holding it; None: no ``.mat`` export read)."""
+    variable of a robot's ``.mat`` export holding it; None: no ``.mat`` export read); ``shank_rod`` (where a second
+    rod just above the ankle pushes, :class:`~loper_analysis.swing_leg.rods.ShankRod`; whether it pushes is the
+    study's design, ``planning.shank_pulse_force_n``)."""
 
     parameters: DeviceParameters = field(default_factory=DeviceParameters)
     leg: FreeLeg = field(default_factory=FreeLeg)
@@ -51,6 +54,7 @@ class DeviceSettings:
     analysis: DeviceAnalysisSettings = field(default_factory=DeviceAnalysisSettings)
     subject: str | None = None
     mat_column_map: Mapping[str, str] | None = None
+    shank_rod: ShankRod = field(default_factory=ShankRod)
 
 
 def device_trial(

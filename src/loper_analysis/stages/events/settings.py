@@ -32,7 +32,8 @@ def read_settings(
 ) -> EventsSettings:
     """The settings of a validated config: ``events.*`` (thresholds in N, durations in s); the GRF's low-pass
     order, the rotation and the load cell's low-pass are the markers', the resting-level rule the ground
-    reactions', the pulse the load cell's pulses are checked against the planned one (N)."""
+    reactions', the pulse the load cell's pulses are checked against the planned one (N), the second rod's
+    against its planned pulse (N; 0: the logs must hold no shank pulses)."""
     e = config["events"]
     events = EventSettings(
         grf_channels=e["grf_channels"],
@@ -48,5 +49,11 @@ def read_settings(
         band_n=grf.band_n,
         max_rest_n=grf.max_rest_n,
     )
-    loadcell = LoadcellSettings(e["sync_channel"], markers.cutoff_hz, markers.order, planning.plan.pulse_force_n)
+    loadcell = LoadcellSettings(
+        e["sync_channel"],
+        markers.cutoff_hz,
+        markers.order,
+        planning.plan.pulse_force_n,
+        planning.plan.shank_pulse_force_n,
+    )
     return EventsSettings(events=events, loadcell=loadcell)

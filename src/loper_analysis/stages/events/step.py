@@ -104,6 +104,7 @@ def _loadcell_of(rec, log_path, s: LoadcellSettings) -> tuple[pd.DataFrame, pd.D
         source=f"{log_path} / {c3d_path}",
         sync_channel=sync_channel,
         pulse_force_n=s.pulse_force_n,
+        shank_pulse_force_n=s.shank_pulse_force_n,
     )
     cm = out.attrs.get("clock_map")
     if cm is not None:

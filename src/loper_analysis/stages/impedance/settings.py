@@ -10,19 +10,22 @@ from loper_analysis.gait.stride_settings import StrideSettings
 from loper_analysis.impedance.identification.impedance import IdentificationSettings
 from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.impedance.responses.response_window import ResponseWindow
+from loper_analysis.stages.device.step import DeviceSettings
 from loper_analysis.stages.impedance.step import FitSettings
 from loper_analysis.stages.study.settings import StudySettings
 
 __all__ = ["NEEDS", "read_settings"]
 
-NEEDS: tuple[str, ...] = ("study", "strides")
+NEEDS: tuple[str, ...] = ("study", "strides", "device")
 
 
-def read_settings(config: Mapping, study: StudySettings, strides: StrideSettings) -> FitSettings:
+def read_settings(
+    config: Mapping, study: StudySettings, strides: StrideSettings, device: DeviceSettings
+) -> FitSettings:
     """The fit's settings of a validated config: the response window (``impedance.window_before_s``,
     ``window_after_s``, ``initial_state_span_s``, s), the counterfactual and every other key of
     ``identification`` (bounds in N·m/rad and N·m·s/rad); the IQR rule and fewest kept strides are the
-    strides', the seed the study's."""
+    strides', the seed the study's, a second rod's place and push the device's (``device.shank_rod``)."""
     ident = config["impedance"]
     window = ResponseWindow(
         before_s=ident["window_before_s"],
@@ -55,4 +58,4 @@ def read_settings(config: Mapping, study: StudySettings, strides: StrideSettings
         averaging_correction=ident["averaging_correction"],
         seed=study.seed,
     )
-    return FitSettings(response=response, identification=identification)
+    return FitSettings(response=response, identification=identification, shank_rod=device.shank_rod)

@@ -21,6 +21,7 @@ from loper_analysis.io.atomic import PathLike, write_figure, write_tsv
 from loper_analysis.io.readers import read_tsv
 from loper_analysis.io.truth import read_truth
 from loper_analysis.stages.impedance.files import FitFiles
+from loper_analysis.swing_leg.rods import ShankRod
 
 __all__ = [
     "FitSettings",
@@ -41,11 +42,13 @@ class FitSettings:
     ``response``: :class:`~loper_analysis.impedance.responses.ResponseSettings` (fit window and initial-state span in s,
     the IQR rule, the fewest kept pairs); ``identification``:
     :class:`~loper_analysis.impedance.identification.impedance.IdentificationSettings` (noise model, starts, bounds in
-    N·m/rad and N·m·s/rad, judgement, seed).
+    N·m/rad and N·m·s/rad, judgement, seed); ``shank_rod``: where a second rod just above the ankle pushes
+    (:class:`~loper_analysis.swing_leg.rods.ShankRod`), used for trials whose force tables hold its load cell.
     """
 
     response: ResponseSettings = field(default_factory=ResponseSettings)
     identification: IdentificationSettings = field(default_factory=IdentificationSettings)
+    shank_rod: ShankRod = field(default_factory=ShankRod)
 
 
 class _Tables:
@@ -101,7 +104,17 @@ def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, ta
         for name, trial in files.null_trials.items()
     ]
     params = read_segments(files.segments) if inputs else None
-    result = fit_onset(inputs, params, int(onset_ms), subject, truth, null, settings.response, settings.identification)
+    result = fit_onset(
+        inputs,
+        params,
+        int(onset_ms),
+        subject,
+        truth,
+        null,
+        settings.response,
+        settings.identification,
+        settings.shank_rod,
+    )
     out = files.outputs
     write_tsv(result.response, out.response)
     write_tsv(result.counts, out.counts)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -78,7 +79,13 @@ def _add_plan(p: argparse.ArgumentParser) -> None:
         "--shank-attachment-fraction",
         type=float,
         help="that rod's point on the shank, as a fraction of the shank's length from the knee (default: "
-        "planning.shank_attachment_fraction, else 0.85)",
+        "device.shank_rod.attachment_fraction, else 0.85)",
+    )
+    p.add_argument(
+        "--shank-direction-deg",
+        type=float,
+        help="that rod's push: the shank's forward normal turned toward the ankle by this angle (deg; default: "
+        "device.shank_rod.direction_deg, else 0)",
     )
     p.add_argument(
         "--target",
@@ -129,9 +136,18 @@ def plan_settings(args: argparse.Namespace, config: dict | None):
         ("pulse_force_n", args.force_n),
         ("pulse_duration_s", args.duration_s),
         ("shank_pulse_force_n", args.shank_force_n),
-        ("shank_attachment_fraction", args.shank_attachment_fraction),
     )
     pulse = {k: v for k, v in options if v is not None}
+    rod = {
+        k: v
+        for k, v in (
+            ("attachment_fraction", args.shank_attachment_fraction),
+            ("direction_rad", None if args.shank_direction_deg is None else math.radians(args.shank_direction_deg)),
+        )
+        if v is not None
+    }
+    if rod:
+        pulse["shank_rod"] = dataclasses.replace(settings.plan.shank_rod, **rod)
     given = {
         "onsets_ms": None if args.onset_ms is None else tuple(args.onset_ms),
         "strides": None if args.strides is None else tuple(args.strides),
@@ -246,7 +262,8 @@ COMMANDS: tuple[Command, ...] = (
             "force_n": ("config", ("planning", "pulse_force_n")),
             "duration_s": ("config", ("planning", "pulse_duration_s")),
             "shank_force_n": ("config", ("planning", "shank_pulse_force_n")),
-            "shank_attachment_fraction": ("config", ("planning", "shank_attachment_fraction")),
+            "shank_attachment_fraction": ("config", ("device", "shank_rod", "attachment_fraction")),
+            "shank_direction_deg": ("config", ("device", "shank_rod", "direction_deg")),
             "strides": ("config", ("planning", "strides")),
         },
     ),

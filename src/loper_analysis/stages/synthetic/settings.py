@@ -1,5 +1,5 @@
 """The synthetic lab's settings (config ``synthetic.*``), with the study's design and seed, the markers' lab
-axes, the load cell's sync channel and the device."""
+axes, the load cell's sync channel and the device (its second rod's place too)."""
 
 from __future__ import annotations
 
@@ -31,9 +31,10 @@ def read_settings(
     """The synthetic lab of a validated config: ``synthetic.*`` (durations in s, noise in m and N, the robot
     clock's offset in s and drift in ppm, the pulse in N and s, the variability and the device adaptation);
     the trials and seed the study's, the lab's axes the markers' rotation, the sync channel the load cell's,
-    the device's parameters the device's; the true impedance (``stiffness_nm_per_rad``, ``damping_nms_per_rad``
-    per onset, ``between_subject_cv``) inside the fit's bounds. The rates, the robot log's margin and the belts'
-    channel names keep their defaults."""
+    the device's parameters and its second rod's place the device's, a second rod's pulse (N,
+    ``shank_pulse_force_n``); the true impedance (``stiffness_nm_per_rad``, ``damping_nms_per_rad`` per onset,
+    ``between_subject_cv``) inside the fit's bounds. The rates, the robot log's margin and the belts' channel names
+    keep their defaults."""
     s, fit = config["synthetic"], impedance.identification
     v, a = s["study_variability"], s["device_adaptation"]
     lab = LabSettings(
@@ -58,6 +59,8 @@ def read_settings(
         pulse_force_n=s["pulse_force_n"],
         pulse_duration_s=s["pulse_duration_s"],
         perturb_every_strides=tuple(s["perturb_every_strides"]),
+        shank_pulse_force_n=s["shank_pulse_force_n"],
+        shank_rod=device.shank_rod,
         variability=s["variability"],
         study_variability=GaitVariability(
             v["amplitude_cv"], v["offset_sd_rad"], v["timing_sd_stride"], v["swing_gain"], v["knots_per_stride"]
