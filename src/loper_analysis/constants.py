@@ -35,6 +35,9 @@ __all__ = [
     "SEGMENTS",
     "PARAMETERS",
     "PARAMETER_UNITS",
+    "COUPLINGS",
+    "COUPLING_PARAMETERS",
+    "COUPLING_UNIT",
     "UNIT_SUFFIX",
     "FLAGGED_EVENTS",
     "CONTACT_FLAGS",
@@ -59,6 +62,15 @@ SEGMENTS: tuple[str, ...] = ("thigh", "shank", "foot")
 PARAMETERS: tuple[str, ...] = ("K_hip", "D_hip", "K_knee", "D_knee", "K_ankle", "D_ankle")
 #: Units of the identified parameters.
 PARAMETER_UNITS: dict[str, str] = {p: ("N·m/rad" if p.startswith("K") else "N·m·s/rad") for p in PARAMETERS}
+#: Inter-joint (bi-articular) stiffness couplings the fit may add, by the pair of neighbouring joints they link:
+#: ``hip_knee`` adds ``-K_hip_knee dtheta_knee`` to the hip torque and ``-K_hip_knee dtheta_hip`` to the knee's,
+#: ``knee_ankle`` the same between knee and ankle (a symmetric stiffness matrix; ``docs/identification.md``,
+#: "Bi-articular stiffness").
+COUPLINGS: tuple[str, ...] = ("hip_knee", "knee_ankle")
+#: Their parameter names, after :data:`PARAMETERS` in a fit's parameter vector, in this order.
+COUPLING_PARAMETERS: tuple[str, ...] = tuple(f"K_{c}" for c in COUPLINGS)
+#: Unit of a coupling stiffness.
+COUPLING_UNIT: str = "N·m/rad"
 #: Unit suffix of stiffness (K) and damping (D) in column names.
 UNIT_SUFFIX: dict[str, str] = {"K": "nm_per_rad", "D": "nms_per_rad"}
 #: Rows of an event table that bound a flagged foot contact (no gait event; strides must not span it).

@@ -33,19 +33,26 @@ from scipy.optimize import least_squares
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification.intervals import bounded_interval, sandwich_covariance
-from loper_analysis.impedance.identification.window import PreparedWindow, prediction_error, simulate_response
+from loper_analysis.impedance.identification.window import (
+    PreparedWindow,
+    check_couplings,
+    prediction_error,
+    simulate_response,
+)
 
 __all__ = [
     "DEFAULT_LOWER",
     "DEFAULT_UPPER",
     "STIFFNESS_BOUNDS_NM_PER_RAD",
     "DAMPING_BOUNDS_NMS_PER_RAD",
+    "COUPLING_BOUNDS_NM_PER_RAD",
     "N_STARTS",
     "FIT_TOLERANCE",
     "MERGE_TOLERANCE",
     "AT_BEST_RELATIVE",
     "ImpedanceFit",
     "check_bounds",
+    "fit_bounds",
     "parameter_bounds",
     "FitBounds",
     "ResidualBatch",
@@ -61,6 +68,12 @@ __all__ = [
 STIFFNESS_BOUNDS_NM_PER_RAD: tuple[float, float] = (0.0, 200.0)
 #: ... and of every D (N·m·s/rad; ``impedance.damping_bounds_nms_per_rad``).
 DAMPING_BOUNDS_NMS_PER_RAD: tuple[float, float] = (0.0, 10.0)
+#: ... and of every inter-joint coupling stiffness (N·m/rad; docs/identification.md, "Bi-articular stiffness"): a
+#: leg whose joint stiffness is spring-like (muscles as springs across one or two joints, feedback about each
+#: joint) has a positive semi-definite stiffness matrix, so |K_hip_knee| <= sqrt(K_hip K_knee), at most the
+#: stiffness bound's upper end; either sign: rectus femoris and the hamstrings (each flexing one joint and
+#: extending the other) give a negative coupling, sartorius and gracilis (flexing both) a positive one.
+COUPLING_BOUNDS_NM_PER_RAD: tuple[float, float] = (-200.0, 200.0)
 #: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS` (:func:`parameter_bounds` of the two above).
 DEFAULT_LOWER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[0], DAMPING_BOUNDS_NMS_PER_RAD[0]] * 3, float)
 DEFAULT_UPPER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[1], DAMPING_BOUNDS_NMS_PER_RAD[1]] * 3, float)
@@ -80,13 +93,15 @@ _COST_ZERO = 2e-30
 
 @dataclass
 class ImpedanceFit:
-    """Result of :func:`identify_impedance` (parameter order :data:`PARAMETERS`).
+    """Result of :func:`identify_impedance` (parameter order :attr:`parameters`: :data:`PARAMETERS`, then
+    ``K_<coupling>`` for each inter-joint coupling of the fit).
 
     ``cost`` and ``start_costs`` are costs as defined in the module docstring
     (rad^2); ``sum_sq_error_rad2`` is the unweighted sum of squared prediction
     errors at the estimate; ``sd`` the parameters' standard deviations (linearised; inf: no information) and
     ``ci_dof`` the degrees of freedom of the intervals' t quantile; ``n_starts_at_best`` counts the starts whose final
-    cost lies within :data:`AT_BEST_RELATIVE` above the lowest start cost.
+    cost lies within :data:`AT_BEST_RELATIVE` above the lowest start cost. ``estimate``, ``sd``, ``ci95_low`` and
+    ``ci95_high`` are (p,), ``correlation`` (p, p), p = ``len(parameters)``.
     """
 
     estimate: np.ndarray
@@ -109,20 +124,32 @@ class ImpedanceFit:
     time_s: np.ndarray = field(repr=False)
     measured: np.ndarray = field(repr=False)
     model: np.ndarray = field(repr=False)
+    parameters: tuple[str, ...] = PARAMETERS
+
+    def value(self, name: str) -> tuple[float, float, float, float]:
+        """Estimate, SD, 95 % CI low and high of the parameter ``name`` (one of :attr:`parameters`)."""
+        if name not in self.parameters:
+            raise LoperInputError(f"the fit holds {', '.join(self.parameters)}; no {name!r}")
+        i = self.parameters.index(name)
+        return float(self.estimate[i]), float(self.sd[i]), float(self.ci95_low[i]), float(self.ci95_high[i])
 
 
 def response_jacobian(window: PreparedWindow, impedance, lower=DEFAULT_LOWER, upper=DEFAULT_UPPER) -> np.ndarray:
-    """Sensitivity of the model response to the parameters, (n_out * 3, 6).
+    """Sensitivity of the model response to the parameters, (n_out * 3, p).
 
-    Row order: samples, then hip/knee/ankle; units rad per (N m/rad) or per
+    Row order: samples, then hip/knee/ankle; columns the window's parameters (p = 6 without inter-joint
+    couplings; :attr:`PreparedWindow.parameters`); units rad per (N m/rad) or per
     (N m s/rad). Forward differences as used by the fit (backward at an upper
     bound). With white noise of SD s on the prediction error,
-    ``s * sqrt(diag((J^T J)^-1))`` is the Cramér-Rao bound of the parameter SD.
+    ``s * sqrt(diag((J^T J)^-1))`` is the Cramér-Rao bound of the parameter SD. ``lower``, ``upper``: as
+    :func:`identify_impedance` takes them (:func:`fit_bounds`).
     """
-    lb, ub = check_bounds(lower, upper)
+    lb, ub = fit_bounds(lower, upper, window.couplings)
     p = np.asarray(impedance, dtype=float)
-    if p.shape != (6,) or not np.all(np.isfinite(p)):
-        raise LoperInputError(f"impedance must be 6 finite values, got {p}")
+    if p.shape != (window.n_parameters,) or not np.all(np.isfinite(p)):
+        raise LoperInputError(
+            f"impedance must be {window.n_parameters} finite values ({', '.join(window.parameters)}), got {p}"
+        )
     _, jacobian = ResidualBatch(window, lb, ub).residuals_and_jacobians(p[None])
     return -jacobian[0]
 
@@ -135,45 +162,78 @@ def variance_accounted_for(measured: np.ndarray, model: np.ndarray) -> np.ndarra
         return np.where(den > 0, 100.0 * (1.0 - num / den), np.nan)
 
 
-def parameter_bounds(stiffness_bounds, damping_bounds) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds (6,) in the order of :data:`PARAMETERS` from one (low, high) pair for every K
-    (N·m/rad) and one for every D (N·m·s/rad)."""
+def parameter_bounds(
+    stiffness_bounds, damping_bounds, couplings=(), coupling_bounds=COUPLING_BOUNDS_NM_PER_RAD
+) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds (p,) in the order of :data:`PARAMETERS` from one (low, high) pair for every K
+    (N·m/rad) and one for every D (N·m·s/rad), then ``coupling_bounds`` (low, high; N·m/rad) for each of the
+    inter-joint ``couplings`` (p = 6 + their number)."""
     k, d = tuple(stiffness_bounds), tuple(damping_bounds)
-    return np.array([k[0], d[0]] * 3, float), np.array([k[1], d[1]] * 3, float)
+    n = len(check_couplings(couplings))
+    c = tuple(coupling_bounds)
+    return np.array([k[0], d[0]] * 3 + [c[0]] * n, float), np.array([k[1], d[1]] * 3 + [c[1]] * n, float)
 
 
 class FitBounds:
     """Base of a settings dataclass that holds the fit's bounds: its K and D bound vectors.
 
     The subclass has the fields ``stiffness_bounds_nm_per_rad`` (low, high; N·m/rad, every K) and
-    ``damping_bounds_nms_per_rad`` (low, high; N·m·s/rad, every D); :attr:`lower` and :attr:`upper` are
-    the bounds (6,) in the order of :data:`PARAMETERS` (:func:`parameter_bounds`).
+    ``damping_bounds_nms_per_rad`` (low, high; N·m·s/rad, every D), and may have ``couplings`` (inter-joint
+    couplings fitted besides them) and ``coupling_bounds_nm_per_rad`` (low, high; N·m/rad, default
+    :data:`COUPLING_BOUNDS_NM_PER_RAD`); :attr:`lower` and :attr:`upper` are the bounds (p,) in the order of
+    :data:`PARAMETERS`, then the couplings' (:func:`parameter_bounds`).
     """
 
     stiffness_bounds_nm_per_rad: tuple[float, float]
     damping_bounds_nms_per_rad: tuple[float, float]
 
+    def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        return parameter_bounds(
+            self.stiffness_bounds_nm_per_rad,
+            self.damping_bounds_nms_per_rad,
+            getattr(self, "couplings", ()),
+            getattr(self, "coupling_bounds_nm_per_rad", COUPLING_BOUNDS_NM_PER_RAD),
+        )
+
     @property
     def lower(self) -> np.ndarray:
-        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[0]
+        return self._bounds()[0]
 
     @property
     def upper(self) -> np.ndarray:
-        return parameter_bounds(self.stiffness_bounds_nm_per_rad, self.damping_bounds_nms_per_rad)[1]
+        return self._bounds()[1]
 
 
-def check_bounds(lower, upper) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds as (6,) arrays, each finite and lower below upper."""
+def check_bounds(lower, upper, parameters: tuple[str, ...] = PARAMETERS) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds as (p,) arrays, p = ``len(parameters)`` (names for the messages), each finite and
+    lower below upper."""
     lb = np.asarray(lower, dtype=float)
     ub = np.asarray(upper, dtype=float)
+    n = len(parameters)
     for name, b in (("lower", lb), ("upper", ub)):
-        if b.shape != (6,) or not np.all(np.isfinite(b)):
-            raise LoperInputError(f"{name} bounds must be 6 finite values ({', '.join(PARAMETERS)}), got {b}")
+        if b.shape != (n,) or not np.all(np.isfinite(b)):
+            raise LoperInputError(f"{name} bounds must be {n} finite values ({', '.join(parameters)}), got {b}")
     bad = np.flatnonzero(lb >= ub)
     if bad.size:
         i = bad[0]
-        raise LoperInputError(f"bounds of {PARAMETERS[i]}: lower {lb[i]} must be below upper {ub[i]}")
+        raise LoperInputError(f"bounds of {parameters[i]}: lower {lb[i]} must be below upper {ub[i]}")
     return lb, ub
+
+
+def fit_bounds(lower, upper, couplings=()) -> tuple[np.ndarray, np.ndarray]:
+    """The bounds (p,) of a fit with the inter-joint ``couplings``, checked (:func:`check_bounds`).
+
+    ``lower``, ``upper``: (6 + number of couplings,) values, or the six of K and D alone, to which each
+    coupling's :data:`COUPLING_BOUNDS_NM_PER_RAD` is appended.
+    """
+    couplings = check_couplings(couplings)
+    names = PARAMETERS + tuple(f"K_{c}" for c in couplings)
+    lb = np.asarray(lower, dtype=float)
+    ub = np.asarray(upper, dtype=float)
+    if couplings and lb.shape == (len(PARAMETERS),) and ub.shape == (len(PARAMETERS),):
+        lb = np.concatenate([lb, np.full(len(couplings), COUPLING_BOUNDS_NM_PER_RAD[0])])
+        ub = np.concatenate([ub, np.full(len(couplings), COUPLING_BOUNDS_NM_PER_RAD[1])])
+    return check_bounds(lb, ub, names)
 
 
 class ResidualBatch:
@@ -202,15 +262,16 @@ class ResidualBatch:
         return costs_of(self.residuals(impedance_sets))
 
     def residuals_and_jacobians(self, impedance_sets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """r (B, m) and J (B, m, 6) of the residuals at the rows of ``impedance_sets``."""
+        """r (B, m) and J (B, m, p) of the residuals at the rows of ``impedance_sets`` (B, p)."""
         sets = impedance_sets
         B = len(sets)
+        n = len(self.lb)
         step = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(sets), self.typical)
         step = np.where(sets + step > self.ub, -step, step)
-        batch = np.repeat(sets[:, None, :], 7, axis=1)
-        idx = np.arange(6)
+        batch = np.repeat(sets[:, None, :], n + 1, axis=1)
+        idx = np.arange(n)
         batch[:, idx + 1, idx] += step
-        R = self.residuals(batch.reshape(-1, 6)).reshape(B, 7, -1)
+        R = self.residuals(batch.reshape(-1, n)).reshape(B, n + 1, -1)
         with np.errstate(over="ignore", invalid="ignore"):  # a diverged simulation: inf - inf
             J = (R[:, 1:, :] - R[:, :1, :]) / step[:, :, None]
         return R[:, 0, :], np.transpose(J, (0, 2, 1))
@@ -283,11 +344,12 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
     Returns
     -------
     (numpy.ndarray, numpy.ndarray, numpy.ndarray, numpy.ndarray)
-        Final parameters (N, 6), final costs (N,), per-start convergence flags
+        Final parameters (N, p), final costs (N,), per-start convergence flags
         (N,) and ``merged_into`` (N,): the start whose result each start shares
         (itself when it was never merged).
     """
     lb, ub = batch.lb, batch.ub
+    n_par = len(lb)
     N = len(starts)
     points = starts.copy()
     r, J = batch.residuals_and_jacobians(points)
@@ -302,7 +364,7 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
         ids = np.flatnonzero(active)
         if ids.size == 0:
             break
-        trial = np.empty((ids.size, 6))
+        trial = np.empty((ids.size, n_par))
         for k, i in enumerate(ids):
             with np.errstate(over="ignore", invalid="ignore"):  # huge sensitivities of a nearly diverging start
                 g = J[i].T @ r[i]
@@ -312,7 +374,7 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
                 continue
             at_bound = ((points[i] <= lb) & (g > 0)) | ((points[i] >= ub) & (g < 0))
             free = ~at_bound
-            step = np.zeros(6)
+            step = np.zeros(n_par)
             if free.any():
                 Af = A[np.ix_(free, free)]
                 d = np.diag(Af).copy()
@@ -322,7 +384,7 @@ def multistart_lm(batch: ResidualBatch, starts: np.ndarray, max_iter: int, tol: 
                 except np.linalg.LinAlgError:
                     step[free] = -g[free] / d
             if not np.all(np.isfinite(step)):  # a start whose simulation overflowed: no step, its damping grows
-                step = np.zeros(6)
+                step = np.zeros(n_par)
             trial[k] = np.clip(points[i] + step, lb, ub)
         rt, Jt = batch.residuals_and_jacobians(trial)
         ct = costs_of(rt)
@@ -384,6 +446,7 @@ def identify_impedance(
     extra_starts=None,
     ci_dof: int | None = None,
     polish_max_evaluations: int = 200,
+    couplings=None,
 ) -> ImpedanceFit:
     """Fit K, D per joint to one prepared window (method: ``docs/identification.md``).
 
@@ -392,19 +455,26 @@ def identify_impedance(
     window : from :func:`loper_analysis.impedance.identification.prepare_window`.
     n_starts : random starts, drawn uniformly inside the bounds.
     seed : seed of the start generator (NumPy ``default_rng``).
-    lower, upper : (6,) bounds in the order of :data:`PARAMETERS`.
+    lower, upper : (p,) bounds in the order of the fit's parameters (:attr:`ImpedanceFit.parameters`), or the six
+        of :data:`PARAMETERS` alone, to which each coupling's :data:`COUPLING_BOUNDS_NM_PER_RAD` is appended
+        (:func:`fit_bounds`).
     max_iterations : Levenberg-Marquardt iterations per start.
     tolerance : relative cost/step tolerance of the multistart phase; the
         SciPy polish of the best start then converges to machine precision.
     merge_tolerance : starts closer than this fraction of the bound range in
         every parameter continue as one (0 disables merging); a merged start
         ends with the cost of the start it joined.
-    extra_starts : (k, 6) starts tried before the random ones (e.g. a
-        previous estimate), clipped to the bounds.
+    extra_starts : (k, p) starts tried before the random ones (e.g. a
+        previous estimate), clipped to the bounds; with couplings also (k, 6), the couplings starting at 0.
     ci_dof : degrees of freedom of the intervals' t quantile; None: the
-        residuals' ``m - 6`` (white fit). A fit whose ``noise_cov`` comes from
+        residuals' ``m - p`` (white fit). A fit whose ``noise_cov`` comes from
         ``N`` null pairs passes ``N - 1`` (:mod:`.intervals`).
     polish_max_evaluations : most residual evaluations of the SciPy polish.
+    couplings : inter-joint stiffnesses fitted besides K and D per joint (names of
+        :data:`~loper_analysis.constants.COUPLINGS`, e.g. ``("hip_knee",)``: the bi-articular hip-knee stiffness
+        ``K_hip_knee``, N·m/rad); None: the window's own (:attr:`PreparedWindow.couplings`, set by
+        :func:`~loper_analysis.impedance.identification.prepare_window`). The estimate, SD, intervals and
+        correlation then hold them after the six.
 
     Returns
     -------
@@ -415,7 +485,9 @@ def identify_impedance(
         that used up ``max_iterations`` and was then polished to a minimum
         counts as converged); the estimate is then still the best point found.
     """
-    lb, ub = check_bounds(lower, upper)
+    if couplings is not None and check_couplings(couplings) != window.couplings:
+        window = replace(window, couplings=couplings)
+    lb, ub = fit_bounds(lower, upper, window.couplings)
     if int(n_starts) != n_starts or n_starts < 1:
         raise LoperInputError(f"n_starts must be an integer >= 1, got {n_starts}")
     if ci_dof is not None and (int(ci_dof) != ci_dof or ci_dof < 1):
@@ -470,26 +542,31 @@ def identify_impedance(
         time_s=window.time_s,
         measured=window.measured,
         model=model,
+        parameters=window.parameters,
     )
 
 
 def _starts(
     lb: np.ndarray, ub: np.ndarray, n_starts: int, seed: int | np.random.SeedSequence | None, extra_starts
 ) -> np.ndarray:
-    """The starts (k + n_starts, 6) of the fit: ``extra_starts`` (k, 6) clipped to the bounds ``lb``, ``ub``
-    (6,), then ``n_starts`` drawn uniformly inside them (NumPy ``default_rng(seed)``)."""
+    """The starts (k + n_starts, p) of the fit: ``extra_starts`` (k, p) clipped to the bounds ``lb``, ``ub``
+    (p,), then ``n_starts`` drawn uniformly inside them (NumPy ``default_rng(seed)``). Extra starts of the six
+    K and D alone, for a fit with couplings (p > 6), start the couplings at 0."""
+    n = len(lb)
     rng = np.random.default_rng(seed)
-    starts = rng.uniform(lb, ub, size=(int(n_starts), 6))
+    starts = rng.uniform(lb, ub, size=(int(n_starts), n))
     if extra_starts is not None:
         extra = np.atleast_2d(np.asarray(extra_starts, dtype=float))
-        if extra.shape[1:] != (6,) or not np.all(np.isfinite(extra)):
-            raise LoperInputError(f"extra_starts must be finite with 6 values per row, got shape {extra.shape}")
+        if extra.shape[1:] == (len(PARAMETERS),) and n > len(PARAMETERS):
+            extra = np.hstack([extra, np.zeros((len(extra), n - len(PARAMETERS)))])
+        if extra.shape[1:] != (n,) or not np.all(np.isfinite(extra)):
+            raise LoperInputError(f"extra_starts must be finite with {n} values per row, got shape {extra.shape}")
         starts = np.vstack([np.clip(extra, lb, ub), starts])
     return starts
 
 
 def _polish(batch: ResidualBatch, start: np.ndarray, max_evaluations: int):
-    """SciPy's ``least_squares`` (trust-region reflective, inside the batch's bounds) from ``start`` (6,),
+    """SciPy's ``least_squares`` (trust-region reflective, inside the batch's bounds) from ``start`` (p,),
     with the batch's residuals and Jacobians, to machine precision or ``max_evaluations`` residual evaluations."""
 
     def fun(p):
@@ -515,15 +592,16 @@ def _polish(batch: ResidualBatch, start: np.ndarray, max_evaluations: int):
 def _parameter_sd_and_correlation(
     window: PreparedWindow, batch: ResidualBatch, estimate: np.ndarray, r: np.ndarray, J: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, int]:
-    """Standard deviations (6,; inf: no information) and correlation (6, 6) of the parameters at ``estimate``
-    from the residuals ``r`` (m,) and their Jacobian ``J`` (m, 6), and the residuals' degrees of freedom.
+    """Standard deviations (p,; inf: no information) and correlation (p, p) of the parameters at ``estimate``
+    from the residuals ``r`` (m,) and their Jacobian ``J`` (m, p), and the residuals' degrees of freedom.
 
     Without ``noise_cov``: white residual noise plus the uncertainty of the initial state, propagated
     (sandwich). With ``noise_cov``: the sandwich of the linearised estimator M = (W J)^+ W; ``noise_cov``
     holds the initial state's share already.
     """
     m = r.size
-    dof = max(m - 6, 1)
+    n_par = J.shape[1]
+    dof = max(m - n_par, 1)
     s2 = float(np.sum(r**2)) / dof
     JTJ = J.T @ J
     A = np.linalg.pinv(JTJ, rcond=1e-13)
@@ -536,7 +614,7 @@ def _parameter_sd_and_correlation(
         sd = np.sqrt(np.clip(np.diag(cov), 0, None))
         corr = cov / np.outer(sd, sd)
     rank = np.linalg.matrix_rank(JTJ, tol=1e-13 * np.max(np.abs(JTJ)) if np.any(JTJ) else None)
-    if rank < 6:
+    if rank < n_par:
         sd = np.where(np.diag(JTJ) > 0, sd, np.inf)
     sd = np.where(np.isnan(sd), np.inf, sd)
     return sd, corr, dof

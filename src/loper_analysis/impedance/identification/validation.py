@@ -50,6 +50,7 @@ __all__ = [
     "nominal_swing",
     "perturbed_trial",
     "two_rod_trial",
+    "coupled_trial",
     "validation_pulse",
     "with_pulse_at_stages",
     "validation_window",
@@ -201,6 +202,42 @@ def two_rod_trial(params: SegmentParameters, impedance, settings: ValidationSett
     t_force = _robot_clock(t, settings)
     force = validation_pulse(t_force, settings)
     return t, qu, qp, thigh_scale * force, pelvis, t_force, shank_scale * force
+
+
+def coupled_trial(
+    params: SegmentParameters,
+    impedance,
+    settings: ValidationSettings,
+    couplings=("hip_knee",),
+    shank_scale: float = 0.0,
+):
+    """Noise-free samples of a stride whose true impedance has inter-joint couplings besides K and D per joint.
+
+    ``impedance``: (6 + number of couplings,) K and D per joint (order of ``PARAMETERS``), then each coupling's
+    stiffness (N·m/rad) in the order of :data:`~loper_analysis.constants.COUPLINGS`; ``couplings``: their names.
+    The stride is pushed by the study's pulse at the thigh and, with ``shank_scale`` (``params`` with a
+    ``shank_attachment_m``), by the same pulse times ``shank_scale`` at the shank; the truth is
+    :func:`perturbed_trial`'s fine-step RK4 with the pulses at every stage.
+
+    Returns
+    -------
+    tuple
+        (time_s (n,), q_u (n, 4), q_p (n, 4), force_p (k, 2), pelvis (n,), force_time_s (k,), shank_force_p (k, 2)) as
+        :func:`two_rod_trial` returns them (the shank's force zero without a shank push); without couplings and
+        the shank push the first six are :func:`perturbed_trial`'s to the bit.
+    """
+    if shank_scale and params.shank_attachment_m is None:
+        raise LoperInputError("coupled_trial: a shank push needs segment parameters with a shank_attachment_m")
+    t, qu, pelvis, window = _truth_window(params, settings)
+    window = replace(window, couplings=couplings)
+    if shank_scale:
+        pulse = validation_pulse(stage_times_s(window), settings)
+        window = replace(window, shank_force_perturbed_n=per_step(shank_scale * pulse))
+    qp = qu.copy()
+    qp[len(t) - window.n_samples :] += simulate_deviation(window, np.asarray(impedance, dtype=float)[None])[0]
+    t_force = _robot_clock(t, settings)
+    force = validation_pulse(t_force, settings)
+    return t, qu, qp, force, pelvis, t_force, shank_scale * force
 
 
 def _robot_clock(t: np.ndarray, settings: ValidationSettings) -> np.ndarray:

@@ -18,6 +18,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from loper_analysis.checks import finite_rows
+from loper_analysis.constants import COUPLING_PARAMETERS, COUPLINGS, PARAMETERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.responses.response_window import (
     INITIAL_STATE_SPAN_S,
@@ -37,6 +38,7 @@ __all__ = [
     "INITIAL_STATE_DEGREE",
     "N_SUBSTEPS",
     "PreparedWindow",
+    "check_couplings",
     "prepare_window",
     "initial_state_basis",
     "stage_force_means",
@@ -86,6 +88,11 @@ class PreparedWindow:
     ``noise_cov`` (m, m) is the covariance of the prediction error at the true
     impedance (rad^2, e.g. from :func:`loper_analysis.impedance.identification.null_pair_errors`
     divided by the number of averaged pairs), from which the CI are taken when given.
+
+    ``couplings``: the inter-joint stiffnesses the model adds to K and D (names of
+    :data:`~loper_analysis.constants.COUPLINGS`, kept in that order; empty: none). A parameter vector of the window
+    holds :attr:`parameters`: the six of :data:`~loper_analysis.constants.PARAMETERS`, then ``K_<coupling>``
+    (N·m/rad) for each coupling (:func:`~loper_analysis.swing_leg.kernels.feedback_torques`).
     """
 
     params: SegmentParameters
@@ -108,10 +115,46 @@ class PreparedWindow:
     noise_cov: np.ndarray | None = None
     residual_weight: np.ndarray | None = None
     shank_force_perturbed_n: np.ndarray | None = None
+    couplings: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "couplings", check_couplings(self.couplings))
 
     @property
     def n_samples(self) -> int:
         return len(self.time_s)
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """Names of a parameter vector's entries: :data:`PARAMETERS`, then ``K_<coupling>`` per coupling."""
+        return PARAMETERS + tuple(f"K_{c}" for c in self.couplings)
+
+    @property
+    def n_parameters(self) -> int:
+        """Length of a parameter vector of this window: 6 plus one per coupling."""
+        return len(PARAMETERS) + len(self.couplings)
+
+
+def check_couplings(couplings) -> tuple[str, ...]:
+    """Inter-joint couplings as a tuple in the order of :data:`~loper_analysis.constants.COUPLINGS`.
+
+    ``couplings``: an iterable of their names (``"hip_knee"``, ``"knee_ankle"``) or of their parameter names
+    (``"K_hip_knee"``, ...); each at most once.
+
+    Raises
+    ------
+    LoperInputError
+        An unknown name, a repeated one, or a plain string instead of a collection of names.
+    """
+    if isinstance(couplings, str):
+        raise LoperInputError(f"couplings must be a collection of names from {COUPLINGS}, got the string {couplings!r}")
+    names = [c[2:] if c in COUPLING_PARAMETERS else c for c in couplings]
+    unknown = [c for c in names if c not in COUPLINGS]
+    if unknown:
+        raise LoperInputError(f"unknown inter-joint coupling(s) {unknown}; known: {', '.join(COUPLINGS)}")
+    if len(set(names)) != len(names):
+        raise LoperInputError(f"an inter-joint coupling is named twice: {list(couplings)}")
+    return tuple(c for c in COUPLINGS if c in names)
 
 
 def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.ndarray:
@@ -155,6 +198,7 @@ def prepare_window(
     reference_cutoff_hz: float | None = None,
     q_reference=None,
     initial_state_degree: int = INITIAL_STATE_DEGREE,
+    couplings=(),
 ) -> PreparedWindow:
     """Check the inputs of one fit and precompute reference, inputs and initial state.
 
@@ -196,6 +240,9 @@ def prepare_window(
         degree through the perturbed-minus-unperturbed coordinates over the
         last ``window.initial_state_span_s`` before the onset, when the perturbation
         has not yet acted (robust to measurement noise; exact for smooth data).
+    couplings : inter-joint stiffnesses of the model besides K and D per joint, names of
+        :data:`~loper_analysis.constants.COUPLINGS` (e.g. ``("hip_knee",)``); the window's parameter vectors then
+        hold ``K_<coupling>`` after the six (:attr:`PreparedWindow.parameters`). Empty: none.
 
     Raises
     ------
@@ -258,6 +305,7 @@ def prepare_window(
         initial_state_span_s=float(initial_state_span_s),
         initial_state_degree=int(initial_state_degree),
         shank_force_perturbed_n=None if shank_p is None else np.ascontiguousarray(shank_p),
+        couplings=couplings,
     )
 
 
@@ -519,12 +567,23 @@ def initial_state_basis(tau: np.ndarray, degree: int) -> np.ndarray:
 def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
     """Model coordinate deviations perturbed - unperturbed (B, n_out, 4) at the window's samples (m, rad).
 
-    ``impedance_sets``: (B, 6) in the order of :data:`~loper_analysis.constants.PARAMETERS`;
-    one batch of the compiled RK4 (:func:`loper_analysis.swing_leg.kernels.simulate_deviation_batch`).
+    ``impedance_sets``: (B, p) in the order of the window's :attr:`~PreparedWindow.parameters` (p = 6 without
+    couplings: :data:`~loper_analysis.constants.PARAMETERS`); one batch of the compiled RK4
+    (:func:`loper_analysis.swing_leg.kernels.simulate_deviation_batch`, given the six as they are and, with
+    couplings, both coupling columns, 0 for a coupling the window does not hold).
     """
     sets = np.ascontiguousarray(np.asarray(impedance_sets, dtype=float))
-    if sets.ndim != 2 or sets.shape[1] != 6 or not np.all(np.isfinite(sets)):
-        raise LoperInputError(f"impedance must be finite with 6 values per row, got shape {sets.shape}")
+    n = window.n_parameters
+    if sets.ndim != 2 or sets.shape[1] != n or not np.all(np.isfinite(sets)):
+        raise LoperInputError(
+            f"impedance must be finite with {n} values per row ({', '.join(window.parameters)}), got shape {sets.shape}"
+        )
+    if window.couplings:
+        coupled = np.zeros((len(sets), len(PARAMETERS) + len(COUPLINGS)))
+        coupled[:, : len(PARAMETERS)] = sets[:, : len(PARAMETERS)]
+        for k, c in enumerate(window.couplings):
+            coupled[:, len(PARAMETERS) + COUPLINGS.index(c)] = sets[:, len(PARAMETERS) + k]
+        sets = coupled
     deviation, _ = kernels.simulate_deviation_batch(
         sets,
         window.params.packed,
@@ -561,11 +620,16 @@ def joint_angle_deviation(deviation: np.ndarray, pelvis_angle_deviation_rad: np.
 def simulate_response(window: PreparedWindow, impedance) -> np.ndarray:
     """Model joint-angle differences perturbed - unperturbed (n_out, 3) or (B, n_out, 3) in rad.
 
-    ``impedance``: (6,) or (B, 6) in the order of :data:`PARAMETERS`.
+    ``impedance``: (p,) or (B, p) in the order of the window's :attr:`~PreparedWindow.parameters` (p = 6 without
+    couplings: :data:`PARAMETERS`).
     """
     impedance = np.asarray(impedance, dtype=float)
-    if impedance.ndim not in (1, 2) or impedance.shape[-1] != 6 or not np.all(np.isfinite(impedance)):
-        raise LoperInputError(f"impedance must be finite with 6 values per row, got shape {impedance.shape}")
+    n = window.n_parameters
+    if impedance.ndim not in (1, 2) or impedance.shape[-1] != n or not np.all(np.isfinite(impedance)):
+        raise LoperInputError(
+            f"impedance must be finite with {n} values per row ({', '.join(window.parameters)}), "
+            f"got shape {impedance.shape}"
+        )
     deviation = simulate_deviation(window, np.atleast_2d(impedance))
     dth = joint_angle_deviation(deviation, window.pelvis_deviation[:: 2 * window.n_substeps, 0])
     return dth[0] if impedance.ndim == 1 else dth
