@@ -3,7 +3,7 @@
 Usage: nice -n 10 python benchmarks/planner_check.py [--repeats 60] [--onset-ms 50] [--strides 10 40] [--seed 2024]
                                                      [--variability study|gentle]
                                                      [--counterfactual conditional|matched_stride]
-                                                     [--pilots-from-repeats]
+                                                     [--pilots-from-repeats] [--shank-force-n 40]
 
 A pilot experiment (one synthetic trial with the device, perturbed at the onset every 3-5 strides, built at
 the coordinate level by :func:`loper_analysis.synthetic.coordinate_trials.perturbation_experiment`: no markers, no IK;
@@ -36,6 +36,10 @@ out and listed.
 its whole trial and its fit of all its perturbed strides, one more prediction per repeat); the table gains
 ``pilots``, the 5th, 50th and 95th percentiles of their predictions over the measured SD and the share of
 them within ±25 % of it (each pilot is also one of the repeats whose SD is measured).
+
+``--shank-force-n F``: the pilot and the repeats are pushed by a second rod just above the ankle too (an F N pulse
+with the thigh's, its load cell in the force tables), the planner plans that design
+(``PlanSettings.shank_pulse_force_n``) and the fits take both rods.
 """
 
 from __future__ import annotations
@@ -131,12 +135,14 @@ def run_check(
     variability: str | None = None,
     counterfactual: str = PLANNED_COUNTERFACTUAL,
     pilots_from_repeats: bool = False,
+    shank_force_n: float = 0.0,
 ) -> pd.DataFrame:
     """Predicted and measured SD per parameter and stride count (hip, knee, ankle; K and D).
 
     With ``pilots_from_repeats`` every kept repeat also plans as the pilot does (from its whole trial and its
     fit of all its perturbed strides), and the rows gain the spread of those predictions over the measured SD
-    (:func:`pilot_spread`)."""
+    (:func:`pilot_spread`). ``shank_force_n`` (N): a second rod's pulse at the shank in every experiment and plan.
+    """
     truth = TRUTH[onset_ms] if truth is None else truth
     params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
     conditional = counterfactual == "conditional"
@@ -149,7 +155,15 @@ def run_check(
 
     def experiment(k: int):
         full, cut = perturbation_experiment(
-            [seed, k], params, HEIGHT_M, onset_ms, truth, counts, angle_noise_sd_rad=angle_noise_sd_rad, **lab_kwargs
+            [seed, k],
+            params,
+            HEIGHT_M,
+            onset_ms,
+            truth,
+            counts,
+            angle_noise_sd_rad=angle_noise_sd_rad,
+            shank_force_n=shank_force_n,
+            **lab_kwargs,
         )
         return full, cut
 
@@ -158,12 +172,13 @@ def run_check(
         from one experiment and its fit of all strides."""
         planned = np.clip(estimates(fit_rows), ident.lower, ident.upper)
         if conditional:
-            sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned)
-            by_count = stretch_covariances([full], onset_ms, counts, params, planned, response=response)
+            plan = PlanSettings(shank_pulse_force_n=shank_force_n)
+            sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned, plan)
+            by_count = stretch_covariances([full], onset_ms, counts, params, planned, settings=plan, response=response)
             return sc, sc, by_count
         null = null_pair_windows([full], onset_ms, response, source="pilot")
         pairs = pilot_perturbed_pairs([full], onset_ms, response)
-        plan = PlanSettings(interval_scatter="perturbed_pairs")
+        plan = PlanSettings(interval_scatter="perturbed_pairs", shank_pulse_force_n=shank_force_n)
         return (
             stride_covariance(null, params, planned, plan, perturbed_pairs=pairs),
             stride_covariance(null, params, planned, plan),
@@ -289,6 +304,12 @@ def main() -> None:
         action="store_true",
         help="every repeat also plans as the pilot: the spread of the predictions over pilots",
     )
+    ap.add_argument(
+        "--shank-force-n",
+        type=float,
+        default=0.0,
+        help="a second rod's pulse just above the ankle with the thigh's (N; default 0: the thigh rod alone)",
+    )
     args = ap.parse_args()
     warnings.simplefilter("ignore")
     logging.disable(logging.WARNING)
@@ -302,9 +323,11 @@ def main() -> None:
         variability=args.variability,
         counterfactual=args.counterfactual,
         pilots_from_repeats=args.pilots_from_repeats,
+        shank_force_n=args.shank_force_n,
     )
     print(
-        f"{args.counterfactual}, onset {args.onset_ms} ms, angle noise {args.angle_noise_sd_rad:g} rad, "
+        f"{args.counterfactual}, shank rod {args.shank_force_n:g} N, onset {args.onset_ms} ms, "
+        f"angle noise {args.angle_noise_sd_rad:g} rad, "
         f"{args.repeats} repeats, "
         f"pilot null pairs {table.attrs['n_null_pairs']}, perturbed pairs {table.attrs['n_perturbed_pairs']}, "
         f"{time.perf_counter() - t0:.0f} s"

@@ -551,6 +551,6 @@ def test_a_planned_second_rod_at_the_shank_sharpens_the_ankle_and_the_knee(param
     ratio = two.sd_of(20) / one.sd_of(20)
     assert np.all(ratio[4:] < 0.5), ratio
     assert np.all(ratio[:4] < 1.0), ratio
-    assert two.scatter == "null_pairs" and "a second rod planned" in two.note
+    assert two.scatter == "null_pairs" and "pushed by 1 rod(s), the plan by 2" in two.note
     table = precision_table(two, [20], ONSET_MS, "S01", replace(PLAN, shank_pulse_force_n=40.0))
     assert set(table["shank_pulse_force_n"]) == {40.0}

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from loper_analysis.checks import integer
+from loper_analysis.constants import PARAMETERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification import (
     cross_validated_covariance,
@@ -48,16 +49,17 @@ MIN_PERTURBED_PAIRS = 5
 
 @dataclass
 class StrideCovariance:
-    """The covariance (6, 6) of the estimate for one averaged perturbed stride (order :data:`PARAMETERS`).
+    """The covariance (p, p) of the estimate for one averaged perturbed stride (order :attr:`parameters`:
+    :data:`PARAMETERS`, then ``K_<coupling>`` for each of ``couplings``, the inter-joint stiffnesses planned).
 
-    ``impedance`` (6,) the planned values it was linearised at; ``dof`` the
+    ``impedance`` (p,) the planned values it was linearised at; ``dof`` the
     degrees of freedom of the CI's Student t as the fit takes them: None for
     ``N - 1`` (the fit's intervals from the scatter of its ``N`` perturbed
     pairs), else a fixed count (the null pairs' ``M - 1``); ``n_null_pairs``
     and ``n_perturbed_pairs`` the pilot's pairs; ``scatter`` whose errors
     gave the covariance (``perturbed_pairs``, ``null_pairs`` or
     ``cross_validated_null_pairs``); ``note`` a caveat for the rows (empty
-    when none). ``spread_covariance`` (6, 6): a part that falls as ``1/N^2``
+    when none). ``spread_covariance`` (p, p): a part that falls as ``1/N^2``
     (the conditional counterfactual: the spread of the perturbed strides'
     prediction weights over candidates whose number grows with ``N``); for
     ``N`` strides the covariance is ``covariance / N + spread_covariance / N^2``.
@@ -72,19 +74,27 @@ class StrideCovariance:
     scatter: str = "null_pairs"
     null_covariance: np.ndarray | None = None
     spread_covariance: np.ndarray | None = None
+    couplings: tuple[str, ...] = ()
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """Names of the covariance's rows: :data:`PARAMETERS`, then ``K_<coupling>`` per coupling."""
+        return PARAMETERS + tuple(f"K_{c}" for c in self.couplings)
 
     @property
     def sd(self) -> np.ndarray:
-        """SD (6,) of K and D for one stride (N·m/rad, N·m·s/rad), the ``1/N`` part."""
+        """SD (p,) of K and D (and the couplings) for one stride (N·m/rad, N·m·s/rad), the ``1/N`` part."""
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
     def variance_terms(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(a, b)`` variances (6,): for ``N`` strides the variance is ``a / N + b / N^2``."""
-        spread = np.zeros(6) if self.spread_covariance is None else np.diag(self.spread_covariance)
-        return np.clip(np.diag(self.covariance), 0.0, None), np.clip(spread, 0.0, None)
+        """``(a, b)`` variances (p,): for ``N`` strides the variance is ``a / N + b / N^2``."""
+        a = np.diag(self.covariance)
+        spread = np.zeros(len(a)) if self.spread_covariance is None else np.diag(self.spread_covariance)
+        return np.clip(a, 0.0, None), np.clip(spread, 0.0, None)
 
     def sd_of(self, n_strides: int) -> np.ndarray:
-        """Predicted SD (6,) of K and D for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
+        """Predicted SD (p,) of K and D (and the couplings) for ``n_strides`` averaged strides (N·m/rad,
+        N·m·s/rad)."""
         a, b = self.variance_terms()
         n = int(n_strides)
         return np.sqrt(a / n + b / n**2)
@@ -96,8 +106,14 @@ class StrideCovariance:
         return t_quantile(dof) if dof >= 1 else math.inf
 
     def half_width(self, n_strides: int) -> np.ndarray:
-        """Predicted 95 % CI half-width (6,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
+        """Predicted 95 % CI half-width (p,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
         return self.t95(n_strides) * self.sd_of(n_strides)
+
+
+def _pilot_rods(pairs: Mapping) -> int:
+    """How many rods pushed the pilot's perturbed pairs: 2 when their forces hold a second rod's (4 columns)."""
+    force = pairs.get("force_perturbed_n")
+    return 2 if force is not None and np.shape(force)[-1] == 4 else 1
 
 
 def stride_covariance(
@@ -112,7 +128,9 @@ def stride_covariance(
     """Covariance of (K, D) per joint for a mean response of **one** perturbed stride.
 
     ``impedance`` (6,): the planned values (order :data:`PARAMETERS`; N·m/rad
-    and N·m·s/rad), e.g. the pilot's estimate. With the window of
+    and N·m·s/rad), e.g. the pilot's estimate; with ``settings.couplings`` also (6 + their number,) with the
+    couplings' planned stiffness (N·m/rad) after them, else each coupling is planned at 0
+    (:func:`~loper_analysis.planning.window.planned_impedance`). With the window of
     :func:`planning_window`, ``J`` = :func:`~loper_analysis.impedance.identification.response_jacobian`
     at ``impedance``, the null-pair errors ``E0`` =
     :func:`~loper_analysis.impedance.identification.null_pair_errors`, ``W`` =
@@ -161,10 +179,14 @@ def stride_covariance(
     WJ = W @ J
     M = np.linalg.pinv(WJ.T @ WJ, rcond=1e-13) @ WJ.T @ W
     n_pert = 0
-    if perturbed_pairs is not None and settings.shank_pulse_force_n:
+    other_design = perturbed_pairs is not None and _pilot_rods(perturbed_pairs) != (
+        2 if settings.shank_pulse_force_n else 1
+    )
+    if other_design:
         notes.append(
-            "a second rod planned: the pilot's perturbed pairs, pushed at the thigh alone, do not show that "
-            "design's response; the null pairs' scatter taken"
+            f"the pilot's perturbed pairs were pushed by {_pilot_rods(perturbed_pairs)} rod(s), the plan by "
+            f"{2 if settings.shank_pulse_force_n else 1}: they do not show that design's response; the null pairs' "
+            "scatter taken"
         )
     elif perturbed_pairs is not None:
         _, _, n_pert = null_pair_arrays(perturbed_pairs, f"{source}, perturbed pairs")
@@ -172,7 +194,7 @@ def stride_covariance(
         E, scatter = null_pair_errors(window, p, perturbed_pairs), "perturbed_pairs"
     else:
         E, scatter = E0, "null_pairs"
-    if n_pert < MIN_PERTURBED_PAIRS and not (perturbed_pairs is not None and settings.shank_pulse_force_n):
+    if n_pert < MIN_PERTURBED_PAIRS and not other_design:
         notes.append(
             (
                 f"{n_pert} perturbed pair(s) of the pilot at this onset, fewer than {MIN_PERTURBED_PAIRS}"
@@ -188,7 +210,9 @@ def stride_covariance(
         return effect.T @ effect / max(errors.shape[0] - 1, 1)
 
     dof = None if settings.interval_scatter == "perturbed_pairs" else n_pairs - 1
-    return StrideCovariance(sandwich(E), p, dof, n_pairs, "; ".join(notes), n_pert, scatter, sandwich(E0))
+    return StrideCovariance(
+        sandwich(E), p, dof, n_pairs, "; ".join(notes), n_pert, scatter, sandwich(E0), couplings=settings.couplings
+    )
 
 
 def conditional_stride_covariance(
@@ -268,6 +292,7 @@ def conditional_stride_covariance(
         "cross_validated_null_pairs",
         None,
         V * n_pert * spread / unit,
+        settings.couplings,
     )
 
 
@@ -328,7 +353,7 @@ def stretch_covariances(
 
 
 def _mean_covariance(covs: Sequence[StrideCovariance], n: int, min_null_pairs: int) -> StrideCovariance:
-    spread = [c.spread_covariance if c.spread_covariance is not None else np.zeros((6, 6)) for c in covs]
+    spread = [c.spread_covariance if c.spread_covariance is not None else np.zeros_like(c.covariance) for c in covs]
     notes = [f"mean over {len(covs)} stretches of the pilot holding {n} perturbed strides each"]
     few = sum(c.n_null_pairs < min_null_pairs for c in covs)
     if few:
@@ -346,6 +371,7 @@ def _mean_covariance(covs: Sequence[StrideCovariance], n: int, min_null_pairs: i
         covs[0].scatter,
         None,
         np.mean(spread, axis=0),
+        covs[0].couplings,
     )
 
 
@@ -353,7 +379,7 @@ def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, St
     """The perturbed pairs' excess scatter pooled over the pilot's onsets (``{onset_ms: StrideCovariance}``).
 
     Per onset ``o`` with the scatter of ``P_o`` perturbed pairs, the ratio
-    ``r_o = diag(cov) / diag(null_covariance)`` (6,) says how much more the
+    ``r_o = diag(cov) / diag(null_covariance)`` (p,) says how much more the
     perturbed pairs scatter than the null pairs for each K and D. The pooled
     ratio ``r = sum (P_o - 1) r_o / sum (P_o - 1)`` is applied to every
     onset's null-pair sandwich, which rests on 100+ pairs:
@@ -386,6 +412,7 @@ def pool_onsets(stride_covs: Mapping[float, StrideCovariance]) -> dict[float, St
             sc.n_perturbed_pairs,
             "pooled_perturbed_pairs",
             sc.null_covariance,
+            couplings=sc.couplings,
         )
     return out
 

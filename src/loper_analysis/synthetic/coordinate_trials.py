@@ -150,6 +150,7 @@ def perturbation_experiment(
     variability=None,
     adaptation=None,
     minimal_impedance=None,
+    shank_force_n: float = 0.0,
 ) -> tuple[dict, dict[int, dict]]:
     """One synthetic perturbation experiment: a trial long enough for ``max(n_strides)`` perturbed strides.
 
@@ -164,9 +165,13 @@ def perturbation_experiment(
     stride-to-stride variability, the subject's adaptation to the device and
     its minimal-impedance walking
     (:func:`loper_analysis.synthetic.variability.lab_variability`; None: the
-    gentle lab of ``timing_cv`` and ``amplitude_cv`` alone).
+    gentle lab of ``timing_cv`` and ``amplitude_cv`` alone). ``shank_force_n``
+    (N): a second rod's pulse just above the ankle with the thigh's (the default
+    :class:`~loper_analysis.swing_leg.rods.ShankRod`); its load cell is then in
+    the force tables and the fit takes both rods.
     """
     from loper_analysis.device.controller import DeviceParameters
+    from loper_analysis.swing_leg.rods import ShankRod
     from loper_analysis.synthetic.gait_curves import NominalGait
     from loper_analysis.synthetic.trials import LabSettings, PerturbationSettings, simulate_walking_trial
 
@@ -178,7 +183,7 @@ def perturbation_experiment(
     trial_s = (counts[-1] + 3) * mean_every * NominalGait().stride_s * 1.1 + 2.0
     sim_seed, noise_seed = np.random.SeedSequence(seed).spawn(2)
     perturbation = PerturbationSettings(
-        onset_ms / 1e3, tuple(float(v) for v in impedance), force_n, duration_s, tuple(every_strides)
+        onset_ms / 1e3, tuple(float(v) for v in impedance), force_n, duration_s, tuple(every_strides), shank_force_n
     )
     walk = simulate_walking_trial(
         trial_s,
@@ -193,6 +198,7 @@ def perturbation_experiment(
         variability=variability,
         adaptation=adaptation,
         minimal_impedance=minimal_impedance,
+        shank_rod=ShankRod() if shank_force_n else None,
     )
     full = trial_inputs(walk, lab, "full", angle_noise_sd_rad=angle_noise_sd_rad, seed=noise_seed)
     heel_strikes = walk.schedule["heel_strike_s"].to_numpy(float)

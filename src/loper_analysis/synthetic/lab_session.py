@@ -114,8 +114,11 @@ class SyntheticLabSettings:
             self.pulse_duration_s,
             tuple(self.perturb_every_strides),
             self.shank_pulse_force_n,
-            self.shank_rod,
         )
+
+    def attached_shank_rod(self) -> ShankRod | None:
+        """The second rod every trial with the device carries, None without one (``shank_pulse_force_n`` 0)."""
+        return self.shank_rod if self.shank_pulse_force_n else None
 
 
 @dataclass(frozen=True)

@@ -141,7 +141,6 @@ class PerturbationSettings:
     duration_s: float = PULSE_DURATION_S
     every_strides: tuple[int, int] = (3, 5)
     shank_force_n: float = 0.0  # a second rod's pulse just above the ankle, with the thigh's (N); 0: none
-    shank_rod: ShankRod = ShankRod()
 
 
 @dataclass
@@ -219,6 +218,7 @@ def simulate_walking_trial(
     variability=None,
     adaptation=None,
     minimal_impedance=None,
+    shank_rod: ShankRod | None = None,
 ) -> WalkingTrial:
     """Simulate kinematics, device and perturbation responses of one walking trial.
 
@@ -241,10 +241,11 @@ def simulate_walking_trial(
     otherwise; None: only the pulses act (their force minus that of a run
     without them).
 
-    With ``perturbation.shank_force_n`` a second device pushes just above the ankle where
-    ``perturbation.shank_rod`` places it, with the thigh's pulses (same onsets and duration), driven by the
-    brace motion of that point; its desired and measured force are the robot log's ``shank_force_desired_n`` and
-    ``shank_force_measured_n`` and the leg answers both rods.
+    ``shank_rod`` (:class:`~loper_analysis.swing_leg.rods.ShankRod`; None: none) attaches a second device just
+    above the ankle, driven by the motion of its point: its desired and measured force are the robot log's
+    ``shank_force_desired_n`` and ``shank_force_measured_n`` and the leg answers both rods. It pushes
+    ``perturbation.shank_force_n`` N with the thigh's pulses (same onsets and duration); without pulses it
+    follows the leg at its minimal impedance as the thigh's does.
     """
     from loper_analysis.device.controller import simulate_device
     from loper_analysis.synthetic.response import perturbation_schedule, pulse_train
@@ -297,13 +298,21 @@ def simulate_walking_trial(
     sim = simulate_device(fd, device, None, brace_position_m=brace, seed=device_seed)
     robot = _robot_frame(t_robot, sim, fd, pulse_train_at(t_robot, starts))
     shank = None
-    if perturbation is not None and perturbation.shank_force_n:
+    if perturbation is not None and perturbation.shank_force_n and shank_rod is None:
+        raise LoperInputError(
+            f"simulate_walking_trial: a {perturbation.shank_force_n:g} N shank pulse needs a shank rod (shank_rod)"
+        )
+    if shank_rod is not None:
         (shank_seed,) = ss.spawn(1)  # after the four above: a trial without a shank rod keeps its seeds
-        rod = perturbation.shank_rod
+        rod = shank_rod
         params = params.replace(shank_attachment_m=rod.attachment_m(params.length_m[1]))
         shank_brace = np.interp(t_mocap, t_fine, _shank_rod_position_m(fine, params))
         shank_brace -= shank_brace.mean()
-        fd_shank = pulse_train(t_robot, onsets_robot, perturbation.shank_force_n, perturbation.duration_s)
+        fd_shank = (
+            pulse_train(t_robot, onsets_robot, perturbation.shank_force_n, perturbation.duration_s)
+            if perturbation
+            else 0 * t_robot
+        )
         shank_sim = simulate_device(fd_shank, device, None, brace_position_m=shank_brace, seed=shank_seed)
         robot = robot.assign(
             shank_force_desired_n=shank_sim["force_desired_n"].to_numpy(),
@@ -539,12 +548,13 @@ def subject_walking_trial(
     variability=None,
     adaptation=None,
     minimal_impedance=None,
+    shank_rod: ShankRod | None = None,
 ) -> tuple[WalkingTrial, C3DRecording]:
     """One walking trial of a synthetic subject (seeded by subject and trial): the simulation and its C3D contents.
 
     ``device`` None simulates walking without the device (no robot log);
-    ``variability``, ``adaptation`` and ``minimal_impedance`` as in
-    :func:`simulate_walking_trial` (None: the gentle lab).
+    ``variability``, ``adaptation``, ``minimal_impedance`` and ``shank_rod`` as in
+    :func:`simulate_walking_trial` (None: the gentle lab; no second rod).
     """
     from loper_analysis.motion.model import build_lower_body_model, segment_parameters_from_model
 
@@ -564,5 +574,6 @@ def subject_walking_trial(
         variability=variability,
         adaptation=adaptation,
         minimal_impedance=minimal_impedance,
+        shank_rod=shank_rod,
     )
     return walk, walking_recording(model, walk, mass_kg, lab, file_seed, f"{subject} {trial}")

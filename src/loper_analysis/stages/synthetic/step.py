@@ -154,6 +154,7 @@ def lab_session(subject: str, row: Mapping, files: LabSessionFiles, settings: La
             variability=variability,
             adaptation=adaptation,
             minimal_impedance=minimal_impedance,
+            shank_rod=s.attached_shank_rod(),
         )
         with generated(c3d, WRITER, "C3D file") as tmp:
             write_recording(tmp, recording)
