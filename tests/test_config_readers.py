@@ -72,6 +72,7 @@ CHANGES = {
     "device.mat_column_map": {"time_s": "time"},
     "dynamics.foot_bodies.left": "toes_l",
     "dynamics.foot_bodies.right": "toes_r",
+    "report.calibration": "config/calibration/other.tsv",
 }
 
 #: Config key -> the rules that read it (the front page reads the run's headline settings): each stage's own keys in

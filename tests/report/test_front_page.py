@@ -19,6 +19,7 @@ import pandas as pd
 import pytest
 
 from loper_analysis.constants import JOINTS
+from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification.across_subjects import impedance_summary
 from loper_analysis.impedance.identification.group_mean import random_effects_mean
 from loper_analysis.report.front_page import RunSettings, front_page_html
@@ -168,10 +169,15 @@ def test_fragment_numbers_are_the_tables_numbers():
     assert found["truth-recovery|K_hip|K_n_within_tolerance"] == (1, "1")
     assert found["truth-recovery|D_hip|n_fits"] == (2, "2")
     assert found["device|bandwidth_hz|value"] == (38.79, "38.8")
-    # the verdicts: 4 of 6 intervals hold the truth, too few for 95 % (p = 0.033)
+    # the verdicts, without a calibration: 4 of 6 intervals hold the truth, not rejected by the target's 90 %
+    # (P(X <= 4 | 6, 0.9) = 1 - 6 · 0.9^5 · 0.1 - 0.9^6 = 0.114265): too few to decide
     assert found["verdict|truth|n_truth_in_ci95"] == (4, "4")
-    assert "Intervals miss the truth" in page and "</span>/6 (67 %; target 90–98 %; binomial p = 0.03" in page
-    assert "Estimates outside tolerance</b>: K" in page
+    assert found["verdict|truth|p_reject_ci95"][0] == pytest.approx(0.114265, abs=1e-6)
+    assert found["verdict|truth|p_reject_ci95"][1] == "0.11"
+    assert "no calibration run is named (report.calibration)" in page
+    assert "<b>Intervals: too few fits to decide</b>: this run's 95 % CIs hold the truth in " in page
+    assert "</span>/6 (67 %); target 90–98 %, not rejected (p = " in page
+    assert "<b>Estimates: too few fits to decide</b>: this run K " in page
     assert found["verdict|transparency|n_transparent"] == (1, "1") and "Transparent</b>" in page
     assert found["verdict|device|max_abs_difference_pct"][1] == "3.3"  # overshoot 31.5 against 30.5
     assert found["verdict|validation|K_max_abs_error"] == (0.02, "0.020")
@@ -242,7 +248,7 @@ def _write_results(root: Path) -> None:
     validation_summary().to_csv(root / PATHS.validation.summary, sep="\t", index=False)
 
 
-def _front_page(root: Path, versions=VERSIONS) -> str:
+def _front_page(root: Path, versions=VERSIONS, calibration: Path | None = None, fingerprint: str = "") -> str:
     from loper_analysis.stages.report.step import FrontPageFiles, front_page
 
     r = root / "results"
@@ -252,6 +258,7 @@ def _front_page(root: Path, versions=VERSIONS) -> str:
         impedance=r / "impedance/impedance.tsv",
         summary=r / "impedance/summary.tsv",
         figure=r / "impedance/impedance.png",
+        calibration=calibration,
         rmsd=r / "transparency/rmsd.tsv",
     )
     return front_page(
@@ -259,9 +266,75 @@ def _front_page(root: Path, versions=VERSIONS) -> str:
         r / "report/front_page.html",
         {s: "synthetic" for s in ("S01", "S02", "S03")},
         {s: ["walk-nodevice", "walk-device", "pert050-1"] for s in ("S01", "S02", "S03")},
-        FrontPageSettings(RunSettings(**SETTINGS)),
+        FrontPageSettings(RunSettings(**SETTINGS), None if calibration is None else str(calibration), fingerprint),
         versions=versions,
     )
+
+
+#: The design fingerprint of the calibration written by :func:`_calibration_file`.
+FINGERPRINT = "0123456789abcdef"
+
+
+def _calibration_file(root: Path, **cells) -> Path:
+    """A calibration table of 34 subjects, every joint's K and D: 100 fits, 94 intervals holding the truth, 92
+    estimates within tolerance; ``cells``: column -> (row, value) changed."""
+    from loper_analysis.report.calibration import CALIBRATION_COLUMNS
+
+    rows = []
+    for joint in JOINTS:
+        for p, floor in (("K", 2.0), ("D", 0.05)):
+            rows.append(
+                dict(
+                    joint=joint, parameter=p, n_fits=100, n_truth_in_ci95=94, n_within_tolerance=92,
+                    n_not_identifiable=20, tolerance_pct=10.0 if p == "K" else 15.0,
+                    tolerance_floor_nm_per_rad=floor if p == "K" else "", tolerance_floor_nms_per_rad=floor if p == "D"
+                    else "", calibration_date="2026-12-01", seed=2024, n_subjects=34, n_subject_onset_fits=102,
+                    mode="coordinates", code_version="loper-analysis 0.1.0, commit abc1234",
+                    design_fingerprint=FINGERPRINT,
+                )
+            )  # fmt: skip
+    table = pd.DataFrame(rows, columns=list(CALIBRATION_COLUMNS)).astype(object)
+    for column, (row, value) in cells.items():
+        table.loc[row, column] = value
+    path = root / "truth_recovery.tsv"
+    table.to_csv(path, sep="\t", index=False)
+    return path
+
+
+def test_the_file_step_takes_the_verdicts_from_a_calibration_of_this_design(tmp_path):
+    """The small results set (27 fits, 51 of 54 intervals holding the truth, K 24 and D 26 within tolerance) against a
+    calibration whose 564 of 600 intervals and 276 of 300 K and D within tolerance meet the targets: this run agrees
+    with it, green; the calibration's shares beside the run's counts in the truth table."""
+    _write_results(tmp_path)
+    page = _front_page(tmp_path, calibration=_calibration_file(tmp_path), fingerprint=FINGERPRINT)
+    assert (
+        "verdict from the calibration run of 2026-12-01, "
+        '<span data-q="verdict|calibration|n_subject_onset_fits" data-v="102">102</span> fits '
+        '(<span data-q="verdict|calibration|n_subjects" data-v="34">34</span> subjects, seed 2024; coordinates level), '
+        "design fingerprint 0123456789abcdef matches this run" in page
+    )
+    found = _Numbers()
+    found.feed(page)
+    assert found.found["verdict|calibration|n_truth_in_ci95"] == (564, "564")
+    assert found.found["verdict|truth|n_truth_in_ci95"] == (51, "51")
+    assert found.found["verdict|truth|K_n_within_tolerance"] == (24, "24")
+    assert found.found["calibration|K_hip|within_tolerance_pct"] == (92.0, "92")
+    assert found.found["calibration|D_ankle|truth_in_ci95_pct"] == (94.0, "94")
+    assert "<b>Intervals hold the truth</b>" in page and "<b>Estimates within tolerance</b>" in page
+    assert "calibration<br>within tol." in page
+    # the same calibration of another design: the run's own counts, with the fallback's wording
+    page = _front_page(tmp_path, calibration=_calibration_file(tmp_path), fingerprint="fedcba9876543210")
+    assert "was made at another design (its fingerprint 0123456789abcdef, this run's fedcba9876543210)" in page
+    assert "too few to decide" in page and "calibration<br>within tol." not in page
+
+
+def test_the_file_step_refuses_a_malformed_calibration_naming_file_column_and_value(tmp_path):
+    _write_results(tmp_path)
+    path = _calibration_file(tmp_path, n_within_tolerance=(4, "ninety"))
+    with pytest.raises(LoperInputError) as err:
+        _front_page(tmp_path, calibration=path, fingerprint=FINGERPRINT)
+    said = "column 'n_within_tolerance', row 5 (ankle K): 'ninety' is not a whole number >= 0"
+    assert str(err.value) == f"{path}: {said}"
 
 
 def test_the_file_step_writes_the_same_bytes_from_the_same_files(tmp_path):

@@ -1,5 +1,6 @@
 """The report's settings (report.front_page_settings): the run's headline settings of a config, each the value the
-settings type that reads its key holds; a changed key reaches the page, a missing key is named."""
+settings type that reads its key holds, the calibration table and the design fingerprint; a changed key reaches the
+page, a missing key is named."""
 
 import copy
 from pathlib import Path
@@ -8,6 +9,7 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.report.calibration import CALIBRATED_STAGES, design_fingerprint
 from loper_analysis.report.front_page import RunSettings
 from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.stages.settings import stage_settings
@@ -36,10 +38,21 @@ SHIPPED = RunSettings(
 
 
 def test_the_shipped_config_s_run_settings():
-    """Every value, and the repr the front page rule's params compare (onsets and bounds as tuples)."""
+    """Every value, and the repr the front page rule's params compare (onsets and bounds as tuples; the design
+    fingerprint left out: a changed design reruns the fits and the page after them)."""
     settings = stage_settings(CONFIG, "report")
-    assert settings == FrontPageSettings(SHIPPED)
-    assert repr(settings) == repr(FrontPageSettings(SHIPPED))
+    fingerprint = design_fingerprint({name: stage_settings(CONFIG, name) for name in CALIBRATED_STAGES})
+    shipped = FrontPageSettings(SHIPPED, "config/calibration/truth_recovery.tsv", fingerprint)
+    assert settings == shipped and len(settings.design_fingerprint) == 16
+    assert repr(settings) == repr(shipped) and fingerprint not in repr(settings)
+
+
+def test_the_calibration_key_reaches_the_settings_and_null_names_none():
+    config = copy.deepcopy(CONFIG)
+    config["report"]["calibration"] = "config/calibration/other.tsv"
+    assert stage_settings(config, "report").calibration == "config/calibration/other.tsv"
+    config["report"]["calibration"] = None
+    assert stage_settings(config, "report").calibration is None
 
 
 def test_every_key_the_page_lists_reaches_its_row():
@@ -66,7 +79,15 @@ def test_every_key_the_page_lists_reaches_its_row():
 
 
 @pytest.mark.parametrize(
-    "path", [("impedance", "n_starts"), ("markers", "filter", "cutoff_hz"), ("synthetic", "pulse_force_n"), ("seed",)]
+    "path",
+    [
+        ("impedance", "n_starts"),
+        ("markers", "filter", "cutoff_hz"),
+        ("synthetic", "pulse_force_n"),
+        ("seed",),
+        ("report", "calibration"),
+        ("report",),
+    ],
 )
 def test_a_missing_key_is_named(path):
     config = copy.deepcopy(CONFIG)

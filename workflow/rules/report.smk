@@ -1,5 +1,6 @@
 # The report: its front page (what was run, the headline numbers and the main figure, as one HTML fragment
-# that workflow/report/workflow.rst pulls in above the methods text) and every result table in Markdown.
+# that workflow/report/workflow.rst pulls in above the methods text) and every result table in Markdown. The front
+# page's inputs include the calibration table its truth verdicts rest on (report.calibration, with synthetic subjects).
 
 from loper_analysis.stages import report_tables
 from loper_analysis.stages.report.files import front_page_inputs, recorded_quality_files

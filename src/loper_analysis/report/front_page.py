@@ -13,7 +13,9 @@ pulls into the report's "Workflow" panel above the methods text:
 Every number the fragment shows sits in a ``<span>`` whose ``data-q`` names
 its table, row and column (``table|row|column``) and whose ``data-v`` holds
 the value at full precision (``repr``), so the page can be checked against
-the tables. The fragment holds no time, host or path: the same tables,
+the tables (:mod:`loper_analysis.report.html_format`). The truth verdicts and
+the truth-recovery table are :mod:`loper_analysis.report.truth_page`'s, on the
+rule of :mod:`loper_analysis.report.truth_verdict`. The fragment holds no time, host or path: the same tables,
 settings, versions and figure give the same bytes. K in N·m/rad, D in
 N·m·s/rad, angles in rad.
 """
@@ -22,23 +24,23 @@ from __future__ import annotations
 
 import base64
 import html
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
-import numpy as np
 import pandas as pd
 
 from loper_analysis.constants import PARAMETER_UNITS, parameter_column
 from loper_analysis.errors import LoperInputError
-from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
 from loper_analysis.reference import STUDY_SWING_IMPEDANCE
-from loper_analysis.report.headline import (
-    COVERAGE_TARGET,
-    PARAMETER_KINDS,
-    WITHIN_TOLERANCE_TARGET,
-    ci_coverage_p,
-)
+from loper_analysis.report.calibration import Calibration
+from loper_analysis.report.headline import PARAMETER_KINDS
+from loper_analysis.report.html_format import count as _count
+from loper_analysis.report.html_format import decimals as _decimals
+from loper_analysis.report.html_format import g as _g
+from loper_analysis.report.html_format import mark as _mark
+from loper_analysis.report.html_format import num as _num
+from loper_analysis.report.truth_page import truth_table_html, truth_verdicts_html
+from loper_analysis.report.truth_verdict import truth_verdicts
 
 __all__ = [
     "SOFTWARE",
@@ -59,7 +61,6 @@ SOFTWARE: dict[str, str] = {
 
 #: Unit of each parameter kind, as the page writes it.
 _UNIT = {p: PARAMETER_UNITS[f"{p}_hip"] for p in PARAMETER_KINDS}
-_MINUS = "\u2212"
 
 
 # ---------------------------------------------------------------------------------------------- the run
@@ -122,11 +123,6 @@ class RunSettings:
         ]
 
 
-def _g(value: float) -> str:
-    """A setting's number without trailing zeros (``40``, ``0.1``, ``12.5``)."""
-    return f"{float(value):g}".replace("-", _MINUS)
-
-
 def _subject_line(subjects: Mapping[str, str], trials: Mapping[str, Sequence[str]]) -> str:
     """'3 synthetic (S01, S02, S03) + 0 recorded subjects, 8 walking trials each' (HTML)."""
     parts = []
@@ -142,49 +138,6 @@ def _subject_line(subjects: Mapping[str, str], trials: Mapping[str, Sequence[str
     else:
         per = f"{counts[0]}–{counts[-1]} walking trials per subject"
     return f"{parts[0]} + {parts[1]} subjects, {per}"
-
-
-# ---------------------------------------------------------------------------------------------- formatting
-
-
-def _decimals(values, significant: int = 3, most: int = 4) -> int:
-    """Decimals that show the largest magnitude among ``values`` with ``significant`` digits (0 to ``most``)."""
-    finite = np.abs(np.asarray([v for v in values if v is not None], dtype=float))
-    finite = finite[np.isfinite(finite) & (finite > 0)]
-    if not finite.size:
-        return 2
-    return int(min(most, max(0, significant - 1 - math.floor(math.log10(finite.max())))))
-
-
-def _text(value: float, decimals: int) -> str:
-    """A number with ``decimals`` decimals and a true minus sign; no negative zero; NaN as an en dash."""
-    if value is None or not math.isfinite(value):
-        return "–"
-    text = f"{value:.{decimals}f}"
-    if float(text) == 0.0:
-        text = text.lstrip("-")
-    return text.replace("-", _MINUS)
-
-
-def _num(value, decimals: int, key: str) -> str:
-    """A number as a ``<span>`` carrying its key (``table|row|column``) and full-precision value."""
-    value = math.nan if value is None else float(value)
-    return f'<span data-q="{html.escape(key)}" data-v="{value!r}">{_text(value, decimals)}</span>'
-
-
-def _count(value: int, key: str) -> str:
-    return f'<span data-q="{html.escape(key)}" data-v="{int(value)!r}">{int(value)}</span>'
-
-
-def _mark(ok: bool | None) -> str:
-    """✓ (green), ✗ (red) or a grey dot (no criterion or no verdict)."""
-    if ok is None:
-        return '<span class="lf-mark lf-dim">●</span>'
-    return '<span class="lf-mark lf-ok">✓</span>' if ok else '<span class="lf-mark lf-bad">✗</span>'
-
-
-def _pct(n: int, total: int) -> str:
-    return f"{100.0 * n / total:.0f} %" if total else "–"
 
 
 #: The fragment's style: every rule under ``.lf`` but the first, which top-aligns the report's content pane while
@@ -269,39 +222,6 @@ def _summary_table(ci: pd.DataFrame) -> str:
     )
 
 
-def _truth_table(truth: pd.DataFrame) -> str:
-    """Bias, median |error|, within tolerance and truth inside the CI, per parameter and joint."""
-    body = []
-    for p in PARAMETER_KINDS:
-        bias, median = parameter_column(p, "error_mean"), parameter_column(p, "error_median_abs")
-        pct, within, inside = f"{p}_error_median_abs_pct", f"{p}_n_within_tolerance", f"{p}_n_truth_in_ci95"
-        d = _decimals(truth[[bias, median]].to_numpy().ravel())
-        for k, r in enumerate(truth.to_dict("records")):
-            key = f"truth-recovery|{p}_{r['joint']}|"
-            n = r["n_fits"]
-            sep = ' class="lf-sep"' if k == 0 and body else ""
-            body.append(
-                f'<tr{sep}><td class="lf-l">{p}<sub>{html.escape(str(r["joint"]))}</sub></td>'
-                f"<td>{_count(n, key + 'n_fits')}</td>"
-                f"<td>{_num(r[bias], d, key + bias)}</td>"
-                f'<td>{_num(r[median], d, key + median)} <span class="lf-dim">({_num(r[pct], 0, key + pct)} %)'
-                "</span></td>"
-                f"<td>{_count(r[within], key + within)}/{n}</td>"
-                f"<td>{_count(r[inside], key + inside)}/{n}</td></tr>"
-            )
-    k_rel, k_abs = TRUTH_TOLERANCE["K"]
-    d_rel, d_abs = TRUTH_TOLERANCE["D"]
-    return (
-        '<table id="lf-truth-recovery"><caption>Truth recovery: estimate − truth</caption>'
-        '<thead><tr><th class="lf-l"></th><th>fits</th><th>mean<br>error</th><th>median |error|<br>'
-        '<span class="lf-dim">(% of truth)</span></th><th>within<br>tolerance</th><th>truth in<br>95 % CI</th>'
-        f"</tr></thead><tbody>{''.join(body)}</tbody></table>"
-        '<p class="lf-note">Synthetic subjects, over subjects and onsets; K in N·m/rad, D in N·m·s/rad. '
-        f"Tolerance: {k_rel * 100:g} % of the truth or {_g(k_abs)} N·m/rad for K, {d_rel * 100:g} % or "
-        f"{_g(d_abs)} N·m·s/rad for D. Fits: status ok or not identifiable.</p>"
-    )
-
-
 def _transparency_table(tr: pd.DataFrame) -> str:
     """Group RMSD against ISV_ave per phase and joint, with the study's values."""
     d = 3
@@ -358,37 +278,6 @@ def _device_table(dev: pd.DataFrame) -> str:
 
 
 # ------------------------------------------------------------------------------------------------ verdicts
-
-
-def _truth_verdicts(truth: pd.DataFrame) -> str:
-    """Two verdicts on the synthetic subjects' fits, each ticked only when its stated target is met: the
-    intervals hold the truth (:data:`~loper_analysis.report.headline.COVERAGE_TARGET`), and the estimates lie
-    within tolerance of it (:data:`~loper_analysis.report.headline.WITHIN_TOLERANCE_TARGET`, K and D each)."""
-    n_fits = int(truth["n_fits"].sum())
-    n_failed = int(truth["n_failed"].sum())
-    n_subjects = int(truth["n_subjects"].max())
-    failed = f", {n_failed} failed" if n_failed else ""
-    who = f"{n_subjects} synthetic subject{'s' if n_subjects != 1 else ''}, {n_fits} joint fits{failed}"
-    if n_fits == 0:
-        return f"<li>{_mark(None)}<b>Truth</b> ({who}): no joint fitted.</li>"
-    inside = int(truth["K_n_truth_in_ci95"].sum() + truth["D_n_truth_in_ci95"].sum())
-    total = 2 * n_fits
-    low, high = COVERAGE_TARGET
-    covered = low <= inside / total <= high
-    p = ci_coverage_p(inside, total)
-    within = {q: int(truth[q + "_n_within_tolerance"].sum()) for q in PARAMETER_KINDS}
-    close = all(n >= WITHIN_TOLERANCE_TARGET * n_fits for n in within.values())
-    counts = ", ".join(
-        f"{q} {_count(within[q], 'verdict|truth|' + q + '_n_within_tolerance')}/{n_fits} ({_pct(within[q], n_fits)})"
-        for q in PARAMETER_KINDS
-    )
-    return (
-        f"<li>{_mark(covered)}<b>Intervals {'hold' if covered else 'miss'} the truth</b> ({who}): inside the "
-        f"95 % CI {_count(inside, 'verdict|truth|n_truth_in_ci95')}/{total} ({_pct(inside, total)}; target "
-        f"{low * 100:.0f}–{high * 100:.0f} %; binomial p = {p:.2f} against 95 %).</li>"
-        f"<li>{_mark(close)}<b>Estimates {'within' if close else 'outside'} tolerance</b>: {counts} "
-        f"(target ≥ {WITHIN_TOLERANCE_TARGET * 100:.0f} % of fits each).</li>"
-    )
 
 
 def _transparency_verdict_line(tr: pd.DataFrame) -> str:
@@ -458,6 +347,8 @@ def front_page_html(
     figure_png: bytes | None = None,
     transparency: pd.DataFrame | None = None,
     recorded_html: str = "",
+    calibration: Calibration | None = None,
+    design_fingerprint: str = "",
 ) -> str:
     """The front page as one HTML fragment (a ``<style>`` and a ``<div class="lf">``).
 
@@ -490,6 +381,12 @@ def front_page_html(
     recorded_html : str
         The section on recorded subjects (:func:`loper_analysis.report.subject_quality.recorded_subjects_html`),
         placed after the impedance results.
+    calibration : Calibration or None
+        The calibration run the truth verdicts rest on when it is of this run's design
+        (:func:`loper_analysis.report.calibration.calibration_from_table`); None: none named, the verdicts rest on
+        this run's own counts (:func:`loper_analysis.report.truth_verdict.truth_verdicts`).
+    design_fingerprint : str
+        This run's design fingerprint (:func:`loper_analysis.report.calibration.design_fingerprint`).
 
     Returns
     -------
@@ -510,7 +407,9 @@ def front_page_html(
         "versions at the end.</p>"
     )
     has_truth = truth is not None and len(truth) > 0
-    parts.append(_verdict_list(truth if has_truth else None, transparency, device, validation))
+    verdicts = truth_verdicts(truth, calibration, design_fingerprint) if has_truth else None
+    truth_lines = truth_verdicts_html(verdicts, truth) if has_truth else ""
+    parts.append(_verdict_list(truth_lines, transparency, device, validation))
     if summary is None:
         parts.append("<p>No perturbation trials in this run: no impedance was identified.</p>")
 
@@ -523,7 +422,7 @@ def front_page_html(
     else:
         parts.append(_summary_table(summary))
     if has_truth and truth["n_fits"].sum() > 0:
-        parts.append(_truth_table(truth))
+        parts.append(truth_table_html(truth, calibration if verdicts.basis == "calibration" else None))
     if figure_png:
         data = base64.b64encode(figure_png).decode("ascii")
         parts.append(
@@ -545,16 +444,15 @@ def front_page_html(
 
 
 def _verdict_list(
-    truth: pd.DataFrame | None,
+    truth_lines: str,
     transparency: pd.DataFrame | None,
     device: pd.DataFrame,
     validation: pd.DataFrame | None,
 ) -> str:
-    """The verdicts (``<ul class="lf-verdicts">``): truth recovery, transparency, device and validation, each
-    when there is something to judge."""
-    verdicts = []
-    if truth is not None:
-        verdicts.append(_truth_verdicts(truth))
+    """The verdicts (``<ul class="lf-verdicts">``): truth recovery (``truth_lines``, from
+    :func:`loper_analysis.report.truth_page.truth_verdicts_html`), transparency, device and validation, each when
+    there is something to judge."""
+    verdicts = [truth_lines] if truth_lines else []
     if transparency is not None and len(transparency):
         verdicts.append(_transparency_verdict_line(transparency))
     if len(device):

@@ -1,5 +1,6 @@
 """The report stage's files: its result files (name -> pattern under ``results/report/``) and the tables the front
-page and the Markdown rendering read."""
+page and the Markdown rendering read (the calibration table of the truth verdicts where the configuration names
+it, ``report.calibration``)."""
 
 from __future__ import annotations
 
@@ -42,14 +43,18 @@ def recorded_quality_files(study: Study) -> dict:
 
 def front_page_inputs(study: Study) -> dict:
     """The tables the front page reads, named as the fields of ``FrontPageFiles``: the validation and device
-    summaries when built, the impedance tables and main figure with perturbation trials, the transparency
-    table with a subject who walked both trials, the recorded subjects' quality files."""
+    summaries when built, the impedance tables and main figure with perturbation trials, the calibration table
+    of the truth verdicts (``report.calibration``) with perturbation trials of a synthetic subject, the
+    transparency table with a subject who walked both trials, the recorded subjects' quality files."""
     p = study.paths
     out = {"validation": p.validation.summary} if study.has_validation() else {}
     if study.has_device_tests():
         out["device"] = p.device.summary
     if study.identifies_impedance():
         out.update(impedance=p.impedance.table, summary=p.impedance.summary, figure=p.impedance.figure)
+        calibration = study.settings["report"].calibration
+        if calibration is not None and "synthetic" in map(study.source, study.processed_subjects()):
+            out["calibration"] = calibration
     if study.transparency_subjects():
         out["rmsd"] = p.transparency.rmsd
     recorded = recorded_quality_files(study)

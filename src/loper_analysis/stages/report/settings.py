@@ -1,11 +1,13 @@
 """The report stage's settings: the run's headline settings the front page lists, each taken from the stage
-that reads its key (the report has no keys of its own)."""
+that reads its key; the calibration table of the truth verdicts (``report.calibration``, the report's own key);
+the fingerprint of the run's design, from the settings of the stages that decide the fits."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping
 
 from loper_analysis.motion.trial_markers import MarkerSettings
+from loper_analysis.report.calibration import CALIBRATED_STAGES, design_fingerprint
 from loper_analysis.report.front_page import RunSettings
 from loper_analysis.report.front_page_settings import FrontPageSettings
 from loper_analysis.stages.impedance.step import FitSettings
@@ -27,8 +29,12 @@ def read_settings(
     """The front page's settings: the perturbations (onsets in ms, repeats, leg) the study's; the low-pass (Hz,
     order) the markers'; the fit window (s), bounds (N·m/rad, N·m·s/rad), starts, noise model and projected
     components the fit's; the seed the study's; the synthetic lab's variability, trial duration (s) and pulse
-    (N, s) the lab's."""
+    (N, s) the lab's; ``report.calibration`` (a path or null); the design fingerprint of the synthetic lab's, the
+    markers' and the fit's settings (:data:`loper_analysis.report.calibration.CALIBRATED_STAGES`, the seed left
+    out)."""
     design, window, fit = study.design, impedance.response.window, impedance.identification
+    calibration = config["report"]["calibration"]
+    decide = {"synthetic": synthetic, "markers": markers, "impedance": impedance}
     return FrontPageSettings(
         RunSettings(
             seed=study.seed,
@@ -48,5 +54,7 @@ def read_settings(
             synthetic_walking_duration_s=synthetic.walking_duration_s,
             pulse_force_n=synthetic.pulse_force_n,
             pulse_duration_s=synthetic.pulse_duration_s,
-        )
+        ),
+        calibration=None if calibration is None else str(calibration),
+        design_fingerprint=design_fingerprint({name: decide[name] for name in CALIBRATED_STAGES}),
     )

@@ -67,7 +67,9 @@ class FrontPageFiles:
     perturbation trials); ``device``: ``results/device/summary.tsv`` (None:
     no device tests); ``impedance``, ``summary`` and ``figure``: the impedance table, its across-subject
     summary and the main figure (None: the run had no perturbation trials; the table and its summary come
-    together); ``rmsd``: the transparency table (None: no subject walked both trials of the pair);
+    together); ``calibration``: the calibration table of the truth verdicts
+    (:data:`loper_analysis.report.calibration.CALIBRATION_COLUMNS`; None: none named, or no synthetic subject);
+    ``rmsd``: the transparency table (None: no subject walked both trials of the pair);
     ``strides``: the strides summary and ``quality`` the recorded subjects' scale reports, IK summaries,
     agreement tables and figures (named in :func:`front_page`'s ``recorded``).
     """
@@ -77,6 +79,7 @@ class FrontPageFiles:
     impedance: PathLike | None = None
     summary: PathLike | None = None
     figure: PathLike | None = None
+    calibration: PathLike | None = None
     rmsd: PathLike | None = None
     strides: PathLike | None = None
     quality: Sequence[PathLike] = ()
@@ -100,12 +103,14 @@ def front_page(
     ``recorded``: recorded subject -> ``{"scale": path or None, "trials": {trial: {"ik", "agreement",
     "angles_png", "grf_png": path or None}}}``, the files of the section on recorded subjects
     (:func:`loper_analysis.report.subject_quality.recorded_subjects_html`).
-    The headline tables come from :mod:`loper_analysis.report.headline`. Writes ``out_html`` and returns
-    the fragment.
+    The headline tables come from :mod:`loper_analysis.report.headline`, the calibration run the truth verdicts
+    rest on from :func:`loper_analysis.report.calibration.calibration_from_table` (compared with the run's design
+    fingerprint, ``settings.design_fingerprint``). Writes ``out_html`` and returns the fragment.
     """
     import pandas
 
     from loper_analysis.errors import LoperInputError
+    from loper_analysis.report.calibration import calibration_from_table
     from loper_analysis.report.front_page import front_page_html
     from loper_analysis.report.headline import (
         device_comparison,
@@ -128,6 +133,10 @@ def front_page(
         status = table["status"].value_counts(sort=False).to_dict() if "status" in table else {}
     if files.figure is not None:
         figure = read_bytes(files.figure, "figure")
+    calibration = None
+    if files.calibration is not None:
+        text_cells = read_tsv(files.calibration, "calibration table", dtype=str, keep_default_na=False)
+        calibration = calibration_from_table(text_cells, str(files.calibration))
     if files.rmsd is not None:
         transparency = transparency_verdict(read_tsv(files.rmsd, "transparency table"), str(files.rmsd))
     text = front_page_html(
@@ -151,6 +160,8 @@ def front_page(
         figure_png=figure,
         transparency=transparency,
         recorded_html=_recorded_html(recorded or {}, files.strides),
+        calibration=calibration,
+        design_fingerprint=settings.design_fingerprint,
     )
     write_text(out_html, text, "front page")
     log.info("front page: %d bytes (%d kB of figure)", len(text.encode()), len(figure or b"") // 1024)
