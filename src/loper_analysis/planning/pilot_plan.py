@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
+from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
@@ -196,7 +196,7 @@ def pilot_plan(
             sc.n_null_pairs,
             sc.n_perturbed_pairs,
             sc.scatter.replace("_", " "),
-            ", ".join(f"{p} {v:.3g}" for p, v in zip(PARAMETERS, sc.impedance)),
+            ", ".join(f"{p} {v:.3g}" for p, v in zip(sc.parameters, sc.impedance)),
         )
         answers += _answers(sc, onset, settings.targets)
     return pd.concat(tables, ignore_index=True), answers

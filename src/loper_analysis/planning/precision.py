@@ -22,7 +22,9 @@ The planner's parts, each in its module:
 * :mod:`loper_analysis.planning.covariance` - the covariance of (K, D) for one perturbed stride, for either
   counterfactual, over the pilot's stretches, pooled over onsets;
 * here: :func:`precision_table` - predicted SD and 95 % half-width per joint, parameter and stride count;
-  :func:`strides_needed` and :func:`target_answer` - how many strides a target half-width needs.
+  :func:`strides_needed` and :func:`target_answer` - how many strides a target half-width needs;
+  :func:`identification_tolerance` and :func:`identification_verdict` - whether a design identifies a
+  parameter (the plan's verdict on the inter-joint couplings, :attr:`PlanSettings.couplings`).
 
 The identification's own functions build the window, the Jacobian, the
 null-pair errors and the projection
@@ -42,17 +44,23 @@ import numpy as np
 import pandas as pd
 
 from loper_analysis.checks import number
-from loper_analysis.constants import JOINTS, PARAMETER_UNITS, PARAMETERS
+from loper_analysis.constants import COUPLING_UNIT, JOINTS, PARAMETER_UNITS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification import (
     t_quantile,
 )
+from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
 from loper_analysis.planning.covariance import StrideCovariance, stride_counts
 from loper_analysis.planning.window import PlanSettings
 
 __all__ = [
     "MAX_ANSWERED_STRIDES",
     "PLAN_COLUMNS",
+    "COUPLING_PLAN_COLUMNS",
+    "IDENTIFIED",
+    "NOT_IDENTIFIED",
+    "identification_tolerance",
+    "identification_verdict",
     "precision_table",
     "strides_needed",
     "target_answer",
@@ -80,8 +88,41 @@ PLAN_COLUMNS: tuple[str, ...] = (
     "note",
 )
 
+#: Columns a plan with inter-joint couplings (:attr:`PlanSettings.couplings`) adds to :data:`PLAN_COLUMNS`, on
+#: every row: the tolerance the verdict holds the predicted half-width to (``unit``), the verdict
+#: (:func:`identification_verdict`) and the fewest perturbed strides whose half-width meets that tolerance
+#: (NaN: more than :data:`MAX_ANSWERED_STRIDES`).
+COUPLING_PLAN_COLUMNS: tuple[str, ...] = ("tolerance", "verdict", "strides_to_identify")
+#: The verdicts of :func:`identification_verdict`.
+IDENTIFIED, NOT_IDENTIFIED = "identified", "not identified"
+
 #: A target that needs more perturbed strides than this is answered as "more than" it.
 MAX_ANSWERED_STRIDES: int = 1_000_000
+
+
+def identification_tolerance(kind: str, planned: float) -> float:
+    """The tolerance (N·m/rad for a stiffness ``kind`` ``"K"``, a coupling's too; N·m·s/rad for ``"D"``) within
+    which a design must place a parameter planned at ``planned`` to identify it: the study's tolerance on the
+    truth, ``max(relative * |planned|, absolute)`` with (10 %, 2 N·m/rad) for K and (15 %, 0.05 N·m·s/rad) for D
+    (:data:`~loper_analysis.impedance.identification.across_subjects.TRUTH_TOLERANCE`). A coupling planned at
+    0 gets 2 N·m/rad."""
+    if kind not in TRUTH_TOLERANCE:
+        raise LoperInputError(f"parameter kind must be one of {sorted(TRUTH_TOLERANCE)}, got {kind!r}")
+    relative, absolute = TRUTH_TOLERANCE[kind]
+    return max(relative * abs(float(planned)), absolute)
+
+
+def identification_verdict(half_width: float, tolerance: float) -> str:
+    """:data:`IDENTIFIED` when the predicted 95 % CI half-width is at most ``tolerance`` (same unit), else
+    :data:`NOT_IDENTIFIED`.
+
+    The rule: the fit's 95 % interval is ``estimate +- t SD``; when ``t SD <= tolerance``, an estimate that
+    scatters as predicted (unbiased, normal) lies within the tolerance of the truth in 95 % of experiments of this
+    design, the standard the study holds every K and D to. A design that fails it may still tell a large coupling
+    from 0; it cannot place one of the size a spring-like leg allows (``|K_hip_knee| <= sqrt(K_hip K_knee)``,
+    12.8 N·m/rad for a hip of 55 and a knee of 3 N·m/rad) within the study's tolerance.
+    """
+    return IDENTIFIED if float(half_width) <= float(tolerance) else NOT_IDENTIFIED
 
 
 def precision_table(
@@ -97,70 +138,87 @@ def precision_table(
     ``by_count``: covariances for some stride counts (:func:`stretch_covariances`) that replace
     ``stride_cov`` in those counts' rows.
 
+    With inter-joint couplings (``stride_cov.couplings``, from :attr:`PlanSettings.couplings`) each coupling
+    gets rows too (``joint`` the pair, e.g. ``hip_knee``; ``parameter`` ``K``; unit N·m/rad), and every row
+    the columns :data:`COUPLING_PLAN_COLUMNS`: ``tolerance`` (:func:`identification_tolerance` of its planned
+    value), ``verdict`` (:func:`identification_verdict` of its half-width) and ``strides_to_identify``
+    (:func:`strides_needed` for a half-width of ``tolerance``, from ``stride_cov``).
+
     ``predicted_sd = sqrt(sd_1^2 / N + b / N^2)`` (:meth:`StrideCovariance.sd_of`) and
     ``ci95_half_width = t * predicted_sd``
     (Student's t at 97.5 % with the fit's degrees of freedom,
     :meth:`StrideCovariance.t95`: ``N - 1`` by default), both in ``unit``;
     ``ci95_half_width_pct`` relative to the planned value (%; NaN for a
-    planned value of 0). Rows: hip, knee, ankle x K, D x ``n_strides``.
+    planned value of 0). Rows: hip, knee, ankle x K, D x ``n_strides``, then each coupling x ``n_strides``.
     """
     counts = stride_counts(n_strides, subject or "plan")
+    coupled = bool(stride_cov.couplings)
     rows = []
-    for j, joint in enumerate(JOINTS):
-        for k, kind in enumerate(("K", "D")):
-            i = 2 * j + k
-            planned = float(stride_cov.impedance[i])
-            for n in counts:
-                sc = (by_count or {}).get(n, stride_cov)
-                sd = float(sc.sd_of(n)[i])
-                half = sc.t95(n) * sd
-                rows.append(
-                    {
-                        "subject": subject,
-                        "onset_ms": float(onset_ms),
-                        "joint": joint,
-                        "parameter": kind,
-                        "unit": PARAMETER_UNITS[PARAMETERS[i]],
-                        "n_strides": n,
-                        "planned_value": planned,
-                        "predicted_sd": sd,
-                        "ci95_half_width": half,
-                        "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
-                        "pulse_force_n": float(settings.pulse_force_n),
-                        "pulse_duration_s": float(settings.pulse_duration_s),
-                        "shank_pulse_force_n": float(settings.shank_pulse_force_n),
-                        "n_null_pairs": sc.n_null_pairs,
-                        "n_perturbed_pairs": sc.n_perturbed_pairs,
-                        "scatter": sc.scatter,
-                        "note": sc.note,
-                    }
-                )
-    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+    for i, name in enumerate(stride_cov.parameters):
+        kind, joint = name.split("_", 1)
+        planned = float(stride_cov.impedance[i])
+        if coupled:
+            tolerance = identification_tolerance(kind, planned)
+            needed = strides_needed(stride_cov, joint, kind, half_width=tolerance)
+        for n in counts:
+            sc = (by_count or {}).get(n, stride_cov)
+            sd = float(sc.sd_of(n)[i])
+            half = sc.t95(n) * sd
+            rows.append(
+                {
+                    "subject": subject,
+                    "onset_ms": float(onset_ms),
+                    "joint": joint,
+                    "parameter": kind,
+                    "unit": PARAMETER_UNITS.get(name, COUPLING_UNIT),
+                    "n_strides": n,
+                    "planned_value": planned,
+                    "predicted_sd": sd,
+                    "ci95_half_width": half,
+                    "ci95_half_width_pct": 100.0 * half / abs(planned) if planned != 0 else np.nan,
+                    "pulse_force_n": float(settings.pulse_force_n),
+                    "pulse_duration_s": float(settings.pulse_duration_s),
+                    "shank_pulse_force_n": float(settings.shank_pulse_force_n),
+                    "n_null_pairs": sc.n_null_pairs,
+                    "n_perturbed_pairs": sc.n_perturbed_pairs,
+                    "scatter": sc.scatter,
+                    "note": sc.note,
+                }
+            )
+            if coupled:
+                rows[-1] |= {
+                    "tolerance": tolerance,
+                    "verdict": identification_verdict(half, tolerance),
+                    "strides_to_identify": float(needed) if needed <= MAX_ANSWERED_STRIDES else np.nan,
+                }
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS + (COUPLING_PLAN_COLUMNS if coupled else ())))
 
 
 def unplanned_rows(
     n_strides: Sequence[int], onset_ms: float, note: str, subject: str = "", settings: PlanSettings = PlanSettings()
 ) -> pd.DataFrame:
-    """Rows of :data:`PLAN_COLUMNS` for an onset that cannot be planned: predictions empty, ``note`` says why."""
+    """Rows of :data:`PLAN_COLUMNS` for an onset that cannot be planned: predictions empty, ``note`` says why
+    (with ``settings.couplings`` also the couplings' rows and :data:`COUPLING_PLAN_COLUMNS`, empty)."""
     counts = stride_counts(n_strides, subject or "plan")
+    pairs = [(joint, kind) for joint in JOINTS for kind in ("K", "D")] + [(c, "K") for c in settings.couplings]
     rows = [
         {
             "subject": subject,
             "onset_ms": float(onset_ms),
             "joint": joint,
             "parameter": kind,
-            "unit": PARAMETER_UNITS[f"{kind}_{joint}"],
+            "unit": PARAMETER_UNITS.get(f"{kind}_{joint}", COUPLING_UNIT),
             "n_strides": n,
             "pulse_force_n": float(settings.pulse_force_n),
             "pulse_duration_s": float(settings.pulse_duration_s),
             "shank_pulse_force_n": float(settings.shank_pulse_force_n),
             "note": note,
         }
-        for joint in JOINTS
-        for kind in ("K", "D")
+        for joint, kind in pairs
         for n in counts
     ]
-    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS))
+    extra = COUPLING_PLAN_COLUMNS if settings.couplings else ()
+    return pd.DataFrame(rows, columns=list(PLAN_COLUMNS + extra))
 
 
 def strides_needed(
@@ -180,13 +238,16 @@ def strides_needed(
     part ``b`` (the conditional counterfactual) and a fixed t, the smallest
     ``N`` with ``t^2 (sd_1^2 / N + b / N^2) <= target^2``.
     """
-    if joint not in JOINTS:
-        raise LoperInputError(f"target joint must be one of {JOINTS}, got {joint!r}")
-    if parameter not in ("K", "D"):
-        raise LoperInputError(f"target parameter must be 'K' or 'D', got {parameter!r}")
+    joints = JOINTS + stride_cov.couplings
+    if joint not in joints:
+        raise LoperInputError(f"target joint must be one of {joints}, got {joint!r}")
+    if parameter not in ("K", "D") or (joint not in JOINTS and parameter != "K"):
+        raise LoperInputError(
+            f"target parameter must be 'K' or 'D' ('K' for an inter-joint coupling), got {parameter!r}"
+        )
     if (percent is None) == (half_width is None):
         raise LoperInputError("give exactly one target: percent or half_width")
-    i = PARAMETERS.index(f"{parameter}_{joint}")
+    i = stride_cov.parameters.index(f"{parameter}_{joint}")
     planned = float(stride_cov.impedance[i])
     if percent is not None:
         pct = number("target percent", percent)
@@ -237,8 +298,9 @@ def target_answer(
 ) -> str:
     """One sentence: how many perturbed strides a target half-width on ``parameter`` of ``joint`` needs."""
     n = strides_needed(stride_cov, joint, parameter, percent=percent, half_width=half_width)
-    i = PARAMETERS.index(f"{parameter}_{joint}")
-    unit, planned = PARAMETER_UNITS[PARAMETERS[i]], float(stride_cov.impedance[i])
+    name = f"{parameter}_{joint}"
+    i = stride_cov.parameters.index(name)
+    unit, planned = PARAMETER_UNITS.get(name, COUPLING_UNIT), float(stride_cov.impedance[i])
     wanted = f"±{percent:g} %" if percent is not None else f"±{half_width:g} {unit}"
     if n > MAX_ANSWERED_STRIDES:
         return (

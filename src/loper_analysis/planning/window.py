@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from loper_analysis.checks import number
-from loper_analysis.constants import PARAMETER_UNITS, PARAMETERS
+from loper_analysis.constants import COUPLING_UNIT, PARAMETER_UNITS, PARAMETERS
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
 from loper_analysis.filtering import CUTOFF_HZ, ORDER
@@ -26,9 +26,13 @@ from loper_analysis.impedance.identification import (
     prepare_window,
     window_options,
 )
-from loper_analysis.impedance.identification.fit import DAMPING_BOUNDS_NMS_PER_RAD, STIFFNESS_BOUNDS_NM_PER_RAD
+from loper_analysis.impedance.identification.fit import (
+    COUPLING_BOUNDS_NM_PER_RAD,
+    DAMPING_BOUNDS_NMS_PER_RAD,
+    STIFFNESS_BOUNDS_NM_PER_RAD,
+)
 from loper_analysis.impedance.identification.null_pairs import MIN_NULL_PAIRS, NULL_PAIR_COMPONENTS
-from loper_analysis.impedance.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS
+from loper_analysis.impedance.identification.window import INITIAL_STATE_DEGREE, N_SUBSTEPS, check_couplings
 from loper_analysis.impedance.responses.response_window import ResponseWindow
 from loper_analysis.planning.inputs import pulse_force_n
 from loper_analysis.study_design import PULSE_DURATION_S, PULSE_FORCE_N
@@ -51,7 +55,11 @@ class PlanSettings(FitBounds):
     the load cell's low-pass; ``force_rate_hz`` the rate of the pulse given
     to the fit (the robot log's). ``shank_pulse_force_n`` (N): a second rod's pulse, just above the ankle where
     ``shank_rod`` (:class:`~loper_analysis.swing_leg.rods.ShankRod`) places and points it, pushed with the
-    thigh's (same timing and device); 0: the thigh rod alone.
+    thigh's (same timing and device); 0: the thigh rod alone. ``couplings``: inter-joint stiffnesses the planned
+    fit adds to K and D per joint (names of :data:`~loper_analysis.constants.COUPLINGS`, e.g. ``("hip_knee",)``
+    for the bi-articular hip-knee stiffness), within ``coupling_bounds_nm_per_rad`` (N·m/rad); the plan then
+    predicts their SD too and says whether the design identifies them
+    (:func:`loper_analysis.planning.precision.precision_table`).
     """
 
     pulse_force_n: float = PULSE_FORCE_N
@@ -69,8 +77,11 @@ class PlanSettings(FitBounds):
     force_rate_hz: float = DeviceParameters.sample_rate_hz
     shank_pulse_force_n: float = 0.0
     shank_rod: ShankRod = field(default_factory=ShankRod)
+    couplings: tuple[str, ...] = ()
+    coupling_bounds_nm_per_rad: tuple[float, float] = COUPLING_BOUNDS_NM_PER_RAD
 
     def __post_init__(self):
+        object.__setattr__(self, "couplings", check_couplings(self.couplings))
         number("pulse_force_n", self.pulse_force_n)
         number("shank_pulse_force_n", self.shank_pulse_force_n)
         check_interval_scatter(self.interval_scatter)
@@ -149,17 +160,23 @@ def planning_window(
 
 
 def planned_impedance(impedance, settings: PlanSettings, source: str) -> np.ndarray:
+    """The planned values (p,) checked to lie within the fit's bounds: K and D per joint (order of
+    :data:`PARAMETERS`), then each of ``settings.couplings`` (N·m/rad); for couplings the six alone plan each
+    coupling at 0 (no coupling: the value a design must tell a coupling from)."""
+    names = PARAMETERS + tuple(f"K_{c}" for c in settings.couplings)
     p = np.asarray(impedance, dtype=float)
-    if p.shape != (6,) or not np.all(np.isfinite(p)):
+    if settings.couplings and p.shape == (len(PARAMETERS),):
+        p = np.concatenate([p, np.zeros(len(settings.couplings))])
+    if p.shape != (len(names),) or not np.all(np.isfinite(p)):
         raise LoperInputError(
-            f"{source}: the planned impedance must be 6 finite values ({', '.join(PARAMETERS)}), "
+            f"{source}: the planned impedance must be {len(names)} finite values ({', '.join(names)}), "
             f"got {np.asarray(impedance).tolist()}"
         )
     out = np.flatnonzero((p < settings.lower) | (p > settings.upper))
     if out.size:
         i = int(out[0])
         raise LoperInputError(
-            f"{source}: planned {PARAMETERS[i]} = {p[i]:g} {PARAMETER_UNITS[PARAMETERS[i]]} lies "
+            f"{source}: planned {names[i]} = {p[i]:g} {PARAMETER_UNITS.get(names[i], COUPLING_UNIT)} lies "
             f"outside the identification bounds {settings.lower[i]:g} .. {settings.upper[i]:g}"
         )
     return p

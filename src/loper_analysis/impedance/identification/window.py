@@ -175,8 +175,12 @@ WINDOW_FIELDS: tuple[str, ...] = ("window", "n_substeps", "initial_state_degree"
 
 
 def window_options(settings) -> dict:
-    """:func:`prepare_window`'s window keywords (:data:`WINDOW_FIELDS`) from a settings object holding them."""
-    return {name: getattr(settings, name) for name in WINDOW_FIELDS}
+    """:func:`prepare_window`'s window keywords (:data:`WINDOW_FIELDS`) from a settings object holding them, and
+    its ``couplings`` (inter-joint stiffnesses of the model) when it holds any."""
+    options = {name: getattr(settings, name) for name in WINDOW_FIELDS}
+    if getattr(settings, "couplings", ()):
+        options["couplings"] = settings.couplings
+    return options
 
 
 def prepare_window(
