@@ -93,3 +93,21 @@ def test_trials_of_two_designs_in_one_fit_are_refused(fits):
     params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
     with pytest.raises(LoperInputError, match=r"hold a second rod's load cell .* and the others do not"):
         fit_onset([fits[1][1], {**fits[2][1], "name": "two"}], params, ONSET_MS, "T", None, [], MATCHED, IDENT)
+
+
+def test_the_conditional_counterfactual_predicts_both_rods_forces(fits):
+    """The workflow's default counterfactual (each perturbed stride's unperturbed course predicted from the
+    onset's unperturbed strides) predicts both load cells too: the fit takes four force components and meets the
+    study's tolerance at the ankle (which both rods place best)."""
+    full, cut, _ = fits[2]
+    params = segment_parameters_from_anthropometry(HEIGHT_M, MASS_KG)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = fit_onset(
+            [cut], params, ONSET_MS, "T", None, [full], ResponseSettings(), IdentificationSettings(n_starts=3)
+        )
+    assert "instead of the conditional" not in " ".join(result.rows["reason"].astype(str))
+    assert {"shank_force_perturbed_x_n", "shank_force_unperturbed_y_n"} <= set(result.force.columns)
+    ankle = result.rows.set_index("joint").loc["ankle"]
+    assert abs(ankle[parameter_column("K")] - TRUTH[4]) <= max(0.1 * TRUTH[4], 2.0)
+    assert abs(ankle[parameter_column("D")] - TRUTH[5]) <= max(0.15 * TRUTH[5], 0.05)

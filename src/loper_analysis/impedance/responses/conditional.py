@@ -193,7 +193,7 @@ class _PoolTrial:
     toe_off_s: np.ndarray
     end_s: np.ndarray
     stride: np.ndarray
-    native: tuple | None  # (robot times s, magnitude N, frame times s, direction (n, 2))
+    native: tuple | None  # (robot times s, magnitude N (n,) or (n, 2), frame times s, direction (n, 2 per rod))
     native_step_s: float = 0.0  # the robot's sample interval (s)
 
 
@@ -207,7 +207,8 @@ class CandidatePool:
         (n_frames, k), e.g. ``joints`` (rad), ``pelvis_angle`` (rad), ``pelvis_x`` (m), ``force`` (N),
         ``force_vector`` (N)); its stride table (``stride``, ``toe_off_s``, ``end_s``, ``perturbed``,
         ``removed``); and None or ``(robot_table, direction)``: the force at the robot rate (``time_s``,
-        ``force_measured_n``) and the rod direction on the frames (n_frames, 2).
+        ``force_measured_n``, and ``shank_force_measured_n`` with a second rod) and the rods' direction on the
+        frames (n_frames, 2 per rod).
     start_s, end_s : float
         The window relative to the anchor (s), ``start_s <= 0 <= end_s``.
     rate_hz : float
@@ -231,6 +232,7 @@ class CandidatePool:
         self.keys: list[str] = []
         self.shapes: list[tuple[int, ...]] = []
         self.trials: list[_PoolTrial] = []
+        self.force_width = 2  # force components at the robot rate: 2 per rod
         for name, t, columns, strides, native in trials:
             if not self.keys:
                 self.keys = list(columns)
@@ -242,6 +244,7 @@ class CandidatePool:
             nat = None
             if native is not None:
                 table, direction = native
+                self.force_width = int(np.shape(direction)[1])
                 nat = (
                     table["time_s"].to_numpy(float),
                     rod_magnitudes(table, direction, name),
@@ -269,7 +272,7 @@ class CandidatePool:
         """Windows of the candidates anchored ``delay_s`` after their toe-off.
 
         Returns the columns (name -> (n_ok, n_grid, ...)), the force vectors at the robot rate on
-        ``native_grid`` (s, relative; (n_ok, n_native, 2) N) or None, (trial, stride) of each window and its
+        ``native_grid`` (s, relative; (n_ok, n_native, 2 per rod) N) or None, (trial, stride) of each window and its
         index among all :attr:`size` candidates.
         """
         parts, native, ids, index = [], [], [], []
@@ -303,7 +306,7 @@ class CandidatePool:
             c += w
         nat = None
         if native_grid is not None:
-            nat = np.concatenate(native) if native else np.empty((0, len(native_grid), 2))
+            nat = np.concatenate(native) if native else np.empty((0, len(native_grid), self.force_width))
         return out, nat, ids, np.asarray(index, dtype=np.int64)
 
     def regressors(self, windows: Mapping[str, np.ndarray]) -> np.ndarray:
@@ -340,7 +343,7 @@ def conditional_windows(
     Returns
     -------
     columns : name -> (n_p, n_grid, ...), the predicted windows (NaN rows for strides without a prediction);
-    native : (n_p, n_native, 2) or None;
+    native : (n_p, n_native, 2 per rod) or None;
     weights : (n_p, pool.size) each stride's weights over all the pool's candidates (0 for those whose window
         leaves the data; a row of zeros without a prediction);
     missing : per stride the reason it has no prediction ("" otherwise).
@@ -348,7 +351,7 @@ def conditional_windows(
     delays = np.asarray(delays_s, dtype=float)
     x = pool.regressors({k: np.asarray(perturbed[k], dtype=float) for k in ("joints", "pelvis_angle")})
     out = {k: np.full((delays.size, pool.grid.size) + shape, np.nan) for k, shape in zip(pool.keys, pool.shapes)}
-    native = None if native_grid is None else np.full((delays.size, len(native_grid), 2), np.nan)
+    native = None if native_grid is None else np.full((delays.size, len(native_grid), pool.force_width), np.nan)
     weights, missing = np.zeros((delays.size, pool.size)), []
     cache: dict[float, tuple] = {}
     for i, d in enumerate(delays):
