@@ -94,7 +94,8 @@ def test_a_correct_chain_s_counts_are_green():
     assert k.verdict is d.verdict is v.estimates is True
     page = truth_verdicts_html(v, CORRECT)
     assert (
-        "<b>Truth</b> (3 synthetic subjects, 26 joint fits, 1 failed): verdict from the calibration run of 2026-12-01, "
+        "<b>Recovering the truth</b> (3 synthetic subjects, 26 joint fits, 1 failed): verdict from the calibration run "
+        "of 2026-12-01, "
         '<span data-q="verdict|calibration|n_subject_onset_fits" data-v="102">102</span> fits '
         '(<span data-q="verdict|calibration|n_subjects" data-v="34">34</span> subjects, seed 2024; coordinates level), '
         "design fingerprint 0123456789abcdef matches this run; ✓ when the calibration meets the target and this run's "
@@ -159,9 +160,10 @@ def test_a_calibration_of_another_design_gives_way_to_this_run_s_own_counts():
     assert v.estimates is False
     page = truth_verdicts_html(v, run)
     assert (
-        "<b>Truth</b> (3 synthetic subjects, 26 joint fits, 1 failed): the calibration run of 2026-12-01 (102 fits) "
-        "was made at another design (its fingerprint fedcba9876543210, this run's 0123456789abcdef): the verdicts rest "
-        "on this run's own counts, too few to decide (●) unless they alone reject the target (p &lt; 0.001: ✗)." in page
+        "<b>Recovering the truth</b> (3 synthetic subjects, 26 joint fits, 1 failed): the calibration run of "
+        "2026-12-01 (102 fits) was made at another design (its fingerprint fedcba9876543210, this run's "
+        "0123456789abcdef): the verdicts rest on this run's own counts, too few to decide (●) unless they alone "
+        "reject the target (p &lt; 0.001: ✗)." in page
     )
     assert "<b>Intervals: too few fits to decide</b>: this run's 95 % CIs hold the truth in " in page
     assert "/52 (87 %); target 90–98 %, not rejected (p = " in page

@@ -76,7 +76,7 @@ def _basis_line(v: TruthVerdicts, who: str) -> str:
         )
     else:
         said = f"no calibration run is named (report.calibration): {alone}"
-    return f"<li>{mark(None)}<b>Truth</b> ({who}): {said}.</li>"
+    return f"<li>{mark(None)}<b>Recovering the truth</b> ({who}): {said}.</li>"
 
 
 def _intervals_line(check: ShareCheck) -> str:
@@ -156,7 +156,7 @@ def truth_verdicts_html(verdicts: TruthVerdicts, truth: pd.DataFrame) -> str:
     failed = f", {n_failed} failed" if n_failed else ""
     who = f"{n_subjects} synthetic subject{'s' if n_subjects != 1 else ''}, {n_fits} joint fits{failed}"
     if n_fits == 0:
-        return f"<li>{mark(None)}<b>Truth</b> ({who}): no joint fitted.</li>"
+        return f"<li>{mark(None)}<b>Recovering the truth</b> ({who}): no joint fitted.</li>"
     return _basis_line(verdicts, who) + _intervals_line(verdicts.intervals) + _estimates_line(verdicts)
 
 
