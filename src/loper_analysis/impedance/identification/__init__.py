@@ -60,9 +60,11 @@ from loper_analysis.impedance.identification.status import (
     COUPLING_CORRELATION,
     DEFAULT_PLAUSIBLE_RANGES,
     MAX_CI_FRACTION,
+    MIN_RESPONSE_TO_RESIDUAL,
     MIN_VAF_PCT,
     check_plausible_range,
     joint_status,
+    response_and_residual_rms,
     strongest_coupling,
 )
 from loper_analysis.impedance.identification.window import (
@@ -124,9 +126,11 @@ __all__ = [
     "refit_with_null_pairs",
     "cross_validated_covariance",
     "MIN_VAF_PCT",
+    "MIN_RESPONSE_TO_RESIDUAL",
     "MAX_CI_FRACTION",
     "AT_BOUND_FRACTION",
     "joint_status",
+    "response_and_residual_rms",
     "strongest_coupling",
     "COUPLING_CORRELATION",
     "DEFAULT_PLAUSIBLE_RANGES",

@@ -14,7 +14,8 @@ and a status (``docs/identification.md``):
   plausible range (``plausible_ranges``: the data cannot tell its size), or
   is at least as wide as that range (the reason names the parameter of
   another joint it trades off against), or spans more than
-  ``max_ci_fraction`` of its bound range;
+  ``max_ci_fraction`` of its bound range, or the joint's model response is
+  smaller than its residual (``min_response_to_residual``);
 * ``missing``: no trial of that onset;
 * ``failed``: too few strides (the reason names ``impedance.window_after_s``
   when strides were too short for the window), the optimiser did not
@@ -44,6 +45,7 @@ from loper_analysis.impedance.identification import (
     MAX_CI_FRACTION,
     MERGE_TOLERANCE,
     MIN_NULL_PAIRS,
+    MIN_RESPONSE_TO_RESIDUAL,
     MIN_VAF_PCT,
     N_STARTS,
     N_SUBSTEPS,
@@ -55,6 +57,7 @@ from loper_analysis.impedance.identification import (
     identify_impedance,
     joint_status,
     refit_with_null_pairs,
+    response_and_residual_rms,
     strongest_coupling,
 )
 from loper_analysis.impedance.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
@@ -267,6 +270,7 @@ def impedance_rows(
     min_vaf_pct: float = MIN_VAF_PCT,
     at_bound_fraction: float = AT_BOUND_FRACTION,
     plausible_ranges: Mapping | None = None,
+    min_response_to_residual: float = MIN_RESPONSE_TO_RESIDUAL,
 ) -> pd.DataFrame:
     """One row per joint from an :class:`~loper_analysis.impedance.identification.ImpedanceFit` (columns
     :data:`IMPEDANCE_COLUMNS`).
@@ -280,8 +284,11 @@ def impedance_rows(
     entry of ``plausible_ranges`` (``{joint: {"stiffness_nm_per_rad": [low,
     high], "damping_nms_per_rad": [low, high]}}``; None:
     :data:`~loper_analysis.impedance.identification.DEFAULT_PLAUSIBLE_RANGES`),
-    ``max_ci_fraction``, ``min_vaf_pct`` and ``at_bound_fraction``.
+    ``max_ci_fraction``, ``min_vaf_pct``, ``at_bound_fraction`` and, against the RMS of each joint's model
+    response and residual (:func:`~loper_analysis.impedance.identification.response_and_residual_rms` of the fit's
+    ``measured`` and ``model``), ``min_response_to_residual``.
     """
+    response_rms, residual_rms = response_and_residual_rms(fit.measured, fit.model)
     rows = []
     for j, joint in enumerate(JOINTS):
         k, d = 2 * j, 2 * j + 1
@@ -328,6 +335,9 @@ def impedance_rows(
             min_vaf_pct=min_vaf_pct,
             at_bound_fraction=at_bound_fraction,
             coupling=coupling,
+            response_rms_rad=response_rms[j],
+            residual_rms_rad=residual_rms[j],
+            min_response_to_residual=min_response_to_residual,
         )
         row.update(status=status, reason=reason)
         if note:

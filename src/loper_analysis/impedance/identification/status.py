@@ -26,9 +26,15 @@ Rules (``docs/identification.md``, section "Fit status"), judged in this order:
    parameter: the data cannot separate the two joints' shares:
    ``not_identifiable``;
 6. the 95 % interval of K or D spans more than ``max_ci_fraction`` of the
-   bound range, or is infinite: ``not_identifiable``.
+   bound range, or is infinite: ``not_identifiable``;
+7. the joint's model response is smaller than its residual (RMS over the
+   window, ratio below ``min_response_to_residual``,
+   :data:`MIN_RESPONSE_TO_RESIDUAL` = 1; :func:`response_and_residual_rms`):
+   the residual, which the interval takes for noise, is larger than the
+   response K and D are fitted to, and the estimate can be biased beyond its
+   interval (a joint that barely moves in the window): ``not_identifiable``.
 
-Every finding of 2-6 is named in the reason (parameter or key, value and
+Every finding of 2-7 is named in the reason (parameter or key, value and
 limit); the status is the most severe. An estimate on a lower bound of zero
 is a valid estimate (no measurable stiffness or damping, e.g. the knee's K
 early in swing): by itself it adds nothing to the reason; rule 4 judges
@@ -45,12 +51,14 @@ from loper_analysis.reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANC
 
 __all__ = [
     "MIN_VAF_PCT",
+    "MIN_RESPONSE_TO_RESIDUAL",
     "MAX_CI_FRACTION",
     "AT_BOUND_FRACTION",
     "COUPLING_CORRELATION",
     "DEFAULT_PLAUSIBLE_RANGES",
     "check_plausible_range",
     "joint_status",
+    "response_and_residual_rms",
     "strongest_coupling",
 ]
 
@@ -61,6 +69,10 @@ AT_BOUND_FRACTION: float = 1e-6
 #: A K or D whose 95 % CI spans more than this share of its bound range is not identifiable (1: only an unbounded
 #: one; ``impedance.max_ci_fraction``).
 MAX_CI_FRACTION: float = 1.0
+
+#: A joint whose model response (RMS over the window) is smaller than this multiple of its residual's is not
+#: identifiable (rule 7): 1, the response no larger than what the fit leaves unexplained (a VAF of about 50 %).
+MIN_RESPONSE_TO_RESIDUAL: float = 1.0
 
 #: A parameter whose estimate correlates at least this strongly (absolute) with one of another joint trades off
 #: against it; a too-wide interval's reason names that parameter (rule 5).
@@ -89,6 +101,26 @@ def check_plausible_range(joint: str, plausible_range) -> np.ndarray:
             f"0 <= low < high, got {np.asarray(plausible_range).tolist()}"
         )
     return r
+
+
+def response_and_residual_rms(measured, model) -> tuple[np.ndarray, np.ndarray]:
+    """Per joint, the RMS of the model response and of the residual over the fit window.
+
+    Parameters
+    ----------
+    measured, model : (n, j) array_like
+        The measured response and the model's (rad; columns hip, knee, ankle), e.g. ``ImpedanceFit.measured``
+        and ``ImpedanceFit.model``.
+
+    Returns
+    -------
+    (numpy.ndarray, numpy.ndarray)
+        RMS of ``model`` and of ``measured - model`` per column (j,), rad.
+    """
+    y, f = np.asarray(measured, dtype=float), np.asarray(model, dtype=float)
+    if y.ndim != 2 or y.shape != f.shape or y.shape[0] == 0:
+        raise LoperInputError(f"measured and model must be one (n, j) shape with n >= 1, got {y.shape} and {f.shape}")
+    return np.sqrt(np.mean(f**2, axis=0)), np.sqrt(np.mean((y - f) ** 2, axis=0))
 
 
 def strongest_coupling(correlation, joint: str) -> tuple[tuple[str, float] | None, tuple[str, float] | None]:
@@ -137,6 +169,9 @@ def joint_status(
     min_vaf_pct: float = MIN_VAF_PCT,
     at_bound_fraction: float = AT_BOUND_FRACTION,
     coupling=None,
+    response_rms_rad: float | None = None,
+    residual_rms_rad: float | None = None,
+    min_response_to_residual: float = MIN_RESPONSE_TO_RESIDUAL,
 ) -> tuple[str, str]:
     """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
 
@@ -160,6 +195,11 @@ def joint_status(
         Per K and D the parameter of another joint it correlates with most strongly and that correlation
         (``("D_hip", -0.93)``), or None; named in the reason of a too-wide interval when
         ``|r| >= COUPLING_CORRELATION`` (rule 5).
+    response_rms_rad, residual_rms_rad : float, optional
+        RMS (rad) of the joint's model response and of its residual over the fit window
+        (:func:`response_and_residual_rms`); rule 7 is skipped when either is None or their ratio is undefined.
+    min_response_to_residual : float
+        Rule 7's least ratio of the two (> 0).
 
     Returns
     -------
@@ -174,6 +214,8 @@ def joint_status(
             raise LoperInputError(f"{joint}: {name} must hold K and D (2 values), got shape {a.shape}")
     if not (0 <= at_bound_fraction < 0.5):
         raise LoperInputError(f"at_bound_fraction must lie in [0, 0.5), got {at_bound_fraction}")
+    if not (min_response_to_residual > 0):
+        raise LoperInputError(f"min_response_to_residual must be > 0, got {min_response_to_residual}")
     if plausible_range is None:
         plausible_range = DEFAULT_PLAUSIBLE_RANGES.get(joint)
     plausible = None if plausible_range is None else check_plausible_range(joint, plausible_range)
@@ -214,6 +256,7 @@ def joint_status(
             f"95 % CI width K {widths[0]:.3g} N·m/rad, D {widths[1]:.3g} N·m·s/rad exceeds "
             f"{max_ci_fraction:g} of the bounds"
         )
+    unidentifiable += _response_findings(joint, response_rms_rad, residual_rms_rad, min_response_to_residual)
     status = "failed" if failed else ("not_identifiable" if unidentifiable else "ok")
     return status, "; ".join(failed + unidentifiable)
 
@@ -229,6 +272,25 @@ def _vaf_findings(joint: str, vaf_pct: float, min_vaf_pct: float) -> list[str]:
             f"the model does not describe the {joint} response"
         )
     return failed
+
+
+def _response_findings(
+    joint: str, response_rms: float | None, residual_rms: float | None, min_ratio: float
+) -> list[str]:
+    """Why the joint's K and D are not identifiable by the size of its response (rule 7): its model response's RMS
+    ``response_rms`` (rad) below ``min_ratio`` times its residual's ``residual_rms``; empty otherwise, or when
+    the ratio is undefined (either None or NaN, or both zero)."""
+    if response_rms is None or residual_rms is None:
+        return []
+    a, e = float(response_rms), float(residual_rms)
+    if not (np.isfinite(a) and np.isfinite(e)) or a >= min_ratio * e:
+        return []
+    ratio = a / e
+    return [
+        f"model response of the {joint} RMS {1e3 * a:.3g} mrad, {ratio:.2g} times its residual's {1e3 * e:.3g} mrad: "
+        f"below {min_ratio:g} (MIN_RESPONSE_TO_RESIDUAL), the residual the interval takes for noise is larger than "
+        f"the response K_{joint} and D_{joint} are fitted to, and they can be biased beyond their 95 % intervals"
+    ]
 
 
 def _bound_findings(joint: str, est: np.ndarray, lb: np.ndarray, ub: np.ndarray, at_bound_fraction: float) -> list[str]:
