@@ -573,8 +573,8 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
 
     ``impedance_sets``: (B, p) in the order of the window's :attr:`~PreparedWindow.parameters` (p = 6 without
     couplings: :data:`~loper_analysis.constants.PARAMETERS`); one batch of the compiled RK4
-    (:func:`loper_analysis.swing_leg.kernels.simulate_deviation_batch`, given the six as they are and, with
-    couplings, both coupling columns, 0 for a coupling the window does not hold).
+    (:func:`loper_analysis.swing_leg.kernels.simulate_deviation_batch`, given the six and, with couplings, both
+    coupling stiffnesses, 0 for a coupling the window does not hold; without couplings its variant without them).
     """
     sets = np.ascontiguousarray(np.asarray(impedance_sets, dtype=float))
     n = window.n_parameters
@@ -582,12 +582,12 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
         raise LoperInputError(
             f"impedance must be finite with {n} values per row ({', '.join(window.parameters)}), got shape {sets.shape}"
         )
+    extra = ()
     if window.couplings:
-        coupled = np.zeros((len(sets), len(PARAMETERS) + len(COUPLINGS)))
-        coupled[:, : len(PARAMETERS)] = sets[:, : len(PARAMETERS)]
+        stiffness = np.zeros((len(sets), len(COUPLINGS)))
         for k, c in enumerate(window.couplings):
-            coupled[:, len(PARAMETERS) + COUPLINGS.index(c)] = sets[:, len(PARAMETERS) + k]
-        sets = coupled
+            stiffness[:, COUPLINGS.index(c)] = sets[:, len(PARAMETERS) + k]
+        sets, extra = np.ascontiguousarray(sets[:, : len(PARAMETERS)]), (stiffness,)
     deviation, _ = kernels.simulate_deviation_batch(
         sets,
         window.params.packed,
@@ -603,6 +603,7 @@ def simulate_deviation(window: PreparedWindow, impedance_sets) -> np.ndarray:
         window.step_s,
         window.n_substeps,
         window.n_samples,
+        *extra,
     )
     return deviation
 
