@@ -162,7 +162,8 @@ def test_mat_bad_map_and_bad_variables(tmp_path):
         "column_map: column(s) force_desired_n not mapped to a .mat variable"
     )
     assert mat_refusal(mat, {**CMAP, "force_n": "Fd"}) == (
-        "column_map: unknown column(s) force_n; columns are " + ", ".join(COLUMNS)
+        "column_map: unknown column(s) force_n; columns are "
+        + ", ".join((*COLUMNS, "shank_force_desired_n", "shank_force_measured_n"))
     )
     assert mat_refusal(mat, {**CMAP, "force_measured_n": None}) == (
         "column_map: column 'force_measured_n' must map to a .mat variable (only time_s, sync_v, perturbation, "
@@ -231,3 +232,22 @@ def test_mat_writer_refuses_bad_names_and_leaves_nothing(tmp_path, names, match)
     with pytest.raises(LoperInputError, match=match):
         write_robot_log_mat(tmp_path / "rec.mat", make_frame(), FS, names)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_mat_with_a_second_rods_load_cell(tmp_path):
+    """The shank rod's two variables, mapped, come back as the log's last two columns with their values; one of
+    them mapped alone is refused naming the other."""
+    rng = np.random.default_rng(5)
+    desired, measured = 30.0 * rng.random(N), rng.random(N)
+    mat = _mat_frame(tmp_path, Fsd=desired, Fsm=measured)
+    cmap = {**CMAP, "shank_force_desired_n": "Fsd", "shank_force_measured_n": "Fsm"}
+    frame, _ = read_robot_log_mat(mat, cmap, FS)
+    assert tuple(frame.columns[-2:]) == ("shank_force_desired_n", "shank_force_measured_n")
+    np.testing.assert_array_equal(frame["shank_force_desired_n"], desired)
+    np.testing.assert_array_equal(frame["shank_force_measured_n"], measured)
+    plain, _ = read_robot_log_mat(mat, {**CMAP, "shank_force_desired_n": None}, FS)
+    assert tuple(plain.columns) == COLUMNS
+    assert mat_refusal(mat, {**CMAP, "shank_force_measured_n": "Fsm"}) == (
+        "column_map: column 'shank_force_measured_n' is mapped but 'shank_force_desired_n' is not: a second rod's "
+        "load cell needs both"
+    )

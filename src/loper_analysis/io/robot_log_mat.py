@@ -12,7 +12,7 @@ import pandas as pd
 
 from loper_analysis.checks import positive
 from loper_analysis.errors import LoperInputError
-from loper_analysis.io.robot_log import COLUMNS, FORMAT_NAME, validated_log
+from loper_analysis.io.robot_log import COLUMNS, FORMAT_NAME, SHANK_COLUMNS, validated_log
 from loper_analysis.timing import timed_io
 
 __all__ = ["MAT_OPTIONAL", "read_robot_log_mat"]
@@ -39,6 +39,9 @@ def read_robot_log_mat(
         Every column must be mapped, except that ``time_s`` may be absent or
         None (then ``time_s = arange(n) / sample_rate_hz``) and ``sync_v``,
         ``perturbation`` and ``safety_state`` may map to None (then zeros).
+        A robot with a second rod at the shank also maps its load cell's
+        :data:`~loper_analysis.io.robot_log.SHANK_COLUMNS` (both, or neither:
+        absent or None).
         Variables are numeric vectors of equal length n, stored as (n,),
         (n, 1) or (1, n).
     sample_rate_hz : float
@@ -49,7 +52,7 @@ def read_robot_log_mat(
     Returns
     -------
     frame : pandas.DataFrame
-        Shape (n, 8), as from :func:`read_robot_log`.
+        Shape (n, 8), or (n, 10) with the shank rod's columns, as from :func:`read_robot_log`.
     metadata : dict
         ``format``, ``sample_rate_hz`` (float, Hz) and ``source`` (the path).
 
@@ -72,15 +75,23 @@ def read_robot_log_mat(
         raise LoperInputError(f"time_scale must be a positive number, got {time_scale!r}")
     if not isinstance(column_map, Mapping):
         raise LoperInputError(f"column_map must be a mapping column -> .mat variable, got {type(column_map).__name__}")
-    unknown = [str(c) for c in column_map if c not in COLUMNS]
+    known = (*COLUMNS, *SHANK_COLUMNS)
+    unknown = [str(c) for c in column_map if c not in known]
     if unknown:
-        raise LoperInputError(f"column_map: unknown column(s) {', '.join(unknown)}; columns are {', '.join(COLUMNS)}")
+        raise LoperInputError(f"column_map: unknown column(s) {', '.join(unknown)}; columns are {', '.join(known)}")
+    shank = [c for c in SHANK_COLUMNS if column_map.get(c) is not None]
+    if len(shank) == 1:
+        other = next(c for c in SHANK_COLUMNS if c not in shank)
+        raise LoperInputError(
+            f"column_map: column '{shank[0]}' is mapped but '{other}' is not: a second rod's load cell needs both"
+        )
+    columns = (*COLUMNS, *SHANK_COLUMNS) if shank else COLUMNS
     unmapped = [c for c in COLUMNS if c != "time_s" and c not in column_map]
     if unmapped:
         raise LoperInputError(f"column_map: column(s) {', '.join(unmapped)} not mapped to a .mat variable")
     for col, var in column_map.items():
         if var is None:
-            if col != "time_s" and col not in MAT_OPTIONAL:
+            if col != "time_s" and col not in (*MAT_OPTIONAL, *SHANK_COLUMNS):
                 raise LoperInputError(
                     f"column_map: column '{col}' must map to a .mat variable (only time_s, "
                     f"{', '.join(MAT_OPTIONAL)} may be None)"
@@ -97,7 +108,7 @@ def read_robot_log_mat(
     available = sorted(k for k in contents if not k.startswith("__"))
 
     vectors: dict[str, np.ndarray] = {}
-    for col in COLUMNS:
+    for col in columns:
         var = column_map.get(col)
         if var is None:
             continue
@@ -128,5 +139,5 @@ def read_robot_log_mat(
         vectors["time_s"] = np.arange(n) / rate
     for col in MAT_OPTIONAL:
         vectors.setdefault(col, np.zeros(n))
-    frame = validated_log(pd.DataFrame({c: vectors[c] for c in COLUMNS}), rate, source)
+    frame = validated_log(pd.DataFrame({c: vectors[c] for c in columns}), rate, source)
     return frame, {"format": FORMAT_NAME, "sample_rate_hz": rate, "source": source}
