@@ -98,8 +98,10 @@ def binomial_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float
     return float(low), float(high)
 
 
-#: Words of the reason of a row whose joint responds less than its residual (rule 7 of ``joint_status``).
-RESPONSE_FINDING = "MIN_RESPONSE_TO_RESIDUAL"
+#: Words of the reason of a row whose interval the status says can miss the truth by more than its width (rules 7
+#: and 8 of ``joint_status``): the joint's model response smaller than its residual; the perturbed pairs' scatter
+#: beyond the interval's.
+DATA_FINDINGS = {"response": "MIN_RESPONSE_TO_RESIDUAL", "pair_scatter": "PAIR_SCATTER_LEVEL"}
 
 
 def _share(inside: pd.Series, has_ci: pd.Series) -> dict:
@@ -113,17 +115,20 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
     """Per joint and parameter, how often the 95 % intervals hold the truth, over three sets of rows.
 
     ``fits``: every fitted row (``ok`` or ``not_identifiable``) with an interval, as the table reports them;
-    ``standing``: those rows less the ones ``not_identifiable`` because the joint's model response is smaller
-    than its residual (their reason names :data:`RESPONSE_FINDING`: the status says their interval can miss a
-    bias); ``ok``: the rows still ``ok``. Each with the number of rows, how many intervals hold the truth, the
-    share (%) and its binomial (Clopper-Pearson) 95 % interval (%); the median width of the fitted rows'
-    intervals, the rows ``not_identifiable`` and those of them for the response.
+    ``standing``: those rows less the ones whose reason names one of :data:`DATA_FINDINGS` (the joint's model
+    response smaller than its residual, or the perturbed pairs' scatter beyond the interval's: the status says
+    their interval can miss the truth by more than it shows); ``ok``: the rows still ``ok``. Each with the number
+    of rows, how many intervals hold the truth, the share (%) and its binomial (Clopper-Pearson) 95 % interval (%);
+    the median width of the fitted rows' intervals, the rows ``not_identifiable`` and those whose reason names each
+    finding.
     """
     fitted = table[table["status"].isin(["ok", "not_identifiable"])]
     rows = []
     for joint in ("hip", "knee", "ankle"):
         g = fitted[fitted["joint"] == joint]
-        flagged = g["reason"].fillna("").str.contains(RESPONSE_FINDING, regex=False)
+        reason = g["reason"].fillna("")
+        found = {name: reason.str.contains(words, regex=False) for name, words in DATA_FINDINGS.items()}
+        flagged = found["response"] | found["pair_scatter"]
         for p, unit in (("K", "nm_per_rad"), ("D", "nms_per_rad")):
             low, high = g[f"{p}_ci95_low_{unit}"], g[f"{p}_ci95_high_{unit}"]
             truth = g[f"{p}_true_{unit}"]
@@ -139,7 +144,7 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
             row.update(
                 median_ci_width=float(np.median((high - low)[has_ci])) if has_ci.any() else np.nan,
                 n_not_identifiable=int((g["status"] == "not_identifiable").sum()),
-                n_response_below_residual=int(flagged.sum()),
+                **{f"n_{name}": int(f.sum()) for name, f in found.items()},
             )
             rows.append(row)
     return pd.DataFrame(rows)

@@ -20,12 +20,13 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.special import (
+    fdtri,  # quantile of the F distribution (what scipy.stats.f.ppf calls)
     stdtrit,  # Student's t quantile (what scipy.stats.t.ppf calls; scipy.stats costs ~0.5 s to import)
 )
 
 from loper_analysis.errors import LoperInputError
 
-__all__ = ["CI_LEVEL", "t_quantile", "bounded_interval", "sandwich_covariance"]
+__all__ = ["CI_LEVEL", "t_quantile", "f_quantile", "bounded_interval", "sandwich_covariance"]
 
 #: Confidence level of the reported intervals.
 CI_LEVEL: float = 0.95
@@ -38,6 +39,21 @@ def t_quantile(dof: float, level: float = CI_LEVEL) -> float:
     if not 0 < level < 1:
         raise LoperInputError(f"confidence level must lie in (0, 1), got {level}")
     return float(stdtrit(dof, 0.5 + level / 2))
+
+
+def f_quantile(dof_numerator: float, dof_denominator: float, level: float) -> float:
+    """Quantile ``level`` of the F distribution with the given degrees of freedom (each >= 1).
+
+    The variance ratio ``s1^2 / s2^2`` of two independent estimates of one variance, with ``dof_numerator`` and
+    ``dof_denominator`` degrees of freedom, exceeds it with probability ``1 - level``.
+    """
+    if not (dof_numerator >= 1 and dof_denominator >= 1):
+        raise LoperInputError(
+            f"degrees of freedom of an F quantile must be >= 1, got {dof_numerator}, {dof_denominator}"
+        )
+    if not 0 < level < 1:
+        raise LoperInputError(f"F quantile level must lie in (0, 1), got {level}")
+    return float(fdtri(dof_numerator, dof_denominator, level))
 
 
 def bounded_interval(estimate, sd, dof: float, lower, upper, level: float = CI_LEVEL) -> tuple[np.ndarray, np.ndarray]:
