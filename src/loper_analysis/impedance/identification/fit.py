@@ -33,12 +33,19 @@ from scipy.optimize import least_squares
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification.intervals import bounded_interval, sandwich_covariance
-from loper_analysis.impedance.identification.window import (
-    PreparedWindow,
+from loper_analysis.impedance.identification.parameters import (
+    COUPLING_BOUNDS_NM_PER_RAD,
+    DAMPING_BOUNDS_NMS_PER_RAD,
+    DEFAULT_LOWER,
+    DEFAULT_UPPER,
+    STIFFNESS_BOUNDS_NM_PER_RAD,
+    FitBounds,
+    check_bounds,
     check_couplings,
-    prediction_error,
-    simulate_response,
+    fit_bounds,
+    parameter_bounds,
 )
+from loper_analysis.impedance.identification.window import PreparedWindow, prediction_error, simulate_response
 
 __all__ = [
     "DEFAULT_LOWER",
@@ -64,19 +71,6 @@ __all__ = [
     "variance_accounted_for",
 ]
 
-#: Default bounds of every K (N·m/rad; ``impedance.stiffness_bounds_nm_per_rad``) ...
-STIFFNESS_BOUNDS_NM_PER_RAD: tuple[float, float] = (0.0, 200.0)
-#: ... and of every D (N·m·s/rad; ``impedance.damping_bounds_nms_per_rad``).
-DAMPING_BOUNDS_NMS_PER_RAD: tuple[float, float] = (0.0, 10.0)
-#: ... and of every inter-joint coupling stiffness (N·m/rad; docs/identification.md, "Bi-articular stiffness"): a
-#: leg whose joint stiffness is spring-like (muscles as springs across one or two joints, feedback about each
-#: joint) has a positive semi-definite stiffness matrix, so |K_hip_knee| <= sqrt(K_hip K_knee), at most the
-#: stiffness bound's upper end; either sign: rectus femoris and the hamstrings (each flexing one joint and
-#: extending the other) give a negative coupling, sartorius and gracilis (flexing both) a positive one.
-COUPLING_BOUNDS_NM_PER_RAD: tuple[float, float] = (-200.0, 200.0)
-#: Default bounds (K N m/rad, D N m s/rad), order of :data:`PARAMETERS` (:func:`parameter_bounds` of the two above).
-DEFAULT_LOWER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[0], DAMPING_BOUNDS_NMS_PER_RAD[0]] * 3, float)
-DEFAULT_UPPER = np.array([STIFFNESS_BOUNDS_NM_PER_RAD[1], DAMPING_BOUNDS_NMS_PER_RAD[1]] * 3, float)
 #: Random starts drawn uniformly inside the bounds (``impedance.n_starts``).
 N_STARTS: int = 10
 #: Relative cost/step tolerance of the multistart phase (``impedance.tolerance``).
@@ -160,80 +154,6 @@ def variance_accounted_for(measured: np.ndarray, model: np.ndarray) -> np.ndarra
     den = np.sum(measured**2, axis=0)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(den > 0, 100.0 * (1.0 - num / den), np.nan)
-
-
-def parameter_bounds(
-    stiffness_bounds, damping_bounds, couplings=(), coupling_bounds=COUPLING_BOUNDS_NM_PER_RAD
-) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds (p,) in the order of :data:`PARAMETERS` from one (low, high) pair for every K
-    (N·m/rad) and one for every D (N·m·s/rad), then ``coupling_bounds`` (low, high; N·m/rad) for each of the
-    inter-joint ``couplings`` (p = 6 + their number)."""
-    k, d = tuple(stiffness_bounds), tuple(damping_bounds)
-    n = len(check_couplings(couplings))
-    c = tuple(coupling_bounds)
-    return np.array([k[0], d[0]] * 3 + [c[0]] * n, float), np.array([k[1], d[1]] * 3 + [c[1]] * n, float)
-
-
-class FitBounds:
-    """Base of a settings dataclass that holds the fit's bounds: its K and D bound vectors.
-
-    The subclass has the fields ``stiffness_bounds_nm_per_rad`` (low, high; N·m/rad, every K) and
-    ``damping_bounds_nms_per_rad`` (low, high; N·m·s/rad, every D), and may have ``couplings`` (inter-joint
-    couplings fitted besides them) and ``coupling_bounds_nm_per_rad`` (low, high; N·m/rad, default
-    :data:`COUPLING_BOUNDS_NM_PER_RAD`); :attr:`lower` and :attr:`upper` are the bounds (p,) in the order of
-    :data:`PARAMETERS`, then the couplings' (:func:`parameter_bounds`).
-    """
-
-    stiffness_bounds_nm_per_rad: tuple[float, float]
-    damping_bounds_nms_per_rad: tuple[float, float]
-
-    def _bounds(self) -> tuple[np.ndarray, np.ndarray]:
-        return parameter_bounds(
-            self.stiffness_bounds_nm_per_rad,
-            self.damping_bounds_nms_per_rad,
-            getattr(self, "couplings", ()),
-            getattr(self, "coupling_bounds_nm_per_rad", COUPLING_BOUNDS_NM_PER_RAD),
-        )
-
-    @property
-    def lower(self) -> np.ndarray:
-        return self._bounds()[0]
-
-    @property
-    def upper(self) -> np.ndarray:
-        return self._bounds()[1]
-
-
-def check_bounds(lower, upper, parameters: tuple[str, ...] = PARAMETERS) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper bounds as (p,) arrays, p = ``len(parameters)`` (names for the messages), each finite and
-    lower below upper."""
-    lb = np.asarray(lower, dtype=float)
-    ub = np.asarray(upper, dtype=float)
-    n = len(parameters)
-    for name, b in (("lower", lb), ("upper", ub)):
-        if b.shape != (n,) or not np.all(np.isfinite(b)):
-            raise LoperInputError(f"{name} bounds must be {n} finite values ({', '.join(parameters)}), got {b}")
-    bad = np.flatnonzero(lb >= ub)
-    if bad.size:
-        i = bad[0]
-        raise LoperInputError(f"bounds of {parameters[i]}: lower {lb[i]} must be below upper {ub[i]}")
-    return lb, ub
-
-
-def fit_bounds(lower, upper, couplings=()) -> tuple[np.ndarray, np.ndarray]:
-    """The bounds (p,) of a fit with the inter-joint ``couplings``, checked (:func:`check_bounds`).
-
-    ``lower``, ``upper``: (6 + number of couplings,) values, or the six of K and D alone, to which each
-    coupling's :data:`COUPLING_BOUNDS_NM_PER_RAD` is appended.
-    """
-    couplings = check_couplings(couplings)
-    names = PARAMETERS + tuple(f"K_{c}" for c in couplings)
-    lb = np.asarray(lower, dtype=float)
-    ub = np.asarray(upper, dtype=float)
-    if couplings and lb.shape == (len(PARAMETERS),) and ub.shape == (len(PARAMETERS),):
-        lb = np.concatenate([lb, np.full(len(couplings), COUPLING_BOUNDS_NM_PER_RAD[0])])
-        ub = np.concatenate([ub, np.full(len(couplings), COUPLING_BOUNDS_NM_PER_RAD[1])])
-    return check_bounds(lb, ub, names)
 
 
 class ResidualBatch:

@@ -18,8 +18,10 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from loper_analysis.checks import finite_rows
-from loper_analysis.constants import COUPLING_PARAMETERS, COUPLINGS, PARAMETERS
+from loper_analysis.constants import COUPLINGS, PARAMETERS
 from loper_analysis.errors import LoperInputError
+from loper_analysis.impedance.identification.parameters import check_couplings, parameter_names
+from loper_analysis.impedance.identification.stage_forces import per_step, stage_force_means, step_stage_forces
 from loper_analysis.impedance.responses.response_window import (
     INITIAL_STATE_SPAN_S,
     WINDOW_AFTER_S,
@@ -127,34 +129,12 @@ class PreparedWindow:
     @property
     def parameters(self) -> tuple[str, ...]:
         """Names of a parameter vector's entries: :data:`PARAMETERS`, then ``K_<coupling>`` per coupling."""
-        return PARAMETERS + tuple(f"K_{c}" for c in self.couplings)
+        return parameter_names(self.couplings)
 
     @property
     def n_parameters(self) -> int:
         """Length of a parameter vector of this window: 6 plus one per coupling."""
         return len(PARAMETERS) + len(self.couplings)
-
-
-def check_couplings(couplings) -> tuple[str, ...]:
-    """Inter-joint couplings as a tuple in the order of :data:`~loper_analysis.constants.COUPLINGS`.
-
-    ``couplings``: an iterable of their names (``"hip_knee"``, ``"knee_ankle"``) or of their parameter names
-    (``"K_hip_knee"``, ...); each at most once.
-
-    Raises
-    ------
-    LoperInputError
-        An unknown name, a repeated one, or a plain string instead of a collection of names.
-    """
-    if isinstance(couplings, str):
-        raise LoperInputError(f"couplings must be a collection of names from {COUPLINGS}, got the string {couplings!r}")
-    names = [c[2:] if c in COUPLING_PARAMETERS else c for c in couplings]
-    unknown = [c for c in names if c not in COUPLINGS]
-    if unknown:
-        raise LoperInputError(f"unknown inter-joint coupling(s) {unknown}; known: {', '.join(COUPLINGS)}")
-    if len(set(names)) != len(names):
-        raise LoperInputError(f"an inter-joint coupling is named twice: {list(couplings)}")
-    return tuple(c for c in COUPLINGS if c in names)
 
 
 def _column(name: str, value, n: int, width: int, like: str = "time_s") -> np.ndarray:
@@ -469,59 +449,6 @@ def stage_times_s(window: PreparedWindow) -> np.ndarray:
     return window.time_s[0] + 0.5 * window.step_s * np.arange(2 * n_steps + 1)
 
 
-def per_step(stage: np.ndarray) -> np.ndarray:
-    """Stage values (2 N + 1, 2) at :func:`stage_times_s` -> the force at the four stages of each step (N, 4, 2).
-
-    Start, middle, middle, end: plain RK4 with the force evaluated at the stage times (the
-    ``force_perturbed_n`` layout of :class:`PreparedWindow`).
-    """
-    return np.stack([stage[:-1:2], stage[1::2], stage[1::2], stage[2::2]], axis=1)
-
-
-def step_stage_forces(
-    force_time_s: np.ndarray, force_n: np.ndarray, start_s: float, step_s: float, n_steps: int
-) -> np.ndarray:
-    """Stage forces (n_steps, 4, 2) that give each RK4 step the exact response of a linear system to the force.
-
-    RK4 on ``y' = A y + b F(t)`` adds per step of length h
-    ``h/6 [(1 + hA + h²A²/2 + h³A³/4) F1 + (2 + hA + h²A²/2) F2 + (2 + hA) F3 + F4] b``;
-    the exact forced response is ``sum_j A^j / j! R_j b`` with the moments
-    ``R_j = int_0^h (h - s)^j F(s) ds``. Equating the powers of A up to the
-    third, RK4's own order, gives ``F1 = 4 R3 / h^4``, ``F1 + F2 = 6 R2 / h^3``,
-    ``F1 + F2 + F3 = 6 R1 / h^2`` and ``F1 + 2 F2 + 2 F3 + F4 = 6 R0 / h``: the
-    step then carries the force's impulse and its timing within the step
-    exactly, however fast its edges (a constant force gives F1 = .. = F4 = F).
-    The force is the cubic spline (not-a-knot) through its samples ``force_n``
-    (k, 2) at ``force_time_s`` (k,); the moments are exact (4-point
-    Gauss-Legendre on every piece between samples and step boundaries).
-    """
-    tf = np.asarray(force_time_s, dtype=float)
-    f = np.asarray(force_n, dtype=float)
-    h = float(step_s)
-    bounds = start_s + h * np.arange(n_steps + 1)
-    inner = tf[(tf > bounds[0]) & (tf < bounds[-1])]
-    edges = np.unique(np.concatenate([bounds, inner]))
-    a, b = edges[:-1], edges[1:]
-    keep = b - a > 1e-12 * h
-    a, b = a[keep], b[keep]
-    mid, half = 0.5 * (a + b), 0.5 * (b - a)
-    step_of = np.clip(np.floor((mid - start_s) / h).astype(int), 0, n_steps - 1)
-    nodes, weights = np.polynomial.legendre.leggauss(4)
-    x = mid[:, None] + half[:, None] * nodes
-    wq = half[:, None] * weights
-    fx = CubicSpline(tf, f, axis=0)(x)  # (n_piece, 4, 2)
-    r = bounds[step_of + 1][:, None] - x  # time to the step's end
-    R = np.zeros((4, n_steps, 2))
-    for j in range(4):
-        np.add.at(R[j], step_of, np.sum((wq * r**j)[..., None] * fx, axis=1))
-    F = np.empty((n_steps, 4, 2))
-    F[:, 0] = 4.0 * R[3] / h**4
-    F[:, 1] = 6.0 * R[2] / h**3 - F[:, 0]
-    F[:, 2] = 6.0 * R[1] / h**2 - F[:, 0] - F[:, 1]
-    F[:, 3] = 6.0 * R[0] / h - F[:, 0] - 2.0 * F[:, 1] - 2.0 * F[:, 2]
-    return F
-
-
 def _finite_times(name: str, value, min_samples: int) -> np.ndarray:
     """Sample times (s) as a 1-D float array of at least ``min_samples`` finite values; ``name`` in messages."""
     t = np.asarray(value, dtype=float)
@@ -539,28 +466,6 @@ def _force_clock(force_time_s) -> np.ndarray:
         i = int(np.argmax(d <= 0))
         raise LoperInputError(f"force_time_s must be strictly increasing; step at sample {i} is {d[i]} s")
     return tf
-
-
-def stage_force_means(force_time_s: np.ndarray, force_n: np.ndarray, stage_time_s: np.ndarray) -> np.ndarray:
-    """Means (n_stage, 2) of a sampled force over the Simpson cells of RK4 stage times.
-
-    ``stage_time_s`` (2 N + 1,) are the RK4 stage times of N steps of length
-    h, every h / 2 from the window start. RK4 weights a step's start, middle
-    and end by 1/6, 4/6 and 1/6 of h; the cells ``[t - h/6, t + h/6]`` around
-    a step boundary and ``[t - h/3, t + h/3]`` around a midpoint (clipped to
-    the window) therefore tile the window, and the mean of the force over
-    each cell makes every step's stage-weighted force equal the force's exact
-    integral over the step. The force is the cubic spline (not-a-knot) through
-    its samples ``force_n`` (k, 2) at ``force_time_s`` (k,), integrated exactly.
-    """
-    ts = np.asarray(stage_time_s, dtype=float)
-    h = 2.0 * (ts[1] - ts[0])
-    half = np.where(np.arange(len(ts)) % 2 == 0, h / 6.0, h / 3.0)
-    lo = np.maximum(ts - half, ts[0])
-    hi = np.minimum(ts + half, ts[-1])
-    spline = CubicSpline(np.asarray(force_time_s, dtype=float), np.asarray(force_n, dtype=float), axis=0)
-    integral = spline.antiderivative()
-    return (integral(hi) - integral(lo)) / (hi - lo)[:, None]
 
 
 def initial_state_basis(tau: np.ndarray, degree: int) -> np.ndarray:
