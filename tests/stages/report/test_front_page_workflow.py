@@ -1,7 +1,7 @@
 """The front page's truth verdicts through the workflow: the rule ``front_page`` takes the calibration table named by
 ``report.calibration`` as an input, and the page says whether it calibrates this run's design.
 
-A short study on a copy of the workflow (one synthetic subject, 25 s trials, one onset, no device tests, a small
+A short study on a copy of the workflow (one synthetic subject, 60 s trials, one onset, no device tests, a small
 validation study), with a calibration table written for its design (its fingerprint as the report's settings
 compute it from the same config), then one of another design: only the front page reruns.
 """
@@ -26,12 +26,13 @@ PATHS = study_paths()
 
 
 def _short_study(work: Path) -> dict:
-    """The shipped config, made short: one synthetic subject, one 25 s trial at 50 ms, no device tests."""
+    """The shipped config, made short: one synthetic subject, one 60 s trial at 50 ms (enough perturbed strides for
+    a fit), no device tests."""
     config = yaml.safe_load((work / "config/config.yaml").read_text())
     (work / "config/subjects.tsv").write_text(
         "subject\tsource\tsex\tage_yr\theight_m\tmass_kg\nS01\tsynthetic\tmale\t26\t1.80\t72.0\n"
     )
-    config["synthetic"]["walking_duration_s"] = 25.0
+    config["synthetic"]["walking_duration_s"] = 60.0
     config["study"].update(perturbation_onsets_ms=[50], perturbation_repeats=1)
     config["impedance"]["n_starts"] = 3
     config["validation"].update(stiffness_levels_nm_per_rad=[0.0, 150.0], damping_levels_nms_per_rad=[0.0, 4.0])
@@ -70,7 +71,7 @@ def test_the_front_page_takes_its_truth_verdicts_from_the_named_calibration(tmp_
     page = (work / PATHS.report.front_page).read_text()
     assert "verdict from the calibration run of 2026-12-01, " in page
     assert f"design fingerprint {report.design_fingerprint} matches this run" in page
-    assert "(1 synthetic subject, 3 joint fits" in page and "calibration<br>within tol." in page
+    assert "<b>Recovering the truth</b> (1 synthetic subject, " in page and "calibration<br>within tol." in page
 
     # a calibration of another design: the rule reruns for its input alone, and the page says so
     _write_calibration(calibration, "0123456789abcdef", "2026-12-02")
