@@ -174,9 +174,9 @@ def test_fragment_numbers_are_the_tables_numbers():
     assert found["verdict|truth|n_truth_in_ci95"] == (4, "4")
     assert found["verdict|truth|p_reject_ci95"][0] == pytest.approx(0.114265, abs=1e-6)
     assert found["verdict|truth|p_reject_ci95"][1] == "0.11"
-    assert "no calibration run is named (report.calibration)" in page
-    assert "<b>Intervals: too few fits to decide</b>: this run's 95 % CIs hold the truth in " in page
-    assert "</span>/6 (67 %); target 90–98 %, not rejected (p = " in page
+    assert "no calibration run named (report.calibration)" in page
+    assert "<b>Intervals: too few fits to decide</b>: this run " in page
+    assert "</span>/6 (67 %), target 90–98 %, not rejected (p = " in page
     assert "<b>Estimates: too few fits to decide</b>: this run K " in page
     assert found["verdict|transparency|n_transparent"] == (1, "1") and "Transparent</b>" in page
     assert found["verdict|device|max_abs_difference_pct"][1] == "3.3"  # overshoot 31.5 against 30.5
@@ -310,9 +310,11 @@ def test_the_file_step_takes_the_verdicts_from_a_calibration_of_this_design(tmp_
     assert (
         "verdict from the calibration run of 2026-12-01, "
         '<span data-q="verdict|calibration|n_subject_onset_fits" data-v="102">102</span> fits '
-        '(<span data-q="verdict|calibration|n_subjects" data-v="34">34</span> subjects, seed 2024; coordinates level), '
-        "design fingerprint 0123456789abcdef matches this run" in page
+        '(<span data-q="verdict|calibration|n_subjects" data-v="34">34</span> subjects, seed 2024), design '
+        "fingerprint matches this run." in page
     )
+    assert "Verdicts on the truth: ✓ when the calibration run's share meets the target" in page  # the rule, stated
+    assert "(coordinates level, loper-analysis 0.1.0, commit abc1234, design fingerprint 0123456789abcdef)." in page
     found = _Numbers()
     found.feed(page)
     assert found.found["verdict|calibration|n_truth_in_ci95"] == (564, "564")
@@ -324,7 +326,7 @@ def test_the_file_step_takes_the_verdicts_from_a_calibration_of_this_design(tmp_
     assert "calibration<br>within tol." in page
     # the same calibration of another design: the run's own counts, with the fallback's wording
     page = _front_page(tmp_path, calibration=_calibration_file(tmp_path), fingerprint="fedcba9876543210")
-    assert "was made at another design (its fingerprint 0123456789abcdef, this run's fedcba9876543210)" in page
+    assert "is of another design (fingerprint 0123456789abcdef; this run fedcba9876543210)" in page
     assert "too few to decide" in page and "calibration<br>within tol." not in page
 
 

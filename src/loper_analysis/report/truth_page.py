@@ -22,7 +22,7 @@ from loper_analysis.report.headline import PARAMETER_KINDS
 from loper_analysis.report.html_format import count, decimals, g, mark, num, pct
 from loper_analysis.report.truth_verdict import CONSISTENCY_P, REJECT_P, ShareCheck, TruthVerdicts
 
-__all__ = ["truth_table_html", "truth_verdicts_html"]
+__all__ = ["RULE", "truth_table_html", "truth_verdicts_html"]
 
 
 def _p(p: float, key: str) -> str:
@@ -50,32 +50,23 @@ def _target(check: ShareCheck) -> str:
 
 
 def _basis_line(v: TruthVerdicts, who: str) -> str:
-    """What the verdicts rest on: the calibration run (its date, size, seed, design) or this run alone."""
+    """What the verdicts rest on: the calibration run (its date, size and seed) or this run alone."""
     c = v.calibration
-    rule = (
-        f"✓ when the calibration meets the target and this run's counts agree with its share (two-sided binomial "
-        f"p ≥ {CONSISTENCY_P:g}), ✗ otherwise"
-    )
-    alone = (
-        "the verdicts rest on this run's own counts, too few to decide (●) unless they alone reject the target "
-        f"(p &lt; {REJECT_P:g}: ✗)"
-    )
+    alone = f"this run's own counts, too few to decide unless they reject the target (p &lt; {REJECT_P:g})"
     if v.basis == "calibration":
         said = (
             f"verdict from the calibration run of {html.escape(c.date)}, "
             f"{count(c.n_subject_onset_fits, 'verdict|calibration|n_subject_onset_fits')} fits "
-            f"({count(c.n_subjects, 'verdict|calibration|n_subjects')} subjects, seed {c.seed}; "
-            f"{html.escape(c.mode)} level), design fingerprint {html.escape(c.design_fingerprint)} matches this "
-            f"run; {rule}"
+            f"({count(c.n_subjects, 'verdict|calibration|n_subjects')} subjects, seed {c.seed}), design fingerprint "
+            "matches this run"
         )
     elif v.basis == "other_design":
         said = (
-            f"the calibration run of {html.escape(c.date)} ({c.n_subject_onset_fits} fits) was made at another "
-            f"design (its fingerprint {html.escape(c.design_fingerprint)}, this run's {html.escape(v.fingerprint)}): "
-            f"{alone}"
+            f"the calibration run of {html.escape(c.date)} ({c.n_subject_onset_fits} fits) is of another design "
+            f"(fingerprint {html.escape(c.design_fingerprint)}; this run {html.escape(v.fingerprint)}): {alone}"
         )
     else:
-        said = f"no calibration run is named (report.calibration): {alone}"
+        said = f"no calibration run named (report.calibration): {alone}"
     return f"<li>{mark(None)}<b>Recovering the truth</b> ({who}): {said}.</li>"
 
 
@@ -93,17 +84,14 @@ def _intervals_line(check: ShareCheck) -> str:
     if check.calibration is None:
         judged = "rejected" if check.verdict is False else "not rejected"
         said = (
-            f"this run's 95 % CIs hold the truth in {run}; target {_target(check)}, {judged} "
-            f"({_p(check.p_reject, 'verdict|truth|p_reject_ci95')})"
+            f"this run {run}, target {_target(check)}, {judged} ({_p(check.p_reject, 'verdict|truth|p_reject_ci95')})"
         )
     else:
         c_n, c_total = check.calibration
         agree = "agreeing" if check.p_consistent >= CONSISTENCY_P else "disagreeing"
-        more = f"binomial 95 % interval {_interval(check)}, target {_target(check)}"
         said = (
-            f"the calibration's 95 % CIs hold the truth in "
-            f"{_share(c_n, c_total, 'verdict|calibration|n_truth_in_ci95', more)}; this run {run}, {agree} with it "
-            f"({_p(check.p_consistent, 'verdict|truth|p_consistent_ci95')})"
+            f"calibration {_share(c_n, c_total, 'verdict|calibration|n_truth_in_ci95', _interval(check))}, target "
+            f"{_target(check)}; this run {run}, {agree} ({_p(check.p_consistent, 'verdict|truth|p_consistent_ci95')})"
         )
     return f"<li>{mark(check.verdict)}<b>{title}</b>: {said}.</li>"
 
@@ -123,16 +111,25 @@ def _estimates_line(v: TruthVerdicts) -> str:
     target = _target(next(iter(checks.values())))
     if not calibrated:
         ps = ", ".join(_p(c.p_reject, f"verdict|truth|{p}_p_reject_within") for p, c in checks.items())
-        said = f"this run {run}; target {target} each ({ps} against it)"
+        judged = "rejected" if v.estimates is False else "not rejected"
+        said = f"this run {run}, target {target}, {judged} ({ps})"
     else:
         cal = ", ".join(
             f"{p} {_share(*c.calibration, f'verdict|calibration|{p}_n_within_tolerance', _interval(c))}"
             for p, c in checks.items()
         )
         ps = ", ".join(_p(c.p_consistent, f"verdict|truth|{p}_p_consistent_within") for p, c in checks.items())
-        agree = "disagreeing" if off_here else "agreeing"
-        said = f"the calibration's within tolerance {cal}, target {target} each; this run {run}, {agree} with it ({ps})"
+        said = f"calibration {cal}, target {target}; this run {run}, {'disagreeing' if off_here else 'agreeing'} ({ps})"
     return f"<li>{mark(v.estimates)}<b>{title}</b>: {said}.</li>"
+
+
+#: The rule of the verdicts, as the note under the truth-recovery table states it.
+RULE = (
+    f"Verdicts on the truth: ✓ when the calibration run's share meets the target (its binomial 95 % interval reaches "
+    f"it) and this run's count agrees with that share (two-sided binomial p ≥ {CONSISTENCY_P:g}), ✗ otherwise; "
+    "without a calibration of this run's design, this run's own counts: ● unless they reject the target (one-sided "
+    f"binomial p &lt; {REJECT_P:g}: ✗). Intervals: K and D of every fit pooled; estimates: K and D each."
+)
 
 
 def truth_verdicts_html(verdicts: TruthVerdicts, truth: pd.DataFrame) -> str:
@@ -212,10 +209,14 @@ def truth_table_html(truth: pd.DataFrame, calibration: Calibration | None = None
                 f"{_calibration_cells(calibration, p, str(r['joint']))}</tr>"
             )
     (k_rel, k_abs), (d_rel, d_abs) = TRUTH_TOLERANCE["K"], TRUTH_TOLERANCE["D"]
-    extra, said = "", ""
+    extra, said = "", f" {RULE}"
     if calibration is not None:
         extra = '<th class="lf-dim">calibration<br>within tol.</th><th class="lf-dim">calibration<br>truth in CI</th>'
-        said = f" Calibration: the shares of the calibration run of {html.escape(calibration.date)}."
+        said += (
+            f" Calibration: the shares of the calibration run of {html.escape(calibration.date)} "
+            f"({html.escape(calibration.mode)} level, {html.escape(calibration.code_version)}, design fingerprint "
+            f"{html.escape(calibration.design_fingerprint)})."
+        )
     return (
         '<table id="lf-truth-recovery"><caption>Truth recovery: estimate − truth</caption>'
         '<thead><tr><th class="lf-l"></th><th>fits</th><th>mean<br>error</th><th>median |error|<br>'

@@ -70,7 +70,7 @@ def test_the_front_page_takes_its_truth_verdicts_from_the_named_calibration(tmp_
     assert res.returncode == 0, res.stderr[-3000:]
     page = (work / PATHS.report.front_page).read_text()
     assert "verdict from the calibration run of 2026-12-01, " in page
-    assert f"design fingerprint {report.design_fingerprint} matches this run" in page
+    assert "design fingerprint matches this run." in page and f"design fingerprint {report.design_fingerprint})" in page
     assert "<b>Recovering the truth</b> (1 synthetic subject, " in page and "calibration<br>within tol." in page
 
     # a calibration of another design: the rule reruns for its input alone, and the page says so
@@ -81,7 +81,6 @@ def test_the_front_page_takes_its_truth_verdicts_from_the_named_calibration(tmp_
     assert res.returncode == 0, res.stderr[-3000:]
     page = (work / PATHS.report.front_page).read_text()
     assert (
-        "the calibration run of 2026-12-02 (102 fits) was made at another design (its fingerprint "
-        f"0123456789abcdef, this run's {report.design_fingerprint}): the verdicts rest on this run's own counts, "
-        "too few to decide" in page
+        "the calibration run of 2026-12-02 (102 fits) is of another design (fingerprint 0123456789abcdef; this run "
+        f"{report.design_fingerprint}): this run's own counts, too few to decide" in page
     )
