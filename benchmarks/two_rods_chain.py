@@ -120,9 +120,8 @@ def main() -> None:
         plan_path = run / "results/planning/plan.tsv"
         if plan_path.is_file():
             table = planner_over_fits(fits, pd.read_csv(plan_path, sep="\t"))
-            print(
-                f"\nplanner over the fits' reported SE: {int(table['within_25pct'].sum())} of {len(table)} within ±25 %\n"
-            )
+            within = int(table["within_25pct"].sum())
+            print(f"\nplanner over the fits' reported SE: {within} of {len(table)} within ±25 %\n")
             print(markdown_table(table.round(4)))
         print()
 
