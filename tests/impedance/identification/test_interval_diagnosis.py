@@ -212,7 +212,7 @@ def test_strides_that_answer_with_their_own_ankle_stiffness_are_not_identifiable
     for seed in range(5):
         windows, mean, full = _pairs(ks, seed)
         sd, dof = jackknife_sd(mean, full.estimate, windows, lower=SETTINGS.lower, upper=SETTINGS.upper)
-        rows = impedance_rows(full, "S01", 175, len(ks), lower=LOWER, upper=UPPER, jackknife_sd=sd, jackknife_dof=dof)
+        rows = impedance_rows(full, "S01", 175, len(ks), lower=LOWER, upper=UPPER, jackknife=(sd, dof))
         rows = rows.set_index("joint")
         flagged += "K_ankle: the perturbed pairs' jackknife SD" in rows.loc["ankle", "reason"]
         hip_flagged += "PAIR_SCATTER_LEVEL" in rows.loc["hip", "reason"]
@@ -227,5 +227,5 @@ def test_strides_that_answer_with_their_own_ankle_stiffness_are_not_identifiable
     for seed in range(5):
         windows, mean, full = _pairs([8.0] * 10, seed)
         sd, dof = jackknife_sd(mean, full.estimate, windows, lower=SETTINGS.lower, upper=SETTINGS.upper)
-        rows = impedance_rows(full, "S01", 175, 10, lower=LOWER, upper=UPPER, jackknife_sd=sd, jackknife_dof=dof)
+        rows = impedance_rows(full, "S01", 175, 10, lower=LOWER, upper=UPPER, jackknife=(sd, dof))
         assert "PAIR_SCATTER_LEVEL" not in "".join(rows["reason"].fillna(""))

@@ -55,13 +55,13 @@ from loper_analysis.impedance.identification import (
     FitBounds,
     ImpedanceFit,
     check_interval_scatter,
+    data_finding_inputs,
     identify_impedance,
     joint_status,
     refit_with_null_pairs,
-    response_and_residual_rms,
     strongest_coupling,
 )
-from loper_analysis.impedance.identification.jackknife import jackknife_sd as pair_jackknife_sd
+from loper_analysis.impedance.identification.jackknife import onset_jackknife
 from loper_analysis.impedance.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
 from loper_analysis.impedance.identification.pair_averaging import averaging_corrected_fit, pair_windows
 from loper_analysis.impedance.responses import (
@@ -273,8 +273,7 @@ def impedance_rows(
     at_bound_fraction: float = AT_BOUND_FRACTION,
     plausible_ranges: Mapping | None = None,
     min_response_to_residual: float = MIN_RESPONSE_TO_RESIDUAL,
-    jackknife_sd=None,
-    jackknife_dof: int | None = None,
+    jackknife: tuple | None = None,
     pair_scatter_level: float = PAIR_SCATTER_LEVEL,
 ) -> pd.DataFrame:
     """One row per joint from an :class:`~loper_analysis.impedance.identification.ImpedanceFit` (columns
@@ -289,14 +288,10 @@ def impedance_rows(
     entry of ``plausible_ranges`` (``{joint: {"stiffness_nm_per_rad": [low,
     high], "damping_nms_per_rad": [low, high]}}``; None:
     :data:`~loper_analysis.impedance.identification.DEFAULT_PLAUSIBLE_RANGES`),
-    ``max_ci_fraction``, ``min_vaf_pct``, ``at_bound_fraction`` and, against the RMS of each joint's model
-    response and residual (:func:`~loper_analysis.impedance.identification.response_and_residual_rms` of the fit's
-    ``measured`` and ``model``), ``min_response_to_residual``; with ``jackknife_sd`` ((6,) N·m/rad and N·m·s/rad,
-    the perturbed pairs' jackknife SD of each estimate,
-    :func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`, and its ``jackknife_dof``), the
-    perturbed pairs' scatter against the interval's (``fit.sd``, ``fit.ci_dof``) at ``pair_scatter_level``.
+    ``max_ci_fraction``, ``min_vaf_pct``, ``at_bound_fraction``, ``min_response_to_residual`` and, with
+    ``jackknife`` (the perturbed pairs' jackknife SD of every estimate and its degrees of freedom,
+    :func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`), ``pair_scatter_level``.
     """
-    response_rms, residual_rms = response_and_residual_rms(fit.measured, fit.model)
     rows = []
     for j, joint in enumerate(JOINTS):
         k, d = 2 * j, 2 * j + 1
@@ -343,13 +338,8 @@ def impedance_rows(
             min_vaf_pct=min_vaf_pct,
             at_bound_fraction=at_bound_fraction,
             coupling=coupling,
-            response_rms_rad=response_rms[j],
-            residual_rms_rad=residual_rms[j],
+            **data_finding_inputs(fit, j, jackknife),
             min_response_to_residual=min_response_to_residual,
-            sd=fit.sd[[k, d]],
-            ci_dof=fit.ci_dof,
-            jackknife_sd=None if jackknife_sd is None else np.asarray(jackknife_sd, dtype=float)[[k, d]],
-            jackknife_dof=jackknife_dof,
             pair_scatter_level=pair_scatter_level,
         )
         row.update(status=status, reason=reason)
@@ -485,7 +475,7 @@ def fit_onset(
         windows = pair_windows(series["pairs"], params, **options)
         window, fit, averaging = averaging_corrected_fit(window, windows, fit, **ident.fit_options())
     used, n_null, note = "white", 0, ""
-    jackknife = (None, None)
+    jackknife = None
     if ident.noise_model == "null_pairs":
         null = fit_null_pairs(inputs, null_trials, series, onset_ms, r, ident.max_null_trial_ratio, subject)
         pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
@@ -502,16 +492,7 @@ def fit_onset(
         )
         fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
         if used == "null_pairs":  # the perturbed pairs' own scatter, to judge the interval by (joint_status rule 8)
-            jackknife = pair_jackknife_sd(
-                window,
-                fit.estimate,
-                pair_windows(series["pairs"], params, **options),
-                null,
-                ident.null_pair_components,
-                covariance_scale=float(series["pairs"].get("covariance_scale", 1.0)),
-                lower=ident.lower,
-                upper=ident.upper,
-            )
+            jackknife = onset_jackknife(window, fit.estimate, series["pairs"], null, params, options, ident)
         note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
     note = "; ".join(filter(None, [fallback, note]))
     rows = impedance_rows(
@@ -528,8 +509,7 @@ def fit_onset(
         note=note,
         min_vaf_pct=ident.min_vaf_pct,
         plausible_ranges=ident.plausible_ranges,
-        jackknife_sd=jackknife[0],
-        jackknife_dof=jackknife[1],
+        jackknife=jackknife,
     )
     return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series))
 

@@ -23,16 +23,18 @@ status").
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification.fit import DEFAULT_LOWER, DEFAULT_UPPER, response_jacobian
 from loper_analysis.impedance.identification.null_pairs import nuisance_projection, null_pair_errors
+from loper_analysis.impedance.identification.pair_averaging import pair_windows
 from loper_analysis.impedance.identification.window import PreparedWindow, simulate_response
+from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["jackknife_sd"]
+__all__ = ["jackknife_sd", "onset_jackknife"]
 
 
 def jackknife_sd(
@@ -95,3 +97,33 @@ def jackknife_sd(
     var = np.sum(moves**2, axis=0) / (n * (n - 1)) * float(covariance_scale)
     sd = np.where(np.sum(WJ**2, axis=0) > 0, np.sqrt(var), np.inf)
     return sd, n - 1
+
+
+def onset_jackknife(
+    window: PreparedWindow,
+    estimate,
+    pairs: Mapping,
+    null_pairs: dict,
+    params: SegmentParameters,
+    window_options: Mapping,
+    settings,
+) -> tuple[np.ndarray, int]:
+    """:func:`jackknife_sd` of one onset's fit as :func:`~loper_analysis.impedance.identification.impedance.fit_onset`
+    makes it.
+
+    ``pairs``: the responses' per-pair series (``series["pairs"]`` of
+    :func:`loper_analysis.impedance.responses.subject_onset_response`, with its ``covariance_scale`` when it has
+    one), each prepared as a window (:func:`~loper_analysis.impedance.identification.pair_windows` with
+    ``params`` and ``window_options``, those of the mean window); ``null_pairs``: the fit's null pairs;
+    ``settings``: the identification settings (``null_pair_components``, ``lower``, ``upper``).
+    """
+    return jackknife_sd(
+        window,
+        estimate,
+        pair_windows(pairs, params, **window_options),
+        null_pairs,
+        settings.null_pair_components,
+        covariance_scale=float(pairs.get("covariance_scale", 1.0)),
+        lower=settings.lower,
+        upper=settings.upper,
+    )

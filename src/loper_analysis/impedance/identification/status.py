@@ -66,6 +66,7 @@ __all__ = [
     "DEFAULT_PLAUSIBLE_RANGES",
     "check_plausible_range",
     "joint_status",
+    "data_finding_inputs",
     "response_and_residual_rms",
     "strongest_coupling",
 ]
@@ -133,6 +134,38 @@ def response_and_residual_rms(measured, model) -> tuple[np.ndarray, np.ndarray]:
     if y.ndim != 2 or y.shape != f.shape or y.shape[0] == 0:
         raise LoperInputError(f"measured and model must be one (n, j) shape with n >= 1, got {y.shape} and {f.shape}")
     return np.sqrt(np.mean(f**2, axis=0)), np.sqrt(np.mean((y - f) ** 2, axis=0))
+
+
+def data_finding_inputs(fit, joint_index: int, jackknife: tuple | None = None) -> dict:
+    """:func:`joint_status`'s inputs of rules 7 and 8 for one joint of a fit.
+
+    Parameters
+    ----------
+    fit : ImpedanceFit
+        The fit (its ``measured``, ``model``, ``sd`` and ``ci_dof``; K and D of joint ``j`` at ``2 j``, ``2 j + 1``).
+    joint_index : int
+        0, 1, 2: hip, knee, ankle.
+    jackknife : (numpy.ndarray, int), optional
+        The perturbed pairs' jackknife SD of every estimate and its degrees of freedom
+        (:func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`); None: rule 8 is skipped.
+
+    Returns
+    -------
+    dict
+        ``response_rms_rad``, ``residual_rms_rad`` (:func:`response_and_residual_rms`), ``sd``, ``ci_dof``,
+        ``jackknife_sd`` and ``jackknife_dof``.
+    """
+    response, residual = response_and_residual_rms(fit.measured, fit.model)
+    kd = [2 * joint_index, 2 * joint_index + 1]
+    sd, dof = (None, None) if jackknife is None else (np.asarray(jackknife[0], dtype=float)[kd], jackknife[1])
+    return dict(
+        response_rms_rad=response[joint_index],
+        residual_rms_rad=residual[joint_index],
+        sd=np.asarray(fit.sd, dtype=float)[kd],
+        ci_dof=fit.ci_dof,
+        jackknife_sd=sd,
+        jackknife_dof=dof,
+    )
 
 
 def strongest_coupling(correlation, joint: str) -> tuple[tuple[str, float] | None, tuple[str, float] | None]:
@@ -239,10 +272,6 @@ def joint_status(
             raise LoperInputError(f"{joint}: {name} must hold K and D (2 values), got shape {a.shape}")
     if not (0 <= at_bound_fraction < 0.5):
         raise LoperInputError(f"at_bound_fraction must lie in [0, 0.5), got {at_bound_fraction}")
-    if not (min_response_to_residual > 0):
-        raise LoperInputError(f"min_response_to_residual must be > 0, got {min_response_to_residual}")
-    if not 0 < pair_scatter_level < 1:
-        raise LoperInputError(f"pair_scatter_level must lie in (0, 1), got {pair_scatter_level}")
     if plausible_range is None:
         plausible_range = DEFAULT_PLAUSIBLE_RANGES.get(joint)
     plausible = None if plausible_range is None else check_plausible_range(joint, plausible_range)
@@ -308,6 +337,8 @@ def _response_findings(
     """Why the joint's K and D are not identifiable by the size of its response (rule 7): its model response's RMS
     ``response_rms`` (rad) below ``min_ratio`` times its residual's ``residual_rms``; empty otherwise, or when
     the ratio is undefined (either None or NaN, or both zero)."""
+    if not (min_ratio > 0):
+        raise LoperInputError(f"min_response_to_residual must be > 0, got {min_ratio}")
     if response_rms is None or residual_rms is None:
         return []
     a, e = float(response_rms), float(residual_rms)
@@ -325,6 +356,8 @@ def _pair_scatter_findings(joint: str, sd, ci_dof, jackknife_sd, jackknife_dof, 
     """Per K and D, why it is not identifiable by the perturbed pairs' scatter (rule 8): its jackknife variance
     over its interval's beyond the F quantile ``level`` with (``jackknife_dof``, ``ci_dof``) degrees of freedom;
     empty when any input is None."""
+    if not 0 < level < 1:
+        raise LoperInputError(f"pair_scatter_level must lie in (0, 1), got {level}")
     if sd is None or jackknife_sd is None or ci_dof is None or jackknife_dof is None:
         return []
     s, sj = np.asarray(sd, dtype=float), np.asarray(jackknife_sd, dtype=float)
