@@ -9,12 +9,12 @@ onset, noise model ``null_pairs``; ``--configfile config/paper.yaml``: the study
 trials), three fits each (onsets 50, 175, 300 ms): 34 subjects give 102 fits.
 Counts, per joint and parameter, the rows whose 95 % CI holds the truth and prints a Markdown table
 (:func:`coverage_table`): over the fitted rows (``ok`` or ``not_identifiable``), over those whose interval
-stands (less the rows ``not_identifiable`` because the joint responds less than its residual) and over the
-rows ``ok``, each with its share and binomial (Clopper-Pearson) 95 % interval; median CI width, rows
-``not_identifiable``.
+stands (less the rows ``not_identifiable`` because the joint's response is smaller than its residual or its
+perturbed pairs scatter beyond the interval) and over the rows ``ok``, each with its share and binomial
+(Clopper-Pearson) 95 % interval; median CI width, rows ``not_identifiable`` and those of each finding.
 
-``--mode coordinates`` (default; 34 subjects with ``--jobs 2`` on two shared cores: 1-3 min at the default
-design, 5-14 min at the study's): the
+``--mode coordinates`` (default; 34 subjects with ``--jobs 2`` on two shared cores: 1-4 min at the default
+design, 5-17 min at the study's): the
 same simulated walking trials as the workflow (same seeds: subject C001 here is C001 there), taken at
 the coordinate level. The motion-capture coordinates (128 Hz) become the joint-angle table with
 IK-like noise added (Gaussian, low-passed like the markers, with the SDs and correlations of the whole
