@@ -225,3 +225,27 @@ def test_the_planned_window_and_values_carry_the_coupling(null_pairs):
     sc = stride_covariance(null_pairs, PARAMS, TRUTH, replace(coupled, null_pair_components=0))
     with pytest.raises(LoperInputError, match="'K' for an inter-joint coupling"):
         strides_needed(sc, "hip_knee", "D", half_width=1.0)
+
+
+def test_a_couplings_answer_names_the_keys_the_verdict_and_the_strides_it_needs():
+    """The answer to a planned coupling reads its largest stride count's row: the verdict, the half-width against
+    the tolerance and the strides needed, naming planning.couplings and the rods' design."""
+    import pandas as pd
+
+    from loper_analysis.planning.pilot_plan import coupling_answers
+
+    table = pd.DataFrame(
+        {
+            "joint": ["hip", "hip_knee", "hip_knee"],
+            "n_strides": [60, 20, 60],
+            "ci95_half_width": [9.0, 10.4, 5.88],
+            "tolerance": [5.5, 2.0, 2.0],
+            "verdict": ["identified", "not identified", "not identified"],
+            "strides_to_identify": [40.0, 507.0, 507.0],
+        }
+    )
+    [answer] = coupling_answers(table, 50.0, PlanSettings(shank_pulse_force_n=40.0, couplings=("hip_knee",)))
+    assert answer == (
+        "K_hip_knee at 50 ms (planning.couplings; planning.shank_pulse_force_n = 40 N): not identified at 60 strides "
+        "(95 % half-width ±5.88 N·m/rad against the tolerance 2); needs 507 perturbed strides to be identified"
+    )

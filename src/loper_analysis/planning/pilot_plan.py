@@ -198,8 +198,29 @@ def pilot_plan(
             sc.scatter.replace("_", " "),
             ", ".join(f"{p} {v:.3g}" for p, v in zip(sc.parameters, sc.impedance)),
         )
-        answers += _answers(sc, onset, settings.targets)
+        answers += _answers(sc, onset, settings.targets) + coupling_answers(tables[-1], onset, settings.plan)
     return pd.concat(tables, ignore_index=True), answers
+
+
+def coupling_answers(table: pd.DataFrame, onset: float, plan: PlanSettings) -> list[str]:
+    """Whether the design identifies each planned coupling at ``onset`` (ms): one sentence per coupling of
+    ``plan.couplings`` from its rows of the precision ``table`` (its largest stride count), naming the keys that
+    set the design (``planning.couplings``, ``planning.shank_pulse_force_n``)."""
+    out = []
+    rods = f"planning.shank_pulse_force_n = {plan.shank_pulse_force_n:g} N"
+    for coupling in plan.couplings:
+        rows = table[table["joint"] == coupling]
+        if rows.empty:
+            continue
+        row = rows.loc[rows["n_strides"].idxmax()]
+        needed = row["strides_to_identify"]
+        more = f"needs {needed:.0f} perturbed strides" if np.isfinite(needed) else "needs more strides than planned"
+        out.append(
+            f"K_{coupling} at {onset:g} ms (planning.couplings; {rods}): {row['verdict']} at {row['n_strides']:.0f} "
+            f"strides (95 % half-width ±{row['ci95_half_width']:.3g} N·m/rad against the tolerance "
+            f"{row['tolerance']:.3g}); {more} to be identified"
+        )
+    return out
 
 
 def _onset_covariance(pool, onset, counts, params, values, settings: PlanningSettings, subject: str, where: str):

@@ -7,5 +7,6 @@ READERS = {
     "planning.pulse_force_n": "events_loadcell planning",
     "planning.pulse_duration_s": "planning",
     "planning.shank_pulse_force_n": "events_loadcell planning",
+    "planning.couplings": "planning",
     "planning.targets": "planning",
 }

@@ -82,6 +82,13 @@ def _add_plan(p: argparse.ArgumentParser) -> None:
         "device.shank_rod.attachment_fraction, else 0.85)",
     )
     p.add_argument(
+        "--couplings",
+        nargs="*",
+        choices=("hip_knee", "knee_ankle"),
+        help="inter-joint (bi-articular) stiffnesses to plan beside the six, planned at 0: the plan says whether the "
+        "design identifies each (default: planning.couplings, else none)",
+    )
+    p.add_argument(
         "--shank-direction-deg",
         type=float,
         help="that rod's push: the shank's forward normal turned toward the ankle by this angle (deg; default: "
@@ -148,6 +155,8 @@ def plan_settings(args: argparse.Namespace, config: dict | None):
     }
     if rod:
         pulse["shank_rod"] = dataclasses.replace(settings.plan.shank_rod, **rod)
+    if args.couplings is not None:
+        pulse["couplings"] = tuple(args.couplings)
     given = {
         "onsets_ms": None if args.onset_ms is None else tuple(args.onset_ms),
         "strides": None if args.strides is None else tuple(args.strides),
