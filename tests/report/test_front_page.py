@@ -313,7 +313,7 @@ def test_the_file_step_takes_the_verdicts_from_a_calibration_of_this_design(tmp_
         '(<span data-q="verdict|calibration|n_subjects" data-v="34">34</span> subjects, seed 2024), design '
         "fingerprint matches this run." in page
     )
-    assert "Verdicts on the truth: ✓ when the calibration run's share meets the target" in page  # the rule, stated
+    assert "Verdicts on the truth: intervals ✓ when the calibration run's share meets the target" in page  # the rule
     assert "(coordinates level, loper-analysis 0.1.0, commit abc1234, design fingerprint 0123456789abcdef)." in page
     found = _Numbers()
     found.feed(page)

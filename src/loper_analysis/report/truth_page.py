@@ -101,34 +101,43 @@ def _estimates_line(v: TruthVerdicts) -> str:
     checks = v.within
     calibrated = v.basis == "calibration"
     off_here = any((c.p_consistent < CONSISTENCY_P) if calibrated else (c.verdict is False) for c in checks.values())
+    design_met = all(c.target_met for c in checks.values())
     if v.estimates:
-        title = "Estimates within tolerance"
+        title = "Estimates within tolerance" if design_met else "Estimates as a correct chain places them"
     elif v.estimates is None:
         title = "Estimates: too few fits to decide"
     else:
-        title = "Estimates off the truth in this run" if off_here else "Estimates outside tolerance at this design"
+        title = "Estimates off the truth in this run"
     run = ", ".join(f"{p} {_share(c.n, c.total, f'verdict|truth|{p}_n_within_tolerance')}" for p, c in checks.items())
     target = _target(next(iter(checks.values())))
     if not calibrated:
         ps = ", ".join(_p(c.p_reject, f"verdict|truth|{p}_p_reject_within") for p, c in checks.items())
-        judged = "rejected" if v.estimates is False else "not rejected"
-        said = f"this run {run}, target {target}, {judged} ({ps})"
+        said = (
+            f"this run {run}, target {target} ({ps}); without a calibration of this design a correct chain's share "
+            "is not known"
+        )
     else:
         cal = ", ".join(
             f"{p} {_share(*c.calibration, f'verdict|calibration|{p}_n_within_tolerance', _interval(c))}"
             for p, c in checks.items()
         )
         ps = ", ".join(_p(c.p_consistent, f"verdict|truth|{p}_p_consistent_within") for p, c in checks.items())
-        said = f"calibration {cal}, target {target}; this run {run}, {'disagreeing' if off_here else 'agreeing'} ({ps})"
+        design = "" if design_met else " (this design's precision misses it)"
+        said = (
+            f"calibration {cal}, target {target}{design}; this run {run}, "
+            f"{'disagreeing' if off_here else 'agreeing'} ({ps})"
+        )
     return f"<li>{mark(v.estimates)}<b>{title}</b>: {said}.</li>"
 
 
 #: The rule of the verdicts, as the note under the truth-recovery table states it.
 RULE = (
-    f"Verdicts on the truth: ✓ when the calibration run's share meets the target (its binomial 95 % interval reaches "
-    f"it) and this run's count agrees with that share (two-sided binomial p ≥ {CONSISTENCY_P:g}), ✗ otherwise; "
-    "without a calibration of this run's design, this run's own counts: ● unless they reject the target (one-sided "
-    f"binomial p &lt; {REJECT_P:g}: ✗). Intervals: K and D of every fit pooled; estimates: K and D each."
+    f"Verdicts on the truth: intervals ✓ when the calibration run's share meets the target (its binomial 95 % interval "
+    f"reaches it) and this run's count agrees with that share (two-sided binomial p ≥ {CONSISTENCY_P:g}), ✗ otherwise; "
+    "estimates ✓ when this run's counts agree with the calibration's (the design's share stated against its target), "
+    "✗ otherwise; without a calibration of this run's design, this run's own counts: ● unless the intervals' reject "
+    f"their target (one-sided binomial p &lt; {REJECT_P:g}: ✗). Intervals: K and D of every fit pooled; estimates: K "
+    "and D each."
 )
 
 

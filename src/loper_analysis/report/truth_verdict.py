@@ -14,8 +14,11 @@ chain that ran is the chain that was calibrated:
   (grey), unless they alone reject the target (p < :data:`REJECT_P`: red).
 
 The intervals' verdict pools K and D over the joints (target :data:`~loper_analysis.report.headline.COVERAGE_TARGET`
-around the nominal 95 %); the estimates' judges K and D each, pooled over the joints (at least
-:data:`~loper_analysis.report.headline.WITHIN_TOLERANCE_TARGET`), and is green only when both are.
+around the nominal 95 %). The estimates' judges K and D each, pooled over the joints, by the chain alone: how
+often they fall within tolerance is the design's precision, which the calibration measures and the page states
+against :data:`~loper_analysis.report.headline.WITHIN_TOLERANCE_TARGET`; the verdict is green when this run's
+counts agree with the calibration's (a correct chain at this design), red when they do not, grey without a
+calibration of this design.
 """
 
 from __future__ import annotations
@@ -103,7 +106,13 @@ def _reject_p(n: int, total: int, target: tuple[float, float]) -> float:
     return 1.0
 
 
-def share_check(n: int, total: int, target: tuple[float, float], calibration: tuple[int, int] | None) -> ShareCheck:
+def share_check(
+    n: int,
+    total: int,
+    target: tuple[float, float],
+    calibration: tuple[int, int] | None,
+    target_decides: bool = True,
+) -> ShareCheck:
     """Judge one share by the rule of this module.
 
     Parameters
@@ -114,6 +123,12 @@ def share_check(n: int, total: int, target: tuple[float, float], calibration: tu
         The share's target range, ``0 <= low <= high <= 1``.
     calibration : (int, int) or None
         The calibration's count and fits (``total >= 1``); None: no calibration of this design.
+    target_decides : bool
+        Whether the target decides the verdict (the intervals': a correct chain's intervals hold the truth about
+        95 % of the time at any design). False for a share that measures the design's precision (the estimates
+        within tolerance): the verdict is then this run's agreement with the calibration alone, green for a
+        correct chain whatever the design's share, and grey without a calibration of this design (a correct
+        chain at an imprecise design and a broken chain cannot be told apart by the run's own few fits).
 
     Returns
     -------
@@ -127,7 +142,7 @@ def share_check(n: int, total: int, target: tuple[float, float], calibration: tu
     low, high = target
     p_reject = _reject_p(n, total, target)
     if calibration is None:
-        rejected = total > 0 and p_reject < REJECT_P
+        rejected = target_decides and total > 0 and p_reject < REJECT_P
         return ShareCheck(n, total, target, None, None, None, None, p_reject, False if rejected else None)
     c_n, c_total = integer("calibration count", calibration[0], minimum=0), calibration[1]
     c_total = integer("calibration fits", c_total, minimum=1)
@@ -138,9 +153,8 @@ def share_check(n: int, total: int, target: tuple[float, float], calibration: tu
     target_met = interval[0] <= high and interval[1] >= low
     p_consistent = float(binomtest(n, total, c_n / c_total).pvalue) if total else math.nan
     consistent = not total or p_consistent >= CONSISTENCY_P
-    return ShareCheck(
-        n, total, target, (c_n, c_total), interval, target_met, p_consistent, p_reject, target_met and consistent
-    )
+    verdict = (target_met and consistent) if target_decides else consistent
+    return ShareCheck(n, total, target, (c_n, c_total), interval, target_met, p_consistent, p_reject, verdict)
 
 
 @dataclass(frozen=True)
@@ -205,6 +219,7 @@ def truth_verdicts(truth: pd.DataFrame, calibration: Calibration | None, fingerp
             n_fits,
             (WITHIN_TOLERANCE_TARGET, 1.0),
             None if used is None else (used.total("n_within_tolerance", (p,)), used.total("n_fits", (p,))),
+            target_decides=False,
         )
         for p in PARAMETER_KINDS
     }
