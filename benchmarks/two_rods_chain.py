@@ -29,8 +29,10 @@ from scipy.stats import beta
 from loper_analysis.constants import JOINTS
 from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
 from loper_analysis.report.markdown import markdown_table
+from loper_analysis.stages import study_paths
 
 UNITS = {"K": "nm_per_rad", "D": "nms_per_rad"}
+PATHS = study_paths()
 
 
 def clopper_pearson(k: int, n: int) -> tuple[float, float]:
@@ -113,11 +115,11 @@ def main() -> None:
     args = ap.parse_args()
     labels = args.labels or [str(r) for r in args.runs]
     for label, run in zip(labels, args.runs, strict=True):
-        fits = pd.read_csv(run / "results/impedance/impedance.tsv", sep="\t")
+        fits = pd.read_csv(run / PATHS.impedance.table, sep="\t")
         fits = fits[fits["status"].isin(["ok", "not_identifiable"])]
         print(f"## {label}: {len(fits)} joint fits of {fits['subject'].nunique()} subjects\n")
         print(markdown_table(recovery(fits).round(4)))
-        plan_path = run / "results/planning/plan.tsv"
+        plan_path = run / PATHS.planning.plan
         if plan_path.is_file():
             table = planner_over_fits(fits, pd.read_csv(plan_path, sep="\t"))
             within = int(table["within_25pct"].sum())

@@ -73,31 +73,7 @@ def read_robot_log_mat(
         scale = math.nan
     if not math.isfinite(scale) or scale <= 0:
         raise LoperInputError(f"time_scale must be a positive number, got {time_scale!r}")
-    if not isinstance(column_map, Mapping):
-        raise LoperInputError(f"column_map must be a mapping column -> .mat variable, got {type(column_map).__name__}")
-    known = (*COLUMNS, *SHANK_COLUMNS)
-    unknown = [str(c) for c in column_map if c not in known]
-    if unknown:
-        raise LoperInputError(f"column_map: unknown column(s) {', '.join(unknown)}; columns are {', '.join(known)}")
-    shank = [c for c in SHANK_COLUMNS if column_map.get(c) is not None]
-    if len(shank) == 1:
-        other = next(c for c in SHANK_COLUMNS if c not in shank)
-        raise LoperInputError(
-            f"column_map: column '{shank[0]}' is mapped but '{other}' is not: a second rod's load cell needs both"
-        )
-    columns = (*COLUMNS, *SHANK_COLUMNS) if shank else COLUMNS
-    unmapped = [c for c in COLUMNS if c != "time_s" and c not in column_map]
-    if unmapped:
-        raise LoperInputError(f"column_map: column(s) {', '.join(unmapped)} not mapped to a .mat variable")
-    for col, var in column_map.items():
-        if var is None:
-            if col != "time_s" and col not in (*MAT_OPTIONAL, *SHANK_COLUMNS):
-                raise LoperInputError(
-                    f"column_map: column '{col}' must map to a .mat variable (only time_s, "
-                    f"{', '.join(MAT_OPTIONAL)} may be None)"
-                )
-        elif not isinstance(var, str) or not var:
-            raise LoperInputError(f"column_map: variable of column '{col}' must be a name or None, got {var!r}")
+    columns = _mapped_columns(column_map)
 
     try:
         contents = loadmat(path)
@@ -141,3 +117,33 @@ def read_robot_log_mat(
         vectors.setdefault(col, np.zeros(n))
     frame = validated_log(pd.DataFrame({c: vectors[c] for c in columns}), rate, source)
     return frame, {"format": FORMAT_NAME, "sample_rate_hz": rate, "source": source}
+
+
+def _mapped_columns(column_map) -> tuple[str, ...]:
+    """The log's columns a .mat ``column_map`` maps (:data:`COLUMNS`, and the shank rod's when mapped), checked."""
+    if not isinstance(column_map, Mapping):
+        raise LoperInputError(f"column_map must be a mapping column -> .mat variable, got {type(column_map).__name__}")
+    known = (*COLUMNS, *SHANK_COLUMNS)
+    unknown = [str(c) for c in column_map if c not in known]
+    if unknown:
+        raise LoperInputError(f"column_map: unknown column(s) {', '.join(unknown)}; columns are {', '.join(known)}")
+    shank = [c for c in SHANK_COLUMNS if column_map.get(c) is not None]
+    if len(shank) == 1:
+        other = next(c for c in SHANK_COLUMNS if c not in shank)
+        raise LoperInputError(
+            f"column_map: column '{shank[0]}' is mapped but '{other}' is not: a second rod's load cell needs both"
+        )
+    columns = (*COLUMNS, *SHANK_COLUMNS) if shank else COLUMNS
+    unmapped = [c for c in COLUMNS if c != "time_s" and c not in column_map]
+    if unmapped:
+        raise LoperInputError(f"column_map: column(s) {', '.join(unmapped)} not mapped to a .mat variable")
+    for col, var in column_map.items():
+        if var is None:
+            if col != "time_s" and col not in (*MAT_OPTIONAL, *SHANK_COLUMNS):
+                raise LoperInputError(
+                    f"column_map: column '{col}' must map to a .mat variable (only time_s, "
+                    f"{', '.join(MAT_OPTIONAL)} may be None)"
+                )
+        elif not isinstance(var, str) or not var:
+            raise LoperInputError(f"column_map: variable of column '{col}' must be a name or None, got {var!r}")
+    return columns

@@ -37,8 +37,8 @@ from loper_analysis.constants import LAB_TO_MODEL_ROTATION_DEG, SIDE_SUFFIX, SID
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.c3d import C3DRecording
 from loper_analysis.study_design import PERTURBED_SIDE, PULSE_DURATION_S, PULSE_FORCE_N
-from loper_analysis.swing_leg.dynamics import segment_coordinates
 from loper_analysis.swing_leg.rods import ShankRod
+from loper_analysis.synthetic.shank_rod import attach_shank_rod
 from loper_analysis.synthetic.walking import AMPLITUDE_CV, TIMING_CV
 
 __all__ = [
@@ -119,16 +119,6 @@ def _brace_position_m(
     """Forward position (m) of the brace on the thigh: pelvis_tx + a·sin(pelvis_tilt + hip_flexion)."""
     angle = coordinates["pelvis_tilt"].to_numpy(float) + coordinates[f"hip_flexion_{side}"].to_numpy(float)
     return coordinates["pelvis_tx"].to_numpy(float) + attachment_m * np.sin(angle)
-
-
-def _shank_rod_position_m(coordinates: pd.DataFrame, params, side: str = SIDE_SUFFIX[PERTURBED_SIDE]) -> np.ndarray:
-    """Forward position (m) of a second rod's point on the shank, ``params.shank_attachment_m`` below the knee."""
-    q = segment_coordinates(
-        coordinates[[f"hip_flexion_{side}", f"knee_flexion_{side}", f"ankle_dorsiflexion_{side}"]].to_numpy(float),
-        -coordinates["pelvis_tilt"].to_numpy(float),
-        coordinates["pelvis_tx"].to_numpy(float),
-    )
-    return q[:, 0] - params.length_m[0] * np.sin(q[:, 1]) - params.shank_attachment_m * np.sin(q[:, 2])
 
 
 @dataclass(frozen=True)
@@ -297,40 +287,30 @@ def simulate_walking_trial(
     )
     sim = simulate_device(fd, device, None, brace_position_m=brace, seed=device_seed)
     robot = _robot_frame(t_robot, sim, fd, pulse_train_at(t_robot, starts))
-    shank = None
-    if perturbation is not None and perturbation.shank_force_n and shank_rod is None:
-        raise LoperInputError(
-            f"simulate_walking_trial: a {perturbation.shank_force_n:g} N shank pulse needs a shank rod (shank_rod)"
-        )
-    if shank_rod is not None:
-        (shank_seed,) = ss.spawn(1)  # after the four above: a trial without a shank rod keeps its seeds
-        rod = shank_rod
-        params = params.replace(shank_attachment_m=rod.attachment_m(params.length_m[1]))
-        shank_brace = np.interp(t_mocap, t_fine, _shank_rod_position_m(fine, params))
-        shank_brace -= shank_brace.mean()
-        fd_shank = (
-            pulse_train(t_robot, onsets_robot, perturbation.shank_force_n, perturbation.duration_s)
-            if perturbation
-            else 0 * t_robot
-        )
-        shank_sim = simulate_device(fd_shank, device, None, brace_position_m=shank_brace, seed=shank_seed)
-        robot = robot.assign(
-            shank_force_desired_n=shank_sim["force_desired_n"].to_numpy(),
-            shank_force_measured_n=shank_sim["force_measured_n"].to_numpy(),
-        )
-        shank = (rod, shank_brace, shank_seed)
+    robot, params, shank = attach_shank_rod(
+        robot, fine, params, shank_rod, perturbation, ((t_robot, t_mocap), onsets_robot, device, ss)
+    )
     if minimal_impedance is not None:
         impedance = perturbation.impedance if perturbation is not None else tuple(minimal_impedance)
         fine = _fine_answering_every_swing(fine, events, t_robot, robot, lab, params, impedance, shank)
     elif perturbation is not None and len(schedule):
-        free = simulate_device(0 * t_robot, device, None, brace_position_m=brace, seed=device_seed)
-        if shank is not None:
-            free_shank = simulate_device(0 * t_robot, device, None, brace_position_m=shank[1], seed=shank[2])
-            free = free.assign(shank_force_measured_n=free_shank["force_measured_n"].to_numpy())
+        free = _free_run(t_robot, device, (brace, device_seed), shank)
         fine = _fine_answering_pulses(
             fine, schedule, t_robot, (robot, free), lab, params, perturbation.impedance, shank
         )
     return WalkingTrial(duration_s, fine, events, schedule, robot, starts)
+
+
+def _free_run(t_robot, device, thigh, shank) -> pd.DataFrame:
+    """The device run without pulses (same noise): the thigh rod's (``thigh``: its brace motion in m and seed),
+    with a second rod's measured force when ``shank`` (rod, its point's motion in m, seed) is not None."""
+    from loper_analysis.device.controller import simulate_device
+
+    free = simulate_device(0 * t_robot, device, None, brace_position_m=thigh[0], seed=thigh[1])
+    if shank is None:
+        return free
+    free_shank = simulate_device(0 * t_robot, device, None, brace_position_m=shank[1], seed=shank[2])
+    return free.assign(shank_force_measured_n=free_shank["force_measured_n"].to_numpy())
 
 
 def _robot_frame(t_robot: np.ndarray, sim: pd.DataFrame, fd: np.ndarray, sync_v: np.ndarray) -> pd.DataFrame:

@@ -398,6 +398,7 @@ def fit_onset(
     null_trials: Sequence[Mapping] = (),
     response: ResponseSettings = ResponseSettings(),
     identification: IdentificationSettings = IdentificationSettings(),
+    *,
     shank_rod: ShankRod | None = None,
 ) -> OnsetFit:
     """Responses and the impedance fit of one subject at one onset.

@@ -113,7 +113,7 @@ def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, ta
         null,
         settings.response,
         settings.identification,
-        settings.shank_rod,
+        shank_rod=settings.shank_rod,
     )
     out = files.outputs
     write_tsv(result.response, out.response)

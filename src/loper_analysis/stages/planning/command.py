@@ -24,6 +24,35 @@ if TYPE_CHECKING:
 __all__ = ["COMMANDS", "plan_pilot", "plan_settings"]
 
 
+def _add_design_options(p: argparse.ArgumentParser) -> None:
+    """The options of the planned design beyond the thigh rod's pulse: a second rod at the shank, couplings."""
+    p.add_argument(
+        "--shank-force-n",
+        type=float,
+        help="a second rod just above the ankle, pushed with the thigh: its pulse (N; default: "
+        "planning.shank_pulse_force_n, else 0: the thigh rod alone)",
+    )
+    p.add_argument(
+        "--shank-attachment-fraction",
+        type=float,
+        help="that rod's point on the shank, as a fraction of the shank's length from the knee (default: "
+        "device.shank_rod.attachment_fraction, else 0.85)",
+    )
+    p.add_argument(
+        "--couplings",
+        nargs="*",
+        choices=("hip_knee", "knee_ankle"),
+        help="inter-joint (bi-articular) stiffnesses to plan beside the six, planned at 0: the plan says whether the "
+        "design identifies each (default: planning.couplings, else none)",
+    )
+    p.add_argument(
+        "--shank-direction-deg",
+        type=float,
+        help="that rod's push: the shank's forward normal turned toward the ankle by this angle (deg; default: "
+        "device.shank_rod.direction_deg, else 0)",
+    )
+
+
 def _add_plan(p: argparse.ArgumentParser) -> None:
     """The ``plan`` subcommand's arguments."""
     from loper_analysis.layout import RESULTS_DIR
@@ -69,31 +98,7 @@ def _add_plan(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--force-n", type=float, help="pulse: desired force (N; default: planning.pulse_force_n, else 40)")
     p.add_argument("--duration-s", type=float, help="pulse duration (s; default: planning.pulse_duration_s, else 0.1)")
-    p.add_argument(
-        "--shank-force-n",
-        type=float,
-        help="a second rod just above the ankle, pushed with the thigh: its pulse (N; default: "
-        "planning.shank_pulse_force_n, else 0: the thigh rod alone)",
-    )
-    p.add_argument(
-        "--shank-attachment-fraction",
-        type=float,
-        help="that rod's point on the shank, as a fraction of the shank's length from the knee (default: "
-        "device.shank_rod.attachment_fraction, else 0.85)",
-    )
-    p.add_argument(
-        "--couplings",
-        nargs="*",
-        choices=("hip_knee", "knee_ankle"),
-        help="inter-joint (bi-articular) stiffnesses to plan beside the six, planned at 0: the plan says whether the "
-        "design identifies each (default: planning.couplings, else none)",
-    )
-    p.add_argument(
-        "--shank-direction-deg",
-        type=float,
-        help="that rod's push: the shank's forward normal turned toward the ankle by this angle (deg; default: "
-        "device.shank_rod.direction_deg, else 0)",
-    )
+    _add_design_options(p)
     p.add_argument(
         "--target",
         nargs=3,
