@@ -23,13 +23,13 @@ from __future__ import annotations
 
 import argparse
 import logging
+import sys
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import yaml
 
 from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.impedance.identification.impedance import IdentificationSettings, fit_onset
@@ -38,25 +38,14 @@ from loper_analysis.planning.pilot_plan import PlanningSettings, pilot_plan
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
 from loper_analysis.synthetic.coordinate_trials import perturbation_experiment
-from loper_analysis.synthetic.variability import lab_variability
 
-ROOT = Path(__file__).resolve().parents[1]
-#: The true impedance per onset (ms): the default study's group values (those of benchmarks/planner_check.py).
-TRUTH = {
-    50: (55.0, 3.5, 3.0, 0.10, 8.0, 0.3),
-    175: (38.0, 2.2, 0.5, 0.04, 8.0, 0.3),
-    300: (62.0, 4.2, 2.5, 0.12, 8.0, 0.3),
-}
-HEIGHT_M, MASS_KG = 1.73, 64.9
-ANGLE_NOISE_SD_RAD = 0.001
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from planner_check import ANGLE_NOISE_SD_RAD, HEIGHT_M, MASS_KG, TRUTH, lab  # noqa: E402  (the same pilot)
 
 
 def pilot(onset_ms: int, seed: int, counts: list[int], params) -> tuple[dict, np.ndarray]:
     """The pilot's trial and its fitted K, D (6,) at ``onset_ms``."""
     truth = TRUTH[onset_ms]
-    syn = yaml.safe_load((ROOT / "config/config.yaml").read_text())["synthetic"]
-    nested = {onset_ms: {j: {"K": truth[2 * i], "D": truth[2 * i + 1]} for i, j in enumerate(JOINTS)}}
-    v, a, m = lab_variability(syn, seed, "P01", nested)
     full, cut = perturbation_experiment(
         [seed, 0],
         params,
@@ -65,9 +54,7 @@ def pilot(onset_ms: int, seed: int, counts: list[int], params) -> tuple[dict, np
         truth,
         counts,
         angle_noise_sd_rad=ANGLE_NOISE_SD_RAD,
-        variability=v,
-        adaptation=a,
-        minimal_impedance=m,
+        **lab(None, seed, onset_ms, truth),
     )
     ident = IdentificationSettings(seed=seed)
     fit = fit_onset([cut[max(counts)]], params, onset_ms, "pilot", None, [full], ResponseSettings(), ident)

@@ -15,7 +15,7 @@ import pandas as pd
 from loper_analysis.checks import positive
 from loper_analysis.errors import LoperInputError
 from loper_analysis.io.atomic import write_bytes
-from loper_analysis.io.robot_log import COLUMNS, validated_log
+from loper_analysis.io.robot_log import COLUMNS, SHANK_COLUMNS, validated_log
 
 __all__ = ["MAT_HEADER_TEXT", "write_robot_log_mat"]
 
@@ -65,11 +65,15 @@ def write_robot_log_mat(
     source = str(path)
     log = validated_log(frame, sample_rate_hz, source)
     names = {c: c for c in COLUMNS} if variable_names is None else dict(variable_names)
-    missing = [c for c in COLUMNS if c not in names]
-    unknown = [str(c) for c in names if c not in COLUMNS]
+    for c in SHANK_COLUMNS:  # a second rod's load cell: written when the log has it and the map names it
+        if names.get(c, "") is None or (c in names and c not in log.columns):
+            names.pop(c)
+    columns = tuple(log.columns)
+    missing = [c for c in columns if c not in names]
+    unknown = [str(c) for c in names if c not in columns]
     if missing or unknown:
         raise LoperInputError(
-            f"{source}: variable_names must name exactly the columns {', '.join(COLUMNS)} "
+            f"{source}: variable_names must name exactly the columns {', '.join(columns)} "
             f"(missing: {', '.join(missing) or 'none'}; unknown: {', '.join(unknown) or 'none'})"
         )
     for col, var in names.items():
@@ -78,7 +82,7 @@ def write_robot_log_mat(
     if len(set(names.values())) != len(names):
         raise LoperInputError(f"{source}: variable_names must be all different, got {sorted(names.values())}")
     scale = positive("time_scale", time_scale, source)
-    variables = {names[c]: log[c].to_numpy(dtype=np.float64)[:, np.newaxis] for c in COLUMNS}
+    variables = {names[c]: log[c].to_numpy(dtype=np.float64)[:, np.newaxis] for c in columns}
     variables[names["time_s"]] = variables[names["time_s"]] / scale
     buffer = io.BytesIO()
     savemat(buffer, variables, format="5", oned_as="column")

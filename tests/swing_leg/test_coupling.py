@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 from loper_analysis.swing_leg import kernels
 from loper_analysis.swing_leg.dynamics import inverse_dynamics, joint_angles
 from tests.parameter_sets import ASYMMETRIC, WINTER
-from tests.swing_leg.reference_dynamics import forward_dynamics, generalized_joint_forces
-from tests.swing_leg.test_kernels import PULSE_S, SHANK_ROD_M, _pelvis_deviation, _reference, _rod_force, _shank_force
+from tests.swing_leg.test_kernels import SHANK_ROD_M, _pelvis_deviation, _reference, _rod_force, _shank_force
+from tests.swing_leg.test_kernels import _peer as peer_deviation
 
 
 def stiffness_matrix(p: np.ndarray) -> np.ndarray:
@@ -50,31 +49,7 @@ def test_coupled_feedback_torques_are_the_stiffness_matrix_times_the_joint_devia
 def _peer(params, p, e0, ed0, t_out, shank):
     """The absolute model q = q_ref + e under u_ff = inverse dynamics of the reference, the rod forces and the
     joint feedback T = -K dtheta - D dtheta' with the full stiffness matrix, integrated by DOP853."""
-    K = stiffness_matrix(p)
-    D = p[1:6:2]
-
-    def rhs(t, y):
-        q, qd = y[:4], y[4:]
-        q_ref, qd_ref, qdd_ref = _reference(t)
-        u_ff = inverse_dynamics(q_ref, qd_ref, qdd_ref, params)[0]
-        pel, peld = _pelvis_deviation(t)[0]
-        dth = joint_angles(q, pel) - joint_angles(q_ref[0], 0.0)
-        dthd = joint_angles(qd, peld) - joint_angles(qd_ref[0], 0.0)
-        u = u_ff + generalized_joint_forces(-K @ dth - D * dthd)
-        shank_force = _shank_force(t) if shank else None
-        return np.concatenate([qd, forward_dynamics(q, qd, u, params, _rod_force(t), shank_force)])
-
-    q0, qd0, _ = _reference(0.0)
-    ys = [np.concatenate([q0[0] + e0, qd0[0] + ed0])[:, None]]
-    kinks = (0.0, 0.5 * PULSE_S, PULSE_S, t_out[-1]) if shank else (0.0, PULSE_S, t_out[-1])
-    for span in zip(kinks[:-1], kinks[1:], strict=True):  # across the kinks of the pulses, not over them
-        t_eval = t_out[(t_out > span[0]) & (t_out <= span[1])]
-        sol = solve_ivp(rhs, span, ys[-1][:, -1], method="DOP853", t_eval=t_eval, rtol=1e-11, atol=1e-13)
-        assert sol.success
-        ys.append(sol.y)
-    y = np.hstack(ys)
-    q_ref, qd_ref, _ = _reference(t_out)
-    return y[:4].T - q_ref, y[4:].T - qd_ref
+    return peer_deviation(params, np.asarray(p, float)[:6], e0, ed0, t_out, shank, stiffness_matrix(p))
 
 
 def _kernel_inputs(params, shank):

@@ -132,9 +132,10 @@ def _pelvis_deviation(t):
     return np.column_stack([0.03 * np.sin(6.0 * t), 0.18 * np.cos(6.0 * t)])
 
 
-def _peer(params, impedance, e0, ed0, t_out, shank=False):
+def _peer(params, impedance, e0, ed0, t_out, shank=False, stiffness=None):
     """The absolute model q = q_ref + e under u_ff = inverse dynamics of the reference, the rod force (and, with
-    ``shank``, the shank rod's) and the joint feedback about the reference angles, integrated by DOP853."""
+    ``shank``, the shank rod's) and the joint feedback about the reference angles, integrated by DOP853; with
+    ``stiffness`` (3, 3) a full joint stiffness matrix in place of ``impedance``'s diagonal K."""
 
     def rhs(t, y):
         q, qd = y[:4], y[4:]
@@ -143,7 +144,8 @@ def _peer(params, impedance, e0, ed0, t_out, shank=False):
         pel, peld = _pelvis_deviation(t)[0]
         dth = joint_angles(q, pel) - joint_angles(q_ref[0], 0.0)
         dthd = joint_angles(qd, peld) - joint_angles(qd_ref[0], 0.0)
-        torques = -impedance[0::2] * dth - impedance[1::2] * dthd
+        spring = impedance[0::2] * dth if stiffness is None else stiffness @ dth
+        torques = -spring - impedance[1::2] * dthd
         u = u_ff + generalized_joint_forces(torques)
         shank_force = _shank_force(t) if shank else None
         return np.concatenate([qd, forward_dynamics(q, qd, u, params, _rod_force(t), shank_force)])
