@@ -24,6 +24,7 @@ from loper_analysis.report.calibration import (
 )
 from loper_analysis.stages.settings import stage_settings
 from tests.headline_tables import impedance_row
+from tests.test_config_readers import _changed
 
 ROOT = Path(__file__).resolve().parents[2]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -172,23 +173,6 @@ def _stages(config: dict) -> dict:
     return {name: stage_settings(config, name) for name in CALIBRATED_STAGES}
 
 
-def _nudged(value):
-    """Another valid value of a setting: a flag flipped, a number up by 10 % (0 to 0.01), every number of a list
-    likewise, the first entry of a mapping nudged."""
-    if isinstance(value, bool):
-        return not value
-    if isinstance(value, int):
-        return value + 1
-    if isinstance(value, float):
-        return value * 1.1 if value else 0.01
-    if isinstance(value, list):
-        return [_nudged(v) for v in value]
-    if isinstance(value, dict) and value:
-        first = next(iter(value))
-        return {**value, first: _nudged(value[first])}
-    return None
-
-
 #: Text settings and empty mappings of the fingerprinted sections, changed to another valid value.
 TEXT_CHANGES = {
     ("synthetic", "variability"): "gentle",
@@ -223,7 +207,7 @@ def test_every_setting_of_the_lab_the_markers_and_the_fit_changes_the_fingerprin
     node = config
     for key in path[:-1]:
         node = node[key]
-    changed = TEXT_CHANGES.get(path, _nudged(value))
+    changed = TEXT_CHANGES.get(path) or _changed(path, value)
     assert changed is not None and changed != value, path
     node[path[-1]] = changed
     assert design_fingerprint(_stages(config)) != design_fingerprint(_stages(CONFIG)), path
