@@ -255,3 +255,15 @@ def test_one_shank_column_without_its_pair_is_refused():
     half = _with_shank_rod(log).drop(columns=["shank_force_desired_n"])
     with pytest.raises(LoperInputError, match="shank_force_measured_n without its pair"):
         robot_log_frames_and_native(half, ROBOT_HZ, sync, ANALOG_HZ, frames, shank_pulse_force_n=30.0)
+
+
+def test_a_shank_load_cell_logged_with_the_wrong_sign_is_refused_naming_its_columns():
+    """Measured force of the opposite sign to the desired pulses (a load cell mounted the other way): the median
+    ratio is about -1, outside the accepted 0.5 .. 2, and the message names the shank rod's columns."""
+    log, sync, frames, _ = make_trial(3.217, 150.0, 0.0, seed=21)
+    two = _with_shank_rod(log)
+    flipped = two.assign(shank_force_measured_n=-two["shank_force_measured_n"])
+    with pytest.raises(
+        LoperInputError, match=r"column 'shank_force_measured_n' is -1\.\d+ times column 'shank_force_desired_n'"
+    ):
+        robot_log_frames_and_native(flipped, ROBOT_HZ, sync, ANALOG_HZ, frames, shank_pulse_force_n=30.0)
