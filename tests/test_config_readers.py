@@ -57,7 +57,7 @@ CHANGES = {
     "events.grf_cutoff_hz": 30.0,
     "events.sync_channel": "sync2",
     "planning.pilot_subject": "S02",
-    "planning.couplings": ["hip_knee"],
+    "impedance.couplings": ["hip_knee"],
     "planning.targets": [{"joint": "hip", "parameter": "K", "percent": 10}],
     "ik.marker_weights": {"LASI": 2.0},
     "ik.coordinate_tasks": {"pelvis_tilt": {"weight": 1.0, "value": None}},

@@ -28,6 +28,7 @@ from loper_analysis.impedance.identification import (
     simulate_deviation,
     window_options,
 )
+from loper_analysis.impedance.identification.coupling_rows import identification_tolerance
 from loper_analysis.impedance.identification.validation import nominal_swing
 from loper_analysis.planning.covariance import stride_covariance
 from loper_analysis.planning.precision import (
@@ -35,7 +36,6 @@ from loper_analysis.planning.precision import (
     IDENTIFIED,
     NOT_IDENTIFIED,
     PLAN_COLUMNS,
-    identification_tolerance,
     precision_table,
     strides_needed,
     target_answer,

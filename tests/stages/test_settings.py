@@ -124,7 +124,7 @@ NOT_SETTINGS_FIELDS = {
     "LabSettings.*": "the synthetic lab's rates, robot log margin and belt channels (documented defaults)",
     "ValidationSettings.reference_cutoff_hz": "the study fits the unfiltered reference (no config key)",
     "PlanSettings.coupling_bounds_nm_per_rad": "the couplings' bounds, a property of the physics (|K_hk| <= "
-    "sqrt(K_hip K_knee), at most the stiffness bound): the impedance stage fits no coupling to bound",
+    "sqrt(K_hip K_knee), at most the stiffness bound), the fit's own (no config key)",
 }
 
 

@@ -1,6 +1,11 @@
 # Perturbation analysis: responses (matched strides) and impedance fits per subject and onset, aggregate tables.
 
-from loper_analysis.stages.impedance.files import fit_files, fit_inputs
+from loper_analysis.stages.impedance.files import fit_files, fit_inputs, fits_couplings
+
+# the inter-joint couplings' rows per onset, written by a fit with impedance.couplings
+COUPLING_OUTPUTS = (
+    {"couplings": expand(PATHS.impedance.couplings, onset=ONSETS, allow_missing=True)} if fits_couplings(STUDY) else {}
+)
 
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
@@ -18,6 +23,7 @@ rule impedance_fit:
     input:
         lambda wc: fit_inputs(STUDY, wc.subject),
     output:
+        **COUPLING_OUTPUTS,
         response=expand(PATHS.impedance.response, onset=ONSETS, allow_missing=True),
         counts=expand(PATHS.impedance.counts, onset=ONSETS, allow_missing=True),
         fit=expand(PATHS.impedance.fit, onset=ONSETS, allow_missing=True),
@@ -50,6 +56,29 @@ rule impedance_table:
         PATHS.benchmark("impedance_table", "impedance")
     script:
         "../scripts/impedance_table.py"
+
+
+if fits_couplings(STUDY):
+
+    localrules:
+        impedance_couplings_table,
+
+    rule impedance_couplings_table:
+        input:
+            STUDY.onset_files("impedance", "couplings"),
+        output:
+            report(
+                PATHS.impedance.coupling_table,
+                caption="../report/coupling_table.rst",
+                category="Impedance",
+                labels={"table": "inter-joint couplings per subject and onset"},
+            ),
+        log:
+            PATHS.log("impedance_couplings_table", "couplings"),
+        benchmark:
+            PATHS.benchmark("impedance_couplings_table", "couplings")
+        script:
+            "../scripts/impedance_table.py"
 
 
 rule impedance_summary:

@@ -23,7 +23,7 @@ The planner's parts, each in its module:
   counterfactual, over the pilot's stretches, pooled over onsets;
 * here: :func:`precision_table` - predicted SD and 95 % half-width per joint, parameter and stride count;
   :func:`strides_needed` and :func:`target_answer` - how many strides a target half-width needs;
-  :func:`identification_tolerance` and :func:`identification_verdict` - whether a design identifies a
+  :func:`identification_verdict` - whether a design identifies a
   parameter (the plan's verdict on the inter-joint couplings, :attr:`PlanSettings.couplings`).
 
 The identification's own functions build the window, the Jacobian, the
@@ -49,7 +49,7 @@ from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification import (
     t_quantile,
 )
-from loper_analysis.impedance.identification.across_subjects import TRUTH_TOLERANCE
+from loper_analysis.impedance.identification.coupling_rows import identification_tolerance
 from loper_analysis.planning.covariance import StrideCovariance, stride_counts
 from loper_analysis.planning.window import PlanSettings
 
@@ -59,7 +59,6 @@ __all__ = [
     "COUPLING_PLAN_COLUMNS",
     "IDENTIFIED",
     "NOT_IDENTIFIED",
-    "identification_tolerance",
     "identification_verdict",
     "precision_table",
     "strides_needed",
@@ -100,18 +99,6 @@ IDENTIFIED, NOT_IDENTIFIED = "identified", "not identified"
 MAX_ANSWERED_STRIDES: int = 1_000_000
 
 
-def identification_tolerance(kind: str, planned: float) -> float:
-    """The tolerance (N·m/rad for a stiffness ``kind`` ``"K"``, a coupling's too; N·m·s/rad for ``"D"``) within
-    which a design must place a parameter planned at ``planned`` to identify it: the study's tolerance on the
-    truth, ``max(relative * |planned|, absolute)`` with (10 %, 2 N·m/rad) for K and (15 %, 0.05 N·m·s/rad) for D
-    (:data:`~loper_analysis.impedance.identification.across_subjects.TRUTH_TOLERANCE`). A coupling planned at
-    0 gets 2 N·m/rad."""
-    if kind not in TRUTH_TOLERANCE:
-        raise LoperInputError(f"parameter kind must be one of {sorted(TRUTH_TOLERANCE)}, got {kind!r}")
-    relative, absolute = TRUTH_TOLERANCE[kind]
-    return max(relative * abs(float(planned)), absolute)
-
-
 def identification_verdict(half_width: float, tolerance: float) -> str:
     """:data:`IDENTIFIED` when the predicted 95 % CI half-width is at most ``tolerance`` (same unit), else
     :data:`NOT_IDENTIFIED`.
@@ -140,7 +127,8 @@ def precision_table(
 
     With inter-joint couplings (``stride_cov.couplings``, from :attr:`PlanSettings.couplings`) each coupling
     gets rows too (``joint`` the pair, e.g. ``hip_knee``; ``parameter`` ``K``; unit N·m/rad), and every row
-    the columns :data:`COUPLING_PLAN_COLUMNS`: ``tolerance`` (:func:`identification_tolerance` of its planned
+    the columns :data:`COUPLING_PLAN_COLUMNS`: ``tolerance``
+    (:func:`~loper_analysis.impedance.identification.coupling_rows.identification_tolerance` of its planned
     value), ``verdict`` (:func:`identification_verdict` of its half-width) and ``strides_to_identify``
     (:func:`strides_needed` for a half-width of ``tolerance``, from ``stride_cov``).
 

@@ -26,4 +26,5 @@ READERS = {
     "impedance.averaging_correction": "impedance_fit",
     "impedance.null_pair_components": "front_page impedance_fit planning",
     "impedance.min_null_pairs": "impedance_fit planning",
+    "impedance.couplings": "impedance_couplings_table impedance_fit planning tables_markdown",
 }

@@ -11,6 +11,7 @@ import pytest
 import yaml
 
 from loper_analysis.errors import LoperInputError
+from loper_analysis.impedance.identification.coupling_rows import COUPLING_COLUMNS
 from loper_analysis.impedance.identification.impedance import IdentificationSettings
 from loper_analysis.impedance.responses import ResponseSettings
 from loper_analysis.io.truth import write_truth
@@ -56,18 +57,22 @@ def test_settings_of_the_config():
 
 
 def test_every_onset_of_a_subject_without_trials(tmp_path):
-    """subject_fits: one FitFiles per onset, in the mapping's order; every output written."""
+    """subject_fits: one FitFiles per onset, in the mapping's order; every output written (the couplings' table of
+    an onset without a fit: its header, no row)."""
+    names = ("r", "c", "f", "k", "force", "couplings")
     fits = {
         onset: FitFiles(
             trials={},
             segments=tmp_path / "segments.tsv",
-            outputs=FitOutputs(*(tmp_path / f"{onset:03d}.{n}.tsv" for n in ("r", "c", "f", "k", "force"))),
+            outputs=FitOutputs(*(tmp_path / f"{onset:03d}.{n}.tsv" for n in names)),
         )
         for onset in (300, 50)
     }
     rows = subject_fits("S01", fits)
     assert rows.onset_ms.tolist() == [300] * 3 + [50] * 3 and (rows.status == "missing").all()
     assert all(p.is_file() for files in fits.values() for p in dataclasses.astuple(files.outputs))
+    couplings = pd.read_csv(tmp_path / "050.couplings.tsv", sep="\t")
+    assert list(couplings.columns) == list(COUPLING_COLUMNS) and couplings.empty
 
 
 def test_an_onset_s_trial_needs_its_force_and_markers(tmp_path):

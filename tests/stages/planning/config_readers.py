@@ -7,6 +7,5 @@ READERS = {
     "planning.pulse_force_n": "events_loadcell planning",
     "planning.pulse_duration_s": "planning",
     "planning.shank_pulse_force_n": "events_loadcell planning",
-    "planning.couplings": "planning",
     "planning.targets": "planning",
 }

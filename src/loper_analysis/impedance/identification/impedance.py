@@ -61,9 +61,11 @@ from loper_analysis.impedance.identification import (
     refit_with_null_pairs,
     strongest_coupling,
 )
+from loper_analysis.impedance.identification.coupling_rows import COUPLING_COLUMNS, coupling_rows
 from loper_analysis.impedance.identification.jackknife import onset_jackknife
 from loper_analysis.impedance.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
 from loper_analysis.impedance.identification.pair_averaging import averaging_corrected_fit, pair_windows
+from loper_analysis.impedance.identification.parameters import check_couplings
 from loper_analysis.impedance.responses import (
     MAX_TRIAL_DEVIATION_RATIO,
     ResponseSettings,
@@ -143,7 +145,9 @@ class IdentificationSettings(FitBounds):
     pair judged by a projection made without it;
     :func:`loper_analysis.impedance.identification.refit_with_null_pairs`).
     ``averaging_correction``: fit the mean response less what averaging the pairs does to the model's
-    response (:mod:`loper_analysis.impedance.identification.pair_averaging`).
+    response (:mod:`loper_analysis.impedance.identification.pair_averaging`). ``couplings``: inter-joint
+    (bi-articular) stiffnesses fitted beside K and D (names of :data:`~loper_analysis.constants.COUPLINGS`, e.g.
+    ``("hip_knee",)``; :func:`~loper_analysis.impedance.identification.coupling_rows.coupling_rows` reports them).
     """
 
     noise_model: str = "null_pairs"
@@ -163,11 +167,16 @@ class IdentificationSettings(FitBounds):
     max_null_trial_ratio: float | None = MAX_TRIAL_DEVIATION_RATIO
     seed: int = 0
     averaging_correction: bool = True
+    couplings: tuple[str, ...] = ()
 
     def __post_init__(self):
         if self.noise_model not in NOISE_MODELS:
             raise LoperInputError(f"impedance.noise_model must be 'null_pairs' or 'white', got {self.noise_model!r}")
         check_interval_scatter(self.interval_scatter)
+        try:
+            object.__setattr__(self, "couplings", check_couplings(self.couplings))
+        except LoperInputError as exc:
+            raise LoperInputError(f"impedance.couplings: {exc}") from None
 
     def fit_options(self) -> dict:
         """Keyword arguments of :func:`loper_analysis.impedance.identification.identify_impedance`."""
@@ -191,7 +200,10 @@ class OnsetFit:
     ``curves``: the measured and model responses of the fit (``time_s``,
     ``{joint}_measured_rad``, ``{joint}_model_rad``; only ``time_s`` when
     nothing was fitted); ``force``: the mean rod forces the model was given
-    (:func:`force_table`; only ``time_s`` when nothing was fitted).
+    (:func:`force_table`; only ``time_s`` when nothing was fitted); ``couplings``: one row per inter-joint
+    coupling fitted (``impedance.couplings``; columns
+    :data:`~loper_analysis.impedance.identification.coupling_rows.COUPLING_COLUMNS`, no row without one or
+    without a fit).
     """
 
     response: pd.DataFrame
@@ -199,6 +211,7 @@ class OnsetFit:
     rows: pd.DataFrame
     curves: pd.DataFrame
     force: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=["time_s"]))
+    couplings: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=list(COUPLING_COLUMNS)))
 
 
 #: Columns of :func:`force_table`.
@@ -320,7 +333,7 @@ def impedance_rows(
         if truth is not None:
             row[parameter_column("K", "error")] = row[_K] - truth[joint]["K"]
             row[parameter_column("D", "error")] = row[_D] - truth[joint]["D"]
-        coupling = strongest_coupling(fit.correlation, joint)
+        coupling = strongest_coupling(fit.correlation, joint, fit.parameters)
         for p, c in zip(("K", "D"), coupling):
             row[f"{p}_coupled_with"], row[f"{p}_coupling_correlation"] = c if c is not None else ("", np.nan)
         status, reason = joint_status(
@@ -468,7 +481,12 @@ def fit_onset(
         rows = status_rows(subject, onset_ms, "failed", _not_fitted_reason(counts, onset_ms, r), n_kept, truth)
         return OnsetFit(mean, counts, rows, _no_curves())
     ident = identification
-    options = dict(window=r.window, n_substeps=ident.n_substeps, initial_state_degree=ident.initial_state_degree)
+    options = dict(
+        window=r.window,
+        n_substeps=ident.n_substeps,
+        initial_state_degree=ident.initial_state_degree,
+        couplings=ident.couplings,
+    )
     window = mean_response_window(series, params, options)
     fit = identify_impedance(window, **ident.fit_options())
     averaging = np.zeros_like(window.measured)
@@ -512,7 +530,8 @@ def fit_onset(
         plausible_ranges=ident.plausible_ranges,
         jackknife=jackknife,
     )
-    return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series))
+    couplings = coupling_rows(fit, subject, onset_ms, n_kept, truth, note=note)
+    return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series), couplings)
 
 
 def _response_input(trial: Mapping, shank_rod: ShankRod | None = None) -> dict:

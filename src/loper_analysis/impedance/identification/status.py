@@ -168,33 +168,39 @@ def data_finding_inputs(fit, joint_index: int, jackknife: tuple | None = None) -
     )
 
 
-def strongest_coupling(correlation, joint: str) -> tuple[tuple[str, float] | None, tuple[str, float] | None]:
-    """Per K and D of ``joint``, the parameter of another joint it correlates with most strongly.
+def strongest_coupling(
+    correlation, joint: str, names: tuple[str, ...] = PARAMETERS
+) -> tuple[tuple[str, float] | None, tuple[str, float] | None]:
+    """Per K and D of ``joint``, the parameter of another joint (or an inter-joint coupling) it correlates with most
+    strongly.
 
     Parameters
     ----------
-    correlation : (6, 6) array_like
-        Correlation of the fit's parameters, order :data:`loper_analysis.constants.PARAMETERS`; NaN
-        where a parameter has no finite standard error.
+    correlation : (p, p) array_like
+        Correlation of the fit's parameters, order ``names``; NaN where a parameter has no finite standard error.
     joint : str
         ``hip``, ``knee`` or ``ankle``.
+    names : the fit's parameters (:attr:`~loper_analysis.impedance.identification.ImpedanceFit.parameters`):
+        :data:`loper_analysis.constants.PARAMETERS`, then its couplings' ``K_<coupling>``.
 
     Returns
     -------
-    (K, D) : each ``(name, r)`` (``("D_hip", -0.93)``), or None when no correlation with another joint is finite.
+    (K, D) : each ``(name, r)`` (``("D_hip", -0.93)``), or None when no correlation with another parameter is finite.
     """
     c = np.asarray(correlation, dtype=float)
-    if c.shape != (len(PARAMETERS),) * 2:
-        raise LoperInputError(f"correlation must be {len(PARAMETERS)} x {len(PARAMETERS)}, got shape {c.shape}")
+    names = tuple(names)
+    if c.shape != (len(names),) * 2:
+        raise LoperInputError(f"correlation must be {len(names)} x {len(names)}, got shape {c.shape}")
+    own = (f"K_{joint}", f"D_{joint}")
     out = []
-    for p in ("K", "D"):
-        i = PARAMETERS.index(f"{p}_{joint}")
-        others = [k for k, name in enumerate(PARAMETERS) if not name.endswith(f"_{joint}") and np.isfinite(c[i, k])]
+    for p in own:
+        i = names.index(p)
+        others = [k for k, name in enumerate(names) if name not in own and np.isfinite(c[i, k])]
         if not others:
             out.append(None)
             continue
         k = max(others, key=lambda k: abs(c[i, k]))
-        out.append((PARAMETERS[k], float(c[i, k])))
+        out.append((names[k], float(c[i, k])))
     return out[0], out[1]
 
 

@@ -14,7 +14,17 @@ from loper_analysis.layout import fill
 if TYPE_CHECKING:
     from loper_analysis.layout import Study
 
-__all__ = ["FILES", "report_tables", "FitFiles", "FitOutputs", "TrialFiles", "fit_files", "fit_inputs", "targets"]
+__all__ = [
+    "FILES",
+    "report_tables",
+    "FitFiles",
+    "FitOutputs",
+    "TrialFiles",
+    "fit_files",
+    "fit_inputs",
+    "fits_couplings",
+    "targets",
+]
 
 FILES: dict[str, str] = {
     "response": "{subject}/{onset}.response.tsv",
@@ -22,9 +32,11 @@ FILES: dict[str, str] = {
     "fit": "{subject}/{onset}.tsv",
     "curves": "{subject}/{onset}.curves.tsv",
     "force": "{subject}/{onset}.force.tsv",
+    "couplings": "{subject}/{onset}.couplings.tsv",
     "responses_figure": "{subject}/responses.png",
     "fit_figure": "{subject}/fit.png",
     "table": "impedance.tsv",
+    "coupling_table": "couplings.tsv",
     "summary": "summary.tsv",
     "literature": "literature.tsv",
     "figure": "impedance.png",
@@ -51,13 +63,15 @@ class TrialFiles:
 @dataclass(frozen=True)
 class FitOutputs:
     """The files one fit writes (TSV): the mean ``response``, the stride ``counts``, the ``fit`` rows, the fit
-    ``curves`` and, optionally, the mean ``force`` the model saw."""
+    ``curves`` and, optionally, the mean ``force`` the model saw and the inter-joint ``couplings``' rows (a fit with
+    ``impedance.couplings``)."""
 
     response: PathLike
     counts: PathLike
     fit: PathLike
     curves: PathLike
     force: PathLike | None = None
+    couplings: PathLike | None = None
 
 
 @dataclass(frozen=True)
@@ -109,7 +123,7 @@ def fit_files(study: Study, subject: str) -> dict:
             return []
         return study.null_pair_trials(s)
 
-    outputs = ("response", "counts", "fit", "curves", "force")
+    outputs = ("response", "counts", "fit", "curves", "force") + (("couplings",) if fits_couplings(study) else ())
     return {
         o: FitFiles(
             trials={t: trial_files(t, True) for t in study.onset_trials(s, o)},
@@ -120,6 +134,11 @@ def fit_files(study: Study, subject: str) -> dict:
         )
         for o in study.design.perturbation_onsets_ms
     }
+
+
+def fits_couplings(study: Study) -> bool:
+    """Whether the fits add inter-joint couplings (``impedance.couplings``), and so write their tables."""
+    return bool(study.settings["impedance"].identification.couplings)
 
 
 def fit_inputs(study: Study, subject: str) -> list[str]:
@@ -139,14 +158,19 @@ def targets(study: Study) -> list[str]:
     p = study.paths.impedance
     figures = ("responses_figure", "fit_figure")
     subjects = [fill(getattr(p, f), subject=s) for s in study.processed_subjects() for f in figures]
-    return [p.table, p.summary, p.literature, p.figure, *subjects]
+    couplings = [p.coupling_table] if fits_couplings(study) else []
+    return [p.table, p.summary, p.literature, p.figure, *couplings, *subjects]
 
 
 def report_tables(study: Study) -> dict[str, str]:
-    """Heading -> table of the run's Markdown tables: the impedance per subject, its summary, the literature."""
+    """Heading -> table of the run's Markdown tables: the impedance per subject, its summary, the literature and,
+    with ``impedance.couplings``, the inter-joint couplings per subject and onset."""
     p = study.paths.impedance
-    return {
+    tables = {
         "Impedance per subject, onset and joint": p.table,
         "Across-subject summary": p.summary,
         "Literature": p.literature,
     }
+    if fits_couplings(study):
+        tables["Inter-joint couplings per subject and onset"] = p.coupling_table
+    return tables

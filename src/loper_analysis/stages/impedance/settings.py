@@ -24,8 +24,9 @@ def read_settings(
 ) -> FitSettings:
     """The fit's settings of a validated config: the response window (``impedance.window_before_s``,
     ``window_after_s``, ``initial_state_span_s``, s), the counterfactual and every other key of
-    ``identification`` (bounds in N·m/rad and N·m·s/rad); the IQR rule and fewest kept strides are the
-    strides', the seed the study's, a second rod's place and push the device's (``device.shank_rod``)."""
+    ``identification`` (bounds in N·m/rad and N·m·s/rad; the inter-joint ``couplings``); the IQR rule and
+    fewest kept strides are the strides', the seed the study's, a second rod's place and push the device's
+    (``device.shank_rod``)."""
     ident = config["impedance"]
     window = ResponseWindow(
         before_s=ident["window_before_s"],
@@ -56,6 +57,7 @@ def read_settings(
         min_vaf_pct=ident["min_vaf_pct"],
         max_null_trial_ratio=ident["max_null_trial_ratio"],
         averaging_correction=ident["averaging_correction"],
+        couplings=tuple(ident["couplings"]),
         seed=study.seed,
     )
     return FitSettings(response=response, identification=identification, shank_rod=device.shank_rod)

@@ -71,8 +71,8 @@ def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, ta
 
     ``files`` (:class:`FitFiles`): the onset's trials, the null-pair trials, the segment table, the truth and
     the outputs; ``settings`` (:class:`FitSettings`): the response and identification settings. Writes the
-    mean response, the stride counts, the fit rows, the fit curves and (when ``files.outputs.force`` is
-    given) the mean forces the model saw; returns the rows.
+    mean response, the stride counts, the fit rows, the fit curves and, when ``files.outputs`` names them, the
+    mean forces the model saw and the inter-joint couplings' rows; returns the rows.
     """
     from loper_analysis.impedance.identification.impedance import fit_onset
     from loper_analysis.io.opensim_tables import read_markers
@@ -122,6 +122,8 @@ def _fit(subject: str, onset_ms: int, files: FitFiles, settings: FitSettings, ta
     write_tsv(result.curves, out.curves)
     if out.force is not None:
         write_tsv(result.force, out.force)
+    if out.couplings is not None:
+        write_tsv(result.couplings, out.couplings)
     log.info("impedance:\n%s", result.rows.to_string(index=False))
     return result.rows
 
@@ -140,7 +142,8 @@ def subject_fits(subject: str, fits: Mapping[int, FitFiles], settings: FitSettin
 
 
 def impedance_table(fit_tsvs: Sequence[PathLike], out_tsv: PathLike) -> pd.DataFrame:
-    """The fit rows of every subject and onset in one table (``results/impedance/impedance.tsv``)."""
+    """The fit rows of every subject and onset in one table (``results/impedance/impedance.tsv``; the couplings'
+    rows likewise in ``results/impedance/couplings.tsv``)."""
     table = pd.concat([read_tsv(f, "impedance rows") for f in fit_tsvs], ignore_index=True)
     write_tsv(table, out_tsv)
     log.info("%d rows, status counts:\n%s", len(table), table.status.value_counts().to_string())

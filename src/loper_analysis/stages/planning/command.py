@@ -43,7 +43,7 @@ def _add_design_options(p: argparse.ArgumentParser) -> None:
         nargs="*",
         choices=("hip_knee", "knee_ankle"),
         help="inter-joint (bi-articular) stiffnesses to plan beside the six, planned at 0: the plan says whether the "
-        "design identifies each (default: planning.couplings, else none)",
+        "design identifies each (default: impedance.couplings, else none)",
     )
     p.add_argument(
         "--shank-direction-deg",

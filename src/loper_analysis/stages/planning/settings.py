@@ -23,9 +23,9 @@ def read_settings(
 ) -> PlanningSettings:
     """The planner's settings of a validated config: the rule ``planning`` and ``loper-analysis plan`` both take
     theirs from here. ``planning.strides``, ``targets``, ``pilot_subject``, the second rod's
-    ``shank_pulse_force_n`` (N; the rod's point and push the device's), the inter-joint ``couplings`` and the
-    pulse ``pulse_force_n`` (N), ``pulse_duration_s`` (s); the onsets the study's; the fit window, substeps,
-    projected components, null-pair minimum, interval scatter, bounds (N·m/rad, N·m·s/rad), counterfactual and
+    ``shank_pulse_force_n`` (N; the rod's point and push the device's) and the pulse ``pulse_force_n`` (N),
+    ``pulse_duration_s`` (s); the onsets the study's; the fit window, substeps, projected components, null-pair
+    minimum, interval scatter, inter-joint couplings, bounds (N·m/rad, N·m·s/rad), counterfactual and
     null-trial ratio the fit's; the load cell's low-pass (Hz, order) the markers' (as the events stage filters the
     force); the force's rate and the device the device's."""
     p, fit = config["planning"], impedance.identification
@@ -34,7 +34,7 @@ def read_settings(
         pulse_duration_s=p["pulse_duration_s"],
         shank_pulse_force_n=p["shank_pulse_force_n"],
         shank_rod=device.shank_rod,
-        couplings=tuple(p["couplings"]),
+        couplings=fit.couplings,
         window=impedance.response.window,
         initial_state_degree=fit.initial_state_degree,
         n_substeps=fit.n_substeps,
