@@ -229,7 +229,7 @@ def test_the_planned_window_and_values_carry_the_coupling(null_pairs):
 
 def test_a_couplings_answer_names_the_keys_the_verdict_and_the_strides_it_needs():
     """The answer to a planned coupling reads its largest stride count's row: the verdict, the half-width against
-    the tolerance and the strides needed, naming planning.couplings and the rods' design."""
+    the tolerance and the strides needed, naming impedance.couplings and the rods' design."""
     import pandas as pd
 
     from loper_analysis.planning.pilot_plan import coupling_answers
@@ -246,6 +246,6 @@ def test_a_couplings_answer_names_the_keys_the_verdict_and_the_strides_it_needs(
     )
     [answer] = coupling_answers(table, 50.0, PlanSettings(shank_pulse_force_n=40.0, couplings=("hip_knee",)))
     assert answer == (
-        "K_hip_knee at 50 ms (planning.couplings; planning.shank_pulse_force_n = 40 N): not identified at 60 strides "
+        "K_hip_knee at 50 ms (impedance.couplings; planning.shank_pulse_force_n = 40 N): not identified at 60 strides "
         "(95 % half-width ±5.88 N·m/rad against the tolerance 2); needs 507 perturbed strides to be identified"
     )

@@ -205,7 +205,7 @@ def pilot_plan(
 def coupling_answers(table: pd.DataFrame, onset: float, plan: PlanSettings) -> list[str]:
     """Whether the design identifies each planned coupling at ``onset`` (ms): one sentence per coupling of
     ``plan.couplings`` from its rows of the precision ``table`` (its largest stride count), naming the keys that
-    set the design (``planning.couplings``, ``planning.shank_pulse_force_n``)."""
+    set the design (``impedance.couplings``, ``planning.shank_pulse_force_n``)."""
     out = []
     rods = f"planning.shank_pulse_force_n = {plan.shank_pulse_force_n:g} N"
     for coupling in plan.couplings:
@@ -216,7 +216,7 @@ def coupling_answers(table: pd.DataFrame, onset: float, plan: PlanSettings) -> l
         needed = row["strides_to_identify"]
         more = f"needs {needed:.0f} perturbed strides" if np.isfinite(needed) else "needs more strides than planned"
         out.append(
-            f"K_{coupling} at {onset:g} ms (planning.couplings; {rods}): {row['verdict']} at {row['n_strides']:.0f} "
+            f"K_{coupling} at {onset:g} ms (impedance.couplings; {rods}): {row['verdict']} at {row['n_strides']:.0f} "
             f"strides (95 % half-width ±{row['ci95_half_width']:.3g} N·m/rad against the tolerance "
             f"{row['tolerance']:.3g}); {more} to be identified"
         )
