@@ -17,7 +17,8 @@ perturbed pairs'
 scatter) with their first N perturbed strides, for each N of ``--strides``; their null pairs come from the
 whole trial. The measured SD is the SD of the estimates over the repeats; the prediction for the same repeats
 is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the table predicted vs measured
-(ratio, and the measured SD's own 95 % range).
+(ratio, and the measured SD's own 95 % range), with the fits' own reported SE and the share of the repeats whose
+joint row is ``not_identifiable``.
 
 ``--counterfactual conditional`` (the workflow's default; without the option the study's matched stride) plans
 and fits with the conditional counterfactual instead: the prediction is
@@ -194,6 +195,7 @@ def run_check(
     found = {n: [] for n in counts}
     kept = {n: [] for n in counts}
     reported = {n: [] for n in counts}
+    statuses = {n: [] for n in counts}
     t0 = time.perf_counter()
     skipped = []
     for k in range(1, repeats + 1):
@@ -223,6 +225,7 @@ def run_check(
             found[n].append(estimates(fit.rows))
             kept[n].append(int(fit.rows["n_strides"].iloc[0]))
             reported[n].append(reported_sd(fit.rows))
+            statuses[n].append(fit.rows.set_index("joint").loc[list(JOINTS), "status"].to_numpy())
         if verbose and k % 10 == 0:
             print(f"  {k} repeats, {time.perf_counter() - t0:.0f} s", flush=True)
     rows = []
@@ -236,6 +239,7 @@ def run_check(
         predicted = np.sqrt(np.mean([by_count.get(n, sc).sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         predicted_null = np.sqrt(np.mean([sc_null.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         fits_say = np.sqrt(np.mean(np.array(reported[n]) ** 2, axis=0))
+        not_identifiable = np.mean(np.array(statuses[n]) == "not_identifiable", axis=0)  # (3,) per joint
         # every repeat as the pilot: its prediction for the same repeats over the measured SD
         pilot_ratios = np.array(
             [
@@ -261,6 +265,7 @@ def run_check(
                     "whole_pilot_predicted_sd": whole[i],
                     "null_pairs_predicted_sd": predicted_null[i],
                     "fits_reported_sd": fits_say[i],
+                    "share_not_identifiable": not_identifiable[i // 2],
                     "measured_sd": measured[i],
                     "measured_sd_mad": robust[i],
                     "measured_sd_95_low": measured[i] * (1 - rel),
