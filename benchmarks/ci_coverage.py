@@ -98,10 +98,12 @@ def binomial_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float
     return float(low), float(high)
 
 
-#: Words of the reason of a row whose interval the status says can miss the truth by more than its width (rules 7
-#: and 8 of ``joint_status``): the joint's model response smaller than its residual; the perturbed pairs' scatter
-#: beyond the interval's.
-DATA_FINDINGS = {"response": "MIN_RESPONSE_TO_RESIDUAL", "pair_scatter": "PAIR_SCATTER_LEVEL"}
+#: Words of the reason of a row whose interval the status says can miss the truth by more than its width (rule 7
+#: of ``joint_status``): the joint's model response smaller than its residual.
+DATA_FINDINGS = {"response": "MIN_RESPONSE_TO_RESIDUAL"}
+#: Words of the reason of a K or D whose interval comes from the perturbed pairs' scatter (it exceeded the null
+#: pairs'; :func:`loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`), after ``{p}_{joint}: ``.
+WIDENED = "95 % CI from the perturbed pairs' scatter"
 
 
 def _share(inside: pd.Series, has_ci: pd.Series) -> dict:
@@ -116,11 +118,11 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
 
     ``fits``: every fitted row (``ok`` or ``not_identifiable``) with an interval, as the table reports them;
     ``standing``: those rows less the ones whose reason names one of :data:`DATA_FINDINGS` (the joint's model
-    response smaller than its residual, or the perturbed pairs' scatter beyond the interval's: the status says
-    their interval can miss the truth by more than it shows); ``ok``: the rows still ``ok``. Each with the number
-    of rows, how many intervals hold the truth, the share (%) and its binomial (Clopper-Pearson) 95 % interval (%);
-    the median width of the fitted rows' intervals, the rows ``not_identifiable`` and those whose reason names each
-    finding.
+    response smaller than its residual: the status says their interval can miss the truth by more than it shows);
+    ``ok``: the rows still ``ok``. Each with the number of rows, how many intervals hold the truth, the share (%)
+    and its binomial (Clopper-Pearson) 95 % interval (%); the median width of the fitted rows' intervals, the rows
+    ``not_identifiable``, those whose reason names each finding and (``n_widened``) those whose interval of this
+    parameter comes from the perturbed pairs' scatter (:data:`WIDENED`).
     """
     fitted = table[table["status"].isin(["ok", "not_identifiable"])]
     rows = []
@@ -128,7 +130,7 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
         g = fitted[fitted["joint"] == joint]
         reason = g["reason"].fillna("")
         found = {name: reason.str.contains(words, regex=False) for name, words in DATA_FINDINGS.items()}
-        flagged = found["response"] | found["pair_scatter"]
+        flagged = found["response"]
         for p, unit in (("K", "nm_per_rad"), ("D", "nms_per_rad")):
             low, high = g[f"{p}_ci95_low_{unit}"], g[f"{p}_ci95_high_{unit}"]
             truth = g[f"{p}_true_{unit}"]
@@ -145,6 +147,7 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
                 median_ci_width=float(np.median((high - low)[has_ci])) if has_ci.any() else np.nan,
                 n_not_identifiable=int((g["status"] == "not_identifiable").sum()),
                 **{f"n_{name}": int(f.sum()) for name, f in found.items()},
+                n_widened=int(reason.str.contains(f"{p}_{joint}: {WIDENED}", regex=False).sum()),
             )
             rows.append(row)
     return pd.DataFrame(rows)

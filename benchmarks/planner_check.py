@@ -17,8 +17,8 @@ perturbed pairs'
 scatter) with their first N perturbed strides, for each N of ``--strides``; their null pairs come from the
 whole trial. The measured SD is the SD of the estimates over the repeats; the prediction for the same repeats
 is ``sd_1 * sqrt(mean(1 / n_i))``, n_i the strides each fit kept. Prints the table predicted vs measured
-(ratio, and the measured SD's own 95 % range), with the fits' own reported SE and the share of the repeats whose
-joint row is ``not_identifiable``.
+(ratio, and the measured SD's own 95 % range), with the fits' own reported SE, the share of the repeats whose
+joint row is ``not_identifiable`` and the share whose 95 % interval holds the truth.
 
 ``--counterfactual conditional`` (the workflow's default; without the option the study's matched stride) plans
 and fits with the conditional counterfactual instead: the prediction is
@@ -84,6 +84,17 @@ def estimates(rows: pd.DataFrame) -> np.ndarray:
     """K, D per joint (6,) in the order of PARAMETERS from the three rows of a fit."""
     by_joint = rows.set_index("joint")
     return np.array([by_joint.loc[j, parameter_column(p)] for j in JOINTS for p in ("K", "D")], float)
+
+
+def truth_in_ci95(rows: pd.DataFrame, truth) -> np.ndarray:
+    """Whether each of the six 95 % intervals of one fit's rows holds its truth (order :data:`PARAMETERS`)."""
+    r = rows.set_index("joint")
+    out = []
+    for name, value in zip(PARAMETERS, truth, strict=True):
+        p, joint = name.split("_")
+        low, high = r.loc[joint, parameter_column(p, "ci95_low")], r.loc[joint, parameter_column(p, "ci95_high")]
+        out.append(bool(low <= value <= high))
+    return np.array(out)
 
 
 def reported_sd(rows: pd.DataFrame) -> np.ndarray:
@@ -196,6 +207,7 @@ def run_check(
     kept = {n: [] for n in counts}
     reported = {n: [] for n in counts}
     statuses = {n: [] for n in counts}
+    inside = {n: [] for n in counts}
     t0 = time.perf_counter()
     skipped = []
     for k in range(1, repeats + 1):
@@ -226,6 +238,7 @@ def run_check(
             kept[n].append(int(fit.rows["n_strides"].iloc[0]))
             reported[n].append(reported_sd(fit.rows))
             statuses[n].append(fit.rows.set_index("joint").loc[list(JOINTS), "status"].to_numpy())
+            inside[n].append(truth_in_ci95(fit.rows, truth))
         if verbose and k % 10 == 0:
             print(f"  {k} repeats, {time.perf_counter() - t0:.0f} s", flush=True)
     rows = []
@@ -240,6 +253,7 @@ def run_check(
         predicted_null = np.sqrt(np.mean([sc_null.sd_of(int(m)) ** 2 for m in n_kept], axis=0))
         fits_say = np.sqrt(np.mean(np.array(reported[n]) ** 2, axis=0))
         not_identifiable = np.mean(np.array(statuses[n]) == "not_identifiable", axis=0)  # (3,) per joint
+        covered = np.mean(inside[n], axis=0)
         # every repeat as the pilot: its prediction for the same repeats over the measured SD
         pilot_ratios = np.array(
             [
@@ -266,6 +280,7 @@ def run_check(
                     "null_pairs_predicted_sd": predicted_null[i],
                     "fits_reported_sd": fits_say[i],
                     "share_not_identifiable": not_identifiable[i // 2],
+                    "share_truth_in_ci95": covered[i],
                     "measured_sd": measured[i],
                     "measured_sd_mad": robust[i],
                     "measured_sd_95_low": measured[i] * (1 - rel),

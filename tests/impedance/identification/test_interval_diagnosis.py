@@ -1,11 +1,13 @@
-"""Fits whose interval can miss the truth by more than it shows (rules 7 and 8 of ``joint_status``).
+"""Fits whose null pairs' interval can miss the truth by more than it shows.
 
-Rule 7: a joint whose model response is smaller than its residual (a joint that barely moves in the window).
-Rule 8: a K or D whose perturbed pairs scatter beyond the interval's scatter (the linearised jackknife over the
-averaged pairs, :func:`loper_analysis.impedance.identification.jackknife.jackknife_sd`, against an F quantile).
-Each rule on a known case, the jackknife against leave-one-out refits, and seeded sets of simulated strides
-with a known truth: a barely moving ankle and ankles whose strides answer with their own stiffness come out
-``not_identifiable`` with the reason, a well-excited joint stays as it was.
+Rule 7 of ``joint_status``: a joint whose model response is smaller than its residual (a joint that barely moves in
+the window) is ``not_identifiable``. A K or D whose perturbed pairs scatter beyond the interval's scatter (the
+linearised jackknife over the averaged pairs, :func:`loper_analysis.impedance.identification.jackknife.jackknife_sd`,
+against an F quantile) gets its interval from that scatter
+(:func:`loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`). Each on a known case, the
+jackknife against leave-one-out refits, and seeded sets of simulated strides with a known truth: a barely moving
+ankle comes out ``not_identifiable`` with the reason, ankles whose strides answer with their own stiffness get the
+interval their scatter says, a well-excited joint stays as it was.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from functools import cache
 import numpy as np
 import pytest
 from scipy.stats import beta, f
+from scipy.stats import t as t_dist
 
 from loper_analysis.errors import LoperInputError
 from loper_analysis.impedance.identification import (
@@ -25,7 +28,7 @@ from loper_analysis.impedance.identification import (
 )
 from loper_analysis.impedance.identification.impedance import impedance_rows
 from loper_analysis.impedance.identification.intervals import f_quantile
-from loper_analysis.impedance.identification.jackknife import jackknife_sd
+from loper_analysis.impedance.identification.jackknife import jackknife_sd, widen_to_pair_scatter
 from loper_analysis.impedance.identification.validation import perturbed_trial
 from tests.impedance.identification.validation_windows import PARAMS, SETTINGS, fit, window_for
 
@@ -93,23 +96,48 @@ def test_the_f_quantile_is_scipy_s():
         f_quantile(0.5, 10, 0.99)
 
 
-def test_pair_scatter_beyond_the_f_quantile_is_not_identifiable():
-    limit = f.ppf(PAIR_SCATTER_LEVEL, 9, 34)  # 2.98: 10 pairs against 35 null pairs
-    sd = np.array([1.0, 0.02])
-    kw = dict(sd=sd, ci_dof=34, jackknife_dof=9)
-    # K's variance ratio just above the quantile, D's just below it
-    status, reason = ok_interval(**kw, jackknife_sd=sd * np.sqrt([1.01 * limit, 0.99 * limit]))
-    assert status == "not_identifiable"
-    assert "K_ankle: the perturbed pairs' jackknife SD 1.74 N·m/rad is 1.7 times the interval's 1 N·m/rad" in reason
-    assert f"F_0.99(9, 34) = {limit:.3g}, PAIR_SCATTER_LEVEL" in reason and "D_ankle" not in reason
-    assert ok_interval(**kw, jackknife_sd=sd * np.sqrt(0.99 * limit))[0] == "ok"
-    # a stricter level: the same ratio passes
-    assert ok_interval(**kw, jackknife_sd=sd * np.sqrt(1.01 * limit), pair_scatter_level=0.999)[0] == "ok"
-    # nothing to compare: no jackknife, or an interval without information
-    assert ok_interval(sd=sd, ci_dof=34)[0] == "ok"
-    assert ok_interval(sd=[np.inf, 0.02], ci_dof=34, jackknife_dof=9, jackknife_sd=[5.0, 0.02])[0] == "ok"
-    with pytest.raises(LoperInputError, match="pair_scatter_level"):
-        ok_interval(**kw, jackknife_sd=sd, pair_scatter_level=1.0)
+def _fit_with_sd(sd, ci_dof=34):
+    """The seeded 8-pair fit of the validation's strides with its SDs replaced (intervals from them, t with
+    ``ci_dof`` degrees of freedom): a fit whose intervals are known by hand."""
+    from dataclasses import replace
+
+    from loper_analysis.impedance.identification import bounded_interval
+
+    _, _, full = _pairs([8.0] * 8, seed=3)
+    sd = np.asarray(sd, dtype=float)
+    low, high = bounded_interval(full.estimate, sd, ci_dof, SETTINGS.lower, SETTINGS.upper)
+    return replace(full, sd=sd, ci_dof=ci_dof, ci95_low=low, ci95_high=high)
+
+
+def test_pair_scatter_beyond_the_f_quantile_widens_that_interval_only():
+    """10 pairs against 35 null pairs: F_0.99(9, 34) = 2.98. The ankle's K with a jackknife variance 1.01 times the
+    quantile over its interval's gets the interval ``estimate +- t_0.975(9) sd_jk`` and a reason giving both SDs;
+    its D at 0.99 times the quantile and every other parameter keep theirs; the estimate does not move."""
+    limit = f.ppf(PAIR_SCATTER_LEVEL, 9, 34)
+    sd = np.array([2.0, 0.1, 0.5, 0.01, 1.0, 0.02])
+    fit = _fit_with_sd(sd)
+    jk = sd.copy()
+    jk[4], jk[5] = sd[4] * np.sqrt(1.01 * limit), sd[5] * np.sqrt(0.99 * limit)
+    wide, notes = widen_to_pair_scatter(fit, (jk, 9), SETTINGS.lower, SETTINGS.upper)
+    assert list(notes) == ["K_ankle"]
+    text = notes["K_ankle"]
+    assert "K_ankle: 95 % CI from the perturbed pairs' scatter (jackknife SD 1.74 N·m/rad, 1.7 times" in text
+    assert f"F_0.99(9, 34) = {limit:.3g}, PAIR_SCATTER_LEVEL; t with 9 degrees of freedom" in notes["K_ankle"]
+    np.testing.assert_array_equal(wide.estimate, fit.estimate)
+    expected = np.array([False, False, False, False, True, False])
+    np.testing.assert_array_equal(wide.sd, np.where(expected, jk, sd))
+    half = 0.5 * (wide.ci95_high - wide.ci95_low)
+    assert half[4] == pytest.approx(t_dist.ppf(0.975, 9) * jk[4], rel=1e-12)  # inside the bounds: symmetric
+    np.testing.assert_array_equal(wide.ci95_low[~expected], fit.ci95_low[~expected])
+    # a stricter level: the same ratio keeps the null pairs' interval
+    assert widen_to_pair_scatter(fit, (jk, 9), SETTINGS.lower, SETTINGS.upper, level=0.999)[1] == {}
+    # nothing to compare: an interval without information
+    inf = _fit_with_sd([np.inf, 0.1, 0.5, 0.01, 1.0, 0.02])
+    assert "K_hip" not in widen_to_pair_scatter(inf, (np.full(6, 50.0), 9), SETTINGS.lower, SETTINGS.upper)[1]
+    with pytest.raises(LoperInputError, match="pair scatter level"):
+        widen_to_pair_scatter(fit, (jk, 9), SETTINGS.lower, SETTINGS.upper, level=1.0)
+    with pytest.raises(LoperInputError, match="jackknife SD must hold the fit's 6 parameters"):
+        widen_to_pair_scatter(fit, (jk[:5], 9), SETTINGS.lower, SETTINGS.upper)
 
 
 # --------------------------------------------------------------------------- seeded strides
@@ -204,28 +232,32 @@ def test_the_jackknife_is_that_of_leave_one_out_refits():
     np.testing.assert_allclose(sd, textbook, rtol=0.1)
 
 
-def test_strides_that_answer_with_their_own_ankle_stiffness_are_not_identifiable_at_the_ankle():
+def test_strides_that_answer_with_their_own_ankle_stiffness_get_the_interval_their_scatter_says():
     """Every stride the same but the ankle's K, 4 … 16 N·m/rad: the mean's interval (from the residual) shows the
-    noise, the pairs show the strides' own ankles."""
+    noise, the pairs show the strides' own ankles, and the ankle's K interval is taken from them (its row's reason
+    says so); the hip's stays."""
     ks = np.linspace(4.0, 16.0, 10)
-    flagged, hip_flagged, jack_var, expected_var = 0, 0, [], []
+    widened, hip_widened, jack_var, expected_var = 0, 0, [], []
     for seed in range(5):
         windows, mean, full = _pairs(ks, seed)
         sd, dof = jackknife_sd(mean, full.estimate, windows, lower=SETTINGS.lower, upper=SETTINGS.upper)
-        rows = impedance_rows(full, "S01", 175, len(ks), lower=LOWER, upper=UPPER, jackknife=(sd, dof))
+        wide, notes = widen_to_pair_scatter(full, (sd, dof), SETTINGS.lower, SETTINGS.upper)
+        rows = impedance_rows(wide, "S01", 175, len(ks), lower=LOWER, upper=UPPER, interval_notes=notes)
         rows = rows.set_index("joint")
-        flagged += "K_ankle: the perturbed pairs' jackknife SD" in rows.loc["ankle", "reason"]
-        hip_flagged += "PAIR_SCATTER_LEVEL" in rows.loc["hip", "reason"]
+        if "K_ankle" in notes:
+            widened += 1
+            assert wide.sd[4] == sd[4]
+            assert "K_ankle: 95 % CI from the perturbed pairs' scatter" in rows.loc["ankle", "reason"]
+        hip_widened += any(name.endswith("_hip") for name in notes)
         jack_var.append(sd[4] ** 2)
         # what the mean of the strides holds: their own ankle K's scatter over n, and the noise's (the interval)
         expected_var.append(np.var(ks, ddof=1) / len(ks) + full.sd[4] ** 2)
     # the jackknife variance of 5 x 10 pairs has 45 degrees of freedom: relative SE sqrt(2 / 45) = 21 %, 10.5 % of
     # the SD; within two of them
     assert np.sqrt(np.mean(jack_var) / np.mean(expected_var)) == pytest.approx(1.0, abs=0.21)
-    assert flagged == 5 and hip_flagged == 0
-    # the same strides with one ankle K: nothing to find at any joint
+    assert widened == 5 and hip_widened == 0
+    # the same strides with one ankle K: nothing to widen at any joint
     for seed in range(5):
         windows, mean, full = _pairs([8.0] * 10, seed)
         sd, dof = jackknife_sd(mean, full.estimate, windows, lower=SETTINGS.lower, upper=SETTINGS.upper)
-        rows = impedance_rows(full, "S01", 175, 10, lower=LOWER, upper=UPPER, jackknife=(sd, dof))
-        assert "PAIR_SCATTER_LEVEL" not in "".join(rows["reason"].fillna(""))
+        assert widen_to_pair_scatter(full, (sd, dof), SETTINGS.lower, SETTINGS.upper)[1] == {}

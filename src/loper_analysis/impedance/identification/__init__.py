@@ -44,6 +44,7 @@ from loper_analysis.impedance.identification.fit import (
     variance_accounted_for,
 )
 from loper_analysis.impedance.identification.intervals import CI_LEVEL, bounded_interval, t_quantile
+from loper_analysis.impedance.identification.jackknife import PAIR_SCATTER_LEVEL
 from loper_analysis.impedance.identification.null_pairs import (
     INTERVAL_SCATTERS,
     MIN_NULL_PAIRS,
@@ -62,7 +63,6 @@ from loper_analysis.impedance.identification.status import (
     MAX_CI_FRACTION,
     MIN_RESPONSE_TO_RESIDUAL,
     MIN_VAF_PCT,
-    PAIR_SCATTER_LEVEL,
     check_plausible_range,
     data_finding_inputs,
     joint_status,

@@ -88,12 +88,14 @@ def coupling_rows(
     *,
     bounds_nm_per_rad: tuple[float, float] = COUPLING_BOUNDS_NM_PER_RAD,
     note: str = "",
+    interval_notes: Mapping[str, str] | None = None,
 ) -> pd.DataFrame:
     """One row per inter-joint coupling of ``fit`` (its parameters after the six; columns :data:`COUPLING_COLUMNS`).
 
     ``truth``: a synthetic subject's ``{name: {"K": ..}}`` at this onset (None for a recorded one: truth and error
     left empty); a coupling it does not name is 0 (the synthetic lab's legs have none). ``bounds_nm_per_rad``:
-    the fit's bounds of a coupling (low, high); ``note`` is appended to every row's reason. Status:
+    the fit's bounds of a coupling (low, high); ``note`` is appended to every row's reason, ``interval_notes``
+    (parameter name -> text, e.g. that its interval comes from the perturbed pairs' scatter) to its own. Status:
     :func:`_status`. No coupling: no row.
     """
     rows = []
@@ -114,7 +116,7 @@ def coupling_rows(
             "tolerance_nm_per_rad": tolerance,
             "n_strides": int(n_strides),
             "status": status,
-            "reason": "; ".join(r for r in (reason, note) if r),
+            "reason": "; ".join(r for r in (reason, (interval_notes or {}).get(name, ""), note) if r),
         }
         if truth is not None:
             true = float(truth.get(name[2:], {"K": 0.0})["K"])

@@ -50,7 +50,6 @@ from loper_analysis.impedance.identification import (
     N_STARTS,
     N_SUBSTEPS,
     NULL_PAIR_COMPONENTS,
-    PAIR_SCATTER_LEVEL,
     STIFFNESS_BOUNDS_NM_PER_RAD,
     FitBounds,
     ImpedanceFit,
@@ -62,7 +61,7 @@ from loper_analysis.impedance.identification import (
     strongest_coupling,
 )
 from loper_analysis.impedance.identification.coupling_rows import COUPLING_COLUMNS, coupling_rows
-from loper_analysis.impedance.identification.jackknife import onset_jackknife
+from loper_analysis.impedance.identification.jackknife import onset_jackknife, widen_to_pair_scatter
 from loper_analysis.impedance.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
 from loper_analysis.impedance.identification.pair_averaging import averaging_corrected_fit, pair_windows
 from loper_analysis.impedance.identification.parameters import check_couplings
@@ -286,8 +285,7 @@ def impedance_rows(
     at_bound_fraction: float = AT_BOUND_FRACTION,
     plausible_ranges: Mapping | None = None,
     min_response_to_residual: float = MIN_RESPONSE_TO_RESIDUAL,
-    jackknife: tuple | None = None,
-    pair_scatter_level: float = PAIR_SCATTER_LEVEL,
+    interval_notes: Mapping[str, str] | None = None,
 ) -> pd.DataFrame:
     """One row per joint from an :class:`~loper_analysis.impedance.identification.ImpedanceFit` (columns
     :data:`IMPEDANCE_COLUMNS`).
@@ -301,9 +299,10 @@ def impedance_rows(
     entry of ``plausible_ranges`` (``{joint: {"stiffness_nm_per_rad": [low,
     high], "damping_nms_per_rad": [low, high]}}``; None:
     :data:`~loper_analysis.impedance.identification.DEFAULT_PLAUSIBLE_RANGES`),
-    ``max_ci_fraction``, ``min_vaf_pct``, ``at_bound_fraction``, ``min_response_to_residual`` and, with
-    ``jackknife`` (the perturbed pairs' jackknife SD of every estimate and its degrees of freedom,
-    :func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`), ``pair_scatter_level``.
+    ``max_ci_fraction``, ``min_vaf_pct``, ``at_bound_fraction`` and ``min_response_to_residual``.
+    ``interval_notes``: per parameter (``K_ankle``) a text its joint's reason carries, e.g. that its interval
+    comes from the perturbed pairs' scatter
+    (:func:`~loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`).
     """
     rows = []
     for j, joint in enumerate(JOINTS):
@@ -351,13 +350,11 @@ def impedance_rows(
             min_vaf_pct=min_vaf_pct,
             at_bound_fraction=at_bound_fraction,
             coupling=coupling,
-            **data_finding_inputs(fit, j, jackknife),
+            **data_finding_inputs(fit, j),
             min_response_to_residual=min_response_to_residual,
-            pair_scatter_level=pair_scatter_level,
         )
-        row.update(status=status, reason=reason)
-        if note:
-            row["reason"] = "; ".join(r for r in (row["reason"], note) if r)
+        own = [(interval_notes or {}).get(f"{p}_{joint}", "") for p in ("K", "D")]
+        row.update(status=status, reason="; ".join(r for r in (reason, *own, note) if r))
         rows.append(row)
     return pd.DataFrame(rows).reindex(columns=IMPEDANCE_COLUMNS)
 
@@ -494,7 +491,7 @@ def fit_onset(
         windows = pair_windows(series["pairs"], params, **options)
         window, fit, averaging = averaging_corrected_fit(window, windows, fit, **ident.fit_options())
     used, n_null, note = "white", 0, ""
-    jackknife = None
+    widened = {}
     if ident.noise_model == "null_pairs":
         null = fit_null_pairs(inputs, null_trials, series, onset_ms, r, ident.max_null_trial_ratio, subject)
         pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
@@ -510,8 +507,9 @@ def fit_onset(
             **ident.fit_options(),
         )
         fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
-        if used == "null_pairs":  # the perturbed pairs' own scatter, to judge the interval by (joint_status rule 8)
+        if used == "null_pairs":  # the perturbed pairs' own scatter, where it exceeds the null pairs' the interval's
             jackknife = onset_jackknife(window, fit.estimate, series["pairs"], null, params, options, ident)
+            fit, widened = widen_to_pair_scatter(fit, jackknife, ident.lower, ident.upper)
         note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
     note = "; ".join(filter(None, [fallback, note]))
     rows = impedance_rows(
@@ -528,9 +526,9 @@ def fit_onset(
         note=note,
         min_vaf_pct=ident.min_vaf_pct,
         plausible_ranges=ident.plausible_ranges,
-        jackknife=jackknife,
+        interval_notes=widened,
     )
-    couplings = coupling_rows(fit, subject, onset_ms, n_kept, truth, note=note)
+    couplings = coupling_rows(fit, subject, onset_ms, n_kept, truth, note=note, interval_notes=widened)
     return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series), couplings)
 
 

@@ -15,26 +15,33 @@ pairs' nuisance projection, both at the estimate); the jackknife variance of the
 times the pairs' ``covariance_scale`` when they carry one (the conditional counterfactual's error shared by all
 pairs, which their scatter cannot show; :func:`loper_analysis.impedance.responses.conditional.covariance_scale`).
 When the perturbed pairs scatter like the null pairs, ``var_jk / sd^2`` (``sd`` the interval's SD) follows an F
-distribution with ``n - 1`` and ``N - 1`` degrees of freedom; a ratio beyond its quantile
-:data:`~loper_analysis.impedance.identification.PAIR_SCATTER_LEVEL` says the interval misses part of this fit's
-error (:func:`~loper_analysis.impedance.identification.joint_status`, rule 8; ``docs/identification.md``, "Fit
-status").
+distribution with ``n - 1`` and ``N - 1`` degrees of freedom; a ratio beyond its quantile at
+:data:`PAIR_SCATTER_LEVEL` says the null pairs' interval misses part of this fit's error, and
+:func:`widen_to_pair_scatter` takes that parameter's interval from the jackknife instead (``docs/identification.md``,
+"Intervals from the perturbed pairs' scatter").
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 
 import numpy as np
 
 from loper_analysis.errors import LoperInputError
-from loper_analysis.impedance.identification.fit import DEFAULT_LOWER, DEFAULT_UPPER, response_jacobian
+from loper_analysis.impedance.identification.fit import DEFAULT_LOWER, DEFAULT_UPPER, ImpedanceFit, response_jacobian
+from loper_analysis.impedance.identification.intervals import bounded_interval, f_quantile
 from loper_analysis.impedance.identification.null_pairs import nuisance_projection, null_pair_errors
 from loper_analysis.impedance.identification.pair_averaging import pair_windows
 from loper_analysis.impedance.identification.window import PreparedWindow, simulate_response
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["jackknife_sd", "onset_jackknife"]
+__all__ = ["PAIR_SCATTER_LEVEL", "jackknife_sd", "onset_jackknife", "widen_to_pair_scatter"]
+
+#: A parameter whose perturbed pairs' jackknife variance exceeds its interval's by more than the F distribution's
+#: quantile at this level gets its interval from the jackknife (:func:`widen_to_pair_scatter`): of the fits whose
+#: perturbed pairs scatter as the null pairs say, 1 % per parameter.
+PAIR_SCATTER_LEVEL: float = 0.99
 
 
 def jackknife_sd(
@@ -127,3 +134,59 @@ def onset_jackknife(
         lower=settings.lower,
         upper=settings.upper,
     )
+
+
+def widen_to_pair_scatter(
+    fit: ImpedanceFit, jackknife: tuple, lower, upper, level: float = PAIR_SCATTER_LEVEL
+) -> tuple[ImpedanceFit, dict[str, str]]:
+    """``fit`` with the intervals of the parameters whose perturbed pairs scatter beyond them taken from that scatter.
+
+    For each parameter ``i`` whose jackknife variance over the interval's, ``(sd_jk / sd)^2``, exceeds the F
+    quantile at ``level`` with (``dof_jk``, ``fit.ci_dof``) degrees of freedom (the null pairs' interval misses an
+    error the perturbed strides hold: each answers the pulse about its own course), its SD becomes ``sd_jk`` and
+    its 95 % interval ``estimate +- t(dof_jk) sd_jk`` within the bounds; the estimate, the correlation and the other
+    parameters stay. Parameters whose SDs are not both finite with ``sd > 0`` are left as they are.
+
+    Parameters
+    ----------
+    fit : ImpedanceFit
+        A fit with the null-pair noise model (its ``sd``, ``ci_dof``, ``parameters``).
+    jackknife : (numpy.ndarray, int)
+        The perturbed pairs' jackknife SD (p,) of every estimate and its degrees of freedom (:func:`jackknife_sd`).
+    lower, upper : (p,) array_like
+        The fit's bounds (N·m/rad, N·m·s/rad).
+    level : float
+        The F quantile's level, in (0, 1).
+
+    Returns
+    -------
+    (ImpedanceFit, dict)
+        The fit, and per widened parameter (its name, ``K_ankle``) the text its row's reason carries.
+    """
+    if not 0 < level < 1:
+        raise LoperInputError(f"pair scatter level must lie in (0, 1), got {level}")
+    sd, sd_jk = np.asarray(fit.sd, dtype=float), np.asarray(jackknife[0], dtype=float)
+    dof = int(jackknife[1])
+    if sd_jk.shape != sd.shape:
+        raise LoperInputError(f"jackknife SD must hold the fit's {sd.shape[0]} parameters, got shape {sd_jk.shape}")
+    limit = f_quantile(dof, fit.ci_dof, level)
+    usable = np.isfinite(sd) & np.isfinite(sd_jk) & (sd > 0)
+    ratio = np.where(usable, (sd_jk / np.where(usable, sd, 1.0)) ** 2, 0.0)
+    wide = np.flatnonzero(ratio > limit)
+    if not wide.size:
+        return fit, {}
+    lb, ub = np.broadcast_to(np.asarray(lower, float), sd.shape), np.broadcast_to(np.asarray(upper, float), sd.shape)
+    new_sd, low, high = sd.copy(), np.array(fit.ci95_low, dtype=float), np.array(fit.ci95_high, dtype=float)
+    new_sd[wide] = sd_jk[wide]
+    low[wide], high[wide] = bounded_interval(fit.estimate[wide], sd_jk[wide], dof, lb[wide], ub[wide])
+    notes = {}
+    for i in wide:
+        name = fit.parameters[i]
+        unit = "N·m/rad" if name.startswith("K") else "N·m·s/rad"
+        notes[name] = (
+            f"{name}: 95 % CI from the perturbed pairs' scatter (jackknife SD {sd_jk[i]:.3g} {unit}, "
+            f"{sd_jk[i] / sd[i]:.2g} times the null pairs' {sd[i]:.3g} {unit}: variance ratio {ratio[i]:.3g} above "
+            f"F_{level:g}({dof}, {fit.ci_dof}) = {limit:.3g}, PAIR_SCATTER_LEVEL; t with {dof} degrees of freedom): "
+            "the perturbed strides hold an error the null pairs do not show"
+        )
+    return replace(fit, sd=new_sd, ci95_low=low, ci95_high=high), notes

@@ -32,15 +32,13 @@ Rules (``docs/identification.md``, section "Fit status"), judged in this order:
    :data:`MIN_RESPONSE_TO_RESIDUAL` = 1; :func:`response_and_residual_rms`):
    the residual, which the interval takes for noise, is larger than the
    response K and D are fitted to, and the estimate can be biased beyond its
-   interval (a joint that barely moves in the window): ``not_identifiable``;
-8. the perturbed pairs' own scatter of K or D (the linearised jackknife over
-   the averaged pairs, :func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`)
-   exceeds the interval's: variance ratio beyond the F distribution's
-   quantile :data:`PAIR_SCATTER_LEVEL` (0.99) with the two variances'
-   degrees of freedom. The interval's scatter (the null pairs) misses part of
-   this fit's error: ``not_identifiable``.
+   interval (a joint that barely moves in the window): ``not_identifiable``.
 
-Every finding of 2-8 is named in the reason (parameter or key, value and
+The intervals these rules judge are the fit's own; where the perturbed pairs scatter beyond the null pairs
+(:func:`~loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`) they come from the perturbed
+pairs' jackknife, and the reason says so.
+
+Every finding of 2-7 is named in the reason (parameter or key, value and
 limit); the status is the most severe. An estimate on a lower bound of zero
 is a valid estimate (no measurable stiffness or damping, e.g. the knee's K
 early in swing): by itself it adds nothing to the reason; rule 4 judges
@@ -53,13 +51,11 @@ import numpy as np
 
 from loper_analysis.constants import PARAMETERS
 from loper_analysis.errors import LoperInputError
-from loper_analysis.impedance.identification.intervals import f_quantile
 from loper_analysis.reference import ANKLE_SWING_IMPEDANCE, STUDY_SWING_IMPEDANCE
 
 __all__ = [
     "MIN_VAF_PCT",
     "MIN_RESPONSE_TO_RESIDUAL",
-    "PAIR_SCATTER_LEVEL",
     "MAX_CI_FRACTION",
     "AT_BOUND_FRACTION",
     "COUPLING_CORRELATION",
@@ -82,10 +78,6 @@ MAX_CI_FRACTION: float = 1.0
 #: A joint whose model response (RMS over the window) is smaller than this multiple of its residual's is not
 #: identifiable (rule 7): 1, the response no larger than what the fit leaves unexplained (a VAF of about 50 %).
 MIN_RESPONSE_TO_RESIDUAL: float = 1.0
-#: A K or D whose perturbed pairs' jackknife variance exceeds its interval's variance by more than the F
-#: distribution's quantile at this level is not identifiable (rule 8): of the fits whose perturbed pairs scatter as
-#: the null pairs say, 1 % per parameter.
-PAIR_SCATTER_LEVEL: float = 0.99
 
 #: A parameter whose estimate correlates at least this strongly (absolute) with one of another joint trades off
 #: against it; a too-wide interval's reason names that parameter (rule 5).
@@ -136,36 +128,23 @@ def response_and_residual_rms(measured, model) -> tuple[np.ndarray, np.ndarray]:
     return np.sqrt(np.mean(f**2, axis=0)), np.sqrt(np.mean((y - f) ** 2, axis=0))
 
 
-def data_finding_inputs(fit, joint_index: int, jackknife: tuple | None = None) -> dict:
-    """:func:`joint_status`'s inputs of rules 7 and 8 for one joint of a fit.
+def data_finding_inputs(fit, joint_index: int) -> dict:
+    """:func:`joint_status`'s inputs of rule 7 for one joint of a fit.
 
     Parameters
     ----------
     fit : ImpedanceFit
-        The fit (its ``measured``, ``model``, ``sd`` and ``ci_dof``; K and D of joint ``j`` at ``2 j``, ``2 j + 1``).
+        The fit (its ``measured`` and ``model``).
     joint_index : int
         0, 1, 2: hip, knee, ankle.
-    jackknife : (numpy.ndarray, int), optional
-        The perturbed pairs' jackknife SD of every estimate and its degrees of freedom
-        (:func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`); None: rule 8 is skipped.
 
     Returns
     -------
     dict
-        ``response_rms_rad``, ``residual_rms_rad`` (:func:`response_and_residual_rms`), ``sd``, ``ci_dof``,
-        ``jackknife_sd`` and ``jackknife_dof``.
+        ``response_rms_rad``, ``residual_rms_rad`` (:func:`response_and_residual_rms`).
     """
     response, residual = response_and_residual_rms(fit.measured, fit.model)
-    kd = [2 * joint_index, 2 * joint_index + 1]
-    sd, dof = (None, None) if jackknife is None else (np.asarray(jackknife[0], dtype=float)[kd], jackknife[1])
-    return dict(
-        response_rms_rad=response[joint_index],
-        residual_rms_rad=residual[joint_index],
-        sd=np.asarray(fit.sd, dtype=float)[kd],
-        ci_dof=fit.ci_dof,
-        jackknife_sd=sd,
-        jackknife_dof=dof,
-    )
+    return dict(response_rms_rad=response[joint_index], residual_rms_rad=residual[joint_index])
 
 
 def strongest_coupling(
@@ -223,11 +202,6 @@ def joint_status(
     response_rms_rad: float | None = None,
     residual_rms_rad: float | None = None,
     min_response_to_residual: float = MIN_RESPONSE_TO_RESIDUAL,
-    sd=None,
-    ci_dof: float | None = None,
-    jackknife_sd=None,
-    jackknife_dof: float | None = None,
-    pair_scatter_level: float = PAIR_SCATTER_LEVEL,
 ) -> tuple[str, str]:
     """Status (``ok`` | ``not_identifiable`` | ``failed``) and reason of one joint's row.
 
@@ -256,14 +230,6 @@ def joint_status(
         (:func:`response_and_residual_rms`); rule 7 is skipped when either is None or their ratio is undefined.
     min_response_to_residual : float
         Rule 7's least ratio of the two (> 0).
-    sd, jackknife_sd : (2,) array_like, optional
-        Standard deviations of K (N·m/rad) and D (N·m·s/rad): the interval's and the perturbed pairs' jackknife
-        SD (:func:`~loper_analysis.impedance.identification.jackknife.jackknife_sd`); rule 8 is skipped when
-        either is None, and for a parameter whose two SDs are not both finite and the interval's above 0.
-    ci_dof, jackknife_dof : float, optional
-        Degrees of freedom of the two variances (the interval's t quantile's, ``n - 1`` of ``n`` pairs).
-    pair_scatter_level : float
-        Rule 8's level of the F quantile, in (0, 1).
 
     Returns
     -------
@@ -319,7 +285,6 @@ def joint_status(
             f"{max_ci_fraction:g} of the bounds"
         )
     unidentifiable += _response_findings(joint, response_rms_rad, residual_rms_rad, min_response_to_residual)
-    unidentifiable += _pair_scatter_findings(joint, sd, ci_dof, jackknife_sd, jackknife_dof, pair_scatter_level)
     status = "failed" if failed else ("not_identifiable" if unidentifiable else "ok")
     return status, "; ".join(failed + unidentifiable)
 
@@ -356,33 +321,6 @@ def _response_findings(
         f"below {min_ratio:g} (MIN_RESPONSE_TO_RESIDUAL), the residual the interval takes for noise is larger than "
         f"the response K_{joint} and D_{joint} are fitted to, and they can be biased beyond their 95 % intervals"
     ]
-
-
-def _pair_scatter_findings(joint: str, sd, ci_dof, jackknife_sd, jackknife_dof, level: float) -> list[str]:
-    """Per K and D, why it is not identifiable by the perturbed pairs' scatter (rule 8): its jackknife variance
-    over its interval's beyond the F quantile ``level`` with (``jackknife_dof``, ``ci_dof``) degrees of freedom;
-    empty when any input is None."""
-    if not 0 < level < 1:
-        raise LoperInputError(f"pair_scatter_level must lie in (0, 1), got {level}")
-    if sd is None or jackknife_sd is None or ci_dof is None or jackknife_dof is None:
-        return []
-    s, sj = np.asarray(sd, dtype=float), np.asarray(jackknife_sd, dtype=float)
-    if s.shape != (2,) or sj.shape != (2,):
-        raise LoperInputError(f"{joint}: sd and jackknife_sd must hold K and D (2 values), got {s.shape}, {sj.shape}")
-    limit = f_quantile(jackknife_dof, ci_dof, level)
-    found = []
-    for i, (p, unit, _, _) in enumerate(_PARAMETERS):
-        if not (np.isfinite(s[i]) and np.isfinite(sj[i]) and s[i] > 0):
-            continue
-        ratio = (sj[i] / s[i]) ** 2
-        if ratio > limit:
-            found.append(
-                f"{p}_{joint}: the perturbed pairs' jackknife SD {sj[i]:.3g} {unit} is {sj[i] / s[i]:.2g} times the "
-                f"interval's {s[i]:.3g} {unit} (variance ratio {ratio:.3g} above F_{level:g}({jackknife_dof:g}, "
-                f"{ci_dof:g}) = {limit:.3g}, PAIR_SCATTER_LEVEL): the perturbed strides hold an error the "
-                f"interval's null pairs do not show, and the estimate can miss the truth by more than its interval"
-            )
-    return found
 
 
 def _bound_findings(joint: str, est: np.ndarray, lb: np.ndarray, ub: np.ndarray, at_bound_fraction: float) -> list[str]:
