@@ -320,6 +320,11 @@ def coordinate_subject(
     minimal_impedance = None if "minimal_impedance" in without else minimal_impedance
     variability = None if "variability" in without else variability
     names = [(t, design.onset_ms(t)) for t in (design.device, *design.perturbation_trials())]
+    # a second rod at the shank (synthetic.shank_pulse_force_n > 0, where device.shank_rod says): in every trial
+    # with the device, as the synthetic lab attaches it
+    shank_force_n = float(syn.get("shank_pulse_force_n", 0.0))
+    shank_rod = stage_settings(config, "impedance").shank_rod
+    attached = shank_rod if shank_force_n else None
     inputs, twins = {}, {}
     for trial, onset in names:
         perturbation = None
@@ -331,6 +336,7 @@ def coordinate_subject(
                 syn["pulse_force_n"],
                 syn["pulse_duration_s"],
                 tuple(syn["perturb_every_strides"]),
+                shank_force_n,
             )
         # the workflow's seeds (synthetic.trials.subject_walking_trial): the same walking as the whole chain
         sim_seed, file_seed = np.random.SeedSequence(
@@ -349,6 +355,7 @@ def coordinate_subject(
             variability=variability,
             adaptation=adaptation,
             minimal_impedance=minimal_impedance,
+            shank_rod=attached,
         )
         inputs[trial] = {
             "name": trial,
@@ -365,10 +372,11 @@ def coordinate_subject(
                 timing_cv=syn["timing_cv"],
                 amplitude_cv=syn["amplitude_cv"],
                 device=device,
-                perturbation=replace(perturbation, force_n=0.0),
+                perturbation=replace(perturbation, force_n=0.0, shank_force_n=0.0),
                 variability=variability,
                 adaptation=adaptation,
                 minimal_impedance=minimal_impedance,
+                shank_rod=attached,
             )
             own = _trial_inputs(twin, model, lab, config, noise_scale, np.random.default_rng(file_seed))
             twins[trial] = {"name": trial, **with_twin(inputs[trial], own)}
@@ -386,7 +394,9 @@ def coordinate_subject(
         fitting = replace(ident, interval_scatter=scatter, averaging_correction=averaging)
         for onset in onsets:
             own = [inputs[name] for name in design.perturbation_trials(onset)]
-            fitted = fit_onset(own, params, onset, subject, truth[onset], null, settings, fitting).rows
+            fitted = fit_onset(
+                own, params, onset, subject, truth[onset], null, settings, fitting, shank_rod=shank_rod
+            ).rows
             rows.append(fitted.assign(estimator=label) if estimators else fitted)
     return pd.concat(rows, ignore_index=True)
 
