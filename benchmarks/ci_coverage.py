@@ -101,9 +101,6 @@ def binomial_interval(k: int, n: int, level: float = 0.95) -> tuple[float, float
 #: Words of the reason of a row whose interval the status says can miss the truth by more than its width (rule 7
 #: of ``joint_status``): the joint's model response smaller than its residual.
 DATA_FINDINGS = {"response": "MIN_RESPONSE_TO_RESIDUAL"}
-#: Words of the reason of a K or D whose interval comes from the perturbed pairs' scatter (it exceeded the null
-#: pairs'; :func:`loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`), after ``{p}_{joint}: ``.
-WIDENED = "95 % CI from the perturbed pairs' scatter"
 
 
 def _share(inside: pd.Series, has_ci: pd.Series) -> dict:
@@ -122,8 +119,11 @@ def coverage_table(table: pd.DataFrame) -> pd.DataFrame:
     ``ok``: the rows still ``ok``. Each with the number of rows, how many intervals hold the truth, the share (%)
     and its binomial (Clopper-Pearson) 95 % interval (%); the median width of the fitted rows' intervals, the rows
     ``not_identifiable``, those whose reason names each finding and (``n_widened``) those whose interval of this
-    parameter comes from the perturbed pairs' scatter (:data:`WIDENED`).
+    parameter comes from the perturbed pairs' scatter (the reason's
+    :data:`~loper_analysis.impedance.identification.jackknife.WIDENED`).
     """
+    from loper_analysis.impedance.identification.jackknife import WIDENED
+
     fitted = table[table["status"].isin(["ok", "not_identifiable"])]
     rows = []
     for joint in ("hip", "knee", "ankle"):

@@ -36,12 +36,14 @@ from loper_analysis.impedance.identification.pair_averaging import pair_windows
 from loper_analysis.impedance.identification.window import PreparedWindow, simulate_response
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["PAIR_SCATTER_LEVEL", "jackknife_sd", "onset_jackknife", "widen_to_pair_scatter"]
+__all__ = ["PAIR_SCATTER_LEVEL", "WIDENED", "jackknife_sd", "onset_jackknife", "widen_to_pair_scatter"]
 
 #: A parameter whose perturbed pairs' jackknife variance exceeds its interval's by more than the F distribution's
 #: quantile at this level gets its interval from the jackknife (:func:`widen_to_pair_scatter`): of the fits whose
 #: perturbed pairs scatter as the null pairs say, 1 % per parameter.
 PAIR_SCATTER_LEVEL: float = 0.99
+#: What a row's reason says after ``{parameter}: `` (``K_ankle: ``) when that parameter's interval was widened.
+WIDENED: str = "95 % CI from the perturbed pairs' scatter"
 
 
 def jackknife_sd(
@@ -184,7 +186,7 @@ def widen_to_pair_scatter(
         name = fit.parameters[i]
         unit = "N·m/rad" if name.startswith("K") else "N·m·s/rad"
         notes[name] = (
-            f"{name}: 95 % CI from the perturbed pairs' scatter (jackknife SD {sd_jk[i]:.3g} {unit}, "
+            f"{name}: {WIDENED} (jackknife SD {sd_jk[i]:.3g} {unit}, "
             f"{sd_jk[i] / sd[i]:.2g} times the null pairs' {sd[i]:.3g} {unit}: variance ratio {ratio[i]:.3g} above "
             f"F_{level:g}({dof}, {fit.ci_dof}) = {limit:.3g}, PAIR_SCATTER_LEVEL; t with {dof} degrees of freedom): "
             "the perturbed strides hold an error the null pairs do not show"
