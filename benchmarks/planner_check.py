@@ -62,7 +62,6 @@ from loper_analysis.impedance.identification.impedance import IdentificationSett
 from loper_analysis.impedance.responses import ResponseSettings, null_pair_windows
 from loper_analysis.planning.covariance import conditional_stride_covariance, stretch_covariances, stride_covariance
 from loper_analysis.planning.inputs import PLANNED_COUNTERFACTUAL, pilot_onset_series, pilot_perturbed_pairs
-from loper_analysis.planning.pilot_plan import widened_interval_scale
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.report.markdown import markdown_table
 from loper_analysis.swing_leg.dynamics import segment_parameters_from_anthropometry
@@ -188,13 +187,6 @@ def run_check(
             plan = PlanSettings(shank_pulse_force_n=shank_force_n)
             sc = conditional_stride_covariance(pilot_onset_series([full], onset_ms, response), params, planned, plan)
             by_count = stretch_covariances([full], onset_ms, counts, params, planned, settings=plan, response=response)
-            # as the workflow's plan: scaled to the pilot fit's intervals widened to its perturbed pairs' scatter
-            scale, note = widened_interval_scale(fit_rows, str(fit_rows["subject"].iloc[0]), onset_ms, sc)
-            if note:
-                null_only = sc
-                sc = sc.scaled(scale, note)
-                by_count = {n: c.scaled(scale, note) for n, c in by_count.items()}
-                return sc, null_only, by_count
             return sc, sc, by_count
         null = null_pair_windows([full], onset_ms, response, source="pilot")
         pairs = pilot_perturbed_pairs([full], onset_ms, response)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -108,21 +108,6 @@ class StrideCovariance:
     def half_width(self, n_strides: int) -> np.ndarray:
         """Predicted 95 % CI half-width (p,) for ``n_strides`` averaged strides (N·m/rad, N·m·s/rad)."""
         return self.t95(n_strides) * self.sd_of(n_strides)
-
-    def scaled(self, scale, note: str) -> StrideCovariance:
-        """This covariance with parameter ``i``'s SD multiplied by ``scale[i]`` (p,; both parts, the correlations
-        kept) and ``note`` added to its caveats."""
-        c = np.asarray(scale, dtype=float)
-        if c.shape != (len(self.parameters),) or not np.all(np.isfinite(c) & (c > 0)):
-            raise LoperInputError(f"scale must be {len(self.parameters)} finite values > 0, got {scale!r}")
-        outer = np.outer(c, c)
-        spread = None if self.spread_covariance is None else self.spread_covariance * outer
-        return replace(
-            self,
-            covariance=self.covariance * outer,
-            spread_covariance=spread,
-            note="; ".join(filter(None, [self.note, note])),
-        )
 
 
 def _pilot_rods(pairs: Mapping) -> int:

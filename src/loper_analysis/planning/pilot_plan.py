@@ -15,13 +15,11 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from loper_analysis.constants import JOINTS, PARAMETERS, parameter_column
+from loper_analysis.constants import JOINTS, parameter_column
 from loper_analysis.device.controller import DeviceParameters
 from loper_analysis.errors import LoperInputError
-from loper_analysis.impedance.identification.jackknife import WIDENED
 from loper_analysis.impedance.responses import MAX_TRIAL_DEVIATION_RATIO, ResponseSettings, null_pair_windows
 from loper_analysis.planning.covariance import (
-    StrideCovariance,
     conditional_stride_covariance,
     pool_onsets,
     stretch_covariances,
@@ -32,14 +30,7 @@ from loper_analysis.planning.precision import precision_table, target_answer, un
 from loper_analysis.planning.window import PlanSettings
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = [
-    "STRIDES",
-    "PlanningSettings",
-    "check_plan_request",
-    "pilot_plan",
-    "planned_impedance",
-    "widened_interval_scale",
-]
+__all__ = ["STRIDES", "PlanningSettings", "check_plan_request", "pilot_plan", "planned_impedance"]
 
 log = logging.getLogger(__name__)
 
@@ -114,44 +105,6 @@ def planned_impedance(table: pd.DataFrame, subject: str, onset_ms: int, source: 
     return np.array(values)
 
 
-def widened_interval_scale(
-    table: pd.DataFrame, subject: str, onset_ms: float, stride_cov: StrideCovariance
-) -> tuple[np.ndarray, str]:
-    """Per planned parameter, the factor that brings the plan to the pilot fit's own interval where that interval
-    was widened to its perturbed pairs' scatter, and a note naming them ("" and ones when none was).
-
-    The fit widens a K or D whose perturbed pairs scatter beyond its null pairs' interval
-    (:func:`~loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`; its row's reason names the
-    parameter with :data:`~loper_analysis.impedance.identification.jackknife.WIDENED`): each stride's own answer
-    to the pulse, which the null pairs the plan is made of do not hold. For such a parameter of the pilot's row at
-    ``onset_ms`` the factor is its reported SE over the plan's SD at the pilot's own ``n_strides`` (at least 1),
-    so that the plan at the pilot's size is the pilot fit's interval and scales from there as the plan does.
-    ``table``: impedance rows (``results/impedance/...``) with ``reason``, ``n_strides`` and the SE columns.
-    """
-    scale = np.ones(len(stride_cov.parameters))
-    if table is None or "reason" not in table.columns:
-        return scale, ""
-    rows = table[(table["subject"].astype(str) == str(subject)) & (table["onset_ms"].astype(float) == float(onset_ms))]
-    named = []
-    for i, name in enumerate(stride_cov.parameters[: len(PARAMETERS)]):
-        kind, joint = name.split("_")
-        row = rows[rows["joint"] == joint]
-        if len(row) != 1 or f"{name}: {WIDENED}" not in str(row["reason"].iloc[0]):
-            continue
-        se = float(row[parameter_column(kind, "se")].iloc[0])
-        planned = float(stride_cov.sd_of(int(row["n_strides"].iloc[0]))[i])
-        if np.isfinite(se) and planned > 0:
-            scale[i] = max(se / planned, 1.0)
-            named.append(f"{name} x{scale[i]:.2g}")
-    note = (
-        f"scaled to the pilot fit's intervals from its perturbed pairs' scatter ({', '.join(named)}): its strides "
-        "answer the pulse each about its own course, which the null pairs do not show"
-        if named
-        else ""
-    )
-    return scale, note
-
-
 def check_plan_request(settings: PlanningSettings, unplannable: str = "raise") -> list[int]:
     """The stride counts to plan for, checked with the onsets and ``unplannable`` before any work.
 
@@ -222,10 +175,6 @@ def pilot_plan(
             planned[onset], by_count[onset] = _onset_covariance(
                 pool, onset, counts, params, values, settings, subject, where
             )
-            scale, note = widened_interval_scale(impedance_rows, subject, onset, planned[onset])
-            if note:
-                planned[onset] = planned[onset].scaled(scale, note)
-                by_count[onset] = {n: c.scaled(scale, note) for n, c in (by_count[onset] or {}).items()}
         except LoperInputError as exc:
             if unplannable == "raise":
                 raise
