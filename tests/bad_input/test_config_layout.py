@@ -78,7 +78,7 @@ def test_the_shipped_config_translated_from_its_former_layout_is_itself():
     assert former["opensim"].pop("tree_step_tolerance") == former["opensim"].pop("opensim_accuracy")
     former["opensim"]["accuracy"] = c["ik"]["opensim_accuracy"]  # one key for both then
     moves = translated(former)
-    assert len(moves) == 6 + 2 + 20 + 2 + 18 and former == c
+    assert len(moves) == 6 + 2 + 21 + 2 + 18 and former == c
 
 
 def test_the_workflow_reads_a_former_layout_file_and_says_so(tmp_path):

@@ -2,11 +2,6 @@
 
 from loper_analysis.stages.impedance.files import fit_files, fit_inputs, fits_couplings
 
-# the inter-joint couplings' rows per onset, written by a fit with impedance.couplings
-COUPLING_OUTPUTS = (
-    {"couplings": expand(PATHS.impedance.couplings, onset=ONSETS, allow_missing=True)} if fits_couplings(STUDY) else {}
-)
-
 
 # small jobs (gathers, tables, figures, a second or less of work each): on a cluster they run in the
 # controlling process instead of paying a SLURM job's start-up
@@ -23,7 +18,12 @@ rule impedance_fit:
     input:
         lambda wc: fit_inputs(STUDY, wc.subject),
     output:
-        **COUPLING_OUTPUTS,
+        # the inter-joint couplings' rows, written by a fit with impedance.couplings
+        **(
+            {"couplings": expand(PATHS.impedance.couplings, onset=ONSETS, allow_missing=True)}
+            if fits_couplings(STUDY)
+            else {}
+        ),
         response=expand(PATHS.impedance.response, onset=ONSETS, allow_missing=True),
         counts=expand(PATHS.impedance.counts, onset=ONSETS, allow_missing=True),
         fit=expand(PATHS.impedance.fit, onset=ONSETS, allow_missing=True),

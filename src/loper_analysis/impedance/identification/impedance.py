@@ -53,6 +53,7 @@ from loper_analysis.impedance.identification import (
     STIFFNESS_BOUNDS_NM_PER_RAD,
     FitBounds,
     ImpedanceFit,
+    PreparedWindow,
     check_interval_scatter,
     data_finding_inputs,
     identify_impedance,
@@ -62,7 +63,12 @@ from loper_analysis.impedance.identification import (
 )
 from loper_analysis.impedance.identification.coupling_rows import COUPLING_COLUMNS, coupling_rows
 from loper_analysis.impedance.identification.jackknife import onset_jackknife, widen_to_pair_scatter
-from loper_analysis.impedance.identification.onset_fit import fit_curves, fit_null_pairs, mean_response_window
+from loper_analysis.impedance.identification.onset_fit import (
+    fit_curves,
+    fit_null_pairs,
+    force_table,
+    mean_response_window,
+)
 from loper_analysis.impedance.identification.pair_averaging import averaging_corrected_fit, pair_windows
 from loper_analysis.impedance.identification.parameters import check_couplings
 from loper_analysis.impedance.responses import (
@@ -79,9 +85,6 @@ __all__ = [
     "NOISE_MODELS",
     "IdentificationSettings",
     "OnsetFit",
-    "FORCE_COLUMNS",
-    "SHANK_FORCE_COLUMNS",
-    "force_table",
     "impedance_rows",
     "status_rows",
     "too_short_reason",
@@ -211,42 +214,6 @@ class OnsetFit:
     curves: pd.DataFrame
     force: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=["time_s"]))
     couplings: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=list(COUPLING_COLUMNS)))
-
-
-#: Columns of :func:`force_table`.
-FORCE_COLUMNS: tuple[str, ...] = (
-    "time_s",
-    "force_perturbed_x_n",
-    "force_perturbed_y_n",
-    "force_unperturbed_x_n",
-    "force_unperturbed_y_n",
-)
-#: Columns :func:`force_table` adds for a second rod at the shank.
-SHANK_FORCE_COLUMNS: tuple[str, ...] = tuple(f"shank_{c}" for c in FORCE_COLUMNS[1:])
-
-
-def force_table(series: Mapping) -> pd.DataFrame:
-    """The mean rod forces of a response as the fit receives them (columns :data:`FORCE_COLUMNS`).
-
-    ``time_s`` relative to the onset (s): ``series["force_time_s"]`` (the robot rate) when the response
-    carries it, else the response's grid; the perturbed and matched unperturbed mean force vectors (N, world x/y);
-    with a second rod at the shank its vectors after them (:data:`SHANK_FORCE_COLUMNS`).
-    """
-    t = series.get("force_time_s", series["time_s"])
-    fp, fu = series["force_perturbed_n"], series["force_unperturbed_n"]
-    if np.shape(fp)[-1] == 4:
-        shank = dict(zip(SHANK_FORCE_COLUMNS, (fp[:, 2], fp[:, 3], fu[:, 2], fu[:, 3])))
-        return force_table({**series, "force_perturbed_n": fp[:, :2], "force_unperturbed_n": fu[:, :2]}).assign(**shank)
-    return pd.DataFrame(
-        {
-            "time_s": t,
-            "force_perturbed_x_n": fp[:, 0],
-            "force_perturbed_y_n": fp[:, 1],
-            "force_unperturbed_x_n": fu[:, 0],
-            "force_unperturbed_y_n": fu[:, 1],
-        },
-        columns=list(FORCE_COLUMNS),
-    )
 
 
 def _truth_columns(row: dict, truth: Mapping | None, joint: str) -> None:
@@ -490,27 +457,12 @@ def fit_onset(
     if ident.averaging_correction:
         windows = pair_windows(series["pairs"], params, **options)
         window, fit, averaging = averaging_corrected_fit(window, windows, fit, **ident.fit_options())
-    used, n_null, note = "white", 0, ""
-    widened = {}
+    used, n_null, note, widened = "white", 0, "", {}
     if ident.noise_model == "null_pairs":
         null = fit_null_pairs(inputs, null_trials, series, onset_ms, r, ident.max_null_trial_ratio, subject)
-        pairs = series["pairs"] if ident.interval_scatter == "perturbed_pairs" else None
-        refit = refit_with_null_pairs(
-            window,
-            fit,
-            null,
-            n_kept,
-            n_components=ident.null_pair_components,
-            min_null_pairs=ident.min_null_pairs,
-            cross_validated=ident.interval_scatter == "cross_validated_null_pairs",
-            perturbed_pairs=pairs,
-            **ident.fit_options(),
+        fit, used, n_null, note, widened = _null_pair_interval_fit(
+            window, fit, series["pairs"], null, n_kept, params, options, ident
         )
-        fit, used, n_null = refit.fit, refit.noise_model, refit.n_null_pairs
-        if used == "null_pairs":  # the perturbed pairs' own scatter, where it exceeds the null pairs' the interval's
-            jackknife = onset_jackknife(window, fit.estimate, series["pairs"], null, params, options, ident)
-            fit, widened = widen_to_pair_scatter(fit, jackknife, ident.lower, ident.upper)
-        note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
     note = "; ".join(filter(None, [fallback, note]))
     rows = impedance_rows(
         fit,
@@ -530,6 +482,45 @@ def fit_onset(
     )
     couplings = coupling_rows(fit, subject, onset_ms, n_kept, truth, note=note, interval_notes=widened)
     return OnsetFit(mean, counts, rows, fit_curves(fit, averaging), force_table(series), couplings)
+
+
+def _null_pair_interval_fit(
+    window: PreparedWindow,
+    fit: ImpedanceFit,
+    pairs: Mapping,
+    null: Mapping,
+    n_kept: int,
+    params: SegmentParameters,
+    options: Mapping,
+    ident,
+) -> tuple[ImpedanceFit, str, int, str, dict[str, str]]:
+    """The refit of ``fit`` with the null pairs ``null``
+    (:func:`~loper_analysis.impedance.identification.refit_with_null_pairs`, intervals from the scatter
+    ``ident.interval_scatter`` names) and, when it took them, its intervals widened where the perturbed ``pairs``
+    (the responses' per-pair series) scatter beyond them
+    (:func:`~loper_analysis.impedance.identification.jackknife.widen_to_pair_scatter`).
+
+    ``n_kept``: the perturbed pairs averaged; ``options``: the window keywords of the mean window; ``ident``: the
+    identification settings. Returns the fit, the noise model used (``null_pairs`` or ``white``), the null pairs
+    taken, the note (trials left out, why the white fit stands) and the widened parameters' texts.
+    """
+    refit = refit_with_null_pairs(
+        window,
+        fit,
+        null,
+        n_kept,
+        n_components=ident.null_pair_components,
+        min_null_pairs=ident.min_null_pairs,
+        cross_validated=ident.interval_scatter == "cross_validated_null_pairs",
+        perturbed_pairs=pairs if ident.interval_scatter == "perturbed_pairs" else None,
+        **ident.fit_options(),
+    )
+    fit, widened = refit.fit, {}
+    if refit.noise_model == "null_pairs":  # the perturbed pairs' own scatter where it exceeds the interval's
+        jackknife = onset_jackknife(window, fit.estimate, pairs, null, params, options, ident)
+        fit, widened = widen_to_pair_scatter(fit, jackknife, ident.lower, ident.upper)
+    note = "; ".join([*null["trials_left_out"].values(), *([refit.note] if refit.note else [])])
+    return fit, refit.noise_model, refit.n_null_pairs, note, widened
 
 
 def _response_input(trial: Mapping, shank_rod: ShankRod | None = None) -> dict:

@@ -3,7 +3,8 @@
 * :func:`mean_response_window` - the identification window of the onset's mean response;
 * :func:`force_keywords` - the rods' forces as the window takes them;
 * :func:`fit_null_pairs` - the null pairs whose deviation weights the fit's prediction errors;
-* :func:`fit_curves` - the measured and model responses of the fit.
+* :func:`fit_curves` - the measured and model responses of the fit;
+* :func:`force_table` - the mean rod forces the fit received.
 """
 
 from __future__ import annotations
@@ -19,7 +20,15 @@ from loper_analysis.impedance.identification.window import PreparedWindow, prepa
 from loper_analysis.impedance.responses import ResponseSettings, null_pair_windows
 from loper_analysis.swing_leg.dynamics import SegmentParameters
 
-__all__ = ["mean_response_window", "force_keywords", "fit_null_pairs", "fit_curves"]
+__all__ = [
+    "FORCE_COLUMNS",
+    "SHANK_FORCE_COLUMNS",
+    "mean_response_window",
+    "force_keywords",
+    "fit_null_pairs",
+    "fit_curves",
+    "force_table",
+]
 
 
 def force_keywords(perturbed_n, unperturbed_n) -> dict:
@@ -83,4 +92,40 @@ def fit_curves(fit: ImpedanceFit, averaging: np.ndarray) -> pd.DataFrame:
             **{f"{j}_measured_rad": fit.measured[:, i] + averaging[:, i] for i, j in enumerate(JOINTS)},
             **{f"{j}_model_rad": fit.model[:, i] + averaging[:, i] for i, j in enumerate(JOINTS)},
         }
+    )
+
+
+#: Columns of :func:`force_table`.
+FORCE_COLUMNS: tuple[str, ...] = (
+    "time_s",
+    "force_perturbed_x_n",
+    "force_perturbed_y_n",
+    "force_unperturbed_x_n",
+    "force_unperturbed_y_n",
+)
+#: Columns :func:`force_table` adds for a second rod at the shank.
+SHANK_FORCE_COLUMNS: tuple[str, ...] = tuple(f"shank_{c}" for c in FORCE_COLUMNS[1:])
+
+
+def force_table(series: Mapping) -> pd.DataFrame:
+    """The mean rod forces of a response as the fit receives them (columns :data:`FORCE_COLUMNS`).
+
+    ``time_s`` relative to the onset (s): ``series["force_time_s"]`` (the robot rate) when the response
+    carries it, else the response's grid; the perturbed and matched unperturbed mean force vectors (N, world x/y);
+    with a second rod at the shank its vectors after them (:data:`SHANK_FORCE_COLUMNS`).
+    """
+    t = series.get("force_time_s", series["time_s"])
+    fp, fu = series["force_perturbed_n"], series["force_unperturbed_n"]
+    if np.shape(fp)[-1] == 4:
+        shank = dict(zip(SHANK_FORCE_COLUMNS, (fp[:, 2], fp[:, 3], fu[:, 2], fu[:, 3])))
+        return force_table({**series, "force_perturbed_n": fp[:, :2], "force_unperturbed_n": fu[:, :2]}).assign(**shank)
+    return pd.DataFrame(
+        {
+            "time_s": t,
+            "force_perturbed_x_n": fp[:, 0],
+            "force_perturbed_y_n": fp[:, 1],
+            "force_unperturbed_x_n": fu[:, 0],
+            "force_unperturbed_y_n": fu[:, 1],
+        },
+        columns=list(FORCE_COLUMNS),
     )
