@@ -18,7 +18,7 @@ When the perturbed pairs scatter like the null pairs, ``var_jk / sd^2`` (``sd`` 
 distribution with ``n - 1`` and ``N - 1`` degrees of freedom; a ratio beyond its quantile at
 :data:`PAIR_SCATTER_LEVEL` says the null pairs' interval misses part of this fit's error, and
 :func:`widen_to_pair_scatter` takes that parameter's interval from the jackknife instead (``docs/identification.md``,
-"Intervals from the perturbed pairs' scatter").
+"Fit status": "Intervals from the perturbed pairs' scatter").
 """
 
 from __future__ import annotations
